@@ -1,0 +1,37 @@
+# The two commands of README.md:
+#   make run   installs what is missing, builds, runs the main job
+#   make test  installs what is missing, builds, runs every test
+PRESET ?= release
+BUILD := build/$(PRESET)
+CLI := $(BUILD)/apps/microcobot/microcobot
+JOBS ?= $(shell nproc)
+
+.PHONY: run test deps configure build asan bench format clean
+
+run: build
+	$(CLI) report --out out/report
+
+test: build
+	ctest --preset $(PRESET) -j $(JOBS)
+
+deps:
+	@scripts/install-deps.sh
+
+configure: deps
+	@cmake --preset $(PRESET) >/dev/null
+
+build: configure
+	cmake --build --preset $(PRESET) -j $(JOBS)
+
+# Sanitizer build and its tests (CI runs this after `make test`).
+asan:
+	$(MAKE) test PRESET=asan
+
+bench: build
+	@for b in $(BUILD)/bench/*_bench; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
+
+format:
+	@git ls-files '*.h' '*.cc' | xargs clang-format -i
+
+clean:
+	rm -rf build out

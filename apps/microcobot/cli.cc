@@ -1,0 +1,92 @@
+#include "cli.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <mutex>
+
+#include <spdlog/spdlog.h>
+
+#include "microcobot/core/error.h"
+
+namespace mc::cli {
+
+namespace {
+std::vector<Group>& group_registry() {
+  static std::vector<Group> registry;
+  return registry;
+}
+std::vector<ReportPart>& part_registry() {
+  static std::vector<ReportPart> registry;
+  return registry;
+}
+
+void check_finite(const nlohmann::json& v, const std::string& path) {
+  if (v.is_number_float() && !std::isfinite(v.get<double>())) {
+    throw ComputationFailed("result '" + path + "' is not a finite number");
+  }
+  if (v.is_object()) {
+    for (auto it = v.begin(); it != v.end(); ++it) check_finite(it.value(), path.empty() ? it.key() : path + "." + it.key());
+  } else if (v.is_array()) {
+    for (std::size_t i = 0; i < v.size(); ++i) check_finite(v[i], path + "[" + std::to_string(i) + "]");
+  }
+}
+}  // namespace
+
+bool register_group(Group group) {
+  group_registry().push_back(std::move(group));
+  return true;
+}
+
+std::vector<Group> groups() {
+  auto out = group_registry();
+  std::stable_sort(out.begin(), out.end(), [](const Group& a, const Group& b) { return a.order < b.order; });
+  return out;
+}
+
+bool register_report_part(ReportPart part) {
+  part_registry().push_back(std::move(part));
+  return true;
+}
+
+std::vector<ReportPart> report_parts() {
+  auto out = part_registry();
+  std::stable_sort(out.begin(), out.end(), [](const ReportPart& a, const ReportPart& b) { return a.order < b.order; });
+  return out;
+}
+
+void add_output_options(CLI::App& cmd, CommonOptions& opts) {
+  cmd.add_flag("--json", opts.json, "Print a machine-readable JSON summary on stdout");
+  cmd.add_option("--out", opts.out, "Write CSV artifacts and an index.html report to this directory");
+}
+
+void add_params_option(CLI::App& cmd, CommonOptions& opts) {
+  cmd.add_option("--params", opts.params, "YAML parameter file (keys as printed by 'params --json')")
+      ->check(CLI::ExistingFile);
+}
+
+void emit(const CommonOptions& opts, const nlohmann::json& summary, const std::string& human) {
+  check_finite(summary, "");
+  if (opts.json) {
+    std::cout << summary.dump() << std::endl;
+  } else if (!human.empty()) {
+    std::cout << human << (human.back() == '\n' ? "" : "\n");
+  } else {
+    std::cout << summary.dump(2) << std::endl;
+  }
+}
+
+void write_report_if_requested(const CommonOptions& opts, const report::Report& report) {
+  if (!opts.out) return;
+  const auto path = report.write(*opts.out);
+  spdlog::info("report written to {}", path.string());
+}
+
+void progress(const std::string& task, std::size_t done, std::size_t total) {
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (spdlog::get_level() > spdlog::level::info) return;
+  std::cerr << "\r" << task << ": " << done << "/" << total << (done >= total ? "\n" : "") << std::flush;
+}
+
+}  // namespace mc::cli

@@ -1,0 +1,72 @@
+#pragma once
+/// @file
+/// The command registry of the `microcobot` CLI. Each command group lives in its own file
+/// and registers itself at static-initialisation time:
+/// @code
+///   namespace {
+///   void add_dsp(CLI::App& group) { ... group.add_subcommand("butter", ...) ... }
+///   const bool kRegistered = mc::cli::register_group({"dsp", "Signal and system toolkit", 20, &add_dsp});
+///   }
+/// @endcode
+/// Conventions every command follows (DESIGN.md): `--json` prints one JSON object on stdout
+/// and nothing else there; `--out DIR` writes CSV artifacts (and an index.html report);
+/// `--params FILE.yaml` takes the keys `<group> params --json` prints. Errors are thrown as
+/// mc::Error subclasses and turned into one line on stderr and the exit code by main.cc.
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "microcobot/report/report.h"
+
+namespace mc::cli {
+
+struct Group {
+  std::string name;
+  std::string description;
+  int order;  ///< position in --help (the architecture's order, bottom-up)
+  std::function<void(CLI::App&)> add;
+};
+
+/// Registers a command group; returns true (for a static initialiser).
+bool register_group(Group group);
+/// All registered groups, sorted by order.
+std::vector<Group> groups();
+
+/// A section of the full report (`microcobot report`), computed by its module.
+struct ReportPart {
+  std::string name;
+  int order;
+  std::function<void(report::Report&)> build;
+};
+bool register_report_part(ReportPart part);
+std::vector<ReportPart> report_parts();
+
+/// Options every command shares.
+struct CommonOptions {
+  bool json = false;
+  std::optional<std::filesystem::path> out;
+  std::optional<std::filesystem::path> params;
+};
+
+/// Adds `--json` and `--out DIR` to `cmd`.
+void add_output_options(CLI::App& cmd, CommonOptions& opts);
+/// Adds `--params FILE` to `cmd`.
+void add_params_option(CLI::App& cmd, CommonOptions& opts);
+
+/// Prints `summary` as JSON on stdout when --json, else `human` (or an indented form of the
+/// summary when `human` is empty). Throws ComputationFailed if the summary holds NaN/Inf.
+void emit(const CommonOptions& opts, const nlohmann::json& summary, const std::string& human = {});
+
+/// Writes `report` to opts.out (if given) and logs where it went.
+void write_report_if_requested(const CommonOptions& opts, const report::Report& report);
+
+/// Progress on stderr for long work (quiet with --json unless -v). Thread-safe.
+void progress(const std::string& task, std::size_t done, std::size_t total);
+
+}  // namespace mc::cli

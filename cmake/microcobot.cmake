@@ -1,0 +1,62 @@
+# mc_add_module(NAME [DEPS mc_a mc_b ...] [LIBS ...])
+# One static library per folder src/microcobot/NAME (every .cc in it), target mc_NAME.
+# A folder without sources yet is skipped, and so are dependencies that do not exist yet.
+function(mc_add_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS;LIBS" ${ARGN})
+  file(GLOB _sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${name}/*.cc)
+  if(NOT _sources)
+    return()
+  endif()
+  set(_deps)
+  foreach(_d IN LISTS ARG_DEPS)
+    if(TARGET ${_d})
+      list(APPEND _deps ${_d})
+    endif()
+  endforeach()
+  if(NOT name STREQUAL "core")
+    list(APPEND _deps mc_core)
+  endif()
+  add_library(mc_${name} STATIC ${_sources})
+  target_include_directories(mc_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(mc_${name} PUBLIC ${_deps} ${ARG_LIBS} PRIVATE mc_warnings)
+  set_property(GLOBAL APPEND PROPERTY MC_MODULES mc_${name})
+endfunction()
+
+# Embeds the charting library (uPlot, pinned by package-lock.json) into the binary so that
+# reports are single self-contained HTML files that open offline.
+function(mc_embed_report_assets target)
+  set(_js ${PROJECT_SOURCE_DIR}/node_modules/uplot/dist/uPlot.iife.min.js)
+  set(_css ${PROJECT_SOURCE_DIR}/node_modules/uplot/dist/uPlot.min.css)
+  if(NOT EXISTS ${_js} OR NOT EXISTS ${_css})
+    message(FATAL_ERROR "uPlot not found in node_modules: run scripts/install-deps.sh (or make run)")
+  endif()
+  set(_out ${PROJECT_BINARY_DIR}/generated/report_assets.cc)
+  set(_page_js ${PROJECT_SOURCE_DIR}/web/report.js)
+  set(_page_css ${PROJECT_SOURCE_DIR}/web/report.css)
+  add_custom_command(OUTPUT ${_out}
+    COMMAND ${CMAKE_COMMAND} -DOUT=${_out} -DJS=${_js} -DCSS=${_css} -DPAGE_JS=${_page_js}
+            -DPAGE_CSS=${_page_css} -P ${PROJECT_SOURCE_DIR}/cmake/embed_assets.cmake
+    DEPENDS ${_js} ${_css} ${_page_js} ${_page_css} ${PROJECT_SOURCE_DIR}/cmake/embed_assets.cmake
+    COMMENT "Embedding uPlot into the report writer")
+  target_sources(${target} PRIVATE ${_out})
+endfunction()
+
+# mc_add_module_tests(NAME [LIBS ...] [LABELS ...])
+# Every tests/NAME/*_test.cc goes into the executable NAME_tests, registered with CTest.
+function(mc_add_module_tests name)
+  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
+  file(GLOB _sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${name}/*_test.cc)
+  if(NOT _sources OR NOT TARGET mc_${name})
+    return()
+  endif()
+  add_executable(${name}_tests ${_sources})
+  target_link_libraries(${name}_tests PRIVATE microcobot mc_test_support ${ARG_LIBS}
+    GTest::gtest GTest::gmock GTest::gtest_main mc_warnings)
+  target_compile_definitions(${name}_tests PRIVATE
+    MC_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
+    MC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    MC_CLI_PATH="$<TARGET_FILE:microcobot_cli>")
+  add_dependencies(${name}_tests microcobot_cli)
+  gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60
+    PROPERTIES LABELS "${name};${ARG_LABELS}")
+endfunction()

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The one list of what microcobot needs on a Debian 12 machine.
+# Idempotent: installs only what is missing and is silent when everything is present.
+# Usage: scripts/install-deps.sh [--dev]   (--dev adds python3-scipy for regenerating reference data)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+DEBIAN_PACKAGES=(
+  build-essential cmake ninja-build pkg-config clang-format
+  libeigen3-dev        # linear algebra, matrix exponential, FFT, Levenberg-Marquardt
+  libyaml-cpp-dev      # parameter files
+  libcli11-dev         # command line
+  libspdlog-dev libfmt-dev  # logging and formatting
+  nlohmann-json3-dev   # --json output
+  libboost-dev         # odeint (reference ODE solver)
+  libgtest-dev libgmock-dev googletest  # unit tests
+  libbenchmark-dev     # benchmarks
+  nodejs npm           # uPlot (bundled into reports) and playwright-core (browser test)
+  chromium             # headless browser for the report test
+)
+if [[ "${1:-}" == "--dev" ]]; then DEBIAN_PACKAGES+=(python3-scipy python3-numpy); fi
+
+missing=()
+for p in "${DEBIAN_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
+done
+# nodejs from another source may already provide npm: accept any working node+npm.
+if command -v node >/dev/null && command -v npm >/dev/null; then
+  tmp=(); for p in "${missing[@]}"; do [[ "$p" == nodejs || "$p" == npm ]] || tmp+=("$p"); done
+  missing=("${tmp[@]+"${tmp[@]}"}")
+fi
+if ((${#missing[@]})); then
+  echo "install-deps: installing ${missing[*]}" >&2
+  SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# npm packages pinned by package-lock.json (uPlot for reports, playwright-core for the browser test).
+if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || package-lock.json -nt node_modules/.package-lock.json ]]; then
+  echo "install-deps: npm ci" >&2
+  npm ci --no-audit --no-fund --loglevel=error >/dev/null
+fi

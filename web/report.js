@@ -1,0 +1,101 @@
+// Renders the report described by the JSON in #report-data with uPlot (embedded above).
+// Each figure container gets data-drawn="1" and data-points="N" once uPlot has drawn it;
+// the browser test (tests/browser/report_renders.mjs) checks these and the canvas pixels.
+(function () {
+  "use strict";
+  const doc = JSON.parse(document.getElementById("report-data").textContent);
+  const root = document.getElementById("report");
+  const palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"];
+
+  function el(tag, attrs, text) {
+    const e = document.createElement(tag);
+    for (const k in attrs || {}) e.setAttribute(k, attrs[k]);
+    if (text !== undefined) e.textContent = text;
+    return e;
+  }
+  function axisTitle(a) { return a.unit ? a.label + " (" + a.unit + ")" : a.label; }
+  function sameX(series) {
+    const x0 = series[0].x;
+    return series.every(s => s.x.length === x0.length && s.x.every((v, i) => v === x0[i])) &&
+           x0.every((v, i) => i === 0 || v > x0[i - 1]);
+  }
+
+  function plot(fig, container) {
+    const width = Math.min(1000, root.clientWidth - 20);
+    const aligned = sameX(fig.series);
+    const scaleOpts = a => (a.log ? { distr: 3, log: 10 } : {});
+    const seriesOpts = fig.series.map((s, i) => ({
+      label: s.name,
+      stroke: palette[i % palette.length],
+      width: s.points ? 0 : 1.5,
+      points: s.points ? { show: true, size: 5, fill: palette[i % palette.length] } : { show: false },
+      paths: s.points ? () => null : undefined,
+      facets: aligned ? undefined : [{ scale: "x", auto: true }, { scale: "y", auto: true }],
+    }));
+    const opts = {
+      title: fig.title,
+      width: width,
+      height: 340,
+      mode: aligned ? 1 : 2,
+      scales: { x: Object.assign({ time: false }, scaleOpts(fig.x)), y: scaleOpts(fig.y) },
+      axes: [{ label: axisTitle(fig.x) }, { label: axisTitle(fig.y) }],
+      series: [aligned ? { label: axisTitle(fig.x) } : {}].concat(seriesOpts),
+      legend: { show: true },
+      hooks: {
+        draw: [u => {
+          container.setAttribute("data-drawn", "1");
+        }],
+      },
+    };
+    let data;
+    let points = 0;
+    if (aligned) {
+      data = [fig.series[0].x].concat(fig.series.map(s => s.y));
+      points = fig.series.reduce((n, s) => n + s.y.length, 0);
+    } else {
+      data = [null].concat(fig.series.map(s => [s.x, s.y]));
+      points = fig.series.reduce((n, s) => n + s.x.length, 0);
+    }
+    container.setAttribute("data-points", String(points));
+    new uPlot(opts, data, container);
+  }
+
+  document.title = doc.title;
+  root.appendChild(el("h1", {}, doc.title));
+  const nav = el("nav");
+  const ul = el("ul");
+  nav.appendChild(ul);
+  root.appendChild(nav);
+  doc.sections.forEach((sec, si) => {
+    const id = "sec-" + (si + 1);
+    const li = el("li");
+    li.appendChild(el("a", { href: "#" + id }, sec.title));
+    ul.appendChild(li);
+    const section = el("section", { id: id });
+    section.appendChild(el("h2", {}, sec.title));
+    (sec.text || "").split(/\n\s*\n/).filter(p => p.trim()).forEach(p => section.appendChild(el("p", {}, p)));
+    if (sec.results.length) {
+      const table = el("table", { class: "results" });
+      sec.results.forEach(r => {
+        const tr = el("tr");
+        tr.appendChild(el("td", {}, r.name));
+        tr.appendChild(el("td", { class: "v" }, r.value));
+        tr.appendChild(el("td", {}, r.unit));
+        table.appendChild(tr);
+      });
+      section.appendChild(table);
+    }
+    sec.figures.forEach(fig => {
+      const box = el("div", { class: "figure", id: fig.id });
+      const chart = el("div", { class: "chart" });
+      box.appendChild(chart);
+      if (fig.caption) box.appendChild(el("p", { class: "caption" }, fig.caption));
+      const link = el("a", { href: fig.csv, class: "csv" }, "data: " + fig.csv);
+      box.appendChild(link);
+      section.appendChild(box);
+      plot(fig, chart);
+    });
+    root.appendChild(section);
+  });
+  if (!doc.sections.length) nav.remove();
+})();
