@@ -20,6 +20,22 @@
            x0.every((v, i) => i === 0 || v > x0[i - 1]);
   }
 
+  // Tick labels: plain numbers in the readable range, engineering notation outside it
+  // (micro-scale positions in metres would otherwise print as 0.000002).
+  function tick(v) {
+    if (v === null || v === undefined) return "";
+    const a = Math.abs(v);
+    if (a === 0) return "0";
+    if (a >= 1e-3 && a < 1e5) return String(+v.toPrecision(6));
+    return v.toExponential(Math.abs(+v.toExponential(2).split("e")[0] % 1) < 1e-9 ? 0 : 2).replace("e+", "e");
+  }
+  function axisOpts(a, vertical) {
+    const o = { label: axisTitle(a) };
+    if (!a.log) o.values = (u, vals) => vals.map(tick);
+    if (vertical) o.size = (u, values) => 28 + 7 * Math.max(3, ...(values || []).map(s => String(s).length));
+    return o;
+  }
+
   function plot(fig, container) {
     const width = Math.min(1000, root.clientWidth - 20);
     const aligned = sameX(fig.series);
@@ -38,7 +54,7 @@
       height: 340,
       mode: aligned ? 1 : 2,
       scales: { x: Object.assign({ time: false }, scaleOpts(fig.x)), y: scaleOpts(fig.y) },
-      axes: [{ label: axisTitle(fig.x) }, { label: axisTitle(fig.y) }],
+      axes: [axisOpts(fig.x, false), axisOpts(fig.y, true)],
       series: [aligned ? { label: axisTitle(fig.x) } : {}].concat(seriesOpts),
       legend: { show: true },
       hooks: {

@@ -61,8 +61,8 @@ void add_output_options(CLI::App& cmd, CommonOptions& opts) {
 }
 
 void add_params_option(CLI::App& cmd, CommonOptions& opts) {
-  cmd.add_option("--params", opts.params, "YAML parameter file (keys as printed by 'params --json')")
-      ->check(CLI::ExistingFile);
+  // No CLI11 existence check: a missing file is invalid input (exit 3), named by load_params().
+  cmd.add_option("--params", opts.params, "YAML parameter file (keys as printed by 'params --json')");
 }
 
 void emit(const CommonOptions& opts, const nlohmann::json& summary, const std::string& human) {

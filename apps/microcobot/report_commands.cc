@@ -1,8 +1,11 @@
 // `microcobot report`: the full report, every module's part in the architecture's order.
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 #include "cli.h"
+#include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
 
 namespace {
@@ -16,6 +19,13 @@ void run_report(const ReportOptions& opts) {
   mc::report::Report full("microcobot report");
   std::size_t done = 0;
   const auto parts = mc::cli::report_parts();
+  for (const auto& name : opts.only) {
+    if (std::none_of(parts.begin(), parts.end(), [&](const auto& p) { return p.name == name; })) {
+      std::string known;
+      for (const auto& p : parts) known += (known.empty() ? "" : ", ") + p.name;
+      throw mc::UsageError("unknown report part '" + name + "' (known: " + known + ")");
+    }
+  }
   std::vector<std::string> built;
   for (const auto& part : parts) {
     if (!opts.only.empty() && std::find(opts.only.begin(), opts.only.end(), part.name) == opts.only.end()) {
