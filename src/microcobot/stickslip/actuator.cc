@@ -1,0 +1,163 @@
+#include "microcobot/stickslip/actuator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "microcobot/core/error.h"
+
+namespace mc::stickslip {
+
+ActuatorModel::ActuatorModel(StickSlipParams params) : ActuatorModel(params, params.integrator.dt_s) {}
+
+ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move(params)), dt_(dt_s) {
+  p_.validate();
+  require(std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1e-4, "integrator.dt_s", "must be in (0, 1e-4] s", dt_s);
+  mode_a_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, dt_);
+  mode_b_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, dt_);
+  substeps_ = p_.integrator.substeps;
+  sub_a_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, dt_ / substeps_);
+  sub_b_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, dt_ / substeps_);
+  c_ = {p_.friction.mass_fraction_a, 1.0 - p_.friction.mass_fraction_a};
+  rho0_ = {p_.friction.rho0_a_N_m, p_.friction.rho0_b_N_m};
+  rho1_ = {p_.friction.rho1_a_N_s_m, p_.friction.rho1_b_N_s_m};
+  lo_ = -0.5 * p_.slider.stroke_m;
+  hi_ = 0.5 * p_.slider.stroke_m;
+}
+
+ActuatorState ActuatorModel::initial_state() const {
+  ActuatorState s;
+  s.pi = make_pi_state(p_.hysteresis, 0.0);
+  s.x2_m = {p_.slider.initial_position_m, p_.slider.initial_position_m};
+  set_operating_point(s, p_.breakaway.amplitudes_V.front(), p_.breakaway.frequencies_Hz.front(),
+                      Direction::kForward);
+  return s;
+}
+
+void ActuatorModel::set_operating_point(ActuatorState& s, double amplitude_V, double frequency_Hz,
+                                        Direction direction) const noexcept {
+  s.z_ba_m = p_.breakaway.lookup(amplitude_V, frequency_Hz, direction);
+}
+
+void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
+  u_V = std::clamp(u_V, p_.drive.min_V, p_.drive.max_V);
+  bool active = std::abs(u_V - s.u_V) > p_.integrator.substep_edge_V;
+  const double frac = p_.integrator.substep_strain_fraction;
+  active = active || std::abs(s.z_m[0]) > frac * s.z_ba_m ||
+           std::abs(s.z_m[1]) > frac * s.z_ba_m * p_.friction.breakaway_strain_ratio_b;
+  if (!active || substeps_ == 1) {
+    substep(s, u_V, dt_, mode_a_, mode_b_);
+    return;
+  }
+  const double u0 = s.u_V;
+  const double h = dt_ / substeps_;
+  for (int k = 1; k <= substeps_; ++k) {
+    substep(s, u0 + (u_V - u0) * static_cast<double>(k) / substeps_, h, sub_a_, sub_b_);
+  }
+}
+
+void ActuatorModel::substep(ActuatorState& s, double u_V, double h, const ModeDiscretization& ma,
+                            const ModeDiscretization& mb) const noexcept {
+  // 1. Static hysteresis (eq. 2.5): equivalent voltage -> metres by the normalised gain.
+  const double uh = p_.pe.static_gain_m_V * pi_update(p_.hysteresis, s.pi, u_V);
+  // 2. PE modes (eq. 2.1-2.2): force = K_pi * (share of g H(U)) - F_f.
+  const double phi = p_.pe.gain_fraction_a;
+  const double ka = p_.pe.stiffness_a_N_m * phi, kb = p_.pe.stiffness_b_N_m * (1.0 - phi);
+  const double ff = p_.slider.attached ? s.friction_N : 0.0;
+  const double x1_old = s.x1_m();
+  const double v1_old = s.v1a_m_s + s.v1b_m_s;
+  ma.step(s.x1a_m, s.v1a_m_s, ka * s.uh_m - ff, ka * uh - ff);
+  mb.step(s.x1b_m, s.v1b_m_s, kb * s.uh_m - ff, kb * uh - ff);
+  s.uh_m = uh;
+  s.u_V = u_V;
+  s.t_s += h;
+  const double x1_new = s.x1_m();
+  const double v1_new = s.v1a_m_s + s.v1b_m_s;
+  if (!p_.slider.attached) {
+    s.friction_N = 0.0;
+    if (!std::isfinite(x1_new)) s.diverged = true;
+    return;
+  }
+  // 3. Slider parts (eq. 2.8 per asperity, eq. 2.20-2.21) by velocity Verlet.
+  const std::array<double, 2> z_ba = {s.z_ba_m, s.z_ba_m * p_.friction.breakaway_strain_ratio_b};
+  const double ms = p_.slider.mass_kg;
+  const double kc = p_.friction.coupling_stiffness_N_m;
+  std::array<double, 2> x_new{};
+  for (int i = 0; i < 2; ++i) {
+    x_new[i] = s.x2_m[i] + s.v2_m_s[i] * h + 0.5 * s.a2_m_s2[i] * h * h;
+  }
+  double total = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    const double dx = (x1_new - x1_old) - (x_new[i] - s.x2_m[i]);
+    const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], z_ba[i] / p_.friction.zba_zss_ratio);
+    const double xdot_rel = 0.5 * (v1_old + v1_new) - s.v2_m_s[i];
+    const double f = rho0_[i] * z_new + rho1_[i] * (z_new - s.z_m[i]) / h + p_.friction.rho2_N_s_m * xdot_rel;
+    s.z_m[i] = z_new;
+    s.f_N[i] = f;
+    total += c_[i] * f;
+  }
+  const double load = p_.slider.load_force_N;
+  for (int i = 0; i < 2; ++i) {
+    const int j = 1 - i;
+    const double force = c_[i] * (s.f_N[i] + load) + kc * (x_new[j] - x_new[i]);
+    const double a_new = force / (c_[i] * ms);
+    double v = s.v2_m_s[i] + 0.5 * (s.a2_m_s2[i] + a_new) * h;
+    double x = x_new[i];
+    // 4. End stops: inelastic, unconditionally stable.
+    if (x > hi_) {
+      x = hi_;
+      v = std::min(v, 0.0);
+    } else if (x < lo_) {
+      x = lo_;
+      v = std::max(v, 0.0);
+    }
+    s.x2_m[i] = x;
+    s.v2_m_s[i] = v;
+    s.a2_m_s2[i] = a_new;
+  }
+  s.friction_N = total;
+  if (!std::isfinite(s.x2_m[0] + s.x2_m[1] + x1_new + total)) s.diverged = true;
+}
+
+double ActuatorModel::slider_position(const ActuatorState& s) const noexcept {
+  return p_.slider.attached ? c_[0] * s.x2_m[0] + c_[1] * s.x2_m[1] : p_.slider.initial_position_m;
+}
+
+double ActuatorModel::slider_velocity(const ActuatorState& s) const noexcept {
+  return p_.slider.attached ? c_[0] * s.v2_m_s[0] + c_[1] * s.v2_m_s[1] : 0.0;
+}
+
+Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every,
+                    ActuatorState* state) {
+  require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
+  require(record_every >= 1, "record_every", "must be >= 1", record_every);
+  wave.validate(m.params().drive);
+  ActuatorState local = state ? *state : m.initial_state();
+  m.set_operating_point(local, wave.amplitude_V, wave.frequency_Hz, wave.direction);
+  const auto steps = static_cast<long>(std::llround(duration_s / m.dt_s()));
+  Trajectory tr;
+  const auto n_rec = static_cast<std::size_t>(steps / record_every + 2);
+  tr.t_s.reserve(n_rec);
+  tr.u_V.reserve(n_rec);
+  tr.x1_m.reserve(n_rec);
+  tr.x2_m.reserve(n_rec);
+  auto record = [&] {
+    tr.t_s.push_back(local.t_s);
+    tr.u_V.push_back(local.u_V);
+    tr.x1_m.push_back(local.x1_m());
+    tr.x2_m.push_back(m.slider_position(local));
+  };
+  record();
+  for (long k = 1; k <= steps; ++k) {
+    m.step(local, wave.value(static_cast<double>(k) * m.dt_s()));
+    if (local.diverged) {
+      throw ComputationFailed("stick-slip simulation diverged (NaN/Inf) at t = " + std::to_string(local.t_s) +
+                              " s; reduce integrator.dt_s or check the parameters");
+    }
+    if (k % record_every == 0) record();
+  }
+  if (state) *state = local;
+  return tr;
+}
+
+}  // namespace mc::stickslip

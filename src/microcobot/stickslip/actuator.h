@@ -1,0 +1,98 @@
+#pragma once
+/// @file
+/// One stick-slip positioning axis: PE (eq. 2.1-2.7) + PI hysteresis (Fig. 2.6) + two-asperity
+/// elasto-plastic friction (eq. 2.9-2.21) + slider (eq. 2.8), and its fixed-step integrator.
+///
+/// Integrator (docs/model.md): each step of length h (split into integrator.substeps sub-steps
+/// while the contact is active: abrupt drive edge or a strain near z_ba)
+///  1. H(U) by the PI operators (rate independent, exact);
+///  2. the PE's two modes by exact discretisation with a first-order hold on g H(U) and a
+///     zero-order hold on the friction reaction (which is < 1e-8 of the modal forces);
+///  3. each slider part by velocity Verlet, its strain z by advance_strain() along the relative
+///     path increment (exact in the elastic phase, so the stick phase has no drift), the
+///     friction force F = rho0 z + rho1 dz/h + rho2 dx/h (the impulse-consistent mean);
+///  4. the end stops as inelastic contacts (position clamped, inward velocity removed).
+///
+/// One ActuatorModel (immutable: params + precomputed matrices) drives any number of
+/// ActuatorStates; step() never allocates, locks, throws or does I/O.
+
+#include <array>
+#include <vector>
+
+#include "microcobot/stickslip/drive.h"
+#include "microcobot/stickslip/piezo_element.h"
+#include "microcobot/stickslip/stickslip_params.h"
+
+namespace mc::stickslip {
+
+/// The state of one axis. Plain copyable data.
+struct ActuatorState {
+  double t_s = 0.0;
+  double u_V = 0.0;        ///< last drive voltage
+  double uh_m = 0.0;       ///< g H(U): hysteretic static PE displacement [m]
+  PiState pi;
+  double x1a_m = 0.0, v1a_m_s = 0.0, x1b_m = 0.0, v1b_m_s = 0.0;  ///< PE modes (eq. 2.1-2.3)
+  std::array<double, 2> x2_m{};    ///< slider part positions (asperity a, b)
+  std::array<double, 2> v2_m_s{};  ///< slider part velocities
+  std::array<double, 2> a2_m_s2{}; ///< slider part accelerations (Verlet)
+  std::array<double, 2> z_m{};     ///< elastic strain of asperity a, b (eq. 2.9)
+  std::array<double, 2> f_N{};     ///< friction force of asperity a, b per unit share (eq. 2.20-2.21)
+  double friction_N = 0.0;         ///< F_f on the slider (reaction -F_f on the PE)
+  double z_ba_m = 1e-6;            ///< current break-away strain (operating point)
+  bool diverged = false;           ///< set when a state became NaN/Inf
+
+  double x1_m() const { return x1a_m + x1b_m; }  ///< PE displacement (eq. 2.3)
+};
+
+class ActuatorModel {
+ public:
+  /// Validates `params` and precomputes the discretisation for params.integrator.dt_s (or `dt_s`).
+  explicit ActuatorModel(StickSlipParams params);
+  ActuatorModel(StickSlipParams params, double dt_s);
+
+  const StickSlipParams& params() const { return p_; }
+  double dt_s() const { return dt_; }
+
+  /// A state at rest at U = 0, slider at slider.initial_position_m.
+  ActuatorState initial_state() const;
+  /// Sets the break-away strain from the table at the drive's operating point (thesis §2.7: the
+  /// sawtooth generator passes its configuration to the model). Real-time safe.
+  void set_operating_point(ActuatorState& s, double amplitude_V, double frequency_Hz,
+                           Direction direction) const noexcept;
+  /// Advances `s` by dt_s() with the drive voltage reaching `u_V` at the end of the step
+  /// (clamped to the amplifier range). Never allocates; NaN/Inf sets s.diverged.
+  void step(ActuatorState& s, double u_V) const noexcept;
+  /// Slider position x2 [m]: the mass-weighted mean of its two parts (docs/model.md).
+  double slider_position(const ActuatorState& s) const noexcept;
+  double slider_velocity(const ActuatorState& s) const noexcept;
+  /// Mass fraction of slider part a and b.
+  std::array<double, 2> mass_fractions() const { return c_; }
+
+ private:
+  StickSlipParams p_;
+  double dt_;
+  /// One integration sub-step of length h (PE exact, contact by Verlet + path-integrated strain).
+  void substep(ActuatorState& s, double u_V, double h, const ModeDiscretization& ma,
+               const ModeDiscretization& mb) const noexcept;
+
+  ModeDiscretization mode_a_, mode_b_, sub_a_, sub_b_;
+  int substeps_ = 1;
+  std::array<double, 2> c_{}, rho0_{}, rho1_{};
+  double lo_ = 0.0, hi_ = 0.0;
+};
+
+/// step(params-model, state, input, ...) in the free-function form used by the platform loop.
+inline void step(const ActuatorModel& m, ActuatorState& s, double u_V) noexcept { m.step(s, u_V); }
+
+/// A sampled run.
+struct Trajectory {
+  std::vector<double> t_s, u_V, x1_m, x2_m;
+};
+
+/// Runs `wave` for `duration_s` from the model's initial state (or `state`), recording every
+/// `record_every` steps. Sets the operating point from the waveform. Throws mc::ComputationFailed
+/// on divergence (never returns NaN).
+Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every = 1,
+                    ActuatorState* state = nullptr);
+
+}  // namespace mc::stickslip

@@ -1,0 +1,168 @@
+// One stick-slip axis: contracts of the model (allocation-free step, many states per params,
+// end stops, divergence, parameter validation) and the physics of eq. 2.1-2.8.
+#include "microcobot/stickslip/actuator.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/params.h"
+#include "support/counting_allocator.h"
+
+namespace mc::stickslip {
+namespace {
+
+TEST(Actuator, DefaultParamsMatchTable28) {
+  const StickSlipParams p;
+  EXPECT_NO_THROW(p.validate());
+  EXPECT_NEAR(p.pe.natural_frequency_a_Hz(), 64.4e3, 0.1e3);   // DESIGN errata 1
+  EXPECT_NEAR(p.pe.natural_frequency_b_Hz(), 119.7e3, 0.1e3);
+  EXPECT_NEAR(std::sqrt(p.friction.rho0_a_N_m / p.slider.mass_kg) / (2 * M_PI), 600.6, 0.5);
+  EXPECT_NEAR(std::sqrt(p.friction.rho0_b_N_m / p.slider.mass_kg) / (2 * M_PI), 1639.0, 1.0);
+  EXPECT_DOUBLE_EQ(p.friction.zba_zss_ratio, 0.667);
+}
+
+TEST(Actuator, StepNeverAllocates) {
+  const ActuatorModel m{StickSlipParams{}};
+  ActuatorState s = m.initial_state();
+  const Waveform w = make_waveform(WaveKind::kSawtooth, 60, 500, Direction::kForward, m.params().drive);
+  m.set_operating_point(s, 60, 500, Direction::kForward);
+  test::AllocationGuard guard;
+  for (int k = 1; k <= 2000; ++k) m.step(s, w.value(k * m.dt_s()));
+  EXPECT_EQ(guard.allocations(), 0u);
+  EXPECT_FALSE(s.diverged);
+}
+
+TEST(Actuator, OneModelDrivesIndependentStates) {
+  const ActuatorModel m{StickSlipParams{}};
+  ActuatorState a = m.initial_state(), b = m.initial_state(), c = m.initial_state();
+  m.set_operating_point(a, 60, 100, Direction::kForward);
+  m.set_operating_point(b, 60, 100, Direction::kBackward);
+  m.set_operating_point(c, 60, 100, Direction::kForward);
+  const auto wf = make_waveform(WaveKind::kSawtooth, 60, 100, Direction::kForward, m.params().drive);
+  const auto wb = make_waveform(WaveKind::kSawtooth, 60, 100, Direction::kBackward, m.params().drive);
+  for (int k = 1; k <= 20000; ++k) {
+    const double t = k * m.dt_s();
+    m.step(a, wf.value(t));
+    m.step(b, wb.value(t));
+    m.step(c, wf.value(t));
+  }
+  EXPECT_GT(m.slider_position(a), 1e-7);
+  EXPECT_LT(m.slider_position(b), -1e-7);
+  EXPECT_DOUBLE_EQ(m.slider_position(a), m.slider_position(c));  // deterministic, no shared state
+}
+
+TEST(Actuator, StaticGainIsNormalised) {
+  // eq. 2.4-2.6: after a slow ramp to U and settling, x1 = g H(U) (friction reaction negligible)
+  // and the slider follows (stick, no slip).
+  StickSlipParams p;
+  const ActuatorModel m{p};
+  ActuatorState s = m.initial_state();
+  const auto w = make_waveform(WaveKind::kStep, 20, 1, Direction::kForward, p.drive);
+  for (int k = 1; k <= 3000; ++k) m.step(s, w.value(k * m.dt_s()));
+  const double expect = p.pe.static_gain_m_V * pi_loading_curve(p.hysteresis, 20.0);
+  EXPECT_NEAR(s.x1_m(), expect, 1e-3 * expect);
+  EXPECT_NEAR(m.slider_position(s), expect, 2e-2 * expect);
+}
+
+TEST(Actuator, EndStopsStopTheSliderWithoutBlowUp) {
+  StickSlipParams p;
+  p.slider.stroke_m = 4e-6;  // short stroke so that stepping reaches the stop quickly
+  const ActuatorModel m{p};
+  ActuatorState s = m.initial_state();
+  const auto w = make_waveform(WaveKind::kSawtooth, 80, 1000, Direction::kForward, p.drive);
+  Trajectory tr = simulate(m, w, 0.05, 10, &s);
+  double max_x = -1;
+  for (double x : tr.x2_m) {
+    ASSERT_TRUE(std::isfinite(x));
+    max_x = std::max(max_x, x);
+  }
+  EXPECT_LE(max_x, 0.5 * p.slider.stroke_m + 1e-15);
+  EXPECT_NEAR(tr.x2_m.back(), 0.5 * p.slider.stroke_m, 0.2e-6);
+}
+
+TEST(Actuator, ExternalLoadPushesTheSlider) {
+  StickSlipParams p;
+  p.slider.load_force_N = -2.0;  // beyond the friction's holding force: the slider slides back
+  const ActuatorModel m{p};
+  ActuatorState s = m.initial_state();
+  for (int k = 0; k < 2000; ++k) m.step(s, 0.0);
+  EXPECT_LT(m.slider_position(s), -1e-6);
+  p.slider.load_force_N = -0.01;  // well inside it: held (elastic deflection only)
+  const ActuatorModel held{p};
+  ActuatorState h = held.initial_state();
+  for (int k = 0; k < 2000; ++k) held.step(h, 0.0);
+  EXPECT_LT(std::abs(held.slider_position(h)), 50e-9);
+}
+
+TEST(Actuator, DivergenceIsReportedNotReturned) {
+  StickSlipParams p;
+  // A contact stiffness far beyond the explicit contact update's stability limit (omega h > 2).
+  p.friction.rho0_b_N_m = 1e10;
+  p.integrator.substeps = 1;
+  const ActuatorModel m{p};
+  const auto w = make_waveform(WaveKind::kSawtooth, 60, 50, Direction::kForward, p.drive);
+  EXPECT_THROW(simulate(m, w, 0.2), ComputationFailed);
+}
+
+TEST(Actuator, ParamsRoundTripAndNameBadFields) {
+  StickSlipParams p;
+  p.slider.mass_kg = 0.03;
+  const std::string yaml = params_to_yaml(p);
+  const auto back = params_from_yaml_text<StickSlipParams>(yaml);
+  EXPECT_DOUBLE_EQ(back.slider.mass_kg, 0.03);
+  EXPECT_EQ(params_to_json(back), params_to_json(p));
+  try {
+    params_from_yaml_text<StickSlipParams>("pe:\n  mass_kg: -1\n");
+    FAIL();
+  } catch (const InvalidParams& e) {
+    EXPECT_EQ(e.field(), "pe.mass_kg");
+  }
+  EXPECT_THROW(params_from_yaml_text<StickSlipParams>("breakaway:\n  forward_m: [[1e-7]]\n"), InvalidParams);
+}
+
+TEST(Drive, WaveformsStayInRangeAndRejectBeyond100V) {
+  const DriveParams d;
+  EXPECT_THROW(make_waveform(WaveKind::kSawtooth, 120, 50, Direction::kForward, d), InvalidParams);
+  EXPECT_THROW(make_waveform(WaveKind::kSine, 60, 50, Direction::kForward, d, 50.0), InvalidParams);
+  EXPECT_THROW(make_waveform(WaveKind::kSawtooth, 40, -5, Direction::kForward, d), InvalidParams);
+  const auto f = make_waveform(WaveKind::kSawtooth, 40, 50, Direction::kForward, d);
+  const auto b = make_waveform(WaveKind::kSawtooth, 40, 50, Direction::kBackward, d);
+  double max_rate_f = 0, max_rate_b = 0;
+  const double h = 1e-7;
+  for (int k = 0; k < 400000; ++k) {
+    const double t = k * h;
+    ASSERT_GE(f.value(t), 0.0);
+    ASSERT_LE(f.value(t), 40.0 + 1e-12);
+    const double rf = (f.value(t + h) - f.value(t)) / h, rb = (b.value(t + h) - b.value(t)) / h;
+    max_rate_f = std::min(max_rate_f, rf);  // forward: abrupt drop
+    max_rate_b = std::max(max_rate_b, rb);  // backward: abrupt rise
+    ASSERT_LE(std::abs(rf), d.slew_rate_V_s * (1 + 1e-6));
+  }
+  EXPECT_NEAR(max_rate_f, -d.slew_rate_V_s, 1e-3 * d.slew_rate_V_s);
+  EXPECT_NEAR(max_rate_b, d.slew_rate_V_s, 1e-3 * d.slew_rate_V_s);
+  EXPECT_EQ(parse_direction("backward"), Direction::kBackward);
+  EXPECT_THROW(parse_wave_kind("square"), UsageError);
+}
+
+TEST(BreakawayTable, InterpolatesAndClamps) {
+  BreakawayTable t;
+  t.amplitudes_V = {10, 50};
+  t.frequencies_Hz = {50, 500};
+  t.forward_m = {{1e-7, 2e-7}, {3e-7, 4e-7}};
+  t.backward_m = {{5e-7, 5e-7}, {5e-7, 5e-7}};
+  EXPECT_NO_THROW(t.validate());
+  EXPECT_NEAR(t.lookup(30, 275, Direction::kForward), 2.5e-7, 1e-20);
+  EXPECT_NEAR(t.lookup(0, 0, Direction::kForward), 1e-7, 1e-20);
+  EXPECT_NEAR(t.lookup(100, 1e4, Direction::kForward), 4e-7, 1e-20);
+  EXPECT_NEAR(t.lookup(30, 100, Direction::kBackward), 5e-7, 1e-20);
+  const BreakawayTable d = default_breakaway_table();
+  EXPECT_NO_THROW(d.validate());
+  // Fig. 2.13: z_ba grows with amplitude; backward above forward (asymmetry, Fig. 2.15-2.16).
+  EXPECT_GT(d.lookup(60, 50, Direction::kForward), d.lookup(40, 50, Direction::kForward));
+  EXPECT_GT(d.lookup(40, 50, Direction::kBackward), d.lookup(40, 50, Direction::kForward));
+}
+
+}  // namespace
+}  // namespace mc::stickslip
