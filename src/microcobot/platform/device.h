@@ -1,0 +1,107 @@
+#pragma once
+/// @file
+/// The lifecycle every device of the platform follows (after ros2_control's hardware
+/// components): configure() allocates and checks, activate() arms, update() runs on the
+/// real-time path, deactivate() disarms. Whatever happens, a device can be put in its safe
+/// state at once (zero force, axes hold at 0 V) with enter_safe_state(), which is real-time
+/// safe and idempotent; fault() does that and latches the fault until reconfigured.
+///
+///     Unconfigured --configure--> Inactive --activate--> Active
+///          ^                        ^  |                   |
+///          |                        |  +----deactivate-----+
+///          +-------configure--------+--- Fault <--fault()--+ (from any state)
+///
+/// A device that is not Active ignores commands and outputs its safe state.
+
+#include <string>
+#include <string_view>
+
+namespace mc::platform {
+
+enum class Lifecycle { kUnconfigured, kInactive, kActive, kFault };
+
+std::string_view to_string(Lifecycle state);
+
+class Device {
+ public:
+  explicit Device(std::string name) : name_(std::move(name)) {}
+  virtual ~Device() = default;
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  const std::string& name() const { return name_; }
+  Lifecycle state() const { return state_; }
+  bool active() const { return state_ == Lifecycle::kActive; }
+
+  /// Unconfigured/Inactive/Fault -> Inactive. May allocate; throws mc::Error on failure
+  /// (the device then stays in Fault).
+  void configure();
+  /// Inactive -> Active. Throws mc::InvalidInput from any other state.
+  void activate();
+  /// Active -> Inactive, through the safe state.
+  void deactivate();
+  /// Safe state now and latch Fault. Real-time safe.
+  void fault() noexcept;
+
+  /// One exchange with the device on the real-time path: apply the latest command, advance
+  /// `dt_s` (a simulated device steps its model; a hardware driver talks to its bus), latch
+  /// new measurements. Called only while Active. Must not allocate, lock, throw or block.
+  virtual void update(double dt_s) noexcept = 0;
+  /// Puts outputs in the safe state (zero force / 0 V / hold). Real-time safe, idempotent.
+  virtual void enter_safe_state() noexcept = 0;
+
+ protected:
+  virtual void on_configure() {}
+  virtual void on_activate() {}
+  virtual void on_deactivate() {}
+
+ private:
+  std::string name_;
+  Lifecycle state_ = Lifecycle::kUnconfigured;
+};
+
+/// A planar vector in SI units.
+struct Vec2 {
+  double x = 0.0;
+  double y = 0.0;
+};
+
+/// The dual-stage haptic interface (Pantograph + Haptuator, ch. 3): handle position in,
+/// force out. `enabled()` is the operator's deadman/enable switch.
+class HapticMaster : public Device {
+ public:
+  using Device::Device;
+  virtual Vec2 handle_position_m() const = 0;
+  virtual bool enabled() const = 0;
+  /// Force to render on the handle; ignored unless Active.
+  virtual void command_force_N(Vec2 force) noexcept = 0;
+};
+
+/// The TéléTweez haptic tweezers (ch. 4): opening of the tips in, grip force out.
+class TweezersMaster : public Device {
+ public:
+  using Device::Device;
+  virtual double opening_m() const = 0;
+  virtual void command_grip_force_N(double force) noexcept = 0;
+};
+
+/// One stick-slip positioning axis of the slave stage (ch. 2): drive voltage out, position in.
+class SlaveAxis : public Device {
+ public:
+  using Device::Device;
+  virtual void command_voltage_V(double volts) noexcept = 0;
+  virtual double position_m() const = 0;
+  /// True while the carriage rests against one of its end stops.
+  virtual bool at_end_stop() const = 0;
+};
+
+/// The slave micro-gripper: opening command out, opening and grip force in.
+class Gripper : public Device {
+ public:
+  using Device::Device;
+  virtual void command_opening_m(double opening) noexcept = 0;
+  virtual double opening_m() const = 0;
+  virtual double grip_force_N() const = 0;
+};
+
+}  // namespace mc::platform

@@ -1,0 +1,93 @@
+#include "microcobot/platform/fixed_rate_loop.h"
+
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "microcobot/core/error.h"
+
+namespace mc::platform {
+
+namespace {
+double now_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+}  // namespace
+
+FixedRateLoop::FixedRateLoop(double base_rate_Hz) : rate_(base_rate_Hz) {
+  require(std::isfinite(base_rate_Hz) && base_rate_Hz > 0 && base_rate_Hz <= 1e6, "loop.base_rate_Hz",
+          "must be in (0, 1e6]", base_rate_Hz);
+  period_ = 1.0 / rate_;
+}
+
+void FixedRateLoop::add_task(std::string name, int divisor, TaskFn fn) {
+  require(divisor >= 1, "loop.task." + name + ".divisor", "must be >= 1", divisor);
+  require(static_cast<bool>(fn), "loop.task." + name, "needs a function");
+  tasks_.push_back(Task{std::move(name), divisor, std::move(fn)});
+}
+
+std::vector<std::pair<std::string, int>> FixedRateLoop::tasks() const {
+  std::vector<std::pair<std::string, int>> out;
+  for (const auto& t : tasks_) out.emplace_back(t.name, t.divisor);
+  return out;
+}
+
+void FixedRateLoop::tick_once() noexcept {
+  const double t = time_s();
+  for (auto& task : tasks_) {
+    if (tick_ % static_cast<std::uint64_t>(task.divisor) == 0) {
+      task.fn(TickInfo{tick_, t, period_ * task.divisor});
+    }
+  }
+  ++tick_;
+}
+
+void FixedRateLoop::run_for(std::uint64_t ticks) {
+  stop_.store(false);
+  for (std::uint64_t i = 0; i < ticks && !stop_requested(); ++i) {
+    const double start = now_s();
+    tick_once();
+    const double cost = now_s() - start;
+    tick_stats_.add(cost);
+    if (cost > period_) ++overruns_;
+  }
+}
+
+bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
+  stop_.store(false);
+  bool fifo = false;
+  std::thread worker([&] {
+    sched_param param{};
+    param.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10;
+    fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    timespec next{};
+    clock_gettime(CLOCK_MONOTONIC, &next);
+    const auto period_ns = static_cast<long>(std::llround(period_ * 1e9));
+    for (std::uint64_t i = 0; i < ticks && !stop_requested(); ++i) {
+      next.tv_nsec += period_ns;
+      while (next.tv_nsec >= 1000000000L) {
+        next.tv_nsec -= 1000000000L;
+        ++next.tv_sec;
+      }
+      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+      const double start = now_s();
+      const double deadline = static_cast<double>(next.tv_sec) + 1e-9 * static_cast<double>(next.tv_nsec);
+      const double late = start - deadline;
+      jitter_stats_.add(late);
+      tick_once();
+      const double cost = now_s() - start;
+      tick_stats_.add(cost);
+      if (cost > period_ || late > period_) ++overruns_;
+    }
+  });
+  worker.join();
+  return fifo;
+}
+
+}  // namespace mc::platform

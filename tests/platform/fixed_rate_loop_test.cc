@@ -1,0 +1,88 @@
+#include "microcobot/platform/fixed_rate_loop.h"
+
+#include <chrono>
+#include <gtest/gtest.h>
+#include <vector>
+
+#include "microcobot/core/error.h"
+#include "support/counting_allocator.h"
+
+namespace mc::platform {
+namespace {
+
+TEST(FixedRateLoop, TasksRunAtTheirDivisorInOrderWithTheirPeriod) {
+  FixedRateLoop loop(10000.0);
+  std::vector<char> order;
+  order.reserve(64);
+  int haptic = 0, slave = 0;
+  double slave_dt = 0, last_t = -1;
+  loop.add_task("haptic", 1, [&](const TickInfo& t) {
+    ++haptic;
+    last_t = t.t_s;
+    if (t.index < 20) order.push_back('h');
+  });
+  loop.add_task("slave", 10, [&](const TickInfo& t) {
+    ++slave;
+    slave_dt = t.dt_s;
+    if (t.index < 20) order.push_back('s');
+  });
+  loop.run_for(1000);
+  EXPECT_EQ(haptic, 1000);
+  EXPECT_EQ(slave, 100);
+  EXPECT_DOUBLE_EQ(slave_dt, 1e-3);
+  EXPECT_DOUBLE_EQ(last_t, 999 * 1e-4);
+  EXPECT_EQ(order[0], 'h');
+  EXPECT_EQ(order[1], 's');  // same tick: in the order added
+  EXPECT_EQ(order[2], 'h');
+  EXPECT_EQ(loop.ticks(), 1000u);
+  EXPECT_EQ(loop.tick_stats().count(), 1000u);
+}
+
+TEST(FixedRateLoop, RunningNeverAllocates) {
+  FixedRateLoop loop(10000.0);
+  double acc = 0;
+  loop.add_task("work", 1, [&](const TickInfo& t) { acc += t.t_s; });
+  loop.add_task("slow", 7, [&](const TickInfo& t) { acc -= t.dt_s; });
+  loop.run_for(10);  // warm-up
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    loop.run_for(20000);
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_NE(acc, 0.0);
+}
+
+TEST(FixedRateLoop, StopFromInsideATaskEndsTheRunAtThatTick) {
+  FixedRateLoop loop(1000.0);
+  loop.add_task("stopper", 1, [&](const TickInfo& t) {
+    if (t.index == 41) loop.request_stop();
+  });
+  loop.run_for(1000);
+  EXPECT_EQ(loop.ticks(), 42u);
+}
+
+TEST(FixedRateLoop, RealTimeRunIsPacedToTheWallClock) {
+  FixedRateLoop loop(5000.0);
+  int n = 0;
+  loop.add_task("count", 1, [&](const TickInfo&) { ++n; });
+  const auto start = std::chrono::steady_clock::now();
+  loop.run_realtime(1000);  // 0.2 s
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(n, 1000);
+  EXPECT_GE(wall, 0.195);
+  EXPECT_LT(wall, 3.0);  // generous: shared CI machines
+  EXPECT_EQ(loop.jitter_stats().count(), 1000u);
+}
+
+TEST(FixedRateLoop, RejectsBadRatesAndDivisors) {
+  EXPECT_THROW(FixedRateLoop(0.0), InvalidParams);
+  EXPECT_THROW(FixedRateLoop(-5.0), InvalidParams);
+  FixedRateLoop loop(1000.0);
+  EXPECT_THROW(loop.add_task("x", 0, [](const TickInfo&) {}), InvalidParams);
+  EXPECT_THROW(loop.add_task("x", 1, TaskFn{}), InvalidParams);
+}
+
+}  // namespace
+}  // namespace mc::platform
