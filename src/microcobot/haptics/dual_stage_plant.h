@@ -1,0 +1,151 @@
+#pragma once
+/// @file
+/// The dual-stage haptic interface as a plant (thesis §3.4.1, Fig. 3.9, eq. 3.4): the
+/// 4-mass model in the handle's y axis driven by the Pantograph motors (f_m on the motor
+/// windings m_2) and by the Haptuator (a force pair f_v between its moving magnet m_v and
+/// the handle m_h), with the Haptuator's coil dynamics and the end stops of its magnet
+/// (stroke saturation). Output: the handle's acceleration, what the accelerometer measures.
+
+#include <complex>
+
+#include <Eigen/Dense>
+
+#include "microcobot/core/params.h"
+
+namespace mc::haptics {
+
+/// Parameters of the dual-stage plant. The thesis gives no values (DESIGN.md erratum 7); the
+/// defaults are chosen (docs/parameters.md) so that the Pantograph channel is flat (+-1 dB)
+/// from 40 to 200 Hz, leaves that band just above 200 Hz, rises through a damped region
+/// into a sharp resonance near 800 Hz (Fig. 3.10), and the Haptuator channel matches
+/// eq. 3.6 within +-1 dB on 100-1000 Hz (Fig. 3.11). With f_m on m_2 as eq. 3.4 prints it,
+/// the Pantograph channel has no antiresonance besides the magnet's (docs/errata.md).
+struct DualStagePlantParams {
+  // Masses (Table 3.3).
+  double m_h_kg = 0.250;   ///< terminal assembly: handle, Haptuator housing, accelerometer, finger pad
+  double m_v_kg = 0.003;   ///< Haptuator moving magnet
+  double m_1_kg = 4.2e-4;  ///< apparent mass of the distal links
+  double m_2_kg = 3.6e-4;  ///< apparent mass of the motor windings
+  // Stiffnesses and dampings (Table 3.3).
+  double k_f_N_per_m = 228.0;   ///< finger stiffness [Wiertlewski 2012]
+  double b_f_Ns_per_m = 35.7;   ///< finger damping
+  double k_v_N_per_m = 537.5;   ///< Haptuator membrane (suspension) stiffness
+  double b_v_Ns_per_m = 1.52;   ///< Haptuator membrane damping
+  double k_1_N_per_m = 3.24e4;  ///< distal links
+  double b_1_Ns_per_m = 0.684;
+  double k_2_N_per_m = 1.573e4;  ///< proximal links
+  double b_2_Ns_per_m = 1.27e-3;
+  // Haptuator electrical dynamics: a current amplifier (transconductance g, PI current loop
+  // k_p, k_i) drives the coil: L di/dt = v - R i - Bl (dy_v - dy_h),
+  // v = k_p (g u - i) + k_i int (g u - i), f_v = Bl i. The loop's closed-loop response
+  // (k_p s + k_i) / (L s^2 + (R + k_p) s + k_i) has the form of eq. 3.6.
+  double amp_gain_A_per_V = 3.512e-2;  ///< transconductance g of the amplifier
+  double coil_R_ohm = 6.0;             ///< coil resistance
+  double coil_L_H = 16.9e-3;           ///< inductance seen by the amplifier (coil and output filter)
+  double loop_kp_V_per_A = 30.07;      ///< current loop proportional gain
+  double loop_ki_V_per_As = 7.705e4;   ///< current loop integral gain
+  double bl_N_per_A = 1.0;             ///< force factor
+  // Stroke saturation: end stops on the magnet's travel relative to the handle.
+  double stroke_m = 0.3e-3;       ///< free travel of the magnet each side of rest
+  double stop_k_N_per_m = 2.0e5;  ///< end-stop contact stiffness
+  double stop_b_Ns_per_m = 2.0;   ///< end-stop contact damping
+  // Time stepping.
+  double dt_s = 1.0e-4;  ///< step of step() (the 10 kHz loop)
+  int substeps = 8;      ///< internal substeps per step (end-stop contact resolution)
+
+  template <class V>
+  void visit(V& v) {
+    v("m_h_kg", m_h_kg);
+    v("m_v_kg", m_v_kg);
+    v("m_1_kg", m_1_kg);
+    v("m_2_kg", m_2_kg);
+    v("k_f_N_per_m", k_f_N_per_m);
+    v("b_f_Ns_per_m", b_f_Ns_per_m);
+    v("k_v_N_per_m", k_v_N_per_m);
+    v("b_v_Ns_per_m", b_v_Ns_per_m);
+    v("k_1_N_per_m", k_1_N_per_m);
+    v("b_1_Ns_per_m", b_1_Ns_per_m);
+    v("k_2_N_per_m", k_2_N_per_m);
+    v("b_2_Ns_per_m", b_2_Ns_per_m);
+    v("amp_gain_A_per_V", amp_gain_A_per_V);
+    v("coil_R_ohm", coil_R_ohm);
+    v("coil_L_H", coil_L_H);
+    v("loop_kp_V_per_A", loop_kp_V_per_A);
+    v("loop_ki_V_per_As", loop_ki_V_per_As);
+    v("bl_N_per_A", bl_N_per_A);
+    v("stroke_m", stroke_m);
+    v("stop_k_N_per_m", stop_k_N_per_m);
+    v("stop_b_Ns_per_m", stop_b_Ns_per_m);
+    v("dt_s", dt_s);
+    v("substeps", substeps);
+  }
+  /// Throws InvalidParams naming the field if a value is out of range.
+  void validate() const;
+};
+
+/// Inputs of the plant.
+enum class Channel {
+  kPantograph,  ///< f_m [N], the low-frequency channel
+  kHaptuator,   ///< u [V], the high-frequency channel
+};
+
+/// State of the plant: x = [y_h, y_v, y_1, y_2, dy_h, dy_v, dy_1, dy_2, i_coil, q] with q the current loop
+/// integral of (g u - i) (SI).
+struct DualStagePlantState {
+  Eigen::Matrix<double, 10, 1> x = Eigen::Matrix<double, 10, 1>::Zero();
+  double accel_m_s2 = 0.0;  ///< handle acceleration at the end of the last step
+};
+
+/// The dual-stage plant of eq. 3.4 with the Haptuator coil and end stops.
+///
+/// Linear part (stops open): M Y'' + C Y' + K Y = [-f_v, f_v, 0, f_m]^T (eq. 3.4), f_v = Bl i,
+/// L i' = k_p (g u - i) + k_i q - R i - Bl (y_v' - y_h'), q' = g u - i. The end stops add a force pair
+/// f_s = -k_s (z - sign(z) s) - b_s z' on the magnet (and its opposite on the handle) while
+/// |z| = |y_v - y_h| exceeds the stroke s: the saturation that spoils the Haptuator's
+/// response below about 100 Hz (Fig. 3.11).
+class DualStagePlant {
+ public:
+  static constexpr int kStates = 10;
+  using StateVector = Eigen::Matrix<double, kStates, 1>;
+  using StateMatrix = Eigen::Matrix<double, kStates, kStates>;
+  /// Inputs: [f_m (N), u (V), f_s (N, end-stop pair)].
+  using InputMatrix = Eigen::Matrix<double, kStates, 3>;
+
+  /// Validates the parameters and discretises the linear part (ZOH over dt/substeps).
+  explicit DualStagePlant(const DualStagePlantParams& params);
+
+  const DualStagePlantParams& params() const { return params_; }
+
+  /// Continuous-time matrices of the linear part (stops open): x' = A x + B [f_m, u, f_s].
+  const StateMatrix& a() const { return a_; }
+  const InputMatrix& b() const { return b_; }
+
+  /// Frequency response of the linear part from `channel` to the handle's acceleration at
+  /// `f_Hz`: (m/s^2)/N for the Pantograph, (m/s^2)/V for the Haptuator.
+  std::complex<double> frf(Channel channel, double f_Hz) const;
+
+  /// Total mass moving with the handle at low frequency (the Pantograph channel's flat
+  /// gain is 1/total_mass above the finger mode).
+  double total_mass_kg() const;
+
+  /// One step of dt_s with inputs held (zero-order hold): f_m [N], u [V]. Updates
+  /// state.accel_m_s2. Never allocates. Throws ComputationFailed on divergence.
+  void step(DualStagePlantState& state, double f_m_N, double u_V) const;
+
+  /// Handle acceleration of `state` under inputs (the accelerometer's reading).
+  double acceleration(const DualStagePlantState& state, double f_m_N, double u_V) const;
+
+  /// Magnet travel relative to the handle, y_v - y_h [m].
+  static double magnet_travel(const DualStagePlantState& state) { return state.x(1) - state.x(0); }
+
+ private:
+  double stop_force(const StateVector& x) const;
+
+  DualStagePlantParams params_;
+  StateMatrix a_;
+  InputMatrix b_;
+  StateMatrix ad_;  // exp(A h), h = dt/substeps
+  InputMatrix bd_;  // int_0^h exp(A t) dt B
+};
+
+}  // namespace mc::haptics

@@ -1,0 +1,61 @@
+#include "microcobot/microworld/optical_trap.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "microcobot/core/error.h"
+
+namespace mc::microworld {
+
+void OpticalTrapParams::validate() const {
+  require_positive(bead_radius_m, "bead_radius_m");
+  require_positive(viscosity_Pa_s, "viscosity_Pa_s");
+  require_positive(temperature_K, "temperature_K");
+  require_positive(trap_stiffness_N_per_m, "trap_stiffness_N_per_m");
+  require_positive(obstacle_radius_m, "obstacle_radius_m");
+  require_non_negative(contact_stiffness_N_per_m, "contact_stiffness_N_per_m");
+  require_positive(dt_s, "dt_s");
+  // The contact force is explicit over a step: its relaxation must be resolved.
+  const double gamma = 6.0 * std::numbers::pi * viscosity_Pa_s * bead_radius_m;
+  require(contact_stiffness_N_per_m * dt_s / gamma < 0.5, "contact_stiffness_N_per_m",
+          "too stiff for dt_s (need k_c dt / gamma < 0.5)", contact_stiffness_N_per_m);
+}
+
+OpticalTrap::OpticalTrap(const OpticalTrapParams& params) : params_(params) {
+  params_.validate();
+  gamma_ = 6.0 * std::numbers::pi * params_.viscosity_Pa_s * params_.bead_radius_m;
+  decay_ = std::exp(-params_.trap_stiffness_N_per_m * params_.dt_s / gamma_);
+  kick_ = std::sqrt(position_variance_m2() * (1.0 - decay_ * decay_));
+}
+
+double OpticalTrap::corner_frequency_Hz() const {
+  return params_.trap_stiffness_N_per_m / (2.0 * std::numbers::pi * gamma_);
+}
+
+double OpticalTrap::position_variance_m2() const {
+  return kBoltzmann * params_.temperature_K / params_.trap_stiffness_N_per_m;
+}
+
+Eigen::Vector2d OpticalTrap::contact_force(const Eigen::Vector2d& bead_m) const {
+  if (!has_obstacle_) return Eigen::Vector2d::Zero();
+  const Eigen::Vector2d d = bead_m - obstacle_;
+  const double dist = d.norm();
+  const double overlap = params_.bead_radius_m + params_.obstacle_radius_m - dist;
+  if (overlap <= 0.0 || dist <= 0.0) return Eigen::Vector2d::Zero();
+  return params_.contact_stiffness_N_per_m * overlap * d / dist;
+}
+
+Eigen::Vector2d OpticalTrap::trap_force(const OpticalTrapState& s) const {
+  return -params_.trap_stiffness_N_per_m * (s.bead_m - s.trap_m);
+}
+
+void OpticalTrap::step(OpticalTrapState& s, Rng& rng) const {
+  const Eigen::Vector2d fc = contact_force(s.bead_m);
+  const Eigen::Vector2d eq = s.trap_m + fc / params_.trap_stiffness_N_per_m;
+  for (int a = 0; a < 2; ++a) {
+    s.bead_m(a) = eq(a) + (s.bead_m(a) - eq(a)) * decay_ + kick_ * rng.normal();
+  }
+  if (!s.bead_m.allFinite()) throw ComputationFailed("optical trap: non-finite bead position");
+}
+
+}  // namespace mc::microworld

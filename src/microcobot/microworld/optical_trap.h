@@ -1,0 +1,86 @@
+#pragma once
+/// @file
+/// A bead in an optical trap (thesis §3.1 Fig. 3.3, §3.5.2): overdamped Langevin dynamics in
+/// the plane, gamma dx = -k (x - x_trap) dt + F_c dt + sqrt(2 k_B T gamma) dW, with Stokes drag
+/// gamma = 6 pi eta r, a probe (the trap centre) moved by the operator, and a large bead stuck
+/// on the dish that the probe bead can touch (repulsive contact force F_c).
+
+#include <Eigen/Dense>
+
+#include "microcobot/core/params.h"
+#include "microcobot/core/rng.h"
+
+namespace mc::microworld {
+
+/// Optical trap and scene. Defaults: a 3 um bead (radius 1.5 um, Fig. 3.14b) in water at
+/// 300 K; trap stiffness 10 pN/um, typical of [Ni 2013b] setups (a documented choice).
+struct OpticalTrapParams {
+  double bead_radius_m = 1.5e-6;    ///< trapped probe bead radius (Fig. 3.14b: 3 um bead)
+  double viscosity_Pa_s = 0.85e-3;  ///< water at 300 K
+  double temperature_K = 300.0;
+  double trap_stiffness_N_per_m = 1.0e-5;     ///< k (10 pN/um)
+  double obstacle_radius_m = 5.0e-6;          ///< large bead stuck on the dish
+  double contact_stiffness_N_per_m = 4.0e-4;  ///< linear repulsion once the beads overlap
+  double dt_s = 1.0e-5;                       ///< integration step (exact Ornstein-Uhlenbeck update)
+
+  template <class V>
+  void visit(V& v) {
+    v("bead_radius_m", bead_radius_m);
+    v("viscosity_Pa_s", viscosity_Pa_s);
+    v("temperature_K", temperature_K);
+    v("trap_stiffness_N_per_m", trap_stiffness_N_per_m);
+    v("obstacle_radius_m", obstacle_radius_m);
+    v("contact_stiffness_N_per_m", contact_stiffness_N_per_m);
+    v("dt_s", dt_s);
+  }
+  void validate() const;
+};
+
+/// State: bead and trap (probe) positions in the dish plane (m).
+struct OpticalTrapState {
+  Eigen::Vector2d bead_m = Eigen::Vector2d::Zero();
+  Eigen::Vector2d trap_m = Eigen::Vector2d::Zero();
+};
+
+/// The trapped bead. step() never allocates.
+class OpticalTrap {
+ public:
+  static constexpr double kBoltzmann = 1.380649e-23;
+
+  explicit OpticalTrap(const OpticalTrapParams& params);
+  const OpticalTrapParams& params() const { return params_; }
+
+  /// Stokes drag coefficient gamma = 6 pi eta r (N s/m).
+  double drag() const { return gamma_; }
+  /// Corner frequency of the trap's position PSD, f_c = k / (2 pi gamma) (Hz).
+  double corner_frequency_Hz() const;
+  /// Equipartition variance of the bead position per axis, k_B T / k (m^2).
+  double position_variance_m2() const;
+
+  /// Places the large stuck bead (centre) or removes it.
+  void set_obstacle(const Eigen::Vector2d& centre_m) {
+    obstacle_ = centre_m;
+    has_obstacle_ = true;
+  }
+  void clear_obstacle() { has_obstacle_ = false; }
+
+  /// Contact force on the probe bead from the stuck bead (N), zero when apart.
+  Eigen::Vector2d contact_force(const Eigen::Vector2d& bead_m) const;
+  /// Trap force on the bead, -k (x - x_trap) (N). The measured force of optical tweezers
+  /// (linear spring model, Fig. 3.3) is its opposite, k (x - x_trap).
+  Eigen::Vector2d trap_force(const OpticalTrapState& s) const;
+
+  /// One step of dt_s with the trap held at s.trap_m: exact OU update towards the
+  /// equilibrium x_trap + F_c/k (F_c frozen over the step). Throws ComputationFailed on NaN.
+  void step(OpticalTrapState& s, Rng& rng) const;
+
+ private:
+  OpticalTrapParams params_;
+  double gamma_ = 0.0;
+  double decay_ = 0.0;  // exp(-k dt / gamma)
+  double kick_ = 0.0;   // sqrt(kT/k (1 - decay^2))
+  Eigen::Vector2d obstacle_ = Eigen::Vector2d::Zero();
+  bool has_obstacle_ = false;
+};
+
+}  // namespace mc::microworld

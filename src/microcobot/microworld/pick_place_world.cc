@@ -1,0 +1,144 @@
+#include "microcobot/microworld/pick_place_world.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mc::microworld {
+
+void PickPlaceParams::validate() const {
+  require_positive(part_side_m, "part_side_m");
+  require_positive(part_density_kg_m3, "part_density_kg_m3");
+  require_non_negative(gravity_m_s2, "gravity_m_s2");
+  require_non_negative(substrate_pulloff_N, "substrate_pulloff_N");
+  require_non_negative(finger_pulloff_N, "finger_pulloff_N");
+  require_in_range(finger_friction, 0.0, 2.0, "finger_friction");
+  require_in_range(substrate_friction, 0.0, 2.0, "substrate_friction");
+  require_positive(substrate_stiffness_N_m, "substrate_stiffness_N_m");
+  gripper.validate();
+  require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
+          gripper.max_opening_m);
+}
+
+double PickPlaceParams::part_weight_N() const {
+  return part_density_kg_m3 * part_side_m * part_side_m * part_side_m * gravity_m_s2;
+}
+
+PickPlaceWorld::PickPlaceWorld(PickPlaceParams params) : p_(std::move(params)) {
+  p_.validate();
+  weight_ = p_.part_weight_N();
+}
+
+PickPlaceState PickPlaceWorld::initial_state() const {
+  PickPlaceState s;
+  s.part_m = {p_.part_start_m.x(), p_.part_start_m.y(), 0.5 * p_.part_side_m};
+  s.gripper.free_opening_m = p_.gripper.max_opening_m;
+  s.last_gripper_m = {p_.part_start_m.x(), p_.part_start_m.y(), 10 * p_.part_side_m};
+  return s;
+}
+
+double PickPlaceWorld::placement_error_m(const PickPlaceState& s) const {
+  return std::hypot(s.part_m.x() - p_.target_m.x(), s.part_m.y() - p_.target_m.y());
+}
+
+bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept {
+  const double half = 0.5 * p_.part_side_m;
+  const double opening = std::max(s.gripper.free_opening_m, p_.part_side_m);
+  const bool in_jaw_x = std::abs(s.part_m.x() - g.x()) <= 0.5 * opening;
+  const bool in_jaw_y = std::abs(s.part_m.y() - g.y()) < half;
+  const bool tips_below_top = g.z() < s.part_m.z() + half;
+  const bool fingers_above_bottom = g.z() + p_.gripper.finger_length_m > s.part_m.z() - half;
+  return in_jaw_x && in_jaw_y && tips_below_top && fingers_above_bottom;
+}
+
+PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g, double opening_command_m,
+                                     double dt_s) const noexcept {
+  PickPlaceOutput out;
+  step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
+  const double side = p_.part_side_m, half = 0.5 * side;
+  const Eigen::Vector3d motion = g - s.last_gripper_m;
+  s.last_gripper_m = g;
+
+  // A finger tip below the substrate: a crash, reported as a stiff vertical reaction.
+  if (g.z() < 0.0) {
+    out.force_on_gripper_N.z() += p_.substrate_stiffness_N_m * (-g.z());
+    s.crashed = true;
+  }
+
+  const bool held = s.phase != PartPhase::kOnSubstrate;
+  const bool between = held || between_fingers(s, g);
+  const double grip = between ? grip_force_N(p_.gripper, s.gripper, side) : 0.0;
+  out.part_between_fingers = between;
+  out.grip_force_N = grip;
+  out.opening_m = grip > 0.0 ? side : s.gripper.free_opening_m;
+  const double hold_capacity = 2.0 * p_.finger_friction * grip;    // friction the grip can transmit
+  const double substrate_hold = p_.substrate_pulloff_N + weight_;  // force to tear the part off
+
+  switch (s.phase) {
+    case PartPhase::kOnSubstrate: {
+      if (grip <= 0.0) break;
+      // The closing fingers centre the part in the jaw (it slides: the fingers are far stronger
+      // than the substrate friction).
+      s.part_m.x() = g.x();
+      const Eigen::Vector2d lateral(motion.x(), motion.y());
+      const double drag_resistance = p_.substrate_friction * substrate_hold;
+      if (lateral.norm() > 0.0 && hold_capacity >= drag_resistance) {
+        s.part_m.y() += motion.y();  // dragged along the substrate with the gripper
+        out.force_on_gripper_N.x() -= drag_resistance * lateral.x() / lateral.norm();
+        out.force_on_gripper_N.y() -= drag_resistance * lateral.y() / lateral.norm();
+      }
+      if (motion.z() > 0.0 && g.z() > s.part_m.z() - half - 1e-12) {
+        if (hold_capacity >= substrate_hold) {
+          s.phase = PartPhase::kGrasped;  // lift-off: the grip beats adhesion + weight
+          s.part_m.z() += motion.z();     // from now on the part moves with the fingers
+          s.offset_m = s.part_m - g;
+        } else {
+          out.force_on_gripper_N.z() -= hold_capacity;  // fingers slip upward along the part
+        }
+      }
+      break;
+    }
+    case PartPhase::kGrasped:
+    case PartPhase::kStuckToFinger: {
+      Eigen::Vector3d next = g + s.offset_m;
+      if (next.z() < half) {  // pressed onto the substrate: the part stops, the fingers slide down
+        const double press = half - next.z();
+        s.offset_m.z() += press;
+        next.z() = half;
+        out.force_on_gripper_N.z() += s.phase == PartPhase::kGrasped ? hold_capacity : 0.0;
+      }
+      s.part_m = next;
+      const bool on_substrate = s.part_m.z() <= half + 1e-12;
+      if (s.phase == PartPhase::kGrasped && grip <= 0.0) {
+        // Fingers opened: which adhesion keeps the part?
+        if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
+          s.phase = PartPhase::kOnSubstrate;
+        } else if (!on_substrate && 2.0 * p_.finger_pulloff_N < weight_) {
+          s.phase = PartPhase::kOnSubstrate;  // falls
+          s.part_m.z() = half;
+        } else {
+          s.phase = PartPhase::kStuckToFinger;
+        }
+      } else if (s.phase == PartPhase::kStuckToFinger) {
+        if (grip > 0.0) {
+          s.phase = PartPhase::kGrasped;  // grasped again
+        } else if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
+          s.phase = PartPhase::kOnSubstrate;  // touched down: the substrate wins
+        }
+      }
+      // A held part dragged on the substrate rubs on it.
+      if (on_substrate && s.phase == PartPhase::kGrasped) {
+        const Eigen::Vector2d lateral(motion.x(), motion.y());
+        if (lateral.norm() > 0.0) {
+          const double drag = p_.substrate_friction * substrate_hold;
+          out.force_on_gripper_N.x() -= drag * lateral.x() / lateral.norm();
+          out.force_on_gripper_N.y() -= drag * lateral.y() / lateral.norm();
+        }
+      }
+      break;
+    }
+  }
+  out.part_on_substrate = s.part_m.z() <= half + 1e-12;
+  return out;
+}
+
+}  // namespace mc::microworld

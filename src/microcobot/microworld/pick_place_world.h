@@ -1,0 +1,112 @@
+#pragma once
+/// @file
+/// The microworld of a watchmaking pick-and-place: a rigid micro-part (a cube, e.g. a 300 um
+/// brass part) on a substrate, held there by adhesion, and the slave PiezoGripper carried by
+/// the XYZ stage.
+///
+/// At this scale surface forces dominate (thesis §1.1.1): a 300 um brass cube weighs 2.3 uN
+/// while a capillary meniscus holds it to the substrate with ~70 uN and van der Waals
+/// forces hold it to a finger with a few uN. Inertia is negligible (a 0.23 ug part reaches
+/// force equilibrium in microseconds), so the world is quasi-static: at each step the part is
+/// where the force balance puts it, and contacts switch by comparing pull-off and friction
+/// capacities:
+///  - lift-off:   2 mu_finger F_grip  >= F_pulloff_substrate + W    (else the fingers slip)
+///  - drag:       2 mu_finger F_grip  >= mu_substrate (F_pulloff_substrate + W)
+///  - release:    on the substrate, fingers open: the part stays on the substrate when
+///                F_pulloff_substrate > 2 F_pulloff_finger, else it sticks to a finger;
+///                opened in the air it sticks to a finger when 2 F_pulloff_finger > W.
+/// The gripper reference point is the middle of the finger tips; fingers close along x.
+
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "microcobot/core/params.h"
+#include "microcobot/microworld/piezo_gripper.h"
+#include "microcobot/microworld/surface_forces.h"
+
+namespace mc::microworld {
+
+struct PickPlaceParams {
+  double part_side_m = 300e-6;         ///< cube side (the 300 um part of the main scenario)
+  double part_density_kg_m3 = 8500.0;  ///< brass (watch parts)
+  double gravity_m_s2 = 9.81;
+  /// Substrate-part pull-off: capillary meniscus in ambient humidity, 4 pi gamma R cos(theta)
+  /// with water (gamma 0.072 N/m, theta 60 deg) and an effective radius of a quarter of the side.
+  double substrate_pulloff_N = capillary_sphere_plane_N(0.072, 75e-6, M_PI / 3.0);  // 33.9 uN
+  /// Finger-part pull-off per finger: van der Waals of the finger's tip asperities,
+  /// A R / (6 D^2) with A = 1e-19 J, D = 0.4 nm and R = 20 um (dry, coated fingers).
+  double finger_pulloff_N = vdw_sphere_plane_N(1e-19, 20e-6, 0.4e-9);  // 2.08 uN
+  double finger_friction = 0.3;                                        ///< finger-part friction coefficient
+  double substrate_friction = 0.3;              ///< part-substrate friction coefficient
+  double substrate_stiffness_N_m = 1e5;         ///< finger-tip crash into the substrate (penalty)
+  Eigen::Vector3d part_start_m{0.0, 0.0, 0.0};  ///< part centre on the substrate (z ignored)
+  Eigen::Vector3d target_m{2e-3, 0.0, 0.0};     ///< where the part must be placed (x, y)
+  PiezoGripperParams gripper;
+
+  template <class V>
+  void visit(V& v) {
+    v("part_side_m", part_side_m);
+    v("part_density_kg_m3", part_density_kg_m3);
+    v("gravity_m_s2", gravity_m_s2);
+    v("substrate_pulloff_N", substrate_pulloff_N);
+    v("finger_pulloff_N", finger_pulloff_N);
+    v("finger_friction", finger_friction);
+    v("substrate_friction", substrate_friction);
+    v("substrate_stiffness_N_m", substrate_stiffness_N_m);
+    v("part_start_x_m", part_start_m.x());
+    v("part_start_y_m", part_start_m.y());
+    v("target_x_m", target_m.x());
+    v("target_y_m", target_m.y());
+    v("gripper", gripper);
+  }
+  void validate() const;
+  double part_weight_N() const;
+};
+
+/// Where the part is held.
+enum class PartPhase {
+  kOnSubstrate,    ///< resting on the substrate (possibly squeezed by the fingers)
+  kGrasped,        ///< lifted and carried by the grip
+  kStuckToFinger,  ///< fingers open but adhesion keeps it on a finger
+};
+
+struct PickPlaceState {
+  Eigen::Vector3d part_m = Eigen::Vector3d::Zero();  ///< part centre
+  PartPhase phase = PartPhase::kOnSubstrate;
+  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();  ///< part centre - gripper point while held
+  Eigen::Vector3d last_gripper_m = Eigen::Vector3d::Zero();
+  PiezoGripperState gripper;
+  bool crashed = false;  ///< a finger tip went into the substrate at some point
+};
+
+/// What the world returns each step: the forces the slave feels (to be fed back, scaled, to
+/// the operator) and contact flags.
+struct PickPlaceOutput {
+  double grip_force_N = 0.0;
+  Eigen::Vector3d force_on_gripper_N = Eigen::Vector3d::Zero();  ///< reaction on the fingers
+  double opening_m = 0.0;  ///< actual finger opening (blocked by the part when gripping)
+  bool part_between_fingers = false;
+  bool part_on_substrate = true;
+};
+
+class PickPlaceWorld {
+ public:
+  explicit PickPlaceWorld(PickPlaceParams params);
+  const PickPlaceParams& params() const { return p_; }
+
+  PickPlaceState initial_state() const;
+  /// Advances by dt with the gripper point at `gripper_m` and its opening commanded to
+  /// `opening_command_m`. Never allocates.
+  PickPlaceOutput step(PickPlaceState& s, const Eigen::Vector3d& gripper_m, double opening_command_m,
+                       double dt_s) const noexcept;
+  /// Horizontal distance from the part centre to the target.
+  double placement_error_m(const PickPlaceState& s) const;
+
+ private:
+  bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept;
+  PickPlaceParams p_;
+  double weight_;
+};
+
+}  // namespace mc::microworld

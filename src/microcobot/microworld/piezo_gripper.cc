@@ -1,0 +1,31 @@
+#include "microcobot/microworld/piezo_gripper.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mc::microworld {
+
+void PiezoGripperParams::validate() const {
+  require_non_negative(min_opening_m, "gripper.min_opening_m");
+  require(max_opening_m > min_opening_m, "gripper.max_opening_m", "must be > min_opening_m", max_opening_m);
+  require_positive(time_constant_s, "gripper.time_constant_s");
+  require_positive(max_speed_m_s, "gripper.max_speed_m_s");
+  require_positive(finger_stiffness_N_m, "gripper.finger_stiffness_N_m");
+  require_positive(finger_length_m, "gripper.finger_length_m");
+}
+
+void step_gripper(const PiezoGripperParams& p, PiezoGripperState& s, double command_m, double dt_s) noexcept {
+  const double target = std::clamp(command_m, p.min_opening_m, p.max_opening_m);
+  // Exact first-order response over dt, then the slew limit.
+  const double alpha = 1.0 - std::exp(-dt_s / p.time_constant_s);
+  double delta = alpha * (target - s.free_opening_m);
+  const double max_delta = p.max_speed_m_s * dt_s;
+  delta = std::clamp(delta, -max_delta, max_delta);
+  s.free_opening_m = std::clamp(s.free_opening_m + delta, p.min_opening_m, p.max_opening_m);
+}
+
+double grip_force_N(const PiezoGripperParams& p, const PiezoGripperState& s, double width_m) noexcept {
+  return s.free_opening_m < width_m ? 0.5 * p.finger_stiffness_N_m * (width_m - s.free_opening_m) : 0.0;
+}
+
+}  // namespace mc::microworld

@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// The slave micro-gripper (Percipio's PiezoGripper, thesis §1.1.4, Fig. 1.14): two
+/// piezoelectric bender fingers closing along x. Each finger is a first-order system
+/// (bender bandwidth) with a slew limit, and a spring of stiffness k_finger at its tip, so
+/// that a part of width w held between fingers commanded to an opening o < w is squeezed by
+///     F_grip = k_finger (w - o) / 2      (each finger deflects by (w - o) / 2).
+
+#include "microcobot/core/params.h"
+
+namespace mc::microworld {
+
+struct PiezoGripperParams {
+  double max_opening_m = 600e-6;       ///< fully open (a 300 um part fits with margin)
+  double min_opening_m = 0.0;          ///< fully closed (fingers touch)
+  double time_constant_s = 2e-3;       ///< bender response (first order)
+  double max_speed_m_s = 5e-3;         ///< slew limit of the opening
+  double finger_stiffness_N_m = 50.0;  ///< bender tip stiffness
+  double finger_length_m = 2e-3;       ///< tips reach this far below the gripper reference
+
+  template <class V>
+  void visit(V& v) {
+    v("max_opening_m", max_opening_m);
+    v("min_opening_m", min_opening_m);
+    v("time_constant_s", time_constant_s);
+    v("max_speed_m_s", max_speed_m_s);
+    v("finger_stiffness_N_m", finger_stiffness_N_m);
+    v("finger_length_m", finger_length_m);
+  }
+  void validate() const;
+};
+
+struct PiezoGripperState {
+  double free_opening_m = 600e-6;  ///< opening the fingers would have without a part between them
+};
+
+/// Advances the free opening toward `command_m` (clamped to the range) over `dt_s`.
+/// Real-time safe.
+void step_gripper(const PiezoGripperParams& p, PiezoGripperState& s, double command_m, double dt_s) noexcept;
+
+/// Grip force on a part of width `width_m` between the fingers (0 if the fingers are open wider).
+double grip_force_N(const PiezoGripperParams& p, const PiezoGripperState& s, double width_m) noexcept;
+
+}  // namespace mc::microworld

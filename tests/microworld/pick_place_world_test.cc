@@ -1,0 +1,116 @@
+#include "microcobot/microworld/pick_place_world.h"
+
+#include <gtest/gtest.h>
+
+#include "microcobot/core/error.h"
+#include "support/counting_allocator.h"
+
+namespace mc::microworld {
+namespace {
+
+// Moves the gripper in a straight line from `from` to `to` in 1 um steps, opening command fixed.
+PickPlaceOutput move(const PickPlaceWorld& w, PickPlaceState& s, Eigen::Vector3d& at,
+                     const Eigen::Vector3d& to, double opening) {
+  PickPlaceOutput out;
+  const int n = std::max(1, static_cast<int>((to - at).norm() / 1e-6));
+  const Eigen::Vector3d from = at;
+  for (int i = 1; i <= n; ++i) {
+    at = from + (to - from) * (static_cast<double>(i) / n);
+    out = w.step(s, at, opening, 1e-3);
+  }
+  return out;
+}
+
+// Holds the gripper still for `t` seconds with an opening command.
+PickPlaceOutput hold(const PickPlaceWorld& w, PickPlaceState& s, const Eigen::Vector3d& at, double opening,
+                     double t) {
+  PickPlaceOutput out;
+  for (double k = 0; k < t; k += 1e-3) out = w.step(s, at, opening, 1e-3);
+  return out;
+}
+
+TEST(SurfaceForces, AdhesionDominatesWeightAtThisScale) {
+  const PickPlaceParams p;
+  EXPECT_NEAR(p.part_weight_N(), 2.25e-6, 0.01e-6);
+  EXPECT_GT(p.substrate_pulloff_N, 10 * p.part_weight_N());
+  EXPECT_GT(2 * p.finger_pulloff_N, p.part_weight_N());  // a part let go in the air stays on a finger
+}
+
+TEST(PickPlaceWorld, PickTransportPlaceAndReleaseDespiteAdhesion) {
+  const PickPlaceWorld w{PickPlaceParams{}};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(0, 0, 1e-3);
+  const double open = 500e-6, closed = 260e-6;
+  move(w, s, g, {0, 0, 50e-6}, open);
+  auto out = hold(w, s, g, closed, 0.05);
+  EXPECT_TRUE(out.part_between_fingers);
+  EXPECT_NEAR(out.grip_force_N, 0.5 * 50.0 * 40e-6, 1e-6);  // k (w - o) / 2 = 1 mN
+  EXPECT_DOUBLE_EQ(out.opening_m, 300e-6);                  // the part blocks the fingers
+  move(w, s, g, {0, 0, 250e-6}, closed);
+  EXPECT_EQ(s.phase, PartPhase::kGrasped);
+  EXPECT_NEAR(s.part_m.z(), 150e-6 + 200e-6, 1e-9);
+  move(w, s, g, {2e-3, 0, 250e-6}, closed);
+  move(w, s, g, {2e-3, 0, 40e-6}, closed);  // set down (10 um of press: fingers slide)
+  EXPECT_NEAR(s.part_m.z(), 150e-6, 1e-12);
+  hold(w, s, g, open, 0.05);
+  EXPECT_EQ(s.phase, PartPhase::kOnSubstrate);
+  move(w, s, g, {2e-3, 0, 1e-3}, open);
+  EXPECT_EQ(s.phase, PartPhase::kOnSubstrate);
+  EXPECT_LT(w.placement_error_m(s), 1e-9);
+  EXPECT_FALSE(s.crashed);
+}
+
+TEST(PickPlaceWorld, AWeakGripSlipsInsteadOfLifting) {
+  const PickPlaceWorld w{PickPlaceParams{}};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(0, 0, 50e-6);
+  // Squeeze of 3 um: F = 75 uN, capacity 2 * 0.3 * 75 = 45 uN > 36 uN needed... use 2 um: 30 uN < 36 uN.
+  hold(w, s, g, 298e-6, 0.05);
+  const auto out = move(w, s, g, {0, 0, 200e-6}, 298e-6);
+  EXPECT_EQ(s.phase, PartPhase::kOnSubstrate);
+  EXPECT_NEAR(s.part_m.z(), 150e-6, 1e-12);
+  EXPECT_LT(out.force_on_gripper_N.z(), 0.0);  // the slipping fingers feel the friction
+}
+
+TEST(PickPlaceWorld, OpenedInTheAirThePartSticksToAFingerUntilItTouchesDown) {
+  const PickPlaceWorld w{PickPlaceParams{}};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(0, 0, 50e-6);
+  hold(w, s, g, 260e-6, 0.05);
+  move(w, s, g, {0, 0, 400e-6}, 260e-6);
+  hold(w, s, g, 500e-6, 0.05);
+  EXPECT_EQ(s.phase, PartPhase::kStuckToFinger);
+  move(w, s, g, {1e-3, 0, 400e-6}, 500e-6);
+  EXPECT_NEAR(s.part_m.x(), 1e-3, 1e-12);  // carried by adhesion alone
+  move(w, s, g, {1e-3, 0, 0.0}, 500e-6);
+  EXPECT_EQ(s.phase, PartPhase::kOnSubstrate);
+  move(w, s, g, {1e-3, 0, 1e-3}, 500e-6);
+  EXPECT_NEAR(s.part_m.x(), 1e-3, 1e-12);
+}
+
+TEST(PickPlaceWorld, TipsIntoTheSubstrateAreACrashWithAStiffReaction) {
+  const PickPlaceWorld w{PickPlaceParams{}};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(1e-3, 1e-3, 10e-6);
+  const auto out = move(w, s, g, {1e-3, 1e-3, -1e-6}, 500e-6);
+  EXPECT_TRUE(s.crashed);
+  EXPECT_NEAR(out.force_on_gripper_N.z(), 1e5 * 1e-6, 1e-9);
+}
+
+TEST(PickPlaceWorld, SteppingNeverAllocatesAndParamsAreValidated) {
+  const PickPlaceWorld w{PickPlaceParams{}};
+  auto s = w.initial_state();
+  std::size_t n = 0;
+  {
+    test::AllocationGuard guard;
+    for (int i = 0; i < 1000; ++i) w.step(s, Eigen::Vector3d(0, 0, 50e-6), 260e-6, 1e-4);
+    n = guard.allocations();
+  }
+  EXPECT_EQ(n, 0u);
+  PickPlaceParams bad;
+  bad.part_side_m = 700e-6;  // does not fit in the open gripper
+  EXPECT_THROW(PickPlaceWorld{bad}, InvalidParams);
+}
+
+}  // namespace
+}  // namespace mc::microworld
