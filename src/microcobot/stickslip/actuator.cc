@@ -41,25 +41,36 @@ void ActuatorModel::set_operating_point(ActuatorState& s, double amplitude_V, do
 
 void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
   u_V = std::clamp(u_V, p_.drive.min_V, p_.drive.max_V);
+  // Sub-step only while the contact may leave the elastic phase: an abrupt drive edge, or a
+  // strain that the step's predicted relative motion carries outward beyond frac * z_ba.
   bool active = std::abs(u_V - s.u_V) > p_.integrator.substep_edge_V;
-  const double frac = p_.integrator.substep_strain_fraction;
-  active = active || std::abs(s.z_m[0]) > frac * s.z_ba_m ||
-           std::abs(s.z_m[1]) > frac * s.z_ba_m * p_.friction.breakaway_strain_ratio_b;
+  if (!active && p_.slider.attached) {
+    const double frac = p_.integrator.substep_strain_fraction;
+    const double v1 = s.v1a_m_s + s.v1b_m_s;
+    const double zba[2] = {s.z_ba_m, s.z_ba_m * p_.friction.breakaway_strain_ratio_b};
+    for (int i = 0; i < 2 && !active; ++i) {
+      const double dx = (v1 - s.v2_m_s[i]) * dt_;
+      const double z_pred = s.z_m[i] + dx;
+      active = std::abs(z_pred) > frac * zba[i] && (z_pred > 0.0) == (dx > 0.0);
+    }
+  }
+  // 1. Static hysteresis (eq. 2.5), once per step: equivalent voltage -> metres by the gain g.
+  const double uh = p_.pe.static_gain_m_V * pi_update(p_.hysteresis, s.pi, u_V);
+  s.u_V = u_V;
   if (!active || substeps_ == 1) {
-    substep(s, u_V, dt_, mode_a_, mode_b_);
+    substep(s, uh, dt_, mode_a_, mode_b_);
     return;
   }
-  const double u0 = s.u_V;
+  // Within the step g H(U) is interpolated linearly (the first-order hold of the PE's input).
+  const double uh0 = s.uh_m;
   const double h = dt_ / substeps_;
   for (int k = 1; k <= substeps_; ++k) {
-    substep(s, u0 + (u_V - u0) * static_cast<double>(k) / substeps_, h, sub_a_, sub_b_);
+    substep(s, uh0 + (uh - uh0) * static_cast<double>(k) / substeps_, h, sub_a_, sub_b_);
   }
 }
 
-void ActuatorModel::substep(ActuatorState& s, double u_V, double h, const ModeDiscretization& ma,
+void ActuatorModel::substep(ActuatorState& s, double uh, double h, const ModeDiscretization& ma,
                             const ModeDiscretization& mb) const noexcept {
-  // 1. Static hysteresis (eq. 2.5): equivalent voltage -> metres by the normalised gain.
-  const double uh = p_.pe.static_gain_m_V * pi_update(p_.hysteresis, s.pi, u_V);
   // 2. PE modes (eq. 2.1-2.2): force = K_pi * (share of g H(U)) - F_f.
   const double phi = p_.pe.gain_fraction_a;
   const double ka = p_.pe.stiffness_a_N_m * phi, kb = p_.pe.stiffness_b_N_m * (1.0 - phi);
@@ -69,7 +80,6 @@ void ActuatorModel::substep(ActuatorState& s, double u_V, double h, const ModeDi
   ma.step(s.x1a_m, s.v1a_m_s, ka * s.uh_m - ff, ka * uh - ff);
   mb.step(s.x1b_m, s.v1b_m_s, kb * s.uh_m - ff, kb * uh - ff);
   s.uh_m = uh;
-  s.u_V = u_V;
   s.t_s += h;
   const double x1_new = s.x1_m();
   const double v1_new = s.v1a_m_s + s.v1b_m_s;
@@ -80,6 +90,8 @@ void ActuatorModel::substep(ActuatorState& s, double u_V, double h, const ModeDi
   }
   // 3. Slider parts (eq. 2.8 per asperity, eq. 2.20-2.21) by velocity Verlet.
   const std::array<double, 2> z_ba = {s.z_ba_m, s.z_ba_m * p_.friction.breakaway_strain_ratio_b};
+  const double inv_ratio = 1.0 / p_.friction.zba_zss_ratio;
+  const double inv_h = 1.0 / h;
   const double ms = p_.slider.mass_kg;
   const double kc = p_.friction.coupling_stiffness_N_m;
   std::array<double, 2> x_new{};
@@ -89,9 +101,9 @@ void ActuatorModel::substep(ActuatorState& s, double u_V, double h, const ModeDi
   double total = 0.0;
   for (int i = 0; i < 2; ++i) {
     const double dx = (x1_new - x1_old) - (x_new[i] - s.x2_m[i]);
-    const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], z_ba[i] / p_.friction.zba_zss_ratio);
+    const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], z_ba[i] * inv_ratio);
     const double xdot_rel = 0.5 * (v1_old + v1_new) - s.v2_m_s[i];
-    const double f = rho0_[i] * z_new + rho1_[i] * (z_new - s.z_m[i]) / h + p_.friction.rho2_N_s_m * xdot_rel;
+    const double f = rho0_[i] * z_new + rho1_[i] * (z_new - s.z_m[i]) * inv_h + p_.friction.rho2_N_s_m * xdot_rel;
     s.z_m[i] = z_new;
     s.f_N[i] = f;
     total += c_[i] * f;

@@ -72,7 +72,7 @@ class ActuatorModel {
   StickSlipParams p_;
   double dt_;
   /// One integration sub-step of length h (PE exact, contact by Verlet + path-integrated strain).
-  void substep(ActuatorState& s, double u_V, double h, const ModeDiscretization& ma,
+  void substep(ActuatorState& s, double uh_m, double h, const ModeDiscretization& ma,
                const ModeDiscretization& mb) const noexcept;
 
   ModeDiscretization mode_a_, mode_b_, sub_a_, sub_b_;
