@@ -1,0 +1,46 @@
+#pragma once
+/// @file
+/// Step 2 of the identification (thesis §2.5.2.2, Fig. 2.12): the Prandtl-Ishlinskii model H(U)
+/// of eq. 2.5 from the slider's response to a sine voltage in scanning mode (thesis: 40 V, 50 Hz,
+/// n = 35 operators), following the procedure of §2.5.2.2 (i)-(v):
+///  - n play operators with half-widths r_i on a non-uniform (quadratic, finer at small widths)
+///    partition of half the input range, r_i = (range / 2) (i / n)^2;
+///  - the operator outputs y_i(t) are computed from the measured voltage; the position is
+///    x2 = x0 + sum_i w'_i y_i (the PE follows quasi-statically far below the 600 Hz mode);
+///  - the weights w'_i >= 0 by non-negative least squares (Lawson-Hanson, ident/nnls.h), the
+///    offset x0 free (the "shift to the positive section" of step (ii));
+///  - only samples after the input has visited its minimum and maximum are fitted: from then on
+///    every operator's state is fixed by the input alone (wiping-out), whatever the history before.
+/// The weights are split as w'_i = g w_i, with g (the PE's static gain, m/V) chosen so that the
+/// loading curve maps the top of the input range to itself (the convention of the defaults).
+
+#include <vector>
+
+#include "microcobot/stickslip/ident_record.h"
+#include "microcobot/stickslip/prandtl_ishlinskii.h"
+
+namespace mc::stickslip {
+
+struct HysteresisResult {
+  PiParams pi;                     ///< thresholds r_i [V] and normalised weights w_i
+  PiParams inverse;                ///< pi_inverse(pi): the exact inverse (for feed-forward)
+  double static_gain_m_V = 0.0;    ///< g
+  double offset_m = 0.0;           ///< x0
+  double rms_m = 0.0;              ///< RMS of the loop fit over the fitted samples
+  double stroke_m = 0.0;           ///< peak-to-peak of the measured loop
+  double rms_fraction = 0.0;       ///< rms_m / stroke_m
+  double inverse_max_error_V = 0.0;///< max |H^-1(H(U)) - U| over the record
+  std::size_t first_fitted = 0;    ///< first sample used (after the wiping-out)
+  std::vector<double> fitted_m;    ///< x0 + g H(U) at every sample
+};
+
+/// Identifies the PI model from `rec` (x_m = slider position) with `operators` play operators.
+/// Throws mc::UsageError for operators < 1, mc::InvalidInput for a record whose voltage spans
+/// less than 1 V or does not complete an excursion min -> max -> min (too short), and
+/// mc::ComputationFailed for a degenerate fit (zero gain).
+HysteresisResult identify_hysteresis(const MeasuredRecord& rec, int operators = 35);
+
+/// The partition used above: r_i = (range / 2) (i / n)^2, i = 0..n-1.
+std::vector<double> pi_thresholds(double range_V, int operators);
+
+}  // namespace mc::stickslip
