@@ -41,18 +41,31 @@ Series log_series(const std::string& name, const mc::dsp::Spectrum& s, double f_
 nlohmann::json step_experiment(Report& r, const std::string& name, const ss::StepSpectrumResult& res,
                                const std::string& what, const std::string& expected) {
   r.section(name, what + " Peaks of the transient's PSD: " +
-                      fmt::format("{:.1f}", fmt::join(res.peaks_Hz, " Hz, ")) + " Hz (thesis: " + expected + ").");
-  for (std::size_t i = 0; i < res.peaks_Hz.size(); ++i) r.add_result(fmt::format("peak {}", i + 1), res.peaks_Hz[i], "Hz");
+                      fmt::format("{:.1f}", fmt::join(res.peaks_Hz, " Hz, ")) + " Hz (thesis: " + expected +
+                      ").");
+  for (std::size_t i = 0; i < res.peaks_Hz.size(); ++i)
+    r.add_result(fmt::format("peak {}", i + 1), res.peaks_Hz[i], "Hz");
   const bool pe = name == "pe-step";
-  Series x{pe ? "x1 (PE)" : "x2 (slider)", res.response.t_s, pe ? res.response.x1_m : res.response.x2_m, false};
-  r.add_figure({name + " response", "Displacement after the step (t = 0).", {"Time", "s"}, {"Displacement", "m"}, {x}});
-  r.add_figure({name + " PSD", "PSD of the transient x(t) - x(final), one Hann window centred on the step.",
-                {"Frequency", "Hz", true}, {"PSD", "m^2/Hz", true}, {log_series("PSD", res.psd)}});
+  Series x{pe ? "x1 (PE)" : "x2 (slider)", res.response.t_s, pe ? res.response.x1_m : res.response.x2_m,
+           false};
+  r.add_figure({name + " response",
+                "Displacement after the step (t = 0).",
+                {"Time", "s"},
+                {"Displacement", "m"},
+                {x}});
+  r.add_figure({name + " PSD",
+                "PSD of the transient x(t) - x(final), one Hann window centred on the step.",
+                {"Frequency", "Hz", true},
+                {"PSD", "m^2/Hz", true},
+                {log_series("PSD", res.psd)}});
   return {{"peaks_Hz", res.peaks_Hz}};
 }
 
 Series periods_series(const ss::SawtoothCase& c) {
-  Series s{fmt::format("{:g} V {:g} Hz {}", c.amplitude_V, c.frequency_Hz, ss::to_string(c.direction)), {}, {}, false};
+  Series s{fmt::format("{:g} V {:g} Hz {}", c.amplitude_V, c.frequency_Hz, ss::to_string(c.direction)),
+           {},
+           {},
+           false};
   const double x0 = c.trajectory.x2_m.front();
   for (std::size_t i = 0; i < c.trajectory.t_s.size(); ++i) {
     s.x.push_back(c.trajectory.t_s[i] * c.frequency_Hz);
@@ -84,15 +97,22 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
   }
   if (name == "hysteresis") {
     const auto loops = ss::run_hysteresis(p);
-    r.section("hysteresis", "Sine 0..A V, last period, x2 against U (thesis §2.5.2.2, Fig. 2.12). The loops "
-                            "widen and tilt near the contact modes (595, 1633 Hz): the static PI hysteresis "
-                            "followed by the linear dynamics makes the loop rate dependent.");
-    Figure f{"Hysteresis loops", "x2 (relative to its minimum) against the drive voltage.", {"Drive voltage", "V"},
-             {"Slider displacement", "m"}, {}};
+    r.section("hysteresis",
+              "Sine 0..A V, last period, x2 against U (thesis §2.5.2.2, Fig. 2.12). The loops "
+              "widen and tilt near the contact modes (595, 1633 Hz): the static PI hysteresis "
+              "followed by the linear dynamics makes the loop rate dependent.");
+    Figure f{"Hysteresis loops",
+             "x2 (relative to its minimum) against the drive voltage.",
+             {"Drive voltage", "V"},
+             {"Slider displacement", "m"},
+             {}};
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& l : loops) {
-      f.series.push_back({fmt::format("{:g} Hz {:g} V", l.frequency_Hz, l.amplitude_V), l.u_V, l.x2_m, false});
-      arr.push_back({{"frequency_Hz", l.frequency_Hz}, {"amplitude_V", l.amplitude_V}, {"area_V_m", l.area_V_m},
+      f.series.push_back(
+          {fmt::format("{:g} Hz {:g} V", l.frequency_Hz, l.amplitude_V), l.u_V, l.x2_m, false});
+      arr.push_back({{"frequency_Hz", l.frequency_Hz},
+                     {"amplitude_V", l.amplitude_V},
+                     {"area_V_m", l.area_V_m},
                      {"range_m", l.range_m}});
       r.add_result(fmt::format("range {:g} Hz {:g} V", l.frequency_Hz, l.amplitude_V), l.range_m, "m");
     }
@@ -101,15 +121,19 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
   }
   if (name == "scanning" || name == "stepping") {
     const auto cases = name == "scanning" ? ss::run_scanning(p) : ss::run_stepping(p);
-    r.section(name, name == "scanning"
-                        ? "Sawtooth 20 V at 50, 100, 500 Hz, both directions (thesis Fig. 2.14): scanning "
-                          "mode, no accumulated stepping (|net| over 20 periods < 2% of g*A)."
-                        : "Sawtooth 40 and 60 V at 50, 100, 500 Hz, both directions (thesis Fig. 2.15-2.16): "
-                          "stepping in the commanded direction, faster at 60 V, forward and backward differ.");
+    r.section(name,
+              name == "scanning"
+                  ? "Sawtooth 20 V at 50, 100, 500 Hz, both directions (thesis Fig. 2.14): scanning "
+                    "mode, no accumulated stepping (|net| over 20 periods < 2% of g*A)."
+                  : "Sawtooth 40 and 60 V at 50, 100, 500 Hz, both directions (thesis Fig. 2.15-2.16): "
+                    "stepping in the commanded direction, faster at 60 V, forward and backward differ.");
     nlohmann::json arr = nlohmann::json::array();
     for (double a : name == "scanning" ? std::vector<double>{20.0} : std::vector<double>{40.0, 60.0}) {
-      Figure f{fmt::format("{} {:g} V", name, a), "Slider displacement against time in drive periods.",
-               {"Time / period", ""}, {"Slider displacement", "m"}, {}};
+      Figure f{fmt::format("{} {:g} V", name, a),
+               "Slider displacement against time in drive periods.",
+               {"Time / period", ""},
+               {"Slider displacement", "m"},
+               {}};
       for (const auto& c : cases) {
         if (c.amplitude_V == a) f.series.push_back(periods_series(c));
       }
@@ -119,18 +143,23 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
       arr.push_back(case_json(c));
       r.add_result(fmt::format("{} {:g} V {:g} Hz {}", name == "scanning" ? "net" : "velocity", c.amplitude_V,
                                c.frequency_Hz, ss::to_string(c.direction)),
-                   name == "scanning" ? c.net_displacement_m : c.velocity_m_s, name == "scanning" ? "m" : "m/s");
+                   name == "scanning" ? c.net_displacement_m : c.velocity_m_s,
+                   name == "scanning" ? "m" : "m/s");
     }
     return {{"cases", arr}};
   }
   if (name == "threshold") {
     const auto t = ss::run_threshold(p);
-    r.section("threshold", "Smallest 50 Hz sawtooth amplitude that steps (|net| over 20 periods >= 2% of g*A "
-                           "in the commanded direction), bisection to 0.25 V (thesis §2.5.2: ~40 V).");
+    r.section("threshold",
+              "Smallest 50 Hz sawtooth amplitude that steps (|net| over 20 periods >= 2% of g*A "
+              "in the commanded direction), bisection to 0.25 V (thesis §2.5.2: ~40 V).");
     r.add_result("forward threshold", t.forward_V, "V");
     r.add_result("backward threshold", t.backward_V, "V");
-    Figure f{"Velocity against amplitude (50 Hz)", "Mean slider velocity over 20 periods.", {"Amplitude", "V"},
-             {"Velocity", "m/s"}, {}};
+    Figure f{"Velocity against amplitude (50 Hz)",
+             "Mean slider velocity over 20 periods.",
+             {"Amplitude", "V"},
+             {"Velocity", "m/s"},
+             {}};
     for (auto d : {ss::Direction::kForward, ss::Direction::kBackward}) {
       Series s{ss::to_string(d), {}, {}, true};
       for (double a = 20; a <= 80; a += 5) {
@@ -144,20 +173,24 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
   }
   if (name == "psd") {
     const auto cases = ss::run_psd(p);
-    r.section("psd", "PSD of the slider position (25 kHz, Welch 4096, 0.5 s) for 20 V / 500 Hz (scanning) and "
-                     "40 V / 50 Hz (stepping), thesis Fig. 2.17.");
+    r.section("psd",
+              "PSD of the slider position (25 kHz, Welch 4096, 0.5 s) for 20 V / 500 Hz (scanning) and "
+              "40 V / 50 Hz (stepping), thesis Fig. 2.17.");
     Figure f{"Output PSD", "Welch PSD of x2.", {"Frequency", "Hz", true}, {"PSD", "m^2/Hz", true}, {}};
     nlohmann::json arr = nlohmann::json::array();
     for (const auto& c : cases) {
       f.series.push_back(log_series(fmt::format("{:g} V {:g} Hz", c.amplitude_V, c.frequency_Hz), c.psd));
-      arr.push_back({{"amplitude_V", c.amplitude_V}, {"frequency_Hz", c.frequency_Hz},
+      arr.push_back({{"amplitude_V", c.amplitude_V},
+                     {"frequency_Hz", c.frequency_Hz},
                      {"dominant_peak_Hz", c.dominant_peak_Hz}});
-      r.add_result(fmt::format("dominant peak {:g} V {:g} Hz", c.amplitude_V, c.frequency_Hz), c.dominant_peak_Hz, "Hz");
+      r.add_result(fmt::format("dominant peak {:g} V {:g} Hz", c.amplitude_V, c.frequency_Hz),
+                   c.dominant_peak_Hz, "Hz");
     }
     r.add_figure(std::move(f));
     return {{"cases", arr}};
   }
-  throw mc::UsageError("unknown experiment '" + name + "' (pe-step, actuator-step, hysteresis, scanning, stepping, "
+  throw mc::UsageError("unknown experiment '" + name +
+                       "' (pe-step, actuator-step, hysteresis, scanning, stepping, "
                        "threshold, psd)");
 }
 
@@ -177,7 +210,8 @@ void run_simulate(const SimulateOptions& o) {
   const ss::ActuatorModel m(p);
   const ss::Waveform w = ss::make_waveform(ss::parse_wave_kind(o.wave), o.amplitude_V, o.frequency_Hz,
                                            ss::parse_direction(o.direction), p.drive);
-  const ss::Trajectory tr = ss::simulate(m, w, o.duration_s);
+  ss::ActuatorState state = m.initial_state();
+  const ss::Trajectory tr = ss::simulate(m, w, o.duration_s, 1, &state);
   const double x0 = tr.x2_m.front(), xf = tr.x2_m.back();
   const double dur = tr.t_s.back() - tr.t_s.front();
   nlohmann::json j{{"wave", o.wave},
@@ -188,7 +222,8 @@ void run_simulate(const SimulateOptions& o) {
                    {"dt_s", m.dt_s()},
                    {"samples", tr.t_s.size()},
                    {"final_position_m", xf},
-                   {"mean_velocity_m_s", (xf - x0) / dur}};
+                   {"mean_velocity_m_s", (xf - x0) / dur},
+                   {"part_separation_m", state.x2_m[0] - state.x2_m[1]}};
   if (o.common.out) {
     mc::ensure_writable_dir(*o.common.out);
     mc::CsvTable t;
@@ -196,13 +231,14 @@ void run_simulate(const SimulateOptions& o) {
     t.add_column("u_V", tr.u_V);
     t.add_column("x1_m", tr.x1_m);
     t.add_column("x2_m", tr.x2_m);
-    mc::write_csv(*o.common.out / "trajectory.csv", t,
-                  {fmt::format("microcobot stickslip simulate --wave {} --amplitude {} --frequency {} --direction {} "
-                               "--duration {}",
-                               o.wave, o.amplitude_V, o.frequency_Hz, o.direction, o.duration_s)});
+    mc::write_csv(
+        *o.common.out / "trajectory.csv", t,
+        {fmt::format("microcobot stickslip simulate --wave {} --amplitude {} --frequency {} --direction {} "
+                     "--duration {}",
+                     o.wave, o.amplitude_V, o.frequency_Hz, o.direction, o.duration_s)});
     Report r("stickslip simulate");
-    r.section("Simulation", fmt::format("{} {:g} V {:g} Hz {} for {:g} s", o.wave, o.amplitude_V, o.frequency_Hz,
-                                        o.direction, dur));
+    r.section("Simulation", fmt::format("{} {:g} V {:g} Hz {} for {:g} s", o.wave, o.amplitude_V,
+                                        o.frequency_Hz, o.direction, dur));
     const std::size_t every = std::max<std::size_t>(1, tr.t_s.size() / 20000);
     Series u{"U", {}, {}, false}, x1{"x1 (PE)", {}, {}, false}, x2{"x2 (slider)", {}, {}, false};
     for (std::size_t i = 0; i < tr.t_s.size(); i += every) {
@@ -213,18 +249,21 @@ void run_simulate(const SimulateOptions& o) {
       x2.x.push_back(tr.t_s[i]);
       x2.y.push_back(tr.x2_m[i]);
     }
-    r.add_figure({"Positions", "PE and slider displacement.", {"Time", "s"}, {"Displacement", "m"}, {x1, x2}});
+    r.add_figure(
+        {"Positions", "PE and slider displacement.", {"Time", "s"}, {"Displacement", "m"}, {x1, x2}});
     r.add_figure({"Drive", "Drive voltage.", {"Time", "s"}, {"Voltage", "V"}, {u}});
     mc::cli::write_report_if_requested(o.common, r);
   }
-  mc::cli::emit(o.common, j,
-                fmt::format("final position {:.6g} m, mean velocity {:.6g} m/s over {:g} s", xf, (xf - x0) / dur, dur));
+  mc::cli::emit(
+      o.common, j,
+      fmt::format("final position {:.6g} m, mean velocity {:.6g} m/s over {:g} s", xf, (xf - x0) / dur, dur));
 }
 
 void add_stickslip(CLI::App& group) {
   {
     auto o = std::make_shared<CommonOptions>();
-    auto* cmd = group.add_subcommand("params", "Print every parameter of the actuator model (the --params keys)");
+    auto* cmd =
+        group.add_subcommand("params", "Print every parameter of the actuator model (the --params keys)");
     mc::cli::add_output_options(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->callback([o] { mc::cli::emit(*o, mc::params_to_json(load(*o)), mc::params_to_yaml(load(*o))); });
@@ -232,13 +271,16 @@ void add_stickslip(CLI::App& group) {
   {
     auto o = std::make_shared<SimulateOptions>();
     auto* cmd = group.add_subcommand("simulate", "Run a drive waveform on one axis; CSV t_s,u_V,x1_m,x2_m");
-    cmd->add_option("--wave", o->wave, "sawtooth | sine | step")->check(CLI::IsMember({"sawtooth", "sine", "step"}));
+    cmd->add_option("--wave", o->wave, "sawtooth | sine | step")
+        ->check(CLI::IsMember({"sawtooth", "sine", "step"}));
     cmd->add_option("--amplitude", o->amplitude_V, "Amplitude [V] (0..100 V with the offset)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--frequency", o->frequency_Hz, "Frequency [Hz]")->check(CLI::PositiveNumber);
-    cmd->add_option("--direction", o->direction, "forward | backward")->check(CLI::IsMember({"forward", "backward"}));
+    cmd->add_option("--direction", o->direction, "forward | backward")
+        ->check(CLI::IsMember({"forward", "backward"}));
     cmd->add_option("--duration", o->duration_s, "Simulated time [s]")->check(CLI::Range(1e-6, 1e4));
-    cmd->add_option("--dt", o->dt_s, "Integrator step [s] (default integrator.dt_s)")->check(CLI::Range(1e-9, 1e-4));
+    cmd->add_option("--dt", o->dt_s, "Integrator step [s] (default integrator.dt_s)")
+        ->check(CLI::Range(1e-9, 1e-4));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_simulate(*o); });
@@ -246,9 +288,12 @@ void add_stickslip(CLI::App& group) {
   {
     auto o = std::make_shared<CommonOptions>();
     auto name = std::make_shared<std::string>();
-    auto* cmd = group.add_subcommand("experiment", "Reproduce a chapter-2 experiment: pe-step, actuator-step, "
-                                                   "hysteresis, scanning, stepping, threshold, psd");
-    cmd->add_option("name", *name, "Experiment name")->required()->check(CLI::IsMember(ss::experiment_names()));
+    auto* cmd = group.add_subcommand("experiment",
+                                     "Reproduce a chapter-2 experiment: pe-step, actuator-step, "
+                                     "hysteresis, scanning, stepping, threshold, psd");
+    cmd->add_option("name", *name, "Experiment name")
+        ->required()
+        ->check(CLI::IsMember(ss::experiment_names()));
     mc::cli::add_output_options(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->callback([o, name] {

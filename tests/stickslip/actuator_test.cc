@@ -3,12 +3,16 @@
 #include "microcobot/stickslip/actuator.h"
 
 #include <cmath>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 #include "support/counting_allocator.h"
+#include "support/test_support.h"
 
 namespace mc::stickslip {
 namespace {
@@ -16,7 +20,7 @@ namespace {
 TEST(Actuator, DefaultParamsMatchTable28) {
   const StickSlipParams p;
   EXPECT_NO_THROW(p.validate());
-  EXPECT_NEAR(p.pe.natural_frequency_a_Hz(), 64.4e3, 0.1e3);   // DESIGN errata 1
+  EXPECT_NEAR(p.pe.natural_frequency_a_Hz(), 64.4e3, 0.1e3);  // DESIGN errata 1
   EXPECT_NEAR(p.pe.natural_frequency_b_Hz(), 119.7e3, 0.1e3);
   EXPECT_NEAR(std::sqrt(p.friction.rho0_a_N_m / p.slider.mass_kg) / (2 * M_PI), 600.6, 0.5);
   EXPECT_NEAR(std::sqrt(p.friction.rho0_b_N_m / p.slider.mass_kg) / (2 * M_PI), 1639.0, 1.0);
@@ -98,8 +102,9 @@ TEST(Actuator, ExternalLoadPushesTheSlider) {
 
 TEST(Actuator, DivergenceIsReportedNotReturned) {
   StickSlipParams p;
-  // A contact stiffness far beyond the explicit contact update's stability limit (omega h > 2).
-  p.friction.rho0_b_N_m = 1e10;
+  // A coupling spring far beyond the explicit update's stability limit (omega h >> 2). The contact
+  // itself cannot diverge: its force is bounded by rho0 z_ss (plastic saturation).
+  p.friction.coupling_stiffness_N_m = 1e12;
   p.integrator.substeps = 1;
   const ActuatorModel m{p};
   const auto w = make_waveform(WaveKind::kSawtooth, 60, 50, Direction::kForward, p.drive);
@@ -164,5 +169,64 @@ TEST(BreakawayTable, InterpolatesAndClamps) {
   EXPECT_GT(d.lookup(40, 50, Direction::kBackward), d.lookup(40, 50, Direction::kForward));
 }
 
+}  // namespace
+}  // namespace mc::stickslip
+
+namespace mc::stickslip {
+namespace {
+TEST(Cli, ParamsSimulateAndErrors) {
+  test::TempDir dir;
+  auto r = test::run_cli({"stickslip", "params", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j["slider"]["mass_kg"].get<double>(), 0.0247);
+  // The printed keys are the --params keys.
+  test::write_text(dir / "p.yaml", "slider:\n  load_force_N: 0.0\nfriction:\n  rho1_a_N_s_m: 60\n");
+  r = test::run_cli({"stickslip", "simulate", "--wave", "sawtooth", "--amplitude", "60", "--frequency", "500",
+                     "--direction", "backward", "--duration", "0.02", "--params", (dir / "p.yaml").string(),
+                     "--out", (dir / "sim").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto s = nlohmann::json::parse(r.out);
+  EXPECT_LT(s["final_position_m"].get<double>(), 0.0);
+  EXPECT_LT(s["mean_velocity_m_s"].get<double>(), 0.0);
+  const std::string csv = test::read_text(dir / "sim" / "trajectory.csv");
+  EXPECT_NE(csv.find("t_s,u_V,x1_m,x2_m"), std::string::npos);
+  EXPECT_EQ(csv.find("nan"), std::string::npos);
+  // 0-100 V enforced with a clear error (exit 3), bad flags exit 2, bad params name the field.
+  r = test::run_cli({"stickslip", "simulate", "--amplitude", "150", "--json"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("100"), std::string::npos);
+  r = test::run_cli({"stickslip", "simulate", "--direction", "sideways"});
+  EXPECT_EQ(r.exit_code, 2);
+  test::write_text(dir / "bad.yaml", "pe:\n  mass_kg: -1\n");
+  r = test::run_cli({"stickslip", "params", "--params", (dir / "bad.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("pe.mass_kg"), std::string::npos);
+  // Divergence: exit 4, no NaN on stdout.
+  test::write_text(dir / "stiff.yaml",
+                   "friction:\n  coupling_stiffness_N_m: 1.0e12\nintegrator:\n  substeps: 1\n");
+  r = test::run_cli(
+      {"stickslip", "simulate", "--duration", "0.05", "--params", (dir / "stiff.yaml").string(), "--json"});
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_EQ(r.out.find("nan"), std::string::npos);
+}
+
+TEST(Cli, ExperimentJson) {
+  test::TempDir dir;
+  auto r =
+      test::run_cli({"stickslip", "experiment", "actuator-step", "--json", "--out", (dir / "a").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["peaks_Hz"].size(), 2u);
+  EXPECT_NEAR(j["peaks_Hz"][0].get<double>(), 595.0, 15.0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "a" / "index.html"));
+  r = test::run_cli({"stickslip", "experiment", "threshold", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto t = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(t["forward_V"].get<double>(), 40.0, 5.0);
+  EXPECT_NEAR(t["backward_V"].get<double>(), 40.0, 5.0);
+  r = test::run_cli({"stickslip", "experiment", "nonsense"});
+  EXPECT_EQ(r.exit_code, 2);
+}
 }  // namespace
 }  // namespace mc::stickslip

@@ -35,7 +35,8 @@ TEST(PrandtlIshlinskii, RateIndependent) {
   for (std::size_t seg = 1; seg < turns.size(); ++seg) {
     for (int j = 1; j <= n_fast; ++j) {
       for (int k = 1; k <= n_slow / n_fast; ++k) {
-        const double frac = (static_cast<double>(j - 1) + static_cast<double>(k) / (n_slow / n_fast)) / n_fast;
+        const double frac =
+            (static_cast<double>(j - 1) + static_cast<double>(k) / (n_slow / n_fast)) / n_fast;
         pi_update(p, slow, turns[seg - 1] + (turns[seg] - turns[seg - 1]) * frac);
       }
       const double u = turns[seg - 1] + (turns[seg] - turns[seg - 1]) * j / n_fast;
@@ -54,7 +55,7 @@ TEST(PrandtlIshlinskii, InverseIsExact) {
   double y = 0.0;
   for (int k = 0; k < 5000; ++k) {
     y = std::clamp(y + 8.0 * (rng.uniform() - 0.5), 0.0, 95.0);
-    const double u = pi_update(q, sq, y);  // H^-1(y)
+    const double u = pi_update(q, sq, y);     // H^-1(y)
     const double back = pi_update(p, sp, u);  // H(H^-1(y))
     ASSERT_NEAR(back, y, 1e-9) << "step " << k;
   }

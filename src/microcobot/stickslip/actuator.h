@@ -28,18 +28,18 @@ namespace mc::stickslip {
 /// The state of one axis. Plain copyable data.
 struct ActuatorState {
   double t_s = 0.0;
-  double u_V = 0.0;        ///< last drive voltage
-  double uh_m = 0.0;       ///< g H(U): hysteretic static PE displacement [m]
+  double u_V = 0.0;   ///< last drive voltage
+  double uh_m = 0.0;  ///< g H(U): hysteretic static PE displacement [m]
   PiState pi;
   double x1a_m = 0.0, v1a_m_s = 0.0, x1b_m = 0.0, v1b_m_s = 0.0;  ///< PE modes (eq. 2.1-2.3)
-  std::array<double, 2> x2_m{};    ///< slider part positions (asperity a, b)
-  std::array<double, 2> v2_m_s{};  ///< slider part velocities
-  std::array<double, 2> a2_m_s2{}; ///< slider part accelerations (Verlet)
-  std::array<double, 2> z_m{};     ///< elastic strain of asperity a, b (eq. 2.9)
-  std::array<double, 2> f_N{};     ///< friction force of asperity a, b per unit share (eq. 2.20-2.21)
-  double friction_N = 0.0;         ///< F_f on the slider (reaction -F_f on the PE)
-  double z_ba_m = 1e-6;            ///< current break-away strain (operating point)
-  bool diverged = false;           ///< set when a state became NaN/Inf
+  std::array<double, 2> x2_m{};                                   ///< slider part positions (asperity a, b)
+  std::array<double, 2> v2_m_s{};                                 ///< slider part velocities
+  std::array<double, 2> a2_m_s2{};                                ///< slider part accelerations (Verlet)
+  std::array<double, 2> z_m{};  ///< elastic strain of asperity a, b (eq. 2.9)
+  std::array<double, 2> f_N{};  ///< friction force of asperity a, b per unit share (eq. 2.20-2.21)
+  double friction_N = 0.0;      ///< F_f on the slider (reaction -F_f on the PE)
+  double z_ba_m = 1e-6;         ///< current break-away strain (operating point)
+  bool diverged = false;        ///< set when a state became NaN/Inf
 
   double x1_m() const { return x1a_m + x1b_m; }  ///< PE displacement (eq. 2.3)
 };
@@ -73,11 +73,13 @@ class ActuatorModel {
   double dt_;
   /// One integration sub-step of length h (PE exact, contact by Verlet + path-integrated strain).
   void substep(ActuatorState& s, double uh_m, double h, const ModeDiscretization& ma,
-               const ModeDiscretization& mb) const noexcept;
+               const ModeDiscretization& mb, const std::array<double, 2>& rho0) const noexcept;
 
   ModeDiscretization mode_a_, mode_b_, sub_a_, sub_b_;
   int substeps_ = 1;
   std::array<double, 2> c_{}, rho0_{}, rho1_{};
+  /// rho0 pre-warped for Verlet at the step and at the sub-step (docs/model.md).
+  std::array<double, 2> rho0_step_{}, rho0_sub_{};
   double lo_ = 0.0, hi_ = 0.0;
 };
 

@@ -22,7 +22,8 @@ void check_axis(const std::vector<double>& axis, const std::string& name) {
 }
 void check_grid(const std::vector<std::vector<double>>& g, std::size_t rows, std::size_t cols,
                 const std::string& name) {
-  require(g.size() == rows, "breakaway." + name, "must have one row per amplitude", static_cast<double>(g.size()));
+  require(g.size() == rows, "breakaway." + name, "must have one row per amplitude",
+          static_cast<double>(g.size()));
   for (std::size_t i = 0; i < rows; ++i) {
     require(g[i].size() == cols, "breakaway." + name + "[" + std::to_string(i) + "]",
             "must have one entry per frequency", static_cast<double>(g[i].size()));
@@ -77,7 +78,7 @@ BreakawayTable default_breakaway_table() {
   BreakawayTable t;
   t.amplitudes_V = {0, 10, 20, 30, 40, 50, 60, 70, 80, 90, 100};
   t.frequencies_Hz = {50, 100, 500, 1000, 2000};
-  const double z0_fwd = 390e-9, slope_fwd = 2e-9, z0_bwd = 405e-9, slope_bwd = 2e-9;
+  const double z0_fwd = 365e-9, slope_fwd = 2e-9, z0_bwd = 372e-9, slope_bwd = 2e-9;
   const double freq_slope = 0.03;
   for (double a : t.amplitudes_V) {
     std::vector<double> f_row, b_row;

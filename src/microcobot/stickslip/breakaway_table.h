@@ -13,8 +13,8 @@ namespace mc::stickslip {
 enum class Direction { kForward, kBackward };
 
 struct BreakawayTable {
-  std::vector<double> amplitudes_V;   ///< grid rows, strictly increasing
-  std::vector<double> frequencies_Hz; ///< grid columns, strictly increasing
+  std::vector<double> amplitudes_V;             ///< grid rows, strictly increasing
+  std::vector<double> frequencies_Hz;           ///< grid columns, strictly increasing
   std::vector<std::vector<double>> forward_m;   ///< z_ba(+) [row = amplitude][col = frequency]
   std::vector<std::vector<double>> backward_m;  ///< z_ba(-)
 

@@ -9,8 +9,8 @@ namespace mc::stickslip {
 
 void DriveParams::validate() const {
   require_positive(slew_rate_V_s, "drive.slew_rate_V_s");
-  require(std::isfinite(min_V) && std::isfinite(max_V) && min_V < max_V, "drive.max_V", "must be > drive.min_V",
-          max_V);
+  require(std::isfinite(min_V) && std::isfinite(max_V) && min_V < max_V, "drive.max_V",
+          "must be > drive.min_V", max_V);
 }
 
 void Waveform::validate(const DriveParams& limits) const {
@@ -25,7 +25,8 @@ void Waveform::validate(const DriveParams& limits) const {
     require_positive(frequency_Hz, "frequency_Hz");
     if (kind == WaveKind::kSawtooth) {
       require(edge_time_s() < 0.5 / frequency_Hz, "frequency_Hz",
-              "the slew-limited edge (amplitude / slew rate) must last less than half a period", frequency_Hz);
+              "the slew-limited edge (amplitude / slew rate) must last less than half a period",
+              frequency_Hz);
     }
   }
 }

@@ -50,7 +50,7 @@ struct Waveform {
 Waveform make_waveform(WaveKind kind, double amplitude_V, double frequency_Hz, Direction direction,
                        const DriveParams& limits, double offset_V = 0.0);
 
-WaveKind parse_wave_kind(const std::string& name);  ///< "sawtooth" | "sine" | "step", else UsageError
+WaveKind parse_wave_kind(const std::string& name);   ///< "sawtooth" | "sine" | "step", else UsageError
 Direction parse_direction(const std::string& name);  ///< "forward" | "backward", else UsageError
 std::string to_string(Direction d);
 std::string to_string(WaveKind k);

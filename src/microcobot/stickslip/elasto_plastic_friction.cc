@@ -47,7 +47,7 @@ inline double outward_rate(double s, double z_ba, double z_ss) noexcept {
 double advance_strain(double z, double dx, double z_ba, double z_ss) noexcept {
   if (dx == 0.0) return z;
   const double d = dx > 0.0 ? 1.0 : -1.0;
-  double s = d * z;           // strain measured along the motion
+  double s = d * z;  // strain measured along the motion
   double remaining = std::abs(dx);
   // Elastic part: relaxing (s < 0, alpha = 0) and loading up to z_ba: dz = dx exactly.
   if (s < z_ba) {

@@ -55,7 +55,8 @@ StepSpectrumResult step_spectrum(const StickSlipParams& p, double amplitude_V, d
   auto peaks = dsp::find_peaks_xy(r.psd.f_Hz, db, po);
   peaks.erase(std::remove_if(peaks.begin(), peaks.end(), [&](const dsp::Peak& pk) { return pk.x < f_min; }),
               peaks.end());
-  std::sort(peaks.begin(), peaks.end(), [](const dsp::Peak& a, const dsp::Peak& b) { return a.height > b.height; });
+  std::sort(peaks.begin(), peaks.end(),
+            [](const dsp::Peak& a, const dsp::Peak& b) { return a.height > b.height; });
   if (peaks.size() > 2) peaks.resize(2);
   for (const auto& pk : peaks) r.peaks_Hz.push_back(pk.x);
   std::sort(r.peaks_Hz.begin(), r.peaks_Hz.end());
@@ -82,7 +83,8 @@ StepSpectrumResult run_actuator_step(const StickSlipParams& params) {
 
 std::vector<HysteresisLoop> run_hysteresis(const StickSlipParams& params) {
   const ActuatorModel m(params);
-  const double conditions[][2] = {{50, 40}, {50, 25}, {250, 40}, {250, 25}, {595, 25}, {595, 14}, {1633, 14}, {1633, 12}};
+  const double conditions[][2] = {{50, 40},  {50, 25},  {250, 40},  {250, 25},
+                                  {595, 25}, {595, 14}, {1633, 14}, {1633, 12}};
   std::vector<HysteresisLoop> loops;
   for (const auto& c : conditions) {
     const Waveform w = make_waveform(WaveKind::kSine, c[1], c[0], Direction::kForward, params.drive);
@@ -123,7 +125,8 @@ SawtoothCase run_sawtooth(const StickSlipParams& params, double amplitude_V, dou
   c.amplitude_V = amplitude_V;
   c.frequency_Hz = frequency_Hz;
   c.direction = direction;
-  c.net_displacement_m = mean_over(tr.x2_m, per * static_cast<std::size_t>(periods + 1), per) - mean_over(tr.x2_m, per, per);
+  c.net_displacement_m =
+      mean_over(tr.x2_m, per * static_cast<std::size_t>(periods + 1), per) - mean_over(tr.x2_m, per, per);
   c.velocity_m_s = c.net_displacement_m / (periods * period);
   c.stroke_m = params.pe.static_gain_m_V * amplitude_V;
   const double sign = direction == Direction::kForward ? 1.0 : -1.0;
@@ -141,7 +144,8 @@ SawtoothCase run_sawtooth(const StickSlipParams& params, double amplitude_V, dou
 std::vector<SawtoothCase> run_scanning(const StickSlipParams& params) {
   std::vector<SawtoothCase> out;
   for (double f : {50.0, 100.0, 500.0}) {
-    for (Direction d : {Direction::kForward, Direction::kBackward}) out.push_back(run_sawtooth(params, 20.0, f, d));
+    for (Direction d : {Direction::kForward, Direction::kBackward})
+      out.push_back(run_sawtooth(params, 20.0, f, d));
   }
   return out;
 }
@@ -150,7 +154,8 @@ std::vector<SawtoothCase> run_stepping(const StickSlipParams& params) {
   std::vector<SawtoothCase> out;
   for (double a : {40.0, 60.0}) {
     for (double f : {50.0, 100.0, 500.0}) {
-      for (Direction d : {Direction::kForward, Direction::kBackward}) out.push_back(run_sawtooth(params, a, f, d));
+      for (Direction d : {Direction::kForward, Direction::kBackward})
+        out.push_back(run_sawtooth(params, a, f, d));
     }
   }
   return out;
@@ -181,7 +186,8 @@ std::vector<PsdCase> run_psd(const StickSlipParams& params) {
   const ActuatorModel m(params);
   std::vector<PsdCase> out;
   for (const auto& c : {std::pair{20.0, 500.0}, std::pair{40.0, 50.0}}) {
-    const Waveform w = make_waveform(WaveKind::kSawtooth, c.first, c.second, Direction::kForward, params.drive);
+    const Waveform w =
+        make_waveform(WaveKind::kSawtooth, c.first, c.second, Direction::kForward, params.drive);
     const int every = static_cast<int>(std::llround(1.0 / (25e3 * m.dt_s())));
     const Trajectory tr = simulate(m, w, 0.5, std::max(every, 1));
     PsdCase pc;

@@ -13,9 +13,9 @@ namespace mc::stickslip {
 
 /// A step response, the PSD of its transient and the PSD's peaks.
 struct StepSpectrumResult {
-  Trajectory response;          ///< sampled at the experiment's rate
-  dsp::Spectrum psd;            ///< PSD of x(t) - x(final) (m^2/Hz)
-  std::vector<double> peaks_Hz; ///< the two dominant resonances, ascending
+  Trajectory response;           ///< sampled at the experiment's rate
+  dsp::Spectrum psd;             ///< PSD of x(t) - x(final) (m^2/Hz)
+  std::vector<double> peaks_Hz;  ///< the two dominant resonances, ascending
 };
 
 /// §2.5.2.1, Fig. 2.10: slider removed, 90 V step, 1 MHz sampling; peaks near 64 and 118 kHz.
@@ -65,7 +65,7 @@ ThresholdResult run_threshold(const StickSlipParams& params, double frequency_Hz
 /// Fig. 2.17: output PSDs for 20 V / 500 Hz and 40 V / 50 Hz.
 struct PsdCase {
   double amplitude_V = 0, frequency_Hz = 0;
-  dsp::Spectrum psd;          ///< PSD of x2 sampled at 25 kHz (m^2/Hz)
+  dsp::Spectrum psd;  ///< PSD of x2 sampled at 25 kHz (m^2/Hz)
   double dominant_peak_Hz = 0;
 };
 std::vector<PsdCase> run_psd(const StickSlipParams& params);

@@ -17,13 +17,13 @@
 namespace mc::stickslip {
 
 struct PiezoParams {
-  double mass_kg = 0.00075;          ///< M_p, Table 2.8
-  double damping_a_N_s_m = 25.86;    ///< D_pa, Table 2.8 (N s/m, DESIGN errata 1)
-  double stiffness_a_N_m = 1.23e8;   ///< K_pa, Table 2.8 (N/m, DESIGN errata 1): 64.4 kHz
-  double damping_b_N_s_m = 82.17;    ///< D_pb, Table 2.8
-  double stiffness_b_N_m = 4.24e8;   ///< K_pb, Table 2.8: 119.7 kHz
-  double static_gain_m_V = 15e-9;    ///< g: PE stroke per equivalent volt (errata 7: ~1.5 um at 100 V)
-  double gain_fraction_a = 0.7;      ///< phi = (K_act1/K_pa) / (K_act1/K_pa + K_act2/K_pb), errata 7
+  double mass_kg = 0.00075;         ///< M_p, Table 2.8
+  double damping_a_N_s_m = 25.86;   ///< D_pa, Table 2.8 (N s/m, DESIGN errata 1)
+  double stiffness_a_N_m = 1.23e8;  ///< K_pa, Table 2.8 (N/m, DESIGN errata 1): 64.4 kHz
+  double damping_b_N_s_m = 82.17;   ///< D_pb, Table 2.8
+  double stiffness_b_N_m = 4.24e8;  ///< K_pb, Table 2.8: 119.7 kHz
+  double static_gain_m_V = 15e-9;   ///< g: PE stroke per equivalent volt (errata 7: ~1.5 um at 100 V)
+  double gain_fraction_a = 0.7;     ///< phi = (K_act1/K_pa) / (K_act1/K_pa + K_act2/K_pb), errata 7
 
   template <class V>
   void visit(V& v) {

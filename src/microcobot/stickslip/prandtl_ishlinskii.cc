@@ -10,20 +10,21 @@ namespace mc::stickslip {
 
 void PiParams::validate() const {
   require(!thresholds_V.empty(), "hysteresis.thresholds_V", "must hold at least one operator");
-  require(thresholds_V.size() == weights.size(), "hysteresis.weights", "must have as many entries as thresholds_V",
-          static_cast<double>(weights.size()));
+  require(thresholds_V.size() == weights.size(), "hysteresis.weights",
+          "must have as many entries as thresholds_V", static_cast<double>(weights.size()));
   double partial = 0.0;
   for (std::size_t i = 0; i < thresholds_V.size(); ++i) {
     const std::string idx = "[" + std::to_string(i) + "]";
-    require(std::isfinite(thresholds_V[i]) && thresholds_V[i] >= 0.0, "hysteresis.thresholds_V" + idx, "must be >= 0",
-            thresholds_V[i]);
+    require(std::isfinite(thresholds_V[i]) && thresholds_V[i] >= 0.0, "hysteresis.thresholds_V" + idx,
+            "must be >= 0", thresholds_V[i]);
     if (i > 0) {
-      require(thresholds_V[i] > thresholds_V[i - 1], "hysteresis.thresholds_V" + idx, "must be strictly increasing",
-              thresholds_V[i]);
+      require(thresholds_V[i] > thresholds_V[i - 1], "hysteresis.thresholds_V" + idx,
+              "must be strictly increasing", thresholds_V[i]);
     }
     require(std::isfinite(weights[i]), "hysteresis.weights" + idx, "must be finite", weights[i]);
     partial += weights[i];
-    require(partial > 0.0, "hysteresis.weights" + idx, "partial sums must stay > 0 (invertible PI model)", partial);
+    require(partial > 0.0, "hysteresis.weights" + idx, "partial sums must stay > 0 (invertible PI model)",
+            partial);
   }
   require(weights[0] > 0.0, "hysteresis.weights[0]", "must be > 0", weights[0]);
 }
@@ -46,7 +47,7 @@ PiParams default_pi_params(int n) {
     sum_rest += rest.back();
   }
   p.weights.push_back(w0);
-  for (double r : rest) p.weights.push_back((1.0 - w0) * r / sum_rest * 1.6);
+  for (double r : rest) p.weights.push_back((1.0 - w0) * r / sum_rest * 4.0);
   // Normalise so that the loading curve maps 100 V to 100 V equivalent.
   const double top = pi_loading_curve(p, span);
   for (double& w : p.weights) w *= span / top;

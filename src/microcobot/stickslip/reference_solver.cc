@@ -49,11 +49,14 @@ struct Rhs {
     }
     const double m = p.pe.mass_kg;
     dy[0] = v1a;
-    dy[1] = kVelScale * (p.pe.stiffness_a_N_m * phi * uh - ff - p.pe.damping_a_N_s_m * v1a -
-                         p.pe.stiffness_a_N_m * y[0]) / m;
+    dy[1] =
+        kVelScale *
+        (p.pe.stiffness_a_N_m * phi * uh - ff - p.pe.damping_a_N_s_m * v1a - p.pe.stiffness_a_N_m * y[0]) / m;
     dy[2] = v1b;
-    dy[3] = kVelScale * (p.pe.stiffness_b_N_m * (1.0 - phi) * uh - ff - p.pe.damping_b_N_s_m * v1b -
-                         p.pe.stiffness_b_N_m * y[2]) / m;
+    dy[3] = kVelScale *
+            (p.pe.stiffness_b_N_m * (1.0 - phi) * uh - ff - p.pe.damping_b_N_s_m * v1b -
+             p.pe.stiffness_b_N_m * y[2]) /
+            m;
     for (int i = 0; i < 2; ++i) {
       const int j = 1 - i;
       if (!p.slider.attached) {
@@ -87,7 +90,8 @@ Trajectory simulate_reference(const StickSlipParams& params, const Waveform& wav
   Rhs rhs{params, wave, pi, z_ba, z_ba * params.friction.breakaway_strain_ratio_b};
   OdeState y{};
   y[4] = y[6] = params.slider.initial_position_m;
-  auto stepper = ode::make_controlled(options.abs_tol_m, options.rel_tol, ode::runge_kutta_dopri5<OdeState>());
+  auto stepper =
+      ode::make_controlled(options.abs_tol_m, options.rel_tol, ode::runge_kutta_dopri5<OdeState>());
   const auto n = static_cast<long>(std::llround(duration_s / options.sample_dt_s));
   Trajectory tr;
   const double ca = params.friction.mass_fraction_a;
@@ -95,7 +99,8 @@ Trajectory simulate_reference(const StickSlipParams& params, const Waveform& wav
     tr.t_s.push_back(t);
     tr.u_V.push_back(std::clamp(wave.value(t), params.drive.min_V, params.drive.max_V));
     tr.x1_m.push_back(y[0] + y[2]);
-    tr.x2_m.push_back(params.slider.attached ? ca * y[4] + (1.0 - ca) * y[6] : params.slider.initial_position_m);
+    tr.x2_m.push_back(params.slider.attached ? ca * y[4] + (1.0 - ca) * y[6]
+                                             : params.slider.initial_position_m);
   };
   record(0.0);
   double h = std::min(1e-7, options.sample_dt_s);
@@ -104,7 +109,8 @@ Trajectory simulate_reference(const StickSlipParams& params, const Waveform& wav
     const double t1 = static_cast<double>(k) * options.sample_dt_s;
     ode::integrate_adaptive(stepper, rhs, y, t0, t1, h);
     for (double v : y) {
-      if (!std::isfinite(v)) throw ComputationFailed("reference solver diverged (NaN/Inf) at t = " + std::to_string(t1));
+      if (!std::isfinite(v))
+        throw ComputationFailed("reference solver diverged (NaN/Inf) at t = " + std::to_string(t1));
     }
     pi_update(params.hysteresis, pi, std::clamp(wave.value(t1), params.drive.min_V, params.drive.max_V));
     record(t1);

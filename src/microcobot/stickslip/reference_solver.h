@@ -14,8 +14,8 @@ namespace mc::stickslip {
 
 struct ReferenceOptions {
   double rel_tol = 1e-9;
-  double abs_tol_m = 1e-15;  ///< absolute tolerance on positions/strains (velocities: / 1 us)
-  double sample_dt_s = 1e-5; ///< output grid (the fixed-step model's dt, for a direct comparison)
+  double abs_tol_m = 1e-15;   ///< absolute tolerance on positions/strains (velocities: / 1 us)
+  double sample_dt_s = 1e-5;  ///< output grid (the fixed-step model's dt, for a direct comparison)
 };
 
 /// Runs `wave` for `duration_s` from rest; returns samples every sample_dt_s (t, U, x1, x2).

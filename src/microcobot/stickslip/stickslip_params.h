@@ -36,8 +36,8 @@ struct IntegratorParams {
   /// Sub-steps per step while the contact is active (abrupt drive edge, strain beyond
   /// `substep_strain_fraction` z_ba): resolves the slip phases and the PE's 64/120 kHz ringing.
   int substeps = 8;
-  double substep_edge_V = 4.0;            ///< drive change per step that counts as an abrupt edge
-  double substep_strain_fraction = 0.9;   ///< |z| / z_ba beyond which the contact is sub-stepped
+  double substep_edge_V = 4.0;           ///< drive change per step that counts as an abrupt edge
+  double substep_strain_fraction = 0.9;  ///< |z| / z_ba beyond which the contact is sub-stepped
 
   template <class V>
   void visit(V& v) {

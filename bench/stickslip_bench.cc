@@ -1,0 +1,97 @@
+// One stick-slip axis at the default step: real-time factor (simulated seconds per wall second,
+// counter "rtf") and the cost of the odeint reference at equal accuracy (docs/benchmarks.md).
+//   build/<dir>/bench/stickslip_bench --benchmark_counters_tabular=true
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <benchmark/benchmark.h>
+
+#include "microcobot/stickslip/actuator.h"
+#include "microcobot/stickslip/reference_solver.h"
+
+namespace {
+
+namespace ss = mc::stickslip;
+
+struct Scenario {
+  double amplitude_V, frequency_Hz;
+  ss::Direction direction;
+  double duration_s;
+};
+const Scenario kScenarios[] = {
+    {20, 50, ss::Direction::kForward, 0.1},    // scanning
+    {40, 50, ss::Direction::kBackward, 0.1},   // stepping near the threshold
+    {60, 500, ss::Direction::kForward, 0.02},  // fast stepping: the most sub-stepping
+};
+
+/// The loosest odeint tolerance whose error against a tight reference (rtol 1e-11) is no larger
+/// than the fixed-step integrator's error: "equal accuracy".
+double equal_accuracy_tolerance(int i) {
+  static std::map<int, double> cache;
+  if (cache.count(i)) return cache[i];
+  const auto& s = kScenarios[i];
+  const ss::StickSlipParams p;
+  const ss::ActuatorModel m(p);
+  const auto w =
+      ss::make_waveform(ss::WaveKind::kSawtooth, s.amplitude_V, s.frequency_Hz, s.direction, p.drive);
+  ss::ReferenceOptions tight;
+  tight.rel_tol = 1e-11;
+  tight.abs_tol_m = 1e-17;
+  tight.sample_dt_s = m.dt_s();
+  const auto truth = ss::simulate_reference(p, w, s.duration_s, tight);
+  const double fixed_error = ss::relative_rms_error(ss::simulate(m, w, s.duration_s), truth);
+  double chosen = 1e-10;
+  for (double tol : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10}) {
+    ss::ReferenceOptions o;
+    o.rel_tol = tol;
+    o.abs_tol_m = tol * 1e-6;
+    o.sample_dt_s = m.dt_s();
+    if (ss::relative_rms_error(ss::simulate_reference(p, w, s.duration_s, o), truth) <= fixed_error) {
+      chosen = tol;
+      break;
+    }
+  }
+  std::fprintf(stderr,
+               "scenario %d: fixed-step error %.3g%% of range; reference rtol %.0e at equal accuracy\n", i,
+               100 * fixed_error, chosen);
+  cache[i] = chosen;
+  return chosen;
+}
+
+void BM_FixedStep(benchmark::State& state) {
+  const auto& s = kScenarios[state.range(0)];
+  const ss::StickSlipParams p;
+  const ss::ActuatorModel m(p);
+  const auto w =
+      ss::make_waveform(ss::WaveKind::kSawtooth, s.amplitude_V, s.frequency_Hz, s.direction, p.drive);
+  const auto steps = static_cast<long>(std::llround(s.duration_s / m.dt_s()));
+  for (auto _ : state) {
+    ss::ActuatorState st = m.initial_state();
+    m.set_operating_point(st, s.amplitude_V, s.frequency_Hz, s.direction);
+    for (long k = 1; k <= steps; ++k) m.step(st, w.value(static_cast<double>(k) * m.dt_s()));
+    benchmark::DoNotOptimize(st.x2_m);
+  }
+  state.counters["rtf"] =
+      benchmark::Counter(s.duration_s * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FixedStep)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+void BM_ReferenceEqualAccuracy(benchmark::State& state) {
+  const int i = static_cast<int>(state.range(0));
+  const auto& s = kScenarios[i];
+  const ss::StickSlipParams p;
+  const auto w =
+      ss::make_waveform(ss::WaveKind::kSawtooth, s.amplitude_V, s.frequency_Hz, s.direction, p.drive);
+  ss::ReferenceOptions o;
+  o.rel_tol = equal_accuracy_tolerance(i);
+  o.abs_tol_m = o.rel_tol * 1e-6;
+  o.sample_dt_s = p.integrator.dt_s;
+  for (auto _ : state) benchmark::DoNotOptimize(ss::simulate_reference(p, w, s.duration_s, o));
+  state.counters["rtf"] =
+      benchmark::Counter(s.duration_s * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["rtol"] = o.rel_tol;
+}
+BENCHMARK(BM_ReferenceEqualAccuracy)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+}  // namespace
