@@ -31,16 +31,16 @@ struct IdentifyAllResult {
   FrictionModesResult friction;
   HysteresisResult hysteresis;
   BreakawayResult breakaway;
-  StickSlipParams params;           ///< the identified axis
-  std::vector<std::string> notes;   ///< what was kept from `base`, skipped runs, filled cells
+  StickSlipParams params;          ///< the identified axis
+  std::vector<std::string> notes;  ///< what was kept from `base`, skipped runs, filled cells
 };
 
 /// Runs the three steps on the files of `dir`. `progress(task, done, total)` reports the steps and
 /// the sawtooth runs. Throws mc::InvalidInput for a missing or malformed file and
 /// mc::ComputationFailed when a step fails.
-IdentifyAllResult identify_all(const std::filesystem::path& dir, const StickSlipParams& base,
-                               const IdentifyAllOptions& options = {},
-                               const std::function<void(const std::string&, std::size_t, std::size_t)>& progress = {});
+IdentifyAllResult identify_all(
+    const std::filesystem::path& dir, const StickSlipParams& base, const IdentifyAllOptions& options = {},
+    const std::function<void(const std::string&, std::size_t, std::size_t)>& progress = {});
 
 /// Combines identified parts into parameters: PE modes (if any) and gain split, asperities, PI
 /// weights with the static gain g from the hysteresis step (the PE step's g assumes H(U) = U).

@@ -35,15 +35,15 @@ struct SawtoothRun {
 };
 
 struct BreakawayOptions {
-  int sim_periods = 4;           ///< simulated periods after the settling period (velocity window)
-  double min_sim_s = 0.004;      ///< simulate at least this long (more periods at high frequency)
-  int scan_points = 10;          ///< coarse log-spaced scan of z_ba
-  int max_iterations = 30;       ///< bracketed search
-  double rel_tol = 2e-3;         ///< on z_ba
+  int sim_periods = 4;       ///< simulated periods after the settling period (velocity window)
+  double min_sim_s = 0.004;  ///< simulate at least this long (more periods at high frequency)
+  int scan_points = 10;      ///< coarse log-spaced scan of z_ba
+  int max_iterations = 30;   ///< bracketed search
+  double rel_tol = 2e-3;     ///< on z_ba
   /// A run "never steps" when its net motion per period is below this fraction of the PE's static
   /// stroke g H(A) (or below 1 nm): it is reported and skipped.
   double no_step_fraction = 0.01;
-  unsigned threads = 0;          ///< 0: std::thread::hardware_concurrency()
+  unsigned threads = 0;  ///< 0: std::thread::hardware_concurrency()
 };
 
 /// The fit of one run.

@@ -22,16 +22,16 @@
 namespace mc::stickslip {
 
 struct HysteresisResult {
-  PiParams pi;                     ///< thresholds r_i [V] and normalised weights w_i
-  PiParams inverse;                ///< pi_inverse(pi): the exact inverse (for feed-forward)
-  double static_gain_m_V = 0.0;    ///< g
-  double offset_m = 0.0;           ///< x0
-  double rms_m = 0.0;              ///< RMS of the loop fit over the fitted samples
-  double stroke_m = 0.0;           ///< peak-to-peak of the measured loop
-  double rms_fraction = 0.0;       ///< rms_m / stroke_m
-  double inverse_max_error_V = 0.0;///< max |H^-1(H(U)) - U| over the record
-  std::size_t first_fitted = 0;    ///< first sample used (after the wiping-out)
-  std::vector<double> fitted_m;    ///< x0 + g H(U) at every sample
+  PiParams pi;                       ///< thresholds r_i [V] and normalised weights w_i
+  PiParams inverse;                  ///< pi_inverse(pi): the exact inverse (for feed-forward)
+  double static_gain_m_V = 0.0;      ///< g
+  double offset_m = 0.0;             ///< x0
+  double rms_m = 0.0;                ///< RMS of the loop fit over the fitted samples
+  double stroke_m = 0.0;             ///< peak-to-peak of the measured loop
+  double rms_fraction = 0.0;         ///< rms_m / stroke_m
+  double inverse_max_error_V = 0.0;  ///< max |H^-1(H(U)) - U| over the record
+  std::size_t first_fitted = 0;      ///< first sample used (after the wiping-out)
+  std::vector<double> fitted_m;      ///< x0 + g H(U) at every sample
 };
 
 /// Identifies the PI model from `rec` (x_m = slider position) with `operators` play operators.

@@ -28,18 +28,21 @@ struct StepInput {
 /// than 64 samples follow the step.
 StepInput fit_step_input(const MeasuredRecord& rec);
 
-/// Welch PSD of the free response (samples after `t_from_s`, final value removed) and its
-/// `count` most prominent peaks in [f_min_Hz, f_max_Hz], sorted by frequency.
+/// Welch PSD of the dynamic part of a step response (the record minus its best affine fit on
+/// the quasi-static response `static_input`, so the step itself does not leak) and its `count`
+/// most prominent peaks in [f_min_Hz, f_max_Hz], sorted by frequency. Short Hann segments
+/// (256 samples, half overlap, zero-padded x8) average the transient with the noise floor.
 struct ModePeaks {
   dsp::Spectrum psd;
   std::vector<double> peaks_Hz;
 };
-ModePeaks free_response_peaks(const MeasuredRecord& rec, double t_from_s, int count, double f_min_Hz,
-                              double f_max_Hz);
+ModePeaks dynamic_response_peaks(const MeasuredRecord& rec, const std::vector<double>& static_input,
+                                 int count, double f_min_Hz, double f_max_Hz);
 
 /// Response of the unit-static-gain mode x'' + 2 zeta w x' + w^2 x = w^2 s(t) (eq. 2.7 normalised
 /// by K as in eq. 2.5), sampled every h from rest at s[0], with a first-order hold on s (exact for a
 /// piecewise-linear input).
-std::vector<double> unit_mode_response(const std::vector<double>& s, double h, double omega_rad_s, double zeta);
+std::vector<double> unit_mode_response(const std::vector<double>& s, double h, double omega_rad_s,
+                                       double zeta);
 
 }  // namespace mc::stickslip

@@ -46,9 +46,9 @@ void require_record_length(const MeasuredRecord& rec, std::size_t min_samples, d
 /// Sensor effects of the thesis's set-up (§2.5.1): interferometer resolution 0.1 nm, a white
 /// position noise, and a white noise on the recorded voltage relative to the drive amplitude.
 struct SensorEffects {
-  double quantisation_m = 0.1e-9;         ///< interferometer resolution (§2.5.1: 0.1 nm)
-  double position_noise_rms_m = 1e-9;     ///< white position noise, RMS
-  double voltage_noise_fraction = 0.01;   ///< RMS voltage noise / drive amplitude
+  double quantisation_m = 0.1e-9;        ///< interferometer resolution (§2.5.1: 0.1 nm)
+  double position_noise_rms_m = 1e-9;    ///< white position noise, RMS
+  double voltage_noise_fraction = 0.01;  ///< RMS voltage noise / drive amplitude
   std::uint64_t seed = 1;
 };
 
@@ -57,10 +57,12 @@ enum class Measured { kSlider, kPiezo };
 
 /// Simulates `wave` on `model` for `duration_s` and samples it at `fs_Hz` (which must be an
 /// integer divisor of 1 / model.dt_s()), then applies `sensor`. `measured` selects x2 (slider)
-/// or x1 (PE without slider, thesis §2.5.2.1). Throws mc::InvalidParams for a bad rate and
-/// mc::ComputationFailed if the simulation diverges.
+/// or x1 (PE without slider, thesis §2.5.2.1). The waveform starts after `pre_trigger_s` at rest
+/// (a recorder's pre-trigger); the record lasts pre_trigger_s + duration_s. Throws
+/// mc::InvalidParams for a bad rate and mc::ComputationFailed if the simulation diverges.
 MeasuredRecord measure(const ActuatorModel& model, const Waveform& wave, double duration_s, double fs_Hz,
-                       const SensorEffects& sensor, Measured measured = Measured::kSlider);
+                       const SensorEffects& sensor, Measured measured = Measured::kSlider,
+                       double pre_trigger_s = 0.0);
 
 /// Mean slider velocity over whole drive periods [m/s]: the difference of the position averaged
 /// over the last and over the first full period after `skip_periods`, divided by their time

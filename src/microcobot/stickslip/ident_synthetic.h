@@ -20,14 +20,15 @@
 namespace mc::stickslip {
 
 struct CampaignPlan {
-  double pe_step_V = 90.0, pe_fs_Hz = 1e6, pe_duration_s = 1e-3;       ///< thesis: 90 V, "1 mHz" = 1 MHz
-  double step_V = 20.0, step_fs_Hz = 25e3, step_duration_s = 0.03;     ///< below the slip threshold
+  double pe_step_V = 90.0, pe_fs_Hz = 1e6, pe_duration_s = 1e-3;    ///< thesis: 90 V, "1 mHz" = 1 MHz
+  double step_V = 20.0, step_fs_Hz = 25e3, step_duration_s = 0.03;  ///< below the slip threshold
+  double pe_pre_trigger_s = 1e-4, step_pre_trigger_s = 2e-3;        ///< rest recorded before the steps
   double sine_V = 40.0, sine_Hz = 50.0, sine_fs_Hz = 25e3, sine_periods = 2.0;  ///< thesis: 40 V, 50 Hz
   std::vector<double> amplitudes_V = {40, 60, 80, 100};
   std::vector<double> frequencies_Hz = {100, 500, 1000};
   double sawtooth_fs_Hz = 100e3;
-  int sawtooth_periods = 6;           ///< recorded periods per run (>= 3)
-  double sawtooth_min_s = 0.006;      ///< at least this long (more periods at high frequency)
+  int sawtooth_periods = 6;       ///< recorded periods per run (>= 3)
+  double sawtooth_min_s = 0.006;  ///< at least this long (more periods at high frequency)
 };
 
 /// The sawtooth record of one run (one settling period is part of the record).
@@ -36,8 +37,8 @@ MeasuredRecord measure_sawtooth(const ActuatorModel& model, double amplitude_V, 
 
 /// Simulates the whole campaign on `truth` and writes it to `dir` (atomic files). Sawtooth runs are
 /// simulated on all cores; `progress(done, total)` is called per run. Returns the file count.
-std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipParams& truth, const CampaignPlan& plan,
-                           const SensorEffects& sensor,
+std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipParams& truth,
+                           const CampaignPlan& plan, const SensorEffects& sensor,
                            const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 }  // namespace mc::stickslip

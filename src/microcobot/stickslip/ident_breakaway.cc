@@ -1,0 +1,308 @@
+#include "microcobot/stickslip/ident_breakaway.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <regex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "microcobot/core/error.h"
+
+namespace mc::stickslip {
+
+double simulated_mean_velocity(const ActuatorModel& model, const Waveform& wave, double z_ba_m, int periods) {
+  const double dt = model.dt_s();
+  const double period = 1.0 / wave.frequency_Hz;
+  const double t_first = period;                                // after one settling period
+  const double t_last = period * static_cast<double>(periods);  // start of the last window
+  const double t_end = t_last + period;
+  ActuatorState s = model.initial_state();
+  s.z_ba_m = z_ba_m;
+  const auto steps = static_cast<long>(std::ceil(t_end / dt));
+  double sum_a = 0.0, sum_b = 0.0, ta = 0.0, tb = 0.0;
+  long na = 0, nb = 0;
+  for (long k = 1; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    model.step(s, wave.value(t));
+    if (s.diverged) throw ComputationFailed(fmt::format("simulation diverged at t = {:.6g} s", t));
+    if (t >= t_first && t < t_first + period) {
+      sum_a += model.slider_position(s);
+      ta += t;
+      ++na;
+    } else if (t >= t_last && t < t_end) {
+      sum_b += model.slider_position(s);
+      tb += t;
+      ++nb;
+    }
+  }
+  if (na == 0 || nb == 0) throw ComputationFailed("drive period shorter than the simulation step");
+  const double xa = sum_a / static_cast<double>(na), xb = sum_b / static_cast<double>(nb);
+  return (xb - xa) / (tb / static_cast<double>(nb) - ta / static_cast<double>(na));
+}
+
+namespace {
+
+RunFit fit_run(const SawtoothRun& run, const ActuatorModel& model, const BreakawayOptions& o) {
+  RunFit r;
+  r.name = run.name;
+  r.amplitude_V = run.amplitude_V;
+  r.frequency_Hz = run.frequency_Hz;
+  r.direction = run.direction;
+  const auto& p = model.params();
+  try {
+    const Waveform wave =
+        make_waveform(WaveKind::kSawtooth, run.amplitude_V, run.frequency_Hz, run.direction, p.drive);
+    r.v_measured_m_s = mean_velocity(run.rec.t_s, run.rec.x_m, run.frequency_Hz, 1, run.rec.source);
+    const double stroke = p.pe.static_gain_m_V * pi_loading_curve(p.hysteresis, run.amplitude_V);
+    const double per_period = std::abs(r.v_measured_m_s) / run.frequency_Hz;
+    if (per_period < std::max(1e-9, o.no_step_fraction * stroke)) {
+      r.skipped = fmt::format("never steps (net motion {:.3g} nm per period)", per_period * 1e9);
+      return r;
+    }
+    const double sign = run.direction == Direction::kForward ? 1.0 : -1.0;
+    if (r.v_measured_m_s * sign < 0.0) {
+      r.skipped = "moves against its drive direction";
+      return r;
+    }
+    const int periods =
+        std::max(o.sim_periods + 1, static_cast<int>(std::ceil(o.min_sim_s * run.frequency_Hz)));
+    const double target = std::abs(r.v_measured_m_s);
+    auto speed = [&](double log_z) {
+      ++r.simulations;
+      return sign * simulated_mean_velocity(model, wave, std::exp(log_z), periods);
+    };
+    // Coarse scan from the stroke down: the largest z_ba whose speed reaches the target.
+    const double hi = std::log(1.2 * stroke), lo = std::log(0.02 * stroke);
+    double z_hi = hi, v_hi = speed(hi), z_lo = 0.0, v_lo = 0.0;
+    bool bracket = false;
+    double v_max = v_hi;
+    for (int i = 1; i < o.scan_points; ++i) {
+      const double z = hi + (lo - hi) * static_cast<double>(i) / static_cast<double>(o.scan_points - 1);
+      const double v = speed(z);
+      v_max = std::max(v_max, v);
+      if (v >= target) {
+        z_lo = z;
+        v_lo = v;
+        bracket = true;
+        break;
+      }
+      z_hi = z;
+      v_hi = v;
+    }
+    if (!bracket) {
+      r.skipped =
+          fmt::format("the model cannot reach the measured speed {:.4g} m/s (max {:.4g} m/s)", target, v_max);
+      return r;
+    }
+    // Illinois regula falsi on f(z) = v(z) - target, f(z_lo) >= 0 > f(z_hi), in log z.
+    double f_lo = v_lo - target, f_hi = v_hi - target;
+    int side = 0;
+    double z = z_lo;
+    for (int it = 0; it < o.max_iterations && (z_hi - z_lo) > o.rel_tol; ++it) {
+      z = (z_lo * f_hi - z_hi * f_lo) / (f_hi - f_lo);
+      if (!(z > z_lo && z < z_hi)) z = 0.5 * (z_lo + z_hi);
+      const double f = speed(z) - target;
+      if (f >= 0.0) {
+        z_lo = z;
+        f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        z_hi = z;
+        f_hi = f;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+    // The crossing: interpolate within the final bracket.
+    z = (f_hi - f_lo) != 0.0 ? (z_lo * f_hi - z_hi * f_lo) / (f_hi - f_lo) : 0.5 * (z_lo + z_hi);
+    z = std::clamp(z, z_lo, z_hi);
+    r.z_ba_m = std::exp(z);
+    r.v_simulated_m_s = sign * (speed(z));
+    r.ok = true;
+  } catch (const Error& e) {
+    r.skipped = e.what();
+  }
+  return r;
+}
+
+/// Fills missing cells of one direction's grid: linear along amplitude, else nearest frequency.
+void fill_grid(std::vector<std::vector<double>>& g, std::vector<std::vector<bool>>& have,
+               const std::vector<double>& amps, const std::string& dir, std::vector<std::string>& filled,
+               const std::vector<double>& freqs) {
+  const std::size_t na = amps.size(), nf = freqs.size();
+  for (std::size_t j = 0; j < nf; ++j) {
+    for (std::size_t i = 0; i < na; ++i) {
+      if (have[i][j]) continue;
+      long lo = -1, hi = -1;
+      for (long k = static_cast<long>(i) - 1; k >= 0; --k) {
+        if (have[static_cast<std::size_t>(k)][j]) {
+          lo = k;
+          break;
+        }
+      }
+      for (std::size_t k = i + 1; k < na; ++k) {
+        if (have[k][j]) {
+          hi = static_cast<long>(k);
+          break;
+        }
+      }
+      double v = 0.0;
+      if (lo >= 0 && hi >= 0) {
+        const auto l = static_cast<std::size_t>(lo), h = static_cast<std::size_t>(hi);
+        const double t = (amps[i] - amps[l]) / (amps[h] - amps[l]);
+        v = g[l][j] * (1.0 - t) + g[h][j] * t;
+      } else if (lo >= 0) {
+        v = g[static_cast<std::size_t>(lo)][j];
+      } else if (hi >= 0) {
+        v = g[static_cast<std::size_t>(hi)][j];
+      } else {
+        continue;  // whole column missing: second pass along frequency
+      }
+      g[i][j] = v;
+      filled.push_back(fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]));
+    }
+  }
+  for (std::size_t i = 0; i < na; ++i) {
+    for (std::size_t j = 0; j < nf; ++j) {
+      if (g[i][j] > 0.0) continue;
+      double best = -1.0, dist = HUGE_VAL;
+      for (std::size_t k = 0; k < nf; ++k) {
+        if (g[i][k] > 0.0 && std::abs(std::log(freqs[k] / freqs[j])) < dist) {
+          dist = std::abs(std::log(freqs[k] / freqs[j]));
+          best = g[i][k];
+        }
+      }
+      if (best > 0.0) {
+        g[i][j] = best;
+        filled.push_back(fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]));
+      }
+    }
+  }
+  (void)have;
+}
+
+}  // namespace
+
+BreakawayResult identify_breakaway(const std::vector<SawtoothRun>& runs, const ActuatorModel& model,
+                                   const BreakawayOptions& options,
+                                   const std::function<void(std::size_t, std::size_t)>& progress) {
+  if (runs.empty()) throw InvalidInput("no sawtooth run to identify the break-away strain from");
+  BreakawayResult out;
+  out.runs.resize(runs.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::mutex mutex;
+  auto worker = [&] {
+    for (std::size_t i = next++; i < runs.size(); i = next++) {
+      out.runs[i] = fit_run(runs[i], model, options);
+      const std::size_t d = ++done;
+      if (progress) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        progress(d, runs.size());
+      }
+    }
+  };
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, static_cast<unsigned>(runs.size()));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+
+  // The grid of the runs.
+  std::vector<double> amps, freqs;
+  for (const auto& r : runs) {
+    amps.push_back(r.amplitude_V);
+    freqs.push_back(r.frequency_Hz);
+  }
+  auto uniq = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end(),
+                        [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::abs(b); }),
+            v.end());
+  };
+  uniq(amps);
+  uniq(freqs);
+  auto index = [](const std::vector<double>& axis, double v) {
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < axis.size(); ++k) {
+      if (std::abs(axis[k] - v) < std::abs(axis[best] - v)) best = k;
+    }
+    return best;
+  };
+  BreakawayTable& tb = out.table;
+  tb.amplitudes_V = amps;
+  tb.frequencies_Hz = freqs;
+  for (Direction d : {Direction::kForward, Direction::kBackward}) {
+    std::vector<std::vector<double>> g(amps.size(), std::vector<double>(freqs.size(), 0.0));
+    std::vector<std::vector<bool>> have(amps.size(), std::vector<bool>(freqs.size(), false));
+    std::size_t count = 0;
+    for (const auto& r : out.runs) {
+      if (r.direction != d || !r.ok) continue;
+      const std::size_t i = index(amps, r.amplitude_V), j = index(freqs, r.frequency_Hz);
+      // Repeated runs at one grid point: mean.
+      g[i][j] = have[i][j] ? 0.5 * (g[i][j] + r.z_ba_m) : r.z_ba_m;
+      have[i][j] = true;
+      ++count;
+    }
+    if (count == 0) {
+      throw ComputationFailed(fmt::format("no usable {} sawtooth run: cannot identify z_ba({})", to_string(d),
+                                          d == Direction::kForward ? "+" : "-"));
+    }
+    fill_grid(g, have, amps, to_string(d), out.filled, freqs);
+    (d == Direction::kForward ? tb.forward_m : tb.backward_m) = g;
+  }
+  for (const auto& r : out.runs) out.skipped += r.ok ? 0 : 1;
+  tb.validate();
+  return out;
+}
+
+std::string sawtooth_file_name(double amplitude_V, double frequency_Hz, Direction direction) {
+  return fmt::format("sawtooth_{:g}V_{:g}Hz_{}.csv", amplitude_V, frequency_Hz, to_string(direction));
+}
+
+bool parse_sawtooth_file_name(const std::string& name, double& amplitude_V, double& frequency_Hz,
+                              Direction& direction) {
+  static const std::regex re(
+      R"(sawtooth_([0-9]+(?:\.[0-9]+)?)V_([0-9]+(?:\.[0-9]+)?)Hz_(forward|backward)\.csv)");
+  std::smatch m;
+  if (!std::regex_match(name, m, re)) return false;
+  amplitude_V = std::stod(m[1].str());
+  frequency_Hz = std::stod(m[2].str());
+  direction = m[3].str() == "forward" ? Direction::kForward : Direction::kBackward;
+  return amplitude_V > 0.0 && frequency_Hz > 0.0;
+}
+
+std::vector<SawtoothRun> read_sawtooth_runs(const std::filesystem::path& dir) {
+  if (!std::filesystem::is_directory(dir)) throw InvalidInput(dir.string(), 0, "not a directory");
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("sawtooth_", 0) == 0 && e.path().extension() == ".csv") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    throw InvalidInput(
+        dir.string(), 0,
+        "no sawtooth run (expected files named sawtooth_<amplitude>V_<frequency>Hz_<forward|backward>"
+        ".csv, e.g. sawtooth_60V_500Hz_forward.csv)");
+  }
+  std::vector<SawtoothRun> runs;
+  for (const auto& f : files) {
+    SawtoothRun r;
+    r.name = f.filename().string();
+    if (!parse_sawtooth_file_name(r.name, r.amplitude_V, r.frequency_Hz, r.direction)) {
+      throw InvalidInput(f.string(), 0,
+                         "file name must read sawtooth_<amplitude>V_<frequency>Hz_<forward|backward>.csv");
+    }
+    r.rec = read_record(f);
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
+
+}  // namespace mc::stickslip
