@@ -1,0 +1,293 @@
+// `microcobot dsp`: the signal and system toolkit on the command line (issue #3).
+
+#include <cmath>
+#include <numbers>
+
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "microcobot/core/csv.h"
+#include "microcobot/core/error.h"
+#include "microcobot/dsp/butterworth.h"
+#include "microcobot/dsp/octave.h"
+#include "microcobot/dsp/signals.h"
+#include "microcobot/dsp/welch.h"
+#include "microcobot/ident/tf_fit.h"
+
+namespace {
+
+using mc::cli::CommonOptions;
+
+struct WelchFlags {
+  std::size_t nperseg = 256;
+  std::optional<std::size_t> noverlap;
+  std::size_t nfft = 0;
+  std::string detrend = "constant";
+  std::string scaling = "density";
+  double fs = 0;
+};
+
+void add_welch_flags(CLI::App* cmd, WelchFlags& w) {
+  cmd->add_option("--fs", w.fs, "Sample rate (Hz)")->required()->check(CLI::PositiveNumber);
+  cmd->add_option("--nperseg", w.nperseg, "Segment length (samples)")->check(CLI::PositiveNumber);
+  cmd->add_option("--noverlap", w.noverlap, "Overlap (samples), default nperseg/2");
+  cmd->add_option("--nfft", w.nfft, "FFT length >= nperseg (default nperseg)");
+  cmd->add_option("--detrend", w.detrend, "constant|none")->check(CLI::IsMember({"constant", "none"}));
+  cmd->add_option("--scaling", w.scaling, "density|spectrum")->check(CLI::IsMember({"density", "spectrum"}));
+}
+
+mc::dsp::WelchOptions to_options(const WelchFlags& w) {
+  mc::dsp::WelchOptions o;
+  o.fs_Hz = w.fs;
+  o.nperseg = w.nperseg;
+  o.noverlap = w.noverlap;
+  o.nfft = w.nfft;
+  o.detrend = mc::dsp::parse_detrend(w.detrend);
+  o.scaling = mc::dsp::parse_scaling(w.scaling);
+  return o;
+}
+
+std::vector<std::complex<double>> read_frf(const mc::CsvTable& t) {
+  const auto& re = t.column("re");
+  const auto& im = t.column("im");
+  std::vector<std::complex<double>> h(re.size());
+  for (std::size_t i = 0; i < h.size(); ++i) h[i] = {re[i], im[i]};
+  return h;
+}
+
+void add_dsp(CLI::App& group) {
+  group.require_subcommand(1);
+  {
+    struct O {
+      CommonOptions common;
+      int order = 2;
+      double fc = 0, fs = 0;
+      std::string type = "low";
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd =
+        group.add_subcommand("butter", "Butterworth / Linkwitz-Riley LR4 design as second-order sections");
+    cmd->add_option("--order", o->order, "Filter order (Butterworth 1..20; LR4 ignores it)")
+        ->check(CLI::Range(1, 20));
+    cmd->add_option("--fc", o->fc, "Cut-off (Hz)")->required()->check(CLI::PositiveNumber);
+    cmd->add_option("--fs", o->fs, "Sample rate (Hz)")->required()->check(CLI::PositiveNumber);
+    cmd->add_option("--type", o->type, "low|high|lr4-low|lr4-high")
+        ->check(CLI::IsMember({"low", "high", "lr4-low", "lr4-high"}));
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      mc::dsp::Sos sos;
+      if (o->type.rfind("lr4-", 0) == 0) {
+        sos = mc::dsp::linkwitz_riley(4, o->fc, o->fs, mc::dsp::parse_filter_type(o->type.substr(4)));
+      } else {
+        sos = mc::dsp::butter(o->order, o->fc, o->fs, mc::dsp::parse_filter_type(o->type));
+      }
+      nlohmann::json rows = nlohmann::json::array();
+      for (const auto& s : sos) rows.push_back(s.row());
+      mc::cli::emit(o->common, {{"sos", rows}});
+    });
+  }
+  {
+    struct O {
+      CommonOptions common;
+      std::string in, column;
+      WelchFlags w;
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd =
+        group.add_subcommand("welch", "Welch power spectral density of one CSV column (scipy.signal.welch)");
+    cmd->add_option("--in", o->in, "CSV file with a header row")->required();
+    cmd->add_option("--column", o->column, "Column name")->required();
+    add_welch_flags(cmd, o->w);
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      const auto table = mc::read_csv(o->in);
+      const auto p = mc::dsp::welch(table.column(o->column), to_options(o->w));
+      mc::cli::emit(o->common, {{"f_Hz", p.f_Hz}, {"psd", p.value}});
+    });
+  }
+  {
+    struct O {
+      CommonOptions common;
+      std::string in, input, output;
+      WelchFlags w;
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd = group.add_subcommand(
+        "frf", "H1 frequency response and coherence; CSV f_Hz,re,im,coherence on stdout");
+    cmd->add_option("--in", o->in, "CSV file with a header row")->required();
+    cmd->add_option("--input", o->input, "Input column")->required();
+    cmd->add_option("--output", o->output, "Output column")->required();
+    add_welch_flags(cmd, o->w);
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      const auto table = mc::read_csv(o->in);
+      const auto e = mc::dsp::frf_h1(table.column(o->input), table.column(o->output), to_options(o->w));
+      std::vector<double> re(e.h.size()), im(e.h.size());
+      for (std::size_t i = 0; i < e.h.size(); ++i) {
+        re[i] = e.h[i].real();
+        im[i] = e.h[i].imag();
+      }
+      if (o->common.json) {
+        mc::cli::emit(o->common, {{"f_Hz", e.f_Hz}, {"re", re}, {"im", im}, {"coherence", e.coherence}});
+        return;
+      }
+      std::string csv = "f_Hz,re,im,coherence\n";
+      for (std::size_t i = 0; i < e.h.size(); ++i) {
+        csv += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}\n", e.f_Hz[i], re[i], im[i], e.coherence[i]);
+      }
+      std::fputs(csv.c_str(), stdout);
+    });
+  }
+  {
+    struct O {
+      CommonOptions common;
+      int bits = 0;
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd = group.add_subcommand("mls", "Maximum-length sequence of 0/1 (scipy.signal.max_len_seq)");
+    cmd->add_option("--bits", o->bits, "Register length 2..32")->required()->check(CLI::Range(2, 32));
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      if (o->bits > 24) throw mc::UsageError("--bits: at most 24 on the command line (2^24 - 1 values)");
+      const auto seq = mc::dsp::max_len_seq(o->bits);
+      mc::cli::emit(o->common, {{"seq", seq}}, fmt::format("MLS of {} values", seq.size()));
+    });
+  }
+  {
+    struct O {
+      CommonOptions common;
+      std::string in;
+      int nz = 1, np = 2;
+      double fmin = 0, fmax = std::numeric_limits<double>::infinity();
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd = group.add_subcommand("tffit", "Rational transfer-function fit of an FRF CSV (f_Hz,re,im)");
+    cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im")->required();
+    cmd->add_option("--nz", o->nz, "Numerator order")->check(CLI::Range(0, 20));
+    cmd->add_option("--np", o->np, "Denominator order")->check(CLI::Range(1, 20));
+    cmd->add_option("--fmin", o->fmin, "Band start (Hz)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--fmax", o->fmax, "Band end (Hz)")->check(CLI::PositiveNumber);
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      if (o->nz > o->np) throw mc::UsageError("--nz must not exceed --np");
+      const auto table = mc::read_csv(o->in);
+      mc::ident::TfFitOptions fo;
+      fo.nz = o->nz;
+      fo.np = o->np;
+      fo.fmin_Hz = o->fmin;
+      fo.fmax_Hz = o->fmax;
+      const auto fit = mc::ident::fit_tf(table.column("f_Hz"), read_frf(table), fo);
+      mc::cli::emit(o->common, {{"num", fit.tf.num()},
+                                {"den", fit.tf.den()},
+                                {"relative_rms_error", fit.relative_rms_error},
+                                {"points", fit.points}});
+    });
+  }
+  {
+    struct O {
+      CommonOptions common;
+      std::string in;
+      double fmin = 0, fmax = 0;
+    };
+    auto o = std::make_shared<O>();
+    auto* cmd = group.add_subcommand("octave", "1/3-octave band averages (IEC 61260 base 10) of an FRF CSV");
+    cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im")->required();
+    cmd->add_option("--fmin", o->fmin, "Lowest band centre (Hz), default the data's")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--fmax", o->fmax, "Highest band centre (Hz), default the data's")
+        ->check(CLI::PositiveNumber);
+    mc::cli::add_output_options(*cmd, o->common);
+    cmd->callback([o] {
+      const auto table = mc::read_csv(o->in);
+      const auto& f = table.column("f_Hz");
+      double lo = o->fmin, hi = o->fmax;
+      if (lo <= 0) {
+        lo = std::numeric_limits<double>::infinity();
+        for (double v : f) {
+          if (v > 0) lo = std::min(lo, v);
+        }
+      }
+      if (hi <= 0) {
+        for (double v : f) hi = std::max(hi, v);
+      }
+      if (!(hi > lo)) throw mc::UsageError("--fmax must exceed --fmin");
+      const auto b = mc::dsp::third_octave_average(f, read_frf(table), lo, hi);
+      mc::cli::emit(o->common, {{"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB}});
+    });
+  }
+}
+
+// Report part: the LR4 crossover of the dual-stage interface (thesis Fig. 3.8), its sum,
+// the Welch PSD of a PRBS and an MLS.
+void dsp_part(mc::report::Report& r) {
+  r.section("Signal and system toolkit",
+            "Linkwitz-Riley LR4 crossovers at 200 Hz and 10 kHz sampled at 50 kHz (thesis Fig. 3.8, "
+            "the split between Pantograph and Haptuator), the magnitude of their sum (an all-pass: "
+            "|LP + HP| = 1), the Welch PSD of a 10 kHz PRBS and the first values of an MLS.");
+  const double fs = 50000.0;
+  mc::report::Figure fig{"LR4 crossover magnitudes",
+                         "Low- and high-pass outputs and |LP + HP|.",
+                         {"Frequency", "Hz", true},
+                         {"Magnitude", "dB", false},
+                         {}};
+  double worst = 0.0;
+  for (double fc : {200.0, 10000.0}) {
+    const auto x = mc::dsp::linkwitz_riley_crossover(4, fc, fs);
+    mc::report::Series lp{fmt::format("LP {} Hz", fc), {}, {}}, hp{fmt::format("HP {} Hz", fc), {}, {}},
+        sum{fmt::format("|LP+HP| {} Hz", fc), {}, {}};
+    for (double f = 10.0; f < fs / 2; f *= 1.05) {
+      const auto l = mc::dsp::sos_response(x.low, f, fs), h = mc::dsp::sos_response(x.high, f, fs);
+      lp.x.push_back(f);
+      lp.y.push_back(20 * std::log10(std::max(std::abs(l), 1e-12)));
+      hp.x.push_back(f);
+      hp.y.push_back(20 * std::log10(std::max(std::abs(h), 1e-12)));
+      sum.x.push_back(f);
+      sum.y.push_back(20 * std::log10(std::abs(l + h)));
+      worst = std::max(worst, std::abs(std::abs(l + h) - 1.0));
+    }
+    fig.series.push_back(lp);
+    fig.series.push_back(hp);
+    fig.series.push_back(sum);
+  }
+  r.add_figure(fig);
+  r.add_result("max | |LP+HP| - 1 | (LR4, 10 Hz..25 kHz)", worst);
+  const double fsp = 10000.0;
+  const auto u = mc::dsp::prbs(15, 1 << 16, 1, 1.0);
+  mc::dsp::WelchOptions o;
+  o.fs_Hz = fsp;
+  o.nperseg = 1024;
+  const auto p = mc::dsp::welch(u, o);
+  mc::report::Figure psd{"Welch PSD of a PRBS",
+                         "+-1 PRBS (15 bits) at 10 kHz: flat at 2/fs = 2e-4 V^2/Hz.",
+                         {"Frequency", "Hz", true},
+                         {"PSD", "V^2/Hz", true},
+                         {}};
+  mc::report::Series s{"PRBS", {}, {}};
+  for (std::size_t k = 1; k < p.f_Hz.size(); ++k) {
+    s.x.push_back(p.f_Hz[k]);
+    s.y.push_back(std::max(p.value[k], 1e-12));
+  }
+  psd.series.push_back(s);
+  r.add_figure(psd);
+  const auto m = mc::dsp::max_len_seq(6);
+  mc::report::Figure mf{"MLS (6 bits)",
+                        "One period (63 values) of scipy's 6-bit MLS.",
+                        {"Index", "", false},
+                        {"Bit", "", false},
+                        {}};
+  mc::report::Series ms{"MLS", {}, {}, true};
+  for (std::size_t k = 0; k < m.size(); ++k) {
+    ms.x.push_back(static_cast<double>(k));
+    ms.y.push_back(m[k]);
+  }
+  mf.series.push_back(ms);
+  r.add_figure(mf);
+}
+
+const bool kRegistered =
+    mc::cli::register_group({"dsp", "Signal and system toolkit (filters, spectra, fits)", 20, &add_dsp});
+const bool kReportRegistered = mc::cli::register_report_part({"dsp", 20, &dsp_part});
+
+}  // namespace
