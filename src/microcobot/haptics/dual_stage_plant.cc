@@ -62,16 +62,18 @@ DualStagePlant::DualStagePlant(const DualStagePlantParams& params) : params_(par
   a_.block<4, 4>(0, 4).setIdentity();
   a_.block<4, 4>(4, 0) = -minv * k;
   a_.block<4, 4>(4, 4) = -minv * c;
-  // Force pair f_v = Bl i: -f_v on the handle, +f_v on the magnet.
-  a_(4, 8) = -p.bl_N_per_A / p.m_h_kg;
-  a_(5, 8) = p.bl_N_per_A / p.m_v_kg;
+  // Force pair (eq. 3.4): -f_v on the handle, +f_v on the magnet, with f_v = -Bl i: the coil
+  // is wired so that a positive command pushes the handle towards +y.
+  a_(4, 8) = p.bl_N_per_A / p.m_h_kg;
+  a_(5, 8) = -p.bl_N_per_A / p.m_v_kg;
   // Coil under a PI current loop: L i' = k_p (g u - i) + k_i q - R i - Bl (y_v' - y_h'),
   // q' = g u - i.
   a_(8, 8) = -(p.coil_R_ohm + p.loop_kp_V_per_A) / p.coil_L_H;
   a_(8, 9) = p.loop_ki_V_per_As / p.coil_L_H;
   a_(9, 8) = -1.0;
-  a_(8, 5) = -p.bl_N_per_A / p.coil_L_H;
-  a_(8, 4) = p.bl_N_per_A / p.coil_L_H;
+  // Back-EMF e = -Bl (y_v' - y_h') (so that e i is the power f_v (y_v' - y_h')).
+  a_(8, 5) = p.bl_N_per_A / p.coil_L_H;
+  a_(8, 4) = -p.bl_N_per_A / p.coil_L_H;
   b_(7, 0) = 1.0 / p.m_2_kg;                                       // f_m on the motor windings
   b_(8, 1) = p.loop_kp_V_per_A * p.amp_gain_A_per_V / p.coil_L_H;  // current reference g u
   b_(9, 1) = p.amp_gain_A_per_V;

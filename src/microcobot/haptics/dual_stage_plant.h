@@ -98,8 +98,8 @@ struct DualStagePlantState {
 
 /// The dual-stage plant of eq. 3.4 with the Haptuator coil and end stops.
 ///
-/// Linear part (stops open): M Y'' + C Y' + K Y = [-f_v, f_v, 0, f_m]^T (eq. 3.4), f_v = Bl i,
-/// L i' = k_p (g u - i) + k_i q - R i - Bl (y_v' - y_h'), q' = g u - i. The end stops add a force pair
+/// Linear part (stops open): M Y'' + C Y' + K Y = [-f_v, f_v, 0, f_m]^T (eq. 3.4), f_v = -Bl i,
+/// L i' = k_p (g u - i) + k_i q - R i + Bl (y_v' - y_h'), q' = g u - i. The end stops add a force pair
 /// f_s = -k_s (z - sign(z) s) - b_s z' on the magnet (and its opposite on the handle) while
 /// |z| = |y_v - y_h| exceeds the stroke s: the saturation that spoils the Haptuator's
 /// response below about 100 Hz (Fig. 3.11).

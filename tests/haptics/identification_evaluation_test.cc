@@ -1,0 +1,64 @@
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "microcobot/core/error.h"
+#include "microcobot/haptics/evaluation.h"
+#include "microcobot/haptics/identification.h"
+
+namespace mc::haptics {
+namespace {
+
+const IdentificationResult& identified() {
+  static const IdentificationResult id = [] {
+    const DualStagePlant plant{DualStagePlantParams{}};
+    return identify(plant, IdentificationOptions{});
+  }();
+  return id;
+}
+
+TEST(Identification, FindsTheStaticGainTheModelAndThe200HzCutoff) {
+  const DualStagePlant plant{DualStagePlantParams{}};
+  const IdentificationResult& id = identified();
+  EXPECT_NEAR(id.lf_gain * plant.total_mass_kg(), 1.0, 0.05);  // mass line 1/M
+  EXPECT_GT(id.lf_flat_upper_Hz, 200.0);
+  EXPECT_LT(id.lf_flat_upper_Hz, 230.0);
+  EXPECT_LT(id.hf_valid_lower_Hz, 120.0);  // saturation spoils only the low band
+  EXPECT_DOUBLE_EQ(id.cutoff_Hz, 200.0);
+  // The identified (not the true) model follows the true channel within 0.3 dB on 150-1000 Hz.
+  for (double f = 150.0; f <= 1000.0; f *= 1.05) {
+    EXPECT_NEAR(
+        20 * std::log10(std::abs(id.hf_model.response(f)) / std::abs(plant.frf(Channel::kHaptuator, f))), 0.0,
+        0.3)
+        << f;
+  }
+}
+
+TEST(Identification, NoOverlapIsReported) {
+  // With a 0.02 dB flatness demand neither channel is "uniform" over a common band.
+  const DualStagePlant plant{DualStagePlantParams{}};
+  IdentificationOptions o;
+  o.flat_tol_dB = 0.02;
+  o.prbs_bits = 14;
+  o.nperseg = 1024;
+  EXPECT_THROW(identify(plant, o), ComputationFailed);
+}
+
+TEST(Evaluation, CombinedResponseIsFlatAndThePantographAloneIsNot) {
+  const DualStagePlant plant{DualStagePlantParams{}};
+  const EvaluationResult ev = evaluate(plant, pipeline_from(identified()), EvaluationOptions{});
+  ASSERT_EQ(ev.fc_Hz.size(), 14u);
+  EXPECT_LT(ev.flatness_dB, 1.0);  // within +-0.5 dB over 63-1250 Hz
+  for (double v : ev.combined_dB) EXPECT_LT(std::abs(v), 0.5);
+  // Complementary channels: LF dominates below the cut-off, HF above.
+  EXPECT_GT(ev.lf_dB.front(), ev.hf_dB.front() + 20.0);
+  EXPECT_GT(ev.hf_dB.back(), ev.lf_dB.back() + 20.0);
+  double dev = 0.0;
+  for (std::size_t i = 0; i < ev.fc_Hz.size(); ++i)
+    if (ev.fc_Hz[i] > 250.0) dev = std::max(dev, std::abs(ev.pantograph_dB[i]));
+  EXPECT_GT(dev, 6.0);
+}
+
+}  // namespace
+}  // namespace mc::haptics
