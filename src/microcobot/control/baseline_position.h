@@ -19,12 +19,12 @@ enum class BaselineKind { kOpenLoopCounting, kThesisPid };
 std::string to_string(BaselineKind k);
 
 struct BaselinePositionParams {
-  double frequency_Hz = 1000.0;       ///< sawtooth frequency (thesis §2.7)
-  double nominal_amplitude_V = 100.0; ///< open loop: amplitude used
-  double nominal_step_m = 300e-9;     ///< open loop: assumed step at that amplitude (datasheet-like)
+  double frequency_Hz = 1000.0;        ///< sawtooth frequency (thesis §2.7)
+  double nominal_amplitude_V = 100.0;  ///< open loop: amplitude used
+  double nominal_step_m = 300e-9;      ///< open loop: assumed step at that amplitude (datasheet-like)
   /// Thesis PID on the amplitude [V per m of error]: saturates at 100 V beyond ~1 um.
   PidParams pid{1.0e8, 2.0e9, 0.0, 0.0, 0.0, 100.0};
-  double deadband_m = 5e-9;           ///< thesis PID: no stepping when |error| is below this
+  double deadband_m = 5e-9;  ///< thesis PID: no stepping when |error| is below this
 
   template <class V>
   void visit(V& v) {
@@ -39,7 +39,8 @@ struct BaselinePositionParams {
 
 class BaselinePositionController {
  public:
-  BaselinePositionController(const BaselinePositionParams& p, BaselineKind kind, double slew_rate_V_s = 1.0e6);
+  BaselinePositionController(const BaselinePositionParams& p, BaselineKind kind,
+                             double slew_rate_V_s = 1.0e6);
   /// Starts a move to `target_m` from the measured position `start_m`.
   void set_target(double target_m, double start_m) noexcept;
   void update(double measured_position_m) noexcept;

@@ -33,8 +33,8 @@ ActuatorState start_state(const ActuatorModel& model, double start_m) {
 
 /// Runs `ticks` control ticks of controller `c` on `s`; `record(k, x_true, u)` after each tick.
 template <class C, class Rec>
-void run_ticks(const ActuatorModel& model, ActuatorState& s, PositionSensor& sensor, C& c, int ratio, long ticks,
-               Rec&& record, const std::function<bool()>& stop = {}) {
+void run_ticks(const ActuatorModel& model, ActuatorState& s, PositionSensor& sensor, C& c, int ratio,
+               long ticks, Rec&& record, const std::function<bool()>& stop = {}) {
   const double dt = model.dt_s();
   for (long k = 0; k < ticks; ++k) {
     c.update(sensor.measure(model.slider_position(s)));
@@ -46,7 +46,8 @@ void run_ticks(const ActuatorModel& model, ActuatorState& s, PositionSensor& sen
       model.step(s, u);
     }
     if (s.diverged) {
-      throw ComputationFailed("closed-loop simulation diverged (NaN/Inf) at t = " + std::to_string(s.t_s) + " s");
+      throw ComputationFailed("closed-loop simulation diverged (NaN/Inf) at t = " + std::to_string(s.t_s) +
+                              " s");
     }
     record(k, model.slider_position(s), u);
     if (stop && stop()) break;
@@ -62,8 +63,8 @@ double mean(const std::vector<double>& v, std::size_t from) {
 }  // namespace
 
 VelocityRun run_velocity(const ActuatorModel& model, const StepMap* map, const VelocityControlParams& p,
-                         VelocityMode mode, double reference_m_s, double duration_s, const PositionSensorParams& sp,
-                         double start_m) {
+                         VelocityMode mode, double reference_m_s, double duration_s,
+                         const PositionSensorParams& sp, double start_m) {
   require(std::isfinite(reference_m_s) && reference_m_s != 0.0, "reference_m_s", "must be finite and != 0",
           reference_m_s);
   require_positive(duration_s, "duration_s");
@@ -142,8 +143,9 @@ PositionRun run_position(const ActuatorModel& model, const StepMap& map, const P
   const int ratio = steps_per_tick(model, p.control_rate_Hz);
   const double tick = static_cast<double>(ratio) * model.dt_s();
   if (max_time_s <= 0.0) {
-    const double speed = std::min(p.max_velocity_m_s, 0.5 * map.max_step_m(p.step_frequency_Hz, stickslip::Direction::kForward) *
-                                                          p.step_frequency_Hz);
+    const double speed = std::min(
+        p.max_velocity_m_s,
+        0.5 * map.max_step_m(p.step_frequency_Hz, stickslip::Direction::kForward) * p.step_frequency_Hz);
     max_time_s = std::abs(target_m - start_m) / std::max(speed, 1e-6) + 0.1 + hold_s;
   }
   const long ticks = std::lround(max_time_s / tick);
@@ -170,7 +172,9 @@ PositionRun run_position(const ActuatorModel& model, const StepMap& map, const P
         }
         rec(k, tick, x, u, static_cast<double>(static_cast<int>(c.mode())));
       },
-      [&] { return (t_hold >= 0.0 && static_cast<double>(k_now + 1) * tick >= t_hold + hold_s) || c.end_stop(); });
+      [&] {
+        return (t_hold >= 0.0 && static_cast<double>(k_now + 1) * tick >= t_hold + hold_s) || c.end_stop();
+      });
   auto& m = run.metrics;
   const double x_end = model.slider_position(s);
   m.final_error_m = std::abs(x_end - target_m);
@@ -185,9 +189,9 @@ PositionRun run_position(const ActuatorModel& model, const StepMap& map, const P
   return run;
 }
 
-PositionRun run_baseline_position(const ActuatorModel& model, const BaselinePositionParams& p, BaselineKind kind,
-                                  const PositionSensorParams& sp, double start_m, double target_m, double duration_s,
-                                  int max_records) {
+PositionRun run_baseline_position(const ActuatorModel& model, const BaselinePositionParams& p,
+                                  BaselineKind kind, const PositionSensorParams& sp, double start_m,
+                                  double target_m, double duration_s, int max_records) {
   require_positive(duration_s, "duration_s");
   BaselinePositionController c(p, kind, model.params().drive.slew_rate_V_s);
   PositionSensor sensor(sp);

@@ -22,7 +22,7 @@ struct VelocityMetrics {
   double steady_state_error_rel = 0.0;  ///< (mean - reference) / reference
   double settling_time_s = 0.0;         ///< from then on the 5-period mean stays within +-5 %
   bool settled = false;
-  double ripple_m_s = 0.0;              ///< std of the one-period velocity over the second half
+  double ripple_m_s = 0.0;  ///< std of the one-period velocity over the second half
 };
 
 struct VelocityRun {
@@ -33,19 +33,19 @@ struct VelocityRun {
   VelocityMetrics metrics;
 };
 
-VelocityRun run_velocity(const stickslip::ActuatorModel& model, const StepMap* map, const VelocityControlParams& p,
-                         VelocityMode mode, double reference_m_s, double duration_s,
-                         const PositionSensorParams& sensor, double start_m = 0.0);
+VelocityRun run_velocity(const stickslip::ActuatorModel& model, const StepMap* map,
+                         const VelocityControlParams& p, VelocityMode mode, double reference_m_s,
+                         double duration_s, const PositionSensorParams& sensor, double start_m = 0.0);
 
 struct PositionMetrics {
-  double final_error_m = 0.0;   ///< |x - target| at the end (true position)
-  double overshoot_m = 0.0;     ///< largest excursion past the target in the direction of the move
-  double move_time_s = 0.0;     ///< time to hold (in position); the run length when never
+  double final_error_m = 0.0;  ///< |x - target| at the end (true position)
+  double overshoot_m = 0.0;    ///< largest excursion past the target in the direction of the move
+  double move_time_s = 0.0;    ///< time to hold (in position); the run length when never
   bool in_position = false;
-  double hold_pp_m = 0.0;       ///< peak-to-peak true position during the hold window
+  double hold_pp_m = 0.0;  ///< peak-to-peak true position during the hold window
   double hold_voltage_pp_V = 0.0;
-  bool stepped_in_hold = false; ///< the axis left hold for stepping (a limit cycle)
-  long switches = 0;            ///< stepping -> scanning switches
+  bool stepped_in_hold = false;  ///< the axis left hold for stepping (a limit cycle)
+  long switches = 0;             ///< stepping -> scanning switches
   bool end_stop = false;
 };
 
@@ -56,9 +56,10 @@ struct PositionRun {
 
 /// A hybrid move from `start_m` to `target_m`, then `hold_s` of hold. The run stops at
 /// `max_time_s` (default: from the step map's speed) when the axis never gets in position.
-PositionRun run_position(const stickslip::ActuatorModel& model, const StepMap& map, const PositionControlParams& p,
-                         const PositionSensorParams& sensor, double start_m, double target_m, double hold_s = 0.03,
-                         double max_time_s = 0.0, int max_records = 20000);
+PositionRun run_position(const stickslip::ActuatorModel& model, const StepMap& map,
+                         const PositionControlParams& p, const PositionSensorParams& sensor, double start_m,
+                         double target_m, double hold_s = 0.03, double max_time_s = 0.0,
+                         int max_records = 20000);
 
 /// The same move by a baseline, for `duration_s`.
 PositionRun run_baseline_position(const stickslip::ActuatorModel& model, const BaselinePositionParams& p,
@@ -72,8 +73,8 @@ struct TrackingRun {
 
 /// Tracks `reference(t, dt)` (called once per control tick, in time order) with the hybrid
 /// controller for `duration_s`; the errors are of the true position.
-TrackingRun run_tracking(const stickslip::ActuatorModel& model, const StepMap& map, const PositionControlParams& p,
-                         const PositionSensorParams& sensor, double start_m,
+TrackingRun run_tracking(const stickslip::ActuatorModel& model, const StepMap& map,
+                         const PositionControlParams& p, const PositionSensorParams& sensor, double start_m,
                          const std::function<ReferenceSample(double, double)>& reference, double duration_s,
                          int max_records = 20000);
 

@@ -15,12 +15,14 @@ void PositionControlParams::validate() const {
   require_positive(max_velocity_m_s, "position.max_velocity_m_s");
   require_non_negative(approach_distance_m, "position.approach_distance_m");
   require_positive(approach_frequency_Hz, "position.approach_frequency_Hz");
-  require(step_fraction > 0.0 && step_fraction <= 1.0, "position.step_fraction", "must be in (0, 1]", step_fraction);
+  require(step_fraction > 0.0 && step_fraction <= 1.0, "position.step_fraction", "must be in (0, 1]",
+          step_fraction);
   require_positive(scan_velocity_m_s, "position.scan_velocity_m_s");
   require_positive(scan_acceleration_m_s2, "position.scan_acceleration_m_s2");
   require_positive(scan_ki_1_s, "position.scan_ki_1_s");
   require_positive(hold_ki_1_s, "position.hold_ki_1_s");
-  require(reach_margin > 0.0 && reach_margin <= 1.0, "position.reach_margin", "must be in (0, 1]", reach_margin);
+  require(reach_margin > 0.0 && reach_margin <= 1.0, "position.reach_margin", "must be in (0, 1]",
+          reach_margin);
   require_non_negative(backward_window_m, "position.backward_window_m");
   require_in_range(raise_voltage_V, 1.0, 100.0, "position.raise_voltage_V");
   require_non_negative(stroke_margin_m, "position.stroke_margin_m");
@@ -52,8 +54,8 @@ std::string to_string(AxisMode m) {
   return "idle";
 }
 
-PositionController::PositionController(const PositionControlParams& p, const stickslip::StickSlipParams& model,
-                                       const StepMap& map)
+PositionController::PositionController(const PositionControlParams& p,
+                                       const stickslip::StickSlipParams& model, const StepMap& map)
     : p_(p),
       map_(map),
       pi_(model.hysteresis),
@@ -89,6 +91,8 @@ void PositionController::set_target(double target_m, double velocity_m_s) noexce
   target_ = target_m;
   v_ff_ = velocity_m_s;
   has_target_ = true;
+  raise_count_ = 0;
+  raise_stalls_ = 0;
   if (mode_ == AxisMode::kEndStop || mode_ == AxisMode::kEmergencyStop || mode_ == AxisMode::kIdle) {
     gen_.halt();
     mode_ = AxisMode::kIdle;  // decide() at the next update
@@ -122,7 +126,8 @@ void PositionController::enter_scan(double x) noexcept {
 void PositionController::plan_period(double x) noexcept {
   // The period now running was latched earlier: plan the next one from its predicted end.
   const Direction cur = gen_.direction();
-  const double cur_step = gen_.amplitude_V() > 0.0 ? map_.step_m(gen_.amplitude_V(), gen_.frequency_Hz(), cur) : 0.0;
+  const double cur_step =
+      gen_.amplitude_V() > 0.0 ? map_.step_m(gen_.amplitude_V(), gen_.frequency_Hz(), cur) : 0.0;
   const double x_pred = x + (cur == Direction::kForward ? cur_step : -cur_step);
   const double e = target_ - x_pred;
   const double f0 = frequency_for(std::abs(e));
@@ -130,8 +135,9 @@ void PositionController::plan_period(double x) noexcept {
   const double d = std::abs(e);
   if (dir == Direction::kForward) {
     // Stop when scanning (from U = 0 V at the period end) can take over.
-    const double reach_up = p_.reach_margin * g_ *
-                            (stickslip::pi_loading_curve(pi_, u_max_) - stickslip::pi_loading_curve(pi_, u_min_));
+    const double reach_up =
+        p_.reach_margin * g_ *
+        (stickslip::pi_loading_curve(pi_, u_max_) - stickslip::pi_loading_curve(pi_, u_min_));
     if (d <= reach_up) {
       gen_.stop_at_period_end();
       return;
@@ -170,9 +176,20 @@ void PositionController::decide(double x) noexcept {
   // A period starting at U = u_ adds the PE's present extension to the excursion.
   const double pre = dir == Direction::kForward ? 0.0 : pe_displacement_m(u_) - pe_displacement_m(u_min_);
   const double a_reach = map_.amplitude_for_reach(d - p_.stroke_margin_m - std::max(0.0, pre), f0, dir);
-  if (dir == Direction::kBackward && u_ < p_.raise_voltage_V && (d <= p_.backward_window_m || a_reach < a_min)) {
+  if (dir == Direction::kBackward && u_ < p_.raise_voltage_V &&
+      (d <= p_.backward_window_m || a_reach < a_min)) {
     // Backward finish: raise U with the abrupt edge (the slider mostly stays), then scan down.
     // A raise + a full scan down is a closed-loop backward step, repeated until in reach.
+    // Raise cycles that make no progress: the backward end stop.
+    const double least = p_.stall_fraction * map_.step_m(p_.raise_voltage_V, p_.approach_frequency_Hz, dir);
+    raise_stalls_ = (raise_count_ > 0 && x > x_raise_ - least) ? raise_stalls_ + 1 : 0;
+    ++raise_count_;
+    x_raise_ = x;
+    if (raise_stalls_ >= 3) {
+      u_ = 0.0;
+      mode_ = AxisMode::kEndStop;
+      return;
+    }
     mode_ = AxisMode::kRaise;
     return;
   }
@@ -187,7 +204,9 @@ void PositionController::decide(double x) noexcept {
   mode_ = AxisMode::kStepping;
   seen_periods_ = gen_.periods();
   x_period_ = x;
+  x_window_ = x;
   expected_step_ = s;
+  expected_sum_ = 0.0;
   stall_count_ = 0;
 }
 
@@ -208,17 +227,20 @@ void PositionController::update(double x) noexcept {
     case AxisMode::kStepping: {
       if (gen_.periods() != seen_periods_) {
         seen_periods_ = gen_.periods();
-        // End stop: the completed period moved far less than the model predicts.
+        // End stop: over stall_periods periods the axis moved far less than the model predicts
+        // (a window, not single periods: the sampling phase within a period adds jitter).
         const double sign = gen_.direction() == Direction::kForward ? 1.0 : -1.0;
-        if (expected_step_ > 0.0 && sign * (x - x_period_) < p_.stall_fraction * expected_step_) {
-          if (++stall_count_ >= p_.stall_periods) {
+        expected_sum_ += expected_step_;
+        if (++stall_count_ >= p_.stall_periods) {
+          if (sign * (x - x_window_) < p_.stall_fraction * expected_sum_) {
             gen_.halt();
             u_ = 0.0;
             mode_ = AxisMode::kEndStop;
             return;
           }
-        } else {
           stall_count_ = 0;
+          expected_sum_ = 0.0;
+          x_window_ = x;
         }
         x_period_ = x;
         expected_step_ = map_.step_m(gen_.amplitude_V(), gen_.frequency_Hz(), gen_.direction());

@@ -26,8 +26,8 @@
 namespace mc::control {
 
 struct PositionControlParams {
-  double control_rate_Hz = 10000.0;      ///< rate of update()
-  double step_frequency_Hz = 2000.0;     ///< stepping frequency when not velocity limited
+  double control_rate_Hz = 10000.0;   ///< rate of update()
+  double step_frequency_Hz = 2000.0;  ///< stepping frequency when not velocity limited
   /// Within this distance of the target the axis steps at approach_frequency_Hz: at 2 kHz the
   /// slider no longer sticks between steps and coasts ~1 um when the sawtooth stops.
   double approach_distance_m = 20e-6;
@@ -35,23 +35,23 @@ struct PositionControlParams {
   /// A step is at most this fraction of the remaining distance: the step map is measured from
   /// rest, and a slider still moving from earlier steps goes further.
   double step_fraction = 0.25;
-  double max_velocity_m_s = 1.5e-3;      ///< velocity limit in stepping (frequency lowered)
+  double max_velocity_m_s = 1.5e-3;  ///< velocity limit in stepping (frequency lowered)
   /// Velocity and acceleration limits of the scanning reference: the slider rides on the friction
   /// contact's 600 Hz mode (errata 2), which a velocity step v rings by ~v / omega.
   double scan_velocity_m_s = 2.0e-4;
   double scan_acceleration_m_s2 = 0.03;
-  double scan_ki_1_s = 300.0;            ///< integral gain of the scanning loop [1/s]
-  double hold_ki_1_s = 100.0;            ///< integral gain in hold [1/s]
-  double reach_margin = 0.8;             ///< fraction of the PE stroke trusted for scanning
-  double backward_window_m = 150e-9;     ///< backward stepping stops this close above the target
-  double raise_voltage_V = 100.0;        ///< U after the raise that starts a backward scan
-  double stroke_margin_m = 30e-9;        ///< forward: x + g H(A) + margin must stay below target
-  double in_position_m = 3e-9;           ///< |error| (filtered) that counts as in position ...
-  double settle_s = 2e-3;                ///< ... for this long
-  double filter_s = 1e-3;                ///< time constant of the in-position filter
-  int saturation_ticks = 20;             ///< scanning saturated this long -> back to stepping
-  double stall_fraction = 0.1;           ///< end stop: step < fraction of the expected one ...
-  int stall_periods = 10;                ///< ... for this many periods
+  double scan_ki_1_s = 300.0;         ///< integral gain of the scanning loop [1/s]
+  double hold_ki_1_s = 100.0;         ///< integral gain in hold [1/s]
+  double reach_margin = 0.8;          ///< fraction of the PE stroke trusted for scanning
+  double backward_window_m = 150e-9;  ///< backward stepping stops this close above the target
+  double raise_voltage_V = 100.0;     ///< U after the raise that starts a backward scan
+  double stroke_margin_m = 30e-9;     ///< forward: x + g H(A) + margin must stay below target
+  double in_position_m = 3e-9;        ///< |error| (filtered) that counts as in position ...
+  double settle_s = 2e-3;             ///< ... for this long
+  double filter_s = 1e-3;             ///< time constant of the in-position filter
+  int saturation_ticks = 20;          ///< scanning saturated this long -> back to stepping
+  double stall_fraction = 0.1;        ///< end stop: step < fraction of the expected one ...
+  int stall_periods = 10;             ///< ... for this many periods
 
   template <class V>
   void visit(V& v) {
@@ -86,7 +86,8 @@ class PositionController {
  public:
   /// `model` gives the PE gain, the hysteresis and the drive limits; `map` the step lengths. Both
   /// must outlive the controller. Allocates (the hysteresis observer) here only.
-  PositionController(const PositionControlParams& p, const stickslip::StickSlipParams& model, const StepMap& map);
+  PositionController(const PositionControlParams& p, const stickslip::StickSlipParams& model,
+                     const StepMap& map);
 
   /// New target [m]; `velocity_m_s` is the reference velocity (trajectory feedforward, 0 for a
   /// move). Clears an end stop. Never allocates.
@@ -135,7 +136,8 @@ class PositionController {
   double x_filt_ = 0.0, settled_s_ = 0.0;
   double x_last_ = 0.0, x_period_ = 0.0, expected_step_ = 0.0;
   std::int64_t seen_periods_ = 0, switches_ = 0;
-  int sat_count_ = 0, stall_count_ = 0;
+  int sat_count_ = 0, stall_count_ = 0, raise_count_ = 0, raise_stalls_ = 0;
+  double x_window_ = 0.0, expected_sum_ = 0.0, x_raise_ = 0.0;
   bool have_x_ = false, has_target_ = false;
 };
 

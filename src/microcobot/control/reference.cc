@@ -22,16 +22,19 @@ ReferenceSample ReferenceLimiter::step(double setpoint_m, double dt_s) noexcept 
   const double e = setpoint_m - s_.x_m;
   const double a = lim_.max_acceleration_m_s2;
   // Velocity that still stops on the setpoint, accounting for the discrete step.
-  const double brake = std::sqrt(std::max(0.0, 2.0 * a * std::abs(e) + 0.25 * a * a * dt_s * dt_s)) - 0.5 * a * dt_s;
+  const double brake =
+      std::sqrt(std::max(0.0, 2.0 * a * std::abs(e) + 0.25 * a * a * dt_s * dt_s)) - 0.5 * a * dt_s;
   double v_cmd = std::copysign(std::min(lim_.max_velocity_m_s, brake), e);
   if (std::abs(e) < 1e-15) v_cmd = 0.0;
   const double dv = std::clamp(v_cmd - s_.v_m_s, -a * dt_s, a * dt_s);
   const double v_new = s_.v_m_s + dv;
-  double x_new = s_.x_m + 0.5 * (s_.v_m_s + v_new) * dt_s;
-  // Land exactly on the setpoint instead of dithering around it.
-  if ((setpoint_m - x_new) * e <= 0.0 && std::abs(v_new) <= a * dt_s) {
-    x_new = setpoint_m;
-    s_ = ReferenceSample{x_new, 0.0, -s_.v_m_s / dt_s};
+  // x advances by v_new dt: with the discrete braking velocity above, the reference reaches the
+  // setpoint without crossing it; it lands exactly when the last step would reach it.
+  const double x_new = s_.x_m + v_new * dt_s;
+  if ((setpoint_m - x_new) * e <= 0.0) {
+    // On the setpoint; the velocity decays at the acceleration limit (at most a step or two).
+    const double v_land = std::abs(s_.v_m_s) <= a * dt_s * (1.0 + 1e-9) ? 0.0 : v_new;
+    s_ = ReferenceSample{setpoint_m, v_land, (v_land - s_.v_m_s) / dt_s};
     return s_;
   }
   s_ = ReferenceSample{x_new, v_new, dv / dt_s};

@@ -11,8 +11,8 @@
 namespace mc::control {
 
 struct MotionLimits {
-  double max_velocity_m_s = 200e-6;       ///< default: 200 um/s, within one axis' stepping speed
-  double max_acceleration_m_s2 = 2e-3;    ///< default: 2 mm/s^2
+  double max_velocity_m_s = 200e-6;     ///< default: 200 um/s, within one axis' stepping speed
+  double max_acceleration_m_s2 = 2e-3;  ///< default: 2 mm/s^2
 
   template <class V>
   void visit(V& v) {

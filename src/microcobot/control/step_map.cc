@@ -26,8 +26,8 @@ void StepMapParams::validate() const {
 
 StepMeasurement measure_step(const stickslip::ActuatorModel& model, double amplitude_V, double frequency_Hz,
                              Direction direction, int warmup_periods, int measure_periods) {
-  const auto wave = stickslip::make_waveform(stickslip::WaveKind::kSawtooth, amplitude_V, frequency_Hz, direction,
-                                             model.params().drive);
+  const auto wave = stickslip::make_waveform(stickslip::WaveKind::kSawtooth, amplitude_V, frequency_Hz,
+                                             direction, model.params().drive);
   stickslip::ActuatorState s = model.initial_state();
   model.set_operating_point(s, amplitude_V, frequency_Hz, direction);
   const double dt = model.dt_s();

@@ -16,8 +16,8 @@ namespace mc::control {
 struct StepMapParams {
   std::vector<double> amplitudes_V = {40, 45, 50, 55, 60, 65, 70, 75, 80, 85, 90, 95, 100};
   std::vector<double> frequencies_Hz = {500, 1000, 2000};
-  int warmup_periods = 3;    ///< periods run before measuring (start transient)
-  int measure_periods = 6;   ///< periods averaged
+  int warmup_periods = 3;   ///< periods run before measuring (start transient)
+  int measure_periods = 6;  ///< periods averaged
 
   template <class V>
   void visit(V& v) {
@@ -39,7 +39,8 @@ class StepMap {
   double step_m(double amplitude_V, double frequency_Hz, stickslip::Direction direction) const noexcept;
   /// The smallest amplitude whose step reaches `step_m` at `frequency_Hz` (monotone part of the
   /// map); the largest amplitude when no grid amplitude reaches it. Never allocates.
-  double amplitude_for_step(double step_m, double frequency_Hz, stickslip::Direction direction) const noexcept;
+  double amplitude_for_step(double step_m, double frequency_Hz,
+                            stickslip::Direction direction) const noexcept;
   /// The smallest amplitude that gives a step of at least `min_fraction` of the largest one.
   double min_stepping_amplitude_V(double frequency_Hz, stickslip::Direction direction,
                                   double min_fraction = 0.05) const noexcept;
@@ -47,7 +48,8 @@ class StepMap {
   /// Reach [m] at (A, f, direction) (see StepMeasurement; bilinear, clamped). Never allocates.
   double reach_m(double amplitude_V, double frequency_Hz, stickslip::Direction direction) const noexcept;
   /// The largest amplitude whose reach stays below `room_m` (0 when none). Never allocates.
-  double amplitude_for_reach(double room_m, double frequency_Hz, stickslip::Direction direction) const noexcept;
+  double amplitude_for_reach(double room_m, double frequency_Hz,
+                             stickslip::Direction direction) const noexcept;
 
   const StepMapParams& params() const { return p_; }
   /// Signed steps [direction][amplitude][frequency] as calibrated (for reports and tests).
@@ -60,7 +62,8 @@ class StepMap {
   std::vector<std::vector<double>> fwd_, bwd_;  ///< |s|, monotone non-decreasing in A (clipped)
   std::vector<std::vector<double>> fwd_raw_, bwd_raw_;
   std::vector<std::vector<double>> fwd_reach_, bwd_reach_;  ///< monotone (running maximum) in A
-  double lookup(const std::vector<std::vector<double>>& g, double amplitude_V, double frequency_Hz) const noexcept;
+  double lookup(const std::vector<std::vector<double>>& g, double amplitude_V,
+                double frequency_Hz) const noexcept;
 };
 
 /// One grid point: the mean signed step per period and the reach, the furthest the slider goes
@@ -73,6 +76,6 @@ struct StepMeasurement {
 
 /// Runs the sawtooth (A, f, direction) from rest and measures it.
 StepMeasurement measure_step(const stickslip::ActuatorModel& model, double amplitude_V, double frequency_Hz,
-                    stickslip::Direction direction, int warmup_periods, int measure_periods);
+                             stickslip::Direction direction, int warmup_periods, int measure_periods);
 
 }  // namespace mc::control

@@ -91,7 +91,8 @@ void VelocityController::update(double measured_position_m) noexcept {
   if (gen_.periods() == seen_periods_) return;  // the amplitude changes only at period boundaries
   seen_periods_ = gen_.periods();
   // Positions one period apart in a ring: v = (x_k - x_{k-N}) / (N T).
-  for (int i = std::min(count_, kMaxDelay); i > 0; --i) ring_[static_cast<std::size_t>(i)] = ring_[static_cast<std::size_t>(i - 1)];
+  for (int i = std::min(count_, kMaxDelay); i > 0; --i)
+    ring_[static_cast<std::size_t>(i)] = ring_[static_cast<std::size_t>(i - 1)];
   ring_[0] = measured_position_m;
   count_ = std::min(count_ + 1, kMaxDelay + 1);
   const int n = std::min(p_.delay_periods, count_ - 1);

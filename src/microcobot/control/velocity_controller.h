@@ -29,7 +29,7 @@ struct VelocityControlParams {
   double control_rate_Hz = 10000.0;       ///< rate of update() (position sampling)
   /// PID on the amplitude [V per m/s]; tuned on the default model (docs/parameters.md).
   PidParams pid{2.0e4, 1.5e7, 0.0, 0.0, 0.0, 100.0};
-  double nominal_step_m = 300e-9;    ///< open-loop baseline: step at nominal_amplitude_V (datasheet-like)
+  double nominal_step_m = 300e-9;  ///< open-loop baseline: step at nominal_amplitude_V (datasheet-like)
   double nominal_amplitude_V = 100.0;
   double stall_fraction = 0.1;  ///< end stop: |v| < stall_fraction |v_ref| ...
   int stall_periods = 20;       ///< ... for this many periods at full amplitude

@@ -43,8 +43,8 @@ XyzStage::XyzStage(const stickslip::ActuatorModel& model, const StepMap& map, co
 
 void XyzStage::place(Axis a, double position_m) {
   const double half = 0.5 * model_.params().slider.stroke_m;
-  require(std::isfinite(position_m) && std::abs(position_m) <= half, "position_m", "must lie within the stroke",
-          position_m);
+  require(std::isfinite(position_m) && std::abs(position_m) <= half, "position_m",
+          "must lie within the stroke", position_m);
   auto& ax = axes_[static_cast<std::size_t>(a)];
   ax.state = model_.initial_state();
   ax.state.x2_m = {position_m, position_m};

@@ -37,8 +37,8 @@ struct XyzStageParams {
 };
 
 struct AxisStatus {
-  double position_m = 0.0;   ///< true slider position (simulation)
-  double measured_m = 0.0;   ///< last sensor reading
+  double position_m = 0.0;  ///< true slider position (simulation)
+  double measured_m = 0.0;  ///< last sensor reading
   double voltage_V = 0.0;
   AxisMode mode = AxisMode::kIdle;
   bool end_stop = false;
@@ -63,7 +63,9 @@ class XyzStage {
   /// True once an axis diverged (every axis was then stopped at 0 V).
   bool fault() const noexcept { return diverged_; }
   double tick_s() const noexcept { return static_cast<double>(ratio_) * model_.dt_s(); }
-  const stickslip::ActuatorState& state(Axis a) const noexcept { return axes_[static_cast<std::size_t>(a)].state; }
+  const stickslip::ActuatorState& state(Axis a) const noexcept {
+    return axes_[static_cast<std::size_t>(a)].state;
+  }
 
  private:
   struct AxisUnit {
