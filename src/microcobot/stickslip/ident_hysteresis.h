@@ -9,8 +9,11 @@
 ///    x2 = x0 + sum_i w'_i y_i (the PE follows quasi-statically far below the 600 Hz mode);
 ///  - the weights w'_i >= 0 by non-negative least squares (Lawson-Hanson, ident/nnls.h), the
 ///    offset x0 free (the "shift to the positive section" of step (ii));
-///  - only samples after the input has visited its minimum and maximum are fitted: from then on
-///    every operator's state is fixed by the input alone (wiping-out), whatever the history before.
+///  - a record starting at rest at its lowest voltage is fitted whole, with thresholds over the
+///    whole range (the initial loading identifies the wide operators) and the offset fixed to the
+///    rest position; otherwise only samples after the input has visited its minimum and maximum
+///    are fitted (from then on every operator's state is set by the input alone: wiping-out), with
+///    thresholds over half the range and a free offset.
 /// The weights are split as w'_i = g w_i, with g (the PE's static gain, m/V) chosen so that the
 /// loading curve maps the top of the input range to itself (the convention of the defaults).
 
@@ -18,6 +21,7 @@
 
 #include "microcobot/stickslip/ident_record.h"
 #include "microcobot/stickslip/prandtl_ishlinskii.h"
+#include "microcobot/stickslip/stickslip_params.h"
 
 namespace mc::stickslip {
 
@@ -38,9 +42,14 @@ struct HysteresisResult {
 /// Throws mc::UsageError for operators < 1, mc::InvalidInput for a record whose voltage spans
 /// less than 1 V or does not complete an excursion min -> max -> min (too short), and
 /// mc::ComputationFailed for a degenerate fit (zero gain).
-HysteresisResult identify_hysteresis(const MeasuredRecord& rec, int operators = 35);
+/// With `dynamics` (the PE and asperities of step 1), each operator output is passed through the
+/// elastic-phase response of the slider (elastic_slider_response) before the regression, so that
+/// the slider's lag at the sine frequency is not mistaken for hysteresis; without it the PE and
+/// slider are taken as quasi-static (the thesis's procedure).
+HysteresisResult identify_hysteresis(const MeasuredRecord& rec, int operators = 35,
+                                     const StickSlipParams* dynamics = nullptr);
 
-/// The partition used above: r_i = (range / 2) (i / n)^2, i = 0..n-1.
+/// The partition used above: r_i = (span / 2) (i / n)^2, i = 0..n-1 (span = range or 2 range).
 std::vector<double> pi_thresholds(double range_V, int operators);
 
 }  // namespace mc::stickslip

@@ -1,0 +1,473 @@
+// `microcobot identify ...`: identification of a stick-slip axis from measured data (thesis
+// §2.5.2, issue #5). Each command writes the identified parameter file (the keys of
+// `stickslip params`), a report section with the fit plots (--out DIR) and --json.
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "microcobot/core/csv.h"
+#include "microcobot/core/error.h"
+#include "microcobot/core/params.h"
+#include "microcobot/stickslip/ident_all.h"
+#include "microcobot/stickslip/ident_synthetic.h"
+
+namespace {
+
+namespace ss = mc::stickslip;
+using mc::cli::CommonOptions;
+using nlohmann::json;
+
+struct Opts {
+  CommonOptions common;
+  std::string in;
+  std::string save;
+  int operators = 35;
+  unsigned threads = 0;
+  std::string grid = "small";
+  std::uint64_t seed = 1;
+};
+
+ss::StickSlipParams base_params(const CommonOptions& o) {
+  return o.params ? mc::load_params<ss::StickSlipParams>(*o.params) : ss::StickSlipParams{};
+}
+
+/// Writes the identified parameters to --save FILE and/or DIR/params.yaml; returns the paths.
+json save_params(const Opts& o, const ss::StickSlipParams& p) {
+  json files = json::array();
+  const std::string yaml =
+      "# identified by microcobot identify (thesis section 2.5.2)\n" + mc::params_to_yaml(p);
+  if (!o.save.empty()) {
+    mc::write_file_atomic(o.save, yaml);
+    files.push_back(o.save);
+  }
+  if (o.common.out) {
+    mc::ensure_writable_dir(*o.common.out);
+    mc::write_file_atomic(*o.common.out / "params.yaml", yaml);
+    files.push_back((*o.common.out / "params.yaml").string());
+  }
+  return files;
+}
+
+/// At most `max` points of a curve (plots stay light).
+mc::report::Series series(std::string name, const std::vector<double>& x, const std::vector<double>& y,
+                          double yscale = 1.0, std::size_t max = 4000, bool points = false) {
+  mc::report::Series s;
+  s.name = std::move(name);
+  s.points = points;
+  const std::size_t step = std::max<std::size_t>(1, x.size() / max);
+  for (std::size_t i = 0; i < x.size(); i += step) {
+    s.x.push_back(x[i]);
+    s.y.push_back(y[i] * yscale);
+  }
+  return s;
+}
+
+json mode_json(const ss::ModeEstimate& m) {
+  return {{"frequency_Hz", m.frequency_Hz}, {"damping_ratio", m.damping_ratio}};
+}
+
+void pe_section(mc::report::Report& rep, const ss::MeasuredRecord& rec, const ss::PeModesResult& r) {
+  rep.section(
+      "identification: PE modes (thesis 2.5.2.1, Fig. 2.10)",
+      "Step response of the PE without slider. The PSD of the free response gives the resonances; a "
+      "separable nonlinear least-squares fit of the time response gives frequencies, damping ratios and the "
+      "split of the static gain between the two modes.");
+  rep.add_result("mode a frequency", r.a.frequency_Hz, "Hz");
+  rep.add_result("mode a damping ratio", r.a.damping_ratio);
+  rep.add_result("mode b frequency", r.b.frequency_Hz, "Hz");
+  rep.add_result("mode b damping ratio", r.b.damping_ratio);
+  rep.add_result("gain fraction phi (mode a)", r.gain_fraction_a);
+  rep.add_result("fit RMS residual", r.rms_m, "m");
+  std::vector<double> f, p;
+  for (std::size_t i = 1; i < r.psd.f_Hz.size(); ++i) {
+    if (r.psd.value[i] > 0) {
+      f.push_back(r.psd.f_Hz[i]);
+      p.push_back(r.psd.value[i]);
+    }
+  }
+  rep.add_figure({"PSD of the PE free response",
+                  "Resonance peaks seed the time-domain fit.",
+                  {"Frequency", "Hz", true},
+                  {"PSD", "m^2/Hz", true},
+                  {series("measured", f, p)}});
+  rep.add_figure({"PE step response",
+                  "Measured (with sensor effects) and identified model.",
+                  {"Time", "s"},
+                  {"x1", "m"},
+                  {series("measured", rec.t_s, rec.x_m), series("model", rec.t_s, r.fitted_m)}});
+}
+
+void friction_section(mc::report::Report& rep, const ss::MeasuredRecord& rec,
+                      const ss::FrictionModesResult& r) {
+  rep.section(
+      "identification: asperity modes (thesis 2.5.2.1, Fig. 2.11)",
+      "Step response of the actuator in scanning mode (no slip). Each asperity's contact stiffness and "
+      "damping (eq. 2.20-2.21) gives one mode of the slider; the fit also gives the slider's mass split.");
+  rep.add_result("asperity a mode", r.a.frequency_Hz, "Hz");
+  rep.add_result("asperity a damping ratio", r.a.damping_ratio);
+  rep.add_result("asperity b mode", r.b.frequency_Hz, "Hz");
+  rep.add_result("asperity b damping ratio", r.b.damping_ratio);
+  rep.add_result("rho0_a", r.params.rho0_a_N_m, "N/m");
+  rep.add_result("rho1_a", r.params.rho1_a_N_s_m, "N s/m");
+  rep.add_result("rho0_b", r.params.rho0_b_N_m, "N/m");
+  rep.add_result("rho1_b", r.params.rho1_b_N_s_m, "N s/m");
+  rep.add_result("mass fraction c_a", r.mass_fraction_a);
+  rep.add_result("fit RMS residual", r.rms_m, "m");
+  std::vector<double> f, p;
+  for (std::size_t i = 1; i < r.psd.f_Hz.size(); ++i) {
+    if (r.psd.value[i] > 0) {
+      f.push_back(r.psd.f_Hz[i]);
+      p.push_back(r.psd.value[i]);
+    }
+  }
+  rep.add_figure({"PSD of the actuator's free response",
+                  "The two asperity modes.",
+                  {"Frequency", "Hz", true},
+                  {"PSD", "m^2/Hz", true},
+                  {series("measured", f, p)}});
+  rep.add_figure({"Actuator step response (scanning mode)",
+                  "Measured and identified elastic-phase model.",
+                  {"Time", "s"},
+                  {"x2", "m"},
+                  {series("measured", rec.t_s, rec.x_m), series("model", rec.t_s, r.fitted_m)}});
+}
+
+void hysteresis_section(mc::report::Report& rep, const ss::MeasuredRecord& rec,
+                        const ss::HysteresisResult& r) {
+  rep.section(
+      "identification: PI hysteresis (thesis 2.5.2.2, Fig. 2.12)",
+      "Play-operator thresholds on a non-uniform partition of the input range; weights by non-negative "
+      "least squares; the inverse PI model for feed-forward.");
+  rep.add_result("operators", static_cast<double>(r.pi.size()));
+  rep.add_result("static gain g", r.static_gain_m_V, "m/V");
+  rep.add_result("loop RMS error", r.rms_m, "m");
+  rep.add_result("loop RMS error / stroke", r.rms_fraction);
+  rep.add_result("max |H^-1(H(U)) - U|", r.inverse_max_error_V, "V");
+  std::vector<double> u(rec.u_V.begin() + static_cast<long>(r.first_fitted), rec.u_V.end());
+  std::vector<double> xm(rec.x_m.begin() + static_cast<long>(r.first_fitted), rec.x_m.end());
+  std::vector<double> xf(r.fitted_m.begin() + static_cast<long>(r.first_fitted), r.fitted_m.end());
+  rep.add_figure({"Hysteresis loop x2(U)",
+                  "Measured and PI model.",
+                  {"Voltage", "V"},
+                  {"x2", "m"},
+                  {series("measured", u, xm, 1.0, 3000, true), series("PI model", u, xf)}});
+  std::vector<double> uu, hh, back;
+  ss::PiState sf = ss::make_pi_state(r.pi), si = ss::make_pi_state(r.inverse);
+  for (int k = 0; k <= 400; ++k) {
+    const double t = static_cast<double>(k) / 400.0;
+    const double v = 100.0 * 0.5 * (1.0 - std::cos(2 * M_PI * 1.5 * t)) * (1.0 - 0.5 * t);
+    uu.push_back(v);
+    hh.push_back(ss::pi_update(r.pi, sf, v));
+    back.push_back(ss::pi_update(r.inverse, si, hh.back()));
+  }
+  rep.add_figure({"PI model and its inverse",
+                  "H(U) and H^-1(H(U)) = U on a decaying excitation.",
+                  {"Voltage U", "V"},
+                  {"Equivalent voltage", "V"},
+                  {series("H(U)", uu, hh), series("H^-1(H(U))", uu, back)}});
+}
+
+void breakaway_section(mc::report::Report& rep, const ss::BreakawayResult& r) {
+  rep.section("identification: break-away strain (thesis 2.5.2.3, Fig. 2.13)",
+              "z_ba of each sawtooth run, matching the measured mean velocity with the simulated one.");
+  rep.add_result("runs", static_cast<double>(r.runs.size()));
+  rep.add_result("skipped runs", static_cast<double>(r.skipped));
+  const auto& t = r.table;
+  for (std::size_t j = 0; j < t.frequencies_Hz.size(); ++j) {
+    std::vector<double> zf, zb;
+    for (std::size_t i = 0; i < t.amplitudes_V.size(); ++i) {
+      zf.push_back(t.forward_m[i][j]);
+      zb.push_back(t.backward_m[i][j]);
+    }
+    rep.add_figure({fmt::format("z_ba versus amplitude at {:g} Hz", t.frequencies_Hz[j]),
+                    "Identified table (cells without a stepping run are filled from neighbours).",
+                    {"Sawtooth amplitude", "V"},
+                    {"z_ba", "m"},
+                    {series("z_ba(+) forward", t.amplitudes_V, zf, 1.0, 4000, true),
+                     series("z_ba(-) backward", t.amplitudes_V, zb, 1.0, 4000, true)}});
+  }
+  std::vector<double> vm, vs;
+  for (const auto& run : r.runs) {
+    if (!run.ok) continue;
+    vm.push_back(run.v_measured_m_s);
+    vs.push_back(run.v_simulated_m_s);
+  }
+  if (!vm.empty()) {
+    rep.add_figure({"Simulated versus measured mean velocity",
+                    "Each point one run (both directions).",
+                    {"measured velocity", "m/s"},
+                    {"simulated velocity", "m/s"},
+                    {series("runs", vm, vs, 1.0, 4000, true), series("identity", vm, vm, 1.0, 4000, true)}});
+  }
+}
+
+json runs_json(const ss::BreakawayResult& r) {
+  json runs = json::array();
+  for (const auto& x : r.runs) {
+    json j{{"name", x.name},
+           {"amplitude_V", x.amplitude_V},
+           {"frequency_Hz", x.frequency_Hz},
+           {"direction", ss::to_string(x.direction)},
+           {"ok", x.ok},
+           {"v_measured_m_s", x.v_measured_m_s},
+           {"simulations", x.simulations}};
+    if (x.ok) {
+      j["z_ba_m"] = x.z_ba_m;
+      j["v_simulated_m_s"] = x.v_simulated_m_s;
+    } else {
+      j["skipped"] = x.skipped;
+    }
+    runs.push_back(j);
+  }
+  return runs;
+}
+
+json pe_json(const ss::PeModesResult& r) {
+  return {{"mode_a", mode_json(r.a)},
+          {"mode_b", mode_json(r.b)},
+          {"gain_fraction_a", r.gain_fraction_a},
+          {"static_gain_m_V", r.static_gain_m_V},
+          {"psd_peaks_Hz", r.psd_peaks_Hz},
+          {"rms_m", r.rms_m},
+          {"step_V", r.step_V}};
+}
+json friction_json(const ss::FrictionModesResult& r) {
+  return {{"mode_a", mode_json(r.a)},
+          {"mode_b", mode_json(r.b)},
+          {"rho0_a_N_m", r.params.rho0_a_N_m},
+          {"rho1_a_N_s_m", r.params.rho1_a_N_s_m},
+          {"rho0_b_N_m", r.params.rho0_b_N_m},
+          {"rho1_b_N_s_m", r.params.rho1_b_N_s_m},
+          {"mass_fraction_a", r.mass_fraction_a},
+          {"psd_peaks_Hz", r.psd_peaks_Hz},
+          {"rms_m", r.rms_m}};
+}
+json hysteresis_json(const ss::HysteresisResult& r) {
+  return {{"thresholds_V", r.pi.thresholds_V},
+          {"weights", r.pi.weights},
+          {"static_gain_m_V", r.static_gain_m_V},
+          {"rms_m", r.rms_m},
+          {"stroke_m", r.stroke_m},
+          {"rms_fraction_of_stroke", r.rms_fraction},
+          {"inverse", {{"thresholds_V", r.inverse.thresholds_V}, {"weights", r.inverse.weights}}},
+          {"inverse_max_error_V", r.inverse_max_error_V}};
+}
+
+void finish(const Opts& o, const std::string& title, const ss::StickSlipParams& p, json j,
+            const mc::report::Report& rep, const std::string& human) {
+  j["params_files"] = save_params(o, p);
+  mc::cli::write_report_if_requested(o.common, rep);
+  (void)title;
+  mc::cli::emit(o.common, j, human);
+}
+
+void progress_cb(const std::string& task, std::size_t d, std::size_t t) { mc::cli::progress(task, d, t); }
+
+CLI::App* command(CLI::App& group, const std::string& name, const std::string& help, std::shared_ptr<Opts> o,
+                  const std::string& in_help) {
+  auto* cmd = group.add_subcommand(name, help);
+  cmd->add_option("--in", o->in, in_help)->required();
+  cmd->add_option("--save", o->save, "Also write the identified parameter file here (YAML)");
+  mc::cli::add_params_option(*cmd, o->common);
+  mc::cli::add_output_options(*cmd, o->common);
+  return cmd;
+}
+
+void add_identify(CLI::App& group) {
+  group.require_subcommand(1);
+  {
+    auto o = std::make_shared<Opts>();
+    command(group, "pe-modes",
+            "PE modes (frequency, damping, gain split) from a step of the PE without slider", o,
+            "CSV t_s,u_V,x_m: PE step response (~1 MHz)")
+        ->callback([o] {
+          const auto base = base_params(o->common);
+          const auto rec = ss::read_record(o->in);
+          const auto r = ss::identify_pe_modes(rec, base.pe);
+          auto p = base;
+          p.pe = r.params;
+          mc::report::Report rep("identify pe-modes");
+          pe_section(rep, rec, r);
+          finish(*o, "pe-modes", p, pe_json(r), rep,
+                 fmt::format(
+                     "PE modes: {:.5g} Hz (zeta {:.4f}), {:.5g} Hz (zeta {:.4f}); gain split phi = {:.3f}",
+                     r.a.frequency_Hz, r.a.damping_ratio, r.b.frequency_Hz, r.b.damping_ratio,
+                     r.gain_fraction_a));
+        });
+  }
+  {
+    auto o = std::make_shared<Opts>();
+    command(group, "friction-modes",
+            "The two asperities (rho0, rho1 each) from a scanning-mode step response", o,
+            "CSV t_s,u_V,x_m: actuator step response (~25 kHz)")
+        ->callback([o] {
+          const auto base = base_params(o->common);
+          const auto rec = ss::read_record(o->in);
+          const auto r = ss::identify_friction_modes(rec, base);
+          auto p = base;
+          p.friction = r.params;
+          mc::report::Report rep("identify friction-modes");
+          friction_section(rep, rec, r);
+          finish(*o, "friction-modes", p, friction_json(r), rep,
+                 fmt::format("asperity modes: {:.5g} Hz (zeta {:.3f}), {:.5g} Hz (zeta {:.3f}); c_a = {:.3f}",
+                             r.a.frequency_Hz, r.a.damping_ratio, r.b.frequency_Hz, r.b.damping_ratio,
+                             r.mass_fraction_a));
+        });
+  }
+  {
+    auto o = std::make_shared<Opts>();
+    auto* cmd =
+        command(group, "hysteresis", "PI thresholds and weights (NNLS) and the inverse from a sine response",
+                o, "CSV t_s,u_V,x_m: slider response to a sine (scanning mode)");
+    cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
+        ->check(CLI::Range(1, 200));
+    cmd->callback([o] {
+      auto base = base_params(o->common);
+      const auto rec = ss::read_record(o->in);
+      const auto r = ss::identify_hysteresis(rec, o->operators, o->common.params ? &base : nullptr);
+      base.hysteresis = r.pi;
+      base.pe.static_gain_m_V = r.static_gain_m_V;
+      mc::report::Report rep("identify hysteresis");
+      hysteresis_section(rep, rec, r);
+      finish(*o, "hysteresis", base, hysteresis_json(r), rep,
+             fmt::format(
+                 "PI model: {} operators, g = {:.4g} m/V, loop RMS error {:.3g} m = {:.2f}% of the stroke",
+                 r.pi.size(), r.static_gain_m_V, r.rms_m, 100 * r.rms_fraction));
+    });
+  }
+  {
+    auto o = std::make_shared<Opts>();
+    auto* cmd = command(group, "breakaway", "z_ba of each sawtooth run and the surface z_ba(A, f, direction)",
+                        o, "Directory of sawtooth_<A>V_<f>Hz_<forward|backward>.csv runs");
+    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 64));
+    cmd->callback([o] {
+      auto base = base_params(o->common);
+      const auto runs = ss::read_sawtooth_runs(o->in);
+      const ss::ActuatorModel model(base);
+      ss::BreakawayOptions bo;
+      bo.threads = o->threads;
+      const auto r = ss::identify_breakaway(runs, model, bo, [](std::size_t d, std::size_t t) {
+        progress_cb("identify breakaway (runs)", d, t);
+      });
+      base.breakaway = r.table;
+      mc::report::Report rep("identify breakaway");
+      breakaway_section(rep, r);
+      json j{{"runs", runs_json(r)}, {"skipped", r.skipped}, {"filled_cells", r.filled}};
+      finish(*o, "breakaway", base, j, rep,
+             fmt::format("z_ba identified for {} of {} runs ({} skipped)", r.runs.size() - r.skipped,
+                         r.runs.size(), r.skipped));
+    });
+  }
+  {
+    auto o = std::make_shared<Opts>();
+    auto* cmd = command(group, "all", "The three steps of section 2.5.2 in order, one parameter file", o,
+                        "Directory with pe_step.csv (optional), step.csv, sine.csv, sawtooth_*.csv");
+    cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
+        ->check(CLI::Range(1, 200));
+    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 64));
+    cmd->callback([o] {
+      const auto base = base_params(o->common);
+      ss::IdentifyAllOptions io;
+      io.operators = o->operators;
+      io.breakaway.threads = o->threads;
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto r = ss::identify_all(o->in, base, io, progress_cb);
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      mc::report::Report rep("identify all");
+      const std::filesystem::path dir(o->in);
+      if (r.pe) pe_section(rep, ss::read_record(dir / "pe_step.csv"), *r.pe);
+      friction_section(rep, ss::read_record(dir / "step.csv"), r.friction);
+      hysteresis_section(rep, ss::read_record(dir / "sine.csv"), r.hysteresis);
+      breakaway_section(rep, r.breakaway);
+      json j{{"friction_modes", friction_json(r.friction)},
+             {"hysteresis", hysteresis_json(r.hysteresis)},
+             {"breakaway",
+              {{"runs", runs_json(r.breakaway)},
+               {"skipped", r.breakaway.skipped},
+               {"filled_cells", r.breakaway.filled}}},
+             {"notes", r.notes},
+             {"elapsed_s", secs}};
+      if (r.pe) j["pe_modes"] = pe_json(*r.pe);
+      finish(*o, "all", r.params, j, rep,
+             fmt::format(
+                 "identified in {:.1f} s: PE {}, asperities {:.4g}/{:.4g} Hz, PI loop error {:.2f}% of the "
+                 "stroke, z_ba for {} of {} runs\n{}",
+                 secs,
+                 r.pe ? fmt::format("{:.4g}/{:.4g} Hz", r.pe->a.frequency_Hz, r.pe->b.frequency_Hz)
+                      : std::string("kept"),
+                 r.friction.a.frequency_Hz, r.friction.b.frequency_Hz, 100 * r.hysteresis.rms_fraction,
+                 r.breakaway.runs.size() - r.breakaway.skipped, r.breakaway.runs.size(),
+                 fmt::format("{}", fmt::join(r.notes, "\n"))));
+    });
+  }
+  {
+    auto o = std::make_shared<Opts>();
+    auto* cmd = group.add_subcommand(
+        "synth", "Write a synthetic measurement campaign (simulated axis + sensor effects) for identify all");
+    cmd->add_option("--grid", o->grid,
+                    "small (4x3x2 runs) or full (10 amplitudes x 5 frequencies x 2 directions)")
+        ->check(CLI::IsMember({"small", "full"}));
+    cmd->add_option("--seed", o->seed, "Noise seed");
+    mc::cli::add_params_option(*cmd, o->common);
+    cmd->add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");
+    cmd->add_option("--out", o->common.out, "Directory to write the campaign to")->required();
+    cmd->callback([o] {
+      const auto truth = base_params(o->common);
+      ss::CampaignPlan plan;
+      if (o->grid == "full") {
+        plan.amplitudes_V = {10, 20, 30, 40, 50, 60, 70, 80, 90, 100};
+        plan.frequencies_Hz = {50, 100, 500, 1000, 2000};
+      }
+      ss::SensorEffects sensor;
+      sensor.seed = o->seed;
+      const std::size_t n = ss::write_campaign(
+          *o->common.out, truth, plan, sensor,
+          [](std::size_t d, std::size_t t) { progress_cb("identify synth (sawtooth runs)", d, t); });
+      mc::write_file_atomic(*o->common.out / "truth.yaml", mc::params_to_yaml(truth));
+      mc::cli::emit(o->common, {{"files", n}, {"dir", o->common.out->string()}},
+                    fmt::format("{} measurement files written to {}", n, o->common.out->string()));
+    });
+  }
+}
+
+/// The report part: a small synthetic campaign of the default axis identified end to end.
+void build_report(mc::report::Report& rep) {
+  const ss::StickSlipParams truth;
+  ss::CampaignPlan plan;
+  plan.amplitudes_V = {50, 80};
+  plan.frequencies_Hz = {500};
+  plan.sawtooth_periods = 4;
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("mc-identify-report-{}", ::getpid());
+  ss::write_campaign(dir, truth, plan, ss::SensorEffects{});
+  ss::IdentifyAllOptions io;
+  io.breakaway.scan_points = 8;
+  ss::IdentifyAllResult r;
+  try {
+    r = ss::identify_all(dir, truth, io);
+  } catch (...) {
+    std::filesystem::remove_all(dir);
+    throw;
+  }
+  rep.section(
+      "identification of a stick-slip axis (thesis 2.5)",
+      "A synthetic campaign of the default axis (simulated, with 0.1 nm quantisation, 1 nm RMS position "
+      "noise and 1% voltage noise) identified by `microcobot identify all`; reproduce with `microcobot "
+      "identify synth --out DIR && microcobot identify all --in DIR --out OUT`.");
+  if (r.pe) pe_section(rep, ss::read_record(dir / "pe_step.csv"), *r.pe);
+  friction_section(rep, ss::read_record(dir / "step.csv"), r.friction);
+  hysteresis_section(rep, ss::read_record(dir / "sine.csv"), r.hysteresis);
+  breakaway_section(rep, r.breakaway);
+  std::filesystem::remove_all(dir);
+}
+
+const bool kRegistered = mc::cli::register_group(
+    {"identify", "Identify a stick-slip axis from measured data (thesis 2.5)", 35, &add_identify});
+const bool kReport = mc::cli::register_report_part({"identify", 35, &build_report});
+
+}  // namespace

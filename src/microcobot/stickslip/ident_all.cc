@@ -1,0 +1,77 @@
+#include "microcobot/stickslip/ident_all.h"
+
+#include <fmt/format.h>
+
+#include "microcobot/core/error.h"
+
+namespace mc::stickslip {
+
+StickSlipParams combine_identified(const StickSlipParams& base, const PeModesResult* pe,
+                                   const FrictionModesResult& friction, const HysteresisResult& hysteresis) {
+  StickSlipParams p = base;
+  if (pe) p.pe = pe->params;
+  p.pe.static_gain_m_V = hysteresis.static_gain_m_V;
+  p.hysteresis = hysteresis.pi;
+  p.friction = friction.params;
+  p.validate();
+  return p;
+}
+
+IdentifyAllResult identify_all(
+    const std::filesystem::path& dir, const StickSlipParams& base, const IdentifyAllOptions& options,
+    const std::function<void(const std::string&, std::size_t, std::size_t)>& progress) {
+  if (!std::filesystem::is_directory(dir)) throw InvalidInput(dir.string(), 0, "not a directory");
+  auto need = [&](const char* name) {
+    const auto f = dir / name;
+    if (!std::filesystem::exists(f)) {
+      throw InvalidInput(f.string(), 0,
+                         fmt::format("missing: identify all needs {} (see docs/model.md)", name));
+    }
+    return f;
+  };
+  auto report = [&](const std::string& task, std::size_t done, std::size_t total) {
+    if (progress) progress(task, done, total);
+  };
+  IdentifyAllResult out;
+  // Read everything first: a malformed file fails before any long computation.
+  const MeasuredRecord step = read_record(need("step.csv"));
+  const MeasuredRecord sine = read_record(need("sine.csv"));
+  const std::vector<SawtoothRun> runs = read_sawtooth_runs(dir);
+  std::optional<MeasuredRecord> pe_rec;
+  if (std::filesystem::exists(dir / "pe_step.csv")) pe_rec = read_record(dir / "pe_step.csv");
+
+  report("identify step 1 (modes)", 0, 2);
+  if (pe_rec) {
+    out.pe = identify_pe_modes(*pe_rec, base.pe);
+  } else {
+    out.notes.push_back("no pe_step.csv: PE modes and gain split kept from the base parameters");
+  }
+  report("identify step 1 (modes)", 1, 2);
+  StickSlipParams with_pe = base;
+  if (out.pe) with_pe.pe = out.pe->params;
+  out.friction = identify_friction_modes(step, with_pe);
+  report("identify step 1 (modes)", 2, 2);
+  report("identify step 2 (hysteresis)", 0, 1);
+  // The slider's lag at the sine frequency, from step 1, is not hysteresis.
+  StickSlipParams dyn = base;
+  if (out.pe) dyn.pe = out.pe->params;
+  dyn.friction = out.friction.params;
+  out.hysteresis = identify_hysteresis(sine, options.operators, &dyn);
+  report("identify step 2 (hysteresis)", 1, 1);
+  StickSlipParams p = combine_identified(base, out.pe ? &*out.pe : nullptr, out.friction, out.hysteresis);
+  const ActuatorModel model(p);
+  out.breakaway = identify_breakaway(runs, model, options.breakaway, [&](std::size_t d, std::size_t t) {
+    report("identify step 3 (break-away, runs)", d, t);
+  });
+  p.breakaway = out.breakaway.table;
+  p.validate();
+  out.params = p;
+  for (const auto& r : out.breakaway.runs) {
+    if (!r.ok) out.notes.push_back("skipped run " + r.name + ": " + r.skipped);
+  }
+  for (const auto& c : out.breakaway.filled)
+    out.notes.push_back("z_ba cell without a fitted run, filled: " + c);
+  return out;
+}
+
+}  // namespace mc::stickslip
