@@ -36,7 +36,28 @@
     return o;
   }
 
+  // uPlot's log-axis tick generator slows to seconds per figure on values far from 1 (its
+  // decimal rounding table stops near 1e-16), e.g. PSDs in m^2/Hz around 1e-21. Such a log
+  // axis is drawn in units of a power of ten, shown in its title ("x 1e-21").
+  function logExponent(values, log) {
+    if (!log) return 0;
+    let max = 0;
+    for (const v of values) if (v > max && Number.isFinite(v)) max = v;
+    if (max === 0 || (max >= 1e-6 && max < 1e9)) return 0;
+    return Math.floor(Math.log10(max));
+  }
+  function scaled(arr, e) { return e === 0 ? arr : arr.map(v => v * Math.pow(10, -e)); }
+
   function plot(fig, container) {
+    const ex = logExponent(fig.series.flatMap(s => s.x), fig.x.log);
+    const ey = logExponent(fig.series.flatMap(s => s.y), fig.y.log);
+    if (ex !== 0 || ey !== 0) {
+      fig = Object.assign({}, fig, {
+        x: ex ? Object.assign({}, fig.x, { unit: (fig.x.unit ? fig.x.unit + " " : "") + "x 1e" + ex }) : fig.x,
+        y: ey ? Object.assign({}, fig.y, { unit: (fig.y.unit ? fig.y.unit + " " : "") + "x 1e" + ey }) : fig.y,
+        series: fig.series.map(s => Object.assign({}, s, { x: scaled(s.x, ex), y: scaled(s.y, ey) })),
+      });
+    }
     const width = Math.min(1000, root.clientWidth - 20);
     const aligned = sameX(fig.series);
     const scaleOpts = a => (a.log ? { distr: 3, log: 10 } : {});
