@@ -11,8 +11,14 @@ namespace {
 class FakeAxis : public SlaveAxis {
  public:
   FakeAxis() : SlaveAxis("x") {}
-  void command_voltage_V(double v) noexcept override {
-    if (active()) volts_ = v;
+  double sample_period_s() const override { return 1e-4; }
+  double max_voltage_V() const override { return 100.0; }
+  void command_drive(const DriveBlock& b) noexcept override {
+    if (active() && b.samples > 0) volts_ = b.volts[b.samples - 1];
+  }
+  void command_voltage_V(double v) noexcept {
+    const double one[1] = {v};
+    command_drive(DriveBlock{one, 1});
   }
   double position_m() const override { return x_; }
   bool at_end_stop() const override { return false; }

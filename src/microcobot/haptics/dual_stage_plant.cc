@@ -117,16 +117,21 @@ double DualStagePlant::stop_force(const StateVector& x) const {
 }
 
 void DualStagePlant::step(DualStagePlantState& state, double f_m_N, double u_V) const {
+  if (!try_step(state, f_m_N, u_V)) {
+    throw ComputationFailed("dual-stage plant diverged (|y| > 1 m or non-finite state)");
+  }
+}
+
+bool DualStagePlant::try_step(DualStagePlantState& state, double f_m_N, double u_V) const noexcept {
   StateVector x = state.x;
   for (int i = 0; i < params_.substeps; ++i) {
     const Eigen::Vector3d u(f_m_N, u_V, stop_force(x));
     x = ad_ * x + bd_ * u;
   }
-  if (!x.allFinite() || x.head<4>().cwiseAbs().maxCoeff() > 1.0) {
-    throw ComputationFailed("dual-stage plant diverged (|y| > 1 m or non-finite state)");
-  }
+  if (!x.allFinite() || x.head<4>().cwiseAbs().maxCoeff() > 1.0) return false;
   state.x = x;
   state.accel_m_s2 = acceleration(state, f_m_N, u_V);
+  return true;
 }
 
 double DualStagePlant::acceleration(const DualStagePlantState& state, double f_m_N, double u_V) const {

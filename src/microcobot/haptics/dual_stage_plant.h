@@ -131,6 +131,8 @@ class DualStagePlant {
   /// One step of dt_s with inputs held (zero-order hold): f_m [N], u [V]. Updates
   /// state.accel_m_s2. Never allocates. Throws ComputationFailed on divergence.
   void step(DualStagePlantState& state, double f_m_N, double u_V) const;
+  /// step() for the real-time path: returns false (state untouched) instead of throwing.
+  bool try_step(DualStagePlantState& state, double f_m_N, double u_V) const noexcept;
 
   /// Handle acceleration of `state` under inputs (the accelerometer's reading).
   double acceleration(const DualStagePlantState& state, double f_m_N, double u_V) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mc::microworld {
 
@@ -11,6 +12,8 @@ void PickPlaceParams::validate() const {
   require_non_negative(gravity_m_s2, "gravity_m_s2");
   require_non_negative(substrate_pulloff_N, "substrate_pulloff_N");
   require_non_negative(finger_pulloff_N, "finger_pulloff_N");
+  require_non_negative(meniscus_rupture_m, "meniscus_rupture_m");
+  require_positive(creep_velocity_m_s, "creep_velocity_m_s");
   require_in_range(finger_friction, 0.0, 2.0, "finger_friction");
   require_in_range(substrate_friction, 0.0, 2.0, "substrate_friction");
   require_positive(substrate_stiffness_N_m, "substrate_stiffness_N_m");
@@ -50,6 +53,17 @@ bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vecto
   return in_jaw_x && in_jaw_y && tips_below_top && fingers_above_bottom;
 }
 
+Eigen::Vector2d PickPlaceWorld::rubbing_force(const Eigen::Vector2d& motion, double dt_s,
+                                              double coulomb_N) const noexcept {
+  const double d = motion.norm();
+  if (d <= 0.0) return Eigen::Vector2d::Zero();
+  // Coulomb friction against the motion, regularised below the creep velocity v_c:
+  // F = -F_c tanh(|v| / v_c) v/|v|. The pure sign law would switch its full value at every
+  // reversal of a micrometre jitter, which a teleoperator amplifies into chatter.
+  const double v = dt_s > 0.0 ? d / dt_s : std::numeric_limits<double>::infinity();
+  return -coulomb_N * std::tanh(v / p_.creep_velocity_m_s) * motion / d;
+}
+
 PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g, double opening_command_m,
                                      double dt_s) const noexcept {
   PickPlaceOutput out;
@@ -83,8 +97,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       const double drag_resistance = p_.substrate_friction * substrate_hold;
       if (lateral.norm() > 0.0 && hold_capacity >= drag_resistance) {
         s.part_m.y() += motion.y();  // dragged along the substrate with the gripper
-        out.force_on_gripper_N.x() -= drag_resistance * lateral.x() / lateral.norm();
-        out.force_on_gripper_N.y() -= drag_resistance * lateral.y() / lateral.norm();
+        out.force_on_gripper_N.head<2>() += rubbing_force(lateral, dt_s, drag_resistance);
       }
       if (motion.z() > 0.0 && g.z() > s.part_m.z() - half - 1e-12) {
         if (hold_capacity >= substrate_hold) {
@@ -107,11 +120,13 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
         out.force_on_gripper_N.z() += s.phase == PartPhase::kGrasped ? hold_capacity : 0.0;
       }
       s.part_m = next;
-      const bool on_substrate = s.part_m.z() <= half + 1e-12;
+      // The meniscus bridges a gap up to its rupture distance: a part that close still touches.
+      const bool on_substrate = s.part_m.z() <= half + p_.meniscus_rupture_m;
       if (s.phase == PartPhase::kGrasped && grip <= 0.0) {
         // Fingers opened: which adhesion keeps the part?
         if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
           s.phase = PartPhase::kOnSubstrate;
+          s.part_m.z() = half;
         } else if (!on_substrate && 2.0 * p_.finger_pulloff_N < weight_) {
           s.phase = PartPhase::kOnSubstrate;  // falls
           s.part_m.z() = half;
@@ -123,21 +138,21 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
           s.phase = PartPhase::kGrasped;  // grasped again
         } else if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
           s.phase = PartPhase::kOnSubstrate;  // touched down: the substrate wins
+          s.part_m.z() = half;
         }
       }
       // A held part dragged on the substrate rubs on it.
       if (on_substrate && s.phase == PartPhase::kGrasped) {
         const Eigen::Vector2d lateral(motion.x(), motion.y());
         if (lateral.norm() > 0.0) {
-          const double drag = p_.substrate_friction * substrate_hold;
-          out.force_on_gripper_N.x() -= drag * lateral.x() / lateral.norm();
-          out.force_on_gripper_N.y() -= drag * lateral.y() / lateral.norm();
+          out.force_on_gripper_N.head<2>() +=
+              rubbing_force(lateral, dt_s, p_.substrate_friction * substrate_hold);
         }
       }
       break;
     }
   }
-  out.part_on_substrate = s.part_m.z() <= half + 1e-12;
+  out.part_on_substrate = s.part_m.z() <= half + p_.meniscus_rupture_m;
   return out;
 }
 

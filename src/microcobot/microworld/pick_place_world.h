@@ -37,8 +37,13 @@ struct PickPlaceParams {
   /// Finger-part pull-off per finger: van der Waals of the finger's tip asperities,
   /// A R / (6 D^2) with A = 1e-19 J, D = 0.4 nm and R = 20 um (dry, coated fingers).
   double finger_pulloff_N = vdw_sphere_plane_N(1e-19, 20e-6, 0.4e-9);  // 2.08 uN
-  double finger_friction = 0.3;                                        ///< finger-part friction coefficient
-  double substrate_friction = 0.3;              ///< part-substrate friction coefficient
+  /// Gap up to which the part-substrate meniscus still holds (its rupture distance, of the
+  /// order of the liquid volume's cube root: ~1 um for a femtolitre meniscus).
+  double meniscus_rupture_m = 1e-6;
+  double finger_friction = 0.3;     ///< finger-part friction coefficient
+  double substrate_friction = 0.3;  ///< part-substrate friction coefficient
+  /// Sliding velocity below which the part-substrate friction is regularised (creep).
+  double creep_velocity_m_s = 10e-6;
   double substrate_stiffness_N_m = 1e5;         ///< finger-tip crash into the substrate (penalty)
   Eigen::Vector3d part_start_m{0.0, 0.0, 0.0};  ///< part centre on the substrate (z ignored)
   Eigen::Vector3d target_m{2e-3, 0.0, 0.0};     ///< where the part must be placed (x, y)
@@ -51,8 +56,10 @@ struct PickPlaceParams {
     v("gravity_m_s2", gravity_m_s2);
     v("substrate_pulloff_N", substrate_pulloff_N);
     v("finger_pulloff_N", finger_pulloff_N);
+    v("meniscus_rupture_m", meniscus_rupture_m);
     v("finger_friction", finger_friction);
     v("substrate_friction", substrate_friction);
+    v("creep_velocity_m_s", creep_velocity_m_s);
     v("substrate_stiffness_N_m", substrate_stiffness_N_m);
     v("part_start_x_m", part_start_m.x());
     v("part_start_y_m", part_start_m.y());
@@ -105,6 +112,7 @@ class PickPlaceWorld {
 
  private:
   bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept;
+  Eigen::Vector2d rubbing_force(const Eigen::Vector2d& motion, double dt_s, double coulomb_N) const noexcept;
   PickPlaceParams p_;
   double weight_;
 };

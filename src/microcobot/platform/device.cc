@@ -6,10 +6,14 @@ namespace mc::platform {
 
 std::string_view to_string(Lifecycle state) {
   switch (state) {
-    case Lifecycle::kUnconfigured: return "unconfigured";
-    case Lifecycle::kInactive: return "inactive";
-    case Lifecycle::kActive: return "active";
-    case Lifecycle::kFault: return "fault";
+    case Lifecycle::kUnconfigured:
+      return "unconfigured";
+    case Lifecycle::kInactive:
+      return "inactive";
+    case Lifecycle::kActive:
+      return "active";
+    case Lifecycle::kFault:
+      return "fault";
   }
   return "?";
 }
@@ -30,7 +34,8 @@ void Device::configure() {
 
 void Device::activate() {
   if (state_ != Lifecycle::kInactive) {
-    throw InvalidInput("device '" + name_ + "': cannot activate from state " + std::string(to_string(state_)));
+    throw InvalidInput("device '" + name_ + "': cannot activate from state " +
+                       std::string(to_string(state_)));
   }
   on_activate();
   state_ = Lifecycle::kActive;

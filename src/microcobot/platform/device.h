@@ -11,8 +11,11 @@
 ///          |                        |  +----deactivate-----+
 ///          +-------configure--------+--- Fault <--fault()--+ (from any state)
 ///
-/// A device that is not Active ignores commands and outputs its safe state.
+/// A device that is not Active ignores commands and outputs its safe state; update() is
+/// called at every tick once configured, whatever the state (a simulated device keeps its
+/// physics running; a hardware driver keeps its bus alive).
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -45,7 +48,8 @@ class Device {
 
   /// One exchange with the device on the real-time path: apply the latest command, advance
   /// `dt_s` (a simulated device steps its model; a hardware driver talks to its bus), latch
-  /// new measurements. Called only while Active. Must not allocate, lock, throw or block.
+  /// new measurements. Called at every tick once configured. Must not allocate, lock, throw
+  /// or block.
   virtual void update(double dt_s) noexcept = 0;
   /// Puts outputs in the safe state (zero force / 0 V / hold). Real-time safe, idempotent.
   virtual void enter_safe_state() noexcept = 0;
@@ -66,13 +70,25 @@ struct Vec2 {
   double y = 0.0;
 };
 
+/// A spatial vector in SI units.
+struct Vec3 {
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+};
+
 /// The dual-stage haptic interface (Pantograph + Haptuator, ch. 3): handle position in,
-/// force out. `enabled()` is the operator's deadman/enable switch.
+/// force out, and the handle's controls: the deadman (enable) switch, the clutch (indexing)
+/// button and a thumb wheel that jogs the slave's Z axis.
 class HapticMaster : public Device {
  public:
   using Device::Device;
   virtual Vec2 handle_position_m() const = 0;
   virtual bool enabled() const = 0;
+  virtual bool clutch() const = 0;
+  virtual double jog_m_s() const = 0;
+  /// Counts fresh readings: a driver whose bus stalls stops counting (the watchdog's input).
+  virtual std::uint64_t reading_count() const = 0;
   /// Force to render on the handle; ignored unless Active.
   virtual void command_force_N(Vec2 force) noexcept = 0;
 };
@@ -82,14 +98,37 @@ class TweezersMaster : public Device {
  public:
   using Device::Device;
   virtual double opening_m() const = 0;
+  virtual std::uint64_t reading_count() const = 0;
+  /// Force to apply on each finger (closing positive is a squeeze felt as resistance);
+  /// ignored unless Active.
   virtual void command_grip_force_N(double force) noexcept = 0;
 };
 
+/// What the slave controller sends an axis for one loop tick: the drive-voltage samples of
+/// the tick at the axis's sample period (a DAC-streaming driver plays them; a stick-slip
+/// sawtooth needs edges of a few us, far faster than the loop) and the sawtooth they come
+/// from (a driver with its own waveform generator programs that instead; the simulation
+/// uses it for the break-away strain, thesis §2.7).
+struct DriveBlock {
+  const double* volts = nullptr;  ///< `samples` voltages [V]
+  int samples = 0;
+  double amplitude_V = 0.0;   ///< sawtooth amplitude
+  double frequency_Hz = 0.0;  ///< sawtooth frequency (0: no sawtooth programmed)
+  int direction = 0;          ///< +1 forward, -1 backward, 0 none
+};
+
 /// One stick-slip positioning axis of the slave stage (ch. 2): drive voltage out, position in.
+/// Voltages are clamped to [0, max_voltage_V()] (the amplifier's range, at most 100 V).
 class SlaveAxis : public Device {
  public:
   using Device::Device;
-  virtual void command_voltage_V(double volts) noexcept = 0;
+  /// Sample period of the drive voltage [s].
+  virtual double sample_period_s() const = 0;
+  virtual double max_voltage_V() const = 0;
+  /// The samples to play during the next update(); ignored unless Active. The samples must
+  /// stay valid until then.
+  virtual void command_drive(const DriveBlock& block) noexcept = 0;
+  /// Sensor reading of the carriage position [m].
   virtual double position_m() const = 0;
   /// True while the carriage rests against one of its end stops.
   virtual bool at_end_stop() const = 0;
@@ -102,6 +141,8 @@ class Gripper : public Device {
   virtual void command_opening_m(double opening) noexcept = 0;
   virtual double opening_m() const = 0;
   virtual double grip_force_N() const = 0;
+  /// Force on the gripper from its contacts (the mount's force sensor), world frame [N].
+  virtual Vec3 contact_force_N() const = 0;
 };
 
 }  // namespace mc::platform

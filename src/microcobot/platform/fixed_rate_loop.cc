@@ -54,6 +54,7 @@ void FixedRateLoop::run_for(std::uint64_t ticks) {
     const double start = now_s();
     tick_once();
     const double cost = now_s() - start;
+    last_tick_s_ = cost;
     tick_stats_.add(cost);
     if (cost > period_) ++overruns_;
   }
@@ -82,6 +83,7 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
       jitter_stats_.add(late);
       tick_once();
       const double cost = now_s() - start;
+      last_tick_s_ = cost;
       tick_stats_.add(cost);
       if (cost > period_ || late > period_) ++overruns_;
     }

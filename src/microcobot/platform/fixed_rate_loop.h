@@ -56,6 +56,8 @@ class FixedRateLoop {
   const TimingStats& tick_stats() const { return tick_stats_; }
   const TimingStats& jitter_stats() const { return jitter_stats_; }
   std::uint64_t overruns() const { return overruns_; }
+  /// Compute time of the last finished tick [s] (read by a task: the previous tick's).
+  double last_tick_s() const { return last_tick_s_; }
   /// Task names and divisors, in execution order.
   std::vector<std::pair<std::string, int>> tasks() const;
 
@@ -72,6 +74,7 @@ class FixedRateLoop {
   std::vector<Task> tasks_;
   std::uint64_t tick_ = 0;
   std::uint64_t overruns_ = 0;
+  double last_tick_s_ = 0.0;
   TimingStats tick_stats_;
   TimingStats jitter_stats_;
   std::atomic<bool> stop_{false};

@@ -1,0 +1,79 @@
+#include "microcobot/control/teleoperation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+
+void TeleoperationParams::validate() const {
+  require_positive(motion_scale, "motion_scale");
+  require_non_negative(force_scale, "force_scale");
+  require_positive(max_force_N, "max_force_N");
+  require_positive(force_filter_Hz, "force_filter_Hz");
+  require_positive(grip_position_scale, "grip_position_scale");
+  require_non_negative(grip_force_scale, "grip_force_scale");
+  require_positive(max_grip_force_N, "max_grip_force_N");
+  require_positive(max_jog_m_s, "max_jog_m_s");
+  require(workspace_min_m < workspace_max_m, "workspace_min_m", "must be below workspace_max_m",
+          workspace_min_m);
+}
+
+Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
+                             const Eigen::Vector3d& slave_start_m, double gripper_start_m)
+    : p_(params), dt_(dt_s) {
+  p_.validate();
+  require_positive(dt_s, "dt_s");
+  out_.slave_target_m = slave_start_m;
+  out_.gripper_opening_m = gripper_start_m;
+  last_xy_m_ = slave_start_m.head<2>();
+  force_alpha_ = 1.0 - std::exp(-2.0 * M_PI * p_.force_filter_Hz * dt_s);
+}
+
+double Teleoperation::clamp_workspace(double v) const noexcept {
+  return std::clamp(v, p_.workspace_min_m, p_.workspace_max_m);
+}
+
+const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
+  const bool engage = in.deadman && !in.clutch && in.haptic_fresh && in.handle_m.allFinite();
+  if (engage && !out_.engaged) {
+    // Re-index: the slave target stays where it is whatever the hand position.
+    offset_m_ = out_.slave_target_m.head<2>() - p_.motion_scale * in.handle_m;
+  }
+  out_.engaged = engage;
+  out_.stale = !in.haptic_fresh || !in.tweezers_fresh;
+  out_.slave_velocity_m_s.setZero();
+  if (engage) {
+    const Eigen::Vector2d xy = offset_m_ + p_.motion_scale * in.handle_m;
+    for (int i = 0; i < 2; ++i) out_.slave_target_m[i] = clamp_workspace(xy[i]);
+    out_.slave_velocity_m_s.head<2>() = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
+    const double jog =
+        std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;
+    out_.slave_target_m.z() = clamp_workspace(out_.slave_target_m.z() + jog * dt_);
+    out_.slave_velocity_m_s.z() = jog;
+    // Slave forces back to the hand, in the handle's plane (slave XY = handle xy).
+    Eigen::Vector2d f = p_.force_scale * in.contact_force_N.head<2>();
+    if (!f.allFinite()) f.setZero();
+    force_filtered_N_ += force_alpha_ * (f - force_filtered_N_);
+    f = force_filtered_N_;
+    const double n = f.norm();
+    if (!(n <= p_.max_force_N))
+      f = n > 0 && std::isfinite(n) ? Eigen::Vector2d(f * (p_.max_force_N / n)) : Eigen::Vector2d::Zero();
+    out_.haptic_force_N = f;
+  } else {
+    out_.haptic_force_N.setZero();
+    force_filtered_N_.setZero();
+  }
+  last_xy_m_ = out_.slave_target_m.head<2>();
+  if (in.tweezers_fresh && std::isfinite(in.tweezers_opening_m)) {
+    out_.gripper_opening_m = p_.grip_position_scale * in.tweezers_opening_m;
+    const double f = p_.grip_force_scale * in.grip_force_N;
+    out_.finger_force_N = std::isfinite(f) ? std::clamp(f, -p_.max_grip_force_N, p_.max_grip_force_N) : 0.0;
+  } else {
+    out_.finger_force_N = 0.0;
+  }
+  return out_;
+}
+
+}  // namespace mc::control

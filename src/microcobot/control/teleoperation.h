@@ -1,0 +1,104 @@
+#pragma once
+/// @file
+/// Teleoperation coupling between the masters (dual-stage haptic interface, TéléTweez) and the
+/// slave (XYZ stick-slip stage, micro-gripper) of the platform (thesis §1.3, Fig. 1.12-1.13):
+///
+///  - position: slave XY target = offset + motion_scale x handle position. The offset is
+///    re-taken whenever the coupling engages, so engaging never moves the slave; releasing the
+///    clutch (indexing) lets the operator bring the hand back while the slave holds, which is
+///    how a 100 mm hand workspace reaches the stage's full stroke at a 1/100 scale;
+///  - Z: the operator's jog knob integrates a velocity into the Z target;
+///  - gripper opening = grip_position_scale x TéléTweez tip opening (the robotic mode of §4.3.2);
+///  - force: the haptic force = force_scale x slave contact force (XY), low-pass filtered, the
+///    TéléTweez finger force = grip_force_scale x slave grip force, both capped;
+///  - safety: the coupling is engaged only while the deadman is held, the clutch released and the
+///    haptic master's readings fresh (the platform's watchdog). Disengaged, the slave targets
+///    freeze (the stage holds where it is) and the haptic force is zero; the gripper follows the
+///    TéléTweez only while its readings are fresh, and holds otherwise.
+///
+/// tick() runs on the real-time path at the haptic rate: no allocation, lock, exception or I/O.
+
+#include <Eigen/Core>
+
+namespace mc::control {
+
+struct TeleoperationParams {
+  double motion_scale = 0.01;  ///< slave metres per hand metre (1 mm of hand -> 10 um)
+  double force_scale = 1.0e4;  ///< hand newtons per slave newton (36 uN -> 0.36 N)
+  double max_force_N = 2.0;    ///< cap on the haptic force (Pantograph rated 4 N)
+  /// First-order low-pass on the haptic force: slave contact forces switch within a tick
+  /// (stick-slip, contact changes), which a scaled rendering would turn into chatter.
+  double force_filter_Hz = 30.0;
+  double grip_position_scale = 0.06;  ///< gripper opening per TéléTweez tip opening (10 mm -> 600 um)
+  double grip_force_scale = 100.0;    ///< TéléTweez finger newtons per slave grip newton
+  double max_grip_force_N = 2.0;      ///< cap on the finger force (2.2 N available, Table 4.8)
+  double max_jog_m_s = 5e-4;          ///< Z jog velocity limit
+  /// Slave workspace in stage coordinates (the stroke of the 12 mm axes with a margin).
+  double workspace_min_m = -5.5e-3;
+  double workspace_max_m = 5.5e-3;
+
+  template <class V>
+  void visit(V& v) {
+    v("motion_scale", motion_scale);
+    v("force_scale", force_scale);
+    v("max_force_N", max_force_N);
+    v("force_filter_Hz", force_filter_Hz);
+    v("grip_position_scale", grip_position_scale);
+    v("grip_force_scale", grip_force_scale);
+    v("max_grip_force_N", max_grip_force_N);
+    v("max_jog_m_s", max_jog_m_s);
+    v("workspace_min_m", workspace_min_m);
+    v("workspace_max_m", workspace_max_m);
+  }
+  void validate() const;
+};
+
+/// What the masters and the slave report at one haptic tick.
+struct TeleoperationInput {
+  Eigen::Vector2d handle_m = Eigen::Vector2d::Zero();          ///< haptic handle position
+  bool deadman = false;                                        ///< enable switch held
+  bool clutch = false;                                         ///< indexing button pressed
+  double z_jog_m_s = 0.0;                                      ///< jog knob velocity
+  bool haptic_fresh = true;                                    ///< haptic master readings are fresh
+  double tweezers_opening_m = 0.0;                             ///< TéléTweez tip opening
+  bool tweezers_fresh = true;                                  ///< TéléTweez readings are fresh
+  Eigen::Vector3d slave_position_m = Eigen::Vector3d::Zero();  ///< measured stage position
+  Eigen::Vector3d contact_force_N = Eigen::Vector3d::Zero();   ///< force on the slave gripper
+  double grip_force_N = 0.0;                                   ///< slave grip force
+};
+
+/// The coupling's commands.
+struct TeleoperationOutput {
+  Eigen::Vector3d slave_target_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d slave_velocity_m_s = Eigen::Vector3d::Zero();  ///< feedforward of the target
+  double gripper_opening_m = 0.0;
+  Eigen::Vector2d haptic_force_N = Eigen::Vector2d::Zero();
+  double finger_force_N = 0.0;
+  bool engaged = false;
+  bool stale = false;  ///< a master's readings went stale
+};
+
+class Teleoperation {
+ public:
+  /// Validates; `dt_s` is the haptic period. The slave starts holding at `slave_start_m`
+  /// with the gripper at `gripper_start_m`.
+  Teleoperation(const TeleoperationParams& params, double dt_s, const Eigen::Vector3d& slave_start_m,
+                double gripper_start_m);
+  /// One haptic tick. Never allocates.
+  const TeleoperationOutput& tick(const TeleoperationInput& in) noexcept;
+  const TeleoperationOutput& output() const noexcept { return out_; }
+  const TeleoperationParams& params() const noexcept { return p_; }
+
+ private:
+  double clamp_workspace(double v) const noexcept;
+
+  TeleoperationParams p_;
+  double dt_;
+  TeleoperationOutput out_;
+  double force_alpha_ = 1.0;  // low-pass coefficient per tick
+  Eigen::Vector2d force_filtered_N_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
+};
+
+}  // namespace mc::control

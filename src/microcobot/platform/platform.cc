@@ -1,0 +1,201 @@
+#include "microcobot/platform/platform.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "microcobot/core/error.h"
+
+namespace mc::platform {
+namespace {
+
+std::vector<std::string> telemetry_names() { return {kTelemetryChannels.begin(), kTelemetryChannels.end()}; }
+
+// Room for a few seconds of telemetry between drains; the drain thread empties it every ms.
+constexpr std::size_t kRingCapacity = 8192;
+
+}  // namespace
+
+Platform::Platform(const PlatformConfig& config)
+    : config_(config),
+      world_((config_.validate(), config_.world)),
+      haptic_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
+      tweezers_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
+      home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
+      loop_(config_.loop.base_rate_Hz),
+      ring_(kRingCapacity),
+      recorder_(std::make_unique<Recorder>(telemetry_names(), 1)) {
+  const double dt = config_.loop.period_s();
+  model_ = std::make_unique<stickslip::ActuatorModel>(axis_params(config_));
+  const double ratio = dt / model_->dt_s();
+  require(std::abs(ratio - std::round(ratio)) < 1e-6 * ratio && ratio >= 1.0, "loop.base_rate_Hz",
+          "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
+  map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
+
+  const char* names[3] = {"axis_x", "axis_y", "axis_z"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    control::PositionSensorParams sp = config_.stage.sensor;
+    sp.seed = config_.stage.sensor.seed + static_cast<int>(i);  // independent noise per axis
+    axes_[i] = std::make_unique<SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
+  }
+  gripper_ = std::make_unique<SimulatedGripper>(
+      "gripper", world_,
+      std::array<const SimulatedSlaveAxis*, 3>{axes_[0].get(), axes_[1].get(), axes_[2].get()},
+      Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
+  haptic_ = std::make_unique<SimulatedHapticMaster>("dual_stage", config_.haptic.plant, config_.haptic.render,
+                                                    config_.haptic.pantograph, dt);
+  tweezers_ = std::make_unique<SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
+  stage_ = std::make_unique<StageController>(config_.stage.control, model_->params(), *map_,
+                                             static_cast<int>(std::lround(ratio)), model_->dt_s());
+  teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
+                                                     world_.params().gripper.max_opening_m);
+
+  for (Device* d : devices()) d->configure();
+  for (Device* d : devices()) d->activate();
+
+  loop_.add_task("operator", config_.loop.operator_divisor, [this](const TickInfo& t) {
+    if (operator_) operator_(t);
+  });
+  loop_.add_task("teleoperation", 1, [this](const TickInfo&) { teleoperation_task(); });
+  loop_.add_task("slave_control", config_.loop.slave_divisor,
+                 [this](const TickInfo&) { slave_control_task(); });
+  loop_.add_task("devices", 1, [this](const TickInfo& t) { devices_task(t.dt_s); });
+  loop_.add_task("telemetry", config_.loop.telemetry_divisor,
+                 [this](const TickInfo& t) { telemetry_task(t.t_s); });
+}
+
+Platform::~Platform() {
+  for (Device* d : devices()) d->deactivate();
+}
+
+std::array<Device*, 6> Platform::devices() {
+  return {axes_[0].get(), axes_[1].get(), axes_[2].get(), gripper_.get(), haptic_.get(), tweezers_.get()};
+}
+
+void Platform::fault_all() noexcept {
+  for (Device* d : devices()) d->fault();
+  stage_->emergency_stop();
+  faulted_ = true;
+}
+
+void Platform::teleoperation_task() noexcept {
+  // The watchdogs see whether each master produced a reading since the last tick.
+  if (haptic_->reading_count() != haptic_seen_) haptic_watchdog_.feed();
+  if (tweezers_->reading_count() != tweezers_seen_) tweezers_watchdog_.feed();
+  haptic_seen_ = haptic_->reading_count();
+  tweezers_seen_ = tweezers_->reading_count();
+
+  control::TeleoperationInput in;
+  const Vec2 h = haptic_->handle_position_m();
+  in.handle_m = {h.x, h.y};
+  in.deadman = haptic_->enabled() && !faulted_;
+  in.clutch = haptic_->clutch();
+  in.z_jog_m_s = haptic_->jog_m_s();
+  in.haptic_fresh = haptic_watchdog_.tick();
+  in.tweezers_opening_m = tweezers_->opening_m();
+  in.tweezers_fresh = tweezers_watchdog_.tick();
+  for (int i = 0; i < 3; ++i) in.slave_position_m[i] = axes_[static_cast<std::size_t>(i)]->position_m();
+  const Vec3 f = gripper_->contact_force_N();
+  in.contact_force_N = {f.x, f.y, f.z};
+  in.grip_force_N = gripper_->grip_force_N();
+  const auto& out = teleop_->tick(in);
+
+  haptic_->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
+  tweezers_->command_grip_force_N(out.finger_force_N);
+  gripper_->command_opening_m(out.gripper_opening_m);
+}
+
+void Platform::slave_control_task() noexcept {
+  if (faulted_) return;
+  const auto& out = teleop_->output();
+  const std::array<double, 3> measured = {axes_[0]->position_m(), axes_[1]->position_m(),
+                                          axes_[2]->position_m()};
+  stage_->update(out.slave_target_m, out.slave_velocity_m_s, measured);
+}
+
+void Platform::devices_task(double dt_s) noexcept {
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!faulted_) axes_[i]->command_drive(stage_->drive(static_cast<int>(i)));
+    axes_[i]->update(dt_s);
+  }
+  gripper_->update(dt_s);
+  haptic_->update(dt_s);
+  tweezers_->update(dt_s);
+  if (!faulted_) {
+    for (Device* d : devices()) {
+      if (d->state() == Lifecycle::kFault) {
+        fault_all();
+        break;
+      }
+    }
+  }
+}
+
+void Platform::telemetry_task(double t_s) noexcept {
+  TelemetrySample s{};
+  const auto& o = teleop_->output();
+  const OperatorHand& hand = haptic_->operator_hand();
+  const Vec2 handle = haptic_->handle_position_m();
+  const auto& w = gripper_->world_state();
+  const Vec3 contact = gripper_->contact_force_N();
+  std::size_t k = 0;
+  auto put = [&](double v) { s[k++] = v; };
+  put(t_s);
+  put(hand.hand_m.x), put(hand.hand_m.y), put(handle.x), put(handle.y);
+  put(hand.deadman), put(hand.clutch), put(o.engaged), put(o.stale);
+  for (int i = 0; i < 3; ++i) put(home_m_[i] + o.slave_target_m[i]);
+  for (std::size_t i = 0; i < 3; ++i)
+    put(home_m_[static_cast<Eigen::Index>(i)] + axes_[i]->true_position_m());
+  for (std::size_t i = 0; i < 3; ++i) put(home_m_[static_cast<Eigen::Index>(i)] + axes_[i]->position_m());
+  for (std::size_t i = 0; i < 3; ++i) put(axes_[i]->voltage_V());
+  put(o.haptic_force_N.x()), put(o.haptic_force_N.y());
+  put(haptic_->channels().f_m_N), put(haptic_->channels().u_V);
+  put(tweezers_->opening_m()), put(o.finger_force_N);
+  put(o.gripper_opening_m), put(gripper_->opening_m()), put(gripper_->grip_force_N());
+  put(contact.x), put(contact.y), put(contact.z);
+  put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
+  put(static_cast<double>(static_cast<int>(w.phase)));
+  put(1e6 * loop_.last_tick_s());
+  ring_.push(s);
+}
+
+void Platform::drain() noexcept {
+  TelemetrySample s;
+  while (ring_.pop(s)) recorder_->sample(s);
+}
+
+void Platform::run(double duration_s) {
+  require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
+  const auto ticks = static_cast<std::uint64_t>(std::llround(duration_s * config_.loop.base_rate_Hz));
+  // Room for the whole run's telemetry, allocated before the loop starts.
+  const std::size_t need =
+      recorder_->size() + ticks / static_cast<std::uint64_t>(config_.loop.telemetry_divisor) + 2;
+  if (need > recorder_->capacity()) {
+    auto bigger = std::make_unique<Recorder>(telemetry_names(), need);
+    TelemetrySample s;
+    for (std::size_t i = 0; i < recorder_->size(); ++i) {
+      for (std::size_t c = 0; c < s.size(); ++c) s[c] = recorder_->at(i, c);
+      bigger->sample(s);
+    }
+    recorder_ = std::move(bigger);
+  }
+  // The drain runs beside the loop: telemetry leaves the loop only through the ring.
+  std::atomic<bool> done{false};
+  std::thread drainer([&] {
+    while (!done.load(std::memory_order_acquire)) {
+      drain();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  if (config_.loop.realtime) {
+    loop_.run_realtime(ticks);
+  } else {
+    loop_.run_for(ticks);
+  }
+  done.store(true, std::memory_order_release);
+  drainer.join();
+  drain();
+}
+
+}  // namespace mc::platform

@@ -1,0 +1,149 @@
+#pragma once
+/// @file
+/// The cobotic platform of Fig. 1.12-1.13 assembled from its configuration: the masters (the
+/// dual-stage haptic interface and the TéléTweez), the slave (three stick-slip axes carrying
+/// the micro-gripper in its microworld), the teleoperation coupling between them, the slave
+/// stage's controller, and the fixed-rate loop that runs it all:
+///
+///   every tick (10 kHz)      watchdogs, teleoperation, force commands to the masters;
+///                            drive samples to the axes; every device's update()
+///   every slave tick (1 kHz) the stage controller on the measured positions and the targets
+///   every operator tick      the (scripted) operator acts, if one is attached
+///   every telemetry tick     one sample into a single-producer ring, drained off the loop
+///
+/// A device that faults (a diverged model, a driver error) puts every device in its safe
+/// state at once: the axes to 0 V, the forces to zero, the gripper holding. Nothing on the
+/// loop path allocates, locks, throws or does I/O (tests/platform/platform_test.cc).
+
+#include <array>
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include "microcobot/control/step_map.h"
+#include "microcobot/control/teleoperation.h"
+#include "microcobot/core/recorder.h"
+#include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/platform/fixed_rate_loop.h"
+#include "microcobot/platform/platform_config.h"
+#include "microcobot/platform/simulated_gripper.h"
+#include "microcobot/platform/simulated_haptic_master.h"
+#include "microcobot/platform/simulated_slave_axis.h"
+#include "microcobot/platform/simulated_tweezers_master.h"
+#include "microcobot/platform/spsc_ring.h"
+#include "microcobot/platform/stage_controller.h"
+#include "microcobot/platform/watchdog.h"
+#include "microcobot/stickslip/actuator.h"
+
+namespace mc::platform {
+
+/// The channels of a telemetry sample, unit-suffixed (the CSV recording's columns).
+inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",
+                                                                   "hand_x_m",
+                                                                   "hand_y_m",
+                                                                   "handle_x_m",
+                                                                   "handle_y_m",
+                                                                   "deadman",
+                                                                   "clutch",
+                                                                   "engaged",
+                                                                   "stale",
+                                                                   "target_x_m",
+                                                                   "target_y_m",
+                                                                   "target_z_m",
+                                                                   "slave_x_m",
+                                                                   "slave_y_m",
+                                                                   "slave_z_m",
+                                                                   "measured_x_m",
+                                                                   "measured_y_m",
+                                                                   "measured_z_m",
+                                                                   "u_x_V",
+                                                                   "u_y_V",
+                                                                   "u_z_V",
+                                                                   "haptic_force_x_N",
+                                                                   "haptic_force_y_N",
+                                                                   "pantograph_y_N",
+                                                                   "haptuator_V",
+                                                                   "tweezers_opening_m",
+                                                                   "finger_force_N",
+                                                                   "gripper_command_m",
+                                                                   "gripper_opening_m",
+                                                                   "grip_force_N",
+                                                                   "contact_x_N",
+                                                                   "contact_y_N",
+                                                                   "contact_z_N",
+                                                                   "part_x_m",
+                                                                   "part_y_m",
+                                                                   "part_z_m",
+                                                                   "part_phase",
+                                                                   "tick_us"};
+using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
+
+class Platform {
+ public:
+  /// Builds the models (the stick-slip step map is computed here: about a second), the
+  /// devices and the loop, then configures and activates every device. Throws mc::Error.
+  explicit Platform(const PlatformConfig& config);
+  ~Platform();
+  Platform(const Platform&) = delete;
+  Platform& operator=(const Platform&) = delete;
+
+  /// The operator's action, called at the operator rate at the start of a tick (the
+  /// scripted operator of a scenario). Set before running; must be real-time safe.
+  void set_operator(std::function<void(const TickInfo&)> op) { operator_ = std::move(op); }
+
+  /// Runs for `duration_s` (as fast as possible, or paced when loop.realtime), recording the
+  /// telemetry. May be called again to continue. Stops early when stop() is called.
+  void run(double duration_s);
+  void stop() noexcept { loop_.request_stop(); }
+
+  /// Every device to its safe state and Fault (a fault injection or an operator's e-stop).
+  void fault_all() noexcept;
+  bool faulted() const noexcept { return faulted_; }
+
+  const PlatformConfig& config() const { return config_; }
+  FixedRateLoop& loop() { return loop_; }
+  const FixedRateLoop& loop() const { return loop_; }
+  SimulatedHapticMaster& haptic() { return *haptic_; }
+  SimulatedTweezersMaster& tweezers() { return *tweezers_; }
+  const SimulatedSlaveAxis& axis(int i) const { return *axes_[static_cast<std::size_t>(i)]; }
+  const SimulatedGripper& gripper() const { return *gripper_; }
+  const StageController& stage_controller() const { return *stage_; }
+  const control::TeleoperationOutput& teleop() const { return teleop_->output(); }
+  const Recorder& recording() const { return *recorder_; }
+  /// Telemetry samples lost because the ring was full (0 when the drain keeps up).
+  std::size_t telemetry_dropped() const { return ring_.dropped() + recorder_->dropped(); }
+
+  /// One tick of the loop's tasks without timing (tests, benchmarks).
+  void tick_for_test() { loop_.run_for(1); }
+
+ private:
+  void teleoperation_task() noexcept;
+  void slave_control_task() noexcept;
+  void devices_task(double dt_s) noexcept;
+  void telemetry_task(double t_s) noexcept;
+  void drain() noexcept;
+  std::array<Device*, 6> devices();
+
+  PlatformConfig config_;
+  std::unique_ptr<stickslip::ActuatorModel> model_;
+  std::unique_ptr<control::StepMap> map_;
+  microworld::PickPlaceWorld world_;
+  std::array<std::unique_ptr<SimulatedSlaveAxis>, 3> axes_;
+  std::unique_ptr<SimulatedGripper> gripper_;
+  std::unique_ptr<SimulatedHapticMaster> haptic_;
+  std::unique_ptr<SimulatedTweezersMaster> tweezers_;
+  std::unique_ptr<StageController> stage_;
+  std::unique_ptr<control::Teleoperation> teleop_;
+  Watchdog haptic_watchdog_;
+  Watchdog tweezers_watchdog_;
+  std::uint64_t haptic_seen_ = 0, tweezers_seen_ = 0;
+  Eigen::Vector3d home_m_;
+  FixedRateLoop loop_;
+  SpscRing<TelemetrySample> ring_;
+  std::unique_ptr<Recorder> recorder_;
+  std::function<void(const TickInfo&)> operator_;
+  bool faulted_ = false;
+};
+
+}  // namespace mc::platform

@@ -1,0 +1,82 @@
+#include "microcobot/platform/platform_config.h"
+
+#include <cmath>
+#include <functional>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/params.h"
+
+namespace mc::platform {
+namespace {
+
+// Runs a section's validate() and prefixes the section's key path to the field it names.
+void in_section(const std::string& section, const std::function<void()>& validate) {
+  try {
+    validate();
+  } catch (const InvalidParams& e) {
+    const std::string what = e.what();
+    const std::string head = "invalid parameter ";
+    const std::string rest = what.rfind(head, 0) == 0 ? what.substr(head.size()) : what;
+    throw Error(ExitCode::kInvalidInput, head + section + "." + rest);
+  }
+}
+
+}  // namespace
+
+void LoopParams::validate() const {
+  require_positive(base_rate_Hz, "base_rate_Hz");
+  require(slave_divisor >= 1, "slave_divisor", "must be >= 1", slave_divisor);
+  require(operator_divisor >= 1, "operator_divisor", "must be >= 1", operator_divisor);
+  require(telemetry_divisor >= 1, "telemetry_divisor", "must be >= 1", telemetry_divisor);
+  require(watchdog_ticks >= 1, "watchdog_ticks", "must be >= 1", watchdog_ticks);
+}
+
+void PlatformConfig::validate() const {
+  in_section("loop", [&] { loop.validate(); });
+  in_section("teleop", [&] { teleop.validate(); });
+  in_section("stage", [&] {
+    stage.control.validate();
+    stage.sensor.validate();
+    stage.step_map.validate();
+    require(std::isfinite(stage.home_x_m) && std::isfinite(stage.home_y_m) && std::isfinite(stage.home_z_m),
+            "home_m", "must be finite");
+  });
+  in_section("stage.control", [&] {
+    require(std::abs(stage.control.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),
+            "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",
+            stage.control.control_rate_Hz);
+  });
+  in_section("haptic", [&] {
+    haptic.plant.validate();
+    haptic.render.validate();
+    haptic.pantograph.validate();
+  });
+  in_section("haptic.plant", [&] {
+    require(std::abs(haptic.plant.dt_s * loop.base_rate_Hz - 1.0) < 1e-9, "dt_s",
+            "must equal 1 / loop.base_rate_Hz", haptic.plant.dt_s);
+  });
+  in_section("haptic.render", [&] {
+    require(std::abs(haptic.render.fs_Hz - loop.base_rate_Hz) <= 1e-9 * loop.base_rate_Hz, "fs_Hz",
+            "must equal loop.base_rate_Hz", haptic.render.fs_Hz);
+  });
+  in_section("tweezers", [&] { tweezers.validate(); });
+  in_section("world", [&] { world.validate(); });
+}
+
+PlatformConfig load_platform_config(const std::filesystem::path& file) {
+  PlatformConfig c;
+  c = load_params(file, c);
+  if (!c.stickslip_params_file.empty()) {
+    const std::filesystem::path p(c.stickslip_params_file);
+    if (p.is_relative()) c.stickslip_params_file = (file.parent_path() / p).string();
+    axis_params(c);  // read now: a bad axis file is a configuration error
+  }
+  return c;
+}
+
+stickslip::StickSlipParams axis_params(const PlatformConfig& config) {
+  if (config.stickslip_params_file.empty()) return stickslip::StickSlipParams{};
+  return load_params<stickslip::StickSlipParams>(config.stickslip_params_file);
+}
+
+}  // namespace mc::platform

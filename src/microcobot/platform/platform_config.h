@@ -1,0 +1,120 @@
+#pragma once
+/// @file
+/// The one description of the platform (issue #9): loop rates, the teleoperation scales and
+/// limits, the slave stage's controller and sensors, the masters' models, the microworld, and
+/// optionally a stick-slip parameter file (as `microcobot stickslip params` prints it). The
+/// built-in default is the platform of the main scenario; a YAML file overrides any key:
+///
+///     loop: {base_rate_Hz: 10000, slave_divisor: 10}
+///     teleop: {motion_scale: 0.01, force_scale: 10000}
+///     stickslip_params_file: axis.yaml      # relative to the configuration file
+///
+/// Unknown keys, wrong types and values out of range are one-line errors naming the key.
+
+#include <filesystem>
+#include <string>
+
+#include "microcobot/control/position_controller.h"
+#include "microcobot/control/position_sensor.h"
+#include "microcobot/control/step_map.h"
+#include "microcobot/control/teleoperation.h"
+#include "microcobot/haptics/dual_stage_plant.h"
+#include "microcobot/haptics/pantograph.h"
+#include "microcobot/haptics/render_pipeline.h"
+#include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/stickslip/stickslip_params.h"
+#include "microcobot/tweezers/teletweez.h"
+
+namespace mc::platform {
+
+struct LoopParams {
+  double base_rate_Hz = 1.0e4;  ///< haptic path (thesis §3.3.1: 10 kHz)
+  int slave_divisor = 10;       ///< slave control every 10 ticks: 1 kHz
+  int operator_divisor = 10;    ///< the (scripted) operator acts at 1 kHz
+  int telemetry_divisor = 10;   ///< telemetry recorded at 1 kHz
+  int watchdog_ticks = 5;       ///< masters stale after this many ticks without a fresh reading
+  bool realtime = false;        ///< pace to the wall clock (else as fast as possible)
+
+  template <class V>
+  void visit(V& v) {
+    v("base_rate_Hz", base_rate_Hz);
+    v("slave_divisor", slave_divisor);
+    v("operator_divisor", operator_divisor);
+    v("telemetry_divisor", telemetry_divisor);
+    v("watchdog_ticks", watchdog_ticks);
+    v("realtime", realtime);
+  }
+  void validate() const;
+  double period_s() const { return 1.0 / base_rate_Hz; }
+  double slave_rate_Hz() const { return base_rate_Hz / slave_divisor; }
+};
+
+struct StageParams {
+  control::PositionControlParams control = default_control();
+  control::PositionSensorParams sensor;
+  control::StepMapParams step_map;
+  /// Finger-tip position (world frame) when the three axes are at 0 (mid-stroke).
+  double home_x_m = -0.2e-3;
+  double home_y_m = 0.0;
+  double home_z_m = 0.45e-3;
+
+  template <class V>
+  void visit(V& v) {
+    v("control", control);
+    v("sensor", sensor);
+    v("step_map", step_map);
+    v("home_x_m", home_x_m);
+    v("home_y_m", home_y_m);
+    v("home_z_m", home_z_m);
+  }
+  static control::PositionControlParams default_control() {
+    control::PositionControlParams p;
+    p.control_rate_Hz = 1000.0;  // the slave rate of LoopParams
+    return p;
+  }
+};
+
+struct HapticMasterParams {
+  haptics::DualStagePlantParams plant;
+  haptics::RenderPipelineParams render;
+  haptics::PantographParams pantograph;
+
+  template <class V>
+  void visit(V& v) {
+    v("plant", plant);
+    v("render", render);
+    v("pantograph", pantograph);
+  }
+};
+
+struct PlatformConfig {
+  LoopParams loop;
+  control::TeleoperationParams teleop;
+  StageParams stage;
+  std::string stickslip_params_file;  ///< empty: the built-in SLC-1720-like axis (#4)
+  HapticMasterParams haptic;
+  tweezers::TeleTweezParams tweezers;
+  microworld::PickPlaceParams world;
+
+  template <class V>
+  void visit(V& v) {
+    v("loop", loop);
+    v("teleop", teleop);
+    v("stage", stage);
+    v("stickslip_params_file", stickslip_params_file);
+    v("haptic", haptic);
+    v("tweezers", tweezers);
+    v("world", world);
+  }
+  /// Validates every section and their consistency (rates); errors name the key path.
+  void validate() const;
+};
+
+/// Reads a configuration file over the defaults; relative file names in it are resolved
+/// against the file's directory. Throws InvalidInput / InvalidParams (exit 3).
+PlatformConfig load_platform_config(const std::filesystem::path& file);
+
+/// The stick-slip parameters the configuration names (the built-in default when none).
+stickslip::StickSlipParams axis_params(const PlatformConfig& config);
+
+}  // namespace mc::platform

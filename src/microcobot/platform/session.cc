@@ -1,0 +1,252 @@
+#include "microcobot/platform/session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "microcobot/core/csv.h"
+#include "microcobot/core/error.h"
+
+namespace mc::platform {
+namespace {
+
+std::vector<double> column(const Recorder& r, const std::string& name) { return r.channel(name); }
+
+std::vector<double> scaled(std::vector<double> v, double k) {
+  for (double& x : v) x *= k;
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> scenario_names() { return {"pick-place", "stale-master"}; }
+
+void SessionParams::validate() const {
+  const auto names = scenario_names();
+  if (std::find(names.begin(), names.end(), scenario) == names.end()) {
+    throw UsageError("unknown scenario '" + scenario + "' (expected pick-place or stale-master)");
+  }
+  require_positive(max_duration_s, "max_duration_s");
+  require_positive(placement_tolerance_m, "placement_tolerance_m");
+  require_non_negative(stale_at_s, "stale_at_s");
+  require_positive(stale_for_s, "stale_for_s");
+  operator_params.validate();
+}
+
+nlohmann::json SessionResult::to_json() const {
+  nlohmann::json j;
+  j["success"] = success;
+  j["verdict"] = verdict;
+  j["placement_error_m"] = placement_error_m;
+  j["ticks"] = ticks;
+  j["overruns"] = overruns;
+  j["tick_mean_us"] = tick_mean_us;
+  j["tick_p99_us"] = tick_p99_us;
+  j["tick_max_us"] = tick_max_us;
+  j["duration_s"] = duration_s;
+  j["wall_s"] = wall_s;
+  j["clutches"] = clutches;
+  j["faulted"] = faulted;
+  j["crashed"] = crashed;
+  j["telemetry_dropped"] = telemetry_dropped;
+  nlohmann::json ph = nlohmann::json::object();
+  for (const auto& [name, t] : phases) ph[name] = t;
+  j["phases_s"] = ph;
+  return j;
+}
+
+Session::Session(const PlatformConfig& config, const SessionParams& params) : params_(params) {
+  params_.validate();
+  platform_ = std::make_unique<Platform>(config);
+  operator_ = std::make_unique<PickPlaceOperator>(*platform_, params_.operator_params);
+  const bool stale = params_.scenario == "stale-master";
+  platform_->set_operator([this, stale](const TickInfo& t) {
+    if (stale) {
+      platform_->haptic().freeze_readings(t.t_s >= params_.stale_at_s &&
+                                          t.t_s < params_.stale_at_s + params_.stale_for_s);
+    }
+    operator_->act(t);
+  });
+}
+
+SessionResult Session::run(const std::function<void(double)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  Platform& p = *platform_;
+  while (!operator_->done() && !operator_->gave_up() && !p.faulted() &&
+         p.loop().time_s() < params_.max_duration_s - 1e-9) {
+    p.run(std::min(1.0, params_.max_duration_s - p.loop().time_s()));
+    if (progress) progress(p.loop().time_s());
+  }
+  SessionResult r;
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto& loop = p.loop();
+  r.duration_s = loop.time_s();
+  r.ticks = loop.ticks();
+  r.overruns = loop.overruns();
+  r.tick_mean_us = 1e6 * loop.tick_stats().mean_s();
+  r.tick_p99_us = 1e6 * loop.tick_stats().quantile_s(0.99);
+  r.tick_max_us = 1e6 * loop.tick_stats().max_s();
+  r.clutches = operator_->clutches();
+  r.faulted = p.faulted();
+  const auto& w = p.gripper().world_state();
+  r.crashed = w.crashed;
+  r.placement_error_m = p.gripper().world().placement_error_m(w);
+  r.telemetry_dropped = p.telemetry_dropped();
+  using Phase = PickPlaceOperator::Phase;
+  for (int i = 0; i <= static_cast<int>(Phase::kDone); ++i) {
+    const double t = operator_->phase_start_s(static_cast<Phase>(i));
+    if (std::isfinite(t))
+      r.phases.emplace_back(std::string(PickPlaceOperator::name(static_cast<Phase>(i))), t);
+  }
+
+  const bool placed =
+      w.phase == microworld::PartPhase::kOnSubstrate && r.placement_error_m <= params_.placement_tolerance_m;
+  if (r.faulted) {
+    r.verdict = "a device faulted: every device went to its safe state";
+  } else if (operator_->gave_up()) {
+    r.verdict = "the operator gave up in phase '" +
+                std::string(PickPlaceOperator::name(operator_->failed_phase())) + "' after " +
+                std::to_string(params_.operator_params.phase_timeout_s) + " s";
+  } else if (!operator_->done()) {
+    r.verdict = "the session reached its maximum duration before the operator finished";
+  } else if (r.crashed) {
+    r.verdict = "a finger tip crashed into the substrate";
+  } else if (!placed) {
+    r.verdict = "the part is not on the substrate within the tolerance of the target";
+  } else {
+    r.verdict = "part placed and released";
+  }
+  r.success = operator_->done() && !r.faulted && !r.crashed && placed;
+
+  if (params_.scenario == "stale-master" && r.success) {
+    // While the readings were stale (after the watchdog's timeout) the slave must hold and the
+    // haptic force be zero.
+    const auto& rec = p.recording();
+    const auto t = rec.channel("t_s"), stale = rec.channel("stale"), fx = rec.channel("haptic_force_x_N"),
+               fy = rec.channel("haptic_force_y_N"), tx = rec.channel("target_x_m");
+    double max_force = 0.0, target_motion = 0.0, held_s = 0.0, first = NAN;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (stale[i] < 0.5) continue;
+      if (std::isnan(first)) first = tx[i];
+      max_force = std::max({max_force, std::abs(fx[i]), std::abs(fy[i])});
+      target_motion = std::max(target_motion, std::abs(tx[i] - first));
+      held_s += 1.0 / (platform_->config().loop.base_rate_Hz / platform_->config().loop.telemetry_divisor);
+    }
+    if (held_s < 0.5 * params_.stale_for_s || max_force > 0.0 || target_motion > 0.0) {
+      r.success = false;
+      r.verdict = "the watchdog did not hold the slave with zero force while the master was stale";
+    } else {
+      r.verdict += "; the slave held with zero force for " + std::to_string(held_s) + " s of stale readings";
+    }
+  }
+  return r;
+}
+
+report::Report Session::report(const SessionResult& r) const {
+  const Recorder& rec = platform_->recording();
+  report::Report rep("microcobot session: " + params_.scenario);
+  const auto t = column(rec, "t_s");
+  auto series = [&](const std::string& name, const std::string& channel, double k = 1.0) {
+    return report::Series{name, t, scaled(column(rec, channel), k)};
+  };
+  std::string phases;
+  for (const auto& [name, start] : r.phases)
+    phases += name + " at " + std::to_string(start).substr(0, 6) + " s; ";
+  rep.section("Outcome", r.verdict + ".\n\nPhases: " + phases);
+  rep.add_result("success", r.success ? 1.0 : 0.0);
+  rep.add_result("placement error", r.placement_error_m, "m");
+  rep.add_result("simulated duration", r.duration_s, "s");
+  rep.add_result("clutches (indexing)", r.clutches);
+  rep.add_result("faulted", r.faulted ? 1.0 : 0.0);
+
+  rep.section("Operator and haptic master",
+              "The scripted operator's hand and the handle of the dual-stage interface, relative to the "
+              "Pantograph's workspace centre. The hand travels 100 times the slave's motion; the clutch "
+              "brings it back across the workspace while the slave holds.");
+  rep.add_figure({"Hand and handle",
+                  "x and y of the hand (set by the operator) and of the handle.",
+                  {"Time", "s"},
+                  {"Position", "m"},
+                  {series("hand x", "hand_x_m"), series("handle x", "handle_x_m"),
+                   series("hand y", "hand_y_m"), series("handle y", "handle_y_m")}});
+  rep.add_figure({"Haptic force",
+                  "Force commanded to the handle (the slave's contact force x 1e4, capped).",
+                  {"Time", "s"},
+                  {"Force", "N"},
+                  {series("x", "haptic_force_x_N"), series("y", "haptic_force_y_N"),
+                   series("Pantograph y (low band)", "pantograph_y_N")}});
+  rep.add_figure({"Coupling state",
+                  "Deadman held, clutch pressed, coupling engaged, masters stale (0/1).",
+                  {"Time", "s"},
+                  {"State", ""},
+                  {series("deadman", "deadman"), series("clutch", "clutch"), series("engaged", "engaged"),
+                   series("stale", "stale")}});
+
+  rep.section("Slave stage and microworld",
+              "The finger tips (the stage's true position plus the mount offset), the teleoperation target "
+              "and the part, in the world frame.");
+  rep.add_figure(
+      {"Slave x",
+       "",
+       {"Time", "s"},
+       {"Position", "m"},
+       {series("target x", "target_x_m"), series("tips x", "slave_x_m"), series("part x", "part_x_m")}});
+  rep.add_figure(
+      {"Slave z",
+       "",
+       {"Time", "s"},
+       {"Height", "m"},
+       {series("target z", "target_z_m"), series("tips z", "slave_z_m"), series("part z", "part_z_m")}});
+  rep.add_figure({"Path in the x-z plane",
+                  "Where the tips and the part went (side view).",
+                  {"x", "m"},
+                  {"z", "m"},
+                  {report::Series{"tips", column(rec, "slave_x_m"), column(rec, "slave_z_m")},
+                   report::Series{"part", column(rec, "part_x_m"), column(rec, "part_z_m")}}});
+  rep.add_figure({"Contact force on the gripper",
+                  "",
+                  {"Time", "s"},
+                  {"Force", "N"},
+                  {series("x", "contact_x_N"), series("y", "contact_y_N"), series("z", "contact_z_N")}});
+  rep.add_figure({"Drive voltages (sampled at 1 kHz)",
+                  "The axes' drive voltage at the telemetry instants.",
+                  {"Time", "s"},
+                  {"Voltage", "V"},
+                  {series("x", "u_x_V"), series("y", "u_y_V"), series("z", "u_z_V")}});
+
+  rep.section("Gripper and TéléTweez",
+              "The TéléTweez tip opening drives the gripper opening (x 0.06); the grip "
+              "force comes back to the operator's fingers (x 100).");
+  rep.add_figure({"Openings",
+                  "",
+                  {"Time", "s"},
+                  {"Opening", "m"},
+                  {series("TéléTweez x 0.06", "tweezers_opening_m", 0.06),
+                   series("gripper command", "gripper_command_m"), series("gripper", "gripper_opening_m")}});
+  rep.add_figure(
+      {"Grip forces",
+       "",
+       {"Time", "s"},
+       {"Force", "N"},
+       {series("slave grip", "grip_force_N"), series("finger force / 100", "finger_force_N", 0.01)}});
+
+  rep.section("Loop timing",
+              "Compute time of each 10 kHz tick (sampled at 1 kHz). An overrun is a tick longer "
+              "than the period.");
+  rep.add_result("ticks", static_cast<double>(r.ticks));
+  rep.add_result("overruns", static_cast<double>(r.overruns));
+  rep.add_result("mean tick", r.tick_mean_us * 1e-6, "s");
+  rep.add_result("p99 tick", r.tick_p99_us * 1e-6, "s");
+  rep.add_result("max tick", r.tick_max_us * 1e-6, "s");
+  rep.add_result("wall time", r.wall_s, "s");
+  rep.add_figure({"Tick compute time", "", {"Time", "s"}, {"Tick", "s"}, {series("tick", "tick_us", 1e-6)}});
+  return rep;
+}
+
+void Session::write(const std::filesystem::path& dir, const SessionResult& result) const {
+  ensure_writable_dir(dir);
+  platform_->recording().write_csv(dir / "recording.csv");
+  report(result).write(dir);
+}
+
+}  // namespace mc::platform

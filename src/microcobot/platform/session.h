@@ -1,0 +1,77 @@
+#pragma once
+/// @file
+/// A session of the platform: a scenario run from its configuration to its verdict, with
+/// the recording and the session report (issue #9, `microcobot run`).
+///
+/// Scenarios:
+///  - "pick-place" (default): the scripted watchmaker of PickPlaceOperator picks a 300 um
+///    part, transports it 2 mm at 100 um/s and places it on the target;
+///  - "stale-master": the same, with the haptic master's readings frozen for
+///    `stale_for_s` from `stale_at_s` during the transport (a stalled bus): the watchdog must
+///    hold the slave and zero the force, and the operator finishes once readings resume.
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/platform/platform.h"
+#include "microcobot/report/report.h"
+
+namespace mc::platform {
+
+struct SessionParams {
+  std::string scenario = "pick-place";
+  double max_duration_s = 120.0;  ///< stop the session after this long (simulated time)
+  double placement_tolerance_m = 5e-6;
+  double stale_at_s = 12.0;  ///< stale-master: when the haptic readings freeze ...
+  double stale_for_s = 0.5;  ///< ... and for how long
+  PickPlaceOperatorParams operator_params;
+  void validate() const;
+};
+
+/// Names of the scenarios, for --help and errors.
+std::vector<std::string> scenario_names();
+
+struct SessionResult {
+  bool success = false;
+  std::string verdict;  ///< one line: why it succeeded or failed
+  double placement_error_m = 0.0;
+  double duration_s = 0.0;  ///< simulated time
+  std::uint64_t ticks = 0;
+  std::uint64_t overruns = 0;
+  double tick_mean_us = 0.0, tick_p99_us = 0.0, tick_max_us = 0.0;
+  double wall_s = 0.0;  ///< wall-clock time of the run
+  int clutches = 0;
+  bool faulted = false;
+  bool crashed = false;
+  std::size_t telemetry_dropped = 0;
+  std::vector<std::pair<std::string, double>> phases;  ///< phase name and start time [s]
+  nlohmann::json to_json() const;
+};
+
+class Session {
+ public:
+  /// Builds the platform (validates everything first).
+  Session(const PlatformConfig& config, const SessionParams& params);
+  /// Runs the scenario to its end; `progress(t_s)` is called about once per simulated second.
+  SessionResult run(const std::function<void(double)>& progress = {});
+  /// The session report: trajectories, forces, gripper, loop timing, phases.
+  report::Report report(const SessionResult& result) const;
+  /// Writes recording.csv and the report (index.html + figure CSVs) into `dir`.
+  void write(const std::filesystem::path& dir, const SessionResult& result) const;
+
+  Platform& platform() { return *platform_; }
+  const PickPlaceOperator& op() const { return *operator_; }
+
+ private:
+  SessionParams params_;
+  std::unique_ptr<Platform> platform_;
+  std::unique_ptr<PickPlaceOperator> operator_;
+};
+
+}  // namespace mc::platform

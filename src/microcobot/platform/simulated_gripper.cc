@@ -1,0 +1,41 @@
+#include "microcobot/platform/simulated_gripper.h"
+
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::platform {
+
+SimulatedGripper::SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
+                                   std::array<const SimulatedSlaveAxis*, 3> axes, const Vec3& home_m)
+    : Gripper(std::move(name)),
+      world_(world),
+      axes_(axes),
+      home_m_(home_m.x, home_m.y, home_m.z),
+      state_(world.initial_state()),
+      command_m_(world.params().gripper.max_opening_m) {
+  for (const auto* a : axes_) require(a != nullptr, this->name() + ".axes", "must all be set");
+  require(home_m_.allFinite(), this->name() + ".home_m", "must be finite");
+}
+
+void SimulatedGripper::on_configure() {
+  state_ = world_.initial_state();
+  command_m_ = world_.params().gripper.max_opening_m;
+  state_.last_gripper_m = tip_position_m();
+  out_ = world_.step(state_, tip_position_m(), command_m_, 0.0);
+}
+
+Eigen::Vector3d SimulatedGripper::tip_position_m() const {
+  return home_m_ + Eigen::Vector3d(axes_[0]->true_position_m(), axes_[1]->true_position_m(),
+                                   axes_[2]->true_position_m());
+}
+
+void SimulatedGripper::command_opening_m(double opening) noexcept {
+  if (active() && std::isfinite(opening)) command_m_ = opening;
+}
+
+void SimulatedGripper::update(double dt_s) noexcept {
+  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s);
+}
+
+}  // namespace mc::platform

@@ -1,0 +1,50 @@
+#pragma once
+/// @file
+/// The slave micro-gripper in its microworld: a PiezoGripper carried by the XYZ stage over a
+/// substrate with a micro-part (microworld::PickPlaceWorld, thesis §1.1.1 surface forces).
+/// The gripper's position is the stage's true position plus the mount offset `home_m` (where
+/// the finger tips are when every axis is at 0). The safe state keeps the last opening
+/// command: a gripper that let go of the part on a fault would drop it.
+
+#include <array>
+
+#include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/platform/device.h"
+#include "microcobot/platform/simulated_slave_axis.h"
+
+namespace mc::platform {
+
+class SimulatedGripper final : public Gripper {
+ public:
+  /// `world` and the axes must outlive the gripper.
+  SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
+                   std::array<const SimulatedSlaveAxis*, 3> axes, const Vec3& home_m);
+
+  void command_opening_m(double opening) noexcept override;
+  double opening_m() const override { return out_.opening_m; }
+  double grip_force_N() const override { return out_.grip_force_N; }
+  Vec3 contact_force_N() const override {
+    return {out_.force_on_gripper_N.x(), out_.force_on_gripper_N.y(), out_.force_on_gripper_N.z()};
+  }
+  void update(double dt_s) noexcept override;
+  void enter_safe_state() noexcept override {}
+
+  /// Where the finger tips are (world frame).
+  Eigen::Vector3d tip_position_m() const;
+  const microworld::PickPlaceState& world_state() const { return state_; }
+  const microworld::PickPlaceOutput& world_output() const { return out_; }
+  const microworld::PickPlaceWorld& world() const { return world_; }
+
+ protected:
+  void on_configure() override;
+
+ private:
+  const microworld::PickPlaceWorld& world_;
+  std::array<const SimulatedSlaveAxis*, 3> axes_;
+  Eigen::Vector3d home_m_;
+  microworld::PickPlaceState state_;
+  microworld::PickPlaceOutput out_;
+  double command_m_;
+};
+
+}  // namespace mc::platform

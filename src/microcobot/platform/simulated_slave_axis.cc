@@ -1,0 +1,65 @@
+#include "microcobot/platform/simulated_slave_axis.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::platform {
+
+SimulatedSlaveAxis::SimulatedSlaveAxis(std::string name, const stickslip::ActuatorModel& model,
+                                       const control::PositionSensorParams& sensor, double start_m)
+    : SlaveAxis(std::move(name)),
+      model_(model),
+      sensor_(sensor),
+      start_m_(start_m),
+      state_(model.initial_state()) {
+  const double half = 0.5 * model.params().slider.stroke_m;
+  require(std::isfinite(start_m) && std::abs(start_m) < half, this->name() + ".start_m",
+          "must lie within the stroke", start_m);
+}
+
+void SimulatedSlaveAxis::on_configure() {
+  state_ = model_.initial_state();
+  state_.x2_m = {start_m_, start_m_};
+  measured_m_ = sensor_.measure(true_position_m());
+}
+
+void SimulatedSlaveAxis::command_drive(const DriveBlock& block) noexcept {
+  if (active()) block_ = block;
+}
+
+bool SimulatedSlaveAxis::at_end_stop() const {
+  const double half = 0.5 * model_.params().slider.stroke_m;
+  return std::abs(true_position_m()) >= half - 1e-9;
+}
+
+void SimulatedSlaveAxis::update(double dt_s) noexcept {
+  const int n = std::max(1, static_cast<int>(std::lround(dt_s / model_.dt_s())));
+  if (block_.frequency_Hz > 0.0 && block_.direction != 0) {
+    model_.set_operating_point(
+        state_, block_.amplitude_V, block_.frequency_Hz,
+        block_.direction < 0 ? stickslip::Direction::kBackward : stickslip::Direction::kForward);
+  }
+  const double vmax = max_voltage_V();
+  for (int i = 0; i < n; ++i) {
+    // Past the block's end the last sample holds (a DAC keeps its output).
+    double u = block_.samples > 0 ? block_.volts[std::min(i, block_.samples - 1)] : state_.u_V;
+    u = active() && std::isfinite(u) ? std::clamp(u, 0.0, vmax) : 0.0;
+    model_.step(state_, u);
+  }
+  block_ = DriveBlock{};  // a block plays once; without a new one the voltage holds
+  if (state_.diverged) {
+    fault();
+    return;
+  }
+  measured_m_ = sensor_.measure(true_position_m());
+}
+
+void SimulatedSlaveAxis::enter_safe_state() noexcept {
+  // Hold at 0 V (update() plays 0 V while not Active): the amplifier's slew limit (1 V/us)
+  // ramps the PE down within the next model steps.
+  block_ = DriveBlock{};
+}
+
+}  // namespace mc::platform

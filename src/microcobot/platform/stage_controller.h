@@ -1,0 +1,46 @@
+#pragma once
+/// @file
+/// The slave stage's controller on the platform: one hybrid position controller per axis
+/// (control::PositionController, stepping + scanning, #6) updated at the slave rate (1 kHz by
+/// default) on the measured positions and the teleoperation targets, and, at every loop tick,
+/// the drive-voltage samples each axis plays until the next tick (one per model step, from
+/// the controller's sawtooth generator or scanning voltage). Buffers are allocated at
+/// construction; update() and drive() never allocate.
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "microcobot/control/position_controller.h"
+#include "microcobot/control/step_map.h"
+#include "microcobot/platform/device.h"
+
+namespace mc::platform {
+
+class StageController {
+ public:
+  /// `params.control_rate_Hz` is the slave rate; `samples_per_tick` drive samples of
+  /// `sample_period_s` make one loop tick. `model` and `map` must outlive the controller.
+  StageController(const control::PositionControlParams& params, const stickslip::StickSlipParams& model,
+                  const control::StepMap& map, int samples_per_tick, double sample_period_s);
+
+  /// One slave-rate tick: new targets (with their velocity feedforward) and measurements.
+  void update(const Eigen::Vector3d& target_m, const Eigen::Vector3d& velocity_m_s,
+              const std::array<double, 3>& measured_m) noexcept;
+  /// The drive samples of axis `i` for the next loop tick.
+  DriveBlock drive(int i) noexcept;
+  /// Every axis to 0 V; they stay stopped until the next update() with a target.
+  void emergency_stop() noexcept;
+
+  const control::PositionController& axis(int i) const { return *ctrl_[static_cast<std::size_t>(i)]; }
+
+ private:
+  std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
+  std::array<std::vector<double>, 3> samples_;
+  double sample_period_s_;
+  bool stopped_ = false;
+};
+
+}  // namespace mc::platform
