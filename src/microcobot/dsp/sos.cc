@@ -1,6 +1,8 @@
 #include "microcobot/dsp/sos.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
 
 #include "microcobot/core/error.h"
@@ -23,25 +25,93 @@ SosFilter::SosFilter(Sos sections) : sections_(std::move(sections)), state_(2 * 
   }
 }
 
+namespace {
+
+/// One TDF-II update of section `s` with states z0, z1, in scipy's operation order
+/// (scipy/signal/_sosfilt.pyx), so that the result is bit-identical to sosfilt.
+inline double tdf2(const Biquad& s, double x, double& z0, double& z1) noexcept {
+  const double y = s.b0 * x + z0;
+  z0 = s.b1 * x - s.a1 * y + z1;
+  z1 = s.b2 * x - s.a2 * y;
+  return y;
+}
+
+/// Runs G consecutive sections over a block as a wavefront: in one pass over the samples,
+/// section g works on sample k - g, fed by the output section g - 1 produced in the previous
+/// iteration. The G recurrences are independent within an iteration, so their dependency chains
+/// (4 dependent floating-point operations per sample, ~16 cycles) overlap instead of adding up;
+/// every section still sees the same inputs in the same order with the same operations, so
+/// the output is bit-identical to filtering section by section. States and coefficients live in
+/// locals (registers or the stack), never behind a pointer the output could alias. `dst` may
+/// equal `src`: the write at k - G + 1 never overtakes the read at k.
+template <int G>
+void run_wavefront(const Biquad* sec, double* state, const double* src, double* dst, std::size_t n) noexcept {
+  Biquad s[G];
+  double z0[G], z1[G], carry[G];
+  for (int g = 0; g < G; ++g) {
+    s[g] = sec[g];
+    z0[g] = state[2 * g];
+    z1[g] = state[2 * g + 1];
+    carry[g] = 0.0;
+  }
+  const std::ptrdiff_t nn = static_cast<std::ptrdiff_t>(n);
+  // Ramp-up and ramp-down: only the sections whose sample index k - g is inside the block run.
+  auto partial = [&](std::ptrdiff_t k) {
+    for (int g = G - 1; g >= 0; --g) {
+      const std::ptrdiff_t j = k - g;
+      if (j < 0 || j >= nn) continue;
+      const double x = g == 0 ? src[j] : carry[g - 1];
+      carry[g] = tdf2(s[g], x, z0[g], z1[g]);
+      if (g == G - 1) dst[j] = carry[g];
+    }
+  };
+  std::ptrdiff_t k = 0;
+  for (; k < G - 1 && k < nn; ++k) partial(k);
+  for (; k < nn; ++k) {
+    double in[G];
+    in[0] = src[k];
+    for (int g = 1; g < G; ++g) in[g] = carry[g - 1];
+    for (int g = 0; g < G; ++g) carry[g] = tdf2(s[g], in[g], z0[g], z1[g]);
+    dst[k - (G - 1)] = carry[G - 1];
+  }
+  for (; k < nn + G - 1; ++k) partial(k);
+  for (int g = 0; g < G; ++g) {
+    state[2 * g] = z0[g];
+    state[2 * g + 1] = z1[g];
+  }
+}
+
+}  // namespace
+
 void SosFilter::process(std::span<const double> in, std::span<double> out) {
   if (out.size() != in.size()) throw InvalidParams("out", "must have the size of the input block");
   const std::size_t n = in.size();
   const double* src = in.data();
-  for (std::size_t i = 0; i < sections_.size(); ++i) {
-    const Biquad s = sections_[i];
-    double z0 = state_[2 * i];
-    double z1 = state_[2 * i + 1];
-    double* dst = out.data();
-    for (std::size_t k = 0; k < n; ++k) {
-      const double x = src[k];
-      const double y = s.b0 * x + z0;
-      z0 = s.b1 * x - s.a1 * y + z1;
-      z1 = s.b2 * x - s.a2 * y;
-      dst[k] = y;
+  double* dst = out.data();
+  // Groups of up to kGroup sections run as wavefronts; the next group filters this one's output
+  // in place.
+  constexpr std::size_t kGroup = 4;
+  std::size_t i = 0;
+  while (i < sections_.size()) {
+    const std::size_t g = std::min(kGroup, sections_.size() - i);
+    const Biquad* sec = &sections_[i];
+    double* z = &state_[2 * i];
+    switch (g) {
+      case 1:
+        run_wavefront<1>(sec, z, src, dst, n);
+        break;
+      case 2:
+        run_wavefront<2>(sec, z, src, dst, n);
+        break;
+      case 3:
+        run_wavefront<3>(sec, z, src, dst, n);
+        break;
+      default:
+        run_wavefront<4>(sec, z, src, dst, n);
+        break;
     }
-    state_[2 * i] = z0;
-    state_[2 * i + 1] = z1;
-    src = out.data();  // next section filters this section's output in place
+    i += g;
+    src = dst;
   }
 }
 
