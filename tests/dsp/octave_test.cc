@@ -1,6 +1,7 @@
 #include "microcobot/dsp/octave.h"
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -19,6 +20,20 @@ TEST(Octave, BaseTenCentres) {
   EXPECT_EQ(third_octave_centres(19.9, 20000.0).size(), 31u);
   EXPECT_EQ(third_octave_centres(20.0, 20000.0).size(), 30u);
   EXPECT_THROW(third_octave_centres(100.0, 50.0), InvalidParams);
+}
+
+TEST(Octave, NominalLabelsOfTheExactCentres) {
+  // Thesis Table 3.4: the bands 63 Hz .. 1.25 kHz by their IEC 61260 nominal labels.
+  const std::vector<double> table = {63, 80, 100, 125, 160, 200, 250, 315, 400, 500, 630, 800, 1000, 1250};
+  const auto c = third_octave_centres(60.0, 1300.0);
+  ASSERT_EQ(c.size(), table.size());
+  for (std::size_t i = 0; i < c.size(); ++i) EXPECT_DOUBLE_EQ(third_octave_nominal(c[i]), table[i]) << c[i];
+  // Below 1 Hz and across decades; a label maps to itself.
+  EXPECT_DOUBLE_EQ(third_octave_nominal(1000.0 * std::pow(10.0, -3.3)), 0.5);
+  EXPECT_DOUBLE_EQ(third_octave_nominal(0.1), 0.1);
+  EXPECT_DOUBLE_EQ(third_octave_nominal(19952.6), 20000.0);
+  EXPECT_DOUBLE_EQ(third_octave_nominal(31.5), 31.5);
+  EXPECT_THROW(third_octave_nominal(0.0), InvalidParams);
 }
 
 TEST(Octave, BandAverageOfAKnownResponse) {

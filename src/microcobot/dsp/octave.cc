@@ -1,5 +1,6 @@
 #include "microcobot/dsp/octave.h"
 
+#include <array>
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -15,6 +16,14 @@ std::vector<double> third_octave_centres(double fmin_Hz, double fmax_Hz) {
   std::vector<double> out;
   for (int k = k0; k <= k1; ++k) out.push_back(1000.0 * std::pow(10.0, k / 10.0));
   return out;
+}
+
+double third_octave_nominal(double fc_Hz) {
+  require(std::isfinite(fc_Hz) && fc_Hz > 0, "fc_Hz", "must be > 0", fc_Hz);
+  static constexpr std::array<double, 10> kR10 = {1.0, 1.25, 1.6, 2.0, 2.5, 3.15, 4.0, 5.0, 6.3, 8.0};
+  const auto k = static_cast<long>(std::lround(10.0 * std::log10(fc_Hz)));  // band index re 1 Hz
+  const long decade = k >= 0 ? k / 10 : -((-k + 9) / 10);                   // floor(k / 10)
+  return kR10[static_cast<std::size_t>(k - 10 * decade)] * std::pow(10.0, static_cast<double>(decade));
 }
 
 OctaveBands third_octave_average(std::span<const double> f_Hz, std::span<const std::complex<double>> h,

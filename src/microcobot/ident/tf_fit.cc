@@ -21,8 +21,10 @@ Cplx eval_low(const Eigen::VectorXd& c, Eigen::Index count, Eigen::Index offset,
 
 struct Problem {
   std::vector<Cplx> x, h;
-  std::vector<double> w;
+  std::vector<double> w;     // weights of the refinement's error
+  std::vector<double> w_sk;  // weights of the (complex) Sanathanan-Koerner start
   int nz, np;
+  bool log_magnitude = false;
   // Parameters p = [b_0..b_nz, a_0..a_{np-1}], D = x^np + sum a_i x^i.
   Cplx num(const Eigen::VectorXd& p, Cplx xi) const { return eval_low(p, nz + 1, 0, xi); }
   Cplx den(const Eigen::VectorXd& p, Cplx xi) const { return eval_low(p, np, nz + 1, xi) + std::pow(xi, np); }
@@ -39,7 +41,7 @@ Eigen::VectorXd sanathanan_koerner(const Problem& pb, int iterations) {
     Eigen::VectorXd rhs(2 * m);
     for (Eigen::Index k = 0; k < m; ++k) {
       const auto uk = static_cast<std::size_t>(k);
-      const double s = pb.w[uk] * inv_d[uk];
+      const double s = pb.w_sk[uk] * inv_d[uk];
       const Cplx xk = pb.x[uk], hk = pb.h[uk];
       Cplx xp(1, 0);
       for (int i = 0; i <= pb.nz; ++i, xp *= xk) {
@@ -65,7 +67,28 @@ Eigen::VectorXd sanathanan_koerner(const Problem& pb, int iterations) {
   return p;
 }
 
+// Log-magnitude error w (ln|N/D| - ln|H|); d ln|N| / d b_i = Re(x^i / N), likewise for D.
+Eigen::VectorXd log_magnitude_residual(const Problem& pb, const Eigen::VectorXd& p, Eigen::MatrixXd* jac) {
+  const auto m = static_cast<Eigen::Index>(pb.x.size());
+  Eigen::VectorXd r(m);
+  if (jac) jac->resize(m, pb.params());
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const auto uk = static_cast<std::size_t>(k);
+    const Cplx xk = pb.x[uk];
+    const Cplx n = pb.num(p, xk), d = pb.den(p, xk);
+    r(k) = pb.w[uk] * (std::log(std::abs(n)) - std::log(std::abs(d)) - std::log(std::abs(pb.h[uk])));
+    if (jac) {
+      Cplx xp(1, 0);
+      for (int i = 0; i <= pb.nz; ++i, xp *= xk) (*jac)(k, i) = pb.w[uk] * (xp / n).real();
+      xp = Cplx(1, 0);
+      for (int i = 0; i < pb.np; ++i, xp *= xk) (*jac)(k, pb.nz + 1 + i) = -pb.w[uk] * (xp / d).real();
+    }
+  }
+  return r;
+}
+
 Eigen::VectorXd residual(const Problem& pb, const Eigen::VectorXd& p, Eigen::MatrixXd* jac) {
+  if (pb.log_magnitude) return log_magnitude_residual(pb, p, jac);
   const auto m = static_cast<Eigen::Index>(pb.x.size());
   Eigen::VectorXd r(2 * m);
   if (jac) jac->resize(2 * m, pb.params());
@@ -137,6 +160,42 @@ std::vector<Cplx> fit_poles(const Problem& pb, const Eigen::VectorXd& p) {
   return dsp::roots(den);
 }
 
+// Roots of a low-first coefficient block of p, reflected into the left half plane
+// (continuous) or the unit disc (discrete); returns the factor by which |poly| shrank.
+double reflect_block(Eigen::VectorXd& p, Eigen::Index offset, int degree, bool monic, bool discrete) {
+  if (degree < 1) return 1.0;
+  std::vector<double> hi(static_cast<std::size_t>(degree) + 1);
+  for (int i = 0; i <= degree; ++i)
+    hi[static_cast<std::size_t>(degree - i)] = (monic && i == degree) ? 1.0 : p(offset + i);
+  const double lead = hi[0];
+  auto r = dsp::roots(hi);
+  double shrink = 1.0;
+  for (Cplx& z : r) {
+    if (!discrete && z.real() > 0.0) z = -std::conj(z);  // |j w - z| unchanged
+    if (discrete && std::abs(z) > 1.0) {
+      shrink *= std::abs(z);  // |e^{jw} - z| = |z| |e^{jw} - 1/conj(z)|
+      z = 1.0 / std::conj(z);
+    }
+  }
+  const auto rebuilt = dsp::poly_from_roots(r);  // monic, highest power first
+  const int top = monic ? degree - 1 : degree;
+  for (int i = 0; i <= top; ++i) p(offset + i) = lead * rebuilt[static_cast<std::size_t>(degree - i)];
+  return shrink;
+}
+
+// A magnitude-only fit leaves each zero's and pole's half plane (and the sign) free: take the
+// stable, minimum-phase model with the sign that agrees best with the data's phase.
+void to_minimum_phase(const Problem& pb, Eigen::VectorXd& p, bool discrete) {
+  const double zero_shrink = reflect_block(p, 0, pb.nz, false, discrete);
+  const double pole_shrink = reflect_block(p, pb.nz + 1, pb.np, true, discrete);
+  const double gain = zero_shrink / pole_shrink;
+  Cplx agree(0.0, 0.0);
+  for (std::size_t k = 0; k < pb.x.size(); ++k)
+    agree += std::conj(pb.num(p, pb.x[k]) / pb.den(p, pb.x[k])) * pb.h[k];
+  const double sign = agree.real() < 0.0 ? -1.0 : 1.0;
+  for (int i = 0; i <= pb.nz; ++i) p(i) *= sign * gain;
+}
+
 }  // namespace
 
 TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<double>> h,
@@ -149,6 +208,7 @@ TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<do
   Problem pb;
   pb.nz = o.nz;
   pb.np = o.np;
+  pb.log_magnitude = o.error == TfFitError::kLogMagnitude;
   double wmax = 0.0;
   std::vector<std::size_t> used;
   for (std::size_t k = 0; k < f_Hz.size(); ++k) {
@@ -166,7 +226,11 @@ TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<do
     const double w = 2 * std::numbers::pi * f_Hz[k];
     pb.x.push_back(discrete ? std::exp(Cplx(0, w * o.dt)) : Cplx(0, w / w0));
     pb.h.push_back(h[k]);
-    pb.w.push_back(o.weights.empty() ? 1.0 / std::abs(h[k]) : o.weights[k]);
+    const double user = o.weights.empty() ? 1.0 : o.weights[k];
+    // The SK start always fits the complex data with relative weights; the log-magnitude
+    // error is relative already.
+    pb.w_sk.push_back(pb.log_magnitude || o.weights.empty() ? user / std::abs(h[k]) : user);
+    pb.w.push_back(pb.log_magnitude || !o.weights.empty() ? user : 1.0 / std::abs(h[k]));
   }
   Eigen::VectorXd p = sanathanan_koerner(pb, o.sk_iterations);
   if (!p.allFinite()) throw ComputationFailed("tf fit: the linear start is singular (check orders and band)");
@@ -182,6 +246,7 @@ TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<do
   }
   p = levenberg_marquardt(pb, p, o.lm_iterations);
   if (!p.allFinite()) throw ComputationFailed("tf fit: Levenberg-Marquardt diverged");
+  if (pb.log_magnitude) to_minimum_phase(pb, p, discrete);
   if (!stable(fit_poles(pb, p), discrete)) {
     throw ComputationFailed("tf fit: no stable model of orders (" + std::to_string(o.nz) + ", " +
                             std::to_string(o.np) + ") fits the data in the band");

@@ -9,6 +9,14 @@
 /// band's upper edge, for conditioning); discrete models use x = exp(j w dt). Unstable poles
 /// are reflected into the stable region before the refinement; if the final model is still
 /// unstable the fit fails with ComputationFailed.
+///
+/// With `error = TfFitError::kLogMagnitude` the refinement minimises
+/// sum w_k^2 (ln|N/D| - ln|H_k|)^2 instead: the magnitude alone, as a fit to a power
+/// spectrum (the thesis identifies eq. 3.6 from PSDs, Fig. 3.11), for data whose phase
+/// carries effects the model order cannot hold. The start is still the complex SK fit. The
+/// magnitude leaves each zero's and pole's side of the stability boundary and the sign
+/// free: the model returned is the stable, minimum-phase one, with the sign whose phase
+/// agrees best with the data.
 
 #include <complex>
 #include <limits>
@@ -19,14 +27,22 @@
 
 namespace mc::ident {
 
+/// What the Levenberg-Marquardt refinement minimises.
+enum class TfFitError {
+  kComplex,       ///< w_k |N/D - H_k| (magnitude and phase)
+  kLogMagnitude,  ///< w_k |ln|N/D| - ln|H_k|| (magnitude only; default weights 1)
+};
+
 struct TfFitOptions {
   int nz = 1;  ///< numerator order
   int np = 2;  ///< denominator order (den monic)
   double fmin_Hz = 0.0;
   double fmax_Hz = std::numeric_limits<double>::infinity();
   double dt = 0.0;  ///< 0: continuous model in s; > 0: discrete model in z with this period
-  /// Per-point weights (same length as the data); empty = relative error (1/|H|).
+  /// Per-point weights (same length as the data); empty = relative error (1/|H| for
+  /// kComplex, 1 for kLogMagnitude, whose error is already relative).
   std::vector<double> weights;
+  TfFitError error = TfFitError::kComplex;
   int sk_iterations = 30;
   int lm_iterations = 200;
 };
