@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -177,27 +179,26 @@ void run_evaluate(const mc::cli::CommonOptions& o) {
   const auto id = hp::identify(plant, hp::IdentificationOptions{});
   const auto rp = hp::pipeline_from(id, p.pipeline);
   const auto ev = hp::evaluate(plant, rp, hp::EvaluationOptions{});
+  // The same columns go to evaluation.csv and to the json summary.
+  const std::pair<const char*, const std::vector<double>*> columns[] = {{"fc_Hz", &ev.fc_Hz},
+                                                                        {"lf_dB", &ev.lf_dB},
+                                                                        {"hf_dB", &ev.hf_dB},
+                                                                        {"combined_dB", &ev.combined_dB},
+                                                                        {"pantograph_dB", &ev.pantograph_dB}};
+  nlohmann::json j{{"flatness_dB", ev.flatness_dB}, {"cutoff_Hz", rp.cutoff_Hz}, {"f_max_Hz", rp.f_max_Hz}};
+  mc::CsvTable t;
+  for (const auto& [name, values] : columns) {
+    t.add_column(name, *values);
+    j[name] = *values;
+  }
   if (o.out) {
     mc::ensure_writable_dir(*o.out);
-    mc::CsvTable t;
-    t.add_column("fc_Hz", ev.fc_Hz);
-    t.add_column("lf_dB", ev.lf_dB);
-    t.add_column("hf_dB", ev.hf_dB);
-    t.add_column("combined_dB", ev.combined_dB);
-    t.add_column("pantograph_dB", ev.pantograph_dB);
     mc::write_csv(*o.out / "evaluation.csv", t, {"microcobot haptics evaluate"});
     Report r("haptics evaluate");
     evaluate_report(r, ev, rp);
     mc::cli::write_report_if_requested(o, r);
   }
-  mc::cli::emit(o, {{"fc_Hz", ev.fc_Hz},
-                    {"lf_dB", ev.lf_dB},
-                    {"hf_dB", ev.hf_dB},
-                    {"combined_dB", ev.combined_dB},
-                    {"pantograph_dB", ev.pantograph_dB},
-                    {"flatness_dB", ev.flatness_dB},
-                    {"cutoff_Hz", rp.cutoff_Hz},
-                    {"f_max_Hz", rp.f_max_Hz}});
+  mc::cli::emit(o, j);
 }
 
 // ---- tweezers ---------------------------------------------------------------------------
@@ -318,41 +319,32 @@ void run_tweezers(const TweezersCmd& c) {
 
 // ---- registration -----------------------------------------------------------------------
 
+/// A verb with the common options (--json, --out, --params) bound to `o`.
+CLI::App* add_verb(CLI::App& group, const std::string& name, const std::string& help,
+                   mc::cli::CommonOptions& o) {
+  auto* cmd = group.add_subcommand(name, help);
+  mc::cli::add_output_options(*cmd, o);
+  mc::cli::add_params_option(*cmd, o);
+  return cmd;
+}
+
 void add_haptics(CLI::App& group) {
-  {
-    auto o = std::make_shared<mc::cli::CommonOptions>();
-    auto* cmd = group.add_subcommand("params", "Print the default parameters (plant, pipeline, trap)");
-    mc::cli::add_output_options(*cmd, *o);
-    mc::cli::add_params_option(*cmd, *o);
-    cmd->callback([o] { mc::cli::emit(*o, mc::params_to_json(load(*o))); });
-  }
-  {
-    auto o = std::make_shared<mc::cli::CommonOptions>();
-    auto* cmd =
-        group.add_subcommand("identify", "PRBS identification of both channels and the cut-off (§3.4.2)");
-    mc::cli::add_output_options(*cmd, *o);
-    mc::cli::add_params_option(*cmd, *o);
-    cmd->callback([o] { run_identify(*o); });
-  }
-  {
-    auto o = std::make_shared<mc::cli::CommonOptions>();
-    auto* cmd =
-        group.add_subcommand("evaluate", "1/3-octave sine-dwell evaluation of the pipeline (Fig. 3.13)");
-    mc::cli::add_output_options(*cmd, *o);
-    mc::cli::add_params_option(*cmd, *o);
-    cmd->callback([o] { run_evaluate(*o); });
-  }
-  {
-    auto c = std::make_shared<TweezersCmd>();
-    auto* cmd =
-        group.add_subcommand("tweezers", "Optical-tweezers recording replayed on the interface (§3.5.2)");
-    mc::cli::add_output_options(*cmd, c->common);
-    mc::cli::add_params_option(*cmd, c->common);
-    cmd->add_option("--scenario", c->scenario, "brownian or contact")
-        ->check(CLI::IsMember({"brownian", "contact"}));
-    cmd->add_option("--duration", c->duration_s, "Recording length (s)")->check(CLI::Range(0.5, 60.0));
-    cmd->callback([c] { run_tweezers(*c); });
-  }
+  auto params = std::make_shared<mc::cli::CommonOptions>();
+  add_verb(group, "params", "Print the default parameters (plant, pipeline, trap)", *params)
+      ->callback([params] { mc::cli::emit(*params, mc::params_to_json(load(*params))); });
+  auto identify = std::make_shared<mc::cli::CommonOptions>();
+  add_verb(group, "identify", "PRBS identification of both channels and the cut-off (§3.4.2)", *identify)
+      ->callback([identify] { run_identify(*identify); });
+  auto evaluate = std::make_shared<mc::cli::CommonOptions>();
+  add_verb(group, "evaluate", "1/3-octave sine-dwell evaluation of the pipeline (Fig. 3.13)", *evaluate)
+      ->callback([evaluate] { run_evaluate(*evaluate); });
+  auto tweezers = std::make_shared<TweezersCmd>();
+  auto* cmd = add_verb(group, "tweezers", "Optical-tweezers recording replayed on the interface (§3.5.2)",
+                       tweezers->common);
+  cmd->add_option("--scenario", tweezers->scenario, "brownian or contact")
+      ->check(CLI::IsMember({"brownian", "contact"}));
+  cmd->add_option("--duration", tweezers->duration_s, "Recording length (s)")->check(CLI::Range(0.5, 60.0));
+  cmd->callback([tweezers] { run_tweezers(*tweezers); });
 }
 
 void build_part(Report& r) {

@@ -1,9 +1,11 @@
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/rng.h"
 #include "microcobot/haptics/evaluation.h"
 #include "microcobot/haptics/identification.h"
 
@@ -58,6 +60,28 @@ TEST(Evaluation, CombinedResponseIsFlatAndThePantographAloneIsNot) {
   for (std::size_t i = 0; i < ev.fc_Hz.size(); ++i)
     if (ev.fc_Hz[i] > 250.0) dev = std::max(dev, std::abs(ev.pantograph_dB[i]));
   EXPECT_GT(dev, 6.0);
+}
+
+TEST(GaussianStats, GaussianSamplesFitAndUniformOnesDoNot) {
+  Rng rng(5);
+  std::vector<double> gauss(20000), uniform(20000);
+  for (double& v : gauss) v = 0.3 + 2.0 * rng.normal();
+  for (double& v : uniform) v = rng.uniform();
+  const GaussianStats g = gaussian_stats(gauss);
+  EXPECT_NEAR(g.mean, 0.3, 0.05);
+  EXPECT_NEAR(g.stddev, 2.0, 0.05);
+  EXPECT_NEAR(g.kurtosis, 3.0, 0.15);  // Pearson's, 3 for a Gaussian
+  EXPECT_GT(g.r2, 0.99);
+  ASSERT_EQ(g.density.size(), 41u);
+  // The histogram is a density: it integrates to ~1 over mean +- 4 std.
+  double area = 0.0;
+  for (double d : g.density) area += d * (g.bin_centre[1] - g.bin_centre[0]);
+  EXPECT_NEAR(area, 1.0, 1e-3);
+  const GaussianStats u = gaussian_stats(uniform);
+  EXPECT_NEAR(u.kurtosis, 1.8, 0.05);  // 9/5 for a uniform distribution
+  EXPECT_LT(u.r2, 0.9);
+  EXPECT_THROW(gaussian_stats(std::vector<double>(50, 1.0)), ComputationFailed);
+  EXPECT_THROW(gaussian_stats(std::vector<double>(500, 1.0)), ComputationFailed);  // zero variance
 }
 
 }  // namespace

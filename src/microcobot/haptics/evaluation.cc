@@ -7,7 +7,9 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/rng.h"
+#include "microcobot/dsp/sine_dwell.h"
 #include "microcobot/haptics/identification.h"
+#include "microcobot/ident/stats.h"
 
 namespace mc::haptics {
 
@@ -17,14 +19,16 @@ double sine_dwell_gain(const DualStagePlant& plant, const RenderPipelineParams& 
   DualStagePlantState s;
   Rng rng(seed);
   const double dt = plant.params().dt_s;
-  const auto settle = static_cast<long>(std::ceil(o.settle_s / dt));
+  const auto settle = static_cast<std::size_t>(std::ceil(o.settle_s / dt));
   const double periods = std::max(1.0, std::round(o.measure_s * f));
-  const auto n = static_cast<long>(std::round(periods / f / dt));
+  const auto n = static_cast<std::size_t>(std::round(periods / f / dt));
   const double c_lf = rp.k_sys_m_s2_per_N / rp.lf_gain_m_s2_per_N;
-  std::complex<double> acc = 0.0;
-  for (long k = 0; k < settle + n; ++k) {
-    const double force = o.amplitude_N * std::sin(2.0 * std::numbers::pi * f * k * dt);
-    const RenderOutput out = pipe.tick(force);
+  // Only the magnitude is kept: the accelerometer's read at the end of each held sample (one
+  // sample after the command) shifts the phase, not |Y/F|.
+  std::vector<double> force(settle + n), y(settle + n);
+  for (std::size_t k = 0; k < settle + n; ++k) {
+    const double cmd = o.amplitude_N * std::sin(2.0 * std::numbers::pi * f * static_cast<double>(k) * dt);
+    const RenderOutput out = pipe.tick(cmd);
     double fm = 0.0, u = 0.0;
     switch (mode) {
       case EvalMode::kLowOnly:
@@ -38,17 +42,14 @@ double sine_dwell_gain(const DualStagePlant& plant, const RenderPipelineParams& 
         u = out.u_V;
         break;
       case EvalMode::kPantographOnly:
-        fm = std::clamp(c_lf * force, -rp.max_force_N, rp.max_force_N);
+        fm = std::clamp(c_lf * cmd, -rp.max_force_N, rp.max_force_N);
         break;
     }
     plant.step(s, fm, u);
-    if (k >= settle) {
-      const double y = s.accel_m_s2 + o.noise_m_s2 * rng.normal();
-      acc += y * std::exp(std::complex<double>(0.0, -2.0 * std::numbers::pi * f * (k + 1) * dt));
-    }
+    force[k] = cmd;
+    y[k] = s.accel_m_s2 + o.noise_m_s2 * rng.normal();
   }
-  const double amp = 2.0 * std::abs(acc) / static_cast<double>(n);
-  const double g = amp / (rp.k_sys_m_s2_per_N * o.amplitude_N);
+  const double g = dsp::sine_dwell(force, y, f, 1.0 / dt, settle).magnitude / rp.k_sys_m_s2_per_N;
   if (!std::isfinite(g)) throw ComputationFailed("sine dwell: non-finite gain");
   return g;
 }
@@ -91,42 +92,21 @@ namespace mc::haptics {
 GaussianStats gaussian_stats(std::span<const double> x, int bins) {
   if (x.size() < 100 || bins < 5) throw ComputationFailed("gaussian_stats: too few samples");
   GaussianStats g;
-  const double n = static_cast<double>(x.size());
-  for (double v : x) g.mean += v;
-  g.mean /= n;
-  double m2 = 0.0, m4 = 0.0;
-  for (double v : x) {
-    const double d = (v - g.mean) * (v - g.mean);
-    m2 += d;
-    m4 += d * d;
+  g.mean = ident::mean(x);
+  g.stddev = ident::stddev(x);
+  if (!(g.stddev > 0.0)) throw ComputationFailed("gaussian_stats: zero variance");
+  g.kurtosis = ident::kurtosis(x) + 3.0;  // Pearson's m4 / m2^2
+  const ident::Histogram h =
+      ident::histogram(x, static_cast<std::size_t>(bins), g.mean - 4.0 * g.stddev, g.mean + 4.0 * g.stddev);
+  const ident::GaussianFit fit = ident::fit_gaussian(h.centres, h.counts);
+  const double to_density = 1.0 / (static_cast<double>(x.size()) * h.width);
+  g.bin_centre = h.centres;
+  for (std::size_t b = 0; b < h.centres.size(); ++b) {
+    const double z = (h.centres[b] - fit.mean) / fit.sigma;
+    g.density.push_back(h.counts[b] * to_density);
+    g.gaussian.push_back(fit.amplitude * std::exp(-0.5 * z * z) * to_density);
   }
-  m2 /= n;
-  m4 /= n;
-  if (!(m2 > 0.0)) throw ComputationFailed("gaussian_stats: zero variance");
-  g.stddev = std::sqrt(m2);
-  g.kurtosis = m4 / (m2 * m2);
-  const double lo = g.mean - 4.0 * g.stddev, width = 8.0 * g.stddev / bins;
-  std::vector<double> count(static_cast<std::size_t>(bins), 0.0);
-  for (double v : x) {
-    const auto b = static_cast<long>(std::floor((v - lo) / width));
-    if (b >= 0 && b < bins) count[static_cast<std::size_t>(b)] += 1.0;
-  }
-  double ss_res = 0.0, ss_tot = 0.0, mean_d = 0.0;
-  for (int b = 0; b < bins; ++b) {
-    const double c = lo + (b + 0.5) * width;
-    const double z = (c - g.mean) / g.stddev;
-    g.bin_centre.push_back(c);
-    g.density.push_back(count[static_cast<std::size_t>(b)] / (n * width));
-    g.gaussian.push_back(std::exp(-0.5 * z * z) / (g.stddev * std::sqrt(2.0 * std::numbers::pi)));
-    mean_d += g.density.back();
-  }
-  mean_d /= bins;
-  for (int b = 0; b < bins; ++b) {
-    const auto i = static_cast<std::size_t>(b);
-    ss_res += (g.density[i] - g.gaussian[i]) * (g.density[i] - g.gaussian[i]);
-    ss_tot += (g.density[i] - mean_d) * (g.density[i] - mean_d);
-  }
-  g.r2 = 1.0 - ss_res / ss_tot;
+  g.r2 = fit.r2;
   return g;
 }
 

@@ -35,7 +35,8 @@ struct EvaluationResult {
 /// Which paths of the pipeline drive the plant.
 enum class EvalMode { kLowOnly, kHighOnly, kBoth, kPantographOnly };
 
-/// Sine-dwell gain |a_handle| / (K_sys |F|) at f (linear), with measurement noise.
+/// Sine-dwell gain |a_handle| / (K_sys |F|) at f (linear), with measurement noise, measured
+/// by dsp::sine_dwell after `settle_s` over a whole number of periods.
 double sine_dwell_gain(const DualStagePlant& plant, const RenderPipelineParams& rp, EvalMode mode,
                        double f_Hz, const EvaluationOptions& options, std::uint64_t seed);
 
@@ -52,9 +53,9 @@ std::vector<double> replay(const DualStagePlant& plant, const RenderPipelinePara
 
 namespace mc::haptics {
 
-/// Distribution statistics of a signal (Fig. 3.15): histogram, the Gaussian with the sample
-/// mean and standard deviation, the R^2 of that Gaussian against the histogram density, and
-/// the kurtosis m4 / m2^2 (3 for a Gaussian).
+/// Distribution statistics of a signal (Fig. 3.15), from ident/stats: histogram over
+/// mean +- 4 std as a density, the least-squares Gaussian fitted to it (ident::fit_gaussian)
+/// and its R^2, and Pearson's kurtosis m4 / m2^2 (3 for a Gaussian).
 struct GaussianStats {
   std::vector<double> bin_centre;
   std::vector<double> density;

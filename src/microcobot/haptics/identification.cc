@@ -4,17 +4,19 @@
 #include <cmath>
 #include <numbers>
 
-#include <Eigen/Dense>
-
 #include "microcobot/core/error.h"
 #include "microcobot/core/rng.h"
+#include "microcobot/dsp/octave.h"
 #include "microcobot/dsp/signals.h"
 #include "microcobot/dsp/welch.h"
+#include "microcobot/ident/tf_fit.h"
 
 namespace mc::haptics {
 
 std::vector<double> table_3_4_centres_Hz() {
-  return {63, 80, 100, 125, 160, 200, 250, 315, 400, 500, 630, 800, 1000, 1250};
+  // The bands labelled 63 Hz .. 1.25 kHz; an exact centre lies within 10^(+-1/20) of its label.
+  const double half_band = std::pow(10.0, 1.0 / 20.0);
+  return dsp::third_octave_centres(63.0 / half_band, 1250.0 * half_band);
 }
 
 ChannelFrf measure_frf(const DualStagePlant& plant, Channel channel, double amplitude,
@@ -41,88 +43,29 @@ ChannelFrf measure_frf(const DualStagePlant& plant, Channel channel, double ampl
 }
 
 HfModel fit_second_order(const ChannelFrf& frf, double lo, double hi, double hold_s) {
-  std::vector<std::size_t> idx;
-  for (std::size_t i = 0; i < frf.f_Hz.size(); ++i)
-    if (frf.f_Hz[i] >= lo && frf.f_Hz[i] <= hi) idx.push_back(i);
-  if (idx.size() < 8) throw ComputationFailed("HF fit: fewer than 8 FRF bins in the fit band");
-  // Unknowns theta = [b1, b0, a1, a0]: b1 s + b0 - H (a1 s + a0) = H s^2, weighted by
-  // 1/|D_prev(s)| (Sanathanan-Koerner) and 1/|H| (relative error).
-  const double f0 = std::sqrt(lo * hi);
-  Eigen::Vector4d theta(0, 0, 0, 0);
-  double a1 = 0.0, a0 = 0.0;
-  bool have_prev = false;
-  for (int it = 0; it < 8; ++it) {
-    Eigen::MatrixXd a(2 * idx.size(), 4);
-    Eigen::VectorXd b(2 * idx.size());
-    for (std::size_t r = 0; r < idx.size(); ++r) {
-      const std::size_t i = idx[r];
-      // Normalised frequency s / w0 keeps the columns at the same scale.
-      const std::complex<double> s(0.0, frf.f_Hz[i] / f0);
-      // Remove the known half-sample delay of the zero-order hold before fitting a
-      // rational model (it would otherwise be absorbed as a right-half-plane zero).
-      const std::complex<double> h =
-          frf.h[i] * std::exp(std::complex<double>(0.0, -std::numbers::pi * frf.f_Hz[i] * hold_s));
-      double wgt = 1.0 / std::max(std::abs(h), 1e-12);
-      wgt /= have_prev ? std::abs(s * s + a1 * s + a0) : std::abs(s * s);
-      const std::complex<double> c[4] = {s, 1.0, -h * s, -h};
-      const std::complex<double> rhs = h * s * s;
-      for (int j = 0; j < 4; ++j) {
-        a(static_cast<Eigen::Index>(2 * r), j) = wgt * c[j].real();
-        a(static_cast<Eigen::Index>(2 * r + 1), j) = wgt * c[j].imag();
-      }
-      b(static_cast<Eigen::Index>(2 * r)) = wgt * rhs.real();
-      b(static_cast<Eigen::Index>(2 * r + 1)) = wgt * rhs.imag();
-    }
-    theta = a.colPivHouseholderQr().solve(b);
-    a1 = theta(2);
-    a0 = theta(3);
-    have_prev = true;
-  }
-  const double w0 = 2.0 * std::numbers::pi * f0;
-  HfModel m{theta(0) * w0, theta(1) * w0 * w0, theta(2) * w0, theta(3) * w0 * w0};
-  // The linear fit matches the complex response, phase included; the channel's phase in the
-  // band also carries the magnet's suspension mode, which a 2nd-order low-pass cannot hold.
-  // As the thesis (PSD-based, Fig. 3.11) the model is refined on the log-magnitude only
-  // (Levenberg-Marquardt on log-parameters, which keeps them positive).
-  Eigen::Vector4d p(std::log(std::abs(m.b1) + 1e-9), std::log(std::abs(m.b0) + 1e-9),
-                    std::log(std::abs(m.a1) + 1e-9), std::log(std::abs(m.a0) + 1e-9));
-  const auto residuals = [&](const Eigen::Vector4d& q) {
-    const HfModel mm{std::exp(q(0)), std::exp(q(1)), std::exp(q(2)), std::exp(q(3))};
-    Eigen::VectorXd r(static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t k = 0; k < idx.size(); ++k) {
-      const std::size_t i = idx[k];
-      r(static_cast<Eigen::Index>(k)) = 20.0 * std::log10(std::abs(mm.response(frf.f_Hz[i]))) -
-                                        20.0 * std::log10(std::max(std::abs(frf.h[i]), 1e-300));
-    }
-    return r;
-  };
-  double lambda = 1e-3;
-  Eigen::VectorXd r = residuals(p);
-  for (int it = 0; it < 100; ++it) {
-    Eigen::MatrixXd jac(r.size(), 4);
-    for (int j = 0; j < 4; ++j) {
-      Eigen::Vector4d q = p;
-      q(j) += 1e-6;
-      jac.col(j) = (residuals(q) - r) / 1e-6;
-    }
-    const Eigen::Matrix4d jtj = jac.transpose() * jac;
-    const Eigen::Vector4d g = jac.transpose() * r;
-    const Eigen::Matrix4d aug = jtj + lambda * Eigen::Matrix4d(jtj.diagonal().asDiagonal());
-    const Eigen::Vector4d step = aug.ldlt().solve(-g);
-    const Eigen::VectorXd rn = residuals(p + step);
-    if (rn.squaredNorm() < r.squaredNorm()) {
-      p += step;
-      lambda = std::max(lambda / 3.0, 1e-9);
-      const bool done = r.squaredNorm() - rn.squaredNorm() < 1e-12 * r.squaredNorm();
-      r = rn;
-      if (done) break;
-    } else {
-      lambda *= 4.0;
-    }
-  }
-  m = HfModel{std::exp(p(0)), std::exp(p(1)), std::exp(p(2)), std::exp(p(3))};
-  theta << m.b1, m.b0, m.a1, m.a0;
-  if (!(m.b1 > 0 && m.b0 > 0 && m.a1 > 0 && m.a0 > 0) || !theta.allFinite()) {
+  // Remove the known half-sample delay of the zero-order hold before fitting a rational model
+  // (the SK start would otherwise absorb it as a right-half-plane zero).
+  std::vector<std::complex<double>> h(frf.h.size());
+  for (std::size_t i = 0; i < h.size(); ++i)
+    h[i] = frf.h[i] * std::exp(std::complex<double>(0.0, -std::numbers::pi * frf.f_Hz[i] * hold_s));
+  ident::TfFitOptions o;
+  o.nz = 1;
+  o.np = 2;
+  o.fmin_Hz = lo;
+  o.fmax_Hz = hi;
+  // The channel's phase in the band also carries the magnet's suspension mode, which a
+  // 2nd-order model cannot hold: as the thesis (PSD-based, Fig. 3.11) the model is refined on
+  // the log-magnitude only.
+  o.error = ident::TfFitError::kLogMagnitude;
+  std::size_t in_band = 0;
+  for (double f : frf.f_Hz) in_band += f >= lo && f <= hi ? 1 : 0;
+  if (in_band < 8) throw ComputationFailed("HF fit: fewer than 8 FRF bins in the fit band");
+  const ident::TfFitResult fit = ident::fit_tf(frf.f_Hz, h, o);
+  const std::vector<double>& num = fit.tf.num();
+  const std::vector<double>& den = fit.tf.den();  // monic
+  if (num.size() != 2 || den.size() != 3) throw ComputationFailed("HF fit: the model lost its order");
+  const HfModel m{num[0], num[1], den[1], den[2]};
+  if (!(m.b1 > 0 && m.b0 > 0 && m.a1 > 0 && m.a0 > 0) || !std::isfinite(m.b1 + m.b0 + m.a1 + m.a0)) {
     throw ComputationFailed("HF fit: model is unstable or non-minimum-phase");
   }
   return m;
@@ -187,7 +130,7 @@ IdentificationResult identify(const DualStagePlant& plant, const IdentificationO
   // Cut-off (§3.3.2): as high as the Pantograph allows inside the overlap, on the 1/3-octave grid.
   r.cutoff_Hz = 0.0;
   for (double fc : table_3_4_centres_Hz()) {
-    if (fc <= r.lf_flat_upper_Hz && fc >= r.hf_valid_lower_Hz) r.cutoff_Hz = fc;
+    if (fc <= r.lf_flat_upper_Hz && fc >= r.hf_valid_lower_Hz) r.cutoff_Hz = dsp::third_octave_nominal(fc);
   }
   if (r.cutoff_Hz == 0.0) r.cutoff_Hz = r.lf_flat_upper_Hz;
   return r;

@@ -42,7 +42,7 @@ struct IdentificationResult {
   HfModel hf_model;                ///< G^HF (eq. 3.6), (m/s^2)/V
   double lf_flat_upper_Hz = 0.0;   ///< the Pantograph stays within flat_tol_dB up to here
   double hf_valid_lower_Hz = 0.0;  ///< the Haptuator follows its model from here up
-  double cutoff_Hz = 0.0;          ///< crossover frequency chosen by the §3.3.2 rule
+  double cutoff_Hz = 0.0;          ///< crossover frequency chosen by the §3.3.2 rule (nominal label)
 };
 
 /// Drives `channel` of `plant` with a PRBS (the other input at zero) and estimates the H1 FRF
@@ -51,10 +51,10 @@ ChannelFrf measure_frf(const DualStagePlant& plant, Channel channel, double ampl
                        const IdentificationOptions& options);
 
 /// Second-order model (b1 s + b0)/(s^2 + a1 s + a0) fitted to `frf` on [lo, hi] Hz by
-/// Sanathanan-Koerner iterated linear least squares. Throws ComputationFailed if the fit is
-/// unstable or non-minimum-phase. `hold_s` is the sample period of the zero-order hold that
-/// fed the plant: its half-sample shift (the accelerometer is read at the end of each held sample) is removed
-/// before the fit.
+/// ident::fit_tf (Sanathanan-Koerner start, Levenberg-Marquardt on the log-magnitude).
+/// Throws ComputationFailed if the fit is unstable or non-minimum-phase. `hold_s` is the sample period of the
+/// zero-order hold that fed the plant: its half-sample shift (the accelerometer is read at the end of each
+/// held sample) is removed before the fit.
 HfModel fit_second_order(const ChannelFrf& frf, double lo_Hz, double hi_Hz, double hold_s);
 
 /// The full §3.4.2 procedure. Cut-off rule (§3.3.2): the highest frequency the Pantograph
@@ -65,7 +65,8 @@ IdentificationResult identify(const DualStagePlant& plant, const IdentificationO
 /// Pipeline parameters built from an identification (compensators from identified models).
 RenderPipelineParams pipeline_from(const IdentificationResult& id, RenderPipelineParams base = {});
 
-/// Table 3.4: the 1/3-octave centres 63 Hz - 1.25 kHz.
+/// Table 3.4: the exact base-10 1/3-octave centres (dsp::third_octave_centres) of the bands
+/// labelled 63 Hz - 1.25 kHz (dsp::third_octave_nominal gives the labels).
 std::vector<double> table_3_4_centres_Hz();
 
 }  // namespace mc::haptics
