@@ -27,19 +27,34 @@ void expect_eq36(const dsp::TransferFunction& tf, double rel) {
   EXPECT_NEAR(tf.den()[2], 4.559e6, rel * 4.559e6);
 }
 
-TEST(TfFit, RecoversEq36FromItsExactFrf) {
+// Eq. 3.6's exact response every 5 Hz on 100-1000 Hz, behind a pure delay of delay_s.
+struct Frf {
   std::vector<double> f;
   std::vector<std::complex<double>> h;
+};
+Frf eq36_frf(double delay_s = 0.0) {
+  Frf out;
   for (double fr = 100.0; fr <= 1000.0; fr += 5.0) {
-    f.push_back(fr);
-    h.push_back(kEq36.response(2 * std::numbers::pi * fr));
+    const double w = 2 * std::numbers::pi * fr;
+    out.f.push_back(fr);
+    out.h.push_back(kEq36.response(w) * std::exp(std::complex<double>(0.0, -w * delay_s)));
   }
+  return out;
+}
+
+// Orders (1, 2) on the thesis's 100-1000 Hz band.
+TfFitOptions eq36_options() {
   TfFitOptions o;
   o.nz = 1;
   o.np = 2;
   o.fmin_Hz = 100;
   o.fmax_Hz = 1000;
-  const auto fit = fit_tf(f, h, o);
+  return o;
+}
+
+TEST(TfFit, RecoversEq36FromItsExactFrf) {
+  const auto [f, h] = eq36_frf();
+  const auto fit = fit_tf(f, h, eq36_options());
   expect_eq36(fit.tf, 1e-6);
   EXPECT_LT(fit.relative_rms_error, 1e-9);
   EXPECT_TRUE(fit.tf.is_stable());
@@ -64,11 +79,7 @@ TEST(TfFit, RecoversEq36FromANoisyPrbsExperiment) {
   w.fs_Hz = fs;
   w.nperseg = 2048;
   const auto est = dsp::frf_h1(u, y, w);
-  TfFitOptions o;
-  o.nz = 1;
-  o.np = 2;
-  o.fmin_Hz = 100;
-  o.fmax_Hz = 1000;
+  TfFitOptions o = eq36_options();
   o.dt = dt;
   const auto fit = fit_tf(est.f_Hz, est.h, o);
   const auto cont = dsp::ss2tf(dsp::d2c_zoh(dsp::tf2ss(fit.tf))).normalized();
@@ -79,18 +90,8 @@ TEST(TfFit, RecoversEq36FromANoisyPrbsExperiment) {
 TEST(TfFit, LogMagnitudeErrorIgnoresAPhaseTheModelCannotHold) {
   // Eq. 3.6 behind a pure delay of 0.2 ms (a phase lag no rational (1, 2) model holds): the
   // magnitude-only refinement recovers the coefficients from |H|, the complex one cannot.
-  std::vector<double> f;
-  std::vector<std::complex<double>> h;
-  for (double fr = 100.0; fr <= 1000.0; fr += 5.0) {
-    f.push_back(fr);
-    const double w = 2 * std::numbers::pi * fr;
-    h.push_back(kEq36.response(w) * std::exp(std::complex<double>(0.0, -w * 2e-4)));
-  }
-  TfFitOptions o;
-  o.nz = 1;
-  o.np = 2;
-  o.fmin_Hz = 100;
-  o.fmax_Hz = 1000;
+  const auto [f, h] = eq36_frf(2e-4);
+  TfFitOptions o = eq36_options();
   const auto complex_fit = fit_tf(f, h, o);
   EXPECT_GT(std::abs(complex_fit.tf.den()[2] / 4.559e6 - 1.0), 0.01);
   o.error = TfFitError::kLogMagnitude;
