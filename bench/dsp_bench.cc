@@ -24,9 +24,42 @@ void BM_SosFilterBlock(benchmark::State& state) {
   }
   const double per = static_cast<double>(x.size()) * sections;
   state.counters["ns_per_sample_section"] =
-      benchmark::Counter(per * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+      benchmark::Counter(per * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_SosFilterBlock)->Arg(1)->Arg(4)->Arg(8);
+
+/// The previous block path (one section at a time over the whole block), kept here as the
+/// baseline that BM_SosFilterBlock is compared with in the same run (docs/benchmarks.md).
+void BM_SosFilterBlockSectionBySection(benchmark::State& state) {
+  const int sections = static_cast<int>(state.range(0));
+  const auto sos = mc::dsp::butter(2 * sections, 500.0, 10000.0, mc::dsp::FilterType::kLowPass);
+  const auto x = mc::dsp::white_noise(65536, 1.0, 1);
+  std::vector<double> y(x.size()), z(2 * sos.size(), 0.0);
+  for (auto _ : state) {
+    const double* src = x.data();
+    for (std::size_t i = 0; i < sos.size(); ++i) {
+      const mc::dsp::Biquad s = sos[i];
+      double z0 = z[2 * i], z1 = z[2 * i + 1];
+      for (std::size_t k = 0; k < x.size(); ++k) {
+        const double in = src[k];
+        const double out = s.b0 * in + z0;
+        z0 = s.b1 * in - s.a1 * out + z1;
+        z1 = s.b2 * in - s.a2 * out;
+        y[k] = out;
+      }
+      z[2 * i] = z0;
+      z[2 * i + 1] = z1;
+      src = y.data();
+    }
+    benchmark::DoNotOptimize(y.data());
+  }
+  const double per = static_cast<double>(x.size()) * sections;
+  state.counters["ns_per_sample_section"] =
+      benchmark::Counter(per * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SosFilterBlockSectionBySection)->Arg(1)->Arg(4)->Arg(8);
 
 std::vector<double> welch_data() {
   if (const char* path = std::getenv("MC_WELCH_DATA")) {

@@ -1,9 +1,11 @@
 #include "microcobot/dsp/sos.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <string>
+#include <utility>
 
 #include "microcobot/core/error.h"
 
@@ -81,6 +83,18 @@ void run_wavefront(const Biquad* sec, double* state, const double* src, double* 
   }
 }
 
+/// Sections per wavefront: enough independent recurrences to hide the latency of one.
+constexpr std::size_t kGroup = 8;
+
+using WavefrontFn = void (*)(const Biquad*, double*, const double*, double*, std::size_t) noexcept;
+
+template <std::size_t... I>
+constexpr std::array<WavefrontFn, sizeof...(I)> wavefront_table(std::index_sequence<I...>) {
+  return {&run_wavefront<static_cast<int>(I) + 1>...};
+}
+/// kWavefront[g - 1] runs a group of g sections.
+constexpr auto kWavefront = wavefront_table(std::make_index_sequence<kGroup>{});
+
 }  // namespace
 
 void SosFilter::process(std::span<const double> in, std::span<double> out) {
@@ -90,26 +104,10 @@ void SosFilter::process(std::span<const double> in, std::span<double> out) {
   double* dst = out.data();
   // Groups of up to kGroup sections run as wavefronts; the next group filters this one's output
   // in place.
-  constexpr std::size_t kGroup = 4;
   std::size_t i = 0;
   while (i < sections_.size()) {
     const std::size_t g = std::min(kGroup, sections_.size() - i);
-    const Biquad* sec = &sections_[i];
-    double* z = &state_[2 * i];
-    switch (g) {
-      case 1:
-        run_wavefront<1>(sec, z, src, dst, n);
-        break;
-      case 2:
-        run_wavefront<2>(sec, z, src, dst, n);
-        break;
-      case 3:
-        run_wavefront<3>(sec, z, src, dst, n);
-        break;
-      default:
-        run_wavefront<4>(sec, z, src, dst, n);
-        break;
-    }
+    kWavefront[g - 1](&sections_[i], &state_[2 * i], src, dst, n);
     i += g;
     src = dst;
   }
