@@ -1,0 +1,27 @@
+#!/usr/bin/python3
+"""scipy.signal.sosfilt against mc::dsp::SosFilter::process (block) and the previous
+section-by-section block loop, on the same filters and block length, in one run.
+
+    /usr/bin/python3 bench/scipy_sos_bench.py build/<dir>/bench/dsp_bench
+
+Prints ns per sample per section (CPU time for ours, best of 5 for scipy) and the ratios.
+"""
+import json, subprocess, sys, timeit
+import numpy as np
+import scipy.signal as sig
+
+n = 65536
+x = np.random.default_rng(1).standard_normal(n)
+out = subprocess.run([sys.argv[1], "--benchmark_filter=BM_SosFilterBlock", "--benchmark_min_time=0.2",
+                      "--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true",
+                      "--benchmark_format=json"], capture_output=True, text=True, check=True)
+# the counter is an inverted rate: seconds per sample-section
+ours = {b["run_name"]: b["ns_per_sample_section"] * 1e9 for b in json.loads(out.stdout)["benchmarks"]
+        if b.get("aggregate_name") == "median"}
+for sections in (1, 4, 8):
+    sos = sig.butter(2 * sections, 500.0, fs=10000.0, output="sos")
+    t = min(timeit.repeat(lambda: sig.sosfilt(sos, x), number=20, repeat=5)) / 20 / (n * sections) * 1e9
+    new = ours[f"BM_SosFilterBlock/{sections}"]
+    old = ours[f"BM_SosFilterBlockSectionBySection/{sections}"]
+    print(f"{sections} section(s): wavefront {new:.2f} ns, section by section {old:.2f} ns, scipy {t:.2f} ns;"
+          f" section-by-section/wavefront = {old / new:.2f}, scipy/wavefront = {t / new:.2f}")
