@@ -37,15 +37,36 @@ struct HapticsParams {
     v("pipeline", pipeline);
     v("trap", trap);
   }
+  /// Names a violated parameter by its full key (e.g. "pipeline.cutoff_Hz").
   void validate() const {
-    plant.validate();
-    pipeline.validate();
-    trap.validate();
+    in_section("plant", [this] { plant.validate(); });
+    in_section("pipeline", [this] { pipeline.validate(); });
+    in_section("trap", [this] { trap.validate(); });
+  }
+
+ private:
+  template <class F>
+  static void in_section(const std::string& section, F check) {
+    try {
+      check();
+    } catch (const mc::InvalidParams& e) {
+      // The message is "invalid parameter <field>: <constraint>"; keep the constraint.
+      const std::string what = e.what();
+      const std::string head = "invalid parameter " + e.field() + ": ";
+      throw mc::InvalidParams(section + "." + e.field(),
+                              what.rfind(head, 0) == 0 ? what.substr(head.size()) : what);
+    }
   }
 };
 
+/// The defaults, or --params FILE over them. A value out of range is reported with the file.
 HapticsParams load(const mc::cli::CommonOptions& o) {
-  return o.params ? mc::load_params<HapticsParams>(*o.params) : HapticsParams{};
+  if (!o.params) return HapticsParams{};
+  try {
+    return mc::load_params<HapticsParams>(*o.params);
+  } catch (const mc::InvalidParams& e) {
+    throw mc::InvalidInput(o.params->string(), 0, e.what());
+  }
 }
 
 double db(std::complex<double> z) { return 20.0 * std::log10(std::max(std::abs(z), 1e-300)); }

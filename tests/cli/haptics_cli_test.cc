@@ -135,12 +135,17 @@ TEST(HapticsCli, BadParamsExitThreeWithOneLineNamingTheProblem) {
       EXPECT_EQ(r.out, "");
     }
   }
-  // Out of range: validation names the parameter.
+  // Out of range: the file and the full key of the parameter, with its constraint.
   test::write_text(dir / "range.yaml", "pipeline:\n  cutoff_Hz: 6000\n");
   auto r = run_cli({"haptics", "identify", "--params", (dir / "range.yaml").string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(line_count(r.err), 1u) << r.err;
-  EXPECT_THAT(r.err, HasSubstr("cutoff_Hz"));
+  EXPECT_THAT(r.err, HasSubstr((dir / "range.yaml").string() +
+                               ": invalid parameter pipeline.cutoff_Hz: must be in (0, fs/2) (got 6000)"));
+  test::write_text(dir / "range.yaml", "plant:\n  m_h_kg: -1\n");
+  r = run_cli({"haptics", "evaluate", "--params", (dir / "range.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_THAT(r.err, HasSubstr((dir / "range.yaml").string() + ": invalid parameter plant.m_h_kg: must be"));
   // A missing file is invalid input naming it.
   r = run_cli({"haptics", "tweezers", "--params", (dir / "missing.yaml").string()});
   EXPECT_EQ(r.exit_code, 3);

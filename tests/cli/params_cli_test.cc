@@ -28,7 +28,7 @@ const std::vector<Command>& commands() {
   static const std::vector<Command> c = {
       {{"stickslip", "simulate", "--duration", "1e-4"}, "integrator", "dt_s", "1.0e-3", "integrator.dt_s"},
       {{"control", "velocity"}, "velocity", "sawtooth_frequency_Hz", "-1", "velocity.sawtooth_frequency_Hz"},
-      {{"haptics", "tweezers"}, "trap", "trap_stiffness_N_per_m", "-1.0e-5", "trap_stiffness_N_per_m"},
+      {{"haptics", "tweezers"}, "trap", "trap_stiffness_N_per_m", "-1.0e-5", "trap.trap_stiffness_N_per_m"},
       {{"tweezers", "identify"}, "model", "lead_m", "-1", "lead_m"},
   };
   return c;
