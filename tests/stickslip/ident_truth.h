@@ -7,6 +7,13 @@
 
 namespace mc::stickslip::test {
 
+/// The truth's break-away surface in closed form: affine in amplitude (Fig. 2.13), weakly
+/// decreasing with log frequency, larger backward. ident_truth_params() samples it on a grid.
+inline double ident_truth_zba(double amplitude_V, double frequency_Hz, Direction d) {
+  const double k = 1.0 - 0.04 * std::log10(frequency_Hz / 50.0);
+  return d == Direction::kForward ? (300e-9 + 3.0e-9 * amplitude_V) * k : (330e-9 + 2.5e-9 * amplitude_V) * k;
+}
+
 inline StickSlipParams ident_truth_params() {
   StickSlipParams p;
   const double mp = p.pe.mass_kg, ms = p.slider.mass_kg;
@@ -38,9 +45,8 @@ inline StickSlipParams ident_truth_params() {
   for (double a : t.amplitudes_V) {
     std::vector<double> f, b;
     for (double fr : t.frequencies_Hz) {
-      const double k = 1.0 - 0.04 * std::log10(fr / 50.0);
-      f.push_back((300e-9 + 3.0e-9 * a) * k);
-      b.push_back((330e-9 + 2.5e-9 * a) * k);
+      f.push_back(ident_truth_zba(a, fr, Direction::kForward));
+      b.push_back(ident_truth_zba(a, fr, Direction::kBackward));
     }
     t.forward_m.push_back(f);
     t.backward_m.push_back(b);

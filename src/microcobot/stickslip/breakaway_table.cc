@@ -35,10 +35,11 @@ void check_grid(const std::vector<std::vector<double>>& g, std::size_t rows, std
   }
 }
 
-/// Index i and weight t of `v` between axis[i] and axis[i+1], clamped.
-inline void bracket(const std::vector<double>& axis, double v, std::size_t& i, double& t) noexcept {
+/// Index i and weight t of `v` between axis[i] and axis[i+1] (t linear in `key`), clamped.
+template <class Key>
+inline void bracket(const std::vector<double>& axis, double v, std::size_t& i, double& t, Key key) noexcept {
   const std::size_t n = axis.size();
-  if (n == 1 || v <= axis.front()) {
+  if (n == 1 || !(v > axis.front())) {  // also NaN: clamp to the first row
     i = 0;
     t = 0.0;
     return;
@@ -50,13 +51,15 @@ inline void bracket(const std::vector<double>& axis, double v, std::size_t& i, d
   }
   const auto it = std::upper_bound(axis.begin(), axis.end(), v);
   i = static_cast<std::size_t>(it - axis.begin()) - 1;
-  t = (v - axis[i]) / (axis[i + 1] - axis[i]);
+  t = (key(v) - key(axis[i])) / (key(axis[i + 1]) - key(axis[i]));
 }
 }  // namespace
 
 void BreakawayTable::validate() const {
   check_axis(amplitudes_V, "amplitudes_V");
   check_axis(frequencies_Hz, "frequencies_Hz");
+  // Interpolated in log f: a frequency must be > 0.
+  require(frequencies_Hz.front() > 0.0, "breakaway.frequencies_Hz[0]", "must be > 0", frequencies_Hz.front());
   check_grid(forward_m, amplitudes_V.size(), frequencies_Hz.size(), "forward_m");
   check_grid(backward_m, amplitudes_V.size(), frequencies_Hz.size(), "backward_m");
 }
@@ -65,8 +68,8 @@ double BreakawayTable::lookup(double amplitude_V, double frequency_Hz, Direction
   const auto& g = direction == Direction::kForward ? forward_m : backward_m;
   std::size_t i = 0, j = 0;
   double ta = 0.0, tf = 0.0;
-  bracket(amplitudes_V, amplitude_V, i, ta);
-  bracket(frequencies_Hz, frequency_Hz, j, tf);
+  bracket(amplitudes_V, amplitude_V, i, ta, [](double a) { return a; });
+  bracket(frequencies_Hz, frequency_Hz, j, tf, [](double f) { return std::log(f); });
   const std::size_t i1 = amplitudes_V.size() > 1 ? i + 1 : i;
   const std::size_t j1 = frequencies_Hz.size() > 1 ? j + 1 : j;
   const double a = g[i][j] * (1.0 - tf) + g[i][j1] * tf;
