@@ -14,16 +14,18 @@ ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move
   p_.validate();
   require(std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1e-4, "integrator.dt_s", "must be in (0, 1e-4] s",
           dt_s);
-  mode_a_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, dt_);
-  mode_b_ = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, dt_);
   substeps_ = p_.integrator.substeps;
-  sub_a_ =
-      ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, dt_ / substeps_);
-  sub_b_ =
-      ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, dt_ / substeps_);
   c_ = {p_.friction.mass_fraction_a, 1.0 - p_.friction.mass_fraction_a};
   rho0_ = {p_.friction.rho0_a_N_m, p_.friction.rho0_b_N_m};
   rho1_ = {p_.friction.rho1_a_N_s_m, p_.friction.rho1_b_N_s_m};
+  for (std::size_t i = 0; i < 2; ++i) {
+    m_[i] = c_[i] * p_.slider.mass_kg;
+    inv_m_[i] = 1.0 / m_[i];
+  }
+  const double phi = p_.pe.gain_fraction_a;
+  ka_ = p_.pe.stiffness_a_N_m * phi;
+  kb_ = p_.pe.stiffness_b_N_m * (1.0 - phi);
+  inv_ratio_ = 1.0 / p_.friction.zba_zss_ratio;
   // Verlet's discrete frequency is (2/h) asin(omega h / 2); pre-warping the contact stiffness by
   // sinc^2(omega h / 2) makes the stick-phase modes (eq. 2.20-2.21 on the slider) ring at their
   // exact frequency, which removes the phase drift of the lightly damped 1.6 kHz mode.
@@ -35,10 +37,24 @@ ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move
     const double sinc = std::sin(half) / half;
     return rho0 * sinc * sinc;
   };
-  for (int i = 0; i < 2; ++i) {
-    rho0_step_[static_cast<std::size_t>(i)] = prewarp(rho0_[static_cast<std::size_t>(i)], dt_);
-    rho0_sub_[static_cast<std::size_t>(i)] = prewarp(rho0_[static_cast<std::size_t>(i)], dt_ / substeps_);
-  }
+  auto constants = [&](double h) {
+    StepConstants k;
+    k.h = h;
+    k.inv_h = 1.0 / h;
+    k.half_h = 0.5 * h;
+    k.ma = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, h);
+    k.mb = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, h);
+    for (std::size_t i = 0; i < 2; ++i) {
+      k.rho0[i] = prewarp(rho0_[i], h);
+      k.p[i] = k.half_h * inv_m_[i];
+      k.q[i] = k.half_h * c_[i] * inv_m_[i];
+      k.q_rho0[i] = k.q[i] * k.rho0[i];
+      k.inv_den_el[i] = 1.0 / (1.0 + k.q[i] * (rho1_[i] + p_.friction.rho2_N_s_m));
+    }
+    return k;
+  };
+  full_ = constants(dt_);
+  sub_ = constants(dt_ / substeps_);
   lo_ = -0.5 * p_.slider.stroke_m;
   hi_ = 0.5 * p_.slider.stroke_m;
 }
@@ -76,26 +92,26 @@ void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
   const double uh = p_.pe.static_gain_m_V * pi_update(p_.hysteresis, s.pi, u_V);
   s.u_V = u_V;
   if (!active || substeps_ == 1) {
-    substep(s, uh, dt_, mode_a_, mode_b_, rho0_step_);
+    substep(s, uh, full_);
     return;
   }
   // Within the step g H(U) is interpolated linearly (the first-order hold of the PE's input).
   const double uh0 = s.uh_m;
-  const double h = dt_ / substeps_;
   for (int k = 1; k <= substeps_; ++k) {
-    substep(s, uh0 + (uh - uh0) * static_cast<double>(k) / substeps_, h, sub_a_, sub_b_, rho0_sub_);
+    substep(s, uh0 + (uh - uh0) * static_cast<double>(k) / substeps_, sub_);
   }
 }
 
-void ActuatorModel::substep(ActuatorState& s, double uh, double h, const ModeDiscretization& ma,
-                            const ModeDiscretization& mb, const std::array<double, 2>& rho0) const noexcept {
+void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k) const noexcept {
+  const double h = k.h;
   // 2. PE modes (eq. 2.1-2.2): force = K_pi * (share of g H(U)) - F_f.
-  const double phi = p_.pe.gain_fraction_a;
-  const double ka = p_.pe.stiffness_a_N_m * phi, kb = p_.pe.stiffness_b_N_m * (1.0 - phi);
+  // The friction reaction enters each mode last (g0 F_f), so that it stays off the long chain of
+  // dependent operations from one sub-step's friction to the next one's.
   const double ff = p_.slider.attached ? s.friction_N : 0.0;
   const double x1_old = s.x1_m();
-  ma.step(s.x1a_m, s.v1a_m_s, ka * s.uh_m - ff, ka * uh - ff);
-  mb.step(s.x1b_m, s.v1b_m_s, kb * s.uh_m - ff, kb * uh - ff);
+  const double du = uh - s.uh_m;
+  k.ma.step_with_reaction(s.x1a_m, s.v1a_m_s, ka_ * s.uh_m, ka_ * du, ff);
+  k.mb.step_with_reaction(s.x1b_m, s.v1b_m_s, kb_ * s.uh_m, kb_ * du, ff);
   s.uh_m = uh;
   s.t_s += h;
   const double x1_new = s.x1_m();
@@ -106,35 +122,34 @@ void ActuatorModel::substep(ActuatorState& s, double uh, double h, const ModeDis
   }
   // 3. Slider parts (eq. 2.8 per asperity, eq. 2.20-2.21) by velocity Verlet.
   const std::array<double, 2> z_ba = {s.z_ba_m, s.z_ba_m * p_.friction.breakaway_strain_ratio_b};
-  const double inv_ratio = 1.0 / p_.friction.zba_zss_ratio;
-  const double ms = p_.slider.mass_kg;
   const double kc = p_.friction.coupling_stiffness_N_m;
   std::array<double, 2> x_new{};
-  for (int i = 0; i < 2; ++i) {
+  for (std::size_t i = 0; i < 2; ++i) {
     x_new[i] = s.x2_m[i] + s.v2_m_s[i] * h + 0.5 * s.a2_m_s2[i] * h * h;
   }
   // Friction at the end of the step (eq. 2.10-2.11): F = rho0 z + (rho1 phi + rho2)(x1' - x2') with
   // phi = dz/dx; the velocity-dependent part is trapezoidal-implicit in x2' (second order).
   // The PE's velocity enters as its mean over the step: its 64/120 kHz ringing is averaged, not
   // sampled (aliased) at the step rate.
-  const double v1_mean = (x1_new - x1_old) / h;
+  const double dx1 = x1_new - x1_old;
+  const double v1_mean = dx1 * k.inv_h;
   const double load = p_.slider.load_force_N;
   const double rho2 = p_.friction.rho2_N_s_m;
   double total = 0.0;
-  for (int i = 0; i < 2; ++i) {
-    const int j = 1 - i;
-    const double dx = (x1_new - x1_old) - (x_new[i] - s.x2_m[i]);
-    const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], z_ba[i] * inv_ratio);
-    const double zss = z_ba[i] * inv_ratio;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::size_t j = 1 - i;
+    const double dx = dx1 - (x_new[i] - s.x2_m[i]);
+    const double zss = z_ba[i] * inv_ratio_;
+    const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], zss);
     const double slope = friction_dz_dx(z_new, dx > 0.0 ? 1.0 : (dx < 0.0 ? -1.0 : 0.0), z_ba[i], zss);
     const double damp = rho1_[i] * slope + rho2;  // N s/m on the relative velocity
-    const double m_i = c_[i] * ms;
-    const double explicit_force =
-        c_[i] * (rho0[i] * z_new + damp * v1_mean + load) + kc * (x_new[j] - x_new[i]);
-    const double v = (s.v2_m_s[i] + 0.5 * h * (s.a2_m_s2[i] + explicit_force / m_i)) /
-                     (1.0 + 0.5 * h * c_[i] * damp / m_i);
-    const double f = rho0[i] * z_new + damp * (v1_mean - v);
-    const double a_new = (c_[i] * (f + load) + kc * (x_new[j] - x_new[i])) / m_i;
+    const double coupling = kc * (x_new[j] - x_new[i]);
+    // Trapezoidal-implicit velocity (StepConstants): the terms known before z_new first.
+    const double known = s.v2_m_s[i] + k.half_h * s.a2_m_s2[i] + k.p[i] * coupling + k.q[i] * load;
+    const double inv_den = slope == 1.0 ? k.inv_den_el[i] : 1.0 / (1.0 + k.q[i] * damp);
+    const double v = (known + k.q_rho0[i] * z_new + k.q[i] * damp * v1_mean) * inv_den;
+    const double f = k.rho0[i] * z_new + damp * (v1_mean - v);
+    const double a_new = (c_[i] * (f + load) + coupling) * inv_m_[i];
     s.z_m[i] = z_new;
     s.f_N[i] = f;
     total += c_[i] * f;

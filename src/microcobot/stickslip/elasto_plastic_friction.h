@@ -13,6 +13,9 @@
 /// dz/dx along an increment dx, so a step of any length stays on the model's manifold
 /// 0 <= dz/dx <= 1 (eq. 2.19) and |z| <= z_ss.
 
+#include <algorithm>
+#include <cmath>
+
 namespace mc::stickslip {
 
 /// Contact parameters of the two asperities (Table 2.8, eq. 2.20-2.21) and of the modal slider.
@@ -47,12 +50,39 @@ struct FrictionParams {
 /// alpha(z, x') of eq. 2.12-2.13 for a motion of sign `dx_sign` (-1, 0, +1).
 double friction_alpha(double z, double dx_sign, double z_ba, double z_ss) noexcept;
 
+/// True when alpha = 0 (eq. 2.13): |z| <= z_ba, no motion, or motion against the strain (relaxing).
+inline bool friction_is_elastic(double z, double dx_sign, double z_ba) noexcept {
+  return std::abs(z) <= z_ba || dx_sign == 0.0 || (z > 0.0) != (dx_sign > 0.0);
+}
+
+namespace internal {
+double friction_dz_dx_mixed(double z, double z_ba, double z_ss) noexcept;
+double advance_strain_mixed(double s, double remaining, double z_ba, double z_ss) noexcept;
+}  // namespace internal
+
 /// dz/dx of eq. 2.11 with z_ss(z) of eq. 2.18: 1 - alpha z / (z_ss sgn z). In [0, 1] (eq. 2.19).
-double friction_dz_dx(double z, double dx_sign, double z_ba, double z_ss) noexcept;
+/// The elastic phase (alpha = 0, the common case on the real-time path) is inline.
+inline double friction_dz_dx(double z, double dx_sign, double z_ba, double z_ss) noexcept {
+  if (friction_is_elastic(z, dx_sign, z_ba)) return 1.0;
+  return internal::friction_dz_dx_mixed(z, z_ba, z_ss);
+}
 
 /// The elastic strain after the relative displacement x moves by `dx` from strain `z`
 /// (integration of eq. 2.11 along the path, exact in the elastic phase, RK4 in the mixed phase).
-/// Never allocates.
-double advance_strain(double z, double dx, double z_ba, double z_ss) noexcept;
+/// Never allocates. The elastic phase is inline; the mixed phase is out of line.
+inline double advance_strain(double z, double dx, double z_ba, double z_ss) noexcept {
+  if (dx == 0.0) return z;
+  const double d = dx > 0.0 ? 1.0 : -1.0;
+  double s = d * z;  // strain measured along the motion
+  double remaining = std::abs(dx);
+  // Elastic part: relaxing (s < 0, alpha = 0) and loading up to z_ba: dz = dx exactly.
+  if (s < z_ba) {
+    const double e = std::min(remaining, z_ba - s);
+    s += e;
+    remaining -= e;
+  }
+  if (remaining > 0.0) s = internal::advance_strain_mixed(s, remaining, z_ba, z_ss);
+  return d * s;
+}
 
 }  // namespace mc::stickslip
