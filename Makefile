@@ -6,9 +6,15 @@ BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
 
-.PHONY: run test deps configure build asan bench format clean
+.PHONY: run report test deps configure build asan bench format clean
 
+# The main job: the teleoperated pick-and-place on the simulated platform; prints where the
+# session report is.
 run: build
+	$(CLI) run --out out/session
+
+# Every module's figures in one HTML report.
+report: build
 	$(CLI) report --out out/report
 
 test: build

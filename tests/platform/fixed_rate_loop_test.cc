@@ -1,7 +1,7 @@
 #include "microcobot/platform/fixed_rate_loop.h"
 
-#include <chrono>
 #include <gtest/gtest.h>
+#include <chrono>
 #include <vector>
 
 #include "microcobot/core/error.h"

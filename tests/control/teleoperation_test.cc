@@ -1,0 +1,130 @@
+#include "microcobot/control/teleoperation.h"
+
+#include <gtest/gtest.h>
+
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+namespace {
+
+constexpr double kDt = 1e-4;
+
+TeleoperationInput engaged_at(double x, double y) {
+  TeleoperationInput in;
+  in.handle_m = {x, y};
+  in.deadman = true;
+  in.tweezers_opening_m = 10e-3;
+  return in;
+}
+
+TEST(Teleoperation, EngagingNeverMovesTheSlaveThenMotionIsScaled) {
+  Teleoperation t(TeleoperationParams{}, kDt, {1e-3, -2e-3, 0.5e-3}, 600e-6);
+  auto out = t.tick(engaged_at(0.02, 0.01));  // the hand is anywhere when the deadman is pressed
+  EXPECT_TRUE(out.engaged);
+  EXPECT_DOUBLE_EQ(out.slave_target_m.x(), 1e-3);
+  EXPECT_DOUBLE_EQ(out.slave_target_m.y(), -2e-3);
+  out = t.tick(engaged_at(0.021, 0.008));  // +1 mm, -2 mm of hand
+  EXPECT_NEAR(out.slave_target_m.x(), 1e-3 + 10e-6, 1e-15);
+  EXPECT_NEAR(out.slave_target_m.y(), -2e-3 - 20e-6, 1e-15);
+  EXPECT_NEAR(out.slave_velocity_m_s.x(), 10e-6 / kDt, 1e-9);  // feedforward of the moving target
+  EXPECT_DOUBLE_EQ(out.slave_target_m.z(), 0.5e-3);
+}
+
+TEST(Teleoperation, ClutchingIndexesTheHandWhileTheSlaveHolds) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  t.tick(engaged_at(0.0, 0.0));
+  t.tick(engaged_at(0.03, 0.0));  // slave at 300 um
+  auto in = engaged_at(0.03, 0.0);
+  in.clutch = true;
+  for (double x = 0.03; x > -0.03; x -= 0.001) {
+    in.handle_m.x() = x;
+    const auto& out = t.tick(in);
+    EXPECT_FALSE(out.engaged);
+    EXPECT_NEAR(out.slave_target_m.x(), 300e-6, 1e-15);
+  }
+  auto out = t.tick(engaged_at(-0.03, 0.0));  // released: re-indexed, no jump
+  EXPECT_NEAR(out.slave_target_m.x(), 300e-6, 1e-15);
+  out = t.tick(engaged_at(0.0, 0.0));  // another 30 mm stroke reaches 600 um
+  EXPECT_NEAR(out.slave_target_m.x(), 600e-6, 1e-12);
+}
+
+TEST(Teleoperation, ForcesAreScaledFilteredAndCapped) {
+  TeleoperationParams p;
+  Teleoperation t(p, kDt, {0, 0, 0}, 600e-6);
+  auto in = engaged_at(0, 0);
+  in.contact_force_N = {36e-6, 0, 0};
+  // First-order filter: 63 % after one time constant 1 / (2 pi 30 Hz).
+  const int tau_ticks = static_cast<int>(std::round(1.0 / (2 * M_PI * p.force_filter_Hz) / kDt));
+  for (int i = 0; i < tau_ticks; ++i) t.tick(in);
+  EXPECT_NEAR(t.output().haptic_force_N.x(), 0.36 * (1 - std::exp(-1.0)), 0.01);
+  for (int i = 0; i < 20 * tau_ticks; ++i) t.tick(in);
+  EXPECT_NEAR(t.output().haptic_force_N.x(), 0.36, 1e-6);  // 36 uN x 1e4
+  in.contact_force_N = {0, -1e-3, 0};                      // 10 N scaled: capped at max_force_N
+  for (int i = 0; i < 20 * tau_ticks; ++i) t.tick(in);
+  EXPECT_NEAR(t.output().haptic_force_N.norm(), p.max_force_N, 1e-9);
+  in.grip_force_N = 1e-3;
+  EXPECT_NEAR(t.tick(in).finger_force_N, 0.1, 1e-12);  // x 100
+  in.grip_force_N = 1.0;
+  EXPECT_DOUBLE_EQ(t.tick(in).finger_force_N, p.max_grip_force_N);
+}
+
+TEST(Teleoperation, DeadmanReleasedOrStaleMasterHoldsTheSlaveWithZeroForce) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  auto in = engaged_at(0, 0);
+  in.contact_force_N = {36e-6, 0, 0};
+  for (int i = 0; i < 1000; ++i) t.tick(in);
+  in.handle_m.x() = 0.01;
+  const double held = t.tick(in).slave_target_m.x();
+  EXPECT_GT(t.output().haptic_force_N.x(), 0.0);
+  in.deadman = false;
+  in.handle_m.x() = 0.02;
+  auto out = t.tick(in);
+  EXPECT_FALSE(out.engaged);
+  EXPECT_DOUBLE_EQ(out.slave_target_m.x(), held);
+  EXPECT_DOUBLE_EQ(out.haptic_force_N.norm(), 0.0);
+  in.deadman = true;
+  in.haptic_fresh = false;
+  out = t.tick(in);
+  EXPECT_TRUE(out.stale);
+  EXPECT_FALSE(out.engaged);
+  EXPECT_DOUBLE_EQ(out.slave_target_m.x(), held);
+  EXPECT_DOUBLE_EQ(out.haptic_force_N.norm(), 0.0);
+}
+
+TEST(Teleoperation, TweezersDriveTheGripperAndStaleTweezersHoldIt) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  auto in = engaged_at(0, 0);
+  in.tweezers_opening_m = 5e-3;
+  EXPECT_NEAR(t.tick(in).gripper_opening_m, 300e-6, 1e-15);  // x 0.06
+  in.tweezers_opening_m = 2e-3;
+  in.tweezers_fresh = false;
+  in.grip_force_N = 1e-3;
+  const auto& out = t.tick(in);
+  EXPECT_NEAR(out.gripper_opening_m, 300e-6, 1e-15);
+  EXPECT_DOUBLE_EQ(out.finger_force_N, 0.0);
+}
+
+TEST(Teleoperation, JogIntegratesZAndTargetsStayInTheWorkspace) {
+  TeleoperationParams p;
+  Teleoperation t(p, kDt, {0, 0, 0}, 600e-6);
+  auto in = engaged_at(0, 0);
+  in.z_jog_m_s = 1.0;  // far above the limit
+  for (int i = 0; i < 10000; ++i) t.tick(in);
+  EXPECT_NEAR(t.output().slave_target_m.z(), p.max_jog_m_s * 1.0, 1e-9);
+  in.handle_m.x() = 10.0;  // 100 mm of slave: clamped to the stroke
+  EXPECT_DOUBLE_EQ(t.tick(in).slave_target_m.x(), p.workspace_max_m);
+}
+
+TEST(Teleoperation, RejectsBadParameters) {
+  TeleoperationParams p;
+  p.motion_scale = 0;
+  EXPECT_THROW(Teleoperation(p, kDt, {0, 0, 0}, 0), InvalidParams);
+  p = {};
+  p.workspace_min_m = 1e-3;
+  p.workspace_max_m = -1e-3;
+  EXPECT_THROW(p.validate(), InvalidParams);
+  EXPECT_THROW(Teleoperation(TeleoperationParams{}, 0.0, {0, 0, 0}, 0), InvalidParams);
+}
+
+}  // namespace
+}  // namespace mc::control
