@@ -27,7 +27,7 @@ void BM_SosFilterBlock(benchmark::State& state) {
       benchmark::Counter(per * static_cast<double>(state.iterations()),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_SosFilterBlock)->Arg(1)->Arg(4)->Arg(8);
+BENCHMARK(BM_SosFilterBlock)->Arg(1)->Arg(2)->Arg(4)->Arg(8);
 
 /// The previous block path (one section at a time over the whole block), kept here as the
 /// baseline that BM_SosFilterBlock is compared with in the same run (docs/benchmarks.md).
@@ -59,7 +59,7 @@ void BM_SosFilterBlockSectionBySection(benchmark::State& state) {
       benchmark::Counter(per * static_cast<double>(state.iterations()),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_SosFilterBlockSectionBySection)->Arg(1)->Arg(4)->Arg(8);
+BENCHMARK(BM_SosFilterBlockSectionBySection)->Arg(1)->Arg(2)->Arg(4)->Arg(8);
 
 std::vector<double> welch_data() {
   if (const char* path = std::getenv("MC_WELCH_DATA")) {
