@@ -46,7 +46,8 @@ class SosFilter {
   }
 
   /// Filters a block; `out` must have in.size() elements and may alias `in`. Never allocates.
-  /// Runs section by section over the block (cache- and pipeline-friendly).
+  /// Runs groups of up to 8 sections as wavefronts (section g on sample k - g, so that their
+  /// dependency chains overlap); bit-identical to calling process(double) on each sample.
   void process(std::span<const double> in, std::span<double> out);
 
   /// Zeroes the states (the filter then responds as if the input had always been 0).
