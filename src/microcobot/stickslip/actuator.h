@@ -71,18 +71,11 @@ class ActuatorModel {
  private:
   StickSlipParams p_;
   double dt_;
-  /// What a step of length h needs, precomputed at construction (so that the real-time path has
-  /// one division per slider part instead of eleven: docs/benchmarks.md).
+  /// What a step of length h needs, precomputed at construction.
   struct StepConstants {
-    double h = 0.0, inv_h = 0.0, half_h = 0.0;
+    double h = 0.0;
     ModeDiscretization ma, mb;     ///< exact PE mode matrices for h
     std::array<double, 2> rho0{};  ///< rho0 pre-warped for Verlet at h (docs/model.md)
-    /// Per slider part i, the trapezoidal-implicit velocity update written as
-    /// v = (v2 + h/2 a2 + p kc dx_c + q F_load + q rho0 z + q damp v1) / (1 + q damp):
-    std::array<double, 2> p{};           ///< h / (2 m_i)
-    std::array<double, 2> q{};           ///< h c_i / (2 m_i)
-    std::array<double, 2> q_rho0{};      ///< q rho0
-    std::array<double, 2> inv_den_el{};  ///< 1 / (1 + q (rho1 + rho2)): elastic phase, dz/dx = 1
   };
   /// One integration sub-step (PE exact, contact by Verlet + path-integrated strain).
   void substep(ActuatorState& s, double uh_m, const StepConstants& k) const noexcept;
@@ -90,9 +83,9 @@ class ActuatorModel {
   StepConstants full_, sub_;
   int substeps_ = 1;
   std::array<double, 2> c_{}, rho0_{}, rho1_{};
-  std::array<double, 2> m_{}, inv_m_{};  ///< part masses c_i M_s and their inverses
-  double ka_ = 0.0, kb_ = 0.0;           ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
-  double inv_ratio_ = 1.0;               ///< 1 / (z_ba / z_ss)
+  std::array<double, 2> m_{};   ///< part masses c_i M_s
+  double ka_ = 0.0, kb_ = 0.0;  ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
+  double inv_ratio_ = 1.0;      ///< 1 / (z_ba / z_ss)
   double lo_ = 0.0, hi_ = 0.0;
 };
 

@@ -63,15 +63,6 @@ struct ModeDiscretization {
     x = xn;
     v = vn;
   }
-  /// The same step with the force split as f(t) = d0 + (d1 - d0) t/h - r: a drive ramping from d0
-  /// by `dd` = d1 - d0 and a reaction r held over the step (the friction on the PE). Equal to
-  /// step(x, v, d0 - r, d0 + dd - r) up to rounding; r enters last, off the drive's arithmetic.
-  void step_with_reaction(double& x, double& v, double d0, double dd, double r) const noexcept {
-    const double xn = (phi[0] * x + phi[1] * v + g0[0] * d0 + g1[0] * dd) - g0[0] * r;
-    const double vn = (phi[2] * x + phi[3] * v + g0[1] * d0 + g1[1] * dd) - g0[1] * r;
-    x = xn;
-    v = vn;
-  }
 };
 
 }  // namespace mc::stickslip
