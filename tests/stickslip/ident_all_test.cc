@@ -142,6 +142,12 @@ TEST(IdentAll, BadDirectoriesGiveOneLineErrors) {
   EXPECT_DOUBLE_EQ(a, 62.5);
   EXPECT_DOUBLE_EQ(fr, 500);
   EXPECT_EQ(d, Direction::kBackward);
+  for (const char* bad : {"sawtooth_62.V_500Hz_forward.csv", "sawtooth_0V_500Hz_forward.csv",
+                          "sawtooth_60V_500Hz_forward.csv.bak", "sawtooth_60V_500Hz_sideways.csv",
+                          "sawtooth_-60V_500Hz_forward.csv", "sawtooth_60V500Hz_forward.csv"}) {
+    EXPECT_FALSE(parse_sawtooth_file_name(bad, a, fr, d)) << bad;
+  }
+  EXPECT_DOUBLE_EQ(a, 62.5);  // a rejected name leaves the outputs untouched
   EXPECT_EQ(sawtooth_file_name(60, 500, Direction::kForward), "sawtooth_60V_500Hz_forward.csv");
 }
 

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <mutex>
-#include <regex>
+#include <string_view>
 #include <thread>
 
 #include <fmt/format.h>
@@ -265,16 +265,58 @@ std::string sawtooth_file_name(double amplitude_V, double frequency_Hz, Directio
   return fmt::format("sawtooth_{:g}V_{:g}Hz_{}.csv", amplitude_V, frequency_Hz, to_string(direction));
 }
 
+namespace {
+
+/// Consumes `prefix` from the front of `s`; false when `s` does not start with it.
+bool consume(std::string_view& s, std::string_view prefix) {
+  if (s.substr(0, prefix.size()) != prefix) return false;
+  s.remove_prefix(prefix.size());
+  return true;
+}
+
+/// Consumes a plain decimal number `[0-9]+(.[0-9]+)?` (no sign, no exponent) into `value`.
+bool consume_decimal(std::string_view& s, double& value) {
+  auto digits = [&s](std::size_t from) {
+    std::size_t i = from;
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+    return i;
+  };
+  std::size_t end = digits(0);
+  if (end == 0) return false;
+  if (end < s.size() && s[end] == '.') {
+    const std::size_t frac_end = digits(end + 1);
+    if (frac_end == end + 1) return false;
+    end = frac_end;
+  }
+  value = std::stod(std::string(s.substr(0, end)));
+  s.remove_prefix(end);
+  return true;
+}
+
+}  // namespace
+
 bool parse_sawtooth_file_name(const std::string& name, double& amplitude_V, double& frequency_Hz,
                               Direction& direction) {
-  static const std::regex re(
-      R"(sawtooth_([0-9]+(?:\.[0-9]+)?)V_([0-9]+(?:\.[0-9]+)?)Hz_(forward|backward)\.csv)");
-  std::smatch m;
-  if (!std::regex_match(name, m, re)) return false;
-  amplitude_V = std::stod(m[1].str());
-  frequency_Hz = std::stod(m[2].str());
-  direction = m[3].str() == "forward" ? Direction::kForward : Direction::kBackward;
-  return amplitude_V > 0.0 && frequency_Hz > 0.0;
+  // sawtooth_<amplitude>V_<frequency>Hz_<forward|backward>.csv
+  std::string_view s = name;
+  double a = 0.0, f = 0.0;
+  if (!consume(s, "sawtooth_") || !consume_decimal(s, a) || !consume(s, "V_") || !consume_decimal(s, f) ||
+      !consume(s, "Hz_")) {
+    return false;
+  }
+  Direction d{};
+  if (s == "forward.csv") {
+    d = Direction::kForward;
+  } else if (s == "backward.csv") {
+    d = Direction::kBackward;
+  } else {
+    return false;
+  }
+  if (!(a > 0.0 && f > 0.0)) return false;
+  amplitude_V = a;
+  frequency_Hz = f;
+  direction = d;
+  return true;
 }
 
 std::vector<SawtoothRun> read_sawtooth_runs(const std::filesystem::path& dir) {
