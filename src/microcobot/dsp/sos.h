@@ -46,8 +46,11 @@ class SosFilter {
   }
 
   /// Filters a block; `out` must have in.size() elements and may alias `in`. Never allocates.
-  /// Runs groups of up to 8 sections as wavefronts (section g on sample k - g, so that their
-  /// dependency chains overlap); bit-identical to calling process(double) on each sample.
+  /// A cascade of two or more sections runs in groups of two to eight sections as wavefronts
+  /// (section g on sample k - g, so that their dependency chains overlap): bit-identical to
+  /// calling process(double) on each sample. A lone section runs a four-sample look-ahead of its
+  /// state-space form instead (sos.cc): equal to process(double) up to rounding, and the filter
+  /// state stays the same TDF-II pair, so block and per-sample calls can be mixed.
   void process(std::span<const double> in, std::span<double> out);
 
   /// Zeroes the states (the filter then responds as if the input had always been 0).
