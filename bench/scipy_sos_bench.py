@@ -23,5 +23,5 @@ for sections in (1, 2, 4, 8):
     t = min(timeit.repeat(lambda: sig.sosfilt(sos, x), number=20, repeat=5)) / 20 / (n * sections) * 1e9
     new = ours[f"BM_SosFilterBlock/{sections}"]
     old = ours[f"BM_SosFilterBlockSectionBySection/{sections}"]
-    print(f"{sections} section(s): wavefront {new:.2f} ns, section by section {old:.2f} ns, scipy {t:.2f} ns;"
-          f" section-by-section/wavefront = {old / new:.2f}, scipy/wavefront = {t / new:.2f}")
+    print(f"{sections} section(s): block path {new:.2f} ns, section by section {old:.2f} ns, scipy {t:.2f} ns;"
+          f" section-by-section/block = {old / new:.2f}, scipy/block = {t / new:.2f}")

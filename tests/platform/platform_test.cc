@@ -85,12 +85,13 @@ TEST(Platform, AFaultingDevicePutsEveryDeviceInItsSafeState) {
   for (int i = 0; i < 3; ++i) EXPECT_EQ(p.axis(i).state(), Lifecycle::kFault);
   EXPECT_EQ(p.haptic().state(), Lifecycle::kFault);
   EXPECT_EQ(p.gripper().state(), Lifecycle::kFault);
-  const double x = p.axis(0).true_position_m();
+  const double x = p.simulation().axes[0]->true_position_m();
   p.loop().run_for(1000);
-  for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(p.axis(i).voltage_V(), 0.0);  // axes at 0 V
-  EXPECT_DOUBLE_EQ(p.haptic().channels().f_m_N, 0.0);                        // no force
-  EXPECT_DOUBLE_EQ(p.haptic().channels().u_V, 0.0);
-  EXPECT_NEAR(p.axis(0).true_position_m(), x, 2e-6);  // at most the PE's retraction
+  for (int i = 0; i < 3; ++i)
+    EXPECT_DOUBLE_EQ(p.simulation().axes[static_cast<std::size_t>(i)]->voltage_V(), 0.0);  // axes at 0 V
+  EXPECT_DOUBLE_EQ(p.simulation().haptic->channels().f_m_N, 0.0);                          // no force
+  EXPECT_DOUBLE_EQ(p.simulation().haptic->channels().u_V, 0.0);
+  EXPECT_NEAR(p.simulation().axes[0]->true_position_m(), x, 2e-6);  // at most the PE's retraction
 }
 
 TEST(Platform, StaleHapticReadingsHoldTheSlaveAndZeroTheForceWithinTheWatchdogTimeout) {
@@ -98,7 +99,7 @@ TEST(Platform, StaleHapticReadingsHoldTheSlaveAndZeroTheForceWithinTheWatchdogTi
   Platform& p = rig.platform;
   p.loop().run_for(10000);
   ASSERT_TRUE(p.teleop().engaged);
-  p.haptic().freeze_readings(true);
+  p.simulation().haptic->freeze_readings(true);
   const int timeout = p.config().loop.watchdog_ticks;
   p.loop().run_for(static_cast<std::uint64_t>(timeout));
   EXPECT_TRUE(p.teleop().engaged);  // a few missed readings are tolerated
@@ -109,7 +110,7 @@ TEST(Platform, StaleHapticReadingsHoldTheSlaveAndZeroTheForceWithinTheWatchdogTi
   p.loop().run_for(5000);
   EXPECT_DOUBLE_EQ(p.teleop().slave_target_m.x(), held);
   EXPECT_DOUBLE_EQ(p.teleop().haptic_force_N.norm(), 0.0);
-  p.haptic().freeze_readings(false);
+  p.simulation().haptic->freeze_readings(false);
   p.loop().run_for(2);
   EXPECT_TRUE(p.teleop().engaged);
 }

@@ -56,7 +56,10 @@ std::string_view PickPlaceOperator::name(Phase p) {
 }
 
 PickPlaceOperator::PickPlaceOperator(Platform& platform, const PickPlaceOperatorParams& params)
-    : platform_(platform), p_(params), motion_scale_(platform.config().teleop.motion_scale) {
+    : platform_(platform),
+      sim_(platform.simulation()),
+      p_(params),
+      motion_scale_(platform.config().teleop.motion_scale) {
   p_.validate();
   std::fill(std::begin(started_), std::end(started_), std::numeric_limits<double>::quiet_NaN());
   started_[0] = 0.0;
@@ -117,10 +120,10 @@ void PickPlaceOperator::act(const TickInfo& tick) noexcept {
     failed_phase_ = phase_;
     enter(Phase::kGaveUp, t);
     hand_.deadman = false;
-    platform_.haptic().set_operator(hand_);
+    sim_.haptic->set_operator(hand_);
     return;
   }
-  const SimulatedGripper& g = platform_.gripper();
+  const SimulatedGripper& g = *sim_.gripper;
   const Eigen::Vector3d tip = g.tip_position_m();
   const Eigen::Vector3d part = g.world_state().part_m;
   const Eigen::Vector2d target = g.world().params().target_m.head<2>();
@@ -171,8 +174,8 @@ void PickPlaceOperator::act(const TickInfo& tick) noexcept {
     case Phase::kGaveUp:
       break;
   }
-  platform_.haptic().set_operator(hand_);
-  platform_.tweezers().set_operator_closing(pinch_);
+  sim_.haptic->set_operator(hand_);
+  sim_.tweezers->set_operator_closing(pinch_);
 }
 
 }  // namespace mc::platform

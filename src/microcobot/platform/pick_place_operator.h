@@ -103,6 +103,7 @@ class PickPlaceOperator {
   double jog_to(double z_seen, double z_goal) const noexcept;
 
   Platform& platform_;
+  const SimulatedDevices& sim_;  ///< the operator acts on the simulated masters' hands
   PickPlaceOperatorParams p_;
   double motion_scale_;
   Phase phase_ = Phase::kApproach;

@@ -10,7 +10,9 @@
 namespace mc::platform {
 namespace {
 
-std::vector<std::string> telemetry_names() { return {kTelemetryChannels.begin(), kTelemetryChannels.end()}; }
+std::vector<std::string> telemetry_names(std::size_t count) {
+  return {kTelemetryChannels.begin(), kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(count)};
+}
 
 // Room for a few seconds of telemetry between drains; the drain thread empties it every ms.
 constexpr std::size_t kRingCapacity = 8192;
@@ -24,35 +26,77 @@ Platform::Platform(const PlatformConfig& config)
       tweezers_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
       home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
       loop_(config_.loop.base_rate_Hz),
-      ring_(kRingCapacity),
-      recorder_(std::make_unique<Recorder>(telemetry_names(), 1)) {
-  const double dt = config_.loop.period_s();
+      ring_(kRingCapacity) {
   model_ = std::make_unique<stickslip::ActuatorModel>(axis_params(config_));
-  const double ratio = dt / model_->dt_s();
-  require(std::abs(ratio - std::round(ratio)) < 1e-6 * ratio && ratio >= 1.0, "loop.base_rate_Hz",
-          "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
-  map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
-
+  const double dt = config_.loop.period_s();
   const char* names[3] = {"axis_x", "axis_y", "axis_z"};
   for (std::size_t i = 0; i < 3; ++i) {
     control::PositionSensorParams sp = config_.stage.sensor;
     sp.seed = config_.stage.sensor.seed + static_cast<int>(i);  // independent noise per axis
-    axes_[i] = std::make_unique<SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
+    auto axis = std::make_unique<SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
+    sim_.axes[i] = axis.get();
+    devices_.axes[i] = std::move(axis);
   }
-  gripper_ = std::make_unique<SimulatedGripper>(
-      "gripper", world_,
-      std::array<const SimulatedSlaveAxis*, 3>{axes_[0].get(), axes_[1].get(), axes_[2].get()},
+  auto gripper = std::make_unique<SimulatedGripper>(
+      "gripper", world_, std::array<const SimulatedSlaveAxis*, 3>{sim_.axes[0], sim_.axes[1], sim_.axes[2]},
       Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
-  haptic_ = std::make_unique<SimulatedHapticMaster>("dual_stage", config_.haptic.plant, config_.haptic.render,
-                                                    config_.haptic.pantograph, dt);
-  tweezers_ = std::make_unique<SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
+  auto haptic = std::make_unique<SimulatedHapticMaster>("dual_stage", config_.haptic.plant,
+                                                        config_.haptic.render, config_.haptic.pantograph, dt);
+  auto tweezers = std::make_unique<SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
+  sim_.gripper = gripper.get();
+  sim_.haptic = haptic.get();
+  sim_.tweezers = tweezers.get();
+  devices_.gripper = std::move(gripper);
+  devices_.haptic = std::move(haptic);
+  devices_.tweezers = std::move(tweezers);
+  build();
+}
+
+Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
+    : config_(config),
+      world_((config_.validate(), config_.world)),
+      devices_(std::move(drivers)),
+      haptic_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
+      tweezers_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
+      home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
+      loop_(config_.loop.base_rate_Hz),
+      ring_(kRingCapacity) {
+  const char* names[6] = {"axes[0]", "axes[1]", "axes[2]", "gripper", "haptic", "tweezers"};
+  const auto d = devices();
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (d[i] == nullptr) throw InvalidParams(std::string("devices.") + names[i], "is missing");
+    if (d[i]->state() != Lifecycle::kUnconfigured)
+      throw InvalidParams(std::string("devices.") + names[i], "must be handed over unconfigured");
+  }
+  model_ = std::make_unique<stickslip::ActuatorModel>(axis_params(config_));
+  build();
+}
+
+void Platform::build() {
+  const double dt = config_.loop.period_s();
+  const double ratio = dt / model_->dt_s();
+  require(std::abs(ratio - std::round(ratio)) < 1e-6 * ratio && ratio >= 1.0, "loop.base_rate_Hz",
+          "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double period = devices_.axes[i]->sample_period_s();
+    require(std::abs(period - model_->dt_s()) <= 1e-9 * model_->dt_s(), "devices.axes.sample_period_s",
+            "must equal the stick-slip model's step (integrator.dt_s)", period);
+  }
+  map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
   stage_ = std::make_unique<StageController>(config_.stage.control, model_->params(), *map_,
                                              static_cast<int>(std::lround(ratio)), model_->dt_s());
   teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                      world_.params().gripper.max_opening_m);
+  recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
 
-  for (Device* d : devices()) d->configure();
-  for (Device* d : devices()) d->activate();
+  // Configure, then activate; a device that throws leaves none of them armed.
+  try {
+    for (Device* d : devices()) d->configure();
+    for (Device* d : devices()) d->activate();
+  } catch (...) {
+    for (Device* d : devices()) d->deactivate();
+    throw;
+  }
 
   loop_.add_task("operator", config_.loop.operator_divisor, [this](const TickInfo& t) {
     if (operator_) operator_(t);
@@ -70,7 +114,13 @@ Platform::~Platform() {
 }
 
 std::array<Device*, 6> Platform::devices() {
-  return {axes_[0].get(), axes_[1].get(), axes_[2].get(), gripper_.get(), haptic_.get(), tweezers_.get()};
+  return {devices_.axes[0].get(), devices_.axes[1].get(), devices_.axes[2].get(),
+          devices_.gripper.get(), devices_.haptic.get(),  devices_.tweezers.get()};
+}
+
+const SimulatedDevices& Platform::simulation() const {
+  if (!simulated()) throw InvalidParams("platform", "runs on hardware drivers, not on the simulation");
+  return sim_;
 }
 
 void Platform::fault_all() noexcept {
@@ -81,47 +131,48 @@ void Platform::fault_all() noexcept {
 
 void Platform::teleoperation_task() noexcept {
   // The watchdogs see whether each master produced a reading since the last tick.
-  if (haptic_->reading_count() != haptic_seen_) haptic_watchdog_.feed();
-  if (tweezers_->reading_count() != tweezers_seen_) tweezers_watchdog_.feed();
-  haptic_seen_ = haptic_->reading_count();
-  tweezers_seen_ = tweezers_->reading_count();
+  if (devices_.haptic->reading_count() != haptic_seen_) haptic_watchdog_.feed();
+  if (devices_.tweezers->reading_count() != tweezers_seen_) tweezers_watchdog_.feed();
+  haptic_seen_ = devices_.haptic->reading_count();
+  tweezers_seen_ = devices_.tweezers->reading_count();
 
   control::TeleoperationInput in;
-  const Vec2 h = haptic_->handle_position_m();
+  const Vec2 h = devices_.haptic->handle_position_m();
   in.handle_m = {h.x, h.y};
-  in.deadman = haptic_->enabled() && !faulted_;
-  in.clutch = haptic_->clutch();
-  in.z_jog_m_s = haptic_->jog_m_s();
+  in.deadman = devices_.haptic->enabled() && !faulted_;
+  in.clutch = devices_.haptic->clutch();
+  in.z_jog_m_s = devices_.haptic->jog_m_s();
   in.haptic_fresh = haptic_watchdog_.tick();
-  in.tweezers_opening_m = tweezers_->opening_m();
+  in.tweezers_opening_m = devices_.tweezers->opening_m();
   in.tweezers_fresh = tweezers_watchdog_.tick();
-  for (int i = 0; i < 3; ++i) in.slave_position_m[i] = axes_[static_cast<std::size_t>(i)]->position_m();
-  const Vec3 f = gripper_->contact_force_N();
+  for (int i = 0; i < 3; ++i)
+    in.slave_position_m[i] = devices_.axes[static_cast<std::size_t>(i)]->position_m();
+  const Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
-  in.grip_force_N = gripper_->grip_force_N();
+  in.grip_force_N = devices_.gripper->grip_force_N();
   const auto& out = teleop_->tick(in);
 
-  haptic_->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
-  tweezers_->command_grip_force_N(out.finger_force_N);
-  gripper_->command_opening_m(out.gripper_opening_m);
+  devices_.haptic->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
+  devices_.tweezers->command_grip_force_N(out.finger_force_N);
+  devices_.gripper->command_opening_m(out.gripper_opening_m);
 }
 
 void Platform::slave_control_task() noexcept {
   if (faulted_) return;
   const auto& out = teleop_->output();
-  const std::array<double, 3> measured = {axes_[0]->position_m(), axes_[1]->position_m(),
-                                          axes_[2]->position_m()};
+  const std::array<double, 3> measured = {devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
+                                          devices_.axes[2]->position_m()};
   stage_->update(out.slave_target_m, out.slave_velocity_m_s, measured);
 }
 
 void Platform::devices_task(double dt_s) noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!faulted_) axes_[i]->command_drive(stage_->drive(static_cast<int>(i)));
-    axes_[i]->update(dt_s);
+    if (!faulted_) devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i)));
+    devices_.axes[i]->update(dt_s);
   }
-  gripper_->update(dt_s);
-  haptic_->update(dt_s);
-  tweezers_->update(dt_s);
+  devices_.gripper->update(dt_s);
+  devices_.haptic->update(dt_s);
+  devices_.tweezers->update(dt_s);
   if (!faulted_) {
     for (Device* d : devices()) {
       if (d->state() == Lifecycle::kFault) {
@@ -135,34 +186,40 @@ void Platform::devices_task(double dt_s) noexcept {
 void Platform::telemetry_task(double t_s) noexcept {
   TelemetrySample s{};
   const auto& o = teleop_->output();
-  const OperatorHand& hand = haptic_->operator_hand();
-  const Vec2 handle = haptic_->handle_position_m();
-  const auto& w = gripper_->world_state();
-  const Vec3 contact = gripper_->contact_force_N();
+  const Vec2 handle = devices_.haptic->handle_position_m();
+  const Vec3 contact = devices_.gripper->contact_force_N();
   std::size_t k = 0;
   auto put = [&](double v) { s[k++] = v; };
+  // Loop channels (kTelemetryChannels' order).
   put(t_s);
-  put(hand.hand_m.x), put(hand.hand_m.y), put(handle.x), put(handle.y);
-  put(hand.deadman), put(hand.clutch), put(o.engaged), put(o.stale);
+  put(handle.x), put(handle.y);
+  put(devices_.haptic->enabled()), put(devices_.haptic->clutch()), put(o.engaged), put(o.stale);
   for (int i = 0; i < 3; ++i) put(home_m_[i] + o.slave_target_m[i]);
   for (std::size_t i = 0; i < 3; ++i)
-    put(home_m_[static_cast<Eigen::Index>(i)] + axes_[i]->true_position_m());
-  for (std::size_t i = 0; i < 3; ++i) put(home_m_[static_cast<Eigen::Index>(i)] + axes_[i]->position_m());
-  for (std::size_t i = 0; i < 3; ++i) put(axes_[i]->voltage_V());
+    put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->position_m());
+  for (int i = 0; i < 3; ++i) put(faulted_ ? 0.0 : stage_->last_voltage_V(i));
   put(o.haptic_force_N.x()), put(o.haptic_force_N.y());
-  put(haptic_->channels().f_m_N), put(haptic_->channels().u_V);
-  put(tweezers_->opening_m()), put(o.finger_force_N);
-  put(o.gripper_opening_m), put(gripper_->opening_m()), put(gripper_->grip_force_N());
+  put(devices_.tweezers->opening_m()), put(o.finger_force_N);
+  put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
   put(contact.x), put(contact.y), put(contact.z);
-  put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
-  put(static_cast<double>(static_cast<int>(w.phase)));
   put(1e6 * loop_.last_tick_s());
+  // Simulation channels: the ground truth.
+  if (simulated()) {
+    const OperatorHand& hand = sim_.haptic->operator_hand();
+    const auto& w = sim_.gripper->world_state();
+    put(hand.hand_m.x), put(hand.hand_m.y);
+    for (std::size_t i = 0; i < 3; ++i)
+      put(home_m_[static_cast<Eigen::Index>(i)] + sim_.axes[i]->true_position_m());
+    put(sim_.haptic->channels().f_m_N), put(sim_.haptic->channels().u_V);
+    put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
+    put(static_cast<double>(static_cast<int>(w.phase)));
+  }
   ring_.push(s);
 }
 
 void Platform::drain() noexcept {
   TelemetrySample s;
-  while (ring_.pop(s)) recorder_->sample(s);
+  while (ring_.pop(s)) recorder_->sample(std::span<const double>(s.data(), telemetry_channel_count()));
 }
 
 void Platform::run(double duration_s) {
@@ -172,11 +229,11 @@ void Platform::run(double duration_s) {
   const std::size_t need =
       recorder_->size() + ticks / static_cast<std::uint64_t>(config_.loop.telemetry_divisor) + 2;
   if (need > recorder_->capacity()) {
-    auto bigger = std::make_unique<Recorder>(telemetry_names(), need);
+    auto bigger = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), need);
     TelemetrySample s;
     for (std::size_t i = 0; i < recorder_->size(); ++i) {
-      for (std::size_t c = 0; c < s.size(); ++c) s[c] = recorder_->at(i, c);
-      bigger->sample(s);
+      for (std::size_t c = 0; c < telemetry_channel_count(); ++c) s[c] = recorder_->at(i, c);
+      bigger->sample(std::span<const double>(s.data(), telemetry_channel_count()));
     }
     recorder_ = std::move(bigger);
   }

@@ -11,6 +11,9 @@
 ///   every operator tick      the (scripted) operator acts, if one is attached
 ///   every telemetry tick     one sample into a single-producer ring, drained off the loop
 ///
+/// The devices are reached through their interfaces only (device.h): the default platform
+/// builds the simulated ones, another constructor takes hardware drivers (docs/hardware.md).
+///
 /// A device that faults (a diverged model, a driver error) puts every device in its safe
 /// state at once: the axes to 0 V, the forces to zero, the gripper holding. Nothing on the
 /// loop path allocates, locks, throws or does I/O (tests/platform/platform_test.cc).
@@ -38,10 +41,12 @@
 
 namespace mc::platform {
 
-/// The channels of a telemetry sample, unit-suffixed (the CSV recording's columns).
-inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",
-                                                                   "hand_x_m",
-                                                                   "hand_y_m",
+/// The channels of a telemetry sample, unit-suffixed (the CSV recording's columns). The first
+/// kLoopChannelCount are what the loop itself sees (the devices' interfaces, the coupling, the
+/// controller's commands): recorded on any devices. The rest are the simulation's ground truth
+/// (the operator's hand, the true carriage positions, the haptic channels' forces, the part):
+/// recorded only when the platform runs its simulated devices.
+inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",  // loop channels
                                                                    "handle_x_m",
                                                                    "handle_y_m",
                                                                    "deadman",
@@ -51,9 +56,6 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",
                                                                    "target_x_m",
                                                                    "target_y_m",
                                                                    "target_z_m",
-                                                                   "slave_x_m",
-                                                                   "slave_y_m",
-                                                                   "slave_z_m",
                                                                    "measured_x_m",
                                                                    "measured_y_m",
                                                                    "measured_z_m",
@@ -62,8 +64,6 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",
                                                                    "u_z_V",
                                                                    "haptic_force_x_N",
                                                                    "haptic_force_y_N",
-                                                                   "pantograph_y_N",
-                                                                   "haptuator_V",
                                                                    "tweezers_opening_m",
                                                                    "finger_force_N",
                                                                    "gripper_command_m",
@@ -72,18 +72,50 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",
                                                                    "contact_x_N",
                                                                    "contact_y_N",
                                                                    "contact_z_N",
+                                                                   "tick_us",
+                                                                   "hand_x_m",  // simulation channels
+                                                                   "hand_y_m",
+                                                                   "slave_x_m",
+                                                                   "slave_y_m",
+                                                                   "slave_z_m",
+                                                                   "pantograph_y_N",
+                                                                   "haptuator_V",
                                                                    "part_x_m",
                                                                    "part_y_m",
                                                                    "part_z_m",
-                                                                   "part_phase",
-                                                                   "tick_us"};
+                                                                   "part_phase"};
+inline constexpr std::size_t kLoopChannelCount = 27;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
+
+/// The devices the loop drives, by their interfaces (device.h). A hardware set-up fills it
+/// with its drivers (docs/hardware.md); the default platform builds the simulated ones.
+struct PlatformDevices {
+  std::array<std::unique_ptr<SlaveAxis>, 3> axes;  ///< X, Y, Z of the slave stage
+  std::unique_ptr<Gripper> gripper;
+  std::unique_ptr<HapticMaster> haptic;
+  std::unique_ptr<TweezersMaster> tweezers;
+};
+
+/// The simulated devices of a simulated platform, by their concrete types (non-owning): the
+/// scripted operator moves their hands, the session report reads their ground truth.
+struct SimulatedDevices {
+  std::array<SimulatedSlaveAxis*, 3> axes{};
+  SimulatedGripper* gripper = nullptr;
+  SimulatedHapticMaster* haptic = nullptr;
+  SimulatedTweezersMaster* tweezers = nullptr;
+};
 
 class Platform {
  public:
-  /// Builds the models (the stick-slip step map is computed here: about a second), the
-  /// devices and the loop, then configures and activates every device. Throws mc::Error.
+  /// The simulated platform: builds the models (the stick-slip step map is computed here: about
+  /// a second), the simulated devices and the loop, then configures and activates every device.
+  /// Throws mc::Error.
   explicit Platform(const PlatformConfig& config);
+  /// The platform on the given devices (hardware drivers): the stage controller still uses the
+  /// stick-slip model of `config` (identified for these axes: stickslip_params_file). Every
+  /// device must be present and unconfigured; they are configured and activated here (a driver
+  /// that throws leaves the platform unbuilt, every device deactivated). Throws mc::Error.
+  Platform(const PlatformConfig& config, PlatformDevices drivers);
   ~Platform();
   Platform(const Platform&) = delete;
   Platform& operator=(const Platform&) = delete;
@@ -104,13 +136,21 @@ class Platform {
   const PlatformConfig& config() const { return config_; }
   FixedRateLoop& loop() { return loop_; }
   const FixedRateLoop& loop() const { return loop_; }
-  SimulatedHapticMaster& haptic() { return *haptic_; }
-  SimulatedTweezersMaster& tweezers() { return *tweezers_; }
-  const SimulatedSlaveAxis& axis(int i) const { return *axes_[static_cast<std::size_t>(i)]; }
-  const SimulatedGripper& gripper() const { return *gripper_; }
+  HapticMaster& haptic() { return *devices_.haptic; }
+  TweezersMaster& tweezers() { return *devices_.tweezers; }
+  const SlaveAxis& axis(int i) const { return *devices_.axes[static_cast<std::size_t>(i)]; }
+  const Gripper& gripper() const { return *devices_.gripper; }
+  /// True when the platform runs its simulated devices.
+  bool simulated() const { return sim_.haptic != nullptr; }
+  /// The simulated devices; throws mc::InvalidParams on a platform built on other devices.
+  const SimulatedDevices& simulation() const;
   const StageController& stage_controller() const { return *stage_; }
   const control::TeleoperationOutput& teleop() const { return teleop_->output(); }
   const Recorder& recording() const { return *recorder_; }
+  /// Channels recorded: all of kTelemetryChannels when simulated, the loop channels otherwise.
+  std::size_t telemetry_channel_count() const {
+    return simulated() ? kTelemetryChannels.size() : kLoopChannelCount;
+  }
   /// Telemetry samples lost because the ring was full (0 when the drain keeps up).
   std::size_t telemetry_dropped() const { return ring_.dropped() + recorder_->dropped(); }
 
@@ -123,16 +163,15 @@ class Platform {
   void devices_task(double dt_s) noexcept;
   void telemetry_task(double t_s) noexcept;
   void drain() noexcept;
+  void build();
   std::array<Device*, 6> devices();
 
   PlatformConfig config_;
   std::unique_ptr<stickslip::ActuatorModel> model_;
   std::unique_ptr<control::StepMap> map_;
   microworld::PickPlaceWorld world_;
-  std::array<std::unique_ptr<SimulatedSlaveAxis>, 3> axes_;
-  std::unique_ptr<SimulatedGripper> gripper_;
-  std::unique_ptr<SimulatedHapticMaster> haptic_;
-  std::unique_ptr<SimulatedTweezersMaster> tweezers_;
+  PlatformDevices devices_;
+  SimulatedDevices sim_;  ///< all null unless simulated
   std::unique_ptr<StageController> stage_;
   std::unique_ptr<control::Teleoperation> teleop_;
   Watchdog haptic_watchdog_;

@@ -60,10 +60,11 @@ Session::Session(const PlatformConfig& config, const SessionParams& params) : pa
   platform_ = std::make_unique<Platform>(config);
   operator_ = std::make_unique<PickPlaceOperator>(*platform_, params_.operator_params);
   const bool stale = params_.scenario == "stale-master";
-  platform_->set_operator([this, stale](const TickInfo& t) {
+  SimulatedHapticMaster* haptic = platform_->simulation().haptic;
+  platform_->set_operator([this, stale, haptic](const TickInfo& t) {
     if (stale) {
-      platform_->haptic().freeze_readings(t.t_s >= params_.stale_at_s &&
-                                          t.t_s < params_.stale_at_s + params_.stale_for_s);
+      haptic->freeze_readings(t.t_s >= params_.stale_at_s &&
+                              t.t_s < params_.stale_at_s + params_.stale_for_s);
     }
     operator_->act(t);
   });
@@ -88,9 +89,10 @@ SessionResult Session::run(const std::function<void(double)>& progress) {
   r.tick_max_us = 1e6 * loop.tick_stats().max_s();
   r.clutches = operator_->clutches();
   r.faulted = p.faulted();
-  const auto& w = p.gripper().world_state();
+  const SimulatedGripper& g = *p.simulation().gripper;
+  const auto& w = g.world_state();
   r.crashed = w.crashed;
-  r.placement_error_m = p.gripper().world().placement_error_m(w);
+  r.placement_error_m = g.world().placement_error_m(w);
   r.telemetry_dropped = p.telemetry_dropped();
   using Phase = PickPlaceOperator::Phase;
   for (int i = 0; i <= static_cast<int>(Phase::kDone); ++i) {

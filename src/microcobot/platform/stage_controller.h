@@ -31,6 +31,11 @@ class StageController {
               const std::array<double, 3>& measured_m) noexcept;
   /// The drive samples of axis `i` for the next loop tick.
   DriveBlock drive(int i) noexcept;
+  /// The last voltage drive(i) produced (0 before the first and after emergency_stop()).
+  double last_voltage_V(int i) const noexcept {
+    const auto& buf = samples_[static_cast<std::size_t>(i)];
+    return stopped_ || buf.empty() ? 0.0 : buf.back();
+  }
   /// Every axis to 0 V; they stay stopped until the next update() with a target.
   void emergency_stop() noexcept;
 
