@@ -48,6 +48,74 @@ TEST(DualStagePlant, PantographChannelHasASharpResonanceNear800Hz) {
   EXPECT_GT(pk - db(plant.frf(Channel::kPantograph, 1.08 * fpk)), 8.0);
 }
 
+// Local extremum of |G_LF| in dB on a 1 Hz grid over [lo, hi]: the lowest (sign +1) or highest
+// (sign -1) point, required to be a true local extremum (its neighbours on both sides are higher/lower).
+struct Extremum {
+  double f_Hz = 0.0;
+  double dB = 0.0;
+  bool local = false;
+};
+Extremum extremum(const DualStagePlant& plant, double lo, double hi, double sign) {
+  Extremum e{lo, sign * 1e9, false};
+  for (double f = lo; f <= hi; f += 1.0) {
+    const double v = db(plant.frf(Channel::kPantograph, f));
+    if (sign * v < sign * e.dB) e = {f, v, false};
+  }
+  const double left = db(plant.frf(Channel::kPantograph, e.f_Hz - 1.0));
+  const double right = db(plant.frf(Channel::kPantograph, e.f_Hz + 1.0));
+  e.local = e.f_Hz > lo && e.f_Hz < hi && sign * left > sign * e.dB && sign * right > sign * e.dB;
+  return e;
+}
+
+// Fig. 3.10: "a first, nicely damped antiresonance slightly after 200 Hz accompanied by a damped
+// resonance at 300 Hz. Another resonance-antiresonance pair around 800 Hz, with a sharp peak".
+TEST(DualStagePlant, PantographChannelHasTheFig310AntiresonancesAndResonances) {
+  const DualStagePlant plant{DualStagePlantParams{}};
+  double lo = 1e9, hi = -1e9, ref = 0.0;
+  int n = 0;
+  for (double f = 40.0; f <= 120.0; f += 1.0, ++n) ref += std::abs(plant.frf(Channel::kPantograph, f));
+  ref = 20.0 * std::log10(ref / n);
+  for (double f = 40.0; f <= 200.0; f += 1.0) {
+    const double v = db(plant.frf(Channel::kPantograph, f)) - ref;
+    lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+  EXPECT_LT(hi, 1.0);
+  EXPECT_GT(lo, -1.0);
+  // Damped antiresonance just above 200 Hz, then a damped resonance near 300 Hz.
+  const Extremum anti = extremum(plant, 200.0, 260.0, +1.0);
+  const Extremum res = extremum(plant, 260.0, 340.0, -1.0);
+  EXPECT_TRUE(anti.local) << anti.f_Hz;
+  EXPECT_TRUE(res.local) << res.f_Hz;
+  EXPECT_GT(res.dB - anti.dB, 1.5);
+  // Damped: the dip is shallow (a few dB below the band), not a notch.
+  EXPECT_GT(anti.dB - ref, -6.0);
+  // Near 800 Hz an antiresonance followed by a sharp resonance.
+  const Extremum res8 = extremum(plant, 700.0, 900.0, -1.0);
+  const Extremum anti8 = extremum(plant, 700.0, res8.f_Hz, +1.0);
+  EXPECT_TRUE(res8.local) << res8.f_Hz;
+  EXPECT_TRUE(anti8.local) << anti8.f_Hz;
+  EXPECT_LT(anti8.f_Hz, res8.f_Hz);
+  EXPECT_GT(res8.dB - anti8.dB, 15.0);
+  EXPECT_GT(res8.dB - db(plant.frf(Channel::kPantograph, 0.92 * res8.f_Hz)), 8.0);
+}
+
+// Without the two linkage modes the plant is eq. 3.4 as printed: no antiresonance on the
+// Pantograph path besides the magnet's, so no local minimum between 150 and 1250 Hz.
+TEST(DualStagePlant, Eq34AsPrintedHasNoLinkageAntiresonance) {
+  DualStagePlantParams p;
+  p.m_p_kg = 0.0;
+  p.m_d_kg = 0.0;
+  const DualStagePlant plant{p};
+  double prev = db(plant.frf(Channel::kPantograph, 150.0)), prev2 = prev;
+  for (double f = 151.0; f <= 1250.0; f += 1.0) {
+    const double v = db(plant.frf(Channel::kPantograph, f));
+    EXPECT_FALSE(prev < prev2 && prev < v) << f - 1.0;
+    prev2 = prev, prev = v;
+  }
+  // ... and the total mass is eq. 3.4's four masses.
+  EXPECT_DOUBLE_EQ(plant.total_mass_kg(), p.m_h_kg + p.m_v_kg + p.m_1_kg + p.m_2_kg);
+}
+
 TEST(DualStagePlant, HaptuatorChannelMatchesEq36On100To1000Hz) {
   const DualStagePlant plant{DualStagePlantParams{}};
   for (double f = 100.0; f <= 1000.0; f *= 1.02) {
@@ -123,6 +191,12 @@ TEST(DualStagePlant, RejectsInvalidParamsAndDivergence) {
   EXPECT_THROW(DualStagePlant{p}, InvalidParams);
   p = {};
   p.stop_k_N_per_m = 1e12;
+  EXPECT_THROW(DualStagePlant{p}, InvalidParams);
+  p = {};
+  p.k_p_N_per_m = 0.0;  // a linkage mode needs its spring
+  EXPECT_THROW(DualStagePlant{p}, InvalidParams);
+  p = {};
+  p.b_d_Ns_per_m = -1.0;
   EXPECT_THROW(DualStagePlant{p}, InvalidParams);
   const DualStagePlant plant{DualStagePlantParams{}};
   DualStagePlantState s;

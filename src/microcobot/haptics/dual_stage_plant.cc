@@ -22,6 +22,14 @@ void DualStagePlantParams::validate() const {
   require_non_negative(b_1_Ns_per_m, "b_1_Ns_per_m");
   require_positive(k_2_N_per_m, "k_2_N_per_m");
   require_non_negative(b_2_Ns_per_m, "b_2_Ns_per_m");
+  require_non_negative(m_p_kg, "m_p_kg");
+  require_non_negative(k_p_N_per_m, "k_p_N_per_m");
+  require_non_negative(b_p_Ns_per_m, "b_p_Ns_per_m");
+  require_non_negative(m_d_kg, "m_d_kg");
+  require_non_negative(k_d_N_per_m, "k_d_N_per_m");
+  require_non_negative(b_d_Ns_per_m, "b_d_Ns_per_m");
+  require(m_p_kg == 0.0 || k_p_N_per_m > 0.0, "k_p_N_per_m", "must be > 0 when m_p_kg > 0", k_p_N_per_m);
+  require(m_d_kg == 0.0 || k_d_N_per_m > 0.0, "k_d_N_per_m", "must be > 0 when m_d_kg > 0", k_d_N_per_m);
   require_positive(amp_gain_A_per_V, "amp_gain_A_per_V");
   require_non_negative(loop_kp_V_per_A, "loop_kp_V_per_A");
   require_positive(loop_ki_V_per_As, "loop_ki_V_per_As");
@@ -44,41 +52,57 @@ void DualStagePlantParams::validate() const {
 DualStagePlant::DualStagePlant(const DualStagePlantParams& params) : params_(params) {
   params_.validate();
   const auto& p = params_;
-  // Eq. 3.4: M, C, K in Y = [y_h, y_v, y_1, y_2].
-  Eigen::Matrix4d m = Eigen::Vector4d(p.m_h_kg, p.m_v_kg, p.m_1_kg, p.m_2_kg).asDiagonal();
-  Eigen::Matrix4d c;
-  c << p.b_1_Ns_per_m + p.b_v_Ns_per_m + p.b_f_Ns_per_m, -p.b_v_Ns_per_m, -p.b_1_Ns_per_m, 0, -p.b_v_Ns_per_m,
-      p.b_v_Ns_per_m, 0, 0,                                                  //
-      -p.b_1_Ns_per_m, 0, p.b_1_Ns_per_m + p.b_2_Ns_per_m, -p.b_2_Ns_per_m,  //
-      0, 0, -p.b_2_Ns_per_m, p.b_2_Ns_per_m;
-  Eigen::Matrix4d k;
-  k << p.k_1_N_per_m + p.k_v_N_per_m + p.k_f_N_per_m, -p.k_v_N_per_m, -p.k_1_N_per_m, 0, -p.k_v_N_per_m,
-      p.k_v_N_per_m, 0, 0,                                               //
-      -p.k_1_N_per_m, 0, p.k_1_N_per_m + p.k_2_N_per_m, -p.k_2_N_per_m,  //
-      0, 0, -p.k_2_N_per_m, p.k_2_N_per_m;
-  const Eigen::Matrix4d minv = m.inverse();
+  constexpr int n = kMasses;
+  using MassMatrix = Eigen::Matrix<double, n, n>;
+  // Eq. 3.4: M, C, K in Y = [y_h, y_v, y_1, y_2], bordered by the linkage modes y_p, y_d.
+  MassMatrix k = MassMatrix::Zero();
+  MassMatrix c = MassMatrix::Zero();
+  // A spring-damper between masses i and j (j < 0: to the ground, i.e. the operator's hand).
+  const auto link = [&](int i, int j, double kk, double bb) {
+    k(i, i) += kk;
+    c(i, i) += bb;
+    if (j < 0) return;
+    k(j, j) += kk;
+    c(j, j) += bb;
+    k(i, j) -= kk;
+    k(j, i) -= kk;
+    c(i, j) -= bb;
+    c(j, i) -= bb;
+  };
+  link(0, -1, p.k_f_N_per_m, p.b_f_Ns_per_m);  // finger (eq. 3.4, k_f, b_f on y_h)
+  link(0, 1, p.k_v_N_per_m, p.b_v_Ns_per_m);   // Haptuator membrane
+  link(0, 2, p.k_1_N_per_m, p.b_1_Ns_per_m);   // distal links
+  link(2, 3, p.k_2_N_per_m, p.b_2_Ns_per_m);   // proximal links
+  // Linkage modes off the force path (extension of eq. 3.4): an absent branch (0 kg) gets a unit
+  // dummy mass with no spring, so its coordinates stay at rest and leave the rest untouched.
+  if (p.m_p_kg > 0.0) link(3, 4, p.k_p_N_per_m, p.b_p_Ns_per_m);  // proximal mode on the motor node
+  if (p.m_d_kg > 0.0) link(2, 5, p.k_d_N_per_m, p.b_d_Ns_per_m);  // distal bending mode on m_1
+  Eigen::Matrix<double, n, 1> mass;
+  mass << p.m_h_kg, p.m_v_kg, p.m_1_kg, p.m_2_kg, p.m_p_kg > 0.0 ? p.m_p_kg : 1.0,
+      p.m_d_kg > 0.0 ? p.m_d_kg : 1.0;
+  const Eigen::Matrix<double, n, 1> minv = mass.cwiseInverse();
   a_.setZero();
   b_.setZero();
-  a_.block<4, 4>(0, 4).setIdentity();
-  a_.block<4, 4>(4, 0) = -minv * k;
-  a_.block<4, 4>(4, 4) = -minv * c;
+  a_.block<n, n>(0, n).setIdentity();
+  a_.block<n, n>(n, 0) = -(minv.asDiagonal() * k);
+  a_.block<n, n>(n, n) = -(minv.asDiagonal() * c);
   // Force pair (eq. 3.4): -f_v on the handle, +f_v on the magnet, with f_v = -Bl i: the coil
   // is wired so that a positive command pushes the handle towards +y.
-  a_(4, 8) = p.bl_N_per_A / p.m_h_kg;
-  a_(5, 8) = -p.bl_N_per_A / p.m_v_kg;
-  // Coil under a PI current loop: L i' = k_p (g u - i) + k_i q - R i - Bl (y_v' - y_h'),
-  // q' = g u - i.
-  a_(8, 8) = -(p.coil_R_ohm + p.loop_kp_V_per_A) / p.coil_L_H;
-  a_(8, 9) = p.loop_ki_V_per_As / p.coil_L_H;
-  a_(9, 8) = -1.0;
+  a_(kVh, kCoil) = p.bl_N_per_A / p.m_h_kg;
+  a_(kVv, kCoil) = -p.bl_N_per_A / p.m_v_kg;
+  // Coil under a PI current loop (the form of eq. 3.6): L i' = k_p (g u - i) + k_i q - R i
+  // - Bl (y_v' - y_h'), q' = g u - i.
+  a_(kCoil, kCoil) = -(p.coil_R_ohm + p.loop_kp_V_per_A) / p.coil_L_H;
+  a_(kCoil, kLoop) = p.loop_ki_V_per_As / p.coil_L_H;
+  a_(kLoop, kCoil) = -1.0;
   // Back-EMF e = -Bl (y_v' - y_h') (so that e i is the power f_v (y_v' - y_h')).
-  a_(8, 5) = p.bl_N_per_A / p.coil_L_H;
-  a_(8, 4) = -p.bl_N_per_A / p.coil_L_H;
-  b_(7, 0) = 1.0 / p.m_2_kg;                                       // f_m on the motor windings
-  b_(8, 1) = p.loop_kp_V_per_A * p.amp_gain_A_per_V / p.coil_L_H;  // current reference g u
-  b_(9, 1) = p.amp_gain_A_per_V;
-  b_(4, 2) = -1.0 / p.m_h_kg;  // end-stop pair
-  b_(5, 2) = 1.0 / p.m_v_kg;
+  a_(kCoil, kVv) = p.bl_N_per_A / p.coil_L_H;
+  a_(kCoil, kVh) = -p.bl_N_per_A / p.coil_L_H;
+  b_(n + 3, 0) = 1.0 / p.m_2_kg;                                       // f_m on the motor windings (eq. 3.4)
+  b_(kCoil, 1) = p.loop_kp_V_per_A * p.amp_gain_A_per_V / p.coil_L_H;  // current reference g u
+  b_(kLoop, 1) = p.amp_gain_A_per_V;
+  b_(kVh, 2) = -1.0 / p.m_h_kg;  // end-stop pair
+  b_(kVv, 2) = 1.0 / p.m_v_kg;
 
   // Zero-order-hold discretisation over one substep.
   const double h = p.dt_s / p.substeps;
@@ -98,18 +122,18 @@ std::complex<double> DualStagePlant::frf(Channel channel, double f_Hz) const {
       s * Eigen::Matrix<std::complex<double>, kStates, kStates>::Identity() - a_.cast<std::complex<double>>();
   const Eigen::Matrix<std::complex<double>, kStates, 1> x =
       sys.partialPivLu().solve(b_.col(col).cast<std::complex<double>>());
-  return s * x(4);  // acceleration = s * velocity of the handle
+  return s * x(kVh);  // acceleration = s * velocity of the handle
 }
 
 double DualStagePlant::total_mass_kg() const {
-  return params_.m_h_kg + params_.m_v_kg + params_.m_1_kg + params_.m_2_kg;
+  return params_.m_h_kg + params_.m_v_kg + params_.m_1_kg + params_.m_2_kg + params_.m_p_kg + params_.m_d_kg;
 }
 
 double DualStagePlant::stop_force(const StateVector& x) const {
-  const double z = x(1) - x(0);
+  const double z = x(kYv) - x(kYh);
   const double excess = std::abs(z) - params_.stroke_m;
   if (excess <= 0.0) return 0.0;
-  const double dz = x(5) - x(4);
+  const double dz = x(kVv) - x(kVh);
   double f = -params_.stop_k_N_per_m * std::copysign(excess, z) - params_.stop_b_Ns_per_m * dz;
   // A contact pushes, never pulls.
   if (f * z > 0.0) f = 0.0;
@@ -128,7 +152,7 @@ bool DualStagePlant::try_step(DualStagePlantState& state, double f_m_N, double u
     const Eigen::Vector3d u(f_m_N, u_V, stop_force(x));
     x = ad_ * x + bd_ * u;
   }
-  if (!x.allFinite() || x.head<4>().cwiseAbs().maxCoeff() > 1.0) return false;
+  if (!x.allFinite() || x.head<kMasses>().cwiseAbs().maxCoeff() > 1.0) return false;
   state.x = x;
   state.accel_m_s2 = acceleration(state, f_m_N, u_V);
   return true;
@@ -136,7 +160,7 @@ bool DualStagePlant::try_step(DualStagePlantState& state, double f_m_N, double u
 
 double DualStagePlant::acceleration(const DualStagePlantState& state, double f_m_N, double u_V) const {
   const Eigen::Vector3d u(f_m_N, u_V, stop_force(state.x));
-  return a_.row(4).dot(state.x) + b_.row(4).dot(u);
+  return a_.row(kVh).dot(state.x) + b_.row(kVh).dot(u);
 }
 
 }  // namespace mc::haptics

@@ -3,8 +3,10 @@
 /// The dual-stage haptic interface as a plant (thesis §3.4.1, Fig. 3.9, eq. 3.4): the
 /// 4-mass model in the handle's y axis driven by the Pantograph motors (f_m on the motor
 /// windings m_2) and by the Haptuator (a force pair f_v between its moving magnet m_v and
-/// the handle m_h), with the Haptuator's coil dynamics and the end stops of its magnet
-/// (stroke saturation). Output: the handle's acceleration, what the accelerometer measures.
+/// the handle m_h), extended by two modes of the Pantograph's linkage that hang off the force
+/// path (side branches on m_2 and m_1, which give Fig. 3.10 its antiresonances; docs/model.md),
+/// with the Haptuator's coil dynamics and the end stops of its magnet (stroke saturation).
+/// Output: the handle's acceleration, what the accelerometer measures.
 
 #include <complex>
 
@@ -16,25 +18,35 @@ namespace mc::haptics {
 
 /// Parameters of the dual-stage plant. The thesis gives no values (DESIGN.md erratum 7); the
 /// defaults are chosen (docs/parameters.md) so that the Pantograph channel is flat (+-1 dB)
-/// from 40 to 200 Hz, leaves that band just above 200 Hz, rises through a damped region
-/// into a sharp resonance near 800 Hz (Fig. 3.10), and the Haptuator channel matches
-/// eq. 3.6 within +-1 dB on 100-1000 Hz (Fig. 3.11). With f_m on m_2 as eq. 3.4 prints it,
-/// the Pantograph channel has no antiresonance besides the magnet's (docs/errata.md).
+/// from 40 to 200 Hz, has a damped antiresonance just above 200 Hz, a damped resonance near
+/// 300 Hz and a sharp antiresonance/resonance pair near 800 Hz (Fig. 3.10), and the Haptuator
+/// channel matches eq. 3.6 within +-1 dB on 100-1000 Hz (Fig. 3.11). Eq. 3.4 as printed has
+/// no antiresonance on the Pantograph path besides the magnet's (docs/errata.md): the two
+/// linkage modes m_p (on m_2) and m_d (on m_1) supply them; a zero mass removes a branch.
 struct DualStagePlantParams {
   // Masses (Table 3.3).
-  double m_h_kg = 0.250;   ///< terminal assembly: handle, Haptuator housing, accelerometer, finger pad
-  double m_v_kg = 0.003;   ///< Haptuator moving magnet
-  double m_1_kg = 4.2e-4;  ///< apparent mass of the distal links
-  double m_2_kg = 3.6e-4;  ///< apparent mass of the motor windings
+  double m_h_kg = 0.250;    ///< terminal assembly: handle, Haptuator housing, accelerometer, finger pad
+  double m_v_kg = 0.003;    ///< Haptuator moving magnet
+  double m_1_kg = 2.19e-4;  ///< apparent mass of the distal links
+  double m_2_kg = 3.70e-3;  ///< apparent mass of the motor windings
   // Stiffnesses and dampings (Table 3.3).
   double k_f_N_per_m = 228.0;   ///< finger stiffness [Wiertlewski 2012]
   double b_f_Ns_per_m = 35.7;   ///< finger damping
   double k_v_N_per_m = 537.5;   ///< Haptuator membrane (suspension) stiffness
   double b_v_Ns_per_m = 1.52;   ///< Haptuator membrane damping
-  double k_1_N_per_m = 3.24e4;  ///< distal links
-  double b_1_Ns_per_m = 0.684;
-  double k_2_N_per_m = 1.573e4;  ///< proximal links
-  double b_2_Ns_per_m = 1.27e-3;
+  double k_1_N_per_m = 2.83e3;  ///< distal links and the terminal assembly's mount (viscous above ~22 Hz)
+  double b_1_Ns_per_m = 20.2;
+  double k_2_N_per_m = 1.20e5;  ///< proximal links
+  double b_2_Ns_per_m = 0.149;
+  // Linkage modes off the force path (extension of eq. 3.4, docs/model.md): each a modal mass on
+  // a spring-damper hung from a node of the chain; it blocks that node at its own frequency
+  // (antiresonance of f_m -> y_h'') and adds a resonance above it. 0 kg removes the branch.
+  double m_p_kg = 3.26e-4;       ///< proximal links' mode, hung from the motor node m_2 (~233 Hz)
+  double k_p_N_per_m = 699.0;    ///< its stiffness
+  double b_p_Ns_per_m = 0.0503;  ///< its damping
+  double m_d_kg = 1.27e-3;       ///< distal links' bending mode, hung from m_1 (light damping, ~764 Hz)
+  double k_d_N_per_m = 2.93e4;   ///< its stiffness
+  double b_d_Ns_per_m = 0.0196;  ///< its damping
   // Haptuator electrical dynamics: a current amplifier (transconductance g, PI current loop
   // k_p, k_i) drives the coil: L di/dt = v - R i - Bl (dy_v - dy_h),
   // v = k_p (g u - i) + k_i int (g u - i), f_v = Bl i. The loop's closed-loop response
@@ -67,6 +79,12 @@ struct DualStagePlantParams {
     v("b_1_Ns_per_m", b_1_Ns_per_m);
     v("k_2_N_per_m", k_2_N_per_m);
     v("b_2_Ns_per_m", b_2_Ns_per_m);
+    v("m_p_kg", m_p_kg);
+    v("k_p_N_per_m", k_p_N_per_m);
+    v("b_p_Ns_per_m", b_p_Ns_per_m);
+    v("m_d_kg", m_d_kg);
+    v("k_d_N_per_m", k_d_N_per_m);
+    v("b_d_Ns_per_m", b_d_Ns_per_m);
     v("amp_gain_A_per_V", amp_gain_A_per_V);
     v("coil_R_ohm", coil_R_ohm);
     v("coil_L_H", coil_L_H);
@@ -89,23 +107,29 @@ enum class Channel {
   kHaptuator,   ///< u [V], the high-frequency channel
 };
 
-/// State of the plant: x = [y_h, y_v, y_1, y_2, dy_h, dy_v, dy_1, dy_2, i_coil, q] with q the current loop
-/// integral of (g u - i) (SI).
+/// State of the plant: x = [y_h, y_v, y_1, y_2, y_p, y_d, dy_h, dy_v, dy_1, dy_2, dy_p, dy_d, i_coil, q]
+/// with y_p, y_d the linkage modes' masses and q the current loop integral of (g u - i) (SI).
 struct DualStagePlantState {
-  Eigen::Matrix<double, 10, 1> x = Eigen::Matrix<double, 10, 1>::Zero();
+  Eigen::Matrix<double, 14, 1> x = Eigen::Matrix<double, 14, 1>::Zero();
   double accel_m_s2 = 0.0;  ///< handle acceleration at the end of the last step
 };
 
-/// The dual-stage plant of eq. 3.4 with the Haptuator coil and end stops.
+/// The dual-stage plant of eq. 3.4 with two linkage modes, the Haptuator coil and end stops.
 ///
-/// Linear part (stops open): M Y'' + C Y' + K Y = [-f_v, f_v, 0, f_m]^T (eq. 3.4), f_v = -Bl i,
+/// Linear part (stops open): M Y'' + C Y' + K Y = [-f_v, f_v, 0, f_m, 0, 0]^T with Y = [y_h, y_v, y_1, y_2,
+/// y_p, y_d]: eq. 3.4's M, C, K bordered by m_p (k_p, b_p to y_2) and m_d (k_d, b_d to y_1), f_v = -Bl i,
 /// L i' = k_p (g u - i) + k_i q - R i + Bl (y_v' - y_h'), q' = g u - i. The end stops add a force pair
 /// f_s = -k_s (z - sign(z) s) - b_s z' on the magnet (and its opposite on the handle) while
 /// |z| = |y_v - y_h| exceeds the stroke s: the saturation that spoils the Haptuator's
 /// response below about 100 Hz (Fig. 3.11).
 class DualStagePlant {
  public:
-  static constexpr int kStates = 10;
+  static constexpr int kMasses = 6;  ///< y_h, y_v, y_1, y_2 (eq. 3.4), y_p, y_d (linkage modes)
+  static constexpr int kStates = 2 * kMasses + 2;
+  // Indices into the state vector.
+  static constexpr int kYh = 0, kYv = 1, kVh = kMasses, kVv = kMasses + 1, kVp = kMasses + 4,
+                       kVd = kMasses + 5;
+  static constexpr int kCoil = 2 * kMasses, kLoop = 2 * kMasses + 1;
   using StateVector = Eigen::Matrix<double, kStates, 1>;
   using StateMatrix = Eigen::Matrix<double, kStates, kStates>;
   /// Inputs: [f_m (N), u (V), f_s (N, end-stop pair)].
@@ -125,7 +149,7 @@ class DualStagePlant {
   std::complex<double> frf(Channel channel, double f_Hz) const;
 
   /// Total mass moving with the handle at low frequency (the Pantograph channel's flat
-  /// gain is 1/total_mass above the finger mode).
+  /// gain is 1/total_mass above the finger mode), linkage modes included.
   double total_mass_kg() const;
 
   /// One step of dt_s with inputs held (zero-order hold): f_m [N], u [V]. Updates
@@ -138,7 +162,7 @@ class DualStagePlant {
   double acceleration(const DualStagePlantState& state, double f_m_N, double u_V) const;
 
   /// Magnet travel relative to the handle, y_v - y_h [m].
-  static double magnet_travel(const DualStagePlantState& state) { return state.x(1) - state.x(0); }
+  static double magnet_travel(const DualStagePlantState& state) { return state.x(kYv) - state.x(kYh); }
 
  private:
   double stop_force(const StateVector& x) const;
