@@ -3,6 +3,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -77,6 +78,35 @@ TEST(RenderPipeline, OutputsAreLimited) {
   EXPECT_DOUBLE_EQ(umax, 1.0);
 }
 
+// The alignment delay shifts the high band by whole samples and leaves the low band alone.
+TEST(RenderPipeline, HighBandDelayShiftsOnlyTheHaptuatorCommand) {
+  RenderPipelineParams p;
+  p.hf_delay_s = 0.0;
+  RenderPipeline plain{p};
+  p.hf_delay_s = 7.0e-4;  // 7 samples at 10 kHz
+  RenderPipeline delayed{p};
+  std::vector<RenderOutput> a, b;
+  for (int k = 0; k < 400; ++k) {
+    const double force = std::sin(0.07 * k) + (k == 3 ? 1.0 : 0.0);
+    a.push_back(plain.tick(force));
+    b.push_back(delayed.tick(force));
+  }
+  for (int k = 0; k < 400; ++k) {
+    EXPECT_EQ(b[k].f_m_N, a[k].f_m_N) << k;
+    EXPECT_EQ(b[k].u_V, k < 7 ? 0.0 : a[k - 7].u_V) << k;
+  }
+  // ... and reset() empties the delay line.
+  delayed.reset();
+  plain.reset();
+  for (int k = 0; k < 7; ++k) EXPECT_EQ(delayed.tick(1.0).u_V, 0.0);
+  EXPECT_NE(plain.tick(1.0).u_V, 0.0);
+  // The compensator's response carries the delay's phase, not its magnitude.
+  const double f = 500.0;
+  EXPECT_NEAR(std::abs(delayed.c_hf_response(f)), std::abs(plain.c_hf_response(f)), 1e-12);
+  EXPECT_NEAR(std::arg(delayed.c_hf_response(f) / plain.c_hf_response(f)),
+              std::remainder(-2.0 * std::numbers::pi * f * 7.0e-4, 2.0 * std::numbers::pi), 1e-9);
+}
+
 TEST(RenderPipeline, TickDoesNotAllocate) {
   RenderPipeline rp{RenderPipelineParams{}};
   test::AllocationGuard guard;
@@ -96,6 +126,13 @@ TEST(RenderPipeline, RejectsBadParameters) {
   p = {};
   p.f_max_Hz = 100.0;
   EXPECT_THROW(RenderPipeline{p}, InvalidParams);
+  p = {};
+  p.hf_delay_s = -1e-4;
+  EXPECT_THROW(RenderPipeline{p}, InvalidParams);
+  p.hf_delay_s = (RenderPipelineParams::kMaxDelaySamples + 1) / p.fs_Hz;
+  EXPECT_THROW(RenderPipeline{p}, InvalidParams);
+  p.hf_delay_s = RenderPipelineParams::kMaxDelaySamples / p.fs_Hz;
+  EXPECT_NO_THROW(RenderPipeline{p});
 }
 
 }  // namespace

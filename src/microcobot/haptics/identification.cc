@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <numbers>
 
 #include "microcobot/core/error.h"
@@ -133,14 +135,66 @@ IdentificationResult identify(const DualStagePlant& plant, const IdentificationO
     if (fc <= r.lf_flat_upper_Hz && fc >= r.hf_valid_lower_Hz) r.cutoff_Hz = dsp::third_octave_nominal(fc);
   }
   if (r.cutoff_Hz == 0.0) r.cutoff_Hz = r.lf_flat_upper_Hz;
+  RenderPipelineParams at_plant_rate;
+  at_plant_rate.fs_Hz = 1.0 / plant.params().dt_s;
+  r.hf_delay_s = choose_hf_delay_s(r, at_plant_rate);
   return r;
 }
 
-RenderPipelineParams pipeline_from(const IdentificationResult& id, RenderPipelineParams base) {
+namespace {
+
+// The measured FRF at f: the complex mean of the five Welch bins nearest to f (less scatter
+// than one bin; the responses barely turn over 5 bins of 2.4 Hz).
+std::complex<double> frf_near(const ChannelFrf& frf, double f_Hz) {
+  const auto it = std::lower_bound(frf.f_Hz.begin(), frf.f_Hz.end(), f_Hz);
+  const auto i = static_cast<std::size_t>(std::distance(frf.f_Hz.begin(), it));
+  const std::size_t a = i > 2 ? i - 2 : 0;
+  const std::size_t b = std::min(frf.f_Hz.size(), a + 5);
+  std::complex<double> sum = 0.0;
+  for (std::size_t j = a; j < b; ++j) sum += frf.h[j];
+  return sum / static_cast<double>(b - a);
+}
+
+RenderPipelineParams with_models(const IdentificationResult& id, RenderPipelineParams base) {
   base.cutoff_Hz = id.cutoff_Hz;
   base.lf_gain_m_s2_per_N = id.lf_gain;
   base.hf_num = {id.hf_model.b1, id.hf_model.b0};
   base.hf_den = {1.0, id.hf_model.a1, id.hf_model.a0};
+  return base;
+}
+
+}  // namespace
+
+double choose_hf_delay_s(const IdentificationResult& id, RenderPipelineParams base) {
+  base = with_models(id, base);
+  base.hf_delay_s = 0.0;
+  const RenderPipeline pipe(base);
+  // Each path's response without the delay, predicted from the measured FRFs.
+  std::vector<double> f = table_3_4_centres_Hz();
+  std::vector<std::complex<double>> low(f.size()), high(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    low[i] = pipe.lowpass_response(f[i]) * pipe.c_lf() * frf_near(id.lf, f[i]);
+    high[i] = pipe.highpass_response(f[i]) * pipe.c_hf_response(f[i]) * frf_near(id.hf, f[i]);
+  }
+  int best = 0;
+  double best_spread = std::numeric_limits<double>::infinity();
+  for (int n = 0; n <= RenderPipelineParams::kMaxDelaySamples; ++n) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const double w = 2.0 * std::numbers::pi * f[i] / base.fs_Hz;
+      const double g = std::abs(low[i] + high[i] * std::exp(std::complex<double>(0.0, -w * n)));
+      const double v = 20.0 * std::log10(std::max(g / base.k_sys_m_s2_per_N, 1e-300));
+      lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    if (hi - lo < best_spread) best_spread = hi - lo, best = n;
+  }
+  return best / base.fs_Hz;
+}
+
+RenderPipelineParams pipeline_from(const IdentificationResult& id, RenderPipelineParams base) {
+  base = with_models(id, base);
+  // The delay was chosen at the plant's rate; the same time rounds to whole samples at base's.
+  base.hf_delay_s = id.hf_delay_s;
   base.validate();
   return base;
 }

@@ -43,6 +43,7 @@ struct IdentificationResult {
   double lf_flat_upper_Hz = 0.0;   ///< the Pantograph stays within flat_tol_dB up to here
   double hf_valid_lower_Hz = 0.0;  ///< the Haptuator follows its model from here up
   double cutoff_Hz = 0.0;          ///< crossover frequency chosen by the §3.3.2 rule (nominal label)
+  double hf_delay_s = 0.0;         ///< high-band time alignment chosen by choose_hf_delay_s
 };
 
 /// Drives `channel` of `plant` with a PRBS (the other input at zero) and estimates the H1 FRF
@@ -59,8 +60,16 @@ HfModel fit_second_order(const ChannelFrf& frf, double lo_Hz, double hi_Hz, doub
 
 /// The full §3.4.2 procedure. Cut-off rule (§3.3.2): the highest frequency the Pantograph
 /// allows inside the overlap [hf_valid_lower, lf_flat_upper], rounded down to the 1/3-octave
-/// grid of Table 3.4. Throws ComputationFailed if the channels do not overlap.
+/// grid of Table 3.4; then the high-band delay (choose_hf_delay_s for the default pipeline at
+/// the plant's rate). Throws ComputationFailed if the channels do not overlap.
 IdentificationResult identify(const DualStagePlant& plant, const IdentificationOptions& options);
+
+/// The high-band alignment delay (RenderPipelineParams::hf_delay_s, an extension of §3.3.2):
+/// for 0, 1, ... RenderPipelineParams::kMaxDelaySamples loop samples, the combined response
+/// that `base` with the identified compensators would give is predicted at the centres of
+/// Table 3.4 from the measured FRFs, (LP C_LF H_LF + HP C_HF z^-n H_HF) / K_sys, and the delay
+/// with the smallest spread (max - min, dB) is returned (the shortest on a tie).
+double choose_hf_delay_s(const IdentificationResult& id, RenderPipelineParams base);
 
 /// Pipeline parameters built from an identification (compensators from identified models).
 RenderPipelineParams pipeline_from(const IdentificationResult& id, RenderPipelineParams base = {});

@@ -77,6 +77,10 @@ HfModel RenderPipelineParams::hf_model() const {
   return m;
 }
 
+int RenderPipelineParams::hf_delay_samples() const {
+  return static_cast<int>(std::lround(hf_delay_s * fs_Hz));
+}
+
 void RenderPipelineParams::validate() const {
   require_positive(fs_Hz, "fs_Hz");
   require(cutoff_Hz > 0.0 && cutoff_Hz < 0.5 * fs_Hz, "cutoff_Hz", "must be in (0, fs/2)", cutoff_Hz);
@@ -88,6 +92,8 @@ void RenderPipelineParams::validate() const {
   for (double v : hf_den) require(std::isfinite(v) && v > 0.0, "hf_den", "must be > 0 (stable)", v);
   require(f_max_Hz > cutoff_Hz && f_max_Hz < 0.5 * fs_Hz, "f_max_Hz", "must be in (cutoff_Hz, fs/2)",
           f_max_Hz);
+  require(std::isfinite(hf_delay_s) && hf_delay_s >= 0.0 && hf_delay_s * fs_Hz < kMaxDelaySamples + 0.5,
+          "hf_delay_s", "must be in [0, " + std::to_string(kMaxDelaySamples) + " / fs_Hz]", hf_delay_s);
   require_positive(max_force_N, "max_force_N");
   require_positive(max_voltage_V, "max_voltage_V");
 }
@@ -98,12 +104,15 @@ RenderPipeline::RenderPipeline(const RenderPipelineParams& params)
            dsp::linkwitz_riley(4, params.cutoff_Hz, params.fs_Hz, dsp::FilterType::kLowPass))),
       hp_(dsp::linkwitz_riley(4, params.cutoff_Hz, params.fs_Hz, dsp::FilterType::kHighPass)),
       c_hf_(design_c_hf(params)),
-      c_lf_(params.k_sys_m_s2_per_N / params.lf_gain_m_s2_per_N) {}
+      c_lf_(params.k_sys_m_s2_per_N / params.lf_gain_m_s2_per_N),
+      delay_(static_cast<unsigned>(params.hf_delay_samples())) {}
 
 void RenderPipeline::reset() {
   lp_.reset();
   hp_.reset();
   c_hf_.reset();
+  delay_line_.fill(0.0);
+  head_ = 0;
 }
 
 std::complex<double> RenderPipeline::lowpass_response(double f_Hz) const {
@@ -113,7 +122,9 @@ std::complex<double> RenderPipeline::highpass_response(double f_Hz) const {
   return dsp::sos_response(hp_.sections(), f_Hz, params_.fs_Hz);
 }
 std::complex<double> RenderPipeline::c_hf_response(double f_Hz) const {
-  return dsp::sos_response(c_hf_.sections(), f_Hz, params_.fs_Hz);
+  const double w = 2.0 * std::numbers::pi * f_Hz / params_.fs_Hz;
+  return dsp::sos_response(c_hf_.sections(), f_Hz, params_.fs_Hz) *
+         std::exp(cd(0.0, -w * static_cast<double>(delay_)));
 }
 std::complex<double> RenderPipeline::c_hf_analog(double f_Hz) const { return c_hf_eq38(params_, f_Hz); }
 

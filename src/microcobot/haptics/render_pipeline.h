@@ -37,6 +37,12 @@ struct RenderPipelineParams {
   /// uses f_max = 1 kHz, which costs -3 dB at 1 kHz; 4 kHz keeps the band to 1.25 kHz flat
   /// (-0.002 dB at 1.25 kHz) while still making C_HF causal and bounded (docs/errata.md).
   double f_max_Hz = 4000.0;
+  /// Time alignment of the high band (extension, docs/errata.md): the Haptuator path leads the
+  /// Pantograph path by some 50 degrees at the cut-off (its 2nd-order model of eq. 3.6 cannot
+  /// hold the magnet's suspension phase), so the two LR4 halves no longer add in phase there; a
+  /// delay of the high band, as loudspeaker crossovers align their drivers, restores the sum.
+  /// Rounded to whole loop samples; haptics::identify chooses it from the measured responses.
+  double hf_delay_s = 4.0e-4;
   double max_force_N = 4.0;     ///< Pantograph force limit (motor saturation)
   double max_voltage_V = 30.0;  ///< Haptuator amplifier input limit
 
@@ -49,11 +55,16 @@ struct RenderPipelineParams {
     v("hf_num", hf_num);
     v("hf_den", hf_den);
     v("f_max_Hz", f_max_Hz);
+    v("hf_delay_s", hf_delay_s);
     v("max_force_N", max_force_N);
     v("max_voltage_V", max_voltage_V);
   }
   void validate() const;
   HfModel hf_model() const;
+  /// hf_delay_s in whole loop samples.
+  int hf_delay_samples() const;
+  /// The longest high-band delay the pipeline holds, in samples.
+  static constexpr int kMaxDelaySamples = 63;
 };
 
 /// Commands for the two channels.
@@ -71,7 +82,10 @@ class RenderPipeline {
   /// One 10 kHz sample: haptic force (N) in, channel commands out. Never allocates.
   RenderOutput tick(double force_N) {
     const double lo = lp_.process(force_N);
-    const double hi = hp_.process(force_N);
+    // High band through the alignment delay line (a ring of kMaxDelaySamples + 1 samples).
+    delay_line_[head_] = hp_.process(force_N);
+    const double hi = delay_line_[(head_ - delay_) & kRingMask];
+    head_ = (head_ + 1) & kRingMask;
     RenderOutput out;
     out.f_m_N = clamp(c_lf_ * lo, params_.max_force_N);
     out.u_V = clamp(c_hf_.process(hi), params_.max_voltage_V);
@@ -84,7 +98,7 @@ class RenderPipeline {
   /// Analog-exact and digital responses of the pieces, for plots and tests.
   std::complex<double> lowpass_response(double f_Hz) const;
   std::complex<double> highpass_response(double f_Hz) const;
-  /// Digital C_HF(e^{j 2 pi f / fs}) in V/N.
+  /// Digital C_HF(e^{j 2 pi f / fs}) in V/N, the alignment delay included.
   std::complex<double> c_hf_response(double f_Hz) const;
   /// Analog C_HF(j 2 pi f) = K_sys / G_HF x F(f_max) of eq. 3.8.
   std::complex<double> c_hf_analog(double f_Hz) const;
@@ -92,11 +106,16 @@ class RenderPipeline {
 
  private:
   static double clamp(double v, double lim) { return v > lim ? lim : (v < -lim ? -lim : v); }
+  static constexpr unsigned kRingMask = RenderPipelineParams::kMaxDelaySamples;
+  static_assert((kRingMask & (kRingMask + 1)) == 0, "the ring length must be a power of two");
   RenderPipelineParams params_;
   dsp::SosFilter lp_;
   dsp::SosFilter hp_;
   dsp::SosFilter c_hf_;
   double c_lf_ = 1.0;
+  std::array<double, kRingMask + 1> delay_line_{};
+  unsigned head_ = 0;
+  unsigned delay_ = 0;
 };
 
 }  // namespace mc::haptics
