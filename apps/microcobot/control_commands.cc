@@ -87,6 +87,8 @@ nlohmann::json velocity_json(const ct::VelocityMetrics& m) {
           {"steady_state_error_rel", m.steady_state_error_rel},
           {"settling_time_s", m.settling_time_s},
           {"settled", m.settled},
+          {"excursions", m.excursions},
+          {"max_excursion_rel", m.max_excursion_rel},
           {"ripple_m_s", m.ripple_m_s}};
 }
 
@@ -121,6 +123,8 @@ nlohmann::json velocity_experiment(const ControlParams& p, const Plant& plant, d
     r.add_result(name + ": steady-state error", run.metrics.steady_state_error_rel * 100.0, "%");
     r.add_result(name + ": settling time", run.metrics.settling_time_s, "s");
     r.add_result(name + ": ripple", run.metrics.ripple_m_s, "m/s");
+    r.add_result(name + ": largest excursion after settling (5-period mean)",
+                 run.metrics.max_excursion_rel * 100.0, "%");
     v_series.push_back(thin(name + " (1-period velocity)", run.t_s, run.v_true_m_s));
     a_series.push_back(thin(name, run.t_s, run.amplitude_V));
     if (table && mode == ct::VelocityMode::kModelBased) {

@@ -1,5 +1,7 @@
 // Velocity control of thesis §2.7 (Fig. 2.18-2.19): 100 um/s forward and backward.
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -13,29 +15,71 @@ namespace {
 
 const PositionSensorParams kSensor{};  // 0.1 nm resolution, 1 nm RMS noise
 
+// The model steps intermittently at the loop's operating points (bursts of the per-period
+// velocity at a constant amplitude), and which sensor-noise stream meets a burst, and when, is
+// chaotic: the loops are judged over several noise streams, by the median where a figure is
+// compared, every stream where a goal is asserted.
+constexpr int kSeeds = 7;
+
+VelocityRun run_seed(VelocityMode mode, double ref, double duration_s, int seed) {
+  PositionSensorParams sensor = kSensor;
+  sensor.seed = seed;
+  return run_velocity(test::model(), mode == VelocityMode::kModelBased ? &test::step_map() : nullptr,
+                      VelocityControlParams{}, mode, ref, duration_s, sensor);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
 TEST(VelocityControl, ModelBasedPidReaches100umPerSecondBothWaysWithin2Percent) {
   for (double ref : {100e-6, -100e-6}) {
-    const auto run = run_velocity(test::model(), &test::step_map(), VelocityControlParams{},
-                                  VelocityMode::kModelBased, ref, 0.3, kSensor);
-    const auto& m = run.metrics;
-    EXPECT_LT(std::abs(m.steady_state_error_rel), 0.02) << "ref " << ref;  // issue goal
-    EXPECT_TRUE(m.settled);
-    EXPECT_LT(m.settling_time_s, 0.1);
-    EXPECT_LT(m.ripple_m_s, 0.1 * std::abs(ref));
-    EXPECT_GT(m.mean_velocity_m_s * ref, 0.0);  // the right direction
+    std::vector<double> settling;
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+      const auto run = run_seed(VelocityMode::kModelBased, ref, 0.3, seed);
+      const auto& m = run.metrics;
+      EXPECT_LT(std::abs(m.steady_state_error_rel), 0.02) << "ref " << ref << " seed " << seed;  // goal
+      EXPECT_TRUE(m.settled) << seed;
+      EXPECT_LT(m.ripple_m_s, 0.1 * std::abs(ref)) << seed;
+      EXPECT_GT(m.mean_velocity_m_s * ref, 0.0);    // the right direction
+      EXPECT_LT(m.max_excursion_rel, 0.3) << seed;  // bursts, not a loss of control
+      settling.push_back(m.settling_time_s);
+    }
+    EXPECT_LT(median(settling), 0.1) << "ref " << ref;
   }
 }
 
+TEST(VelocityControl, SettlingIsTheLoopsConvergenceAndLaterBurstsAreCounted) {
+  // A made-up record: on the reference from 10 periods on, one 3-period burst at +40 % later.
+  VelocityRun r = run_seed(VelocityMode::kModelBased, 100e-6, 0.1, 1);
+  ASSERT_EQ(r.v_true_m_s.size(), 100u);
+  for (std::size_t i = 0; i < r.v_true_m_s.size(); ++i) r.v_true_m_s[i] = i < 10 ? 0.0 : 100e-6;
+  for (std::size_t i = 60; i < 63; ++i) r.v_true_m_s[i] = 140e-6;
+  const VelocityMetrics m = velocity_metrics(r, 100e-6);
+  EXPECT_TRUE(m.settled);
+  EXPECT_NEAR(m.settling_time_s, r.t_s[14], 1e-12);  // the first 5-period mean inside +-5 %
+  EXPECT_EQ(m.excursions, 7);                        // the windows that hold a burst period (3 + 5 - 1)
+  EXPECT_NEAR(m.max_excursion_rel, 0.24, 1e-9);      // 3 x 40 % / 5
+  // Never 20 periods inside: not settled.
+  for (std::size_t i = 0; i < r.v_true_m_s.size(); ++i) r.v_true_m_s[i] = i % 15 == 0 ? 0.0 : 100e-6;
+  EXPECT_FALSE(velocity_metrics(r, 100e-6).settled);
+}
+
 TEST(VelocityControl, ThesisPidGetsThereSlowerAndOpenLoopCountingDoesNot) {
-  const VelocityControlParams p;
-  const auto model_based =
-      run_velocity(test::model(), &test::step_map(), p, VelocityMode::kModelBased, 100e-6, 0.4, kSensor);
-  const auto pid = run_velocity(test::model(), nullptr, p, VelocityMode::kThesisPid, 100e-6, 0.4, kSensor);
-  const auto open = run_velocity(test::model(), nullptr, p, VelocityMode::kOpenLoop, 100e-6, 0.4, kSensor);
-  EXPECT_LT(std::abs(pid.metrics.steady_state_error_rel), 0.02);  // the integrator gets there ...
-  EXPECT_GT(pid.metrics.settling_time_s, model_based.metrics.settling_time_s);  // ... later
+  for (double ref : {100e-6, -100e-6}) {
+    std::vector<double> model_based, pid;
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+      model_based.push_back(run_seed(VelocityMode::kModelBased, ref, 0.4, seed).metrics.settling_time_s);
+      const auto p = run_seed(VelocityMode::kThesisPid, ref, 0.4, seed);
+      EXPECT_LT(std::abs(p.metrics.steady_state_error_rel), 0.02) << seed;  // the integrator gets there ...
+      pid.push_back(p.metrics.settling_time_s);
+    }
+    EXPECT_GT(median(pid), median(model_based)) << "ref " << ref;  // ... later
+  }
   // A step assumed proportional to the amplitude misses the stick-slip threshold entirely or
   // lands far off: no feedback corrects it.
+  const auto open = run_seed(VelocityMode::kOpenLoop, 100e-6, 0.4, 1);
   EXPECT_GT(std::abs(open.metrics.steady_state_error_rel), 0.2);
 }
 

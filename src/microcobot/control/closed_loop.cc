@@ -88,7 +88,14 @@ VelocityRun run_velocity(const ActuatorModel& model, const StepMap* map, const V
     x_prev = x;
   });
   require(run.t_s.size() >= 10, "duration_s", "must cover at least 10 sawtooth periods", duration_s);
-  auto& m = run.metrics;
+  run.metrics = velocity_metrics(run, reference_m_s);
+  return run;
+}
+
+VelocityMetrics velocity_metrics(const VelocityRun& run, double reference_m_s) {
+  require(run.t_s.size() >= 10 && run.v_true_m_s.size() == run.t_s.size(), "run",
+          "needs >= 10 periods with one velocity each");
+  VelocityMetrics m;
   const std::size_t half = run.t_s.size() / 2;
   m.mean_velocity_m_s = mean(run.v_true_m_s, half);
   m.steady_state_error_rel = (m.mean_velocity_m_s - reference_m_s) / reference_m_s;
@@ -97,22 +104,31 @@ VelocityRun run_velocity(const ActuatorModel& model, const StepMap* map, const V
     var += (run.v_true_m_s[i] - m.mean_velocity_m_s) * (run.v_true_m_s[i] - m.mean_velocity_m_s);
   }
   m.ripple_m_s = std::sqrt(var / static_cast<double>(run.v_true_m_s.size() - half));
-  // Settling: the last 5-period mean outside +-5 % of the reference.
-  const std::size_t w = 5;
-  std::size_t last_bad = 0;
-  bool any_bad = false;
+  // Settling: the first 5-period mean inside +-5 % of the reference that stays inside for
+  // kSettleHoldPeriods; later excursions are counted, not waited for.
+  const std::size_t w = VelocityMetrics::kSettleWindowPeriods;
+  const std::size_t hold = VelocityMetrics::kSettleHoldPeriods;
+  std::vector<double> dev;  // |5-period mean / reference - 1| ending at sample i + w - 1
   for (std::size_t i = w; i <= run.v_true_m_s.size(); ++i) {
     double acc = 0.0;
     for (std::size_t j = i - w; j < i; ++j) acc += run.v_true_m_s[j];
-    if (std::abs(acc / w - reference_m_s) > 0.05 * std::abs(reference_m_s)) {
-      last_bad = i;
-      any_bad = true;
-    }
+    dev.push_back(std::abs(acc / static_cast<double>(w) / reference_m_s - 1.0));
   }
-  m.settled = !any_bad || last_bad < run.t_s.size();
-  m.settling_time_s = any_bad ? run.t_s[std::min(last_bad, run.t_s.size()) - 1] : run.t_s[w - 1];
-  if (any_bad && last_bad >= run.t_s.size()) m.settled = false;
-  return run;
+  std::size_t inside = 0;
+  for (std::size_t i = 0; i < dev.size(); ++i) {
+    inside = dev[i] <= 0.05 ? inside + 1 : 0;
+    if (inside < hold) continue;
+    const std::size_t first = i + 1 - hold;
+    m.settled = true;
+    m.settling_time_s = run.t_s[first + w - 1];
+    for (std::size_t k = first; k < dev.size(); ++k) {
+      m.excursions += dev[k] > 0.05 ? 1 : 0;
+      m.max_excursion_rel = std::max(m.max_excursion_rel, dev[k]);
+    }
+    break;
+  }
+  if (!m.settled) m.settling_time_s = run.t_s.back();
+  return m;
 }
 
 namespace {
