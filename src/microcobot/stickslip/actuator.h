@@ -74,6 +74,7 @@ class ActuatorModel {
   /// What a step of length h needs, precomputed at construction.
   struct StepConstants {
     double h = 0.0;
+    double inv_h = 0.0;
     ModeDiscretization ma, mb;     ///< exact PE mode matrices for h
     std::array<double, 2> rho0{};  ///< rho0 pre-warped for Verlet at h (docs/model.md)
   };
@@ -83,9 +84,9 @@ class ActuatorModel {
   StepConstants full_, sub_;
   int substeps_ = 1;
   std::array<double, 2> c_{}, rho0_{}, rho1_{};
-  std::array<double, 2> m_{};   ///< part masses c_i M_s
-  double ka_ = 0.0, kb_ = 0.0;  ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
-  double inv_ratio_ = 1.0;      ///< 1 / (z_ba / z_ss)
+  std::array<double, 2> inv_m_{};  ///< 1 / (c_i M_s), the part masses' reciprocals
+  double ka_ = 0.0, kb_ = 0.0;     ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
+  double inv_ratio_ = 1.0;         ///< 1 / (z_ba / z_ss)
   double lo_ = 0.0, hi_ = 0.0;
 };
 

@@ -32,36 +32,40 @@ double friction_alpha(double z, double dx_sign, double z_ba, double z_ss) noexce
 namespace internal {
 
 namespace {
+/// The constants of eq. 2.12 for one band [z_ba, z_ss], computed once per call.
+struct Band {
+  double z_ss, inv_z_ss, mid, k;  ///< alpha = 1/2 sin(k (s - mid)) + 1/2
+  Band(double z_ba, double zss) noexcept
+      : z_ss(zss), inv_z_ss(1.0 / zss), mid(0.5 * (zss + z_ba)), k(M_PI / (zss - z_ba)) {}
+};
 /// ds/dr for the strain s = |z| >= z_ba moving outward (eq. 2.11-2.12 with 2.18).
-inline double outward_rate(double s, double z_ba, double z_ss) noexcept {
-  if (s >= z_ss) return 1.0 - s / z_ss;  // alpha = 1: pulled back onto z_ss
-  const double a = 0.5 * std::sin(M_PI * (s - 0.5 * (z_ss + z_ba)) / (z_ss - z_ba)) + 0.5;
-  return 1.0 - a * s / z_ss;
+inline double outward_rate(double s, const Band& b) noexcept {
+  if (s >= b.z_ss) return 1.0 - s * b.inv_z_ss;  // alpha = 1: pulled back onto z_ss
+  const double a = 0.5 * std::sin(b.k * (s - b.mid)) + 0.5;
+  return 1.0 - a * s * b.inv_z_ss;
 }
 }  // namespace
 
 double friction_dz_dx_mixed(double z, double z_ba, double z_ss) noexcept {
   // Outward motion beyond z_ba; z / z_ss(z) = |z| / z_ss by eq. 2.18.
-  const double az = std::abs(z);
-  if (az >= z_ss) return 1.0 - 1.0 * az / z_ss;                                              // alpha = 1
-  const double a = 0.5 * std::sin(M_PI * (az - 0.5 * (z_ss + z_ba)) / (z_ss - z_ba)) + 0.5;  // eq. 2.12
-  return 1.0 - a * az / z_ss;
+  return outward_rate(std::abs(z), Band(z_ba, z_ss));
 }
 
 double advance_strain_mixed(double s, double remaining, double z_ba, double z_ss) noexcept {
   // Mixed/plastic part: RK4 in the path variable. Beyond a few z_ss of sliding the strain sits
   // on z_ss to machine precision (exponential approach, rate 1/z_ss per metre of path).
   const double width = z_ss - z_ba;
+  const Band band(z_ba, z_ss);
   const double path = std::min(remaining, 40.0 * z_ss);
   // At most a quarter of the band per RK4 step; one step in the common case (no division).
   const double quarter = 0.25 * width;
   const int n = path <= quarter ? 1 : std::clamp(static_cast<int>(std::ceil(path / quarter)), 1, 400);
   const double h = n == 1 ? path : path / n;
   for (int i = 0; i < n; ++i) {
-    const double k1 = outward_rate(s, z_ba, z_ss);
-    const double k2 = outward_rate(s + 0.5 * h * k1, z_ba, z_ss);
-    const double k3 = outward_rate(s + 0.5 * h * k2, z_ba, z_ss);
-    const double k4 = outward_rate(s + h * k3, z_ba, z_ss);
+    const double k1 = outward_rate(s, band);
+    const double k2 = outward_rate(s + 0.5 * h * k1, band);
+    const double k3 = outward_rate(s + 0.5 * h * k2, band);
+    const double k4 = outward_rate(s + h * k3, band);
     s += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   }
   if (remaining > path) s = std::min(s, z_ss);

@@ -56,6 +56,16 @@ struct ModeDiscretization {
   /// Builds the matrices from the matrix exponential of the augmented system (configure time).
   static ModeDiscretization make(double mass, double damping, double stiffness, double h);
 
+  /// One exact step with the force split as f = drive - reaction, the reaction held over the step:
+  /// the reaction (the friction of the previous sub-step, the latest value to arrive) enters last.
+  void step_with_reaction(double& x, double& v, double drive0, double drive1,
+                          double reaction) const noexcept {
+    const double xn = phi[0] * x + phi[1] * v + g0[0] * drive0 + g1[0] * (drive1 - drive0) - g0[0] * reaction;
+    const double vn = phi[2] * x + phi[3] * v + g0[1] * drive0 + g1[1] * (drive1 - drive0) - g0[1] * reaction;
+    x = xn;
+    v = vn;
+  }
+
   /// One exact step. Never allocates.
   void step(double& x, double& v, double f0, double f1) const noexcept {
     const double xn = phi[0] * x + phi[1] * v + g0[0] * f0 + g1[0] * (f1 - f0);
