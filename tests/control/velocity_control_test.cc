@@ -64,6 +64,7 @@ TEST(VelocityControl, SettlingIsTheLoopsConvergenceAndLaterBurstsAreCounted) {
   // Never 20 periods inside: not settled.
   for (std::size_t i = 0; i < r.v_true_m_s.size(); ++i) r.v_true_m_s[i] = i % 15 == 0 ? 0.0 : 100e-6;
   EXPECT_FALSE(velocity_metrics(r, 100e-6).settled);
+  EXPECT_THROW(velocity_metrics(r, 0.0), InvalidParams);  // no relative error against zero
 }
 
 TEST(VelocityControl, ThesisPidGetsThereSlowerAndOpenLoopCountingDoesNot) {

@@ -81,6 +81,12 @@ TEST(Evaluation, AlignmentDelayChosenFromTheMeasurementsFlattensTheCutoff) {
   EXPECT_LT(aligned.flatness_dB, raw.flatness_dB);
 }
 
+TEST(Evaluation, AlignmentDelayNeedsMeasuredResponses) {
+  IdentificationResult empty = identified();
+  empty.hf = {};
+  EXPECT_THROW(choose_hf_delay_s(empty, RenderPipelineParams{}), ComputationFailed);
+}
+
 TEST(GaussianStats, GaussianSamplesFitAndUniformOnesDoNot) {
   Rng rng(5);
   std::vector<double> gauss(20000), uniform(20000);

@@ -93,6 +93,8 @@ VelocityRun run_velocity(const ActuatorModel& model, const StepMap* map, const V
 }
 
 VelocityMetrics velocity_metrics(const VelocityRun& run, double reference_m_s) {
+  require(std::isfinite(reference_m_s) && reference_m_s != 0.0, "reference_m_s", "must be finite and != 0",
+          reference_m_s);
   require(run.t_s.size() >= 10 && run.v_true_m_s.size() == run.t_s.size(), "run",
           "needs >= 10 periods with one velocity each");
   VelocityMetrics m;

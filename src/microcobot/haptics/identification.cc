@@ -166,6 +166,11 @@ RenderPipelineParams with_models(const IdentificationResult& id, RenderPipelineP
 }  // namespace
 
 double choose_hf_delay_s(const IdentificationResult& id, RenderPipelineParams base) {
+  for (const ChannelFrf* c : {&id.lf, &id.hf}) {
+    if (c->f_Hz.empty() || c->h.size() != c->f_Hz.size())
+      throw ComputationFailed(
+          "high-band delay: a measured FRF is empty or its bins and values differ in count");
+  }
   base = with_models(id, base);
   base.hf_delay_s = 0.0;
   const RenderPipeline pipe(base);
