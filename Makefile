@@ -6,7 +6,7 @@ BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
 
-.PHONY: run report test deps configure build asan bench format clean
+.PHONY: run report test deps configure build asan fuzz bench format clean
 
 # The main job: the teleoperated pick-and-place on the simulated platform; prints where the
 # session report is.
@@ -32,6 +32,11 @@ build: configure
 # Sanitizer build and its tests (CI runs this after `make test`).
 asan:
 	$(MAKE) test PRESET=asan
+
+# The parsers under libFuzzer (clang preset `fuzz`), 10 minutes each; CI runs 30 s each
+# through ctest (label fuzz).
+fuzz: deps
+	scripts/fuzz.sh 600
 
 bench: build
 	@for b in $(BUILD)/bench/*_bench; do echo "== $$b"; $$b --benchmark_min_time=0.2; done

@@ -1,5 +1,5 @@
 // Cost per control tick of the stick-slip controllers (docs/benchmarks.md, control section):
-// update() once plus next_voltage() for the 10 model steps of a 10 kHz tick at dt = 10 us; the
+// update() once plus next_drive() for the 10 model steps of a 10 kHz tick at dt = 10 us; the
 // plant is not included except in BM_XyzStageTick (three axes, model included).
 #include <benchmark/benchmark.h>
 
@@ -28,7 +28,7 @@ void BM_VelocityControllerTick(benchmark::State& st) {
   double x = 0.0;
   for (auto _ : st) {
     c.update(x);
-    for (int i = 0; i < 10; ++i) x += 1e-12 * c.next_voltage(1e-5);
+    for (int i = 0; i < 10; ++i) x += 1e-12 * c.next_drive(1e-5).end_V;
     benchmark::DoNotOptimize(x);
   }
 }
@@ -39,12 +39,12 @@ void position_tick(benchmark::State& st, double target) {
   ct::PositionController c(ct::PositionControlParams{}, model().params(), step_map());
   auto s = model().initial_state();
   c.set_target(target);
-  double u[10];
+  mc::stickslip::DriveSegment u[10];
   for (auto _ : st) {
     c.update(model().slider_position(s));
-    for (double& v : u) v = c.next_voltage(1e-5);
+    for (auto& v : u) v = c.next_drive(1e-5);
     st.PauseTiming();
-    for (double v : u) model().step(s, v);
+    for (const auto& v : u) model().step(s, v);
     st.ResumeTiming();
   }
 }

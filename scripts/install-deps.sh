@@ -17,6 +17,7 @@ DEBIAN_PACKAGES=(
   libbenchmark-dev     # benchmarks
   nodejs npm           # uPlot (bundled into reports) and playwright-core (browser test)
   chromium             # headless browser for the report test
+  clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
 )
 if [[ "${1:-}" == "--dev" ]]; then DEBIAN_PACKAGES+=(python3-scipy python3-numpy); fi
 

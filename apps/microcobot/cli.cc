@@ -5,9 +5,12 @@
 #include <iostream>
 #include <mutex>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
+#include "signals.h"
 
 namespace mc::cli {
 
@@ -26,7 +29,8 @@ void check_finite(const nlohmann::json& v, const std::string& path) {
     throw ComputationFailed("result '" + path + "' is not a finite number");
   }
   if (v.is_object()) {
-    for (auto it = v.begin(); it != v.end(); ++it) check_finite(it.value(), path.empty() ? it.key() : path + "." + it.key());
+    for (auto it = v.begin(); it != v.end(); ++it)
+      check_finite(it.value(), path.empty() ? it.key() : path + "." + it.key());
   } else if (v.is_array()) {
     for (std::size_t i = 0; i < v.size(); ++i) check_finite(v[i], path + "[" + std::to_string(i) + "]");
   }
@@ -51,9 +55,43 @@ bool register_report_part(ReportPart part) {
 
 std::vector<ReportPart> report_parts() {
   auto out = part_registry();
-  std::stable_sort(out.begin(), out.end(), [](const ReportPart& a, const ReportPart& b) { return a.order < b.order; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const ReportPart& a, const ReportPart& b) { return a.order < b.order; });
   return out;
 }
+
+CLI::Validator Range(double lo, double hi) {
+  const std::string desc = fmt::format("[{:g} - {:g}]", lo, hi);
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + excerpt(text) + "' is not a number";
+        if (!std::isfinite(v)) return "'" + excerpt(text) + "' is not a finite number";
+        if (!(v >= lo && v <= hi)) {
+          return fmt::format("{} is out of range: expected {:g} to {:g}", excerpt(text), lo, hi);
+        }
+        return {};
+      },
+      desc, "RANGE");
+}
+
+namespace {
+CLI::Validator lower_bound(bool strict) {
+  return CLI::Validator(
+      [strict](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + excerpt(text) + "' is not a number";
+        if (!std::isfinite(v)) return "'" + excerpt(text) + "' is not a finite number";
+        if (strict ? !(v > 0.0) : !(v >= 0.0))
+          return excerpt(text) + (strict ? " must be > 0" : " must be >= 0");
+        return {};
+      },
+      strict ? "POSITIVE" : "NONNEGATIVE", strict ? "POSITIVE" : "NONNEGATIVE");
+}
+}  // namespace
+
+const CLI::Validator PositiveNumber = lower_bound(true);
+const CLI::Validator NonNegativeNumber = lower_bound(false);
 
 void add_output_options(CLI::App& cmd, CommonOptions& opts) {
   cmd.add_flag("--json", opts.json, "Print a machine-readable JSON summary on stdout");
@@ -67,19 +105,22 @@ void add_params_option(CLI::App& cmd, CommonOptions& opts) {
 
 void emit(const CommonOptions& opts, const nlohmann::json& summary, const std::string& human) {
   check_finite(summary, "");
+  // Paths name the output directories, not their staging directories; while outputs are
+  // staged the text waits for them to be committed (signals.h): a failed command prints no
+  // summary.
   if (opts.json) {
-    std::cout << summary.dump() << std::endl;
+    print_after_commit(unstaged(summary.dump()) + "\n");
   } else if (!human.empty()) {
-    std::cout << human << (human.back() == '\n' ? "" : "\n");
+    print_after_commit(unstaged(human) + (human.back() == '\n' ? "" : "\n"));
   } else {
-    std::cout << summary.dump(2) << std::endl;
+    print_after_commit(unstaged(summary.dump(2)) + "\n");
   }
 }
 
 void write_report_if_requested(const CommonOptions& opts, const report::Report& report) {
   if (!opts.out) return;
   const auto path = report.write(*opts.out);
-  spdlog::info("report written to {}", path.string());
+  spdlog::info("report written to {}", unstaged(path.string()));
 }
 
 void progress(const std::string& task, std::size_t done, std::size_t total) {

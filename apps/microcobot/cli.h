@@ -47,6 +47,13 @@ struct ReportPart {
 bool register_report_part(ReportPart part);
 std::vector<ReportPart> report_parts();
 
+/// CLI11's Range with the bounds in `%g` style ("1e-09 to 0.0001", not "0.000000 to
+/// 0.000100") and NaN refused; the message names the flag (CLI11 prefixes it).
+CLI::Validator Range(double lo, double hi);
+/// CLI11's PositiveNumber / NonNegativeNumber without their DBL_MAX bound in the message.
+extern const CLI::Validator PositiveNumber;
+extern const CLI::Validator NonNegativeNumber;
+
 /// Options every command shares.
 struct CommonOptions {
   bool json = false;

@@ -302,6 +302,12 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
     duration = 0.25;
     what = "setpoints streamed at 1 kHz (staircase 4 x 10 um plus a 7 Hz wobble), limited";
   }
+  // The work budget, before the run: a slow trapezoid (tiny velocity or acceleration limit)
+  // would otherwise simulate for days.
+  mc::require_budget(
+      duration / plant.model.dt_s(), mc::kMaxSimulatedSteps,
+      o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
+      fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
   const auto run = ct::run_tracking(plant.model, plant.map, p.position, p.sensor, start, ref, duration);
   r.add_result(o.profile + ": RMS tracking error", run.rms_error_m, "m");
   r.add_result(o.profile + ": max tracking error", run.max_error_m, "m");
@@ -359,10 +365,10 @@ void add_control(CLI::App& group) {
     auto o = std::make_shared<VelocityOptions>();
     auto* cmd =
         group.add_subcommand("velocity", "Velocity control (thesis §2.7, Fig. 2.18-2.19) with baselines");
-    cmd->add_option("--reference", o->reference, "Reference speed [m/s]")->check(CLI::Range(1e-7, 1e-2));
+    cmd->add_option("--reference", o->reference, "Reference speed [m/s]")->check(mc::cli::Range(1e-7, 1e-2));
     cmd->add_option("--direction", o->direction, "forward | backward")
         ->check(CLI::IsMember({"forward", "backward"}));
-    cmd->add_option("--duration", o->duration, "Simulated time [s]")->check(CLI::Range(0.02, 100.0));
+    cmd->add_option("--duration", o->duration, "Simulated time [s]")->check(mc::cli::Range(0.02, 100.0));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_velocity_cmd(*o); });
@@ -373,8 +379,8 @@ void add_control(CLI::App& group) {
         group.add_subcommand("position", "Hybrid stepping/scanning move of one XYZ axis, with baselines");
     cmd->add_option("--target", o->target, "Target position [m] (stroke +-6 mm)")
         ->required()
-        ->check(CLI::Range(-6.5e-3, 6.5e-3));
-    cmd->add_option("--start", o->start, "Start position [m]")->check(CLI::Range(-6e-3, 6e-3));
+        ->check(mc::cli::Range(-6.5e-3, 6.5e-3));
+    cmd->add_option("--start", o->start, "Start position [m]")->check(mc::cli::Range(-6e-3, 6e-3));
     cmd->add_option("--axis", o->axis, "x | y | z")->check(CLI::IsMember({"x", "y", "z"}));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
@@ -385,12 +391,12 @@ void add_control(CLI::App& group) {
     auto* cmd = group.add_subcommand("trajectory", "Trajectory tracking under velocity/acceleration limits");
     cmd->add_option("--profile", o->profile, "trapezoid | sine | stream")
         ->check(CLI::IsMember({"trapezoid", "sine", "stream"}));
-    cmd->add_option("--distance", o->distance, "Trapezoid: distance [m]")->check(CLI::Range(1e-9, 12e-3));
-    cmd->add_option("--velocity", o->velocity, "Velocity limit [m/s]")->check(CLI::Range(1e-7, 1e-2));
+    cmd->add_option("--distance", o->distance, "Trapezoid: distance [m]")->check(mc::cli::Range(1e-9, 12e-3));
+    cmd->add_option("--velocity", o->velocity, "Velocity limit [m/s]")->check(mc::cli::Range(1e-7, 1e-2));
     cmd->add_option("--acceleration", o->acceleration, "Acceleration limit [m/s^2]")
-        ->check(CLI::Range(1e-6, 10.0));
-    cmd->add_option("--amplitude", o->amplitude, "Sine: amplitude [m]")->check(CLI::Range(1e-9, 6e-3));
-    cmd->add_option("--frequency", o->frequency, "Sine: frequency [Hz]")->check(CLI::Range(1e-3, 100.0));
+        ->check(mc::cli::Range(1e-6, 10.0));
+    cmd->add_option("--amplitude", o->amplitude, "Sine: amplitude [m]")->check(mc::cli::Range(1e-9, 6e-3));
+    cmd->add_option("--frequency", o->frequency, "Sine: frequency [Hz]")->check(mc::cli::Range(1e-3, 100.0));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_trajectory_cmd(*o); });

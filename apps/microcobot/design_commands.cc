@@ -31,7 +31,7 @@ struct Calc {
 };
 
 CLI::Option* number(CLI::App* cmd, const std::string& flag, double& value, const std::string& help,
-                    bool required = true, const CLI::Validator& check = CLI::PositiveNumber) {
+                    bool required = true, const CLI::Validator& check = mc::cli::PositiveNumber) {
   auto* opt = cmd->add_option(flag, value, help)->check(check);
   if (required) opt->required();
   return opt;
@@ -43,7 +43,7 @@ void add_ballscrew(CLI::App& group) {
                                    "Lead angle and forward/backward efficiency of a ball screw (app. B)");
   number(cmd, "--diameter", c->v[0], "Nominal diameter d [m]");
   number(cmd, "--lead", c->v[1], "Lead p per turn [m]");
-  number(cmd, "--mu", c->v[2], "Friction coefficient mu (mu = tan phi)", true, CLI::NonNegativeNumber);
+  number(cmd, "--mu", c->v[2], "Friction coefficient mu (mu = tan phi)", true, mc::cli::NonNegativeNumber);
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
     const auto e = tw::ball_screw_efficiency(c->v[0], c->v[1], c->v[2]);
@@ -63,7 +63,7 @@ void add_actuator(CLI::App& group) {
   auto* cmd = group.add_subcommand("actuator", "Axial force of the ball screw driven by the motor (eq. 4.4)");
   number(cmd, "--torque", c->v[0], "Motor torque C [N m]");
   number(cmd, "--lead", c->v[1], "Lead p [m]");
-  number(cmd, "--efficiency", c->v[2], "Forward efficiency eta_f", true, CLI::Range(0.0, 1.0));
+  number(cmd, "--efficiency", c->v[2], "Forward efficiency eta_f", true, mc::cli::Range(0.0, 1.0));
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
     const double f = tw::axial_force(c->v[0], c->v[1], c->v[2]);
@@ -76,12 +76,12 @@ void add_transmission(CLI::App& group) {
   c->v[3] = tw::TweezersSpecs{}.min_force_N();
   auto* cmd =
       group.add_subcommand("transmission", "Finger force (eq. 4.5) and magnetic preload (section 4.4.2)");
-  number(cmd, "--alpha", c->v[0], "Contact angle alpha [deg]", true, CLI::Range(0.0, 90.0));
-  number(cmd, "--eta", c->v[1], "Transmission efficiency eta_t", true, CLI::Range(0.0, 1.0));
+  number(cmd, "--alpha", c->v[0], "Contact angle alpha [deg]", true, mc::cli::Range(0.0, 90.0));
+  number(cmd, "--eta", c->v[1], "Transmission efficiency eta_t", true, mc::cli::Range(0.0, 1.0));
   number(cmd, "--axial-force", c->v[2], "Axial force of the ball screw F_a [N]", true,
-         CLI::NonNegativeNumber);
+         mc::cli::NonNegativeNumber);
   number(cmd, "--closing-force", c->v[3], "Finger force to pull while closing [N] (default: eq. 4.1)", false,
-         CLI::NonNegativeNumber);
+         mc::cli::NonNegativeNumber);
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
     if (c->v[0] <= 0 || c->v[0] >= 90) throw mc::UsageError("--alpha: must be in (0, 90) deg");
@@ -101,8 +101,8 @@ void add_stiffness_force(CLI::App& group) {
   auto c = std::make_shared<Calc>();
   auto* cmd = group.add_subcommand("stiffness-force", "Force to hold the tweezers closed (eq. 4.1)");
   number(cmd, "--stiffness", c->v[0], "Clamping stiffness at the fingers [N/m]", true,
-         CLI::NonNegativeNumber);
-  number(cmd, "--opening", c->v[1], "Opening to close [m]", true, CLI::NonNegativeNumber);
+         mc::cli::NonNegativeNumber);
+  number(cmd, "--opening", c->v[1], "Opening to close [m]", true, mc::cli::NonNegativeNumber);
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
     const double f = tw::stiffness_force(c->v[0], c->v[1]);
@@ -116,7 +116,7 @@ void add_amplifier(CLI::App& group) {
       group.add_subcommand("amplifier", "Transverse expansion of the piezo amplifier (eq. A.8, Table 4.5)");
   number(cmd, "--length", c->v[0], "Piezo stack length L [m]");
   number(cmd, "--stroke", c->v[1], "Stack stroke dL [m]");
-  number(cmd, "--e", c->v[2], "Connection length e [m]", true, CLI::NonNegativeNumber);
+  number(cmd, "--e", c->v[2], "Connection length e [m]", true, mc::cli::NonNegativeNumber);
   number(cmd, "--a", c->v[3], "Amplifier half-height a [m]");
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
@@ -132,10 +132,10 @@ void add_piezo_brake(CLI::App& group) {
   auto* cmd = group.add_subcommand("piezo-brake", "Blocking force of the piezo friction brake (eq. 4.2-4.3)");
   number(cmd, "--max-force", c->v[0], "Stack maximum push force [N]");
   number(cmd, "--travel-used", c->v[1], "Fraction of the travel spent closing the gap", true,
-         CLI::Range(0.0, 1.0));
-  number(cmd, "--mu", c->v[2], "Friction coefficient plate/stack", true, CLI::NonNegativeNumber);
+         mc::cli::Range(0.0, 1.0));
+  number(cmd, "--mu", c->v[2], "Friction coefficient plate/stack", true, mc::cli::NonNegativeNumber);
   number(cmd, "--geometry", c->v[3], "Geometry coefficient (friction -> force between tips)", true,
-         CLI::NonNegativeNumber);
+         mc::cli::NonNegativeNumber);
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
     const double f = tw::piezo_block_force(c->v[0], c->v[1], c->v[2], c->v[3]);

@@ -30,8 +30,8 @@ struct WelchFlags {
 };
 
 void add_welch_flags(CLI::App* cmd, WelchFlags& w) {
-  cmd->add_option("--fs", w.fs, "Sample rate (Hz)")->required()->check(CLI::PositiveNumber);
-  cmd->add_option("--nperseg", w.nperseg, "Segment length (samples)")->check(CLI::PositiveNumber);
+  cmd->add_option("--fs", w.fs, "Sample rate (Hz)")->required()->check(mc::cli::PositiveNumber);
+  cmd->add_option("--nperseg", w.nperseg, "Segment length (samples)")->check(mc::cli::PositiveNumber);
   cmd->add_option("--noverlap", w.noverlap, "Overlap (samples), default nperseg/2");
   cmd->add_option("--nfft", w.nfft, "FFT length >= nperseg (default nperseg)");
   cmd->add_option("--detrend", w.detrend, "constant|none")->check(CLI::IsMember({"constant", "none"}));
@@ -70,9 +70,9 @@ void add_dsp(CLI::App& group) {
     auto* cmd =
         group.add_subcommand("butter", "Butterworth / Linkwitz-Riley LR4 design as second-order sections");
     cmd->add_option("--order", o->order, "Filter order (Butterworth 1..20; LR4 ignores it)")
-        ->check(CLI::Range(1, 20));
-    cmd->add_option("--fc", o->fc, "Cut-off (Hz)")->required()->check(CLI::PositiveNumber);
-    cmd->add_option("--fs", o->fs, "Sample rate (Hz)")->required()->check(CLI::PositiveNumber);
+        ->check(mc::cli::Range(1, 20));
+    cmd->add_option("--fc", o->fc, "Cut-off (Hz)")->required()->check(mc::cli::PositiveNumber);
+    cmd->add_option("--fs", o->fs, "Sample rate (Hz)")->required()->check(mc::cli::PositiveNumber);
     cmd->add_option("--type", o->type, "low|high|lr4-low|lr4-high")
         ->check(CLI::IsMember({"low", "high", "lr4-low", "lr4-high"}));
     mc::cli::add_output_options(*cmd, o->common);
@@ -147,7 +147,7 @@ void add_dsp(CLI::App& group) {
     };
     auto o = std::make_shared<O>();
     auto* cmd = group.add_subcommand("mls", "Maximum-length sequence of 0/1 (scipy.signal.max_len_seq)");
-    cmd->add_option("--bits", o->bits, "Register length 2..32")->required()->check(CLI::Range(2, 32));
+    cmd->add_option("--bits", o->bits, "Register length 2..32")->required()->check(mc::cli::Range(2, 32));
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] {
       if (o->bits > 24) throw mc::UsageError("--bits: at most 24 on the command line (2^24 - 1 values)");
@@ -165,10 +165,10 @@ void add_dsp(CLI::App& group) {
     auto o = std::make_shared<O>();
     auto* cmd = group.add_subcommand("tffit", "Rational transfer-function fit of an FRF CSV (f_Hz,re,im)");
     cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im")->required();
-    cmd->add_option("--nz", o->nz, "Numerator order")->check(CLI::Range(0, 20));
-    cmd->add_option("--np", o->np, "Denominator order")->check(CLI::Range(1, 20));
-    cmd->add_option("--fmin", o->fmin, "Band start (Hz)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--fmax", o->fmax, "Band end (Hz)")->check(CLI::PositiveNumber);
+    cmd->add_option("--nz", o->nz, "Numerator order")->check(mc::cli::Range(0, 20));
+    cmd->add_option("--np", o->np, "Denominator order")->check(mc::cli::Range(1, 20));
+    cmd->add_option("--fmin", o->fmin, "Band start (Hz)")->check(mc::cli::NonNegativeNumber);
+    cmd->add_option("--fmax", o->fmax, "Band end (Hz)")->check(mc::cli::PositiveNumber);
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] {
       if (o->nz > o->np) throw mc::UsageError("--nz must not exceed --np");
@@ -195,9 +195,9 @@ void add_dsp(CLI::App& group) {
     auto* cmd = group.add_subcommand("octave", "1/3-octave band averages (IEC 61260 base 10) of an FRF CSV");
     cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im")->required();
     cmd->add_option("--fmin", o->fmin, "Lowest band centre (Hz), default the data's")
-        ->check(CLI::PositiveNumber);
+        ->check(mc::cli::PositiveNumber);
     cmd->add_option("--fmax", o->fmax, "Highest band centre (Hz), default the data's")
-        ->check(CLI::PositiveNumber);
+        ->check(mc::cli::PositiveNumber);
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_csv(o->in);
@@ -212,7 +212,15 @@ void add_dsp(CLI::App& group) {
       if (hi <= 0) {
         for (double v : f) hi = std::max(hi, v);
       }
-      if (!(hi > lo)) throw mc::UsageError("--fmax must exceed --fmin");
+      if (!(hi > lo)) {
+        // Name what was given: a flag, or the data's end it defaulted to.
+        const std::string lo_what = o->fmin > 0 ? "--fmin" : "the data's lowest frequency";
+        const std::string hi_what = o->fmax > 0 ? "--fmax" : "the data's highest frequency";
+        const std::string msg =
+            fmt::format("{} ({:g} Hz) must exceed {} ({:g} Hz)", hi_what, hi, lo_what, lo);
+        if (o->fmin > 0 || o->fmax > 0) throw mc::UsageError(msg);
+        throw mc::InvalidInput(o->in, 0, msg);
+      }
       const auto b = mc::dsp::third_octave_average(f, read_frf(table), lo, hi);
       mc::cli::emit(o->common, {{"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB}});
     });

@@ -370,7 +370,8 @@ void add_haptics(CLI::App& group) {
                        tweezers->common);
   cmd->add_option("--scenario", tweezers->scenario, "brownian or contact")
       ->check(CLI::IsMember({"brownian", "contact"}));
-  cmd->add_option("--duration", tweezers->duration_s, "Recording length (s)")->check(CLI::Range(0.5, 60.0));
+  cmd->add_option("--duration", tweezers->duration_s, "Recording length (s)")
+      ->check(mc::cli::Range(0.5, 60.0));
   cmd->callback([tweezers] { run_tweezers(*tweezers); });
 }
 

@@ -326,7 +326,7 @@ void add_identify(CLI::App& group) {
         command(group, "hysteresis", "PI thresholds and weights (NNLS) and the inverse from a sine response",
                 o, "CSV t_s,u_V,x_m: slider response to a sine (scanning mode)");
     cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
-        ->check(CLI::Range(1, 200));
+        ->check(mc::cli::Range(1, 200));
     cmd->callback([o] {
       auto base = base_params(o->common);
       const auto rec = ss::read_record(o->in);
@@ -345,7 +345,8 @@ void add_identify(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     auto* cmd = command(group, "breakaway", "z_ba of each sawtooth run and the surface z_ba(A, f, direction)",
                         o, "Directory of sawtooth_<A>V_<f>Hz_<forward|backward>.csv runs");
-    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 64));
+    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")
+        ->check(mc::cli::Range(1, 64));
     cmd->callback([o] {
       auto base = base_params(o->common);
       const auto runs = ss::read_sawtooth_runs(o->in);
@@ -369,8 +370,9 @@ void add_identify(CLI::App& group) {
     auto* cmd = command(group, "all", "The three steps of section 2.5.2 in order, one parameter file", o,
                         "Directory with pe_step.csv (optional), step.csv, sine.csv, sawtooth_*.csv");
     cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
-        ->check(CLI::Range(1, 200));
-    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 64));
+        ->check(mc::cli::Range(1, 200));
+    cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")
+        ->check(mc::cli::Range(1, 64));
     cmd->callback([o] {
       const auto base = base_params(o->common);
       ss::IdentifyAllOptions io;

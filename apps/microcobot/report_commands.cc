@@ -7,6 +7,7 @@
 #include "cli.h"
 #include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
+#include "signals.h"
 
 namespace {
 
@@ -37,7 +38,7 @@ void run_report(const ReportOptions& opts) {
     built.push_back(part.name);
     mc::cli::progress("report", ++done, opts.only.empty() ? parts.size() : opts.only.size());
   }
-  const auto dir = opts.common.out.value_or("out/report");
+  const auto dir = opts.common.out ? *opts.common.out : mc::cli::stage_output("out/report");
   const auto path = full.write(dir);
   nlohmann::json summary{{"index", path.string()}, {"parts", built}, {"figures", full.figure_count()}};
   mc::cli::emit(opts.common, summary, "report written to " + path.string());
@@ -88,8 +89,10 @@ void rng_part(mc::report::Report& r) {
   const double mean = sum / kDraws;
   r.add_result("mean of draws", mean);
   r.add_result("variance of draws", sum2 / kDraws - mean * mean);
-  r.add_figure({"Normal draws", "Histogram (points) against the N(0,1) density (line).",
-                {"Value", "", false}, {"Probability density", "", false},
+  r.add_figure({"Normal draws",
+                "Histogram (points) against the N(0,1) density (line).",
+                {"Value", "", false},
+                {"Probability density", "", false},
                 {{"histogram", centre, count, true}, {"N(0,1) density", centre, density, false}}});
 }
 const bool kRngPart = mc::cli::register_report_part({"rng", 5, &rng_part});

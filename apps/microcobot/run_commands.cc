@@ -11,6 +11,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 #include "microcobot/platform/session.h"
+#include "signals.h"
 
 namespace {
 
@@ -45,11 +46,18 @@ void run(const RunOptions& o) {
   sp.validate();
   pf::Session session(config, sp);
   const auto total = static_cast<std::size_t>(std::ceil(o.duration_s));
-  const auto result = session.run([&](double t) {
-    mc::cli::progress("run " + o.scenario, static_cast<std::size_t>(std::lround(t)), total);
-  });
-  const auto dir = o.common.out.value_or("out/session");
+  // A signal during the run stops it cleanly: the recording and report are written, marked
+  // as interrupted, and the command exits 128 + signal.
+  mc::cli::set_cooperative_interrupts(true);
+  const auto result = session.run(
+      [&](double t) {
+        mc::cli::progress("run " + o.scenario, static_cast<std::size_t>(std::lround(t)), total);
+      },
+      [] { return mc::cli::interrupt_signal() != 0; });
+  const auto dir = o.common.out ? *o.common.out : mc::cli::stage_output("out/session");
   session.write(dir, result);
+  mc::cli::set_cooperative_interrupts(false);
+  if (result.interrupted) throw mc::cli::Interrupted(mc::cli::interrupt_signal());
   auto summary = result.to_json();
   summary["scenario"] = o.scenario;
   summary["report"] = (dir / "index.html").string();
@@ -65,11 +73,12 @@ void run(const RunOptions& o) {
 
 void add_run(CLI::App& cmd) {
   auto o = std::make_shared<RunOptions>();
-  cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as --print-config shows)")
-      ->check(CLI::ExistingFile);
-  cmd.add_option("--scenario", o->scenario, "Scenario: pick-place (default) or stale-master");
+  // No CLI11 existence check: a missing file is invalid input (exit 3), as for --params.
+  cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as --print-config shows)");
+  cmd.add_option("--scenario", o->scenario, "Scenario: pick-place (default) or stale-master")
+      ->check(CLI::IsMember({"pick-place", "stale-master"}));
   cmd.add_option("--duration", o->duration_s, "Longest simulated time [s] (default 120)")
-      ->check(CLI::PositiveNumber);
+      ->check(mc::cli::Range(pf::SessionParams::kMinDuration_s, pf::SessionParams::kMaxDuration_s));
   cmd.add_flag("--realtime", o->realtime, "Pace the loop to the wall clock (SCHED_FIFO when permitted)");
   cmd.add_flag("--print-config", o->print_config, "Print the configuration (default or --config) and exit");
   cmd.add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");

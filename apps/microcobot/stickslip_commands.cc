@@ -1,6 +1,7 @@
 // `microcobot stickslip ...`: the stick-slip actuator model of thesis ch. 2 — its parameters, a
 // waveform simulator, and the chapter's experiments (Fig. 2.10-2.17) with their figures.
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -12,6 +13,7 @@
 #include "microcobot/core/params.h"
 #include "microcobot/stickslip/actuator.h"
 #include "microcobot/stickslip/experiments.h"
+#include "microcobot/stickslip/integrator_accuracy.h"
 
 namespace {
 
@@ -207,13 +209,33 @@ struct SimulateOptions {
 void run_simulate(const SimulateOptions& o) {
   ss::StickSlipParams p = load(o.common);
   if (o.dt_s > 0) p.integrator.dt_s = o.dt_s;
+  // Every step is recorded: bound the samples before anything is allocated.
+  mc::require_budget(o.duration_s / p.integrator.dt_s, mc::kMaxRecordedSamples, "--duration",
+                     "recorded samples (duration / dt)");
   const ss::ActuatorModel m(p);
   const ss::Waveform w = ss::make_waveform(ss::parse_wave_kind(o.wave), o.amplitude_V, o.frequency_Hz,
                                            ss::parse_direction(o.direction), p.drive);
   ss::ActuatorState state = m.initial_state();
   const ss::Trajectory tr = ss::simulate(m, w, o.duration_s, 1, &state);
+  for (std::size_t i = 0; i < tr.t_s.size(); ++i) {
+    p.check_physical_bounds(tr.x1_m[i], tr.x2_m[i], tr.t_s[i], "stickslip simulate");
+  }
   const double x0 = tr.x2_m.front(), xf = tr.x2_m.back();
   const double dur = tr.t_s.back() - tr.t_s.front();
+  // Mean velocity from the same phase to the same phase: over the whole periods of the run (the
+  // slider's position within a period swings by up to the PE's stroke), none for a step.
+  nlohmann::json mean_velocity = nullptr;
+  double whole_periods = 0.0;
+  if (w.kind != ss::WaveKind::kStep) {
+    whole_periods = std::floor(dur * w.frequency_Hz + 1e-9);
+    if (whole_periods >= 1.0) {
+      const double t_w = whole_periods / w.frequency_Hz;
+      const auto k = std::min(tr.t_s.size() - 2, static_cast<std::size_t>(t_w / m.dt_s()));
+      const double frac = std::clamp((t_w - tr.t_s[k]) / (tr.t_s[k + 1] - tr.t_s[k]), 0.0, 1.0);
+      const double x_w = tr.x2_m[k] + frac * (tr.x2_m[k + 1] - tr.x2_m[k]);
+      mean_velocity = (x_w - x0) / t_w;
+    }
+  }
   nlohmann::json j{{"wave", o.wave},
                    {"amplitude_V", o.amplitude_V},
                    {"frequency_Hz", o.frequency_Hz},
@@ -222,7 +244,9 @@ void run_simulate(const SimulateOptions& o) {
                    {"dt_s", m.dt_s()},
                    {"samples", tr.t_s.size()},
                    {"final_position_m", xf},
-                   {"mean_velocity_m_s", (xf - x0) / dur},
+                   {"displacement_m", xf - x0},
+                   {"whole_periods", whole_periods},
+                   {"mean_velocity_m_s", mean_velocity},
                    {"part_separation_m", state.x2_m[0] - state.x2_m[1]}};
   if (o.common.out) {
     mc::ensure_writable_dir(*o.common.out);
@@ -256,7 +280,108 @@ void run_simulate(const SimulateOptions& o) {
   }
   mc::cli::emit(
       o.common, j,
-      fmt::format("final position {:.6g} m, mean velocity {:.6g} m/s over {:g} s", xf, (xf - x0) / dur, dur));
+      mean_velocity.is_null()
+          ? fmt::format("final position {:.6g} m after {:g} s", xf, dur)
+          : fmt::format("final position {:.6g} m after {:g} s; mean velocity {:.6g} m/s over {:g} whole "
+                        "periods",
+                        xf, dur, mean_velocity.get<double>(), whole_periods));
+}
+
+struct AccuracyOptions {
+  CommonOptions common;
+  int drives = 40;
+  std::uint64_t seed = 12;
+  double rtol = 1e-9;
+};
+
+double quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
+}
+
+/// The integrator against the reference solver on drives drawn at random (issue #12).
+void run_accuracy(const AccuracyOptions& o) {
+  const ss::ActuatorModel m(load(o.common));
+  const auto drives = ss::accuracy_drives(o.drives, o.seed, m.params().drive);
+  nlohmann::json cases = nlohmann::json::array();
+  std::vector<double> rms, mx, step;
+  ss::DriveAccuracy worst;
+  std::size_t worst_i = 0;
+  for (std::size_t i = 0; i < drives.size(); ++i) {
+    const auto& d = drives[i];
+    ss::ReferenceOptions ro;
+    ro.rel_tol = o.rtol;
+    ro.abs_tol_m = o.rtol * 1e-6;
+    ss::DriveAccuracy a = ss::check_drive(m, d, ro);
+    rms.push_back(a.rms_error);
+    mx.push_back(a.max_error);
+    step.push_back(a.step_error);
+    cases.push_back({{"wave", ss::to_string(d.wave.kind)},
+                     {"amplitude_V", d.wave.amplitude_V},
+                     {"frequency_Hz", d.wave.kind == ss::WaveKind::kStep ? 0.0 : d.wave.frequency_Hz},
+                     {"direction", ss::to_string(d.wave.direction)},
+                     {"duration_s", d.duration_s},
+                     {"range_m", a.range_m},
+                     {"rms_error", a.rms_error},
+                     {"max_error", a.max_error},
+                     {"step_m", a.step_m},
+                     {"step_ref_m", a.step_ref_m},
+                     {"step_error", a.step_error}});
+    mc::cli::progress("accuracy", i + 1, drives.size());
+    if (i == 0 || a.rms_error > worst.rms_error) {
+      worst = std::move(a);
+      worst_i = i;
+    }
+  }
+  auto stats = [&](const std::vector<double>& v) {
+    return nlohmann::json{{"median", quantile(v, 0.5)}, {"max", *std::max_element(v.begin(), v.end())}};
+  };
+  const nlohmann::json j{{"dt_s", m.dt_s()},        {"drives", o.drives},     {"seed", o.seed},
+                         {"rms_error", stats(rms)}, {"max_error", stats(mx)}, {"step_error", stats(step)},
+                         {"cases", cases}};
+  if (o.common.out) {
+    mc::ensure_writable_dir(*o.common.out);
+    Report r("stickslip accuracy");
+    r.section(
+        "Integrator against the reference solver",
+        fmt::format("{} drives drawn at random (seed {}), step {:g} s; errors of the slider position as "
+                    "fractions of its range, and of the net step per period.",
+                    o.drives, o.seed, m.dt_s()));
+    Series sr{"RMS error", {}, {}, true}, sm{"max error", {}, {}, true}, ss_{"step error", {}, {}, true};
+    for (std::size_t i = 0; i < drives.size(); ++i) {
+      const double f = drives[i].wave.kind == ss::WaveKind::kStep ? 1.0 : drives[i].wave.frequency_Hz;
+      sr.x.push_back(f);
+      sr.y.push_back(rms[i]);
+      sm.x.push_back(f);
+      sm.y.push_back(mx[i]);
+      ss_.x.push_back(f);
+      ss_.y.push_back(step[i]);
+    }
+    r.add_result("RMS error, median", quantile(rms, 0.5), "");
+    r.add_result("RMS error, max", *std::max_element(rms.begin(), rms.end()), "");
+    r.add_result("step error, max", *std::max_element(step.begin(), step.end()), "");
+    r.add_figure({"Errors by drive frequency",
+                  "Each drive's errors (steps drawn at 1 Hz).",
+                  {"Frequency", "Hz", true},
+                  {"Relative error", "", true},
+                  {sr, sm, ss_}});
+    const auto& w = drives[worst_i].wave;
+    r.add_figure(
+        {"Largest RMS error: slider position",
+         fmt::format("{} {:.1f} V {:.1f} Hz {}: the model at its step and the reference solver.",
+                     ss::to_string(w.kind), w.amplitude_V, w.frequency_Hz, ss::to_string(w.direction)),
+         {"Time", "s"},
+         {"Slider position", "m"},
+         {{"model", worst.model.t_s, worst.model.x2_m, false},
+          {"reference", worst.reference.t_s, worst.reference.x2_m, false}}});
+    mc::cli::write_report_if_requested(o.common, r);
+  }
+  mc::cli::emit(
+      o.common, j,
+      fmt::format("{} drives: slider RMS error median {:.3g} %, max {:.3g} % of the range; step per "
+                  "period error median {:.3g} %, max {:.3g} %",
+                  o.drives, 100 * quantile(rms, 0.5), 100 * *std::max_element(rms.begin(), rms.end()),
+                  100 * quantile(step, 0.5), 100 * *std::max_element(step.begin(), step.end())));
 }
 
 void add_stickslip(CLI::App& group) {
@@ -273,17 +398,32 @@ void add_stickslip(CLI::App& group) {
     auto* cmd = group.add_subcommand("simulate", "Run a drive waveform on one axis; CSV t_s,u_V,x1_m,x2_m");
     cmd->add_option("--wave", o->wave, "sawtooth | sine | step")
         ->check(CLI::IsMember({"sawtooth", "sine", "step"}));
-    cmd->add_option("--amplitude", o->amplitude_V, "Amplitude [V] (0..100 V with the offset)")
-        ->check(CLI::NonNegativeNumber);
-    cmd->add_option("--frequency", o->frequency_Hz, "Frequency [Hz]")->check(CLI::PositiveNumber);
+    cmd->add_option("--amplitude", o->amplitude_V,
+                    "Amplitude [V] (0..100 V, the amplifier's range; the drive starts at 0 V)")
+        ->check(mc::cli::NonNegativeNumber);
+    cmd->add_option("--frequency", o->frequency_Hz,
+                    "Frequency [Hz] (sawtooth: each period starts at 0 V; ignored by a step)")
+        ->check(mc::cli::PositiveNumber);
     cmd->add_option("--direction", o->direction, "forward | backward")
         ->check(CLI::IsMember({"forward", "backward"}));
-    cmd->add_option("--duration", o->duration_s, "Simulated time [s]")->check(CLI::Range(1e-6, 1e4));
+    cmd->add_option("--duration", o->duration_s, "Simulated time [s]")->check(mc::cli::Range(1e-6, 1e4));
     cmd->add_option("--dt", o->dt_s, "Integrator step [s] (default integrator.dt_s)")
-        ->check(CLI::Range(1e-9, 1e-4));
+        ->check(mc::cli::Range(1e-9, 1e-4));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_simulate(*o); });
+  }
+  {
+    auto o = std::make_shared<AccuracyOptions>();
+    auto* cmd = group.add_subcommand(
+        "accuracy", "The integrator against the reference solver on drives drawn at random (errors, steps)");
+    cmd->add_option("--drives", o->drives, "Number of drives")->check(mc::cli::Range(1, 1000));
+    cmd->add_option("--seed", o->seed, "Seed of the drives' generator");
+    cmd->add_option("--rtol", o->rtol, "Reference solver's relative tolerance (absolute: rtol x 1 um)")
+        ->check(mc::cli::Range(1e-13, 1e-6));
+    mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_params_option(*cmd, o->common);
+    cmd->callback([o] { run_accuracy(*o); });
   }
   {
     auto o = std::make_shared<CommonOptions>();

@@ -284,8 +284,9 @@ void add_tweezers(CLI::App& group) {
                                      "Virtual cube between the tips: chatter and lag compensator (4.5.3)");
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
-    cmd->add_option("--stiffness", o->stiffness, "Wall stiffness per tip [N/m]")->check(CLI::PositiveNumber);
-    cmd->add_option("--rate", o->rate, "Controller rate [Hz] (default 1000)")->check(CLI::PositiveNumber);
+    cmd->add_option("--stiffness", o->stiffness, "Wall stiffness per tip [N/m]")
+        ->check(mc::cli::PositiveNumber);
+    cmd->add_option("--rate", o->rate, "Controller rate [Hz] (default 1000)")->check(mc::cli::PositiveNumber);
     cmd->add_flag("--no-compensator", o->no_comp, "Render the bare spring (no lag compensator)");
     cmd->add_flag("--sweep", o->sweep, "Largest chatter-free stiffness with and without the compensator");
     cmd->callback([o] { run_cube(*o); });

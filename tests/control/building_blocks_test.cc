@@ -21,7 +21,7 @@ TEST(SawtoothGenerator, ForwardPeriodRisesSlowlyAndDropsAtTheSlewRate) {
   const double dt = 1e-6;
   double peak = 0.0, max_rise = 0.0, max_drop = 0.0, u_prev = 0.0;
   for (int i = 0; i < 1000; ++i) {
-    const double u = g.next(dt);
+    const double u = g.next(dt).end_V;
     peak = std::max(peak, u);
     max_rise = std::max(max_rise, u - u_prev);
     max_drop = std::max(max_drop, u_prev - u);
@@ -40,11 +40,11 @@ TEST(SawtoothGenerator, BackwardIsTheMirrorAndCommandsLatchAtPeriodBoundaries) {
   g.start(0.0);
   const double dt = 1e-6;
   double u_prev = 0.0, max_jump = 0.0;
-  for (int i = 0; i < 500; ++i) u_prev = g.next(dt);
+  for (int i = 0; i < 500; ++i) u_prev = g.next(dt).end_V;
   g.command(80.0, 2000.0, Direction::kForward);  // mid-period: must not change this period
   EXPECT_DOUBLE_EQ(g.amplitude_V(), 40.0);
   for (int i = 0; i < 3000; ++i) {
-    const double u = g.next(dt);
+    const double u = g.next(dt).end_V;
     if (g.direction() == Direction::kForward) max_jump = std::max(max_jump, u - u_prev);
     u_prev = u;
   }
@@ -57,11 +57,11 @@ TEST(SawtoothGenerator, StartsBumplessFromAScanVoltageAndCountsZeroAmplitudePeri
   SawtoothGenerator g(1.0e6);
   g.command(60.0, 1000.0, Direction::kForward);
   g.start(30.0);
-  EXPECT_NEAR(g.next(1e-6), 30.0, 0.1);
+  EXPECT_NEAR(g.next(1e-6).end_V, 30.0, 0.1);
   SawtoothGenerator z(1.0e6);
   z.command(0.0, 1000.0, Direction::kForward);
   z.start(0.0);
-  for (int i = 0; i < 5000; ++i) EXPECT_EQ(z.next(1e-6), 0.0);
+  for (int i = 0; i < 5000; ++i) EXPECT_EQ(z.next(1e-6).end_V, 0.0);
   EXPECT_EQ(z.periods(), 5);
 }
 

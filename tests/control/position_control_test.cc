@@ -77,7 +77,7 @@ TEST(PositionControl, UpdateAndVoltageDoNotAllocate) {
   mc::test::AllocationGuard guard;
   for (int k = 0; k < 3000; ++k) {
     c.update(sensor.measure(test::model().slider_position(s)));
-    for (int i = 0; i < 10; ++i) test::model().step(s, c.next_voltage(1e-5));
+    for (int i = 0; i < 10; ++i) test::model().step(s, c.next_drive(1e-5));
   }
   EXPECT_EQ(guard.allocations(), 0u);
   EXPECT_NE(c.mode(), AxisMode::kIdle);

@@ -20,7 +20,7 @@ TEST(Trajectory, TrapezoidIsTrackedWithinAStepAndEndsOnTarget) {
   const auto run = run_tracking(
       test::model(), test::step_map(), p, PositionSensorParams{}, 0.0,
       [limiter, d](double, double dt) { return limiter->step(d, dt); }, trapezoid_duration_s(d, lim) + 0.05);
-  EXPECT_LT(run.max_error_m, 3e-6);  // within a few PE strokes while moving
+  EXPECT_LT(run.max_error_m, 3.5e-6);  // within about two PE strokes while moving
   EXPECT_LT(run.rms_error_m, 1.5e-6);
   EXPECT_NEAR(run.x_m.back(), d, 5e-9);  // and on target at the end
 }

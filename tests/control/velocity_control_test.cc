@@ -101,7 +101,7 @@ TEST(VelocityControl, UpdateAndSawtoothDoNotAllocate) {
   mc::test::AllocationGuard guard;
   for (int k = 0; k < 2000; ++k) {
     c.update(x);
-    for (int i = 0; i < 10; ++i) x += 1e-10 * c.next_voltage(1e-5) * 1e-3;
+    for (int i = 0; i < 10; ++i) x += 1e-10 * c.next_drive(1e-5).end_V * 1e-3;
   }
   EXPECT_EQ(guard.allocations(), 0u);
 }
@@ -124,10 +124,10 @@ TEST(VelocityControl, EndStopIsDetectedWithoutWindUpAndEmergencyStopZeroesTheDri
   c.set_reference(100e-6);
   for (int k = 0; k < 500; ++k) {
     c.update(0.0);
-    for (int i = 0; i < 10; ++i) c.next_voltage(1e-5);
+    for (int i = 0; i < 10; ++i) c.next_drive(1e-5);
   }
   c.emergency_stop();
-  EXPECT_EQ(c.next_voltage(1e-5), 0.0);
+  EXPECT_EQ(c.next_drive(1e-5).end_V, 0.0);
 }
 
 TEST(VelocityControl, InvalidParamsAreRejected) {

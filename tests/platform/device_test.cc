@@ -14,10 +14,10 @@ class FakeAxis : public SlaveAxis {
   double sample_period_s() const override { return 1e-4; }
   double max_voltage_V() const override { return 100.0; }
   void command_drive(const DriveBlock& b) noexcept override {
-    if (active() && b.samples > 0) volts_ = b.volts[b.samples - 1];
+    if (active() && b.count > 0) volts_ = b.segments[b.count - 1].end_V;
   }
   void command_voltage_V(double v) noexcept {
-    const double one[1] = {v};
+    const stickslip::DriveSegment one[1] = {stickslip::DriveSegment::to(v)};
     command_drive(DriveBlock{one, 1});
   }
   double position_m() const override { return x_; }

@@ -47,9 +47,9 @@ class SkeletonAxisDriver final : public SlaveAxis {
   void command_drive(const DriveBlock& b) noexcept override {
     if (!active()) return;
     // Copy into the FIFO (no allocation), clamped to the amplifier's range.
-    bus_.fifo_size = std::min(b.samples, FakeBus::kFifo);
+    bus_.fifo_size = std::min(b.count, FakeBus::kFifo);
     for (int i = 0; i < bus_.fifo_size; ++i)
-      bus_.dac_fifo[static_cast<std::size_t>(i)] = std::clamp(b.volts[i], 0.0, 100.0);
+      bus_.dac_fifo[static_cast<std::size_t>(i)] = std::clamp(b.segments[i].end_V, 0.0, 100.0);
   }
   double position_m() const override { return static_cast<double>(bus_.encoder_counts) * 0.1e-9; }
   bool at_end_stop() const override { return false; }

@@ -18,8 +18,8 @@ TEST(SimulatedSlaveAxis, PlaysItsDriveClampedToTheAmplifierRangeOnlyWhileActive)
   SimulatedSlaveAxis axis("x", model, control::PositionSensorParams{}, 1e-3);
   axis.configure();
   EXPECT_NEAR(axis.true_position_m(), 1e-3, 1e-12);
-  std::array<double, 10> volts;
-  volts.fill(150.0);  // above the 100 V amplifier
+  std::array<stickslip::DriveSegment, 10> volts;
+  volts.fill(stickslip::DriveSegment::to(150.0));  // above the 100 V amplifier
   axis.command_drive(DriveBlock{volts.data(), 10, 0, 0, 0});
   axis.update(kDt);
   EXPECT_DOUBLE_EQ(axis.voltage_V(), 0.0);  // not active: commands ignored, 0 V

@@ -64,6 +64,8 @@ void BaselinePositionController::update(double x) noexcept {
   gen_.command(amp, p_.frequency_Hz, sign > 0.0 ? Direction::kForward : Direction::kBackward);
 }
 
-double BaselinePositionController::next_voltage(double dt_s) noexcept { return gen_.next(dt_s); }
+stickslip::DriveSegment BaselinePositionController::next_drive(double dt_s) noexcept {
+  return gen_.next(dt_s);
+}
 
 }  // namespace mc::control

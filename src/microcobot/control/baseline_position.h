@@ -5,7 +5,7 @@
 ///    sawtooth periods at the nominal amplitude (datasheet step), no feedback;
 ///  - kThesisPid: the thesis's scheme (§2.7, Fig. 2.18) applied to position: a PID on the
 ///    sawtooth amplitude from |error|, direction by the sign of the error, stepping only.
-/// update() and next_voltage() never allocate.
+/// update() and next_drive() never allocate.
 
 #include <cstdint>
 #include <string>
@@ -44,7 +44,8 @@ class BaselinePositionController {
   /// Starts a move to `target_m` from the measured position `start_m`.
   void set_target(double target_m, double start_m) noexcept;
   void update(double measured_position_m) noexcept;
-  double next_voltage(double dt_s) noexcept;
+  /// The drive over the next actuator step `dt_s` (the sawtooth's corners, the end voltage).
+  stickslip::DriveSegment next_drive(double dt_s) noexcept;
   const SawtoothGenerator& generator() const noexcept { return gen_; }
   /// Open loop: periods still to run.
   std::int64_t remaining_periods() const noexcept { return remaining_; }

@@ -42,8 +42,9 @@ void run_ticks(const ActuatorModel& model, ActuatorState& s, PositionSensor& sen
     model.set_operating_point(s, g.amplitude_V(), g.frequency_Hz(), g.direction());
     double u = 0.0;
     for (int i = 0; i < ratio; ++i) {
-      u = c.next_voltage(dt);
-      model.step(s, u);
+      const stickslip::DriveSegment d = c.next_drive(dt);
+      model.step(s, d);
+      u = d.end_V;
     }
     if (s.diverged) {
       throw ComputationFailed("closed-loop simulation diverged (NaN/Inf) at t = " + std::to_string(s.t_s) +
@@ -262,7 +263,7 @@ TrackingRun run_tracking(const ActuatorModel& model, const StepMap& map, const P
       c.update(x);
       ++k;
     }
-    double next_voltage(double dt) noexcept { return c.next_voltage(dt); }
+    stickslip::DriveSegment next_drive(double dt) noexcept { return c.next_drive(dt); }
     const SawtoothGenerator& generator() const noexcept { return c.generator(); }
   } w{c, reference, tick, ref_now};
   run_ticks(model, s, sensor, w, ratio, ticks, [&](long k, double x, double u) {

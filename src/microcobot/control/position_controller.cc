@@ -285,10 +285,12 @@ void PositionController::update(double x) noexcept {
   }
 }
 
-double PositionController::next_voltage(double dt_s) noexcept {
+stickslip::DriveSegment PositionController::next_drive(double dt_s) noexcept {
+  stickslip::DriveSegment seg;
   switch (mode_) {
     case AxisMode::kStepping:
-      u_ = gen_.next(dt_s);
+      seg = gen_.next(dt_s);
+      u_ = seg.end_V;
       break;
     case AxisMode::kRaise:
       u_ = std::min(u_ + slew_ * dt_s, p_.raise_voltage_V);
@@ -306,9 +308,16 @@ double PositionController::next_voltage(double dt_s) noexcept {
     case AxisMode::kIdle:
       break;
   }
+  // The observer's PI follows the path's turning points too (its hysteresis branches there).
+  for (int j = 0; j < seg.corners; ++j) {
+    auto& c = seg.u_V[static_cast<std::size_t>(j)];
+    c = std::clamp(c, u_min_, u_max_);
+    stickslip::pi_update(pi_, obs_, c);
+  }
   u_ = std::clamp(u_, u_min_, u_max_);
   stickslip::pi_update(pi_, obs_, u_);
-  return u_;
+  seg.end_V = u_;
+  return seg;
 }
 
 }  // namespace mc::control

@@ -13,7 +13,7 @@
 ///    raise U with the slew-limited edge (the slider mostly stays, as in a backward step) and then
 ///    scan down; scanning that saturates (0 or 100 V) hands back to stepping from the present U;
 ///  - hold: the scanning loop stays on (no stepping, hence no stick-slip limit cycle).
-/// update() (control rate) and next_voltage() (actuator step) never allocate.
+/// update() (control rate) and next_drive() (actuator step) never allocate.
 
 #include <cstdint>
 #include <string>
@@ -94,8 +94,9 @@ class PositionController {
   void set_target(double target_m, double velocity_m_s = 0.0) noexcept;
   /// One control tick. Never allocates.
   void update(double measured_position_m) noexcept;
-  /// The drive voltage after the actuator step `dt_s` [V]. Never allocates.
-  double next_voltage(double dt_s) noexcept;
+  /// The drive over the actuator step `dt_s`: the sawtooth's corners while stepping, linear
+  /// otherwise, and the voltage at its end [V]. Never allocates.
+  stickslip::DriveSegment next_drive(double dt_s) noexcept;
   /// 0 V at once; the axis stays stopped until the next set_target().
   void emergency_stop() noexcept;
 

@@ -40,8 +40,11 @@ double SawtoothGenerator::rate(Phase ph) const noexcept {
   return abrupt ? slew_ : slow;
 }
 
-double SawtoothGenerator::next(double dt_s) noexcept {
+stickslip::DriveSegment SawtoothGenerator::next(double dt_s) noexcept {
+  stickslip::DriveSegment seg;
   double left = dt_s;
+  // U turns here: a corner of the path, at the time elapsed in this interval.
+  auto corner = [&] { seg.add_corner((dt_s - left) / dt_s, u_); };
   if (phase_ != Phase::kIdle && amp_ <= 0.0 && u_ <= 0.0) {
     // A zero-amplitude period: 0 V, but the period clock keeps running (controllers sample on it).
     u_ = 0.0;
@@ -59,7 +62,8 @@ double SawtoothGenerator::next(double dt_s) noexcept {
         phase_ = Phase::kRise;
       }
     }
-    return u_;
+    seg.end_V = u_;
+    return seg;
   }
   wait_ = 0.0;
   // At most a few phase changes per call (each phase lasts >= one slew-limited edge).
@@ -67,6 +71,7 @@ double SawtoothGenerator::next(double dt_s) noexcept {
     if (phase_ == Phase::kRise) {
       const double r = rate(Phase::kRise);
       if (u_ >= amp_) {
+        corner();
         phase_ = Phase::kFall;
         continue;
       }
@@ -77,6 +82,7 @@ double SawtoothGenerator::next(double dt_s) noexcept {
       } else {
         u_ = amp_;
         left -= need;
+        corner();
         phase_ = Phase::kFall;
       }
     } else {
@@ -88,6 +94,7 @@ double SawtoothGenerator::next(double dt_s) noexcept {
       } else {
         u_ = 0.0;
         left -= need;
+        corner();
         ++periods_;
         latch();
         if (stop_requested_) {
@@ -99,7 +106,8 @@ double SawtoothGenerator::next(double dt_s) noexcept {
       }
     }
   }
-  return u_;
+  seg.end_V = u_;
+  return seg;
 }
 
 }  // namespace mc::control

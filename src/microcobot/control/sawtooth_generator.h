@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "microcobot/stickslip/breakaway_table.h"
+#include "microcobot/stickslip/drive_segment.h"
 
 namespace mc::control {
 
@@ -27,8 +28,9 @@ class SawtoothGenerator {
   void stop_at_period_end() noexcept { stop_requested_ = true; }
   /// Stops at once (emergency stop): output 0 V.
   void halt() noexcept;
-  /// Advances by `dt_s` and returns U [V]. Never allocates.
-  double next(double dt_s) noexcept;
+  /// Advances by `dt_s` and returns U over that interval: its corners (the top of each ramp and
+  /// each period's start, wherever they fall) and the voltage at its end. Never allocates.
+  stickslip::DriveSegment next(double dt_s) noexcept;
 
   bool running() const noexcept { return phase_ != Phase::kIdle; }
   double output_V() const noexcept { return u_; }

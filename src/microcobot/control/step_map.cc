@@ -43,7 +43,7 @@ StepMeasurement measure_step(const stickslip::ActuatorModel& model, double ampli
       const double x_start = model.slider_position(s);
       for (long i = 0; i < per; ++i) {
         ++k;
-        model.step(s, w.value(static_cast<double>(k) * dt));
+        model.step(s, w.segment(static_cast<double>(k - 1) * dt, dt));
         if (measure) reach = std::max(reach, sign * (model.slider_position(s) - x_start));
       }
     }
@@ -59,7 +59,7 @@ StepMeasurement measure_step(const stickslip::ActuatorModel& model, double ampli
   const double x_last = model.slider_position(s);
   for (long i = 0; i < per; ++i) {
     ++k;
-    model.step(s, w.value(static_cast<double>(k) * dt));
+    model.step(s, w.segment(static_cast<double>(k - 1) * dt, dt));
     reach = std::max(reach, sign * (model.slider_position(s) - x_last));
   }
   for (long i = 0; i < 2 * per; ++i) {

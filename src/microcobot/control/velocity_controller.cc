@@ -121,7 +121,7 @@ void VelocityController::update(double measured_position_m) noexcept {
   gen_.command(amp_, f, dir);
 }
 
-double VelocityController::next_voltage(double dt_s) noexcept {
+stickslip::DriveSegment VelocityController::next_drive(double dt_s) noexcept {
   if (!gen_.running() && started_ && amp_ > 0.0) gen_.start(gen_.output_V());
   return gen_.next(dt_s);
 }

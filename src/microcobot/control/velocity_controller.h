@@ -8,7 +8,7 @@
 ///  - kThesisPid: the thesis's PID alone (Fig. 2.18);
 ///  - kOpenLoop:  no feedback; a controller without the model assumes a step proportional to the
 ///                amplitude (nominal_step_m at nominal_amplitude_V, a datasheet figure).
-/// update() (at control_rate_Hz) and next_voltage() (at the actuator's step) never allocate.
+/// update() (at control_rate_Hz) and next_drive() (at the actuator's step) never allocate.
 
 #include <array>
 #include <string>
@@ -60,8 +60,9 @@ class VelocityController {
   void set_reference(double v_m_s) noexcept;
   /// One control tick with the measured slider position. Never allocates.
   void update(double measured_position_m) noexcept;
-  /// Advances the sawtooth by the actuator step `dt_s` and returns U [V]. Never allocates.
-  double next_voltage(double dt_s) noexcept;
+  /// Advances the sawtooth by the actuator step `dt_s` and returns U over it (corners and end
+  /// voltage [V]). Never allocates.
+  stickslip::DriveSegment next_drive(double dt_s) noexcept;
   /// Emergency stop: 0 V at once, integrator cleared.
   void emergency_stop() noexcept;
 

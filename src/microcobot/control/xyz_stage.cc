@@ -69,8 +69,9 @@ void XyzStage::tick() noexcept {
     const auto& g = ax.ctrl->generator();
     model_.set_operating_point(ax.state, g.amplitude_V(), g.frequency_Hz(), g.direction());
     for (int i = 0; i < ratio_; ++i) {
-      ax.u = ax.ctrl->next_voltage(dt);
-      model_.step(ax.state, ax.u);
+      const stickslip::DriveSegment d = ax.ctrl->next_drive(dt);
+      model_.step(ax.state, d);
+      ax.u = d.end_V;
     }
     if (ax.state.diverged) {
       // Safe state on a fault: this axis and the others to 0 V.

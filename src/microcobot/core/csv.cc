@@ -1,22 +1,23 @@
 #include "microcobot/core/csv.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
-#include <sys/stat.h>
-#include <unistd.h>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
 
 namespace mc {
 
-CsvTable::CsvTable(std::vector<std::string> names)
-    : names_(std::move(names)), columns_(names_.size()) {}
+CsvTable::CsvTable(std::vector<std::string> names) : names_(std::move(names)), columns_(names_.size()) {}
 
 void CsvTable::add_column(std::string name, std::vector<double> values) {
   names_.push_back(std::move(name));
@@ -43,8 +44,11 @@ const std::vector<double>& CsvTable::column(const std::string& name) const {
     if (names_[i] == name) return columns_[i];
   }
   std::string have;
-  for (const auto& n : names_) have += (have.empty() ? "" : ",") + n;
-  throw InvalidInput(source_, 0, fmt::format("missing column '{}' (have: {})", name, have));
+  for (const auto& n : names_) {
+    have += (have.empty() ? "" : ",") + n;
+    if (have.size() > 80) break;
+  }
+  throw InvalidInput(source_, 0, fmt::format("missing column '{}' (have: {})", excerpt(name), excerpt(have)));
 }
 
 namespace {
@@ -70,8 +74,30 @@ std::vector<std::string> split(const std::string& line) {
 
 }  // namespace
 
-CsvTable parse_csv(const std::string& text, const std::string& source) {
-  std::istringstream in(text);
+namespace {
+
+// Text with its line endings made '\n': a UTF-8 byte-order mark is dropped, CRLF and lone CR
+// (old Mac files) end lines like LF.
+std::string normalized(const std::string& raw) {
+  std::string_view text(raw);
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\r') {
+      out += '\n';
+      if (i + 1 < text.size() && text[i + 1] == '\n') ++i;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+CsvTable parse_csv(const std::string& raw, const std::string& source) {
+  std::istringstream in(normalized(raw));
   std::string line;
   std::size_t line_no = 0;
   CsvTable table;
@@ -82,14 +108,14 @@ CsvTable parse_csv(const std::string& text, const std::string& source) {
     if (t.empty() || t[0] == '#') continue;
     std::vector<std::string> cells = split(t);
     if (!have_header) {
+      std::unordered_set<std::string_view> seen;  // linear in the header's width
+      seen.reserve(cells.size());
       for (std::size_t i = 0; i < cells.size(); ++i) {
         if (cells[i].empty()) {
           throw InvalidInput(source, line_no, fmt::format("empty column name in header (column {})", i + 1));
         }
-        for (std::size_t j = 0; j < i; ++j) {
-          if (cells[j] == cells[i]) {
-            throw InvalidInput(source, line_no, fmt::format("duplicate column '{}'", cells[i]));
-          }
+        if (!seen.insert(cells[i]).second) {
+          throw InvalidInput(source, line_no, fmt::format("duplicate column '{}'", excerpt(cells[i])));
         }
       }
       table = CsvTable(cells);
@@ -110,12 +136,14 @@ CsvTable parse_csv(const std::string& text, const std::string& source) {
       if (!c.empty() && *first == '+') ++first;
       const auto [ptr, ec] = std::from_chars(first, last, v);
       if (c.empty() || ec != std::errc() || ptr != last) {
-        throw InvalidInput(source, line_no,
-                           fmt::format("column '{}': '{}' is not a number", table.names()[i], c));
+        throw InvalidInput(
+            source, line_no,
+            fmt::format("column '{}': '{}' is not a number", excerpt(table.names()[i]), excerpt(c)));
       }
       if (!std::isfinite(v)) {
-        throw InvalidInput(source, line_no,
-                           fmt::format("column '{}': non-finite value '{}'", table.names()[i], c));
+        throw InvalidInput(
+            source, line_no,
+            fmt::format("column '{}': non-finite value '{}'", excerpt(table.names()[i]), excerpt(c)));
       }
       row[i] = v;
     }
@@ -127,11 +155,7 @@ CsvTable parse_csv(const std::string& text, const std::string& source) {
 }
 
 CsvTable read_csv(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InvalidInput(file.string(), 0, "cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_csv(buffer.str(), file.string());
+  return parse_csv(read_input_file(file, kMaxCsvFileBytes, "CSV file"), file.string());
 }
 
 void ensure_writable_dir(const std::filesystem::path& dir) {
@@ -194,8 +218,8 @@ void write_csv(const std::filesystem::path& file, const CsvTable& table,
       if (c) out += ',';
       const double v = table.column(c)[r];
       if (!std::isfinite(v)) {
-        throw ComputationFailed(fmt::format("{}: non-finite value in column '{}' at row {}",
-                                            file.string(), table.names()[c], r + 1));
+        throw ComputationFailed(fmt::format("{}: non-finite value in column '{}' at row {}", file.string(),
+                                            table.names()[c], r + 1));
       }
       const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
       out.append(buf, res.ptr);

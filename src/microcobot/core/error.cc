@@ -6,8 +6,7 @@
 
 namespace mc {
 
-Error::Error(ExitCode code, const std::string& message)
-    : std::runtime_error(message), code_(code) {}
+Error::Error(ExitCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
 
 UsageError::UsageError(const std::string& message) : Error(ExitCode::kUsage, message) {}
 
@@ -17,7 +16,7 @@ InvalidParams::InvalidParams(const std::string& field, const std::string& constr
 
 InvalidParams::InvalidParams(const std::string& field, const std::string& constraint, double got)
     : Error(ExitCode::kInvalidInput,
-            fmt::format("invalid parameter {}: {} (got {})", field, constraint, got)),
+            fmt::format("invalid parameter {}: {} (got {:g})", field, constraint, got)),
       field_(field) {}
 
 namespace {
@@ -33,8 +32,7 @@ InvalidInput::InvalidInput(const std::string& file, std::size_t line, const std:
 
 InvalidInput::InvalidInput(const std::string& what) : Error(ExitCode::kInvalidInput, what) {}
 
-ComputationFailed::ComputationFailed(const std::string& what)
-    : Error(ExitCode::kComputationFailed, what) {}
+ComputationFailed::ComputationFailed(const std::string& what) : Error(ExitCode::kComputationFailed, what) {}
 
 void require(bool ok, const std::string& field, const std::string& constraint, double value) {
   if (!ok) throw InvalidParams(field, constraint, value);
@@ -42,6 +40,13 @@ void require(bool ok, const std::string& field, const std::string& constraint, d
 
 void require(bool ok, const std::string& field, const std::string& constraint) {
   if (!ok) throw InvalidParams(field, constraint);
+}
+
+void require_budget(double amount, double limit, const std::string& field, const std::string& what) {
+  if (std::isfinite(amount) && amount <= limit) return;
+  throw InvalidParams(field, fmt::format("the run would need {:.3g} {}; the limit is {:g} (work budget, "
+                                         "docs/cli.md)",
+                                         amount, what, limit));
 }
 
 void require_positive(double value, const std::string& field) {
@@ -54,7 +59,7 @@ void require_non_negative(double value, const std::string& field) {
 
 void require_in_range(double value, double lo, double hi, const std::string& field) {
   require(std::isfinite(value) && value >= lo && value <= hi, field,
-          fmt::format("must be in [{}, {}]", lo, hi), value);
+          fmt::format("must be in [{:g}, {:g}]", lo, hi), value);
 }
 
 }  // namespace mc

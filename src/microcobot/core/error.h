@@ -71,6 +71,14 @@ void require(bool ok, const std::string& field, const std::string& constraint, d
 /// Throws InvalidParams(field, constraint) unless `ok`.
 void require(bool ok, const std::string& field, const std::string& constraint);
 
+/// Work budgets, checked before a run starts (docs/cli.md, "Limits"): the simulated steps of
+/// one command and the samples it keeps in memory.
+inline constexpr double kMaxSimulatedSteps = 5e7;
+inline constexpr double kMaxRecordedSamples = 2e7;
+/// Throws InvalidParams(field) unless `amount` (steps, samples) is finite and <= `limit`;
+/// `what` says what is counted, e.g. "simulated steps (duration / dt)".
+void require_budget(double amount, double limit, const std::string& field, const std::string& what);
+
 /// Throws InvalidParams unless value is finite and > 0.
 void require_positive(double value, const std::string& field);
 /// Throws InvalidParams unless value is finite and >= 0.

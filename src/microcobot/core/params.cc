@@ -4,8 +4,11 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <unordered_set>
 
 #include <fmt/format.h>
+
+#include "microcobot/core/input_file.h"
 
 namespace mc::detail {
 
@@ -133,27 +136,91 @@ void YamlReader::reject_unknown_keys() const {
     if (std::find(used_.begin(), used_.end(), key) == used_.end()) {
       std::string known;
       for (const auto& k : used_) known += (known.empty() ? "" : ", ") + k;
-      throw InvalidInput(source_, line_of(it->first),
-                         fmt::format("unknown key '{}' (known: {})", path(key.c_str()), known));
+      throw InvalidInput(
+          source_, line_of(it->first),
+          fmt::format("unknown key '{}' (known: {})", excerpt(path(key.c_str())), excerpt(known, 200)));
     }
   }
 }
 
-YAML::Node parse_yaml_text(const std::string& text, const std::string& source) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    const std::size_t line = e.mark.line >= 0 ? static_cast<std::size_t>(e.mark.line) + 1 : 0;
-    throw InvalidInput(source, line, "malformed YAML: " + e.msg);
+namespace {
+
+// Refuses a key repeated in one map (yaml-cpp keeps both and lookups would take the first,
+// silently dropping the second, e.g. a repeated `friction:` section). `budget` bounds the
+// walk: aliases share nodes, so a small file can describe an exponentially large tree.
+void reject_duplicate_keys(const YAML::Node& node, const std::string& source, std::size_t& budget) {
+  if (budget == 0)
+    throw InvalidInput(source, line_of(node), "YAML too large (more than 100000 nodes, counting aliases)");
+  --budget;
+  if (node.IsMap()) {
+    std::unordered_set<std::string> keys;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      if (it->first.IsScalar() && !keys.insert(it->first.Scalar()).second) {
+        throw InvalidInput(source, line_of(it->first),
+                           fmt::format("duplicate key '{}'", excerpt(it->first.Scalar())));
+      }
+      reject_duplicate_keys(it->second, source, budget);
+    }
+  } else if (node.IsSequence()) {
+    for (auto it = node.begin(); it != node.end(); ++it) reject_duplicate_keys(*it, source, budget);
   }
 }
 
+}  // namespace
+
+namespace {
+
+// The line of a second document's marker ("---" or "..." followed by content), or 0. yaml-cpp
+// 0.7's LoadAll() loops forever on some inputs (a lone ',': found by the parameter fuzzer), so
+// the documents are told apart on the text: markers stand at the start of a line.
+std::size_t second_document_line(const std::string& text) {
+  bool content = false, ended = false;
+  std::size_t line_no = 0;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t eol = std::min(text.find('\n', pos), text.size());
+    const std::string_view line(text.data() + pos, eol - pos);
+    ++line_no;
+    const auto is_marker = [&](std::string_view m) {
+      return line.substr(0, 3) == m &&
+             (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+    };
+    std::size_t first = line.find_first_not_of(" \t\r");
+    const bool blank = first == std::string_view::npos || line[first] == '#';
+    if (is_marker("---")) {
+      if (content || ended) return line_no;
+      content = line.find_first_not_of(" \t\r", 3) != std::string_view::npos;  // "--- value"
+    } else if (is_marker("...")) {
+      ended = content;
+    } else if (!blank && line[0] != '%') {
+      if (ended) return line_no;
+      content = true;
+    }
+    pos = eol + 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+YAML::Node parse_yaml_text(const std::string& text, const std::string& source) {
+  if (const std::size_t line = second_document_line(text)) {
+    throw InvalidInput(source, line, "a second YAML document (a parameter file holds one)");
+  }
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    const std::size_t line = e.mark.line >= 0 ? static_cast<std::size_t>(e.mark.line) + 1 : 0;
+    throw InvalidInput(source, line, "malformed YAML: " + excerpt(e.msg));
+  }
+  std::size_t budget = 100000;
+  reject_duplicate_keys(doc, source, budget);
+  return doc;
+}
+
 YAML::Node parse_yaml_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InvalidInput(file.string(), 0, "cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_yaml_text(buffer.str(), file.string());
+  return parse_yaml_text(read_input_file(file, kMaxParamsFileBytes, "parameter file"), file.string());
 }
 
 }  // namespace mc::detail

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
 #include <unsupported/Eigen/FFT>
 
 #include "microcobot/core/error.h"
@@ -71,14 +72,19 @@ WelchEstimator::WelchEstimator(const WelchOptions& options, std::size_t signal_l
   auto& m = *impl_;
   m.opt = options;
   require_positive(options.fs_Hz, "fs_Hz");
-  require(signal_length > 0, "x", "signal must not be empty");
-  require(options.nperseg > 0, "nperseg", "must be > 0");
+  // A one-point FFT has no spectrum (and Eigen's half-spectrum real FFT of length 1 reads
+  // out of bounds): segments and signals need two samples at least.
+  require(signal_length >= 2, "x", "signal must have at least 2 samples", static_cast<double>(signal_length));
+  require(options.nperseg >= 2, "nperseg", "must be >= 2", static_cast<double>(options.nperseg));
   m.opt.nperseg = std::min(options.nperseg, signal_length);
   const std::size_t noverlap = options.noverlap.value_or(m.opt.nperseg / 2);
   require(noverlap < m.opt.nperseg, "noverlap", "must be < nperseg", static_cast<double>(noverlap));
   m.opt.noverlap = noverlap;
   m.opt.nfft = options.nfft == 0 ? m.opt.nperseg : options.nfft;
   require(m.opt.nfft >= m.opt.nperseg, "nfft", "must be >= nperseg", static_cast<double>(options.nfft));
+  // The work budget: buffers of ~48 bytes per FFT point are made before any data is read.
+  require(m.opt.nfft <= kMaxNfft, options.nfft == 0 ? "nperseg" : "nfft",
+          fmt::format("must be <= {} (the FFT length limit)", kMaxNfft), static_cast<double>(m.opt.nfft));
   m.length = signal_length;
   m.step = m.opt.nperseg - noverlap;
   m.nseg = (signal_length - noverlap) / m.step;

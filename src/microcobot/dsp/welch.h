@@ -25,6 +25,10 @@ enum class Scaling { kDensity, kSpectrum };
 Detrend parse_detrend(const std::string& text);
 Scaling parse_scaling(const std::string& text);
 
+/// The longest FFT (nperseg, nfft) an estimator accepts: 2^22 points, about 200 MB of
+/// buffers; beyond it the request is refused before anything is allocated.
+inline constexpr std::size_t kMaxNfft = std::size_t{1} << 22;
+
 struct WelchOptions {
   double fs_Hz = 1.0;                    ///< sample rate
   std::size_t nperseg = 256;             ///< segment length (clamped to the signal length, as scipy)
@@ -58,7 +62,8 @@ struct FrfEstimate {
 /// options set and signal length, so repeated estimates do not allocate beyond their results.
 class WelchEstimator {
  public:
-  /// Throws InvalidParams for nperseg = 0, noverlap >= nperseg, nfft < nperseg, fs <= 0.
+  /// Throws InvalidParams for a signal or nperseg shorter than 2, nfft > kMaxNfft, noverlap >= nperseg, nfft
+  /// < nperseg, fs <= 0.
   WelchEstimator(const WelchOptions& options, std::size_t signal_length);
   ~WelchEstimator();
   WelchEstimator(WelchEstimator&&) noexcept;

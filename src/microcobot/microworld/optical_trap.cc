@@ -14,7 +14,9 @@ void OpticalTrapParams::validate() const {
   require_positive(trap_stiffness_N_per_m, "trap_stiffness_N_per_m");
   require_positive(obstacle_radius_m, "obstacle_radius_m");
   require_non_negative(contact_stiffness_N_per_m, "contact_stiffness_N_per_m");
-  require_positive(dt_s, "dt_s");
+  // A physical lower bound on the step (the bead's inertia-free dynamics need nothing finer;
+  // the work budget of a run is duration / dt_s).
+  require(std::isfinite(dt_s) && dt_s >= 1e-9, "dt_s", "must be >= 1e-09 s", dt_s);
   // The contact force is explicit over a step: its relaxation must be resolved.
   const double gamma = 6.0 * std::numbers::pi * viscosity_Pa_s * bead_radius_m;
   require(contact_stiffness_N_per_m * dt_s / gamma < 0.5, "contact_stiffness_N_per_m",

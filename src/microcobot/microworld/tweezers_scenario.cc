@@ -24,6 +24,10 @@ TweezersRecord simulate_tweezers(const OpticalTrapParams& params, TweezersScenar
   const double dt = params.dt_s;
   const auto every = static_cast<long>(std::llround(1.0 / (o.record_rate_Hz * dt)));
   require(every >= 1, "record_rate_Hz", "must not exceed 1/dt_s", o.record_rate_Hz);
+  require_budget(o.duration_s / dt, kMaxSimulatedSteps, "trap.dt_s",
+                 "simulated steps (duration / trap.dt_s)");
+  require_budget(o.duration_s * o.record_rate_Hz, kMaxRecordedSamples, "record_rate_Hz",
+                 "recorded samples (duration x record_rate_Hz)");
   const auto steps = static_cast<long>(std::llround(o.duration_s / dt));
   Rng rng(o.seed);
   OpticalTrapState s;

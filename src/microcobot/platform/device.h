@@ -19,6 +19,8 @@
 #include <string>
 #include <string_view>
 
+#include "microcobot/stickslip/drive_segment.h"
+
 namespace mc::platform {
 
 enum class Lifecycle { kUnconfigured, kInactive, kActive, kFault };
@@ -104,14 +106,15 @@ class TweezersMaster : public Device {
   virtual void command_grip_force_N(double force) noexcept = 0;
 };
 
-/// What the slave controller sends an axis for one loop tick: the drive-voltage samples of
-/// the tick at the axis's sample period (a DAC-streaming driver plays them; a stick-slip
-/// sawtooth needs edges of a few us, far faster than the loop) and the sawtooth they come
-/// from (a driver with its own waveform generator programs that instead; the simulation
-/// uses it for the break-away strain, thesis §2.7).
+/// What the slave controller sends an axis for one loop tick: the drive voltage of the tick,
+/// one segment per sample period, and the sawtooth it comes from. A DAC-streaming driver plays
+/// each segment's end voltage as its sample (a stick-slip sawtooth needs edges of a few us, far
+/// faster than the loop); a driver with its own waveform generator programs the sawtooth
+/// instead; the simulation follows each segment's path, corners included, and uses the
+/// sawtooth for the break-away strain (thesis §2.7).
 struct DriveBlock {
-  const double* volts = nullptr;  ///< `samples` voltages [V]
-  int samples = 0;
+  const stickslip::DriveSegment* segments = nullptr;  ///< `count` consecutive segments
+  int count = 0;
   double amplitude_V = 0.0;   ///< sawtooth amplitude
   double frequency_Hz = 0.0;  ///< sawtooth frequency (0: no sawtooth programmed)
   int direction = 0;          ///< +1 forward, -1 backward, 0 none

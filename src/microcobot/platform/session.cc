@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 
@@ -26,7 +28,7 @@ void SessionParams::validate() const {
   if (std::find(names.begin(), names.end(), scenario) == names.end()) {
     throw UsageError("unknown scenario '" + scenario + "' (expected pick-place or stale-master)");
   }
-  require_positive(max_duration_s, "max_duration_s");
+  require_in_range(max_duration_s, kMinDuration_s, kMaxDuration_s, "max_duration_s");
   require_positive(placement_tolerance_m, "placement_tolerance_m");
   require_non_negative(stale_at_s, "stale_at_s");
   require_positive(stale_for_s, "stale_for_s");
@@ -48,6 +50,7 @@ nlohmann::json SessionResult::to_json() const {
   j["clutches"] = clutches;
   j["faulted"] = faulted;
   j["crashed"] = crashed;
+  j["interrupted"] = interrupted;
   j["telemetry_dropped"] = telemetry_dropped;
   nlohmann::json ph = nlohmann::json::object();
   for (const auto& [name, t] : phases) ph[name] = t;
@@ -70,15 +73,21 @@ Session::Session(const PlatformConfig& config, const SessionParams& params) : pa
   });
 }
 
-SessionResult Session::run(const std::function<void(double)>& progress) {
+SessionResult Session::run(const std::function<void(double)>& progress, const std::function<bool()>& stop) {
   const auto start = std::chrono::steady_clock::now();
   Platform& p = *platform_;
+  bool interrupted = false;
   while (!operator_->done() && !operator_->gave_up() && !p.faulted() &&
          p.loop().time_s() < params_.max_duration_s - 1e-9) {
     p.run(std::min(1.0, params_.max_duration_s - p.loop().time_s()));
     if (progress) progress(p.loop().time_s());
+    if (stop && stop()) {
+      interrupted = true;
+      break;
+    }
   }
   SessionResult r;
+  r.interrupted = interrupted;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto& loop = p.loop();
   r.duration_s = loop.time_s();
@@ -103,7 +112,10 @@ SessionResult Session::run(const std::function<void(double)>& progress) {
 
   const bool placed =
       w.phase == microworld::PartPhase::kOnSubstrate && r.placement_error_m <= params_.placement_tolerance_m;
-  if (r.faulted) {
+  if (r.interrupted) {
+    r.verdict =
+        fmt::format("interrupted at t = {:g} s (simulated), before the operator finished", r.duration_s);
+  } else if (r.faulted) {
     r.verdict = "a device faulted: every device went to its safe state";
   } else if (operator_->gave_up()) {
     r.verdict = "the operator gave up in phase '" +
@@ -118,7 +130,7 @@ SessionResult Session::run(const std::function<void(double)>& progress) {
   } else {
     r.verdict = "part placed and released";
   }
-  r.success = operator_->done() && !r.faulted && !r.crashed && placed;
+  r.success = !r.interrupted && operator_->done() && !r.faulted && !r.crashed && placed;
 
   if (params_.scenario == "stale-master" && r.success) {
     // While the readings were stale (after the watchdog's timeout) the slave must hold and the
@@ -247,7 +259,9 @@ report::Report Session::report(const SessionResult& r) const {
 
 void Session::write(const std::filesystem::path& dir, const SessionResult& result) const {
   ensure_writable_dir(dir);
-  platform_->recording().write_csv(dir / "recording.csv");
+  std::vector<std::string> comment;
+  if (result.interrupted) comment.push_back(result.verdict);
+  write_csv(dir / "recording.csv", platform_->recording().to_table(), comment);
   report(result).write(dir);
 }
 

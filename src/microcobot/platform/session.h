@@ -26,7 +26,11 @@ namespace mc::platform {
 
 struct SessionParams {
   std::string scenario = "pick-place";
-  double max_duration_s = 120.0;  ///< stop the session after this long (simulated time)
+  /// Stop the session after this long (simulated time). Bounds: kMinDuration_s (a report
+  /// needs samples to plot) to kMaxDuration_s (the recording's memory: ~0.3 MB per second).
+  double max_duration_s = 120.0;
+  static constexpr double kMinDuration_s = 0.01;
+  static constexpr double kMaxDuration_s = 3600.0;
   double placement_tolerance_m = 5e-6;
   double stale_at_s = 12.0;  ///< stale-master: when the haptic readings freeze ...
   double stale_for_s = 0.5;  ///< ... and for how long
@@ -49,6 +53,7 @@ struct SessionResult {
   int clutches = 0;
   bool faulted = false;
   bool crashed = false;
+  bool interrupted = false;  ///< stopped early on request (a signal); the verdict says so
   std::size_t telemetry_dropped = 0;
   std::vector<std::pair<std::string, double>> phases;  ///< phase name and start time [s]
   nlohmann::json to_json() const;
@@ -59,10 +64,12 @@ class Session {
   /// Builds the platform (validates everything first).
   Session(const PlatformConfig& config, const SessionParams& params);
   /// Runs the scenario to its end; `progress(t_s)` is called about once per simulated second.
-  SessionResult run(const std::function<void(double)>& progress = {});
+  /// When `stop()` returns true (checked as often) the session ends early, interrupted.
+  SessionResult run(const std::function<void(double)>& progress = {}, const std::function<bool()>& stop = {});
   /// The session report: trajectories, forces, gripper, loop timing, phases.
   report::Report report(const SessionResult& result) const;
-  /// Writes recording.csv and the report (index.html + figure CSVs) into `dir`.
+  /// Writes recording.csv and the report (index.html + figure CSVs) into `dir`. An
+  /// interrupted session's recording starts with the comment line "# interrupted at ...".
   void write(const std::filesystem::path& dir, const SessionResult& result) const;
 
   Platform& platform() { return *platform_; }

@@ -43,10 +43,16 @@ void SimulatedSlaveAxis::update(double dt_s) noexcept {
   }
   const double vmax = max_voltage_V();
   for (int i = 0; i < n; ++i) {
-    // Past the block's end the last sample holds (a DAC keeps its output).
-    double u = block_.samples > 0 ? block_.volts[std::min(i, block_.samples - 1)] : state_.u_V;
-    u = active() && std::isfinite(u) ? std::clamp(u, 0.0, vmax) : 0.0;
-    model_.step(state_, u);
+    // Past the block's end the last voltage holds (a DAC keeps its output).
+    stickslip::DriveSegment d =
+        i < block_.count ? block_.segments[i]
+                         : stickslip::DriveSegment::to(
+                               block_.count > 0 ? block_.segments[block_.count - 1].end_V : state_.u_V);
+    auto safe = [&](double u) { return active() && std::isfinite(u) ? std::clamp(u, 0.0, vmax) : 0.0; };
+    for (int j = 0; j < d.corners; ++j)
+      d.u_V[static_cast<std::size_t>(j)] = safe(d.u_V[static_cast<std::size_t>(j)]);
+    d.end_V = safe(d.end_V);
+    model_.step(state_, d);
   }
   block_ = DriveBlock{};  // a block plays once; without a new one the voltage holds
   if (state_.diverged) {

@@ -12,7 +12,7 @@ StageController::StageController(const control::PositionControlParams& params,
   require_positive(sample_period_s, "sample_period_s");
   for (std::size_t i = 0; i < 3; ++i) {
     ctrl_[i] = std::make_unique<control::PositionController>(params, model, map);
-    samples_[i].assign(static_cast<std::size_t>(samples_per_tick), 0.0);
+    samples_[i].assign(static_cast<std::size_t>(samples_per_tick), stickslip::DriveSegment{});
   }
 }
 
@@ -33,11 +33,11 @@ void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vecto
 DriveBlock StageController::drive(int i) noexcept {
   auto& c = *ctrl_[static_cast<std::size_t>(i)];
   auto& buf = samples_[static_cast<std::size_t>(i)];
-  for (double& u : buf) u = c.next_voltage(sample_period_s_);
+  for (auto& d : buf) d = c.next_drive(sample_period_s_);
   const auto& g = c.generator();
   DriveBlock b;
-  b.volts = buf.data();
-  b.samples = static_cast<int>(buf.size());
+  b.segments = buf.data();
+  b.count = static_cast<int>(buf.size());
   b.amplitude_V = g.amplitude_V();
   b.frequency_Hz = g.frequency_Hz();
   b.direction = g.direction() == stickslip::Direction::kBackward ? -1 : 1;

@@ -34,7 +34,7 @@ class StageController {
   /// The last voltage drive(i) produced (0 before the first and after emergency_stop()).
   double last_voltage_V(int i) const noexcept {
     const auto& buf = samples_[static_cast<std::size_t>(i)];
-    return stopped_ || buf.empty() ? 0.0 : buf.back();
+    return stopped_ || buf.empty() ? 0.0 : buf.back().end_V;
   }
   /// Every axis to 0 V; they stay stopped until the next update() with a target.
   void emergency_stop() noexcept;
@@ -43,7 +43,7 @@ class StageController {
 
  private:
   std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
-  std::array<std::vector<double>, 3> samples_;
+  std::array<std::vector<stickslip::DriveSegment>, 3> samples_;
   double sample_period_s_;
   bool stopped_ = false;
 };

@@ -23,26 +23,11 @@ ActuatorModel::ActuatorModel(StickSlipParams params, double dt_s) : p_(std::move
   ka_ = p_.pe.stiffness_a_N_m * phi;
   kb_ = p_.pe.stiffness_b_N_m * (1.0 - phi);
   inv_ratio_ = 1.0 / p_.friction.zba_zss_ratio;
-  // Verlet's discrete frequency is (2/h) asin(omega h / 2); pre-warping the contact stiffness by
-  // sinc^2(omega h / 2) makes the stick-phase modes (eq. 2.20-2.21 on the slider) ring at their
-  // exact frequency, which removes the phase drift of the lightly damped 1.6 kHz mode.
-  auto prewarp = [&](double rho0, double h) {
-    const double half = 0.5 * std::sqrt(rho0 / p_.slider.mass_kg) * h;
-    if (half >= 0.5)
-      return rho0;  // far from the accurate regime: no correction (and no masking
-                    // of an unstable step, omega h > 2, which must still diverge)
-    const double sinc = std::sin(half) / half;
-    return rho0 * sinc * sinc;
-  };
-  auto constants = [&](double h) {
-    StepConstants k;
-    k.h = h;
-    k.inv_h = 1.0 / h;
-    k.ma = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, h);
-    k.mb = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, h);
-    for (std::size_t i = 0; i < 2; ++i) k.rho0[i] = prewarp(rho0_[i], h);
-    return k;
-  };
+  inv_ka_ = 1.0 / p_.pe.stiffness_a_N_m;
+  inv_kb_ = 1.0 / p_.pe.stiffness_b_N_m;
+  inv_wa_ = std::sqrt(p_.pe.mass_kg * inv_ka_);
+  inv_wb_ = std::sqrt(p_.pe.mass_kg * inv_kb_);
+  ringing_sq_ = p_.integrator.substep_ringing_m * p_.integrator.substep_ringing_m;
   full_ = constants(dt_);
   sub_ = constants(dt_ / substeps_);
   lo_ = -0.5 * p_.slider.stroke_m;
@@ -63,11 +48,64 @@ void ActuatorModel::set_operating_point(ActuatorState& s, double amplitude_V, do
   s.z_ba_m = p_.breakaway.lookup(amplitude_V, frequency_Hz, direction);
 }
 
-void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
-  u_V = std::clamp(u_V, p_.drive.min_V, p_.drive.max_V);
+namespace {
+
+/// Verlet's discrete frequency is (2/h) asin(omega h / 2); pre-warping the contact stiffness by
+/// sinc^2(omega h / 2) makes the stick-phase modes (eq. 2.20-2.21 on the slider) ring at their
+/// exact frequency, which removes the phase drift of the lightly damped 1.6 kHz mode.
+double prewarp(double rho0, double slider_mass, double h) noexcept {
+  const double half = 0.5 * std::sqrt(rho0 / slider_mass) * h;
+  if (half >= 0.5)
+    return rho0;  // far from the accurate regime: no correction (and no masking
+                  // of an unstable step, omega h > 2, which must still diverge)
+  const double sinc = std::sin(half) / half;
+  return rho0 * sinc * sinc;
+}
+
+/// Corners closer than this fraction of a sub-step to a grid point are moved onto it: the shift
+/// (< 1.3e-10 s at the default step) is far below the drive's time scales and saves a split.
+constexpr double kCornerSnap = 1e-4;
+
+}  // namespace
+
+ActuatorModel::StepConstants ActuatorModel::constants(double h) const noexcept {
+  StepConstants k;
+  k.h = h;
+  k.inv_h = 1.0 / h;
+  k.ma = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_a_N_s_m, p_.pe.stiffness_a_N_m, h);
+  k.mb = ModeDiscretization::make(p_.pe.mass_kg, p_.pe.damping_b_N_s_m, p_.pe.stiffness_b_N_m, h);
+  for (std::size_t i = 0; i < 2; ++i) k.rho0[i] = prewarp(rho0_[i], p_.slider.mass_kg, h);
+  return k;
+}
+
+void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept { step(s, DriveSegment::to(u_V)); }
+
+void ActuatorModel::step(ActuatorState& s, const DriveSegment& drive) const noexcept {
+  // The path's knots: its corners, then the end (voltages clamped to the amplifier's range).
+  std::array<double, DriveSegment::kMaxCorners + 1> knot_at{}, knot_u{};
+  const int knots = std::min(drive.corners, DriveSegment::kMaxCorners) + 1;
+  double variation = 0.0, prev = s.u_V;
+  for (int j = 0; j < knots; ++j) {
+    const auto jj = static_cast<std::size_t>(j);
+    const bool last = j == knots - 1;
+    knot_at[jj] = last ? 1.0 : drive.at[jj];
+    knot_u[jj] = std::clamp(last ? drive.end_V : drive.u_V[jj], p_.drive.min_V, p_.drive.max_V);
+    if (!(knot_u[jj] == knot_u[jj])) knot_u[jj] = prev;  // NaN: hold (the caller faults on it)
+    variation += std::abs(knot_u[jj] - prev);
+    prev = knot_u[jj];
+  }
   // Sub-step only while the contact may leave the elastic phase: an abrupt drive edge, or a
   // strain that the step's predicted relative motion carries outward beyond frac * z_ba.
-  bool active = std::abs(u_V - s.u_V) > p_.integrator.substep_edge_V;
+  bool active = variation > p_.integrator.substep_edge_V;
+  if (!active) {
+    // The PE rings (an edge's 64/120 kHz transient): each mode's distance from its static
+    // equilibrium under the present forces, as an amplitude (position and velocity / omega).
+    const double ff = p_.slider.attached ? s.friction_N : 0.0;
+    const double ea = s.x1a_m - (ka_ * s.uh_m - ff) * inv_ka_;
+    const double eb = s.x1b_m - (kb_ * s.uh_m - ff) * inv_kb_;
+    const double va = s.v1a_m_s * inv_wa_, vb = s.v1b_m_s * inv_wb_;
+    active = ea * ea + va * va > ringing_sq_ || eb * eb + vb * vb > ringing_sq_;
+  }
   if (!active && p_.slider.attached) {
     const double frac = p_.integrator.substep_strain_fraction;
     const double v1 = s.v1a_m_s + s.v1b_m_s;
@@ -78,17 +116,58 @@ void ActuatorModel::step(ActuatorState& s, double u_V) const noexcept {
       active = std::abs(z_pred) > frac * zba[i] && (z_pred > 0.0) == (dx > 0.0);
     }
   }
-  // 1. Static hysteresis (eq. 2.5), once per step: equivalent voltage -> metres by the gain g.
-  const double uh = p_.pe.static_gain_m_V * pi_update(p_.hysteresis, s.pi, u_V);
-  s.u_V = u_V;
-  if (!active || substeps_ == 1) {
-    substep(s, uh, full_);
+  const int n = active ? substeps_ : 1;
+  const StepConstants& grid = n == 1 ? full_ : sub_;
+  const double g = p_.pe.static_gain_m_V;
+  if (knots == 1) {
+    // No corner: the PI once at the end (eq. 2.5), g H(U) linear over the step (first-order hold).
+    const double uh = g * pi_update(p_.hysteresis, s.pi, knot_u[0]);
+    s.u_V = knot_u[0];
+    const double uh0 = s.uh_m;
+    if (n == 1) {
+      substep(s, uh, full_);
+      return;
+    }
+    for (int k = 1; k <= n; ++k) substep(s, uh0 + (uh - uh0) * static_cast<double>(k) / n, sub_);
     return;
   }
-  // Within the step g H(U) is interpolated linearly (the first-order hold of the PE's input).
-  const double uh0 = s.uh_m;
-  for (int k = 1; k <= substeps_; ++k) {
-    substep(s, uh0 + (uh - uh0) * static_cast<double>(k) / substeps_, sub_);
+  // Corners near a grid point move onto it; the others split the sub-step that holds them.
+  const double nd = static_cast<double>(n);
+  for (int j = 0; j + 1 < knots; ++j) {
+    const auto jj = static_cast<std::size_t>(j);
+    const double grid_at = std::round(knot_at[jj] * nd) / nd;
+    if (std::abs(knot_at[jj] - grid_at) * nd < kCornerSnap) knot_at[jj] = grid_at;
+  }
+  // Walk the knots: the PI is evaluated exactly at each (a corner is where U turns, where the
+  // hysteresis branches), g H(U) is linear in time between them, and the path is cut at every
+  // grid point and every knot.
+  double a = 0.0;         // start of the next piece (fraction of the step)
+  int next_grid = 1;      // index of the next grid point
+  double knot0_at = 0.0;  // the previous knot and its g H(U)
+  double knot0_uh = s.uh_m;
+  for (int j = 0; j < knots; ++j) {
+    const auto jj = static_cast<std::size_t>(j);
+    const double knot1_at = knot_at[jj];
+    const double knot1_uh = g * pi_update(p_.hysteresis, s.pi, knot_u[jj]);
+    s.u_V = knot_u[jj];
+    while (a < knot1_at) {
+      const double grid_b = static_cast<double>(next_grid) / nd;
+      const bool on_grid = grid_b <= knot1_at;
+      const double b = on_grid ? grid_b : knot1_at;
+      const bool whole = on_grid && a == static_cast<double>(next_grid - 1) / nd;
+      const double uh = b == knot1_at
+                            ? knot1_uh
+                            : knot0_uh + (knot1_uh - knot0_uh) * (b - knot0_at) / (knot1_at - knot0_at);
+      if (whole) {
+        substep(s, uh, grid);
+      } else {
+        substep(s, uh, constants((b - a) * dt_));
+      }
+      a = b;
+      if (on_grid) ++next_grid;
+    }
+    knot0_at = knot1_at;
+    knot0_uh = knot1_uh;
   }
 }
 
@@ -174,8 +253,13 @@ Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duratio
   require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
   require(record_every >= 1, "record_every", "must be >= 1", record_every);
   wave.validate(m.params().drive);
+  require(wave.kind == WaveKind::kStep || wave.frequency_Hz * m.dt_s() <= 1.0, "frequency_Hz",
+          "the drive's period must be at least one model step (integrator.dt_s)", wave.frequency_Hz);
   ActuatorState local = state ? *state : m.initial_state();
-  m.set_operating_point(local, wave.amplitude_V, wave.frequency_Hz, wave.direction);
+  // A step has no frequency: its break-away strain is the table's quasi-static end.
+  const double f_op =
+      wave.kind == WaveKind::kStep ? m.params().breakaway.frequencies_Hz.front() : wave.frequency_Hz;
+  m.set_operating_point(local, wave.amplitude_V, f_op, wave.direction);
   const auto steps = static_cast<long>(std::llround(duration_s / m.dt_s()));
   Trajectory tr;
   const auto n_rec = static_cast<std::size_t>(steps / record_every + 2);
@@ -191,7 +275,7 @@ Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duratio
   };
   record();
   for (long k = 1; k <= steps; ++k) {
-    m.step(local, wave.value(static_cast<double>(k) * m.dt_s()));
+    m.step(local, wave.segment(static_cast<double>(k - 1) * m.dt_s(), m.dt_s()));
     if (local.diverged) {
       throw ComputationFailed("stick-slip simulation diverged (NaN/Inf) at t = " + std::to_string(local.t_s) +
                               " s; reduce integrator.dt_s or check the parameters");

@@ -4,8 +4,10 @@
 /// elasto-plastic friction (eq. 2.9-2.21) + slider (eq. 2.8), and its fixed-step integrator.
 ///
 /// Integrator (docs/model.md): each step of length h (split into integrator.substeps sub-steps
-/// while the contact is active: abrupt drive edge or a strain near z_ba)
-///  1. H(U) by the PI operators (rate independent, exact);
+/// while the contact is active: abrupt drive edge or a strain near z_ba; and cut at the drive's
+/// corners, DriveSegment)
+///  1. H(U) by the PI operators (rate independent, exact) at each corner and at the step's end,
+///     linear in time between them;
 ///  2. the PE's two modes by exact discretisation with a first-order hold on g H(U) and a
 ///     zero-order hold on the friction reaction (which is < 1e-8 of the modal forces);
 ///  3. each slider part by velocity Verlet, its strain z by advance_strain() along the relative
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "microcobot/stickslip/drive.h"
+#include "microcobot/stickslip/drive_segment.h"
 #include "microcobot/stickslip/piezo_element.h"
 #include "microcobot/stickslip/stickslip_params.h"
 
@@ -59,8 +62,12 @@ class ActuatorModel {
   /// sawtooth generator passes its configuration to the model). Real-time safe.
   void set_operating_point(ActuatorState& s, double amplitude_V, double frequency_Hz,
                            Direction direction) const noexcept;
-  /// Advances `s` by dt_s() with the drive voltage reaching `u_V` at the end of the step
-  /// (clamped to the amplifier range). Never allocates; NaN/Inf sets s.diverged.
+  /// Advances `s` by dt_s() along the drive's path over the step: linear from s.u_V through the
+  /// segment's corners to its end voltage (each clamped to the amplifier range). Never
+  /// allocates; NaN/Inf sets s.diverged.
+  void step(ActuatorState& s, const DriveSegment& drive) const noexcept;
+  /// A step whose drive is linear from s.u_V to `u_V` (a sample stream played by a DAC through
+  /// its reconstruction filter).
   void step(ActuatorState& s, double u_V) const noexcept;
   /// Slider position x2 [m]: the mass-weighted mean of its two parts (docs/model.md).
   double slider_position(const ActuatorState& s) const noexcept;
@@ -78,20 +85,27 @@ class ActuatorModel {
     ModeDiscretization ma, mb;     ///< exact PE mode matrices for h
     std::array<double, 2> rho0{};  ///< rho0 pre-warped for Verlet at h (docs/model.md)
   };
+  /// The constants of a step of length h (the grid's, and a sub-step split at a corner).
+  StepConstants constants(double h) const noexcept;
   /// One integration sub-step (PE exact, contact by Verlet + path-integrated strain).
   void substep(ActuatorState& s, double uh_m, const StepConstants& k) const noexcept;
 
   StepConstants full_, sub_;
   int substeps_ = 1;
   std::array<double, 2> c_{}, rho0_{}, rho1_{};
-  std::array<double, 2> inv_m_{};  ///< 1 / (c_i M_s), the part masses' reciprocals
-  double ka_ = 0.0, kb_ = 0.0;     ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
-  double inv_ratio_ = 1.0;         ///< 1 / (z_ba / z_ss)
+  std::array<double, 2> inv_m_{};       ///< 1 / (c_i M_s), the part masses' reciprocals
+  double ka_ = 0.0, kb_ = 0.0;          ///< K_pa phi, K_pb (1 - phi): force per metre of g H(U)
+  double inv_ratio_ = 1.0;              ///< 1 / (z_ba / z_ss)
+  double inv_wa_ = 0.0, inv_wb_ = 0.0;  ///< 1 / omega of the PE modes
+  double inv_ka_ = 0.0, inv_kb_ = 0.0;  ///< 1 / K_pa, 1 / K_pb
+  double ringing_sq_ = 0.0;             ///< integrator.substep_ringing_m squared
   double lo_ = 0.0, hi_ = 0.0;
 };
 
 /// step(params-model, state, input, ...) in the free-function form used by the platform loop.
-inline void step(const ActuatorModel& m, ActuatorState& s, double u_V) noexcept { m.step(s, u_V); }
+inline void step(const ActuatorModel& m, ActuatorState& s, const DriveSegment& drive) noexcept {
+  m.step(s, drive);
+}
 
 /// A sampled run.
 struct Trajectory {
@@ -99,8 +113,9 @@ struct Trajectory {
 };
 
 /// Runs `wave` for `duration_s` from the model's initial state (or `state`), recording every
-/// `record_every` steps. Sets the operating point from the waveform. Throws mc::ComputationFailed
-/// on divergence (never returns NaN).
+/// `record_every` steps. The model follows the exact waveform (Waveform::segment: its corners
+/// wherever they fall in time). Sets the operating point from the waveform. Throws
+/// mc::ComputationFailed on divergence (never returns NaN).
 Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every = 1,
                     ActuatorState* state = nullptr);
 

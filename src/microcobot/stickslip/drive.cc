@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 
 namespace mc::stickslip {
@@ -24,9 +26,13 @@ void Waveform::validate(const DriveParams& limits) const {
   if (kind != WaveKind::kStep) {
     require_positive(frequency_Hz, "frequency_Hz");
     if (kind == WaveKind::kSawtooth) {
-      require(edge_time_s() < 0.5 / frequency_Hz, "frequency_Hz",
-              "the slew-limited edge (amplitude / slew rate) must last less than half a period",
-              frequency_Hz);
+      // Name the quantity that is out of scale: an absurd slew rate, else the frequency.
+      const bool slow_slew = edge_time_s() >= 0.5 && slew_rate_V_s < 1e3;
+      require(edge_time_s() < 0.5 / frequency_Hz, slow_slew ? "drive.slew_rate_V_s" : "frequency_Hz",
+              fmt::format("the slew-limited edge (amplitude / slew rate = {:g} s) must last less than half "
+                          "a period ({:g} s)",
+                          edge_time_s(), 0.5 / frequency_Hz),
+              slow_slew ? slew_rate_V_s : frequency_Hz);
     }
   }
 }
@@ -53,6 +59,40 @@ double Waveform::value(double t) const noexcept {
     }
   }
   return offset_V;
+}
+
+DriveSegment Waveform::segment(double t0, double h) const noexcept {
+  const double t1 = t0 + h;
+  DriveSegment seg;
+  seg.end_V = value(t1);
+  auto corner = [&](double tc) {
+    if (tc > t0 && tc < t1) seg.add_corner((tc - t0) / h, value(tc));
+  };
+  if (amplitude_V == 0.0 || t1 <= 0.0) return seg;
+  switch (kind) {
+    case WaveKind::kStep:
+      corner(0.0);
+      corner(edge_time_s());
+      break;
+    case WaveKind::kSine: {
+      // Extrema of 1 - cos(2 pi f t) at t = n / 2f (n = 0: the start).
+      const double half = 0.5 / frequency_Hz;
+      for (double n = std::max(0.0, std::ceil(t0 / half)); n * half < t1; n += 1.0) corner(n * half);
+      break;
+    }
+    case WaveKind::kSawtooth: {
+      // Each period: its start (U at the offset) and the top of the ramp (U = offset + A), which
+      // the forward drive reaches after the slow ramp and the backward one after the edge.
+      const double period = 1.0 / frequency_Hz;
+      const double top = direction == Direction::kForward ? period - edge_time_s() : edge_time_s();
+      for (double k = std::max(0.0, std::floor(t0 / period)); k * period < t1; k += 1.0) {
+        corner(k * period);
+        corner(k * period + top);
+      }
+      break;
+    }
+  }
+  return seg;
 }
 
 Waveform make_waveform(WaveKind kind, double amplitude_V, double frequency_Hz, Direction direction,

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "microcobot/stickslip/breakaway_table.h"
+#include "microcobot/stickslip/drive_segment.h"
 
 namespace mc::stickslip {
 
@@ -42,6 +43,11 @@ struct Waveform {
   void validate(const DriveParams& limits) const;
   /// U(t) [V]. Never allocates.
   double value(double t) const noexcept;
+  /// U over [t0, t0 + h] as the model takes it: every corner inside the interval (the drive's
+  /// start at t = 0; the sawtooth's period start and the top of each edge; the step's end of
+  /// edge; the sine's extrema, where U turns and the PI hysteresis branches) and U(t0 + h).
+  /// At most DriveSegment::kMaxCorners corners: h must not exceed the period. Never allocates.
+  DriveSegment segment(double t0, double h) const noexcept;
   /// Duration of the abrupt edge [s].
   double edge_time_s() const noexcept { return amplitude_V / slew_rate_V_s; }
 };

@@ -35,7 +35,7 @@ StepSpectrumResult step_spectrum(const StickSlipParams& p, double amplitude_V, d
       r.response.x1_m.push_back(s.x1_m());
       r.response.x2_m.push_back(m.slider_position(s));
     }
-    m.step(s, w.value(static_cast<double>(k + 1) * dt - t_pre));
+    m.step(s, w.segment(static_cast<double>(k) * dt - t_pre, dt));
     if (s.diverged) throw ComputationFailed("step experiment diverged (NaN/Inf)");
   }
   const auto& x = p.slider.attached ? r.response.x2_m : r.response.x1_m;

@@ -26,7 +26,7 @@ double simulated_mean_velocity(const ActuatorModel& model, const Waveform& wave,
   long na = 0, nb = 0;
   for (long k = 1; k <= steps; ++k) {
     const double t = static_cast<double>(k) * dt;
-    model.step(s, wave.value(t));
+    model.step(s, wave.segment(t - dt, dt));
     if (s.diverged) throw ComputationFailed(fmt::format("simulation diverged at t = {:.6g} s", t));
     if (t >= t_first && t < t_first + period) {
       sum_a += model.slider_position(s);

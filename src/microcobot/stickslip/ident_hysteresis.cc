@@ -39,6 +39,13 @@ HysteresisResult identify_hysteresis(const MeasuredRecord& rec, int operators,
   }
   const auto [it_min, it_max] = std::minmax_element(u.begin(), u.end());
   const double u_min = *it_min, u_max = *it_max, range = u_max - u_min;
+  if (!std::isfinite(range)) {
+    throw InvalidInput(rec.source, 0,
+                       fmt::format("column 'u_V': the voltage range overflows (values up to {:g} V): not a "
+                                   "measured voltage",
+                                   std::max(std::abs(*std::min_element(rec.u_V.begin(), rec.u_V.end())),
+                                            std::abs(*std::max_element(rec.u_V.begin(), rec.u_V.end())))));
+  }
   if (!(range >= 1.0)) {
     throw InvalidInput(
         rec.source, 0,

@@ -99,7 +99,7 @@ MeasuredRecord measure(const ActuatorModel& model, const Waveform& wave, double 
   };
   record();
   for (long k = 1; k <= steps; ++k) {
-    model.step(st, wave.value(static_cast<double>(k) * dt - pre_trigger_s));
+    model.step(st, wave.segment(static_cast<double>(k - 1) * dt - pre_trigger_s, dt));
     if (st.diverged) {
       throw ComputationFailed(fmt::format("simulated measurement diverged at t = {:.6g} s", st.t_s));
     }

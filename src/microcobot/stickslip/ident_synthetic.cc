@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <mutex>
 #include <thread>
 
@@ -76,7 +77,7 @@ std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipPara
   }
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex mutex;
-  std::string error;
+  std::exception_ptr error;  // the first failure, rethrown with its own type (and exit code)
   auto worker = [&] {
     for (std::size_t i = next++; i < jobs.size(); i = next++) {
       try {
@@ -85,9 +86,9 @@ std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipPara
         const auto& j = jobs[i];
         const MeasuredRecord r = measure_sawtooth(model, j.a, j.f, j.d, plan, s);
         write_record(dir / r.source, r, note);
-      } catch (const std::exception& e) {
+      } catch (...) {
         const std::lock_guard<std::mutex> lock(mutex);
-        if (error.empty()) error = e.what();
+        if (!error) error = std::current_exception();
       }
       const std::size_t d = ++done;
       if (progress) {
@@ -102,7 +103,7 @@ std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipPara
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (auto& t : pool) t.join();
-  if (!error.empty()) throw ComputationFailed("synthetic campaign: " + error);
+  if (error) std::rethrow_exception(error);
   return files + jobs.size();
 }
 

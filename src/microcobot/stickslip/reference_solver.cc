@@ -86,7 +86,8 @@ Trajectory simulate_reference(const StickSlipParams& params, const Waveform& wav
   namespace ode = boost::numeric::odeint;
   PiState pi = make_pi_state(params.hysteresis, 0.0);
   BreakawayTable const& table = params.breakaway;
-  const double z_ba = table.lookup(wave.amplitude_V, wave.frequency_Hz, wave.direction);
+  const double f_op = wave.kind == WaveKind::kStep ? table.frequencies_Hz.front() : wave.frequency_Hz;
+  const double z_ba = table.lookup(wave.amplitude_V, f_op, wave.direction);
   Rhs rhs{params, wave, pi, z_ba, z_ba * params.friction.breakaway_strain_ratio_b};
   OdeState y{};
   y[4] = y[6] = params.slider.initial_position_m;
@@ -107,12 +108,21 @@ Trajectory simulate_reference(const StickSlipParams& params, const Waveform& wav
   for (long k = 1; k <= n; ++k) {
     const double t0 = static_cast<double>(k - 1) * options.sample_dt_s;
     const double t1 = static_cast<double>(k) * options.sample_dt_s;
-    ode::integrate_adaptive(stepper, rhs, y, t0, t1, h);
+    // Integrate corner to corner: U is linear, so monotone, between corners, and the PI's
+    // branches are committed where U turns (the kinks also end the adaptive steps exactly).
+    const DriveSegment seg = wave.segment(t0, t1 - t0);
+    double ta = t0;
+    for (int c = 0; c <= seg.corners; ++c) {
+      const bool last = c == seg.corners;
+      const double tb = last ? t1 : t0 + seg.at[static_cast<std::size_t>(c)] * (t1 - t0);
+      if (tb > ta) ode::integrate_adaptive(stepper, rhs, y, ta, tb, h);
+      pi_update(params.hysteresis, pi, std::clamp(wave.value(tb), params.drive.min_V, params.drive.max_V));
+      ta = tb;
+    }
     for (double v : y) {
       if (!std::isfinite(v))
         throw ComputationFailed("reference solver diverged (NaN/Inf) at t = " + std::to_string(t1));
     }
-    pi_update(params.hysteresis, pi, std::clamp(wave.value(t1), params.drive.min_V, params.drive.max_V));
     record(t1);
   }
   return tr;

@@ -15,6 +15,9 @@ void BandwidthIdentParams::validate() const {
   require_positive(fs_Hz, "fs_Hz");
   require(prbs_bits >= 4 && prbs_bits <= 24, "prbs_bits", "must be in 4..24", prbs_bits);
   require_positive(duration_s, "duration_s");
+  // The work budget, before the record is made (docs/cli.md, "Limits").
+  require_budget(duration_s * fs_Hz, kMaxRecordedSamples, "identify.duration_s",
+                 "recorded samples (duration_s x fs_Hz)");
   require_non_negative(settle_s, "settle_s");
   require(settle_s < duration_s, "settle_s", "must be shorter than duration_s", settle_s);
   require_positive(torque_amplitude_N_m, "torque_amplitude_N_m");

@@ -22,6 +22,9 @@ void VirtualCubeParams::validate() const {
   require(hold_window_s > 0 && hold_window_s < duration_s - ramp_s, "hold_window_s",
           "must be > 0 and fit after the ramp", hold_window_s);
   require_positive(chatter_rel_rms, "chatter_rel_rms");
+  // The work budget, before the run (docs/cli.md, "Limits").
+  require_budget(duration_s * plant_rate_Hz, kMaxSimulatedSteps, "cube.plant_rate_Hz",
+                 "simulated steps (duration_s x plant_rate_Hz; --rate sets plant_rate_Hz = 20 x rate)");
 }
 
 VirtualCubeRenderer::VirtualCubeRenderer(const TeleTweezParams& model, const VirtualCubeParams& cube)

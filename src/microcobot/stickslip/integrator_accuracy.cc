@@ -1,0 +1,76 @@
+#include "microcobot/stickslip/integrator_accuracy.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/rng.h"
+
+namespace mc::stickslip {
+
+namespace {
+/// A drive whose net step is below this fraction of its slider's range does not step (creep, a
+/// sine, a backward drive whose two slips nearly cancel): its step error is judged against it.
+constexpr double kStepFloorOfRange = 0.1;
+}  // namespace
+
+std::vector<AccuracyDrive> accuracy_drives(int n, std::uint64_t seed, const DriveParams& limits) {
+  require(n >= 1, "drives", "must be >= 1", n);
+  Rng rng(seed);
+  std::vector<AccuracyDrive> out;
+  out.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double pick = rng.uniform();
+    const WaveKind kind =
+        pick < 0.7 ? WaveKind::kSawtooth : (pick < 0.85 ? WaveKind::kSine : WaveKind::kStep);
+    const double amplitude = rng.uniform(10.0, std::min(100.0, limits.max_V - limits.min_V));
+    const double frequency = 20.0 * std::pow(100.0, rng.uniform());  // log-uniform 20..2000 Hz
+    const Direction direction = rng.uniform() < 0.5 ? Direction::kForward : Direction::kBackward;
+    AccuracyDrive d;
+    d.wave = make_waveform(kind, amplitude, frequency, direction, limits, limits.min_V);
+    d.duration_s = kind == WaveKind::kStep ? 5e-3 : std::clamp(3.0 / frequency, 3e-3, 60e-3);
+    out.push_back(d);
+  }
+  return out;
+}
+
+DriveAccuracy check_drive(const ActuatorModel& model, const AccuracyDrive& drive,
+                          const ReferenceOptions& options) {
+  ReferenceOptions o = options;
+  o.sample_dt_s = model.dt_s();
+  Trajectory fixed = simulate(model, drive.wave, drive.duration_s);
+  Trajectory ref = simulate_reference(model.params(), drive.wave, drive.duration_s, o);
+  const std::size_t n = std::min(fixed.x2_m.size(), ref.x2_m.size());
+  DriveAccuracy r;
+  const auto [lo, hi] = std::minmax_element(ref.x2_m.begin(), ref.x2_m.begin() + static_cast<long>(n));
+  r.range_m = *hi - *lo;
+  require(r.range_m > 0.0, "drive", "the reference slider does not move");
+  double sq = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double e = fixed.x2_m[i] - ref.x2_m[i];
+    sq += e * e;
+    r.max_error = std::max(r.max_error, std::abs(e));
+  }
+  r.rms_error = std::sqrt(sq / static_cast<double>(n)) / r.range_m;
+  r.max_error /= r.range_m;
+  // Net motion over whole periods (same phase to same phase), on the common grid.
+  std::size_t last = n - 1;
+  double periods = 1.0;
+  if (drive.wave.kind != WaveKind::kStep) {
+    const double period = 1.0 / drive.wave.frequency_Hz;
+    periods = std::floor(drive.duration_s / period + 1e-9);
+    if (periods >= 1.0)
+      last = std::min(n - 1, static_cast<std::size_t>(std::llround(periods * period / model.dt_s())));
+    else
+      periods = drive.duration_s / period;
+  }
+  r.step_m = (fixed.x2_m[last] - fixed.x2_m[0]) / periods;
+  r.step_ref_m = (ref.x2_m[last] - ref.x2_m[0]) / periods;
+  r.step_error =
+      std::abs(r.step_m - r.step_ref_m) / std::max(std::abs(r.step_ref_m), kStepFloorOfRange * r.range_m);
+  r.model = std::move(fixed);
+  r.reference = std::move(ref);
+  return r;
+}
+
+}  // namespace mc::stickslip
