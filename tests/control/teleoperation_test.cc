@@ -126,5 +126,62 @@ TEST(Teleoperation, RejectsBadParameters) {
   EXPECT_THROW(Teleoperation(TeleoperationParams{}, 0.0, {0, 0, 0}, 0), InvalidParams);
 }
 
+TeleoperationInput console_at(double vx, bool deadman = true) {
+  TeleoperationInput in;
+  in.console.active = true;
+  in.console.fresh = true;
+  in.console.deadman = deadman;
+  in.console.velocity_m_s = {vx, 0, 0};
+  in.handle_m = {0.04, 0.04};  // the haptic handle is ignored while the console holds control
+  return in;
+}
+
+TEST(Teleoperation, TheConsoleJogsTheStageAtItsVelocityCappedAndOnlyWithTheDeadman) {
+  TeleoperationParams p;
+  Teleoperation t(p, kDt, {0, 0, 0}, 600e-6);
+  for (int i = 0; i < 1000; ++i) t.tick(console_at(200e-6));  // 0.1 s at 200 um/s
+  EXPECT_NEAR(t.output().slave_target_m.x(), 20e-6, 1e-12);
+  EXPECT_NEAR(t.output().slave_velocity_m_s.x(), 200e-6, 1e-12);
+  EXPECT_DOUBLE_EQ(t.output().haptic_force_N.norm(), 0.0);
+  for (int i = 0; i < 1000; ++i) t.tick(console_at(1.0));  // 1 m/s asked: the cap holds
+  EXPECT_NEAR(t.output().slave_target_m.x(), 20e-6 + p.console_max_speed_m_s * 0.1, 1e-12);
+  const double held = t.output().slave_target_m.x();
+  for (int i = 0; i < 100; ++i) t.tick(console_at(200e-6, /*deadman=*/false));
+  EXPECT_FALSE(t.output().engaged);
+  EXPECT_DOUBLE_EQ(t.output().slave_target_m.x(), held);
+  auto stale = console_at(200e-6);
+  stale.console.fresh = false;  // the watchdog: stale commands hold the stage
+  for (int i = 0; i < 100; ++i) t.tick(stale);
+  EXPECT_TRUE(t.output().stale);
+  EXPECT_DOUBLE_EQ(t.output().slave_target_m.x(), held);
+}
+
+TEST(Teleoperation, ClickToGoMovesStraightToTheGoalAndLandsOnIt) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  auto in = console_at(0.0);
+  in.console.has_goal = true;
+  in.console.goal_m = {30e-6, 40e-6, 0};  // 50 um away
+  in.console.goal_speed_m_s = 100e-6;
+  for (int i = 0; i < 2500; ++i) {  // half way after 0.25 s
+    t.tick(in);
+  }
+  EXPECT_NEAR(t.output().slave_target_m.x(), 15e-6, 1e-10);
+  EXPECT_NEAR(t.output().slave_target_m.y(), 20e-6, 1e-10);
+  for (int i = 0; i < 3000; ++i) t.tick(in);
+  EXPECT_DOUBLE_EQ(t.output().slave_target_m.x(), 30e-6);
+  EXPECT_DOUBLE_EQ(t.output().slave_target_m.y(), 40e-6);
+  EXPECT_DOUBLE_EQ(t.output().slave_velocity_m_s.norm(), 0.0);
+}
+
+TEST(Teleoperation, HandingControlBackToTheHapticMasterNeverMovesTheSlave) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  for (int i = 0; i < 1000; ++i) t.tick(console_at(100e-6));
+  const Eigen::Vector3d at = t.output().slave_target_m;
+  auto out = t.tick(engaged_at(0.03, -0.02));  // the hand is elsewhere: re-indexed
+  EXPECT_NEAR((out.slave_target_m - at).norm(), 0.0, 1e-15);
+  out = t.tick(engaged_at(0.031, -0.02));
+  EXPECT_NEAR(out.slave_target_m.x(), at.x() + 10e-6, 1e-12);
+}
+
 }  // namespace
 }  // namespace mc::control

@@ -7,9 +7,16 @@
 namespace {
 std::atomic<std::size_t> g_allocations{0};
 std::atomic<int> g_active{0};
+std::atomic<std::thread::id> g_only{};  // count this thread's allocations only (default id: all)
+
+bool counted_thread() {
+  const std::thread::id only = g_only.load(std::memory_order_relaxed);
+  return only == std::thread::id{} || only == std::this_thread::get_id();
+}
 
 void* counted_alloc(std::size_t size, std::size_t align) {
-  if (g_active.load(std::memory_order_relaxed) > 0) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (g_active.load(std::memory_order_relaxed) > 0 && counted_thread())
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (size == 0) size = 1;
   void* p = nullptr;
   if (align > alignof(std::max_align_t)) {
@@ -66,7 +73,14 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 namespace mc::test {
 
 AllocationGuard::AllocationGuard() : start_(g_allocations.load()) { g_active.fetch_add(1); }
-AllocationGuard::~AllocationGuard() { g_active.fetch_sub(1); }
+AllocationGuard::AllocationGuard(std::thread::id thread) : start_(g_allocations.load()) {
+  g_only.store(thread);
+  g_active.fetch_add(1);
+}
+AllocationGuard::~AllocationGuard() {
+  g_active.fetch_sub(1);
+  g_only.store(std::thread::id{});
+}
 std::size_t AllocationGuard::allocations() const { return g_allocations.load() - start_; }
 
 }  // namespace mc::test

@@ -9,12 +9,15 @@
 /// @endcode
 
 #include <cstddef>
+#include <thread>
 
 namespace mc::test {
 
 class AllocationGuard {
  public:
   AllocationGuard();
+  /// Counts only the allocations made by `thread` (the loop's, while a server runs beside it).
+  explicit AllocationGuard(std::thread::id thread);
   ~AllocationGuard();
   AllocationGuard(const AllocationGuard&) = delete;
   AllocationGuard& operator=(const AllocationGuard&) = delete;

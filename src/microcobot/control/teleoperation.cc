@@ -16,6 +16,7 @@ void TeleoperationParams::validate() const {
   require_non_negative(grip_force_scale, "grip_force_scale");
   require_positive(max_grip_force_N, "max_grip_force_N");
   require_positive(max_jog_m_s, "max_jog_m_s");
+  require_positive(console_max_speed_m_s, "console_max_speed_m_s");
   require(workspace_min_m < workspace_max_m, "workspace_min_m", "must be below workspace_max_m",
           workspace_min_m);
 }
@@ -35,12 +36,52 @@ double Teleoperation::clamp_workspace(double v) const noexcept {
   return std::clamp(v, p_.workspace_min_m, p_.workspace_max_m);
 }
 
+void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
+  const ConsoleInput& c = in.console;
+  out_.engaged = c.deadman && c.fresh;
+  out_.stale = !c.fresh;
+  out_.slave_velocity_m_s.setZero();
+  out_.haptic_force_N.setZero();
+  force_filtered_N_.setZero();
+  if (out_.engaged) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    if (c.has_goal && c.goal_m.allFinite()) {
+      // Straight to the goal at the requested speed, landing on it exactly.
+      const double speed = std::clamp(c.goal_speed_m_s, 0.0, p_.console_max_speed_m_s);
+      Eigen::Vector3d goal = c.goal_m;
+      for (int i = 0; i < 3; ++i) goal[i] = clamp_workspace(goal[i]);
+      const Eigen::Vector3d d = goal - out_.slave_target_m;
+      const double n = d.norm();
+      v = n <= speed * dt_ ? Eigen::Vector3d(d / dt_) : Eigen::Vector3d(d * (speed / n));
+    } else if (c.velocity_m_s.allFinite()) {
+      v = c.velocity_m_s;
+      const double n = v.norm();
+      if (n > p_.console_max_speed_m_s) v *= p_.console_max_speed_m_s / n;
+    }
+    for (int i = 0; i < 3; ++i) {
+      const double before = out_.slave_target_m[i];
+      out_.slave_target_m[i] = clamp_workspace(before + v[i] * dt_);
+      out_.slave_velocity_m_s[i] = (out_.slave_target_m[i] - before) / dt_;
+    }
+  }
+  last_xy_m_ = out_.slave_target_m.head<2>();
+  if (c.has_gripper && std::isfinite(c.gripper_opening_m))
+    out_.gripper_opening_m = std::max(0.0, c.gripper_opening_m);
+  out_.finger_force_N = 0.0;
+  console_had_control_ = true;
+}
+
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
+  if (in.console.active) {
+    console_tick(in);
+    return out_;
+  }
   const bool engage = in.deadman && !in.clutch && in.haptic_fresh && in.handle_m.allFinite();
-  if (engage && !out_.engaged) {
+  if (engage && (!out_.engaged || console_had_control_)) {
     // Re-index: the slave target stays where it is whatever the hand position.
     offset_m_ = out_.slave_target_m.head<2>() - p_.motion_scale * in.handle_m;
   }
+  console_had_control_ = false;
   out_.engaged = engage;
   out_.stale = !in.haptic_fresh || !in.tweezers_fresh;
   out_.slave_velocity_m_s.setZero();

@@ -11,9 +11,12 @@
 ///  - gripper opening = grip_position_scale x TéléTweez tip opening (the robotic mode of §4.3.2);
 ///  - force: the haptic force = force_scale x slave contact force (XY), low-pass filtered, the
 ///    TéléTweez finger force = grip_force_scale x slave grip force, both capped;
+///  - console (issue #14): while the operator's console holds control, it replaces the haptic
+///    master: the stage target moves at the joystick's velocity or straight to a clicked goal
+///    (rate-limited), and the gripper opening is the console's; the haptic force is zero;
 ///  - safety: the coupling is engaged only while the deadman is held, the clutch released and the
-///    haptic master's readings fresh (the platform's watchdog). Disengaged, the slave targets
-///    freeze (the stage holds where it is) and the haptic force is zero; the gripper follows the
+///    haptic master's (or the console's) commands fresh (the platform's watchdog). Disengaged, the slave
+///    targets freeze (the stage holds where it is) and the haptic force is zero; the gripper follows the
 ///    TéléTweez only while its readings are fresh, and holds otherwise.
 ///
 /// tick() runs on the real-time path at the haptic rate: no allocation, lock, exception or I/O.
@@ -36,6 +39,7 @@ struct TeleoperationParams {
   /// Slave workspace in stage coordinates (the stroke of the 12 mm axes with a margin).
   double workspace_min_m = -5.5e-3;
   double workspace_max_m = 5.5e-3;
+  double console_max_speed_m_s = 1e-3;  ///< stage speed limit of the console's commands
 
   template <class V>
   void visit(V& v) {
@@ -49,8 +53,23 @@ struct TeleoperationParams {
     v("max_jog_m_s", max_jog_m_s);
     v("workspace_min_m", workspace_min_m);
     v("workspace_max_m", workspace_max_m);
+    v("console_max_speed_m_s", console_max_speed_m_s);
   }
   void validate() const;
+};
+
+/// The operator console's command (joystick/tablet teleoperation, click-to-go; issue #14), in
+/// the coupling's stage coordinates. The platform validates and clamps it before it gets here.
+struct ConsoleInput {
+  bool active = false;   ///< the console holds control: the haptic master is ignored
+  bool fresh = false;    ///< its commands are fresh (the platform's watchdog)
+  bool deadman = false;  ///< the console's deadman is held
+  Eigen::Vector3d velocity_m_s = Eigen::Vector3d::Zero();  ///< joystick stage velocity
+  bool has_goal = false;                                   ///< go to goal_m (overrides velocity)
+  Eigen::Vector3d goal_m = Eigen::Vector3d::Zero();
+  double goal_speed_m_s = 100e-6;  ///< speed of the straight move to the goal
+  double gripper_opening_m = 0.0;
+  bool has_gripper = false;  ///< false: the TéléTweez drives the gripper
 };
 
 /// What the masters and the slave report at one haptic tick.
@@ -65,6 +84,7 @@ struct TeleoperationInput {
   Eigen::Vector3d slave_position_m = Eigen::Vector3d::Zero();  ///< measured stage position
   Eigen::Vector3d contact_force_N = Eigen::Vector3d::Zero();   ///< force on the slave gripper
   double grip_force_N = 0.0;                                   ///< slave grip force
+  ConsoleInput console;                                        ///< the console, when it holds control
 };
 
 /// The coupling's commands.
@@ -91,6 +111,7 @@ class Teleoperation {
 
  private:
   double clamp_workspace(double v) const noexcept;
+  void console_tick(const TeleoperationInput& in) noexcept;
 
   TeleoperationParams p_;
   double dt_;
@@ -99,6 +120,7 @@ class Teleoperation {
   Eigen::Vector2d force_filtered_N_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
+  bool console_had_control_ = false;  // the haptic path re-indexes when it takes over
 };
 
 }  // namespace mc::control

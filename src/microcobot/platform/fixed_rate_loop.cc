@@ -50,6 +50,7 @@ void FixedRateLoop::tick_once() noexcept {
 
 void FixedRateLoop::run_for(std::uint64_t ticks) {
   stop_.store(false);
+  thread_id_.store(std::this_thread::get_id());
   for (std::uint64_t i = 0; i < ticks && !stop_requested(); ++i) {
     const double start = now_s();
     tick_once();
@@ -62,11 +63,13 @@ void FixedRateLoop::run_for(std::uint64_t ticks) {
 
 bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
   stop_.store(false);
+  thread_id_.store(std::this_thread::get_id());
   bool fifo = false;
   std::thread worker([&] {
     sched_param param{};
     param.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10;
     fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    thread_id_.store(std::this_thread::get_id());
     timespec next{};
     clock_gettime(CLOCK_MONOTONIC, &next);
     const auto period_ns = static_cast<long>(std::llround(period_ * 1e9));
@@ -81,6 +84,12 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
       const double deadline = static_cast<double>(next.tv_sec) + 1e-9 * static_cast<double>(next.tv_nsec);
       const double late = start - deadline;
       jitter_stats_.add(late);
+      if (late > kResyncPeriods * period_) {
+        // Far behind (the process was stopped, the machine overloaded): skip the missed ticks
+        // rather than run them back to back, which would starve the machine and make up nothing.
+        clock_gettime(CLOCK_MONOTONIC, &next);
+        ++resyncs_;
+      }
       tick_once();
       const double cost = now_s() - start;
       last_tick_s_ = cost;

@@ -11,12 +11,14 @@
 ///    dedicated thread, SCHED_FIFO when the process may use it, best effort otherwise.
 /// Both measure each tick's compute time; real time also measures wake-up lateness (jitter).
 /// An overrun is a tick whose compute time exceeded the period, or, in real time, a tick that
-/// started a full period late.
+/// started a full period late. A real-time loop that falls more than kResyncPeriods behind
+/// (a stopped process, an overloaded machine) skips the missed ticks instead of bursting.
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "microcobot/platform/timing_stats.h"
@@ -58,6 +60,12 @@ class FixedRateLoop {
   std::uint64_t overruns() const { return overruns_; }
   /// Compute time of the last finished tick [s] (read by a task: the previous tick's).
   double last_tick_s() const { return last_tick_s_; }
+  /// Ticks skipped to catch up with the wall clock (real time only), counted in resyncs.
+  std::uint64_t resyncs() const { return resyncs_; }
+  /// The thread that runs (or last ran) the ticks: how a test proves the loop path allocates
+  /// nothing while other threads (a server) do.
+  std::thread::id thread_id() const { return thread_id_.load(); }
+  static constexpr double kResyncPeriods = 100.0;
   /// Task names and divisors, in execution order.
   std::vector<std::pair<std::string, int>> tasks() const;
 
@@ -74,6 +82,8 @@ class FixedRateLoop {
   std::vector<Task> tasks_;
   std::uint64_t tick_ = 0;
   std::uint64_t overruns_ = 0;
+  std::uint64_t resyncs_ = 0;
+  std::atomic<std::thread::id> thread_id_{};
   double last_tick_s_ = 0.0;
   TimingStats tick_stats_;
   TimingStats jitter_stats_;

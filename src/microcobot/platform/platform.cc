@@ -150,6 +150,8 @@ void Platform::teleoperation_task() noexcept {
   const Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
   in.grip_force_N = devices_.gripper->grip_force_N();
+  in.console = console_;
+  in.console.deadman = console_.deadman && !faulted_;
   const auto& out = teleop_->tick(in);
 
   devices_.haptic->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
@@ -222,6 +224,53 @@ void Platform::drain() noexcept {
   while (ring_.pop(s)) recorder_->sample(std::span<const double>(s.data(), telemetry_channel_count()));
 }
 
+void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
+  console_ = in;
+  // World coordinates (the telemetry's) to the coupling's, which are relative to home.
+  console_.goal_m = in.goal_m - home_m_;
+}
+
+void Platform::recover() {
+  try {
+    for (Device* d : devices()) d->configure();
+    for (Device* d : devices()) d->activate();
+  } catch (...) {
+    for (Device* d : devices()) d->fault();
+    throw;
+  }
+  faulted_ = false;
+}
+
+void Platform::run_streaming(double duration_s, const TelemetrySink& sink) {
+  require(duration_s > 0.0, "duration_s", "must be > 0", duration_s);
+  run_loop(duration_s, [this, &sink] {
+    TelemetrySample s;
+    while (ring_.pop(s)) sink(s);
+  });
+}
+
+void Platform::run_loop(double duration_s, const std::function<void()>& drain_fn) {
+  const double max_ticks = 9e18;
+  const double want = duration_s * config_.loop.base_rate_Hz;
+  const auto ticks = static_cast<std::uint64_t>(std::llround(std::min(want, max_ticks)));
+  // The drain runs beside the loop: telemetry leaves the loop only through the ring.
+  std::atomic<bool> done{false};
+  std::thread drainer([&] {
+    while (!done.load(std::memory_order_acquire)) {
+      drain_fn();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  if (config_.loop.realtime) {
+    loop_.run_realtime(ticks);
+  } else {
+    loop_.run_for(ticks);
+  }
+  done.store(true, std::memory_order_release);
+  drainer.join();
+  drain_fn();
+}
+
 void Platform::run(double duration_s) {
   require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
   const auto ticks = static_cast<std::uint64_t>(std::llround(duration_s * config_.loop.base_rate_Hz));
@@ -237,22 +286,7 @@ void Platform::run(double duration_s) {
     }
     recorder_ = std::move(bigger);
   }
-  // The drain runs beside the loop: telemetry leaves the loop only through the ring.
-  std::atomic<bool> done{false};
-  std::thread drainer([&] {
-    while (!done.load(std::memory_order_acquire)) {
-      drain();
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
-  });
-  if (config_.loop.realtime) {
-    loop_.run_realtime(ticks);
-  } else {
-    loop_.run_for(ticks);
-  }
-  done.store(true, std::memory_order_release);
-  drainer.join();
-  drain();
+  run_loop(duration_s, [this] { drain(); });
 }
 
 }  // namespace mc::platform

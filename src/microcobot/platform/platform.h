@@ -127,6 +127,19 @@ class Platform {
   /// Runs for `duration_s` (as fast as possible, or paced when loop.realtime), recording the
   /// telemetry. May be called again to continue. Stops early when stop() is called.
   void run(double duration_s);
+  /// Runs like run() but hands every telemetry sample to `sink` (on a thread beside the loop,
+  /// about every millisecond) instead of recording it: the live server's way (issue #14), whose
+  /// runs have no end known in advance. `duration_s` may be infinite.
+  using TelemetrySink = std::function<void(const TelemetrySample&)>;
+  void run_streaming(double duration_s, const TelemetrySink& sink);
+
+  /// The operator console's command for the next ticks (issue #14), in world coordinates (the
+  /// telemetry's): set from the operator task, on the loop. Real-time safe.
+  void set_console_input(const control::ConsoleInput& in) noexcept;
+  /// After an e-stop (fault_all), the explicit reset: every device configured and activated
+  /// again, the stage holding where it is. Off the loop only (it may allocate): call it between
+  /// runs. Throws mc::Error when a device refuses (every device is then left in its safe state).
+  void recover();
   void stop() noexcept { loop_.request_stop(); }
 
   /// Every device to its safe state and Fault (a fault injection or an operator's e-stop).
@@ -163,6 +176,7 @@ class Platform {
   void devices_task(double dt_s) noexcept;
   void telemetry_task(double t_s) noexcept;
   void drain() noexcept;
+  void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
   std::array<Device*, 6> devices();
 
@@ -182,6 +196,7 @@ class Platform {
   SpscRing<TelemetrySample> ring_;
   std::unique_ptr<Recorder> recorder_;
   std::function<void(const TickInfo&)> operator_;
+  control::ConsoleInput console_;
   bool faulted_ = false;
 };
 

@@ -1,0 +1,100 @@
+#include "microcobot/live/console_command.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "microcobot/core/error.h"
+
+namespace mc::live {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void refuse(const char* channel, const std::string& field, const std::string& what) {
+  throw InvalidInput(std::string(channel) + ": " + field + ": " + what);
+}
+
+json parse_object(const char* channel, std::string_view text) {
+  json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded()) refuse(channel, "payload", "is not valid JSON");
+  if (!j.is_object()) refuse(channel, "payload", "must be a JSON object");
+  return j;
+}
+
+double finite(const char* channel, const json& v, const std::string& field) {
+  if (!v.is_number()) refuse(channel, field, "must be a number");
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) refuse(channel, field, "must be a finite number");
+  return x;
+}
+
+std::array<double, 3> vec3(const char* channel, const json& v, const std::string& field) {
+  if (!v.is_array() || v.size() != 3) refuse(channel, field, "must be an array of 3 numbers");
+  std::array<double, 3> out{};
+  for (std::size_t i = 0; i < 3; ++i) out[i] = finite(channel, v[i], field + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+}  // namespace
+
+ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits& limits) {
+  constexpr const char* kChannel = "/console/command";
+  const json j = parse_object(kChannel, text);
+  ConsoleCommand c;
+  for (const auto& [key, value] : j.items()) {
+    if (key == "deadman") {
+      if (!value.is_boolean()) refuse(kChannel, key, "must be true or false");
+      c.deadman = value.get<bool>();
+    } else if (key == "velocity_m_s") {
+      c.velocity_m_s = vec3(kChannel, value, key);
+    } else if (key == "goal_m") {
+      c.goal_m = vec3(kChannel, value, key);
+      c.has_goal = true;
+    } else if (key == "goal_speed_m_s") {
+      c.goal_speed_m_s = finite(kChannel, value, key);
+      if (c.goal_speed_m_s <= 0.0) refuse(kChannel, key, "must be > 0");
+    } else if (key == "gripper_opening_m") {
+      c.gripper_opening_m = finite(kChannel, value, key);
+      c.has_gripper = true;
+    } else {
+      refuse(kChannel, key,
+             "is not a known key (deadman, velocity_m_s, goal_m, goal_speed_m_s, gripper_opening_m)");
+    }
+  }
+  // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.
+  const double speed = std::hypot(c.velocity_m_s[0], c.velocity_m_s[1], c.velocity_m_s[2]);
+  if (speed > limits.max_speed_m_s)
+    for (double& v : c.velocity_m_s) v *= limits.max_speed_m_s / speed;
+  c.goal_speed_m_s = std::min(c.goal_speed_m_s, limits.max_speed_m_s);
+  for (std::size_t i = 0; i < 3; ++i) c.goal_m[i] = std::clamp(c.goal_m[i], limits.min_m[i], limits.max_m[i]);
+  c.gripper_opening_m = std::clamp(c.gripper_opening_m, 0.0, limits.max_opening_m);
+  return c;
+}
+
+ConsoleAction parse_console_action(std::string_view text) {
+  constexpr const char* kChannel = "/console/action";
+  const json j = parse_object(kChannel, text);
+  if (j.size() != 1 || !j.contains("action")) refuse(kChannel, "payload", "must be {\"action\": NAME}");
+  const json& a = j["action"];
+  if (!a.is_string()) refuse(kChannel, "action", "must be a string");
+  static constexpr std::pair<std::string_view, ConsoleAction> kNames[] = {
+      {"estop", ConsoleAction::kEstop},
+      {"reset", ConsoleAction::kReset},
+      {"take_control", ConsoleAction::kTakeControl},
+      {"release_control", ConsoleAction::kReleaseControl},
+      {"demo", ConsoleAction::kDemo},
+      {"restart", ConsoleAction::kRestart},
+      {"record_start", ConsoleAction::kRecordStart},
+      {"record_stop", ConsoleAction::kRecordStop},
+  };
+  const std::string name = a.get<std::string>();
+  for (const auto& [n, action] : kNames)
+    if (n == name) return action;
+  refuse(kChannel, "action",
+         "must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
+         "record_stop");
+}
+
+}  // namespace mc::live

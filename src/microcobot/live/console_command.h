@@ -1,0 +1,58 @@
+#pragma once
+/// @file
+/// What the operator console sends (docs/console.md, channels `/console/command` and
+/// `/console/action`), parsed, checked and clamped before it may reach the loop (issue #14):
+/// types, finite numbers, ranges; anything else is refused with a one-line message naming the
+/// field. The result is plain data, copied into the loop through a single-producer ring.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace mc::live {
+
+/// Limits every console command is clamped to (the platform's: the teleoperation's speed cap,
+/// the stage's workspace in world coordinates, the gripper's stroke).
+struct ConsoleLimits {
+  double max_speed_m_s = 1e-3;
+  std::array<double, 3> min_m = {-6e-3, -6e-3, -6e-3};
+  std::array<double, 3> max_m = {6e-3, 6e-3, 6e-3};
+  double max_opening_m = 600e-6;
+};
+
+/// The console's continuous command (sent at ~30 Hz by the client in control: also its
+/// heartbeat for the watchdog).
+struct ConsoleCommand {
+  bool deadman = false;
+  std::array<double, 3> velocity_m_s{};  ///< joystick/keyboard/gamepad stage velocity
+  bool has_goal = false;                 ///< click-to-go
+  std::array<double, 3> goal_m{};        ///< world coordinates (the telemetry's)
+  double goal_speed_m_s = 100e-6;
+  bool has_gripper = false;
+  double gripper_opening_m = 0.0;
+};
+
+/// One-shot actions of `/console/action`.
+enum class ConsoleAction {
+  kEstop,           ///< every device to its safe state, latched
+  kReset,           ///< clear a latched e-stop: devices reconfigured and activated
+  kTakeControl,     ///< this client becomes the controlling one
+  kReleaseControl,  ///< this client observes again
+  kDemo,            ///< restart the scene with the scripted operator (the pick-and-place)
+  kRestart,         ///< restart the scene, console in control
+  kRecordStart,     ///< start an MCAP recording in --out
+  kRecordStop,
+};
+
+/// Parses `{"deadman": bool, "velocity_m_s": [vx, vy, vz], "goal_m": [x, y, z] (optional),
+/// "goal_speed_m_s": v (optional), "gripper_opening_m": o (optional)}`; unknown keys are
+/// refused. Values are checked finite and clamped to `limits`. Throws mc::InvalidInput
+/// ("/console/command: velocity_m_s[1]: must be a finite number").
+ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
+
+/// Parses `{"action": "estop" | "reset" | "take_control" | "release_control" | "demo" |
+/// "restart" | "record_start" | "record_stop"}`. Throws mc::InvalidInput.
+ConsoleAction parse_console_action(std::string_view json);
+
+}  // namespace mc::live

@@ -1,0 +1,174 @@
+#include "microcobot/live/live_platform.h"
+
+#include <cmath>
+#include <limits>
+
+#include "microcobot/core/error.h"
+
+namespace mc::live {
+
+using platform::Lifecycle;
+using platform::PickPlaceOperator;
+using platform::Platform;
+
+void LiveParams::validate() const {
+  platform.validate();
+  demo.validate();
+  require(std::isfinite(command_timeout_s) && command_timeout_s >= 0.01 && command_timeout_s <= 10.0,
+          "command_timeout_s", "must be within [0.01, 10] s", command_timeout_s);
+}
+
+LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
+  params_.platform.loop.realtime = params_.paced;
+  params_.validate();
+  build(/*demo=*/false);
+  const auto& tp = params_.platform.teleop;
+  limits_.max_speed_m_s = tp.console_max_speed_m_s;
+  const double home[3] = {params_.platform.stage.home_x_m, params_.platform.stage.home_y_m,
+                          params_.platform.stage.home_z_m};
+  for (std::size_t i = 0; i < 3; ++i) {
+    limits_.min_m[i] = home[i] + tp.workspace_min_m;
+    limits_.max_m[i] = home[i] + tp.workspace_max_m;
+  }
+  limits_.max_opening_m = params_.platform.world.gripper.max_opening_m;
+}
+
+LivePlatform::~LivePlatform() { stop(); }
+
+void LivePlatform::build(bool demo) {
+  // A new scene: the old platform's devices are deactivated (safe state) by its destructor.
+  demo_.reset();
+  platform_.reset();
+  auto p = std::make_unique<Platform>(params_.platform);
+  std::unique_ptr<PickPlaceOperator> op;
+  if (demo) op = std::make_unique<PickPlaceOperator>(*p, params_.demo);
+  p->set_operator([this](const platform::TickInfo& t) { operator_tick(t); });
+  channel_count_ = p->telemetry_channel_count();
+  platform_ = std::move(p);
+  demo_ = std::move(op);
+  demo_running_.store(demo);
+  latest_ = ConsoleCommand{};
+  last_command_t_ = -1e9;
+}
+
+bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return commands_.push(c); }
+
+void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
+  Platform& p = *platform_;
+  if (estop_.exchange(false) && !p.faulted()) p.fault_all();
+  if (interrupt_.load(std::memory_order_acquire)) p.stop();
+
+  ConsoleCommand c;
+  bool got = false;
+  while (commands_.pop(c)) got = true;
+  if (got) {
+    latest_ = c;
+    last_command_t_ = t.t_s;
+  }
+  const bool fresh =
+      in_control_.load(std::memory_order_relaxed) && t.t_s - last_command_t_ <= params_.command_timeout_s;
+  control::ConsoleInput in;
+  if (demo_) {
+    demo_->act(t);  // the scripted operator drives the simulated masters' hands
+  } else {
+    in.active = true;
+    in.fresh = fresh;
+    in.deadman = latest_.deadman;
+    in.velocity_m_s = {latest_.velocity_m_s[0], latest_.velocity_m_s[1], latest_.velocity_m_s[2]};
+    in.has_goal = latest_.has_goal;
+    in.goal_m = {latest_.goal_m[0], latest_.goal_m[1], latest_.goal_m[2]};
+    in.goal_speed_m_s = latest_.goal_speed_m_s;
+    in.has_gripper = latest_.has_gripper;
+    in.gripper_opening_m = latest_.gripper_opening_m;
+  }
+  p.set_console_input(in);
+
+  t_s_.store(t_offset_s_ + t.t_s, std::memory_order_relaxed);
+  estopped_.store(p.faulted(), std::memory_order_relaxed);
+  fresh_.store(fresh, std::memory_order_relaxed);
+  demo_phase_.store(demo_ ? static_cast<int>(demo_->phase()) : 0, std::memory_order_relaxed);
+  for (int i = 0; i < 3; ++i)
+    lifecycle_[i].store(static_cast<int>(p.axis(i).state()), std::memory_order_relaxed);
+  lifecycle_[3].store(static_cast<int>(p.gripper().state()), std::memory_order_relaxed);
+  lifecycle_[4].store(static_cast<int>(p.haptic().state()), std::memory_order_relaxed);
+  lifecycle_[5].store(static_cast<int>(p.tweezers().state()), std::memory_order_relaxed);
+  overruns_.store(p.loop().overruns(), std::memory_order_relaxed);
+}
+
+void LivePlatform::start(Sink sink) {
+  if (started_.exchange(true)) throw InvalidInput("live platform: already started");
+  sink_ = std::move(sink);
+  thread_ = std::thread([this] { control_thread(); });
+}
+
+void LivePlatform::control_thread() {
+  const double forever = std::numeric_limits<double>::infinity();
+  while (!quit_.load()) {
+    const double offset = t_offset_s_;
+    const std::size_t channels = channel_count_;
+    platform_->run_streaming(forever, [this, offset, channels](const platform::TelemetrySample& s) {
+      platform::TelemetrySample shifted = s;
+      shifted[0] += offset;
+      sink_(shifted, channels);
+    });
+    if (quit_.load()) break;
+    int action = -1;
+    {
+      std::lock_guard lock(request_mutex_);
+      action = pending_;
+      pending_ = -1;
+      interrupt_.store(false, std::memory_order_release);
+    }
+    try {
+      if (action == static_cast<int>(ConsoleAction::kReset)) {
+        platform_->recover();
+      } else if (action == static_cast<int>(ConsoleAction::kDemo) ||
+                 action == static_cast<int>(ConsoleAction::kRestart)) {
+        t_offset_s_ += platform_->loop().time_s();
+        build(action == static_cast<int>(ConsoleAction::kDemo));
+        restarts_.fetch_add(1);
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(request_mutex_);
+      last_error_ = e.what();
+      if (platform_ && !platform_->faulted()) platform_->fault_all();
+    }
+  }
+}
+
+void LivePlatform::request(ConsoleAction action) {
+  if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo && action != ConsoleAction::kRestart)
+    return;
+  std::lock_guard lock(request_mutex_);
+  pending_ = static_cast<int>(action);
+  last_error_.clear();
+  interrupt_.store(true, std::memory_order_release);
+}
+
+void LivePlatform::stop() {
+  if (!started_.load() || !thread_.joinable()) return;
+  quit_.store(true);
+  interrupt_.store(true, std::memory_order_release);
+  thread_.join();
+  // Safe state now; the devices are deactivated when the platform goes.
+  platform_->fault_all();
+  estopped_.store(true);
+}
+
+LiveStatus LivePlatform::status() const {
+  LiveStatus s;
+  s.t_s = t_s_.load(std::memory_order_relaxed);
+  s.estopped = estopped_.load(std::memory_order_relaxed);
+  s.demo = demo_running_.load(std::memory_order_relaxed);
+  if (s.demo)
+    s.demo_phase = PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_phase_.load()));
+  s.console_fresh = fresh_.load(std::memory_order_relaxed);
+  for (std::size_t i = 0; i < 6; ++i) s.lifecycle[i] = static_cast<Lifecycle>(lifecycle_[i].load());
+  s.overruns = overruns_.load(std::memory_order_relaxed);
+  s.restarts = restarts_.load(std::memory_order_relaxed);
+  std::lock_guard lock(request_mutex_);
+  s.last_error = last_error_;
+  return s;
+}
+
+}  // namespace mc::live

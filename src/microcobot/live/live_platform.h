@@ -1,0 +1,119 @@
+#pragma once
+/// @file
+/// The platform run live (issue #14, `microcobot serve`): its loop paced to the wall clock in
+/// its real-time thread, for as long as the server runs, operated by the console.
+///
+///   server thread  --ConsoleCommand--> SPSC ring --> operator task (loop, 1 kHz) --> coupling
+///   any thread     --estop()--> atomic flag ------> operator task: fault_all() at once
+///   any thread     --request(reset|demo|restart)--> control thread, between two loop runs
+///   loop           --telemetry--> ring --> drain thread --> sink (server, recording)
+///
+/// The console's commands are its heartbeat: when the controlling client's last command is
+/// older than `command_timeout_s` (or nobody holds control) the coupling sees stale commands
+/// and the stage holds (the platform's watchdog). The e-stop latches until an explicit reset:
+/// devices reconfigured and re-activated off the loop (like ros2_control's lifecycle
+/// transitions, which never run inside update()). "demo" and "restart" rebuild the scene
+/// (about a second: the step map) with the scripted pick-and-place operator or the console in
+/// control. Nothing on the loop path allocates, locks, throws or does I/O.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "microcobot/live/console_command.h"
+#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/platform/platform.h"
+#include "microcobot/platform/spsc_ring.h"
+
+namespace mc::live {
+
+struct LiveParams {
+  platform::PlatformConfig platform;  ///< loop.realtime is forced on
+  platform::PickPlaceOperatorParams demo;
+  double command_timeout_s = 0.2;  ///< the console's commands go stale after this long
+  bool paced = true;               ///< false: as fast as possible (tests that need no wall clock)
+  void validate() const;
+};
+
+/// What the loop reports, readable from any thread.
+struct LiveStatus {
+  double t_s = 0.0;  ///< live time since serve started (continues across scene restarts)
+  bool estopped = false;
+  bool demo = false;                               ///< the scripted operator is driving
+  std::string demo_phase;                          ///< its phase (empty unless demo)
+  bool console_fresh = false;                      ///< the controlling client's commands are fresh
+  std::array<platform::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
+  std::uint64_t overruns = 0;
+  std::uint64_t restarts = 0;
+  std::string last_error;  ///< the last failed request (reset refused, rebuild failed)
+};
+
+class LivePlatform {
+ public:
+  using Sink = std::function<void(const platform::TelemetrySample&, std::size_t channel_count)>;
+  /// Validates and builds the platform (about a second). Throws mc::Error.
+  explicit LivePlatform(LiveParams params);
+  ~LivePlatform();
+  LivePlatform(const LivePlatform&) = delete;
+  LivePlatform& operator=(const LivePlatform&) = delete;
+
+  /// Starts the control thread, which runs the loop; telemetry samples reach `sink` on the
+  /// drain thread (keep it quick). Times are shifted to live time.
+  void start(Sink sink);
+  /// Every device to its safe state, the loop stopped, the threads joined. Idempotent.
+  void stop();
+
+  /// The controlling client's command (one producer thread: the server's). Wait-free.
+  bool push_command(const ConsoleCommand& c) noexcept;
+  /// Whether a client holds control (its commands count; otherwise the stage holds).
+  void set_console_in_control(bool in_control) noexcept { in_control_.store(in_control); }
+  /// Latches the e-stop at the next operator tick (at most 1 ms). Any thread, async-signal-safe.
+  void estop() noexcept { estop_.store(true); }
+  /// Reset, demo or restart, done by the control thread between two loop runs; other actions
+  /// are the server's business and ignored here.
+  void request(ConsoleAction action);
+
+  LiveStatus status() const;
+  /// The loop's thread (tests prove it never allocates while the server runs). Started only.
+  std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
+  const ConsoleLimits& limits() const { return limits_; }
+  std::size_t channel_count() const { return channel_count_; }
+
+ private:
+  void build(bool demo);
+  void operator_tick(const platform::TickInfo& t) noexcept;
+  void control_thread();
+
+  LiveParams params_;
+  ConsoleLimits limits_;
+  std::size_t channel_count_ = 0;
+  std::unique_ptr<platform::Platform> platform_;
+  std::unique_ptr<platform::PickPlaceOperator> demo_;
+  platform::SpscRing<ConsoleCommand> commands_{256};
+  ConsoleCommand latest_;  // loop thread only
+  double last_command_t_ = -1e9;
+  double t_offset_s_ = 0.0;
+
+  std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false}, in_control_{false};
+  std::atomic<bool> started_{false};
+  Sink sink_;
+  std::thread thread_;
+
+  // Status written by the loop (atomics) and by the control thread (under status_mutex_, never
+  // taken by the loop).
+  std::atomic<double> t_s_{0.0};
+  std::atomic<bool> estopped_{false}, fresh_{false}, demo_running_{false};
+  std::atomic<int> demo_phase_{0};
+  std::array<std::atomic<int>, 6> lifecycle_{};
+  std::atomic<std::uint64_t> overruns_{0}, restarts_{0};
+  mutable std::mutex request_mutex_;  // control thread and requesters; never the loop
+  int pending_ = -1;                  // a ConsoleAction, or -1
+  std::string last_error_;
+};
+
+}  // namespace mc::live

@@ -1,0 +1,67 @@
+#include "microcobot/live/console_command.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "microcobot/core/error.h"
+
+namespace mc::live {
+namespace {
+
+std::string message_of(const std::string& json) {
+  try {
+    parse_console_command(json, ConsoleLimits{});
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+TEST(ConsoleCommand, ParsesTheOperatorsCommandAndClampsItToThePlatformsLimits) {
+  ConsoleLimits limits;
+  limits.max_speed_m_s = 1e-3;
+  const auto c = parse_console_command(
+      R"({"deadman": true, "velocity_m_s": [3e-3, 4e-3, 0], "goal_m": [1, -2e-3, 0.5e-3],)"
+      R"( "goal_speed_m_s": 5, "gripper_opening_m": 1e-3})",
+      limits);
+  EXPECT_TRUE(c.deadman);
+  EXPECT_NEAR(c.velocity_m_s[0], 0.6e-3, 1e-15);  // 5 mm/s asked, 1 mm/s given, same direction
+  EXPECT_NEAR(c.velocity_m_s[1], 0.8e-3, 1e-15);
+  EXPECT_TRUE(c.has_goal);
+  EXPECT_DOUBLE_EQ(c.goal_m[0], limits.max_m[0]);
+  EXPECT_DOUBLE_EQ(c.goal_m[1], -2e-3);
+  EXPECT_DOUBLE_EQ(c.goal_speed_m_s, 1e-3);
+  EXPECT_TRUE(c.has_gripper);
+  EXPECT_DOUBLE_EQ(c.gripper_opening_m, limits.max_opening_m);
+  const auto idle = parse_console_command("{}", limits);
+  EXPECT_FALSE(idle.deadman);
+  EXPECT_FALSE(idle.has_goal);
+  EXPECT_FALSE(idle.has_gripper);
+}
+
+TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
+  EXPECT_EQ(message_of("not json"), "/console/command: payload: is not valid JSON");
+  EXPECT_EQ(message_of("[1,2]"), "/console/command: payload: must be a JSON object");
+  EXPECT_EQ(message_of(R"({"deadman": 1})"), "/console/command: deadman: must be true or false");
+  EXPECT_EQ(message_of(R"({"velocity_m_s": [0, "a", 0]})"),
+            "/console/command: velocity_m_s[1]: must be a number");
+  EXPECT_EQ(message_of(R"({"velocity_m_s": [0, 0]})"),
+            "/console/command: velocity_m_s: must be an array of 3 numbers");
+  EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e999]})"), "/console/command: payload: is not valid JSON");
+  EXPECT_EQ(message_of(R"({"goal_speed_m_s": -1})"), "/console/command: goal_speed_m_s: must be > 0");
+  EXPECT_NE(message_of(R"({"fly": true})").find("fly: is not a known key"), std::string::npos);
+  EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e308]})"), "accepted");  // finite: clamped to the workspace
+}
+
+TEST(ConsoleCommand, ParsesActionsAndRefusesUnknownOnes) {
+  EXPECT_EQ(parse_console_action(R"({"action": "estop"})"), ConsoleAction::kEstop);
+  EXPECT_EQ(parse_console_action(R"({"action": "reset"})"), ConsoleAction::kReset);
+  EXPECT_EQ(parse_console_action(R"({"action": "demo"})"), ConsoleAction::kDemo);
+  EXPECT_THROW(parse_console_action(R"({"action": "self_destruct"})"), InvalidInput);
+  EXPECT_THROW(parse_console_action(R"({"action": 3})"), InvalidInput);
+  EXPECT_THROW(parse_console_action(R"({"action": "estop", "x": 1})"), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mc::live
