@@ -1,26 +1,36 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses of the input parsers (CSV reader, YAML parameter parser,
-# platform configuration parser) with clang (preset `fuzz`) and runs each for SECONDS.
-# Usage: scripts/fuzz.sh [SECONDS]   (default 30; `make fuzz` runs 600)
+# platform configuration parser, console commands) with clang (preset `fuzz`) and runs each.
+# Usage: scripts/fuzz.sh [SECONDS]     explore for SECONDS each (default 30; `make fuzz`: 600),
+#                                      new inputs kept in build/fuzz/corpus-*
+#        scripts/fuzz.sh --runs N      the test suite's run (ctest fuzz_parsers): N inputs each
+#                                      from a fixed seed and the committed corpus only, so the
+#                                      same build gives the same verdict on every machine
 # Exit 0 when no harness found a crash; 77 (skipped) when clang or libFuzzer is missing;
 # 1 with the crashing input kept under build/fuzz/findings/ otherwise (make it a regression
 # test: tests/cli/hardening_test.cc or tests/core).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds="${1:-30}"
+limit=(-max_total_time="${1:-30}")
+fresh=""
+if [[ "${1:-}" == --runs ]]; then
+  limit=(-runs="${2:?--runs needs a count}" -seed=1)
+  fresh=$(mktemp -d)
+  trap 'rm -rf "$fresh"' EXIT
+fi
 if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
   echo "fuzz: skipped (clang++ and libclang-rt-14-dev are needed: scripts/install-deps.sh)" >&2
   exit 77
 fi
 cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config -j "${JOBS:-2}" >/dev/null
+cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console -j "${JOBS:-2}" >/dev/null
 status=0
-for h in csv params config; do
-  work="build/fuzz/corpus-$h"   # new inputs go here; the seed corpus stays untouched
+for h in csv params config console; do
+  work="${fresh:-build/fuzz}/corpus-$h"   # new inputs go here; the seed corpus stays untouched
   mkdir -p "$work" build/fuzz/findings
-  echo "fuzz: $h for ${seconds} s" >&2
+  echo "fuzz: $h (${limit[*]})" >&2
   if ! ASAN_OPTIONS=detect_leaks=1 build/fuzz/tests/fuzz/fuzz_$h "$work" "tests/fuzz/corpus/$h" \
-      -max_total_time="$seconds" -max_len=4096 -rss_limit_mb=2048 -timeout=10 \
+      "${limit[@]}" -max_len=4096 -rss_limit_mb=2048 -timeout=10 \
       -artifact_prefix="build/fuzz/findings/$h-" -print_final_stats=1 >"build/fuzz/$h.log" 2>&1; then
     echo "fuzz: $h FAILED, see build/fuzz/$h.log and build/fuzz/findings/" >&2
     tail -30 "build/fuzz/$h.log" >&2

@@ -95,8 +95,7 @@ void StickSlipParams::validate_step(double dt_s) const {
   }
 }
 
-void StickSlipParams::check_physical_bounds(double x1_m, double x2_m, double t_s,
-                                            const std::string& where) const {
+StickSlipParams::PhysicalBounds StickSlipParams::physical_bounds() const {
   // max |H(U)| over the amplifier's range: the PI operator's output for a monotone ramp to
   // the extreme voltage (the largest the hysteresis can reach from rest).
   auto reach = [&](double u_end) {
@@ -106,7 +105,12 @@ void StickSlipParams::check_physical_bounds(double x1_m, double x2_m, double t_s
     return out;
   };
   const double h_max = std::max(reach(drive.max_V), reach(drive.min_V));
-  const double x1_bound = 3.0 * std::abs(pe.static_gain_m_V) * std::max(h_max, 1.0);
+  return {3.0 * std::abs(pe.static_gain_m_V) * std::max(h_max, 1.0), 0.5 * slider.stroke_m * 1.02};
+}
+
+void StickSlipParams::check_physical_bounds(const PhysicalBounds& bounds, double x1_m, double x2_m, double t_s,
+                                            const std::string& where) const {
+  const double x1_bound = bounds.x1_m;
   if (!std::isfinite(x1_m) || std::abs(x1_m) > x1_bound) {
     throw ComputationFailed(
         fmt::format("{}: the PE displacement {:.3g} m at t = {:g} s exceeds its physical "
@@ -114,7 +118,7 @@ void StickSlipParams::check_physical_bounds(double x1_m, double x2_m, double t_s
                     "reduce integrator.dt_s or check the contact parameters",
                     where, x1_m, t_s, x1_bound));
   }
-  const double x2_bound = 0.5 * slider.stroke_m * 1.02;
+  const double x2_bound = bounds.x2_m;
   if (!std::isfinite(x2_m) || std::abs(x2_m) > x2_bound) {
     throw ComputationFailed(
         fmt::format("{}: the slider position {:.3g} m at t = {:g} s is beyond its end stops "

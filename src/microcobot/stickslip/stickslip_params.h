@@ -96,11 +96,18 @@ struct StickSlipParams {
   /// is exactly when the actuator does not sub-step (it sub-steps only near break-away).
   void validate_step(double dt_s) const;
 
-  /// Throws ComputationFailed when a simulated state is physically impossible: the PE's
-  /// displacement beyond 3 g max|H(U)| (the stroke the drive can produce, with the ringing's
-  /// overshoot and the contact's push as margin) or the slider beyond its end stops by more
-  /// than 1 % of the stroke. `where` names the computation in the message.
-  void check_physical_bounds(double x1_m, double x2_m, double t_s, const std::string& where) const;
+  /// The physically possible states: the PE's displacement within 3 g max|H(U)| (the stroke
+  /// the drive can produce, with the ringing's overshoot and the contact's push as margin), the
+  /// slider within its end stops plus 1 % of the stroke. Computed once per run (it runs the PI).
+  struct PhysicalBounds {
+    double x1_m;
+    double x2_m;
+  };
+  PhysicalBounds physical_bounds() const;
+  /// Throws ComputationFailed when a simulated state lies outside `bounds` (physical_bounds()).
+  /// `where` names the computation in the message.
+  void check_physical_bounds(const PhysicalBounds& bounds, double x1_m, double x2_m, double t_s,
+                             const std::string& where) const;
 };
 
 }  // namespace mc::stickslip
