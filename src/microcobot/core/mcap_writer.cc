@@ -70,7 +70,7 @@ McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_byte
     throw InvalidInput(path_.string(), 0, "cannot write (directory missing or not writable)");
   }
   out_.reserve(kIoBuffer);
-  chunk_.reserve(std::min(chunk_target_ + 4096, std::size_t{64} << 20));
+  chunk_.reserve(std::min(chunk_target_, std::size_t{64} << 20) + 4096);
   put(kMcapMagic);
   scratch_.clear();
   put_str(scratch_, "");            // profile
