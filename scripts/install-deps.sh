@@ -38,8 +38,10 @@ if ((${#missing[@]})); then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# npm packages pinned by package-lock.json (uPlot for reports, playwright-core for the browser test).
-if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || package-lock.json -nt node_modules/.package-lock.json ]]; then
+# npm packages pinned by package-lock.json (uPlot for reports, playwright-core for the browser test,
+# @mcap/core for the MCAP test).
+if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || ! -d node_modules/@mcap/core ||
+      package-lock.json -nt node_modules/.package-lock.json ]]; then
   echo "install-deps: npm ci" >&2
   npm ci --no-audit --no-fund --loglevel=error >/dev/null
 fi

@@ -62,6 +62,7 @@ void run(const RunOptions& o) {
   summary["scenario"] = o.scenario;
   summary["report"] = (dir / "index.html").string();
   summary["recording"] = (dir / "recording.csv").string();
+  summary["recording_mcap"] = (dir / "recording.mcap").string();
   mc::cli::emit(o.common, summary,
                 fmt::format("{}: {} (placement error {:.2f} um, {:.1f} s simulated in {:.1f} s, {} ticks, "
                             "tick mean {:.1f} us, p99 {:.1f} us, {} overruns)\nsession report: {}",

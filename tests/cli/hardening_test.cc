@@ -346,6 +346,7 @@ TEST(Hardening, AnInterruptedRunKeepsAMarkedRecording) {
   EXPECT_THAT(err, HasSubstr("SIGTERM"));
   ASSERT_TRUE(fs::exists(d / "s" / "recording.csv"));
   EXPECT_TRUE(fs::exists(d / "s" / "index.html"));
+  EXPECT_TRUE(fs::exists(d / "s" / "recording.mcap"));
   const auto rec = test::read_text(d / "s" / "recording.csv");
   EXPECT_THAT(rec.substr(0, 200), HasSubstr("# interrupted at t = "));
 }

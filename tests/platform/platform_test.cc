@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/mcap_reader.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/session.h"
 #include "support/counting_allocator.h"
@@ -129,6 +130,9 @@ TEST(Session, AShortPickAndPlaceSucceedsAndWritesItsReport) {
   s.write(dir.path(), r);
   EXPECT_TRUE(std::filesystem::exists(dir / "index.html"));
   EXPECT_TRUE(std::filesystem::exists(dir / "recording.csv"));
+  const auto mcap = read_mcap(dir / "recording.mcap");  // the same samples, checked strictly
+  EXPECT_EQ(mcap.messages.size(), s.platform().recording().size());
+  EXPECT_EQ(mcap.statistics.message_count, s.platform().recording().size());
   const auto j = r.to_json();
   for (const char* k : {"success", "placement_error_m", "ticks", "overruns", "tick_p99_us"})
     EXPECT_TRUE(j.contains(k));

@@ -8,6 +8,7 @@
 
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/platform/telemetry_json.h"
 
 namespace mc::platform {
 namespace {
@@ -262,6 +263,7 @@ void Session::write(const std::filesystem::path& dir, const SessionResult& resul
   std::vector<std::string> comment;
   if (result.interrupted) comment.push_back(result.verdict);
   write_csv(dir / "recording.csv", platform_->recording().to_table(), comment);
+  write_telemetry_mcap(platform_->recording(), dir / "recording.mcap");
   report(result).write(dir);
 }
 

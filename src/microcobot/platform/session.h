@@ -68,7 +68,8 @@ class Session {
   SessionResult run(const std::function<void(double)>& progress = {}, const std::function<bool()>& stop = {});
   /// The session report: trajectories, forces, gripper, loop timing, phases.
   report::Report report(const SessionResult& result) const;
-  /// Writes recording.csv and the report (index.html + figure CSVs) into `dir`. An
+  /// Writes recording.csv, recording.mcap (the same samples as JSON messages on
+  /// /platform/telemetry, telemetry_json.h) and the report (index.html + figure CSVs) into `dir`. An
   /// interrupted session's recording starts with the comment line "# interrupted at ...".
   void write(const std::filesystem::path& dir, const SessionResult& result) const;
 

@@ -1,0 +1,349 @@
+#include "microcobot/core/mcap_writer.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "microcobot/core/error.h"
+
+namespace mc {
+
+namespace {
+
+// zlib's crc32 would do, but zlib is not among the project's dependencies; a byte-wise table
+// (1 KiB, built once) runs at several hundred MB/s, far more than a recording needs.
+constexpr std::array<std::uint32_t, 256> make_crc_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t n = 0; n < 256; ++n) {
+    std::uint32_t c = n;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[n] = c;
+  }
+  return t;
+}
+constexpr auto kCrcTable = make_crc_table();
+
+// Little-endian fields (spec, "Serialization").
+void put_u8(std::string& s, std::uint8_t v) { s.push_back(static_cast<char>(v)); }
+void put_u16(std::string& s, std::uint16_t v) {
+  for (int i = 0; i < 2; ++i) s.push_back(static_cast<char>((v >> (8 * i)) & 0xFFu));
+}
+void put_u32(std::string& s, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) s.push_back(static_cast<char>((v >> (8 * i)) & 0xFFu));
+}
+void put_u64(std::string& s, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) s.push_back(static_cast<char>((v >> (8 * i)) & 0xFFu));
+}
+// String and Bytes: uint32 length prefix, then the bytes.
+void put_str(std::string& s, std::string_view v) {
+  put_u32(s, static_cast<std::uint32_t>(v.size()));
+  s.append(v);
+}
+
+constexpr std::size_t kRecordPrefix = 1 + 8;           // opcode, content length
+constexpr std::size_t kMessagePrefix = 2 + 4 + 8 + 8;  // channel, sequence, log and publish time
+constexpr std::size_t kIoBuffer = std::size_t{1} << 20;
+
+}  // namespace
+
+std::uint32_t crc32(std::string_view bytes, std::uint32_t previous) {
+  std::uint32_t c = previous ^ 0xFFFFFFFFu;
+  for (const char ch : bytes) c = kCrcTable[(c ^ static_cast<std::uint8_t>(ch)) & 0xFFu] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes)
+    : path_(std::move(path)), chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)) {
+  const std::filesystem::path dir = path_.has_parent_path() ? path_.parent_path() : ".";
+  tmp_path_ = (dir / ("." + path_.filename().string() + ".XXXXXX")).string();
+  fd_ = ::mkstemp(tmp_path_.data());
+  if (fd_ < 0) {
+    throw InvalidInput(path_.string(), 0, "cannot write (directory missing or not writable)");
+  }
+  out_.reserve(kIoBuffer);
+  chunk_.reserve(std::min(chunk_target_, std::size_t{64} << 20) + 4096);
+  put(kMcapMagic);
+  scratch_.clear();
+  put_str(scratch_, "");            // profile
+  put_str(scratch_, "microcobot");  // library
+  put_record(McapOpcode::kHeader, scratch_);
+}
+
+McapWriter::~McapWriter() {
+  if (!closed_) discard();
+}
+
+void McapWriter::discard() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!tmp_path_.empty()) ::unlink(tmp_path_.c_str());
+  tmp_path_.clear();
+  closed_ = true;
+}
+
+void McapWriter::fail(const std::string& what) {
+  discard();
+  throw InvalidInput(path_.string(), 0, what);
+}
+
+void McapWriter::flush_buffer() {
+  std::size_t done = 0;
+  while (done < out_.size()) {
+    const ssize_t n = ::write(fd_, out_.data() + done, out_.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail("write failed (disk full or not writable)");
+    done += static_cast<std::size_t>(n);
+  }
+  flushed_ += out_.size();
+  out_.clear();
+}
+
+void McapWriter::put(std::string_view bytes) {
+  if (in_data_) data_crc_ = crc32(bytes, data_crc_);
+  if (out_.size() + bytes.size() > kIoBuffer) flush_buffer();
+  out_.append(bytes);
+  if (out_.size() >= kIoBuffer) flush_buffer();
+}
+
+void McapWriter::put_record(McapOpcode op, std::string_view content) {
+  std::string prefix;
+  prefix.reserve(kRecordPrefix);
+  put_u8(prefix, static_cast<std::uint8_t>(op));
+  put_u64(prefix, content.size());
+  put(prefix);
+  put(content);
+}
+
+std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding,
+                                     std::string_view data) {
+  if (closed_) throw InvalidInput(path_.string(), 0, "add_schema after close");
+  if (schemas_.size() >= 0xFFFFu) throw InvalidInput(path_.string(), 0, "too many schemas (65535 at most)");
+  const auto id = static_cast<std::uint16_t>(schemas_.size() + 1);
+  std::string rec;
+  put_u16(rec, id);
+  put_str(rec, name);
+  put_str(rec, encoding);
+  put_str(rec, data);
+  put_record(McapOpcode::kSchema, rec);
+  schemas_.push_back(std::move(rec));
+  return id;
+}
+
+std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, std::string_view topic,
+                                      std::string_view message_encoding,
+                                      const std::vector<std::pair<std::string, std::string>>& metadata) {
+  if (closed_) throw InvalidInput(path_.string(), 0, "add_channel after close");
+  if (schema_id > schemas_.size()) {
+    throw InvalidInput(
+        path_.string(), 0,
+        fmt::format("channel '{}': unknown schema id {} ({} schemas)", topic, schema_id, schemas_.size()));
+  }
+  if (channels_.size() >= 0xFFFFu) throw InvalidInput(path_.string(), 0, "too many channels (65535 at most)");
+  const auto id = static_cast<std::uint16_t>(channels_.size() + 1);
+  ChannelState ch;
+  put_u16(ch.record, id);
+  put_u16(ch.record, schema_id);
+  put_str(ch.record, topic);
+  put_str(ch.record, message_encoding);
+  std::string map;
+  for (const auto& [k, v] : metadata) {
+    put_str(map, k);
+    put_str(map, v);
+  }
+  put_str(ch.record, map);  // Map<string,string>: uint32 byte length, then the pairs
+  put_record(McapOpcode::kChannel, ch.record);
+  channels_.push_back(std::move(ch));
+  return id;
+}
+
+void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
+                       std::span<const std::byte> payload) {
+  write(channel_id, log_time_ns, publish_time_ns,
+        std::string_view(reinterpret_cast<const char*>(payload.data()), payload.size()));
+}
+
+void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
+                       std::string_view payload) {
+  if (closed_) throw InvalidInput(path_.string(), 0, "write after close");
+  if (channel_id == 0 || channel_id > channels_.size()) {
+    throw InvalidInput(
+        path_.string(), 0,
+        fmt::format("message on unknown channel id {} ({} channels)", channel_id, channels_.size()));
+  }
+  ChannelState& ch = channels_[channel_id - 1u];
+  if (chunk_.empty()) {
+    chunk_start_ns_ = chunk_end_ns_ = log_time_ns;
+  } else {
+    chunk_start_ns_ = std::min(chunk_start_ns_, log_time_ns);
+    chunk_end_ns_ = std::max(chunk_end_ns_, log_time_ns);
+  }
+  if (message_count_ == 0) {
+    start_ns_ = end_ns_ = log_time_ns;
+  } else {
+    start_ns_ = std::min(start_ns_, log_time_ns);
+    end_ns_ = std::max(end_ns_, log_time_ns);
+  }
+  ch.index.emplace_back(log_time_ns, chunk_.size());  // offset within the chunk's records
+  put_u8(chunk_, static_cast<std::uint8_t>(McapOpcode::kMessage));
+  put_u64(chunk_, kMessagePrefix + payload.size());
+  put_u16(chunk_, channel_id);
+  put_u32(chunk_, static_cast<std::uint32_t>(ch.count));  // sequence: per channel, wraps
+  put_u64(chunk_, log_time_ns);
+  put_u64(chunk_, publish_time_ns);
+  chunk_.append(payload);
+  ++ch.count;
+  ++message_count_;
+  if (chunk_.size() >= chunk_target_) close_chunk();
+}
+
+void McapWriter::close_chunk() {
+  if (chunk_.empty()) return;
+  ChunkIndex ci{};
+  ci.start_ns = chunk_start_ns_;
+  ci.end_ns = chunk_end_ns_;
+  ci.offset = position();
+  ci.records_size = chunk_.size();
+  // Chunk: start, end, uncompressed size, uncompressed CRC, compression "", records (u64 length).
+  scratch_.clear();
+  put_u8(scratch_, static_cast<std::uint8_t>(McapOpcode::kChunk));
+  const std::uint64_t content = 8 + 8 + 8 + 4 + 4 + 8 + chunk_.size();
+  put_u64(scratch_, content);
+  put_u64(scratch_, chunk_start_ns_);
+  put_u64(scratch_, chunk_end_ns_);
+  put_u64(scratch_, chunk_.size());
+  put_u32(scratch_, crc32(chunk_));
+  put_str(scratch_, "");
+  put_u64(scratch_, chunk_.size());
+  put(scratch_);
+  put(chunk_);
+  ci.length = kRecordPrefix + content;
+  // One MessageIndex per channel present in the chunk, entries in log-time order.
+  const std::uint64_t index_start = position();
+  for (std::size_t c = 0; c < channels_.size(); ++c) {
+    auto& index = channels_[c].index;
+    if (index.empty()) continue;
+    if (!std::is_sorted(index.begin(), index.end())) std::stable_sort(index.begin(), index.end());
+    ci.index_offsets.emplace_back(static_cast<std::uint16_t>(c + 1), position());
+    scratch_.clear();
+    put_u16(scratch_, static_cast<std::uint16_t>(c + 1));
+    put_u32(scratch_, static_cast<std::uint32_t>(index.size() * 16));
+    for (const auto& [t, off] : index) {
+      put_u64(scratch_, t);
+      put_u64(scratch_, off);
+    }
+    put_record(McapOpcode::kMessageIndex, scratch_);
+    index.clear();
+  }
+  ci.index_length = position() - index_start;
+  chunk_indexes_.push_back(std::move(ci));
+  chunk_.clear();
+}
+
+void McapWriter::close() {
+  if (closed_) return;
+  close_chunk();
+  // DataEnd carries the CRC of everything before it.
+  const std::uint32_t data_crc = data_crc_;
+  in_data_ = false;
+  scratch_.clear();
+  put_u32(scratch_, data_crc);
+  put_record(McapOpcode::kDataEnd, scratch_);
+
+  // The summary, in groups, each group listed in a SummaryOffset record.
+  const std::uint64_t summary_start = position();
+  std::string summary;
+  std::vector<std::tuple<McapOpcode, std::uint64_t, std::uint64_t>> groups;  // opcode, start, length
+  const auto add_record = [&](McapOpcode op, std::string_view content) {
+    put_u8(summary, static_cast<std::uint8_t>(op));
+    put_u64(summary, content.size());
+    summary.append(content);
+  };
+  const auto group = [&](McapOpcode op, const auto& fill) {
+    const std::size_t begin = summary.size();
+    fill();
+    if (summary.size() > begin) groups.emplace_back(op, summary_start + begin, summary.size() - begin);
+  };
+  group(McapOpcode::kSchema, [&] {
+    for (const auto& s : schemas_) add_record(McapOpcode::kSchema, s);
+  });
+  group(McapOpcode::kChannel, [&] {
+    for (const auto& c : channels_) add_record(McapOpcode::kChannel, c.record);
+  });
+  group(McapOpcode::kStatistics, [&] {
+    std::string s;
+    put_u64(s, message_count_);
+    put_u16(s, static_cast<std::uint16_t>(schemas_.size()));
+    put_u32(s, static_cast<std::uint32_t>(channels_.size()));
+    put_u32(s, 0);  // attachments
+    put_u32(s, 0);  // metadata
+    put_u32(s, static_cast<std::uint32_t>(chunk_indexes_.size()));
+    put_u64(s, message_count_ ? start_ns_ : 0);
+    put_u64(s, message_count_ ? end_ns_ : 0);
+    std::string counts;
+    for (std::size_t c = 0; c < channels_.size(); ++c) {
+      put_u16(counts, static_cast<std::uint16_t>(c + 1));
+      put_u64(counts, channels_[c].count);
+    }
+    put_str(s, counts);
+    add_record(McapOpcode::kStatistics, s);
+  });
+  group(McapOpcode::kChunkIndex, [&] {
+    for (const auto& ci : chunk_indexes_) {
+      std::string s;
+      put_u64(s, ci.start_ns);
+      put_u64(s, ci.end_ns);
+      put_u64(s, ci.offset);
+      put_u64(s, ci.length);
+      std::string offsets;
+      for (const auto& [id, off] : ci.index_offsets) {
+        put_u16(offsets, id);
+        put_u64(offsets, off);
+      }
+      put_str(s, offsets);
+      put_u64(s, ci.index_length);
+      put_str(s, "");               // compression
+      put_u64(s, ci.records_size);  // compressed size
+      put_u64(s, ci.records_size);  // uncompressed size
+      add_record(McapOpcode::kChunkIndex, s);
+    }
+  });
+  const std::uint64_t summary_offset_start = summary_start + summary.size();
+  for (const auto& [op, start, length] : groups) {
+    std::string s;
+    put_u8(s, static_cast<std::uint8_t>(op));
+    put_u64(s, start);
+    put_u64(s, length);
+    add_record(McapOpcode::kSummaryOffset, s);
+  }
+  // Footer: the summary CRC covers the summary, the summary offsets and the footer up to it.
+  put_u8(summary, static_cast<std::uint8_t>(McapOpcode::kFooter));
+  put_u64(summary, 8 + 8 + 4);
+  put_u64(summary, summary_start);
+  put_u64(summary, summary_offset_start);
+  put_u32(summary, crc32(summary));
+  summary.append(kMcapMagic);
+  put(summary);
+  flush_buffer();
+
+  bool ok = ::fsync(fd_) == 0;
+  ok = (::close(fd_) == 0) && ok;
+  fd_ = -1;
+  // mkstemp creates 0600; output files are meant to be shared like any other.
+  ok = ok && ::chmod(tmp_path_.c_str(), 0644) == 0;
+  std::error_code ec;
+  if (ok) std::filesystem::rename(tmp_path_, path_, ec);
+  if (!ok || ec) fail("write failed (disk full or not writable)");
+  tmp_path_.clear();
+  closed_ = true;
+}
+
+}  // namespace mc

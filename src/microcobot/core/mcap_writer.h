@@ -1,0 +1,136 @@
+#pragma once
+/// @file
+/// An MCAP writer (https://mcap.dev/spec, major version 0), written from the specification:
+/// no MCAP package exists for Debian. It writes indexed files that viewers (Foxglove,
+/// Lichtblick, `@mcap/core`'s McapIndexedReader) can seek in:
+///
+///     magic Header  Schema* Channel*  (Chunk MessageIndex*)*  DataEnd
+///     Summary: Schema* Channel* Statistics ChunkIndex*   SummaryOffset*   Footer magic
+///
+/// Messages go into uncompressed chunks of about `chunk_target_bytes`; each chunk carries the
+/// CRC-32 of its records and is followed by one MessageIndex per channel it holds. The data
+/// section's and the summary's CRCs are written too.
+///
+/// The file is written under a temporary name beside the target and renamed at close(), so an
+/// interrupted run never leaves a partial file under the final name (DESIGN.md, "Errors").
+/// Not for the real-time path (it does I/O), but a message costs no allocation once the
+/// chunk buffer has grown to its size.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace mc {
+
+/// CRC-32 as zlib's crc32() and MCAP use (ISO-HDLC: reflected polynomial 0xEDB88320, initial
+/// value and final XOR 0xFFFFFFFF). Chains like zlib: crc32(b, crc32(a)) == crc32(a + b);
+/// start with 0.
+std::uint32_t crc32(std::string_view bytes, std::uint32_t previous = 0);
+
+/// The record opcodes of MCAP version 0 (spec, "Records").
+enum class McapOpcode : std::uint8_t {
+  kHeader = 0x01,
+  kFooter = 0x02,
+  kSchema = 0x03,
+  kChannel = 0x04,
+  kMessage = 0x05,
+  kChunk = 0x06,
+  kMessageIndex = 0x07,
+  kChunkIndex = 0x08,
+  kAttachment = 0x09,
+  kAttachmentIndex = 0x0A,
+  kStatistics = 0x0B,
+  kMetadata = 0x0C,
+  kMetadataIndex = 0x0D,
+  kSummaryOffset = 0x0E,
+  kDataEnd = 0x0F,
+};
+
+/// The 8 bytes that open and close every MCAP file: "\x89MCAP0\r\n".
+inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
+
+class McapWriter {
+ public:
+  static constexpr std::size_t kDefaultChunkBytes = std::size_t{1} << 20;
+
+  /// Opens a temporary file beside `path` and writes the magic and the Header (profile "",
+  /// library "microcobot"). A chunk is closed once its records reach `chunk_target_bytes`.
+  /// Throws InvalidInput naming `path` when the directory is missing or not writable.
+  explicit McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes = kDefaultChunkBytes);
+  /// Without close() (an exception unwinding, a cut run) the temporary file is removed and
+  /// nothing appears under the target name.
+  ~McapWriter();
+  McapWriter(const McapWriter&) = delete;
+  McapWriter& operator=(const McapWriter&) = delete;
+
+  /// Adds a Schema record (e.g. encoding "jsonschema", data the JSON Schema text). Returns its
+  /// id: 1, 2, ... (0 means "no schema" in MCAP).
+  std::uint16_t add_schema(std::string_view name, std::string_view encoding, std::string_view data);
+  /// Adds a Channel record on schema `schema_id` (0 for none, else an id add_schema returned)
+  /// with `message_encoding` (e.g. "json"). Returns its id: 1, 2, ... Throws InvalidInput on
+  /// an unknown schema id.
+  std::uint16_t add_channel(std::uint16_t schema_id, std::string_view topic,
+                            std::string_view message_encoding,
+                            const std::vector<std::pair<std::string, std::string>>& metadata = {});
+
+  /// Writes one message on `channel_id`; times in nanoseconds. Throws InvalidInput on an
+  /// unknown channel or a failed write.
+  void write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
+             std::string_view payload);
+  void write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
+             std::span<const std::byte> payload);
+
+  /// Closes the last chunk, writes DataEnd, the summary, the summary offsets, the footer and
+  /// the closing magic, flushes and renames the file to its target name. Throws InvalidInput
+  /// naming the file when a write fails (the temporary file is then removed). Idempotent.
+  void close();
+
+  const std::filesystem::path& path() const { return path_; }
+  std::uint64_t message_count() const { return message_count_; }
+  std::size_t chunk_count() const { return chunk_indexes_.size(); }
+
+ private:
+  struct ChunkIndex {
+    std::uint64_t start_ns, end_ns, offset, length, index_length, records_size;
+    std::vector<std::pair<std::uint16_t, std::uint64_t>> index_offsets;  // channel, file offset
+  };
+  struct ChannelState {
+    std::string record;  // the Channel record's content, repeated in the summary
+    std::uint64_t count = 0;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> index;  // this chunk: log time, offset
+  };
+
+  std::uint64_t position() const { return flushed_ + out_.size(); }
+  void put(std::string_view bytes);  // to the file (buffered); CRC'd while in the data section
+  void put_record(McapOpcode op, std::string_view content);
+  void flush_buffer();
+  void close_chunk();
+  void discard() noexcept;
+  [[noreturn]] void fail(const std::string& what);
+
+  std::filesystem::path path_;
+  std::string tmp_path_;
+  int fd_ = -1;
+  std::size_t chunk_target_;
+  std::string out_;            // bytes not yet written to fd_
+  std::uint64_t flushed_ = 0;  // bytes written to fd_
+  bool in_data_ = true;
+  std::uint32_t data_crc_ = 0;
+
+  std::vector<std::string> schemas_;    // Schema record contents, id - 1
+  std::vector<ChannelState> channels_;  // id - 1
+  std::string chunk_;                   // the open chunk's records
+  std::string scratch_;                 // record being assembled
+  std::uint64_t chunk_start_ns_ = 0, chunk_end_ns_ = 0;
+  std::vector<ChunkIndex> chunk_indexes_;
+  std::uint64_t message_count_ = 0;
+  std::uint64_t start_ns_ = 0, end_ns_ = 0;
+  bool closed_ = false;
+};
+
+}  // namespace mc
