@@ -60,3 +60,18 @@ function(mc_add_module_tests name)
   gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60
     PROPERTIES LABELS "${name};${ARG_LABELS}")
 endfunction()
+
+# Embeds the live console's page, script and style (web/console.*) into `target`, so that
+# `microcobot serve` serves a console that works offline (uPlot comes from the report's assets).
+function(mc_embed_console_assets target)
+  set(_out ${PROJECT_BINARY_DIR}/generated/console_assets.cc)
+  set(_files ${PROJECT_SOURCE_DIR}/web/console.html ${PROJECT_SOURCE_DIR}/web/console.js
+             ${PROJECT_SOURCE_DIR}/web/console.css)
+  add_custom_command(OUTPUT ${_out}
+    COMMAND ${CMAKE_COMMAND} -DOUT=${_out} -DNAMESPACE=mc::live::assets
+            "-DFILES=kConsoleHtml=${PROJECT_SOURCE_DIR}/web/console.html\;kConsoleJs=${PROJECT_SOURCE_DIR}/web/console.js\;kConsoleCss=${PROJECT_SOURCE_DIR}/web/console.css"
+            -P ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    DEPENDS ${_files} ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    COMMENT "Embedding the live console")
+  target_sources(${target} PRIVATE ${_out})
+endfunction()

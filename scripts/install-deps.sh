@@ -38,9 +38,10 @@ if ((${#missing[@]})); then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# npm packages pinned by package-lock.json (uPlot for reports, playwright-core for the browser test,
-# @mcap/core for the MCAP test).
+# npm packages pinned by package-lock.json (uPlot for reports and the console, playwright-core for
+# the browser tests, @mcap/core for the MCAP test, @foxglove/ws-protocol for the protocol test).
 if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || ! -d node_modules/@mcap/core ||
+      ! -d node_modules/@foxglove/ws-protocol ||
       package-lock.json -nt node_modules/.package-lock.json ]]; then
   echo "install-deps: npm ci" >&2
   npm ci --no-audit --no-fund --loglevel=error >/dev/null

@@ -56,7 +56,8 @@ const CLI::Validator kStaged(
 void harden(CLI::App& app) {
   for (CLI::Option* opt : app.get_options()) {
     if (opt->get_type_name().find("FLOAT") != std::string::npos) opt->check(kFinite);
-    if (opt->check_lname("out")) opt->transform(kStaged);
+    // serve's recordings appear in --out while it runs, each file atomic on its own.
+    if (opt->check_lname("out") && app.get_name() != "serve") opt->transform(kStaged);
   }
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) harden(*sub);
 }

@@ -16,6 +16,10 @@ void LiveParams::validate() const {
   demo.validate();
   require(std::isfinite(command_timeout_s) && command_timeout_s >= 0.01 && command_timeout_s <= 10.0,
           "command_timeout_s", "must be within [0.01, 10] s", command_timeout_s);
+  require(placement_tolerance_m > 0 && placement_tolerance_m < 1e-3, "placement_tolerance_m",
+          "must be within (0, 1 mm)", placement_tolerance_m);
+  require(finger_width_m > 0 && finger_width_m < 1e-3, "finger_width_m", "must be within (0, 1 mm)",
+          finger_width_m);
 }
 
 LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {

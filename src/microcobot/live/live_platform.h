@@ -36,6 +36,9 @@ struct LiveParams {
   platform::PlatformConfig platform;  ///< loop.realtime is forced on
   platform::PickPlaceOperatorParams demo;
   double command_timeout_s = 0.2;  ///< the console's commands go stale after this long
+  double placement_tolerance_m = 5e-6;  ///< shown around the target (the session's criterion)
+  /// Drawn width of a finger tip in the microscope view (the model's fingers are lines).
+  double finger_width_m = 40e-6;
   bool paced = true;               ///< false: as fast as possible (tests that need no wall clock)
   void validate() const;
 };
@@ -82,6 +85,13 @@ class LivePlatform {
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
+  /// The scene's geometry, for the microscope view (world coordinates).
+  double part_side_m() const { return params_.platform.world.part_side_m; }
+  std::array<double, 3> target_m() const {
+    return {params_.platform.world.target_m.x(), params_.platform.world.target_m.y(), 0.0};
+  }
+  double placement_tolerance_m() const { return params_.placement_tolerance_m; }
+  double finger_width_m() const { return params_.finger_width_m; }
   std::size_t channel_count() const { return channel_count_; }
 
  private:

@@ -1,0 +1,131 @@
+// `microcobot serve`: the platform live (issue #14). Builds the platform (simulated devices),
+// runs its loop paced to the wall clock and serves the operator's console over HTTP and the
+// Foxglove WebSocket protocol (docs/console.md). The first line on stdout is the console's URL.
+// Runs until SIGINT/SIGTERM, then puts every device in its safe state, closes the recording
+// and exits 0.
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
+#include "microcobot/core/params.h"
+#include "microcobot/live/console_server.h"
+#include "microcobot/live/live_platform.h"
+#include "microcobot/platform/platform_config.h"
+#include "signals.h"
+
+namespace {
+
+namespace pf = mc::platform;
+
+struct ServeOptions {
+  std::optional<std::filesystem::path> config;
+  std::string scene = "pick-place";
+  std::string listen = "127.0.0.1:8080";
+  std::string token;
+  std::filesystem::path out = "out/live";
+  bool record = false;
+  double duration_s = 0.0;
+};
+
+// "HOST:PORT" or "[V6]:PORT".
+std::pair<std::string, std::uint16_t> parse_listen(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size())
+    throw mc::UsageError("--listen: '" + mc::excerpt(text) + "' must be ADDRESS:PORT (e.g. 127.0.0.1:8080)");
+  std::string host = text.substr(0, colon);
+  if (host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  const std::string port = text.substr(colon + 1);
+  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos || std::stoul(port) > 65535)
+    throw mc::UsageError("--listen: port '" + mc::excerpt(port) + "' must be a number within [0, 65535]");
+  return {host, static_cast<std::uint16_t>(std::stoul(port))};
+}
+
+bool is_loopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+// A token for a server reachable from the network: 128 bits from the kernel's generator.
+std::string random_token() {
+  std::ifstream in("/dev/urandom", std::ios::binary);
+  unsigned char bytes[16];
+  if (!in.read(reinterpret_cast<char*>(bytes), sizeof bytes))
+    throw mc::InvalidInput("/dev/urandom: cannot read a token; give one with --token");
+  std::string t;
+  for (unsigned char b : bytes) t += fmt::format("{:02x}", b);
+  return t;
+}
+
+void serve(const ServeOptions& o) {
+  mc::live::LiveParams lp;
+  if (o.config) lp.platform = pf::load_platform_config(*o.config);
+  if (o.scene != "pick-place") {
+    // A scene file: the microworld's keys (part, start, target, adhesion, gripper).
+    lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
+  }
+  auto [host, port] = parse_listen(o.listen);
+  mc::live::ConsoleServerParams sp;
+  sp.server.address = host;
+  sp.server.port = port;
+  sp.server.token = o.token;
+  if (sp.server.token.empty() && !is_loopback(host)) sp.server.token = random_token();
+  if (!sp.server.token.empty() && (sp.server.token.size() < 8 || sp.server.token.size() > 256 ||
+                                   sp.server.token.find_first_of(" &#?%/\"'<>") != std::string::npos))
+    throw mc::UsageError("--token: must be 8 to 256 characters without spaces or any of &#?%/\"'<>");
+  sp.out_dir = o.out;
+  std::filesystem::create_directories(o.out);
+  if (!std::filesystem::is_directory(o.out))
+    throw mc::InvalidInput(o.out.string(), 0, "--out must be a directory");
+
+  mc::cli::set_cooperative_interrupts(true);
+  std::cerr << "serve: building the platform (the stick-slip step map takes about a second)\n";
+  mc::live::LivePlatform live(lp);
+  mc::live::ConsoleServer server(live, sp);
+  server.start();
+  if (o.record) server.start_recording();
+  // The first line on stdout: what the operator opens.
+  std::cout << server.url() << std::endl;
+  std::cerr << "serve: console at " << server.url() << " (Ctrl-C stops: devices to their safe state)\n";
+  const auto start = std::chrono::steady_clock::now();
+  while (mc::cli::interrupt_signal() == 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (o.duration_s > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration_s)
+      break;
+  }
+  server.stop();
+  mc::cli::set_cooperative_interrupts(false);
+  const int sig = mc::cli::interrupt_signal();
+  std::cerr << "serve: stopped" << (sig ? " on " + mc::cli::signal_name(sig) : std::string())
+            << ": every device in its safe state, recordings closed in " << o.out.string() << "\n";
+}
+
+void add_serve(CLI::App& cmd) {
+  auto o = std::make_shared<ServeOptions>();
+  cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as `run --print-config` shows)");
+  cmd.add_option("--scene", o->scene,
+                 "Scene: pick-place (default: the 300 um part) or a YAML file of the microworld's keys");
+  cmd.add_option("--listen", o->listen,
+                 "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
+                 "address requires a token)");
+  cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
+  cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
+  cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
+  cmd.add_option("--duration", o->duration_s, "Stop after this many seconds of wall-clock time (default: never)")
+      ->check(mc::cli::Range(0.0, 1e7));
+  cmd.callback([o] { serve(*o); });
+}
+
+const bool kRegistered = mc::cli::register_group(
+    {"serve", "Run the platform live: the operator's console in a browser, Foxglove WebSocket, MCAP", 6,
+     &add_serve});
+
+}  // namespace
