@@ -785,6 +785,8 @@ void Core::on_accept(const error_code& ec, tcp::socket socket) {
     return;
   }
   accepted.fetch_add(1, std::memory_order_relaxed);
+  error_code ignored;
+  socket.set_option(tcp::no_delay(true), ignored);  // live telemetry: no Nagle delay on small frames
   try {
     if (open_connections.fetch_add(1) < opt.max_connections) {
       std::make_shared<HttpSession>(*this, std::move(socket), Slot(&open_connections), false)->run();
@@ -795,7 +797,6 @@ void Core::on_accept(const error_code& ec, tcp::socket socket) {
         std::make_shared<HttpSession>(*this, std::move(socket), Slot(&refusing), true)->run();
       } else {
         refusing.fetch_sub(1);
-        error_code ignored;
         socket.close(ignored);
       }
     }
