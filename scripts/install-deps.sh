@@ -12,7 +12,7 @@ DEBIAN_PACKAGES=(
   libcli11-dev         # command line
   libspdlog-dev libfmt-dev  # logging and formatting
   nlohmann-json3-dev   # --json output
-  libboost-dev         # odeint (reference ODE solver)
+  libboost-dev         # odeint (reference ODE solver); Beast/Asio (HTTP + WebSocket server)
   libgtest-dev libgmock-dev googletest  # unit tests
   libbenchmark-dev     # benchmarks
   nodejs npm           # uPlot (bundled into reports) and playwright-core (browser test)
