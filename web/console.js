@@ -304,6 +304,30 @@ function blurPx(dz, o, scale) {
   return Math.max(o.resolution, Math.abs(dz) * tan) * scale;
 }
 
+// A rectangle blurred by `blur` pixels. A wide blur is rendered at a reduced scale and drawn
+// enlarged: the result is the same to the eye, at a fraction of the cost (a blur filter over a
+// large area would stall the page, and with it the commands' heartbeat).
+const blurCanvas = document.createElement("canvas");
+function drawBlurred(g, x, y, w, h, blur, color) {
+  if (blur < 1) {
+    g.fillStyle = color;
+    g.fillRect(x, y, w, h);
+    return;
+  }
+  const k = Math.max(1, blur / 2);  // downscale so that the blur is ~2 px there
+  const margin = 2 * blur;
+  const bw = Math.ceil((w + 2 * margin) / k), bh = Math.ceil((h + 2 * margin) / k);
+  if (bw > 2048 || bh > 2048) return;
+  blurCanvas.width = bw;
+  blurCanvas.height = bh;
+  const b = blurCanvas.getContext("2d");
+  b.filter = `blur(${(blur / k).toFixed(2)}px)`;
+  b.fillStyle = color;
+  b.fillRect(margin / k, margin / k, w / k, h / k);
+  g.imageSmoothingEnabled = true;
+  g.drawImage(blurCanvas, x - margin, y - margin, bw * k, bh * k);
+}
+
 function drawMicroscope() {
   const c = $("microscope"), g = c.getContext("2d"), t = mc.telemetry, sc = mc.scene;
   const o = optics();
@@ -315,31 +339,28 @@ function drawMicroscope() {
   g.fillRect(0, 0, c.width, c.height);
   if (!t || !sc) return;
   const focus = t.measured_z_m;  // autofocus on the finger tips
-  // The substrate's texture (a 50 um polishing grid) at z = 0.
-  g.filter = `blur(${blurPx(focus, o, s).toFixed(1)}px)`;
-  g.strokeStyle = "#3b372f";
-  g.lineWidth = 1;
-  const step = 50e-6, [x0, y1] = canvasToWorld(0, 0), [x1, y0] = canvasToWorld(c.width, c.height);
-  g.beginPath();
-  for (let x = Math.floor(x0 / step) * step; x <= x1; x += step) { const [px] = worldToCanvas(x, 0); g.moveTo(px, 0); g.lineTo(px, c.height); }
-  for (let y = Math.floor(y0 / step) * step; y <= y1; y += step) { const [, py] = worldToCanvas(0, y); g.moveTo(0, py); g.lineTo(c.width, py); }
-  g.stroke();
-  // The target (a reticle on the substrate) with the placement tolerance.
+  // The substrate's texture (a 50 um polishing grid) at z = 0: out of focus by more than a
+  // few pixels it washes out entirely, as a fine pattern does under a microscope.
+  if (blurPx(focus, o, s) < 2) {
+    g.strokeStyle = "#3b372f";
+    g.lineWidth = 1;
+    const step = 50e-6, [x0, y1] = canvasToWorld(0, 0), [x1, y0] = canvasToWorld(c.width, c.height);
+    g.beginPath();
+    for (let x = Math.floor(x0 / step) * step; x <= x1; x += step) { const [px] = worldToCanvas(x, 0); g.moveTo(px, 0); g.lineTo(px, c.height); }
+    for (let y = Math.floor(y0 / step) * step; y <= y1; y += step) { const [, py] = worldToCanvas(0, y); g.moveTo(0, py); g.lineTo(c.width, py); }
+    g.stroke();
+  }
+  // The part: a brass cube, its top face at part_z + side / 2, blurred by its defocus.
+  const side = sc.part_side_m;
+  const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
+  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + side / 2), o, s), "#c9a04a");
+  // The target: a reticle overlaid on the view (a graticule, always sharp), with the tolerance.
   const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
   g.strokeStyle = "#46c47e";
   g.lineWidth = 2;
   g.beginPath(); g.arc(tx, ty, Math.max(3, sc.tolerance_m * s), 0, 2 * Math.PI);
   g.moveTo(tx - 20, ty); g.lineTo(tx + 20, ty); g.moveTo(tx, ty - 20); g.lineTo(tx, ty + 20); g.stroke();
-  // The part: a brass cube, its top face at part_z + side / 2.
-  const side = sc.part_side_m;
-  g.filter = `blur(${blurPx(focus - (t.part_z_m + side / 2), o, s).toFixed(1)}px)`;
-  const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-  g.fillStyle = "#c9a04a";
-  g.fillRect(px, py, side * s, side * s);
-  g.strokeStyle = "#8c6c2a";
-  g.strokeRect(px, py, side * s, side * s);
   // The gripper's two fingers (in focus: the microscope follows their tips), along x.
-  g.filter = `blur(${blurPx(0, o, s).toFixed(1)}px)`;
   const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
   g.fillStyle = "#b8c4d6";
   for (const sign of [-1, 1]) {
@@ -347,7 +368,6 @@ function drawMicroscope() {
     const [fx, fy] = worldToCanvas(cx - w / 2, t.measured_y_m + w);
     g.fillRect(fx, fy, w * s, 2 * w * s);
   }
-  g.filter = "none";
   if (mc.input.goal) {
     const [gx, gy] = worldToCanvas(mc.input.goal[0], mc.input.goal[1]);
     g.strokeStyle = "#4fa3ff";
@@ -534,9 +554,15 @@ function onTelemetry(t) {
 }
 setInterval(() => { for (const p of plots) p.u.setData(p.data); }, 100);
 
-function draw() {
-  drawMicroscope();
-  drawSide();
+// 30 frames per second: the blurred optics cost CPU on a tablet, and the commands' timer (the
+// watchdog's heartbeat) must never wait behind the drawing.
+let lastDraw = 0;
+function draw(now) {
+  if (!(now - lastDraw < 33)) {
+    lastDraw = now;
+    drawMicroscope();
+    drawSide();
+  }
   requestAnimationFrame(draw);
 }
 requestAnimationFrame(draw);

@@ -44,7 +44,8 @@ std::pair<std::string, std::uint16_t> parse_listen(const std::string& text) {
   std::string host = text.substr(0, colon);
   if (host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   const std::string port = text.substr(colon + 1);
-  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos || std::stoul(port) > 65535)
+  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoul(port) > 65535)
     throw mc::UsageError("--listen: port '" + mc::excerpt(port) + "' must be a number within [0, 65535]");
   return {host, static_cast<std::uint16_t>(std::stoul(port))};
 }
@@ -119,7 +120,8 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
   cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
-  cmd.add_option("--duration", o->duration_s, "Stop after this many seconds of wall-clock time (default: never)")
+  cmd.add_option("--duration", o->duration_s,
+                 "Stop after this many seconds of wall-clock time (default: never)")
       ->check(mc::cli::Range(0.0, 1e7));
   cmd.callback([o] { serve(*o); });
 }

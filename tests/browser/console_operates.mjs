@@ -36,6 +36,12 @@ const url = await new Promise((resolve, reject) => {
   setTimeout(() => reject(new Error("serve printed no URL within 60 s")), 60000);
 });
 log("console at " + url);
+// Whatever happens, never outlive CTest's timeout with the server left running.
+const guard = setTimeout(() => {
+  console.error("FAIL: console_operates took longer than 240 s");
+  server.kill("SIGKILL");
+  process.exit(1);
+}, 240000);
 
 const browser = await chromium.launch({
   executablePath: chromiumPath,
@@ -138,15 +144,19 @@ try {
   const held = await t();
   await clickSide(held.measured_x_m, 400e-6);
   await goWithDeadman("lift", 20);
+  log("lifted");
   if ((await t()).part_z_m < 100e-6) fail("the part did not come up with the gripper");
   await page.selectOption("#objective", "2");
+  await setSlider("#speed", 500);  // the long move at the console's full speed scale
   await clickTop(scene.target_m[0], scene.target_m[1]);
   await goWithDeadman("transport", 60);
+  await setSlider("#speed", 200);
   await page.selectOption("#objective", "20");
   const near = await t();
   await clickTop(near.measured_x_m + (scene.target_m[0] - near.part_x_m),
                  near.measured_y_m + (scene.target_m[1] - near.part_y_m));
   await goWithDeadman("refine over the target", 20);
+  log("over the target");
   await shot("03-over-target");
 
   // Place: set down, release, retract.
@@ -157,14 +167,16 @@ try {
   await page.keyboard.down(" ");
   await until("released", () => window.mc.telemetry.grip_force_N < 1e-7, 10);
   await page.keyboard.up(" ");
-  const down = await t();
-  await clickSide(down.measured_x_m, 600e-6);
-  await goWithDeadman("retract", 20);
-  await page.waitForTimeout(300);
-  const end = await t();
-  const error = Math.hypot(end.part_x_m - scene.target_m[0], end.part_y_m - scene.target_m[1]);
-  log(`placement error ${(error * 1e6).toFixed(2)} um (part z ${(end.part_z_m * 1e6).toFixed(1)} um)`);
+  const placed = await t();
+  const error = Math.hypot(placed.part_x_m - scene.target_m[0], placed.part_y_m - scene.target_m[1]);
+  log(`placement error ${(error * 1e6).toFixed(2)} um (part z ${(placed.part_z_m * 1e6).toFixed(1)} um)`);
   if (!(error <= 10e-6)) fail(`the part ended ${(error * 1e6).toFixed(1)} um from its target (10 um allowed)`);
+  // Retract: the part stays where it was set down.
+  await clickSide(placed.measured_x_m, 300e-6);
+  await goWithDeadman("retract", 30);
+  const end = await t();
+  const moved = Math.hypot(end.part_x_m - placed.part_x_m, end.part_y_m - placed.part_y_m);
+  if (!(moved <= 2e-6)) fail(`the part moved ${(moved * 1e6).toFixed(1)} um when the gripper retracted`);
   await shot("04-placed");
 
   // E-stop: every device in its safe state, latched.
@@ -203,6 +215,7 @@ else {
   log(`recording ${recordings[0]}: ${bytes.length} bytes`);
 }
 log(`screenshots in ${artifacts}`);
+clearTimeout(guard);
 if (failures) {
   console.error(`console_operates: ${failures} failure(s)`);
   process.exit(1);

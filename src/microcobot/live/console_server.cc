@@ -46,7 +46,8 @@ void ConsoleServerParams::validate() const {
   require(std::isfinite(status_rate_Hz) && status_rate_Hz >= 0.5 && status_rate_Hz <= 100, "status_rate_Hz",
           "must be within [0.5, 100] Hz", status_rate_Hz);
   require(std::isfinite(rumble_crossover_Hz) && rumble_crossover_Hz > 0 && rumble_crossover_Hz < 450,
-          "rumble_crossover_Hz", "must be within (0, 450) Hz (below the telemetry's Nyquist)", rumble_crossover_Hz);
+          "rumble_crossover_Hz", "must be within (0, 450) Hz (below the telemetry's Nyquist)",
+          rumble_crossover_Hz);
   require(std::isfinite(rumble_full_scale_N) && rumble_full_scale_N > 0, "rumble_full_scale_N", "must be > 0",
           rumble_full_scale_N);
 }
@@ -60,7 +61,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       rumble_x_(rumble_filter(params_.rumble_crossover_Hz)),
       rumble_y_(rumble_filter(params_.rumble_crossover_Hz)),
       rumble_z_(rumble_filter(params_.rumble_crossover_Hz)) {
-  decimation_ = static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
+  decimation_ =
+      static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
   telemetry_ch_ = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
                                        std::string(platform::kTelemetrySchemaName), "jsonschema",
                                        platform::telemetry_json_schema(live_.channel_count())});
@@ -184,7 +186,8 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
         return;
       }
       if (!live_.push_command(c))
-        server_.send_status(m.client, StatusLevel::kWarning, "/console/command: the loop is busy; command dropped");
+        server_.send_status(m.client, StatusLevel::kWarning,
+                            "/console/command: the loop is busy; command dropped");
       return;
     }
     if (m.topic != "/console/action") {

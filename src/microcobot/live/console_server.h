@@ -40,9 +40,9 @@ class McapWriter;
 namespace mc::live {
 
 struct ConsoleServerParams {
-  server::ServerOptions server;       ///< listen address, port, token, limits
-  std::filesystem::path out_dir;      ///< where recordings go (empty: recording disabled)
-  double telemetry_rate_Hz = 60.0;    ///< to clients (the recording keeps every sample)
+  server::ServerOptions server;     ///< listen address, port, token, limits
+  std::filesystem::path out_dir;    ///< where recordings go (empty: recording disabled)
+  double telemetry_rate_Hz = 60.0;  ///< to clients (the recording keeps every sample)
   double status_rate_Hz = 5.0;
   double rumble_crossover_Hz = 100.0;  ///< the high band of the contact force
   double rumble_full_scale_N = 5e-6;   ///< high-band RMS that drives the rumble fully

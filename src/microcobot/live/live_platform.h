@@ -35,11 +35,11 @@ namespace mc::live {
 struct LiveParams {
   platform::PlatformConfig platform;  ///< loop.realtime is forced on
   platform::PickPlaceOperatorParams demo;
-  double command_timeout_s = 0.2;  ///< the console's commands go stale after this long
+  double command_timeout_s = 0.2;       ///< the console's commands go stale after this long
   double placement_tolerance_m = 5e-6;  ///< shown around the target (the session's criterion)
   /// Drawn width of a finger tip in the microscope view (the model's fingers are lines).
   double finger_width_m = 40e-6;
-  bool paced = true;               ///< false: as fast as possible (tests that need no wall clock)
+  bool paced = true;  ///< false: as fast as possible (tests that need no wall clock)
   void validate() const;
 };
 

@@ -108,8 +108,8 @@ StickSlipParams::PhysicalBounds StickSlipParams::physical_bounds() const {
   return {3.0 * std::abs(pe.static_gain_m_V) * std::max(h_max, 1.0), 0.5 * slider.stroke_m * 1.02};
 }
 
-void StickSlipParams::check_physical_bounds(const PhysicalBounds& bounds, double x1_m, double x2_m, double t_s,
-                                            const std::string& where) const {
+void StickSlipParams::check_physical_bounds(const PhysicalBounds& bounds, double x1_m, double x2_m,
+                                            double t_s, const std::string& where) const {
   const double x1_bound = bounds.x1_m;
   if (!std::isfinite(x1_m) || std::abs(x1_m) > x1_bound) {
     throw ComputationFailed(
