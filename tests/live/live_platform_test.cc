@@ -24,7 +24,8 @@ std::size_t channel(const char* name) {
 
 // The platform live, with the latest telemetry sample kept for the test to read.
 struct Live {
-  LivePlatform live{LiveParams{}};
+  LiveParams params;  // named: GCC 12 warns (falsely) on a temporary's vectors here
+  LivePlatform live{params};
   std::mutex mutex;
   platform::TelemetrySample last{};
   std::size_t samples = 0;
