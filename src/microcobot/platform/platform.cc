@@ -89,14 +89,7 @@ void Platform::build() {
                                                      world_.params().gripper.max_opening_m);
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
 
-  // Configure, then activate; a device that throws leaves none of them armed.
-  try {
-    for (Device* d : devices()) d->configure();
-    for (Device* d : devices()) d->activate();
-  } catch (...) {
-    for (Device* d : devices()) d->deactivate();
-    throw;
-  }
+  arm_devices(/*fault_on_failure=*/false);
 
   loop_.add_task("operator", config_.loop.operator_divisor, [this](const TickInfo& t) {
     if (operator_) operator_(t);
@@ -230,14 +223,19 @@ void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
   console_.goal_m = in.goal_m - home_m_;
 }
 
-void Platform::recover() {
+void Platform::arm_devices(bool fault_on_failure) {
+  // Configure, then activate; a device that throws leaves none of them armed.
   try {
     for (Device* d : devices()) d->configure();
     for (Device* d : devices()) d->activate();
   } catch (...) {
-    for (Device* d : devices()) d->fault();
+    for (Device* d : devices()) fault_on_failure ? d->fault() : d->deactivate();
     throw;
   }
+}
+
+void Platform::recover() {
+  arm_devices(/*fault_on_failure=*/true);  // a refused reset stays latched
   faulted_ = false;
 }
 

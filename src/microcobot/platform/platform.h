@@ -178,6 +178,7 @@ class Platform {
   void drain() noexcept;
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
+  void arm_devices(bool fault_on_failure);
   std::array<Device*, 6> devices();
 
   PlatformConfig config_;
