@@ -23,7 +23,14 @@ if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux
   exit 77
 fi
 cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console -j "${JOBS:-2}" >/dev/null
+mkdir -p build/fuzz
+# The build's log is shown when it fails (CI=true makes warnings errors, clang's included).
+if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console -j "${JOBS:-2}" \
+    >build/fuzz/build.log 2>&1; then
+  echo "fuzz: the clang build failed (build/fuzz/build.log):" >&2
+  grep -E "error|FAILED" build/fuzz/build.log | head -20 >&2
+  exit 1
+fi
 status=0
 for h in csv params config console; do
   work="${fresh:-build/fuzz}/corpus-$h"   # new inputs go here; the seed corpus stays untouched
