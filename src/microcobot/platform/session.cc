@@ -140,7 +140,8 @@ SessionResult Session::run(const std::function<void(double)>& progress, const st
     const auto& rec = p.recording();
     const auto t = rec.channel("t_s"), stale = rec.channel("stale"), fx = rec.channel("haptic_force_x_N"),
                fy = rec.channel("haptic_force_y_N"), tx = rec.channel("target_x_m");
-    double max_force = 0.0, target_motion = 0.0, held_s = 0.0, first = std::numeric_limits<double>::quiet_NaN();
+    double max_force = 0.0, target_motion = 0.0, held_s = 0.0,
+           first = std::numeric_limits<double>::quiet_NaN();
     for (std::size_t i = 0; i < t.size(); ++i) {
       if (stale[i] < 0.5) continue;
       if (std::isnan(first)) first = tx[i];
