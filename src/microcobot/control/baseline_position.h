@@ -43,6 +43,8 @@ class BaselinePositionController {
                              double slew_rate_V_s = 1.0e6);
   /// Starts a move to `target_m` from the measured position `start_m`.
   void set_target(double target_m, double start_m) noexcept;
+  /// Moves the target of a running move (trajectory tracking) without restarting it.
+  void track(double target_m) noexcept { target_ = target_m; }
   void update(double measured_position_m) noexcept;
   /// The drive over the next actuator step `dt_s` (the sawtooth's corners, the end voltage).
   stickslip::DriveSegment next_drive(double dt_s) noexcept;

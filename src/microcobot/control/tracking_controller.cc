@@ -1,0 +1,253 @@
+#include "microcobot/control/tracking_controller.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+
+using stickslip::Direction;
+
+void TrackingParams::validate() const {
+  require_positive(control_rate_Hz, "tracking.control_rate_Hz");
+  require_in_range(low_V, 0.0, 100.0, "tracking.low_V");
+  require_in_range(high_V, 0.0, 100.0, "tracking.high_V");
+  require(high_V - low_V >= 20.0, "tracking.high_V", "must exceed low_V by >= 20 V (an edge must slip)",
+          high_V - low_V);
+  require_in_range(guard_V, 0.0, 10.0, "tracking.guard_V");
+  require(unload_V >= 0.0 && unload_V <= high_V - low_V - 10.0, "tracking.unload_V",
+          "must be in [0, high_V - low_V - 10]", unload_V);
+  require_non_negative(edge_margin_m, "tracking.edge_margin_m");
+  require_in_range(lead_fraction, 0.0, 1.0, "tracking.lead_fraction");
+  require_positive(lead_window_m, "tracking.lead_window_m");
+  require_positive(catchup_s, "tracking.catchup_s");
+  require_non_negative(settle_s, "tracking.settle_s");
+  require(settle_s < catchup_s, "tracking.settle_s", "must be shorter than catchup_s", settle_s);
+  require_non_negative(ki_1_s, "tracking.ki_1_s");
+  require_in_range(kp, 0.0, 1.0, "tracking.kp");
+  require_in_range(backslip_gain, 0.0, 1.0, "tracking.backslip_gain");
+  require_positive(in_position_m, "tracking.in_position_m");
+  require_positive(filter_s, "tracking.filter_s");
+}
+
+namespace {
+/// Raised cosine from 0 (s <= 0) to 1 (s >= 1): zero slope at both ends (no velocity step).
+double blend(double s) noexcept {
+  if (s <= 0.0) return 0.0;
+  if (s >= 1.0) return 1.0;
+  return 0.5 - 0.5 * std::cos(std::numbers::pi * s);
+}
+}  // namespace
+
+TrackingController::TrackingController(const TrackingParams& p, const stickslip::StickSlipParams& model,
+                                       const StepMap& map)
+    : p_((p.validate(), p)),
+      map_(map),
+      pi_((model.validate(), model.hysteresis)),
+      g_(model.pe.static_gain_m_V),
+      slew_(model.drive.slew_rate_V_s),
+      dt_c_(1.0 / p.control_rate_Hz),
+      obs_(stickslip::make_pi_state(model.hysteresis, 0.0)) {
+  require(p.low_V >= model.drive.min_V && p.high_V <= model.drive.max_V, "tracking.low_V/high_V",
+          "must lie within the amplifier's range (drive.min_V..max_V)");
+  b_fwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward);
+  b_bwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kBackward);
+  op_.amplitude_V = p_.high_V - p_.low_V;
+  reset(0.0, p_.low_V);
+}
+
+double TrackingController::pe_displacement_m(double u_V) const noexcept {
+  return g_ * stickslip::pi_peek(pi_, obs_, u_V);
+}
+
+double TrackingController::inverse_V(double y_m) const noexcept {
+  double lo = p_.low_V, hi = p_.high_V;
+  if (y_m <= pe_displacement_m(lo)) return lo;
+  if (y_m >= pe_displacement_m(hi)) return hi;
+  // g H(U) is continuous and strictly increasing in U from any state (w_0 > 0): bisection.
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (pe_displacement_m(mid) < y_m ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double TrackingController::predicted_backslip_m(double frequency_Hz, Direction d) const noexcept {
+  const double a = p_.high_V - p_.low_V;
+  return std::max(0.0, map_.reach_m(a, frequency_Hz, d) - map_.step_m(a, frequency_Hz, d));
+}
+
+double TrackingController::flyback_frequency_Hz(double v_m_s, Direction d) const noexcept {
+  // f = |v| / s(A, f, d): the step map's inverse at the operating point (a fixed point in f).
+  const double a = p_.high_V - p_.low_V;
+  double f = 1000.0;
+  for (int i = 0; i < 4; ++i) {
+    const double s = map_.step_m(a, f, d);
+    if (s <= 0.0) break;
+    f = std::clamp(std::abs(v_m_s) / s, 1.0, 2000.0);
+  }
+  return f;
+}
+
+void TrackingController::reset(double x_m, double u_V) noexcept {
+  u_V = std::clamp(u_V, p_.low_V, p_.high_V);
+  // Drive the observer to u_V from the bottom of the range (no allocation).
+  stickslip::pi_update(pi_, obs_, p_.low_V);
+  stickslip::pi_update(pi_, obs_, u_V);
+  u_ = u_cmd_ = u_prev_cmd_ = u_V;
+  ref_ = ReferenceSample{x_m, 0.0, 0.0};
+  y_anchor_ = pe_displacement_m(u_V);
+  r_anchor_ = x_m;
+  corr_from_ = corr_ = corr_to_ = 0.0;
+  since_edge_s_ = 1.0;
+  integ_ = 0.0;
+  x_filt_ = x_m;
+  have_x_ = true;
+  edge_ = pending_anchor_ = check_backslip_ = false;
+  stopped_ = false;
+}
+
+void TrackingController::emergency_stop() noexcept {
+  stopped_ = true;
+  edge_ = false;
+  u_ = u_cmd_ = 0.0;
+}
+
+void TrackingController::start_edge(double x, bool forward) noexcept {
+  const Direction d = forward ? Direction::kForward : Direction::kBackward;
+  op_.amplitude_V = p_.high_V - p_.low_V;
+  op_.frequency_Hz = flyback_frequency_Hz(ref_.v_m_s, d);
+  op_.direction = d;
+  edge_ = true;
+  edge_forward_ = forward;
+  edge_target_V_ = forward ? p_.low_V : p_.high_V;
+  unloading_ = false;
+  x_edge_ = x;
+  b_used_ = forward ? b_fwd_ : b_bwd_;
+  ++edges_;
+}
+
+void TrackingController::anchor_after_edge() noexcept {
+  // The slider kept its place but for the backslip: anchor the ramp there. The error the plan
+  // now has (the reference moved on, the lead, the backslip) is caught up smoothly.
+  const double x_after = x_edge_ + (edge_forward_ ? -b_used_ : b_used_);
+  y_anchor_ = pe_displacement_m(u_);
+  r_anchor_ = ref_.x_m;
+  corr_from_ = corr_ = 0.0;
+  corr_to_ = ref_.x_m - x_after;
+  integ_ = 0.0;  // the anchor restarts the plan: the ramp's correction starts again from zero
+  since_edge_s_ = 0.0;
+  pending_anchor_ = false;
+  check_backslip_ = true;
+}
+
+void TrackingController::update(double x) noexcept {
+  if (stopped_) return;
+  if (!have_x_) {
+    x_filt_ = x;
+    have_x_ = true;
+  }
+  x_filt_ += dt_c_ / (p_.filter_s + dt_c_) * (x - x_filt_);
+  in_position_ = ref_.v_m_s == 0.0 && std::abs(ref_.x_m - x_filt_) < p_.in_position_m;
+  if (edge_) return;  // the edge runs in next_drive()
+  if (pending_anchor_) anchor_after_edge();
+  since_edge_s_ += dt_c_;
+  corr_ = corr_from_ + (corr_to_ - corr_from_) * blend(since_edge_s_ / p_.catchup_s);
+  const double e = ref_.x_m - x;
+  const double e_plan = corr_to_ - corr_;  // the error the catch-up still expects
+  if (check_backslip_ && since_edge_s_ >= p_.settle_s) {
+    // The edge's outcome: the anchor was off by `miss` (measured). Refine the backslip estimate
+    // and catch the miss up too (a second raised cosine from here).
+    check_backslip_ = false;
+    const double miss = e - e_plan;
+    double& b = edge_forward_ ? b_fwd_ : b_bwd_;
+    b = std::max(0.0, b + p_.backslip_gain * (edge_forward_ ? miss : -miss));
+    corr_from_ = corr_;
+    corr_to_ += miss;
+    since_edge_s_ = 0.0;
+  }
+  // Lead before an edge: the ramp runs ahead of (forward) or behind (backward) the reference by a
+  // growing fraction of the backslip, so the edge's jump is split around zero.
+  const double y_base = y_anchor_ + (ref_.x_m - r_anchor_) + corr_ + integ_;
+  const double top = pe_displacement_m(p_.high_V - p_.guard_V);
+  const double bottom = pe_displacement_m(p_.low_V + p_.guard_V);
+  double lead = 0.0;
+  if (ref_.v_m_s > 0.0) {
+    lead = p_.lead_fraction * b_fwd_ * std::clamp(1.0 - (top - y_base) / p_.lead_window_m, 0.0, 1.0);
+  } else if (ref_.v_m_s < 0.0) {
+    lead = -p_.lead_fraction * b_bwd_ * std::clamp(1.0 - (y_base - bottom) / p_.lead_window_m, 0.0, 1.0);
+  }
+  // The residual: the measured error minus the error the plan expects (catch-up still to go, lead).
+  const double e_res = e - (corr_to_ - corr_) + lead;
+  const double y_des = y_base + lead + p_.kp * e_res;
+  // An edge when the ramp runs out of range in the direction the reference moves, or, at rest,
+  // when the wanted position lies beyond the range by more than the edge margin; never against
+  // the reference's motion.
+  const double v = ref_.v_m_s;
+  if (y_des > top && v >= 0.0 && (v > 0.0 || y_des > pe_displacement_m(p_.high_V) + p_.edge_margin_m)) {
+    start_edge(x, true);
+    return;
+  }
+  if (y_des < bottom && v <= 0.0 && (v < 0.0 || y_des < pe_displacement_m(p_.low_V) - p_.edge_margin_m)) {
+    start_edge(x, false);
+    return;
+  }
+  // Integral on the residual, frozen while the slip rings and when the ramp is saturated the way
+  // the residual pushes (anti-windup).
+  const bool sat_hi = y_des >= pe_displacement_m(p_.high_V) && e_res > 0.0;
+  const bool sat_lo = y_des <= pe_displacement_m(p_.low_V) && e_res < 0.0;
+  if (!check_backslip_ && !sat_hi && !sat_lo) integ_ += p_.ki_1_s * dt_c_ * e_res;
+  u_prev_cmd_ = u_cmd_;
+  u_cmd_ = inverse_V(y_des);
+}
+
+stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
+  stickslip::DriveSegment seg;
+  if (stopped_) {
+    u_ = 0.0;
+    seg.end_V = 0.0;
+    return seg;
+  }
+  if (edge_) {
+    // The edge (and its unloading reversal) at the slew limit; a corner wherever a leg ends.
+    double left = dt_s;
+    while (edge_ && left > 0.0) {
+      const double need = std::abs(edge_target_V_ - u_) / slew_;
+      if (need > left) {
+        u_ += std::copysign(slew_ * left, edge_target_V_ - u_);
+        break;
+      }
+      left -= need;
+      u_ = edge_target_V_;
+      if (left > dt_s * 1e-9 && seg.corners < stickslip::DriveSegment::kMaxCorners) {
+        seg.u_V[static_cast<std::size_t>(seg.corners)] = u_;
+        seg.at[static_cast<std::size_t>(seg.corners)] = (dt_s - left) / dt_s;
+        ++seg.corners;
+      }
+      if (!unloading_ && p_.unload_V > 0.0) {
+        unloading_ = true;
+        edge_target_V_ = edge_forward_ ? p_.low_V + p_.unload_V : p_.high_V - p_.unload_V;
+      } else {
+        edge_ = false;
+        pending_anchor_ = true;
+        u_cmd_ = u_prev_cmd_ = u_;
+      }
+    }
+    if (!edge_ && left > 0.0 && seg.corners > 0 && seg.at[static_cast<std::size_t>(seg.corners - 1)] >= 1.0) {
+      --seg.corners;
+    }
+  } else {
+    // The ramp: linear from the last command to this one over the control period.
+    const double du = std::max(std::abs(u_cmd_ - u_prev_cmd_) / dt_c_, 1.0) * dt_s;
+    u_ += std::clamp(u_cmd_ - u_, -du, du);
+  }
+  for (int j = 0; j < seg.corners; ++j) stickslip::pi_update(pi_, obs_, seg.u_V[static_cast<std::size_t>(j)]);
+  u_ = std::clamp(u_, p_.low_V, p_.high_V);
+  stickslip::pi_update(pi_, obs_, u_);
+  seg.end_V = u_;
+  return seg;
+}
+
+}  // namespace mc::control

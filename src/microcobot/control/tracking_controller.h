@@ -1,0 +1,168 @@
+#pragma once
+/// @file
+/// Trajectory tracking within one step (issue #15; the "trajectory tracking" that thesis §2.7 and
+/// §2.8 name as what the model makes possible): one continuous scanning loop whose sawtooth is
+/// phased by the reference itself.
+///
+///  - Scanning is the slow ramp of every period: the slider sticks to the PE (thesis §2.2.2,
+///    Fig. 2.2a), so the voltage that puts it on the reference is the exact inverse of the
+///    Prandtl-Ishlinskii hysteresis (eq. 2.5) applied to the wanted PE extension
+///    y = y_anchor + (r - r_anchor) + catch-up + integral. The ramp is therefore never linear: it
+///    follows the reference's position, velocity and acceleration continuously (sub-step
+///    resolution while stepping).
+///  - The abrupt edge (Fig. 2.2b, 2.3) is a "flyback": when the ramp reaches the end of the PE's
+///    range in the direction of motion, the voltage returns to the other end at the amplifier's
+///    slew limit, the slider slips and keeps its place but for a backslip b. The period of the
+///    resulting sawtooth is set by the reference velocity: f = |v| / s(A, f, direction) from the
+///    model's step map (the step map's inverse at the operating point), and it is this operating
+///    point (A, f, direction) that the model's break-away strain z_ba sees (thesis §2.7: the
+///    generator passes its configuration on).
+///  - Feedforward of the backslip: before an edge the ramp leads the reference by a fraction of
+///    the predicted backslip b = g H(A) - s(A, f, direction) (the step map's reach minus its step,
+///    direction dependent through z_ba), after the edge it catches up along a smooth (raised
+///    cosine) profile, so the error is split around zero instead of a one-sided jump and the
+///    slider's 600 Hz contact mode is not rung by a velocity step. The feedback (integral on the
+///    measured error minus the error this plan expects) corrects only the residual; a running
+///    estimate of the backslip (per direction) is updated from each edge's measured outcome.
+///  - Step-scan blending: stepping is nothing but scanning with edges, so there is no mode switch.
+///    Around zero velocity and at the end of a move no edge is needed while the PE has range left;
+///    when one is, it is the same edge. The final position is held by the same scanning loop.
+/// update() and next_drive() never allocate; the model and the step map are fixed at construction.
+
+#include <cstdint>
+
+#include "microcobot/control/reference.h"
+#include "microcobot/control/step_map.h"
+#include "microcobot/stickslip/drive_segment.h"
+#include "microcobot/stickslip/prandtl_ishlinskii.h"
+
+namespace mc::control {
+
+struct TrackingParams {
+  double control_rate_Hz = 10000.0;  ///< rate of update()
+  /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low).
+  double low_V = 0.0;
+  double high_V = 100.0;
+  /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
+  double guard_V = 0.5;
+  /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
+  /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
+  /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V].
+  double unload_V = 60.0;
+  /// Backslip of an unloaded edge assumed before the first edge is measured [m].
+  double backslip_m = 0.0;
+  /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
+  double edge_margin_m = 20e-9;
+  /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
+  double lead_fraction = 0.5;
+  /// The lead builds up over this last part of the PE's range before the edge [m].
+  double lead_window_m = 300e-9;
+  /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
+  double catchup_s = 0.6e-3;
+  /// After an edge: the integral is frozen while the slip rings [s].
+  double settle_s = 0.4e-3;
+  double ki_1_s = 400.0;       ///< integral gain on the residual error [1/s]
+  double kp = 0.15;            ///< proportional correction of the residual (fraction per tick)
+  double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
+  /// In position: |filtered error| below this with the reference at rest [m] (reported only).
+  double in_position_m = 3e-9;
+  double filter_s = 1e-3;  ///< time constant of the in-position filter [s]
+
+  template <class V>
+  void visit(V& v) {
+    v("control_rate_Hz", control_rate_Hz);
+    v("low_V", low_V);
+    v("high_V", high_V);
+    v("guard_V", guard_V);
+    v("unload_V", unload_V);
+    v("backslip_m", backslip_m);
+    v("edge_margin_m", edge_margin_m);
+    v("lead_fraction", lead_fraction);
+    v("lead_window_m", lead_window_m);
+    v("catchup_s", catchup_s);
+    v("settle_s", settle_s);
+    v("ki_1_s", ki_1_s);
+    v("kp", kp);
+    v("backslip_gain", backslip_gain);
+    v("in_position_m", in_position_m);
+    v("filter_s", filter_s);
+  }
+  void validate() const;
+};
+
+/// The sawtooth operating point that the model's z_ba(A, f, direction) sees (thesis §2.7).
+struct OperatingPoint {
+  double amplitude_V = 0.0;
+  double frequency_Hz = 1000.0;
+  stickslip::Direction direction = stickslip::Direction::kForward;
+};
+
+class TrackingController {
+ public:
+  /// `model` gives the PE gain, the hysteresis and the drive limits; `map` the step lengths (it
+  /// must outlive the controller). Allocates (the hysteresis observer) here only.
+  TrackingController(const TrackingParams& p, const stickslip::StickSlipParams& model, const StepMap& map);
+
+  /// Starts from the measured position `x_m` with the drive at `u_V` (the PE's present voltage).
+  void reset(double x_m, double u_V = 0.0) noexcept;
+  /// The reference for the next update() (position, velocity, acceleration). Never allocates.
+  void set_reference(const ReferenceSample& r) noexcept { ref_ = r; }
+  /// One control tick on the measured position. Never allocates.
+  void update(double measured_position_m) noexcept;
+  /// The drive over the actuator step `dt_s`: the ramp (linear between ticks) or the edge at the
+  /// slew limit, with a corner where the edge ends inside the step. Never allocates.
+  stickslip::DriveSegment next_drive(double dt_s) noexcept;
+  /// 0 V at once; the axis stays stopped until reset().
+  void emergency_stop() noexcept;
+
+  const OperatingPoint& operating_point() const noexcept { return op_; }
+  double voltage_V() const noexcept { return u_; }
+  /// Edges (steps) since construction, and of them those taken forward.
+  std::int64_t edges() const noexcept { return edges_; }
+  bool in_edge() const noexcept { return edge_; }
+  bool stopped() const noexcept { return stopped_; }
+  /// |filtered error| < in_position_m with the reference at rest.
+  bool in_position() const noexcept { return in_position_; }
+  /// Present backslip estimate [m] per direction (model prediction refined by the edges).
+  double backslip_m(stickslip::Direction d) const noexcept {
+    return d == stickslip::Direction::kForward ? b_fwd_ : b_bwd_;
+  }
+  /// Model prediction of the backslip of an edge of the full range at `frequency_Hz`:
+  /// g H(A) - s(A, f, direction) from the step map [m].
+  double predicted_backslip_m(double frequency_Hz, stickslip::Direction d) const noexcept;
+  /// The PE's static displacement g H(U) from the present hysteresis state at voltage U [m].
+  double pe_displacement_m(double u_V) const noexcept;
+  /// U that makes g H(U) = `y_m` from the present hysteresis state (exact PI inverse) [V].
+  double inverse_V(double y_m) const noexcept;
+  const TrackingParams& params() const noexcept { return p_; }
+
+ private:
+  void start_edge(double x, bool forward) noexcept;
+  void anchor_after_edge() noexcept;
+  double flyback_frequency_Hz(double v_m_s, stickslip::Direction d) const noexcept;
+
+  // Fixed at construction.
+  const TrackingParams p_;
+  const StepMap& map_;
+  const stickslip::PiParams pi_;
+  const double g_, slew_, dt_c_;
+
+  // State.
+  stickslip::PiState obs_;
+  OperatingPoint op_;
+  ReferenceSample ref_;
+  double u_ = 0.0, u_cmd_ = 0.0, u_prev_cmd_ = 0.0;
+  double y_anchor_ = 0.0, r_anchor_ = 0.0, integ_ = 0.0;
+  double corr_from_ = 0.0, corr_ = 0.0, corr_to_ = 0.0;  ///< catch-up offset (raised cosine)
+  double since_edge_s_ = 1.0;
+  double b_fwd_ = 0.0, b_bwd_ = 0.0;
+  double x_edge_ = 0.0, b_used_ = 0.0;
+  double x_filt_ = 0.0;
+  double edge_target_V_ = 0.0;
+  bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
+       check_backslip_ = false;
+  bool stopped_ = false, in_position_ = false, have_x_ = false;
+  std::int64_t edges_ = 0;
+};
+
+}  // namespace mc::control

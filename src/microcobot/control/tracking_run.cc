@@ -1,0 +1,224 @@
+#include "microcobot/control/tracking_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "microcobot/control/closed_loop.h"
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+
+using stickslip::ActuatorModel;
+using stickslip::ActuatorState;
+
+std::string to_string(TrackerKind k) {
+  switch (k) {
+    case TrackerKind::kTracking:
+      return "tracking";
+    case TrackerKind::kHybrid:
+      return "hybrid";
+    case TrackerKind::kThesisPid:
+      return "thesis-pid";
+  }
+  return "tracking";
+}
+
+TrackingMetrics tracking_metrics(const std::vector<double>& ref, const std::vector<double>& x,
+                                 const std::vector<char>& moving, double tick_s) {
+  require(ref.size() == x.size() && moving.size() == x.size() && !x.empty(), "records",
+          "need equal, non-empty lengths");
+  TrackingMetrics m;
+  double sq = 0.0, sq_all = 0.0;
+  long n = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const double e = x[k] - ref[k];
+    sq_all += e * e;
+    if (!moving[k]) continue;
+    sq += e * e;
+    m.max_error_m = std::max(m.max_error_m, std::abs(e));
+    ++n;
+  }
+  m.rms_error_m = n > 0 ? std::sqrt(sq / static_cast<double>(n)) : 0.0;
+  m.rms_all_m = std::sqrt(sq_all / static_cast<double>(x.size()));
+  m.final_error_m = std::abs(x.back() - ref.back());
+  // Lag: the shift (0 .. 50 ms, whole ticks, then a parabola through the best three) that
+  // minimises the RMS of x(t) - r(t - tau) over the moving ticks.
+  if (n > 10) {
+    const long max_shift = std::min<long>(std::lround(0.05 / tick_s), static_cast<long>(x.size()) / 2);
+    auto cost = [&](long s) {
+      double c = 0.0;
+      long cnt = 0;
+      for (std::size_t k = static_cast<std::size_t>(s); k < x.size(); ++k) {
+        if (!moving[k]) continue;
+        const double e = x[k] - ref[k - static_cast<std::size_t>(s)];
+        c += e * e;
+        ++cnt;
+      }
+      return cnt > 0 ? c / static_cast<double>(cnt) : 1e300;
+    };
+    long best = 0;
+    double cb = cost(0);
+    // Coarse to fine: the cost is smooth in the shift for smooth references.
+    for (long s = 1; s <= max_shift; ++s) {
+      const double c = cost(s);
+      if (c < cb) {
+        cb = c;
+        best = s;
+      } else if (c > 4.0 * cb && s > best + 20) {
+        break;
+      }
+    }
+    double frac = 0.0;
+    if (best > 0 && best < max_shift) {
+      const double cm = cost(best - 1), cp = cost(best + 1);
+      const double den = cm - 2.0 * cb + cp;
+      if (den > 0.0) frac = std::clamp(0.5 * (cm - cp) / den, -0.5, 0.5);
+    }
+    m.lag_s = (static_cast<double>(best) + frac) * tick_s;
+  }
+  return m;
+}
+
+namespace {
+
+ActuatorState start_state(const ActuatorModel& model, double start_m) {
+  const double half = 0.5 * model.params().slider.stroke_m;
+  require(std::isfinite(start_m) && std::abs(start_m) <= half, "start_m", "must lie within the stroke",
+          start_m);
+  ActuatorState s = model.initial_state();
+  s.x2_m = {start_m, start_m};
+  return s;
+}
+
+/// The three trackers behind one interface for the loop below.
+struct Tracker {
+  virtual ~Tracker() = default;
+  virtual void update(const ReferenceSample& r, double x) noexcept = 0;
+  virtual stickslip::DriveSegment next_drive(double dt) noexcept = 0;
+  virtual void operating_point(double& a, double& f, stickslip::Direction& d) const noexcept = 0;
+  virtual long edges() const noexcept = 0;
+};
+
+struct NewTracker final : Tracker {
+  TrackingController c;
+  NewTracker(const TrackerSetup& s, const ActuatorModel& m, const StepMap& map, double x0)
+      : c(s.tracking, m.params(), map) {
+    c.reset(x0, s.tracking.low_V);
+  }
+  void update(const ReferenceSample& r, double x) noexcept override {
+    c.set_reference(r);
+    c.update(x);
+  }
+  stickslip::DriveSegment next_drive(double dt) noexcept override { return c.next_drive(dt); }
+  void operating_point(double& a, double& f, stickslip::Direction& d) const noexcept override {
+    a = c.operating_point().amplitude_V;
+    f = c.operating_point().frequency_Hz;
+    d = c.operating_point().direction;
+  }
+  long edges() const noexcept override { return static_cast<long>(c.edges()); }
+};
+
+struct HybridTracker final : Tracker {
+  PositionController c;
+  HybridTracker(const TrackerSetup& s, const ActuatorModel& m, const StepMap& map)
+      : c(s.hybrid, m.params(), map) {}
+  void update(const ReferenceSample& r, double x) noexcept override {
+    c.set_target(r.x_m, r.v_m_s);
+    c.update(x);
+  }
+  stickslip::DriveSegment next_drive(double dt) noexcept override { return c.next_drive(dt); }
+  void operating_point(double& a, double& f, stickslip::Direction& d) const noexcept override {
+    a = c.generator().amplitude_V();
+    f = c.generator().frequency_Hz();
+    d = c.generator().direction();
+  }
+  long edges() const noexcept override { return static_cast<long>(c.generator().periods()); }
+};
+
+struct PidTracker final : Tracker {
+  BaselinePositionController c;
+  bool started = false;
+  PidTracker(const TrackerSetup& s, const ActuatorModel& m)
+      : c(s.pid, BaselineKind::kThesisPid, m.params().drive.slew_rate_V_s) {}
+  void update(const ReferenceSample& r, double x) noexcept override {
+    if (!started) {
+      c.set_target(r.x_m, x);
+      started = true;
+    }
+    c.track(r.x_m);
+    c.update(x);
+  }
+  stickslip::DriveSegment next_drive(double dt) noexcept override { return c.next_drive(dt); }
+  void operating_point(double& a, double& f, stickslip::Direction& d) const noexcept override {
+    a = c.generator().amplitude_V();
+    f = c.generator().frequency_Hz();
+    d = c.generator().direction();
+  }
+  long edges() const noexcept override { return static_cast<long>(c.generator().periods()); }
+};
+
+}  // namespace
+
+TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, TrackerKind kind,
+                           const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
+                           double duration_s, int max_records) {
+  require_positive(duration_s, "duration_s");
+  require(max_records >= 10, "max_records", "must be >= 10", max_records);
+  std::unique_ptr<Tracker> tr;
+  switch (kind) {
+    case TrackerKind::kTracking:
+      tr = std::make_unique<NewTracker>(setup, model, map, start_m);
+      break;
+    case TrackerKind::kHybrid:
+      tr = std::make_unique<HybridTracker>(setup, model, map);
+      break;
+    case TrackerKind::kThesisPid:
+      tr = std::make_unique<PidTracker>(setup, model);
+      break;
+  }
+  PositionSensor sensor(setup.sensor);
+  ActuatorState s = start_state(model, start_m);
+  const int ratio = steps_per_tick(model, 10000.0);
+  const double tick = static_cast<double>(ratio) * model.dt_s();
+  const long ticks = std::lround(duration_s / tick);
+  const long every = std::max(1L, ticks / max_records);
+  std::vector<double> ref(static_cast<std::size_t>(ticks)), xs(static_cast<std::size_t>(ticks));
+  std::vector<char> moving(static_cast<std::size_t>(ticks));
+  TrackingRecord rec;
+  const double dt = model.dt_s();
+  for (long k = 0; k < ticks; ++k) {
+    const ReferenceSample r = reference(static_cast<double>(k) * tick, tick);
+    tr->update(r, sensor.measure(model.slider_position(s)));
+    double a = 0.0, f = 1000.0;
+    stickslip::Direction d = stickslip::Direction::kForward;
+    tr->operating_point(a, f, d);
+    model.set_operating_point(s, a, f, d);
+    double u = 0.0;
+    for (int i = 0; i < ratio; ++i) {
+      const stickslip::DriveSegment seg = tr->next_drive(dt);
+      model.step(s, seg);
+      u = seg.end_V;
+    }
+    if (s.diverged) {
+      throw ComputationFailed("closed-loop simulation diverged (NaN/Inf) at t = " + std::to_string(s.t_s) +
+                              " s");
+    }
+    const double x = model.slider_position(s);
+    const auto ku = static_cast<std::size_t>(k);
+    ref[ku] = r.x_m;
+    xs[ku] = x;
+    moving[ku] = r.v_m_s != 0.0 ? 1 : 0;
+    if (k % every == 0) {
+      rec.t_s.push_back(static_cast<double>(k + 1) * tick);
+      rec.ref_m.push_back(r.x_m);
+      rec.x_m.push_back(x);
+      rec.u_V.push_back(u);
+    }
+  }
+  rec.metrics = tracking_metrics(ref, xs, moving, tick);
+  rec.metrics.edges = tr->edges();
+  return rec;
+}
+
+}  // namespace mc::control

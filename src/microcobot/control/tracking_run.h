@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// Closed-loop trajectory-tracking runs of one axis (issue #15): the tracking controller and its
+/// baselines (today's hybrid position controller fed the moving target, the thesis's PID on the
+/// sawtooth amplitude, §2.7 Fig. 2.18) on the same model, sensor noise and reference, with the
+/// metrics of the issue: RMS and max error during motion, lag, final error. The runner allocates
+/// its records only; the controllers inside never allocate.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "microcobot/control/baseline_position.h"
+#include "microcobot/control/position_controller.h"
+#include "microcobot/control/position_sensor.h"
+#include "microcobot/control/reference.h"
+#include "microcobot/control/tracking_controller.h"
+#include "microcobot/stickslip/actuator.h"
+
+namespace mc::control {
+
+enum class TrackerKind { kTracking, kHybrid, kThesisPid };
+std::string to_string(TrackerKind k);
+
+struct TrackingMetrics {
+  double rms_error_m = 0.0;    ///< RMS of x - r (true position) while the reference moves
+  double max_error_m = 0.0;    ///< max |x - r| while the reference moves
+  double rms_all_m = 0.0;      ///< RMS over the whole run
+  double lag_s = 0.0;          ///< the delay tau that minimises RMS(x(t) - r(t - tau)) in motion
+  double final_error_m = 0.0;  ///< |x - r| at the end of the run (reference at rest)
+  long edges = 0;              ///< steps taken (tracking controller: edges)
+};
+
+struct TrackingRecord {
+  std::vector<double> t_s, ref_m, x_m, u_V;
+  TrackingMetrics metrics;
+};
+
+/// Everything the three trackers need.
+struct TrackerSetup {
+  TrackingParams tracking;
+  PositionControlParams hybrid;
+  BaselinePositionParams pid;
+  PositionSensorParams sensor;
+};
+
+using ReferenceFn = std::function<ReferenceSample(double t_s, double dt_s)>;
+
+/// Tracks `reference` (called once per 10 kHz control tick in time order) from `start_m` for
+/// `duration_s` with tracker `kind`. Divergence throws mc::ComputationFailed.
+TrackingRecord run_tracker(const stickslip::ActuatorModel& model, const StepMap& map, TrackerKind kind,
+                           const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
+                           double duration_s, int max_records = 20000);
+
+/// The metrics of per-tick records: `moving[k]` marks ticks where the reference moves.
+TrackingMetrics tracking_metrics(const std::vector<double>& ref_m, const std::vector<double>& x_m,
+                                 const std::vector<char>& moving, double tick_s);
+
+}  // namespace mc::control
