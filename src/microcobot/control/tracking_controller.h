@@ -60,9 +60,11 @@ struct TrackingParams {
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
   double catchup_s = 0.6e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
-  double settle_s = 0.4e-3;
-  double ki_1_s = 400.0;       ///< integral gain on the residual error [1/s]
-  double kp = 0.15;            ///< proportional correction of the residual (fraction per tick)
+  double settle_s = 0.55e-3;
+  double ki_1_s = 1000.0;  ///< integral gain on the residual error [1/s]
+  /// Proportional correction of the residual (fraction per tick): 0 by default, any gain rings
+  /// the contact after the edges (tuned: RMS 156 nm at 0, 220 nm at 0.1; 200 um/s trapezoid).
+  double kp = 0.0;
   double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
