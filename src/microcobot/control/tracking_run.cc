@@ -160,23 +160,98 @@ struct PidTracker final : Tracker {
 
 }  // namespace
 
+namespace {
+std::unique_ptr<Tracker> make_tracker(TrackerKind kind, const TrackerSetup& setup, const ActuatorModel& model,
+                                      const StepMap& map, double start_m) {
+  switch (kind) {
+    case TrackerKind::kTracking:
+      return std::make_unique<NewTracker>(setup, model, map, start_m);
+    case TrackerKind::kHybrid:
+      return std::make_unique<HybridTracker>(setup, model, map);
+    case TrackerKind::kThesisPid:
+      return std::make_unique<PidTracker>(setup, model);
+  }
+  return nullptr;
+}
+}  // namespace
+
+PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind kind,
+                    const TrackerSetup& setup, const PathGenerator& path, double hold_s, int max_records) {
+  require_non_negative(hold_s, "hold_s");
+  require(max_records >= 10, "max_records", "must be >= 10", max_records);
+  const int ratio = steps_per_tick(model, 10000.0);
+  const double tick = static_cast<double>(ratio) * model.dt_s();
+  const double duration = path.duration_s() + hold_s;
+  const long ticks = std::lround(duration / tick);
+  const long every = std::max(1L, ticks / max_records);
+  const PathSample p0 = path.sample(0.0);
+  std::array<std::unique_ptr<Tracker>, 3> tr;
+  std::array<ActuatorState, 3> st;
+  std::vector<PositionSensor> sensors;
+  for (int i = 0; i < 3; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    tr[iu] = make_tracker(kind, setup, model, map, p0.x_m[i]);
+    st[iu] = start_state(model, p0.x_m[i]);
+    auto sp = setup.sensor;
+    sp.seed += i;  // the XYZ stage's per-axis noise stream
+    sensors.emplace_back(sp);
+  }
+  PathRecord rec;
+  double sq_dev = 0.0, sq_err = 0.0;
+  long n = 0;
+  const double dt = model.dt_s();
+  Eigen::Vector3d x = p0.x_m, r = p0.x_m;
+  for (long k = 0; k < ticks; ++k) {
+    const double t = static_cast<double>(k) * tick;
+    const PathSample ps = path.sample(t);
+    for (int i = 0; i < 3; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      ActuatorState& s = st[iu];
+      tr[iu]->update(ReferenceSample{ps.x_m[i], ps.v_m_s[i], ps.a_m_s2[i]},
+                     sensors[iu].measure(model.slider_position(s)));
+      double a = 0.0, f = 1000.0;
+      stickslip::Direction d = stickslip::Direction::kForward;
+      tr[iu]->operating_point(a, f, d);
+      model.set_operating_point(s, a, f, d);
+      for (int j = 0; j < ratio; ++j) model.step(s, tr[iu]->next_drive(dt));
+      if (s.diverged) {
+        throw ComputationFailed("closed-loop simulation diverged (NaN/Inf) at t = " + std::to_string(s.t_s) +
+                                " s");
+      }
+      x[i] = model.slider_position(s);
+    }
+    r = ps.x_m;
+    const double dev = path.distance_to_path(x);
+    const double err = (x - r).norm();
+    if (t <= path.duration_s()) {
+      sq_dev += dev * dev;
+      sq_err += err * err;
+      ++n;
+      rec.metrics.max_deviation_m = std::max(rec.metrics.max_deviation_m, dev);
+      rec.metrics.max_error_m = std::max(rec.metrics.max_error_m, err);
+    }
+    if (k % every == 0) {
+      rec.t_s.push_back(t + tick);
+      rec.deviation_m.push_back(dev);
+      for (std::size_t i = 0; i < 3; ++i) {
+        rec.x_m[i].push_back(x[static_cast<Eigen::Index>(i)]);
+        rec.ref_m[i].push_back(r[static_cast<Eigen::Index>(i)]);
+      }
+    }
+  }
+  rec.metrics.rms_deviation_m = std::sqrt(sq_dev / static_cast<double>(std::max(1L, n)));
+  rec.metrics.rms_error_m = std::sqrt(sq_err / static_cast<double>(std::max(1L, n)));
+  rec.metrics.final_error_m = (x - r).norm();
+  for (const auto& t : tr) rec.metrics.edges += t->edges();
+  return rec;
+}
+
 TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, TrackerKind kind,
                            const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
                            double duration_s, int max_records) {
   require_positive(duration_s, "duration_s");
   require(max_records >= 10, "max_records", "must be >= 10", max_records);
-  std::unique_ptr<Tracker> tr;
-  switch (kind) {
-    case TrackerKind::kTracking:
-      tr = std::make_unique<NewTracker>(setup, model, map, start_m);
-      break;
-    case TrackerKind::kHybrid:
-      tr = std::make_unique<HybridTracker>(setup, model, map);
-      break;
-    case TrackerKind::kThesisPid:
-      tr = std::make_unique<PidTracker>(setup, model);
-      break;
-  }
+  std::unique_ptr<Tracker> tr = make_tracker(kind, setup, model, map, start_m);
   PositionSensor sensor(setup.sensor);
   ActuatorState s = start_state(model, start_m);
   const int ratio = steps_per_tick(model, 10000.0);

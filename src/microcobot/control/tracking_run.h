@@ -10,7 +10,10 @@
 #include <string>
 #include <vector>
 
+#include <array>
+
 #include "microcobot/control/baseline_position.h"
+#include "microcobot/control/path_generator.h"
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/position_sensor.h"
 #include "microcobot/control/reference.h"
@@ -55,5 +58,26 @@ TrackingRecord run_tracker(const stickslip::ActuatorModel& model, const StepMap&
 /// The metrics of per-tick records: `moving[k]` marks ticks where the reference moves.
 TrackingMetrics tracking_metrics(const std::vector<double>& ref_m, const std::vector<double>& x_m,
                                  const std::vector<char>& moving, double tick_s);
+
+struct PathMetrics {
+  double max_deviation_m = 0.0;  ///< max distance of the true 3-D position to the ideal path
+  double rms_deviation_m = 0.0;  ///< RMS of that distance while the path runs
+  double rms_error_m = 0.0;      ///< RMS of |x - r| (3-D, to the timed reference) while it runs
+  double max_error_m = 0.0;
+  double final_error_m = 0.0;  ///< |x - r| (3-D) at the end
+  long edges = 0;              ///< steps of the three axes
+};
+
+struct PathRecord {
+  std::vector<double> t_s, deviation_m;
+  std::array<std::vector<double>, 3> x_m, ref_m;
+  PathMetrics metrics;
+};
+
+/// The three axes of the XYZ stage (one model, three states, per-axis sensor noise streams:
+/// seed + axis) follow `path` with tracker `kind`, then `hold_s` at rest.
+PathRecord run_path(const stickslip::ActuatorModel& model, const StepMap& map, TrackerKind kind,
+                    const TrackerSetup& setup, const PathGenerator& path, double hold_s = 0.03,
+                    int max_records = 20000);
 
 }  // namespace mc::control
