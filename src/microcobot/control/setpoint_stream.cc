@@ -1,5 +1,6 @@
 #include "microcobot/control/setpoint_stream.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -9,15 +10,17 @@ namespace mc::control {
 void SetpointStreamParams::validate() const {
   require_non_negative(delay_s, "stream.delay_s");
   require(capacity >= 2 && capacity <= 100000, "stream.capacity", "must be in [2, 100000]", capacity);
-  limits.validate();
+  require_positive(max_velocity_m_s, "stream.max_velocity_m_s");
 }
 
 SetpointStream::SetpointStream(const SetpointStreamParams& p, double x0_m)
-    : p_((p.validate(), p)), ring_(static_cast<std::size_t>(p.capacity)), lim_(p.limits, x0_m) {}
+    : p_((p.validate(), p)), ring_(static_cast<std::size_t>(p.capacity)) {
+  out_.x_m = x0_m;
+}
 
 void SetpointStream::reset(double x0_m) noexcept {
   head_ = count_ = 0;
-  lim_.reset(x0_m);
+  out_ = ReferenceSample{x0_m, 0.0, 0.0};
   holding_ = false;
 }
 
@@ -36,7 +39,7 @@ bool SetpointStream::push(double stamp_s, double x_m) noexcept {
 ReferenceSample SetpointStream::sample(double t_s, double dt_s) noexcept {
   if (count_ == 0) {
     holding_ = true;
-    return lim_.step(lim_.state().x_m, dt_s);
+    return follow(out_.x_m, dt_s);
   }
   const double tq = t_s - p_.delay_s;
   // Drop setpoints that the interpolation has passed (keep one before tq).
@@ -55,7 +58,15 @@ ReferenceSample SetpointStream::sample(double t_s, double dt_s) noexcept {
   } else {
     holding_ = true;  // past the newest setpoint: hold it, never extrapolate
   }
-  return lim_.step(x, dt_s);
+  return follow(x, dt_s);
+}
+
+ReferenceSample SetpointStream::follow(double x_m, double dt_s) noexcept {
+  const double step = p_.max_velocity_m_s * dt_s;
+  const double x_new = out_.x_m + std::clamp(x_m - out_.x_m, -step, step);
+  const double v_new = dt_s > 0.0 ? (x_new - out_.x_m) / dt_s : 0.0;
+  out_ = ReferenceSample{x_new, v_new, dt_s > 0.0 ? (v_new - out_.v_m_s) / dt_s : 0.0};
+  return out_;
 }
 
 }  // namespace mc::control

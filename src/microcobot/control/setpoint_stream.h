@@ -6,9 +6,10 @@
 /// stamp's clock (a bounded look-ahead: the interpolation sees at most `capacity` setpoints and
 /// never waits longer than `delay_s`), linearly interpolated between the two setpoints around
 /// t - delay. Late or missing setpoints hold: beyond the newest setpoint the output stays on it
-/// (no extrapolation), and the result passes through a ReferenceLimiter so that a late setpoint
-/// that arrives after a hold is joined under the velocity and acceleration limits, never by a
-/// jump. push() and sample() never allocate (a ring of `capacity` entries made at construction).
+/// (no extrapolation), and the output is rate limited so that a late setpoint that arrives after
+/// a hold is joined at `max_velocity_m_s`, never by a jump (a stream that stays within the limit
+/// passes unchanged: no lag beyond the look-ahead). push() and sample() never allocate (a ring of `capacity`
+/// entries made at construction).
 
 #include <cstddef>
 #include <vector>
@@ -18,15 +19,15 @@
 namespace mc::control {
 
 struct SetpointStreamParams {
-  double delay_s = 2e-3;            ///< look-ahead: the output lags the setpoints by this much
-  int capacity = 32;                ///< setpoints kept (>= delay / period + 2)
-  MotionLimits limits{1e-3, 0.05};  ///< limits applied to the interpolated stream
+  double delay_s = 2e-3;           ///< look-ahead: the output lags the setpoints by this much
+  int capacity = 32;               ///< setpoints kept (>= delay / period + 2)
+  double max_velocity_m_s = 1e-3;  ///< rate limit of the output (rejoining after a hold)
 
   template <class V>
   void visit(V& v) {
     v("delay_s", delay_s);
     v("capacity", capacity);
-    v("limits", limits);
+    v("max_velocity_m_s", max_velocity_m_s);
   }
   void validate() const;
 };
@@ -50,11 +51,12 @@ class SetpointStream {
   struct Entry {
     double t = 0.0, x = 0.0;
   };
+  ReferenceSample follow(double x_m, double dt_s) noexcept;
   const Entry& at(std::size_t i) const noexcept { return ring_[(head_ + i) % ring_.size()]; }
   SetpointStreamParams p_;
   std::vector<Entry> ring_;
   std::size_t head_ = 0, count_ = 0;
-  ReferenceLimiter lim_;
+  ReferenceSample out_;
   bool holding_ = false;
 };
 
