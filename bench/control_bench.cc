@@ -4,6 +4,8 @@
 #include <benchmark/benchmark.h>
 
 #include "microcobot/control/position_controller.h"
+#include "microcobot/control/setpoint_stream.h"
+#include "microcobot/control/tracking_controller.h"
 #include "microcobot/control/velocity_controller.h"
 #include "microcobot/control/xyz_stage.h"
 #include "microcobot/stickslip/actuator.h"
@@ -52,6 +54,41 @@ void BM_PositionControllerTickStepping(benchmark::State& st) { position_tick(st,
 void BM_PositionControllerTickScanning(benchmark::State& st) { position_tick(st, 0.5e-6); }
 BENCHMARK(BM_PositionControllerTickStepping)->Iterations(20000);
 BENCHMARK(BM_PositionControllerTickScanning)->Iterations(20000);
+
+/// Tracking controller (issue #15) following a 200 um/s ramp on the model (edges every ~2.5 ms),
+/// timed without the model's steps.
+void BM_TrackingControllerTick(benchmark::State& st) {
+  ct::TrackingController c(ct::TrackingParams{}, model().params(), step_map());
+  auto s = model().initial_state();
+  c.reset(0.0, 0.0);
+  double r = 0.0;
+  mc::stickslip::DriveSegment u[10];
+  for (auto _ : st) {
+    r += 200e-6 * 1e-4;
+    c.set_reference({r, 200e-6, 0.0});
+    c.update(model().slider_position(s));
+    for (auto& v : u) v = c.next_drive(1e-5);
+    st.PauseTiming();
+    model().set_operating_point(s, c.operating_point().amplitude_V, c.operating_point().frequency_Hz,
+                                c.operating_point().direction);
+    for (const auto& v : u) model().step(s, v);
+    st.ResumeTiming();
+  }
+}
+BENCHMARK(BM_TrackingControllerTick)->Iterations(20000);
+
+/// Setpoint stream: one setpoint per 10 ticks (1 kHz) and a sample per tick (10 kHz).
+void BM_SetpointStreamSample(benchmark::State& st) {
+  ct::SetpointStream s(ct::SetpointStreamParams{}, 0.0);
+  long k = 0;
+  for (auto _ : st) {
+    const double t = static_cast<double>(k) * 1e-4;
+    if (k % 10 == 0) s.push(t, 1e-9 * static_cast<double>(k));
+    benchmark::DoNotOptimize(s.sample(t, 1e-4));
+    ++k;
+  }
+}
+BENCHMARK(BM_SetpointStreamSample);
 
 void BM_XyzStageTick(benchmark::State& st) {
   ct::XyzStage stage(model(), step_map());

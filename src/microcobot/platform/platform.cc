@@ -83,8 +83,9 @@ void Platform::build() {
             "must equal the stick-slip model's step (integrator.dt_s)", period);
   }
   map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
-  stage_ = std::make_unique<StageController>(config_.stage.control, model_->params(), *map_,
-                                             static_cast<int>(std::lround(ratio)), model_->dt_s());
+  stage_ = std::make_unique<StageController>(
+      config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
+      config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr);
   teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                      world_.params().gripper.max_opening_m);
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
@@ -157,6 +158,14 @@ void Platform::slave_control_task() noexcept {
   const auto& out = teleop_->output();
   const std::array<double, 3> measured = {devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
                                           devices_.axes[2]->position_m()};
+  // Operator-to-slave tracking error (issue #15): the target the operator commands now against
+  // where the slave is, while the coupling is engaged.
+  if (out.engaged) {
+    const double e = (out.slave_target_m - Eigen::Vector3d(measured[0], measured[1], measured[2])).norm();
+    tracking_.sum_sq_m2 += e * e;
+    tracking_.max_m = std::max(tracking_.max_m, e);
+    ++tracking_.samples;
+  }
   stage_->update(out.slave_target_m, out.slave_velocity_m_s, measured);
 }
 

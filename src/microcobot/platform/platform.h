@@ -20,6 +20,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <thread>
@@ -158,6 +159,14 @@ class Platform {
   /// The simulated devices; throws mc::InvalidParams on a platform built on other devices.
   const SimulatedDevices& simulation() const;
   const StageController& stage_controller() const { return *stage_; }
+  /// Operator-to-slave tracking error: |slave target - measured slave position| (3-D) at every
+  /// slave tick while the teleoperation coupling is engaged (issue #15).
+  struct TrackingErrorStats {
+    double sum_sq_m2 = 0.0, max_m = 0.0;
+    std::uint64_t samples = 0;
+    double rms_m() const { return samples > 0 ? std::sqrt(sum_sq_m2 / static_cast<double>(samples)) : 0.0; }
+  };
+  const TrackingErrorStats& tracking_error() const { return tracking_; }
   const control::TeleoperationOutput& teleop() const { return teleop_->output(); }
   const Recorder& recording() const { return *recorder_; }
   /// Channels recorded: all of kTelemetryChannels when simulated, the loop channels otherwise.
@@ -188,6 +197,7 @@ class Platform {
   PlatformDevices devices_;
   SimulatedDevices sim_;  ///< all null unless simulated
   std::unique_ptr<StageController> stage_;
+  TrackingErrorStats tracking_;
   std::unique_ptr<control::Teleoperation> teleop_;
   Watchdog haptic_watchdog_;
   Watchdog tweezers_watchdog_;

@@ -18,6 +18,7 @@
 #include "microcobot/control/position_sensor.h"
 #include "microcobot/control/step_map.h"
 #include "microcobot/control/teleoperation.h"
+#include "microcobot/control/tracking_controller.h"
 #include "microcobot/haptics/dual_stage_plant.h"
 #include "microcobot/haptics/pantograph.h"
 #include "microcobot/haptics/render_pipeline.h"
@@ -51,6 +52,11 @@ struct LoopParams {
 
 struct StageParams {
   control::PositionControlParams control = default_control();
+  /// Issue #15: the axes follow the teleoperation target with the tracking controller
+  /// (reference-phased sawtooth) instead of the hybrid position controller. Off by default: see
+  /// docs/errata.md (not yet validated against the platform's pick-and-place acceptance tests).
+  bool tracking_enabled = false;
+  control::TrackingParams tracking = default_tracking();
   control::PositionSensorParams sensor;
   control::StepMapParams step_map;
   /// Finger-tip position (world frame) when the three axes are at 0 (mid-stroke).
@@ -61,11 +67,18 @@ struct StageParams {
   template <class V>
   void visit(V& v) {
     v("control", control);
+    v("tracking_enabled", tracking_enabled);
+    v("tracking", tracking);
     v("sensor", sensor);
     v("step_map", step_map);
     v("home_x_m", home_x_m);
     v("home_y_m", home_y_m);
     v("home_z_m", home_z_m);
+  }
+  static control::TrackingParams default_tracking() {
+    control::TrackingParams p;
+    p.control_rate_Hz = 1000.0;  // the slave rate of LoopParams
+    return p;
   }
   static control::PositionControlParams default_control() {
     control::PositionControlParams p;

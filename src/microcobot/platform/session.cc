@@ -42,6 +42,8 @@ nlohmann::json SessionResult::to_json() const {
   j["success"] = success;
   j["verdict"] = verdict;
   j["placement_error_m"] = placement_error_m;
+  j["tracking_error_rms_m"] = tracking_error_rms_m;
+  j["tracking_error_max_m"] = tracking_error_max_m;
   j["ticks"] = ticks;
   j["overruns"] = overruns;
   j["tick_mean_us"] = tick_mean_us;
@@ -105,6 +107,8 @@ SessionResult Session::run(const std::function<void(double)>& progress, const st
   r.crashed = w.crashed;
   r.placement_error_m = g.world().placement_error_m(w);
   r.telemetry_dropped = p.telemetry_dropped();
+  r.tracking_error_rms_m = p.tracking_error().rms_m();
+  r.tracking_error_max_m = p.tracking_error().max_m;
   using Phase = PickPlaceOperator::Phase;
   for (int i = 0; i <= static_cast<int>(Phase::kDone); ++i) {
     const double t = operator_->phase_start_s(static_cast<Phase>(i));
@@ -172,6 +176,8 @@ report::Report Session::report(const SessionResult& r) const {
   rep.section("Outcome", r.verdict + ".\n\nPhases: " + phases);
   rep.add_result("success", r.success ? 1.0 : 0.0);
   rep.add_result("placement error", r.placement_error_m, "m");
+  rep.add_result("operator-to-slave tracking error (RMS, engaged)", r.tracking_error_rms_m, "m");
+  rep.add_result("operator-to-slave tracking error (max, engaged)", r.tracking_error_max_m, "m");
   rep.add_result("simulated duration", r.duration_s, "s");
   rep.add_result("clutches (indexing)", r.clutches);
   rep.add_result("faulted", r.faulted ? 1.0 : 0.0);

@@ -45,6 +45,8 @@ struct SessionResult {
   bool success = false;
   std::string verdict;  ///< one line: why it succeeded or failed
   double placement_error_m = 0.0;
+  /// Operator-to-slave tracking error while engaged (Platform::tracking_error()).
+  double tracking_error_rms_m = 0.0, tracking_error_max_m = 0.0;
   double duration_s = 0.0;  ///< simulated time
   std::uint64_t ticks = 0;
   std::uint64_t overruns = 0;

@@ -6,12 +6,17 @@ namespace mc::platform {
 
 StageController::StageController(const control::PositionControlParams& params,
                                  const stickslip::StickSlipParams& model, const control::StepMap& map,
-                                 int samples_per_tick, double sample_period_s)
+                                 int samples_per_tick, double sample_period_s,
+                                 const control::TrackingParams* tracking)
     : sample_period_s_(sample_period_s) {
   require(samples_per_tick >= 1, "samples_per_tick", "must be at least 1", samples_per_tick);
   require_positive(sample_period_s, "sample_period_s");
   for (std::size_t i = 0; i < 3; ++i) {
-    ctrl_[i] = std::make_unique<control::PositionController>(params, model, map);
+    if (tracking) {
+      track_[i] = std::make_unique<control::TrackingController>(*tracking, model, map);
+    } else {
+      ctrl_[i] = std::make_unique<control::PositionController>(params, model, map);
+    }
     samples_[i].assign(static_cast<std::size_t>(samples_per_tick), stickslip::DriveSegment{});
   }
 }
@@ -19,8 +24,16 @@ StageController::StageController(const control::PositionControlParams& params,
 void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vector3d& velocity_m_s,
                              const std::array<double, 3>& measured_m) noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
-    auto& c = *ctrl_[i];
     const auto k = static_cast<Eigen::Index>(i);
+    if (track_[i]) {
+      auto& t = *track_[i];
+      // The first tick (and the first after an emergency stop) starts from where the axis is.
+      if (!started_ || stopped_) t.reset(measured_m[i], stopped_ ? 0.0 : t.voltage_V());
+      t.set_reference(control::ReferenceSample{target_m[k], velocity_m_s[k], 0.0});
+      t.update(measured_m[i]);
+      continue;
+    }
+    auto& c = *ctrl_[i];
     // A changed target (teleoperation moves it) is tracked with its velocity; an unchanged
     // one is left alone so that the controller settles into hold.
     if (stopped_ || c.target_m() != target_m[k] || velocity_m_s[k] != 0.0)
@@ -28,11 +41,23 @@ void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vecto
     c.update(measured_m[i]);
   }
   stopped_ = false;
+  started_ = true;
 }
 
 DriveBlock StageController::drive(int i) noexcept {
-  auto& c = *ctrl_[static_cast<std::size_t>(i)];
   auto& buf = samples_[static_cast<std::size_t>(i)];
+  if (auto* t = track_[static_cast<std::size_t>(i)].get()) {
+    for (auto& d : buf) d = t->next_drive(sample_period_s_);
+    const auto& op = t->operating_point();
+    DriveBlock b;
+    b.segments = buf.data();
+    b.count = static_cast<int>(buf.size());
+    b.amplitude_V = op.amplitude_V;
+    b.frequency_Hz = op.frequency_Hz;
+    b.direction = op.direction == stickslip::Direction::kBackward ? -1 : 1;
+    return b;
+  }
+  auto& c = *ctrl_[static_cast<std::size_t>(i)];
   for (auto& d : buf) d = c.next_drive(sample_period_s_);
   const auto& g = c.generator();
   DriveBlock b;
@@ -45,7 +70,10 @@ DriveBlock StageController::drive(int i) noexcept {
 }
 
 void StageController::emergency_stop() noexcept {
-  for (auto& c : ctrl_) c->emergency_stop();
+  for (auto& c : ctrl_)
+    if (c) c->emergency_stop();
+  for (auto& t : track_)
+    if (t) t->emergency_stop();
   stopped_ = true;
 }
 

@@ -15,6 +15,7 @@
 
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/step_map.h"
+#include "microcobot/control/tracking_controller.h"
 #include "microcobot/platform/device.h"
 
 namespace mc::platform {
@@ -23,8 +24,10 @@ class StageController {
  public:
   /// `params.control_rate_Hz` is the slave rate; `samples_per_tick` drive samples of
   /// `sample_period_s` make one loop tick. `model` and `map` must outlive the controller.
+  /// With `tracking` (issue #15) each axis runs a control::TrackingController instead.
   StageController(const control::PositionControlParams& params, const stickslip::StickSlipParams& model,
-                  const control::StepMap& map, int samples_per_tick, double sample_period_s);
+                  const control::StepMap& map, int samples_per_tick, double sample_period_s,
+                  const control::TrackingParams* tracking = nullptr);
 
   /// One slave-rate tick: new targets (with their velocity feedforward) and measurements.
   void update(const Eigen::Vector3d& target_m, const Eigen::Vector3d& velocity_m_s,
@@ -39,10 +42,17 @@ class StageController {
   /// Every axis to 0 V; they stay stopped until the next update() with a target.
   void emergency_stop() noexcept;
 
-  const control::PositionController& axis(int i) const { return *ctrl_[static_cast<std::size_t>(i)]; }
+  /// The hybrid controller of axis i (null when tracking).
+  const control::PositionController* axis(int i) const { return ctrl_[static_cast<std::size_t>(i)].get(); }
+  /// The tracking controller of axis i (null unless tracking).
+  const control::TrackingController* tracker(int i) const {
+    return track_[static_cast<std::size_t>(i)].get();
+  }
 
  private:
   std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
+  std::array<std::unique_ptr<control::TrackingController>, 3> track_;
+  bool started_ = false;
   std::array<std::vector<stickslip::DriveSegment>, 3> samples_;
   double sample_period_s_;
   bool stopped_ = false;
