@@ -2,6 +2,7 @@
 // thesis §2.7 (Fig. 2.18-2.19), hybrid closed-loop positioning, trajectory tracking, each with its
 // baselines (open-loop step counting, the thesis's PID) measured in the same run.
 
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -9,6 +10,8 @@
 
 #include "cli.h"
 #include "microcobot/control/closed_loop.h"
+#include "microcobot/control/setpoint_stream.h"
+#include "microcobot/control/tracking_run.h"
 #include "microcobot/control/xyz_stage.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
@@ -32,6 +35,9 @@ struct ControlParams {
   ct::PositionControlParams position;
   ct::BaselinePositionParams baseline;
   ct::MotionLimits limits;
+  ct::TrackingParams tracking;
+  ct::SetpointStreamParams stream;
+  ct::PathLimits path;
 
   template <class V>
   void visit(V& v) {
@@ -42,6 +48,9 @@ struct ControlParams {
     v("position", position);
     v("baseline", baseline);
     v("limits", limits);
+    v("tracking", tracking);
+    v("stream", stream);
+    v("path", path);
   }
   void validate() const {
     model.validate();
@@ -51,6 +60,9 @@ struct ControlParams {
     position.validate();
     baseline.validate();
     limits.validate();
+    tracking.validate();
+    stream.validate();
+    path.validate();
   }
 };
 
@@ -252,12 +264,99 @@ void run_position_cmd(const PositionOptions& o) {
 struct TrajectoryOptions {
   CommonOptions common;
   std::string profile = "trapezoid";
+  std::string direction = "forward";
   double distance = 100e-6;
   double velocity = 0.0;      // 0: limits.max_velocity_m_s
   double acceleration = 0.0;  // 0: limits.max_acceleration_m_s2
+  double jerk = 0.0;          // 0: path.max_jerk_m_s3
   double amplitude = 20e-6;
   double frequency = 1.0;
+  double radius = 100e-6;
+  double angle = M_PI;
 };
+
+nlohmann::json tracking_json(const ct::TrackingMetrics& m) {
+  return {{"rms_error_m", m.rms_error_m},     {"max_error_m", m.max_error_m},   {"lag_s", m.lag_s},
+          {"final_error_m", m.final_error_m}, {"rms_error_all_m", m.rms_all_m}, {"steps", m.edges}};
+}
+
+nlohmann::json path_json(const ct::PathMetrics& m) {
+  return {{"rms_error_m", m.rms_error_m},          {"max_error_m", m.max_error_m},
+          {"path_deviation_m", m.max_deviation_m}, {"path_deviation_rms_m", m.rms_deviation_m},
+          {"final_error_m", m.final_error_m},      {"steps", m.edges}};
+}
+
+constexpr std::array<ct::TrackerKind, 3> kTrackers{ct::TrackerKind::kTracking, ct::TrackerKind::kHybrid,
+                                                   ct::TrackerKind::kThesisPid};
+
+std::string json_name(ct::TrackerKind k) {
+  return k == ct::TrackerKind::kThesisPid ? "thesis_pid" : ct::to_string(k);
+}
+
+ct::TrackerSetup tracker_setup(const ControlParams& p) {
+  ct::TrackerSetup su{p.tracking, p.position, p.baseline, p.sensor};
+  // Today's controller: its scanning reference must keep up with the trajectory.
+  su.hybrid.scan_velocity_m_s = std::max(su.hybrid.scan_velocity_m_s, 1.5 * p.limits.max_velocity_m_s);
+  su.hybrid.scan_acceleration_m_s2 =
+      std::max(su.hybrid.scan_acceleration_m_s2, 1.5 * p.limits.max_acceleration_m_s2);
+  return su;
+}
+
+/// 3-D line and arc: the three axes on the path, the tracker and both baselines.
+nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const TrajectoryOptions& o,
+                               Report& r, mc::CsvTable* table) {
+  ct::PathLimits lim = p.path;
+  lim.max_velocity_m_s = p.limits.max_velocity_m_s;
+  lim.max_acceleration_m_s2 = p.limits.max_acceleration_m_s2;
+  if (o.jerk > 0.0) lim.max_jerk_m_s3 = o.jerk;
+  const Eigen::Vector3d dir = Eigen::Vector3d(0.6, 0.64, 0.48).normalized();
+  const auto path = o.profile == "line"
+                        ? ct::PathGenerator::line(-0.5 * o.distance * dir, 0.5 * o.distance * dir, lim)
+                        : ct::PathGenerator::arc(Eigen::Vector3d(o.radius, 0.0, 0.0), Eigen::Vector3d::Zero(),
+                                                 Eigen::Vector3d(0.0, 0.3, 1.0), o.angle, lim);
+  mc::require_budget(
+      3.0 * (path.duration_s() + 0.03) / plant.model.dt_s(), mc::kMaxSimulatedSteps,
+      "--distance/--velocity/--acceleration (path duration)",
+      fmt::format("simulated steps (3 axes, {:.3g} s at {:g} s)", path.duration_s(), plant.model.dt_s()));
+  const auto su = tracker_setup(p);
+  nlohmann::json j;
+  std::vector<Series> dev;
+  for (auto k : kTrackers) {
+    const auto run = ct::run_path(plant.model, plant.map, k, su, path);
+    const auto name = ct::to_string(k);
+    if (k == ct::TrackerKind::kTracking) {
+      j = path_json(run.metrics);
+      if (table) {
+        table->add_column("t_s", run.t_s);
+        table->add_column("deviation_m", run.deviation_m);
+        for (std::size_t i = 0; i < 3; ++i) {
+          const std::string ax = ct::to_string(static_cast<ct::Axis>(i));
+          table->add_column("ref_" + ax + "_m", run.ref_m[i]);
+          table->add_column(ax + "_m", run.x_m[i]);
+        }
+      }
+    } else {
+      j["baseline"][json_name(k)] = path_json(run.metrics);
+    }
+    r.add_result(name + ": path deviation (max)", run.metrics.max_deviation_m, "m");
+    r.add_result(name + ": path deviation (RMS)", run.metrics.rms_deviation_m, "m");
+    r.add_result(name + ": final error", run.metrics.final_error_m, "m");
+    dev.push_back(thin(name, run.t_s, run.deviation_m));
+  }
+  r.add_figure(
+      {"Path deviation: " + o.profile,
+       fmt::format("Distance of the true 3-D position to the ideal {} (length {:.4g} m, <= {:g} m/s, "
+                   "<= {:g} m/s^2, <= {:g} m/s^3).",
+                   o.profile, path.length_m(), path.path_velocity_m_s(), lim.max_acceleration_m_s2,
+                   lim.max_jerk_m_s3),
+       {"Time", "s"},
+       {"Deviation", "m"},
+       dev});
+  j["profile"] = o.profile;
+  j["length_m"] = path.length_m();
+  j["duration_s"] = path.duration_s();
+  return j;
+}
 
 nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant, const TrajectoryOptions& o,
                                      Report& r, mc::CsvTable* table) {
@@ -265,81 +364,114 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
   if (o.velocity > 0.0) p.limits.max_velocity_m_s = o.velocity;
   if (o.acceleration > 0.0) p.limits.max_acceleration_m_s2 = o.acceleration;
   p.limits.validate();
-  // The scanning reference must keep up with the trajectory.
-  p.position.scan_velocity_m_s = std::max(p.position.scan_velocity_m_s, 1.5 * p.limits.max_velocity_m_s);
-  p.position.scan_acceleration_m_s2 =
-      std::max(p.position.scan_acceleration_m_s2, 1.5 * p.limits.max_acceleration_m_s2);
-  const double start = o.profile == "trapezoid" ? -0.5 * o.distance : 0.0;
-  std::function<ct::ReferenceSample(double, double)> ref;
+  if (o.profile == "line" || o.profile == "arc") return path_experiment(p, plant, o, r, table);
+  const double sign = o.direction == "backward" ? -1.0 : 1.0;
+  const double start = o.profile == "trapezoid" ? -0.5 * sign * o.distance : 0.0;
+  // A fresh (stateful) reference per run: every tracker sees the same one.
+  std::function<ct::ReferenceFn()> make_ref;
   double duration = 0.0;
   std::string what;
   if (o.profile == "trapezoid") {
-    auto lim = std::make_shared<ct::ReferenceLimiter>(p.limits, start);
-    const double end = start + o.distance;
-    ref = [lim, end](double, double dt) { return lim->step(end, dt); };
+    const double end = start + sign * o.distance;
+    const auto lim = p.limits;
+    make_ref = [lim, start, end] {
+      auto l = std::make_shared<ct::ReferenceLimiter>(lim, start);
+      return ct::ReferenceFn([l, end](double, double dt) { return l->step(end, dt); });
+    };
     duration = ct::trapezoid_duration_s(o.distance, p.limits) + 0.05;
-    what = fmt::format("trapezoidal move of {:g} m at <= {:g} m/s, <= {:g} m/s^2", o.distance,
+    what = fmt::format("trapezoidal move of {:g} m {} at <= {:g} m/s, <= {:g} m/s^2", o.distance, o.direction,
                        p.limits.max_velocity_m_s, p.limits.max_acceleration_m_s2);
   } else if (o.profile == "sine") {
-    auto sine = std::make_shared<ct::SineReference>(start, o.amplitude, o.frequency, p.limits);
-    ref = [sine](double t, double) { return sine->at(t); };
+    auto sine = std::make_shared<ct::SineReference>(start, sign * o.amplitude, o.frequency, p.limits);
+    make_ref = [sine] { return ct::ReferenceFn([sine](double t, double) { return sine->at(t); }); };
     duration = 2.0 / o.frequency;
     what = fmt::format("sine of {:g} m amplitude at {:g} Hz", o.amplitude, o.frequency);
   } else {
-    // A setpoint sequence streamed at 1 kHz: a staircase of 5 setpoints (10 um apart, 40 ms each)
-    // with sensor-like jitter, smoothed by the limiter.
-    auto lim = std::make_shared<ct::ReferenceLimiter>(p.limits, start);
-    auto held = std::make_shared<double>(start);
-    auto next_ms = std::make_shared<double>(0.0);
-    ref = [lim, held, next_ms, start](double t, double dt) {
-      if (t >= *next_ms) {  // a new setpoint arrives every 1 ms
-        const int stair = static_cast<int>(t / 0.04);
-        *held = start + 10e-6 * std::min(stair, 4) + 0.5e-6 * std::sin(2.0 * M_PI * 7.0 * t);
-        *next_ms += 1e-3;
-      }
-      return lim->step(*held, dt);
+    // Setpoints streamed at 1 kHz (a staircase of 5 setpoints 10 um apart, 40 ms each, plus a
+    // 7 Hz wobble), none between 100 and 110 ms (a dropout: the stream holds, then rejoins
+    // under the limits), read through the setpoint stream's bounded look-ahead.
+    const auto sp = p.stream;
+    const auto lim = p.limits;
+    make_ref = [sp, lim, start, sign] {
+      auto sps = sp;
+      sps.max_velocity_m_s = 1.5 * lim.max_velocity_m_s;  // rejoins after a dropout
+      auto stream = std::make_shared<ct::SetpointStream>(sps, start);
+      auto next_ms = std::make_shared<double>(0.0);
+      return ct::ReferenceFn([stream, next_ms, start, sign](double t, double dt) {
+        while (t >= *next_ms) {  // a new setpoint every 1 ms (sender's clock)
+          const double ts = *next_ms;
+          const int stair = static_cast<int>(ts / 0.04);
+          const bool dropout = ts >= 0.1 && ts < 0.11;
+          if (!dropout) {
+            stream->push(
+                ts, start + sign * (10e-6 * std::min(stair, 4) + 0.5e-6 * std::sin(2.0 * M_PI * 7.0 * ts)));
+          }
+          *next_ms += 1e-3;
+        }
+        return stream->sample(t, dt);
+      });
     };
     duration = 0.25;
-    what = "setpoints streamed at 1 kHz (staircase 4 x 10 um plus a 7 Hz wobble), limited";
+    what =
+        "setpoints streamed at 1 kHz (staircase 4 x 10 um plus a 7 Hz wobble, a 10 ms dropout), "
+        "interpolated with a bounded look-ahead, limited";
   }
-  // The work budget, before the run: a slow trapezoid (tiny velocity or acceleration limit)
+  // The work budget, before the runs: a slow trapezoid (tiny velocity or acceleration limit)
   // would otherwise simulate for days.
   mc::require_budget(
       duration / plant.model.dt_s(), mc::kMaxSimulatedSteps,
       o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
       fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
-  const auto run = ct::run_tracking(plant.model, plant.map, p.position, p.sensor, start, ref, duration);
-  r.add_result(o.profile + ": RMS tracking error", run.rms_error_m, "m");
-  r.add_result(o.profile + ": max tracking error", run.max_error_m, "m");
-  std::vector<double> err(run.x_m.size());
-  for (std::size_t i = 0; i < err.size(); ++i) err[i] = run.x_m[i] - run.ref_m[i];
-  r.add_figure({"Tracking: " + o.profile,
-                what,
-                {"Time", "s"},
-                {"Position", "m"},
-                {thin("reference", run.t_s, run.ref_m), thin("slider", run.t_s, run.x_m)}});
+  const auto su = tracker_setup(p);
+  nlohmann::json j;
+  std::vector<Series> xs, errs;
+  for (auto k : kTrackers) {
+    const auto run = ct::run_tracker(plant.model, plant.map, k, su, start, make_ref(), duration);
+    const auto name = ct::to_string(k);
+    if (k == ct::TrackerKind::kTracking) {
+      j = tracking_json(run.metrics);
+      xs.push_back(thin("reference", run.t_s, run.ref_m));
+      if (table) {
+        table->add_column("t_s", run.t_s);
+        table->add_column("ref_m", run.ref_m);
+        table->add_column("x_m", run.x_m);
+        table->add_column("u_V", run.u_V);
+      }
+    } else {
+      j["baseline"][json_name(k)] = tracking_json(run.metrics);
+    }
+    r.add_result(o.profile + ", " + name + ": RMS tracking error in motion", run.metrics.rms_error_m, "m");
+    r.add_result(o.profile + ", " + name + ": max tracking error in motion", run.metrics.max_error_m, "m");
+    r.add_result(o.profile + ", " + name + ": lag", run.metrics.lag_s, "s");
+    r.add_result(o.profile + ", " + name + ": final error", run.metrics.final_error_m, "m");
+    std::vector<double> err(run.x_m.size());
+    for (std::size_t i = 0; i < err.size(); ++i) err[i] = run.x_m[i] - run.ref_m[i];
+    xs.push_back(thin(name, run.t_s, run.x_m));
+    errs.push_back(thin(name, run.t_s, err));
+  }
+  r.add_figure({"Tracking: " + o.profile, what, {"Time", "s"}, {"Position", "m"}, xs});
   r.add_figure({"Tracking error: " + o.profile,
-                "x - reference (true position).",
+                "x - reference (true position): the tracking controller (reference-phased sawtooth) and the "
+                "baselines (today's hybrid controller fed the moving target, the thesis's PID).",
                 {"Time", "s"},
                 {"Error", "m"},
-                {thin("error", run.t_s, err)}});
-  if (table) {
-    table->add_column("t_s", run.t_s);
-    table->add_column("ref_m", run.ref_m);
-    table->add_column("x_m", run.x_m);
-    table->add_column("u_V", run.u_V);
-  }
-  return {{"rms_error_m", run.rms_error_m}, {"max_error_m", run.max_error_m}, {"profile", o.profile}};
+                errs});
+  j["profile"] = o.profile;
+  j["direction"] = o.direction;
+  return j;
 }
 
 void run_trajectory_cmd(const TrajectoryOptions& o) {
   const auto p = load(o.common);
   const double half = 0.5 * p.model.slider.stroke_m;
-  if (o.profile == "trapezoid" && o.distance > 2.0 * half) {
+  if ((o.profile == "trapezoid" || o.profile == "line") && o.distance > 2.0 * half) {
     throw mc::UsageError(fmt::format("--distance must be <= the stroke ({:g} m)", 2.0 * half));
   }
   if (o.profile == "sine" && o.amplitude > half) {
     throw mc::UsageError(fmt::format("--amplitude must be <= half the stroke ({:g} m)", half));
+  }
+  if (o.profile == "arc" && o.radius > half) {
+    throw mc::UsageError(fmt::format("--radius must be <= half the stroke ({:g} m)", half));
   }
   const Plant plant(p);
   Report r("control trajectory");
@@ -348,9 +480,16 @@ void run_trajectory_cmd(const TrajectoryOptions& o) {
   auto j = trajectory_experiment(p, plant, o, r, &t);
   write_table(o.common, "trajectory.csv", t);
   mc::cli::write_report_if_requested(o.common, r);
-  mc::cli::emit(o.common, j,
-                fmt::format("RMS error {:.3g} m, max error {:.3g} m", j["rms_error_m"].get<double>(),
-                            j["max_error_m"].get<double>()));
+  std::string line = fmt::format("RMS error {:.3g} m, max error {:.3g} m", j["rms_error_m"].get<double>(),
+                                 j["max_error_m"].get<double>());
+  if (j.contains("lag_s")) line += fmt::format(", lag {:.3g} s", j["lag_s"].get<double>());
+  if (j.contains("path_deviation_m")) {
+    line += fmt::format(", path deviation {:.3g} m", j["path_deviation_m"].get<double>());
+  }
+  line += fmt::format(" (baselines: hybrid RMS {:.3g} m, thesis PID RMS {:.3g} m)",
+                      j["baseline"]["hybrid"]["rms_error_m"].get<double>(),
+                      j["baseline"]["thesis_pid"]["rms_error_m"].get<double>());
+  mc::cli::emit(o.common, j, line);
 }
 
 void add_control(CLI::App& group) {
@@ -388,15 +527,23 @@ void add_control(CLI::App& group) {
   }
   {
     auto o = std::make_shared<TrajectoryOptions>();
-    auto* cmd = group.add_subcommand("trajectory", "Trajectory tracking under velocity/acceleration limits");
-    cmd->add_option("--profile", o->profile, "trapezoid | sine | stream")
-        ->check(CLI::IsMember({"trapezoid", "sine", "stream"}));
-    cmd->add_option("--distance", o->distance, "Trapezoid: distance [m]")->check(mc::cli::Range(1e-9, 12e-3));
+    auto* cmd = group.add_subcommand(
+        "trajectory",
+        "Trajectory tracking (trapezoid, sine, streamed setpoints, 3-D line and arc) with baselines");
+    cmd->add_option("--profile", o->profile, "trapezoid | sine | stream | line | arc")
+        ->check(CLI::IsMember({"trapezoid", "sine", "stream", "line", "arc"}));
+    cmd->add_option("--direction", o->direction, "forward | backward (1-D profiles)")
+        ->check(CLI::IsMember({"forward", "backward"}));
+    cmd->add_option("--distance", o->distance, "Trapezoid / line: distance [m]")
+        ->check(mc::cli::Range(1e-9, 12e-3));
     cmd->add_option("--velocity", o->velocity, "Velocity limit [m/s]")->check(mc::cli::Range(1e-7, 1e-2));
     cmd->add_option("--acceleration", o->acceleration, "Acceleration limit [m/s^2]")
         ->check(mc::cli::Range(1e-6, 10.0));
+    cmd->add_option("--jerk", o->jerk, "Line / arc: jerk limit [m/s^3]")->check(mc::cli::Range(1e-6, 1e6));
     cmd->add_option("--amplitude", o->amplitude, "Sine: amplitude [m]")->check(mc::cli::Range(1e-9, 6e-3));
     cmd->add_option("--frequency", o->frequency, "Sine: frequency [Hz]")->check(mc::cli::Range(1e-3, 100.0));
+    cmd->add_option("--radius", o->radius, "Arc: radius [m]")->check(mc::cli::Range(1e-7, 6e-3));
+    cmd->add_option("--angle", o->angle, "Arc: angle [rad]")->check(mc::cli::Range(-2.0 * M_PI, 2.0 * M_PI));
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_trajectory_cmd(*o); });
@@ -418,8 +565,10 @@ void control_part(Report& r) {
             "Stepping (amplitude/frequency from the step map) -> scanning with the PI inverse -> hold.");
   position_experiment(p, plant, ct::Axis::kX, -100e-6, 100e-6, r, nullptr);
   position_experiment(p, plant, ct::Axis::kX, 100e-6, 100e-6 - 10e-9, r, nullptr);
-  r.section("Control: trajectory tracking", "microcobot control trajectory --profile trapezoid|sine|stream");
-  for (const char* prof : {"trapezoid", "sine", "stream"}) {
+  r.section("Control: trajectory tracking (issue #15)",
+            "microcobot control trajectory --profile trapezoid|sine|stream|arc: the tracking controller "
+            "(reference-phased sawtooth) beside today's hybrid controller and the thesis's PID.");
+  for (const char* prof : {"trapezoid", "sine", "stream", "arc"}) {
     TrajectoryOptions o;
     o.profile = prof;
     trajectory_experiment(p, plant, o, r, nullptr);

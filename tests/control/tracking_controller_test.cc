@@ -83,7 +83,9 @@ TEST(TrackingController, EdgesGoTheWayTheReferenceMoves) {
     x_ref -= 100e-6 * 1e-4;
     c.set_reference({x_ref, -100e-6, 0.0});
     c.update(sensor.measure(test::model().slider_position(s)));
-    if (c.in_edge()) EXPECT_EQ(c.operating_point().direction, Direction::kBackward);
+    if (c.in_edge()) {
+      EXPECT_EQ(c.operating_point().direction, Direction::kBackward);
+    }
     test::model().set_operating_point(s, c.operating_point().amplitude_V, c.operating_point().frequency_Hz,
                                       c.operating_point().direction);
     for (int i = 0; i < 10; ++i) test::model().step(s, c.next_drive(1e-5));
