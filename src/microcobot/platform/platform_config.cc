@@ -46,6 +46,13 @@ void PlatformConfig::validate() const {
             "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",
             stage.control.control_rate_Hz);
   });
+  in_section("stage.tracking", [&] {
+    stage.tracking.validate();
+    if (!stage.tracking_enabled) return;
+    require(std::abs(stage.tracking.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),
+            "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",
+            stage.tracking.control_rate_Hz);
+  });
   in_section("haptic", [&] {
     haptic.plant.validate();
     haptic.render.validate();
