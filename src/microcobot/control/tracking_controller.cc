@@ -175,9 +175,11 @@ void TrackingController::update(double x) noexcept {
   const double bottom = pe_displacement_m(p_.low_V + p_.guard_V);
   double lead = 0.0;
   if (ref_.v_m_s > 0.0) {
-    lead = p_.lead_fraction * b_fwd_ * std::clamp(1.0 - (top - y_base) / p_.lead_window_m, 0.0, 1.0);
+    lead = (p_.lead_fraction * b_fwd_ + p_.lead_m) *
+           std::clamp(1.0 - (top - y_base) / p_.lead_window_m, 0.0, 1.0);
   } else if (ref_.v_m_s < 0.0) {
-    lead = -p_.lead_fraction * b_bwd_ * std::clamp(1.0 - (y_base - bottom) / p_.lead_window_m, 0.0, 1.0);
+    lead = -(p_.lead_fraction * b_bwd_ + p_.lead_m) *
+           std::clamp(1.0 - (y_base - bottom) / p_.lead_window_m, 0.0, 1.0);
   }
   // The residual: the measured error minus the error the plan expects (catch-up still to go, lead).
   const double e_res = e - (corr_to_ - corr_) + lead;

@@ -55,6 +55,9 @@ struct TrackingParams {
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
   double lead_fraction = 0.5;
+  /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
+  /// the unloading run, then returns) [m].
+  double lead_m = 300e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
   double lead_window_m = 300e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
@@ -80,6 +83,7 @@ struct TrackingParams {
     v("backslip_m", backslip_m);
     v("edge_margin_m", edge_margin_m);
     v("lead_fraction", lead_fraction);
+    v("lead_m", lead_m);
     v("lead_window_m", lead_window_m);
     v("catchup_s", catchup_s);
     v("settle_s", settle_s);
