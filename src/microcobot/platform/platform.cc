@@ -171,7 +171,9 @@ void Platform::slave_control_task() noexcept {
 
 void Platform::devices_task(double dt_s) noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!faulted_) devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i)));
+    if (!faulted_) {
+      devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m()));
+    }
     devices_.axes[i]->update(dt_s);
   }
   devices_.gripper->update(dt_s);

@@ -49,9 +49,10 @@ void PlatformConfig::validate() const {
   in_section("stage.tracking", [&] {
     stage.tracking.validate();
     if (!stage.tracking_enabled) return;
-    require(std::abs(stage.tracking.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),
-            "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",
-            stage.tracking.control_rate_Hz);
+    const double f = stage.tracking.control_rate_Hz;
+    require(std::abs(f - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz() ||
+                std::abs(f - loop.base_rate_Hz) <= 1e-9 * loop.base_rate_Hz,
+            "control_rate_Hz", "must equal loop.base_rate_Hz (updated every loop tick) or the slave rate", f);
   });
   in_section("haptic", [&] {
     haptic.plant.validate();

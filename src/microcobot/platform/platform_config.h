@@ -76,8 +76,7 @@ struct StageParams {
     v("home_z_m", home_z_m);
   }
   static control::TrackingParams default_tracking() {
-    control::TrackingParams p;
-    p.control_rate_Hz = 1000.0;  // the slave rate of LoopParams
+    control::TrackingParams p;  // 10 kHz: updated at every loop tick (LoopParams.base_rate_Hz)
     return p;
   }
   static control::PositionControlParams default_control() {

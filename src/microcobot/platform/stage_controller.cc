@@ -1,5 +1,7 @@
 #include "microcobot/platform/stage_controller.h"
 
+#include <cmath>
+
 #include "microcobot/core/error.h"
 
 namespace mc::platform {
@@ -11,6 +13,8 @@ StageController::StageController(const control::PositionControlParams& params,
     : sample_period_s_(sample_period_s) {
   require(samples_per_tick >= 1, "samples_per_tick", "must be at least 1", samples_per_tick);
   require_positive(sample_period_s, "sample_period_s");
+  tick_s_ = static_cast<double>(samples_per_tick) * sample_period_s;
+  fast_ = tracking != nullptr && std::abs(tracking->control_rate_Hz * tick_s_ - 1.0) < 1e-9;
   for (std::size_t i = 0; i < 3; ++i) {
     if (tracking) {
       track_[i] = std::make_unique<control::TrackingController>(*tracking, model, map);
@@ -29,7 +33,10 @@ void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vecto
       auto& t = *track_[i];
       // The first tick (and the first after an emergency stop) starts from where the axis is.
       if (!started_ || stopped_) t.reset(measured_m[i], stopped_ ? 0.0 : t.voltage_V());
-      t.set_reference(control::ReferenceSample{target_m[k], velocity_m_s[k], 0.0});
+      ref_[i] = control::ReferenceSample{target_m[k], velocity_m_s[k], 0.0};
+      since_update_s_[i] = 0.0;
+      if (fast_) continue;  // updated at every loop tick by drive(i, measured)
+      t.set_reference(ref_[i]);
       t.update(measured_m[i]);
       continue;
     }
@@ -42,6 +49,17 @@ void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vecto
   }
   stopped_ = false;
   started_ = true;
+}
+
+DriveBlock StageController::drive(int i, double measured_m) noexcept {
+  const auto iu = static_cast<std::size_t>(i);
+  if (fast_ && started_ && !stopped_ && track_[iu]) {
+    const auto& r = ref_[iu];
+    track_[iu]->set_reference(control::ReferenceSample{r.x_m + r.v_m_s * since_update_s_[iu], r.v_m_s, 0.0});
+    track_[iu]->update(measured_m);
+    since_update_s_[iu] += tick_s_;
+  }
+  return drive(i);
 }
 
 DriveBlock StageController::drive(int i) noexcept {

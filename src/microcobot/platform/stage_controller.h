@@ -34,6 +34,10 @@ class StageController {
               const std::array<double, 3>& measured_m) noexcept;
   /// The drive samples of axis `i` for the next loop tick.
   DriveBlock drive(int i) noexcept;
+  /// The same with the axis' position measured now: a tracking controller whose rate is the loop's
+  /// (tracking.control_rate_Hz = 1 / (samples_per_tick sample_period_s)) is updated at every loop
+  /// tick on it, following the slave-rate target extrapolated with its velocity.
+  DriveBlock drive(int i, double measured_m) noexcept;
   /// The last voltage drive(i) produced (0 before the first and after emergency_stop()).
   double last_voltage_V(int i) const noexcept {
     const auto& buf = samples_[static_cast<std::size_t>(i)];
@@ -52,6 +56,10 @@ class StageController {
  private:
   std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
   std::array<std::unique_ptr<control::TrackingController>, 3> track_;
+  std::array<control::ReferenceSample, 3> ref_{};  ///< slave-rate target and velocity
+  std::array<double, 3> since_update_s_{};          ///< time since that target (loop ticks)
+  double tick_s_ = 0.0;                             ///< the loop tick: samples x sample period
+  bool fast_ = false;                               ///< tracking at the loop's rate
   bool started_ = false;
   std::array<std::vector<stickslip::DriveSegment>, 3> samples_;
   double sample_period_s_;
