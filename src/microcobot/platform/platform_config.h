@@ -53,9 +53,9 @@ struct LoopParams {
 struct StageParams {
   control::PositionControlParams control = default_control();
   /// Issue #15: the axes follow the teleoperation target with the tracking controller
-  /// (reference-phased sawtooth) instead of the hybrid position controller. Off by default: see
-  /// docs/errata.md (not yet validated against the platform's pick-and-place acceptance tests).
-  bool tracking_enabled = false;
+  /// (reference-phased sawtooth, updated at every loop tick on the axis positions; the 1 kHz target
+  /// is extrapolated with its velocity) instead of the hybrid position controller (false).
+  bool tracking_enabled = true;
   control::TrackingParams tracking = default_tracking();
   control::PositionSensorParams sensor;
   control::StepMapParams step_map;

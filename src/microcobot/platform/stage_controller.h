@@ -57,9 +57,9 @@ class StageController {
   std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
   std::array<std::unique_ptr<control::TrackingController>, 3> track_;
   std::array<control::ReferenceSample, 3> ref_{};  ///< slave-rate target and velocity
-  std::array<double, 3> since_update_s_{};          ///< time since that target (loop ticks)
-  double tick_s_ = 0.0;                             ///< the loop tick: samples x sample period
-  bool fast_ = false;                               ///< tracking at the loop's rate
+  std::array<double, 3> since_update_s_{};         ///< time since that target (loop ticks)
+  double tick_s_ = 0.0;                            ///< the loop tick: samples x sample period
+  bool fast_ = false;                              ///< tracking at the loop's rate
   bool started_ = false;
   std::array<std::vector<stickslip::DriveSegment>, 3> samples_;
   double sample_period_s_;
