@@ -1,5 +1,6 @@
 // Setpoint streaming (issue #15): 1 kHz setpoints, bounded look-ahead, late/missing ones hold.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -59,8 +60,8 @@ TEST(SetpointStream, RejectsOutOfOrderAndNonFiniteSetpointsAndStaysBounded) {
   EXPECT_TRUE(s.push(1.0, 1e-6));
   EXPECT_FALSE(s.push(0.5, 2e-6));
   EXPECT_FALSE(s.push(1.0, 2e-6));
-  EXPECT_FALSE(s.push(2.0, NAN));
-  EXPECT_FALSE(s.push(INFINITY, 1e-6));
+  EXPECT_FALSE(s.push(2.0, std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_FALSE(s.push(std::numeric_limits<double>::infinity(), 1e-6));
   for (int i = 0; i < 10; ++i) s.push(2.0 + i, 1e-6);
   EXPECT_EQ(s.size(), 4u);
   p.capacity = 1;
