@@ -14,20 +14,26 @@ namespace {
 
 namespace pf = mc::platform;
 
+pf::PlatformConfig bench_config(bool tracking) {
+  pf::PlatformConfig c;
+  c.stage.tracking_enabled = tracking;
+  return c;
+}
+
 struct Rig {
+  explicit Rig(bool tracking = true) : config(bench_config(tracking)) {
+    platform.set_operator([this](const pf::TickInfo& t) { op.act(t); });
+  }
   pf::PlatformConfig config;
   pf::Platform platform{config};
   pf::PickPlaceOperator op{platform, pf::PickPlaceOperatorParams{}};
-  Rig() {
-    platform.set_operator([this](const pf::TickInfo& t) { op.act(t); });
-  }
 };
 
 // Ticks of the scenario from `start_s` on: approach (0 s, one axis stepping) or transport
 // (12 s, the part carried, x stepping at 100 um/s). The telemetry ring is drained outside
 // the timing.
-void platform_ticks(benchmark::State& state, double start_s) {
-  auto rig = std::make_unique<Rig>();
+void platform_ticks(benchmark::State& state, double start_s, bool tracking = true) {
+  auto rig = std::make_unique<Rig>(tracking);
   auto& loop = rig->platform.loop();
   if (start_s > 0) rig->platform.run(start_s);
   std::uint64_t n = 0;
@@ -45,6 +51,11 @@ void BM_PlatformTickApproach(benchmark::State& state) { platform_ticks(state, 0.
 void BM_PlatformTickTransport(benchmark::State& state) { platform_ticks(state, 12.0); }
 BENCHMARK(BM_PlatformTickApproach)->Iterations(30000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PlatformTickTransport)->Iterations(50000)->Unit(benchmark::kMicrosecond);
+// The same with the hybrid position controller on the stage (stage.tracking_enabled: false).
+void BM_PlatformTickApproachHybrid(benchmark::State& state) { platform_ticks(state, 0.0, false); }
+void BM_PlatformTickTransportHybrid(benchmark::State& state) { platform_ticks(state, 12.0, false); }
+BENCHMARK(BM_PlatformTickApproachHybrid)->Iterations(30000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PlatformTickTransportHybrid)->Iterations(50000)->Unit(benchmark::kMicrosecond);
 
 // The stick-slip share: three axes, ten 10 us model steps each, under a 2 kHz 60 V sawtooth.
 void BM_ThreeAxesOneTick(benchmark::State& state) {
