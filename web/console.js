@@ -114,6 +114,7 @@ function connect() {
       setTimeout(connect, 1000);
     },
     status(m) {
+      if (m.id === "report") listRecordings();
       if (m.message.startsWith("control: ")) {
         setControl(m.message === "control: granted");
       }
@@ -489,6 +490,8 @@ function onStatus(s) {
   rows.push(["tick p99", s.tick_p99_us.toFixed(1) + " µs", true]);
   rows.push(["clients", String(s.clients), true]);
   rows.push(["recording", s.recording || "off", true]);
+  const lat = s.command_latency_ms;
+  if (lat && lat.count > 0) rows.push(["command latency", "p50 " + lat.p50.toFixed(2) + " ms, p99 " + lat.p99.toFixed(2) + " ms", lat.p99 < 5]);
   $("status").innerHTML = "";
   for (const [name, value, ok] of rows) {
     const tr = document.createElement("tr");
@@ -502,6 +505,46 @@ function onStatus(s) {
   $("estop").classList.toggle("latched", s.estopped);
   $("record").textContent = s.recording ? "Stop recording" : "Record";
   $("record").classList.toggle("on", !!s.recording);
+  if ((s.recording || "") !== mc.lastRecording) {  // a recording started or ended: list again
+    mc.lastRecording = s.recording || "";
+    listRecordings();
+  }
+}
+
+// The recordings in --out with their downloads and session reports (made on the first click).
+function listRecordings() {
+  fetch("/recordings" + location.search, {cache: "no-store"})
+    .then((r) => (r.ok ? r.json() : {recordings: []}))
+    .then((j) => {
+      const table = $("recordings");
+      table.innerHTML = "";
+      if (!j.recordings.length) {
+        table.innerHTML = "<tr><td>none yet: press Record</td></tr>";
+        return;
+      }
+      for (const rec of j.recordings) {
+        const tr = document.createElement("tr");
+        const name = document.createElement("td"), size = document.createElement("td"), links = document.createElement("td");
+        name.textContent = rec.name;
+        size.textContent = rec.recording ? "" : (rec.bytes / 1e6).toFixed(1) + " MB";
+        if (rec.recording) {
+          links.textContent = "recording…";
+        } else {
+          const dl = document.createElement("a");
+          dl.href = rec.url + location.search;  // the token, when the server needs one
+          dl.textContent = "download";
+          dl.setAttribute("download", rec.name);
+          const rep = document.createElement("a");
+          rep.href = rec.report_url + location.search;
+          rep.target = "_blank";
+          rep.textContent = rec.report_ready ? "report" : "make report";
+          links.append(dl, " · ", rep);
+        }
+        tr.append(name, size, links);
+        table.append(tr);
+      }
+    })
+    .catch(() => {});
 }
 
 function onScene(s) {
