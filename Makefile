@@ -45,6 +45,7 @@ fuzz: deps
 
 bench: build
 	@for b in $(BUILD)/bench/*_bench; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
+	@echo "== bench/serve_bench.mjs"; MC_CLI=$(CLI) node --experimental-websocket --no-warnings bench/serve_bench.mjs
 
 format:
 	@git ls-files '*.h' '*.cc' | xargs clang-format -i
