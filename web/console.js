@@ -351,10 +351,15 @@ function drawMicroscope() {
     for (let y = Math.floor(y0 / step) * step; y <= y1; y += step) { const [, py] = worldToCanvas(0, y); g.moveTo(0, py); g.lineTo(c.width, py); }
     g.stroke();
   }
-  // The part: a brass cube, its top face at part_z + side / 2, blurred by its defocus.
-  const side = sc.part_side_m;
+  // The hole at the target (pin-in-hole): its rim at z = 0.
+  if (sc.hole_side_m > 0) {
+    const hs = sc.hole_side_m, [hx, hy] = worldToCanvas(sc.target_m[0] - hs / 2, sc.target_m[1] + hs / 2);
+    drawBlurred(g, hx, hy, hs * s, hs * s, blurPx(focus, o, s), "#0c0b09");
+  }
+  // The part: a brass cube or pin, its top face at part_z + height / 2, blurred by its defocus.
+  const side = sc.part_side_m, height = sc.part_height_m || side;
   const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + side / 2), o, s), "#c9a04a");
+  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a");
   // The target: a reticle overlaid on the view (a graticule, always sharp), with the tolerance.
   const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
   g.strokeStyle = "#46c47e";
@@ -390,13 +395,17 @@ function drawSide() {
   g.fillStyle = "#111";
   g.fillRect(0, 0, c.width, c.height);
   if (!t || !sc) return;
-  const s = c.width / view.fov, zmax = 1.0e-3, zs = (c.height - 20) / zmax;
-  const X = (x) => c.width / 2 + (x - view.center[0]) * s, Z = (z) => c.height - 10 - z * zs;
+  const s = c.width / view.fov, zmax = 1.0e-3, zs = sideScale();
+  const X = (x) => c.width / 2 + (x - view.center[0]) * s, Z = (z) => mc.worldToSide(0, z)[1];
   g.fillStyle = "#3b372f";
-  g.fillRect(0, Z(0), c.width, 10);
-  const side = sc.part_side_m;
+  g.fillRect(0, Z(0), c.width, c.height - Z(0));
+  if (sc.hole_side_m > 0) {  // the hole, in section
+    g.fillStyle = "#111";
+    g.fillRect(X(sc.target_m[0] - sc.hole_side_m / 2), Z(0), sc.hole_side_m * s, sc.hole_depth_m * zs);
+  }
+  const side = sc.part_side_m, height = sc.part_height_m || side;
   g.fillStyle = "#c9a04a";
-  g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + side / 2), side * s, side * zs);
+  g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + height / 2), side * s, height * zs);
   g.fillStyle = "#b8c4d6";
   const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
   for (const sign of [-1, 1]) {
@@ -408,13 +417,16 @@ function drawSide() {
   g.fillStyle = "#8a93a3";
   g.fillText(`z ${(t.measured_z_m * um).toFixed(1)} µm`, 8, 14);
 }
+// The side view spans z from the bottom of the hole (or the substrate) to 1 mm above it.
+const sideZmin = () => (mc.scene && mc.scene.hole_side_m > 0 ? -mc.scene.hole_depth_m : 0);
+const sideScale = () => ($("side").height - 20) / (1.0e-3 - sideZmin());
 mc.sideToWorld = (px, py) => {
-  const c = $("side"), s = c.width / view.fov, zs = (c.height - 20) / 1.0e-3;
-  return [view.center[0] + (px - c.width / 2) / s, (c.height - 10 - py) / zs];
+  const c = $("side"), s = c.width / view.fov;
+  return [view.center[0] + (px - c.width / 2) / s, sideZmin() + (c.height - 10 - py) / sideScale()];
 };
 mc.worldToSide = (x, z) => {
-  const c = $("side"), s = c.width / view.fov, zs = (c.height - 20) / 1.0e-3;
-  return [c.width / 2 + (x - view.center[0]) * s, c.height - 10 - z * zs];
+  const c = $("side"), s = c.width / view.fov;
+  return [c.width / 2 + (x - view.center[0]) * s, c.height - 10 - (z - sideZmin()) * sideScale()];
 };
 
 // Click-to-go: the stage moves straight to the clicked point while the deadman is held (the

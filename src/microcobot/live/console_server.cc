@@ -132,6 +132,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                                    schema({{"part_side_m", number},
+                                           {"part_height_m", number},
+                                           {"hole_side_m", number},
+                                           {"hole_depth_m", number},
                                            {"target_m", vec3},
                                            {"tolerance_m", number},
                                            {"max_opening_m", number},
@@ -333,13 +336,11 @@ void ConsoleServer::stop_recording() {
 
 std::string ConsoleServer::scene_json() const {
   const auto& c = live_.limits();
-  return json{{"part_side_m", live_.part_side_m()},
-              {"target_m", live_.target_m()},
-              {"tolerance_m", live_.placement_tolerance_m()},
-              {"max_opening_m", c.max_opening_m},
-              {"finger_width_m", live_.finger_width_m()},
-              {"workspace_min_m", c.min_m},
-              {"workspace_max_m", c.max_m},
+  return json{{"part_side_m", live_.part_side_m()}, {"part_height_m", live_.part_height_m()},
+              {"hole_side_m", live_.hole_side_m()}, {"hole_depth_m", live_.hole_depth_m()},
+              {"target_m", live_.target_m()},       {"tolerance_m", live_.placement_tolerance_m()},
+              {"max_opening_m", c.max_opening_m},   {"finger_width_m", live_.finger_width_m()},
+              {"workspace_min_m", c.min_m},         {"workspace_max_m", c.max_m},
               {"max_speed_m_s", c.max_speed_m_s}}
       .dump();
 }
