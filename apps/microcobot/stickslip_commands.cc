@@ -217,10 +217,10 @@ void run_simulate(const SimulateOptions& o) {
                                            ss::parse_direction(o.direction), p.drive);
   ss::ActuatorState state = m.initial_state();
   const ss::Trajectory tr = ss::simulate(m, w, o.duration_s, 1, &state);
-  const auto bounds = p.physical_bounds();  // once: it runs the PI over the drive's range
-  for (std::size_t i = 0; i < tr.t_s.size(); ++i) {
-    p.check_physical_bounds(bounds, tr.x1_m[i], tr.x2_m[i], tr.t_s[i], "stickslip simulate");
-  }
+  const auto bounds = p.physical_bounds();         // once: it runs the PI over the drive's range
+  const std::string where = "stickslip simulate";  // once: a literal would be a string per sample
+  for (std::size_t i = 0; i < tr.t_s.size(); ++i)
+    p.check_physical_bounds(bounds, tr.x1_m[i], tr.x2_m[i], tr.t_s[i], where);
   const double x0 = tr.x2_m.front(), xf = tr.x2_m.back();
   const double dur = tr.t_s.back() - tr.t_s.front();
   // Mean velocity from the same phase to the same phase: over the whole periods of the run (the
