@@ -33,20 +33,21 @@ YAML::Node to_yaml(py::handle value, const std::string& where);
 /// keep their default), or a path to a YAML/JSON file. Validated; bad values raise ValueError with
 /// the CLI's message.
 template <class P>
-P params_from(py::handle obj, P defaults = P{}) {
+P params_from(py::handle obj) {
   if (obj.is_none()) {
-    if constexpr (detail::HasValidate<P>::value) defaults.validate();
-    return defaults;
+    P p;
+    if constexpr (detail::HasValidate<P>::value) p.validate();
+    return p;
   }
   if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) {
     const auto path = py::str(py::module_::import("os").attr("fspath")(obj)).cast<std::string>();
-    return load_params<P>(std::filesystem::path(path), std::move(defaults));
+    return load_params<P>(std::filesystem::path(path));
   }
   if (!py::isinstance<py::dict>(obj)) {
     throw InvalidInput("parameters must be a dict, a YAML file name or None (got " +
                        py::str(py::type::of(obj).attr("__name__")).cast<std::string>() + ")");
   }
-  return params_from_yaml(to_yaml(obj, "<dict>"), "<dict>", std::move(defaults));
+  return params_from_yaml<P>(to_yaml(obj, "<dict>"), "<dict>");
 }
 
 /// JSON value -> Python object (dict, list, float, int, bool, str, None).

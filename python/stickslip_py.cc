@@ -383,8 +383,9 @@ void bind_stickslip(py::module_& m) {
       "`microcobot stickslip params --json`.");
   m.def(
       "save_params",
-      [](py::handle params, const std::string& path) {
-        write_file_atomic(path, params_to_yaml(params_from<ss::StickSlipParams>(params)));
+      [](py::handle params, py::handle path) {
+        const auto file = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        write_file_atomic(file, params_to_yaml(params_from<ss::StickSlipParams>(params)));
       },
       "params"_a, "path"_a, "Writes validated parameters as a YAML file that --params and params() read.");
   m.def(

@@ -31,3 +31,4 @@ del _name
 __all__ = [
     "ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers"
 ]
+ComputationFailed.__module__ = __name__
