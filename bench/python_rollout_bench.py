@@ -25,16 +25,20 @@ N_AXES, DURATION_S = 64, 0.1
 
 
 def cpp_axis_seconds_per_s(bench):
+    """(per wall second, per CPU second) of the C++ loop on one axis."""
     p = subprocess.run([bench, "--benchmark_filter=BM_SampleStream", "--benchmark_format=json",
                         "--benchmark_min_time=1"], capture_output=True, text=True, check=True)
     b = json.loads(p.stdout)["benchmarks"][0]
-    return b["rtf"]
+    scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[b["time_unit"]]
+    return DURATION_S / (b["real_time"] * scale), DURATION_S / (b["cpu_time"] * scale)
 
 
 def rollout_axis_seconds_per_s(actuator, voltages, threads):
-    t0 = time.perf_counter()
+    """(per wall second, per CPU second of this process, all threads) of one rollout call."""
+    t0, c0 = time.perf_counter(), time.process_time()
     stickslip.rollout(actuator, None, voltages, threads=threads, operating_point=(60.0, 500.0, "forward"))
-    return N_AXES * DURATION_S / (time.perf_counter() - t0)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return N_AXES * DURATION_S / wall, N_AXES * DURATION_S / cpu
 
 
 def main():
@@ -43,20 +47,30 @@ def main():
     a = stickslip.Actuator()
     u = stickslip.simulate(a, amplitude_V=60.0, frequency_Hz=500.0, duration_s=DURATION_S)["u_V"][1:]
     voltages = np.tile(u, (N_AXES, 1))
-    best = {"cpp": 0.0, "py1": 0.0, "py2": 0.0}
+    best = {k: 0.0 for k in ("cpp_wall", "cpp_cpu", "py1_wall", "py1_cpu", "py2_wall", "py2_cpu")}
+
+    def keep(prefix, rates):
+        best[prefix + "_wall"] = max(best[prefix + "_wall"], rates[0])
+        best[prefix + "_cpu"] = max(best[prefix + "_cpu"], rates[1])
+
+    load0 = os.getloadavg()
     for r in range(rounds):
-        best["cpp"] = max(best["cpp"], cpp_axis_seconds_per_s(bench))
-        best["py1"] = max(best["py1"], rollout_axis_seconds_per_s(a, voltages, 1))
-        best["py2"] = max(best["py2"], rollout_axis_seconds_per_s(a, voltages, 2))
+        keep("cpp", cpp_axis_seconds_per_s(bench))
+        keep("py1", rollout_axis_seconds_per_s(a, voltages, 1))
+        keep("py2", rollout_axis_seconds_per_s(a, voltages, 2))
         print(f"round {r + 1}: best so far {best}", file=sys.stderr)
-    overhead = 1.0 - best["py1"] / best["cpp"]
-    scaling = best["py2"] / best["py1"]
     out = {
         "axes": N_AXES, "duration_s": DURATION_S, "cores": os.cpu_count(),
-        "cpp_axis_s_per_s": best["cpp"], "rollout_1_thread_axis_s_per_s": best["py1"],
-        "rollout_2_threads_axis_s_per_s": best["py2"],
-        "python_overhead": overhead, "two_thread_speedup": scaling,
-        "load_average": os.getloadavg(),
+        "axis_s_per_wall_s": {"cpp_1_axis": best["cpp_wall"], "rollout_1_thread": best["py1_wall"],
+                              "rollout_2_threads": best["py2_wall"]},
+        "axis_s_per_cpu_s": {"cpp_1_axis": best["cpp_cpu"], "rollout_1_thread": best["py1_cpu"],
+                             "rollout_2_threads": best["py2_cpu"]},
+        # Python's cost against the C++ loop, per CPU second (insensitive to other processes taking
+        # the core) and per wall second.
+        "python_overhead_cpu": 1.0 - best["py1_cpu"] / best["cpp_cpu"],
+        "python_overhead_wall": 1.0 - best["py1_wall"] / best["cpp_wall"],
+        "two_thread_speedup_wall": best["py2_wall"] / best["py1_wall"],
+        "load_average_before_after": [load0[0], os.getloadavg()[0]],
     }
     print(json.dumps(out, indent=1))
 
