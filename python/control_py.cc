@@ -226,7 +226,7 @@ void bind_control(py::module_& m) {
           "measured_position_m"_a, "One control tick with the measured slider position [m].")
       .def("next_drive", &ct::VelocityController::next_drive, "dt_s"_a,
            "The drive over the next model step (pass it to Actuator.step).")
-      .def("emergency_stop", &ct::VelocityController::emergency_stop)
+      .def("emergency_stop", &ct::VelocityController::emergency_stop, "0 V at once, integrator cleared.")
       .def_property_readonly("velocity_estimate_m_s", &ct::VelocityController::velocity_estimate_m_s)
       .def_property_readonly("amplitude_V", &ct::VelocityController::amplitude_V)
       .def_property_readonly("end_stop", &ct::VelocityController::end_stop)
@@ -249,16 +249,20 @@ void bind_control(py::module_& m) {
             require(std::isfinite(target) && std::isfinite(v), "target_m", "must be finite", target);
             c.set_target(target, v);
           },
-          "target_m"_a, "velocity_m_s"_a = 0.0)
+          "target_m"_a, "velocity_m_s"_a = 0.0,
+          "New target [m] and reference velocity [m/s] (trajectory feedforward; 0 for a move). Clears an end "
+          "stop.")
       .def(
           "update",
           [](ct::PositionController& c, double x) {
             require(std::isfinite(x), "measured_position_m", "must be finite", x);
             c.update(x);
           },
-          "measured_position_m"_a)
-      .def("next_drive", &ct::PositionController::next_drive, "dt_s"_a)
-      .def("emergency_stop", &ct::PositionController::emergency_stop)
+          "measured_position_m"_a, "One control tick with the measured slider position [m].")
+      .def("next_drive", &ct::PositionController::next_drive, "dt_s"_a,
+           "The drive over the next model step (pass it to Actuator.step).")
+      .def("emergency_stop", &ct::PositionController::emergency_stop,
+           "0 V at once; the axis stays stopped until the next set_target().")
       .def_property_readonly("mode", [](const ct::PositionController& c) { return ct::to_string(c.mode()); })
       .def_property_readonly("in_position", &ct::PositionController::in_position)
       .def_property_readonly("end_stop", &ct::PositionController::end_stop)
@@ -334,9 +338,11 @@ void bind_haptics(py::module_& m) {
             return py::dict("f_m_N"_a = fm, "u_V"_a = u);
           },
           "force_N"_a, "A block of ticks (the same as tick() on each sample): {'f_m_N', 'u_V'} arrays.")
-      .def("reset", &hp::RenderPipeline::reset)
-      .def("lowpass_response", &hp::RenderPipeline::lowpass_response, "f_Hz"_a)
-      .def("highpass_response", &hp::RenderPipeline::highpass_response, "f_Hz"_a);
+      .def("reset", &hp::RenderPipeline::reset, "Zeroes the filter and delay-line states.")
+      .def("lowpass_response", &hp::RenderPipeline::lowpass_response, "f_Hz"_a,
+           "Complex response of the crossover's low band at f_Hz [Hz].")
+      .def("highpass_response", &hp::RenderPipeline::highpass_response, "f_Hz"_a,
+           "Complex response of the crossover's high band at f_Hz [Hz] (without the alignment delay).");
 }
 
 void bind_tweezers(py::module_& m) {

@@ -290,7 +290,8 @@ void bind_stickslip(py::module_& m) {
   py::class_<ss::ActuatorState>(m, "ActuatorState",
                                 "The state of one axis (plain data; copy with copy.copy or .copy()).")
       .def(py::init<>())
-      .def("copy", [](const ss::ActuatorState& s) { return s; })
+      .def(
+          "copy", [](const ss::ActuatorState& s) { return s; }, "An independent copy of the state.")
       .def("__copy__", [](const ss::ActuatorState& s) { return s; })
       .def("__deepcopy__", [](const ss::ActuatorState& s, py::dict) { return s; })
       .def_readonly("t_s", &ss::ActuatorState::t_s, "Time [s]")
@@ -398,7 +399,7 @@ void bind_stickslip(py::module_& m) {
       "experiment", &experiment, "name"_a, "params"_a = py::none(),
       "One chapter-2 experiment (thesis §2.5, Fig. 2.10-2.17): pe-step, actuator-step, hysteresis, scanning, "
       "stepping, threshold, psd. Returns its results as a dict.");
-  m.def("experiment_names", &ss::experiment_names);
+  m.def("experiment_names", &ss::experiment_names, "Names experiment() accepts.");
   m.def(
       "rollout", &rollout, "params"_a, "initial_states"_a, "voltages"_a, "threads"_a = 1,
       "operating_point"_a = py::none(), "out"_a = py::none(),

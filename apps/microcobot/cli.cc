@@ -101,9 +101,12 @@ void add_output_options(CLI::App& cmd, CommonOptions& opts) {
 }
 
 void add_format_option(CLI::App& cmd, CommonOptions& opts) {
-  cmd.add_option("--format", opts.format,
-                 "Format of the result data under --out: csv (default) or mat (one results.mat, MAT 5)")
-      ->check(CLI::IsMember({"csv", "mat"}));
+  auto* format =
+      cmd.add_option("--format", opts.format,
+                     "Format of the result data under --out: csv (default) or mat (one results.mat, MAT 5)")
+          ->check(CLI::IsMember({"csv", "mat"}));
+  // A format without an output directory would be silently ignored: refuse it (exit 2).
+  if (CLI::Option* out = cmd.get_option_no_throw("--out")) format->needs(out);
 }
 
 namespace {

@@ -47,6 +47,9 @@ def test_cli_simulate_format_mat(tmp_path, cli):
         np.testing.assert_array_equal(d[k][:, 0], r[k])
     assert d["final_position_m"][0, 0] == r["x2_m"][-1]
     assert not (tmp_path / "m" / "trajectory.csv").exists()
+    # Without --out the format would have nowhere to go: a usage error (exit 2), one line.
+    rc, _, err = cli("stickslip", "simulate", "--duration", 0.001, "--format", "mat")
+    assert rc == 2 and "--out" in cli_error(err)
 
 
 @pytest.fixture(scope="module")
