@@ -16,10 +16,14 @@
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mat_file.h"
 #include "microcobot/core/mcap_reader.h"
+#include "microcobot/haptics/dual_stage_plant.h"
+#include "microcobot/haptics/evaluation.h"
+#include "microcobot/haptics/identification.h"
 #include "microcobot/haptics/render_pipeline.h"
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/platform/session.h"
 #include "microcobot/tweezers/ballscrew.h"
+#include "microcobot/tweezers/bandwidth.h"
 #include "microcobot/tweezers/specs.h"
 #include "microcobot/tweezers/transmission.h"
 
@@ -300,6 +304,8 @@ void bind_control(py::module_& m) {
       "position`.");
 }
 
+void bind_haptics_identification(py::module_& m);
+
 void bind_haptics(py::module_& m) {
   namespace hp = mc::haptics;
   py::class_<hp::RenderPipeline>(
@@ -343,6 +349,69 @@ void bind_haptics(py::module_& m) {
            "Complex response of the crossover's low band at f_Hz [Hz].")
       .def("highpass_response", &hp::RenderPipeline::highpass_response, "f_Hz"_a,
            "Complex response of the crossover's high band at f_Hz [Hz] (without the alignment delay).");
+  bind_haptics_identification(m);
+}
+
+namespace {
+
+py::array_t<std::complex<double>> complex_array(const std::vector<std::complex<double>>& v) {
+  py::array_t<std::complex<double>> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+py::dict frf_dict(const haptics::ChannelFrf& f) {
+  return py::dict("f_Hz"_a = to_array(f.f_Hz), "h"_a = complex_array(f.h),
+                  "coherence"_a = to_array(f.coherence));
+}
+
+}  // namespace
+
+void bind_haptics_identification(py::module_& m) {
+  namespace hp = mc::haptics;
+  m.def(
+      "identify",
+      [](py::handle plant_params, std::uint64_t seed) {
+        const hp::DualStagePlant plant(params_from<hp::DualStagePlantParams>(plant_params));
+        hp::IdentificationOptions o;
+        o.seed = seed;
+        const auto id = nogil([&] { return hp::identify(plant, o); });
+        const auto& g = id.hf_model;
+        return py::dict(
+            "lf"_a = frf_dict(id.lf), "hf"_a = frf_dict(id.hf), "lf_gain_m_s2_per_N"_a = id.lf_gain,
+            "hf_model"_a = py::dict("b1"_a = g.b1, "b0"_a = g.b0, "a1"_a = g.a1, "a0"_a = g.a0),
+            "lf_flat_upper_Hz"_a = id.lf_flat_upper_Hz, "hf_valid_lower_Hz"_a = id.hf_valid_lower_Hz,
+            "cutoff_Hz"_a = id.cutoff_Hz, "hf_delay_s"_a = id.hf_delay_s,
+            "total_mass_kg"_a = plant.total_mass_kg(), "pipeline"_a = params_dict(hp::pipeline_from(id)));
+      },
+      "plant"_a = py::none(), "seed"_a = 1,
+      "PRBS identification of the dual-stage plant (thesis §3.4, eq. 3.5-3.6), as `microcobot haptics "
+      "identify`: "
+      "both channels' H1 responses, G_0^LF, the second-order G^HF, the crossover and the high band's "
+      "alignment "
+      "delay, and the rendering 'pipeline' parameters they give.");
+  m.def(
+      "evaluate",
+      [](py::handle plant_params, py::handle pipeline_params) {
+        const hp::DualStagePlant plant(params_from<hp::DualStagePlantParams>(plant_params));
+        // As `microcobot haptics evaluate`: the pipeline from the identified plant unless given.
+        const bool given = !pipeline_params.is_none();
+        hp::RenderPipelineParams rp =
+            given ? params_from<hp::RenderPipelineParams>(pipeline_params) : hp::RenderPipelineParams{};
+        const auto ev = nogil([&] {
+          if (!given) rp = hp::pipeline_from(hp::identify(plant, hp::IdentificationOptions{}));
+          return hp::evaluate(plant, rp, hp::EvaluationOptions{});
+        });
+        return py::dict("fc_Hz"_a = to_array(ev.fc_Hz), "lf_dB"_a = to_array(ev.lf_dB),
+                        "hf_dB"_a = to_array(ev.hf_dB), "combined_dB"_a = to_array(ev.combined_dB),
+                        "pantograph_dB"_a = to_array(ev.pantograph_dB), "flatness_dB"_a = ev.flatness_dB,
+                        "pipeline"_a = params_dict(rp));
+      },
+      "plant"_a = py::none(), "pipeline"_a = py::none(),
+      "Sine-dwell evaluation at the 1/3-octave centres of Table 3.4 (thesis §3.5.1, Fig. 3.13): the gain of "
+      "each "
+      "channel, of both and of the Pantograph alone [dB]; the pipeline identified from the plant unless "
+      "given.");
 }
 
 void bind_tweezers(py::module_& m) {
@@ -364,6 +433,23 @@ void bind_tweezers(py::module_& m) {
         "Force at each finger F_Y = eta_t (F_a / 2) / tan(alpha) [N] (eq. 4.5).");
   m.def("min_preload", &tw::min_preload, "closing_force_N"_a, "alpha_rad"_a,
         "Magnetic preload keeping the roller on its track [N] (§4.4.2).");
+  m.def(
+      "identify_bandwidth",
+      [](py::handle model, py::handle options) {
+        const auto mp = params_from<tw::TeleTweezParams>(model);
+        const auto op = params_from<tw::BandwidthIdentParams>(options);
+        const auto r = nogil([&] { return tw::identify_bandwidth(mp, op); });
+        return py::dict("mode_Hz"_a = r.features.mode_Hz, "antiresonance_Hz"_a = r.features.antiresonance_Hz,
+                        "bandwidth_Hz"_a = r.features.bandwidth_Hz, "t_s"_a = to_array(r.t_s),
+                        "torque_N_m"_a = to_array(r.torque_N_m), "accel_m_s2"_a = to_array(r.accel_m_s2),
+                        "f_Hz"_a = to_array(r.f_Hz), "magnitude"_a = to_array(r.magnitude),
+                        "phase_rad"_a = to_array(r.phase_rad), "coherence"_a = to_array(r.coherence),
+                        "model_magnitude"_a = to_array(r.model_magnitude));
+      },
+      "model"_a = py::none(), "options"_a = py::none(),
+      "Bandwidth identification of the TéléTweez (thesis §4.5.2, Fig. 4.24-4.25): PRBS torque at 10 kHz, the "
+      "H1 "
+      "response to the finger acceleration [m/s^2 / (N m)], its mode, antiresonance and flat band [Hz].");
   m.def("stiffness_force", &tw::stiffness_force, "stiffness_N_per_m"_a, "opening_m"_a,
         "Force holding tweezers of clamping stiffness k closed over opening d: F = k d [N] (eq. 4.1).");
 }

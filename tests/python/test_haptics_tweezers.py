@@ -52,3 +52,37 @@ def test_tweezers_calculators_reproduce_the_thesis():
     assert tweezers.ball_screw_efficiency(d, p, 0.2)["backward_efficiency"] == 0.0
     with pytest.raises(ValueError, match="diameter"):
         tweezers.lead_angle(-1.0, 1e-3)
+
+
+def test_identification_and_evaluation_of_the_dual_stage_interface():
+    idr = haptics.identify()
+    # Eq. 3.5: below its first mode the Pantograph is a mass, G_0^LF = 1 / M_total.
+    assert idr["lf_gain_m_s2_per_N"] * idr["total_mass_kg"] == pytest.approx(1.0, abs=0.05)
+    assert idr["cutoff_Hz"] == 200.0  # §3.4.2's crossover
+    assert 1.5e-4 < idr["hf_delay_s"] < 1e-3
+    assert idr["pipeline"]["lf_gain_m_s2_per_N"] == idr["lf_gain_m_s2_per_N"]
+    assert len(idr["lf"]["f_Hz"]) == len(idr["lf"]["h"]) == len(idr["lf"]["coherence"])
+    ev = haptics.evaluate(pipeline=idr["pipeline"])
+    # Fig. 3.13: both channels together render flatter than the Pantograph alone, which falls away
+    # by more than 6 dB above its first mode.
+    pant = np.asarray(ev["pantograph_dB"])
+    assert ev["flatness_dB"] < np.ptp(pant)
+    assert np.max(np.abs(pant[np.asarray(ev["fc_Hz"]) > 250.0])) > 6.0
+    # Without an explicit pipeline, evaluate identifies one first: the same numbers.
+    assert haptics.evaluate()["flatness_dB"] == ev["flatness_dB"]
+
+
+def test_teletweez_bandwidth_identification_reproduces_fig_4_25():
+    r = tweezers.identify_bandwidth()
+    # Thesis Fig. 4.25: the dominant mode near 150 Hz, the antiresonance near 390 Hz, a flat band of
+    # at least 100 Hz below the mode.
+    assert r["mode_Hz"] == pytest.approx(150.0, abs=10.0)
+    assert r["antiresonance_Hz"] == pytest.approx(390.0, abs=20.0)
+    assert 100.0 <= r["bandwidth_Hz"] < r["mode_Hz"]
+    # The H1 estimate agrees with the model's analytic response where the coherence is high (1 dB).
+    f, c = r["f_Hz"], r["coherence"]
+    sel = (f > 20) & (f < 1000) & (c > 0.95)
+    assert sel.sum() > 500
+    np.testing.assert_allclose(20 * np.log10(r["magnitude"][sel] / r["model_magnitude"][sel]), 0.0, atol=1.0)
+    with pytest.raises(ValueError, match="fs_Hz"):
+        tweezers.identify_bandwidth(options={"fs_Hz": -1.0})
