@@ -156,7 +156,12 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
     }
   }
   if (!operating_point.is_none()) {
-    const auto op = operating_point.cast<std::tuple<double, double, std::string>>();
+    std::tuple<double, double, std::string> op;
+    try {
+      op = operating_point.cast<std::tuple<double, double, std::string>>();
+    } catch (const py::cast_error&) {
+      throw InvalidInput("operating_point: expected (amplitude_V, frequency_Hz, 'forward' | 'backward')");
+    }
     const auto dir = ss::parse_direction(std::get<2>(op));
     require(std::isfinite(std::get<0>(op)) && std::isfinite(std::get<1>(op)) && std::get<1>(op) > 0,
             "operating_point", "amplitude_V and frequency_Hz must be finite, frequency > 0");
@@ -230,14 +235,13 @@ ss::MeasuredRecord record_from(py::handle t_or_file, py::handle u, py::handle x,
   }
   if (u.is_none() || x.is_none()) throw InvalidInput(name + ": give t, u and x (arrays), or one file name");
   const auto ta = t_or_file.cast<DoubleArray>(), ua = u.cast<DoubleArray>(), xa = x.cast<DoubleArray>();
-  CsvTable table;
-  table.add_column("t_s",
-                   std::vector<double>(span_of(ta, name + ".t").begin(), span_of(ta, name + ".t").end()));
-  const auto us = span_of(ua, name + ".u"), xs = span_of(xa, name + ".x");
-  if (us.size() != static_cast<std::size_t>(ta.size()) || xs.size() != us.size()) {
-    throw InvalidInput(name + ": t, u and x must have the same length (got " + std::to_string(ta.size()) +
+  const auto ts = span_of(ta, name + ".t"), us = span_of(ua, name + ".u"), xs = span_of(xa, name + ".x");
+  if (us.size() != ts.size() || xs.size() != ts.size()) {
+    throw InvalidInput(name + ": t, u and x must have the same length (got " + std::to_string(ts.size()) +
                        ", " + std::to_string(us.size()) + ", " + std::to_string(xs.size()) + ")");
   }
+  CsvTable table;
+  table.add_column("t_s", std::vector<double>(ts.begin(), ts.end()));
   table.add_column("u_V", std::vector<double>(us.begin(), us.end()));
   table.add_column("x_m", std::vector<double>(xs.begin(), xs.end()));
   return ss::record_from_table(table, name);

@@ -287,3 +287,15 @@ def test_rollout_releases_the_gil():
     th.join()
     assert span[0] > 0.05  # long enough to see
     assert gap < 0.5 * span[0], (gap, span[0])
+
+
+def test_identification_inputs_are_checked():
+    t = np.arange(100) / 25000.0
+    with pytest.raises(ValueError, match=r"t, u and x must have the same length \(got 100, 99, 100\)"):
+        microcobot.identify.record(t, np.zeros(99), np.zeros(100))
+    with pytest.raises(ValueError, match=r"record\.x: non-finite value nan at flat index 5"):
+        microcobot.identify.record(t, np.zeros(100), np.r_[np.zeros(5), np.nan, np.zeros(94)])
+    r = microcobot.identify.record(t, np.zeros(100), np.ones(100))
+    np.testing.assert_array_equal(r["t_s"], t)
+    with pytest.raises(ValueError, match="operating_point"):
+        ss.rollout(ss.Actuator(), None, np.zeros((1, 10)), operating_point=(60.0, "fast"))
