@@ -6,7 +6,7 @@ BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
 
-.PHONY: run demo report test deps configure build asan fuzz bench format clean
+.PHONY: run demo report test deps configure build python asan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state.
@@ -33,6 +33,10 @@ configure: deps
 
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
+
+# The Python module only: build/$(PRESET)/python/microcobot (PYTHONPATH=build/$(PRESET)/python).
+python: configure
+	cmake --build --preset $(PRESET) -j $(JOBS) --target _microcobot
 
 # Sanitizer build and its tests (CI runs this after `make test`).
 asan:
