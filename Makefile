@@ -6,7 +6,7 @@ BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
 
-.PHONY: run demo report test deps configure build asan fuzz bench format clean
+.PHONY: run demo report test deps configure build python asan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state.
@@ -34,6 +34,10 @@ configure: deps
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
+# The Python module only: build/$(PRESET)/python/microcobot (PYTHONPATH=build/$(PRESET)/python).
+python: configure
+	cmake --build --preset $(PRESET) -j $(JOBS) --target _microcobot
+
 # Sanitizer build and its tests (CI runs this after `make test`).
 asan:
 	$(MAKE) test PRESET=asan
@@ -45,6 +49,7 @@ fuzz: deps
 
 bench: build
 	@for b in $(BUILD)/bench/*_bench; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
+	@echo "== bench/serve_bench.mjs"; MC_CLI=$(CLI) node --experimental-websocket --no-warnings bench/serve_bench.mjs
 
 format:
 	@git ls-files '*.h' '*.cc' | xargs clang-format -i

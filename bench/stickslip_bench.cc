@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
@@ -79,6 +80,34 @@ void BM_FixedStep(benchmark::State& state) {
       benchmark::Counter(s.duration_s * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FixedStep)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
+
+/// The loop of the Python module's rollout (python/stickslip_py.cc) for one axis: fast stepping
+/// (60 V, 500 Hz, 0.1 s) as a stream of one voltage sample per model step (step(state, u), linear
+/// between samples), writing x1 and x2 each step. bench/python_rollout_bench.py compares the
+/// module's rollout with this (docs/benchmarks.md).
+void BM_SampleStream(benchmark::State& state) {
+  const ss::StickSlipParams p;
+  const ss::ActuatorModel m(p);
+  const auto w = ss::make_waveform(ss::WaveKind::kSawtooth, 60.0, 500.0, ss::Direction::kForward, p.drive);
+  const double duration_s = 0.1;
+  const auto steps = static_cast<std::size_t>(std::llround(duration_s / m.dt_s()));
+  std::vector<double> u(steps), x1(steps), x2(steps);
+  for (std::size_t k = 0; k < steps; ++k) u[k] = w.value(static_cast<double>(k + 1) * m.dt_s());
+  for (auto _ : state) {
+    ss::ActuatorState st = m.initial_state();
+    m.set_operating_point(st, 60.0, 500.0, ss::Direction::kForward);
+    for (std::size_t k = 0; k < steps; ++k) {
+      m.step(st, u[k]);
+      x2[k] = m.slider_position(st);
+      x1[k] = st.x1_m();
+    }
+    benchmark::DoNotOptimize(x2.data());
+    benchmark::DoNotOptimize(x1.data());
+  }
+  state.counters["rtf"] =
+      benchmark::Counter(duration_s * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_SampleStream)->Unit(benchmark::kMillisecond);
 
 void BM_ReferenceEqualAccuracy(benchmark::State& state) {
   const int i = static_cast<int>(state.range(0));

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The one list of what microcobot needs on a Debian 12 machine.
 # Idempotent: installs only what is missing and is silent when everything is present.
-# Usage: scripts/install-deps.sh [--dev]   (--dev adds python3-scipy for regenerating reference data)
+# Usage: scripts/install-deps.sh   (python3-scipy also regenerates the reference data of tests/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,8 +18,10 @@ DEBIAN_PACKAGES=(
   nodejs npm           # uPlot (bundled into reports) and playwright-core (browser test)
   chromium             # headless browser for the report test
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
+  libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
+  pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
+  python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
 )
-if [[ "${1:-}" == "--dev" ]]; then DEBIAN_PACKAGES+=(python3-scipy python3-numpy); fi
 
 missing=()
 for p in "${DEBIAN_PACKAGES[@]}"; do

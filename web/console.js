@@ -114,6 +114,7 @@ function connect() {
       setTimeout(connect, 1000);
     },
     status(m) {
+      if (m.id === "report") listRecordings();
       if (m.message.startsWith("control: ")) {
         setControl(m.message === "control: granted");
       }
@@ -350,10 +351,15 @@ function drawMicroscope() {
     for (let y = Math.floor(y0 / step) * step; y <= y1; y += step) { const [, py] = worldToCanvas(0, y); g.moveTo(0, py); g.lineTo(c.width, py); }
     g.stroke();
   }
-  // The part: a brass cube, its top face at part_z + side / 2, blurred by its defocus.
-  const side = sc.part_side_m;
+  // The hole at the target (pin-in-hole): its rim at z = 0.
+  if (sc.hole_side_m > 0) {
+    const hs = sc.hole_side_m, [hx, hy] = worldToCanvas(sc.target_m[0] - hs / 2, sc.target_m[1] + hs / 2);
+    drawBlurred(g, hx, hy, hs * s, hs * s, blurPx(focus, o, s), "#0c0b09");
+  }
+  // The part: a brass cube or pin, its top face at part_z + height / 2, blurred by its defocus.
+  const side = sc.part_side_m, height = sc.part_height_m || side;
   const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + side / 2), o, s), "#c9a04a");
+  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a");
   // The target: a reticle overlaid on the view (a graticule, always sharp), with the tolerance.
   const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
   g.strokeStyle = "#46c47e";
@@ -389,13 +395,17 @@ function drawSide() {
   g.fillStyle = "#111";
   g.fillRect(0, 0, c.width, c.height);
   if (!t || !sc) return;
-  const s = c.width / view.fov, zmax = 1.0e-3, zs = (c.height - 20) / zmax;
-  const X = (x) => c.width / 2 + (x - view.center[0]) * s, Z = (z) => c.height - 10 - z * zs;
+  const s = c.width / view.fov, zmax = 1.0e-3, zs = sideScale();
+  const X = (x) => c.width / 2 + (x - view.center[0]) * s, Z = (z) => mc.worldToSide(0, z)[1];
   g.fillStyle = "#3b372f";
-  g.fillRect(0, Z(0), c.width, 10);
-  const side = sc.part_side_m;
+  g.fillRect(0, Z(0), c.width, c.height - Z(0));
+  if (sc.hole_side_m > 0) {  // the hole, in section
+    g.fillStyle = "#111";
+    g.fillRect(X(sc.target_m[0] - sc.hole_side_m / 2), Z(0), sc.hole_side_m * s, sc.hole_depth_m * zs);
+  }
+  const side = sc.part_side_m, height = sc.part_height_m || side;
   g.fillStyle = "#c9a04a";
-  g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + side / 2), side * s, side * zs);
+  g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + height / 2), side * s, height * zs);
   g.fillStyle = "#b8c4d6";
   const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
   for (const sign of [-1, 1]) {
@@ -407,13 +417,16 @@ function drawSide() {
   g.fillStyle = "#8a93a3";
   g.fillText(`z ${(t.measured_z_m * um).toFixed(1)} µm`, 8, 14);
 }
+// The side view spans z from the bottom of the hole (or the substrate) to 1 mm above it.
+const sideZmin = () => (mc.scene && mc.scene.hole_side_m > 0 ? -mc.scene.hole_depth_m : 0);
+const sideScale = () => ($("side").height - 20) / (1.0e-3 - sideZmin());
 mc.sideToWorld = (px, py) => {
-  const c = $("side"), s = c.width / view.fov, zs = (c.height - 20) / 1.0e-3;
-  return [view.center[0] + (px - c.width / 2) / s, (c.height - 10 - py) / zs];
+  const c = $("side"), s = c.width / view.fov;
+  return [view.center[0] + (px - c.width / 2) / s, sideZmin() + (c.height - 10 - py) / sideScale()];
 };
 mc.worldToSide = (x, z) => {
-  const c = $("side"), s = c.width / view.fov, zs = (c.height - 20) / 1.0e-3;
-  return [c.width / 2 + (x - view.center[0]) * s, c.height - 10 - z * zs];
+  const c = $("side"), s = c.width / view.fov;
+  return [c.width / 2 + (x - view.center[0]) * s, c.height - 10 - (z - sideZmin()) * sideScale()];
 };
 
 // Click-to-go: the stage moves straight to the clicked point while the deadman is held (the
@@ -489,6 +502,8 @@ function onStatus(s) {
   rows.push(["tick p99", s.tick_p99_us.toFixed(1) + " µs", true]);
   rows.push(["clients", String(s.clients), true]);
   rows.push(["recording", s.recording || "off", true]);
+  const lat = s.command_latency_ms;
+  if (lat && lat.count > 0) rows.push(["command latency", "p50 " + lat.p50.toFixed(2) + " ms, p99 " + lat.p99.toFixed(2) + " ms", lat.p99 < 5]);
   $("status").innerHTML = "";
   for (const [name, value, ok] of rows) {
     const tr = document.createElement("tr");
@@ -502,6 +517,46 @@ function onStatus(s) {
   $("estop").classList.toggle("latched", s.estopped);
   $("record").textContent = s.recording ? "Stop recording" : "Record";
   $("record").classList.toggle("on", !!s.recording);
+  if ((s.recording || "") !== mc.lastRecording) {  // a recording started or ended: list again
+    mc.lastRecording = s.recording || "";
+    listRecordings();
+  }
+}
+
+// The recordings in --out with their downloads and session reports (made on the first click).
+function listRecordings() {
+  fetch("/recordings" + location.search, {cache: "no-store"})
+    .then((r) => (r.ok ? r.json() : {recordings: []}))
+    .then((j) => {
+      const table = $("recordings");
+      table.innerHTML = "";
+      if (!j.recordings.length) {
+        table.innerHTML = "<tr><td>none yet: press Record</td></tr>";
+        return;
+      }
+      for (const rec of j.recordings) {
+        const tr = document.createElement("tr");
+        const name = document.createElement("td"), size = document.createElement("td"), links = document.createElement("td");
+        name.textContent = rec.name;
+        size.textContent = rec.recording ? "" : (rec.bytes / 1e6).toFixed(1) + " MB";
+        if (rec.recording) {
+          links.textContent = "recording…";
+        } else {
+          const dl = document.createElement("a");
+          dl.href = rec.url + location.search;  // the token, when the server needs one
+          dl.textContent = "download";
+          dl.setAttribute("download", rec.name);
+          const rep = document.createElement("a");
+          rep.href = rec.report_url + location.search;
+          rep.target = "_blank";
+          rep.textContent = rec.report_ready ? "report" : "make report";
+          links.append(dl, " · ", rep);
+        }
+        tr.append(name, size, links);
+        table.append(tr);
+      }
+    })
+    .catch(() => {});
 }
 
 function onScene(s) {

@@ -1,6 +1,7 @@
 #include "cli.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <mutex>
@@ -10,6 +11,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/core/mat_file.h"
 #include "signals.h"
 
 namespace mc::cli {
@@ -96,6 +98,65 @@ const CLI::Validator NonNegativeNumber = lower_bound(false);
 void add_output_options(CLI::App& cmd, CommonOptions& opts) {
   cmd.add_flag("--json", opts.json, "Print a machine-readable JSON summary on stdout");
   cmd.add_option("--out", opts.out, "Write CSV artifacts and an index.html report to this directory");
+}
+
+void add_format_option(CLI::App& cmd, CommonOptions& opts) {
+  auto* format =
+      cmd.add_option("--format", opts.format,
+                     "Format of the result data under --out: csv (default) or mat (one results.mat, MAT 5)")
+          ->check(CLI::IsMember({"csv", "mat"}));
+  // A format without an output directory would be silently ignored: refuse it (exit 2).
+  if (CLI::Option* out = cmd.get_option_no_throw("--out")) format->needs(out);
+}
+
+namespace {
+
+bool is_numeric_array(const nlohmann::json& j) {
+  if (!j.is_array() || j.empty()) return false;
+  for (const auto& x : j) {
+    if (!x.is_number()) return false;
+  }
+  return true;
+}
+
+/// The numbers and numeric arrays of a JSON summary as .mat variables (key paths joined by '_').
+void collect_mat(const nlohmann::json& j, const std::string& prefix, std::vector<mc::MatArray>& out) {
+  for (const auto& [key, v] : j.items()) {
+    std::string name = prefix.empty() ? key : prefix + "_" + key;
+    for (char& c : name) {
+      if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    }
+    if (name.size() > 63 || !std::isalpha(static_cast<unsigned char>(name[0]))) continue;
+    if (v.is_number()) {
+      out.push_back(mc::MatArray::scalar(name, v.get<double>()));
+    } else if (v.is_boolean()) {
+      out.push_back(mc::MatArray::scalar(name, v.get<bool>() ? 1.0 : 0.0));
+    } else if (is_numeric_array(v)) {
+      out.push_back(mc::MatArray::column(name, v.get<std::vector<double>>()));
+    } else if (v.is_object()) {
+      collect_mat(v, name, out);
+    }
+  }
+}
+
+}  // namespace
+
+bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
+                       const std::vector<std::pair<std::string, std::vector<double>>>& arrays) {
+  if (!opts.out || opts.format != "mat") return false;
+  check_finite(summary, "");
+  mc::ensure_writable_dir(*opts.out);
+  std::vector<mc::MatArray> vars;
+  for (const auto& [name, values] : arrays) vars.push_back(mc::MatArray::column(name, values));
+  std::vector<mc::MatArray> scalars;
+  collect_mat(summary, "", scalars);
+  for (auto& v : scalars) {
+    const bool taken =
+        std::any_of(vars.begin(), vars.end(), [&](const mc::MatArray& a) { return a.name == v.name; });
+    if (!taken) vars.push_back(std::move(v));
+  }
+  mc::write_mat(*opts.out / "results.mat", vars);
+  return true;
 }
 
 void add_params_option(CLI::App& cmd, CommonOptions& opts) {

@@ -59,10 +59,18 @@ struct CommonOptions {
   bool json = false;
   std::optional<std::filesystem::path> out;
   std::optional<std::filesystem::path> params;
+  std::string format = "csv";  ///< --format: "csv" (CSV files) or "mat" (one results.mat)
 };
 
 /// Adds `--json` and `--out DIR` to `cmd`.
 void add_output_options(CLI::App& cmd, CommonOptions& opts);
+/// Adds `--format csv|mat` to `cmd` (commands whose --out holds result data).
+void add_format_option(CLI::App& cmd, CommonOptions& opts);
+/// With --out and --format mat: writes DIR/results.mat (MAT 5, docs/cli.md) holding `arrays` and
+/// every number and numeric array of `summary`, named by its key path joined by '_'
+/// (e.g. mode_a_frequency_Hz). Returns true when it wrote the file.
+bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
+                       const std::vector<std::pair<std::string, std::vector<double>>>& arrays = {});
 /// Adds `--params FILE` to `cmd`.
 void add_params_option(CLI::App& cmd, CommonOptions& opts);
 

@@ -10,6 +10,7 @@
 
 #include "cli.h"
 #include "microcobot/control/closed_loop.h"
+#include "microcobot/control/control_params.h"
 #include "microcobot/control/setpoint_stream.h"
 #include "microcobot/control/tracking_run.h"
 #include "microcobot/control/xyz_stage.h"
@@ -26,45 +27,7 @@ using mc::report::Figure;
 using mc::report::Report;
 using mc::report::Series;
 
-/// Every key `--params FILE.yaml` accepts (`microcobot control params --json`).
-struct ControlParams {
-  ss::StickSlipParams model;
-  ct::StepMapParams step_map;
-  ct::PositionSensorParams sensor;
-  ct::VelocityControlParams velocity;
-  ct::PositionControlParams position;
-  ct::BaselinePositionParams baseline;
-  ct::MotionLimits limits;
-  ct::TrackingParams tracking;
-  ct::SetpointStreamParams stream;
-  ct::PathLimits path;
-
-  template <class V>
-  void visit(V& v) {
-    v("model", model);
-    v("step_map", step_map);
-    v("sensor", sensor);
-    v("velocity", velocity);
-    v("position", position);
-    v("baseline", baseline);
-    v("limits", limits);
-    v("tracking", tracking);
-    v("stream", stream);
-    v("path", path);
-  }
-  void validate() const {
-    model.validate();
-    step_map.validate();
-    sensor.validate();
-    velocity.validate();
-    position.validate();
-    baseline.validate();
-    limits.validate();
-    tracking.validate();
-    stream.validate();
-    path.validate();
-  }
-};
+using ct::ControlParams;
 
 ControlParams load(const CommonOptions& o) {
   return o.params ? mc::load_params<ControlParams>(*o.params) : ControlParams{};

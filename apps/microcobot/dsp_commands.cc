@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/core/mat_file.h"
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/dsp/octave.h"
 #include "microcobot/dsp/signals.h"
@@ -97,12 +98,13 @@ void add_dsp(CLI::App& group) {
     auto o = std::make_shared<O>();
     auto* cmd =
         group.add_subcommand("welch", "Welch power spectral density of one CSV column (scipy.signal.welch)");
-    cmd->add_option("--in", o->in, "CSV file with a header row")->required();
+    cmd->add_option("--in", o->in, "CSV file with a header row, or a .mat file (vector variables)")
+        ->required();
     cmd->add_option("--column", o->column, "Column name")->required();
     add_welch_flags(cmd, o->w);
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] {
-      const auto table = mc::read_csv(o->in);
+      const auto table = mc::read_columns(o->in, {o->column});
       const auto p = mc::dsp::welch(table.column(o->column), to_options(o->w));
       mc::cli::emit(o->common, {{"f_Hz", p.f_Hz}, {"psd", p.value}});
     });
@@ -116,13 +118,14 @@ void add_dsp(CLI::App& group) {
     auto o = std::make_shared<O>();
     auto* cmd = group.add_subcommand(
         "frf", "H1 frequency response and coherence; CSV f_Hz,re,im,coherence on stdout");
-    cmd->add_option("--in", o->in, "CSV file with a header row")->required();
+    cmd->add_option("--in", o->in, "CSV file with a header row, or a .mat file (vector variables)")
+        ->required();
     cmd->add_option("--input", o->input, "Input column")->required();
     cmd->add_option("--output", o->output, "Output column")->required();
     add_welch_flags(cmd, o->w);
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] {
-      const auto table = mc::read_csv(o->in);
+      const auto table = mc::read_columns(o->in, {o->input, o->output});
       const auto e = mc::dsp::frf_h1(table.column(o->input), table.column(o->output), to_options(o->w));
       std::vector<double> re(e.h.size()), im(e.h.size());
       for (std::size_t i = 0; i < e.h.size(); ++i) {
@@ -164,7 +167,8 @@ void add_dsp(CLI::App& group) {
     };
     auto o = std::make_shared<O>();
     auto* cmd = group.add_subcommand("tffit", "Rational transfer-function fit of an FRF CSV (f_Hz,re,im)");
-    cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im")->required();
+    cmd->add_option("--in", o->in, "FRF CSV with columns f_Hz,re,im (or a .mat with those variables)")
+        ->required();
     cmd->add_option("--nz", o->nz, "Numerator order")->check(mc::cli::Range(0, 20));
     cmd->add_option("--np", o->np, "Denominator order")->check(mc::cli::Range(1, 20));
     cmd->add_option("--fmin", o->fmin, "Band start (Hz)")->check(mc::cli::NonNegativeNumber);

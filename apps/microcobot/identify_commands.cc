@@ -262,6 +262,8 @@ json hysteresis_json(const ss::HysteresisResult& r) {
 void finish(const Opts& o, const std::string& title, const ss::StickSlipParams& p, json j,
             const mc::report::Report& rep, const std::string& human) {
   j["params_files"] = save_params(o, p);
+  // --format mat: results.mat holds every number of the summary (e.g. mode_a_frequency_Hz).
+  mc::cli::write_results_mat(o.common, j);
   mc::cli::write_report_if_requested(o.common, rep);
   (void)title;
   mc::cli::emit(o.common, j, human);
@@ -276,6 +278,7 @@ CLI::App* command(CLI::App& group, const std::string& name, const std::string& h
   cmd->add_option("--save", o->save, "Also write the identified parameter file here (YAML)");
   mc::cli::add_params_option(*cmd, o->common);
   mc::cli::add_output_options(*cmd, o->common);
+  mc::cli::add_format_option(*cmd, o->common);
   return cmd;
 }
 
@@ -285,7 +288,7 @@ void add_identify(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     command(group, "pe-modes",
             "PE modes (frequency, damping, gain split) from a step of the PE without slider", o,
-            "CSV t_s,u_V,x_m: PE step response (~1 MHz)")
+            "CSV t_s,u_V,x_m or .mat with t, u, x (SI): PE step response (~1 MHz)")
         ->callback([o] {
           const auto base = base_params(o->common);
           const auto rec = ss::read_record(o->in);
@@ -305,7 +308,7 @@ void add_identify(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     command(group, "friction-modes",
             "The two asperities (rho0, rho1 each) from a scanning-mode step response", o,
-            "CSV t_s,u_V,x_m: actuator step response (~25 kHz)")
+            "CSV t_s,u_V,x_m or .mat with t, u, x (SI): actuator step response (~25 kHz)")
         ->callback([o] {
           const auto base = base_params(o->common);
           const auto rec = ss::read_record(o->in);
@@ -324,7 +327,7 @@ void add_identify(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     auto* cmd =
         command(group, "hysteresis", "PI thresholds and weights (NNLS) and the inverse from a sine response",
-                o, "CSV t_s,u_V,x_m: slider response to a sine (scanning mode)");
+                o, "CSV t_s,u_V,x_m or .mat with t, u, x (SI): slider response to a sine (scanning mode)");
     cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
         ->check(mc::cli::Range(1, 200));
     cmd->callback([o] {

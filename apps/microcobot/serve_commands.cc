@@ -68,8 +68,10 @@ std::string random_token() {
 void serve(const ServeOptions& o) {
   mc::live::LiveParams lp;
   if (o.config) lp.platform = pf::load_platform_config(*o.config);
-  if (o.scene != "pick-place") {
-    // A scene file: the microworld's keys (part, start, target, adhesion, gripper).
+  if (o.scene == "pin-in-hole") {
+    lp.platform.world = mc::microworld::pin_in_hole_scene();
+  } else if (o.scene != "pick-place") {
+    // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
   }
   auto [host, port] = parse_listen(o.listen);
@@ -113,7 +115,8 @@ void add_serve(CLI::App& cmd) {
   auto o = std::make_shared<ServeOptions>();
   cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as `run --print-config` shows)");
   cmd.add_option("--scene", o->scene,
-                 "Scene: pick-place (default: the 300 um part) or a YAML file of the microworld's keys");
+                 "Scene: pick-place (default: the 300 um part), pin-in-hole (a 200 um pin into a hole with "
+                 "20 um of clearance) or a YAML file of the microworld's keys (scenes/*.yaml)");
   cmd.add_option("--listen", o->listen,
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");

@@ -217,10 +217,10 @@ void run_simulate(const SimulateOptions& o) {
                                            ss::parse_direction(o.direction), p.drive);
   ss::ActuatorState state = m.initial_state();
   const ss::Trajectory tr = ss::simulate(m, w, o.duration_s, 1, &state);
-  const auto bounds = p.physical_bounds();  // once: it runs the PI over the drive's range
-  for (std::size_t i = 0; i < tr.t_s.size(); ++i) {
-    p.check_physical_bounds(bounds, tr.x1_m[i], tr.x2_m[i], tr.t_s[i], "stickslip simulate");
-  }
+  const auto bounds = p.physical_bounds();         // once: it runs the PI over the drive's range
+  const std::string where = "stickslip simulate";  // once: a literal would be a string per sample
+  for (std::size_t i = 0; i < tr.t_s.size(); ++i)
+    p.check_physical_bounds(bounds, tr.x1_m[i], tr.x2_m[i], tr.t_s[i], where);
   const double x0 = tr.x2_m.front(), xf = tr.x2_m.back();
   const double dur = tr.t_s.back() - tr.t_s.front();
   // Mean velocity from the same phase to the same phase: over the whole periods of the run (the
@@ -256,11 +256,14 @@ void run_simulate(const SimulateOptions& o) {
     t.add_column("u_V", tr.u_V);
     t.add_column("x1_m", tr.x1_m);
     t.add_column("x2_m", tr.x2_m);
-    mc::write_csv(
-        *o.common.out / "trajectory.csv", t,
-        {fmt::format("microcobot stickslip simulate --wave {} --amplitude {} --frequency {} --direction {} "
-                     "--duration {}",
-                     o.wave, o.amplitude_V, o.frequency_Hz, o.direction, o.duration_s)});
+    // --format mat: results.mat holds the trajectory's columns and the summary's numbers.
+    if (!mc::cli::write_results_mat(o.common, j,
+                                    {{"t_s", tr.t_s}, {"u_V", tr.u_V}, {"x1_m", tr.x1_m}, {"x2_m", tr.x2_m}}))
+      mc::write_csv(
+          *o.common.out / "trajectory.csv", t,
+          {fmt::format("microcobot stickslip simulate --wave {} --amplitude {} --frequency {} --direction {} "
+                       "--duration {}",
+                       o.wave, o.amplitude_V, o.frequency_Hz, o.direction, o.duration_s)});
     Report r("stickslip simulate");
     r.section("Simulation", fmt::format("{} {:g} V {:g} Hz {} for {:g} s", o.wave, o.amplitude_V,
                                         o.frequency_Hz, o.direction, dur));
@@ -411,6 +414,7 @@ void add_stickslip(CLI::App& group) {
     cmd->add_option("--dt", o->dt_s, "Integrator step [s] (default integrator.dt_s)")
         ->check(mc::cli::Range(1e-9, 1e-4));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_simulate(*o); });
   }

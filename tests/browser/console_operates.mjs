@@ -188,6 +188,32 @@ try {
   const stopped = await t();
   if (stopped.u_x_V !== 0 || stopped.u_y_V !== 0 || stopped.u_z_V !== 0) fail("drive voltages not zero after the e-stop");
   await shot("05-estop");
+
+  // Stop the recording: it is listed with its download and report links; the report is made on
+  // demand and draws the session's figures. Then record again (SIGTERM must close that one).
+  await page.click("#record");
+  await until("the recording listed as finished", () => !!document.querySelector("#recordings a[download]"), 10);
+  const download = await page.$eval("#recordings a[download]", (a) => a.href);
+  const reportLink = await page.$("#recordings a[target=_blank]");
+  const [reportPage] = await Promise.all([page.context().waitForEvent("page"), reportLink.click()]);
+  reportPage.on("pageerror", (e) => pageErrors.push("report: " + String(e)));
+  const reportDeadline = Date.now() + 60000;
+  let figures = 0;
+  while (Date.now() < reportDeadline) {
+    await reportPage.waitForLoadState("load").catch(() => {});
+    figures = await reportPage.evaluate(() => document.querySelectorAll(".uplot canvas").length).catch(() => 0);
+    if (figures > 0) break;
+    await reportPage.waitForTimeout(200);
+  }
+  const title = await reportPage.title().catch(() => "");
+  log(`report on demand: "${title}", ${figures} plots; download ${download}`);
+  if (!title.startsWith("microcobot recording: ") || figures < 8) fail(`the report did not render ("${title}", ${figures} plots)`);
+  await reportPage.screenshot({ path: join(artifacts, "06-report.png") });
+  await reportPage.close();
+  const res = await page.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, bytes: (await r.arrayBuffer()).byteLength }; }, download);
+  if (res.status !== 200 || res.bytes < 1000) fail(`download: HTTP ${res.status}, ${res.bytes} bytes`);
+  await page.click("#record");
+  await until("recording again", () => window.mc.status && !!window.mc.status.recording, 5);
 } catch (e) {
   fail(String(e.stack || e));
   const diag = await page.evaluate(() => JSON.stringify({ messages: window.mc.messages.slice(-10), status: window.mc.status,
@@ -205,14 +231,14 @@ if (outside.length) fail("the console fetched from elsewhere (it must work offli
 server.kill("SIGTERM");
 const { code, signal } = await exited;
 if (code !== 0) fail(`serve exited with ${code} (${signal}) on SIGTERM`);
-const recordings = readdirSync(join(dir, "rec")).filter((f) => f.endsWith(".mcap"));
-if (recordings.length !== 1) fail("expected one recording, found: " + readdirSync(join(dir, "rec")).join(", "));
+const recordings = readdirSync(join(dir, "rec")).filter((f) => f.endsWith(".mcap")).sort();
+if (recordings.length !== 2) fail("expected two recordings, found: " + readdirSync(join(dir, "rec")).join(", "));
 else {
-  const bytes = readFileSync(join(dir, "rec", recordings[0]));
+  const bytes = readFileSync(join(dir, "rec", recordings[1]));  // the one SIGTERM closed
   const magic = Buffer.from([0x89, 0x4d, 0x43, 0x41, 0x50, 0x30, 0x0d, 0x0a]);
   if (!bytes.subarray(0, 8).equals(magic) || !bytes.subarray(bytes.length - 8).equals(magic))
     fail("the recording is not a closed MCAP file");
-  log(`recording ${recordings[0]}: ${bytes.length} bytes`);
+  log(`recording ${recordings[1]}: ${bytes.length} bytes`);
 }
 log(`screenshots in ${artifacts}`);
 clearTimeout(guard);

@@ -114,5 +114,69 @@ TEST(PickPlaceWorld, SteppingNeverAllocatesAndParamsAreValidated) {
   EXPECT_THROW(PickPlaceWorld{bad}, InvalidParams);
 }
 
+// The pin-in-hole scene: a 200 um pin (600 um tall) into a 220 um hole 300 um deep at the target.
+struct Pin {
+  PickPlaceWorld w{pin_in_hole_scene()};
+  PickPlaceState s = w.initial_state();
+  Eigen::Vector3d g{0, 0, 1e-3};
+  static constexpr double open = 400e-6, closed = 160e-6;
+  // Grasps the pin 50 um above its middle and carries it 200 um higher, over (x, y).
+  void carry_over(double x, double y) {
+    move(w, s, g, {0, 0, 350e-6}, open);
+    hold(w, s, g, closed, 0.1);
+    move(w, s, g, {0, 0, 550e-6}, closed);
+    EXPECT_EQ(s.phase, PartPhase::kGrasped);
+    move(w, s, g, {x, y, 550e-6}, closed);
+  }
+};
+
+TEST(PinInHole, AnAlignedPinGoesDownToTheBottomOfTheHoleAndStaysThereWhenReleased) {
+  Pin pin;
+  EXPECT_NEAR(pin.s.part_m.z(), 300e-6, 1e-12) << "the pin stands on the substrate";
+  pin.carry_over(2e-3 + 8e-6, -6e-6);  // within the 10 um of play
+  move(pin.w, pin.s, pin.g, {2e-3 + 8e-6, -6e-6, 40e-6}, Pin::closed);
+  EXPECT_NEAR(pin.s.part_m.z(), 0.0, 1e-12) << "its bottom on the hole's bottom, 300 um down";
+  EXPECT_TRUE(pin.w.inserted(pin.s));
+  EXPECT_FALSE(pin.s.crashed) << "the fingers held it above the substrate";
+  hold(pin.w, pin.s, pin.g, Pin::open, 0.1);
+  move(pin.w, pin.s, pin.g, {2e-3 + 8e-6, -6e-6, 1e-3}, Pin::open);
+  EXPECT_EQ(pin.s.phase, PartPhase::kOnSubstrate);
+  EXPECT_TRUE(pin.w.inserted(pin.s));
+  EXPECT_LT(pin.w.placement_error_m(pin.s), 10e-6 * std::sqrt(2.0));
+}
+
+TEST(PinInHole, AMisalignedPinLandsOnTheRimAndTheFingersFeelIt) {
+  Pin pin;
+  pin.carry_over(2e-3 + 30e-6, 0);  // 30 um off: more than the 10 um of play
+  const auto out = move(pin.w, pin.s, pin.g, {2e-3 + 30e-6, 0, 340e-6}, Pin::closed);
+  EXPECT_NEAR(pin.s.part_m.z(), 300e-6, 1e-12) << "stopped on the rim";
+  EXPECT_FALSE(pin.w.inserted(pin.s));
+  EXPECT_GT(out.force_on_gripper_N.z(), 0.0) << "the press comes back to the fingers";
+}
+
+TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
+  Pin pin;
+  pin.carry_over(2e-3, 0);
+  move(pin.w, pin.s, pin.g, {2e-3, 0, 100e-6}, Pin::closed);
+  ASSERT_TRUE(pin.w.inserted(pin.s));
+  const auto out = move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 100e-6}, Pin::closed);
+  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-12) << "against the wall";
+  EXPECT_NEAR(out.force_on_gripper_N.x(), -1e5 * 1e-6, 1e-9) << "the last micrometre pressed into the wall";
+  // Pulled out, it is free again.
+  move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 600e-6}, Pin::closed);
+  EXPECT_FALSE(pin.w.inserted(pin.s));
+  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-12) << "it slipped in the fingers while held by the wall";
+}
+
+TEST(PinInHole, TheHoleMustLeaveClearanceAndHoldThePinAboveTheSubstrate) {
+  PickPlaceParams p = pin_in_hole_scene();
+  p.hole_side_m = p.part_side_m;
+  EXPECT_THROW(PickPlaceWorld{p}, InvalidParams);
+  p = pin_in_hole_scene();
+  p.hole_depth_m = p.part_height_m;
+  EXPECT_THROW(PickPlaceWorld{p}, InvalidParams);
+  EXPECT_NEAR(pin_in_hole_scene().part_weight_N(), 8500 * 200e-6 * 200e-6 * 600e-6 * 9.81, 1e-15);
+}
+
 }  // namespace
 }  // namespace mc::microworld

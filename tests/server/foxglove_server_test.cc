@@ -1,14 +1,9 @@
-// The server over loopback with a small Beast client (the only test file that includes Beast).
+// The server over loopback with the tests' small Foxglove client (support/ws_client.h).
 #include "microcobot/server/foxglove_server.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/beast/core.hpp>
-#include <boost/beast/http.hpp>
-#include <boost/beast/websocket.hpp>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -19,20 +14,15 @@
 #include <vector>
 
 #include "microcobot/core/error.h"
+#include "support/ws_client.h"
 
 namespace mc::server {
 namespace {
 
-namespace beast = boost::beast;
-namespace http = beast::http;
-namespace websocket = beast::websocket;
-namespace net = boost::asio;
-using tcp = net::ip::tcp;
 using nlohmann::json;
 using namespace std::chrono_literals;
-using error_code = boost::system::error_code;
 
-constexpr auto kTimeout = 5s;
+constexpr auto kTimeout = test::kClientTimeout;
 
 ServerOptions loopback() {
   ServerOptions o;
@@ -40,139 +30,8 @@ ServerOptions loopback() {
   return o;
 }
 
-/// A Foxglove client: every operation is asynchronous under a deadline, so a broken server fails
-/// the test instead of hanging it.
-class Client {
- public:
-  /// Connects and upgrades; returns the HTTP status of the upgrade (101 when accepted).
-  int connect(std::uint16_t port, const std::string& target = "/", bool subprotocol = true) {
-    bool done = false;
-    error_code ec;
-    beast::get_lowest_layer(ws_).expires_after(kTimeout);
-    beast::get_lowest_layer(ws_).async_connect(tcp::endpoint(net::ip::address_v4::loopback(), port),
-                                               [&](const error_code& e) {
-                                                 ec = e;
-                                                 done = true;
-                                               });
-    if (!run_until(done) || ec) return -1;
-    if (subprotocol) {
-      ws_.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
-        req.set(http::field::sec_websocket_protocol, "foxglove.websocket.v1");
-      }));
-    }
-    done = false;
-    ws_.async_handshake(response_, "127.0.0.1", target, [&](const error_code& e) {
-      ec = e;
-      done = true;
-    });
-    if (!run_until(done)) return -1;
-    beast::get_lowest_layer(ws_).expires_never();
-    return response_.result_int();
-  }
-  const websocket::response_type& response() const { return response_; }
-
-  struct Message {
-    bool text = false;
-    std::string data;
-  };
-  /// The next message, or nullopt on error/timeout (then the client is unusable).
-  std::optional<Message> read(std::chrono::milliseconds timeout = kTimeout) {
-    buffer_.clear();
-    bool done = false;
-    error_code ec;
-    ws_.async_read(buffer_, [&](const error_code& e, std::size_t) {
-      ec = e;
-      done = true;
-    });
-    if (!run_until(done, timeout) || ec) return std::nullopt;
-    return Message{ws_.got_text(), beast::buffers_to_string(buffer_.data())};
-  }
-  /// The next text message as JSON (binary messages before it are skipped).
-  json read_json() {
-    for (int i = 0; i < 100000; ++i) {
-      auto m = read();
-      if (!m) return json();
-      if (m->text) return json::parse(m->data);
-    }
-    return json();
-  }
-  /// Reads until a status with this id arrives (other messages skipped); null on timeout.
-  json read_status(const std::string& id) {
-    for (int i = 0; i < 100000; ++i) {
-      json j = read_json();
-      if (j.is_null()) return j;
-      if (j.value("op", "") == "status" && j.value("id", "") == id) return j;
-    }
-    return json();
-  }
-
-  bool send(const std::string& data, bool binary = false) {
-    ws_.binary(binary);
-    bool done = false;
-    error_code ec;
-    ws_.async_write(net::buffer(data), [&](const error_code& e, std::size_t) {
-      ec = e;
-      done = true;
-    });
-    return run_until(done) && !ec;
-  }
-  bool send_json(const json& j) { return send(j.dump()); }
-  /// Sends an op the server answers with an error, and waits for that answer: every message sent
-  /// before it has then been handled (the server handles a client's messages in order).
-  bool sync() {
-    return send_json({{"op", "unsubscribe"}, {"subscriptionIds", {4000000000u}}}) &&
-           !read_status("unknown-subscription").is_null();
-  }
-  void close() {
-    bool done = false;
-    ws_.async_close(websocket::close_code::normal, [&](const error_code&) { done = true; });
-    run_until(done, 1000ms);
-  }
-
- private:
-  bool run_until(const bool& done, std::chrono::milliseconds timeout = kTimeout) {
-    ioc_.restart();
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (!done) {
-      const auto now = std::chrono::steady_clock::now();
-      if (now >= deadline) return false;
-      ioc_.run_one_for(deadline - now);
-    }
-    return true;
-  }
-
-  net::io_context ioc_;
-  websocket::stream<beast::tcp_stream> ws_{ioc_};
-  websocket::response_type response_;
-  beast::flat_buffer buffer_;
-};
-
-/// One HTTP request on a fresh connection; status -1 when no answer came.
-http::response<http::string_body> http_request(std::uint16_t port, http::verb verb, const std::string& target,
-                                               const std::string& extra_header = "") {
-  net::io_context ioc;
-  beast::tcp_stream stream(ioc);
-  http::response<http::string_body> res;
-  res.result(http::status::unknown);
-  stream.expires_after(kTimeout);
-  http::request<http::string_body> req(verb, target, 11);
-  req.set(http::field::host, "127.0.0.1");
-  if (!extra_header.empty()) req.set("X-Filler", extra_header);
-  if (verb == http::verb::post) {
-    req.body() = "x=1";
-    req.prepare_payload();
-  }
-  beast::flat_buffer buf;
-  stream.async_connect(tcp::endpoint(net::ip::address_v4::loopback(), port), [&](const error_code& ec) {
-    if (ec) return;
-    http::async_write(stream, req, [&](const error_code& ec2, std::size_t) {
-      if (ec2) return;
-      http::async_read(stream, buf, res, [](const error_code&, std::size_t) {});
-    });
-  });
-  ioc.run_for(kTimeout);
-  return res;
-}
+using Client = test::WsClient;
+using test::http_request;
 
 template <typename Pred>
 bool eventually(Pred pred, std::chrono::milliseconds timeout = 3000ms) {
@@ -202,7 +61,7 @@ TEST(FoxgloveServer, HandshakeSendsServerInfoThenAdvertise) {
 
   Client c;
   ASSERT_EQ(c.connect(server.port()), 101);
-  EXPECT_EQ(c.response()[http::field::sec_websocket_protocol], "foxglove.websocket.v1");
+  EXPECT_EQ(c.response_header("Sec-WebSocket-Protocol"), "foxglove.websocket.v1");
   const json info = c.read_json();
   EXPECT_EQ(info["op"], "serverInfo");
   EXPECT_EQ(info["name"], "test server");
@@ -385,7 +244,7 @@ TEST(FoxgloveServer, TokenIsRequiredOnTheUpgrade) {
   EXPECT_EQ(ok.connect(server.port(), "/?a=1&token=s3cr3t%2F%2B"), 101);
   EXPECT_EQ(ok.read_json()["op"], "serverInfo");
   // The HTTP resources do not need it.
-  EXPECT_EQ(http_request(server.port(), http::verb::get, "/").result_int(), 200);
+  EXPECT_EQ(http_request(server.port(), "GET", "/").status, 200);
 }
 
 TEST(FoxgloveServer, ConnectionsBeyondTheLimitGet503ThenRecover) {
@@ -400,7 +259,7 @@ TEST(FoxgloveServer, ConnectionsBeyondTheLimitGet503ThenRecover) {
     Client c;
     EXPECT_EQ(c.connect(server.port()), 503);
   }
-  EXPECT_EQ(http_request(server.port(), http::verb::get, "/").result_int(), 503);
+  EXPECT_EQ(http_request(server.port(), "GET", "/").status, 503);
   EXPECT_GE(server.counters().connections_refused, 2u);
   a.close();
   // Once a slot is free a new client gets in.
@@ -475,21 +334,21 @@ TEST(FoxgloveServer, HttpResources) {
                         {{"/", {"text/html; charset=utf-8", "<!doctype html><p>console</p>"}},
                          {"/app.js", {"text/javascript", "console.log(1);"}}});
   server.start();
-  const auto index = http_request(server.port(), http::verb::get, "/");
-  EXPECT_EQ(index.result_int(), 200);
-  EXPECT_EQ(index.body(), "<!doctype html><p>console</p>");
-  EXPECT_EQ(index[http::field::content_type], "text/html; charset=utf-8");
-  EXPECT_EQ(index[http::field::cache_control], "no-store");
-  EXPECT_EQ(index[http::field::content_length], std::to_string(index.body().size()));
-  EXPECT_EQ(http_request(server.port(), http::verb::get, "/app.js?v=2").body(), "console.log(1);");
+  const auto index = http_request(server.port(), "GET", "/");
+  EXPECT_EQ(index.status, 200);
+  EXPECT_EQ(index.body, "<!doctype html><p>console</p>");
+  EXPECT_EQ(index.header("Content-Type"), "text/html; charset=utf-8");
+  EXPECT_EQ(index.header("Cache-Control"), "no-store");
+  EXPECT_EQ(index.header("Content-Length"), std::to_string(index.body.size()));
+  EXPECT_EQ(http_request(server.port(), "GET", "/app.js?v=2").body, "console.log(1);");
 
-  const auto missing = http_request(server.port(), http::verb::get, "/nope");
-  EXPECT_EQ(missing.result_int(), 404);
-  EXPECT_EQ(missing.body(), "not found: /nope\n");
-  const auto post = http_request(server.port(), http::verb::post, "/");
-  EXPECT_EQ(post.result_int(), 405);
-  EXPECT_EQ(post[http::field::allow], "GET, HEAD");
-  EXPECT_EQ(http_request(server.port(), http::verb::get, "/", std::string(10000, 'h')).result_int(), 431);
+  const auto missing = http_request(server.port(), "GET", "/nope");
+  EXPECT_EQ(missing.status, 404);
+  EXPECT_EQ(missing.body, "not found: /nope\n");
+  const auto post = http_request(server.port(), "POST", "/");
+  EXPECT_EQ(post.status, 405);
+  EXPECT_EQ(post.header("Allow"), "GET, HEAD");
+  EXPECT_EQ(http_request(server.port(), "GET", "/", std::string(10000, 'h')).status, 431);
 }
 
 TEST(FoxgloveServer, StopWithConnectedClientsIsPrompt) {

@@ -3,8 +3,9 @@
 /// Reading input files safely: every file the platform reads (parameter and configuration
 /// YAML, CSV data) goes through read_input_file(), which accepts only regular files (a
 /// directory, a device such as /dev/zero or a FIFO is refused before it is read) and refuses
-/// files larger than a cap before reading them, so a bad path can neither hang the command
-/// nor exhaust memory. Also the helpers that keep error messages to one readable line.
+/// files larger than a cap before reading them (.mat files: core/mat_file does the same checks), so a bad
+/// path can neither hang the command nor exhaust memory. Also the helpers that keep error messages to one
+/// readable line.
 
 #include <cstddef>
 #include <filesystem>

@@ -31,6 +31,9 @@ struct ConsoleCommand {
   double goal_speed_m_s = 100e-6;
   bool has_gripper = false;
   double gripper_opening_m = 0.0;
+  /// When the server received it (steady clock, ns; 0: unknown): the loop measures the
+  /// command-to-target latency from it.
+  std::int64_t received_ns = 0;
 };
 
 /// One-shot actions of `/console/action`.

@@ -1,15 +1,20 @@
 #include "microcobot/live/console_server.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
+#include <system_error>
 
 #include <nlohmann/json.hpp>
 
+#include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/mcap_writer.h"
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/live/console_page.h"
+#include "microcobot/platform/session.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::live {
@@ -31,6 +36,49 @@ const std::size_t kTick = channel_index("tick_us");
 
 std::string schema(const json& properties) {
   return json{{"type", "object"}, {"properties", properties}}.dump();
+}
+
+// A recording's stem: "recording-" then digits and dashes (what start_recording() names), so a
+// request can name nothing else (no path, no hidden or temporary file).
+bool is_recording_stem(std::string_view stem) {
+  constexpr std::string_view prefix = "recording-";
+  if (stem.size() <= prefix.size() || stem.size() > 64 || stem.substr(0, prefix.size()) != prefix)
+    return false;
+  return stem.find_first_not_of("0123456789-", prefix.size()) == std::string_view::npos;
+}
+
+std::string html_escape(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+server::HttpReply html_page(int status, const std::string& title, const std::string& text, int refresh_s) {
+  server::HttpReply r;
+  r.status = status;
+  r.content_type = "text/html; charset=utf-8";
+  r.refresh_s = refresh_s;
+  r.body = "<!doctype html><meta charset=\"utf-8\"><title>" + html_escape(title) +
+           "</title><body style=\"font-family:sans-serif\"><h1>" + html_escape(title) + "</h1><p>" +
+           html_escape(text) + "</p>";
+  return r;
 }
 
 dsp::SosFilter rumble_filter(double fc_Hz) {
@@ -77,12 +125,16 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"lifecycle", {{"type", "object"}}},
                                             {"overruns", number},
                                             {"tick_p99_us", number},
+                                            {"command_latency_ms", {{"type", "object"}}},
                                             {"clients", number},
                                             {"recording", {{"type", {"string", "null"}}}},
                                             {"last_error", text}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                                    schema({{"part_side_m", number},
+                                           {"part_height_m", number},
+                                           {"hole_side_m", number},
+                                           {"hole_depth_m", number},
                                            {"target_m", vec3},
                                            {"tolerance_m", number},
                                            {"max_opening_m", number},
@@ -94,6 +146,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                       schema({{"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
   server_.on_disconnect([this](server::ClientId c) { on_disconnect(c); });
+  server_.on_http_get([this](std::string_view path) { return on_http(path); });
   json_.reserve(4096);
 }
 
@@ -126,7 +179,8 @@ void ConsoleServer::stop() {
     // The recording could not be finished (disk full): its temporary file is gone; stopping
     // goes on regardless.
   }
-  server_.stop();
+  server_.stop();  // no more requests: no new report
+  if (report_thread_.joinable()) report_thread_.join();
 }
 
 void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t count) {
@@ -179,7 +233,10 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
   const server::ClientId controller = controller_.load();
   try {
     if (m.topic == "/console/command") {
-      const ConsoleCommand c = parse_console_command(m.payload, live_.limits());
+      ConsoleCommand c = parse_console_command(m.payload, live_.limits());
+      c.received_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                          std::chrono::steady_clock::now().time_since_epoch())
+                          .count();
       if (m.client != controller) {
         server_.send_status(m.client, StatusLevel::kWarning, "control: take control first; command ignored",
                             "control");
@@ -254,8 +311,11 @@ void ConsoleServer::start_recording() {
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
   localtime_r(&now, &tm);
-  char name[64];
-  std::strftime(name, sizeof name, "recording-%Y%m%d-%H%M%S.mcap", &tm);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "recording-%Y%m%d-%H%M%S", &tm);
+  std::string name = std::string(stamp) + ".mcap";
+  for (int i = 2; std::filesystem::exists(params_.out_dir / name) && i < 1000; ++i)
+    name = std::string(stamp) + "-" + std::to_string(i) + ".mcap";  // two in the same second
   auto w = std::make_unique<McapWriter>(params_.out_dir / name);
   const auto schema_id = w->add_schema(platform::kTelemetrySchemaName, "jsonschema",
                                        platform::telemetry_json_schema(live_.channel_count()));
@@ -276,13 +336,11 @@ void ConsoleServer::stop_recording() {
 
 std::string ConsoleServer::scene_json() const {
   const auto& c = live_.limits();
-  return json{{"part_side_m", live_.part_side_m()},
-              {"target_m", live_.target_m()},
-              {"tolerance_m", live_.placement_tolerance_m()},
-              {"max_opening_m", c.max_opening_m},
-              {"finger_width_m", live_.finger_width_m()},
-              {"workspace_min_m", c.min_m},
-              {"workspace_max_m", c.max_m},
+  return json{{"part_side_m", live_.part_side_m()}, {"part_height_m", live_.part_height_m()},
+              {"hole_side_m", live_.hole_side_m()}, {"hole_depth_m", live_.hole_depth_m()},
+              {"target_m", live_.target_m()},       {"tolerance_m", live_.placement_tolerance_m()},
+              {"max_opening_m", c.max_opening_m},   {"finger_width_m", live_.finger_width_m()},
+              {"workspace_min_m", c.min_m},         {"workspace_max_m", c.max_m},
               {"max_speed_m_s", c.max_speed_m_s}}
       .dump();
 }
@@ -306,6 +364,11 @@ std::string ConsoleServer::status_json() {
             {"lifecycle", lifecycle},
             {"overruns", s.overruns},
             {"tick_p99_us", tick_p99_us_.load()},
+            {"command_latency_ms",
+             {{"count", latency_.count()},
+              {"p50", 1e3 * latency_.quantile_s(0.5)},
+              {"p99", 1e3 * latency_.quantile_s(0.99)},
+              {"max", 1e3 * latency_.max_s()}}},
             {"clients", server_.client_count()},
             {"recording", recording.empty() ? json(nullptr) : json(recording)},
             {"last_error", s.last_error}};
@@ -320,10 +383,133 @@ void ConsoleServer::status_thread() {
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
     std::this_thread::sleep_until(next);
     const auto ns = static_cast<std::uint64_t>(std::llround(live_.status().t_s * 1e9));
+    live_.drain_command_latencies(latency_);
     server_.publish(status_ch_, ns, status_json());
     if (n++ % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0)
       server_.publish(scene_ch_, ns, scene_json());
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Recordings over HTTP, and their reports on demand.
+
+std::optional<server::HttpReply> ConsoleServer::on_http(std::string_view path) {
+  if (params_.out_dir.empty()) return std::nullopt;
+  if (path == "/recordings") {
+    server::HttpReply r;
+    r.content_type = "application/json";
+    r.body = recordings_json();
+    return r;
+  }
+  constexpr std::string_view prefix = "/recordings/";
+  if (path.substr(0, prefix.size()) != prefix) return std::nullopt;
+  const std::string file(path.substr(prefix.size()));
+  const auto dot = file.rfind('.');
+  if (dot == std::string::npos || !is_recording_stem(std::string_view(file).substr(0, dot)))
+    return std::nullopt;
+  const std::string stem = file.substr(0, dot), ext = file.substr(dot);
+  std::string active;
+  {
+    std::lock_guard lock(recording_mutex_);
+    active = recording_name_;
+  }
+  std::error_code ec;
+  if (ext == ".mcap") {
+    if (file == active)
+      return html_page(409, "Recording in progress", file + " is being recorded: stop the recording first.",
+                       0);
+    if (!std::filesystem::is_regular_file(params_.out_dir / file, ec)) return std::nullopt;
+    server::HttpReply r;
+    r.content_type = "application/octet-stream";
+    r.file = params_.out_dir / file;
+    r.attachment_name = file;
+    return r;
+  }
+  if (ext != ".html") return std::nullopt;
+  if (std::filesystem::is_regular_file(params_.out_dir / file, ec)) {
+    server::HttpReply r;
+    r.content_type = "text/html; charset=utf-8";
+    r.file = params_.out_dir / file;
+    return r;
+  }
+  if (stem + ".mcap" == active)
+    return html_page(409, "Recording in progress",
+                     stem + ".mcap is being recorded: stop the recording first.", 0);
+  if (!std::filesystem::is_regular_file(params_.out_dir / (stem + ".mcap"), ec)) return std::nullopt;
+  return report_reply(stem);
+}
+
+server::HttpReply ConsoleServer::report_reply(const std::string& stem) {
+  std::lock_guard lock(report_mutex_);
+  if (const auto it = report_errors_.find(stem); it != report_errors_.end())
+    return html_page(500, "No report for " + stem + ".mcap", it->second, 0);
+  if (reporting_ == stem)
+    return html_page(202, "Making the report of " + stem + ".mcap", "This page reloads when it is ready.", 1);
+  if (!reporting_.empty())
+    return html_page(503, "Busy", "Making the report of " + reporting_ + ".mcap; this page retries.", 2);
+  if (report_thread_.joinable()) report_thread_.join();  // the previous one has finished
+  reporting_ = stem;
+  report_thread_ = std::thread([this, stem] { make_report(stem); });
+  return html_page(202, "Making the report of " + stem + ".mcap", "This page reloads when it is ready.", 1);
+}
+
+void ConsoleServer::make_report(const std::string& stem) {
+  const auto mcap = params_.out_dir / (stem + ".mcap");
+  std::string error;
+  try {
+    if (std::filesystem::file_size(mcap) > kMaxReportRecordingBytes)
+      throw InvalidInput(mcap.string(), 0,
+                         "larger than " + std::to_string(kMaxReportRecordingBytes >> 20) +
+                             " MB: too long for a report (record shorter sessions)");
+    const Recorder rec = platform::read_telemetry_mcap(mcap, kReportSamples);
+    write_file_atomic(params_.out_dir / (stem + ".html"),
+                      platform::recording_report(rec, stem + ".mcap").html());
+    server_.broadcast_status(StatusLevel::kInfo, "report ready: /recordings/" + stem + ".html", "report");
+  } catch (const std::exception& e) {
+    error = e.what();
+    server_.broadcast_status(StatusLevel::kError, "report of " + stem + ".mcap: " + error, "report");
+  }
+  std::lock_guard lock(report_mutex_);
+  if (!error.empty()) report_errors_[stem] = error;
+  reporting_.clear();
+}
+
+std::string ConsoleServer::recordings_json() const {
+  std::string active;
+  {
+    std::lock_guard lock(recording_mutex_);
+    active = recording_name_;
+  }
+  json list = json::array();
+  std::error_code ec;
+  for (auto it = std::filesystem::directory_iterator(params_.out_dir, ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    const auto& p = it->path();
+    if (p.extension() != ".mcap" || !is_recording_stem(p.stem().string()) || !it->is_regular_file(ec))
+      continue;
+    const std::string name = p.filename().string();
+    std::error_code size_error, report_error;
+    const auto size = it->file_size(size_error);
+    const std::uintmax_t bytes = size_error ? 0 : size;
+    const bool has_report =
+        std::filesystem::is_regular_file(params_.out_dir / (p.stem().string() + ".html"), report_error);
+    list.push_back({{"name", name},
+                    {"bytes", bytes},
+                    {"recording", false},
+                    {"url", "/recordings/" + name},
+                    {"report_url", "/recordings/" + p.stem().string() + ".html"},
+                    {"report_ready", has_report}});
+  }
+  if (!active.empty()) {  // written under a temporary name until it is closed
+    list.push_back({{"name", active},
+                    {"bytes", 0},
+                    {"recording", true},
+                    {"url", nullptr},
+                    {"report_url", nullptr},
+                    {"report_ready", false}});
+  }
+  std::sort(list.begin(), list.end(), [](const json& a, const json& b) { return a["name"] > b["name"]; });
+  return json{{"recordings", list}}.dump();
 }
 
 }  // namespace mc::live

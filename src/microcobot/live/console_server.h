@@ -10,6 +10,11 @@
 ///   client /console/command      the controlling client's command (~30 Hz heartbeat)
 ///   client /console/action       estop, reset, take/release control, demo, restart, record
 ///
+/// HTTP: `/` the console; `/recordings` the recordings in --out (JSON); `/recordings/<name>.mcap`
+/// a download (not the one being written); `/recordings/<name>.html` its session report, made
+/// on demand by a worker thread on the first request (the page reloads until it is ready) and
+/// kept beside the recording.
+///
 /// One client controls at a time; the others observe until they take control. Any client may
 /// press the e-stop. Every message is parsed, checked and clamped (console_command.h) before it
 /// reaches the loop, through the live platform's single-producer ring (the server runs one I/O
@@ -23,8 +28,10 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -73,6 +80,11 @@ class ConsoleServer {
   void stop_recording();
   server::ServerCounters counters() const { return server_.counters(); }
 
+  /// Recordings longer than this are refused a report (the reader holds the file in memory).
+  static constexpr std::uintmax_t kMaxReportRecordingBytes = 512ull << 20;
+  /// Samples a report plots at most (evenly decimated).
+  static constexpr std::size_t kReportSamples = 20000;
+
  private:
   void on_sample(const platform::TelemetrySample& s, std::size_t count);
   void on_message(const server::ClientMessage& m);
@@ -80,6 +92,10 @@ class ConsoleServer {
   void status_thread();
   std::string status_json();
   std::string scene_json() const;
+  std::optional<server::HttpReply> on_http(std::string_view path);
+  std::string recordings_json() const;
+  server::HttpReply report_reply(const std::string& stem);
+  void make_report(const std::string& stem);
 
   LivePlatform& live_;
   ConsoleServerParams params_;
@@ -105,6 +121,13 @@ class ConsoleServer {
   std::uint16_t recording_channel_ = 0;
   std::string recording_name_;
   std::atomic<double> tick_p99_us_{0.0};
+  platform::TimingStats latency_{1e-5};  // status thread: command-to-target, 10 us bins
+
+  // Reports made on demand, one at a time, off the server's I/O thread.
+  std::mutex report_mutex_;
+  std::thread report_thread_;
+  std::string reporting_;                             // the stem being made, empty when idle
+  std::map<std::string, std::string> report_errors_;  // stem -> why its report failed
 };
 
 }  // namespace mc::live

@@ -1,5 +1,6 @@
 #include "microcobot/live/live_platform.h"
 
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -64,7 +65,16 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
 
   ConsoleCommand c;
   bool got = false;
-  while (commands_.pop(c)) got = true;
+  while (commands_.pop(c)) {
+    got = true;
+    if (c.received_ns > 0) {
+      // Applied in this tick: the command-to-target latency (a full ring drops the sample).
+      const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count();
+      latencies_.push(1e-9 * static_cast<double>(now - c.received_ns));
+    }
+  }
   if (got) {
     latest_ = c;
     last_command_t_ = t.t_s;
@@ -157,6 +167,11 @@ void LivePlatform::stop() {
   // Safe state now; the devices are deactivated when the platform goes.
   platform_->fault_all();
   estopped_.store(true);
+}
+
+void LivePlatform::drain_command_latencies(platform::TimingStats& stats) noexcept {
+  double latency_s = 0.0;
+  while (latencies_.pop(latency_s)) stats.add(latency_s);
 }
 
 LiveStatus LivePlatform::status() const {

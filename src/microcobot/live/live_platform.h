@@ -29,6 +29,7 @@
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/spsc_ring.h"
+#include "microcobot/platform/timing_stats.h"
 
 namespace mc::live {
 
@@ -82,11 +83,18 @@ class LivePlatform {
   void request(ConsoleAction action);
 
   LiveStatus status() const;
+  /// Moves the command-to-target latencies measured by the loop since the last call (from the
+  /// server's receipt of a command to the tick that applies it) into `stats`. One consumer
+  /// thread.
+  void drain_command_latencies(platform::TimingStats& stats) noexcept;
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
   /// The scene's geometry, for the microscope view (world coordinates).
   double part_side_m() const { return params_.platform.world.part_side_m; }
+  double part_height_m() const { return params_.platform.world.height_m(); }
+  double hole_side_m() const { return params_.platform.world.hole_side_m; }
+  double hole_depth_m() const { return params_.platform.world.hole_depth_m; }
   std::array<double, 3> target_m() const {
     return {params_.platform.world.target_m.x(), params_.platform.world.target_m.y(), 0.0};
   }
@@ -105,7 +113,8 @@ class LivePlatform {
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<platform::PickPlaceOperator> demo_;
   platform::SpscRing<ConsoleCommand> commands_{256};
-  ConsoleCommand latest_;  // loop thread only
+  platform::SpscRing<double> latencies_{4096};  // loop -> status thread [s]
+  ConsoleCommand latest_;                       // loop thread only
   double last_command_t_ = -1e9;
   double t_offset_s_ = 0.0;
 

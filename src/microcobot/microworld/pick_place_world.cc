@@ -17,13 +17,32 @@ void PickPlaceParams::validate() const {
   require_in_range(finger_friction, 0.0, 2.0, "finger_friction");
   require_in_range(substrate_friction, 0.0, 2.0, "substrate_friction");
   require_positive(substrate_stiffness_N_m, "substrate_stiffness_N_m");
+  require_non_negative(part_height_m, "part_height_m");
+  require_non_negative(hole_side_m, "hole_side_m");
+  require_non_negative(hole_depth_m, "hole_depth_m");
+  if (hole_side_m > 0.0) {
+    require(hole_side_m > part_side_m, "hole_side_m",
+            "must exceed part_side_m (the clearance must be positive)", hole_side_m);
+    require(hole_depth_m > 0.0 && hole_depth_m < height_m(), "hole_depth_m",
+            "must be within (0, the part's height): the fingers must hold the part above the substrate",
+            hole_depth_m);
+  }
   gripper.validate();
   require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
           gripper.max_opening_m);
 }
 
 double PickPlaceParams::part_weight_N() const {
-  return part_density_kg_m3 * part_side_m * part_side_m * part_side_m * gravity_m_s2;
+  return part_density_kg_m3 * part_side_m * part_side_m * height_m() * gravity_m_s2;
+}
+
+PickPlaceParams pin_in_hole_scene() {
+  PickPlaceParams p;
+  p.part_side_m = 200e-6;
+  p.part_height_m = 600e-6;
+  p.hole_side_m = 220e-6;
+  p.hole_depth_m = 300e-6;
+  return p;
 }
 
 PickPlaceWorld::PickPlaceWorld(PickPlaceParams params) : p_(std::move(params)) {
@@ -33,7 +52,7 @@ PickPlaceWorld::PickPlaceWorld(PickPlaceParams params) : p_(std::move(params)) {
 
 PickPlaceState PickPlaceWorld::initial_state() const {
   PickPlaceState s;
-  s.part_m = {p_.part_start_m.x(), p_.part_start_m.y(), 0.5 * p_.part_side_m};
+  s.part_m = {p_.part_start_m.x(), p_.part_start_m.y(), rest_z_m(p_.part_start_m.x(), p_.part_start_m.y())};
   s.gripper.free_opening_m = p_.gripper.max_opening_m;
   s.last_gripper_m = {p_.part_start_m.x(), p_.part_start_m.y(), 10 * p_.part_side_m};
   return s;
@@ -43,13 +62,39 @@ double PickPlaceWorld::placement_error_m(const PickPlaceState& s) const {
   return std::hypot(s.part_m.x() - p_.target_m.x(), s.part_m.y() - p_.target_m.y());
 }
 
+double PickPlaceWorld::rest_z_m(double x, double y) const noexcept {
+  const double half_height = 0.5 * p_.height_m();
+  if (p_.hole_side_m <= 0.0) return half_height;
+  const double play = 0.5 * (p_.hole_side_m - p_.part_side_m) + 1e-12;
+  const bool fits = std::abs(x - p_.target_m.x()) <= play && std::abs(y - p_.target_m.y()) <= play;
+  return fits ? half_height - p_.hole_depth_m : half_height;
+}
+
+bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
+  return p_.hole_side_m > 0.0 && s.part_m.z() < 0.5 * p_.height_m() - 1e-9;
+}
+
+Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_hole) const noexcept {
+  if (!in_hole) return Eigen::Vector2d::Zero();
+  const double play = 0.5 * (p_.hole_side_m - p_.part_side_m);
+  Eigen::Vector2d reaction = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 2; ++i) {
+    const double centre = p_.target_m[i], d = part[i] - centre;
+    const double inside = std::clamp(d, -play, play);
+    // The wall stops the part; the fingers, pressing it into the wall, feel its stiffness.
+    reaction[i] = p_.substrate_stiffness_N_m * (inside - d);
+    part[i] = centre + inside;
+  }
+  return reaction;
+}
+
 bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept {
-  const double half = 0.5 * p_.part_side_m;
+  const double half = 0.5 * p_.part_side_m, half_height = 0.5 * p_.height_m();
   const double opening = std::max(s.gripper.free_opening_m, p_.part_side_m);
   const bool in_jaw_x = std::abs(s.part_m.x() - g.x()) <= 0.5 * opening;
   const bool in_jaw_y = std::abs(s.part_m.y() - g.y()) < half;
-  const bool tips_below_top = g.z() < s.part_m.z() + half;
-  const bool fingers_above_bottom = g.z() + p_.gripper.finger_length_m > s.part_m.z() - half;
+  const bool tips_below_top = g.z() < s.part_m.z() + half_height;
+  const bool fingers_above_bottom = g.z() + p_.gripper.finger_length_m > s.part_m.z() - half_height;
   return in_jaw_x && in_jaw_y && tips_below_top && fingers_above_bottom;
 }
 
@@ -68,7 +113,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
                                      double dt_s) const noexcept {
   PickPlaceOutput out;
   step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
-  const double side = p_.part_side_m, half = 0.5 * side;
+  const double side = p_.part_side_m;
   const Eigen::Vector3d motion = g - s.last_gripper_m;
   s.last_gripper_m = g;
 
@@ -79,6 +124,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
   }
 
   const bool held = s.phase != PartPhase::kOnSubstrate;
+  const bool in_hole = inserted(s);
   const bool between = held || between_fingers(s, g);
   const double grip = between ? grip_force_N(p_.gripper, s.gripper, side) : 0.0;
   out.part_between_fingers = between;
@@ -99,7 +145,8 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
         s.part_m.y() += motion.y();  // dragged along the substrate with the gripper
         out.force_on_gripper_N.head<2>() += rubbing_force(lateral, dt_s, drag_resistance);
       }
-      if (motion.z() > 0.0 && g.z() > s.part_m.z() - half - 1e-12) {
+      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, in_hole);
+      if (motion.z() > 0.0 && g.z() > s.part_m.z() - 0.5 * p_.height_m() - 1e-12) {
         if (hold_capacity >= substrate_hold) {
           s.phase = PartPhase::kGrasped;  // lift-off: the grip beats adhesion + weight
           s.part_m.z() += motion.z();     // from now on the part moves with the fingers
@@ -113,23 +160,28 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
     case PartPhase::kGrasped:
     case PartPhase::kStuckToFinger: {
       Eigen::Vector3d next = g + s.offset_m;
-      if (next.z() < half) {  // pressed onto the substrate: the part stops, the fingers slide down
-        const double press = half - next.z();
+      // In the hole, its walls hold the part: it slips in the fingers, which feel the wall.
+      const Eigen::Vector3d unconfined = next;
+      out.force_on_gripper_N.head<2>() += confine_to_hole(next, in_hole);
+      s.offset_m.head<2>() += (next - unconfined).head<2>();
+      const double floor = rest_z_m(next.x(), next.y());
+      if (next.z() < floor) {  // pressed onto the substrate: the part stops, the fingers slide down
+        const double press = floor - next.z();
         s.offset_m.z() += press;
-        next.z() = half;
+        next.z() = floor;
         out.force_on_gripper_N.z() += s.phase == PartPhase::kGrasped ? hold_capacity : 0.0;
       }
       s.part_m = next;
       // The meniscus bridges a gap up to its rupture distance: a part that close still touches.
-      const bool on_substrate = s.part_m.z() <= half + p_.meniscus_rupture_m;
+      const bool on_substrate = s.part_m.z() <= floor + p_.meniscus_rupture_m;
       if (s.phase == PartPhase::kGrasped && grip <= 0.0) {
         // Fingers opened: which adhesion keeps the part?
         if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
           s.phase = PartPhase::kOnSubstrate;
-          s.part_m.z() = half;
+          s.part_m.z() = floor;
         } else if (!on_substrate && 2.0 * p_.finger_pulloff_N < weight_) {
           s.phase = PartPhase::kOnSubstrate;  // falls
-          s.part_m.z() = half;
+          s.part_m.z() = floor;
         } else {
           s.phase = PartPhase::kStuckToFinger;
         }
@@ -138,7 +190,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
           s.phase = PartPhase::kGrasped;  // grasped again
         } else if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
           s.phase = PartPhase::kOnSubstrate;  // touched down: the substrate wins
-          s.part_m.z() = half;
+          s.part_m.z() = floor;
         }
       }
       // A held part dragged on the substrate rubs on it.
@@ -152,7 +204,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       break;
     }
   }
-  out.part_on_substrate = s.part_m.z() <= half + p_.meniscus_rupture_m;
+  out.part_on_substrate = s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y()) + p_.meniscus_rupture_m;
   return out;
 }
 

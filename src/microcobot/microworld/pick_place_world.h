@@ -16,6 +16,12 @@
 ///                F_pulloff_substrate > 2 F_pulloff_finger, else it sticks to a finger;
 ///                opened in the air it sticks to a finger when 2 F_pulloff_finger > W.
 /// The gripper reference point is the middle of the finger tips; fingers close along x.
+///
+/// The part is a block part_side_m x part_side_m x part_height_m (a cube by default, a pin when
+/// taller). With hole_side_m > 0 the target is a square hole of that side and hole_depth_m deep
+/// (a pin-in-hole insertion with clearance hole_side_m - part_side_m): the part goes down into
+/// it only when its footprint fits (|x - x_hole| and |y - y_hole| <= clearance / 2), else it
+/// lands on the rim; once in, the hole's walls stop it sideways (a stiff reaction on the fingers).
 
 #include <cmath>
 
@@ -29,6 +35,9 @@ namespace mc::microworld {
 
 struct PickPlaceParams {
   double part_side_m = 300e-6;         ///< cube side (the 300 um part of the main scenario)
+  double part_height_m = 0.0;          ///< the part's height; 0: part_side_m (a cube)
+  double hole_side_m = 0.0;            ///< side of the square hole at the target; 0: no hole
+  double hole_depth_m = 0.0;           ///< its depth
   double part_density_kg_m3 = 8500.0;  ///< brass (watch parts)
   double gravity_m_s2 = 9.81;
   /// Substrate-part pull-off: capillary meniscus in ambient humidity, 4 pi gamma R cos(theta)
@@ -52,6 +61,9 @@ struct PickPlaceParams {
   template <class V>
   void visit(V& v) {
     v("part_side_m", part_side_m);
+    v("part_height_m", part_height_m);
+    v("hole_side_m", hole_side_m);
+    v("hole_depth_m", hole_depth_m);
     v("part_density_kg_m3", part_density_kg_m3);
     v("gravity_m_s2", gravity_m_s2);
     v("substrate_pulloff_N", substrate_pulloff_N);
@@ -69,7 +81,13 @@ struct PickPlaceParams {
   }
   void validate() const;
   double part_weight_N() const;
+  double height_m() const { return part_height_m > 0.0 ? part_height_m : part_side_m; }
 };
+
+/// The pin-in-hole scene: a 200 um square brass pin, 600 um tall, into a 220 um hole 300 um
+/// deep at the target (20 um of clearance, 10 um each side). `microcobot serve --scene
+/// pin-in-hole`; scenes/pin-in-hole.yaml is the same scene as a file.
+PickPlaceParams pin_in_hole_scene();
 
 /// Where the part is held.
 enum class PartPhase {
@@ -109,10 +127,18 @@ class PickPlaceWorld {
                        double dt_s) const noexcept;
   /// Horizontal distance from the part centre to the target.
   double placement_error_m(const PickPlaceState& s) const;
+  /// Height of the part's centre when it rests at (x, y): in the hole when its footprint fits
+  /// the hole's clearance, on the substrate (or the hole's rim) otherwise.
+  double rest_z_m(double x, double y) const noexcept;
+  /// The part is down in the hole (its bottom below the substrate).
+  bool inserted(const PickPlaceState& s) const noexcept;
 
  private:
   bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept;
   Eigen::Vector2d rubbing_force(const Eigen::Vector2d& motion, double dt_s, double coulomb_N) const noexcept;
+  /// Keeps a part that was in the hole (`in_hole`, before this step's motion) inside its walls;
+  /// returns the wall's reaction [N].
+  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, bool in_hole) const noexcept;
   PickPlaceParams p_;
   double weight_;
 };

@@ -166,10 +166,6 @@ SessionResult Session::run(const std::function<void(double)>& progress, const st
 report::Report Session::report(const SessionResult& r) const {
   const Recorder& rec = platform_->recording();
   report::Report rep("microcobot session: " + params_.scenario);
-  const auto t = column(rec, "t_s");
-  auto series = [&](const std::string& name, const std::string& channel, double k = 1.0) {
-    return report::Series{name, t, scaled(column(rec, channel), k)};
-  };
   std::string phases;
   for (const auto& [name, start] : r.phases)
     phases += name + " at " + std::to_string(start).substr(0, 6) + " s; ";
@@ -182,6 +178,21 @@ report::Report Session::report(const SessionResult& r) const {
   rep.add_result("clutches (indexing)", r.clutches);
   rep.add_result("faulted", r.faulted ? 1.0 : 0.0);
 
+  add_recording_figures(rep, rec);
+  rep.add_result("ticks", static_cast<double>(r.ticks));
+  rep.add_result("overruns", static_cast<double>(r.overruns));
+  rep.add_result("mean tick", r.tick_mean_us * 1e-6, "s");
+  rep.add_result("p99 tick", r.tick_p99_us * 1e-6, "s");
+  rep.add_result("max tick", r.tick_max_us * 1e-6, "s");
+  rep.add_result("wall time", r.wall_s, "s");
+  return rep;
+}
+
+void add_recording_figures(report::Report& rep, const Recorder& rec) {
+  const auto t = column(rec, "t_s");
+  auto series = [&](const std::string& name, const std::string& channel, double k = 1.0) {
+    return report::Series{name, t, scaled(column(rec, channel), k)};
+  };
   rep.section("Operator and haptic master",
               "The scripted operator's hand and the handle of the dual-stage interface, relative to the "
               "Pantograph's workspace centre. The hand travels 100 times the slave's motion; the clutch "
@@ -256,13 +267,25 @@ report::Report Session::report(const SessionResult& r) const {
   rep.section("Loop timing",
               "Compute time of each 10 kHz tick (sampled at 1 kHz). An overrun is a tick longer "
               "than the period.");
-  rep.add_result("ticks", static_cast<double>(r.ticks));
-  rep.add_result("overruns", static_cast<double>(r.overruns));
-  rep.add_result("mean tick", r.tick_mean_us * 1e-6, "s");
-  rep.add_result("p99 tick", r.tick_p99_us * 1e-6, "s");
-  rep.add_result("max tick", r.tick_max_us * 1e-6, "s");
-  rep.add_result("wall time", r.wall_s, "s");
   rep.add_figure({"Tick compute time", "", {"Time", "s"}, {"Tick", "s"}, {series("tick", "tick_us", 1e-6)}});
+}
+
+report::Report recording_report(const Recorder& rec, const std::string& name) {
+  report::Report rep("microcobot recording: " + name);
+  const auto t = column(rec, "t_s");
+  if (t.empty()) throw InvalidInput(name, 0, "the recording holds no sample");
+  const auto tick = column(rec, "tick_us");
+  double tick_max = 0.0;
+  for (double v : tick)
+    if (std::isfinite(v)) tick_max = std::max(tick_max, v);
+  rep.section("Recording", "The live session recorded by `microcobot serve` in " + name + ", from t = " +
+                               fmt::format("{:.3f}", t.front()) + " s to " + fmt::format("{:.3f}", t.back()) +
+                               " s of live time (" + std::to_string(rec.size()) + " samples plotted).");
+  rep.add_result("start", t.front(), "s");
+  rep.add_result("duration", t.back() - t.front(), "s");
+  rep.add_result("samples plotted", static_cast<double>(rec.size()));
+  rep.add_result("max sampled tick", tick_max * 1e-6, "s");
+  add_recording_figures(rep, rec);
   return rep;
 }
 

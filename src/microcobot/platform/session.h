@@ -61,6 +61,13 @@ struct SessionResult {
   nlohmann::json to_json() const;
 };
 
+/// The figures of a recording (operator and haptic master, slave stage and microworld, gripper
+/// and TéléTweez, loop timing), shared by the session report and the live recordings' reports.
+void add_recording_figures(report::Report& rep, const Recorder& rec);
+/// The report of a live recording (`serve`, read back with read_telemetry_mcap): its span and
+/// the figures. Throws InvalidInput for an empty recording.
+report::Report recording_report(const Recorder& rec, const std::string& name);
+
 class Session {
  public:
   /// Builds the platform (validates everything first).

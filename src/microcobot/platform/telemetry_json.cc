@@ -2,11 +2,14 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/mcap_reader.h"
 #include "microcobot/core/mcap_writer.h"
 #include "microcobot/platform/platform.h"
 
@@ -102,6 +105,55 @@ void write_telemetry_mcap(const Recorder& rec, const std::filesystem::path& file
     w.write(channel, ns, ns, json);
   }
   w.close();
+}
+
+Recorder read_telemetry_mcap(const std::filesystem::path& file, std::size_t max_samples) {
+  require(max_samples >= 1, "max_samples", "must be >= 1", static_cast<double>(max_samples));
+  const McapContents m = read_mcap(file);
+  const McapChannel* channel = nullptr;
+  for (const auto& c : m.channels)
+    if (c.topic == kTelemetryTopic && c.message_encoding == "json") channel = &c;
+  if (!channel)
+    throw InvalidInput(file.string(), 0, "no " + std::string(kTelemetryTopic) + " channel of JSON messages");
+  std::size_t total = 0;
+  for (const auto& msg : m.messages) total += msg.channel_id == channel->id;
+  if (total == 0) throw InvalidInput(file.string(), 0, "no telemetry message");
+
+  std::vector<std::string> names;
+  std::vector<double> values;
+  std::unique_ptr<Recorder> rec;
+  std::size_t index = 0;
+  for (const auto& msg : m.messages) {
+    if (msg.channel_id != channel->id) continue;
+    auto fail = [&](const std::string& what) {
+      throw InvalidInput(file.string(), 0, "telemetry message " + std::to_string(index) + ": " + what);
+    };
+    const auto j = nlohmann::json::parse(msg.data, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object()) fail("not a JSON object");
+    if (!rec) {  // the first message fixes the channels
+      if (j.empty() || j.size() > kTelemetryChannels.size()) fail("unexpected number of members");
+      for (std::size_t c = 0; c < j.size(); ++c) names.emplace_back(kTelemetryChannels[c]);
+      values.resize(names.size());
+      rec = std::make_unique<Recorder>(names, std::min(total, max_samples),
+                                       (total + max_samples - 1) / max_samples);
+    }
+    if (j.size() != names.size())
+      fail("has " + std::to_string(j.size()) + " members, the first had " + std::to_string(names.size()));
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      const auto it = j.find(names[c]);
+      if (it == j.end()) fail("no member " + names[c]);
+      if (it->is_null()) {
+        values[c] = std::numeric_limits<double>::quiet_NaN();
+      } else if (it->is_number()) {
+        values[c] = it->get<double>();
+      } else {
+        fail(names[c] + " must be a number or null");
+      }
+    }
+    rec->sample(values);
+    ++index;
+  }
+  return std::move(*rec);
 }
 
 }  // namespace mc::platform

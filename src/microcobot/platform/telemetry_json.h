@@ -43,4 +43,10 @@ void telemetry_to_json(std::span<const double> sample, std::string& out);
 /// channels must be the first rec.channels() names of kTelemetryChannels. Throws mc::Error.
 void write_telemetry_mcap(const Recorder& rec, const std::filesystem::path& file);
 
+/// Reads a telemetry recording back (what write_telemetry_mcap and `serve` write): the messages
+/// of kTelemetryTopic, whose members must be the first N names of kTelemetryChannels (null is
+/// read as NaN). Keeps at most `max_samples` samples, evenly decimated (a report's plots need no
+/// more). Throws InvalidInput "<file>: ..." for a file that is not such a recording.
+Recorder read_telemetry_mcap(const std::filesystem::path& file, std::size_t max_samples);
+
 }  // namespace mc::platform

@@ -157,6 +157,7 @@ struct Core {
   ServerOptions opt;
   std::string name;
   std::map<std::string, HttpResource> http;
+  std::function<std::optional<HttpReply>(std::string_view)> http_handler;
   std::map<std::string, std::string> metadata;
   std::string session_id;
   std::function<void(const ClientMessage&)> on_message;
@@ -680,20 +681,90 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     std::string_view path = sv(req.target());
     path = path.substr(0, path.find('?'));
     const auto it = srv_.http.find(std::string(path));
-    if (it == srv_.http.end()) {
+    if (it != srv_.http.end()) {
+      auto res = std::make_shared<http::response<http::string_body>>(http::status::ok, version);
+      res->set(http::field::content_type, it->second.content_type);
+      if (head) {
+        res->content_length(it->second.body.size());
+      } else {
+        res->body() = it->second.body;
+        res->prepare_payload();
+      }
+      send(std::move(res), req.keep_alive());
+      return;
+    }
+    std::optional<HttpReply> reply;
+    if (srv_.http_handler && !srv_.opt.token.empty()) {
+      // Dynamic resources are the platform's data (recordings): the token guards them as it
+      // guards the WebSocket.
+      const auto token = query_param(sv(req.target()), "token");
+      if (!constant_time_equal(srv_.opt.token, token.value_or(std::string()))) {
+        respond(http::status::unauthorized, "missing or wrong token (add ?token=... to the URL)", version,
+                req.keep_alive(), false, head);
+        return;
+      }
+    }
+    if (srv_.http_handler) {
+      try {
+        reply = srv_.http_handler(path);
+      } catch (const std::exception& e) {
+        respond(http::status::internal_server_error, one_line(e.what(), 300), version, req.keep_alive(),
+                false, head);
+        return;
+      }
+    }
+    if (!reply) {
       respond(http::status::not_found, "not found: " + one_line(path, 200), version, req.keep_alive(), false,
               head);
       return;
     }
-    auto res = std::make_shared<http::response<http::string_body>>(http::status::ok, version);
-    res->set(http::field::content_type, it->second.content_type);
-    if (head) {
-      res->content_length(it->second.body.size());
-    } else {
-      res->body() = it->second.body;
-      res->prepare_payload();
+    answer(std::move(*reply), version, req.keep_alive(), head);
+  }
+
+  /// A dynamic answer: a string, or a file streamed from disk.
+  void answer(HttpReply reply, unsigned version, bool keep_alive, bool head) {
+    const auto status = static_cast<http::status>(reply.status);
+    auto decorate = [&](auto& res) {
+      res.set(http::field::content_type, reply.content_type);
+      if (!reply.attachment_name.empty())
+        res.set(http::field::content_disposition, "attachment; filename=\"" + reply.attachment_name + "\"");
+      if (reply.refresh_s > 0) res.set("Refresh", std::to_string(reply.refresh_s));
+    };
+    if (reply.file.empty()) {
+      auto res = std::make_shared<http::response<http::string_body>>(status, version);
+      decorate(*res);
+      if (head) {
+        res->content_length(reply.body.size());
+      } else {
+        res->body() = std::move(reply.body);
+        res->prepare_payload();
+      }
+      send(std::move(res), keep_alive);
+      return;
     }
-    send(std::move(res), req.keep_alive());
+    http::file_body::value_type file;
+    error_code ec;
+    file.open(reply.file.c_str(), beast::file_mode::scan, ec);
+    if (ec) {
+      respond(http::status::not_found, "not found: " + one_line(reply.file.filename().string(), 200), version,
+              keep_alive, false, head);
+      return;
+    }
+    const std::uint64_t size = file.size();
+    if (head) {
+      auto res = std::make_shared<http::response<http::empty_body>>(status, version);
+      decorate(*res);
+      res->content_length(size);
+      send(std::move(res), keep_alive);
+      return;
+    }
+    auto res = std::make_shared<http::response<http::file_body>>(
+        std::piecewise_construct, std::make_tuple(std::move(file)), std::make_tuple(status, version));
+    decorate(*res);
+    res->prepare_payload();
+    // A large download over a slow link may take longer than one request's timeout: allow
+    // 1 MB/s on top of it.
+    send(std::move(res), keep_alive, static_cast<double>(size) / 1e6);
   }
 
   /// A one-line text/plain answer.
@@ -712,17 +783,18 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     send(std::move(res), keep_alive);
   }
 
-  void send(std::shared_ptr<http::response<http::string_body>> res, bool keep_alive) {
+  template <class Body>
+  void send(std::shared_ptr<http::response<Body>> res, bool keep_alive, double extra_time_s = 0.0) {
     res->set(http::field::server, "microcobot");
     res->set(http::field::cache_control, "no-store");
     res->set("X-Content-Type-Options", "nosniff");
     res->keep_alive(keep_alive && !refuse_ && !srv_.stopped);
-    response_ = std::move(res);
-    stream_.expires_after(to_duration(srv_.opt.http_timeout_s));
-    http::async_write(stream_, *response_, [self = shared_from_this()](const error_code& ec, std::size_t) {
-      const bool again = !ec && self->response_->keep_alive();
+    const bool again = res->keep_alive();
+    response_ = res;  // kept alive until written
+    stream_.expires_after(to_duration(srv_.opt.http_timeout_s + extra_time_s));
+    http::async_write(stream_, *res, [self = shared_from_this(), again](const error_code& ec, std::size_t) {
       self->response_.reset();
-      if (again) {
+      if (!ec && again) {
         self->do_read();
       } else {
         self->close();
@@ -760,7 +832,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::array<char, 4096> scratch_{};
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
-  std::shared_ptr<http::response<http::string_body>> response_;
+  std::shared_ptr<void> response_;
 };
 
 }  // namespace
@@ -879,6 +951,9 @@ void FoxgloveServer::set_metadata(std::map<std::string, std::string> metadata) {
 
 void FoxgloveServer::on_client_message(std::function<void(const ClientMessage&)> callback) {
   impl_->on_message = std::move(callback);
+}
+void FoxgloveServer::on_http_get(std::function<std::optional<HttpReply>(std::string_view)> handler) {
+  impl_->http_handler = std::move(handler);
 }
 void FoxgloveServer::on_connect(std::function<void(ClientId)> callback) {
   impl_->on_connect = std::move(callback);

@@ -8,9 +8,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -52,6 +54,18 @@ struct ServerOptions {
 struct HttpResource {
   std::string content_type;
   std::string body;
+};
+
+/// The answer of the dynamic HTTP handler (FoxgloveServer::on_http_get).
+struct HttpReply {
+  int status = 200;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body;            ///< the answer, unless `file` is set
+  std::filesystem::path file;  ///< a file streamed from disk (404 when it cannot be opened)
+  /// When set: `Content-Disposition: attachment; filename="<name>"` (a download).
+  std::string attachment_name;
+  /// When > 0: `Refresh: <s>` (a browser reloads the page, e.g. while a result is being made).
+  int refresh_s = 0;
 };
 
 /// A message a client published on one of its advertised channels. The views are valid only
@@ -97,6 +111,11 @@ class FoxgloveServer {
 
   /// Messages clients publish on their `json` channels.
   void on_client_message(std::function<void(const ClientMessage&)> callback);
+  /// GET/HEAD of a path outside the fixed resources (the path without its query). Runs on a
+  /// server thread: it must be quick (look at files, hand long work to another thread); nullopt
+  /// answers 404 and an exception 500, each with a one-line message. With a token, these
+  /// requests must carry `?token=` as the WebSocket upgrade does (else 401).
+  void on_http_get(std::function<std::optional<HttpReply>(std::string_view path)> handler);
   /// A WebSocket client finished its handshake.
   void on_connect(std::function<void(ClientId)> callback);
   /// A WebSocket client went away (closed, timed out, failed or stop()).

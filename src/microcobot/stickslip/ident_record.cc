@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/mat_file.h"
 #include "microcobot/core/rng.h"
 
 namespace mc::stickslip {
@@ -43,7 +44,9 @@ MeasuredRecord record_from_table(const CsvTable& table, const std::string& sourc
 }
 
 MeasuredRecord read_record(const std::filesystem::path& file) {
-  const CsvTable t = read_csv(file);
+  // A .mat file holds the same record as the variables t, u, x (SI units, docs/cli.md).
+  const CsvTable t =
+      is_mat_file(file) ? read_mat_columns(file, {"t", "u", "x"}, {"t_s", "u_V", "x_m"}) : read_csv(file);
   return record_from_table(t, file.string());
 }
 

@@ -32,7 +32,7 @@ struct MeasuredRecord {
 /// "<source>: ..." for a missing column, fewer than 16 samples, non-increasing time or a
 /// sampling that is not uniform (spacing deviating by more than 1% from the mean).
 MeasuredRecord record_from_table(const CsvTable& table, const std::string& source);
-/// read_csv() + record_from_table().
+/// read_csv() + record_from_table(); a .mat file (is_mat_file) holds the variables t, u, x instead.
 MeasuredRecord read_record(const std::filesystem::path& file);
 /// Writes the record as `t_s,u_V,x_m` (atomic); `comment` lines go above the header.
 void write_record(const std::filesystem::path& file, const MeasuredRecord& rec,

@@ -1,0 +1,101 @@
+#pragma once
+// Conversions shared by the binding translation units (python/*.cc): parameters between Python
+// dicts / YAML files and the library's Params structs (through their visit(), the same keys as
+// `microcobot <group> params --json`), numpy arrays in and out, and the checks on array inputs.
+// No model logic lives here.
+
+#include <cmath>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <yaml-cpp/yaml.h>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/params.h"
+
+namespace mc::py {
+
+namespace py = pybind11;
+
+/// A C-contiguous float64 array (numpy converts lists and other dtypes on the way in).
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// A Python value (dict, list, number, bool, str) as a YAML node, so that the library's own
+/// params_from_yaml() checks keys and types with its usual one-line messages.
+YAML::Node to_yaml(py::handle value, const std::string& where);
+
+/// Parameters from None (the defaults), a dict (keys as `params --json` prints them; missing keys
+/// keep their default), or a path to a YAML/JSON file. Validated; bad values raise ValueError with
+/// the CLI's message.
+template <class P>
+P params_from(py::handle obj) {
+  if (obj.is_none()) {
+    P p;
+    if constexpr (detail::HasValidate<P>::value) p.validate();
+    return p;
+  }
+  if (py::isinstance<py::str>(obj) || py::hasattr(obj, "__fspath__")) {
+    const auto path = py::str(py::module_::import("os").attr("fspath")(obj)).cast<std::string>();
+    return load_params<P>(std::filesystem::path(path));
+  }
+  if (!py::isinstance<py::dict>(obj)) {
+    throw InvalidInput("parameters must be a dict, a YAML file name or None (got " +
+                       py::str(py::type::of(obj).attr("__name__")).cast<std::string>() + ")");
+  }
+  return params_from_yaml<P>(to_yaml(obj, "<dict>"), "<dict>");
+}
+
+/// JSON value -> Python object (dict, list, float, int, bool, str, None).
+py::object from_json(const nlohmann::json& j);
+
+/// Every field of `p` as a nested dict (params_to_json()).
+template <class P>
+py::dict params_dict(const P& p) {
+  return from_json(params_to_json(p));
+}
+
+/// A 1-D float64 numpy array copied from `v`.
+inline py::array_t<double> to_array(std::span<const double> v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+/// Raises ValueError "<name>: ..." unless `a` has `ndim` dimensions, and `min_size` samples or more
+/// along its last one; then unless every value is finite (naming the first bad index).
+void check_array(const DoubleArray& a, const std::string& name, int ndim, py::ssize_t min_size = 1);
+
+/// `a` (checked: 1-D, finite) as a span over its data (valid while `a` lives).
+inline std::span<const double> span_of(const DoubleArray& a, const std::string& name,
+                                       py::ssize_t min_size = 1) {
+  check_array(a, name, 1, min_size);
+  return {a.data(), static_cast<std::size_t>(a.size())};
+}
+
+/// Raises ComputationFailed unless every value of `v` is finite (no call returns NaN).
+void require_finite_result(std::span<const double> v, const std::string& what);
+
+// The submodules, one function per translation unit.
+void bind_stickslip(py::module_& m);
+void bind_identify(py::module_& m);
+void bind_dsp(py::module_& m);
+void bind_control(py::module_& m);
+void bind_platform(py::module_& m);
+void bind_haptics(py::module_& m);
+void bind_tweezers(py::module_& m);
+
+}  // namespace mc::py
+
+namespace mc::py {
+/// Runs `f` with the GIL released (library computations; they touch no Python object).
+template <class F>
+auto nogil(F&& f) {
+  pybind11::gil_scoped_release release;
+  return f();
+}
+}  // namespace mc::py

@@ -1,0 +1,34 @@
+"""microcobot: the desktop micro-manipulation platform's library in Python.
+
+A thin layer over the C++ library (the same calls as the ``microcobot`` command line): numpy
+arrays in and out, SI units everywhere (m, s, V, N, Hz), results as dicts of arrays that
+``pandas.DataFrame`` takes as they are.
+
+Submodules:
+    stickslip  the stick-slip actuator of thesis ch. 2: parameters, simulate, experiments, rollout
+    identify   its identification (thesis §2.5.2) from arrays or files (CSV, .mat)
+    dsp        Butterworth / Linkwitz-Riley, sosfilt, Welch, MLS, tffit (scipy.signal's signatures)
+    control    velocity and position controllers (thesis §2.7) and the closed-loop runs
+    platform   scenario runs and recordings (CSV, MCAP, .mat)
+    haptics    the dual-stage interface's rendering pipeline (thesis ch. 3), per tick and per block
+    tweezers   TéléTweez design calculators (thesis ch. 4, app. A-B)
+
+Errors: invalid parameters or inputs raise ``ValueError`` with the command line's one-line
+message; a computation that fails (divergence, no convergence) raises
+``microcobot.ComputationFailed``. No call returns NaN.
+"""
+
+import sys as _sys
+
+from ._microcobot import (ComputationFailed, __version__, control, dsp, haptics, identify, platform, stickslip,
+                          tweezers)
+
+# `import microcobot.dsp` and `from microcobot.dsp import butter` work like for a package.
+for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers"):
+    _sys.modules[__name__ + "." + _name] = globals()[_name]
+del _name
+
+__all__ = [
+    "ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers"
+]
+ComputationFailed.__module__ = __name__

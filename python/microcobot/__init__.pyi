@@ -1,0 +1,15 @@
+from . import control as control
+from . import dsp as dsp
+from . import haptics as haptics
+from . import identify as identify
+from . import platform as platform
+from . import stickslip as stickslip
+from . import tweezers as tweezers
+
+__version__: str
+
+class ComputationFailed(RuntimeError):
+    """A computation could not produce a valid result (divergence, no convergence): CLI exit 4."""
+
+__all__ = ["ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip",
+           "tweezers"]

@@ -1,0 +1,19 @@
+"""Identification of the stick-slip axis (thesis §2.5.2) from arrays (t [s], u [V], x [m]) or files."""
+
+import os
+from typing import Any, Dict, Optional, Union
+
+import numpy.typing as npt
+
+TOrFile = Union[npt.ArrayLike, str, os.PathLike]
+Params = Union[None, Dict[str, Any], str, os.PathLike]
+
+def record(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[npt.ArrayLike] = None) -> Dict[str, Any]: ...
+def pe_modes(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[npt.ArrayLike] = None,
+             params: Params = None) -> Dict[str, Any]: ...
+def friction_modes(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[npt.ArrayLike] = None,
+                   params: Params = None) -> Dict[str, Any]: ...
+def hysteresis(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[npt.ArrayLike] = None,
+               operators: int = 35, params: Params = None) -> Dict[str, Any]: ...
+def breakaway(directory: str, params: Params = None, threads: int = 0) -> Dict[str, Any]: ...
+def all(directory: str, params: Params = None, operators: int = 35) -> Dict[str, Any]: ...

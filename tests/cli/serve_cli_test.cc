@@ -1,0 +1,47 @@
+// `microcobot serve`'s scenes from the command line: a built-in name or a YAML file; a bad file
+// is refused before anything starts, with one line naming the key (issue #14).
+#include <gtest/gtest.h>
+
+#include "support/test_support.h"
+
+namespace mc {
+namespace {
+
+using test::run_cli;
+
+std::size_t lines(const std::string& s) { return test::line_count(s); }
+
+TEST(ServeCli, TheSceneFileOfTheRepositoryAndTheBuiltInScenesStart) {
+  test::TempDir dir;
+  for (const std::string scene : {"pick-place", "pin-in-hole", MC_SOURCE_DIR "/scenes/pin-in-hole.yaml"}) {
+    const auto r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", dir.path().string(), "--scene",
+                            scene, "--duration", "0.3"});
+    EXPECT_EQ(r.exit_code, 0) << scene << ": " << r.err;
+    EXPECT_EQ(r.out.rfind("http://127.0.0.1:", 0), 0u) << "the first line is the console's URL: " << r.out;
+  }
+}
+
+TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
+  test::TempDir dir;
+  const struct {
+    std::string yaml, expected;
+  } cases[] = {
+      {"part_side_m: 200.0e-6\nhole_side_m: 150.0e-6\nhole_depth_m: 100.0e-6\n", "hole_side_m"},
+      {"part_side_m: 200.0e-6\npart_height_m: 300.0e-6\nhole_side_m: 220.0e-6\nhole_depth_m: 400.0e-6\n",
+       "hole_depth_m"},
+      {"part_sides_m: 1.0e-4\n", "part_sides_m"},
+      {"part_side_m: .nan\n", "part_side_m"},
+  };
+  for (const auto& c : cases) {
+    test::write_text(dir / "scene.yaml", c.yaml);
+    const auto r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", (dir / "out").string(), "--scene",
+                            (dir / "scene.yaml").string(), "--duration", "0.3"});
+    EXPECT_EQ(r.exit_code, 3) << c.yaml << r.err;  // invalid input (docs/cli.md)
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << "nothing served";
+  }
+}
+
+}  // namespace
+}  // namespace mc
