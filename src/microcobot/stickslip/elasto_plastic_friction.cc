@@ -38,27 +38,10 @@ struct Band {
   Band(double z_ba, double zss) noexcept
       : z_ss(zss), inv_z_ss(1.0 / zss), mid(0.5 * (zss + z_ba)), k(M_PI / (zss - z_ba)) {}
 };
-/// sin(t) on the half wave |t| <= pi/2 of eq. 2.12: its Taylor series to t^19 (truncation
-/// below 3e-16 there), a quarter of libm's cost in the integrator's innermost loop. Beyond the
-/// half wave the argument is clamped: alpha stays within [0, 1] as eq. 2.12 defines it.
-inline double half_wave_sin(double t) noexcept {
-  t = std::clamp(t, -0.5 * M_PI, 0.5 * M_PI);
-  const double t2 = t * t;
-  double r = 1.0 / 121645100408832000.0;  // 1/19!
-  r = r * t2 - 1.0 / 355687428096000.0;   // 1/17!
-  r = r * t2 + 1.0 / 1307674368000.0;     // 1/15!
-  r = r * t2 - 1.0 / 6227020800.0;        // 1/13!
-  r = r * t2 + 1.0 / 39916800.0;          // 1/11!
-  r = r * t2 - 1.0 / 362880.0;            // 1/9!
-  r = r * t2 + 1.0 / 5040.0;              // 1/7!
-  r = r * t2 - 1.0 / 120.0;               // 1/5!
-  r = r * t2 + 1.0 / 6.0;                 // 1/3!
-  return t * (1.0 - t2 * r);
-}
 /// ds/dr for the strain s = |z| >= z_ba moving outward (eq. 2.11-2.12 with 2.18).
 inline double outward_rate(double s, const Band& b) noexcept {
   if (s >= b.z_ss) return 1.0 - s * b.inv_z_ss;  // alpha = 1: pulled back onto z_ss
-  const double a = 0.5 * half_wave_sin(b.k * (s - b.mid)) + 0.5;
+  const double a = 0.5 * std::sin(b.k * (s - b.mid)) + 0.5;
   return 1.0 - a * s * b.inv_z_ss;
 }
 }  // namespace
