@@ -195,7 +195,9 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
     std::atomic<std::size_t> next{0};
     auto work = [&] {
       for (std::size_t i = next.fetch_add(1); i < n; i = next.fetch_add(1)) {
-        ss::ActuatorState& s = states[i];
+        // Stepped in a copy owned by this thread: neighbouring axes' states (and their PI
+        // operators) share cache lines, which two threads writing every sub-step would ping-pong.
+        ss::ActuatorState s = states[i];
         const double* ui = u + i * steps;
         double* xo = x2_out + i * steps;
         double* x1o = x1_out + i * steps;
@@ -204,6 +206,7 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
           xo[k] = m.slider_position(s);
           x1o[k] = s.x1_m();
         }
+        states[i] = std::move(s);
       }
     };
     std::vector<std::thread> pool;
