@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -104,20 +105,29 @@ TEST(ConsoleServer, TheLoopNeverAllocatesWhileTheServerServesEightClientsAndAHos
   ASSERT_FALSE(controller.ws.read_status("control").is_null());
   rig.server.start_recording();  // encoding and recording run on the drain thread, not the loop
 
-  std::atomic<bool> quit{false};
-  std::atomic<std::uint64_t> received{0};
+  // Every client connects and is served before the guarded window opens (a sanitized build on
+  // a loaded machine takes seconds to connect nine clients), and the window stays open until
+  // each observer has been served and the hostile client refused, within a generous deadline:
+  // the test asserts what happened while the loop was watched, not how fast a machine is.
+  std::atomic<bool> quit{false}, watching{false};
+  std::atomic<int> ready{0};
+  std::array<std::atomic<std::uint64_t>, 8> received{};  // while watched, per observer
   std::vector<std::thread> observers;
-  for (int i = 0; i < 8; ++i) {
-    observers.emplace_back([&] {
+  for (std::size_t i = 0; i < received.size(); ++i) {
+    observers.emplace_back([&, i] {
       Console c(rig.server.port());
       c.subscribe_all();
+      bool counted_ready = false;
       while (!quit.load()) {
-        if (c.ws.read(1000ms)) received.fetch_add(1);
+        if (!c.ws.read(1000ms)) continue;
+        if (!counted_ready) ready.fetch_add(1), counted_ready = true;
+        if (watching.load()) received[i].fetch_add(1);
       }
     });
   }
   std::thread hostile([&] {
     Console c(rig.server.port());
+    ready.fetch_add(1);
     const std::vector<std::string> garbage = {"{", "[]", R"({"op":"subscribe","subscriptions":7})",
                                               std::string(70000, 'x')};
     for (int i = 0; !quit.load(); ++i) {
@@ -126,27 +136,42 @@ TEST(ConsoleServer, TheLoopNeverAllocatesWhileTheServerServesEightClientsAndAHos
       std::this_thread::sleep_for(2ms);
     }
   });
-  auto drive = [&](std::chrono::milliseconds d) {
-    for (const auto end = std::chrono::steady_clock::now() + d; std::chrono::steady_clock::now() < end;) {
+  const auto drive_until = [&](std::chrono::milliseconds at_least, const auto& done) {
+    const auto start = std::chrono::steady_clock::now();
+    for (auto now = start; now < start + 30s; now = std::chrono::steady_clock::now()) {
+      if (now >= start + at_least && done()) return true;
       controller.command(kJog);
       std::this_thread::sleep_for(20ms);
     }
+    return false;
   };
-  drive(500ms);  // warm-up: every path of the loop touched once
+  // Warm-up: every path of the loop touched once, every client connected and served.
+  const bool all_ready = drive_until(500ms, [&] { return ready.load() == 9; });
   ASSERT_NE(rig.live.loop_thread_id(), std::thread::id{});
+  const std::uint64_t rejected_before = rig.server.counters().messages_rejected;
+  const auto all_served = [&] {
+    for (const auto& r : received)
+      if (r.load() < 60) return false;  // about a second of telemetry at 60 Hz
+    return rig.server.counters().messages_rejected > rejected_before + 10;
+  };
   std::size_t allocations = 0;
+  bool served = false;
   {
     test::AllocationGuard guard(rig.live.loop_thread_id());
-    drive(1000ms);
+    watching.store(true);
+    served = drive_until(1000ms, all_served);
+    watching.store(false);
     allocations = guard.allocations();
   }
   quit.store(true);
   for (auto& t : observers) t.join();
   hostile.join();
   rig.server.stop_recording();
+  EXPECT_TRUE(all_ready) << ready.load() << " of 9 clients connected and served within 30 s";
   EXPECT_EQ(allocations, 0u) << "the loop thread allocated while the server served";
-  EXPECT_GT(received.load(), 8u * 60u) << "the eight observers were served (60 Hz telemetry each)";
-  EXPECT_GT(rig.server.counters().messages_rejected, 10u) << "the hostile client's garbage was refused";
+  EXPECT_TRUE(served) << "within 30 s, each of the eight observers got 60 messages and the hostile "
+                         "client's garbage was refused more than 10 times (refused: "
+                      << rig.server.counters().messages_rejected - rejected_before << ")";
 }
 
 TEST(ConsoleServer, TheStatusReportsTheCommandToTargetLatency) {
@@ -204,7 +229,7 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   const std::string report_url = list["recordings"][0]["report_url"];
   auto r = test::http_request(port, "GET", report_url);
   EXPECT_TRUE(r.status == 202 || r.status == 200) << r.status;
-  for (int i = 0; i < 300 && r.status != 200; ++i) {
+  for (int i = 0; i < 1200 && r.status != 200; ++i) {  // up to a minute (sanitized, loaded)
     std::this_thread::sleep_for(50ms);
     r = test::http_request(port, "GET", report_url);
   }

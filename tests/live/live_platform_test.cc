@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "support/counting_allocator.h"
+#include "support/test_support.h"
 
 namespace mc::live {
 namespace {
@@ -59,8 +60,10 @@ ConsoleCommand jog(double vx, bool deadman = true) {
 
 TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFreshCommands) {
   Live rig;
-  std::this_thread::sleep_for(100ms);
-  ASSERT_GT(rig.samples, 50u) << "the loop runs paced and streams telemetry";
+  ASSERT_TRUE(test::eventually([&] {
+    std::lock_guard lock(rig.mutex);
+    return rig.samples > 50;
+  })) << "the loop runs paced and streams telemetry";
   const double x0 = rig.get("target_x_m");
   rig.live.set_console_in_control(true);
   rig.drive(jog(100e-6, /*deadman=*/false), 300ms);
@@ -78,7 +81,7 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
 
   // The client goes silent: after the command timeout the stage holds.
   std::this_thread::sleep_for(300ms);
-  EXPECT_FALSE(rig.live.status().console_fresh);
+  EXPECT_TRUE(test::eventually([&] { return !rig.live.status().console_fresh; }));
   const double held = rig.get("target_x_m");
   std::this_thread::sleep_for(200ms);
   EXPECT_DOUBLE_EQ(rig.get("target_x_m"), held);
@@ -90,9 +93,8 @@ TEST(LivePlatform, TheEstopLatchesEveryDeviceInItsSafeStateUntilAnExplicitReset)
   rig.live.set_console_in_control(true);
   rig.drive(jog(200e-6), 300ms);
   rig.live.estop();
-  std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(test::eventually([&] { return rig.live.status().estopped; }));
   auto s = rig.live.status();
-  ASSERT_TRUE(s.estopped);
   for (Lifecycle l : s.lifecycle) EXPECT_EQ(l, Lifecycle::kFault);
   const double held = rig.get("target_x_m");
   rig.drive(jog(200e-6), 300ms);  // commands with the deadman: nothing moves
@@ -101,7 +103,7 @@ TEST(LivePlatform, TheEstopLatchesEveryDeviceInItsSafeStateUntilAnExplicitReset)
   EXPECT_TRUE(rig.live.status().estopped) << "latched";
 
   rig.live.request(ConsoleAction::kReset);
-  std::this_thread::sleep_for(100ms);
+  EXPECT_TRUE(test::eventually([&] { return !rig.live.status().estopped; }));
   s = rig.live.status();
   EXPECT_FALSE(s.estopped) << s.last_error;
   for (Lifecycle l : s.lifecycle) EXPECT_EQ(l, Lifecycle::kActive);
@@ -126,7 +128,8 @@ TEST(LivePlatform, TheLoopThreadNeverAllocatesWhileCommandsAndTelemetryFlow) {
     c.goal_m = {0, 0, 1e-3};
     rig.drive(c, 300ms);
     rig.live.estop();
-    std::this_thread::sleep_for(50ms);
+    EXPECT_TRUE(test::eventually([&] { return rig.live.status().estopped; }));
+    std::this_thread::sleep_for(20ms);  // the faulted loop ticks on
     allocations = guard.allocations();
   }
   EXPECT_EQ(allocations, 0u);
@@ -138,7 +141,9 @@ TEST(LivePlatform, TheDemoRestartsTheSceneWithTheScriptedOperatorAndTimeGoesOn) 
   std::this_thread::sleep_for(200ms);
   const double t = rig.get("t_s");
   rig.live.request(ConsoleAction::kDemo);
-  std::this_thread::sleep_for(2500ms);  // the rebuild takes about a second
+  // The rebuild takes about a second (longer in a sanitized build on a loaded machine).
+  EXPECT_TRUE(test::eventually([&] { return rig.live.status().restarts == 1; }));
+  std::this_thread::sleep_for(200ms);
   const auto s = rig.live.status();
   EXPECT_TRUE(s.demo);
   EXPECT_EQ(s.restarts, 1u);

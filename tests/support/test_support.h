@@ -1,9 +1,11 @@
 #pragma once
 /// @file
-/// Helpers for tests: run the CLI as a user would, and scratch directories.
+/// Helpers for tests: run the CLI as a user would, scratch directories, waiting for conditions.
 
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace mc::test {
@@ -37,5 +39,18 @@ void write_text(const std::filesystem::path& file, const std::string& text);
 std::string read_text(const std::filesystem::path& file);
 /// Number of lines in `s` (a trailing newline does not start a new line).
 std::size_t line_count(const std::string& s);
+
+/// Polls `condition` every 10 ms until it holds or `timeout` passes; returns whether it held.
+/// Tests of threads and wall-clock loops wait for what they assert rather than for a fixed time,
+/// so that a sanitized build on a loaded machine is slower, not failed.
+template <class Condition>
+bool eventually(Condition&& condition, std::chrono::milliseconds timeout = std::chrono::seconds(20)) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() >= end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
 
 }  // namespace mc::test
