@@ -61,6 +61,21 @@ TEST(PrandtlIshlinskii, InverseIsExact) {
   }
 }
 
+TEST(PrandtlIshlinskii, PeekInverseFindsTheInputOfAGivenOutputFromAnyStateAndClampsOutside) {
+  const PiParams p = default_pi_params();
+  PiState s = make_pi_state(p);
+  Rng rng(11);
+  for (int k = 0; k < 200; ++k) {
+    pi_update(p, s, 100.0 * rng.uniform());  // a random history: the operators' states differ
+    const double lo = pi_peek(p, s, 0.0), hi = pi_peek(p, s, 100.0);
+    const double h = lo + (hi - lo) * rng.uniform();
+    const double u = pi_peek_inverse(p, s, h, 0.0, 100.0);
+    ASSERT_NEAR(pi_peek(p, s, u), h, 1e-8) << "step " << k;
+    EXPECT_EQ(pi_peek_inverse(p, s, lo - 1.0, 0.0, 100.0), 0.0);
+    EXPECT_EQ(pi_peek_inverse(p, s, hi + 1.0, 0.0, 100.0), 100.0);
+  }
+}
+
 TEST(PrandtlIshlinskii, LoopHasAreaAndReturnsOnItself) {
   const PiParams p = default_pi_params();
   PiState s = make_pi_state(p);

@@ -76,15 +76,7 @@ double PositionController::pe_displacement_m(double u_V) const noexcept {
 }
 
 double PositionController::inverse_V(double y_m) const noexcept {
-  double lo = u_min_, hi = u_max_;
-  if (y_m <= pe_displacement_m(lo)) return lo;
-  if (y_m >= pe_displacement_m(hi)) return hi;
-  // g H(U) is continuous and strictly increasing in U from any state (w_0 > 0): bisection.
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (pe_displacement_m(mid) < y_m ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return stickslip::pi_peek_inverse(pi_, obs_, y_m / g_, u_min_, u_max_);
 }
 
 void PositionController::set_target(double target_m, double velocity_m_s) noexcept {

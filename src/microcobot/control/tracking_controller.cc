@@ -63,15 +63,7 @@ double TrackingController::pe_displacement_m(double u_V) const noexcept {
 }
 
 double TrackingController::inverse_V(double y_m) const noexcept {
-  double lo = p_.low_V, hi = p_.high_V;
-  if (y_m <= pe_displacement_m(lo)) return lo;
-  if (y_m >= pe_displacement_m(hi)) return hi;
-  // g H(U) is continuous and strictly increasing in U from any state (w_0 > 0): bisection.
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (pe_displacement_m(mid) < y_m ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return stickslip::pi_peek_inverse(pi_, obs_, y_m / g_, p_.low_V, p_.high_V);
 }
 
 double TrackingController::predicted_backslip_m(double frequency_Hz, Direction d) const noexcept {

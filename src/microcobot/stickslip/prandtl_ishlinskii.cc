@@ -85,6 +85,16 @@ double pi_peek(const PiParams& p, const PiState& s, double u) noexcept {
   return out;
 }
 
+double pi_peek_inverse(const PiParams& p, const PiState& s, double h, double u_lo, double u_hi) noexcept {
+  if (h <= pi_peek(p, s, u_lo)) return u_lo;
+  if (h >= pi_peek(p, s, u_hi)) return u_hi;
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (u_lo + u_hi);
+    (pi_peek(p, s, mid) < h ? u_lo : u_hi) = mid;
+  }
+  return 0.5 * (u_lo + u_hi);
+}
+
 double pi_loading_curve(const PiParams& p, double u) noexcept {
   double out = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) out += p.weights[i] * std::max(u - p.thresholds_V[i], 0.0);

@@ -46,6 +46,13 @@ double pi_update(const PiParams& p, PiState& s, double u) noexcept;
 /// H(U) that the operators would output at input `u`, without committing (for ODE stages).
 double pi_peek(const PiParams& p, const PiState& s, double u) noexcept;
 
+/// The input u in [u_lo, u_hi] at which pi_peek(p, s, u) = h, clamped to the interval's ends when
+/// h lies outside their outputs: the voltage that puts the element at a given extension from its
+/// present state (the controllers' scanning feedforward). pi_peek is continuous and strictly
+/// increasing in u from any state (w_0 > 0), so bisection converges; 40 halvings of a 100 V
+/// interval leave < 1e-10 V. Never allocates.
+double pi_peek_inverse(const PiParams& p, const PiState& s, double h, double u_lo, double u_hi) noexcept;
+
 /// The exact inverse PI model (Kuhnen / Krejci): another PI operator whose composition with `p`
 /// is the identity, H(H^-1(y)) = y, when both start relaxed at 0.
 PiParams pi_inverse(const PiParams& p);
