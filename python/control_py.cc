@@ -11,7 +11,9 @@
 #include "microcobot/control/control_params.h"
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/position_sensor.h"
+#include "microcobot/control/setpoint_stream.h"
 #include "microcobot/control/step_map.h"
+#include "microcobot/control/tracking_run.h"
 #include "microcobot/control/velocity_controller.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mat_file.h"
@@ -302,6 +304,52 @@ void bind_control(py::module_& m) {
       "plant"_a, "target_m"_a, "start_m"_a = 0.0, "hold_s"_a = 0.03, "max_time_s"_a = 0.0,
       "Closed-loop hybrid move from start_m to target_m then hold_s of hold, as `microcobot control "
       "position`.");
+  m.def(
+      "run_tracking",
+      [](const Plant& p, const DoubleArray& setpoints, double setpoint_rate_Hz, const std::string& tracker,
+         py::object start, double duration_s) {
+        const auto sp = span_of(setpoints, "setpoints_m");
+        if (!(setpoint_rate_Hz > 0.0 && setpoint_rate_Hz <= 1e5))
+          throw InvalidParams("setpoint_rate_Hz", "in (0, 1e5] Hz", setpoint_rate_Hz);
+        const auto kind = ct::parse_tracker_kind(tracker);
+        const double start_m = start.is_none() ? sp.front() : start.cast<double>();
+        if (!std::isfinite(start_m)) throw InvalidParams("start_m", "finite", start_m);
+        const double streamed_s = static_cast<double>(sp.size()) / setpoint_rate_Hz;
+        if (duration_s <= 0.0) duration_s = streamed_s + 0.05;
+        require_budget(duration_s / p.model.dt_s(), kMaxSimulatedSteps, "duration_s",
+                       "simulated steps of the tracking run");
+        const std::vector<double> values(sp.begin(), sp.end());  // the GIL is released below
+        const auto r = nogil([&] {
+          // The setpoints are stamped on the sender's clock, k / rate, and read through the
+          // stream's bounded look-ahead by the 10 kHz controller (issue #15 item 4): past the
+          // last one the stream holds.
+          ct::SetpointStream stream(p.params.stream, start_m);
+          std::size_t next = 0;
+          const auto reference = [&](double t, double dt) {
+            for (; next < values.size() && static_cast<double>(next) / setpoint_rate_Hz <= t; ++next)
+              stream.push(static_cast<double>(next) / setpoint_rate_Hz, values[next]);
+            return stream.sample(t, dt);
+          };
+          return ct::run_tracker(p.model, p.map, kind, ct::tracker_setup(p.params), start_m, reference,
+                                 duration_s);
+        });
+        const auto& mt = r.metrics;
+        return py::dict(
+            "t_s"_a = to_array(r.t_s), "ref_m"_a = to_array(r.ref_m), "x_m"_a = to_array(r.x_m),
+            "u_V"_a = to_array(r.u_V),
+            "metrics"_a = py::dict("rms_error_m"_a = mt.rms_error_m, "max_error_m"_a = mt.max_error_m,
+                                   "rms_all_m"_a = mt.rms_all_m, "lag_s"_a = mt.lag_s,
+                                   "final_error_m"_a = mt.final_error_m, "edges"_a = mt.edges));
+      },
+      "plant"_a, "setpoints_m"_a, "setpoint_rate_Hz"_a = 1000.0, "tracker"_a = "tracking",
+      "start_m"_a = py::none(), "duration_s"_a = 0.0,
+      "Follows position setpoints streamed from Python (issue #15): setpoints_m [m] at setpoint_rate_Hz "
+      "(the console's and the network link's 1 kHz by default) pass through the setpoint stream's "
+      "bounded look-ahead (plant params 'stream') into the 10 kHz tracker ('tracking', or the "
+      "baselines 'hybrid' and 'thesis-pid'), from start_m (default: the first setpoint) for duration_s "
+      "(default: the setpoints' span + 50 ms, holding the last). Returns {'t_s', 'ref_m', 'x_m' (true "
+      "position), 'u_V', 'metrics': {'rms_error_m', 'max_error_m' (while the reference moves), "
+      "'rms_all_m', 'lag_s', 'final_error_m', 'edges'}}, as `microcobot control trajectory --json`.");
 }
 
 void bind_haptics_identification(py::module_& m);

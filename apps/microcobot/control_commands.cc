@@ -256,15 +256,6 @@ std::string json_name(ct::TrackerKind k) {
   return k == ct::TrackerKind::kThesisPid ? "thesis_pid" : ct::to_string(k);
 }
 
-ct::TrackerSetup tracker_setup(const ControlParams& p) {
-  ct::TrackerSetup su{p.tracking, p.position, p.baseline, p.sensor};
-  // Today's controller: its scanning reference must keep up with the trajectory.
-  su.hybrid.scan_velocity_m_s = std::max(su.hybrid.scan_velocity_m_s, 1.5 * p.limits.max_velocity_m_s);
-  su.hybrid.scan_acceleration_m_s2 =
-      std::max(su.hybrid.scan_acceleration_m_s2, 1.5 * p.limits.max_acceleration_m_s2);
-  return su;
-}
-
 /// 3-D line and arc: the three axes on the path, the tracker and both baselines.
 nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const TrajectoryOptions& o,
                                Report& r, mc::CsvTable* table) {
@@ -281,7 +272,7 @@ nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const
       3.0 * (path.duration_s() + 0.03) / plant.model.dt_s(), mc::kMaxSimulatedSteps,
       "--distance/--velocity/--acceleration (path duration)",
       fmt::format("simulated steps (3 axes, {:.3g} s at {:g} s)", path.duration_s(), plant.model.dt_s()));
-  const auto su = tracker_setup(p);
+  const auto su = ct::tracker_setup(p);
   nlohmann::json j;
   std::vector<Series> dev;
   for (auto k : kTrackers) {
@@ -385,7 +376,7 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
       duration / plant.model.dt_s(), mc::kMaxSimulatedSteps,
       o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
       fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
-  const auto su = tracker_setup(p);
+  const auto su = ct::tracker_setup(p);
   nlohmann::json j;
   std::vector<Series> xs, errs;
   for (auto k : kTrackers) {

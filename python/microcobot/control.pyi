@@ -1,6 +1,8 @@
 """Velocity and position control of a stick-slip axis (thesis §2.7)."""
 
-from typing import Any, Dict, Tuple, Union
+from typing import Any, Dict, Optional, Tuple, Union
+
+import numpy.typing as npt
 
 from .stickslip import Actuator, DriveSegment
 
@@ -57,3 +59,6 @@ def run_velocity(plant: Plant, reference_m_s: float, mode: str = "model", durati
                  start_m: float = 0.0) -> Dict[str, Any]: ...
 def run_position(plant: Plant, target_m: float, start_m: float = 0.0, hold_s: float = 0.03,
                  max_time_s: float = 0.0) -> Dict[str, Any]: ...
+def run_tracking(plant: Plant, setpoints_m: npt.ArrayLike, setpoint_rate_Hz: float = 1000.0,
+                 tracker: str = "tracking", start_m: Optional[float] = None,
+                 duration_s: float = 0.0) -> Dict[str, Any]: ...

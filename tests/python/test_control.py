@@ -62,6 +62,33 @@ def test_position_run_gets_in_position(plant):
     assert abs(r["x_m"][-1] - 50e-6) < 20e-9
 
 
+def test_streamed_setpoints_are_followed_closer_than_todays_controller_follows_them(plant):
+    # A 20 um ramp at 200 um/s streamed at 1 kHz from Python (issue #15 item 4), then held.
+    t = np.arange(0, 0.15, 1e-3)
+    setpoints = np.clip(200e-6 * t, 0.0, 20e-6)
+    runs = {k: control.run_tracking(plant, setpoints, tracker=k) for k in ("tracking", "hybrid")}
+    for k, r in runs.items():
+        assert len(r["t_s"]) == len(r["x_m"]) == len(r["ref_m"]) == len(r["u_V"]), k
+        assert np.all(np.isfinite(r["x_m"])), k
+        assert abs(r["ref_m"][-1] - 20e-6) < 1e-9, "the stream holds the last setpoint"
+    tr, hy = runs["tracking"]["metrics"], runs["hybrid"]["metrics"]
+    assert tr["rms_error_m"] < 0.5e-6, tr
+    assert tr["rms_error_m"] < hy["rms_error_m"], (tr, hy)
+    assert tr["final_error_m"] < 5e-9, tr
+    assert tr["edges"] > 0, "20 um is many steps"
+
+
+def test_run_tracking_refuses_bad_input(plant):
+    with pytest.raises(ValueError, match="tracker"):
+        control.run_tracking(plant, np.zeros(10), tracker="fuzzy")
+    with pytest.raises(ValueError, match="setpoints_m"):
+        control.run_tracking(plant, np.array([0.0, np.nan]))
+    with pytest.raises(ValueError, match="setpoint_rate_Hz"):
+        control.run_tracking(plant, np.zeros(10), setpoint_rate_Hz=0.0)
+    with pytest.raises(ValueError, match="duration_s"):
+        control.run_tracking(plant, np.zeros(10), duration_s=1e9)
+
+
 def test_position_controller_steppable(plant):
     model = plant.model
     ctl = control.PositionController(plant)

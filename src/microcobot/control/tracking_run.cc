@@ -24,6 +24,20 @@ std::string to_string(TrackerKind k) {
   return "tracking";
 }
 
+TrackerKind parse_tracker_kind(const std::string& name, const std::string& field) {
+  for (auto k : {TrackerKind::kTracking, TrackerKind::kHybrid, TrackerKind::kThesisPid})
+    if (name == to_string(k)) return k;
+  throw InvalidParams(field, "one of tracking, hybrid, thesis-pid (got '" + name + "')");
+}
+
+TrackerSetup tracker_setup(const ControlParams& p) {
+  TrackerSetup su{p.tracking, p.position, p.baseline, p.sensor};
+  su.hybrid.scan_velocity_m_s = std::max(su.hybrid.scan_velocity_m_s, 1.5 * p.limits.max_velocity_m_s);
+  su.hybrid.scan_acceleration_m_s2 =
+      std::max(su.hybrid.scan_acceleration_m_s2, 1.5 * p.limits.max_acceleration_m_s2);
+  return su;
+}
+
 TrackingMetrics tracking_metrics(const std::vector<double>& ref, const std::vector<double>& x,
                                  const std::vector<char>& moving, double tick_s) {
   require(ref.size() == x.size() && moving.size() == x.size() && !x.empty(), "records",

@@ -13,6 +13,7 @@
 #include <array>
 
 #include "microcobot/control/baseline_position.h"
+#include "microcobot/control/control_params.h"
 #include "microcobot/control/path_generator.h"
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/position_sensor.h"
@@ -24,6 +25,8 @@ namespace mc::control {
 
 enum class TrackerKind { kTracking, kHybrid, kThesisPid };
 std::string to_string(TrackerKind k);
+/// "tracking", "hybrid" or "thesis-pid"; anything else throws mc::InvalidParams naming `field`.
+TrackerKind parse_tracker_kind(const std::string& name, const std::string& field = "tracker");
 
 struct TrackingMetrics {
   double rms_error_m = 0.0;    ///< RMS of x - r (true position) while the reference moves
@@ -46,6 +49,11 @@ struct TrackerSetup {
   BaselinePositionParams pid;
   PositionSensorParams sensor;
 };
+
+/// The three trackers set up from an axis' parameters. Today's hybrid controller gets a scanning
+/// reference fast enough to keep up with the trajectory (1.5x the motion limits), or it would
+/// lag by construction rather than by its control law.
+TrackerSetup tracker_setup(const ControlParams& p);
 
 using ReferenceFn = std::function<ReferenceSample(double t_s, double dt_s)>;
 
