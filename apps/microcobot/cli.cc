@@ -159,6 +159,18 @@ bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
   return true;
 }
 
+void write_result_table(const CommonOptions& opts, const std::string& csv_name, const mc::CsvTable& table,
+                        const nlohmann::json& summary) {
+  if (!opts.out) return;
+  std::vector<std::pair<std::string, std::vector<double>>> columns;
+  for (std::size_t i = 0; i < table.cols(); ++i) {
+    columns.emplace_back(table.names()[i], table.column(i));
+  }
+  if (write_results_mat(opts, summary, columns)) return;
+  mc::ensure_writable_dir(*opts.out);
+  mc::write_csv(*opts.out / csv_name, table);
+}
+
 void add_params_option(CLI::App& cmd, CommonOptions& opts) {
   // No CLI11 existence check: a missing file is invalid input (exit 3), named by load_params().
   cmd.add_option("--params", opts.params, "YAML parameter file (keys as printed by 'params --json')");

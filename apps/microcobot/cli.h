@@ -22,6 +22,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "microcobot/core/csv.h"
 #include "microcobot/report/report.h"
 
 namespace mc::cli {
@@ -71,6 +72,11 @@ void add_format_option(CLI::App& cmd, CommonOptions& opts);
 /// (e.g. mode_a_frequency_Hz). Returns true when it wrote the file.
 bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
                        const std::vector<std::pair<std::string, std::vector<double>>>& arrays = {});
+/// The result table under --out: DIR/`csv_name` (CSV, the default), or with --format mat
+/// DIR/results.mat holding the table's columns (by their CSV names) and the summary's numbers as
+/// write_results_mat() does. Nothing without --out.
+void write_result_table(const CommonOptions& opts, const std::string& csv_name, const mc::CsvTable& table,
+                        const nlohmann::json& summary);
 /// Adds `--params FILE` to `cmd`.
 void add_params_option(CLI::App& cmd, CommonOptions& opts);
 

@@ -51,12 +51,6 @@ Series thin(const std::string& name, const std::vector<double>& x, const std::ve
   return s;
 }
 
-void write_table(const CommonOptions& o, const std::string& file, const mc::CsvTable& t) {
-  if (!o.out) return;
-  mc::ensure_writable_dir(*o.out);
-  mc::write_csv(*o.out / file, t);
-}
-
 nlohmann::json velocity_json(const ct::VelocityMetrics& m) {
   return {{"mean_velocity_m_s", m.mean_velocity_m_s},
           {"steady_state_error_rel", m.steady_state_error_rel},
@@ -137,7 +131,7 @@ void run_velocity_cmd(const VelocityOptions& o) {
                         o.reference, o.direction, o.duration));
   mc::CsvTable t;
   auto j = velocity_experiment(p, plant, o.reference, ss::parse_direction(o.direction), o.duration, r, &t);
-  write_table(o.common, "velocity.csv", t);
+  mc::cli::write_result_table(o.common, "velocity.csv", t, j);
   mc::cli::write_report_if_requested(o.common, r);
   mc::cli::emit(
       o.common, j,
@@ -214,7 +208,7 @@ void run_position_cmd(const PositionOptions& o) {
                         o.axis));
   mc::CsvTable t;
   auto j = position_experiment(p, plant, ct::parse_axis(o.axis), o.start, o.target, r, &t);
-  write_table(o.common, "position.csv", t);
+  mc::cli::write_result_table(o.common, "position.csv", t, j);
   mc::cli::write_report_if_requested(o.common, r);
   mc::cli::emit(o.common, j,
                 fmt::format("final error {:.3g} m, overshoot {:.3g} m, move time {:.4g} s",
@@ -432,7 +426,7 @@ void run_trajectory_cmd(const TrajectoryOptions& o) {
   r.section("Trajectory tracking", "microcobot control trajectory --profile " + o.profile);
   mc::CsvTable t;
   auto j = trajectory_experiment(p, plant, o, r, &t);
-  write_table(o.common, "trajectory.csv", t);
+  mc::cli::write_result_table(o.common, "trajectory.csv", t, j);
   mc::cli::write_report_if_requested(o.common, r);
   std::string line = fmt::format("RMS error {:.3g} m, max error {:.3g} m", j["rms_error_m"].get<double>(),
                                  j["max_error_m"].get<double>());
@@ -463,6 +457,7 @@ void add_control(CLI::App& group) {
         ->check(CLI::IsMember({"forward", "backward"}));
     cmd->add_option("--duration", o->duration, "Simulated time [s]")->check(mc::cli::Range(0.02, 100.0));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_velocity_cmd(*o); });
   }
@@ -476,6 +471,7 @@ void add_control(CLI::App& group) {
     cmd->add_option("--start", o->start, "Start position [m]")->check(mc::cli::Range(-6e-3, 6e-3));
     cmd->add_option("--axis", o->axis, "x | y | z")->check(CLI::IsMember({"x", "y", "z"}));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_position_cmd(*o); });
   }
@@ -499,6 +495,7 @@ void add_control(CLI::App& group) {
     cmd->add_option("--radius", o->radius, "Arc: radius [m]")->check(mc::cli::Range(1e-7, 6e-3));
     cmd->add_option("--angle", o->angle, "Arc: angle [rad]")->check(mc::cli::Range(-2.0 * M_PI, 2.0 * M_PI));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_trajectory_cmd(*o); });
   }

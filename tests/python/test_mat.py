@@ -52,6 +52,25 @@ def test_cli_simulate_format_mat(tmp_path, cli):
     assert rc == 2 and "--out" in cli_error(err)
 
 
+def test_cli_control_trajectory_format_mat_equals_its_csv(tmp_path, cli):
+    # The same run twice (deterministic): results.mat holds the CSV's columns and the summary.
+    args = ("control", "trajectory", "--profile", "trapezoid", "--distance", 20e-6, "--json")
+    rc, out, err = cli(*args, "--out", tmp_path / "csv")
+    assert rc == 0, err
+    rc, out_mat, err = cli(*args, "--format", "mat", "--out", tmp_path / "mat")
+    assert rc == 0, err
+    assert out == out_mat
+    d = scipy.io.loadmat(tmp_path / "mat" / "results.mat")
+    csv = np.genfromtxt(tmp_path / "csv" / "trajectory.csv", delimiter=",", names=True, comments="#")
+    assert len(csv) > 100
+    for k in csv.dtype.names:
+        np.testing.assert_allclose(d[k][:, 0], csv[k], rtol=1e-15, atol=0, err_msg=k)
+    summary = json.loads(out)
+    assert d["rms_error_m"][0, 0] == summary["rms_error_m"]
+    assert d["baseline_hybrid_rms_error_m"][0, 0] == summary["baseline"]["hybrid"]["rms_error_m"]
+    assert not (tmp_path / "mat" / "trajectory.csv").exists()
+
+
 @pytest.fixture(scope="module")
 def sine_record(tmp_path_factory):
     """A slider response to a 40 V / 50 Hz sine (scanning mode), the input of identify hysteresis."""
