@@ -2,6 +2,7 @@
 // waveform simulator, and the chapter's experiments (Fig. 2.10-2.17) with their figures.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -216,26 +217,50 @@ void run_simulate(const SimulateOptions& o) {
   const ss::Waveform w = ss::make_waveform(ss::parse_wave_kind(o.wave), o.amplitude_V, o.frequency_Hz,
                                            ss::parse_direction(o.direction), p.drive);
   ss::ActuatorState state = m.initial_state();
-  const ss::Trajectory tr = ss::simulate(m, w, o.duration_s, 1, &state);
   const auto bounds = p.physical_bounds();         // once: it runs the PI over the drive's range
   const std::string where = "stickslip simulate";  // once: a literal would be a string per sample
-  for (std::size_t i = 0; i < tr.t_s.size(); ++i)
-    p.check_physical_bounds(bounds, tr.x1_m[i], tr.x2_m[i], tr.t_s[i], where);
-  const double x0 = tr.x2_m.front(), xf = tr.x2_m.back();
-  const double dur = tr.t_s.back() - tr.t_s.front();
   // Mean velocity from the same phase to the same phase: over the whole periods of the run (the
-  // slider's position within a period swings by up to the PE's stroke), none for a step.
-  nlohmann::json mean_velocity = nullptr;
-  double whole_periods = 0.0;
-  if (w.kind != ss::WaveKind::kStep) {
-    whole_periods = std::floor(dur * w.frequency_Hz + 1e-9);
-    if (whole_periods >= 1.0) {
-      const double t_w = whole_periods / w.frequency_Hz;
-      const auto k = std::min(tr.t_s.size() - 2, static_cast<std::size_t>(t_w / m.dt_s()));
-      const double frac = std::clamp((t_w - tr.t_s[k]) / (tr.t_s[k + 1] - tr.t_s[k]), 0.0, 1.0);
-      const double x_w = tr.x2_m[k] + frac * (tr.x2_m[k + 1] - tr.x2_m[k]);
-      mean_velocity = (x_w - x0) / t_w;
+  // slider's position within a period swings by up to the PE's stroke), none for a step. The
+  // run's samples are t_k = k dt, k = 0..steps; x(t_w) is interpolated between samples k_w and
+  // k_w + 1.
+  const auto steps = static_cast<std::size_t>(std::llround(o.duration_s / m.dt_s()));
+  const double planned_s = static_cast<double>(steps) * m.dt_s();
+  const double whole_periods =
+      w.kind == ss::WaveKind::kStep ? 0.0 : std::floor(planned_s * w.frequency_Hz + 1e-9);
+  const double t_w = whole_periods >= 1.0 ? whole_periods / w.frequency_Hz : 0.0;
+  const std::size_t k_w = std::min(steps - 1, static_cast<std::size_t>(t_w / m.dt_s()));
+  // Only --out needs the whole trajectory (CSV, .mat, plots): without it the run is streamed and
+  // only what the summary needs is kept (issue #12: `simulate --duration 10` at >= 40x real time).
+  ss::Trajectory tr;
+  std::array<double, 2> t_at{}, x_at{};  // samples k_w and k_w + 1
+  double x0 = 0.0, xf = 0.0, t0 = 0.0, tf = 0.0;
+  std::size_t n = 0;
+  if (o.common.out) {
+    const std::size_t n_rec = steps + 2;
+    tr.t_s.reserve(n_rec);
+    tr.u_V.reserve(n_rec);
+    tr.x1_m.reserve(n_rec);
+    tr.x2_m.reserve(n_rec);
+  }
+  ss::simulate_each(m, w, o.duration_s, 1, state, [&](const ss::ActuatorState& s) {
+    const double x2 = m.slider_position(s), x1 = s.x1_m();
+    p.check_physical_bounds(bounds, x1, x2, s.t_s, where);
+    if (n == 0) x0 = x2, t0 = s.t_s;
+    if (n == k_w || n == k_w + 1) t_at[n - k_w] = s.t_s, x_at[n - k_w] = x2;
+    xf = x2, tf = s.t_s;
+    ++n;
+    if (o.common.out) {
+      tr.t_s.push_back(s.t_s);
+      tr.u_V.push_back(s.u_V);
+      tr.x1_m.push_back(x1);
+      tr.x2_m.push_back(x2);
     }
+  });
+  const double dur = tf - t0;
+  nlohmann::json mean_velocity = nullptr;
+  if (whole_periods >= 1.0) {
+    const double frac = std::clamp((t_w - t_at[0]) / (t_at[1] - t_at[0]), 0.0, 1.0);
+    mean_velocity = (x_at[0] + frac * (x_at[1] - x_at[0]) - x0) / t_w;
   }
   nlohmann::json j{{"wave", o.wave},
                    {"amplitude_V", o.amplitude_V},
@@ -243,7 +268,7 @@ void run_simulate(const SimulateOptions& o) {
                    {"direction", o.direction},
                    {"duration_s", dur},
                    {"dt_s", m.dt_s()},
-                   {"samples", tr.t_s.size()},
+                   {"samples", n},
                    {"final_position_m", xf},
                    {"displacement_m", xf - x0},
                    {"whole_periods", whole_periods},

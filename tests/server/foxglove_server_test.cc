@@ -316,7 +316,7 @@ TEST(FoxgloveServer, SlowClientDoesNotBlockPublish) {
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < 10000; ++i) server.publish(ch, static_cast<std::uint64_t>(i), payload);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EXPECT_LT(seconds, 2.0);
+  EXPECT_LT(seconds, 10.0) << "publish waited for the client (blocked, it would wait forever)";
   const ServerCounters k = server.counters();
   EXPECT_GT(k.messages_dropped, 5000u);  // at most 4 MB queued plus the socket buffers
   // The first message is still the oldest undropped one: the stream is intact.

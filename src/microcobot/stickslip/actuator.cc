@@ -248,40 +248,46 @@ double ActuatorModel::slider_velocity(const ActuatorState& s) const noexcept {
   return p_.slider.attached ? c_[0] * s.v2_m_s[0] + c_[1] * s.v2_m_s[1] : 0.0;
 }
 
-Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every,
-                    ActuatorState* state) {
+void simulate_each(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every,
+                   ActuatorState& state, const std::function<void(const ActuatorState&)>& on_sample) {
   require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
   require(record_every >= 1, "record_every", "must be >= 1", record_every);
   wave.validate(m.params().drive);
   require(wave.kind == WaveKind::kStep || wave.frequency_Hz * m.dt_s() <= 1.0, "frequency_Hz",
           "the drive's period must be at least one model step (integrator.dt_s)", wave.frequency_Hz);
-  ActuatorState local = state ? *state : m.initial_state();
   // A step has no frequency: its break-away strain is the table's quasi-static end.
   const double f_op =
       wave.kind == WaveKind::kStep ? m.params().breakaway.frequencies_Hz.front() : wave.frequency_Hz;
-  m.set_operating_point(local, wave.amplitude_V, f_op, wave.direction);
+  m.set_operating_point(state, wave.amplitude_V, f_op, wave.direction);
   const auto steps = static_cast<long>(std::llround(duration_s / m.dt_s()));
+  on_sample(state);
+  for (long k = 1; k <= steps; ++k) {
+    m.step(state, wave.segment(static_cast<double>(k - 1) * m.dt_s(), m.dt_s()));
+    if (state.diverged) {
+      throw ComputationFailed("stick-slip simulation diverged (NaN/Inf) at t = " + std::to_string(state.t_s) +
+                              " s; reduce integrator.dt_s or check the parameters");
+    }
+    if (k % record_every == 0) on_sample(state);
+  }
+}
+
+Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every,
+                    ActuatorState* state) {
+  require(std::isfinite(duration_s) && duration_s > 0.0, "duration_s", "must be > 0", duration_s);
+  require(record_every >= 1, "record_every", "must be >= 1", record_every);
+  ActuatorState local = state ? *state : m.initial_state();
   Trajectory tr;
-  const auto n_rec = static_cast<std::size_t>(steps / record_every + 2);
+  const auto n_rec = static_cast<std::size_t>(std::llround(duration_s / m.dt_s()) / record_every + 2);
   tr.t_s.reserve(n_rec);
   tr.u_V.reserve(n_rec);
   tr.x1_m.reserve(n_rec);
   tr.x2_m.reserve(n_rec);
-  auto record = [&] {
-    tr.t_s.push_back(local.t_s);
-    tr.u_V.push_back(local.u_V);
-    tr.x1_m.push_back(local.x1_m());
-    tr.x2_m.push_back(m.slider_position(local));
-  };
-  record();
-  for (long k = 1; k <= steps; ++k) {
-    m.step(local, wave.segment(static_cast<double>(k - 1) * m.dt_s(), m.dt_s()));
-    if (local.diverged) {
-      throw ComputationFailed("stick-slip simulation diverged (NaN/Inf) at t = " + std::to_string(local.t_s) +
-                              " s; reduce integrator.dt_s or check the parameters");
-    }
-    if (k % record_every == 0) record();
-  }
+  simulate_each(m, wave, duration_s, record_every, local, [&](const ActuatorState& s) {
+    tr.t_s.push_back(s.t_s);
+    tr.u_V.push_back(s.u_V);
+    tr.x1_m.push_back(s.x1_m());
+    tr.x2_m.push_back(m.slider_position(s));
+  });
   if (state) *state = local;
   return tr;
 }

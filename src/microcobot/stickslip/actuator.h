@@ -19,6 +19,7 @@
 /// ActuatorStates; step() never allocates, locks, throws or does I/O.
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "microcobot/stickslip/drive.h"
@@ -118,5 +119,13 @@ struct Trajectory {
 /// mc::ComputationFailed on divergence (never returns NaN).
 Trajectory simulate(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every = 1,
                     ActuatorState* state = nullptr);
+
+/// The streaming form of simulate(): steps `state` through `wave` for `duration_s` (operating
+/// point set from the waveform) and hands the first state and every `record_every`-th after it
+/// to `on_sample`, for callers that keep only what they need (the CLI without --out keeps no
+/// 32 MB record of a 10 s run). Throws mc::ComputationFailed on divergence, `state` then
+/// unspecified.
+void simulate_each(const ActuatorModel& m, const Waveform& wave, double duration_s, int record_every,
+                   ActuatorState& state, const std::function<void(const ActuatorState&)>& on_sample);
 
 }  // namespace mc::stickslip
