@@ -41,6 +41,12 @@ struct Live {
     std::lock_guard lock(mutex);
     return last[channel(name)];
   }
+  // Waits until the telemetry (which reaches the sink through the drain thread, behind the
+  // loop) shows the loop's state of now: a sample 20 ms of live time newer than the status.
+  bool catch_up() {
+    const double t = live.status().t_s;
+    return test::eventually([&] { return get("t_s") > t + 0.02; });
+  }
   // Sends `c` at 50 Hz for `duration` (the console's heartbeat).
   void drive(const ConsoleCommand& c, std::chrono::milliseconds duration) {
     const auto end = std::chrono::steady_clock::now() + duration;
@@ -82,6 +88,7 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   // The client goes silent: after the command timeout the stage holds.
   std::this_thread::sleep_for(300ms);
   EXPECT_TRUE(test::eventually([&] { return !rig.live.status().console_fresh; }));
+  ASSERT_TRUE(rig.catch_up());
   const double held = rig.get("target_x_m");
   std::this_thread::sleep_for(200ms);
   EXPECT_DOUBLE_EQ(rig.get("target_x_m"), held);
@@ -96,6 +103,7 @@ TEST(LivePlatform, TheEstopLatchesEveryDeviceInItsSafeStateUntilAnExplicitReset)
   ASSERT_TRUE(test::eventually([&] { return rig.live.status().estopped; }));
   auto s = rig.live.status();
   for (Lifecycle l : s.lifecycle) EXPECT_EQ(l, Lifecycle::kFault);
+  ASSERT_TRUE(rig.catch_up());
   const double held = rig.get("target_x_m");
   rig.drive(jog(200e-6), 300ms);  // commands with the deadman: nothing moves
   EXPECT_DOUBLE_EQ(rig.get("target_x_m"), held);

@@ -33,6 +33,22 @@ struct WsClient::Impl {
   websocket::stream<beast::tcp_stream> ws{ioc};
   websocket::response_type response;
   beast::flat_buffer buffer;
+  // A read that timed out stays pending (a loaded machine is slow, not broken): the next read()
+  // goes on waiting for it rather than starting a second one, which Beast forbids. Its state
+  // lives here, not on the stack of the read() that started it.
+  bool read_pending = false, read_done = false;
+  error_code read_ec;
+
+  // Connect, handshake, write and close have no such continuation: when one times out the
+  // connection is given up, and its handlers run here, while the caller's stack they refer to
+  // still exists (never later, into a frame that is gone).
+  void abandon() {
+    error_code ignored;
+    beast::get_lowest_layer(ws).socket().close(ignored);
+    ioc.restart();
+    ioc.run();
+    read_pending = false;
+  }
 
   bool run_until(const bool& done, std::chrono::milliseconds timeout = kClientTimeout) {
     ioc.restart();
@@ -53,13 +69,17 @@ int WsClient::connect(std::uint16_t port, const std::string& target, bool subpro
   Impl& c = *impl_;
   bool done = false;
   error_code ec;
-  beast::get_lowest_layer(c.ws).expires_after(kClientTimeout);
+  beast::get_lowest_layer(c.ws).expires_after(kExchangeTimeout);
   beast::get_lowest_layer(c.ws).async_connect(tcp::endpoint(net::ip::address_v4::loopback(), port),
                                               [&](const error_code& e) {
                                                 ec = e;
                                                 done = true;
                                               });
-  if (!c.run_until(done) || ec) return -1;
+  if (!c.run_until(done, kExchangeTimeout)) {
+    c.abandon();
+    return -1;
+  }
+  if (ec) return -1;
   if (subprotocol) {
     c.ws.set_option(websocket::stream_base::decorator([](websocket::request_type& req) {
       req.set(http::field::sec_websocket_protocol, "foxglove.websocket.v1");
@@ -70,8 +90,14 @@ int WsClient::connect(std::uint16_t port, const std::string& target, bool subpro
     ec = e;
     done = true;
   });
-  if (!c.run_until(done)) return -1;
+  if (!c.run_until(done, kExchangeTimeout)) {
+    c.abandon();
+    return -1;
+  }
   beast::get_lowest_layer(c.ws).expires_never();
+  // A refused upgrade (401, 400, 503) is answered with its status; a connection closed or
+  // timed out before any answer is -1 (the response would still say its default, 200).
+  if (ec && c.response.result_int() == 200) return -1;
   return c.response.result_int();
 }
 
@@ -82,14 +108,18 @@ std::string WsClient::response_header(const std::string& name) const {
 
 std::optional<WsClient::Message> WsClient::read(std::chrono::milliseconds timeout) {
   Impl& c = *impl_;
-  c.buffer.clear();
-  bool done = false;
-  error_code ec;
-  c.ws.async_read(c.buffer, [&](const error_code& e, std::size_t) {
-    ec = e;
-    done = true;
-  });
-  if (!c.run_until(done, timeout) || ec) return std::nullopt;
+  if (!c.read_pending) {
+    c.buffer.clear();
+    c.read_done = false;
+    c.read_pending = true;
+    c.ws.async_read(c.buffer, [&c](const error_code& e, std::size_t) {
+      c.read_ec = e;
+      c.read_done = true;
+    });
+  }
+  if (!c.run_until(c.read_done, timeout)) return std::nullopt;  // still pending
+  c.read_pending = false;
+  if (c.read_ec) return std::nullopt;
   return Message{c.ws.got_text(), beast::buffers_to_string(c.buffer.data())};
 }
 
@@ -120,7 +150,11 @@ bool WsClient::send(const std::string& data, bool binary) {
     ec = e;
     done = true;
   });
-  return c.run_until(done) && !ec;
+  if (!c.run_until(done)) {
+    c.abandon();
+    return false;
+  }
+  return !ec;
 }
 
 bool WsClient::sync() {
@@ -131,7 +165,7 @@ bool WsClient::sync() {
 void WsClient::close() {
   bool done = false;
   impl_->ws.async_close(websocket::close_code::normal, [&](const error_code&) { done = true; });
-  impl_->run_until(done, 1000ms);
+  if (!impl_->run_until(done, 1000ms)) impl_->abandon();
 }
 
 std::string HttpResult::header(const std::string& name) const {
@@ -145,7 +179,7 @@ HttpResult http_request(std::uint16_t port, const std::string& method, const std
   beast::tcp_stream stream(ioc);
   http::response<http::string_body> res;
   res.result(http::status::unknown);
-  stream.expires_after(kClientTimeout);
+  stream.expires_after(kExchangeTimeout);
   http::request<http::string_body> req(http::string_to_verb(method), target, 11);
   req.set(http::field::host, "127.0.0.1");
   if (!extra_header.empty()) req.set("X-Filler", extra_header);
@@ -165,7 +199,7 @@ HttpResult http_request(std::uint16_t port, const std::string& method, const std
       http::async_read(stream, buf, parser, [&](const error_code& ec3, std::size_t) { answered = !ec3; });
     });
   });
-  ioc.run_for(kClientTimeout);
+  ioc.run_for(kExchangeTimeout);
   HttpResult r;
   if (!answered) return r;
   const auto& m = parser.get();

@@ -15,7 +15,12 @@
 
 namespace mc::test {
 
+/// How long a read waits for a message by default.
 inline constexpr std::chrono::milliseconds kClientTimeout{5000};
+/// How long a connection, an upgrade or an HTTP exchange may take: long, because a server that
+/// answers at all is what the tests assert, and a sanitized build on a loaded machine answers
+/// slowly (a refused or answered request comes back at once anyway).
+inline constexpr std::chrono::milliseconds kExchangeTimeout{30000};
 
 class WsClient {
  public:
