@@ -77,8 +77,10 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
   ASSERT_EQ(ping.exit_code, 0) << ping.err;
   const auto p = nlohmann::json::parse(ping.out);
   EXPECT_EQ(p["sent"], 2000);
-  // Best effort on a shared machine: most, not necessarily all, echoes come back.
-  EXPECT_GT(p["received"].get<int>(), 1000) << ping.out;
+  // Best effort, keep last 1: when a starved process (a loaded 2-core machine under ctest -j2)
+  // is not scheduled for a period, the newer target overwrites the older one; measured 3 % lost
+  // on a quiet machine, 59 % under a full parallel build. Echoes must come back, not all of them.
+  EXPECT_GE(p["received"].get<int>(), 200) << ping.out;
   EXPECT_LT(p["rtt_p99_s"].get<double>(), 0.05) << ping.out;
   EXPECT_LE(p["rtt_p50_s"].get<double>(), p["rtt_p99_s"].get<double>());
   EXPECT_EQ(p["rejected"], 0);
