@@ -78,8 +78,9 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
   const auto p = nlohmann::json::parse(ping.out);
   EXPECT_EQ(p["sent"], 2000);
   // Best effort, keep last 1: when a starved process (a loaded 2-core machine under ctest -j2)
-  // is not scheduled for a period, the newer target overwrites the older one; measured 3 % lost
-  // on a quiet machine, 59 % under a full parallel build. Echoes must come back, not all of them.
+  // is not scheduled for a period, the newer target overwrites the older one; measured 3-17 % lost
+  // at a load average of 5, 59 % inside ctest -j2 (docs/benchmarks.md). Echoes must come back, not
+  // all of them.
   EXPECT_GE(p["received"].get<int>(), 200) << ping.out;
   EXPECT_LT(p["rtt_p99_s"].get<double>(), 0.05) << ping.out;
   EXPECT_LE(p["rtt_p50_s"].get<double>(), p["rtt_p99_s"].get<double>());
