@@ -19,6 +19,7 @@ DEBIAN_PACKAGES=(
   chromium             # headless browser for the report test
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
+  cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
 )

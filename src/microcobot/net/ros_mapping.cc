@@ -1,0 +1,140 @@
+#include "microcobot/net/ros_mapping.h"
+
+#include <cmath>
+#include <limits>
+
+#include "microcobot/core/error.h"
+
+namespace mc::net {
+
+namespace {
+
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+
+void fill_header(std::int64_t stamp_ns, std_msgs_msg_dds__Header_& h) {
+  h.stamp_ = to_ros_time(stamp_ns);
+  // Never written through: the DDS serialiser only reads it.
+  h.frame_id_ = const_cast<char*>(kStageFrame);
+}
+
+bool finite3(double x, double y, double z) {
+  return std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
+}
+
+bool within(double x, double y, double z, double bound) {
+  return std::abs(x) <= bound && std::abs(y) <= bound && std::abs(z) <= bound;
+}
+
+Rejection check_vector(double x, double y, double z, double bound, const std_msgs_msg_dds__Header_& h,
+                       Channel c, NetSample& out) {
+  if (!finite3(x, y, z)) return Rejection::kNonFinite;
+  if (!within(x, y, z, bound)) return Rejection::kOutOfRange;
+  std::int64_t stamp = 0;
+  if (!from_ros_time(h.stamp_, stamp)) return Rejection::kBadStamp;
+  out = NetSample{};
+  out.channel = c;
+  out.stamp_ns = stamp;
+  out.xyz = {x, y, z};
+  return Rejection::kNone;
+}
+
+}  // namespace
+
+void NetLimits::validate() const {
+  if (!(max_abs_position_m > 0) || !std::isfinite(max_abs_position_m))
+    throw InvalidParams("max_abs_position_m", "must be a finite number > 0");
+  if (!(max_abs_force_N > 0) || !std::isfinite(max_abs_force_N))
+    throw InvalidParams("max_abs_force_N", "must be a finite number > 0");
+  if (!(max_opening_m > 0) || !std::isfinite(max_opening_m))
+    throw InvalidParams("max_opening_m", "must be a finite number > 0");
+}
+
+builtin_interfaces_msg_dds__Time_ to_ros_time(std::int64_t stamp_ns) {
+  if (stamp_ns < 0) stamp_ns = 0;
+  constexpr std::int64_t kMaxNs =
+      static_cast<std::int64_t>(std::numeric_limits<std::int32_t>::max()) * kNsPerS + (kNsPerS - 1);
+  if (stamp_ns > kMaxNs) stamp_ns = kMaxNs;
+  builtin_interfaces_msg_dds__Time_ t{};
+  t.sec_ = static_cast<std::int32_t>(stamp_ns / kNsPerS);
+  t.nanosec_ = static_cast<std::uint32_t>(stamp_ns % kNsPerS);
+  return t;
+}
+
+bool from_ros_time(const builtin_interfaces_msg_dds__Time_& t, std::int64_t& stamp_ns) {
+  if (t.sec_ < 0 || t.nanosec_ >= kNsPerS) return false;
+  stamp_ns = static_cast<std::int64_t>(t.sec_) * kNsPerS + static_cast<std::int64_t>(t.nanosec_);
+  return true;
+}
+
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__PoseStamped_& m) {
+  m = {};
+  fill_header(s.stamp_ns, m.header_);
+  m.pose_.position_.x_ = s.xyz[0];
+  m.pose_.position_.y_ = s.xyz[1];
+  m.pose_.position_.z_ = s.xyz[2];
+  m.pose_.orientation_.w_ = 1.0;  // the stage translates only: the identity rotation
+}
+
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__WrenchStamped_& m) {
+  m = {};
+  fill_header(s.stamp_ns, m.header_);
+  m.wrench_.force_.x_ = s.xyz[0];
+  m.wrench_.force_.y_ = s.xyz[1];
+  m.wrench_.force_.z_ = s.xyz[2];
+}
+
+void to_ros(const NetSample& s, std_msgs_msg_dds__Bool_& m) { m.data_ = s.scalar != 0.0; }
+
+void to_ros(const NetSample& s, JointStateBuffer& buf, sensor_msgs_msg_dds__JointState_& m) {
+  m = {};
+  fill_header(s.stamp_ns, m.header_);
+  buf.name[0] = const_cast<char*>(kGripperJoint);
+  buf.position[0] = s.scalar;
+  m.name_._length = m.name_._maximum = 1;
+  m.name_._buffer = buf.name;
+  m.name_._release = false;
+  m.position_._length = m.position_._maximum = 1;
+  m.position_._buffer = buf.position;
+  m.position_._release = false;
+}
+
+Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out) {
+  const auto& p = m.pose_.position_;
+  return check_vector(p.x_, p.y_, p.z_, lim.max_abs_position_m, m.header_, c, out);
+}
+
+Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out) {
+  const auto& f = m.wrench_.force_;
+  return check_vector(f.x_, f.y_, f.z_, lim.max_abs_force_N, m.header_, c, out);
+}
+
+Rejection from_ros(const sensor_msgs_msg_dds__JointState_& m, Channel c, const NetLimits& lim,
+                   NetSample& out) {
+  if (m.position_._length != 1 || m.position_._buffer == nullptr) return Rejection::kBadSize;
+  if (m.name_._length > 1 || m.velocity_._length > 1 || m.effort_._length > 1) return Rejection::kBadSize;
+  const double x = m.position_._buffer[0];
+  for (const auto* seq : {&m.velocity_, &m.effort_}) {
+    if (seq->_length == 1 && (seq->_buffer == nullptr || !std::isfinite(seq->_buffer[0])))
+      return Rejection::kNonFinite;
+  }
+  if (!std::isfinite(x)) return Rejection::kNonFinite;
+  if (x < 0.0 || x > lim.max_opening_m) return Rejection::kOutOfRange;
+  std::int64_t stamp = 0;
+  if (!from_ros_time(m.header_.stamp_, stamp)) return Rejection::kBadStamp;
+  out = NetSample{};
+  out.channel = c;
+  out.stamp_ns = stamp;
+  out.scalar = x;
+  return Rejection::kNone;
+}
+
+Rejection from_ros(const std_msgs_msg_dds__Bool_& m, Channel c, NetSample& out) {
+  out = NetSample{};
+  out.channel = c;
+  out.scalar = m.data_ ? 1.0 : 0.0;
+  return Rejection::kNone;
+}
+
+}  // namespace mc::net

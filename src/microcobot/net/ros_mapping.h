@@ -1,0 +1,51 @@
+#pragma once
+/// @file
+/// Our samples (net_sample.h) to and from the ROS 2 message types (ros2_messages.idl). SI units
+/// on both sides (ROS 2's REP 103): positions in m, forces in N, openings in m; stamps are ROS
+/// time, builtin_interfaces/Time {sec, nanosec}. Samples from the network are checked before they
+/// are accepted: finite, within NetLimits, a valid stamp, sequences of the expected length;
+/// anything else is refused with its reason.
+///
+/// The outgoing messages point at static strings (frame ids, joint names) and at storage the
+/// caller owns (JointStateBuffer): filling one never allocates.
+
+#include <cstdint>
+
+#include "microcobot/net/net_sample.h"
+#include "ros2_messages.h"
+
+namespace mc::net {
+
+/// Frame of positions and forces: the stage's frame (the XYZ stick-slip positioner).
+inline constexpr const char* kStageFrame = "microcobot_stage";
+/// JointState's joint name of the gripper opening.
+inline constexpr const char* kGripperJoint = "gripper_opening";
+
+/// ns since the epoch -> Time (nanosec in [0, 1e9)). Negative times are clamped to 0.
+builtin_interfaces_msg_dds__Time_ to_ros_time(std::int64_t stamp_ns);
+/// Time -> ns since the epoch; false when nanosec >= 1e9 or sec < 0.
+bool from_ros_time(const builtin_interfaces_msg_dds__Time_& t, std::int64_t& stamp_ns);
+
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__PoseStamped_& m);
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__WrenchStamped_& m);
+void to_ros(const NetSample& s, std_msgs_msg_dds__Bool_& m);
+
+/// The storage a JointState of one joint points at.
+struct JointStateBuffer {
+  char* name[1] = {const_cast<char*>(kGripperJoint)};
+  double position[1] = {0.0};
+};
+void to_ros(const NetSample& s, JointStateBuffer& buf, sensor_msgs_msg_dds__JointState_& m);
+
+/// Each from_ros fills `out` (channel `c`) and returns kNone, or returns why it refused.
+/// A pose's orientation is ignored (the stage only translates); a wrench's torque likewise.
+Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out);
+Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out);
+/// Exactly one position; velocity and effort empty or of length one (and finite).
+Rejection from_ros(const sensor_msgs_msg_dds__JointState_& m, Channel c, const NetLimits& lim,
+                   NetSample& out);
+Rejection from_ros(const std_msgs_msg_dds__Bool_& m, Channel c, NetSample& out);
+
+}  // namespace mc::net
