@@ -312,6 +312,11 @@ void bind_control(py::module_& m) {
         if (!(setpoint_rate_Hz > 0.0 && setpoint_rate_Hz <= 1e5))
           throw InvalidParams("setpoint_rate_Hz", "in (0, 1e5] Hz", setpoint_rate_Hz);
         const auto kind = ct::parse_tracker_kind(tracker);
+        const double half = 0.5 * p.model.params().slider.stroke_m;
+        for (std::size_t k = 0; k < sp.size(); ++k)
+          if (std::abs(sp[k]) > half)
+            throw InvalidParams("setpoints_m[" + std::to_string(k) + "]", "must lie within the stroke",
+                                sp[k]);
         const double start_m = start.is_none() ? sp.front() : start.cast<double>();
         if (!std::isfinite(start_m)) throw InvalidParams("start_m", "finite", start_m);
         const double streamed_s = static_cast<double>(sp.size()) / setpoint_rate_Hz;

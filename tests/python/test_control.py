@@ -83,6 +83,8 @@ def test_run_tracking_refuses_bad_input(plant):
         control.run_tracking(plant, np.zeros(10), tracker="fuzzy")
     with pytest.raises(ValueError, match="setpoints_m"):
         control.run_tracking(plant, np.array([0.0, np.nan]))
+    with pytest.raises(ValueError, match=r"setpoints_m\[1\].*stroke"):
+        control.run_tracking(plant, np.array([0.0, 1.0]))
     with pytest.raises(ValueError, match="setpoint_rate_Hz"):
         control.run_tracking(plant, np.zeros(10), setpoint_rate_Hz=0.0)
     with pytest.raises(ValueError, match="duration_s"):
