@@ -19,6 +19,9 @@
 #include "microcobot/core/params.h"
 #include "microcobot/live/console_server.h"
 #include "microcobot/live/live_platform.h"
+#include "microcobot/net/cyclone_config.h"
+#include "microcobot/net/remote_master.h"
+#include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/platform_config.h"
 #include "signals.h"
 
@@ -34,7 +37,46 @@ struct ServeOptions {
   std::filesystem::path out = "out/live";
   bool record = false;
   double duration_s = 0.0;
+  std::string role = "single";  // single | master | slave (issue #17)
+  int domain = 0;
 };
+
+// The distributed platform's far end (issue #17): the master process sees the slave stage as
+// remote devices, the slave process takes its commands from the remote master.
+struct RemoteEnds {
+  std::unique_ptr<mc::net::RemoteSlave> slave;
+  std::unique_ptr<mc::net::RemoteMaster> master;
+};
+
+RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
+  RemoteEnds ends;
+  if (o.role == "single") return ends;
+  const mc::stickslip::StickSlipParams axis = pf::axis_params(lp.platform);
+  if (o.role == "master") {
+    mc::net::RemoteSlaveParams rp;
+    rp.link.domain_id = o.domain;
+    rp.sample_period_s = axis.integrator.dt_s;
+    rp.max_voltage_V = axis.drive.max_V;
+    ends.slave = std::make_unique<mc::net::RemoteSlave>(rp);
+    // The masters are this machine's (simulated: the operator uses the console); the stage is
+    // the slave process's.
+    lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform] {
+      pf::PlatformDevices d = remote->make_devices();
+      d.haptic = std::make_unique<pf::SimulatedHapticMaster>("dual_stage", cfg.haptic.plant, cfg.haptic.render,
+                                                             cfg.haptic.pantograph, cfg.loop.period_s());
+      d.tweezers = std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+      return d;
+    };
+  } else {
+    mc::net::RemoteMasterParams rp;
+    rp.link.domain_id = o.domain;
+    rp.home_m = {lp.platform.stage.home_x_m, lp.platform.stage.home_y_m, lp.platform.stage.home_z_m};
+    rp.goal_speed_m_s = lp.platform.teleop.console_max_speed_m_s;
+    ends.master = std::make_unique<mc::net::RemoteMaster>(rp);
+    lp.remote = ends.master.get();
+  }
+  return ends;
+}
 
 // "HOST:PORT" or "[V6]:PORT".
 std::pair<std::string, std::uint16_t> parse_listen(const std::string& text) {
@@ -90,6 +132,11 @@ void serve(const ServeOptions& o) {
 
   mc::cli::set_cooperative_interrupts(true);
   std::cerr << "serve: building the platform (the stick-slip step map takes about a second)\n";
+  RemoteEnds ends = attach_role(o, lp);
+  if (o.role != "single")
+    std::cerr << "serve: " << o.role << " of a distributed platform on DDS domain " << o.domain
+              << " (loopback; the peer: serve --role " << (o.role == "master" ? "slave" : "master")
+              << " --domain " << o.domain << ")\n";
   mc::live::LivePlatform live(lp);
   mc::live::ConsoleServer server(live, sp);
   server.start();
@@ -126,6 +173,15 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--duration", o->duration_s,
                  "Stop after this many seconds of wall-clock time (default: never)")
       ->check(mc::cli::Range(0.0, 1e7));
+  cmd.add_option("--role", o->role,
+                 "single (default: the whole platform here), master (the operator's side: console, masters, "
+                 "coupling; the stage is the slave process's) or slave (stage, gripper, microworld, stage "
+                 "controller; commands from the master process), joined over DDS (docs/distributed.md)")
+      ->check(CLI::IsMember({"single", "master", "slave"}));
+  cmd.add_option("--domain", o->domain,
+                 fmt::format("DDS domain id of the master-slave link, 0 to {} (default 0; both ends the same)",
+                             mc::net::kMaxDomainId))
+      ->check(CLI::Range(0, mc::net::kMaxDomainId));
   cmd.callback([o] { serve(*o); });
 }
 

@@ -91,6 +91,35 @@ TEST(Teleoperation, DeadmanReleasedOrStaleMasterHoldsTheSlaveWithZeroForce) {
   EXPECT_DOUBLE_EQ(out.haptic_force_N.norm(), 0.0);
 }
 
+TEST(Teleoperation, ASilentSlaveReleasesBothMastersAndReEngagesWhereItNowIs) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  auto in = engaged_at(0.0, 0.0);
+  in.contact_force_N = {50e-6, 0, 0};  // 0.5 N on the hand
+  in.grip_force_N = 5e-3;              // 0.5 N on the fingers
+  for (int i = 0; i < 1000; ++i) t.tick(in);
+  ASSERT_GT(t.output().haptic_force_N.x(), 0.4);
+  ASSERT_GT(t.output().finger_force_N, 0.4);
+  // The slave falls silent (a remote slave's link): no force on either master at once.
+  in.slave_fresh = false;
+  in.handle_m.x() = 0.02;  // the hand moves on meanwhile
+  auto out = t.tick(in);
+  EXPECT_FALSE(out.engaged);
+  EXPECT_TRUE(out.stale);
+  EXPECT_EQ(out.haptic_force_N.norm(), 0.0);
+  EXPECT_EQ(out.finger_force_N, 0.0);
+  EXPECT_EQ(out.slave_target_m.x(), 0.0) << "the target holds";
+  // It returns elsewhere (a restarted slave at its home): the target is re-taken from where it
+  // is, and the hand's new position does not move it (re-indexed like a clutch).
+  in.slave_fresh = true;
+  in.slave_position_m = {-150e-6, 20e-6, 5e-6};
+  out = t.tick(in);
+  EXPECT_TRUE(out.engaged);
+  EXPECT_NEAR((out.slave_target_m - in.slave_position_m).norm(), 0.0, 1e-15);
+  in.handle_m.x() = 0.021;  // +1 mm of hand: +10 um from there
+  out = t.tick(in);
+  EXPECT_NEAR(out.slave_target_m.x(), -150e-6 + 10e-6, 1e-15);
+}
+
 TEST(Teleoperation, TweezersDriveTheGripperAndStaleTweezersHoldIt) {
   Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
   auto in = engaged_at(0, 0);

@@ -1,11 +1,7 @@
 // `microcobot link echo` and `link ping` as a user runs them: two processes over DDS on loopback,
 // on a domain id of this test process.
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <string>
@@ -19,8 +15,6 @@
 #include "net/net_test_support.h"
 #include "support/test_support.h"
 
-extern char** environ;
-
 namespace mc {
 namespace {
 
@@ -28,51 +22,12 @@ using mc::test::run_cli;
 using mc::test::TempDir;
 using ::testing::HasSubstr;
 
-// A CLI process in the background, its stdout and stderr in files.
-struct Background {
-  pid_t pid = 0;
-  std::filesystem::path out, err;
-};
-
-Background spawn_cli(const std::vector<std::string>& args, const TempDir& dir) {
-  Background b;
-  b.out = dir / "echo.out";
-  b.err = dir / "echo.err";
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, b.out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, b.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> argv_s{MC_CLI_PATH};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  EXPECT_EQ(posix_spawn(&b.pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&actions);
-  return b;
-}
-
-// The exit code, or 128 + signal; -1 when it did not exit within `timeout_s` (then killed).
-int wait_exit(pid_t pid, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() >= end) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      return -1;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
 TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
   TempDir dir;
   const std::string domain = std::to_string(net::test::test_domain_id());
   // --duration: a safety net should the test die before it signals the echo.
-  Background echo = spawn_cli({"link", "echo", "--domain", domain, "--json", "--duration", "120"}, dir);
+  const test::BackgroundCli echo =
+      test::spawn_cli({"link", "echo", "--domain", domain, "--json", "--duration", "120"}, dir / "echo");
   const auto ping = run_cli({"link", "ping", "--domain", domain, "--count", "2000", "--estop", "--json"});
   ASSERT_EQ(ping.exit_code, 0) << ping.err;
   const auto p = nlohmann::json::parse(ping.out);
@@ -90,7 +45,7 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
 
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   ::kill(echo.pid, SIGTERM);
-  ASSERT_EQ(wait_exit(echo.pid, 10.0), 0) << test::read_text(echo.err);
+  ASSERT_EQ(test::wait_exit(echo.pid, 10.0), 0) << test::read_text(echo.err);
   const auto e = nlohmann::json::parse(test::read_text(echo.out));
   EXPECT_TRUE(e["estop_received"].get<bool>()) << e.dump();
   EXPECT_TRUE(e["estop"].get<bool>());

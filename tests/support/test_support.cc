@@ -1,6 +1,7 @@
 #include "support/test_support.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,9 +16,9 @@ extern char** environ;
 namespace mc::test {
 
 
-CliResult run_cli(const std::vector<std::string>& args) {
-  TempDir tmp;
-  const std::string out_file = (tmp / "stdout").string(), err_file = (tmp / "stderr").string();
+namespace {
+
+pid_t spawn(const std::vector<std::string>& args, const std::string& out_file, const std::string& err_file) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
@@ -32,6 +33,37 @@ CliResult run_cli(const std::vector<std::string>& args) {
   const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw std::runtime_error("cannot start " + argv_s[0]);
+  return pid;
+}
+
+}  // namespace
+
+BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix) {
+  BackgroundCli b;
+  b.out = prefix.string() + ".out";
+  b.err = prefix.string() + ".err";
+  b.pid = spawn(args, b.out.string(), b.err.string());
+  return b;
+}
+
+int wait_exit(pid_t pid, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() >= end) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+CliResult run_cli(const std::vector<std::string>& args) {
+  TempDir tmp;
+  const std::string out_file = (tmp / "stdout").string(), err_file = (tmp / "stderr").string();
+  const pid_t pid = spawn(args, out_file, err_file);
   int status = 0;
   waitpid(pid, &status, 0);
   CliResult r;

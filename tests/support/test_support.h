@@ -2,6 +2,8 @@
 /// @file
 /// Helpers for tests: run the CLI as a user would, scratch directories, waiting for conditions.
 
+#include <sys/types.h>
+
 #include <chrono>
 #include <filesystem>
 #include <string>
@@ -18,6 +20,16 @@ struct CliResult {
 
 /// Runs the built `microcobot` binary with `args` (no shell), capturing stdout and stderr.
 CliResult run_cli(const std::vector<std::string>& args);
+
+/// A `microcobot` process in the background (a server, a DDS peer): stdout and stderr go to
+/// `<prefix>.out` and `<prefix>.err`.
+struct BackgroundCli {
+  pid_t pid = 0;
+  std::filesystem::path out, err;
+};
+BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix);
+/// The exit code, or 128 + signal; -1 when it did not exit within `timeout_s` (then killed).
+int wait_exit(pid_t pid, double timeout_s);
 
 /// A fresh empty directory under the system temp dir, removed on destruction.
 class TempDir {

@@ -72,6 +72,26 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
 }
 
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
+  if (!in.slave_fresh) {
+    // A silent slave (a remote one whose link went quiet): nothing to couple to. No force on
+    // either master; the target is re-taken from the slave once it reports again.
+    out_.engaged = false;
+    out_.stale = true;
+    out_.slave_velocity_m_s.setZero();
+    out_.haptic_force_N.setZero();
+    out_.finger_force_N = 0.0;
+    force_filtered_N_.setZero();
+    slave_was_stale_ = true;
+    return out_;
+  }
+  if (slave_was_stale_ && in.slave_position_m.allFinite()) {
+    // Back from silence (possibly a restarted slave, elsewhere): hold where it is now, so that
+    // re-engaging never moves it (the haptic path below re-indexes its offset on engagement).
+    out_.slave_target_m = in.slave_position_m;
+    last_xy_m_ = out_.slave_target_m.head<2>();
+    out_.engaged = false;
+    slave_was_stale_ = false;
+  }
   if (in.console.active) {
     console_tick(in);
     return out_;

@@ -84,6 +84,10 @@ struct TeleoperationInput {
   Eigen::Vector3d slave_position_m = Eigen::Vector3d::Zero();  ///< measured stage position
   Eigen::Vector3d contact_force_N = Eigen::Vector3d::Zero();   ///< force on the slave gripper
   double grip_force_N = 0.0;                                   ///< slave grip force
+  /// The slave's measurements are fresh (a remote slave that went silent is not): while they
+  /// are stale the coupling disengages with no force on the masters, and the slave target is
+  /// re-taken from the measured position when they return.
+  bool slave_fresh = true;
   ConsoleInput console;                                        ///< the console, when it holds control
 };
 
@@ -121,6 +125,7 @@ class Teleoperation {
   Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
   bool console_had_control_ = false;  // the haptic path re-indexes when it takes over
+  bool slave_was_stale_ = false;      // re-take the target from the slave when it returns
 };
 
 }  // namespace mc::control

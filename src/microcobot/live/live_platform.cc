@@ -44,7 +44,10 @@ void LivePlatform::build(bool demo) {
   // A new scene: the old platform's devices are deactivated (safe state) by its destructor.
   demo_.reset();
   platform_.reset();
-  auto p = std::make_unique<Platform>(params_.platform);
+  if (demo && (params_.make_devices || params_.remote))
+    throw InvalidInput("demo: the scripted operator needs the whole simulated platform in this process");
+  auto p = params_.make_devices ? std::make_unique<Platform>(params_.platform, params_.make_devices())
+                                : std::make_unique<Platform>(params_.platform);
   std::unique_ptr<PickPlaceOperator> op;
   if (demo) op = std::make_unique<PickPlaceOperator>(*p, params_.demo);
   p->set_operator([this](const platform::TickInfo& t) { operator_tick(t); });
@@ -54,6 +57,7 @@ void LivePlatform::build(bool demo) {
   demo_running_.store(demo);
   latest_ = ConsoleCommand{};
   last_command_t_ = -1e9;
+  remote_estopped_ = false;
 }
 
 bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return commands_.push(c); }
@@ -65,7 +69,22 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
 
   ConsoleCommand c;
   bool got = false;
-  while (commands_.pop(c)) {
+  bool remote_fresh = false;
+  if (params_.remote) {
+    // The master process drives: its e-stop latches ours, its release resets what it latched.
+    const RemoteRequest r = params_.remote->poll(t.t_s, latest_);
+    remote_fresh = r.fresh;
+    if (r.estop && !p.faulted()) {
+      p.fault_all();
+      remote_estopped_ = true;
+    }
+    if (r.reset && remote_estopped_ && p.faulted()) {
+      remote_estopped_ = false;
+      loop_request_.store(static_cast<int>(ConsoleAction::kReset), std::memory_order_release);
+      p.stop();
+    }
+  }
+  while (!params_.remote && commands_.pop(c)) {
     got = true;
     if (c.received_ns > 0) {
       // Applied in this tick: the command-to-target latency (a full ring drops the sample).
@@ -79,8 +98,9 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     latest_ = c;
     last_command_t_ = t.t_s;
   }
-  const bool fresh =
-      in_control_.load(std::memory_order_relaxed) && t.t_s - last_command_t_ <= params_.command_timeout_s;
+  const bool fresh = params_.remote ? remote_fresh
+                                    : in_control_.load(std::memory_order_relaxed) &&
+                                          t.t_s - last_command_t_ <= params_.command_timeout_s;
   control::ConsoleInput in;
   if (demo_) {
     demo_->act(t);  // the scripted operator drives the simulated masters' hands
@@ -96,6 +116,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.gripper_opening_m = latest_.gripper_opening_m;
   }
   p.set_console_input(in);
+  if (params_.remote) params_.remote->publish(p);
 
   t_s_.store(t_offset_s_ + t.t_s, std::memory_order_relaxed);
   estopped_.store(p.faulted(), std::memory_order_relaxed);
@@ -131,6 +152,8 @@ void LivePlatform::control_thread() {
       std::lock_guard lock(request_mutex_);
       action = pending_;
       pending_ = -1;
+      const int from_loop = loop_request_.exchange(-1, std::memory_order_acq_rel);
+      if (action < 0) action = from_loop;
       interrupt_.store(false, std::memory_order_release);
     }
     try {
@@ -154,6 +177,10 @@ void LivePlatform::request(ConsoleAction action) {
   if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo && action != ConsoleAction::kRestart)
     return;
   std::lock_guard lock(request_mutex_);
+  if (action == ConsoleAction::kDemo && (params_.make_devices || params_.remote)) {
+    last_error_ = "demo: the scripted operator needs the whole simulated platform in this process";
+    return;
+  }
   pending_ = static_cast<int>(action);
   last_error_.clear();
   interrupt_.store(true, std::memory_order_release);

@@ -25,6 +25,7 @@
 #include <string>
 #include <thread>
 
+#include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
@@ -41,6 +42,13 @@ struct LiveParams {
   /// Drawn width of a finger tip in the microscope view (the model's fingers are lines).
   double finger_width_m = 40e-6;
   bool paced = true;  ///< false: as fast as possible (tests that need no wall clock)
+  /// The devices of each scene (re)build; empty: the simulated platform. A master process of a
+  /// distributed platform gives the remote slave stage here (net/remote_slave.h); the scripted
+  /// demo needs the simulation and is refused then.
+  std::function<platform::PlatformDevices()> make_devices;
+  /// Commands from the far end instead of the console (a slave process: net/remote_master.h);
+  /// not owned, must outlive the live platform. The console then observes (and may e-stop).
+  CommandSource* remote = nullptr;
   void validate() const;
 };
 
@@ -120,6 +128,8 @@ class LivePlatform {
 
   std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false}, in_control_{false};
   std::atomic<bool> started_{false};
+  bool remote_estopped_ = false;               // loop thread only: the far end latched our e-stop
+  std::atomic<int> loop_request_{-1};          // a ConsoleAction the loop asks of the control thread
   Sink sink_;
   std::thread thread_;
 

@@ -135,6 +135,19 @@ class SlaveAxis : public Device {
   virtual double position_m() const = 0;
   /// True while the carriage rests against one of its end stops.
   virtual bool at_end_stop() const = 0;
+
+  /// True for an axis closed in position beyond this process: the slave stage of a distributed
+  /// platform (net/remote_slave.h), or a controller with its own position loop. The platform
+  /// then sends it targets (command_target_m) and keeps its own stage controller aside;
+  /// command_drive() is never called. Every axis of a platform must agree.
+  virtual bool position_controlled() const { return false; }
+  /// Target position and its velocity (m, m/s, stage coordinates) for a position-controlled
+  /// axis, once per slave tick; ignored unless Active.
+  virtual void command_target_m(double /*target_m*/, double /*velocity_m_s*/) noexcept {}
+  /// False while the measurements are stale: a remote slave that went silent. The coupling
+  /// then disengages (no force on the masters) and re-engages at the measured position once
+  /// fresh readings return (re-indexed like a clutch). A local axis is always fresh.
+  virtual bool measurement_fresh() const { return true; }
 };
 
 /// The slave micro-gripper: opening command out, opening and grip force in.

@@ -77,7 +77,10 @@ void Platform::build() {
   const double ratio = dt / model_->dt_s();
   require(std::abs(ratio - std::round(ratio)) < 1e-6 * ratio && ratio >= 1.0, "loop.base_rate_Hz",
           "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
+  position_controlled_ = devices_.axes[0]->position_controlled();
   for (std::size_t i = 0; i < 3; ++i) {
+    require(devices_.axes[i]->position_controlled() == position_controlled_, "devices.axes",
+            "must all be position-controlled or all voltage-driven", static_cast<double>(i));
     const double period = devices_.axes[i]->sample_period_s();
     require(std::abs(period - model_->dt_s()) <= 1e-9 * model_->dt_s(), "devices.axes.sample_period_s",
             "must equal the stick-slip model's step (integrator.dt_s)", period);
@@ -144,6 +147,8 @@ void Platform::teleoperation_task() noexcept {
   const Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
   in.grip_force_N = devices_.gripper->grip_force_N();
+  in.slave_fresh = devices_.axes[0]->measurement_fresh() && devices_.axes[1]->measurement_fresh() &&
+                   devices_.axes[2]->measurement_fresh();
   in.console = console_;
   in.console.deadman = console_.deadman && !faulted_;
   const auto& out = teleop_->tick(in);
@@ -166,12 +171,19 @@ void Platform::slave_control_task() noexcept {
     tracking_.max_m = std::max(tracking_.max_m, e);
     ++tracking_.samples;
   }
+  if (position_controlled_) {
+    // The stage's own loop (the slave process) follows the target.
+    for (std::size_t i = 0; i < 3; ++i)
+      devices_.axes[i]->command_target_m(out.slave_target_m[static_cast<Eigen::Index>(i)],
+                                         out.slave_velocity_m_s[static_cast<Eigen::Index>(i)]);
+    return;
+  }
   stage_->update(out.slave_target_m, out.slave_velocity_m_s, measured);
 }
 
 void Platform::devices_task(double dt_s) noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!faulted_) {
+    if (!faulted_ && !position_controlled_) {
       devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m()));
     }
     devices_.axes[i]->update(dt_s);

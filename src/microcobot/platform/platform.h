@@ -209,6 +209,7 @@ class Platform {
   std::function<void(const TickInfo&)> operator_;
   control::ConsoleInput console_;
   bool faulted_ = false;
+  bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)
 };
 
 }  // namespace mc::platform

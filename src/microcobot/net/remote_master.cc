@@ -1,0 +1,81 @@
+#include "microcobot/net/remote_master.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::net {
+
+void RemoteMasterParams::validate() const {
+  link.validate();
+  require(std::isfinite(stale_timeout_s) && stale_timeout_s >= 1e-3 && stale_timeout_s <= 10.0,
+          "stale_timeout_s", "must be within [0.001, 10] s", stale_timeout_s);
+  for (double h : home_m) require(std::isfinite(h), "home_m", "must be finite", h);
+  require_positive(goal_speed_m_s, "goal_speed_m_s");
+}
+
+RemoteMaster::RemoteMaster(const RemoteMasterParams& params) : params_(params) {
+  params_.link.role = Role::kSlave;
+  params_.validate();
+  link_ = std::make_unique<Link>(params_.link);
+}
+
+RemoteMaster::~RemoteMaster() = default;
+
+live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command) noexcept {
+  live::RemoteRequest r;
+  NetSample s;
+  while (link_->receive(s)) {  // validated by the link thread: finite and within NetLimits
+    switch (s.channel) {
+      case Channel::kTarget:
+        command.has_goal = true;
+        for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + s.xyz[i];
+        command.velocity_m_s = {};
+        command.goal_speed_m_s = params_.goal_speed_m_s;
+        last_target_t_ = t_s;
+        break;
+      case Channel::kGripperTarget:
+        command.has_gripper = true;
+        command.gripper_opening_m = s.scalar;
+        break;
+      case Channel::kEstop: {
+        const bool on = s.scalar != 0.0;
+        if (estop_ && !on) r.reset = true;
+        estop_ = on;
+        break;
+      }
+      case Channel::kEngaged: engaged_ = s.scalar != 0.0; break;
+      default: break;  // the slave's own channels never come back (the link ignores them)
+    }
+  }
+  r.estop = estop_;
+  r.fresh = engaged_ && t_s - last_target_t_ <= params_.stale_timeout_s;
+  command.deadman = engaged_;
+  return r;
+}
+
+void RemoteMaster::send(Channel c, const std::array<double, 3>& xyz, double scalar,
+                        std::int64_t stamp_ns) noexcept {
+  NetSample s;
+  s.channel = c;
+  s.stamp_ns = stamp_ns;
+  s.xyz = xyz;
+  s.scalar = scalar;
+  link_->send(s);  // a full ring is counted by the link
+}
+
+void RemoteMaster::publish(const platform::Platform& p) noexcept {
+  const std::int64_t stamp = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count();
+  const auto& g = p.gripper();
+  const platform::Vec3 f = g.contact_force_N();
+  send(Channel::kMeasuredPose, {p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m()}, 0.0,
+       stamp);
+  send(Channel::kContactForce, {f.x, f.y, f.z}, 0.0, stamp);
+  send(Channel::kGripForce, {g.grip_force_N(), 0.0, 0.0}, 0.0, stamp);
+  send(Channel::kGripperOpening, {}, g.opening_m(), stamp);
+}
+
+}  // namespace mc::net

@@ -1,0 +1,54 @@
+#pragma once
+/// @file
+/// The master of a distributed platform as the slave process sees it (issue #17,
+/// `microcobot serve --role slave`): the source of the live platform's operator commands
+/// (live/command_source.h) in place of the console, over the DDS link. Each operator tick it
+/// takes the master's latest target pose and gripper target into a console command (a
+/// straight move to the target, at most at the coupling's console speed), reads the master's
+/// e-stop and engaged flags, and publishes the slave's measured pose, contact and grip forces
+/// and gripper opening.
+///
+/// The master is fresh while it is engaged and its last target is at most `stale_timeout_s`
+/// old (issue #17 point 6: a dead master holds the slave within 10 ms: the coupling disengages
+/// and the stage holds its target). Its e-stop latches the slave's; releasing it resets it.
+
+#include <array>
+#include <memory>
+
+#include "microcobot/live/command_source.h"
+#include "microcobot/net/link.h"
+
+namespace mc::net {
+
+struct RemoteMasterParams {
+  LinkConfig link;               ///< its role is forced to slave
+  /// A target older than this: the master is silent. 8 ms, so that the hold (at the next
+  /// operator tick) lands within the 10 ms of issue #17 point 6.
+  double stale_timeout_s = 0.008;
+  std::array<double, 3> home_m{};  ///< the stage's home, world coordinates (targets are relative)
+  double goal_speed_m_s = 1e-3;    ///< speed cap of the move to each target (the coupling caps too)
+  void validate() const;
+};
+
+class RemoteMaster final : public live::CommandSource {
+ public:
+  /// Starts the link (throws mc::Error: parameters, DDS).
+  explicit RemoteMaster(const RemoteMasterParams& params);
+  ~RemoteMaster() override;
+
+  live::RemoteRequest poll(double t_s, live::ConsoleCommand& command) noexcept override;
+  void publish(const platform::Platform& platform) noexcept override;
+
+  const Link& link() const { return *link_; }
+
+ private:
+  void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns) noexcept;
+
+  RemoteMasterParams params_;
+  std::unique_ptr<Link> link_;
+  double last_target_t_ = -1e9;
+  bool engaged_ = false;
+  bool estop_ = false;
+};
+
+}  // namespace mc::net

@@ -1,0 +1,153 @@
+#include "microcobot/net/remote_slave.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "microcobot/core/error.h"
+
+namespace mc::net {
+namespace {
+
+std::int64_t ros_time_ns() noexcept {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+/// One axis of the remote stage: its measurements are the slave's latest pose.
+class RemoteSlaveAxis final : public platform::SlaveAxis {
+ public:
+  RemoteSlaveAxis(std::string name, RemoteSlave& slave, int index, const RemoteSlaveParams& p)
+      : SlaveAxis(std::move(name)), slave_(slave), index_(index), period_s_(p.sample_period_s),
+        max_V_(p.max_voltage_V) {}
+  double sample_period_s() const override { return period_s_; }
+  double max_voltage_V() const override { return max_V_; }
+  // Never called: the platform sends targets to position-controlled axes.
+  void command_drive(const platform::DriveBlock&) noexcept override {}
+  double position_m() const override { return slave_.state().position_m[static_cast<std::size_t>(index_)]; }
+  bool at_end_stop() const override { return false; }  // the slave's stage controller knows
+  bool position_controlled() const override { return true; }
+  void command_target_m(double target_m, double velocity_m_s) noexcept override {
+    if (active()) slave_.set_target(index_, target_m, velocity_m_s);
+  }
+  bool measurement_fresh() const override { return slave_.fresh(); }
+  void update(double) noexcept override {}
+  // Leaving operation (a fault, an e-stop, shutdown) latches the slave's e-stop; configure()
+  // from rest does not.
+  void enter_safe_state() noexcept override {
+    if (active()) slave_.set_estop(true);
+  }
+
+ protected:
+  void on_activate() override { slave_.set_estop(false); }
+
+ private:
+  RemoteSlave& slave_;
+  int index_;
+  double period_s_, max_V_;
+};
+
+/// The slave's gripper; its update() runs the link exchange once per tick.
+class RemoteGripper final : public platform::Gripper {
+ public:
+  RemoteGripper(std::string name, RemoteSlave& slave) : Gripper(std::move(name)), slave_(slave) {}
+  void command_opening_m(double opening) noexcept override {
+    if (active()) slave_.set_gripper_target(opening);
+  }
+  double opening_m() const override { return slave_.state().opening_m; }
+  double grip_force_N() const override { return slave_.state().grip_force_N; }
+  platform::Vec3 contact_force_N() const override {
+    const auto& f = slave_.state().contact_force_N;
+    return {f[0], f[1], f[2]};
+  }
+  void update(double dt_s) noexcept override { slave_.exchange(dt_s); }
+  // Leaving operation (a fault, an e-stop, shutdown) latches the slave's e-stop; configure()
+  // from rest does not.
+  void enter_safe_state() noexcept override {
+    if (active()) slave_.set_estop(true);
+  }
+
+ protected:
+  void on_activate() override { slave_.set_estop(false); }
+
+ private:
+  RemoteSlave& slave_;
+};
+
+}  // namespace
+
+void RemoteSlaveParams::validate() const {
+  link.validate();
+  require(std::isfinite(stale_timeout_s) && stale_timeout_s >= 1e-3 && stale_timeout_s <= 10.0,
+          "stale_timeout_s", "must be within [0.001, 10] s", stale_timeout_s);
+  require_positive(sample_period_s, "sample_period_s");
+  require(max_voltage_V > 0 && max_voltage_V <= 100.0, "max_voltage_V", "must be within (0, 100] V",
+          max_voltage_V);
+}
+
+RemoteSlave::RemoteSlave(const RemoteSlaveParams& params) : params_(params) {
+  params_.link.role = Role::kMaster;
+  params_.validate();
+  link_ = std::make_unique<Link>(params_.link);
+}
+
+RemoteSlave::~RemoteSlave() = default;
+
+platform::PlatformDevices RemoteSlave::make_devices() {
+  platform::PlatformDevices d;
+  const char* names[3] = {"remote_axis_x", "remote_axis_y", "remote_axis_z"};
+  for (int i = 0; i < 3; ++i)
+    d.axes[static_cast<std::size_t>(i)] = std::make_unique<RemoteSlaveAxis>(names[i], *this, i, params_);
+  d.gripper = std::make_unique<RemoteGripper>("remote_gripper", *this);
+  return d;
+}
+
+void RemoteSlave::send(Channel c, const std::array<double, 3>& xyz, double scalar) noexcept {
+  NetSample s;
+  s.channel = c;
+  s.stamp_ns = ros_time_ns();
+  s.xyz = xyz;
+  s.scalar = scalar;
+  link_->send(s);  // a full ring is counted by the link
+}
+
+void RemoteSlave::set_target(int axis, double target_m, double /*velocity_m_s*/) noexcept {
+  target_m_[static_cast<std::size_t>(axis)] = target_m;
+  target_mask_ |= 1u << axis;
+  // A target computed while the slave was silent is the coupling's frozen guess, not a command
+  // for a slave that (re)appears: only targets computed on fresh measurements are sent.
+  targets_fresh_ = fresh();
+}
+
+void RemoteSlave::set_estop(bool on) noexcept {
+  if (estop_sent_ == static_cast<int>(on)) return;
+  estop_sent_ = static_cast<int>(on);
+  send(Channel::kEstop, {}, on ? 1.0 : 0.0);
+  send(Channel::kEngaged, {}, on ? 0.0 : 1.0);
+}
+
+void RemoteSlave::exchange(double dt_s) noexcept {
+  state_.age_s += dt_s;
+  NetSample s;
+  while (link_->receive(s)) {  // validated by the link thread: finite and within NetLimits
+    switch (s.channel) {
+      case Channel::kMeasuredPose:
+        state_.position_m = s.xyz;
+        state_.age_s = 0.0;
+        break;
+      case Channel::kContactForce: state_.contact_force_N = s.xyz; break;
+      case Channel::kGripForce: state_.grip_force_N = s.xyz[0]; break;
+      case Channel::kGripperOpening: state_.opening_m = s.scalar; break;
+      default: break;  // the master's own channels never come back (the link ignores them)
+    }
+  }
+  if (target_mask_ == 0b111u) {
+    target_mask_ = 0;
+    if (!targets_fresh_) return;
+    send(Channel::kTarget, target_m_, 0.0);
+    send(Channel::kGripperTarget, {}, gripper_target_m_);
+  }
+}
+
+}  // namespace mc::net

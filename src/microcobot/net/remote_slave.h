@@ -1,0 +1,88 @@
+#pragma once
+/// @file
+/// The slave stage of a distributed platform as the master process sees it (issue #17,
+/// `microcobot serve --role master`): three position-controlled axes and a gripper whose far end
+/// is the slave process, over the DDS link. They are one more implementation of the platform's
+/// device interfaces (platform/device.h, docs/hardware.md): the master's platform runs its
+/// masters and the teleoperation coupling as always and hands the coupling's targets to these
+/// axes; the slave process's stage controller follows them.
+///
+///   slave tick (1 kHz)  command_target_m() x 3, command_opening_m()
+///   every tick          the gripper's update(): the link's incoming ring drained into the latest
+///                       measurements; once all three targets of a slave tick are in, the target
+///                       pose and the gripper target are queued for the link thread (only when
+///                       they were computed on fresh measurements: a slave that appears gets
+///                       no target before the coupling has re-taken it from its position)
+///   safe state          the e-stop topic latched on (reliable, transient local), the coupling's
+///                       engaged flag off; activate() releases both
+///
+/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave) the
+/// axes report stale measurements: the coupling disengages with zero force on the masters at
+/// once, and re-engages at the slave's measured position when poses return (a restarted slave
+/// does not jump). Everything on the loop path only pushes to and pops from the link's rings.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "microcobot/net/link.h"
+#include "microcobot/platform/platform.h"
+
+namespace mc::net {
+
+struct RemoteSlaveParams {
+  LinkConfig link;  ///< its role is forced to master
+  /// No pose for this long and the slave counts as silent: 8 ms, so that the release (at the
+  /// next tick) lands within the 10 ms of issue #17 point 6.
+  double stale_timeout_s = 0.008;
+  double sample_period_s = 1e-5;  ///< reported as the axes' drive period (the model's step)
+  double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
+  void validate() const;
+};
+
+/// What the master knows of the slave (loop thread).
+struct RemoteSlaveState {
+  std::array<double, 3> position_m{};       ///< measured, stage coordinates
+  std::array<double, 3> contact_force_N{};  ///< on the gripper, world frame
+  double grip_force_N = 0.0;
+  double opening_m = 0.0;
+  double age_s = 1e9;  ///< since the last pose (starts stale)
+};
+
+class RemoteSlave {
+ public:
+  /// Starts the link (throws mc::Error: parameters, DDS).
+  explicit RemoteSlave(const RemoteSlaveParams& params);
+  ~RemoteSlave();
+  RemoteSlave(const RemoteSlave&) = delete;
+  RemoteSlave& operator=(const RemoteSlave&) = delete;
+
+  /// New devices for one platform build: the three axes and the gripper (views of this link,
+  /// which must outlive them). The masters are not filled in.
+  platform::PlatformDevices make_devices();
+
+  const Link& link() const { return *link_; }
+  bool fresh() const noexcept { return state_.age_s <= params_.stale_timeout_s; }
+  const RemoteSlaveState& state() const noexcept { return state_; }
+
+  // The devices' side (loop thread).
+  void set_target(int axis, double target_m, double velocity_m_s) noexcept;
+  void set_gripper_target(double opening_m) noexcept { gripper_target_m_ = opening_m; }
+  void exchange(double dt_s) noexcept;
+  /// Latches the e-stop on the slave (a device entered its safe state) or releases it.
+  void set_estop(bool on) noexcept;
+
+ private:
+  void send(Channel c, const std::array<double, 3>& xyz, double scalar) noexcept;
+
+  RemoteSlaveParams params_;
+  std::unique_ptr<Link> link_;
+  RemoteSlaveState state_;
+  std::array<double, 3> target_m_{};
+  unsigned target_mask_ = 0;  // bit i: axis i's target of this slave tick is in
+  bool targets_fresh_ = false;  // they were computed on fresh measurements
+  double gripper_target_m_ = 0.0;
+  int estop_sent_ = -1;  // -1: never sent
+};
+
+}  // namespace mc::net

@@ -1,0 +1,249 @@
+// The distributed platform as a lab runs it (issue #17): `microcobot serve --role slave` and
+// `serve --role master` as real processes joined over DDS on loopback, on this test's own domain
+// id. The operator drives the master's console; the slave's console shows what the stage does.
+// Then the link faults of point 6: a killed master holds the slave, a silent slave disengages the
+// master, and a restarted peer re-engages without a jump.
+
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "microcobot/platform/telemetry_json.h"
+#include "net/net_test_support.h"
+#include "support/console_client.h"
+#include "support/test_support.h"
+
+namespace mc {
+namespace {
+
+using namespace std::chrono_literals;
+using nlohmann::json;
+using test::BackgroundCli;
+using test::Console;
+
+constexpr std::uint32_t kTelemetrySub = 10;
+constexpr double kTolerance_m = 10e-6;
+
+// A `serve` process and its console's port (read off the first line of its stdout).
+struct Server {
+  BackgroundCli process;
+  std::uint16_t port = 0;
+};
+
+Server start_serve(const std::string& role, const std::string& domain, const test::TempDir& dir,
+                   const std::string& name) {
+  Server s;
+  s.process = test::spawn_cli({"serve", "--role", role, "--domain", domain, "--listen", "127.0.0.1:0", "--out",
+                               (dir / name).string(), "--record", "--duration", "300"},
+                              dir / name);
+  std::string url;
+  EXPECT_TRUE(test::eventually(
+      [&] {
+        url = test::read_text(s.process.out);
+        return url.find('\n') != std::string::npos;
+      },
+      60s))
+      << role << " did not print its URL: " << test::read_text(s.process.err);
+  const auto colon = url.rfind(':');
+  s.port = static_cast<std::uint16_t>(std::stoi(url.substr(colon + 1)));
+  return s;
+}
+
+// A console subscribed to the telemetry; `latest()` reads the next telemetry message.
+struct Watch {
+  Console console;
+  json last;
+  explicit Watch(std::uint16_t port) : console(port) { console.subscribe("/platform/telemetry", kTelemetrySub); }
+  const json& next() {
+    const std::string payload = console.next_on(kTelemetrySub);
+    last = payload.empty() ? json() : json::parse(payload);
+    return last;
+  }
+};
+
+double at(const json& t, const char* key) { return t.is_object() ? t.value(key, NAN) : NAN; }
+
+// Drives the master's console (a heartbeat at every telemetry frame, ~60 Hz) until `done`
+// holds on the telemetry of both ends (`slave` may be null: the master's only), or `timeout`
+// passes.
+template <class Done>
+bool drive(Watch& master, Watch* slave, const json& command, Done done, std::chrono::seconds timeout = 30s) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  static const json none;
+  while (std::chrono::steady_clock::now() < end) {
+    master.console.command(command);
+    if (master.next().is_null() || (slave && slave->next().is_null())) return false;
+    if (done(master.last, slave ? slave->last : none)) return true;
+  }
+  return false;
+}
+
+// In a recording (loop time): for every rise of `flag` (0 -> 1) that lasts at least `lasting`
+// samples (a peer that died, not a momentary gap of a loaded machine) and follows a stretch where
+// `channel` was changing (within `window` samples), the delay from the last change of `channel`
+// to the rise: how long the process took to notice that its peer fell silent.
+std::vector<double> reactions_s(const Recorder& r, const std::string& channel, const std::string& flag,
+                                std::size_t lasting = 100, std::size_t window = 20) {
+  const auto v = r.channel(channel), f = r.channel(flag), t = r.channel("t_s");
+  std::vector<double> out;
+  for (std::size_t i = window + 1; i + lasting < t.size(); ++i) {
+    if (!(f[i] > 0.5) || f[i - 1] > 0.5) continue;
+    bool lasted = true;
+    for (std::size_t k = i; k < i + lasting && lasted; ++k) lasted = f[k] > 0.5;
+    if (!lasted) continue;
+    std::size_t last_change = i;
+    while (last_change > i - window && v[last_change] == v[last_change - 1]) --last_change;
+    if (last_change == i - window) continue;  // nothing was moving: not a peer that fell silent
+    out.push_back(t[i] - t[last_change]);
+  }
+  return out;
+}
+
+std::filesystem::path only_recording(const std::filesystem::path& dir) {
+  std::filesystem::path found;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".mcap") found = e.path();
+  return found;
+}
+
+TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
+  test::TempDir dir;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+  Server slave1 = start_serve("slave", domain, dir, "slave1");
+  Server master1 = start_serve("master", domain, dir, "master1");
+  ASSERT_NE(slave1.port, 0);
+  ASSERT_NE(master1.port, 0);
+
+  // 1. A teleoperated move: the master's console jogs +x at 100 um/s; the slave's stage follows
+  //    and the master sees the slave's measured position.
+  double x0 = NAN;
+  {
+    Watch m(master1.port), s(slave1.port);
+    ASSERT_TRUE(m.console.action("take_control"));
+    const json jog = {{"deadman", true}, {"velocity_m_s", {100e-6, 0, 0}}};
+    ASSERT_TRUE(drive(m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}},
+                      [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s))
+        << "the master never engaged: " << m.last.dump();
+    x0 = at(s.last, "measured_x_m");
+    ASSERT_TRUE(drive(m, &s, jog, [&](const json&, const json& st) { return at(st, "measured_x_m") > x0 + 50e-6; }))
+        << "the slave did not follow: " << s.last.dump();
+    // The master's view of the slave trails its telemetry by the link and the frame times only.
+    ASSERT_TRUE(drive(m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}}, [&](const json& mt, const json& st) {
+      return std::abs(at(mt, "measured_x_m") - at(st, "measured_x_m")) < 2e-6 &&
+             std::abs(at(mt, "target_x_m") - at(st, "target_x_m")) < 2e-6;
+    })) << m.last.dump() << "\n"
+        << s.last.dump();
+    // 2. A grasp command: the slave's gripper closes to 100 um; the master reads its opening.
+    const json grip = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}, {"gripper_opening_m", 100e-6}};
+    ASSERT_TRUE(drive(m, &s, grip, [&](const json& mt, const json& st) {
+      return std::abs(at(st, "gripper_opening_m") - 100e-6) < kTolerance_m &&
+             std::abs(at(mt, "gripper_opening_m") - 100e-6) < kTolerance_m;
+    })) << s.last.dump();
+
+    // 3. The master dies mid-jog (SIGKILL): the slave holds.
+    for (int i = 0; i < 30; ++i) {
+      m.console.command(jog);
+      m.next();
+    }
+    ::kill(master1.process.pid, SIGKILL);
+    test::wait_exit(master1.process.pid, 10.0);
+    // Disengaged for good (frames still in flight, or a momentary gap of a loaded machine,
+    // may show a short release before).
+    int released = 0;
+    ASSERT_TRUE(test::eventually([&] {
+      released = at(s.next(), "engaged") == 0.0 ? released + 1 : 0;
+      return released >= 10;
+    })) << "the slave stayed engaged to a dead master: " << s.last.dump();
+    // And it rests there: half a second of frames within 1 um (frames in flight when the master
+    // died may still show motion first).
+    double held = at(s.last, "measured_x_m");
+    int resting = 0;
+    EXPECT_TRUE(test::eventually([&] {
+      const double x = at(s.next(), "measured_x_m");
+      resting = std::abs(x - held) < 1e-6 && at(s.last, "engaged") == 0.0 ? resting + 1 : (held = x, 0);
+      return resting >= 30;
+    })) << "the slave must hold where it was: " << s.last.dump();
+  }
+
+  // 4. A restarted master re-engages at the slave's position: no jump.
+  Server master2 = start_serve("master", domain, dir, "master2");
+  {
+    Watch m(master2.port), s(slave1.port);
+    ASSERT_TRUE(m.console.action("take_control"));
+    const double before = at(s.next(), "measured_x_m");
+    ASSERT_GT(before, x0 + 50e-6);
+    const json hold = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}};
+    ASSERT_TRUE(drive(m, &s, hold, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
+    int frames = 0;
+    ASSERT_TRUE(drive(m, &s, hold, [&](const json& mt, const json& st) {
+      EXPECT_NEAR(at(st, "measured_x_m"), before, 2e-6) << "the slave jumped on re-engagement";
+      EXPECT_NEAR(at(mt, "target_x_m"), at(mt, "measured_x_m"), 2e-6);
+      return ++frames >= 30;
+    }));
+  }
+
+  // 5. The slave stops (SIGTERM: its recording is closed) while the operator holds the master
+  //    engaged: the master disengages. A new slave starts at home, and the master re-engages
+  //    there instead of driving it back.
+  const json still = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}};
+  {
+    Watch m(master2.port);
+    ASSERT_TRUE(m.console.action("take_control"));
+    ASSERT_TRUE(drive(m, nullptr, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }));
+    // Moving, so that the master's recording shows when the last pose came (a resting stage's
+    // poses repeat at the recording's precision).
+    const json back = {{"deadman", true}, {"velocity_m_s", {-100e-6, 0, 0}}};
+    for (int i = 0; i < 20; ++i) {
+      m.console.command(back);
+      m.next();
+    }
+    ::kill(slave1.process.pid, SIGTERM);
+    ASSERT_TRUE(drive(m, nullptr, back, [&](const json& mt, const json&) { return at(mt, "engaged") == 0.0; }))
+        << "the master stayed engaged to a dead slave";
+    ASSERT_EQ(test::wait_exit(slave1.process.pid, 30.0), 0) << test::read_text(slave1.process.err);
+  }
+  Server slave2 = start_serve("slave", domain, dir, "slave2");
+  {
+    Watch m(master2.port), s(slave2.port);
+    ASSERT_TRUE(m.console.action("take_control"));
+    ASSERT_TRUE(drive(m, &s, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
+    int frames = 0;
+    ASSERT_TRUE(drive(m, &s, still, [&](const json& mt, const json& st) {
+      EXPECT_NEAR(at(st, "measured_x_m"), x0, 2e-6) << "the new slave was driven away from home";
+      EXPECT_NEAR(at(mt, "target_x_m"), at(st, "measured_x_m"), 2e-6);
+      return ++frames >= 30;
+    }));
+  }
+  ::kill(master2.process.pid, SIGTERM);
+  ::kill(slave2.process.pid, SIGTERM);
+  ASSERT_EQ(test::wait_exit(master2.process.pid, 30.0), 0) << test::read_text(master2.process.err);
+  ASSERT_EQ(test::wait_exit(slave2.process.pid, 30.0), 0) << test::read_text(slave2.process.err);
+
+  // The reaction times, in each process's own loop time (1 kHz recordings): the slave holds
+  // (its coupling stale) within 10 ms of the last target of the master that died mid-move; the
+  // master disengages within 10 ms of the last pose of the slave that stopped.
+  const Recorder s1 = platform::read_telemetry_mcap(only_recording(dir / "slave1"), 10'000'000);
+  const Recorder m2 = platform::read_telemetry_mcap(only_recording(dir / "master2"), 10'000'000);
+  const auto slave_holds = reactions_s(s1, "target_x_m", "stale");
+  const auto master_releases = reactions_s(m2, "measured_x_m", "stale");
+  ASSERT_FALSE(slave_holds.empty()) << "the slave never saw its master die";
+  ASSERT_FALSE(master_releases.empty()) << "the master never saw its slave stop";
+  for (double r : slave_holds) EXPECT_LE(r, 0.010) << "slave: from the last target to the hold";
+  for (double r : master_releases) EXPECT_LE(r, 0.010) << "master: from the last pose to disengaging";
+  std::cerr << "reaction times: slave holds after " << 1e3 * *std::max_element(slave_holds.begin(), slave_holds.end())
+            << " ms (" << slave_holds.size() << " events), master releases after "
+            << 1e3 * *std::max_element(master_releases.begin(), master_releases.end()) << " ms ("
+            << master_releases.size() << " events)\n";
+}
+
+}  // namespace
+}  // namespace mc

@@ -1,0 +1,161 @@
+// The two ends of the distributed platform in one process (issue #17): a master live platform
+// whose stage is the remote slave (net/remote_slave.h) and a slave live platform driven by the
+// remote master (net/remote_master.h), over DDS on loopback, on this test's domain. Neither loop
+// allocates while the link carries commands and measurements; the master's e-stop latches the
+// slave's and its reset releases it.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "microcobot/live/live_platform.h"
+#include "microcobot/net/remote_master.h"
+#include "microcobot/net/remote_slave.h"
+#include "net/net_test_support.h"
+#include "support/counting_allocator.h"
+#include "support/test_support.h"
+
+namespace mc::net {
+namespace {
+
+using namespace std::chrono_literals;
+using platform::kTelemetryChannels;
+
+std::size_t channel(const char* name) {
+  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
+    if (std::string_view(kTelemetryChannels[i]) == name) return i;
+  throw std::logic_error(name);
+}
+
+// A live platform keeping its latest telemetry sample.
+struct End {
+  std::unique_ptr<live::LivePlatform> live;
+  std::mutex mutex;
+  platform::TelemetrySample last{};
+  explicit End(live::LiveParams p) : live(std::make_unique<live::LivePlatform>(std::move(p))) {
+    live->start([this](const platform::TelemetrySample& s, std::size_t) {
+      std::lock_guard lock(mutex);
+      last = s;
+    });
+  }
+  double get(const char* name) {
+    std::lock_guard lock(mutex);
+    return last[channel(name)];
+  }
+};
+
+struct Pair {
+  platform::PlatformConfig config;
+  std::unique_ptr<RemoteSlave> slave_link;
+  std::unique_ptr<RemoteMaster> master_link;
+  std::unique_ptr<End> master, slave;
+
+  Pair() {
+    const int domain = test::test_domain_id();
+    RemoteMasterParams mp;
+    mp.link.domain_id = domain;
+    mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
+    master_link = std::make_unique<RemoteMaster>(mp);
+    live::LiveParams sp;
+    sp.remote = master_link.get();
+    slave = std::make_unique<End>(sp);
+
+    const auto axis = platform::axis_params(config);
+    RemoteSlaveParams rp;
+    rp.link.domain_id = domain;
+    rp.sample_period_s = axis.integrator.dt_s;
+    slave_link = std::make_unique<RemoteSlave>(rp);
+    live::LiveParams lp;
+    lp.make_devices = [this] {
+      platform::PlatformDevices d = slave_link->make_devices();
+      d.haptic = std::make_unique<platform::SimulatedHapticMaster>(
+          "dual_stage", config.haptic.plant, config.haptic.render, config.haptic.pantograph, config.loop.period_s());
+      d.tweezers =
+          std::make_unique<platform::SimulatedTweezersMaster>("teletweez", config.tweezers, config.loop.period_s());
+      return d;
+    };
+    master = std::make_unique<End>(lp);
+    master->live->set_console_in_control(true);
+  }
+  ~Pair() {
+    master.reset();  // before the links they use
+    slave.reset();
+  }
+  // Sends `c` at 50 Hz to the master's console for `duration`.
+  void drive(const live::ConsoleCommand& c, std::chrono::milliseconds duration) {
+    const auto end = std::chrono::steady_clock::now() + duration;
+    while (std::chrono::steady_clock::now() < end) {
+      master->live->push_command(c);
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+};
+
+live::ConsoleCommand jog(double vx) {
+  live::ConsoleCommand c;
+  c.deadman = true;
+  c.velocity_m_s = {vx, 0, 0};
+  return c;
+}
+
+TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
+  Pair pair;
+  ASSERT_TRUE(test::wait_until([&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); },
+                               30.0))
+      << "the master never engaged with the slave";
+  const double x0 = pair.slave->get("measured_x_m");
+  // One loop watched at a time (the counting allocator follows one thread), each while the
+  // link carries targets one way and measurements the other.
+  live::ConsoleCommand c = jog(200e-6);
+  c.has_gripper = true;
+  c.gripper_opening_m = 200e-6;
+  for (const auto* end : {pair.master.get(), pair.slave.get()}) {
+    std::size_t allocations = 0;
+    {
+      mc::test::AllocationGuard guard(end->live->loop_thread_id());
+      pair.drive(c, 300ms);
+      allocations = guard.allocations();
+    }
+    EXPECT_EQ(allocations, 0u) << (end == pair.master.get() ? "master" : "slave") << " loop";
+  }
+  ASSERT_TRUE(mc::test::eventually([&] {
+    pair.drive(jog(0), 20ms);
+    return pair.slave->get("measured_x_m") > x0 + 50e-6 &&
+           std::abs(pair.slave->get("gripper_opening_m") - 200e-6) < 10e-6;
+  })) << "x moved " << 1e6 * (pair.slave->get("measured_x_m") - x0) << " um, gripper at "
+      << 1e6 * pair.slave->get("gripper_opening_m") << " um";
+  // The master sees what the slave measures.
+  EXPECT_TRUE(mc::test::eventually([&] {
+    pair.drive(jog(0), 20ms);
+    return std::abs(pair.master->get("measured_x_m") - pair.slave->get("measured_x_m")) < 1e-6 &&
+           std::abs(pair.master->get("gripper_opening_m") - pair.slave->get("gripper_opening_m")) < 1e-6;
+  }));
+  EXPECT_EQ(pair.master_link->link().stats().rejected_total(), 0u);
+  EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
+}
+
+TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
+  Pair pair;
+  ASSERT_TRUE(test::wait_until([&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); },
+                               30.0));
+  pair.master->live->estop();
+  ASSERT_TRUE(mc::test::eventually([&] { return pair.slave->live->status().estopped; }))
+      << "the slave did not latch the master's e-stop";
+  for (auto l : {pair.slave->live->status().lifecycle[0], pair.slave->live->status().lifecycle[3]})
+    EXPECT_EQ(l, platform::Lifecycle::kFault);
+  pair.master->live->request(live::ConsoleAction::kReset);
+  ASSERT_TRUE(mc::test::eventually([&] {
+    return !pair.master->live->status().estopped && !pair.slave->live->status().estopped;
+  })) << "slave: " << pair.slave->live->status().last_error;
+  const double x0 = pair.slave->get("measured_x_m");
+  EXPECT_TRUE(mc::test::eventually([&] {
+    pair.drive(jog(200e-6), 20ms);
+    return pair.slave->get("measured_x_m") > x0 + 20e-6;
+  })) << "the slave does not follow again after the reset";
+}
+
+}  // namespace
+}  // namespace mc::net
