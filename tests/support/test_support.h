@@ -2,6 +2,8 @@
 /// @file
 /// Helpers for tests: run the CLI as a user would, scratch directories, waiting for conditions.
 
+#include <sys/types.h>
+
 #include <chrono>
 #include <filesystem>
 #include <string>
@@ -18,6 +20,15 @@ struct CliResult {
 
 /// Runs the built `microcobot` binary with `args` (no shell), capturing stdout and stderr.
 CliResult run_cli(const std::vector<std::string>& args);
+
+/// Starts `argv` (argv[0] the program's path; no shell) in the background, stdin from /dev/null,
+/// stdout and stderr into the files `out` and `err`; returns its pid (throws when it cannot start).
+pid_t spawn_process(const std::vector<std::string>& argv, const std::filesystem::path& out,
+                    const std::filesystem::path& err);
+
+/// Waits up to `timeout` for the child `pid`: its exit code, 128 + signal when a signal ended it,
+/// -1 when it was still running (then it is killed with SIGKILL and reaped).
+int wait_process(pid_t pid, std::chrono::milliseconds timeout);
 
 /// A fresh empty directory under the system temp dir, removed on destruction.
 class TempDir {
