@@ -88,8 +88,8 @@ struct Listener {
   std::string topic, type;
   int count;
   pid_t pid = -1;
-  std::filesystem::path out, err, ready;
-  std::vector<json> samples;
+  std::filesystem::path out{}, err{}, ready{};
+  std::vector<json> samples{};
 };
 
 TEST(WireCompat, ACProgramFromTheRos2IdlReadsThePlatformsTopics) {
