@@ -125,6 +125,7 @@ struct PingOptions {
   double rate_Hz = 1000.0;
   double wait_s = 10.0;
   bool estop = false;
+  bool gripper = false;
 };
 
 double percentile(const std::vector<double>& sorted, double p) {
@@ -184,6 +185,8 @@ void run_ping(const PingOptions& o) {
       std::this_thread::sleep_for(std::chrono::microseconds(50));
     }
     // A 1 mm circle in x-y: distinct, plausible targets (stamps identify them: strictly increasing).
+    // Target i is (1 mm cos(2 pi i / 1000), 1 mm sin(2 pi i / 1000), 0): a fixed pattern that a
+    // subscriber checks value by value (tests/net/wire).
     const double phase = 2.0 * M_PI * static_cast<double>(i) / 1000.0;
     net::NetSample s;
     s.channel = net::Channel::kTarget;
@@ -194,6 +197,14 @@ void run_ping(const PingOptions& o) {
     sent_ns[i] = ns_since_epoch(Clock::now());
     sent = i + 1;
     link.send(s);
+    if (o.gripper) {
+      // Gripper target i: an opening of 5 mm + 2 mm sin(2 pi i / 1000), with the target's stamp.
+      net::NetSample g;
+      g.channel = net::Channel::kGripperTarget;
+      g.stamp_ns = s.stamp_ns;
+      g.scalar = 5e-3 + 2e-3 * std::sin(phase);
+      link.send(g);
+    }
   }
   // Late echoes: wait up to 0.5 s for the rest.
   const auto tail_end = Clock::now() + std::chrono::milliseconds(500);
@@ -231,6 +242,7 @@ void run_ping(const PingOptions& o) {
                                   {"rejected_by_reason", rejected_json(st)},
                                   {"send_dropped", st.send_dropped},
                                   {"duration_s", duration_s},
+                                  {"gripper_sent", o.gripper},
                                   {"estop_sent", o.estop},
                                   {"estop_acknowledged", estop_acked}};
   mc::cli::emit(
@@ -265,6 +277,8 @@ void add_link(CLI::App& group) {
   ping->add_flag(
       "--estop", po->estop,
       "Publish the e-stop (reliable, transient-local) at the end and wait for its acknowledgement");
+  ping->add_flag("--gripper", po->gripper,
+                 "Also publish a gripper target (opening 5 mm + 2 mm sin(2 pi i / 1000)) with each target");
   ping->callback([po] { run_ping(*po); });
 }
 

@@ -155,7 +155,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
       m.next();
     }
     ::kill(master1.process.pid, SIGKILL);
-    test::wait_exit(master1.process.pid, 10.0);
+    test::wait_process(master1.process.pid, 10s);
     // Disengaged for good (frames still in flight, or a momentary gap of a loaded machine,
     // may show a short release before).
     int released = 0;
@@ -209,7 +209,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     ::kill(slave1.process.pid, SIGTERM);
     ASSERT_TRUE(drive(m, nullptr, back, [&](const json& mt, const json&) { return at(mt, "engaged") == 0.0; }))
         << "the master stayed engaged to a dead slave";
-    ASSERT_EQ(test::wait_exit(slave1.process.pid, 30.0), 0) << test::read_text(slave1.process.err);
+    ASSERT_EQ(test::wait_process(slave1.process.pid, 30s), 0) << test::read_text(slave1.process.err);
   }
   Server slave2 = start_serve("slave", domain, dir, "slave2");
   {
@@ -225,8 +225,8 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   }
   ::kill(master2.process.pid, SIGTERM);
   ::kill(slave2.process.pid, SIGTERM);
-  ASSERT_EQ(test::wait_exit(master2.process.pid, 30.0), 0) << test::read_text(master2.process.err);
-  ASSERT_EQ(test::wait_exit(slave2.process.pid, 30.0), 0) << test::read_text(slave2.process.err);
+  ASSERT_EQ(test::wait_process(master2.process.pid, 30s), 0) << test::read_text(master2.process.err);
+  ASSERT_EQ(test::wait_process(slave2.process.pid, 30s), 0) << test::read_text(slave2.process.err);
 
   // The reaction times, in each process's own loop time (1 kHz recordings): the slave holds
   // (its coupling stale) within 10 ms of the last target of the master that died mid-move; the

@@ -18,6 +18,7 @@
 namespace mc {
 namespace {
 
+using namespace std::chrono_literals;
 using mc::test::run_cli;
 using mc::test::TempDir;
 using ::testing::HasSubstr;
@@ -45,7 +46,7 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
 
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   ::kill(echo.pid, SIGTERM);
-  ASSERT_EQ(test::wait_exit(echo.pid, 10.0), 0) << test::read_text(echo.err);
+  ASSERT_EQ(test::wait_process(echo.pid, 10s), 0) << test::read_text(echo.err);
   const auto e = nlohmann::json::parse(test::read_text(echo.out));
   EXPECT_TRUE(e["estop_received"].get<bool>()) << e.dump();
   EXPECT_TRUE(e["estop"].get<bool>());

@@ -15,41 +15,32 @@ extern char** environ;
 
 namespace mc::test {
 
-
-namespace {
-
-pid_t spawn(const std::vector<std::string>& args, const std::string& out_file, const std::string& err_file) {
+pid_t spawn_process(const std::vector<std::string>& args, const std::filesystem::path& out,
+                    const std::filesystem::path& err) {
+  if (args.empty()) throw std::invalid_argument("spawn_process: no program");
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  std::vector<std::string> argv_s{MC_CLI_PATH};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<std::string> argv_s = args;
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
   const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw std::runtime_error("cannot start " + argv_s[0]);
+  if (rc != 0) throw std::runtime_error("cannot start " + args[0]);
   return pid;
 }
 
-}  // namespace
-
-BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix) {
-  BackgroundCli b;
-  b.out = prefix.string() + ".out";
-  b.err = prefix.string() + ".err";
-  b.pid = spawn(args, b.out.string(), b.err.string());
-  return b;
-}
-
-int wait_exit(pid_t pid, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+int wait_process(pid_t pid, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
   int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
+  for (;;) {
+    const pid_t r = ::waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (r < 0) return -1;  // not a child of this process (or already reaped)
     if (std::chrono::steady_clock::now() >= end) {
       ::kill(pid, SIGKILL);
       ::waitpid(pid, &status, 0);
@@ -60,16 +51,27 @@ int wait_exit(pid_t pid, double timeout_s) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix) {
+  std::vector<std::string> argv{MC_CLI_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  BackgroundCli b;
+  b.out = prefix.string() + ".out";
+  b.err = prefix.string() + ".err";
+  b.pid = spawn_process(argv, b.out, b.err);
+  return b;
+}
+
 CliResult run_cli(const std::vector<std::string>& args) {
   TempDir tmp;
-  const std::string out_file = (tmp / "stdout").string(), err_file = (tmp / "stderr").string();
-  const pid_t pid = spawn(args, out_file, err_file);
+  std::vector<std::string> argv{MC_CLI_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const pid_t pid = spawn_process(argv, tmp / "stdout", tmp / "stderr");
   int status = 0;
   waitpid(pid, &status, 0);
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = read_text(out_file);
-  r.err = read_text(err_file);
+  r.out = read_text(tmp / "stdout");
+  r.err = read_text(tmp / "stderr");
   return r;
 }
 

@@ -21,15 +21,22 @@ struct CliResult {
 /// Runs the built `microcobot` binary with `args` (no shell), capturing stdout and stderr.
 CliResult run_cli(const std::vector<std::string>& args);
 
-/// A `microcobot` process in the background (a server, a DDS peer): stdout and stderr go to
+/// Starts `argv` (argv[0] the program's path; no shell) in the background, stdin from /dev/null,
+/// stdout and stderr into the files `out` and `err`; returns its pid (throws when it cannot start).
+pid_t spawn_process(const std::vector<std::string>& argv, const std::filesystem::path& out,
+                    const std::filesystem::path& err);
+
+/// Waits up to `timeout` for the child `pid`: its exit code, 128 + signal when a signal ended it,
+/// -1 when it was still running (then it is killed with SIGKILL and reaped).
+int wait_process(pid_t pid, std::chrono::milliseconds timeout);
+
+/// The `microcobot` binary in the background (a server, a DDS peer): stdout and stderr go to
 /// `<prefix>.out` and `<prefix>.err`.
 struct BackgroundCli {
   pid_t pid = 0;
   std::filesystem::path out, err;
 };
 BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix);
-/// The exit code, or 128 + signal; -1 when it did not exit within `timeout_s` (then killed).
-int wait_exit(pid_t pid, double timeout_s);
 
 /// A fresh empty directory under the system temp dir, removed on destruction.
 class TempDir {

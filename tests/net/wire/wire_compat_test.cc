@@ -1,0 +1,219 @@
+// Wire compatibility of the DDS link (issue #17): a separate plain C program, compiled by idlc from
+// the ROS 2 IDL in this directory (not the platform's), subscribes by the ROS 2 names to what a real
+// `microcobot link ping` (master) and `microcobot link echo` (slave) publish over loopback, and
+// reads the values ping sends: target i is (1 mm cos(2 pi i / 1000), 1 mm sin(2 pi i / 1000), 0),
+// gripper target i an opening of 5 mm + 2 mm sin(2 pi i / 1000); the echo returns both with the
+// target's stamp; the e-stop is true.
+
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "net/net_test_support.h"
+#include "support/test_support.h"
+
+namespace mc {
+namespace {
+
+using nlohmann::json;
+using test::TempDir;
+
+constexpr char kPoseType[] = "geometry_msgs::msg::dds_::PoseStamped_";
+constexpr char kJointType[] = "sensor_msgs::msg::dds_::JointState_";
+constexpr char kBoolType[] = "std_msgs::msg::dds_::Bool_";
+constexpr int kPatternPeriod = 1000;  // link ping's targets go round the circle in 1000 steps
+constexpr double kTol = 1e-15;        // m: the values as sent (a few ulp of 1 mm)
+
+double phase(int i) { return 2.0 * M_PI * static_cast<double>(i) / kPatternPeriod; }
+
+// The index of ping's target pattern at (x, y), -1 when the point is not on it.
+int target_index(double x, double y) {
+  for (int i = 0; i < kPatternPeriod; ++i) {
+    if (std::abs(x - 1e-3 * std::cos(phase(i))) <= kTol && std::abs(y - 1e-3 * std::sin(phase(i))) <= kTol)
+      return i;
+  }
+  return -1;
+}
+
+double gripper_opening(int i) { return 5e-3 + 2e-3 * std::sin(phase(i)); }
+
+bool on_gripper_pattern(double opening) {
+  for (int i = 0; i < kPatternPeriod; ++i) {
+    if (std::abs(opening - gripper_opening(i)) <= kTol) return true;
+  }
+  return false;
+}
+
+std::int64_t system_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::vector<json> json_lines(const std::string& text) {
+  std::vector<json> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty()) lines.push_back(json::parse(line));
+  }
+  return lines;
+}
+
+// Kills (SIGKILL) and reaps the children still running when the test ends early.
+struct Reaper {
+  std::vector<pid_t> pids;
+  ~Reaper() {
+    for (pid_t p : pids) {
+      int status = 0;
+      if (::waitpid(p, &status, WNOHANG) == 0) {
+        ::kill(p, SIGKILL);
+        ::waitpid(p, &status, 0);
+      }
+    }
+  }
+};
+
+struct Listener {
+  std::string topic, type;
+  int count;
+  pid_t pid = -1;
+  std::filesystem::path out{}, err{}, ready{};
+  std::vector<json> samples{};
+};
+
+TEST(WireCompat, ACProgramFromTheRos2IdlReadsThePlatformsTopics) {
+  TempDir dir;
+  Reaper reaper;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+
+  // --duration: a safety net should the test die before it signals the echo.
+  const pid_t echo =
+      test::spawn_process({MC_CLI_PATH, "link", "echo", "--domain", domain, "--json", "--duration", "60"},
+                          dir / "echo.out", dir / "echo.err");
+  reaper.pids.push_back(echo);
+
+  std::vector<Listener> listeners{{"/microcobot/slave/target_pose", "pose", 20},
+                                  {"/microcobot/slave/pose", "pose", 20},
+                                  {"/microcobot/slave/gripper/target", "joint", 20},
+                                  {"/microcobot/slave/gripper/state", "joint", 20},
+                                  {"/microcobot/estop", "bool", 1}};
+  for (std::size_t k = 0; k < listeners.size(); ++k) {
+    Listener& l = listeners[k];
+    const std::string n = std::to_string(k);
+    l.out = dir / ("listener" + n + ".out");
+    l.err = dir / ("listener" + n + ".err");
+    l.ready = dir / ("listener" + n + ".ready");
+    l.pid = test::spawn_process(
+        {MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", l.topic, "--type", l.type, "--count",
+         std::to_string(l.count), "--timeout", "20", "--ready-file", l.ready.string()},
+        l.out, l.err);
+    reaper.pids.push_back(l.pid);
+  }
+  // Every reader exists before the first target is published.
+  for (const Listener& l : listeners) {
+    ASSERT_TRUE(test::eventually([&] { return std::filesystem::exists(l.ready); })) << l.topic;
+  }
+
+  const std::int64_t t0 = system_ns();
+  // 3 s of targets at 1 kHz: every listener discovers ping and takes its samples meanwhile.
+  const auto ping = test::run_cli(
+      {"link", "ping", "--domain", domain, "--count", "3000", "--gripper", "--estop", "--json"});
+  const std::int64_t t1 = system_ns();
+  ASSERT_EQ(ping.exit_code, 0) << ping.err;
+  EXPECT_TRUE(json::parse(ping.out)["estop_acknowledged"].get<bool>()) << ping.out;
+
+  for (Listener& l : listeners) {
+    const int rc = test::wait_process(l.pid, std::chrono::seconds(25));
+    ASSERT_EQ(rc, 0) << l.topic << ": " << test::read_text(l.err);
+    l.samples = json_lines(test::read_text(l.out));
+    ASSERT_EQ(l.samples.size(), static_cast<std::size_t>(l.count)) << l.topic;
+  }
+  ::kill(echo, SIGTERM);
+  ASSERT_EQ(test::wait_process(echo, std::chrono::seconds(10)), 0) << test::read_text(dir / "echo.err");
+
+  // The stamp of every sample: within the ping's run, strictly increasing on each topic; one stamp
+  // is one target index across topics (the echo keeps the target's stamp).
+  std::map<std::int64_t, int> index_of_stamp;
+  auto check_header = [&](const json& s, std::int64_t& last) {
+    EXPECT_EQ(s["frame_id"], "microcobot_stage") << s;
+    const auto sec = s["stamp"]["sec"].get<std::int64_t>();
+    const auto nanosec = s["stamp"]["nanosec"].get<std::int64_t>();
+    EXPECT_LT(nanosec, 1'000'000'000) << s;
+    const std::int64_t stamp = sec * 1'000'000'000 + nanosec;
+    EXPECT_GE(stamp, t0) << s;
+    EXPECT_LE(stamp, t1) << s;
+    EXPECT_GT(stamp, last) << s;
+    last = stamp;
+    return stamp;
+  };
+
+  for (const Listener& l : listeners) {
+    std::int64_t last = 0;
+    for (const json& s : l.samples) {
+      EXPECT_EQ(s["topic"], l.topic);
+      if (l.type == "pose") {
+        EXPECT_EQ(s["type"], kPoseType);
+        const std::int64_t stamp = check_header(s, last);
+        const auto p = s["position"].get<std::vector<double>>();
+        ASSERT_EQ(p.size(), 3u);
+        const int i = target_index(p[0], p[1]);
+        EXPECT_GE(i, 0) << "not one of ping's targets: " << s;
+        EXPECT_EQ(p[2], 0.0) << s;
+        EXPECT_EQ(s["orientation"], json::parse("[0, 0, 0, 1]")) << s;
+        const auto it = index_of_stamp.emplace(stamp, i).first;
+        EXPECT_EQ(it->second, i) << "the same stamp with another target: " << s;
+      } else if (l.type == "joint") {
+        EXPECT_EQ(s["type"], kJointType);
+        check_header(s, last);
+        EXPECT_EQ(s["name"], json::parse(R"(["gripper_opening"])")) << s;
+        const auto q = s["position"].get<std::vector<double>>();
+        ASSERT_EQ(q.size(), 1u) << s;
+        EXPECT_TRUE(on_gripper_pattern(q[0])) << "not one of ping's gripper targets: " << s;
+        EXPECT_TRUE(s["velocity"].empty()) << s;
+        EXPECT_TRUE(s["effort"].empty()) << s;
+      } else {
+        EXPECT_EQ(s["type"], kBoolType);
+        EXPECT_EQ(s["data"], true) << s;
+      }
+    }
+  }
+  // A gripper sample whose stamp is also a pose sample's: the opening of that same index.
+  for (const Listener& l : listeners) {
+    if (l.type != "joint") continue;
+    for (const json& s : l.samples) {
+      const std::int64_t stamp =
+          s["stamp"]["sec"].get<std::int64_t>() * 1'000'000'000 + s["stamp"]["nanosec"].get<std::int64_t>();
+      const auto it = index_of_stamp.find(stamp);
+      if (it == index_of_stamp.end() || it->second < 0) continue;
+      EXPECT_NEAR(s["position"][0].get<double>(), gripper_opening(it->second), kTol) << s;
+    }
+  }
+}
+
+TEST(WireCompat, TheListenerTimesOutWithOneLine) {
+  // This test's own domain, nothing published on it.
+  TempDir dir;
+  const pid_t pid =
+      test::spawn_process({MC_ROS2_LISTENER_PATH, "--domain", std::to_string(net::test::test_domain_id()),
+                           "--topic", "/microcobot/slave/pose", "--type", "pose", "--timeout", "0.5"},
+                          dir / "out", dir / "err");
+  EXPECT_EQ(test::wait_process(pid, std::chrono::seconds(20)), 1);
+  const std::string err = test::read_text(dir / "err");
+  EXPECT_EQ(test::line_count(err), 1u) << err;
+  EXPECT_NE(err.find("0 of 1 samples on rt/microcobot/slave/pose"), std::string::npos) << err;
+  EXPECT_TRUE(test::read_text(dir / "out").empty());
+}
+
+}  // namespace
+}  // namespace mc
