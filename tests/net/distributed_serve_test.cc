@@ -2,11 +2,12 @@
 // `serve --role master` as real processes joined over DDS on loopback, on this test's own domain
 // id. The operator drives the master's console; the slave's console shows what the stage does.
 // Then the link faults of point 6: a killed master holds the slave, a silent slave disengages the
-// master, and a restarted peer re-engages without a jump.
+// master, and a restarted peer re-engages without a jump. (The 8 ms timeouts behind these
+// reactions are asserted in loop time by remote_ends_test.cc: here the link's delivery jitter
+// of a few ms would blur any timing read off the recordings.)
 
 #include <signal.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -17,7 +18,6 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "microcobot/platform/telemetry_json.h"
 #include "net/net_test_support.h"
 #include "support/console_client.h"
 #include "support/test_support.h"
@@ -33,6 +33,14 @@ using test::Console;
 constexpr std::uint32_t kTelemetrySub = 10;
 constexpr double kTolerance_m = 10e-6;
 
+// Every process a test started is killed when the test ends, passed or failed.
+struct Reaper {
+  std::vector<pid_t> pids;
+  ~Reaper() {
+    for (pid_t p : pids) test::wait_process(p, 0ms);  // already reaped: nothing happens
+  }
+};
+
 // A `serve` process and its console's port (read off the first line of its stdout).
 struct Server {
   BackgroundCli process;
@@ -40,11 +48,12 @@ struct Server {
 };
 
 Server start_serve(const std::string& role, const std::string& domain, const test::TempDir& dir,
-                   const std::string& name) {
+                   const std::string& name, Reaper& reaper) {
   Server s;
   s.process = test::spawn_cli({"serve", "--role", role, "--domain", domain, "--listen", "127.0.0.1:0", "--out",
-                               (dir / name).string(), "--record", "--duration", "300"},
+                               (dir / name).string(), "--duration", "300"},
                               dir / name);
+  reaper.pids.push_back(s.process.pid);
   std::string url;
   EXPECT_TRUE(test::eventually(
       [&] {
@@ -87,39 +96,12 @@ bool drive(Watch& master, Watch* slave, const json& command, Done done, std::chr
   return false;
 }
 
-// In a recording (loop time): for every rise of `flag` (0 -> 1) that lasts at least `lasting`
-// samples (a peer that died, not a momentary gap of a loaded machine) and follows a stretch where
-// `channel` was changing (within `window` samples), the delay from the last change of `channel`
-// to the rise: how long the process took to notice that its peer fell silent.
-std::vector<double> reactions_s(const Recorder& r, const std::string& channel, const std::string& flag,
-                                std::size_t lasting = 100, std::size_t window = 20) {
-  const auto v = r.channel(channel), f = r.channel(flag), t = r.channel("t_s");
-  std::vector<double> out;
-  for (std::size_t i = window + 1; i + lasting < t.size(); ++i) {
-    if (!(f[i] > 0.5) || f[i - 1] > 0.5) continue;
-    bool lasted = true;
-    for (std::size_t k = i; k < i + lasting && lasted; ++k) lasted = f[k] > 0.5;
-    if (!lasted) continue;
-    std::size_t last_change = i;
-    while (last_change > i - window && v[last_change] == v[last_change - 1]) --last_change;
-    if (last_change == i - window) continue;  // nothing was moving: not a peer that fell silent
-    out.push_back(t[i] - t[last_change]);
-  }
-  return out;
-}
-
-std::filesystem::path only_recording(const std::filesystem::path& dir) {
-  std::filesystem::path found;
-  for (const auto& e : std::filesystem::directory_iterator(dir))
-    if (e.path().extension() == ".mcap") found = e.path();
-  return found;
-}
-
 TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   test::TempDir dir;
+  Reaper reaper;
   const std::string domain = std::to_string(net::test::test_domain_id());
-  Server slave1 = start_serve("slave", domain, dir, "slave1");
-  Server master1 = start_serve("master", domain, dir, "master1");
+  Server slave1 = start_serve("slave", domain, dir, "slave1", reaper);
+  Server master1 = start_serve("master", domain, dir, "master1", reaper);
   ASSERT_NE(slave1.port, 0);
   ASSERT_NE(master1.port, 0);
 
@@ -175,7 +157,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   }
 
   // 4. A restarted master re-engages at the slave's position: no jump.
-  Server master2 = start_serve("master", domain, dir, "master2");
+  Server master2 = start_serve("master", domain, dir, "master2", reaper);
   {
     Watch m(master2.port), s(slave1.port);
     ASSERT_TRUE(m.console.action("take_control"));
@@ -191,7 +173,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     }));
   }
 
-  // 5. The slave stops (SIGTERM: its recording is closed) while the operator holds the master
+  // 5. The slave stops (SIGTERM: it exits 0, devices safe) while the operator holds the master
   //    engaged: the master disengages. A new slave starts at home, and the master re-engages
   //    there instead of driving it back.
   const json still = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}};
@@ -199,8 +181,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     Watch m(master2.port);
     ASSERT_TRUE(m.console.action("take_control"));
     ASSERT_TRUE(drive(m, nullptr, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }));
-    // Moving, so that the master's recording shows when the last pose came (a resting stage's
-    // poses repeat at the recording's precision).
+    // Moving when it stops.
     const json back = {{"deadman", true}, {"velocity_m_s", {-100e-6, 0, 0}}};
     for (int i = 0; i < 20; ++i) {
       m.console.command(back);
@@ -211,7 +192,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
         << "the master stayed engaged to a dead slave";
     ASSERT_EQ(test::wait_process(slave1.process.pid, 30s), 0) << test::read_text(slave1.process.err);
   }
-  Server slave2 = start_serve("slave", domain, dir, "slave2");
+  Server slave2 = start_serve("slave", domain, dir, "slave2", reaper);
   {
     Watch m(master2.port), s(slave2.port);
     ASSERT_TRUE(m.console.action("take_control"));
@@ -228,21 +209,6 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   ASSERT_EQ(test::wait_process(master2.process.pid, 30s), 0) << test::read_text(master2.process.err);
   ASSERT_EQ(test::wait_process(slave2.process.pid, 30s), 0) << test::read_text(slave2.process.err);
 
-  // The reaction times, in each process's own loop time (1 kHz recordings): the slave holds
-  // (its coupling stale) within 10 ms of the last target of the master that died mid-move; the
-  // master disengages within 10 ms of the last pose of the slave that stopped.
-  const Recorder s1 = platform::read_telemetry_mcap(only_recording(dir / "slave1"), 10'000'000);
-  const Recorder m2 = platform::read_telemetry_mcap(only_recording(dir / "master2"), 10'000'000);
-  const auto slave_holds = reactions_s(s1, "target_x_m", "stale");
-  const auto master_releases = reactions_s(m2, "measured_x_m", "stale");
-  ASSERT_FALSE(slave_holds.empty()) << "the slave never saw its master die";
-  ASSERT_FALSE(master_releases.empty()) << "the master never saw its slave stop";
-  for (double r : slave_holds) EXPECT_LE(r, 0.010) << "slave: from the last target to the hold";
-  for (double r : master_releases) EXPECT_LE(r, 0.010) << "master: from the last pose to disengaging";
-  std::cerr << "reaction times: slave holds after " << 1e3 * *std::max_element(slave_holds.begin(), slave_holds.end())
-            << " ms (" << slave_holds.size() << " events), master releases after "
-            << 1e3 * *std::max_element(master_releases.begin(), master_releases.end()) << " ms ("
-            << master_releases.size() << " events)\n";
 }
 
 }  // namespace

@@ -122,7 +122,7 @@ TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
     EXPECT_EQ(allocations, 0u) << (end == pair.master.get() ? "master" : "slave") << " loop";
   }
   ASSERT_TRUE(mc::test::eventually([&] {
-    pair.drive(jog(0), 20ms);
+    pair.drive(c, 20ms);
     return pair.slave->get("measured_x_m") > x0 + 50e-6 &&
            std::abs(pair.slave->get("gripper_opening_m") - 200e-6) < 10e-6;
   })) << "x moved " << 1e6 * (pair.slave->get("measured_x_m") - x0) << " um, gripper at "
@@ -135,6 +135,71 @@ TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
   }));
   EXPECT_EQ(pair.master_link->link().stats().rejected_total(), 0u);
   EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
+}
+
+// A sample from the peer's side of the link, once the two links have matched.
+template <class Received>
+void deliver(Link& from, Channel channel, std::array<double, 3> xyz, double scalar, Received received) {
+  NetSample s;
+  s.channel = channel;
+  s.stamp_ns = 1;
+  s.xyz = xyz;
+  s.scalar = scalar;
+  ASSERT_TRUE(test::wait_until([&] { return from.peer_matched(); }, 20.0)) << "no peer";
+  ASSERT_TRUE(test::wait_until([&] { return (from.send(s), received()); }, 20.0)) << "nothing arrived";
+}
+
+TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
+  RemoteSlaveParams rp;
+  rp.link.domain_id = test::test_domain_id();
+  RemoteSlave remote(rp);
+  LinkConfig peer_config;
+  peer_config.domain_id = rp.link.domain_id;
+  peer_config.role = Role::kSlave;
+  Link peer(peer_config);
+  auto devices = remote.make_devices();
+  EXPECT_FALSE(devices.axes[0]->measurement_fresh()) << "no pose yet";
+  deliver(peer, Channel::kMeasuredPose, {1e-6, 2e-6, 3e-6}, 0.0, [&] {
+    remote.exchange(0.0);  // takes what arrived without ageing it
+    return remote.fresh();
+  });
+  EXPECT_EQ(devices.axes[1]->position_m(), 2e-6);
+  // 10 kHz ticks without a pose: fresh through 8 ms, silent from the next tick on.
+  int fresh_ticks = 0;
+  while (devices.axes[0]->measurement_fresh() && fresh_ticks < 1000) {
+    remote.exchange(1e-4);
+    ++fresh_ticks;
+  }
+  // The release comes at the tick that passes 8 ms (80 ticks of 0.1 ms, give or take the
+  // rounding of their sum): 8.1 ms at the latest.
+  EXPECT_GE(fresh_ticks, 80);
+  EXPECT_LE(fresh_ticks, 81);
+}
+
+TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
+  platform::PlatformConfig config;
+  RemoteMasterParams mp;
+  mp.link.domain_id = test::test_domain_id();
+  mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
+  RemoteMaster remote(mp);
+  LinkConfig peer_config;
+  peer_config.domain_id = mp.link.domain_id;
+  peer_config.role = Role::kMaster;
+  Link peer(peer_config);
+  live::ConsoleCommand c;
+  deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(0.0, c), c.deadman; });
+  deliver(peer, Channel::kTarget, {10e-6, 0, 0}, 0.0, [&] { return remote.poll(1.0, c).fresh; });
+  EXPECT_TRUE(c.has_goal);
+  EXPECT_DOUBLE_EQ(c.goal_m[0], config.stage.home_x_m + 10e-6) << "targets are relative to home";
+  // 1 kHz operator ticks after the target of t = 1 s: fresh through 8 ms, then the slave holds.
+  EXPECT_TRUE(remote.poll(1.0079, c).fresh);
+  EXPECT_FALSE(remote.poll(1.0081, c).fresh);
+  // The master's e-stop latches, its release asks for the reset once.
+  deliver(peer, Channel::kEstop, {}, 1.0, [&] { return remote.poll(1.01, c).estop; });
+  live::RemoteRequest r;
+  deliver(peer, Channel::kEstop, {}, 0.0, [&] { return (r = remote.poll(1.011, c)).reset; });
+  EXPECT_FALSE(r.estop);
+  EXPECT_FALSE(remote.poll(1.012, c).reset);
 }
 
 TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
