@@ -39,6 +39,7 @@ struct ServeOptions {
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
+  mc::control::LinkParams link;  // the emulated impairment of what this end receives
 };
 
 // The distributed platform's far end (issue #17): the master process sees the slave stage as
@@ -50,11 +51,18 @@ struct RemoteEnds {
 
 RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
   RemoteEnds ends;
-  if (o.role == "single") return ends;
+  if (o.role == "single") {
+    if (mc::net::impairs(o.link))
+      throw mc::UsageError("--link-delay, --link-jitter, --link-loss: need --role master or slave");
+    return ends;
+  }
+  if (o.link.jitter_s > o.link.delay_s)
+    throw mc::UsageError("--link-jitter: must not exceed --link-delay (delays are delay +- jitter, never negative)");
   const mc::stickslip::StickSlipParams axis = pf::axis_params(lp.platform);
   if (o.role == "master") {
     mc::net::RemoteSlaveParams rp;
     rp.link.domain_id = o.domain;
+    rp.emulate = o.link;
     rp.sample_period_s = axis.integrator.dt_s;
     rp.max_voltage_V = axis.drive.max_V;
     ends.slave = std::make_unique<mc::net::RemoteSlave>(rp);
@@ -70,6 +78,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
   } else {
     mc::net::RemoteMasterParams rp;
     rp.link.domain_id = o.domain;
+    rp.emulate = o.link;
     rp.home_m = {lp.platform.stage.home_x_m, lp.platform.stage.home_y_m, lp.platform.stage.home_z_m};
     rp.goal_speed_m_s = lp.platform.teleop.console_max_speed_m_s;
     ends.master = std::make_unique<mc::net::RemoteMaster>(rp);
@@ -130,9 +139,9 @@ void serve(const ServeOptions& o) {
   if (!std::filesystem::is_directory(o.out))
     throw mc::InvalidInput(o.out.string(), 0, "--out must be a directory");
 
+  RemoteEnds ends = attach_role(o, lp);
   mc::cli::set_cooperative_interrupts(true);
   std::cerr << "serve: building the platform (the stick-slip step map takes about a second)\n";
-  RemoteEnds ends = attach_role(o, lp);
   if (o.role != "single")
     std::cerr << "serve: " << o.role << " of a distributed platform on DDS domain " << o.domain
               << " (loopback; the peer: serve --role " << (o.role == "master" ? "slave" : "master")
@@ -182,6 +191,17 @@ void add_serve(CLI::App& cmd) {
                  fmt::format("DDS domain id of the master-slave link, 0 to {} (default 0; both ends the same)",
                              mc::net::kMaxDomainId))
       ->check(CLI::Range(0, mc::net::kMaxDomainId));
+  cmd.add_option("--link-delay", o->link.delay_s,
+                 "Emulated one-way delay of what this end receives, s (default 0; both ends: a round trip "
+                 "of twice it)")
+      ->check(mc::cli::Range(0.0, 10.0));
+  cmd.add_option("--link-jitter", o->link.jitter_s,
+                 "Emulated jitter, s: each delay uniform in delay +- jitter (default 0; at most the delay)")
+      ->check(mc::cli::Range(0.0, 10.0));
+  cmd.add_option("--link-loss", o->link.loss,
+                 "Emulated probability of losing a best-effort sample, [0, 1) (default 0; the reliable e-stop "
+                 "and engaged topics are only delayed)")
+      ->check(mc::cli::Range(0.0, 0.999));
   cmd.callback([o] { serve(*o); });
 }
 

@@ -43,5 +43,28 @@ TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
   }
 }
 
+TEST(ServeCli, TheLinkFlagsAreUsageErrorsNamingTheFlag) {
+  const struct {
+    std::vector<std::string> args;
+    std::string flag;
+  } cases[] = {
+      {{"--role", "both"}, "--role"},
+      {{"--role", "slave", "--domain", "231"}, "--domain"},
+      {{"--link-delay", "0.05"}, "--link-delay"},  // only between two processes
+      {{"--role", "master", "--link-delay", "0.01", "--link-jitter", "0.02"}, "--link-jitter"},
+      {{"--role", "master", "--link-loss", "1"}, "--link-loss"},
+      {{"--role", "slave", "--link-delay", "nan"}, "--link-delay"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = {"serve", "--listen", "127.0.0.1:0", "--duration", "0.2"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const auto r = run_cli(args);
+    EXPECT_EQ(r.exit_code, 2) << c.flag << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(c.flag), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "") << "nothing served";
+  }
+}
+
 }  // namespace
 }  // namespace mc

@@ -53,10 +53,11 @@ struct Pair {
   std::unique_ptr<RemoteMaster> master_link;
   std::unique_ptr<End> master, slave;
 
-  Pair() {
+  explicit Pair(const control::LinkParams& emulate = {}) {
     const int domain = test::test_domain_id();
     RemoteMasterParams mp;
     mp.link.domain_id = domain;
+    mp.emulate = emulate;
     mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     master_link = std::make_unique<RemoteMaster>(mp);
     live::LiveParams sp;
@@ -66,6 +67,7 @@ struct Pair {
     const auto axis = platform::axis_params(config);
     RemoteSlaveParams rp;
     rp.link.domain_id = domain;
+    rp.emulate = emulate;
     rp.sample_period_s = axis.integrator.dt_s;
     slave_link = std::make_unique<RemoteSlave>(rp);
     live::LiveParams lp;
@@ -101,8 +103,23 @@ live::ConsoleCommand jog(double vx) {
   return c;
 }
 
+void moves_the_slave_without_allocating(Pair& pair);
+
 TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
   Pair pair;
+  moves_the_slave_without_allocating(pair);
+}
+
+TEST(RemoteEnds, SoOverAnEmulatedLinkOf100msRoundTripWithJitterAndLoss) {
+  control::LinkParams link;
+  link.delay_s = 0.05;  // each way
+  link.jitter_s = 0.005;
+  link.loss = 0.2;
+  Pair pair(link);
+  moves_the_slave_without_allocating(pair);
+}
+
+void moves_the_slave_without_allocating(Pair& pair) {
   ASSERT_TRUE(test::wait_until([&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); },
                                30.0))
       << "the master never engaged with the slave";

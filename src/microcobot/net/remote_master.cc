@@ -9,6 +9,7 @@ namespace mc::net {
 
 void RemoteMasterParams::validate() const {
   link.validate();
+  emulate.validate();
   require(std::isfinite(stale_timeout_s) && stale_timeout_s >= 1e-3 && stale_timeout_s <= 10.0,
           "stale_timeout_s", "must be within [0.001, 10] s", stale_timeout_s);
   for (double h : home_m) require(std::isfinite(h), "home_m", "must be finite", h);
@@ -18,39 +19,51 @@ void RemoteMasterParams::validate() const {
 RemoteMaster::RemoteMaster(const RemoteMasterParams& params) : params_(params) {
   params_.link.role = Role::kSlave;
   params_.validate();
+  stale_timeout_s_ = params_.stale_timeout_s + 2.0 * params_.emulate.jitter_s;
+  if (impairs(params_.emulate)) emulator_ = std::make_unique<WireEmulator>(params_.emulate, kStateRate_Hz);
   link_ = std::make_unique<Link>(params_.link);
 }
 
 RemoteMaster::~RemoteMaster() = default;
 
+void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& command,
+                         live::RemoteRequest& r) noexcept {
+  switch (s.channel) {
+    case Channel::kTarget:
+      command.has_goal = true;
+      for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + s.xyz[i];
+      command.velocity_m_s = {};
+      command.goal_speed_m_s = params_.goal_speed_m_s;
+      last_target_t_ = t_s;
+      break;
+    case Channel::kGripperTarget:
+      command.has_gripper = true;
+      command.gripper_opening_m = s.scalar;
+      break;
+    case Channel::kEstop: {
+      const bool on = s.scalar != 0.0;
+      if (estop_ && !on) r.reset = true;
+      estop_ = on;
+      break;
+    }
+    case Channel::kEngaged: engaged_ = s.scalar != 0.0; break;
+    default: break;  // the slave's own channels never come back (the link ignores them)
+  }
+}
+
 live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command) noexcept {
   live::RemoteRequest r;
   NetSample s;
   while (link_->receive(s)) {  // validated by the link thread: finite and within NetLimits
-    switch (s.channel) {
-      case Channel::kTarget:
-        command.has_goal = true;
-        for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + s.xyz[i];
-        command.velocity_m_s = {};
-        command.goal_speed_m_s = params_.goal_speed_m_s;
-        last_target_t_ = t_s;
-        break;
-      case Channel::kGripperTarget:
-        command.has_gripper = true;
-        command.gripper_opening_m = s.scalar;
-        break;
-      case Channel::kEstop: {
-        const bool on = s.scalar != 0.0;
-        if (estop_ && !on) r.reset = true;
-        estop_ = on;
-        break;
-      }
-      case Channel::kEngaged: engaged_ = s.scalar != 0.0; break;
-      default: break;  // the slave's own channels never come back (the link ignores them)
+    if (emulator_) {
+      emulator_->arrive(t_s, s);
+    } else {
+      apply(s, t_s, command, r);
     }
   }
+  if (emulator_) emulator_->deliver(t_s, [&](const NetSample& d) { apply(d, t_s, command, r); });
   r.estop = estop_;
-  r.fresh = engaged_ && t_s - last_target_t_ <= params_.stale_timeout_s;
+  r.fresh = engaged_ && t_s - last_target_t_ <= stale_timeout_s_;
   command.deadman = engaged_;
   return r;
 }

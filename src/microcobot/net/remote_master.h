@@ -17,6 +17,7 @@
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/net/link.h"
+#include "microcobot/net/wire_emulator.h"
 
 namespace mc::net {
 
@@ -27,6 +28,9 @@ struct RemoteMasterParams {
   double stale_timeout_s = 0.008;
   std::array<double, 3> home_m{};  ///< the stage's home, world coordinates (targets are relative)
   double goal_speed_m_s = 1e-3;    ///< speed cap of the move to each target (the coupling caps too)
+  /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
+  /// jitter the timeout grows by twice the jitter.
+  control::LinkParams emulate;
   void validate() const;
 };
 
@@ -43,9 +47,12 @@ class RemoteMaster final : public live::CommandSource {
 
  private:
   void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns) noexcept;
+  void apply(const NetSample& s, double t_s, live::ConsoleCommand& command, live::RemoteRequest& r) noexcept;
 
   RemoteMasterParams params_;
   std::unique_ptr<Link> link_;
+  std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
+  double stale_timeout_s_ = 0.0;
   double last_target_t_ = -1e9;
   bool engaged_ = false;
   bool estop_ = false;

@@ -79,6 +79,7 @@ class RemoteGripper final : public platform::Gripper {
 
 void RemoteSlaveParams::validate() const {
   link.validate();
+  emulate.validate();
   require(std::isfinite(stale_timeout_s) && stale_timeout_s >= 1e-3 && stale_timeout_s <= 10.0,
           "stale_timeout_s", "must be within [0.001, 10] s", stale_timeout_s);
   require_positive(sample_period_s, "sample_period_s");
@@ -89,6 +90,8 @@ void RemoteSlaveParams::validate() const {
 RemoteSlave::RemoteSlave(const RemoteSlaveParams& params) : params_(params) {
   params_.link.role = Role::kMaster;
   params_.validate();
+  stale_timeout_s_ = params_.stale_timeout_s + 2.0 * params_.emulate.jitter_s;
+  if (impairs(params_.emulate)) emulator_ = std::make_unique<WireEmulator>(params_.emulate, kStateRate_Hz);
   link_ = std::make_unique<Link>(params_.link);
 }
 
@@ -127,21 +130,31 @@ void RemoteSlave::set_estop(bool on) noexcept {
   send(Channel::kEngaged, {}, on ? 0.0 : 1.0);
 }
 
+void RemoteSlave::apply(const NetSample& s) noexcept {
+  switch (s.channel) {
+    case Channel::kMeasuredPose:
+      state_.position_m = s.xyz;
+      state_.age_s = 0.0;
+      break;
+    case Channel::kContactForce: state_.contact_force_N = s.xyz; break;
+    case Channel::kGripForce: state_.grip_force_N = s.xyz[0]; break;
+    case Channel::kGripperOpening: state_.opening_m = s.scalar; break;
+    default: break;  // the master's own channels never come back (the link ignores them)
+  }
+}
+
 void RemoteSlave::exchange(double dt_s) noexcept {
   state_.age_s += dt_s;
+  now_s_ += dt_s;
   NetSample s;
   while (link_->receive(s)) {  // validated by the link thread: finite and within NetLimits
-    switch (s.channel) {
-      case Channel::kMeasuredPose:
-        state_.position_m = s.xyz;
-        state_.age_s = 0.0;
-        break;
-      case Channel::kContactForce: state_.contact_force_N = s.xyz; break;
-      case Channel::kGripForce: state_.grip_force_N = s.xyz[0]; break;
-      case Channel::kGripperOpening: state_.opening_m = s.scalar; break;
-      default: break;  // the master's own channels never come back (the link ignores them)
+    if (emulator_) {
+      emulator_->arrive(now_s_, s);
+    } else {
+      apply(s);
     }
   }
+  if (emulator_) emulator_->deliver(now_s_, [this](const NetSample& d) { apply(d); });
   if (target_mask_ == 0b111u) {
     target_mask_ = 0;
     if (!targets_fresh_) return;

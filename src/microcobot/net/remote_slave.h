@@ -26,6 +26,7 @@
 #include <memory>
 
 #include "microcobot/net/link.h"
+#include "microcobot/net/wire_emulator.h"
 #include "microcobot/platform/platform.h"
 
 namespace mc::net {
@@ -37,6 +38,9 @@ struct RemoteSlaveParams {
   double stale_timeout_s = 0.008;
   double sample_period_s = 1e-5;  ///< reported as the axes' drive period (the model's step)
   double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
+  /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
+  /// jitter the timeout grows by twice the jitter (keep-latest lines then leave gaps that long).
+  control::LinkParams emulate;
   void validate() const;
 };
 
@@ -62,7 +66,7 @@ class RemoteSlave {
   platform::PlatformDevices make_devices();
 
   const Link& link() const { return *link_; }
-  bool fresh() const noexcept { return state_.age_s <= params_.stale_timeout_s; }
+  bool fresh() const noexcept { return state_.age_s <= stale_timeout_s_; }
   const RemoteSlaveState& state() const noexcept { return state_; }
 
   // The devices' side (loop thread).
@@ -74,9 +78,13 @@ class RemoteSlave {
 
  private:
   void send(Channel c, const std::array<double, 3>& xyz, double scalar) noexcept;
+  void apply(const NetSample& s) noexcept;
 
   RemoteSlaveParams params_;
   std::unique_ptr<Link> link_;
+  std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
+  double stale_timeout_s_ = 0.0;
+  double now_s_ = 0.0;  // loop time, from the ticks' dt
   RemoteSlaveState state_;
   std::array<double, 3> target_m_{};
   unsigned target_mask_ = 0;  // bit i: axis i's target of this slave tick is in
