@@ -357,9 +357,13 @@ function drawMicroscope() {
     drawBlurred(g, hx, hy, hs * s, hs * s, blurPx(focus, o, s), "#0c0b09");
   }
   // The part: a brass cube or pin, its top face at part_z + height / 2, blurred by its defocus.
+  // (A master of a distributed platform has no part in its telemetry: the microworld is the
+  // slave's.)
   const side = sc.part_side_m, height = sc.part_height_m || side;
-  const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-  drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a");
+  if (t.part_x_m !== undefined) {
+    const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
+    drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a");
+  }
   // The target: a reticle overlaid on the view (a graticule, always sharp), with the tolerance.
   const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
   g.strokeStyle = "#46c47e";
@@ -405,7 +409,7 @@ function drawSide() {
   }
   const side = sc.part_side_m, height = sc.part_height_m || side;
   g.fillStyle = "#c9a04a";
-  g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + height / 2), side * s, height * zs);
+  if (t.part_x_m !== undefined) g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + height / 2), side * s, height * zs);
   g.fillStyle = "#b8c4d6";
   const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
   for (const sign of [-1, 1]) {
