@@ -31,7 +31,6 @@ using test::BackgroundCli;
 using test::Console;
 
 constexpr std::uint32_t kTelemetrySub = 10;
-constexpr double kTolerance_m = 10e-6;
 
 // Every process a test started is killed when the test ends, passed or failed.
 struct Reaper {
@@ -124,12 +123,35 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
              std::abs(at(mt, "target_x_m") - at(st, "target_x_m")) < 2e-6;
     })) << m.last.dump() << "\n"
         << s.last.dump();
-    // 2. A grasp command: the slave's gripper closes to 100 um; the master reads its opening.
-    const json grip = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}, {"gripper_opening_m", 100e-6}};
-    ASSERT_TRUE(drive(m, &s, grip, [&](const json& mt, const json& st) {
-      return std::abs(at(st, "gripper_opening_m") - 100e-6) < kTolerance_m &&
-             std::abs(at(mt, "gripper_opening_m") - 100e-6) < kTolerance_m;
-    })) << s.last.dump();
+    // 2. A grasp: the master's console takes the gripper over the part (the slave's microworld:
+    //    its position comes from the slave's telemetry, as the operator sees it under the
+    //    microscope), down to the grasp height, closes it until the part is held, and lifts it.
+    //    The grip force comes back to the master.
+    const double part_x = at(s.last, "part_x_m"), part_y = at(s.last, "part_y_m");
+    const auto go = [&](double x, double y, double z, double opening) {
+      return json{{"deadman", true},
+                  {"velocity_m_s", {0, 0, 0}},
+                  {"goal_m", {x, y, z}},
+                  {"goal_speed_m_s", 500e-6},
+                  {"gripper_opening_m", opening}};
+    };
+    const auto reached = [](double x, double y, double z) {
+      return [=](const json&, const json& st) {
+        return std::abs(at(st, "measured_x_m") - x) < 3e-6 && std::abs(at(st, "measured_y_m") - y) < 3e-6 &&
+               std::abs(at(st, "measured_z_m") - z) < 3e-6;
+      };
+    };
+    const double z_over = at(s.last, "measured_z_m");
+    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, z_over, 600e-6), reached(part_x, part_y, z_over)))
+        << "over the part: " << s.last.dump();
+    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 100e-6, 600e-6), reached(part_x, part_y, 100e-6)))
+        << "down to the grasp height: " << s.last.dump();
+    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 100e-6, 0.0), [&](const json& mt, const json& st) {
+      return at(st, "grip_force_N") > 10e-6 && std::abs(at(mt, "grip_force_N") - at(st, "grip_force_N")) < 1e-6;
+    })) << "gripped: slave " << s.last.dump() << "\nmaster " << m.last.dump();
+    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 400e-6, 0.0), reached(part_x, part_y, 400e-6)))
+        << "lift: " << s.last.dump();
+    EXPECT_GT(at(s.last, "part_z_m"), 300e-6) << "the part came up with the gripper";
 
     // 3. The master dies mid-jog (SIGKILL): the slave holds.
     for (int i = 0; i < 30; ++i) {
