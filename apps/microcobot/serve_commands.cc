@@ -57,7 +57,8 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     return ends;
   }
   if (o.link.jitter_s > o.link.delay_s)
-    throw mc::UsageError("--link-jitter: must not exceed --link-delay (delays are delay +- jitter, never negative)");
+    throw mc::UsageError(
+        "--link-jitter: must not exceed --link-delay (delays are delay +- jitter, never negative)");
   const mc::stickslip::StickSlipParams axis = pf::axis_params(lp.platform);
   if (o.role == "master") {
     mc::net::RemoteSlaveParams rp;
@@ -70,9 +71,10 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     // the slave process's.
     lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform] {
       pf::PlatformDevices d = remote->make_devices();
-      d.haptic = std::make_unique<pf::SimulatedHapticMaster>("dual_stage", cfg.haptic.plant, cfg.haptic.render,
-                                                             cfg.haptic.pantograph, cfg.loop.period_s());
-      d.tweezers = std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+      d.haptic = std::make_unique<pf::SimulatedHapticMaster>(
+          "dual_stage", cfg.haptic.plant, cfg.haptic.render, cfg.haptic.pantograph, cfg.loop.period_s());
+      d.tweezers =
+          std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
       return d;
     };
   } else {
@@ -187,9 +189,10 @@ void add_serve(CLI::App& cmd) {
                  "coupling; the stage is the slave process's) or slave (stage, gripper, microworld, stage "
                  "controller; commands from the master process), joined over DDS (docs/distributed.md)")
       ->check(CLI::IsMember({"single", "master", "slave"}));
-  cmd.add_option("--domain", o->domain,
-                 fmt::format("DDS domain id of the master-slave link, 0 to {} (default 0; both ends the same)",
-                             mc::net::kMaxDomainId))
+  cmd.add_option(
+         "--domain", o->domain,
+         fmt::format("DDS domain id of the master-slave link, 0 to {} (default 0; both ends the same)",
+                     mc::net::kMaxDomainId))
       ->check(CLI::Range(0, mc::net::kMaxDomainId));
   cmd.add_option("--link-delay", o->link.delay_s,
                  "Emulated one-way delay of what this end receives, s (default 0; both ends: a round trip "
@@ -198,9 +201,10 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--link-jitter", o->link.jitter_s,
                  "Emulated jitter, s: each delay uniform in delay +- jitter (default 0; at most the delay)")
       ->check(mc::cli::Range(0.0, 10.0));
-  cmd.add_option("--link-loss", o->link.loss,
-                 "Emulated probability of losing a best-effort sample, [0, 1) (default 0; the reliable e-stop "
-                 "and engaged topics are only delayed)")
+  cmd.add_option(
+         "--link-loss", o->link.loss,
+         "Emulated probability of losing a best-effort sample, [0, 1) (default 0; the reliable e-stop "
+         "and engaged topics are only delayed)")
       ->check(mc::cli::Range(0.0, 0.999));
   cmd.callback([o] { serve(*o); });
 }

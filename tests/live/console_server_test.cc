@@ -14,9 +14,9 @@
 
 #include "microcobot/core/mcap_reader.h"
 #include "microcobot/server/foxglove_protocol.h"
+#include "support/console_client.h"
 #include "support/counting_allocator.h"
 #include "support/test_support.h"
-#include "support/console_client.h"
 #include "support/ws_client.h"
 
 namespace mc::live {

@@ -49,8 +49,8 @@ struct Server {
 Server start_serve(const std::string& role, const std::string& domain, const test::TempDir& dir,
                    const std::string& name, Reaper& reaper) {
   Server s;
-  s.process = test::spawn_cli({"serve", "--role", role, "--domain", domain, "--listen", "127.0.0.1:0", "--out",
-                               (dir / name).string(), "--duration", "300"},
+  s.process = test::spawn_cli({"serve", "--role", role, "--domain", domain, "--listen", "127.0.0.1:0",
+                               "--out", (dir / name).string(), "--duration", "300"},
                               dir / name);
   reaper.pids.push_back(s.process.pid);
   std::string url;
@@ -70,7 +70,9 @@ Server start_serve(const std::string& role, const std::string& domain, const tes
 struct Watch {
   Console console;
   json last;
-  explicit Watch(std::uint16_t port) : console(port) { console.subscribe("/platform/telemetry", kTelemetrySub); }
+  explicit Watch(std::uint16_t port) : console(port) {
+    console.subscribe("/platform/telemetry", kTelemetrySub);
+  }
   const json& next() {
     const std::string payload = console.next_on(kTelemetrySub);
     last = payload.empty() ? json() : json::parse(payload);
@@ -111,17 +113,21 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     Watch m(master1.port), s(slave1.port);
     ASSERT_TRUE(m.console.action("take_control"));
     const json jog = {{"deadman", true}, {"velocity_m_s", {100e-6, 0, 0}}};
-    ASSERT_TRUE(drive(m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}},
-                      [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s))
+    ASSERT_TRUE(drive(
+        m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}},
+        [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s))
         << "the master never engaged: " << m.last.dump();
     x0 = at(s.last, "measured_x_m");
-    ASSERT_TRUE(drive(m, &s, jog, [&](const json&, const json& st) { return at(st, "measured_x_m") > x0 + 50e-6; }))
+    ASSERT_TRUE(
+        drive(m, &s, jog, [&](const json&, const json& st) { return at(st, "measured_x_m") > x0 + 50e-6; }))
         << "the slave did not follow: " << s.last.dump();
     // The master's view of the slave trails its telemetry by the link and the frame times only.
-    ASSERT_TRUE(drive(m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}}, [&](const json& mt, const json& st) {
-      return std::abs(at(mt, "measured_x_m") - at(st, "measured_x_m")) < 2e-6 &&
-             std::abs(at(mt, "target_x_m") - at(st, "target_x_m")) < 2e-6;
-    })) << m.last.dump() << "\n"
+    ASSERT_TRUE(drive(m, &s, {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}},
+                      [&](const json& mt, const json& st) {
+                        return std::abs(at(mt, "measured_x_m") - at(st, "measured_x_m")) < 2e-6 &&
+                               std::abs(at(mt, "target_x_m") - at(st, "target_x_m")) < 2e-6;
+                      }))
+        << m.last.dump() << "\n"
         << s.last.dump();
     // 2. A grasp: the master's console takes the gripper over the part (the slave's microworld:
     //    its position comes from the slave's telemetry, as the operator sees it under the
@@ -146,9 +152,12 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
         << "over the part: " << s.last.dump();
     ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 100e-6, 600e-6), reached(part_x, part_y, 100e-6)))
         << "down to the grasp height: " << s.last.dump();
-    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 100e-6, 0.0), [&](const json& mt, const json& st) {
-      return at(st, "grip_force_N") > 10e-6 && std::abs(at(mt, "grip_force_N") - at(st, "grip_force_N")) < 1e-6;
-    })) << "gripped: slave " << s.last.dump() << "\nmaster " << m.last.dump();
+    ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 100e-6, 0.0),
+                      [&](const json& mt, const json& st) {
+                        return at(st, "grip_force_N") > 10e-6 &&
+                               std::abs(at(mt, "grip_force_N") - at(st, "grip_force_N")) < 1e-6;
+                      }))
+        << "gripped: slave " << s.last.dump() << "\nmaster " << m.last.dump();
     ASSERT_TRUE(drive(m, &s, go(part_x, part_y, 400e-6, 0.0), reached(part_x, part_y, 400e-6)))
         << "lift: " << s.last.dump();
     EXPECT_GT(at(s.last, "part_z_m"), 300e-6) << "the part came up with the gripper";
@@ -166,7 +175,8 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     ASSERT_TRUE(test::eventually([&] {
       released = at(s.next(), "engaged") == 0.0 ? released + 1 : 0;
       return released >= 10;
-    })) << "the slave stayed engaged to a dead master: " << s.last.dump();
+    })) << "the slave stayed engaged to a dead master: "
+        << s.last.dump();
     // And it rests there: half a second of frames within 1 um (frames in flight when the master
     // died may still show motion first).
     double held = at(s.last, "measured_x_m");
@@ -175,7 +185,8 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
       const double x = at(s.next(), "measured_x_m");
       resting = std::abs(x - held) < 1e-6 && at(s.last, "engaged") == 0.0 ? resting + 1 : (held = x, 0);
       return resting >= 30;
-    })) << "the slave must hold where it was: " << s.last.dump();
+    })) << "the slave must hold where it was: "
+        << s.last.dump();
   }
 
   // 4. A restarted master re-engages at the slave's position: no jump.
@@ -186,7 +197,8 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
     const double before = at(s.next(), "measured_x_m");
     ASSERT_GT(before, x0 + 50e-6);
     const json hold = {{"deadman", true}, {"velocity_m_s", {0, 0, 0}}};
-    ASSERT_TRUE(drive(m, &s, hold, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
+    ASSERT_TRUE(drive(
+        m, &s, hold, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
     int frames = 0;
     ASSERT_TRUE(drive(m, &s, hold, [&](const json& mt, const json& st) {
       EXPECT_NEAR(at(st, "measured_x_m"), before, 2e-6) << "the slave jumped on re-engagement";
@@ -202,7 +214,8 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   {
     Watch m(master2.port);
     ASSERT_TRUE(m.console.action("take_control"));
-    ASSERT_TRUE(drive(m, nullptr, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }));
+    ASSERT_TRUE(
+        drive(m, nullptr, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }));
     // Moving when it stops.
     const json back = {{"deadman", true}, {"velocity_m_s", {-100e-6, 0, 0}}};
     for (int i = 0; i < 20; ++i) {
@@ -210,15 +223,17 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
       m.next();
     }
     ::kill(slave1.process.pid, SIGTERM);
-    ASSERT_TRUE(drive(m, nullptr, back, [&](const json& mt, const json&) { return at(mt, "engaged") == 0.0; }))
-        << "the master stayed engaged to a dead slave";
+    ASSERT_TRUE(drive(m, nullptr, back, [&](const json& mt, const json&) {
+      return at(mt, "engaged") == 0.0;
+    })) << "the master stayed engaged to a dead slave";
     ASSERT_EQ(test::wait_process(slave1.process.pid, 30s), 0) << test::read_text(slave1.process.err);
   }
   Server slave2 = start_serve("slave", domain, dir, "slave2", reaper);
   {
     Watch m(master2.port), s(slave2.port);
     ASSERT_TRUE(m.console.action("take_control"));
-    ASSERT_TRUE(drive(m, &s, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
+    ASSERT_TRUE(drive(
+        m, &s, still, [&](const json& mt, const json&) { return at(mt, "engaged") == 1.0; }, 60s));
     int frames = 0;
     ASSERT_TRUE(drive(m, &s, still, [&](const json& mt, const json& st) {
       EXPECT_NEAR(at(st, "measured_x_m"), x0, 2e-6) << "the new slave was driven away from home";
@@ -230,7 +245,6 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   ::kill(slave2.process.pid, SIGTERM);
   ASSERT_EQ(test::wait_process(master2.process.pid, 30s), 0) << test::read_text(master2.process.err);
   ASSERT_EQ(test::wait_process(slave2.process.pid, 30s), 0) << test::read_text(slave2.process.err);
-
 }
 
 }  // namespace

@@ -74,9 +74,10 @@ struct Pair {
     lp.make_devices = [this] {
       platform::PlatformDevices d = slave_link->make_devices();
       d.haptic = std::make_unique<platform::SimulatedHapticMaster>(
-          "dual_stage", config.haptic.plant, config.haptic.render, config.haptic.pantograph, config.loop.period_s());
-      d.tweezers =
-          std::make_unique<platform::SimulatedTweezersMaster>("teletweez", config.tweezers, config.loop.period_s());
+          "dual_stage", config.haptic.plant, config.haptic.render, config.haptic.pantograph,
+          config.loop.period_s());
+      d.tweezers = std::make_unique<platform::SimulatedTweezersMaster>("teletweez", config.tweezers,
+                                                                       config.loop.period_s());
       return d;
     };
     master = std::make_unique<End>(lp);
@@ -120,8 +121,8 @@ TEST(RemoteEnds, SoOverAnEmulatedLinkOf100msRoundTripWithJitterAndLoss) {
 }
 
 void moves_the_slave_without_allocating(Pair& pair) {
-  ASSERT_TRUE(test::wait_until([&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); },
-                               30.0))
+  ASSERT_TRUE(test::wait_until(
+      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0))
       << "the master never engaged with the slave";
   const double x0 = pair.slave->get("measured_x_m");
   // One loop watched at a time (the counting allocator follows one thread), each while the
@@ -142,7 +143,8 @@ void moves_the_slave_without_allocating(Pair& pair) {
     pair.drive(c, 20ms);
     return pair.slave->get("measured_x_m") > x0 + 50e-6 &&
            std::abs(pair.slave->get("gripper_opening_m") - 200e-6) < 10e-6;
-  })) << "x moved " << 1e6 * (pair.slave->get("measured_x_m") - x0) << " um, gripper at "
+  })) << "x moved "
+      << 1e6 * (pair.slave->get("measured_x_m") - x0) << " um, gripper at "
       << 1e6 * pair.slave->get("gripper_opening_m") << " um";
   // The master sees what the slave measures.
   EXPECT_TRUE(mc::test::eventually([&] {
@@ -176,6 +178,11 @@ TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
   Link peer(peer_config);
   auto devices = remote.make_devices();
   EXPECT_FALSE(devices.axes[0]->measurement_fresh()) << "no pose yet";
+  constexpr double kActive = static_cast<double>(platform::Lifecycle::kActive);
+  deliver(peer, Channel::kSlaveDiagnostics, {kActive, kActive, kActive}, kActive, [&] {
+    remote.exchange(0.0);
+    return remote.state().slave_active();
+  });
   deliver(peer, Channel::kMeasuredPose, {1e-6, 2e-6, 3e-6}, 0.0, [&] {
     remote.exchange(0.0);  // takes what arrived without ageing it
     return remote.fresh();
@@ -219,10 +226,27 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   EXPECT_FALSE(remote.poll(1.012, c).reset);
 }
 
+TEST(RemoteEnds, TheMasterLetsGoOfASlaveThatStoppedItselfAndReEngagesAfterItsReset) {
+  Pair pair;
+  ASSERT_TRUE(test::wait_until(
+      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0));
+  pair.slave->live->estop();  // the slave's own console
+  ASSERT_TRUE(mc::test::eventually([&] {
+    pair.drive(jog(0), 20ms);
+    return pair.master->get("engaged") == 0.0 && pair.master->get("stale") == 1.0;
+  })) << "the master must let go of a slave in fault (its /diagnostics)";
+  EXPECT_FALSE(pair.master->live->status().estopped) << "the master itself is fine";
+  pair.slave->live->request(live::ConsoleAction::kReset);
+  EXPECT_TRUE(mc::test::eventually([&] {
+    pair.drive(jog(0), 20ms);
+    return pair.master->get("engaged") == 1.0;
+  })) << "the master re-engages once the slave is reset";
+}
+
 TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
   Pair pair;
-  ASSERT_TRUE(test::wait_until([&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); },
-                               30.0));
+  ASSERT_TRUE(test::wait_until(
+      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0));
   pair.master->live->estop();
   ASSERT_TRUE(mc::test::eventually([&] { return pair.slave->live->status().estopped; }))
       << "the slave did not latch the master's e-stop";
@@ -231,7 +255,8 @@ TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
   pair.master->live->request(live::ConsoleAction::kReset);
   ASSERT_TRUE(mc::test::eventually([&] {
     return !pair.master->live->status().estopped && !pair.slave->live->status().estopped;
-  })) << "slave: " << pair.slave->live->status().last_error;
+  })) << "slave: "
+      << pair.slave->live->status().last_error;
   const double x0 = pair.slave->get("measured_x_m");
   EXPECT_TRUE(mc::test::eventually([&] {
     pair.drive(jog(200e-6), 20ms);

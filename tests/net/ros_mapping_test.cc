@@ -151,6 +151,42 @@ TEST(RosMapping, BoolIsZeroOrOne) {
   EXPECT_EQ(back.channel, Channel::kEstop);
 }
 
+TEST(RosMapping, DiagnosticsReportEachSlaveDeviceWithItsLevelAndLifecycle) {
+  NetSample s;
+  s.channel = Channel::kSlaveDiagnostics;
+  s.stamp_ns = 2'000'000'001;
+  s.xyz = {2, 2, 3};  // axes active, z in fault
+  s.scalar = 1;       // gripper inactive
+  DiagnosticsBuffer buf;
+  diagnostic_msgs_msg_dds__DiagnosticArray_ m;
+  to_ros(s, buf, m);
+  ASSERT_EQ(m.status_._length, 4u);
+  EXPECT_STREQ(m.status_._buffer[0].name_, "microcobot/slave/axis_x");
+  EXPECT_EQ(m.status_._buffer[0].level_, 0);  // OK
+  EXPECT_STREQ(m.status_._buffer[0].message_, "active");
+  EXPECT_EQ(m.status_._buffer[2].level_, 2);  // ERROR
+  EXPECT_STREQ(m.status_._buffer[2].message_, "fault");
+  EXPECT_EQ(m.status_._buffer[3].level_, 1);  // WARN
+  EXPECT_STREQ(m.status_._buffer[3].hardware_id_, "microcobot_slave");
+  NetSample back;
+  ASSERT_EQ(from_ros(m, Channel::kSlaveDiagnostics, back), Rejection::kNone);
+  EXPECT_EQ(back.xyz, s.xyz);
+  EXPECT_EQ(back.scalar, s.scalar);
+  EXPECT_EQ(back.stamp_ns, s.stamp_ns);
+  // Refused: a level that contradicts the message, an unknown state, a missing device.
+  buf.status[1].level_ = 0;
+  buf.status[1].message_ = const_cast<char*>("fault");
+  EXPECT_EQ(from_ros(m, Channel::kSlaveDiagnostics, back), Rejection::kOutOfRange);
+  buf.status[1].message_ = const_cast<char*>("exploded");
+  EXPECT_EQ(from_ros(m, Channel::kSlaveDiagnostics, back), Rejection::kOutOfRange);
+  to_ros(s, buf, m);
+  m.status_._length = 3;
+  EXPECT_EQ(from_ros(m, Channel::kSlaveDiagnostics, back), Rejection::kBadSize);
+  m.status_._length = 4;
+  buf.status[0].name_ = const_cast<char*>("someone/else");
+  EXPECT_EQ(from_ros(m, Channel::kSlaveDiagnostics, back), Rejection::kBadSize);
+}
+
 TEST(NetLimits, RefusesNonPositiveOrNonFiniteBounds) {
   NetLimits l;
   EXPECT_NO_THROW(l.validate());

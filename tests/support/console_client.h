@@ -55,7 +55,9 @@ struct Console {
   bool action(const std::string& name) {
     return ws.send(server::encode_client_message_data(2, nlohmann::json{{"action", name}}.dump()), true);
   }
-  bool command(const nlohmann::json& c) { return ws.send(server::encode_client_message_data(1, c.dump()), true); }
+  bool command(const nlohmann::json& c) {
+    return ws.send(server::encode_client_message_data(1, c.dump()), true);
+  }
   // The payload of the next message on subscription `id` (empty on timeout).
   std::string next_on(std::uint32_t id) {
     for (int i = 0; i < 100000; ++i) {

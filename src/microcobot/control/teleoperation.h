@@ -88,7 +88,7 @@ struct TeleoperationInput {
   /// are stale the coupling disengages with no force on the masters, and the slave target is
   /// re-taken from the measured position when they return.
   bool slave_fresh = true;
-  ConsoleInput console;                                        ///< the console, when it holds control
+  ConsoleInput console;  ///< the console, when it holds control
 };
 
 /// The coupling's commands.

@@ -128,8 +128,8 @@ class LivePlatform {
 
   std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false}, in_control_{false};
   std::atomic<bool> started_{false};
-  bool remote_estopped_ = false;               // loop thread only: the far end latched our e-stop
-  std::atomic<int> loop_request_{-1};          // a ConsoleAction the loop asks of the control thread
+  bool remote_estopped_ = false;       // loop thread only: the far end latched our e-stop
+  std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;
   std::thread thread_;
 

@@ -181,6 +181,13 @@ void Link::write(const NetSample& s) noexcept {
       rc = dds_write(writers_[i], &m);
       break;
     }
+    case RosType::kDiagnosticArray: {
+      diagnostic_msgs_msg_dds__DiagnosticArray_ m;
+      DiagnosticsBuffer buf;
+      to_ros(s, buf, m);
+      rc = dds_write(writers_[i], &m);
+      break;
+    }
   }
   (rc < 0 ? write_failed_ : written_).fetch_add(1, std::memory_order_relaxed);
 }
@@ -211,6 +218,9 @@ void Link::take(Channel c) noexcept {
         break;
       case RosType::kBool:
         r = from_ros(*static_cast<const std_msgs_msg_dds__Bool_*>(samples[k]), c, s);
+        break;
+      case RosType::kDiagnosticArray:
+        r = from_ros(*static_cast<const diagnostic_msgs_msg_dds__DiagnosticArray_*>(samples[k]), c, s);
         break;
     }
     if (r != Rejection::kNone) {

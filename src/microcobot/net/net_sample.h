@@ -20,8 +20,12 @@ enum class Channel : std::uint8_t {
   kGripperOpening,  ///< slave -> master: the gripper's measured opening (m)
   kEstop,           ///< master -> slave: emergency stop (latched state, 0 or 1)
   kEngaged,         ///< master -> slave: the coupling is engaged (clutch; 0 or 1)
+  /// slave -> master: the slave's device states (/diagnostics): `xyz` the lifecycles of axes x,
+  /// y, z and `scalar` the gripper's, as platform::Lifecycle values (0 unconfigured, 1 inactive,
+  /// 2 active, 3 fault)
+  kSlaveDiagnostics,
 };
-inline constexpr std::size_t kChannelCount = 8;
+inline constexpr std::size_t kChannelCount = 9;
 
 /// One message. `xyz` holds a position (m) or a force (N) in the stage frame; `scalar` the
 /// gripper opening (m) or a boolean (0/1). Unused fields are zero.

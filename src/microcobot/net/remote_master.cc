@@ -46,8 +46,11 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& c
       estop_ = on;
       break;
     }
-    case Channel::kEngaged: engaged_ = s.scalar != 0.0; break;
-    default: break;  // the slave's own channels never come back (the link ignores them)
+    case Channel::kEngaged:
+      engaged_ = s.scalar != 0.0;
+      break;
+    default:
+      break;  // the slave's own channels never come back (the link ignores them)
   }
 }
 
@@ -89,6 +92,15 @@ void RemoteMaster::publish(const platform::Platform& p) noexcept {
   send(Channel::kContactForce, {f.x, f.y, f.z}, 0.0, stamp);
   send(Channel::kGripForce, {g.grip_force_N(), 0.0, 0.0}, 0.0, stamp);
   send(Channel::kGripperOpening, {}, g.opening_m(), stamp);
+  // The device states: on a change at once, else at 10 Hz of the 1 kHz operator ticks.
+  const std::array<double, 4> states = {
+      static_cast<double>(p.axis(0).state()), static_cast<double>(p.axis(1).state()),
+      static_cast<double>(p.axis(2).state()), static_cast<double>(g.state())};
+  if (states != states_sent_ || --ticks_to_diagnostics_ <= 0) {
+    send(Channel::kSlaveDiagnostics, {states[0], states[1], states[2]}, states[3], stamp);
+    states_sent_ = states;
+    ticks_to_diagnostics_ = static_cast<int>(kStateRate_Hz / kDiagnosticsRate_Hz);
+  }
 }
 
 }  // namespace mc::net

@@ -6,7 +6,7 @@
 /// takes the master's latest target pose and gripper target into a console command (a
 /// straight move to the target, at most at the coupling's console speed), reads the master's
 /// e-stop and engaged flags, and publishes the slave's measured pose, contact and grip forces
-/// and gripper opening.
+/// and gripper opening, and its devices' states on /diagnostics (10 Hz, and at once on a change).
 ///
 /// The master is fresh while it is engaged and its last target is at most `stale_timeout_s`
 /// old (issue #17 point 6: a dead master holds the slave within 10 ms: the coupling disengages
@@ -22,7 +22,7 @@
 namespace mc::net {
 
 struct RemoteMasterParams {
-  LinkConfig link;               ///< its role is forced to slave
+  LinkConfig link;  ///< its role is forced to slave
   /// A target older than this: the master is silent. 8 ms, so that the hold (at the next
   /// operator tick) lands within the 10 ms of issue #17 point 6.
   double stale_timeout_s = 0.008;
@@ -56,6 +56,8 @@ class RemoteMaster final : public live::CommandSource {
   double last_target_t_ = -1e9;
   bool engaged_ = false;
   bool estop_ = false;
+  std::array<double, 4> states_sent_{-1, -1, -1, -1};  // lifecycles last put on /diagnostics
+  int ticks_to_diagnostics_ = 0;
 };
 
 }  // namespace mc::net

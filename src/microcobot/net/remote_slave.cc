@@ -19,7 +19,10 @@ std::int64_t ros_time_ns() noexcept {
 class RemoteSlaveAxis final : public platform::SlaveAxis {
  public:
   RemoteSlaveAxis(std::string name, RemoteSlave& slave, int index, const RemoteSlaveParams& p)
-      : SlaveAxis(std::move(name)), slave_(slave), index_(index), period_s_(p.sample_period_s),
+      : SlaveAxis(std::move(name)),
+        slave_(slave),
+        index_(index),
+        period_s_(p.sample_period_s),
         max_V_(p.max_voltage_V) {}
   double sample_period_s() const override { return period_s_; }
   double max_voltage_V() const override { return max_V_; }
@@ -136,10 +139,21 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
       state_.position_m = s.xyz;
       state_.age_s = 0.0;
       break;
-    case Channel::kContactForce: state_.contact_force_N = s.xyz; break;
-    case Channel::kGripForce: state_.grip_force_N = s.xyz[0]; break;
-    case Channel::kGripperOpening: state_.opening_m = s.scalar; break;
-    default: break;  // the master's own channels never come back (the link ignores them)
+    case Channel::kContactForce:
+      state_.contact_force_N = s.xyz;
+      break;
+    case Channel::kGripForce:
+      state_.grip_force_N = s.xyz[0];
+      break;
+    case Channel::kGripperOpening:
+      state_.opening_m = s.scalar;
+      break;
+    case Channel::kSlaveDiagnostics:  // checked by the link: each a Lifecycle value
+      for (std::size_t i = 0; i < 3; ++i) state_.lifecycle[i] = static_cast<platform::Lifecycle>(s.xyz[i]);
+      state_.lifecycle[3] = static_cast<platform::Lifecycle>(s.scalar);
+      break;
+    default:
+      break;  // the master's own channels never come back (the link ignores them)
   }
 }
 

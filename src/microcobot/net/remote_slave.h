@@ -16,8 +16,9 @@
 ///   safe state          the e-stop topic latched on (reliable, transient local), the coupling's
 ///                       engaged flag off; activate() releases both
 ///
-/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave) the
-/// axes report stale measurements: the coupling disengages with zero force on the masters at
+/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave), or its
+/// /diagnostics report a device that is not active (its own e-stop, a fault), the axes report
+/// stale measurements: the coupling disengages with zero force on the masters at
 /// once, and re-engages at the slave's measured position when poses return (a restarted slave
 /// does not jump). Everything on the loop path only pushes to and pops from the link's rings.
 
@@ -51,6 +52,14 @@ struct RemoteSlaveState {
   double grip_force_N = 0.0;
   double opening_m = 0.0;
   double age_s = 1e9;  ///< since the last pose (starts stale)
+  /// The slave's devices (axes x, y, z, gripper) as its /diagnostics last reported them;
+  /// unknown (Unconfigured) until the first report.
+  std::array<platform::Lifecycle, 4> lifecycle{};
+  bool slave_active() const {
+    for (auto l : lifecycle)
+      if (l != platform::Lifecycle::kActive) return false;
+    return true;
+  }
 };
 
 class RemoteSlave {
@@ -66,7 +75,9 @@ class RemoteSlave {
   platform::PlatformDevices make_devices();
 
   const Link& link() const { return *link_; }
-  bool fresh() const noexcept { return state_.age_s <= stale_timeout_s_; }
+  /// Poses flow and every slave device is active (a slave that faulted or e-stopped itself is
+  /// as good as silent to the coupling: it lets go, and re-engages once the slave is reset).
+  bool fresh() const noexcept { return state_.age_s <= stale_timeout_s_ && state_.slave_active(); }
   const RemoteSlaveState& state() const noexcept { return state_; }
 
   // The devices' side (loop thread).
@@ -87,7 +98,7 @@ class RemoteSlave {
   double now_s_ = 0.0;  // loop time, from the ticks' dt
   RemoteSlaveState state_;
   std::array<double, 3> target_m_{};
-  unsigned target_mask_ = 0;  // bit i: axis i's target of this slave tick is in
+  unsigned target_mask_ = 0;    // bit i: axis i's target of this slave tick is in
   bool targets_fresh_ = false;  // they were computed on fresh measurements
   double gripper_target_m_ = 0.0;
   int estop_sent_ = -1;  // -1: never sent

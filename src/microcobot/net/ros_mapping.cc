@@ -1,7 +1,9 @@
 #include "microcobot/net/ros_mapping.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 #include "microcobot/core/error.h"
 
@@ -96,6 +98,54 @@ void to_ros(const NetSample& s, JointStateBuffer& buf, sensor_msgs_msg_dds__Join
   m.position_._length = m.position_._maximum = 1;
   m.position_._buffer = buf.position;
   m.position_._release = false;
+}
+
+namespace {
+
+// platform::Lifecycle's order: unconfigured, inactive, active, fault.
+constexpr const char* kLifecycleNames[4] = {"unconfigured", "inactive", "active", "fault"};
+constexpr std::uint8_t kLifecycleLevels[4] = {3, 1, 0, 2};  // STALE, WARN, OK, ERROR
+
+}  // namespace
+
+void to_ros(const NetSample& s, DiagnosticsBuffer& buf, diagnostic_msgs_msg_dds__DiagnosticArray_& m) {
+  m = {};
+  fill_header(s.stamp_ns, m.header_);
+  const double states[4] = {s.xyz[0], s.xyz[1], s.xyz[2], s.scalar};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto k = static_cast<std::size_t>(std::clamp(states[i], 0.0, 3.0));
+    auto& st = buf.status[i];
+    st = {};
+    st.level_ = kLifecycleLevels[k];
+    st.name_ = const_cast<char*>(kSlaveDeviceNames[i]);
+    st.message_ = const_cast<char*>(kLifecycleNames[k]);
+    st.hardware_id_ = const_cast<char*>(kSlaveHardwareId);
+  }
+  m.status_._length = m.status_._maximum = 4;
+  m.status_._buffer = buf.status;
+  m.status_._release = false;
+}
+
+Rejection from_ros(const diagnostic_msgs_msg_dds__DiagnosticArray_& m, Channel c, NetSample& out) {
+  if (m.status_._length != 4 || m.status_._buffer == nullptr) return Rejection::kBadSize;
+  double states[4] = {};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& st = m.status_._buffer[i];
+    if (st.name_ == nullptr || std::string_view(st.name_) != kSlaveDeviceNames[i]) return Rejection::kBadSize;
+    int k = -1;
+    for (int j = 0; j < 4; ++j)
+      if (st.message_ != nullptr && std::string_view(st.message_) == kLifecycleNames[j]) k = j;
+    if (k < 0 || st.level_ != kLifecycleLevels[k]) return Rejection::kOutOfRange;
+    states[i] = k;
+  }
+  std::int64_t stamp = 0;
+  if (!from_ros_time(m.header_.stamp_, stamp)) return Rejection::kBadStamp;
+  out = NetSample{};
+  out.channel = c;
+  out.stamp_ns = stamp;
+  out.xyz = {states[0], states[1], states[2]};
+  out.scalar = states[3];
+  return Rejection::kNone;
 }
 
 Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,

@@ -37,6 +37,19 @@ struct JointStateBuffer {
 };
 void to_ros(const NetSample& s, JointStateBuffer& buf, sensor_msgs_msg_dds__JointState_& m);
 
+/// The slave's devices on /diagnostics, in the order of NetSample's kSlaveDiagnostics fields.
+inline constexpr const char* kSlaveDeviceNames[4] = {"microcobot/slave/axis_x", "microcobot/slave/axis_y",
+                                                     "microcobot/slave/axis_z", "microcobot/slave/gripper"};
+inline constexpr const char* kSlaveHardwareId = "microcobot_slave";
+
+/// The storage a DiagnosticArray of the slave's four devices points at (static strings).
+struct DiagnosticsBuffer {
+  diagnostic_msgs_msg_dds__DiagnosticStatus_ status[4] = {};
+};
+/// One status per device: level OK (active), WARN (inactive), ERROR (fault), STALE
+/// (unconfigured); the message is the lifecycle state ("active", ...), no key-values.
+void to_ros(const NetSample& s, DiagnosticsBuffer& buf, diagnostic_msgs_msg_dds__DiagnosticArray_& m);
+
 /// Each from_ros fills `out` (channel `c`) and returns kNone, or returns why it refused.
 /// A pose's orientation is ignored (the stage only translates); a wrench's torque likewise.
 Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
@@ -47,5 +60,8 @@ Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, co
 Rejection from_ros(const sensor_msgs_msg_dds__JointState_& m, Channel c, const NetLimits& lim,
                    NetSample& out);
 Rejection from_ros(const std_msgs_msg_dds__Bool_& m, Channel c, NetSample& out);
+/// Exactly the four statuses of kSlaveDeviceNames, in order, each message a lifecycle state's
+/// name whose level matches it.
+Rejection from_ros(const diagnostic_msgs_msg_dds__DiagnosticArray_& m, Channel c, NetSample& out);
 
 }  // namespace mc::net

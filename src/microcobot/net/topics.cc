@@ -12,6 +12,7 @@ constexpr std::string_view kPoseStamped = "geometry_msgs::msg::dds_::PoseStamped
 constexpr std::string_view kWrenchStamped = "geometry_msgs::msg::dds_::WrenchStamped_";
 constexpr std::string_view kJointState = "sensor_msgs::msg::dds_::JointState_";
 constexpr std::string_view kBool = "std_msgs::msg::dds_::Bool_";
+constexpr std::string_view kDiagnosticArray = "diagnostic_msgs::msg::dds_::DiagnosticArray_";
 
 constexpr TopicSpec state(Channel c, std::string_view ros, std::string_view dds, RosType type,
                           std::string_view type_name, Role publisher, std::string_view unit) {
@@ -61,6 +62,11 @@ constexpr std::array<TopicSpec, kChannelCount> kTable{{
           RosType::kJointState, kJointState, Role::kSlave, "m"),
     latched(Channel::kEstop, "/microcobot/estop", "rt/microcobot/estop", Role::kMaster),
     latched(Channel::kEngaged, "/microcobot/master/engaged", "rt/microcobot/master/engaged", Role::kMaster),
+    // ROS 2's /diagnostics: reliable, keep last 1 (a late state is still worth having; the newest
+    // is the one that counts), volatile (states are republished at 10 Hz).
+    {Channel::kSlaveDiagnostics, "/diagnostics", "rt/diagnostics", RosType::kDiagnosticArray,
+     kDiagnosticArray, Role::kSlave, kDiagnosticsRate_Hz, Reliability::kReliable, Durability::kVolatile, 1,
+     0.0, 0.0, "level 0 OK (active), 1 WARN (inactive), 2 ERROR (fault), 3 STALE (unconfigured)"},
 }};
 
 constexpr bool table_is_indexed_by_channel() {
@@ -105,6 +111,8 @@ const dds_topic_descriptor_t* descriptor(RosType type) {
       return &sensor_msgs_msg_dds__JointState__desc;
     case RosType::kBool:
       return &std_msgs_msg_dds__Bool__desc;
+    case RosType::kDiagnosticArray:
+      return &diagnostic_msgs_msg_dds__DiagnosticArray__desc;
   }
   return nullptr;
 }

@@ -23,7 +23,7 @@ enum class Reliability : std::uint8_t { kBestEffort, kReliable };
 enum class Durability : std::uint8_t { kVolatile, kTransientLocal };
 
 /// The ROS 2 message types the link uses (their DDS names in TopicSpec::type_name).
-enum class RosType : std::uint8_t { kPoseStamped, kWrenchStamped, kJointState, kBool };
+enum class RosType : std::uint8_t { kPoseStamped, kWrenchStamped, kJointState, kBool, kDiagnosticArray };
 
 struct TopicSpec {
   Channel channel;
@@ -48,6 +48,8 @@ struct TopicSpec {
 inline constexpr double kStateRate_Hz = 1000.0;
 inline constexpr double kStateDeadline_s = 0.01;
 inline constexpr double kStateLease_s = 0.1;
+/// Rate of the device states on /diagnostics (also sent at once when one changes).
+inline constexpr double kDiagnosticsRate_Hz = 10.0;
 
 /// The table, indexed by Channel.
 const std::array<TopicSpec, kChannelCount>& topic_table();
