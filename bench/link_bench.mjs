@@ -12,12 +12,11 @@
 // 1 kHz, the round trip master -> slave -> master.
 import { spawn, execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readdirSync, rmSync } from "node:fs";
-import { open } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import foxglove from "@foxglove/ws-protocol";
-import { McapIndexedReader } from "@mcap/core";
+import { jogAsOperator, quantile, readTelemetry } from "./serve_common.mjs";
 const { FoxgloveClient } = foxglove;
 
 const arg = (name, fallback) => {
@@ -34,11 +33,6 @@ if (!existsSync(cli)) {
 const domain = String(100 + (process.pid % 100));
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const log = (msg) => asJson || console.error(msg);
-const quantile = (v, q) => {
-  const s = [...v].sort((a, b) => a - b);
-  return s[Math.min(s.length - 1, Math.ceil(q * s.length) - 1)];
-};
-
 // A `serve` process recording into its own directory; resolves once it printed its URL.
 async function serve(args) {
   const dir = mkdtempSync(join(tmpdir(), "mc-link-bench-"));
@@ -52,22 +46,13 @@ async function serve(args) {
   return { p, dir, exited, ws: url.replace(/^http/, "ws").replace(/\/(\?.*)?$/, "/ws$1") };
 }
 
-// The controlling client: takes control and jogs at 50 Hz until stopped.
+// The controlling client: takes control and jogs until stopped.
 async function operate(wsUrl) {
   const c = new FoxgloveClient({ ws: new WebSocket(wsUrl, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
   await new Promise((resolve) => c.on("advertise", resolve));
-  const command = c.advertise({ topic: "/console/command", encoding: "json", schemaName: "microcobot.Command" });
-  const action = c.advertise({ topic: "/console/action", encoding: "json", schemaName: "microcobot.Action" });
-  const send = (ch, obj) => c.sendMessage(ch, new TextEncoder().encode(JSON.stringify(obj)));
-  send(action, { action: "take_control" });
-  let sent = 0;
-  const timer = setInterval(() => {
-    const vx = Math.floor(sent / 100) % 2 ? -20e-6 : 20e-6;  // 2 s each way
-    send(command, { deadman: true, velocity_m_s: [vx, 0, 0] });
-    sent++;
-  }, 20);
+  const stopJog = jogAsOperator(c);
   return () => {
-    clearInterval(timer);
+    stopJog();
     c.close();
   };
 }
@@ -78,25 +63,8 @@ async function ticks(server) {
   const code = await server.exited;
   if (code !== 0) throw new Error(`serve exited with ${code}`);
   const name = readdirSync(server.dir).find((f) => f.endsWith(".mcap"));
-  const file = await open(join(server.dir, name), "r");
-  const reader = await McapIndexedReader.Initialize({
-    readable: {
-      size: async () => BigInt((await file.stat()).size),
-      read: async (offset, size) => {
-        const buf = Buffer.alloc(Number(size));
-        await file.read(buf, 0, buf.length, Number(offset));
-        return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
-      },
-    },
-  });
-  const t = [];
-  let t0 = null;
-  for await (const msg of reader.readMessages()) {
-    const s = JSON.parse(new TextDecoder().decode(msg.data));
-    t0 ??= s.t_s;
-    if (s.t_s >= t0 + 1) t.push(s.tick_us);
-  }
-  await file.close();
+  const samples = await readTelemetry(join(server.dir, name));
+  const t = samples.filter((s) => s.t_s >= samples[0].t_s + 1).map((s) => s.tick_us);
   rmSync(server.dir, { recursive: true, force: true });
   return { samples: t.length, p50: quantile(t, 0.5), p99: quantile(t, 0.99), max: Math.max(...t) };
 }

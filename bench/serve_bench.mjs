@@ -12,12 +12,11 @@
 // to the loop tick that applies the command) from the status the server publishes.
 import { spawn } from "node:child_process";
 import { existsSync, mkdtempSync, readdirSync, rmSync } from "node:fs";
-import { open } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import foxglove from "@foxglove/ws-protocol";
-import { McapIndexedReader } from "@mcap/core";
+import { jogAsOperator, quantile, readTelemetry } from "./serve_common.mjs";
 const { FoxgloveClient } = foxglove;
 
 const arg = (name, fallback) => {
@@ -63,18 +62,7 @@ function connect(topics) {
 }
 
 const controller = await connect(["/platform/status"]);
-const [commandCh, actionCh] = [
-  controller.client.advertise({ topic: "/console/command", encoding: "json", schemaName: "microcobot.Command" }),
-  controller.client.advertise({ topic: "/console/action", encoding: "json", schemaName: "microcobot.Action" }),
-];
-const send = (ch, obj) => controller.client.sendMessage(ch, new TextEncoder().encode(JSON.stringify(obj)));
-send(actionCh, { action: "take_control" });
-let sent = 0;
-const heartbeat = setInterval(() => {
-  const vx = Math.floor(sent / 100) % 2 ? -20e-6 : 20e-6;  // 2 s each way
-  send(commandCh, { deadman: true, velocity_m_s: [vx, 0, 0] });
-  sent++;
-}, 20);
+const stopJog = jogAsOperator(controller.client);
 
 const liveTime = async () => {
   const before = controller.status;
@@ -95,7 +83,7 @@ await sleep(phaseS * 1000);
 const perClientHz = observers.map((o, i) => (o.received - counted0[i]) / ((performance.now() - wall0) / 1000));
 const bEnd = await liveTime();
 const latency = controller.status.command_latency_ms;
-clearInterval(heartbeat);
+stopJog();
 for (const o of observers) o.client.close();
 controller.client.close();
 server.kill("SIGTERM");
@@ -107,29 +95,12 @@ if (code !== 0) {
 
 // The loop's tick times of each phase, from the recording.
 const name = readdirSync(dir).find((f) => f.endsWith(".mcap"));
-const file = await open(join(dir, name), "r");
-const reader = await McapIndexedReader.Initialize({
-  readable: {
-    size: async () => BigInt((await file.stat()).size),
-    read: async (offset, size) => {
-      const buf = Buffer.alloc(Number(size));
-      await file.read(buf, 0, buf.length, Number(offset));
-      return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
-    },
-  },
-});
 const ticks = { A: [], B: [] };
-for await (const msg of reader.readMessages()) {
-  const s = JSON.parse(new TextDecoder().decode(msg.data));
+for (const s of await readTelemetry(join(dir, name))) {
   if (s.t_s >= aStart + 1 && s.t_s < aEnd) ticks.A.push(s.tick_us);
   else if (s.t_s >= bStart + 1 && s.t_s < bEnd) ticks.B.push(s.tick_us);
 }
-await file.close();
 rmSync(dir, { recursive: true, force: true });
-const quantile = (v, q) => {
-  const s = [...v].sort((a, b) => a - b);
-  return s[Math.min(s.length - 1, Math.ceil(q * s.length) - 1)];
-};
 const result = {
   phase_s: phaseS,
   clients: nClients,

@@ -15,12 +15,27 @@ std::int64_t ros_time_ns() noexcept {
       .count();
 }
 
+/// What every remote device shares: the link, and the e-stop semantics of its lifecycle.
+/// Leaving operation (a fault, an e-stop, shutdown) latches the slave's e-stop; configure() from
+/// rest does not; activate() releases it.
+template <class Interface>
+class RemoteDevice : public Interface {
+ public:
+  RemoteDevice(std::string name, RemoteSlave& slave) : Interface(std::move(name)), slave_(slave) {}
+  void enter_safe_state() noexcept override {
+    if (this->active()) slave_.set_estop(true);
+  }
+
+ protected:
+  void on_activate() override { slave_.set_estop(false); }
+  RemoteSlave& slave_;
+};
+
 /// One axis of the remote stage: its measurements are the slave's latest pose.
-class RemoteSlaveAxis final : public platform::SlaveAxis {
+class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
  public:
   RemoteSlaveAxis(std::string name, RemoteSlave& slave, int index, const RemoteSlaveParams& p)
-      : SlaveAxis(std::move(name)),
-        slave_(slave),
+      : RemoteDevice(std::move(name), slave),
         index_(index),
         period_s_(p.sample_period_s),
         max_V_(p.max_voltage_V) {}
@@ -36,25 +51,16 @@ class RemoteSlaveAxis final : public platform::SlaveAxis {
   }
   bool measurement_fresh() const override { return slave_.fresh(); }
   void update(double) noexcept override {}
-  // Leaving operation (a fault, an e-stop, shutdown) latches the slave's e-stop; configure()
-  // from rest does not.
-  void enter_safe_state() noexcept override {
-    if (active()) slave_.set_estop(true);
-  }
-
- protected:
-  void on_activate() override { slave_.set_estop(false); }
 
  private:
-  RemoteSlave& slave_;
   int index_;
   double period_s_, max_V_;
 };
 
 /// The slave's gripper; its update() runs the link exchange once per tick.
-class RemoteGripper final : public platform::Gripper {
+class RemoteGripper final : public RemoteDevice<platform::Gripper> {
  public:
-  RemoteGripper(std::string name, RemoteSlave& slave) : Gripper(std::move(name)), slave_(slave) {}
+  using RemoteDevice::RemoteDevice;
   void command_opening_m(double opening) noexcept override {
     if (active()) slave_.set_gripper_target(opening);
   }
@@ -65,17 +71,6 @@ class RemoteGripper final : public platform::Gripper {
     return {f[0], f[1], f[2]};
   }
   void update(double dt_s) noexcept override { slave_.exchange(dt_s); }
-  // Leaving operation (a fault, an e-stop, shutdown) latches the slave's e-stop; configure()
-  // from rest does not.
-  void enter_safe_state() noexcept override {
-    if (active()) slave_.set_estop(true);
-  }
-
- protected:
-  void on_activate() override { slave_.set_estop(false); }
-
- private:
-  RemoteSlave& slave_;
 };
 
 }  // namespace

@@ -1,0 +1,44 @@
+// What the serve benchmarks share (serve_bench.mjs, link_bench.mjs): the controlling operator's
+// jog, the telemetry read back from a recording, quantiles.
+import { open } from "node:fs/promises";
+import { McapIndexedReader } from "@mcap/core";
+
+// Takes control on a connected FoxgloveClient and jogs the stage back and forth at 20 um/s
+// (deadman held) at 50 Hz, the console's heartbeat. Returns the function that stops it.
+export function jogAsOperator(client) {
+  const command = client.advertise({ topic: "/console/command", encoding: "json", schemaName: "microcobot.Command" });
+  const action = client.advertise({ topic: "/console/action", encoding: "json", schemaName: "microcobot.Action" });
+  const send = (ch, obj) => client.sendMessage(ch, new TextEncoder().encode(JSON.stringify(obj)));
+  send(action, { action: "take_control" });
+  let sent = 0;
+  const timer = setInterval(() => {
+    const vx = Math.floor(sent / 100) % 2 ? -20e-6 : 20e-6;  // 2 s each way
+    send(command, { deadman: true, velocity_m_s: [vx, 0, 0] });
+    sent++;
+  }, 20);
+  return () => clearInterval(timer);
+}
+
+// Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader).
+export async function readTelemetry(path) {
+  const file = await open(path, "r");
+  const reader = await McapIndexedReader.Initialize({
+    readable: {
+      size: async () => BigInt((await file.stat()).size),
+      read: async (offset, size) => {
+        const buf = Buffer.alloc(Number(size));
+        await file.read(buf, 0, buf.length, Number(offset));
+        return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
+      },
+    },
+  });
+  const samples = [];
+  for await (const msg of reader.readMessages()) samples.push(JSON.parse(new TextDecoder().decode(msg.data)));
+  await file.close();
+  return samples;
+}
+
+export const quantile = (v, q) => {
+  const s = [...v].sort((a, b) => a - b);
+  return s[Math.min(s.length - 1, Math.ceil(q * s.length) - 1)];
+};
