@@ -4,7 +4,7 @@
  * name, and prints what it reads. The wire-compatibility test (wire_compat_test.cc) checks the
  * values against what `microcobot link ping` publishes.
  *
- *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|joint|bool
+ *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|joint|bool|diag
  *                 [--count K] [--timeout S] [--ready-file PATH]
  *
  * Waits for K samples (default 1) and prints each as one JSON line on stdout, then exits 0.
@@ -15,7 +15,8 @@
  * Same middleware configuration as the platform (loopback, no multicast, unicast discovery on
  * 127.0.0.1), same QoS as its publishers: state topics best effort, volatile, keep last 1; the
  * latched topics (bool: /microcobot/estop, /microcobot/master/engaged) reliable, transient
- * local, keep last 1 so that the current state arrives even when published before the start.
+ * local, keep last 1 so that the current state arrives even when published before the start;
+ * /diagnostics (diag) reliable, volatile, keep last 1.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -42,7 +43,7 @@ static const char kLoopbackConfig[] =
     "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
     "</Discovery>";
 
-enum MsgType { kPose, kWrench, kJoint, kBool };
+enum MsgType { kPose, kWrench, kJoint, kBool, kDiag };
 
 struct Options {
   long domain;
@@ -55,7 +56,7 @@ struct Options {
 
 static int usage(const char* msg, const char* arg) {
   fprintf(stderr,
-          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|joint|bool "
+          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|joint|bool|diag "
           "[--count K] [--timeout S] [--ready-file PATH])\n",
           msg, arg ? ": " : "", arg ? arg : "");
   return 2;
@@ -106,8 +107,10 @@ static int parse_args(int argc, char** argv, struct Options* o, int* rc) {
         o->type = kJoint;
       } else if (strcmp(value, "bool") == 0) {
         o->type = kBool;
+      } else if (strcmp(value, "diag") == 0) {
+        o->type = kDiag;
       } else {
-        *rc = usage("--type must be pose, wrench, joint or bool", value);
+        *rc = usage("--type must be pose, wrench, joint, bool or diag", value);
         return 0;
       }
       have_type = 1;
@@ -229,6 +232,23 @@ static void print_sample(const struct Options* o, const char* type_name, const v
       put_doubles(m->effort_._buffer, m->effort_._length);
       break;
     }
+    case kDiag: {
+      const diagnostic_msgs_msg_dds__DiagnosticArray_* m = sample;
+      put_header(o->topic, type_name, &m->header_);
+      fputs(",\"status\":[", stdout);
+      for (uint32_t i = 0; i < m->status_._length; ++i) {
+        const diagnostic_msgs_msg_dds__DiagnosticStatus_* st = &m->status_._buffer[i];
+        printf("%s{\"level\":%u,\"name\":", i ? "," : "", (unsigned)st->level_);
+        put_string(st->name_);
+        fputs(",\"message\":", stdout);
+        put_string(st->message_);
+        fputs(",\"hardware_id\":", stdout);
+        put_string(st->hardware_id_);
+        printf(",\"values\":%u}", (unsigned)st->values_._length);
+      }
+      putchar(']');
+      break;
+    }
     case kBool: {
       const std_msgs_msg_dds__Bool_* m = sample;
       fputs("{\"topic\":", stdout);
@@ -255,6 +275,8 @@ static const dds_topic_descriptor_t* descriptor(enum MsgType t) {
       return &sensor_msgs_msg_dds__JointState__desc;
     case kBool:
       return &std_msgs_msg_dds__Bool__desc;
+    case kDiag:
+      return &diagnostic_msgs_msg_dds__DiagnosticArray__desc;
   }
   return NULL;
 }
@@ -290,6 +312,9 @@ static int run_listener(const struct Options* o) {
   if (o->type == kBool) {
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  } else if (o->type == kDiag) {
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
   } else {
     dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);

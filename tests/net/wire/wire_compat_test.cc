@@ -201,6 +201,66 @@ TEST(WireCompat, ACProgramFromTheRos2IdlReadsThePlatformsTopics) {
   }
 }
 
+// The slave of a distributed platform (`serve --role slave`) publishes its measurements and
+// device states from the start, with or without a master: the listener reads them by their ROS 2
+// names, with the values of a stage at rest (the gripper above the part, nothing touched).
+TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
+  TempDir dir;
+  Reaper reaper;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+  std::vector<Listener> listeners{{"/microcobot/slave/pose", "pose", 5},
+                                  {"/microcobot/slave/contact_wrench", "wrench", 5},
+                                  {"/microcobot/slave/grip_wrench", "wrench", 5},
+                                  {"/diagnostics", "diag", 2}};
+  for (std::size_t k = 0; k < listeners.size(); ++k) {
+    Listener& l = listeners[k];
+    const std::string n = std::to_string(k);
+    l.out = dir / ("listener" + n + ".out");
+    l.err = dir / ("listener" + n + ".err");
+    l.pid = test::spawn_process({MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", l.topic, "--type", l.type,
+                                 "--count", std::to_string(l.count), "--timeout", "40"},
+                                l.out, l.err);
+    reaper.pids.push_back(l.pid);
+  }
+  const pid_t slave = test::spawn_process({MC_CLI_PATH, "serve", "--role", "slave", "--domain", domain, "--listen",
+                                           "127.0.0.1:0", "--out", (dir / "slave").string(), "--duration", "60"},
+                                          dir / "slave.out", dir / "slave.err");
+  reaper.pids.push_back(slave);
+  for (Listener& l : listeners) {
+    ASSERT_EQ(test::wait_process(l.pid, std::chrono::seconds(50)), 0) << l.topic << ": " << test::read_text(l.err);
+    l.samples = json_lines(test::read_text(l.out));
+    ASSERT_EQ(l.samples.size(), static_cast<std::size_t>(l.count)) << l.topic;
+  }
+  ::kill(slave, SIGTERM);
+  EXPECT_EQ(test::wait_process(slave, std::chrono::seconds(30)), 0) << test::read_text(dir / "slave.err");
+
+  for (const json& s : listeners[0].samples) {
+    EXPECT_EQ(s["frame_id"], "microcobot_stage") << s;
+    for (double x : s["position"].get<std::vector<double>>()) EXPECT_LT(std::abs(x), 1e-6) << "at home: " << s;
+  }
+  for (const Listener& l : {listeners[1], listeners[2]}) {
+    for (const json& s : l.samples) {
+      EXPECT_EQ(s["type"], "geometry_msgs::msg::dds_::WrenchStamped_") << s;
+      EXPECT_EQ(s["frame_id"], "microcobot_stage") << s;
+      EXPECT_EQ(s["force"], json::parse("[0, 0, 0]")) << "nothing touched: " << s;
+      EXPECT_EQ(s["torque"], json::parse("[0, 0, 0]")) << s;
+    }
+  }
+  const char* devices[] = {"microcobot/slave/axis_x", "microcobot/slave/axis_y", "microcobot/slave/axis_z",
+                           "microcobot/slave/gripper"};
+  for (const json& s : listeners[3].samples) {
+    EXPECT_EQ(s["type"], "diagnostic_msgs::msg::dds_::DiagnosticArray_") << s;
+    ASSERT_EQ(s["status"].size(), 4u) << s;
+    for (std::size_t i = 0; i < 4; ++i) {
+      const json& st = s["status"][i];
+      EXPECT_EQ(st["name"], devices[i]) << st;
+      EXPECT_EQ(st["level"], 0) << "OK: " << st;
+      EXPECT_EQ(st["message"], "active") << st;
+      EXPECT_EQ(st["hardware_id"], "microcobot_slave") << st;
+    }
+  }
+}
+
 TEST(WireCompat, TheListenerTimesOutWithOneLine) {
   // This test's own domain, nothing published on it.
   TempDir dir;
