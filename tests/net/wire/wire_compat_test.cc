@@ -217,17 +217,19 @@ TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
     const std::string n = std::to_string(k);
     l.out = dir / ("listener" + n + ".out");
     l.err = dir / ("listener" + n + ".err");
-    l.pid = test::spawn_process({MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", l.topic, "--type", l.type,
-                                 "--count", std::to_string(l.count), "--timeout", "40"},
+    l.pid = test::spawn_process({MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", l.topic, "--type",
+                                 l.type, "--count", std::to_string(l.count), "--timeout", "40"},
                                 l.out, l.err);
     reaper.pids.push_back(l.pid);
   }
-  const pid_t slave = test::spawn_process({MC_CLI_PATH, "serve", "--role", "slave", "--domain", domain, "--listen",
-                                           "127.0.0.1:0", "--out", (dir / "slave").string(), "--duration", "60"},
-                                          dir / "slave.out", dir / "slave.err");
+  const pid_t slave =
+      test::spawn_process({MC_CLI_PATH, "serve", "--role", "slave", "--domain", domain, "--listen",
+                           "127.0.0.1:0", "--out", (dir / "slave").string(), "--duration", "60"},
+                          dir / "slave.out", dir / "slave.err");
   reaper.pids.push_back(slave);
   for (Listener& l : listeners) {
-    ASSERT_EQ(test::wait_process(l.pid, std::chrono::seconds(50)), 0) << l.topic << ": " << test::read_text(l.err);
+    ASSERT_EQ(test::wait_process(l.pid, std::chrono::seconds(50)), 0)
+        << l.topic << ": " << test::read_text(l.err);
     l.samples = json_lines(test::read_text(l.out));
     ASSERT_EQ(l.samples.size(), static_cast<std::size_t>(l.count)) << l.topic;
   }
@@ -236,7 +238,8 @@ TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
 
   for (const json& s : listeners[0].samples) {
     EXPECT_EQ(s["frame_id"], "microcobot_stage") << s;
-    for (double x : s["position"].get<std::vector<double>>()) EXPECT_LT(std::abs(x), 1e-6) << "at home: " << s;
+    for (double x : s["position"].get<std::vector<double>>())
+      EXPECT_LT(std::abs(x), 1e-6) << "at home: " << s;
   }
   for (const Listener& l : {listeners[1], listeners[2]}) {
     for (const json& s : l.samples) {
