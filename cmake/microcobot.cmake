@@ -41,10 +41,12 @@ function(mc_embed_report_assets target)
   target_sources(${target} PRIVATE ${_out})
 endfunction()
 
-# mc_add_module_tests(NAME [LIBS ...] [LABELS ...])
-# Every tests/NAME/*_test.cc goes into the executable NAME_tests, registered with CTest.
+# mc_add_module_tests(NAME [LIBS ...] [LABELS ...] [SERIAL gtest-filter])
+# Every tests/NAME/*_test.cc goes into the executable NAME_tests, registered with CTest. Tests
+# matching SERIAL run alone (RUN_SERIAL): tests that load both cores (e.g. two real-time loops in
+# two processes) would otherwise starve whatever ctest -j runs beside them.
 function(mc_add_module_tests name)
-  cmake_parse_arguments(ARG "" "" "LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "SERIAL" "LIBS;LABELS" ${ARGN})
   file(GLOB _sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${name}/*_test.cc)
   if(NOT _sources OR (NOT TARGET mc_${name} AND NOT name MATCHES "^(cli|acceptance)$"))
     return()
@@ -57,8 +59,15 @@ function(mc_add_module_tests name)
     MC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     MC_CLI_PATH="$<TARGET_FILE:microcobot_cli>")
   add_dependencies(${name}_tests microcobot_cli)
-  gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS "${name};${ARG_LABELS}")
+  if(ARG_SERIAL)
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "-${ARG_SERIAL}"
+      PROPERTIES LABELS "${name};${ARG_LABELS}")
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "${ARG_SERIAL}"
+      PROPERTIES LABELS "${name};${ARG_LABELS}" RUN_SERIAL TRUE)
+  else()
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60
+      PROPERTIES LABELS "${name};${ARG_LABELS}")
+  endif()
 endfunction()
 
 # Embeds the live console's page, script and style (web/console.*) into `target`, so that

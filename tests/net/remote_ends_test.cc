@@ -156,7 +156,9 @@ void moves_the_slave_without_allocating(Pair& pair) {
   EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
 }
 
-// A sample from the peer's side of the link, once the two links have matched.
+// A sample from the peer's side of the link, once the two links have matched. It is sent until
+// `received()` sees it; the copies still in flight then are given time to land and taken by one
+// more `received()`, so that none arrives later, in the middle of a test's timed ticks.
 template <class Received>
 void deliver(Link& from, Channel channel, std::array<double, 3> xyz, double scalar, Received received) {
   NetSample s;
@@ -166,6 +168,8 @@ void deliver(Link& from, Channel channel, std::array<double, 3> xyz, double scal
   s.scalar = scalar;
   ASSERT_TRUE(test::wait_until([&] { return from.peer_matched(); }, 20.0)) << "no peer";
   ASSERT_TRUE(test::wait_until([&] { return (from.send(s), received()); }, 20.0)) << "nothing arrived";
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  received();
 }
 
 TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
