@@ -119,7 +119,7 @@ py::dict experiment(const std::string& name, py::handle params) {
 /// linear between samples: ActuatorModel::step(state, u)). The axes are spread over `threads`
 /// std::threads with the GIL released; outputs are written into arrays allocated before.
 py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray& voltages, int threads,
-                 py::handle operating_point, py::object out) {
+                 py::handle operating_point, py::object out, py::object out_x1) {
   const ss::ActuatorModel m = model_from(params, std::nullopt);
   check_array(voltages, "voltages", 2);
   const auto n = static_cast<std::size_t>(voltages.shape(0));
@@ -168,21 +168,28 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
     for (auto& s : states) m.set_operating_point(s, std::get<0>(op), std::get<1>(op), dir);
   }
 
-  py::array_t<double> x2;
-  if (out.is_none()) {
-    x2 = py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(steps)});
-  } else {
-    // Caller-owned output (as MuJoCo's rollout): float64, C-contiguous, shape (N, T), written in place.
-    if (!py::isinstance<py::array_t<double>>(out)) throw InvalidInput("out: expected a float64 numpy array");
-    x2 = out.cast<py::array_t<double>>();
-    if (x2.ndim() != 2 || static_cast<std::size_t>(x2.shape(0)) != n ||
-        static_cast<std::size_t>(x2.shape(1)) != steps || !(x2.flags() & py::array::c_style) ||
-        !x2.writeable()) {
-      throw InvalidInput("out: expected a writeable C-contiguous float64 array of shape (" +
+  // Caller-owned outputs (as MuJoCo's rollout): float64, C-contiguous, shape (N, T), written in
+  // place; a caller that reuses them across calls saves the first-touch page faults of fresh ones.
+  const auto output = [&](const py::object& given, const char* name) {
+    if (given.is_none()) return py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(steps)});
+    if (!py::isinstance<py::array_t<double>>(given)) {
+      throw InvalidInput(std::string(name) + ": expected a float64 numpy array");
+    }
+    auto a = given.cast<py::array_t<double>>();
+    if (a.ndim() != 2 || static_cast<std::size_t>(a.shape(0)) != n || static_cast<std::size_t>(a.shape(1)) != steps ||
+        !(a.flags() & py::array::c_style) || !a.writeable()) {
+      throw InvalidInput(std::string(name) + ": expected a writeable C-contiguous float64 array of shape (" +
                          std::to_string(n) + ", " + std::to_string(steps) + ")");
     }
+    return a;
+  };
+  py::array_t<double> x2 = output(out, "out");
+  py::array_t<double> x1 = output(out_x1, "out_x1");
+  const double* const x2_begin = x2.data();
+  const double* const x1_begin = x1.data();
+  if (n * steps > 0 && x1_begin < x2_begin + n * steps && x2_begin < x1_begin + n * steps) {
+    throw InvalidInput("out_x1: must not share memory with out");
   }
-  py::array_t<double> x1({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(steps)});
   const double* u = voltages.data();
   double* x2_out = x2.mutable_data();
   double* x1_out = x1.mutable_data();
@@ -409,13 +416,13 @@ void bind_stickslip(py::module_& m) {
   m.def("experiment_names", &ss::experiment_names, "Names experiment() accepts.");
   m.def(
       "rollout", &rollout, "params"_a, "initial_states"_a, "voltages"_a, "threads"_a = 1,
-      "operating_point"_a = py::none(), "out"_a = py::none(),
+      "operating_point"_a = py::none(), "out"_a = py::none(), "out_x1"_a = py::none(),
       "N independent axes driven by voltages[N, T] [V] (one sample per model step, linear between samples). "
       "initial_states: None, slider positions [m] of shape (N,), or N ActuatorState. operating_point: "
       "(amplitude_V, frequency_Hz, direction) for z_ba. The GIL is released and the axes spread over "
       "`threads` "
       "threads (0: one per core). Returns {'t_s' (T,), 'x1_m' (N, T), 'x2_m' (N, T), 'states' (final)}; "
-      "x2_m is `out` when given (float64, C-contiguous, (N, T)).");
+      "x2_m is `out` and x1_m is `out_x1` when given (float64, C-contiguous, (N, T), written in place).");
 }
 
 void bind_identify(py::module_& m) {

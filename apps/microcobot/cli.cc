@@ -119,7 +119,30 @@ bool is_numeric_array(const nlohmann::json& j) {
   return true;
 }
 
-/// The numbers and numeric arrays of a JSON summary as .mat variables (key paths joined by '_').
+/// A non-empty array of numeric arrays of one length (e.g. a filter's second-order sections).
+bool is_numeric_matrix(const nlohmann::json& j) {
+  if (!j.is_array() || j.empty() || !is_numeric_array(j.front())) return false;
+  for (const auto& row : j) {
+    if (!is_numeric_array(row) || row.size() != j.front().size()) return false;
+  }
+  return true;
+}
+
+/// Rows of a JSON matrix as a rows x cols .mat variable (column-major).
+mc::MatArray matrix(const std::string& name, const nlohmann::json& rows) {
+  mc::MatArray a;
+  a.name = name;
+  a.rows = rows.size();
+  a.cols = rows.front().size();
+  a.data.resize(a.rows * a.cols);
+  for (std::size_t r = 0; r < a.rows; ++r) {
+    for (std::size_t c = 0; c < a.cols; ++c) a.data[r + c * a.rows] = rows[r][c].get<double>();
+  }
+  return a;
+}
+
+/// The numbers and numeric arrays (vectors and matrices) of a JSON summary as .mat variables
+/// (key paths joined by '_').
 void collect_mat(const nlohmann::json& j, const std::string& prefix, std::vector<mc::MatArray>& out) {
   for (const auto& [key, v] : j.items()) {
     std::string name = prefix.empty() ? key : prefix + "_" + key;
@@ -133,6 +156,8 @@ void collect_mat(const nlohmann::json& j, const std::string& prefix, std::vector
       out.push_back(mc::MatArray::scalar(name, v.get<bool>() ? 1.0 : 0.0));
     } else if (is_numeric_array(v)) {
       out.push_back(mc::MatArray::column(name, v.get<std::vector<double>>()));
+    } else if (is_numeric_matrix(v)) {
+      out.push_back(matrix(name, v));
     } else if (v.is_object()) {
       collect_mat(v, name, out);
     }
@@ -159,16 +184,23 @@ bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
   return true;
 }
 
-void write_result_table(const CommonOptions& opts, const std::string& csv_name, const mc::CsvTable& table,
-                        const nlohmann::json& summary) {
+void write_result_tables(const CommonOptions& opts, const std::vector<ResultTable>& tables,
+                         const nlohmann::json& summary) {
   if (!opts.out) return;
   std::vector<std::pair<std::string, std::vector<double>>> columns;
-  for (std::size_t i = 0; i < table.cols(); ++i) {
-    columns.emplace_back(table.names()[i], table.column(i));
+  for (const auto& t : tables) {
+    for (std::size_t i = 0; i < t.table.cols(); ++i) {
+      columns.emplace_back(t.mat_prefix + t.table.names()[i], t.table.column(i));
+    }
   }
   if (write_results_mat(opts, summary, columns)) return;
   mc::ensure_writable_dir(*opts.out);
-  mc::write_csv(*opts.out / csv_name, table);
+  for (const auto& t : tables) mc::write_csv(*opts.out / t.csv_name, t.table, t.comments);
+}
+
+void write_result_table(const CommonOptions& opts, const std::string& csv_name, const mc::CsvTable& table,
+                        const nlohmann::json& summary) {
+  write_result_tables(opts, {{csv_name, table, "", {}}}, summary);
 }
 
 void add_params_option(CLI::App& cmd, CommonOptions& opts) {

@@ -77,6 +77,18 @@ bool write_results_mat(const CommonOptions& opts, const nlohmann::json& summary,
 /// write_results_mat() does. Nothing without --out.
 void write_result_table(const CommonOptions& opts, const std::string& csv_name, const mc::CsvTable& table,
                         const nlohmann::json& summary);
+/// One result table under --out: DIR/`csv_name` (with `comments` as '#' lines), or with
+/// --format mat its columns in results.mat, named `mat_prefix` + the column's name.
+struct ResultTable {
+  std::string csv_name;
+  const mc::CsvTable& table;
+  std::string mat_prefix;
+  std::vector<std::string> comments;
+};
+/// Several result tables: each to its CSV file, or all of them and the summary's numbers to one
+/// results.mat (write_results_mat()). Nothing without --out.
+void write_result_tables(const CommonOptions& opts, const std::vector<ResultTable>& tables,
+                         const nlohmann::json& summary);
 /// Adds `--params FILE` to `cmd`.
 void add_params_option(CLI::App& cmd, CommonOptions& opts);
 

@@ -1,9 +1,11 @@
 // `microcobot dsp`: the signal and system toolkit on the command line (issue #3).
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include <cstdio>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -77,6 +79,7 @@ void add_dsp(CLI::App& group) {
     cmd->add_option("--type", o->type, "low|high|lr4-low|lr4-high")
         ->check(CLI::IsMember({"low", "high", "lr4-low", "lr4-high"}));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       mc::dsp::Sos sos;
       if (o->type.rfind("lr4-", 0) == 0) {
@@ -86,7 +89,17 @@ void add_dsp(CLI::App& group) {
       }
       nlohmann::json rows = nlohmann::json::array();
       for (const auto& s : sos) rows.push_back(s.row());
-      mc::cli::emit(o->common, {{"sos", rows}});
+      const nlohmann::json j{{"sos", rows}};
+      // One row per section, scipy's layout: b0 b1 b2 a0 a1 a2 (results.mat: also `sos`, N x 6).
+      mc::CsvTable t;
+      const char* names[] = {"b0", "b1", "b2", "a0", "a1", "a2"};
+      for (std::size_t c = 0; c < 6; ++c) {
+        std::vector<double> column;
+        for (const auto& row : rows) column.push_back(row[c].get<double>());
+        t.add_column(names[c], column);
+      }
+      mc::cli::write_result_table(o->common, "sos.csv", t, j);
+      mc::cli::emit(o->common, j);
     });
   }
   {
@@ -103,10 +116,16 @@ void add_dsp(CLI::App& group) {
     cmd->add_option("--column", o->column, "Column name")->required();
     add_welch_flags(cmd, o->w);
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->column});
       const auto p = mc::dsp::welch(table.column(o->column), to_options(o->w));
-      mc::cli::emit(o->common, {{"f_Hz", p.f_Hz}, {"psd", p.value}});
+      const nlohmann::json j{{"f_Hz", p.f_Hz}, {"psd", p.value}};
+      mc::CsvTable t;
+      t.add_column("f_Hz", p.f_Hz);
+      t.add_column("psd", p.value);
+      mc::cli::write_result_table(o->common, "psd.csv", t, j);
+      mc::cli::emit(o->common, j);
     });
   }
   {
@@ -124,6 +143,7 @@ void add_dsp(CLI::App& group) {
     cmd->add_option("--output", o->output, "Output column")->required();
     add_welch_flags(cmd, o->w);
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->input, o->output});
       const auto e = mc::dsp::frf_h1(table.column(o->input), table.column(o->output), to_options(o->w));
@@ -132,6 +152,12 @@ void add_dsp(CLI::App& group) {
         re[i] = e.h[i].real();
         im[i] = e.h[i].imag();
       }
+      mc::CsvTable t;
+      t.add_column("f_Hz", e.f_Hz);
+      t.add_column("re", re);
+      t.add_column("im", im);
+      t.add_column("coherence", e.coherence);
+      mc::cli::write_result_table(o->common, "frf.csv", t, nlohmann::json::object());
       if (o->common.json) {
         mc::cli::emit(o->common, {{"f_Hz", e.f_Hz}, {"re", re}, {"im", im}, {"coherence", e.coherence}});
         return;
@@ -152,9 +178,13 @@ void add_dsp(CLI::App& group) {
     auto* cmd = group.add_subcommand("mls", "Maximum-length sequence of 0/1 (scipy.signal.max_len_seq)");
     cmd->add_option("--bits", o->bits, "Register length 2..32")->required()->check(mc::cli::Range(2, 32));
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       if (o->bits > 24) throw mc::UsageError("--bits: at most 24 on the command line (2^24 - 1 values)");
       const auto seq = mc::dsp::max_len_seq(o->bits);
+      mc::CsvTable t;
+      t.add_column("seq", std::vector<double>(seq.begin(), seq.end()));
+      mc::cli::write_result_table(o->common, "mls.csv", t, nlohmann::json::object());
       mc::cli::emit(o->common, {{"seq", seq}}, fmt::format("MLS of {} values", seq.size()));
     });
   }
@@ -174,6 +204,7 @@ void add_dsp(CLI::App& group) {
     cmd->add_option("--fmin", o->fmin, "Band start (Hz)")->check(mc::cli::NonNegativeNumber);
     cmd->add_option("--fmax", o->fmax, "Band end (Hz)")->check(mc::cli::PositiveNumber);
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       if (o->nz > o->np) throw mc::UsageError("--nz must not exceed --np");
       const auto table = mc::read_csv(o->in);
@@ -183,10 +214,23 @@ void add_dsp(CLI::App& group) {
       fo.fmin_Hz = o->fmin;
       fo.fmax_Hz = o->fmax;
       const auto fit = mc::ident::fit_tf(table.column("f_Hz"), read_frf(table), fo);
-      mc::cli::emit(o->common, {{"num", fit.tf.num()},
-                                {"den", fit.tf.den()},
-                                {"relative_rms_error", fit.relative_rms_error},
-                                {"points", fit.points}});
+      const nlohmann::json j{{"num", fit.tf.num()},
+                             {"den", fit.tf.den()},
+                             {"relative_rms_error", fit.relative_rms_error},
+                             {"points", fit.points}};
+      // tf.csv: one row per power of s, highest first; num padded with leading zeros to den's
+      // length (np.polyval and scipy.signal take it as it is).
+      const auto& den = fit.tf.den();
+      const auto& num = fit.tf.num();
+      std::vector<double> power(den.size()), padded(den.size(), 0.0);
+      for (std::size_t k = 0; k < den.size(); ++k) power[k] = static_cast<double>(den.size() - 1 - k);
+      std::copy(num.begin(), num.end(), padded.end() - static_cast<std::ptrdiff_t>(num.size()));
+      mc::CsvTable t;
+      t.add_column("power", power);
+      t.add_column("num", padded);
+      t.add_column("den", den);
+      mc::cli::write_result_table(o->common, "tf.csv", t, j);
+      mc::cli::emit(o->common, j);
     });
   }
   {
@@ -203,6 +247,7 @@ void add_dsp(CLI::App& group) {
     cmd->add_option("--fmax", o->fmax, "Highest band centre (Hz), default the data's")
         ->check(mc::cli::PositiveNumber);
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_csv(o->in);
       const auto& f = table.column("f_Hz");
@@ -226,7 +271,12 @@ void add_dsp(CLI::App& group) {
         throw mc::InvalidInput(o->in, 0, msg);
       }
       const auto b = mc::dsp::third_octave_average(f, read_frf(table), lo, hi);
-      mc::cli::emit(o->common, {{"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB}});
+      const nlohmann::json j{{"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB}};
+      mc::CsvTable t;
+      t.add_column("fc_Hz", b.fc_Hz);
+      t.add_column("mag_dB", b.mag_dB);
+      mc::cli::write_result_table(o->common, "octave.csv", t, j);
+      mc::cli::emit(o->common, j);
     });
   }
 }

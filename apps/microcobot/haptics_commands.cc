@@ -129,7 +129,7 @@ nlohmann::json identify_json(const hp::IdentificationResult& id) {
           {"hf_delay_s", id.hf_delay_s}};
 }
 
-void write_frf(const std::filesystem::path& file, const hp::ChannelFrf& f) {
+mc::CsvTable frf_table(const hp::ChannelFrf& f) {
   mc::CsvTable t;
   std::vector<double> mag, ph;
   for (const auto& h : f.h) {
@@ -140,7 +140,7 @@ void write_frf(const std::filesystem::path& file, const hp::ChannelFrf& f) {
   t.add_column("mag_dB", mag);
   t.add_column("phase_deg", ph);
   t.add_column("coherence", f.coherence);
-  mc::write_csv(file, t);
+  return t;
 }
 
 void run_identify(const mc::cli::CommonOptions& o) {
@@ -148,9 +148,9 @@ void run_identify(const mc::cli::CommonOptions& o) {
   const hp::DualStagePlant plant(p.plant);
   const auto id = hp::identify(plant, hp::IdentificationOptions{});
   if (o.out) {
-    mc::ensure_writable_dir(*o.out);
-    write_frf(*o.out / "frf_lf.csv", id.lf);
-    write_frf(*o.out / "frf_hf.csv", id.hf);
+    const mc::CsvTable lf = frf_table(id.lf), hf = frf_table(id.hf);
+    mc::cli::write_result_tables(o, {{"frf_lf.csv", lf, "lf_", {}}, {"frf_hf.csv", hf, "hf_", {}}},
+                                 identify_json(id));
     Report r("haptics identify");
     identify_report(r, id);
     mc::cli::write_report_if_requested(o, r);
@@ -219,8 +219,7 @@ void run_evaluate(const mc::cli::CommonOptions& o) {
     j[name] = *values;
   }
   if (o.out) {
-    mc::ensure_writable_dir(*o.out);
-    mc::write_csv(*o.out / "evaluation.csv", t, {"microcobot haptics evaluate"});
+    mc::cli::write_result_tables(o, {{"evaluation.csv", t, "", {"microcobot haptics evaluate"}}}, j);
     Report r("haptics evaluate");
     evaluate_report(r, ev, rp);
     mc::cli::write_report_if_requested(o, r);
@@ -317,21 +316,6 @@ void run_tweezers(const TweezersCmd& c) {
   const HapticsParams p = load(c.common);
   const TweezersOut t = run_tweezers_core(p, sc, c.duration_s);
   const bool contact = sc == mw::TweezersScenario::kContact;
-  if (c.common.out) {
-    mc::ensure_writable_dir(*c.common.out);
-    mc::CsvTable tab;
-    tab.add_column("t_s", t.rec.t_s);
-    tab.add_column("bead_y_m", t.rec.bead_y_m);
-    tab.add_column("trap_y_m", t.rec.trap_y_m);
-    tab.add_column("force_y_N", t.rec.force_y_N);
-    tab.add_column("hand_force_N", t.rec.hand_force_N);
-    tab.add_column("accel_m_s2", t.accel);
-    mc::write_csv(*c.common.out / "tweezers.csv", tab,
-                  {"microcobot haptics tweezers --scenario " + c.scenario});
-    Report r("haptics tweezers");
-    tweezers_report(r, t, contact);
-    mc::cli::write_report_if_requested(c.common, r);
-  }
   nlohmann::json j{{"r2", t.stats.r2},
                    {"kurtosis", t.stats.kurtosis},
                    {"corner_Hz", t.corner_Hz},
@@ -340,6 +324,20 @@ void run_tweezers(const TweezersCmd& c) {
   if (contact) {
     j["contact_time_s"] = t.rec.contact_time_s;
     j["force_peak_time_s"] = t.peak_time_s;
+  }
+  if (c.common.out) {
+    mc::CsvTable tab;
+    tab.add_column("t_s", t.rec.t_s);
+    tab.add_column("bead_y_m", t.rec.bead_y_m);
+    tab.add_column("trap_y_m", t.rec.trap_y_m);
+    tab.add_column("force_y_N", t.rec.force_y_N);
+    tab.add_column("hand_force_N", t.rec.hand_force_N);
+    tab.add_column("accel_m_s2", t.accel);
+    mc::cli::write_result_tables(
+        c.common, {{"tweezers.csv", tab, "", {"microcobot haptics tweezers --scenario " + c.scenario}}}, j);
+    Report r("haptics tweezers");
+    tweezers_report(r, t, contact);
+    mc::cli::write_report_if_requested(c.common, r);
   }
   mc::cli::emit(c.common, j);
 }
@@ -360,14 +358,19 @@ void add_haptics(CLI::App& group) {
   add_verb(group, "params", "Print the default parameters (plant, pipeline, trap)", *params)
       ->callback([params] { mc::cli::emit(*params, mc::params_to_json(load(*params))); });
   auto identify = std::make_shared<mc::cli::CommonOptions>();
-  add_verb(group, "identify", "PRBS identification of both channels and the cut-off (§3.4.2)", *identify)
-      ->callback([identify] { run_identify(*identify); });
+  auto* id_cmd =
+      add_verb(group, "identify", "PRBS identification of both channels and the cut-off (§3.4.2)", *identify);
+  mc::cli::add_format_option(*id_cmd, *identify);
+  id_cmd->callback([identify] { run_identify(*identify); });
   auto evaluate = std::make_shared<mc::cli::CommonOptions>();
-  add_verb(group, "evaluate", "1/3-octave sine-dwell evaluation of the pipeline (Fig. 3.13)", *evaluate)
-      ->callback([evaluate] { run_evaluate(*evaluate); });
+  auto* ev_cmd =
+      add_verb(group, "evaluate", "1/3-octave sine-dwell evaluation of the pipeline (Fig. 3.13)", *evaluate);
+  mc::cli::add_format_option(*ev_cmd, *evaluate);
+  ev_cmd->callback([evaluate] { run_evaluate(*evaluate); });
   auto tweezers = std::make_shared<TweezersCmd>();
   auto* cmd = add_verb(group, "tweezers", "Optical-tweezers recording replayed on the interface (§3.5.2)",
                        tweezers->common);
+  mc::cli::add_format_option(*cmd, tweezers->common);
   cmd->add_option("--scenario", tweezers->scenario, "brownian or contact")
       ->check(CLI::IsMember({"brownian", "contact"}));
   cmd->add_option("--duration", tweezers->duration_s, "Recording length (s)")

@@ -465,10 +465,12 @@ void add_stickslip(CLI::App& group) {
         ->required()
         ->check(CLI::IsMember(ss::experiment_names()));
     mc::cli::add_output_options(*cmd, *o);
+    mc::cli::add_format_option(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->callback([o, name] {
       Report r("stickslip experiment " + *name);
       const auto j = run_experiment(*name, load(*o), r);
+      mc::cli::write_results_mat(*o, j);  // --format mat: the summary's numbers and arrays
       mc::cli::write_report_if_requested(*o, r);
       mc::cli::emit(*o, j);
     });

@@ -74,22 +74,21 @@ void identify_section(Report& rep, const tw::BandwidthIdentResult& r) {
 void run_identify(const CommonOptions& o) {
   const auto cfg = load(o);
   const auto r = tw::identify_bandwidth(cfg.model, cfg.identify);
+  const nlohmann::json j{{"mode_Hz", r.features.mode_Hz},
+                         {"antiresonance_Hz", r.features.antiresonance_Hz},
+                         {"bandwidth_Hz", r.features.bandwidth_Hz}};
   if (o.out) {
-    mc::ensure_writable_dir(*o.out);
     mc::CsvTable t;
     t.add_column("f_Hz", r.f_Hz);
     t.add_column("magnitude_dB", db(r.magnitude));
     t.add_column("phase_rad", r.phase_rad);
     t.add_column("coherence", r.coherence);
     t.add_column("model_magnitude_dB", db(r.model_magnitude));
-    mc::write_csv(*o.out / "frf.csv", t);
+    mc::cli::write_result_table(o, "frf.csv", t, j);
     Report rep("tweezers identify");
     identify_section(rep, r);
     mc::cli::write_report_if_requested(o, rep);
   }
-  nlohmann::json j{{"mode_Hz", r.features.mode_Hz},
-                   {"antiresonance_Hz", r.features.antiresonance_Hz},
-                   {"bandwidth_Hz", r.features.bandwidth_Hz}};
   mc::cli::emit(
       o, j,
       fmt::format(
@@ -135,6 +134,7 @@ void run_cube(const CubeOptions& co) {
                      {"passivity_bound_N_m", bound},
                      {"tip_damping_N_s_m", tw::tip_damping(cfg.model)},
                      {"control_rate_Hz", c.control_rate_Hz}};
+    mc::cli::write_results_mat(co.common, j);  // --format mat: the figures; CSV: no table to write
     mc::cli::emit(
         co.common, j,
         fmt::format("largest chatter-free stiffness at {:.0f} Hz: {:.0f} N/m without, {:.0f} N/m with the "
@@ -144,15 +144,18 @@ void run_cube(const CubeOptions& co) {
     return;
   }
   const auto r = tw::simulate_virtual_cube(cfg.model, cfg.cube);
+  const nlohmann::json j{{"chatter", r.chatter},
+                         {"max_penetration_m", r.max_penetration_m},
+                         {"oscillation_rms_N", r.oscillation_rms_N},
+                         {"mean_force_N", r.mean_force_N}};
   if (co.common.out) {
-    mc::ensure_writable_dir(*co.common.out);
     mc::CsvTable t;
     t.add_column("t_s", r.t_s);
     t.add_column("tip_opening_m", r.opening_m);
     t.add_column("penetration_m", r.penetration_m);
     t.add_column("wall_force_N", r.wall_force_N);
     t.add_column("torque_N_m", r.torque_N_m);
-    mc::write_csv(*co.common.out / "virtual_cube.csv", t);
+    mc::cli::write_result_table(co.common, "virtual_cube.csv", t, j);
     Report rep("tweezers virtual-cube");
     rep.section("Virtual cube", "");
     rep.add_figure({"Wall force",
@@ -162,10 +165,6 @@ void run_cube(const CubeOptions& co) {
                     {{"wall force", r.t_s, r.wall_force_N, false}}});
     mc::cli::write_report_if_requested(co.common, rep);
   }
-  nlohmann::json j{{"chatter", r.chatter},
-                   {"max_penetration_m", r.max_penetration_m},
-                   {"oscillation_rms_N", r.oscillation_rms_N},
-                   {"mean_force_N", r.mean_force_N}};
   mc::cli::emit(co.common, j,
                 fmt::format("K = {:.0f} N/m, {} compensator, {:.0f} Hz loop: {}\nmax penetration {:.3g} m, "
                             "hold force {:.3f} N, "
@@ -176,7 +175,7 @@ void run_cube(const CubeOptions& co) {
 }
 
 // ---- modes ----------------------------------------------------------------------------------
-void write_trace(const std::filesystem::path& file, const tw::ModeTrace& tr) {
+mc::CsvTable trace_table(const tw::ModeTrace& tr) {
   mc::CsvTable t;
   t.add_column("t_s", tr.t_s);
   t.add_column("tip_opening_m", tr.master_opening_m);
@@ -184,7 +183,7 @@ void write_trace(const std::filesystem::path& file, const tw::ModeTrace& tr) {
   t.add_column("contact_force_N", tr.contact_force_N);
   t.add_column("finger_force_N", tr.finger_force_N);
   t.add_column("torque_N_m", tr.torque_N_m);
-  mc::write_csv(file, t);
+  return t;
 }
 
 void robotic_section(Report& rep, const tw::RoboticModeResult& r, const tw::RoboticModeParams& p) {
@@ -231,35 +230,35 @@ void manual_section(Report& rep, const tw::ManualModeResult& hold, const tw::Man
 void run_robotic(const CommonOptions& o) {
   const auto cfg = load(o);
   const auto r = tw::simulate_robotic_mode(cfg.model, cfg.robotic);
+  const nlohmann::json j{{"slave_force_N", r.final_slave_force_N},
+                         {"finger_force_N", r.final_rendered_force_N},
+                         {"slave_opening_m", r.trace.slave_opening_m.back()},
+                         {"tip_opening_m", r.trace.master_opening_m.back()}};
   if (o.out) {
-    mc::ensure_writable_dir(*o.out);
-    write_trace(*o.out / "robotic.csv", r.trace);
+    mc::cli::write_result_table(o, "robotic.csv", trace_table(r.trace), j);
     Report rep("tweezers robotic");
     robotic_section(rep, r, cfg.robotic);
     mc::cli::write_report_if_requested(o, rep);
   }
-  mc::cli::emit(o, {{"slave_force_N", r.final_slave_force_N},
-                    {"finger_force_N", r.final_rendered_force_N},
-                    {"slave_opening_m", r.trace.slave_opening_m.back()},
-                    {"tip_opening_m", r.trace.master_opening_m.back()}});
+  mc::cli::emit(o, j);
 }
 
 void run_manual(const CommonOptions& o, bool no_hold) {
   auto cfg = load(o);
   if (no_hold) cfg.manual.hold = false;
   const auto r = tw::simulate_manual_mode(cfg.model, cfg.manual);
+  const nlohmann::json j{{"held_force_N", r.held_force_N},
+                         {"held_force_error_N", r.held_force_error_N},
+                         {"set_force_N", cfg.manual.set_force_N}};
   if (o.out) {
-    mc::ensure_writable_dir(*o.out);
-    write_trace(*o.out / "manual.csv", r.trace);
+    mc::cli::write_result_table(o, "manual.csv", trace_table(r.trace), j);
     auto plain = cfg.manual;
     plain.hold = false;
     Report rep("tweezers manual");
     manual_section(rep, r, tw::simulate_manual_mode(cfg.model, plain), cfg.manual);
     mc::cli::write_report_if_requested(o, rep);
   }
-  mc::cli::emit(o, {{"held_force_N", r.held_force_N},
-                    {"held_force_error_N", r.held_force_error_N},
-                    {"set_force_N", cfg.manual.set_force_N}});
+  mc::cli::emit(o, j);
 }
 
 void add_tweezers(CLI::App& group) {
@@ -275,6 +274,7 @@ void add_tweezers(CLI::App& group) {
     auto o = std::make_shared<CommonOptions>();
     auto* cmd = group.add_subcommand("identify", "PRBS bandwidth identification at 10 kHz (section 4.5.2)");
     mc::cli::add_output_options(*cmd, *o);
+    mc::cli::add_format_option(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->callback([o] { run_identify(*o); });
   }
@@ -283,6 +283,7 @@ void add_tweezers(CLI::App& group) {
     auto* cmd = group.add_subcommand("virtual-cube",
                                      "Virtual cube between the tips: chatter and lag compensator (4.5.3)");
     mc::cli::add_output_options(*cmd, o->common);
+    mc::cli::add_format_option(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->add_option("--stiffness", o->stiffness, "Wall stiffness per tip [N/m]")
         ->check(mc::cli::PositiveNumber);
@@ -296,6 +297,7 @@ void add_tweezers(CLI::App& group) {
     auto* cmd =
         group.add_subcommand("robotic", "Robotic mode: opening to a slave gripper, its force back (4.3.2.1)");
     mc::cli::add_output_options(*cmd, *o);
+    mc::cli::add_format_option(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->callback([o] { run_robotic(*o); });
   }
@@ -305,6 +307,7 @@ void add_tweezers(CLI::App& group) {
     auto* cmd =
         group.add_subcommand("manual", "Manual mode: hold a set clamping force on a real object (4.3.2.2)");
     mc::cli::add_output_options(*cmd, *o);
+    mc::cli::add_format_option(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
     cmd->add_flag("--no-hold", *no_hold, "Plain tweezers: no force loop");
     cmd->callback([o, no_hold] { run_manual(*o, *no_hold); });

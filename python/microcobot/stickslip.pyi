@@ -66,5 +66,6 @@ def experiment_names() -> List[str]: ...
 def rollout(params: Params, initial_states: Union[None, npt.ArrayLike, Sequence[ActuatorState]],
             voltages: npt.ArrayLike, threads: int = 1,
             operating_point: Optional[Tuple[float, float, str]] = None,
-            out: Optional[Array] = None) -> Dict[str, Any]:
-    """N axes driven by voltages[N, T] [V]; {'t_s', 'x1_m' (N, T), 'x2_m' (N, T), 'states'}. Releases the GIL."""
+            out: Optional[Array] = None, out_x1: Optional[Array] = None) -> Dict[str, Any]:
+    """N axes driven by voltages[N, T] [V]; {'t_s', 'x1_m' (N, T), 'x2_m' (N, T), 'states'}. Releases the GIL.
+    out / out_x1: caller-owned float64 C-contiguous (N, T) arrays for x2_m / x1_m, written in place."""

@@ -148,3 +148,73 @@ def test_not_a_mat_file(tmp_path, cli):
     assert rc == 3 and "not a MATLAB .mat file" in cli_error(err)
     rc, _, err = cli("identify", "hysteresis", "--in", tmp_path / "missing.mat")
     assert rc == 3 and "no such file" in cli_error(err)
+
+
+def test_dsp_butter_writes_scipys_sos_as_csv_and_mat(tmp_path, cli):
+    import scipy.signal
+
+    args = ("dsp", "butter", "--order", 4, "--fc", 200, "--fs", 10000, "--json")
+    rc, out, err = cli(*args, "--out", tmp_path / "csv")
+    assert rc == 0, err
+    rc, out_mat, err = cli(*args, "--format", "mat", "--out", tmp_path / "mat")
+    assert rc == 0, err
+    assert out == out_mat
+    ref = scipy.signal.butter(4, 200, fs=10000, output="sos")
+    csv = np.genfromtxt(tmp_path / "csv" / "sos.csv", delimiter=",", names=True, comments="#")
+    np.testing.assert_allclose(np.column_stack([csv[k] for k in ("b0", "b1", "b2", "a0", "a1", "a2")]), ref,
+                               rtol=1e-9, atol=1e-15)
+    d = scipy.io.loadmat(tmp_path / "mat" / "results.mat")
+    assert d["sos"].shape == (2, 6)  # sections x coefficients, scipy's layout
+    np.testing.assert_allclose(d["sos"], ref, rtol=1e-9, atol=1e-15)
+    np.testing.assert_array_equal(d["b0"][:, 0], d["sos"][:, 0])
+    assert not (tmp_path / "mat" / "sos.csv").exists()
+
+
+def test_dsp_commands_write_what_they_print(tmp_path, cli):
+    rc, out, err = cli("dsp", "mls", "--bits", 5, "--json", "--format", "mat", "--out", tmp_path / "m")
+    assert rc == 0, err
+    np.testing.assert_array_equal(scipy.io.loadmat(tmp_path / "m" / "results.mat")["seq"][:, 0],
+                                  json.loads(out)["seq"])
+    # An FRF of a known system, fitted back: tf.csv holds num (padded) and den, highest power first.
+    f = np.linspace(1.0, 2000.0, 400)
+    s = 2j * np.pi * f
+    h = 1.0 / (s**2 / (2 * np.pi * 300.0) ** 2 + s / (2 * np.pi * 300.0 * 5.0) + 1.0)
+    frf = tmp_path / "frf.csv"
+    np.savetxt(frf, np.column_stack([f, h.real, h.imag]), delimiter=",", header="f_Hz,re,im", comments="")
+    rc, out, err = cli("dsp", "tffit", "--in", frf, "--nz", 0, "--np", 2, "--json", "--out", tmp_path / "t")
+    assert rc == 0, err
+    j = json.loads(out)
+    tf = np.genfromtxt(tmp_path / "t" / "tf.csv", delimiter=",", names=True, comments="#")
+    np.testing.assert_array_equal(tf["power"], [2, 1, 0])
+    np.testing.assert_array_equal(tf["den"], j["den"])
+    np.testing.assert_array_equal(tf["num"], [0.0, 0.0] + j["num"])
+    np.testing.assert_allclose(np.polyval(tf["num"], s) / np.polyval(tf["den"], s), h, rtol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "command,csv_names",
+    [
+        (("haptics", "identify"), {"frf_lf.csv": "lf_", "frf_hf.csv": "hf_"}),
+        (("tweezers", "robotic"), {"robotic.csv": ""}),
+    ],
+)
+def test_device_commands_format_mat_equals_their_csv(tmp_path, cli, command, csv_names):
+    rc, out, err = cli(*command, "--json", "--out", tmp_path / "csv")
+    assert rc == 0, err
+    rc, out_mat, err = cli(*command, "--json", "--format", "mat", "--out", tmp_path / "mat")
+    assert rc == 0, err
+    assert out == out_mat
+    d = scipy.io.loadmat(tmp_path / "mat" / "results.mat")
+    columns = set()
+    for name, prefix in csv_names.items():
+        csv = np.genfromtxt(tmp_path / "csv" / name, delimiter=",", names=True, comments="#")
+        for k in csv.dtype.names:
+            np.testing.assert_allclose(d[prefix + k][:, 0], csv[k], rtol=1e-15, atol=0, err_msg=k)
+            columns.add(prefix + k)
+        assert not (tmp_path / "mat" / name).exists()
+    for k, v in json.loads(out).items():
+        # A summary number under a column's name (tweezers robotic's final finger_force_N) is
+        # left to the column (docs/cli.md).
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and k not in columns:
+            assert d[k].shape == (1, 1) and d[k][0, 0] == v, k
+    assert (tmp_path / "mat" / "index.html").exists()  # the report as usual

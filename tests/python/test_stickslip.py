@@ -202,9 +202,13 @@ def test_rollout_writes_into_a_caller_owned_array():
     a = ss.Actuator()
     v = sawtooth_samples(2, 100)
     out = np.full((2, 100), -1.0)
-    r = ss.rollout(a, None, v, out=out)
-    assert r["x2_m"] is out
-    assert np.all(out != -1.0)
+    out_x1 = np.full((2, 100), -1.0)
+    r = ss.rollout(a, None, v, out=out, out_x1=out_x1)
+    assert r["x2_m"] is out and r["x1_m"] is out_x1
+    assert np.all(out != -1.0) and np.all(out_x1 != -1.0)
+    fresh = ss.rollout(a, None, v)
+    np.testing.assert_array_equal(fresh["x2_m"], out)
+    np.testing.assert_array_equal(fresh["x1_m"], out_x1)
 
 
 def test_rollout_validates_its_inputs():
@@ -222,6 +226,15 @@ def test_rollout_validates_its_inputs():
         ss.rollout(a, np.array([0.0, 1.0]), v)
     with pytest.raises(ValueError, match="out: expected"):
         ss.rollout(a, None, v, out=np.zeros((2, 99)))
+    with pytest.raises(ValueError, match="out_x1: expected a writeable"):
+        ss.rollout(a, None, v, out_x1=np.zeros((2, 100), order="F"))
+    with pytest.raises(ValueError, match="out_x1: expected a float64"):
+        ss.rollout(a, None, v, out_x1=np.zeros((2, 100), dtype=np.float32))
+    same = np.zeros((2, 100))
+    with pytest.raises(ValueError, match="out_x1: must not share memory with out"):
+        ss.rollout(a, None, v, out=same, out_x1=same)
+    with pytest.raises(ValueError, match="out_x1: must not share memory with out"):
+        ss.rollout(a, None, v, out=same, out_x1=same[:])
     with pytest.raises(ValueError, match="threads"):
         ss.rollout(a, None, v, threads=-1)
 

@@ -1,6 +1,7 @@
 // Elasto-plastic friction with z_ss(z) = z_ss sgn(z) (thesis eq. 2.9-2.13, 2.18-2.19).
 #include "microcobot/stickslip/elasto_plastic_friction.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -25,6 +26,29 @@ TEST(ElastoPlasticFriction, AlphaPhases) {
   // Continuity at both phase borders.
   EXPECT_NEAR(friction_alpha(kZba * (1 + 1e-9), 1.0, kZba, kZss), 0.0, 1e-9);
   EXPECT_NEAR(friction_alpha(kZss * (1 - 1e-9), 1.0, kZba, kZss), 1.0, 1e-9);
+}
+
+TEST(ElastoPlasticFriction, TheHotPathsSineIsLibmsWithin1e13) {
+  // The polynomial that replaces std::sin in the strain integration, on its domain and clamped
+  // beyond it (alpha = 0 below z_ba, 1 at z_ss: eq. 2.13).
+  double worst = 0.0;
+  for (int i = -100000; i <= 100000; ++i) {
+    const double x = 0.5 * M_PI * i / 100000.0;
+    worst = std::max(worst, std::abs(internal::sin_within_half_pi(x) - std::sin(x)));
+  }
+  EXPECT_LT(worst, 1e-13);
+  EXPECT_EQ(internal::sin_within_half_pi(0.0), 0.0);
+  EXPECT_NEAR(internal::sin_within_half_pi(3.0), 1.0, 1e-13);
+  EXPECT_NEAR(internal::sin_within_half_pi(-40.0), -1.0, 1e-13);
+  // So the mixed-phase slope is eq. 2.11-2.12 evaluated with libm (friction_alpha), to 1e-13.
+  for (int i = 1; i < 1000; ++i) {
+    const double z = kZba + (kZss - kZba) * i / 1000.0;
+    for (const double sign : {1.0, -1.0}) {
+      EXPECT_NEAR(friction_dz_dx(sign * z, sign, kZba, kZss),
+                  1.0 - friction_alpha(sign * z, sign, kZba, kZss) * z / kZss, 1e-13)
+          << z;
+    }
+  }
 }
 
 TEST(ElastoPlasticFriction, SlopeWithinZeroOneOnRandomDrives) {
