@@ -171,13 +171,15 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
   // Caller-owned outputs (as MuJoCo's rollout): float64, C-contiguous, shape (N, T), written in
   // place; a caller that reuses them across calls saves the first-touch page faults of fresh ones.
   const auto output = [&](const py::object& given, const char* name) {
-    if (given.is_none()) return py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(steps)});
+    if (given.is_none())
+      return py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(steps)});
     if (!py::isinstance<py::array_t<double>>(given)) {
       throw InvalidInput(std::string(name) + ": expected a float64 numpy array");
     }
     auto a = given.cast<py::array_t<double>>();
-    if (a.ndim() != 2 || static_cast<std::size_t>(a.shape(0)) != n || static_cast<std::size_t>(a.shape(1)) != steps ||
-        !(a.flags() & py::array::c_style) || !a.writeable()) {
+    if (a.ndim() != 2 || static_cast<std::size_t>(a.shape(0)) != n ||
+        static_cast<std::size_t>(a.shape(1)) != steps || !(a.flags() & py::array::c_style) ||
+        !a.writeable()) {
       throw InvalidInput(std::string(name) + ": expected a writeable C-contiguous float64 array of shape (" +
                          std::to_string(n) + ", " + std::to_string(steps) + ")");
     }
@@ -255,6 +257,84 @@ ss::MeasuredRecord record_from(py::handle t_or_file, py::handle u, py::handle x,
   table.add_column("u_V", std::vector<double>(us.begin(), us.end()));
   table.add_column("x_m", std::vector<double>(xs.begin(), xs.end()));
   return ss::record_from_table(table, name);
+}
+
+bool is_path(py::handle h) { return py::isinstance<py::str>(h) || py::hasattr(h, "__fspath__"); }
+
+std::string path_of(py::handle h) {
+  return py::str(py::module_::import("os").attr("fspath")(h)).cast<std::string>();
+}
+
+/// A record given as a file name or as a dict {'t', 'u', 'x'} of arrays (SI units).
+ss::MeasuredRecord record_entry(py::handle v, const std::string& name) {
+  if (is_path(v)) return ss::read_record(path_of(v));
+  if (!py::isinstance<py::dict>(v)) {
+    throw InvalidInput(name + ": expected a file name or a dict {'t', 'u', 'x'} of arrays");
+  }
+  const auto d = py::reinterpret_borrow<py::dict>(v);
+  for (const char* k : {"t", "u", "x"}) {
+    if (!d.contains(k)) throw InvalidInput(name + ": missing '" + k + "' (a dict {'t', 'u', 'x'} of arrays)");
+  }
+  return record_from(d["t"], d["u"], d["x"], name);
+}
+
+/// Sawtooth runs: a directory of sawtooth_*.csv, or a sequence of dicts {'t', 'u', 'x',
+/// 'amplitude_V', 'frequency_Hz', 'direction'}.
+std::vector<ss::SawtoothRun> sawtooth_runs_from(py::handle v, const std::string& name) {
+  if (is_path(v)) return ss::read_sawtooth_runs(path_of(v));
+  if (!py::isinstance<py::sequence>(v)) {
+    throw InvalidInput(name +
+                       ": expected a directory or a list of dicts {'t', 'u', 'x', 'amplitude_V', "
+                       "'frequency_Hz', 'direction'}");
+  }
+  const auto seq = py::reinterpret_borrow<py::sequence>(v);
+  if (py::len(seq) == 0) throw InvalidInput(name + ": no run (step 3 needs at least one)");
+  std::vector<ss::SawtoothRun> runs;
+  for (std::size_t i = 0; i < py::len(seq); ++i) {
+    const std::string where = name + "[" + std::to_string(i) + "]";
+    ss::SawtoothRun r;
+    r.name = where;
+    r.rec = record_entry(seq[i], where);
+    const auto d = py::reinterpret_borrow<py::dict>(seq[i]);
+    for (const char* k : {"amplitude_V", "frequency_Hz", "direction"}) {
+      if (!d.contains(k)) throw InvalidInput(where + ": missing '" + k + "'");
+    }
+    r.amplitude_V = d["amplitude_V"].cast<double>();
+    r.frequency_Hz = d["frequency_Hz"].cast<double>();
+    require(std::isfinite(r.amplitude_V) && r.amplitude_V > 0.0, where + ".amplitude_V", "must be > 0 V",
+            r.amplitude_V);
+    require(std::isfinite(r.frequency_Hz) && r.frequency_Hz > 0.0, where + ".frequency_Hz", "must be > 0 Hz",
+            r.frequency_Hz);
+    r.direction = ss::parse_direction(d["direction"].cast<std::string>());
+    runs.push_back(std::move(r));
+  }
+  return runs;
+}
+
+/// The records of the whole identification: a directory, or a dict {'pe_step' (optional), 'step',
+/// 'sine', 'sawtooth'} of records (record_entry) and runs (sawtooth_runs_from).
+ss::IdentificationRecords records_from(py::handle v) {
+  if (is_path(v)) return ss::read_identification_records(path_of(v));
+  if (!py::isinstance<py::dict>(v)) {
+    throw InvalidInput("records: expected a directory or a dict {'pe_step', 'step', 'sine', 'sawtooth'}");
+  }
+  const auto d = py::reinterpret_borrow<py::dict>(v);
+  for (const auto& [k, _] : d) {
+    const auto key = py::str(k).cast<std::string>();
+    if (key != "pe_step" && key != "step" && key != "sine" && key != "sawtooth") {
+      throw InvalidInput("records: unknown key '" + key + "' (pe_step, step, sine, sawtooth)");
+    }
+  }
+  for (const char* k : {"step", "sine", "sawtooth"}) {
+    if (!d.contains(k)) throw InvalidInput(std::string("records: missing '") + k + "'");
+  }
+  ss::IdentificationRecords r;
+  if (d.contains("pe_step") && !d["pe_step"].is_none())
+    r.pe_step = record_entry(d["pe_step"], "records.pe_step");
+  r.step = record_entry(d["step"], "records.step");
+  r.sine = record_entry(d["sine"], "records.sine");
+  r.sawtooth = sawtooth_runs_from(d["sawtooth"], "records.sawtooth");
+  return r;
 }
 
 py::dict mode_dict(const ss::ModeEstimate& m) {
@@ -474,37 +554,40 @@ void bind_identify(py::module_& m) {
       "sine response in scanning mode.");
   m.def(
       "breakaway",
-      [](const std::string& dir, py::handle params, unsigned threads) {
+      [](py::handle runs_in, py::handle params, unsigned threads) {
         const auto base = params_from<ss::StickSlipParams>(params);
         ss::BreakawayOptions bo;
         bo.threads = threads;
+        const auto runs = sawtooth_runs_from(runs_in, "runs");
         const auto r = nogil([&] {
-          const auto runs = ss::read_sawtooth_runs(dir);
           const ss::ActuatorModel model(base);
           return ss::identify_breakaway(runs, model, bo);
         });
         return breakaway_dict(r);
       },
-      "directory"_a, "params"_a = py::none(), "threads"_a = 0,
-      "Step 3 (thesis §2.5.2.3, Fig. 2.13): z_ba of every sawtooth_*.csv run of `directory` and the table "
-      "z_ba(amplitude, frequency, direction).");
+      "runs"_a, "params"_a = py::none(), "threads"_a = 0,
+      "Step 3 (thesis §2.5.2.3, Fig. 2.13): z_ba of every sawtooth run and the table z_ba(amplitude, "
+      "frequency, direction). runs: a directory of sawtooth_<A>V_<f>Hz_<direction>.csv, or a list of dicts "
+      "{'t' [s], 'u' [V], 'x' [m] (arrays), 'amplitude_V', 'frequency_Hz', 'direction'}.");
   m.def(
       "all",
-      [](const std::string& dir, py::handle params, int operators) {
+      [](py::handle records_in, py::handle params, int operators) {
         const auto base = params_from<ss::StickSlipParams>(params);
         ss::IdentifyAllOptions io;
         io.operators = operators;
-        const auto r = nogil([&] { return ss::identify_all(dir, base, io); });
+        const auto records = records_from(records_in);
+        const auto r = nogil([&] { return ss::identify_all(records, base, io); });
         py::dict d("friction"_a = friction_dict(r.friction), "hysteresis"_a = hysteresis_dict(r.hysteresis),
                    "breakaway"_a = breakaway_dict(r.breakaway), "params"_a = params_dict(r.params),
                    "notes"_a = r.notes);
         d["pe"] = r.pe ? py::object(pe_dict(*r.pe)) : py::none();
         return d;
       },
-      "directory"_a, "params"_a = py::none(), "operators"_a = 35,
-      "The whole identification (thesis §2.5.2 steps 1-3) from a directory of records (pe_step.csv, "
-      "step.csv, "
-      "sine.csv, sawtooth_*.csv): each step's diagnostics and the identified 'params'.");
+      "records"_a, "params"_a = py::none(), "operators"_a = 35,
+      "The whole identification (thesis §2.5.2 steps 1-3): each step's diagnostics and the identified "
+      "'params'. records: a directory (pe_step.csv optional, step.csv, sine.csv, sawtooth_*.csv), or a dict "
+      "{'pe_step' (optional), 'step', 'sine': a file name or {'t', 'u', 'x'} of arrays; 'sawtooth': as "
+      "breakaway()'s runs}.");
 }
 
 }  // namespace mc::py

@@ -1,7 +1,7 @@
 """Identification of the stick-slip axis (thesis §2.5.2) from arrays (t [s], u [V], x [m]) or files."""
 
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Optional, Sequence, Union
 
 import numpy.typing as npt
 
@@ -15,5 +15,13 @@ def friction_modes(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[np
                    params: Params = None) -> Dict[str, Any]: ...
 def hysteresis(t: TOrFile, u: Optional[npt.ArrayLike] = None, x: Optional[npt.ArrayLike] = None,
                operators: int = 35, params: Params = None) -> Dict[str, Any]: ...
-def breakaway(directory: str, params: Params = None, threads: int = 0) -> Dict[str, Any]: ...
-def all(directory: str, params: Params = None, operators: int = 35) -> Dict[str, Any]: ...
+# A record: a file name, or {'t': [s], 'u': [V], 'x': [m]} arrays. A sawtooth run adds
+# 'amplitude_V', 'frequency_Hz' and 'direction' ('forward' | 'backward') to such a dict.
+Record = Union[str, os.PathLike, Dict[str, Any]]
+Runs = Union[str, os.PathLike, Sequence[Dict[str, Any]]]
+
+def breakaway(runs: Runs, params: Params = None, threads: int = 0) -> Dict[str, Any]:
+    """Step 3: z_ba per run and the table; runs: a directory of sawtooth_*.csv or a list of run dicts."""
+def all(records: Union[str, os.PathLike, Dict[str, Any]], params: Params = None,
+        operators: int = 35) -> Dict[str, Any]:
+    """Steps 1-3: a directory, or {'pe_step' (optional), 'step', 'sine': Record, 'sawtooth': Runs}."""

@@ -17,9 +17,7 @@ StickSlipParams combine_identified(const StickSlipParams& base, const PeModesRes
   return p;
 }
 
-IdentifyAllResult identify_all(
-    const std::filesystem::path& dir, const StickSlipParams& base, const IdentifyAllOptions& options,
-    const std::function<void(const std::string&, std::size_t, std::size_t)>& progress) {
+IdentificationRecords read_identification_records(const std::filesystem::path& dir) {
   if (!std::filesystem::is_directory(dir)) throw InvalidInput(dir.string(), 0, "not a directory");
   auto need = [&](const char* name) {
     const auto f = dir / name;
@@ -29,22 +27,36 @@ IdentifyAllResult identify_all(
     }
     return f;
   };
+  IdentificationRecords r;
+  r.step = read_record(need("step.csv"));
+  r.sine = read_record(need("sine.csv"));
+  r.sawtooth = read_sawtooth_runs(dir);
+  if (std::filesystem::exists(dir / "pe_step.csv")) r.pe_step = read_record(dir / "pe_step.csv");
+  return r;
+}
+
+IdentifyAllResult identify_all(const std::filesystem::path& dir, const StickSlipParams& base,
+                               const IdentifyAllOptions& options, const IdentifyProgress& progress) {
+  return identify_all(read_identification_records(dir), base, options, progress);
+}
+
+IdentifyAllResult identify_all(const IdentificationRecords& records, const StickSlipParams& base,
+                               const IdentifyAllOptions& options, const IdentifyProgress& progress) {
+  if (records.sawtooth.empty()) throw InvalidInput("sawtooth: no run (step 3 needs at least one)");
   auto report = [&](const std::string& task, std::size_t done, std::size_t total) {
     if (progress) progress(task, done, total);
   };
   IdentifyAllResult out;
-  // Read everything first: a malformed file fails before any long computation.
-  const MeasuredRecord step = read_record(need("step.csv"));
-  const MeasuredRecord sine = read_record(need("sine.csv"));
-  const std::vector<SawtoothRun> runs = read_sawtooth_runs(dir);
-  std::optional<MeasuredRecord> pe_rec;
-  if (std::filesystem::exists(dir / "pe_step.csv")) pe_rec = read_record(dir / "pe_step.csv");
+  const MeasuredRecord& step = records.step;
+  const MeasuredRecord& sine = records.sine;
+  const std::vector<SawtoothRun>& runs = records.sawtooth;
+  const std::optional<MeasuredRecord>& pe_rec = records.pe_step;
 
   report("identify step 1 (modes)", 0, 2);
   if (pe_rec) {
     out.pe = identify_pe_modes(*pe_rec, base.pe);
   } else {
-    out.notes.push_back("no pe_step.csv: PE modes and gain split kept from the base parameters");
+    out.notes.push_back("no pe_step record: PE modes and gain split kept from the base parameters");
   }
   report("identify step 1 (modes)", 1, 2);
   StickSlipParams with_pe = base;

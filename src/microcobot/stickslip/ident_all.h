@@ -27,7 +27,7 @@ struct IdentifyAllOptions {
 };
 
 struct IdentifyAllResult {
-  std::optional<PeModesResult> pe;  ///< absent when the directory has no pe_step.csv
+  std::optional<PeModesResult> pe;  ///< absent without a pe_step record (pe_step.csv)
   FrictionModesResult friction;
   HysteresisResult hysteresis;
   BreakawayResult breakaway;
@@ -35,12 +35,28 @@ struct IdentifyAllResult {
   std::vector<std::string> notes;  ///< what was kept from `base`, skipped runs, filled cells
 };
 
-/// Runs the three steps on the files of `dir`. `progress(task, done, total)` reports the steps and
-/// the sawtooth runs. Throws mc::InvalidInput for a missing or malformed file and
+/// The measurements the three steps take, whatever they were read from.
+struct IdentificationRecords {
+  std::optional<MeasuredRecord> pe_step;  ///< PE without slider (optional)
+  MeasuredRecord step;                    ///< actuator step response (slider position)
+  MeasuredRecord sine;                    ///< scanning-mode sine response
+  std::vector<SawtoothRun> sawtooth;      ///< at least one run
+};
+
+/// Reads the records of `dir` (pe_step.csv optional, step.csv, sine.csv, sawtooth_*.csv): all
+/// of them before any computation, so a malformed file fails first. Throws mc::InvalidInput.
+IdentificationRecords read_identification_records(const std::filesystem::path& dir);
+
+using IdentifyProgress = std::function<void(const std::string&, std::size_t, std::size_t)>;
+
+/// Runs the three steps on `records`. `progress(task, done, total)` reports the steps and the
+/// sawtooth runs. Throws mc::InvalidInput when there is no sawtooth run and
 /// mc::ComputationFailed when a step fails.
-IdentifyAllResult identify_all(
-    const std::filesystem::path& dir, const StickSlipParams& base, const IdentifyAllOptions& options = {},
-    const std::function<void(const std::string&, std::size_t, std::size_t)>& progress = {});
+IdentifyAllResult identify_all(const IdentificationRecords& records, const StickSlipParams& base,
+                               const IdentifyAllOptions& options = {}, const IdentifyProgress& progress = {});
+/// The same on the files of `dir` (read_identification_records()).
+IdentifyAllResult identify_all(const std::filesystem::path& dir, const StickSlipParams& base,
+                               const IdentifyAllOptions& options = {}, const IdentifyProgress& progress = {});
 
 /// Combines identified parts into parameters: PE modes (if any) and gain split, asperities, PI
 /// weights with the static gain g from the hysteresis step (the PE step's g assumes H(U) = U).
