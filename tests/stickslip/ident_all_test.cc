@@ -124,6 +124,16 @@ TEST(IdentAll, ThreadsDoNotChangeTheResult) {
   }
 }
 
+TEST(IdentAll, RecordsWithoutASawtoothRunAreRefusedBeforeAnyComputation) {
+  const IdentificationRecords none;  // empty step and sine records too: refused first for the runs
+  try {
+    identify_all(none, StickSlipParams{});
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "sawtooth: no run (step 3 needs at least one)");
+  }
+}
+
 TEST(IdentAll, BadDirectoriesGiveOneLineErrors) {
   mc::test::TempDir dir;
   EXPECT_THROW(identify_all(dir.path() / "nope", StickSlipParams{}), InvalidInput);
