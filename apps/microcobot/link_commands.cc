@@ -17,6 +17,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/link.h"
+#include "network_options.h"
 #include "signals.h"
 
 namespace {
@@ -54,6 +55,7 @@ void add_domain_option(CLI::App& cmd, int& domain) {
 struct EchoOptions {
   CommonOptions common;
   int domain = 0;
+  mc::cli::NetworkOptions network;
   double duration_s = 0.0;
 };
 
@@ -61,9 +63,11 @@ void run_echo(const EchoOptions& o) {
   net::LinkConfig config;
   config.domain_id = o.domain;
   config.role = net::Role::kSlave;
+  config.network = mc::cli::network_config(o.network);
   mc::cli::set_cooperative_interrupts(true);
   net::Link link(config);
-  std::cerr << fmt::format("link echo: slave on DDS domain {} (loopback); SIGINT/SIGTERM stops\n", o.domain);
+  std::cerr << fmt::format("link echo: slave on DDS domain {} ({}); SIGINT/SIGTERM stops\n", o.domain,
+                           mc::cli::describe(config.network));
   std::uint64_t echoed = 0, estops = 0;
   bool estop = false;
   const auto start = Clock::now();
@@ -121,6 +125,7 @@ void run_echo(const EchoOptions& o) {
 struct PingOptions {
   CommonOptions common;
   int domain = 0;
+  mc::cli::NetworkOptions network;
   int count = 1000;
   double rate_Hz = 1000.0;
   double wait_s = 10.0;
@@ -138,6 +143,7 @@ void run_ping(const PingOptions& o) {
   net::LinkConfig config;
   config.domain_id = o.domain;
   config.role = net::Role::kMaster;
+  config.network = mc::cli::network_config(o.network);
   config.ring_capacity = 1024;
   net::Link link(config);
 
@@ -259,6 +265,7 @@ void add_link(CLI::App& group) {
       "echo", "Slave end: return every target as the measured position (until SIGINT/SIGTERM or --duration)");
   auto eo = std::make_shared<EchoOptions>();
   add_domain_option(*echo, eo->domain);
+  mc::cli::add_network_options(*echo, eo->network);
   echo->add_flag("--json", eo->common.json, "Print a machine-readable JSON summary on stdout when stopped");
   echo->add_option("--duration", eo->duration_s, "Stop after this many seconds (default: on a signal only)")
       ->check(mc::cli::Range(0.0, 1e7));
@@ -268,6 +275,7 @@ void add_link(CLI::App& group) {
       "ping", "Master end: publish targets at a fixed rate to `link echo` and measure the round trips");
   auto po = std::make_shared<PingOptions>();
   add_domain_option(*ping, po->domain);
+  mc::cli::add_network_options(*ping, po->network);
   ping->add_flag("--json", po->common.json, "Print a machine-readable JSON summary on stdout");
   ping->add_option("--count", po->count, "Targets to publish (default 1000)")->check(CLI::Range(1, 10000000));
   ping->add_option("--rate", po->rate_Hz, "Publishing rate in Hz (default 1000)")

@@ -23,6 +23,7 @@
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/platform_config.h"
+#include "network_options.h"
 #include "signals.h"
 
 namespace {
@@ -39,7 +40,8 @@ struct ServeOptions {
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
-  mc::control::LinkParams link;  // the emulated impairment of what this end receives
+  mc::cli::NetworkOptions network;  // where the DDS link goes (master and slave roles)
+  mc::control::LinkParams link;     // the emulated impairment of what this end receives
 };
 
 // The distributed platform's far end (issue #17): the master process sees the slave stage as
@@ -54,6 +56,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
   if (o.role == "single") {
     if (mc::net::impairs(o.link))
       throw mc::UsageError("--link-delay, --link-jitter, --link-loss: need --role master or slave");
+    if (o.network.given()) throw mc::UsageError("--interface, --peer: need --role master or slave");
     return ends;
   }
   if (o.link.jitter_s > o.link.delay_s)
@@ -63,6 +66,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
   if (o.role == "master") {
     mc::net::RemoteSlaveParams rp;
     rp.link.domain_id = o.domain;
+    rp.link.network = mc::cli::network_config(o.network);
     rp.emulate = o.link;
     rp.sample_period_s = axis.integrator.dt_s;
     rp.max_voltage_V = axis.drive.max_V;
@@ -80,6 +84,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
   } else {
     mc::net::RemoteMasterParams rp;
     rp.link.domain_id = o.domain;
+    rp.link.network = mc::cli::network_config(o.network);
     rp.emulate = o.link;
     rp.home_m = {lp.platform.stage.home_x_m, lp.platform.stage.home_y_m, lp.platform.stage.home_z_m};
     rp.goal_speed_m_s = lp.platform.teleop.console_max_speed_m_s;
@@ -145,9 +150,9 @@ void serve(const ServeOptions& o) {
   mc::cli::set_cooperative_interrupts(true);
   std::cerr << "serve: building the platform (the stick-slip step map takes about a second)\n";
   if (o.role != "single")
-    std::cerr << "serve: " << o.role << " of a distributed platform on DDS domain " << o.domain
-              << " (loopback; the peer: serve --role " << (o.role == "master" ? "slave" : "master")
-              << " --domain " << o.domain << ")\n";
+    std::cerr << "serve: " << o.role << " of a distributed platform on DDS domain " << o.domain << " ("
+              << mc::cli::describe(mc::cli::network_config(o.network)) << "; the peer: serve --role "
+              << (o.role == "master" ? "slave" : "master") << " --domain " << o.domain << ")\n";
   mc::live::LivePlatform live(lp);
   mc::live::ConsoleServer server(live, sp);
   server.start();
@@ -194,6 +199,7 @@ void add_serve(CLI::App& cmd) {
          fmt::format("DDS domain id of the master-slave link, 0 to {} (default 0; both ends the same)",
                      mc::net::kMaxDomainId))
       ->check(CLI::Range(0, mc::net::kMaxDomainId));
+  mc::cli::add_network_options(cmd, o->network);
   cmd.add_option("--link-delay", o->link.delay_s,
                  "Emulated one-way delay of what this end receives, s (default 0; both ends: a round trip "
                  "of twice it)")

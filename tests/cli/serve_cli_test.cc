@@ -54,6 +54,9 @@ TEST(ServeCli, TheLinkFlagsAreUsageErrorsNamingTheFlag) {
       {{"--role", "master", "--link-delay", "0.01", "--link-jitter", "0.02"}, "--link-jitter"},
       {{"--role", "master", "--link-loss", "1"}, "--link-loss"},
       {{"--role", "slave", "--link-delay", "nan"}, "--link-delay"},
+      {{"--interface", "eth0"}, "--interface"},  // a link's, as the emulator's flags
+      {{"--role", "slave", "--interface", "eth0\"/><x"}, "--interface"},
+      {{"--role", "master", "--peer", "10.0.0.2", "--peer", "a b"}, "--peer"},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args = {"serve", "--listen", "127.0.0.1:0", "--duration", "0.2"};

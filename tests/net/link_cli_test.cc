@@ -27,8 +27,12 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
   TempDir dir;
   const std::string domain = std::to_string(net::test::test_domain_id());
   // --duration: a safety net should the test die before it signals the echo.
+  // The echo names its interface and peer as on two machines (here both loopback); the ping
+  // keeps the default: the same configuration.
   const test::BackgroundCli echo =
-      test::spawn_cli({"link", "echo", "--domain", domain, "--json", "--duration", "120"}, dir / "echo");
+      test::spawn_cli({"link", "echo", "--domain", domain, "--json", "--duration", "120", "--interface",
+                       "127.0.0.1", "--peer", "127.0.0.1"},
+                      dir / "echo");
   const auto ping = run_cli({"link", "ping", "--domain", domain, "--count", "2000", "--estop", "--json"});
   ASSERT_EQ(ping.exit_code, 0) << ping.err;
   const auto p = nlohmann::json::parse(ping.out);
@@ -65,6 +69,14 @@ TEST(LinkCli, PingWithoutAPeerFailsWithOneLine) {
   EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
 }
 
+TEST(LinkCli, AnInterfaceThisMachineLacksIsOneLineWithCyclonesReason) {
+  const auto r = run_cli({"link", "echo", "--domain", std::to_string(net::test::test_domain_id()),
+                          "--interface", "mcnosuch0", "--duration", "1"});
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("interface 'mcnosuch0': mcnosuch0: does not match an available interface"));
+}
+
 TEST(LinkCli, BadFlagsAreUsageErrorsNamingTheFlag) {
   for (const auto& args : std::vector<std::vector<std::string>>{{"link", "ping", "--domain", "231"},
                                                                 {"link", "ping", "--domain", "x"},
@@ -74,8 +86,13 @@ TEST(LinkCli, BadFlagsAreUsageErrorsNamingTheFlag) {
     EXPECT_THAT(r.err, HasSubstr("--domain"));
     EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
   }
-  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
-           {"--count", "0"}, {"--rate", "nan"}, {"--rate", "0"}, {"--wait", "-1"}}) {
+  for (const auto& [flag, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--count", "0"},
+                                                        {"--rate", "nan"},
+                                                        {"--rate", "0"},
+                                                        {"--wait", "-1"},
+                                                        {"--interface", "eth0;rm"},
+                                                        {"--peer", ""}}) {
     const auto r = run_cli({"link", "ping", flag, value});
     EXPECT_EQ(r.exit_code, 2) << flag;
     EXPECT_THAT(r.err, HasSubstr(flag));

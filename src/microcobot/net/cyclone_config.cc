@@ -1,19 +1,60 @@
 #include "microcobot/net/cyclone_config.h"
 
+#include <algorithm>
+#include <cctype>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
+
 namespace mc::net {
 
-std::string loopback_config() {
-  // Without multicast, discovery goes by unicast to the peers' participant indices 0..Max on
-  // 127.0.0.1: a handful of processes per domain is what the link needs.
-  return "<General>"
-         "<Interfaces><NetworkInterface address=\"127.0.0.1\"/></Interfaces>"
-         "<AllowMulticast>false</AllowMulticast>"
-         "</General>"
-         "<Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex>"
-         "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-         "</Discovery>";
+namespace {
+
+void check_host(const std::string& value, const std::string& field) {
+  if (value.empty() || value.size() > 253) throw InvalidParams(field, "must hold 1 to 253 characters");
+  const bool clean = std::all_of(value.begin(), value.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == ':' || c == '-' || c == '_' ||
+           c == '%';
+  });
+  if (!clean) {
+    throw InvalidParams(
+        field,
+        "'" + excerpt(value) + "' is not an address, host or interface name (letters, digits, . : - _ %)");
+  }
+}
+
+/// An IPv4 or IPv6 literal (digits, hex digits, dots, colons), as opposed to an interface name.
+bool is_address(const std::string& value) {
+  const bool chars = std::all_of(value.begin(), value.end(), [](char c) {
+    return std::isxdigit(static_cast<unsigned char>(c)) || c == '.' || c == ':';
+  });
+  return chars && (value.find('.') != std::string::npos || value.find(':') != std::string::npos);
+}
+
+}  // namespace
+
+void NetworkConfig::validate() const {
+  check_host(interface, "network.interface");
+  if (peers.empty() || peers.size() > 16) {
+    throw InvalidParams("network.peers", "must list 1 to 16 peers", static_cast<double>(peers.size()));
+  }
+  for (std::size_t i = 0; i < peers.size(); ++i)
+    check_host(peers[i], "network.peers[" + std::to_string(i) + "]");
+}
+
+std::string cyclone_config(const NetworkConfig& network) {
+  network.validate();
+  // Without multicast, discovery goes by unicast to the peers' participant indices 0..Max: a
+  // handful of processes per domain and machine is what the link needs.
+  std::string xml = "<General><Interfaces><NetworkInterface ";
+  xml += is_address(network.interface) ? "address" : "name";
+  xml += "=\"" + network.interface + "\"/></Interfaces><AllowMulticast>false</AllowMulticast></General>";
+  xml +=
+      "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
+      "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers>";
+  for (const auto& p : network.peers) xml += "<Peer address=\"" + p + "\"/>";
+  xml += "</Peers></Discovery>";
+  return xml;
 }
 
 }  // namespace mc::net

@@ -39,6 +39,7 @@ void delete_all(dds_entity_t waitset, const std::array<dds_entity_t, kChannelCou
 
 void LinkConfig::validate() const {
   limits.validate();
+  network.validate();
   if (ring_capacity < 1 || ring_capacity > (1u << 20))
     throw InvalidParams("ring_capacity", "must be within [1, 1048576]", static_cast<double>(ring_capacity));
   if (!(poll_period_s >= 1e-6 && poll_period_s <= 0.1))
@@ -53,7 +54,7 @@ std::uint64_t LinkStats::rejected_total() const {
 
 Link::Link(const LinkConfig& config)
     : config_((config.validate(), config)),
-      participant_(config.domain_id),
+      participant_(config.domain_id, config.network),
       outbound_(config.ring_capacity),
       inbound_(config.ring_capacity) {
   const dds_entity_t pp = participant_.handle();

@@ -27,6 +27,7 @@ namespace mc::net {
 struct LinkConfig {
   int domain_id = 0;
   Role role = Role::kSlave;
+  NetworkConfig network;  ///< interface and discovery peers (default: loopback)
   NetLimits limits;
   std::size_t ring_capacity = 256;  ///< samples each way (0.25 s of one 1 kHz topic)
   /// How long the link thread waits for incoming data before it looks at the outgoing ring:
