@@ -203,6 +203,9 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
     // Axes are handed out one at a time (their costs differ with the sub-stepping).
     std::atomic<std::size_t> next{0};
     auto work = [&] {
+      // The model is copied too: the caller's lies on the calling thread's stack, near what that
+      // thread writes every step (docs/benchmarks.md, Python rollout).
+      const ss::ActuatorModel model = m;
       for (std::size_t i = next.fetch_add(1); i < n; i = next.fetch_add(1)) {
         // Stepped in a copy owned by this thread: neighbouring axes' states (and their PI
         // operators) share cache lines, which two threads writing every sub-step would ping-pong.
@@ -211,8 +214,8 @@ py::dict rollout(py::handle params, py::handle initial_states, const DoubleArray
         double* xo = x2_out + i * steps;
         double* x1o = x1_out + i * steps;
         for (std::size_t k = 0; k < steps && !s.diverged; ++k) {
-          m.step(s, ui[k]);
-          xo[k] = m.slider_position(s);
+          model.step(s, ui[k]);
+          xo[k] = model.slider_position(s);
           x1o[k] = s.x1_m();
         }
         states[i] = std::move(s);
