@@ -1,7 +1,11 @@
 #include "microcobot/net/link.h"
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <memory>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -15,6 +19,7 @@
 namespace mc::net {
 namespace {
 
+using test::StatePublisher;
 using test::test_domain_id;
 using test::wait_until;
 
@@ -166,6 +171,37 @@ TEST(Link, TheLoopSideNeverAllocates) {
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_GT(slave.stats().received, 0u);
+}
+
+// The watchdogs' DDS verdict (issue #17 point 3: deadline and liveliness feed them).
+TEST(Link, APeerIsAliveWhileItsStateFlowsAndNotOnceItFallsSilentOrLeaves) {
+  Link master(config(Role::kMaster));
+  auto slave = std::make_unique<Link>(config(Role::kSlave));
+  StatePublisher from_master(master);
+  auto from_slave = std::make_unique<StatePublisher>(*slave);
+  ASSERT_TRUE(wait_until([&] { return master.peer_alive() && slave->peer_alive(); }, 20.0))
+      << "matched " << master.peer_matched() << slave->peer_matched();
+
+  // Silent but present: the requested deadline (10 ms) is missed, then the state flows again.
+  from_slave->on = false;
+  const auto silent = std::chrono::steady_clock::now();
+  ASSERT_TRUE(wait_until([&] { return !master.peer_alive(); }, 5.0))
+      << "deadlines missed " << master.stats().deadline_missed << ", liveliness lost "
+      << master.stats().liveliness_lost << ", received " << master.stats().received << ", rejected "
+      << master.stats().rejected_total() << ", slave wrote " << slave->stats().written << " failed "
+      << slave->stats().write_failed;
+  const double noticed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - silent).count();
+  std::printf("silent slave noticed after %.1f ms (deadline %.0f ms)\n", 1e3 * noticed_s,
+              1e3 * kStateDeadline_s);
+  EXPECT_GT(master.stats().deadline_missed, 0u);
+  EXPECT_TRUE(master.peer_matched());  // still there
+  from_slave->on = true;
+  EXPECT_TRUE(wait_until([&] { return master.peer_alive(); }, 5.0));
+
+  // Gone: its writers leave with it.
+  from_slave.reset();
+  slave.reset();
+  EXPECT_TRUE(wait_until([&] { return !master.peer_alive() && !master.peer_matched(); }, 5.0));
 }
 
 TEST(Link, RefusesADomainIdOutsideTheRange) {

@@ -175,6 +175,7 @@ void deliver(Link& from, Channel channel, std::array<double, 3> xyz, double scal
 TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
   RemoteSlaveParams rp;
   rp.link.domain_id = test::test_domain_id();
+  rp.watch_dds = false;  // the peer sends one pose: the loop-time timeout alone is under test
   RemoteSlave remote(rp);
   LinkConfig peer_config;
   peer_config.domain_id = rp.link.domain_id;
@@ -209,6 +210,7 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   RemoteMasterParams mp;
   mp.link.domain_id = test::test_domain_id();
   mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
+  mp.watch_dds = false;  // the peer sends single samples: the loop-time timeout alone is under test
   RemoteMaster remote(mp);
   LinkConfig peer_config;
   peer_config.domain_id = mp.link.domain_id;
@@ -228,6 +230,33 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   deliver(peer, Channel::kEstop, {}, 0.0, [&] { return (r = remote.poll(1.011, c)).reset; });
   EXPECT_FALSE(r.estop);
   EXPECT_FALSE(remote.poll(1.012, c).reset);
+}
+
+// DDS's verdict feeds the watchdog (issue #17 point 3): with no loop time passing at all, a slave
+// that stops publishing is let go once its topics miss their deadline, and taken back when they
+// flow again; a slave whose process is gone is let go too.
+TEST(RemoteEnds, AMasterLetsGoOfASlaveWhoseTopicsMissTheirDdsDeadline) {
+  RemoteSlaveParams rp;
+  rp.link.domain_id = test::test_domain_id();
+  RemoteSlave remote(rp);
+  LinkConfig peer_config;
+  peer_config.domain_id = rp.link.domain_id;
+  peer_config.role = Role::kSlave;
+  auto peer = std::make_unique<Link>(peer_config);
+  auto publisher = std::make_unique<test::StatePublisher>(*peer);  // devices active, at 1 kHz
+  const auto fresh = [&] {
+    remote.exchange(0.0);  // drains what arrived; loop time stands still
+    return remote.fresh();
+  };
+  ASSERT_TRUE(test::wait_until(fresh, 20.0)) << "matched " << remote.link().peer_matched();
+  publisher->on = false;
+  EXPECT_TRUE(test::wait_until([&] { return !fresh(); }, 5.0));
+  EXPECT_GT(remote.link().stats().deadline_missed, 0u);
+  publisher->on = true;
+  EXPECT_TRUE(test::wait_until(fresh, 5.0));
+  publisher.reset();
+  peer.reset();
+  EXPECT_TRUE(test::wait_until([&] { return !fresh(); }, 5.0));
 }
 
 TEST(RemoteEnds, TheMasterLetsGoOfASlaveThatStoppedItselfAndReEngagesAfterItsReset) {

@@ -13,8 +13,8 @@ namespace {
 
 // Samples taken per reader and wake-up: keep-last 1 holds at most one on the state topics.
 constexpr std::uint32_t kTakeBatch = 8;
-// Statuses (deadlines, matches) are read every this many wake-ups (about 10 ms).
-constexpr int kStatusEvery = 100;
+// Statuses (matches, liveliness, deadlines) are read this often: the watchdog's resolution.
+constexpr std::int64_t kStatusPeriod_ns = 1'000'000;
 
 std::int64_t steady_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -57,6 +57,7 @@ Link::Link(const LinkConfig& config)
       participant_(config.domain_id, config.network),
       outbound_(config.ring_capacity),
       inbound_(config.ring_capacity) {
+  awaiting_sample_.fill(true);
   const dds_entity_t pp = participant_.handle();
   try {
     for (const TopicSpec& spec : topic_table()) {
@@ -125,13 +126,15 @@ LinkStats Link::stats() const {
   s.receive_dropped = inbound_.dropped();
   for (std::size_t i = 0; i < kRejectionCount; ++i) s.rejected[i] = rejected_[i].load();
   s.deadline_missed = deadline_missed_.load();
+  s.liveliness_lost = liveliness_lost_.load();
   s.peer_matched = peer_matched_.load();
+  s.peer_alive = peer_alive_.load();
   return s;
 }
 
 void Link::run() noexcept {
   const auto timeout = static_cast<dds_duration_t>(std::llround(config_.poll_period_s * 1e9));
-  int wakeups = 0;
+  std::int64_t next_poll_ns = 0;
   while (!stop_.load(std::memory_order_acquire)) {
     NetSample s;
     while (outbound_.pop(s)) write(s);
@@ -139,8 +142,8 @@ void Link::run() noexcept {
     for (std::size_t i = 0; i < kChannelCount; ++i) {
       if (readers_[i] > 0) take(static_cast<Channel>(i));
     }
-    if (++wakeups >= kStatusEvery) {
-      wakeups = 0;
+    if (const std::int64_t now = steady_ns(); now >= next_poll_ns) {
+      next_poll_ns = now + kStatusPeriod_ns;
       poll_statuses();
     }
   }
@@ -229,6 +232,7 @@ void Link::take(Channel c) noexcept {
       continue;
     }
     s.received_ns = now;
+    awaiting_sample_[i] = false;
     if (inbound_.push(s)) {
       received_.fetch_add(1, std::memory_order_relaxed);
     }
@@ -237,15 +241,27 @@ void Link::take(Channel c) noexcept {
 }
 
 void Link::poll_statuses() noexcept {
-  bool matched = true;
+  bool matched = true, alive = true;
   for (std::size_t i = 0; i < kChannelCount; ++i) {
     if (topic_table()[i].rate_Hz <= 0) continue;  // latched topics: matched with the state ones
     if (readers_[i] > 0) {
       dds_subscription_matched_status_t m{};
-      if (dds_get_subscription_matched_status(readers_[i], &m) < 0 || m.current_count == 0) matched = false;
+      const bool reader_matched =
+          dds_get_subscription_matched_status(readers_[i], &m) >= 0 && m.current_count > 0;
+      if (!reader_matched) matched = false;
+      if (!reader_matched || m.current_count_change > 0)
+        awaiting_sample_[i] = true;  // a new peer: data first
+      dds_liveliness_changed_status_t l{};
+      if (dds_get_liveliness_changed_status(readers_[i], &l) < 0 || l.alive_count == 0) alive = false;
+      if (l.not_alive_count_change > 0)
+        liveliness_lost_.fetch_add(static_cast<std::uint64_t>(l.not_alive_count_change),
+                                   std::memory_order_relaxed);
       dds_requested_deadline_missed_status_t d{};
-      if (dds_get_requested_deadline_missed_status(readers_[i], &d) >= 0)
+      if (dds_get_requested_deadline_missed_status(readers_[i], &d) >= 0 && d.total_count_change > 0) {
         deadline_missed_.fetch_add(d.total_count_change, std::memory_order_relaxed);
+        awaiting_sample_[i] = true;  // until the next valid sample (take())
+      }
+      if (awaiting_sample_[i]) alive = false;
     }
     if (writers_[i] > 0) {
       dds_publication_matched_status_t m{};
@@ -253,6 +269,7 @@ void Link::poll_statuses() noexcept {
     }
   }
   peer_matched_.store(matched, std::memory_order_release);
+  peer_alive_.store(matched && alive, std::memory_order_release);
 }
 
 }  // namespace mc::net

@@ -4,7 +4,9 @@
 /// pushes and pops NetSample through two SpscRing (send(), receive(): wait-free, no allocation,
 /// no DDS call); a link thread does every DDS write and take, maps between NetSample and the ROS 2
 /// types (ros_mapping.h), refuses and counts what the network sends out of bounds, and reads the
-/// watchdog's statuses (deadlines, matched peers).
+/// watchdog's statuses every millisecond: matched peers, liveliness and requested deadlines.
+/// peer_alive() is their verdict, one atomic load for the loop's watchdogs (remote_slave.h,
+/// remote_master.h).
 ///
 /// A master link publishes the master's topics of the table (topics.h) and subscribes to the
 /// slave's, and the other way round; each link ignores its own participant's samples.
@@ -46,7 +48,9 @@ struct LinkStats {
   std::uint64_t receive_dropped = 0;  ///< valid samples dropped: the incoming ring was full
   std::array<std::uint64_t, kRejectionCount> rejected{};  ///< refused samples, by Rejection
   std::uint64_t deadline_missed = 0;                      ///< requested deadlines missed on the state topics
-  bool peer_matched = false;                              ///< every state topic has a matched peer both ways
+  std::uint64_t liveliness_lost = 0;  ///< writers of the state topics that lost their liveliness
+  bool peer_matched = false;          ///< every state topic has a matched peer both ways
+  bool peer_alive = false;            ///< Link::peer_alive() at the snapshot
   std::uint64_t rejected_total() const;
 };
 
@@ -72,6 +76,13 @@ class Link {
 
   LinkStats stats() const;
   bool peer_matched() const { return peer_matched_.load(std::memory_order_acquire); }
+  /// Loop side (one atomic load): DDS itself sees the peer. Every state topic is matched both
+  /// ways, each state reader has a writer whose liveliness lease (kStateLease_s) holds, and each
+  /// has had a valid sample since it matched and since it last missed its requested deadline
+  /// (kStateDeadline_s): a peer that is present but has sent nothing yet is not alive. False
+  /// within the deadline plus a status poll (1 ms) of a peer that falls silent, at once when it
+  /// leaves cleanly, within the lease when its process dies.
+  bool peer_alive() const noexcept { return peer_alive_.load(std::memory_order_acquire); }
   Role role() const { return config_.role; }
   int domain_id() const { return config_.domain_id; }
 
@@ -90,9 +101,12 @@ class Link {
   platform::SpscRing<NetSample> outbound_, inbound_;
 
   std::atomic<bool> stop_{false};
-  std::atomic<bool> peer_matched_{false};
+  std::atomic<bool> peer_matched_{false}, peer_alive_{false};
   std::atomic<std::uint64_t> written_{0}, write_failed_{0}, not_published_{0}, received_{0},
-      deadline_missed_{0};
+      deadline_missed_{0}, liveliness_lost_{0};
+  /// Link thread only: a state reader has had no valid sample since the start, since its writer
+  /// matched, or since it missed its deadline.
+  std::array<bool, kChannelCount> awaiting_sample_{};
   std::array<std::atomic<std::uint64_t>, kRejectionCount> rejected_{};
   std::thread thread_;
 };

@@ -66,7 +66,8 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
   }
   if (emulator_) emulator_->deliver(t_s, [&](const NetSample& d) { apply(d, t_s, command, r); });
   r.estop = estop_;
-  r.fresh = engaged_ && t_s - last_target_t_ <= stale_timeout_s_;
+  r.fresh =
+      engaged_ && t_s - last_target_t_ <= stale_timeout_s_ && (!params_.watch_dds || link_->peer_alive());
   command.deadman = engaged_;
   return r;
 }

@@ -8,9 +8,10 @@
 /// e-stop and engaged flags, and publishes the slave's measured pose, contact and grip forces
 /// and gripper opening, and its devices' states on /diagnostics (10 Hz, and at once on a change).
 ///
-/// The master is fresh while it is engaged and its last target is at most `stale_timeout_s`
-/// old (issue #17 point 6: a dead master holds the slave within 10 ms: the coupling disengages
-/// and the stage holds its target). Its e-stop latches the slave's; releasing it resets it.
+/// The master is fresh while it is engaged, its last target is at most `stale_timeout_s` old
+/// and DDS sees it (Link::peer_alive(): matched, alive, within its deadlines) (issue #17 point 6:
+/// a dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
+/// target). Its e-stop latches the slave's; releasing it resets it.
 
 #include <array>
 #include <memory>
@@ -26,6 +27,11 @@ struct RemoteMasterParams {
   /// A target older than this: the master is silent. 8 ms, so that the hold (at the next
   /// operator tick) lands within the 10 ms of issue #17 point 6.
   double stale_timeout_s = 0.008;
+  /// Also require DDS's verdict on the peer (Link::peer_alive(): every state topic matched, alive
+  /// and within its deadline). Off only for a peer that is not a whole end of the platform: one
+  /// that publishes some of the state topics, or slower than their 10 ms deadline (a ROS 2 tool;
+  /// the tests of the loop-time timeout alone). The loop-time timeout above applies either way.
+  bool watch_dds = true;
   std::array<double, 3> home_m{};  ///< the stage's home, world coordinates (targets are relative)
   double goal_speed_m_s = 1e-3;    ///< speed cap of the move to each target (the coupling caps too)
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With

@@ -16,8 +16,10 @@
 ///   safe state          the e-stop topic latched on (reliable, transient local), the coupling's
 ///                       engaged flag off; activate() releases both
 ///
-/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave), or its
-/// /diagnostics report a device that is not active (its own e-stop, a fault), the axes report
+/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave), DDS no
+/// longer sees it (Link::peer_alive(): a state topic unmatched, its liveliness lost or its deadline
+/// missed), or its /diagnostics report a device that is not active (its own e-stop, a fault), the
+/// axes report
 /// stale measurements: the coupling disengages with zero force on the masters at
 /// once, and re-engages at the slave's measured position when poses return (a restarted slave
 /// does not jump). Everything on the loop path only pushes to and pops from the link's rings.
@@ -37,6 +39,11 @@ struct RemoteSlaveParams {
   /// No pose for this long and the slave counts as silent: 8 ms, so that the release (at the
   /// next tick) lands within the 10 ms of issue #17 point 6.
   double stale_timeout_s = 0.008;
+  /// Also require DDS's verdict on the peer (Link::peer_alive(): every state topic matched, alive
+  /// and within its deadline). Off only for a peer that is not a whole end of the platform: one
+  /// that publishes some of the state topics, or slower than their 10 ms deadline (a ROS 2 tool;
+  /// the tests of the loop-time timeout alone). The loop-time timeout above applies either way.
+  bool watch_dds = true;
   double sample_period_s = 1e-5;  ///< reported as the axes' drive period (the model's step)
   double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
@@ -77,7 +84,10 @@ class RemoteSlave {
   const Link& link() const { return *link_; }
   /// Poses flow and every slave device is active (a slave that faulted or e-stopped itself is
   /// as good as silent to the coupling: it lets go, and re-engages once the slave is reset).
-  bool fresh() const noexcept { return state_.age_s <= stale_timeout_s_ && state_.slave_active(); }
+  bool fresh() const noexcept {
+    return state_.age_s <= stale_timeout_s_ && state_.slave_active() &&
+           (!params_.watch_dds || link_->peer_alive());
+  }
   const RemoteSlaveState& state() const noexcept { return state_; }
 
   // The devices' side (loop thread).
