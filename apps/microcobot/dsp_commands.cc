@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <cstdio>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -58,6 +59,19 @@ std::vector<std::complex<double>> read_frf(const mc::CsvTable& t) {
   std::vector<std::complex<double>> h(re.size());
   for (std::size_t i = 0; i < h.size(); ++i) h[i] = {re[i], im[i]};
   return h;
+}
+
+using NamedColumn = std::pair<const char*, const std::vector<double>&>;
+
+// A spectrum-like result: two columns, as JSON on stdout and as `csv_name` (or results.mat).
+void write_two_columns(const mc::cli::CommonOptions& common, const char* csv_name, const NamedColumn& x,
+                       const NamedColumn& y) {
+  const nlohmann::json j{{x.first, x.second}, {y.first, y.second}};
+  mc::CsvTable t;
+  t.add_column(x.first, x.second);
+  t.add_column(y.first, y.second);
+  mc::cli::write_result_table(common, csv_name, t, j);
+  mc::cli::emit(common, j);
 }
 
 void add_dsp(CLI::App& group) {
@@ -120,12 +134,7 @@ void add_dsp(CLI::App& group) {
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->column});
       const auto p = mc::dsp::welch(table.column(o->column), to_options(o->w));
-      const nlohmann::json j{{"f_Hz", p.f_Hz}, {"psd", p.value}};
-      mc::CsvTable t;
-      t.add_column("f_Hz", p.f_Hz);
-      t.add_column("psd", p.value);
-      mc::cli::write_result_table(o->common, "psd.csv", t, j);
-      mc::cli::emit(o->common, j);
+      write_two_columns(o->common, "psd.csv", {"f_Hz", p.f_Hz}, {"psd", p.value});
     });
   }
   {
@@ -271,12 +280,7 @@ void add_dsp(CLI::App& group) {
         throw mc::InvalidInput(o->in, 0, msg);
       }
       const auto b = mc::dsp::third_octave_average(f, read_frf(table), lo, hi);
-      const nlohmann::json j{{"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB}};
-      mc::CsvTable t;
-      t.add_column("fc_Hz", b.fc_Hz);
-      t.add_column("mag_dB", b.mag_dB);
-      mc::cli::write_result_table(o->common, "octave.csv", t, j);
-      mc::cli::emit(o->common, j);
+      write_two_columns(o->common, "octave.csv", {"fc_Hz", b.fc_Hz}, {"mag_dB", b.mag_dB});
     });
   }
 }
