@@ -42,6 +42,7 @@ struct ServeOptions {
   int domain = 0;
   mc::cli::NetworkOptions network;  // where the DDS link goes (master and slave roles)
   mc::control::LinkParams link;     // the emulated impairment of what this end receives
+  std::string passivity = "on";     // time-domain passivity control at this end's ports
 };
 
 // The distributed platform's far end (issue #17): the master process sees the slave stage as
@@ -57,6 +58,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     if (mc::net::impairs(o.link))
       throw mc::UsageError("--link-delay, --link-jitter, --link-loss: need --role master or slave");
     if (o.network.given()) throw mc::UsageError("--interface, --peer: need --role master or slave");
+    if (o.passivity != "on") throw mc::UsageError("--passivity: needs --role master or slave");
     return ends;
   }
   if (o.link.jitter_s > o.link.delay_s)
@@ -68,6 +70,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     rp.link.domain_id = o.domain;
     rp.link.network = mc::cli::network_config(o.network);
     rp.emulate = o.link;
+    rp.passivity = o.passivity == "on";
     rp.sample_period_s = axis.integrator.dt_s;
     rp.max_voltage_V = axis.drive.max_V;
     ends.slave = std::make_unique<mc::net::RemoteSlave>(rp);
@@ -86,6 +89,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     rp.link.domain_id = o.domain;
     rp.link.network = mc::cli::network_config(o.network);
     rp.emulate = o.link;
+    rp.passivity = o.passivity == "on";
     rp.home_m = {lp.platform.stage.home_x_m, lp.platform.stage.home_y_m, lp.platform.stage.home_z_m};
     rp.goal_speed_m_s = lp.platform.teleop.console_max_speed_m_s;
     ends.master = std::make_unique<mc::net::RemoteMaster>(rp);
@@ -169,6 +173,15 @@ void serve(const ServeOptions& o) {
   }
   server.stop();
   mc::cli::set_cooperative_interrupts(false);
+  if (ends.slave || ends.master) {
+    const double lowest =
+        ends.slave ? ends.slave->min_observed_energy_J() : ends.master->min_observed_energy_J();
+    const double dissipated =
+        ends.slave ? ends.slave->dissipated_energy_J() : ends.master->dissipated_energy_J();
+    std::cerr << fmt::format(
+        "serve: this end's ports (passivity control {}): lowest observed energy {:.3g} J, {:.3g} J refused\n",
+        o.passivity, lowest, dissipated);
+  }
   const int sig = mc::cli::interrupt_signal();
   std::cerr << "serve: stopped" << (sig ? " on " + mc::cli::signal_name(sig) : std::string())
             << ": every device in its safe state, recordings closed in " << o.out.string() << "\n";
@@ -212,6 +225,11 @@ void add_serve(CLI::App& cmd) {
          "Emulated probability of losing a best-effort sample, [0, 1) (default 0; the reliable e-stop "
          "and engaged topics are only delayed)")
       ->check(mc::cli::Range(0.0, 0.999));
+  cmd.add_option("--passivity", o->passivity,
+                 "Time-domain passivity control at this end's ports of the master-slave channel: on "
+                 "(default; keeps the coupling passive under delay and loss, docs/model.md) or off "
+                 "(observed only). Needs --role")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd.callback([o] { serve(*o); });
 }
 

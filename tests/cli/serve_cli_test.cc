@@ -57,6 +57,8 @@ TEST(ServeCli, TheLinkFlagsAreUsageErrorsNamingTheFlag) {
       {{"--interface", "eth0"}, "--interface"},  // a link's, as the emulator's flags
       {{"--role", "slave", "--interface", "eth0\"/><x"}, "--interface"},
       {{"--role", "master", "--peer", "10.0.0.2", "--peer", "a b"}, "--peer"},
+      {{"--passivity", "off"}, "--passivity"},  // the ports are the link's
+      {{"--role", "slave", "--passivity", "yes"}, "--passivity"},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args = {"serve", "--listen", "127.0.0.1:0", "--duration", "0.2"};

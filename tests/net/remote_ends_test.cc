@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -53,11 +54,12 @@ struct Pair {
   std::unique_ptr<RemoteMaster> master_link;
   std::unique_ptr<End> master, slave;
 
-  explicit Pair(const control::LinkParams& emulate = {}) {
+  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true) {
     const int domain = test::test_domain_id();
     RemoteMasterParams mp;
     mp.link.domain_id = domain;
     mp.emulate = emulate;
+    mp.passivity = passivity;
     mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     master_link = std::make_unique<RemoteMaster>(mp);
     live::LiveParams sp;
@@ -68,6 +70,7 @@ struct Pair {
     RemoteSlaveParams rp;
     rp.link.domain_id = domain;
     rp.emulate = emulate;
+    rp.passivity = passivity;
     rp.sample_period_s = axis.integrator.dt_s;
     slave_link = std::make_unique<RemoteSlave>(rp);
     live::LiveParams lp;
@@ -154,6 +157,77 @@ void moves_the_slave_without_allocating(Pair& pair) {
   }));
   EXPECT_EQ(pair.master_link->link().stats().rejected_total(), 0u);
   EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
+}
+
+// Time-domain passivity across the two ends (issue #17 point 4): over a 200 ms round trip with
+// jitter and 20 % loss, the master's console presses the slave's fingers 5 um into the substrate
+// (a 1e5 N/m contact). The slave reaches the contact 100 ms before the master hears of it, and
+// the master's target has stopped before the force has come back: the master has put in far less
+// energy than pressing 5 um deep takes out.
+struct Press {
+  double min_observed_master_end_J, min_observed_slave_end_J, dissipated_J, lowest_z_m, max_contact_N;
+};
+
+Press press_into_the_substrate(bool passivity) {
+  control::LinkParams link;
+  link.delay_s = 0.1;  // each way
+  link.jitter_s = 0.01;
+  link.loss = 0.2;
+  link.seed = 5;
+  Pair pair(link, passivity);
+  const auto engaged = [&] {
+    return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false);
+  };
+  EXPECT_TRUE(test::wait_until(engaged, 30.0)) << "the master never engaged with the slave";
+  live::ConsoleCommand c;
+  c.deadman = true;
+  c.has_goal = true;
+  c.goal_m = {-1e-3, pair.master->get("target_y_m"), 20e-6};  // away from the part, 20 um up
+  c.goal_speed_m_s = 1e-3;
+  EXPECT_TRUE(mc::test::eventually([&] {
+    pair.drive(c, 20ms);
+    return std::abs(pair.slave->get("measured_z_m") - 20e-6) < 1e-6 &&
+           std::abs(pair.slave->get("measured_x_m") + 1e-3) < 1e-6;
+  })) << "z "
+      << pair.slave->get("measured_z_m");
+  EXPECT_EQ(pair.slave->get("contact_z_N"), 0.0) << "not yet in contact";
+  c.goal_m[2] = -5e-6;
+  c.goal_speed_m_s = 20e-6;
+  Press p{};
+  p.lowest_z_m = 1.0;
+  const auto end = std::chrono::steady_clock::now() + 2500ms;
+  while (std::chrono::steady_clock::now() < end) {
+    pair.drive(c, 20ms);
+    p.lowest_z_m = std::min(p.lowest_z_m, pair.slave->get("measured_z_m"));
+    p.max_contact_N = std::max(p.max_contact_N, pair.slave->get("contact_z_N"));
+  }
+  p.min_observed_master_end_J = pair.slave_link->min_observed_energy_J();
+  p.min_observed_slave_end_J = pair.master_link->min_observed_energy_J();
+  p.dissipated_J = pair.slave_link->dissipated_energy_J() + pair.master_link->dissipated_energy_J();
+  return p;
+}
+
+TEST(RemoteEnds, PassivityControlKeepsTheChannelPassiveOver200msRoundTripWith20PercentLoss) {
+  const Press open = press_into_the_substrate(false);
+  EXPECT_GT(open.max_contact_N, 0.2) << "the unprotected slave pressed " << -1e6 * open.lowest_z_m
+                                     << " um deep";
+  EXPECT_LT(open.min_observed_slave_end_J, -1e-7)
+      << "unprotected, the slave's end outputs energy the master has not put in";
+  const Press protected_ = press_into_the_substrate(true);
+  EXPECT_GE(protected_.min_observed_slave_end_J, -1e-15);
+  EXPECT_GE(protected_.min_observed_master_end_J, -1e-15);
+  EXPECT_GT(protected_.dissipated_J, 0.0);
+  EXPECT_LT(protected_.max_contact_N, open.max_contact_N)
+      << "the protected slave presses only as far as the master's energy lets it";
+  RecordProperty("open_min_observed_J", std::to_string(open.min_observed_slave_end_J));
+  RecordProperty("open_max_contact_N", std::to_string(open.max_contact_N));
+  RecordProperty("protected_max_contact_N", std::to_string(protected_.max_contact_N));
+  RecordProperty("protected_dissipated_J", std::to_string(protected_.dissipated_J));
+  std::printf(
+      "unprotected: min PO %.3g J, contact up to %.3g N; protected: min PO %.3g / %.3g J, contact up to "
+      "%.3g N, dissipated %.3g J\n",
+      open.min_observed_slave_end_J, open.max_contact_N, protected_.min_observed_slave_end_J,
+      protected_.min_observed_master_end_J, protected_.max_contact_N, protected_.dissipated_J);
 }
 
 // A sample from the peer's side of the link, once the two links have matched. It is sent until

@@ -90,6 +90,26 @@ TEST(RosMapping, WrenchStampedCarriesNewtonsAndRefusesExcessiveForces) {
   EXPECT_EQ(from_ros(m, Channel::kContactForce, NetLimits{}, back), Rejection::kNonFinite);
 }
 
+TEST(RosMapping, PortEnergiesAreNonNegativeFiniteJoulesWithinTheLimit) {
+  NetSample s = pose_sample();
+  s.channel = Channel::kSlavePortEnergy;
+  s.xyz = {1.5e-6, 0.0, 2e-9};
+  geometry_msgs_msg_dds__Vector3Stamped_ m;
+  to_ros(s, m);
+  EXPECT_DOUBLE_EQ(m.vector_.x_, 1.5e-6);
+  EXPECT_STREQ(m.header_.frame_id_, kStageFrame);
+  NetSample back;
+  ASSERT_EQ(from_ros(m, Channel::kSlavePortEnergy, NetLimits{}, back), Rejection::kNone);
+  EXPECT_EQ(back.xyz, s.xyz);
+  EXPECT_EQ(back.stamp_ns, s.stamp_ns);
+  m.vector_.y_ = -1e-12;  // energy put into the channel never goes below zero
+  EXPECT_EQ(from_ros(m, Channel::kSlavePortEnergy, NetLimits{}, back), Rejection::kOutOfRange);
+  m.vector_.y_ = 2e3;
+  EXPECT_EQ(from_ros(m, Channel::kSlavePortEnergy, NetLimits{}, back), Rejection::kOutOfRange);
+  m.vector_.y_ = kNaN;
+  EXPECT_EQ(from_ros(m, Channel::kSlavePortEnergy, NetLimits{}, back), Rejection::kNonFinite);
+}
+
 TEST(RosMapping, JointStateHoldsTheGripperOpeningAsOneNamedJoint) {
   NetSample s;
   s.channel = Channel::kGripperOpening;
@@ -194,6 +214,9 @@ TEST(NetLimits, RefusesNonPositiveOrNonFiniteBounds) {
   EXPECT_THROW(l.validate(), InvalidParams);
   l = NetLimits{};
   l.max_abs_position_m = kNaN;
+  EXPECT_THROW(l.validate(), InvalidParams);
+  l = NetLimits{};
+  l.max_port_energy_J = -1.0;
   EXPECT_THROW(l.validate(), InvalidParams);
 }
 

@@ -179,6 +179,12 @@ void Link::write(const NetSample& s) noexcept {
       rc = dds_write(writers_[i], &m);
       break;
     }
+    case RosType::kVector3Stamped: {
+      geometry_msgs_msg_dds__Vector3Stamped_ m;
+      to_ros(s, m);
+      rc = dds_write(writers_[i], &m);
+      break;
+    }
     case RosType::kBool: {
       std_msgs_msg_dds__Bool_ m;
       to_ros(s, m);
@@ -219,6 +225,10 @@ void Link::take(Channel c) noexcept {
         break;
       case RosType::kJointState:
         r = from_ros(*static_cast<const sensor_msgs_msg_dds__JointState_*>(samples[k]), c, config_.limits, s);
+        break;
+      case RosType::kVector3Stamped:
+        r = from_ros(*static_cast<const geometry_msgs_msg_dds__Vector3Stamped_*>(samples[k]), c,
+                     config_.limits, s);
         break;
       case RosType::kBool:
         r = from_ros(*static_cast<const std_msgs_msg_dds__Bool_*>(samples[k]), c, s);

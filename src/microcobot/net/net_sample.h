@@ -24,10 +24,16 @@ enum class Channel : std::uint8_t {
   /// y, z and `scalar` the gripper's, as platform::Lifecycle values (0 unconfigured, 1 inactive,
   /// 2 active, 3 fault)
   kSlaveDiagnostics,
+  /// master -> slave: the energy the master's end has put into the coupling's channel since it
+  /// started, one port per stage axis (J; time-domain passivity, passive_ports.h)
+  kMasterPortEnergy,
+  /// slave -> master: the same of the slave's end (J)
+  kSlavePortEnergy,
 };
-inline constexpr std::size_t kChannelCount = 9;
+inline constexpr std::size_t kChannelCount = 11;
 
-/// One message. `xyz` holds a position (m) or a force (N) in the stage frame; `scalar` the
+/// One message. `xyz` holds a position (m), a force (N) or the energies of the axes' ports (J)
+/// in the stage frame; `scalar` the
 /// gripper opening (m) or a boolean (0/1). Unused fields are zero.
 struct NetSample {
   Channel channel = Channel::kTarget;
@@ -52,6 +58,8 @@ struct NetLimits {
   double max_abs_position_m = 0.05;  ///< stage positions (the XYZ stage travels a few mm)
   double max_abs_force_N = 10.0;     ///< contact and grip forces
   double max_opening_m = 0.01;       ///< gripper opening, [0, max]
+  /// A port's input energy, [0, max]: 1 kJ is 10 N pushed over 100 m, beyond any session.
+  double max_port_energy_J = 1e3;
   void validate() const;
 };
 

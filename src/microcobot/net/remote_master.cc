@@ -16,7 +16,7 @@ void RemoteMasterParams::validate() const {
   require_positive(goal_speed_m_s, "goal_speed_m_s");
 }
 
-RemoteMaster::RemoteMaster(const RemoteMasterParams& params) : params_(params) {
+RemoteMaster::RemoteMaster(const RemoteMasterParams& params) : params_(params), ports_(params.passivity) {
   params_.link.role = Role::kSlave;
   params_.validate();
   stale_timeout_s_ = params_.stale_timeout_s + 2.0 * params_.emulate.jitter_s;
@@ -30,11 +30,12 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& c
                          live::RemoteRequest& r) noexcept {
   switch (s.channel) {
     case Channel::kTarget:
-      command.has_goal = true;
-      for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + s.xyz[i];
-      command.velocity_m_s = {};
-      command.goal_speed_m_s = params_.goal_speed_m_s;
+      asked_m_ = s.xyz;  // the goal follows in poll(), through the ports
+      has_target_ = true;
       last_target_t_ = t_s;
+      break;
+    case Channel::kMasterPortEnergy:
+      ports_.arrived(s.xyz);
       break;
     case Channel::kGripperTarget:
       command.has_gripper = true;
@@ -69,6 +70,29 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
   r.fresh =
       engaged_ && t_s - last_target_t_ <= stale_timeout_s_ && (!params_.watch_dds || link_->peer_alive());
   command.deadman = engaged_;
+  const double dt = last_poll_t_ >= 0.0 ? t_s - last_poll_t_ : 0.0;
+  last_poll_t_ = t_s;
+  if (r.fresh && !was_fresh_) {
+    // The master (re)appeared: a new session of the channel, starting where it asks.
+    ports_.restart();
+    goal_m_ = asked_m_;
+  }
+  was_fresh_ = r.fresh;
+  if (r.fresh && has_target_ && dt > 0.0) {
+    Axes3 asked_v{};
+    for (std::size_t i = 0; i < 3; ++i) asked_v[i] = (asked_m_[i] - goal_m_[i]) / dt;
+    const Axes3 v = ports_.velocity(asked_v, contact_N_, dt);
+    for (std::size_t i = 0; i < 3; ++i) goal_m_[i] += v[i] * dt;
+  }
+  if (has_target_) {
+    command.has_goal = true;
+    for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + goal_m_[i];
+    command.velocity_m_s = {};
+    command.goal_speed_m_s = params_.goal_speed_m_s;
+  }
+  const PortsReport ports = ports_.report();
+  min_observed_J_.store(ports.min_observed_J, std::memory_order_relaxed);
+  dissipated_J_.store(ports.dissipated_J, std::memory_order_relaxed);
   return r;
 }
 
@@ -93,6 +117,8 @@ void RemoteMaster::publish(const platform::Platform& p) noexcept {
   send(Channel::kContactForce, {f.x, f.y, f.z}, 0.0, stamp);
   send(Channel::kGripForce, {g.grip_force_N(), 0.0, 0.0}, 0.0, stamp);
   send(Channel::kGripperOpening, {}, g.opening_m(), stamp);
+  contact_N_ = {f.x, f.y, f.z};  // the slave's port reads it at the next poll
+  send(Channel::kSlavePortEnergy, ports_.report().input_energy_J, 0.0, stamp);
   // The device states: on a change at once, else at 10 Hz of the 1 kHz operator ticks.
   const std::array<double, 4> states = {
       static_cast<double>(p.axis(0).state()), static_cast<double>(p.axis(1).state()),

@@ -12,12 +12,19 @@
 /// and DDS sees it (Link::peer_alive(): matched, alive, within its deadlines) (issue #17 point 6:
 /// a dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
 /// target). Its e-stop latches the slave's; releasing it resets it.
+///
+/// The target leaves the channel through this end's passivity controller (passive_ports.h): the
+/// stage's goal is the integral of the velocity the controller lets through towards the master's
+/// target, which is the target itself unless the master's energy has not arrived yet (a contact
+/// pressed before the master felt it); the goal then lags and catches up once it has.
 
 #include <array>
+#include <atomic>
 #include <memory>
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/net/link.h"
+#include "microcobot/net/passive_ports.h"
 #include "microcobot/net/wire_emulator.h"
 
 namespace mc::net {
@@ -34,6 +41,8 @@ struct RemoteMasterParams {
   bool watch_dds = true;
   std::array<double, 3> home_m{};  ///< the stage's home, world coordinates (targets are relative)
   double goal_speed_m_s = 1e-3;    ///< speed cap of the move to each target (the coupling caps too)
+  /// Time-domain passivity control at this end's ports (passive_ports.h); false: observed only.
+  bool passivity = true;
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
   /// jitter the timeout grows by twice the jitter.
   control::LinkParams emulate;
@@ -50,6 +59,10 @@ class RemoteMaster final : public live::CommandSource {
   void publish(const platform::Platform& platform) noexcept override;
 
   const Link& link() const { return *link_; }
+  /// Not for the loop (any thread): the lowest observed energy of this end's ports since the
+  /// start (J; >= 0 up to rounding with passivity control) and what its controller dissipated.
+  double min_observed_energy_J() const noexcept { return min_observed_J_.load(std::memory_order_relaxed); }
+  double dissipated_energy_J() const noexcept { return dissipated_J_.load(std::memory_order_relaxed); }
 
  private:
   void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns) noexcept;
@@ -64,6 +77,14 @@ class RemoteMaster final : public live::CommandSource {
   bool estop_ = false;
   std::array<double, 4> states_sent_{-1, -1, -1, -1};  // lifecycles last put on /diagnostics
   int ticks_to_diagnostics_ = 0;
+  // The channel's slave end: the master's latest target and the goal let through towards it
+  // (both relative to home), the contact force of the last publish, the sessions.
+  SlavePorts ports_;
+  Axes3 asked_m_{}, goal_m_{}, contact_N_{};
+  bool has_target_ = false;
+  bool was_fresh_ = false;
+  double last_poll_t_ = -1.0;
+  std::atomic<double> min_observed_J_{0.0}, dissipated_J_{0.0};
 };
 
 }  // namespace mc::net

@@ -85,7 +85,7 @@ void RemoteSlaveParams::validate() const {
           max_voltage_V);
 }
 
-RemoteSlave::RemoteSlave(const RemoteSlaveParams& params) : params_(params) {
+RemoteSlave::RemoteSlave(const RemoteSlaveParams& params) : params_(params), ports_(params.passivity) {
   params_.link.role = Role::kMaster;
   params_.validate();
   stale_timeout_s_ = params_.stale_timeout_s + 2.0 * params_.emulate.jitter_s;
@@ -135,7 +135,10 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
       state_.age_s = 0.0;
       break;
     case Channel::kContactForce:
-      state_.contact_force_N = s.xyz;
+      received_contact_N_ = s.xyz;  // out through the ports in exchange()
+      break;
+    case Channel::kSlavePortEnergy:
+      ports_.arrived(s.xyz);
       break;
     case Channel::kGripForce:
       state_.grip_force_N = s.xyz[0];
@@ -164,12 +167,34 @@ void RemoteSlave::exchange(double dt_s) noexcept {
     }
   }
   if (emulator_) emulator_->deliver(now_s_, [this](const NetSample& d) { apply(d); });
-  if (target_mask_ == 0b111u) {
-    target_mask_ = 0;
-    if (!targets_fresh_) return;
-    send(Channel::kTarget, target_m_, 0.0);
-    send(Channel::kGripperTarget, {}, gripper_target_m_);
+  const bool is_fresh = fresh();
+  if (is_fresh && !was_fresh_) {
+    // The slave (re)appeared: a new session of the channel; targets count from the next one.
+    ports_.restart();
+    target_sent_ = false;
+    target_rate_m_s_ = {};
   }
+  was_fresh_ = is_fresh;
+  // This tick's force out of the channel, against the rate of the target last sent.
+  state_.contact_force_N = ports_.contact_force(received_contact_N_, target_rate_m_s_, dt_s);
+  const PortsReport ports = ports_.report();
+  min_observed_J_.store(ports.min_observed_J, std::memory_order_relaxed);
+  dissipated_J_.store(ports.dissipated_J, std::memory_order_relaxed);
+  since_sent_s_ += dt_s;
+  if (target_mask_ != 0b111u) return;
+  target_mask_ = 0;
+  if (!targets_fresh_) {
+    target_rate_m_s_ = {};
+    return;
+  }
+  for (std::size_t i = 0; i < 3; ++i)
+    target_rate_m_s_[i] = target_sent_ ? (target_m_[i] - sent_target_m_[i]) / since_sent_s_ : 0.0;
+  sent_target_m_ = target_m_;
+  target_sent_ = true;
+  since_sent_s_ = 0.0;
+  send(Channel::kTarget, target_m_, 0.0);
+  send(Channel::kGripperTarget, {}, gripper_target_m_);
+  send(Channel::kMasterPortEnergy, ports.input_energy_J, 0.0);
 }
 
 }  // namespace mc::net

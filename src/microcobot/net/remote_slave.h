@@ -19,16 +19,19 @@
 /// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave), DDS no
 /// longer sees it (Link::peer_alive(): a state topic unmatched, its liveliness lost or its deadline
 /// missed), or its /diagnostics report a device that is not active (its own e-stop, a fault), the
-/// axes report
-/// stale measurements: the coupling disengages with zero force on the masters at
+/// axes report stale measurements: the coupling disengages with zero force on the masters at
 /// once, and re-engages at the slave's measured position when poses return (a restarted slave
-/// does not jump). Everything on the loop path only pushes to and pops from the link's rings.
+/// does not jump). The contact force the coupling renders has come out of the channel through
+/// this end's passivity controller (passive_ports.h). Everything on the loop path only pushes to
+/// and pops from the link's rings.
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 
 #include "microcobot/net/link.h"
+#include "microcobot/net/passive_ports.h"
 #include "microcobot/net/wire_emulator.h"
 #include "microcobot/platform/platform.h"
 
@@ -44,6 +47,8 @@ struct RemoteSlaveParams {
   /// that publishes some of the state topics, or slower than their 10 ms deadline (a ROS 2 tool;
   /// the tests of the loop-time timeout alone). The loop-time timeout above applies either way.
   bool watch_dds = true;
+  /// Time-domain passivity control at this end's ports (passive_ports.h); false: observed only.
+  bool passivity = true;
   double sample_period_s = 1e-5;  ///< reported as the axes' drive period (the model's step)
   double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
@@ -54,8 +59,9 @@ struct RemoteSlaveParams {
 
 /// What the master knows of the slave (loop thread).
 struct RemoteSlaveState {
-  std::array<double, 3> position_m{};       ///< measured, stage coordinates
-  std::array<double, 3> contact_force_N{};  ///< on the gripper, world frame
+  std::array<double, 3> position_m{};  ///< measured, stage coordinates
+  /// On the gripper, world frame, as it comes out of the channel (after the passivity controller)
+  std::array<double, 3> contact_force_N{};
   double grip_force_N = 0.0;
   double opening_m = 0.0;
   double age_s = 1e9;  ///< since the last pose (starts stale)
@@ -89,6 +95,10 @@ class RemoteSlave {
            (!params_.watch_dds || link_->peer_alive());
   }
   const RemoteSlaveState& state() const noexcept { return state_; }
+  /// Not for the loop (any thread): the lowest observed energy of this end's ports since the
+  /// start (J; >= 0 up to rounding with passivity control) and what its controller dissipated.
+  double min_observed_energy_J() const noexcept { return min_observed_J_.load(std::memory_order_relaxed); }
+  double dissipated_energy_J() const noexcept { return dissipated_J_.load(std::memory_order_relaxed); }
 
   // The devices' side (loop thread).
   void set_target(int axis, double target_m, double velocity_m_s) noexcept;
@@ -112,6 +122,14 @@ class RemoteSlave {
   bool targets_fresh_ = false;  // they were computed on fresh measurements
   double gripper_target_m_ = 0.0;
   int estop_sent_ = -1;  // -1: never sent
+  // The channel's master end: the force received, the rate of the targets sent, the sessions.
+  MasterPorts ports_;
+  std::array<double, 3> received_contact_N_{};
+  std::array<double, 3> sent_target_m_{}, target_rate_m_s_{};
+  bool target_sent_ = false;  // in this session
+  double since_sent_s_ = 0.0;
+  bool was_fresh_ = false;
+  std::atomic<double> min_observed_J_{0.0}, dissipated_J_{0.0};
 };
 
 }  // namespace mc::net

@@ -49,6 +49,8 @@ void NetLimits::validate() const {
     throw InvalidParams("max_abs_force_N", "must be a finite number > 0");
   if (!(max_opening_m > 0) || !std::isfinite(max_opening_m))
     throw InvalidParams("max_opening_m", "must be a finite number > 0");
+  if (!(max_port_energy_J > 0) || !std::isfinite(max_port_energy_J))
+    throw InvalidParams("max_port_energy_J", "must be a finite number > 0");
 }
 
 builtin_interfaces_msg_dds__Time_ to_ros_time(std::int64_t stamp_ns) {
@@ -83,6 +85,14 @@ void to_ros(const NetSample& s, geometry_msgs_msg_dds__WrenchStamped_& m) {
   m.wrench_.force_.x_ = s.xyz[0];
   m.wrench_.force_.y_ = s.xyz[1];
   m.wrench_.force_.z_ = s.xyz[2];
+}
+
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__Vector3Stamped_& m) {
+  m = {};
+  fill_header(s.stamp_ns, m.header_);
+  m.vector_.x_ = s.xyz[0];
+  m.vector_.y_ = s.xyz[1];
+  m.vector_.z_ = s.xyz[2];
 }
 
 void to_ros(const NetSample& s, std_msgs_msg_dds__Bool_& m) { m.data_ = s.scalar != 0.0; }
@@ -158,6 +168,15 @@ Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, co
                    NetSample& out) {
   const auto& f = m.wrench_.force_;
   return check_vector(f.x_, f.y_, f.z_, lim.max_abs_force_N, m.header_, c, out);
+}
+
+Rejection from_ros(const geometry_msgs_msg_dds__Vector3Stamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out) {
+  const auto& e = m.vector_;
+  const Rejection r = check_vector(e.x_, e.y_, e.z_, lim.max_port_energy_J, m.header_, c, out);
+  // Energies put into the channel only grow from zero.
+  if (r == Rejection::kNone && (e.x_ < 0.0 || e.y_ < 0.0 || e.z_ < 0.0)) return Rejection::kOutOfRange;
+  return r;
 }
 
 Rejection from_ros(const sensor_msgs_msg_dds__JointState_& m, Channel c, const NetLimits& lim,

@@ -28,6 +28,8 @@ bool from_ros_time(const builtin_interfaces_msg_dds__Time_& t, std::int64_t& sta
 
 void to_ros(const NetSample& s, geometry_msgs_msg_dds__PoseStamped_& m);
 void to_ros(const NetSample& s, geometry_msgs_msg_dds__WrenchStamped_& m);
+/// The ports' energies (J) of the time-domain passivity control, one per stage axis.
+void to_ros(const NetSample& s, geometry_msgs_msg_dds__Vector3Stamped_& m);
 void to_ros(const NetSample& s, std_msgs_msg_dds__Bool_& m);
 
 /// The storage a JointState of one joint points at.
@@ -55,6 +57,9 @@ void to_ros(const NetSample& s, DiagnosticsBuffer& buf, diagnostic_msgs_msg_dds_
 Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
                    NetSample& out);
 Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, const NetLimits& lim,
+                   NetSample& out);
+/// Each energy finite, within [0, max_port_energy_J].
+Rejection from_ros(const geometry_msgs_msg_dds__Vector3Stamped_& m, Channel c, const NetLimits& lim,
                    NetSample& out);
 /// Exactly one position; velocity and effort empty or of length one (and finite).
 Rejection from_ros(const sensor_msgs_msg_dds__JointState_& m, Channel c, const NetLimits& lim,

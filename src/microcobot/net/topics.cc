@@ -12,6 +12,7 @@ constexpr std::string_view kPoseStamped = "geometry_msgs::msg::dds_::PoseStamped
 constexpr std::string_view kWrenchStamped = "geometry_msgs::msg::dds_::WrenchStamped_";
 constexpr std::string_view kJointState = "sensor_msgs::msg::dds_::JointState_";
 constexpr std::string_view kBool = "std_msgs::msg::dds_::Bool_";
+constexpr std::string_view kVector3Stamped = "geometry_msgs::msg::dds_::Vector3Stamped_";
 constexpr std::string_view kDiagnosticArray = "diagnostic_msgs::msg::dds_::DiagnosticArray_";
 
 constexpr TopicSpec state(Channel c, std::string_view ros, std::string_view dds, RosType type,
@@ -67,6 +68,12 @@ constexpr std::array<TopicSpec, kChannelCount> kTable{{
     {Channel::kSlaveDiagnostics, "/diagnostics", "rt/diagnostics", RosType::kDiagnosticArray,
      kDiagnosticArray, Role::kSlave, kDiagnosticsRate_Hz, Reliability::kReliable, Durability::kVolatile, 1,
      0.0, 0.0, "level 0 OK (active), 1 WARN (inactive), 2 ERROR (fault), 3 STALE (unconfigured)"},
+    // Time-domain passivity: each end's input energy travels with its state, at its rate (a
+    // lost sample only delays the energy it carried: the next one holds the total).
+    state(Channel::kMasterPortEnergy, "/microcobot/master/port_energy", "rt/microcobot/master/port_energy",
+          RosType::kVector3Stamped, kVector3Stamped, Role::kMaster, "J (x, y, z: the stage axes' ports)"),
+    state(Channel::kSlavePortEnergy, "/microcobot/slave/port_energy", "rt/microcobot/slave/port_energy",
+          RosType::kVector3Stamped, kVector3Stamped, Role::kSlave, "J (x, y, z: the stage axes' ports)"),
 }};
 
 constexpr bool table_is_indexed_by_channel() {
@@ -113,6 +120,8 @@ const dds_topic_descriptor_t* descriptor(RosType type) {
       return &std_msgs_msg_dds__Bool__desc;
     case RosType::kDiagnosticArray:
       return &diagnostic_msgs_msg_dds__DiagnosticArray__desc;
+    case RosType::kVector3Stamped:
+      return &geometry_msgs_msg_dds__Vector3Stamped__desc;
   }
   return nullptr;
 }

@@ -23,7 +23,14 @@ enum class Reliability : std::uint8_t { kBestEffort, kReliable };
 enum class Durability : std::uint8_t { kVolatile, kTransientLocal };
 
 /// The ROS 2 message types the link uses (their DDS names in TopicSpec::type_name).
-enum class RosType : std::uint8_t { kPoseStamped, kWrenchStamped, kJointState, kBool, kDiagnosticArray };
+enum class RosType : std::uint8_t {
+  kPoseStamped,
+  kWrenchStamped,
+  kJointState,
+  kBool,
+  kDiagnosticArray,
+  kVector3Stamped
+};
 
 struct TopicSpec {
   Channel channel;

@@ -4,7 +4,7 @@
  * name, and prints what it reads. The wire-compatibility test (wire_compat_test.cc) checks the
  * values against what `microcobot link ping` publishes.
  *
- *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|joint|bool|diag
+ *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag
  *                 [--count K] [--timeout S] [--ready-file PATH]
  *
  * Waits for K samples (default 1) and prints each as one JSON line on stdout, then exits 0.
@@ -43,7 +43,7 @@ static const char kLoopbackConfig[] =
     "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
     "</Discovery>";
 
-enum MsgType { kPose, kWrench, kJoint, kBool, kDiag };
+enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag };
 
 struct Options {
   long domain;
@@ -56,7 +56,7 @@ struct Options {
 
 static int usage(const char* msg, const char* arg) {
   fprintf(stderr,
-          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|joint|bool|diag "
+          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|vector3|joint|bool|diag "
           "[--count K] [--timeout S] [--ready-file PATH])\n",
           msg, arg ? ": " : "", arg ? arg : "");
   return 2;
@@ -103,6 +103,8 @@ static int parse_args(int argc, char** argv, struct Options* o, int* rc) {
         o->type = kPose;
       } else if (strcmp(value, "wrench") == 0) {
         o->type = kWrench;
+      } else if (strcmp(value, "vector3") == 0) {
+        o->type = kVector3;
       } else if (strcmp(value, "joint") == 0) {
         o->type = kJoint;
       } else if (strcmp(value, "bool") == 0) {
@@ -110,7 +112,7 @@ static int parse_args(int argc, char** argv, struct Options* o, int* rc) {
       } else if (strcmp(value, "diag") == 0) {
         o->type = kDiag;
       } else {
-        *rc = usage("--type must be pose, wrench, joint, bool or diag", value);
+        *rc = usage("--type must be pose, wrench, vector3, joint, bool or diag", value);
         return 0;
       }
       have_type = 1;
@@ -216,6 +218,14 @@ static void print_sample(const struct Options* o, const char* type_name, const v
       put_doubles(t, 3);
       break;
     }
+    case kVector3: {
+      const geometry_msgs_msg_dds__Vector3Stamped_* m = sample;
+      const double v[3] = {m->vector_.x_, m->vector_.y_, m->vector_.z_};
+      put_header(o->topic, type_name, &m->header_);
+      fputs(",\"vector\":", stdout);
+      put_doubles(v, 3);
+      break;
+    }
     case kJoint: {
       const sensor_msgs_msg_dds__JointState_* m = sample;
       put_header(o->topic, type_name, &m->header_);
@@ -271,6 +281,8 @@ static const dds_topic_descriptor_t* descriptor(enum MsgType t) {
       return &geometry_msgs_msg_dds__PoseStamped__desc;
     case kWrench:
       return &geometry_msgs_msg_dds__WrenchStamped__desc;
+    case kVector3:
+      return &geometry_msgs_msg_dds__Vector3Stamped__desc;
     case kJoint:
       return &sensor_msgs_msg_dds__JointState__desc;
     case kBool:

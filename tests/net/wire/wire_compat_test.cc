@@ -211,7 +211,8 @@ TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
   std::vector<Listener> listeners{{"/microcobot/slave/pose", "pose", 5},
                                   {"/microcobot/slave/contact_wrench", "wrench", 5},
                                   {"/microcobot/slave/grip_wrench", "wrench", 5},
-                                  {"/diagnostics", "diag", 2}};
+                                  {"/diagnostics", "diag", 2},
+                                  {"/microcobot/slave/port_energy", "vector3", 5}};
   for (std::size_t k = 0; k < listeners.size(); ++k) {
     Listener& l = listeners[k];
     const std::string n = std::to_string(k);
@@ -261,6 +262,10 @@ TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
       EXPECT_EQ(st["message"], "active") << st;
       EXPECT_EQ(st["hardware_id"], "microcobot_slave") << st;
     }
+  }
+  for (const json& s : listeners[4].samples) {
+    EXPECT_EQ(s["type"], "geometry_msgs::msg::dds_::Vector3Stamped_") << s;
+    EXPECT_EQ(s["vector"], json::parse("[0, 0, 0]")) << "no master, no motion, no energy: " << s;
   }
 }
 

@@ -1,0 +1,118 @@
+// Time-domain passivity across the two processes (issue #17 point 4): each end outputs only the
+// energy the other has put in and that has arrived; a peer's restart opens a new session; the
+// channel between the two ends never creates energy, whatever the delay, jitter, loss and the
+// signals.
+#include "microcobot/net/passive_ports.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <random>
+
+#include "microcobot/control/link_emulator.h"
+
+namespace mc::net {
+namespace {
+
+constexpr double kDt = 1e-3;
+
+TEST(PassivePorts, NothingLeavesTheSlavesEndBeforeTheMastersEnergyArrivesThenExactlyThat) {
+  SlavePorts slave(true);
+  // The stage asked at 1 mm/s into a contact that pushes back with 1 N: 1 uJ per tick.
+  const Axes3 asked{1e-3, 0, 0}, contact{-1.0, 0, 0};
+  EXPECT_EQ(slave.velocity(asked, contact, kDt)[0], 0.0) << "no session yet: nothing may leave";
+  slave.arrived({0.5e-6, 0, 0});  // opens the session: counts from here
+  EXPECT_NEAR(slave.velocity(asked, contact, kDt)[0], 0.0, 1e-15);
+  slave.arrived({2.0e-6, 0, 0});  // 1.5 uJ of the master's arrived
+  EXPECT_NEAR(slave.velocity(asked, contact, kDt)[0], 1e-3, 1e-15) << "all of the first uJ";
+  EXPECT_NEAR(slave.velocity(asked, contact, kDt)[0], 0.5e-3, 1e-15) << "the half that is left";
+  EXPECT_NEAR(slave.velocity(asked, contact, kDt)[0], 0.0, 1e-15);
+  const PortsReport r = slave.report();
+  EXPECT_NEAR(r.output_energy_J[0], 1.5e-6, 1e-18);
+  EXPECT_GE(r.min_observed_J, -1e-18);
+  EXPECT_NEAR(r.dissipated_J, 1e-6 + 1e-6 + 0.5e-6 + 1e-6, 1e-18) << "what was refused, tick by tick";
+  // Moving away from the contact takes energy in, freely.
+  EXPECT_NEAR(slave.velocity({-1e-3, 0, 0}, contact, kDt)[0], -1e-3, 1e-15);
+  EXPECT_NEAR(slave.report().input_energy_J[0], 1e-6, 1e-18);
+  // Without the controller the same requests pass and the observer goes negative.
+  SlavePorts open(false);
+  EXPECT_EQ(open.velocity(asked, contact, kDt)[0], 1e-3);
+  EXPECT_NEAR(open.report().min_observed_J, -1e-6, 1e-18);
+}
+
+TEST(PassivePorts, ARestartedPeerOpensANewSessionAndOldSamplesChangeNothing) {
+  MasterPorts master(true);
+  // The force pushes the hand back (target moving at -1 mm/s against +1 N): 1 uJ out per tick.
+  const Axes3 received{-1.0, 0, 0}, rate{-1e-3, 0, 0};
+  master.arrived({0.0, 0, 0});
+  master.arrived({1e-6, 0, 0});
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], -1.0, 1e-12);
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], 0.0, 1e-12) << "spent: the damper cancels it";
+  master.arrived({0.5e-6, 0, 0});  // an older sample overtaken by the newer one
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], 0.0, 1e-12);
+  // The slave restarts: its totals begin again at zero. It is not locked out by what its
+  // predecessor put in and this end spent...
+  master.restart();
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], 0.0, 1e-12) << "nothing before its first sample";
+  master.arrived({0.0, 0, 0});
+  master.arrived({2e-6, 0, 0});
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], -1.0, 1e-12);
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], -1.0, 1e-12);
+  // ... and what this end output before does not come back either.
+  EXPECT_NEAR(master.contact_force(received, rate, kDt)[0], 0.0, 1e-12);
+  EXPECT_NEAR(master.report().output_energy_J[0], 3e-6, 1e-18);
+  EXPECT_GE(master.report().min_observed_J, -1e-18);
+}
+
+// Both ends joined by emulated lines (the energies travel with the loss and jitter of the state
+// they ride on), driven by random forces and velocities, with the master restarted half way.
+double lowest_channel_energy(bool passivity, const control::LinkParams& line) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto master = std::make_unique<MasterPorts>(passivity);
+  SlavePorts slave(passivity);
+  control::LinkParams back = line;
+  back.seed = line.seed + 1;
+  control::EmulatedLink forward(line, kDt), backward(back, kDt);
+  double dead_master_balance = 0.0;  // the restarted master's predecessor: in - out
+  double lowest = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    const double t = k * kDt;
+    if (k == 10000) {
+      const PortsReport r = master->report();
+      dead_master_balance = r.input_energy_J[0] - r.output_energy_J[0];
+      master = std::make_unique<MasterPorts>(passivity);
+      slave.restart();
+    }
+    const double f = 1e-3 * u(rng), v = 1e-3 * u(rng), fs = 1e-3 * u(rng), vs = 1e-3 * u(rng);
+    master->contact_force({f, 0, 0}, {v, 0, 0}, kDt);
+    slave.velocity({vs, 0, 0}, {fs, 0, 0}, kDt);
+    forward.send({t, 0.0, master->report().input_energy_J[0]});
+    backward.send({t, 0.0, slave.report().input_energy_J[0]});
+    control::LinkSample got;
+    if (forward.receive(t, got)) slave.arrived({got.energy_J, 0, 0});
+    if (backward.receive(t, got)) master->arrived({got.energy_J, 0, 0});
+    const PortsReport m = master->report(), s = slave.report();
+    const double channel = dead_master_balance + m.input_energy_J[0] - m.output_energy_J[0] +
+                           s.input_energy_J[0] - s.output_energy_J[0];
+    lowest = std::min(lowest, channel);
+  }
+  return lowest;
+}
+
+TEST(PassivePorts, TheChannelNeverCreatesEnergyWhateverTheDelayJitterLossAndRestarts) {
+  for (const control::LinkParams& line :
+       {control::LinkParams{0.0, 0.0, 0.0, 3}, control::LinkParams{0.1, 0.0, 0.0, 5},
+        control::LinkParams{0.1, 0.02, 0.2, 7}}) {
+    SCOPED_TRACE(testing::Message() << "delay " << line.delay_s << " s, jitter " << line.jitter_s
+                                    << " s, loss " << line.loss);
+    // Powers are about 1e-6 W: 1 nJ per ms of steps. Rounding stays far below.
+    EXPECT_GE(lowest_channel_energy(true, line), -1e-15);
+    // A random walk of 1 nJ steps: 20 000 of them stray about 100 nJ from zero.
+    EXPECT_LT(lowest_channel_energy(false, line), -1e-8) << "the unprotected channel creates energy";
+  }
+}
+
+}  // namespace
+}  // namespace mc::net
