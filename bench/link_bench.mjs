@@ -6,7 +6,10 @@
 //
 // 1. `serve` (the whole platform in one process), alone and beside a second `serve` (two loops,
 // no link), 2. `serve --role slave` + `serve --role master` on a free DDS domain: each for --phase-s seconds with one controlling client on the (master's)
-// console, jogging the stage back and forth at 20 um/s (deadman held, 50 Hz). The loops' tick
+// console, jogging the stage back and forth at 20 um/s (deadman held, 50 Hz). 3. The link's own
+// cost at equal work: `serve` alone without a client, and slave + master without a client (the
+// stage holding while the link carries its whole 1 kHz traffic both ways: targets, poses,
+// forces, port energies). The loops' tick
 // times come from each process's recording (every 1 kHz telemetry sample's tick_us, read back
 // with @mcap/core), the first second dropped. 3. `link ping` through `link echo`: 5000 targets at
 // 1 kHz, the round trip master -> slave -> master.
@@ -96,6 +99,18 @@ stop();
 const masterTicks = await ticks(master);
 const slaveTicks = await ticks(slave);
 
+// The same work with and without the link: nobody operates, every stage holds its place.
+log(`single process, holding, no client: ${phaseS} s`);
+const idle = await serve([]);
+await sleep(phaseS * 1000);
+const idleTicks = await ticks(idle);
+log(`slave + master, holding, no client: ${phaseS} s`);
+const idleSlave = await serve(["--role", "slave", "--domain", domain]);
+const idleMaster = await serve(["--role", "master", "--domain", domain]);
+await sleep(phaseS * 1000);
+await ticks(idleMaster);
+const idleSlaveTicks = await ticks(idleSlave);
+
 log("link ping through link echo: 5000 targets at 1 kHz");
 const echo = spawn(cli, ["link", "echo", "--domain", domain, "--duration", "120"], { stdio: "ignore" });
 const ping = JSON.parse(execFileSync(cli, ["link", "ping", "--domain", domain, "--count", "5000", "--json"]).toString());
@@ -107,6 +122,8 @@ const result = {
   tick_p99_ratio_slave_single: slaveTicks.p99 / singleTicks.p99,
   tick_p99_ratio_slave_single_beside_another: slaveTicks.p99 / besidePeerTicks.p99,
   tick_p99_ratio_master_single: masterTicks.p99 / singleTicks.p99,
+  holding_tick_us: { single: idleTicks, slave: idleSlaveTicks },
+  holding_tick_p99_ratio_slave_single: idleSlaveTicks.p99 / idleTicks.p99,
   round_trip_ms: { p50: 1e3 * ping.rtt_p50_s, p99: 1e3 * ping.rtt_p99_s, max: 1e3 * ping.rtt_max_s, loss: ping.loss },
 };
 if (asJson) {
@@ -118,6 +135,8 @@ if (asJson) {
   console.log(`loop tick, slave:          ${f(slaveTicks)}; p99 ratio to single ${result.tick_p99_ratio_slave_single.toFixed(3)}, ` +
               `to single beside another ${result.tick_p99_ratio_slave_single_beside_another.toFixed(3)}`);
   console.log(`loop tick, master:         ${f(masterTicks)}; p99 ratio to single ${result.tick_p99_ratio_master_single.toFixed(3)}`);
+  console.log(`holding, single:          ${f(idleTicks)}`);
+  console.log(`holding, slave (link on): ${f(idleSlaveTicks)}; p99 ratio ${result.holding_tick_p99_ratio_slave_single.toFixed(3)}`);
   const r = result.round_trip_ms;
   console.log(`round trip at 1 kHz: p50 ${r.p50.toFixed(3)} ms, p99 ${r.p99.toFixed(3)} ms, max ${r.max.toFixed(3)} ms, ` +
               `loss ${(100 * r.loss).toFixed(1)} %`);
