@@ -73,16 +73,20 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
   const double dt = last_poll_t_ >= 0.0 ? t_s - last_poll_t_ : 0.0;
   last_poll_t_ = t_s;
   if (r.fresh && !was_fresh_) {
-    // The master (re)appeared: a new session of the channel, starting where it asks.
+    // The master (re)appeared: a new session of the channel. The goal stays where it is: it
+    // joins the master's target through the ports like any motion (snapping it there would
+    // output energy that no observer saw, e.g. into a contact after a lossy moment).
     ports_.restart();
-    goal_m_ = asked_m_;
   }
   was_fresh_ = r.fresh;
-  if (r.fresh && has_target_ && dt > 0.0) {
+  if (r.fresh && has_target_) {
+    // The energy booked is force times displacement whatever the step: two polls at one time
+    // (a test's) move the goal as one tick would.
+    const double h = dt > 0.0 ? dt : 1e-3;
     Axes3 asked_v{};
-    for (std::size_t i = 0; i < 3; ++i) asked_v[i] = (asked_m_[i] - goal_m_[i]) / dt;
-    const Axes3 v = ports_.velocity(asked_v, contact_N_, dt);
-    for (std::size_t i = 0; i < 3; ++i) goal_m_[i] += v[i] * dt;
+    for (std::size_t i = 0; i < 3; ++i) asked_v[i] = (asked_m_[i] - goal_m_[i]) / h;
+    const Axes3 v = ports_.velocity(asked_v, contact_N_, h);
+    for (std::size_t i = 0; i < 3; ++i) goal_m_[i] += v[i] * h;
   }
   if (has_target_) {
     command.has_goal = true;
