@@ -46,6 +46,10 @@ struct End {
     std::lock_guard lock(mutex);
     return last[channel(name)];
   }
+  std::pair<double, double> get2(const char* a, const char* b) {
+    std::lock_guard lock(mutex);
+    return {last[channel(a)], last[channel(b)]};
+  }
 };
 
 struct Pair {
@@ -164,6 +168,11 @@ void moves_the_slave_without_allocating(Pair& pair) {
 // (a 1e5 N/m contact). The slave reaches the contact 100 ms before the master hears of it, and
 // the master's target has stopped before the force has come back: the master has put in far less
 // energy than pressing 5 um deep takes out.
+// (Not run under the sanitizers: the asan preset excludes it by name. The slave's port books
+// the goal's motion against the contact force measured when the goal moves; a sanitized stage
+// runs behind the wall clock and lagged its goal by over 5 um in one run, so that the goal had
+// arrived before the contact began and the unprotected case observed nothing to contrast. The
+// ports' bounds run under the sanitizers in passive_ports_test.cc.)
 struct Press {
   double min_observed_master_end_J, min_observed_slave_end_J, dissipated_J, lowest_z_m, max_contact_N;
 };
@@ -197,13 +206,16 @@ Press press_into_the_substrate(bool passivity) {
   p.lowest_z_m = 1.0;
   // The master's target takes 1.25 s down to -5 um; on a loaded machine the coupling may let go
   // for a moment (a DDS deadline missed) and resume from where the slave is, which takes longer.
-  // Pressed 4 um deep, or 6 s.
-  const auto end = std::chrono::steady_clock::now() + 6000ms;
+  // Pressed 4 um deep, or 10 s.
+  const auto end = std::chrono::steady_clock::now() + 10000ms;
   while (std::chrono::steady_clock::now() < end && p.lowest_z_m > -4e-6) {
     pair.drive(c, 20ms);
-    p.lowest_z_m = std::min(p.lowest_z_m, pair.slave->get("measured_z_m"));
-    p.max_contact_N = std::max(p.max_contact_N, pair.slave->get("contact_z_N"));
+    const auto [z, fz] = pair.slave->get2("measured_z_m", "contact_z_N");  // one sample
+    p.lowest_z_m = std::min(p.lowest_z_m, z);
+    p.max_contact_N = std::max(p.max_contact_N, fz);
   }
+  std::printf("press (passivity %s): lowest z %.3f um, contact up to %.3f N\n", passivity ? "on" : "off",
+              1e6 * p.lowest_z_m, p.max_contact_N);
   p.min_observed_master_end_J = pair.slave_link->min_observed_energy_J();
   p.min_observed_slave_end_J = pair.master_link->min_observed_energy_J();
   p.dissipated_J = pair.slave_link->dissipated_energy_J() + pair.master_link->dissipated_energy_J();
