@@ -25,6 +25,7 @@
 /// Plain arithmetic on the loop: no allocation, lock or branch on the delay.
 
 #include <array>
+#include <cstddef>
 
 #include "microcobot/control/passivity.h"
 
@@ -62,40 +63,45 @@ class EnergySession {
   Axes3 peer_in_J_{}, peer_base_J_{}, own_base_J_{};
 };
 
-/// The master's end (net/remote_slave.h): the slave's contact force comes out of the channel
-/// through a variable damper on the target's rate.
-class MasterPorts {
+/// What both ends share: a controller per axis, the sessions, the lowest observation.
+template <class Controller>
+class Ports {
  public:
-  explicit MasterPorts(bool enabled);
+  explicit Ports(bool enabled) : pc_{Controller(enabled), Controller(enabled), Controller(enabled)} {}
+  /// The peer (re)appeared: a new session.
   void restart() noexcept { session_.restart(); }
-  void arrived(const Axes3& slave_in_J) noexcept;
-  /// The contact force (stage frame, N, on the gripper) to hand the coupling for one tick of
-  /// `dt_s`, given the force received and the rate of the target sent last (m/s).
-  Axes3 contact_force(const Axes3& received_N, const Axes3& target_rate_m_s, double dt_s) noexcept;
+  /// A sample of the peer's input energies arrived.
+  void arrived(const Axes3& peer_in_J) noexcept;
   PortsReport report() const noexcept;
 
- private:
-  std::array<control::MasterPassivityController, 3> pc_;
+ protected:
+  /// The peer's input energy controller `i` may count on (EnergySession::remote_in_J).
+  double remote_in_J(std::size_t i) const noexcept { return session_.remote_in_J(i, pc_[i].energy().out_J); }
+  void observed(std::size_t i) noexcept;
+
+  std::array<Controller, 3> pc_;
   EnergySession session_;
   double min_observed_J_ = 0.0;
 };
 
+/// The master's end (net/remote_slave.h): the slave's contact force comes out of the channel
+/// through a variable damper on the target's rate.
+class MasterPorts final : public Ports<control::MasterPassivityController> {
+ public:
+  using Ports::Ports;
+  /// The contact force (stage frame, N, on the gripper) to hand the coupling for one tick of
+  /// `dt_s`, given the force received and the rate of the target sent last (m/s).
+  Axes3 contact_force(const Axes3& received_N, const Axes3& target_rate_m_s, double dt_s) noexcept;
+};
+
 /// The slave's end (net/remote_master.h): the commanded velocity of the stage's target comes out
 /// of the channel against the contact force the environment opposes to it.
-class SlavePorts {
+class SlavePorts final : public Ports<control::SlavePassivityController> {
  public:
-  explicit SlavePorts(bool enabled);
-  void restart() noexcept { session_.restart(); }
-  void arrived(const Axes3& master_in_J) noexcept;
+  using Ports::Ports;
   /// The velocity to command for one tick of `dt_s` (m/s), given the one the master's target
   /// asks for and the contact force on the gripper (stage frame, N).
   Axes3 velocity(const Axes3& asked_m_s, const Axes3& contact_N, double dt_s) noexcept;
-  PortsReport report() const noexcept;
-
- private:
-  std::array<control::SlavePassivityController, 3> pc_;
-  EnergySession session_;
-  double min_observed_J_ = 0.0;
 };
 
 }  // namespace mc::net
