@@ -111,6 +111,7 @@ void run_echo(const EchoOptions& o) {
                                   {"rejected_by_reason", rejected_json(st)},
                                   {"receive_dropped", st.receive_dropped},
                                   {"deadline_missed", st.deadline_missed},
+                                  {"liveliness_lost", st.liveliness_lost},
                                   {"stopped_by", sig ? mc::cli::signal_name(sig) : "duration"}};
   mc::cli::emit(
       o.common, summary,

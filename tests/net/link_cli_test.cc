@@ -57,6 +57,7 @@ TEST(LinkCli, PingThroughAnEchoProcessOverLoopback) {
   EXPECT_TRUE(e["estop"].get<bool>());
   EXPECT_GE(e["echoed"].get<int>(), p["received"].get<int>());
   EXPECT_EQ(e["rejected"], 0);
+  EXPECT_TRUE(e["liveliness_lost"].is_number_unsigned()) << e.dump();
   EXPECT_EQ(e["stopped_by"], "SIGTERM");
 }
 
