@@ -52,6 +52,7 @@ template class Ports<control::SlavePassivityController>;
 
 Axes3 MasterPorts::contact_force(const Axes3& received_N, const Axes3& target_rate_m_s,
                                  double dt_s) noexcept {
+  if (!(dt_s > 0.0)) return received_N;  // no time, no energy (a damper over 0 s is undefined)
   Axes3 out{};
   for (std::size_t i = 0; i < 3; ++i) {
     out[i] = opposing(pc_[i].force(opposing(received_N[i]), target_rate_m_s[i], remote_in_J(i), dt_s));
@@ -61,6 +62,7 @@ Axes3 MasterPorts::contact_force(const Axes3& received_N, const Axes3& target_ra
 }
 
 Axes3 SlavePorts::velocity(const Axes3& asked_m_s, const Axes3& contact_N, double dt_s) noexcept {
+  if (!(dt_s > 0.0)) return {};  // no time: nothing moves
   Axes3 out{};
   for (std::size_t i = 0; i < 3; ++i) {
     out[i] = pc_[i].velocity(asked_m_s[i], opposing(contact_N[i]), remote_in_J(i), dt_s);

@@ -90,7 +90,8 @@ class MasterPorts final : public Ports<control::MasterPassivityController> {
  public:
   using Ports::Ports;
   /// The contact force (stage frame, N, on the gripper) to hand the coupling for one tick of
-  /// `dt_s`, given the force received and the rate of the target sent last (m/s).
+  /// `dt_s`, given the force received and the rate of the target sent last (m/s). A tick of no
+  /// time (dt_s <= 0) passes the force unchanged and books nothing.
   Axes3 contact_force(const Axes3& received_N, const Axes3& target_rate_m_s, double dt_s) noexcept;
 };
 
@@ -100,7 +101,7 @@ class SlavePorts final : public Ports<control::SlavePassivityController> {
  public:
   using Ports::Ports;
   /// The velocity to command for one tick of `dt_s` (m/s), given the one the master's target
-  /// asks for and the contact force on the gripper (stage frame, N).
+  /// asks for and the contact force on the gripper (stage frame, N). A tick of no time: zero.
   Axes3 velocity(const Axes3& asked_m_s, const Axes3& contact_N, double dt_s) noexcept;
 };
 

@@ -188,7 +188,8 @@ void RemoteSlave::exchange(double dt_s) noexcept {
     return;
   }
   for (std::size_t i = 0; i < 3; ++i)
-    target_rate_m_s_[i] = target_sent_ ? (target_m_[i] - sent_target_m_[i]) / since_sent_s_ : 0.0;
+    target_rate_m_s_[i] =
+        target_sent_ && since_sent_s_ > 0.0 ? (target_m_[i] - sent_target_m_[i]) / since_sent_s_ : 0.0;
   sent_target_m_ = target_m_;
   target_sent_ = true;
   since_sent_s_ = 0.0;
