@@ -26,7 +26,7 @@ void TrackingParams::validate() const {
   require_non_negative(settle_s, "tracking.settle_s");
   require(settle_s < catchup_s, "tracking.settle_s", "must be shorter than catchup_s", settle_s);
   require_non_negative(ki_1_s, "tracking.ki_1_s");
-  require_in_range(kp, 0.0, 1.0, "tracking.kp");
+  require_in_range(kp, -1.0, 1.0, "tracking.kp");
   require_in_range(backslip_gain, 0.0, 1.0, "tracking.backslip_gain");
   require_positive(in_position_m, "tracking.in_position_m");
   require_positive(filter_s, "tracking.filter_s");

@@ -65,9 +65,13 @@ struct TrackingParams {
   /// After an edge: the integral is frozen while the slip rings [s].
   double settle_s = 0.55e-3;
   double ki_1_s = 1000.0;  ///< integral gain on the residual error [1/s]
-  /// Proportional correction of the residual (fraction per tick): 0 by default, any gain rings
-  /// the contact after the edges (tuned: RMS 156 nm at 0, 220 nm at 0.1; 200 um/s trapezoid).
-  double kp = 0.0;
+  /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
+  /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
+  /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
+  /// a quarter of that period, so -|kp| e acts on the ringing as velocity feedback, i.e. damping;
+  /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
+  /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1).
+  double kp = -0.3;
   double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
