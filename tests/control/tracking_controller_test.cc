@@ -31,14 +31,15 @@ TrackingRecord trapezoid(TrackerKind kind, double distance_m, double velocity_m_
 
 // The issue's goals are RMS <= 100 nm and max <= 250 nm: not reached on this model (each edge
 // leaves a ~300-500 nm transient of the contact, docs/errata.md). These bounds are the measured
-// figures with a margin; they fail if the controller regresses towards the baselines.
+// figures (119-125 nm RMS, 400-630 nm max on the CLI's runs) with a margin; they fail if the
+// controller regresses (159-161 nm before the damping of kp < 0).
 TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
   for (double d : {100e-6, -100e-6}) {
     SCOPED_TRACE(d);
     const auto t = trapezoid(TrackerKind::kTracking, d, 200e-6).metrics;
     const auto h = trapezoid(TrackerKind::kHybrid, d, 200e-6).metrics;
-    EXPECT_LE(t.rms_error_m, 250e-9);
-    EXPECT_LE(t.max_error_m, 1.2e-6);
+    EXPECT_LE(t.rms_error_m, 150e-9);
+    EXPECT_LE(t.max_error_m, 900e-9);
     EXPECT_LE(t.final_error_m, 5e-9);  // issue goal: final error unchanged
     EXPECT_LE(t.lag_s, 0.5e-3);
     EXPECT_LT(t.rms_error_m, 0.25 * h.rms_error_m);  // >= 4x better than today's controller
@@ -61,8 +62,22 @@ TEST(TrackingController, SineOf20umAt1Hz) {
   const auto r = run_tracker(
       test::model(), test::step_map(), TrackerKind::kTracking, TrackerSetup{}, 0.0,
       [sine](double t, double) { return sine->at(t); }, 1.0);
-  EXPECT_LE(r.metrics.rms_error_m, 250e-9);
-  EXPECT_LE(r.metrics.max_error_m, 1.5e-6);
+  EXPECT_LE(r.metrics.rms_error_m, 120e-9);  // measured 92-94 nm (issue goal: 100 nm)
+  EXPECT_LE(r.metrics.max_error_m, 1e-6);
+}
+
+TEST(TrackingController, AnAxisThatFellBehindCatchesUp) {
+  // 400 um at 2 mm/s: faster than the edges can step (~1.3 mm/s with the default range), so the
+  // axis falls behind; once the reference stops it must still arrive, at full stepping speed.
+  // (Before the edge waited for the ramp to use its range, an axis this far behind took its edges
+  // straight after each unloading, advanced ~80 um/s and was still ~270 um short here.)
+  const MotionLimits lim{2e-3, 0.1};
+  auto l = std::make_shared<ReferenceLimiter>(lim, -200e-6);
+  const auto r = run_tracker(
+      test::model(), test::step_map(), TrackerKind::kTracking, TrackerSetup{}, -200e-6,
+      [l](double, double dt) { return l->step(200e-6, dt); }, trapezoid_duration_s(400e-6, lim) + 0.3);
+  EXPECT_GT(r.metrics.max_error_m, 5e-6);  // it did fall behind
+  EXPECT_LE(r.metrics.final_error_m, 5e-9);
 }
 
 TEST(TrackingController, WithinThePeStrokeItOnlyScans) {

@@ -20,6 +20,7 @@ void TrackingParams::validate() const {
   require(unload_V >= 0.0 && unload_V <= high_V - low_V - 10.0, "tracking.unload_V",
           "must be in [0, high_V - low_V - 10]", unload_V);
   require_non_negative(edge_margin_m, "tracking.edge_margin_m");
+  require_in_range(edge_ready_V, 0.0, 50.0, "tracking.edge_ready_V");
   require_in_range(lead_fraction, 0.0, 1.0, "tracking.lead_fraction");
   require_positive(lead_window_m, "tracking.lead_window_m");
   require_positive(catchup_s, "tracking.catchup_s");
@@ -48,6 +49,7 @@ TrackingController::TrackingController(const TrackingParams& p, const stickslip:
       pi_((model.validate(), model.hysteresis)),
       g_(model.pe.static_gain_m_V),
       slew_(model.drive.slew_rate_V_s),
+      min_V_(model.drive.min_V),
       dt_c_(1.0 / p.control_rate_Hz),
       obs_(stickslip::make_pi_state(model.hysteresis, 0.0)) {
   require(p.low_V >= model.drive.min_V && p.high_V <= model.drive.max_V, "tracking.low_V/high_V",
@@ -55,7 +57,7 @@ TrackingController::TrackingController(const TrackingParams& p, const stickslip:
   b_fwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward);
   b_bwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kBackward);
   op_.amplitude_V = p_.high_V - p_.low_V;
-  reset(0.0, p_.low_V);
+  reset(0.0, 0.0);  // the amplifier at power-up
 }
 
 double TrackingController::pe_displacement_m(double u_V) const noexcept {
@@ -63,7 +65,7 @@ double TrackingController::pe_displacement_m(double u_V) const noexcept {
 }
 
 double TrackingController::inverse_V(double y_m) const noexcept {
-  return stickslip::pi_peek_inverse(pi_, obs_, y_m / g_, p_.low_V, p_.high_V);
+  return stickslip::pi_peek_inverse(pi_, obs_, y_m / g_, floor_V_, p_.high_V);
 }
 
 double TrackingController::predicted_backslip_m(double frequency_Hz, Direction d) const noexcept {
@@ -84,7 +86,11 @@ double TrackingController::flyback_frequency_Hz(double v_m_s, Direction d) const
 }
 
 void TrackingController::reset(double x_m, double u_V) noexcept {
-  u_V = std::clamp(u_V, p_.low_V, p_.high_V);
+  // A drive below the ramp's range (the amplifier at 0 V at power-up) is not jumped into range:
+  // that would move the slider by g low_V at once; the ramp may use the voltages below until it
+  // first reaches low_V.
+  floor_V_ = std::clamp(u_V, min_V_, p_.low_V);
+  u_V = std::clamp(u_V, floor_V_, p_.high_V);
   // Drive the observer to u_V from the bottom of the range (no allocation).
   stickslip::pi_update(pi_, obs_, p_.low_V);
   stickslip::pi_update(pi_, obs_, u_V);
@@ -115,6 +121,7 @@ void TrackingController::start_edge(double x, bool forward) noexcept {
   edge_ = true;
   edge_forward_ = forward;
   edge_target_V_ = forward ? p_.low_V : p_.high_V;
+  floor_V_ = p_.low_V;
   unloading_ = false;
   x_edge_ = x;
   b_used_ = forward ? b_fwd_ : b_bwd_;
@@ -178,20 +185,24 @@ void TrackingController::update(double x) noexcept {
   const double y_des = y_base + lead + p_.kp * e_res;
   // An edge when the ramp runs out of range in the direction the reference moves, or, at rest,
   // when the wanted position lies beyond the range by more than the edge margin; never against
-  // the reference's motion.
+  // the reference's motion; and only once the drive has used its range (within edge_ready_V of
+  // its end): an axis that fell behind would otherwise take its edges straight after the
+  // unloading, each advancing by a few volts' worth, and never catch up.
   const double v = ref_.v_m_s;
-  if (y_des > top && v >= 0.0 && (v > 0.0 || y_des > pe_displacement_m(p_.high_V) + p_.edge_margin_m)) {
+  if (y_des > top && v >= 0.0 && (v > 0.0 || y_des > pe_displacement_m(p_.high_V) + p_.edge_margin_m) &&
+      u_ >= p_.high_V - p_.guard_V - p_.edge_ready_V) {
     start_edge(x, true);
     return;
   }
-  if (y_des < bottom && v <= 0.0 && (v < 0.0 || y_des < pe_displacement_m(p_.low_V) - p_.edge_margin_m)) {
+  if (y_des < bottom && v <= 0.0 && (v < 0.0 || y_des < pe_displacement_m(p_.low_V) - p_.edge_margin_m) &&
+      u_ <= p_.low_V + p_.guard_V + p_.edge_ready_V) {
     start_edge(x, false);
     return;
   }
   // Integral on the residual, frozen while the slip rings and when the ramp is saturated the way
   // the residual pushes (anti-windup).
   const bool sat_hi = y_des >= pe_displacement_m(p_.high_V) && e_res > 0.0;
-  const bool sat_lo = y_des <= pe_displacement_m(p_.low_V) && e_res < 0.0;
+  const bool sat_lo = y_des <= pe_displacement_m(floor_V_) && e_res < 0.0;
   if (!check_backslip_ && !sat_hi && !sat_lo) integ_ += p_.ki_1_s * dt_c_ * e_res;
   u_prev_cmd_ = u_cmd_;
   u_cmd_ = inverse_V(y_des);
@@ -238,7 +249,8 @@ stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
     u_ += std::clamp(u_cmd_ - u_, -du, du);
   }
   for (int j = 0; j < seg.corners; ++j) stickslip::pi_update(pi_, obs_, seg.u_V[static_cast<std::size_t>(j)]);
-  u_ = std::clamp(u_, p_.low_V, p_.high_V);
+  u_ = std::clamp(u_, floor_V_, p_.high_V);
+  if (u_ >= p_.low_V) floor_V_ = p_.low_V;
   stickslip::pi_update(pi_, obs_, u_);
   seg.end_V = u_;
   return seg;

@@ -41,37 +41,40 @@ namespace mc::control {
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
   /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low).
-  double low_V = 0.0;
+  double low_V = 7.5;
   double high_V = 100.0;
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
+  /// ...and only when the drive is already within this much of that end: the ramp uses its range
+  /// before an edge (an axis that fell behind catches up instead of stalling) [V].
+  double edge_ready_V = 10.0;
   /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
   /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
   /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V].
-  double unload_V = 60.0;
+  double unload_V = 64.0;
   /// Backslip of an unloaded edge assumed before the first edge is measured [m].
   double backslip_m = 0.0;
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
-  double lead_fraction = 0.5;
+  double lead_fraction = 0.95;
   /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
   /// the unloading run, then returns) [m].
-  double lead_m = 300e-9;
+  double lead_m = 450e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
   double lead_window_m = 300e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
   double catchup_s = 0.6e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
   double settle_s = 0.55e-3;
-  double ki_1_s = 1000.0;  ///< integral gain on the residual error [1/s]
+  double ki_1_s = 500.0;  ///< integral gain on the residual error [1/s]
   /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
   /// a quarter of that period, so -|kp| e acts on the ringing as velocity feedback, i.e. damping;
   /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
-  /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1).
-  double kp = -0.3;
+  /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1, with the other defaults of 2026-11-24).
+  double kp = -0.4;
   double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
@@ -83,6 +86,7 @@ struct TrackingParams {
     v("low_V", low_V);
     v("high_V", high_V);
     v("guard_V", guard_V);
+    v("edge_ready_V", edge_ready_V);
     v("unload_V", unload_V);
     v("backslip_m", backslip_m);
     v("edge_margin_m", edge_margin_m);
@@ -155,7 +159,7 @@ class TrackingController {
   const TrackingParams p_;
   const StepMap& map_;
   const stickslip::PiParams pi_;
-  const double g_, slew_, dt_c_;
+  const double g_, slew_, min_V_, dt_c_;
 
   // State.
   stickslip::PiState obs_;
@@ -169,6 +173,7 @@ class TrackingController {
   double x_edge_ = 0.0, b_used_ = 0.0;
   double x_filt_ = 0.0;
   double edge_target_V_ = 0.0;
+  double floor_V_ = 0.0;  ///< the ramp's lowest voltage: low_V, or below it until it first gets there
   bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
        check_backslip_ = false;
   bool stopped_ = false, in_position_ = false, have_x_ = false;

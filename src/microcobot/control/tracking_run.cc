@@ -118,7 +118,7 @@ struct NewTracker final : Tracker {
   TrackingController c;
   NewTracker(const TrackerSetup& s, const ActuatorModel& m, const StepMap& map, double x0)
       : c(s.tracking, m.params(), map) {
-    c.reset(x0, s.tracking.low_V);
+    c.reset(x0, m.initial_state().u_V);  // where the plant's drive starts
   }
   void update(const ReferenceSample& r, double x) noexcept override {
     c.set_reference(r);
