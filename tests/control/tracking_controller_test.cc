@@ -31,7 +31,7 @@ TrackingRecord trapezoid(TrackerKind kind, double distance_m, double velocity_m_
 
 // The goals are RMS <= 100 nm and max <= 250 nm: not reached on this model (each edge
 // leaves a ~300-500 nm transient of the contact, docs/errata.md). These bounds are the measured
-// figures (119-125 nm RMS, 400-630 nm max on the CLI's runs) with a margin; they fail if the
+// figures (117-125 nm RMS, 400-650 nm max on the CLI's runs) with a margin; they fail if the
 // controller regresses (159-161 nm before the damping of kp < 0).
 TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
   for (double d : {100e-6, -100e-6}) {
@@ -67,10 +67,10 @@ TEST(TrackingController, SineOf20umAt1Hz) {
 }
 
 TEST(TrackingController, AnAxisThatFellBehindCatchesUp) {
-  // 400 um at 2 mm/s: faster than the edges can step (~1.3 mm/s with the default range), so the
-  // axis falls behind; once the reference stops it must still arrive, at full stepping speed.
-  // (Before the edge waited for the ramp to use its range, an axis this far behind took its edges
-  // straight after each unloading, advanced ~80 um/s and was still ~270 um short here.)
+  // 400 um at 2 mm/s: faster than the edges can step (1.5 mm/s is still followed, docs/errata.md),
+  // so the axis falls behind; once the reference stops it must still arrive, at full stepping
+  // speed. (With the wait disabled, tracking.edge_ready_V = 50, an axis this far behind takes its
+  // edges straight after each unloading and ends this run 351 um short.)
   const MotionLimits lim{2e-3, 0.1};
   auto l = std::make_shared<ReferenceLimiter>(lim, -200e-6);
   const auto r = run_tracker(
