@@ -279,7 +279,9 @@ $("record").addEventListener("click", () => action(mc.status && mc.status.record
 // The microscope: top view through an objective (field of view, numerical aperture), focused on
 // the finger tips; what lies off the focal plane is blurred by defocus, detail finer than the
 // optical resolution (0.61 lambda / NA) is not shown. Plus a side view (x, z).
-const objectives = {2: 0.06, 5: 0.14, 10: 0.28, 20: 0.42, 50: 0.55};  // magnification: NA
+// magnification: NA (100x: the oil-immersion objective that focuses optical tweezers' trap;
+// 200x: the same behind a 2x tube lens, which magnifies without resolving more)
+const objectives = {2: 0.06, 5: 0.14, 10: 0.28, 20: 0.42, 50: 0.55, 100: 1.3, 200: 1.3};
 const kFieldNumber = 12e-3;  // field of view = field number / magnification
 const kLambda = 550e-9;
 const view = {center: [0, 0], fov: 1.2e-3};
@@ -339,6 +341,13 @@ function drawMicroscope() {
   g.fillStyle = "#2a2722";
   g.fillRect(0, 0, c.width, c.height);
   if (!t || !sc) return;
+  if (sc.kind === "optical-trap") {
+    drawTrapScene(g, o, s);
+    drawScaleBar(g, c, s);
+    $("scope-info").textContent = `NA ${o.na}, resolution ${(o.resolution * um).toFixed(2)} µm, ` +
+                                  `focus on the trap's plane`;
+    return;
+  }
   const focus = t.measured_z_m;  // autofocus on the finger tips
   // The substrate's texture (a 50 um polishing grid) at z = 0: out of focus by more than a
   // few pixels it washes out entirely, as a fine pattern does under a microscope.
@@ -383,15 +392,54 @@ function drawMicroscope() {
     g.strokeStyle = "#4fa3ff";
     g.beginPath(); g.arc(gx, gy, 6, 0, 2 * Math.PI); g.stroke();
   }
-  // Scale bar: a round length near a fifth of the field.
+  drawScaleBar(g, c, s);
+  $("scope-info").textContent = `NA ${o.na}, resolution ${(o.resolution * um).toFixed(1)} µm, ` +
+                                `focus z ${(focus * um).toFixed(0)} µm`;
+}
+
+// Scale bar: a round length near a fifth of the field.
+function drawScaleBar(g, c, s) {
   const nice = [1e-6, 2e-6, 5e-6, 10e-6, 20e-6, 50e-6, 100e-6, 200e-6, 500e-6, 1e-3, 2e-3];
   const bar = nice.find((v) => v * s > c.width / 6) || 1e-3;
   g.fillStyle = "#fff";
   g.fillRect(c.width - 20 - bar * s, c.height - 24, bar * s, 5);
   g.font = "13px system-ui";
   g.fillText(bar >= 1e-3 ? bar * 1e3 + " mm" : Math.round(bar * um) + " µm", c.width - 20 - bar * s, c.height - 30);
-  $("scope-info").textContent = `NA ${o.na}, resolution ${(o.resolution * um).toFixed(1)} µm, ` +
-                                `focus z ${(focus * um).toFixed(0)} µm`;
+}
+
+// The optical-tweezers scene (thesis §3.5.2, Fig. 3.16) in bright field: the stuck bead and the
+// probe bead as dark-rimmed discs (a bead smaller than the resolution would be a blur), the
+// trap's focus as a green mark at the stage's measured position, and the force the trap
+// measures as an arrow from the probe's centre (Fig. 3.14b's black arrow).
+function drawTrapScene(g, o, s) {
+  const t = mc.telemetry, sc = mc.scene;
+  const bead = (x, y, r, fill) => {
+    const [px, py] = worldToCanvas(x, y), pr = Math.max(r * s, (o.resolution * s) / 2);
+    g.filter = o.resolution * s > 2 ? `blur(${((o.resolution * s) / 4).toFixed(1)}px)` : "none";
+    g.fillStyle = fill;
+    g.beginPath(); g.arc(px, py, pr, 0, 2 * Math.PI); g.fill();
+    g.strokeStyle = "#0c0b09";
+    g.lineWidth = Math.max(1, 0.15 * pr);
+    g.stroke();
+    g.filter = "none";
+  };
+  bead(sc.obstacle_m[0], sc.obstacle_m[1], sc.obstacle_radius_m, "#8d8778");
+  if (t.part_x_m !== undefined) bead(t.part_x_m, t.part_y_m, sc.bead_radius_m, "#b9b3a2");
+  const [tx, ty] = worldToCanvas(t.measured_x_m, t.measured_y_m);
+  g.strokeStyle = "#46c47e";
+  g.lineWidth = 2;
+  g.beginPath(); g.moveTo(tx - 8, ty); g.lineTo(tx + 8, ty); g.moveTo(tx, ty - 8); g.lineTo(tx, ty + 8); g.stroke();
+  if (t.part_x_m !== undefined) {
+    const [bx, by] = worldToCanvas(t.part_x_m, t.part_y_m), k = (sc.bead_radius_m * s * 3) / sc.force_full_scale_N;
+    g.strokeStyle = "#ff9f43";
+    g.beginPath(); g.moveTo(bx, by); g.lineTo(bx + t.contact_x_N * k, by - t.contact_y_N * k); g.stroke();
+  }
+  if (mc.input.goal) {
+    const [gx, gy] = worldToCanvas(mc.input.goal[0], mc.input.goal[1]);
+    g.strokeStyle = "#4fa3ff";
+    g.beginPath(); g.arc(gx, gy, 6, 0, 2 * Math.PI); g.stroke();
+  }
+  g.lineWidth = 1;
 }
 
 function drawSide() {
@@ -399,6 +447,11 @@ function drawSide() {
   g.fillStyle = "#111";
   g.fillRect(0, 0, c.width, c.height);
   if (!t || !sc) return;
+  if (sc.kind === "optical-trap") {  // the trap's model is planar: nothing to show in z
+    g.fillStyle = "#8a93a3";
+    g.fillText("optical trap: a planar scene (the probe stays in the trap's focal plane)", 8, 14);
+    return;
+  }
   const s = c.width / view.fov, zmax = 1.0e-3, zs = sideScale();
   const X = (x) => c.width / 2 + (x - view.center[0]) * s, Z = (z) => mc.worldToSide(0, z)[1];
   g.fillStyle = "#3b372f";
@@ -465,7 +518,7 @@ function drawForce(f) {
   g.clearRect(0, 0, c.width, c.height);
   g.strokeStyle = "#3a4250";
   g.beginPath(); g.arc(r, r, r - 2, 0, 2 * Math.PI); g.stroke();
-  const full = 50e-6, k = (r - 6) / full;
+  const full = mc.scene ? mc.scene.force_full_scale_N : 50e-6, k = (r - 6) / full;
   const fx = Math.max(-full, Math.min(full, f[0])), fy = Math.max(-full, Math.min(full, f[1]));
   g.strokeStyle = "#ff9f43";
   g.lineWidth = 3;
@@ -475,9 +528,10 @@ function drawForce(f) {
 function onFeedback(p) {
   mc.feedback = p;
   const [fx, fy, fz] = p.contact_N;
-  const n = Math.hypot(fx, fy, fz);
-  $("contact-gauge").value = n * um;
-  $("contact-out").textContent = (n * um).toFixed(1) + " µN";
+  const n = Math.hypot(fx, fy, fz), f = forceUnit();
+  $("contact-gauge").max = mc.scene ? mc.scene.force_full_scale_N * f.scale : 50;
+  $("contact-gauge").value = n * f.scale;
+  $("contact-out").textContent = (n * f.scale).toFixed(1) + " " + f.label;
   $("grip-gauge").value = p.grip_N * um;
   $("grip-out").textContent = (p.grip_N * um).toFixed(1) + " µN";
   $("rumble-gauge").value = p.rumble;
@@ -563,8 +617,28 @@ function listRecordings() {
     .catch(() => {});
 }
 
+// Forces are micronewtons on a watch part, piconewtons on a trapped bead.
+function forceUnit() {
+  return mc.scene && mc.scene.kind === "optical-trap" ? {scale: 1e12, label: "pN"} : {scale: um, label: "µN"};
+}
+
 function onScene(s) {
+  const first = !mc.scene || mc.scene.kind !== s.kind;
   mc.scene = s;
+  // The speed scale spans what the server accepts (20 um/s for a bead, 1 mm/s for a part).
+  const maxSpeed = Math.max(1, Math.round(s.max_speed_m_s * um));
+  if (Number($("speed").max) !== maxSpeed) {
+    $("speed").max = maxSpeed;
+    if (Number($("speed").value) > maxSpeed) $("speed").value = maxSpeed;
+    $("speed-out").textContent = $("speed").value + " µm/s";
+  }
+  if (first) {
+    // A bead a hundred times smaller than a watch part: the tweezers' objective.
+    if (s.kind === "optical-trap") $("objective").value = "200";
+    forcePlot.title.textContent = s.kind === "optical-trap" ? "Force on the probe bead [pN]" : "Forces on the gripper [µN]";
+    forcePlot.scale = forceUnit().scale;
+    for (const a of forcePlot.data) a.length = 0;
+  }
   $("gripper").max = Math.round(s.max_opening_m * um);
   if (!mc.input.gripperTouched) {
     mc.input.gripper = s.max_opening_m;
@@ -577,7 +651,7 @@ function onScene(s) {
 // Live plots (uPlot): the last 10 s.
 const kWindow = 600;  // samples at 60 Hz
 const plots = [];
-function makePlot(title, unit, scale, series) {
+function makePlot(title, unit, scale, series) {  // returns the plot (its title, scale and data)
   const div = document.createElement("div");
   div.className = "plot";
   const h = document.createElement("h3");
@@ -593,12 +667,14 @@ function makePlot(title, unit, scale, series) {
   };
   const data = [[]].concat(series.map(() => []));
   const u = new uPlot(opts, data, div);
-  plots.push({u, data, series, scale});
+  const plot = {u, data, series, scale, title: h};
+  plots.push(plot);
+  return plot;
 }
 makePlot("Positions against targets", "µm", um, [
   ["measured_x_m", "x"], ["target_x_m", "x target", true], ["measured_y_m", "y"], ["target_y_m", "y target", true],
   ["measured_z_m", "z"], ["target_z_m", "z target", true]]);
-makePlot("Forces on the gripper", "µN", um, [
+const forcePlot = makePlot("Forces on the gripper [µN]", "", um, [
   ["contact_x_N", "contact x"], ["contact_y_N", "contact y"], ["contact_z_N", "contact z"], ["grip_force_N", "grip"]]);
 makePlot("Drive amplitude", "V", 1, [["u_x_V", "u x"], ["u_y_V", "u y"], ["u_z_V", "u z"]]);
 makePlot("Loop tick", "µs", 1, [["tick_us", "tick compute time"]]);

@@ -132,6 +132,8 @@ void serve(const ServeOptions& o) {
   if (o.config) lp.platform = pf::load_platform_config(*o.config);
   if (o.scene == "pin-in-hole") {
     lp.platform.world = mc::microworld::pin_in_hole_scene();
+  } else if (o.scene == "optical-trap") {
+    lp.platform = pf::with_optical_trap_scene(lp.platform);
   } else if (o.scene != "pick-place") {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
@@ -192,7 +194,8 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as `run --print-config` shows)");
   cmd.add_option("--scene", o->scene,
                  "Scene: pick-place (default: the 300 um part), pin-in-hole (a 200 um pin into a hole with "
-                 "20 um of clearance) or a YAML file of the microworld's keys (scenes/*.yaml)");
+                 "20 um of clearance), optical-trap (a 3 um bead in optical tweezers, touching a stuck "
+                 "bead) or a YAML file of the microworld's keys (scenes/*.yaml)");
   cmd.add_option("--listen", o->listen,
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");

@@ -5,99 +5,12 @@
 // that the part ends within 10 um of its target, presses the e-stop and checks the safe state,
 // and stops the server with SIGTERM (exit 0, a closed MCAP recording). Screenshots go to
 // MC_ARTIFACTS (default: a temporary directory). Run by CTest (`console_browser`).
-import { spawn } from "node:child_process";
-import { mkdtempSync, mkdirSync, readdirSync, readFileSync, existsSync } from "node:fs";
-import { tmpdir } from "node:os";
+import { readdirSync, readFileSync } from "node:fs";
 import { join } from "node:path";
-import { createInterface } from "node:readline";
-import { chromium } from "playwright-core";
+import { startConsole } from "./console_session.mjs";
 
-const cli = process.env.MC_CLI;
-if (!cli || !existsSync(cli)) {
-  console.error("console_operates: set MC_CLI to the microcobot binary");
-  process.exit(2);
-}
-const chromiumPath = process.env.MC_CHROMIUM || "/usr/bin/chromium";
-const dir = mkdtempSync(join(tmpdir(), "mc-console-"));
-const artifacts = process.env.MC_ARTIFACTS || join(dir, "screenshots");
-mkdirSync(artifacts, { recursive: true });
-let failures = 0;
-const fail = (msg) => { console.error("FAIL: " + msg); failures++; };
-const log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(1)} s] ${msg}`);
-
-// The server: its first stdout line is the console's URL.
-const server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", "--out", join(dir, "rec"), "--record"],
-                     { stdio: ["ignore", "pipe", "inherit"] });
-const exited = new Promise((resolve) => server.on("exit", (code, signal) => resolve({ code, signal })));
-const url = await new Promise((resolve, reject) => {
-  const rl = createInterface({ input: server.stdout });
-  rl.once("line", resolve);
-  server.once("exit", () => reject(new Error("serve exited before printing its URL")));
-  setTimeout(() => reject(new Error("serve printed no URL within 60 s")), 60000);
-});
-log("console at " + url);
-// Whatever happens, never outlive CTest's timeout with the server left running.
-const guard = setTimeout(() => {
-  console.error("FAIL: console_operates took longer than 240 s");
-  server.kill("SIGKILL");
-  process.exit(1);
-}, 240000);
-
-const browser = await chromium.launch({
-  executablePath: chromiumPath,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-});
-const page = await browser.newPage({ viewport: { width: 1280, height: 1000 } });
-const pageErrors = [];
-page.on("pageerror", (e) => pageErrors.push(String(e)));
-page.on("console", (m) => { if (m.type() === "error") pageErrors.push(m.text()); });
-const outside = [];
-page.on("request", (r) => { if (!r.url().startsWith(url.split("?")[0])) outside.push(r.url()); });
-
-const t = () => page.evaluate(() => window.mc.telemetry);
-async function until(what, predicate, timeoutS) {
-  const end = Date.now() + timeoutS * 1000;
-  while (Date.now() < end) {
-    if (await page.evaluate(predicate)) return true;
-    await page.waitForTimeout(50);
-  }
-  throw new Error(`timed out after ${timeoutS} s: ${what}`);
-}
-const shot = (name) => page.screenshot({ path: join(artifacts, name + ".png") });
-
-// Clicks the microscope (top view) at world (x, y) or the side view at (x, z), as an operator
-// clicks what they see: the page's own mapping from the world to its canvases.
-async function clickTop(x, y) {
-  const [px, py] = await page.evaluate(([x, y]) => window.mc.worldToCanvas(x, y), [x, y]);
-  const box = await page.locator("#microscope").boundingBox();
-  const c = await page.evaluate(() => [document.getElementById("microscope").width, document.getElementById("microscope").height]);
-  await page.mouse.click(box.x + px * box.width / c[0], box.y + py * box.height / c[1]);
-}
-async function clickSide(x, z) {
-  const [px, py] = await page.evaluate(([x, z]) => window.mc.worldToSide(x, z), [x, z]);
-  const box = await page.locator("#side").boundingBox();
-  const c = await page.evaluate(() => [document.getElementById("side").width, document.getElementById("side").height]);
-  await page.mouse.click(box.x + px * box.width / c[0], box.y + py * box.height / c[1]);
-}
-// Holds the deadman (Space) until the stage has reached the clicked goal (all three axes).
-async function goWithDeadman(what, timeoutS) {
-  await page.keyboard.down(" ");
-  try {
-    await until(what, () => {
-      const g = window.mc.input.goal, t = window.mc.telemetry;
-      if (!g || !t) return false;
-      return Math.abs(t.measured_x_m - g[0]) < 2e-6 && Math.abs(t.measured_y_m - g[1]) < 2e-6 &&
-             Math.abs(t.measured_z_m - g[2]) < 3e-6;
-    }, timeoutS);
-  } finally {
-    await page.keyboard.up(" ");
-  }
-}
-async function setSlider(id, value) {
-  await page.locator(id).fill(String(value));
-}
-
+const s = await startConsole("console_operates", (dir) => ["--out", join(dir, "rec"), "--record"], 240);
+const { page, t, until, shot, clickTop, clickSide, goWithDeadman, setSlider, fail, log, url, dir } = s;
 try {
   await page.goto(url, { waitUntil: "domcontentloaded" });
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
@@ -196,7 +109,7 @@ try {
   const download = await page.$eval("#recordings a[download]", (a) => a.href);
   const reportLink = await page.$("#recordings a[target=_blank]");
   const [reportPage] = await Promise.all([page.context().waitForEvent("page"), reportLink.click()]);
-  reportPage.on("pageerror", (e) => pageErrors.push("report: " + String(e)));
+  reportPage.on("pageerror", (e) => s.pageErrors.push("report: " + String(e)));
   const reportDeadline = Date.now() + 60000;
   let figures = 0;
   while (Date.now() < reportDeadline) {
@@ -208,7 +121,7 @@ try {
   const title = await reportPage.title().catch(() => "");
   log(`report on demand: "${title}", ${figures} plots; download ${download}`);
   if (!title.startsWith("microcobot recording: ") || figures < 8) fail(`the report did not render ("${title}", ${figures} plots)`);
-  await reportPage.screenshot({ path: join(artifacts, "06-report.png") });
+  await reportPage.screenshot({ path: join(s.artifacts, "06-report.png") });
   await reportPage.close();
   const res = await page.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, bytes: (await r.arrayBuffer()).byteLength }; }, download);
   if (res.status !== 200 || res.bytes < 1000) fail(`download: HTTP ${res.status}, ${res.bytes} bytes`);
@@ -216,21 +129,12 @@ try {
   await until("recording again", () => window.mc.status && !!window.mc.status.recording, 5);
 } catch (e) {
   fail(String(e.stack || e));
-  const diag = await page.evaluate(() => JSON.stringify({ messages: window.mc.messages.slice(-10), status: window.mc.status,
-                                                         goal: window.mc.input.goal, t: window.mc.telemetry })).catch(() => "");
-  console.error("page state: " + diag);
-  await shot("failure").catch(() => {});
-} finally {
-  await browser.close();
+  await s.diagnose();
 }
-
-if (pageErrors.length) fail("the page reported errors: " + pageErrors.join(" | "));
-if (outside.length) fail("the console fetched from elsewhere (it must work offline): " + outside.join(", "));
+await s.closeBrowser();
 
 // SIGTERM: devices safe, the recording closed as a valid MCAP file (both magics), exit 0.
-server.kill("SIGTERM");
-const { code, signal } = await exited;
-if (code !== 0) fail(`serve exited with ${code} (${signal}) on SIGTERM`);
+await s.terminate();
 const recordings = readdirSync(join(dir, "rec")).filter((f) => f.endsWith(".mcap")).sort();
 if (recordings.length !== 2) fail("expected two recordings, found: " + readdirSync(join(dir, "rec")).join(", "));
 else {
@@ -240,10 +144,9 @@ else {
     fail("the recording is not a closed MCAP file");
   log(`recording ${recordings[1]}: ${bytes.length} bytes`);
 }
-log(`screenshots in ${artifacts}`);
-clearTimeout(guard);
-if (failures) {
-  console.error(`console_operates: ${failures} failure(s)`);
+log(`screenshots in ${s.artifacts}`);
+if (s.failures) {
+  console.error(`console_operates: ${s.failures} failure(s)`);
   process.exit(1);
 }
 log("console_operates: pick-and-place through the console, e-stop and SIGTERM all held");

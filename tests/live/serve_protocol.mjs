@@ -25,11 +25,13 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 const dir = mkdtempSync(join(tmpdir(), "mc-serve-"));
 const server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", "--out", dir], { stdio: ["ignore", "pipe", "inherit"] });
 const exited = new Promise((resolve) => server.on("exit", (code, signal) => resolve({ code, signal })));
+let urlTimer;
 const url = await new Promise((resolve, reject) => {
   createInterface({ input: server.stdout }).once("line", resolve);
   server.once("exit", () => reject(new Error("serve exited before printing its URL")));
-  setTimeout(() => reject(new Error("no URL within 60 s")), 60000);
+  urlTimer = setTimeout(() => reject(new Error("no URL within 60 s")), 60000);
 });
+clearTimeout(urlTimer);  // pending, it would keep node alive for its whole minute
 const wsUrl = url.replace(/^http/, "ws").replace(/\/(\?.*)?$/, "/ws$1");
 log("serve at " + url);
 
@@ -50,8 +52,12 @@ observer.on("advertise", (list) => {
 function check(schema, value, path) {
   if (schema.type === "object") {
     if (typeof value !== "object" || value === null || Array.isArray(value)) return `${path}: not an object`;
+    // JSON Schema: the properties listed as required must be there (all of them when the schema
+    // lists none: our channels' schemas say when some are optional).
+    const required = schema.required || Object.keys(schema.properties || {});
+    for (const k of required) if (!(k in value)) return `${path}.${k}: missing`;
     for (const [k, s] of Object.entries(schema.properties || {})) {
-      if (!(k in value)) return `${path}.${k}: missing`;
+      if (!(k in value)) continue;
       const e = check(s, value[k], `${path}.${k}`);
       if (e) return e;
     }

@@ -6,6 +6,7 @@
 #include <ctime>
 #include <filesystem>
 #include <system_error>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -36,6 +37,11 @@ const std::size_t kTick = channel_index("tick_us");
 
 std::string schema(const json& properties) {
   return json{{"type", "object"}, {"properties", properties}}.dump();
+}
+
+// With only some properties always present (the others depend on the scene).
+std::string schema(const json& properties, const std::vector<std::string>& required) {
+  return json{{"type", "object"}, {"properties", properties}, {"required", required}}.dump();
 }
 
 // A recording's stem: "recording-" then digits and dashes (what start_recording() names), so a
@@ -130,8 +136,23 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"recording", {{"type", {"string", "null"}}}},
                                             {"last_error", text}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
+  // The optical-trap scene adds its beads; the pick-and-place keys are always there.
+  const std::vector<std::string> scene_keys = {"kind",
+                                               "part_side_m",
+                                               "part_height_m",
+                                               "hole_side_m",
+                                               "hole_depth_m",
+                                               "target_m",
+                                               "tolerance_m",
+                                               "max_opening_m",
+                                               "finger_width_m",
+                                               "workspace_min_m",
+                                               "workspace_max_m",
+                                               "max_speed_m_s",
+                                               "force_full_scale_N"};
   scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
-                                   schema({{"part_side_m", number},
+                                   schema({{"kind", text},
+                                           {"part_side_m", number},
                                            {"part_height_m", number},
                                            {"hole_side_m", number},
                                            {"hole_depth_m", number},
@@ -141,7 +162,12 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                            {"finger_width_m", number},
                                            {"workspace_min_m", vec3},
                                            {"workspace_max_m", vec3},
-                                           {"max_speed_m_s", number}})});
+                                           {"max_speed_m_s", number},
+                                           {"force_full_scale_N", number},
+                                           {"bead_radius_m", number},
+                                           {"obstacle_m", {{"type", "array"}, {"items", number}}},
+                                           {"obstacle_radius_m", number}},
+                                          scene_keys)});
   feedback_ch_ = server_.add_channel({"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
                                       schema({{"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
@@ -336,13 +362,30 @@ void ConsoleServer::stop_recording() {
 
 std::string ConsoleServer::scene_json() const {
   const auto& c = live_.limits();
-  return json{{"part_side_m", live_.part_side_m()}, {"part_height_m", live_.part_height_m()},
-              {"hole_side_m", live_.hole_side_m()}, {"hole_depth_m", live_.hole_depth_m()},
-              {"target_m", live_.target_m()},       {"tolerance_m", live_.placement_tolerance_m()},
-              {"max_opening_m", c.max_opening_m},   {"finger_width_m", live_.finger_width_m()},
-              {"workspace_min_m", c.min_m},         {"workspace_max_m", c.max_m},
-              {"max_speed_m_s", c.max_speed_m_s}}
-      .dump();
+  json j{{"kind", "pick-place"},
+         {"part_side_m", live_.part_side_m()},
+         {"part_height_m", live_.part_height_m()},
+         {"hole_side_m", live_.hole_side_m()},
+         {"hole_depth_m", live_.hole_depth_m()},
+         {"target_m", live_.target_m()},
+         {"tolerance_m", live_.placement_tolerance_m()},
+         {"max_opening_m", c.max_opening_m},
+         {"finger_width_m", live_.finger_width_m()},
+         {"workspace_min_m", c.min_m},
+         {"workspace_max_m", c.max_m},
+         {"max_speed_m_s", c.max_speed_m_s},
+         {"force_full_scale_N", 50e-6}};
+  if (live_.optical_trap_scene()) {
+    // The probe bead (the telemetry's part_* channels) and the stuck bead; forces in piconewtons:
+    // the gauge's full scale is the trap's escape force, k times the probe's radius.
+    const auto& trap = live_.optical_trap().trap;
+    j["kind"] = "optical-trap";
+    j["bead_radius_m"] = trap.bead_radius_m;
+    j["obstacle_m"] = live_.obstacle_m();
+    j["obstacle_radius_m"] = trap.obstacle_radius_m;
+    j["force_full_scale_N"] = trap.trap_stiffness_N_per_m * trap.bead_radius_m;
+  }
+  return j.dump();
 }
 
 std::string ConsoleServer::status_json() {

@@ -181,6 +181,11 @@ void LivePlatform::request(ConsoleAction action) {
     last_error_ = "demo: the scripted operator needs the whole simulated platform in this process";
     return;
   }
+  if (action == ConsoleAction::kDemo && params_.platform.optical_trap_scene()) {
+    last_error_ =
+        "demo: the scripted operator is the pick-and-place; the optical-trap scene is operated by hand";
+    return;
+  }
   pending_ = static_cast<int>(action);
   last_error_.clear();
   interrupt_.store(true, std::memory_order_release);

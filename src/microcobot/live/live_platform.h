@@ -107,6 +107,15 @@ class LivePlatform {
     return {params_.platform.world.target_m.x(), params_.platform.world.target_m.y(), 0.0};
   }
   double placement_tolerance_m() const { return params_.placement_tolerance_m; }
+  /// The optical-trap scene (else the pick-and-place's part, hole and target above).
+  bool optical_trap_scene() const { return params_.platform.optical_trap_scene(); }
+  const microworld::OpticalTrapSceneParams& optical_trap() const { return params_.platform.optical_trap; }
+  /// The stuck bead's centre (world frame; optical-trap scene).
+  std::array<double, 2> obstacle_m() const {
+    const auto& st = params_.platform.stage;
+    const Eigen::Vector2d c = params_.platform.optical_trap.obstacle_m({st.home_x_m, st.home_y_m});
+    return {c.x(), c.y()};
+  }
   double finger_width_m() const { return params_.finger_width_m; }
   std::size_t channel_count() const { return channel_count_; }
 

@@ -23,6 +23,18 @@ void OpticalTrapParams::validate() const {
           "too stiff for dt_s (need k_c dt / gamma < 0.5)", contact_stiffness_N_per_m);
 }
 
+void OpticalTrapSceneParams::validate() const {
+  trap.validate();
+  require(std::isfinite(obstacle_offset_x_m) && std::isfinite(obstacle_offset_y_m), "obstacle_offset_m",
+          "must be finite");
+  // Apart at the start (the probe would start inside the stuck bead) and within a microscope's
+  // field (the scene is a dish region of tens of micrometres).
+  const double d = std::hypot(obstacle_offset_x_m, obstacle_offset_y_m);
+  require(d > trap.bead_radius_m + trap.obstacle_radius_m, "obstacle_offset_x_m",
+          "puts the stuck bead on the probe (need a distance above the two radii)", d);
+  require(d <= 1e-3, "obstacle_offset_x_m", "must put the stuck bead within 1 mm of the probe", d);
+}
+
 OpticalTrap::OpticalTrap(const OpticalTrapParams& params) : params_(params) {
   params_.validate();
   gamma_ = 6.0 * std::numbers::pi * params_.viscosity_Pa_s * params_.bead_radius_m;
@@ -51,13 +63,17 @@ Eigen::Vector2d OpticalTrap::trap_force(const OpticalTrapState& s) const {
   return -params_.trap_stiffness_N_per_m * (s.bead_m - s.trap_m);
 }
 
-void OpticalTrap::step(OpticalTrapState& s, Rng& rng) const {
+bool OpticalTrap::try_step(OpticalTrapState& s, Rng& rng) const noexcept {
   const Eigen::Vector2d fc = contact_force(s.bead_m);
   const Eigen::Vector2d eq = s.trap_m + fc / params_.trap_stiffness_N_per_m;
   for (int a = 0; a < 2; ++a) {
     s.bead_m(a) = eq(a) + (s.bead_m(a) - eq(a)) * decay_ + kick_ * rng.normal();
   }
-  if (!s.bead_m.allFinite()) throw ComputationFailed("optical trap: non-finite bead position");
+  return s.bead_m.allFinite();
+}
+
+void OpticalTrap::step(OpticalTrapState& s, Rng& rng) const {
+  if (!try_step(s, rng)) throw ComputationFailed("optical trap: non-finite bead position");
 }
 
 }  // namespace mc::microworld

@@ -36,6 +36,32 @@ struct OpticalTrapParams {
   void validate() const;
 };
 
+/// The optical-tweezers scene of the live platform (`microcobot serve --scene optical-trap`,
+/// thesis §3.5.2 Fig. 3.16): the probe bead in a trap that the slave stage carries across the
+/// dish, and a large bead stuck on the dish at a fixed offset from where the probe starts. The
+/// operator feels the probe's force, Brownian motion and contact, through the dual-stage master.
+struct OpticalTrapSceneParams {
+  OpticalTrapParams trap;
+  /// Centre of the stuck bead relative to where the probe starts (the tool point with the stage
+  /// at home): 10 um along x, 3.5 um of free travel before the beads touch (1.5 + 5 um radii).
+  double obstacle_offset_x_m = 10e-6;
+  double obstacle_offset_y_m = 0.0;
+  int seed = 1;  ///< of the thermal noise
+
+  template <class V>
+  void visit(V& v) {
+    trap.visit(v);
+    v("obstacle_offset_x_m", obstacle_offset_x_m);
+    v("obstacle_offset_y_m", obstacle_offset_y_m);
+    v("seed", seed);
+  }
+  void validate() const;
+  /// The stuck bead's centre (world frame) when the probe starts at `start_m`.
+  Eigen::Vector2d obstacle_m(const Eigen::Vector2d& start_m) const {
+    return start_m + Eigen::Vector2d(obstacle_offset_x_m, obstacle_offset_y_m);
+  }
+};
+
 /// State: bead and trap (probe) positions in the dish plane (m).
 struct OpticalTrapState {
   Eigen::Vector2d bead_m = Eigen::Vector2d::Zero();
@@ -73,6 +99,9 @@ class OpticalTrap {
   /// One step of dt_s with the trap held at s.trap_m: exact OU update towards the
   /// equilibrium x_trap + F_c/k (F_c frozen over the step). Throws ComputationFailed on NaN.
   void step(OpticalTrapState& s, Rng& rng) const;
+  /// The same step for a real-time loop: returns false instead of throwing when the bead's
+  /// position is no longer finite (the caller faults). Never allocates.
+  bool try_step(OpticalTrapState& s, Rng& rng) const noexcept;
 
  private:
   OpticalTrapParams params_;

@@ -61,6 +61,7 @@ PickPlaceOperator::PickPlaceOperator(Platform& platform, const PickPlaceOperator
       p_(params),
       motion_scale_(platform.config().teleop.motion_scale) {
   p_.validate();
+  require(sim_.gripper != nullptr, "microworld", "the scripted pick-and-place needs the pick-place scene");
   std::fill(std::begin(started_), std::end(started_), std::numeric_limits<double>::quiet_NaN());
   started_[0] = 0.0;
 }

@@ -37,16 +37,23 @@ Platform::Platform(const PlatformConfig& config)
     sim_.axes[i] = axis.get();
     devices_.axes[i] = std::move(axis);
   }
-  auto gripper = std::make_unique<SimulatedGripper>(
-      "gripper", world_, std::array<const SimulatedSlaveAxis*, 3>{sim_.axes[0], sim_.axes[1], sim_.axes[2]},
-      Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
+  const std::array<const SimulatedSlaveAxis*, 3> carriers{sim_.axes[0], sim_.axes[1], sim_.axes[2]};
+  const Vec3 home{home_m_.x(), home_m_.y(), home_m_.z()};
+  if (config_.optical_trap_scene()) {
+    auto trap = std::make_unique<SimulatedOpticalTweezers>("optical_tweezers", config_.optical_trap, carriers,
+                                                           home, dt);
+    sim_.optical_tweezers = trap.get();
+    devices_.gripper = std::move(trap);
+  } else {
+    auto gripper = std::make_unique<SimulatedGripper>("gripper", world_, carriers, home);
+    sim_.gripper = gripper.get();
+    devices_.gripper = std::move(gripper);
+  }
   auto haptic = std::make_unique<SimulatedHapticMaster>("dual_stage", config_.haptic.plant,
                                                         config_.haptic.render, config_.haptic.pantograph, dt);
   auto tweezers = std::make_unique<SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
-  sim_.gripper = gripper.get();
   sim_.haptic = haptic.get();
   sim_.tweezers = tweezers.get();
-  devices_.gripper = std::move(gripper);
   devices_.haptic = std::move(haptic);
   devices_.tweezers = std::move(tweezers);
   build();
@@ -224,13 +231,18 @@ void Platform::telemetry_task(double t_s) noexcept {
   // Simulation channels: the ground truth.
   if (simulated()) {
     const OperatorHand& hand = sim_.haptic->operator_hand();
-    const auto& w = sim_.gripper->world_state();
     put(hand.hand_m.x), put(hand.hand_m.y);
     for (std::size_t i = 0; i < 3; ++i)
       put(home_m_[static_cast<Eigen::Index>(i)] + sim_.axes[i]->true_position_m());
     put(sim_.haptic->channels().f_m_N), put(sim_.haptic->channels().u_V);
-    put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
-    put(static_cast<double>(static_cast<int>(w.phase)));
+    if (sim_.gripper != nullptr) {
+      const auto& w = sim_.gripper->world_state();
+      put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
+      put(static_cast<double>(static_cast<int>(w.phase)));
+    } else {
+      const Eigen::Vector3d bead = sim_.optical_tweezers->bead_m();
+      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0);
+    }
   }
   ring_.push(s);
 }

@@ -33,6 +33,7 @@
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/platform/simulated_gripper.h"
 #include "microcobot/platform/simulated_haptic_master.h"
+#include "microcobot/platform/simulated_optical_tweezers.h"
 #include "microcobot/platform/simulated_slave_axis.h"
 #include "microcobot/platform/simulated_tweezers_master.h"
 #include "microcobot/platform/spsc_ring.h"
@@ -85,6 +86,7 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",  // lo
                                                                    "part_y_m",
                                                                    "part_z_m",
                                                                    "part_phase"};
+// In the optical-trap scene the part channels are the probe bead's (part_phase 0).
 inline constexpr std::size_t kLoopChannelCount = 27;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
@@ -101,7 +103,8 @@ struct PlatformDevices {
 /// scripted operator moves their hands, the session report reads their ground truth.
 struct SimulatedDevices {
   std::array<SimulatedSlaveAxis*, 3> axes{};
-  SimulatedGripper* gripper = nullptr;
+  SimulatedGripper* gripper = nullptr;  ///< the pick-and-place's (null in the optical-trap scene)
+  SimulatedOpticalTweezers* optical_tweezers = nullptr;  ///< the optical-trap scene's (else null)
   SimulatedHapticMaster* haptic = nullptr;
   SimulatedTweezersMaster* tweezers = nullptr;
 };

@@ -4,6 +4,7 @@
 #include <functional>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
 
 namespace mc::platform {
@@ -69,6 +70,23 @@ void PlatformConfig::validate() const {
   });
   in_section("tweezers", [&] { tweezers.validate(); });
   in_section("world", [&] { world.validate(); });
+  require(microworld == "pick-place" || microworld == "optical-trap", "microworld",
+          "must be pick-place or optical-trap, not '" + excerpt(microworld) + "'");
+  in_section("optical_trap", [&] {
+    optical_trap.validate();
+    const double ratio = loop.period_s() / optical_trap.trap.dt_s;
+    require(ratio >= 1.0 && std::abs(ratio - std::round(ratio)) < 1e-6 * ratio, "dt_s",
+            "must divide the loop period (1 / loop.base_rate_Hz)", optical_trap.trap.dt_s);
+  });
+}
+
+PlatformConfig with_optical_trap_scene(PlatformConfig config) {
+  config.microworld = "optical-trap";
+  config.teleop.motion_scale = 5e-4;
+  config.teleop.force_scale = 1e10;
+  config.teleop.force_filter_Hz = 1000.0;
+  config.teleop.console_max_speed_m_s = 20e-6;
+  return config;
 }
 
 PlatformConfig load_platform_config(const std::filesystem::path& file) {

@@ -22,6 +22,7 @@
 #include "microcobot/haptics/dual_stage_plant.h"
 #include "microcobot/haptics/pantograph.h"
 #include "microcobot/haptics/render_pipeline.h"
+#include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/stickslip/stickslip_params.h"
 #include "microcobot/tweezers/teletweez.h"
@@ -106,7 +107,11 @@ struct PlatformConfig {
   std::string stickslip_params_file;  ///< empty: the built-in SLC-1720-like axis (#4)
   HapticMasterParams haptic;
   tweezers::TeleTweezParams tweezers;
+  /// What the slave works in: "pick-place" (the gripper over a part, `world`) or
+  /// "optical-trap" (a trapped probe bead and a stuck bead, `optical_trap`; thesis §3.5.2).
+  std::string microworld = "pick-place";
   microworld::PickPlaceParams world;
+  microworld::OpticalTrapSceneParams optical_trap;
 
   template <class V>
   void visit(V& v) {
@@ -116,11 +121,24 @@ struct PlatformConfig {
     v("stickslip_params_file", stickslip_params_file);
     v("haptic", haptic);
     v("tweezers", tweezers);
+    v("microworld", microworld);
     v("world", world);
+    v("optical_trap", optical_trap);
   }
+  bool optical_trap_scene() const { return microworld == "optical-trap"; }
   /// Validates every section and their consistency (rates); errors name the key path.
   void validate() const;
 };
+
+/// The optical-tweezers scene (`serve --scene optical-trap`) on `config`: its microworld, and the
+/// coupling's scales for a bead a hundred times smaller than a watch part: 1 cm of hand moves
+/// the trap by 5 um; 1 pN of probe force is 10 mN in the hand, rendered up to 1 kHz (the
+/// crossover's band, not the pick-and-place's 30 Hz smoothing: the thermal agitation is what the
+/// operator should feel, Fig. 3.15); the console's speed limited to 20 um/s. The product of the
+/// scales sets the stiffness the trap shows the hand, motion_scale * force_scale * k = 50 N/m:
+/// above the finger's 228 N/m the loop through the finger oscillates (the probe lags its trap,
+/// so every motion of the trap comes back as a force that moves the handle further).
+PlatformConfig with_optical_trap_scene(PlatformConfig config);
 
 /// Reads a configuration file over the defaults; relative file names in it are resolved
 /// against the file's directory. Throws InvalidInput / InvalidParams (exit 3).

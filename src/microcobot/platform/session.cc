@@ -64,6 +64,8 @@ nlohmann::json SessionResult::to_json() const {
 
 Session::Session(const PlatformConfig& config, const SessionParams& params) : params_(params) {
   params_.validate();
+  require(!config.optical_trap_scene(), "microworld",
+          "the scripted session is the pick-and-place: run it on the pick-place scene");
   platform_ = std::make_unique<Platform>(config);
   operator_ = std::make_unique<PickPlaceOperator>(*platform_, params_.operator_params);
   const bool stale = params_.scenario == "stale-master";

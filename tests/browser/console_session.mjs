@@ -1,0 +1,112 @@
+// What the console's browser tests share: `microcobot serve` started on a free port (its first
+// stdout line is the console's URL), Debian's headless Chromium through playwright-core on it,
+// and the operator's gestures as the page's own controls take them (click-to-go through the
+// page's world-to-canvas mapping, the Space deadman, sliders). Failures are counted, not thrown.
+import { spawn } from "node:child_process";
+import { mkdtempSync, mkdirSync, existsSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { createInterface } from "node:readline";
+import { chromium } from "playwright-core";
+
+export async function startConsole(name, serveArgs, timeoutS) {
+  const cli = process.env.MC_CLI;
+  if (!cli || !existsSync(cli)) {
+    console.error(`${name}: set MC_CLI to the microcobot binary`);
+    process.exit(2);
+  }
+  const dir = mkdtempSync(join(tmpdir(), "mc-console-"));
+  const artifacts = process.env.MC_ARTIFACTS || join(dir, "screenshots");
+  mkdirSync(artifacts, { recursive: true });
+  const s = { dir, artifacts, failures: 0, pageErrors: [], outside: [] };
+  s.fail = (msg) => { console.error("FAIL: " + msg); s.failures++; };
+  s.log = (msg) => console.log(`[${(performance.now() / 1000).toFixed(1)} s] ${msg}`);
+
+  const args = typeof serveArgs === "function" ? serveArgs(dir) : serveArgs;  // (dir) => args: files in dir
+  s.server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", ...args], { stdio: ["ignore", "pipe", "inherit"] });
+  s.exited = new Promise((resolve) => s.server.on("exit", (code, signal) => resolve({ code, signal })));
+  let urlTimer;
+  s.url = await new Promise((resolve, reject) => {
+    const rl = createInterface({ input: s.server.stdout });
+    rl.once("line", resolve);
+    s.server.once("exit", () => reject(new Error("serve exited before printing its URL")));
+    urlTimer = setTimeout(() => reject(new Error("serve printed no URL within 60 s")), 60000);
+  });
+  clearTimeout(urlTimer);  // a pending timer would keep node alive for its whole minute
+  s.log("console at " + s.url);
+  // Whatever happens, never outlive CTest's timeout with the server left running.
+  s.guard = setTimeout(() => {
+    console.error(`FAIL: ${name} took longer than ${timeoutS} s`);
+    s.server.kill("SIGKILL");
+    process.exit(1);
+  }, timeoutS * 1000);
+
+  s.browser = await chromium.launch({
+    executablePath: process.env.MC_CHROMIUM || "/usr/bin/chromium",
+    args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+           "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+  });
+  const page = await s.browser.newPage({ viewport: { width: 1280, height: 1000 } });
+  s.page = page;
+  page.on("pageerror", (e) => s.pageErrors.push(String(e)));
+  page.on("console", (m) => { if (m.type() === "error") s.pageErrors.push(m.text()); });
+  page.on("request", (r) => { if (!r.url().startsWith(s.url.split("?")[0])) s.outside.push(r.url()); });
+
+  s.t = () => page.evaluate(() => window.mc.telemetry);
+  s.until = async (what, predicate, timeoutS, arg) => {
+    const end = Date.now() + timeoutS * 1000;
+    while (Date.now() < end) {
+      if (await page.evaluate(predicate, arg)) return true;
+      await page.waitForTimeout(50);
+    }
+    throw new Error(`timed out after ${timeoutS} s: ${what}`);
+  };
+  s.shot = (file) => page.screenshot({ path: join(artifacts, file + ".png") });
+  // Clicks the microscope (top view) at world (x, y) or the side view at (x, z), as an operator
+  // clicks what they see: the page's own mapping from the world to its canvases.
+  const clickCanvas = async (id, toCanvas, a, b) => {
+    const [px, py] = await page.evaluate(([f, a, b]) => window.mc[f](a, b), [toCanvas, a, b]);
+    const box = await page.locator(id).boundingBox();
+    const c = await page.evaluate((id) => [document.querySelector(id).width, document.querySelector(id).height], id);
+    await page.mouse.click(box.x + px * box.width / c[0], box.y + py * box.height / c[1]);
+  };
+  s.clickTop = (x, y) => clickCanvas("#microscope", "worldToCanvas", x, y);
+  s.clickSide = (x, z) => clickCanvas("#side", "worldToSide", x, z);
+  // Holds the deadman (Space) until the stage is within `tol` of the clicked goal (x, y; z
+  // within 1.5 tol).
+  s.goWithDeadman = async (what, timeoutS, tol = 2e-6) => {
+    await page.keyboard.down(" ");
+    try {
+      await s.until(what, (tol) => {
+        const g = window.mc.input.goal, t = window.mc.telemetry;
+        if (!g || !t) return false;
+        return Math.abs(t.measured_x_m - g[0]) < tol && Math.abs(t.measured_y_m - g[1]) < tol &&
+               Math.abs(t.measured_z_m - g[2]) < 1.5 * tol;
+      }, timeoutS, tol);
+    } finally {
+      await page.keyboard.up(" ");
+    }
+  };
+  s.setSlider = (id, value) => page.locator(id).fill(String(value));
+  // After a failure: what the page last saw, and a screenshot.
+  s.diagnose = async () => {
+    const diag = await page.evaluate(() => JSON.stringify({ messages: window.mc.messages.slice(-10), status: window.mc.status,
+                                                           goal: window.mc.input.goal, t: window.mc.telemetry })).catch(() => "");
+    console.error("page state: " + diag);
+    await s.shot("failure").catch(() => {});
+  };
+  // Closes the browser and checks what the page did overall (no errors, nothing fetched elsewhere).
+  s.closeBrowser = async () => {
+    await s.browser.close();
+    if (s.pageErrors.length) s.fail("the page reported errors: " + s.pageErrors.join(" | "));
+    if (s.outside.length) s.fail("the console fetched from elsewhere (it must work offline): " + s.outside.join(", "));
+  };
+  // SIGTERM: the server must put every device in its safe state and exit 0.
+  s.terminate = async () => {
+    s.server.kill("SIGTERM");
+    const { code, signal } = await s.exited;
+    if (code !== 0) s.fail(`serve exited with ${code} (${signal}) on SIGTERM`);
+    clearTimeout(s.guard);
+  };
+  return s;
+}
