@@ -70,9 +70,43 @@ TEST(PassivePorts, ARestartedPeerOpensANewSessionAndOldSamplesChangeNothing) {
   EXPECT_NEAR(master.report().output_energy_J[0], 3e-6, 1e-18);
 }
 
+TEST(PassivePorts, TheGrippersPortLetsTheJawsSqueezeOnlyWithTheEnergyTheMasterPutIn) {
+  SlavePorts slave(true);
+  // Closing at 1 mm/s on a part that pushes the jaws open with 1 N: 1 uJ per tick.
+  EXPECT_EQ(slave.opening_rate(-1e-3, 1.0, kDt), 0.0) << "no session yet: nothing may leave";
+  slave.arrived({5e-6, 5e-6, 5e-6});  // the axes' energies open the axes' sessions only
+  EXPECT_EQ(slave.opening_rate(-1e-3, 1.0, kDt), 0.0);
+  EXPECT_FALSE(slave.report().session_open);
+  slave.arrived_gripper(0.5e-6);
+  EXPECT_TRUE(slave.report().session_open);
+  slave.arrived_gripper(2.0e-6);  // 1.5 uJ of the master's squeeze arrived
+  EXPECT_NEAR(slave.opening_rate(-1e-3, 1.0, kDt), -1e-3, 1e-15);
+  EXPECT_NEAR(slave.opening_rate(-1e-3, 1.0, kDt), -0.5e-3, 1e-15) << "the half that is left";
+  EXPECT_NEAR(slave.opening_rate(-1e-3, 1.0, kDt), 0.0, 1e-15);
+  // Opening, the part's push does work on the jaws: energy in, freely; free air costs nothing.
+  EXPECT_NEAR(slave.opening_rate(1e-3, 1.0, kDt), 1e-3, 1e-15);
+  EXPECT_NEAR(slave.opening_rate(-1e-3, 0.0, kDt), -1e-3, 1e-15);
+  EXPECT_NEAR(slave.report().input_energy_J[kGripperPort], 1e-6, 1e-18);
+  EXPECT_GE(slave.report().min_observed_J, -1e-18);
+  // The master's end: the grip force pushing the operator's fingers open while they open is
+  // energy out, let through as far as the slave's squeeze has arrived, then damped away.
+  MasterPorts master(true);
+  master.arrived_gripper(0.0);
+  master.arrived_gripper(1e-6);
+  EXPECT_NEAR(master.grip_force(1.0, 1e-3, kDt), 1.0, 1e-12);
+  EXPECT_NEAR(master.grip_force(1.0, 1e-3, kDt), 0.0, 1e-12) << "spent: the damper cancels it";
+  EXPECT_NEAR(master.grip_force(1.0, -1e-3, kDt), 1.0, 1e-12) << "squeezing puts energy in: passes";
+  EXPECT_GE(master.report().min_observed_J, -1e-18);
+  MasterPorts open(false);
+  EXPECT_EQ(open.grip_force(1.0, 1e-3, kDt), 1.0);
+  EXPECT_NEAR(open.report().min_observed_J, -1e-6, 1e-18);
+}
+
 // Both ends joined by emulated lines (the energies travel with the loss and jitter of the state
-// they ride on), driven by random forces and velocities, with the master restarted half way.
-double lowest_channel_energy(bool passivity, const control::LinkParams& line) {
+// they ride on), driven by random forces and velocities, with the master restarted half way;
+// through an axis' port or the gripper's.
+double lowest_channel_energy(bool passivity, const control::LinkParams& line, bool gripper) {
+  const std::size_t port = gripper ? kGripperPort : 0;
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto master = std::make_unique<MasterPorts>(passivity);
@@ -86,21 +120,29 @@ double lowest_channel_energy(bool passivity, const control::LinkParams& line) {
     const double t = k * kDt;
     if (k == 10000) {
       const PortsReport r = master->report();
-      dead_master_balance = r.input_energy_J[0] - r.output_energy_J[0];
+      dead_master_balance = r.input_energy_J[port] - r.output_energy_J[port];
       master = std::make_unique<MasterPorts>(passivity);
       slave.restart();
     }
     const double f = 1e-3 * u(rng), v = 1e-3 * u(rng), fs = 1e-3 * u(rng), vs = 1e-3 * u(rng);
-    master->contact_force({f, 0, 0}, {v, 0, 0}, kDt);
-    slave.velocity({vs, 0, 0}, {fs, 0, 0}, kDt);
-    forward.send({t, 0.0, master->report().input_energy_J[0]});
-    backward.send({t, 0.0, slave.report().input_energy_J[0]});
+    if (gripper) {
+      master->grip_force(f, v, kDt);
+      slave.opening_rate(vs, fs, kDt);
+    } else {
+      master->contact_force({f, 0, 0}, {v, 0, 0}, kDt);
+      slave.velocity({vs, 0, 0}, {fs, 0, 0}, kDt);
+    }
+    forward.send({t, 0.0, master->report().input_energy_J[port]});
+    backward.send({t, 0.0, slave.report().input_energy_J[port]});
     control::LinkSample got;
-    if (forward.receive(t, got)) slave.arrived({got.energy_J, 0, 0});
-    if (backward.receive(t, got)) master->arrived({got.energy_J, 0, 0});
+    const auto arrive = [&](auto& end, double e) {
+      gripper ? end.arrived_gripper(e) : end.arrived({e, 0, 0});
+    };
+    if (forward.receive(t, got)) arrive(slave, got.energy_J);
+    if (backward.receive(t, got)) arrive(*master, got.energy_J);
     const PortsReport m = master->report(), s = slave.report();
-    const double channel = dead_master_balance + m.input_energy_J[0] - m.output_energy_J[0] +
-                           s.input_energy_J[0] - s.output_energy_J[0];
+    const double channel = dead_master_balance + m.input_energy_J[port] - m.output_energy_J[port] +
+                           s.input_energy_J[port] - s.output_energy_J[port];
     lowest = std::min(lowest, channel);
   }
   return lowest;
@@ -112,12 +154,17 @@ TEST(PassivePorts, TheChannelNeverCreatesEnergyWhateverTheDelayJitterLossAndRest
         control::LinkParams{0.1, 0.02, 0.2, 7}}) {
     SCOPED_TRACE(testing::Message() << "delay " << line.delay_s << " s, jitter " << line.jitter_s
                                     << " s, loss " << line.loss);
-    // Powers are about 1e-6 W: 1 nJ per ms of steps. Rounding stays far below.
-    const double protected_J = lowest_channel_energy(true, line), open_J = lowest_channel_energy(false, line);
-    EXPECT_GE(protected_J, -1e-15);
-    // A random walk of 1 nJ steps: 20 000 of them stray about 100 nJ from zero.
-    EXPECT_LT(open_J, -1e-8) << "the unprotected channel creates energy";
-    std::printf("lowest channel energy: protected %.3g J, unprotected %.3g J\n", protected_J, open_J);
+    for (bool gripper : {false, true}) {
+      SCOPED_TRACE(gripper ? "the gripper's port" : "an axis' port");
+      // Powers are about 1e-6 W: 1 nJ per ms of steps. Rounding stays far below.
+      const double protected_J = lowest_channel_energy(true, line, gripper);
+      const double open_J = lowest_channel_energy(false, line, gripper);
+      EXPECT_GE(protected_J, -1e-15);
+      // A random walk of 1 nJ steps: 20 000 of them stray about 100 nJ from zero.
+      EXPECT_LT(open_J, -1e-8) << "the unprotected channel creates energy";
+      std::printf("lowest channel energy (%s): protected %.3g J, unprotected %.3g J\n",
+                  gripper ? "gripper" : "axis", protected_J, open_J);
+    }
   }
 }
 

@@ -29,12 +29,15 @@ enum class Channel : std::uint8_t {
   kMasterPortEnergy,
   /// slave -> master: the same of the slave's end (J)
   kSlavePortEnergy,
+  /// master -> slave: the energy the master's end has put into the gripper's port (J, in `xyz[0]`)
+  kMasterGripperPortEnergy,
+  /// slave -> master: the same of the slave's end (J, in `xyz[0]`)
+  kSlaveGripperPortEnergy,
 };
-inline constexpr std::size_t kChannelCount = 11;
+inline constexpr std::size_t kChannelCount = 13;
 
-/// One message. `xyz` holds a position (m), a force (N) or the energies of the axes' ports (J)
-/// in the stage frame; `scalar` the
-/// gripper opening (m) or a boolean (0/1). Unused fields are zero.
+/// One message. `xyz` holds a position (m), a force (N) or the energies of the ports (J) in the
+/// stage frame; `scalar` the gripper opening (m) or a boolean (0/1). Unused fields are zero.
 struct NetSample {
   Channel channel = Channel::kTarget;
   std::int64_t stamp_ns = 0;     ///< header stamp: ROS time (ns since the Unix epoch), >= 0

@@ -12,20 +12,25 @@ double opposing(double contact_N) { return -contact_N; }
 
 }  // namespace
 
-void EnergySession::arrived(const Axes3& peer_in_J, const Axes3& own_out_J) noexcept {
-  if (!open_) {
-    open_ = true;
-    peer_in_J_ = peer_base_J_ = peer_in_J;
-    own_base_J_ = own_out_J;
+void EnergySession::arrived(std::size_t i, double peer_in_J, double own_out_J) noexcept {
+  if (!open_[i]) {
+    open_[i] = true;
+    peer_in_J_[i] = peer_base_J_[i] = peer_in_J;
+    own_base_J_[i] = own_out_J;
     return;
   }
   // Totals only grow: an older sample overtaken by a newer one changes nothing.
-  for (std::size_t i = 0; i < 3; ++i) peer_in_J_[i] = std::max(peer_in_J_[i], peer_in_J[i]);
+  peer_in_J_[i] = std::max(peer_in_J_[i], peer_in_J);
 }
 
 template <class Controller>
 void Ports<Controller>::arrived(const Axes3& peer_in_J) noexcept {
-  session_.arrived(peer_in_J, {pc_[0].energy().out_J, pc_[1].energy().out_J, pc_[2].energy().out_J});
+  for (std::size_t i = 0; i < 3; ++i) session_.arrived(i, peer_in_J[i], pc_[i].energy().out_J);
+}
+
+template <class Controller>
+void Ports<Controller>::arrived_gripper(double peer_in_J) noexcept {
+  session_.arrived(kGripperPort, peer_in_J, pc_[kGripperPort].energy().out_J);
 }
 
 template <class Controller>
@@ -36,7 +41,7 @@ void Ports<Controller>::observed(std::size_t i) noexcept {
 template <class Controller>
 PortsReport Ports<Controller>::report() const noexcept {
   PortsReport r;
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < kPortCount; ++i) {
     r.observed_J[i] = pc_[i].observed_J();
     r.dissipated_J += pc_[i].dissipated_J();
     r.input_energy_J[i] = pc_[i].energy().in_J;
@@ -58,6 +63,23 @@ Axes3 MasterPorts::contact_force(const Axes3& received_N, const Axes3& target_ra
     out[i] = opposing(pc_[i].force(opposing(received_N[i]), target_rate_m_s[i], remote_in_J(i), dt_s));
     observed(i);
   }
+  return out;
+}
+
+double MasterPorts::grip_force(double received_N, double opening_rate_m_s, double dt_s) noexcept {
+  if (!(dt_s > 0.0)) return received_N;
+  // Along the opening the grip force is the part's push on the jaws: a contact force like the
+  // axes' (it opposes closing as a contact opposes pressing).
+  const double out = opposing(
+      pc_[kGripperPort].force(opposing(received_N), opening_rate_m_s, remote_in_J(kGripperPort), dt_s));
+  observed(kGripperPort);
+  return out;
+}
+
+double SlavePorts::opening_rate(double asked_m_s, double grip_N, double dt_s) noexcept {
+  if (!(dt_s > 0.0)) return 0.0;
+  const double out = pc_[kGripperPort].velocity(asked_m_s, opposing(grip_N), remote_in_J(kGripperPort), dt_s);
+  observed(kGripperPort);
   return out;
 }
 

@@ -37,9 +37,12 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& c
     case Channel::kMasterPortEnergy:
       ports_.arrived(s.xyz);
       break;
+    case Channel::kMasterGripperPortEnergy:
+      ports_.arrived_gripper(s.xyz[0]);
+      break;
     case Channel::kGripperTarget:
-      command.has_gripper = true;
-      command.gripper_opening_m = s.scalar;
+      asked_opening_m_ = s.scalar;  // the opening follows in poll(), through the gripper's port
+      has_gripper_target_ = true;
       break;
     case Channel::kEstop: {
       const bool on = s.scalar != 0.0;
@@ -87,6 +90,14 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
     for (std::size_t i = 0; i < 3; ++i) asked_v[i] = (asked_m_[i] - goal_m_[i]) / h;
     const Axes3 v = ports_.velocity(asked_v, contact_N_, h);
     for (std::size_t i = 0; i < 3; ++i) goal_m_[i] += v[i] * h;
+    if (has_gripper_target_ && opening_known_) {
+      const double w = ports_.opening_rate((asked_opening_m_ - goal_opening_m_) / h, grip_N_, h);
+      goal_opening_m_ += w * h;
+    }
+  }
+  if (has_gripper_target_ && opening_known_) {
+    command.has_gripper = true;
+    command.gripper_opening_m = goal_opening_m_;
   }
   if (has_target_) {
     command.has_goal = true;
@@ -122,7 +133,16 @@ void RemoteMaster::publish(const platform::Platform& p) noexcept {
   send(Channel::kGripForce, {g.grip_force_N(), 0.0, 0.0}, 0.0, stamp);
   send(Channel::kGripperOpening, {}, g.opening_m(), stamp);
   contact_N_ = {f.x, f.y, f.z};  // the slave's port reads it at the next poll
-  send(Channel::kSlavePortEnergy, ports_.report().input_energy_J, 0.0, stamp);
+  grip_N_ = g.grip_force_N();
+  if (!opening_known_) {
+    // The opening goal starts where the gripper is: it joins the master's target through the
+    // port like any motion.
+    goal_opening_m_ = g.opening_m();
+    opening_known_ = true;
+  }
+  const PortsReport ports = ports_.report();
+  send(Channel::kSlavePortEnergy, ports.axes_input_energy_J(), 0.0, stamp);
+  send(Channel::kSlaveGripperPortEnergy, {ports.input_energy_J[kGripperPort], 0.0, 0.0}, 0.0, stamp);
   // The device states: on a change at once, else at 10 Hz of the 1 kHz operator ticks.
   const std::array<double, 4> states = {
       static_cast<double>(p.axis(0).state()), static_cast<double>(p.axis(1).state()),

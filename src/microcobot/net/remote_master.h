@@ -82,6 +82,10 @@ class RemoteMaster final : public live::CommandSource {
   SlavePorts ports_;
   Axes3 asked_m_{}, goal_m_{}, contact_N_{};
   bool has_target_ = false;
+  // The gripper's port likewise: the opening asked, the one let through (from the gripper's
+  // measured opening at the first publish), the grip force of the last publish.
+  double asked_opening_m_ = 0.0, goal_opening_m_ = 0.0, grip_N_ = 0.0;
+  bool has_gripper_target_ = false, opening_known_ = false;
   bool was_fresh_ = false;
   double last_poll_t_ = -1.0;
   std::atomic<double> min_observed_J_{0.0}, dissipated_J_{0.0};

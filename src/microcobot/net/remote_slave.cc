@@ -140,8 +140,11 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
     case Channel::kSlavePortEnergy:
       ports_.arrived(s.xyz);
       break;
+    case Channel::kSlaveGripperPortEnergy:
+      ports_.arrived_gripper(s.xyz[0]);
+      break;
     case Channel::kGripForce:
-      state_.grip_force_N = s.xyz[0];
+      received_grip_N_ = s.xyz[0];  // out through the gripper's port in exchange()
       break;
     case Channel::kGripperOpening:
       state_.opening_m = s.scalar;
@@ -173,10 +176,12 @@ void RemoteSlave::exchange(double dt_s) noexcept {
     ports_.restart();
     target_sent_ = false;
     target_rate_m_s_ = {};
+    gripper_rate_m_s_ = 0.0;
   }
   was_fresh_ = is_fresh;
   // This tick's force out of the channel, against the rate of the target last sent.
   state_.contact_force_N = ports_.contact_force(received_contact_N_, target_rate_m_s_, dt_s);
+  state_.grip_force_N = ports_.grip_force(received_grip_N_, gripper_rate_m_s_, dt_s);
   const PortsReport ports = ports_.report();
   min_observed_J_.store(ports.min_observed_J, std::memory_order_relaxed);
   dissipated_J_.store(ports.dissipated_J, std::memory_order_relaxed);
@@ -185,17 +190,21 @@ void RemoteSlave::exchange(double dt_s) noexcept {
   target_mask_ = 0;
   if (!targets_fresh_) {
     target_rate_m_s_ = {};
+    gripper_rate_m_s_ = 0.0;
     return;
   }
+  const bool rate_known = target_sent_ && since_sent_s_ > 0.0;
   for (std::size_t i = 0; i < 3; ++i)
-    target_rate_m_s_[i] =
-        target_sent_ && since_sent_s_ > 0.0 ? (target_m_[i] - sent_target_m_[i]) / since_sent_s_ : 0.0;
+    target_rate_m_s_[i] = rate_known ? (target_m_[i] - sent_target_m_[i]) / since_sent_s_ : 0.0;
+  gripper_rate_m_s_ = rate_known ? (gripper_target_m_ - sent_gripper_m_) / since_sent_s_ : 0.0;
   sent_target_m_ = target_m_;
+  sent_gripper_m_ = gripper_target_m_;
   target_sent_ = true;
   since_sent_s_ = 0.0;
   send(Channel::kTarget, target_m_, 0.0);
   send(Channel::kGripperTarget, {}, gripper_target_m_);
-  send(Channel::kMasterPortEnergy, ports.input_energy_J, 0.0);
+  send(Channel::kMasterPortEnergy, ports.axes_input_energy_J(), 0.0);
+  send(Channel::kMasterGripperPortEnergy, {ports.input_energy_J[kGripperPort], 0.0, 0.0}, 0.0);
 }
 
 }  // namespace mc::net

@@ -126,6 +126,8 @@ class RemoteSlave {
   MasterPorts ports_;
   std::array<double, 3> received_contact_N_{};
   std::array<double, 3> sent_target_m_{}, target_rate_m_s_{};
+  double received_grip_N_ = 0.0;  // and the gripper's port: the grip force, the opening target's rate
+  double sent_gripper_m_ = 0.0, gripper_rate_m_s_ = 0.0;
   bool target_sent_ = false;  // in this session
   double since_sent_s_ = 0.0;
   bool was_fresh_ = false;

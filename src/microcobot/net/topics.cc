@@ -74,6 +74,12 @@ constexpr std::array<TopicSpec, kChannelCount> kTable{{
           RosType::kVector3Stamped, kVector3Stamped, Role::kMaster, "J (x, y, z: the stage axes' ports)"),
     state(Channel::kSlavePortEnergy, "/microcobot/slave/port_energy", "rt/microcobot/slave/port_energy",
           RosType::kVector3Stamped, kVector3Stamped, Role::kSlave, "J (x, y, z: the stage axes' ports)"),
+    state(Channel::kMasterGripperPortEnergy, "/microcobot/master/gripper/port_energy",
+          "rt/microcobot/master/gripper/port_energy", RosType::kVector3Stamped, kVector3Stamped,
+          Role::kMaster, "J (x: the gripper's opening port; y, z: 0)"),
+    state(Channel::kSlaveGripperPortEnergy, "/microcobot/slave/gripper/port_energy",
+          "rt/microcobot/slave/gripper/port_energy", RosType::kVector3Stamped, kVector3Stamped, Role::kSlave,
+          "J (x: the gripper's opening port; y, z: 0)"),
 }};
 
 constexpr bool table_is_indexed_by_channel() {
