@@ -86,6 +86,7 @@ PlatformConfig with_optical_trap_scene(PlatformConfig config) {
   config.teleop.force_scale = 1e10;
   config.teleop.force_filter_Hz = 1000.0;
   config.teleop.console_max_speed_m_s = 20e-6;
+  config.stage.tracking_enabled = false;
   return config;
 }
 
