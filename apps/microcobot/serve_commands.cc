@@ -133,7 +133,7 @@ void serve(const ServeOptions& o) {
   if (o.scene == "pin-in-hole") {
     lp.platform.world = mc::microworld::pin_in_hole_scene();
   } else if (o.scene == "optical-trap") {
-    lp.platform = pf::with_optical_trap_scene(lp.platform);
+    pf::use_optical_trap_scene(lp.platform);
   } else if (o.scene != "pick-place") {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);

@@ -93,13 +93,7 @@ try {
   await shot("04-placed");
 
   // E-stop: every device in its safe state, latched.
-  await page.click("#estop");
-  await until("e-stop latched", () => window.mc.status && window.mc.status.estopped, 5);
-  const status = await page.evaluate(() => window.mc.status);
-  for (const [device, state] of Object.entries(status.lifecycle)) if (state !== "fault") fail(`${device} is ${state} after the e-stop`);
-  await page.waitForTimeout(300);
-  const stopped = await t();
-  if (stopped.u_x_V !== 0 || stopped.u_y_V !== 0 || stopped.u_z_V !== 0) fail("drive voltages not zero after the e-stop");
+  await s.estopAndCheck();
   await shot("05-estop");
 
   // Stop the recording: it is listed with its download and report links; the report is made on

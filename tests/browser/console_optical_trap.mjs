@@ -44,13 +44,7 @@ try {
   if (!/pN$/.test(shown) || !(parseFloat(shown) > 3)) fail(`the contact gauge shows "${shown}"`);
   await shot("trap-02-contact");
 
-  await page.click("#estop");
-  await until("e-stop latched", () => window.mc.status && window.mc.status.estopped, 5);
-  const status = await page.evaluate(() => window.mc.status);
-  for (const [device, state] of Object.entries(status.lifecycle)) if (state !== "fault") fail(`${device} is ${state} after the e-stop`);
-  await page.waitForTimeout(300);
-  const stopped = await t();
-  if (stopped.u_x_V !== 0 || stopped.u_y_V !== 0 || stopped.u_z_V !== 0) fail("drive voltages not zero after the e-stop");
+  const stopped = await s.estopAndCheck();
   // The laser stays on: the probe is still held near its trap.
   if (!(Math.abs(stopped.part_x_m - stopped.measured_x_m) < 3e-6)) fail("the probe left its trap at the e-stop");
   await shot("trap-03-estop");

@@ -88,6 +88,18 @@ export async function startConsole(name, serveArgs, timeoutS) {
     }
   };
   s.setSlider = (id, value) => page.locator(id).fill(String(value));
+  // The e-stop button: latched, every device in fault (its safe state), the drives at 0 V.
+  // Returns the telemetry after it.
+  s.estopAndCheck = async () => {
+    await page.click("#estop");
+    await s.until("e-stop latched", () => window.mc.status && window.mc.status.estopped, 5);
+    const status = await page.evaluate(() => window.mc.status);
+    for (const [device, state] of Object.entries(status.lifecycle)) if (state !== "fault") s.fail(`${device} is ${state} after the e-stop`);
+    await page.waitForTimeout(300);
+    const stopped = await s.t();
+    if (stopped.u_x_V !== 0 || stopped.u_y_V !== 0 || stopped.u_z_V !== 0) s.fail("drive voltages not zero after the e-stop");
+    return stopped;
+  };
   // After a failure: what the page last saw, and a screenshot.
   s.diagnose = async () => {
     const diag = await page.evaluate(() => JSON.stringify({ messages: window.mc.messages.slice(-10), status: window.mc.status,

@@ -111,6 +111,8 @@ struct Pair {
       std::this_thread::sleep_for(20ms);
     }
   }
+  // Holds the deadman until the master engages with the slave (30 s at most).
+  bool engage();
 };
 
 live::ConsoleCommand jog(double vx) {
@@ -118,6 +120,21 @@ live::ConsoleCommand jog(double vx) {
   c.deadman = true;
   c.velocity_m_s = {vx, 0, 0};
   return c;
+}
+
+bool Pair::engage() {
+  return test::wait_until([&] { return master->get("engaged") == 1.0 || (drive(jog(0), 20ms), false); },
+                          30.0);
+}
+
+// 100 ms each way, 10 ms of jitter, 20 % loss: the 200 ms round trip of issue #17's goal.
+control::LinkParams lossy_200ms_round_trip(std::uint64_t seed) {
+  control::LinkParams link;
+  link.delay_s = 0.1;
+  link.jitter_s = 0.01;
+  link.loss = 0.2;
+  link.seed = seed;
+  return link;
 }
 
 void moves_the_slave_without_allocating(Pair& pair);
@@ -137,9 +154,7 @@ TEST(RemoteEnds, SoOverAnEmulatedLinkOf100msRoundTripWithJitterAndLoss) {
 }
 
 void moves_the_slave_without_allocating(Pair& pair) {
-  ASSERT_TRUE(test::wait_until(
-      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0))
-      << "the master never engaged with the slave";
+  ASSERT_TRUE(pair.engage()) << "the master never engaged with the slave";
   const double x0 = pair.slave->get("measured_x_m");
   // One loop watched at a time (the counting allocator follows one thread), each while the
   // link carries targets one way and measurements the other.
@@ -187,16 +202,8 @@ struct Press {
 };
 
 Press press_into_the_substrate(bool passivity) {
-  control::LinkParams link;
-  link.delay_s = 0.1;  // each way
-  link.jitter_s = 0.01;
-  link.loss = 0.2;
-  link.seed = 5;
-  Pair pair(link, passivity);
-  const auto engaged = [&] {
-    return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false);
-  };
-  EXPECT_TRUE(test::wait_until(engaged, 30.0)) << "the master never engaged with the slave";
+  Pair pair(lossy_200ms_round_trip(5), passivity);
+  EXPECT_TRUE(pair.engage()) << "the master never engaged with the slave";
   live::ConsoleCommand c;
   c.deadman = true;
   c.has_goal = true;
@@ -263,15 +270,8 @@ struct Grasp {
 };
 
 Grasp grasp_across_the_link(bool passivity) {
-  control::LinkParams link;
-  link.delay_s = 0.1;  // each way
-  link.jitter_s = 0.01;
-  link.loss = 0.2;
-  link.seed = 9;
-  Pair pair(link, passivity);
-  EXPECT_TRUE(test::wait_until(
-      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0))
-      << "the master never engaged with the slave";
+  Pair pair(lossy_200ms_round_trip(9), passivity);
+  EXPECT_TRUE(pair.engage()) << "the master never engaged with the slave";
   live::ConsoleCommand c;
   c.deadman = true;
   c.has_goal = true;
@@ -330,9 +330,7 @@ std::pair<double, double> slave_target_roughness(bool interpolate) {
   link.loss = 0.2;
   link.seed = 4;
   Pair pair(link, true, interpolate);
-  EXPECT_TRUE(test::wait_until(
-      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0))
-      << "the master never engaged with the slave";
+  EXPECT_TRUE(pair.engage()) << "the master never engaged with the slave";
   pair.drive(jog(200e-6), 500ms);  // up to speed
   pair.slave->record(true);
   pair.drive(jog(200e-6), 1000ms);
@@ -481,8 +479,7 @@ TEST(RemoteEnds, AMasterLetsGoOfASlaveWhoseTopicsMissTheirDdsDeadline) {
 
 TEST(RemoteEnds, TheMasterLetsGoOfASlaveThatStoppedItselfAndReEngagesAfterItsReset) {
   Pair pair;
-  ASSERT_TRUE(test::wait_until(
-      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0));
+  ASSERT_TRUE(pair.engage());
   pair.slave->live->estop();  // the slave's own console
   ASSERT_TRUE(mc::test::eventually([&] {
     pair.drive(jog(0), 20ms);
@@ -498,8 +495,7 @@ TEST(RemoteEnds, TheMasterLetsGoOfASlaveThatStoppedItselfAndReEngagesAfterItsRes
 
 TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
   Pair pair;
-  ASSERT_TRUE(test::wait_until(
-      [&] { return pair.master->get("engaged") == 1.0 || (pair.drive(jog(0), 20ms), false); }, 30.0));
+  ASSERT_TRUE(pair.engage());
   pair.master->live->estop();
   ASSERT_TRUE(mc::test::eventually([&] { return pair.slave->live->status().estopped; }))
       << "the slave did not latch the master's e-stop";

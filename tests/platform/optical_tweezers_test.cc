@@ -13,6 +13,13 @@
 namespace mc::platform {
 namespace {
 
+// The default platform in the optical-trap scene.
+PlatformConfig trap_scene() {
+  PlatformConfig c;
+  use_optical_trap_scene(c);
+  return c;
+}
+
 std::size_t channel(const char* name) {
   for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
     if (std::string(kTelemetryChannels[i]) == name) return i;
@@ -31,7 +38,7 @@ double stddev(const Recorder& r, const char* name, std::size_t from, std::size_t
 
 // The optical-trap scene with the simulated operator's hand on the dual-stage master.
 struct TrapRig {
-  PlatformConfig config = with_optical_trap_scene(PlatformConfig{});
+  PlatformConfig config = trap_scene();
   Platform platform{config};
   OperatorHand hand;
   TrapRig() {
@@ -135,32 +142,33 @@ TEST(OpticalTweezersScene, TheLoopPathNeitherAllocatesNorThrows) {
 }
 
 TEST(OpticalTweezersScene, TheScriptedPickAndPlaceRefusesIt) {
-  const PlatformConfig c = with_optical_trap_scene(PlatformConfig{});
+  const PlatformConfig c = trap_scene();
   EXPECT_THROW(Session(c, SessionParams{}), InvalidParams);
   Platform p(c);
   EXPECT_THROW(PickPlaceOperator(p, PickPlaceOperatorParams{}), InvalidParams);
 }
 
+// The error's text for a configuration that must be refused.
+std::string refusal(const PlatformConfig& c) {
+  try {
+    c.validate();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 TEST(OpticalTweezersScene, BadSceneParametersNameTheKey) {
-  PlatformConfig c = with_optical_trap_scene(PlatformConfig{});
-  c.optical_trap.obstacle_offset_x_m = 3e-6;  // the stuck bead on the probe
-  try {
-    c.validate();
-    FAIL() << "accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("optical_trap.obstacle_offset_x_m"), std::string::npos) << e.what();
-  }
-  c = with_optical_trap_scene(PlatformConfig{});
-  c.optical_trap.trap.dt_s = 3e-5;  // not a divisor of the 100 us loop period
-  EXPECT_THROW(c.validate(), Error);
-  c = PlatformConfig{};
-  c.microworld = "optical_trap";
-  try {
-    c.validate();
-    FAIL() << "accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("microworld"), std::string::npos) << e.what();
-  }
+  PlatformConfig on_the_probe = trap_scene();
+  on_the_probe.optical_trap.obstacle_offset_x_m = 3e-6;  // the stuck bead on the probe
+  EXPECT_NE(refusal(on_the_probe).find("optical_trap.obstacle_offset_x_m"), std::string::npos)
+      << refusal(on_the_probe);
+  PlatformConfig odd_step = trap_scene();
+  odd_step.optical_trap.trap.dt_s = 3e-5;  // not a divisor of the 100 us loop period
+  EXPECT_NE(refusal(odd_step).find("optical_trap.dt_s"), std::string::npos) << refusal(odd_step);
+  PlatformConfig misspelt;
+  misspelt.microworld = "optical_trap";
+  EXPECT_NE(refusal(misspelt).find("microworld"), std::string::npos) << refusal(misspelt);
 }
 
 }  // namespace

@@ -46,8 +46,7 @@ RemoteMaster::RemoteMaster(const RemoteMasterParams& params)
 
 RemoteMaster::~RemoteMaster() = default;
 
-void RemoteMaster::apply(const NetSample& s, double t_s, live::ConsoleCommand& command,
-                         live::RemoteRequest& r) noexcept {
+void RemoteMaster::apply(const NetSample& s, double t_s, live::RemoteRequest& r) noexcept {
   switch (s.channel) {
     case Channel::kTarget:
       // The goal follows in poll(), through the jitter buffer and the ports.
@@ -94,10 +93,10 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
     if (emulator_) {
       emulator_->arrive(t_s, s);
     } else {
-      apply(s, t_s, command, r);
+      apply(s, t_s, r);
     }
   }
-  if (emulator_) emulator_->deliver(t_s, [&](const NetSample& d) { apply(d, t_s, command, r); });
+  if (emulator_) emulator_->deliver(t_s, [&](const NetSample& d) { apply(d, t_s, r); });
   r.estop = estop_;
   r.fresh =
       engaged_ && t_s - last_target_t_ <= stale_timeout_s_ && (!params_.watch_dds || link_->peer_alive());

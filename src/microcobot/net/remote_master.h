@@ -83,7 +83,7 @@ class RemoteMaster final : public live::CommandSource {
 
  private:
   void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns) noexcept;
-  void apply(const NetSample& s, double t_s, live::ConsoleCommand& command, live::RemoteRequest& r) noexcept;
+  void apply(const NetSample& s, double t_s, live::RemoteRequest& r) noexcept;
 
   RemoteMasterParams params_;
   std::unique_ptr<Link> link_;

@@ -80,14 +80,13 @@ void PlatformConfig::validate() const {
   });
 }
 
-PlatformConfig with_optical_trap_scene(PlatformConfig config) {
+void use_optical_trap_scene(PlatformConfig& config) {
   config.microworld = "optical-trap";
   config.teleop.motion_scale = 5e-4;
   config.teleop.force_scale = 1e10;
   config.teleop.force_filter_Hz = 1000.0;
   config.teleop.console_max_speed_m_s = 20e-6;
   config.stage.tracking_enabled = false;
-  return config;
 }
 
 PlatformConfig load_platform_config(const std::filesystem::path& file) {

@@ -143,7 +143,7 @@ struct PlatformConfig {
 /// tracking controller (tuned for references moving at 50-500 um/s) amplified into 35 nm of
 /// trap motion and a probe force 1.9 times the thermal one; the hybrid controller follows it
 /// within 5 nm and leaves the thermal force (0.19 pN against 0.20 pN).
-PlatformConfig with_optical_trap_scene(PlatformConfig config);
+void use_optical_trap_scene(PlatformConfig& config);
 
 /// Reads a configuration file over the defaults; relative file names in it are resolved
 /// against the file's directory. Throws InvalidInput / InvalidParams (exit 3).
