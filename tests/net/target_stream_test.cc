@@ -117,5 +117,23 @@ TEST(TargetStream, LateTargetsHoldAndAreRejoinedAtTheSpeedLimitNeverByAJump) {
   EXPECT_NEAR(x, 20e-6, 1e-12) << "rejoined within 20 ms";
 }
 
+TEST(TargetStream, AStampFromTheFutureIsDroppedAndDoesNotFreezeTheGoal) {
+  TargetStream stream(control::SetpointStreamParams{});
+  double now = 0.0;
+  for (int k = 0; k < 50; ++k, now += kDt) {
+    ASSERT_TRUE(stream.push(now, {k * 1e-9, 0.0, 0.0}, now + 1e-3));
+    stream.sample(now + 1e-3, kDt);
+  }
+  // A corrupt stamp a year ahead (a finite, valid ROS time): refused, the stream goes on.
+  EXPECT_FALSE(stream.push(now + 3.15e7, {1e-3, 0.0, 0.0}, now + 1e-3));
+  EXPECT_FALSE(stream.push(std::nan(""), {0.0, 0.0, 0.0}, now));
+  for (int k = 50; k < 100; ++k, now += kDt) {
+    ASSERT_TRUE(stream.push(now, {k * 1e-9, 0.0, 0.0}, now + 1e-3)) << k;
+    stream.sample(now + 1e-3, kDt);
+  }
+  EXPECT_NEAR(stream.sample(now + 1e-3, kDt)[0], 97e-9, 2e-9) << "still following the sender";
+  EXPECT_NEAR(stream.transit_s(), 1e-3, 1e-9);
+}
+
 }  // namespace
 }  // namespace mc::net

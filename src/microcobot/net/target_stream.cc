@@ -23,12 +23,16 @@ TargetStream::TargetStream(const control::SetpointStreamParams& stream, double w
           "must be within [0.01, 60] s", window_s);
 }
 
-void TargetStream::push(double stamp_s, const Axes3& target_m, double now_s) noexcept {
-  if (!std::isfinite(stamp_s) || !std::isfinite(now_s)) return;
+bool TargetStream::push(double stamp_s, const Axes3& target_m, double now_s) noexcept {
+  if (!std::isfinite(stamp_s) || !std::isfinite(now_s)) return false;
   const double transit = now_s - stamp_s;
+  if (std::isfinite(transit_s_) && transit < transit_s_ - kMaxStampLead_s) return false;
+  bool taken = true;
+  for (std::size_t i = 0; i < 3; ++i) taken = axes_[i].push(stamp_s, target_m[i]) && taken;
+  if (!taken) return false;
   bucket_min_s_ = std::min(bucket_min_s_, transit);
   transit_s_ = std::min(transit_s_, transit);
-  for (std::size_t i = 0; i < 3; ++i) axes_[i].push(stamp_s, target_m[i]);
+  return true;
 }
 
 TargetStream::Axes3 TargetStream::sample(double now_s, double dt_s) noexcept {

@@ -29,8 +29,11 @@ class TargetStream {
   explicit TargetStream(const control::SetpointStreamParams& stream, double window_s = 1.0);
 
   /// A target stamped `stamp_s` by the sender, arriving at `now_s` (this end's clock, s). An
-  /// out-of-order one is dropped.
-  void push(double stamp_s, const Axes3& target_m, double now_s) noexcept;
+  /// out-of-order one is dropped, and so is one stamped more than `kMaxStampLead_s` ahead of the
+  /// sender's clock as learned so far (a forged or corrupt stamp would otherwise make every later
+  /// target look out of order and freeze the goal). Returns whether it was taken.
+  bool push(double stamp_s, const Axes3& target_m, double now_s) noexcept;
+  static constexpr double kMaxStampLead_s = 0.5;
   /// The target to follow at `now_s`, advanced by `dt_s`.
   Axes3 sample(double now_s, double dt_s) noexcept;
   /// A new session (the sender came back): hold `target_m`, learn the transit anew.
