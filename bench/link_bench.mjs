@@ -67,9 +67,11 @@ async function ticks(server) {
   if (code !== 0) throw new Error(`serve exited with ${code}`);
   const name = readdirSync(server.dir).find((f) => f.endsWith(".mcap"));
   const samples = await readTelemetry(join(server.dir, name));
-  const t = samples.filter((s) => s.t_s >= samples[0].t_s + 1).map((s) => s.tick_us);
+  const kept = samples.filter((s) => s.t_s >= samples[0].t_s + 1);
   rmSync(server.dir, { recursive: true, force: true });
-  return { samples: t.length, p50: quantile(t, 0.5), p99: quantile(t, 0.99), max: Math.max(...t) };
+  const stats = (t) => ({ samples: t.length, p50: quantile(t, 0.5), p99: quantile(t, 0.99), max: Math.max(...t) });
+  // Wall clock (tick_us), and the loop thread's CPU clock (tick_cpu_us: preemption excluded).
+  return { ...stats(kept.map((s) => s.tick_us)), cpu: stats(kept.map((s) => s.tick_cpu_us)) };
 }
 
 log(`single process: ${phaseS} s`);
@@ -124,6 +126,9 @@ const result = {
   tick_p99_ratio_master_single: masterTicks.p99 / singleTicks.p99,
   holding_tick_us: { single: idleTicks, slave: idleSlaveTicks },
   holding_tick_p99_ratio_slave_single: idleSlaveTicks.p99 / idleTicks.p99,
+  tick_cpu_p99_ratio_slave_single: slaveTicks.cpu.p99 / singleTicks.cpu.p99,
+  tick_cpu_p99_ratio_slave_single_beside_another: slaveTicks.cpu.p99 / besidePeerTicks.cpu.p99,
+  holding_tick_cpu_p99_ratio_slave_single: idleSlaveTicks.cpu.p99 / idleTicks.cpu.p99,
   round_trip_ms: { p50: 1e3 * ping.rtt_p50_s, p99: 1e3 * ping.rtt_p99_s, max: 1e3 * ping.rtt_max_s, loss: ping.loss },
 };
 if (asJson) {
@@ -137,6 +142,12 @@ if (asJson) {
   console.log(`loop tick, master:         ${f(masterTicks)}; p99 ratio to single ${result.tick_p99_ratio_master_single.toFixed(3)}`);
   console.log(`holding, single:          ${f(idleTicks)}`);
   console.log(`holding, slave (link on): ${f(idleSlaveTicks)}; p99 ratio ${result.holding_tick_p99_ratio_slave_single.toFixed(3)}`);
+  const c = (t) => `CPU p50 ${t.cpu.p50.toFixed(2)} us, p99 ${t.cpu.p99.toFixed(2)} us`;
+  console.log(`loop thread CPU per tick: single ${c(singleTicks)}; beside another ${c(besidePeerTicks)}; ` +
+              `slave ${c(slaveTicks)} (p99 ratio to single ${result.tick_cpu_p99_ratio_slave_single.toFixed(3)}, ` +
+              `to beside another ${result.tick_cpu_p99_ratio_slave_single_beside_another.toFixed(3)})`);
+  console.log(`loop thread CPU per tick, holding: single ${c(idleTicks)}; slave ${c(idleSlaveTicks)} ` +
+              `(p99 ratio ${result.holding_tick_cpu_p99_ratio_slave_single.toFixed(3)})`);
   const r = result.round_trip_ms;
   console.log(`round trip at 1 kHz: p50 ${r.p50.toFixed(3)} ms, p99 ${r.p99.toFixed(3)} ms, max ${r.max.toFixed(3)} ms, ` +
               `loss ${(100 * r.loss).toFixed(1)} %`);

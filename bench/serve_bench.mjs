@@ -93,35 +93,38 @@ if (code !== 0) {
   process.exit(1);
 }
 
-// The loop's tick times of each phase, from the recording.
+// The loop's tick times of each phase, from the recording: on the wall clock (tick_us) and on
+// the loop thread's CPU clock (tick_cpu_us: the tick and its wake-up, preemption excluded).
 const name = readdirSync(dir).find((f) => f.endsWith(".mcap"));
-const ticks = { A: [], B: [] };
+const ticks = { A: { wall: [], cpu: [] }, B: { wall: [], cpu: [] } };
 for (const s of await readTelemetry(join(dir, name))) {
-  if (s.t_s >= aStart + 1 && s.t_s < aEnd) ticks.A.push(s.tick_us);
-  else if (s.t_s >= bStart + 1 && s.t_s < bEnd) ticks.B.push(s.tick_us);
+  const phase = s.t_s >= aStart + 1 && s.t_s < aEnd ? ticks.A : s.t_s >= bStart + 1 && s.t_s < bEnd ? ticks.B : null;
+  if (phase) phase.wall.push(s.tick_us), phase.cpu.push(s.tick_cpu_us);
 }
 rmSync(dir, { recursive: true, force: true });
+const stats = (v) => ({ samples: v.length, p50: quantile(v, 0.5), p99: quantile(v, 0.99) });
 const result = {
   phase_s: phaseS,
   clients: nClients,
   command_latency_ms: { p50: latency.p50, p99: latency.p99, max: latency.max, count: latency.count },
   telemetry_clients_msgs_per_s: { min: Math.min(...perClientHz), max: Math.max(...perClientHz) },
-  tick_us: {
-    without_clients: { samples: ticks.A.length, p50: quantile(ticks.A, 0.5), p99: quantile(ticks.A, 0.99) },
-    with_clients: { samples: ticks.B.length, p50: quantile(ticks.B, 0.5), p99: quantile(ticks.B, 0.99) },
-  },
+  tick_us: { without_clients: stats(ticks.A.wall), with_clients: stats(ticks.B.wall) },
+  tick_cpu_us: { without_clients: stats(ticks.A.cpu), with_clients: stats(ticks.B.cpu) },
 };
 result.tick_p99_ratio_with_without = result.tick_us.with_clients.p99 / result.tick_us.without_clients.p99;
+result.tick_cpu_p99_ratio_with_without = result.tick_cpu_us.with_clients.p99 / result.tick_cpu_us.without_clients.p99;
 if (asJson) {
   console.log(JSON.stringify(result, null, 2));
 } else {
-  const t = result.tick_us;
   console.log(`command-to-target latency: p50 ${latency.p50.toFixed(3)} ms, p99 ${latency.p99.toFixed(3)} ms ` +
               `(max ${latency.max.toFixed(3)} ms, ${latency.count} commands)`);
   console.log(`${nClients} clients: ${result.telemetry_clients_msgs_per_s.min.toFixed(1)}-` +
               `${result.telemetry_clients_msgs_per_s.max.toFixed(1)} messages/s each`);
-  console.log(`loop tick without clients: p50 ${t.without_clients.p50.toFixed(2)} us, p99 ${t.without_clients.p99.toFixed(2)} us ` +
-              `(${t.without_clients.samples} samples)`);
-  console.log(`loop tick with ${nClients} clients: p50 ${t.with_clients.p50.toFixed(2)} us, p99 ${t.with_clients.p99.toFixed(2)} us ` +
-              `(${t.with_clients.samples} samples); p99 ratio ${result.tick_p99_ratio_with_without.toFixed(3)}`);
+  for (const [label, t, ratio] of [["wall clock", result.tick_us, result.tick_p99_ratio_with_without],
+                                    ["loop thread CPU", result.tick_cpu_us, result.tick_cpu_p99_ratio_with_without]]) {
+    console.log(`loop tick (${label}) without clients: p50 ${t.without_clients.p50.toFixed(2)} us, ` +
+                `p99 ${t.without_clients.p99.toFixed(2)} us (${t.without_clients.samples} samples)`);
+    console.log(`loop tick (${label}) with ${nClients} clients: p50 ${t.with_clients.p50.toFixed(2)} us, ` +
+                `p99 ${t.with_clients.p99.toFixed(2)} us (${t.with_clients.samples} samples); p99 ratio ${ratio.toFixed(3)}`);
+  }
 }

@@ -557,7 +557,7 @@ function onStatus(s) {
   ];
   for (const [name, state] of Object.entries(s.lifecycle)) rows.push([name, state, state === "active"]);
   rows.push(["loop overruns", String(s.overruns), s.overruns === 0]);
-  rows.push(["tick p99", s.tick_p99_us.toFixed(1) + " µs", true]);
+  rows.push(["tick p99", s.tick_p99_us.toFixed(1) + " µs (CPU " + s.tick_cpu_p99_us.toFixed(1) + " µs)", true]);
   rows.push(["clients", String(s.clients), true]);
   rows.push(["recording", s.recording || "off", true]);
   const lat = s.command_latency_ms;
@@ -677,7 +677,7 @@ makePlot("Positions against targets", "µm", um, [
 const forcePlot = makePlot("Forces on the gripper [µN]", "", um, [
   ["contact_x_N", "contact x"], ["contact_y_N", "contact y"], ["contact_z_N", "contact z"], ["grip_force_N", "grip"]]);
 makePlot("Drive amplitude", "V", 1, [["u_x_V", "u x"], ["u_y_V", "u y"], ["u_z_V", "u z"]]);
-makePlot("Loop tick", "µs", 1, [["tick_us", "tick compute time"]]);
+makePlot("Loop tick", "µs", 1, [["tick_us", "tick (wall clock)"], ["tick_cpu_us", "tick (loop thread CPU)"]]);
 
 function onTelemetry(t) {
   mc.telemetry = t;

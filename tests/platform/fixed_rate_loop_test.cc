@@ -1,7 +1,10 @@
 #include "microcobot/platform/fixed_rate_loop.h"
 
 #include <gtest/gtest.h>
+#include <time.h>
+
 #include <chrono>
+#include <thread>
 #include <vector>
 
 #include "microcobot/core/error.h"
@@ -74,6 +77,49 @@ TEST(FixedRateLoop, RealTimeRunIsPacedToTheWallClock) {
   EXPECT_GE(wall, 0.195);
   EXPECT_LT(wall, 3.0);  // generous: shared CI machines
   EXPECT_EQ(loop.jitter_stats().count(), 1000u);
+}
+
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The two tick measures part where a tick is off the CPU: a tick that computes for 300 us costs
+// the loop thread at least 300 us of CPU, a tick that waits 3 ms (as if preempted) lasts 3 ms on
+// the wall clock and costs its thread next to nothing.
+TEST(FixedRateLoop, TheTicksCpuTimeCountsComputeNotTimeOffTheCpu) {
+  for (const bool realtime : {false, true}) {
+    FixedRateLoop loop(100.0);
+    std::vector<double> wall, cpu;
+    wall.reserve(8), cpu.reserve(8);
+    loop.add_task("work", 1, [&](const TickInfo& t) {
+      if (t.index > 0) wall.push_back(loop.last_tick_s()), cpu.push_back(loop.last_tick_cpu_s());
+      if (t.index % 2 == 0) {
+        const double until = thread_cpu_s() + 300e-6;
+        while (thread_cpu_s() < until) {
+        }
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      }
+    });
+    if (realtime)
+      loop.run_realtime(7);
+    else
+      loop.run_for(7);
+    ASSERT_EQ(cpu.size(), 6u);
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+      const bool computed = i % 2 == 0;  // the value read at tick i + 1 is tick i's
+      SCOPED_TRACE(std::string(realtime ? "real time" : "simulation") + ", tick " + std::to_string(i));
+      if (computed) {
+        EXPECT_GE(cpu[i], 300e-6);
+        EXPECT_LT(cpu[i], 5e-3);
+      } else {
+        EXPECT_GE(wall[i], 3e-3);
+        EXPECT_LT(cpu[i], 1e-3) << "a tick off the CPU for 3 ms";
+      }
+    }
+  }
 }
 
 TEST(FixedRateLoop, RejectsBadRatesAndDivisors) {

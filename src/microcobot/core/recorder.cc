@@ -30,6 +30,10 @@ bool Recorder::sample(std::span<const double> values) {
   return true;
 }
 
+bool Recorder::has_channel(const std::string& name) const {
+  return std::find(names_.begin(), names_.end(), name) != names_.end();
+}
+
 std::vector<double> Recorder::channel(const std::string& name) const {
   const auto it = std::find(names_.begin(), names_.end(), name);
   if (it == names_.end()) throw InvalidInput(fmt::format("recorder: no channel '{}'", name));

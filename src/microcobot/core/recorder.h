@@ -32,6 +32,8 @@ class Recorder {
   double at(std::size_t i, std::size_t c) const { return data_[i * names_.size() + c]; }
   /// A copy of channel `name` (outside the loop).
   std::vector<double> channel(const std::string& name) const;
+  /// Whether a channel is called `name` (a recording of an earlier version may lack one).
+  bool has_channel(const std::string& name) const;
 
   /// Forgets the samples, keeps the buffers.
   void clear();

@@ -34,6 +34,7 @@ std::size_t channel_index(const char* name) {
 const std::size_t kContactX = channel_index("contact_x_N");
 const std::size_t kGrip = channel_index("grip_force_N");
 const std::size_t kTick = channel_index("tick_us");
+const std::size_t kTickCpu = channel_index("tick_cpu_us");
 
 std::string schema(const json& properties) {
   return json{{"type", "object"}, {"properties", properties}}.dump();
@@ -131,6 +132,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"lifecycle", {{"type", "object"}}},
                                             {"overruns", number},
                                             {"tick_p99_us", number},
+                                            {"tick_cpu_p99_us", number},
                                             {"command_latency_ms", {{"type", "object"}}},
                                             {"clients", number},
                                             {"recording", {{"type", {"string", "null"}}}},
@@ -227,9 +229,12 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
     }
   }
   ticks_.add(s[kTick] * 1e-6);
+  ticks_cpu_.add(s[kTickCpu] * 1e-6);
   if (ticks_.count() >= 1000) {  // the loop's tick p99 over the last second
     tick_p99_us_.store(1e6 * ticks_.quantile_s(0.99));
+    tick_cpu_p99_us_.store(1e6 * ticks_cpu_.quantile_s(0.99));
     ticks_.reset();
+    ticks_cpu_.reset();
   }
   const double hx = rumble_x_.process(s[kContactX]), hy = rumble_y_.process(s[kContactX + 1]),
                hz = rumble_z_.process(s[kContactX + 2]);
@@ -407,6 +412,7 @@ std::string ConsoleServer::status_json() {
             {"lifecycle", lifecycle},
             {"overruns", s.overruns},
             {"tick_p99_us", tick_p99_us_.load()},
+            {"tick_cpu_p99_us", tick_cpu_p99_us_.load()},
             {"command_latency_ms",
              {{"count", latency_.count()},
               {"p50", 1e3 * latency_.quantile_s(0.5)},
@@ -424,6 +430,10 @@ void ConsoleServer::status_thread() {
   int n = 0;
   while (!quit_.load()) {
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+    // A thread kept off the CPU for several periods resumes on time rather than publishing the
+    // missed statuses back to back (each would repeat the same figures).
+    const auto now = std::chrono::steady_clock::now();
+    if (next < now) next = now;
     std::this_thread::sleep_until(next);
     const auto ns = static_cast<std::uint64_t>(std::llround(live_.status().t_s * 1e9));
     live_.drain_command_latencies(latency_);

@@ -113,14 +113,15 @@ class ConsoleServer {
   double rumble_sum_ = 0.0;
   std::size_t rumble_n_ = 0;
   std::string json_;
-  platform::TimingStats ticks_;  // the telemetry's tick_us, per status period
+  platform::TimingStats ticks_;      // the telemetry's tick_us, per second
+  platform::TimingStats ticks_cpu_;  // its tick_cpu_us, per second
 
   // Recording: written on the drain thread, opened and closed by the server thread.
   mutable std::mutex recording_mutex_;
   std::unique_ptr<McapWriter> recording_;
   std::uint16_t recording_channel_ = 0;
   std::string recording_name_;
-  std::atomic<double> tick_p99_us_{0.0};
+  std::atomic<double> tick_p99_us_{0.0}, tick_cpu_p99_us_{0.0};
   platform::TimingStats latency_{1e-5};  // status thread: command-to-target, 10 us bins
 
   // Reports made on demand, one at a time, off the server's I/O thread.

@@ -9,7 +9,9 @@
 ///  - run_for(n): simulation, back to back as fast as possible; time advances by the period.
 ///  - run_realtime(n): paced to the wall clock with absolute deadlines (clock_nanosleep) in a
 ///    dedicated thread, SCHED_FIFO when the process may use it, best effort otherwise.
-/// Both measure each tick's compute time; real time also measures wake-up lateness (jitter).
+/// Both measure each tick's compute time (wall clock: a tick preempted by another thread lasts
+/// longer) and the loop thread's CPU time per tick (thread CPU clock: what the tick itself cost,
+/// preemption excluded); real time also measures wake-up lateness (jitter).
 /// An overrun is a tick whose compute time exceeded the period, or, in real time, a tick that
 /// started a full period late. A real-time loop that falls more than kResyncPeriods behind
 /// (a stopped process, an overloaded machine) skips the missed ticks instead of bursting.
@@ -60,6 +62,11 @@ class FixedRateLoop {
   std::uint64_t overruns() const { return overruns_; }
   /// Compute time of the last finished tick [s] (read by a task: the previous tick's).
   double last_tick_s() const { return last_tick_s_; }
+  /// CPU time the loop thread used from the end of the tick before the last finished one to the
+  /// end of that one [s]: the tick plus its wake-up (real time), on the thread's CPU clock, so a
+  /// preemption (another thread, another tenant of the machine) does not count. What other
+  /// threads cost the loop itself (shared caches, memory bandwidth, locks) does.
+  double last_tick_cpu_s() const { return last_tick_cpu_s_; }
   /// Ticks skipped to catch up with the wall clock (real time only), counted in resyncs.
   std::uint64_t resyncs() const { return resyncs_; }
   /// The thread that runs (or last ran) the ticks: how a test proves the loop path allocates
@@ -85,6 +92,7 @@ class FixedRateLoop {
   std::uint64_t resyncs_ = 0;
   std::atomic<std::thread::id> thread_id_{};
   double last_tick_s_ = 0.0;
+  double last_tick_cpu_s_ = 0.0;
   TimingStats tick_stats_;
   TimingStats jitter_stats_;
   std::atomic<bool> stop_{false};

@@ -228,6 +228,7 @@ void Platform::telemetry_task(double t_s) noexcept {
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
   put(contact.x), put(contact.y), put(contact.z);
   put(1e6 * loop_.last_tick_s());
+  put(1e6 * loop_.last_tick_cpu_s());
   // Simulation channels: the ground truth.
   if (simulated()) {
     const OperatorHand& hand = sim_.haptic->operator_hand();

@@ -48,7 +48,7 @@ namespace mc::platform {
 /// controller's commands): recorded on any devices. The rest are the simulation's ground truth
 /// (the operator's hand, the true carriage positions, the haptic channels' forces, the part):
 /// recorded only when the platform runs its simulated devices.
-inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",  // loop channels
+inline constexpr std::array<const char*, 39> kTelemetryChannels = {"t_s",  // loop channels
                                                                    "handle_x_m",
                                                                    "handle_y_m",
                                                                    "deadman",
@@ -75,6 +75,7 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",  // lo
                                                                    "contact_y_N",
                                                                    "contact_z_N",
                                                                    "tick_us",
+                                                                   "tick_cpu_us",
                                                                    "hand_x_m",  // simulation channels
                                                                    "hand_y_m",
                                                                    "slave_x_m",
@@ -87,7 +88,7 @@ inline constexpr std::array<const char*, 38> kTelemetryChannels = {"t_s",  // lo
                                                                    "part_z_m",
                                                                    "part_phase"};
 // In the optical-trap scene the part channels are the probe bead's (part_phase 0).
-inline constexpr std::size_t kLoopChannelCount = 27;
+inline constexpr std::size_t kLoopChannelCount = 28;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
 /// The devices the loop drives, by their interfaces (device.h). A hardware set-up fills it
