@@ -94,7 +94,7 @@ TEST(FixedRateLoop, TheTicksCpuTimeCountsComputeNotTimeOffTheCpu) {
     std::vector<double> wall, cpu;
     wall.reserve(8), cpu.reserve(8);
     loop.add_task("work", 1, [&](const TickInfo& t) {
-      if (t.index > 0) wall.push_back(loop.last_tick_s()), cpu.push_back(loop.last_tick_cpu_s());
+      if (t.index > 0) wall.push_back(loop.sampled_tick_s()), cpu.push_back(loop.sampled_tick_cpu_s());
       if (t.index % 2 == 0) {
         const double until = thread_cpu_s() + 300e-6;
         while (thread_cpu_s() < until) {
@@ -122,12 +122,33 @@ TEST(FixedRateLoop, TheTicksCpuTimeCountsComputeNotTimeOffTheCpu) {
   }
 }
 
+// Sampling every third tick: the figures are those of ticks 0, 3, 6 (the heavy ones here), never
+// of the light ticks between them.
+TEST(FixedRateLoop, TheSampledTicksAreTheMultiplesOfTheDivisor) {
+  FixedRateLoop loop(100.0);
+  loop.sample_ticks_every(3);
+  std::vector<double> cpu;
+  cpu.reserve(16);
+  loop.add_task("every third is heavy", 1, [&](const TickInfo& t) {
+    if (t.index > 0) cpu.push_back(loop.sampled_tick_cpu_s());
+    if (t.index % 3 == 0) {
+      const double until = thread_cpu_s() + 300e-6;
+      while (thread_cpu_s() < until) {
+      }
+    }
+  });
+  loop.run_for(9);
+  ASSERT_EQ(cpu.size(), 8u);
+  for (const double c : cpu) EXPECT_GE(c, 300e-6);
+}
+
 TEST(FixedRateLoop, RejectsBadRatesAndDivisors) {
   EXPECT_THROW(FixedRateLoop(0.0), InvalidParams);
   EXPECT_THROW(FixedRateLoop(-5.0), InvalidParams);
   FixedRateLoop loop(1000.0);
   EXPECT_THROW(loop.add_task("x", 0, [](const TickInfo&) {}), InvalidParams);
   EXPECT_THROW(loop.add_task("x", 1, TaskFn{}), InvalidParams);
+  EXPECT_THROW(loop.sample_ticks_every(0), InvalidParams);
 }
 
 }  // namespace

@@ -19,8 +19,7 @@ double seconds(clockid_t clock) {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 double now_s() { return seconds(CLOCK_MONOTONIC); }
-// One system call (the vDSO does not serve the thread CPU clock): one read per tick, the
-// previous tick's end doubling as this one's start.
+// A system call: the vDSO does not serve the thread CPU clock.
 double thread_cpu_s() { return seconds(CLOCK_THREAD_CPUTIME_ID); }
 }  // namespace
 
@@ -34,6 +33,11 @@ void FixedRateLoop::add_task(std::string name, int divisor, TaskFn fn) {
   require(divisor >= 1, "loop.task." + name + ".divisor", "must be >= 1", divisor);
   require(static_cast<bool>(fn), "loop.task." + name, "needs a function");
   tasks_.push_back(Task{std::move(name), divisor, std::move(fn)});
+}
+
+void FixedRateLoop::sample_ticks_every(int divisor) {
+  require(divisor >= 1, "loop.sample_ticks_every", "must be >= 1", divisor);
+  sample_every_ = static_cast<std::uint64_t>(divisor);
 }
 
 std::vector<std::pair<std::string, int>> FixedRateLoop::tasks() const {
@@ -52,20 +56,27 @@ void FixedRateLoop::tick_once() noexcept {
   ++tick_;
 }
 
+double FixedRateLoop::timed_tick() noexcept {
+  const bool sampled = tick_ % sample_every_ == 0;
+  // The CPU clock's reads bracket the wall clock's, so that they do not lengthen the wall time.
+  const double cpu_start = sampled ? thread_cpu_s() : 0.0;
+  const double start = now_s();
+  tick_once();
+  const double cost = now_s() - start;
+  last_tick_s_ = cost;
+  if (sampled) {
+    sampled_tick_cpu_s_ = thread_cpu_s() - cpu_start;
+    sampled_tick_s_ = cost;
+  }
+  tick_stats_.add(cost);
+  return cost;
+}
+
 void FixedRateLoop::run_for(std::uint64_t ticks) {
   stop_.store(false);
   thread_id_.store(std::this_thread::get_id());
-  double cpu = thread_cpu_s();
   for (std::uint64_t i = 0; i < ticks && !stop_requested(); ++i) {
-    const double start = now_s();
-    tick_once();
-    const double cost = now_s() - start;
-    last_tick_s_ = cost;
-    const double cpu_end = thread_cpu_s();
-    last_tick_cpu_s_ = cpu_end - cpu;
-    cpu = cpu_end;
-    tick_stats_.add(cost);
-    if (cost > period_) ++overruns_;
+    if (timed_tick() > period_) ++overruns_;
   }
 }
 
@@ -80,7 +91,6 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
     thread_id_.store(std::this_thread::get_id());
     timespec next{};
     clock_gettime(CLOCK_MONOTONIC, &next);
-    double cpu = thread_cpu_s();
     const auto period_ns = static_cast<long>(std::llround(period_ * 1e9));
     for (std::uint64_t i = 0; i < ticks && !stop_requested(); ++i) {
       next.tv_nsec += period_ns;
@@ -99,14 +109,7 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
         clock_gettime(CLOCK_MONOTONIC, &next);
         ++resyncs_;
       }
-      tick_once();
-      const double cost = now_s() - start;
-      last_tick_s_ = cost;
-      const double cpu_end = thread_cpu_s();
-      last_tick_cpu_s_ = cpu_end - cpu;
-      cpu = cpu_end;
-      tick_stats_.add(cost);
-      if (cost > period_ || late > period_) ++overruns_;
+      if (timed_tick() > period_ || late > period_) ++overruns_;
     }
   });
   worker.join();

@@ -9,9 +9,9 @@
 ///  - run_for(n): simulation, back to back as fast as possible; time advances by the period.
 ///  - run_realtime(n): paced to the wall clock with absolute deadlines (clock_nanosleep) in a
 ///    dedicated thread, SCHED_FIFO when the process may use it, best effort otherwise.
-/// Both measure each tick's compute time (wall clock: a tick preempted by another thread lasts
-/// longer) and the loop thread's CPU time per tick (thread CPU clock: what the tick itself cost,
-/// preemption excluded); real time also measures wake-up lateness (jitter).
+/// Both measure each tick's compute time on the wall clock (a tick preempted by another thread
+/// lasts longer) and, on the sampled ticks, also on the loop thread's CPU clock (what the tick
+/// itself cost, preemption excluded); real time also measures wake-up lateness (jitter).
 /// An overrun is a tick whose compute time exceeded the period, or, in real time, a tick that
 /// started a full period late. A real-time loop that falls more than kResyncPeriods behind
 /// (a stopped process, an overloaded machine) skips the missed ticks instead of bursting.
@@ -62,11 +62,18 @@ class FixedRateLoop {
   std::uint64_t overruns() const { return overruns_; }
   /// Compute time of the last finished tick [s] (read by a task: the previous tick's).
   double last_tick_s() const { return last_tick_s_; }
-  /// CPU time the loop thread used from the end of the tick before the last finished one to the
-  /// end of that one [s]: the tick plus its wake-up (real time), on the thread's CPU clock, so a
-  /// preemption (another thread, another tenant of the machine) does not count. What other
-  /// threads cost the loop itself (shared caches, memory bandwidth, locks) does.
-  double last_tick_cpu_s() const { return last_tick_cpu_s_; }
+  /// The sampled ticks are those whose index is a multiple of `divisor` (1: every tick; a
+  /// telemetry task's divisor: the ticks where every task runs, the heaviest). Configuration
+  /// phase only. Their CPU time is read off the thread's CPU clock, which costs a system call
+  /// (~1.3 us on the 2-core VM of docs/benchmarks.md: reading it at every 10 kHz tick would
+  /// cost the loop more than a tenth of its tick).
+  void sample_ticks_every(int divisor);
+  /// Compute time of the last finished sampled tick [s], on the wall clock.
+  double sampled_tick_s() const { return sampled_tick_s_; }
+  /// The same tick's CPU time on the loop thread's clock [s]: a preemption (another thread,
+  /// another tenant of the machine) does not count; what other threads cost the tick itself
+  /// (shared caches, memory bandwidth) does, and so does about one clock read.
+  double sampled_tick_cpu_s() const { return sampled_tick_cpu_s_; }
   /// Ticks skipped to catch up with the wall clock (real time only), counted in resyncs.
   std::uint64_t resyncs() const { return resyncs_; }
   /// The thread that runs (or last ran) the ticks: how a test proves the loop path allocates
@@ -83,6 +90,9 @@ class FixedRateLoop {
     TaskFn fn;
   };
   void tick_once() noexcept;
+  /// One tick, timed: wall clock always, the thread's CPU clock on a sampled tick. Returns the
+  /// wall-clock compute time.
+  double timed_tick() noexcept;
 
   double rate_;
   double period_;
@@ -92,7 +102,9 @@ class FixedRateLoop {
   std::uint64_t resyncs_ = 0;
   std::atomic<std::thread::id> thread_id_{};
   double last_tick_s_ = 0.0;
-  double last_tick_cpu_s_ = 0.0;
+  std::uint64_t sample_every_ = 1;
+  double sampled_tick_s_ = 0.0;
+  double sampled_tick_cpu_s_ = 0.0;
   TimingStats tick_stats_;
   TimingStats jitter_stats_;
   std::atomic<bool> stop_{false};

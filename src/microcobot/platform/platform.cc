@@ -111,6 +111,7 @@ void Platform::build() {
   loop_.add_task("devices", 1, [this](const TickInfo& t) { devices_task(t.dt_s); });
   loop_.add_task("telemetry", config_.loop.telemetry_divisor,
                  [this](const TickInfo& t) { telemetry_task(t.t_s); });
+  loop_.sample_ticks_every(config_.loop.telemetry_divisor);
 }
 
 Platform::~Platform() {
@@ -227,8 +228,10 @@ void Platform::telemetry_task(double t_s) noexcept {
   put(devices_.tweezers->opening_m()), put(o.finger_force_N);
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
   put(contact.x), put(contact.y), put(contact.z);
-  put(1e6 * loop_.last_tick_s());
-  put(1e6 * loop_.last_tick_cpu_s());
+  // The last tick where this task ran with the others (slave control, telemetry: the heaviest),
+  // one sample late: this tick is not over yet.
+  put(1e6 * loop_.sampled_tick_s());
+  put(1e6 * loop_.sampled_tick_cpu_s());
   // Simulation channels: the ground truth.
   if (simulated()) {
     const OperatorHand& hand = sim_.haptic->operator_hand();

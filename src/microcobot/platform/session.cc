@@ -267,9 +267,10 @@ void add_recording_figures(report::Report& rep, const Recorder& rec) {
        {series("slave grip", "grip_force_N"), series("finger force / 100", "finger_force_N", 0.01)}});
 
   rep.section("Loop timing",
-              "Compute time of each 10 kHz tick (sampled at 1 kHz), on the wall clock and on the loop "
-              "thread's CPU clock (the tick and its wake-up; a preemption by another thread counts on "
-              "the wall clock only). An overrun is a tick longer than the period.");
+              "Compute time of the 10 kHz loop's ticks that run every task (slave control, telemetry: "
+              "one in ten, the heaviest), on the wall clock and on the loop thread's CPU clock (a "
+              "preemption by another thread counts on the wall clock only). An overrun is a tick longer "
+              "than the period.");
   std::vector<report::Series> ticks = {series("tick (wall)", "tick_us", 1e-6)};
   if (rec.has_channel("tick_cpu_us")) ticks.push_back(series("tick (loop thread CPU)", "tick_cpu_us", 1e-6));
   rep.add_figure({"Tick compute time", "", {"Time", "s"}, {"Tick", "s"}, std::move(ticks)});
