@@ -7,6 +7,8 @@ cd "$(dirname "$0")/.."
 
 DEBIAN_PACKAGES=(
   build-essential cmake ninja-build pkg-config clang-format
+  ccache               # compilations cached across build trees (CI rebuilds only what changed)
+  iproute2             # ip netns: the two-machine link test runs each end in its own network stack
   libeigen3-dev        # linear algebra, matrix exponential, FFT, Levenberg-Marquardt
   libyaml-cpp-dev      # parameter files
   libcli11-dev         # command line

@@ -24,83 +24,19 @@
 #include <nlohmann/json.hpp>
 
 #include "net/net_test_support.h"
-#include "support/console_client.h"
-#include "support/test_support.h"
+#include "net/serve_pair.h"
 
 namespace mc {
 namespace {
 
 using namespace std::chrono_literals;
 using nlohmann::json;
-using test::BackgroundCli;
-using test::Console;
-
-constexpr std::uint32_t kTelemetrySub = 10;
-
-// Every process a test started is killed when the test ends, passed or failed.
-struct Reaper {
-  std::vector<pid_t> pids;
-  ~Reaper() {
-    for (pid_t p : pids) test::wait_process(p, 0ms);  // already reaped: nothing happens
-  }
-};
-
-// A `serve` process and its console's port (read off the first line of its stdout).
-struct Server {
-  BackgroundCli process;
-  std::uint16_t port = 0;
-};
-
-Server start_serve(const std::string& role, const std::string& domain, const test::TempDir& dir,
-                   const std::string& name, Reaper& reaper) {
-  Server s;
-  s.process = test::spawn_cli({"serve", "--role", role, "--domain", domain, "--listen", "127.0.0.1:0",
-                               "--out", (dir / name).string(), "--duration", "300"},
-                              dir / name);
-  reaper.pids.push_back(s.process.pid);
-  std::string url;
-  EXPECT_TRUE(test::eventually(
-      [&] {
-        url = test::read_text(s.process.out);
-        return url.find('\n') != std::string::npos;
-      },
-      60s))
-      << role << " did not print its URL: " << test::read_text(s.process.err);
-  const auto colon = url.rfind(':');
-  s.port = static_cast<std::uint16_t>(std::stoi(url.substr(colon + 1)));
-  return s;
-}
-
-// A console subscribed to the telemetry; `latest()` reads the next telemetry message.
-struct Watch {
-  Console console;
-  json last;
-  explicit Watch(std::uint16_t port) : console(port) {
-    console.subscribe("/platform/telemetry", kTelemetrySub);
-  }
-  const json& next() {
-    const std::string payload = console.next_on(kTelemetrySub);
-    last = payload.empty() ? json() : json::parse(payload);
-    return last;
-  }
-};
-
-double at(const json& t, const char* key) { return t.is_object() ? t.value(key, NAN) : NAN; }
-
-// Drives the master's console (a heartbeat at every telemetry frame, ~60 Hz) until `done`
-// holds on the telemetry of both ends (`slave` may be null: the master's only), or `timeout`
-// passes.
-template <class Done>
-bool drive(Watch& master, Watch* slave, const json& command, Done done, std::chrono::seconds timeout = 30s) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  static const json none;
-  while (std::chrono::steady_clock::now() < end) {
-    master.console.command(command);
-    if (master.next().is_null() || (slave && slave->next().is_null())) return false;
-    if (done(master.last, slave ? slave->last : none)) return true;
-  }
-  return false;
-}
+using test::at;
+using test::drive;
+using test::Reaper;
+using test::Server;
+using test::start_serve;
+using test::Watch;
 
 TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   test::TempDir dir;
