@@ -22,6 +22,7 @@
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
+#include "microcobot/platform/driver_registry.h"
 #include "microcobot/platform/platform_config.h"
 #include "network_options.h"
 #include "signals.h"
@@ -74,14 +75,22 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     rp.sample_period_s = axis.integrator.dt_s;
     rp.max_voltage_V = axis.drive.max_V;
     ends.slave = std::make_unique<mc::net::RemoteSlave>(rp);
-    // The masters are this machine's (simulated: the operator uses the console); the stage is
-    // the slave process's.
+    // The masters are this machine's (simulated, the operator then uses the console, or the
+    // drivers' masters: their stage and gripper, built but never configured, are not opened);
+    // the stage is the slave process's.
     lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform] {
-      pf::PlatformDevices d = remote->make_devices();
-      d.haptic = std::make_unique<pf::SimulatedHapticMaster>(
-          "dual_stage", cfg.haptic.plant, cfg.haptic.render, cfg.haptic.pantograph, cfg.loop.period_s());
-      d.tweezers =
-          std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+      pf::PlatformDevices d;
+      if (cfg.devices.simulated()) {
+        d.haptic = std::make_unique<pf::SimulatedHapticMaster>(
+            "dual_stage", cfg.haptic.plant, cfg.haptic.render, cfg.haptic.pantograph, cfg.loop.period_s());
+        d.tweezers =
+            std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+      } else {
+        d = pf::make_driver_devices(cfg);
+      }
+      pf::PlatformDevices stage = remote->make_devices();
+      d.axes = std::move(stage.axes);
+      d.gripper = std::move(stage.gripper);
       return d;
     };
   } else {
@@ -154,7 +163,11 @@ void serve(const ServeOptions& o) {
 
   RemoteEnds ends = attach_role(o, lp);
   mc::cli::set_cooperative_interrupts(true);
-  std::cerr << "serve: building the platform (the stick-slip step map takes about a second)\n";
+  std::cerr << "serve: building the platform (the stick-slip step map takes about a second) on "
+            << (lp.platform.devices.simulated() ? std::string("the simulated devices")
+                                                : "the drivers '" + lp.platform.devices.driver + "' (" +
+                                                      lp.platform.devices.connection + ")")
+            << "\n";
   if (o.role != "single")
     std::cerr << "serve: " << o.role << " of a distributed platform on DDS domain " << o.domain << " ("
               << mc::cli::describe(mc::cli::network_config(o.network)) << "; the peer: serve --role "

@@ -43,6 +43,22 @@ TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
   }
 }
 
+TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
+  // This build registers no hardware drivers (docs/hardware.md): the simulation is the one known.
+  test::TempDir dir;
+  test::write_text(dir / "bench.yaml", "devices: {driver: smaract, connection: \"usb:0\"}\n");
+  for (const std::string command : {"serve", "run"}) {
+    const auto r =
+        run_cli({command, "--config", (dir / "bench.yaml").string(), "--out", (dir / "out").string()});
+    EXPECT_EQ(r.exit_code, 3) << command << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("devices.driver: 'smaract' is not a registered driver (known: simulated)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.out, "") << "nothing served or run";
+  }
+}
+
 TEST(ServeCli, TheLinkFlagsAreUsageErrorsNamingTheFlag) {
   const struct {
     std::vector<std::string> args;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "microcobot/core/error.h"
+#include "microcobot/platform/driver_registry.h"
 
 namespace mc::live {
 
@@ -44,10 +45,10 @@ void LivePlatform::build(bool demo) {
   // A new scene: the old platform's devices are deactivated (safe state) by its destructor.
   demo_.reset();
   platform_.reset();
-  if (demo && (params_.make_devices || params_.remote))
+  if (demo && !whole_simulation())
     throw InvalidInput("demo: the scripted operator needs the whole simulated platform in this process");
   auto p = params_.make_devices ? std::make_unique<Platform>(params_.platform, params_.make_devices())
-                                : std::make_unique<Platform>(params_.platform);
+                                : platform::make_platform(params_.platform);
   std::unique_ptr<PickPlaceOperator> op;
   if (demo) op = std::make_unique<PickPlaceOperator>(*p, params_.demo);
   p->set_operator([this](const platform::TickInfo& t) { operator_tick(t); });
@@ -177,7 +178,7 @@ void LivePlatform::request(ConsoleAction action) {
   if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo && action != ConsoleAction::kRestart)
     return;
   std::lock_guard lock(request_mutex_);
-  if (action == ConsoleAction::kDemo && (params_.make_devices || params_.remote)) {
+  if (action == ConsoleAction::kDemo && !whole_simulation()) {
     last_error_ = "demo: the scripted operator needs the whole simulated platform in this process";
     return;
   }

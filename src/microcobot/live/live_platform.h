@@ -121,6 +121,10 @@ class LivePlatform {
 
  private:
   void build(bool demo);
+  /// Every device simulated here (the scripted demo needs their ground truth).
+  bool whole_simulation() const {
+    return !params_.make_devices && !params_.remote && params_.platform.devices.simulated();
+  }
   void operator_tick(const platform::TickInfo& t) noexcept;
   void control_thread();
 

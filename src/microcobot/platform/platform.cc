@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
 
 namespace mc::platform {
 namespace {
@@ -21,7 +22,12 @@ constexpr std::size_t kRingCapacity = 8192;
 
 Platform::Platform(const PlatformConfig& config)
     : config_(config),
-      world_((config_.validate(), config_.world)),
+      world_((config_.validate(),
+              require(config_.devices.simulated(), "devices.driver",
+                      "'" + excerpt(config_.devices.driver) +
+                          "' selects hardware drivers; this runs the simulated platform only (microcobot "
+                          "serve runs on drivers; in C++, make_platform)"),
+              config_.world)),
       haptic_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
       tweezers_watchdog_(static_cast<std::uint32_t>(config_.loop.watchdog_ticks)),
       home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),

@@ -6,6 +6,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
+#include "microcobot/platform/driver_registry.h"
 
 namespace mc::platform {
 namespace {
@@ -33,6 +34,13 @@ void LoopParams::validate() const {
 }
 
 void PlatformConfig::validate() const {
+  in_section("devices", [&] {
+    if (is_device_driver(devices.driver)) return;
+    std::string known;
+    for (const std::string& n : device_driver_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InvalidParams(
+        "driver", "'" + excerpt(devices.driver) + "' is not a registered driver (known: " + known + ")");
+  });
   in_section("loop", [&] { loop.validate(); });
   in_section("teleop", [&] { teleop.validate(); });
   in_section("stage", [&] {

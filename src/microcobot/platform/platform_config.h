@@ -8,6 +8,7 @@
 ///     loop: {base_rate_Hz: 10000, slave_divisor: 10}
 ///     teleop: {motion_scale: 0.01, force_scale: 10000}
 ///     stickslip_params_file: axis.yaml      # relative to the configuration file
+///     devices: {driver: lab-bench, connection: "192.168.10.5:5000"}   # docs/hardware.md
 ///
 /// Unknown keys, wrong types and values out of range are one-line errors naming the key.
 
@@ -100,7 +101,24 @@ struct HapticMasterParams {
   }
 };
 
+/// Which devices the platform runs on (docs/hardware.md): "simulated", the digital twin, or a
+/// driver set registered under that name (platform/driver_registry.h).
+struct DeviceSelection {
+  std::string driver = "simulated";
+  /// What the driver opens, in the driver's own syntax (a device file, HOST:PORT, a bus id);
+  /// unused by the simulation.
+  std::string connection;
+
+  template <class V>
+  void visit(V& v) {
+    v("driver", driver);
+    v("connection", connection);
+  }
+  bool simulated() const { return driver == "simulated"; }
+};
+
 struct PlatformConfig {
+  DeviceSelection devices;
   LoopParams loop;
   control::TeleoperationParams teleop;
   StageParams stage;
@@ -115,6 +133,7 @@ struct PlatformConfig {
 
   template <class V>
   void visit(V& v) {
+    v("devices", devices);
     v("loop", loop);
     v("teleop", teleop);
     v("stage", stage);
