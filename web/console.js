@@ -602,13 +602,21 @@ function listRecordings() {
         } else {
           const dl = document.createElement("a");
           dl.href = rec.url + location.search;  // the token, when the server needs one
-          dl.textContent = "download";
+          dl.textContent = "MCAP";
           dl.setAttribute("download", rec.name);
           const rep = document.createElement("a");
           rep.href = rec.report_url + location.search;
           rep.target = "_blank";
           rep.textContent = rec.report_ready ? "report" : "make report";
-          links.append(dl, " · ", rep);
+          links.append(dl);
+          if (rec.csv_url) {  // the same samples as a CSV table
+            const csv = document.createElement("a");
+            csv.href = rec.csv_url + location.search;
+            csv.textContent = "CSV";
+            csv.setAttribute("download", rec.csv_url.split("/").pop());
+            links.append(" · ", csv);
+          }
+          links.append(" · ", rep);
         }
         tr.append(name, size, links);
         table.append(tr);

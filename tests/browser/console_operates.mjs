@@ -5,7 +5,7 @@
 // that the part ends within 10 um of its target, presses the e-stop and checks the safe state,
 // and stops the server with SIGTERM (exit 0, a closed MCAP recording). Screenshots go to
 // MC_ARTIFACTS (default: a temporary directory). Run by CTest (`console_browser`).
-import { readdirSync, readFileSync } from "node:fs";
+import { existsSync, readdirSync, readFileSync } from "node:fs";
 import { join } from "node:path";
 import { startConsole } from "./console_session.mjs";
 
@@ -119,6 +119,12 @@ try {
   await reportPage.close();
   const res = await page.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, bytes: (await r.arrayBuffer()).byteLength }; }, download);
   if (res.status !== 200 || res.bytes < 1000) fail(`download: HTTP ${res.status}, ${res.bytes} bytes`);
+  // The same samples as a CSV table, linked beside it.
+  const csvLink = await page.$eval("#recordings a[download$='.csv']", (a) => a.href).catch(() => "");
+  const csv = csvLink ? await page.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, text: await r.text() }; }, csvLink) : { status: 0, text: "" };
+  const csvRows = csv.text.split("\n").filter((l) => l.length).length - 1;
+  log(`CSV download ${csvLink}: HTTP ${csv.status}, ${csvRows} rows`);
+  if (csv.status !== 200 || !csv.text.startsWith("t_s,") || csvRows < 100) fail(`CSV download: HTTP ${csv.status}, ${csvRows} rows`);
   await page.click("#record");
   await until("recording again", () => window.mc.status && !!window.mc.status.recording, 5);
 } catch (e) {
@@ -127,7 +133,8 @@ try {
 }
 await s.closeBrowser();
 
-// SIGTERM: devices safe, the recording closed as a valid MCAP file (both magics), exit 0.
+// SIGTERM: devices safe, the recording closed as a valid MCAP file (both magics) with its CSV
+// beside it, exit 0.
 await s.terminate();
 const recordings = readdirSync(join(dir, "rec")).filter((f) => f.endsWith(".mcap")).sort();
 if (recordings.length !== 2) fail("expected two recordings, found: " + readdirSync(join(dir, "rec")).join(", "));
@@ -136,7 +143,10 @@ else {
   const magic = Buffer.from([0x89, 0x4d, 0x43, 0x41, 0x50, 0x30, 0x0d, 0x0a]);
   if (!bytes.subarray(0, 8).equals(magic) || !bytes.subarray(bytes.length - 8).equals(magic))
     fail("the recording is not a closed MCAP file");
-  log(`recording ${recordings[1]}: ${bytes.length} bytes`);
+  const csvName = recordings[1].replace(/\.mcap$/, ".csv");
+  const text = existsSync(join(dir, "rec", csvName)) ? readFileSync(join(dir, "rec", csvName), "utf8") : "";
+  if (!text.startsWith("t_s,") || !text.endsWith("\n")) fail(`no complete ${csvName} beside it`);
+  log(`recording ${recordings[1]}: ${bytes.length} bytes; ${csvName}: ${text.split("\n").length - 2} rows`);
 }
 log(`screenshots in ${s.artifacts}`);
 if (s.failures) {

@@ -8,10 +8,12 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <thread>
 #include <vector>
 
+#include "microcobot/core/csv.h"
 #include "microcobot/core/mcap_reader.h"
 #include "microcobot/server/foxglove_protocol.h"
 #include "support/console_client.h"
@@ -162,7 +164,10 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   const std::string name = rec["name"];
   EXPECT_TRUE(rec["recording"].get<bool>());
   EXPECT_TRUE(rec["url"].is_null()) << "no download of the file being written";
+  EXPECT_TRUE(rec["csv_url"].is_null());
   EXPECT_EQ(test::http_request(port, "GET", "/recordings/" + name).status, 409);
+  const std::string stem = name.substr(0, name.size() - 5);
+  EXPECT_EQ(test::http_request(port, "GET", "/recordings/" + stem + ".csv").status, 409);
 
   rig.server.stop_recording();
   list = json::parse(test::http_request(port, "GET", "/recordings").body);
@@ -175,7 +180,28 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   EXPECT_EQ(dl.status, 200);
   EXPECT_EQ(dl.body, test::read_text(rig.dir / name));
   EXPECT_NE(dl.header("Content-Disposition").find(name), std::string::npos);
-  EXPECT_NO_THROW(parse_mcap(dl.body, name)) << "a valid MCAP file";
+  McapContents mcap;
+  ASSERT_NO_THROW(mcap = parse_mcap(dl.body, name)) << "a valid MCAP file";
+
+  // Beside it, the same samples as a CSV table: a row per MCAP message, a column per channel.
+  const std::string csv_name = name.substr(0, name.size() - 5) + ".csv";
+  ASSERT_EQ(list["recordings"][0]["csv_url"], "/recordings/" + csv_name) << list.dump();
+  const auto csv_dl = test::http_request(port, "GET", list["recordings"][0]["csv_url"]);
+  EXPECT_EQ(csv_dl.status, 200);
+  EXPECT_EQ(csv_dl.body, test::read_text(rig.dir / csv_name));
+  EXPECT_NE(csv_dl.header("Content-Type").find("text/csv"), std::string::npos);
+  const CsvTable table = parse_csv(csv_dl.body, csv_name);
+  ASSERT_EQ(table.rows(), mcap.messages.size());
+  ASSERT_GT(table.rows(), 100u);
+  EXPECT_EQ(table.cols(), rig.live.channel_count());
+  for (std::size_t i = 0; i < table.rows(); i += table.rows() / 7) {
+    const json m = json::parse(mcap.messages[i].data);
+    for (const char* c : {"t_s", "target_x_m", "measured_x_m", "tick_us"}) {
+      // The JSON carries 10 significant digits, the CSV every digit.
+      const double want = m[c].get<double>();
+      EXPECT_NEAR(table.column(c)[i], want, 1e-9 * std::abs(want)) << c << " row " << i;
+    }
+  }
 
   // The report: made on the first request (202, the page reloads), then served.
   const std::string report_url = list["recordings"][0]["report_url"];

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/csv.h"
+#include "microcobot/core/csv_stream_writer.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/mcap_writer.h"
 #include "microcobot/dsp/butterworth.h"
@@ -221,9 +222,11 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
       const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, s[0]) * 1e9));
       try {
         recording_->write(recording_channel_, ns, ns, json_);
+        recording_csv_->append(sample);
       } catch (const std::exception& e) {
         server_.broadcast_status(StatusLevel::kError, std::string("recording stopped: ") + e.what());
-        recording_.reset();  // removes the temporary file; nothing half-written remains
+        recording_.reset();  // removes the temporary files; nothing half-written remains
+        recording_csv_.reset();
         recording_name_.clear();
       }
     }
@@ -344,25 +347,37 @@ void ConsoleServer::start_recording() {
   localtime_r(&now, &tm);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "recording-%Y%m%d-%H%M%S", &tm);
-  std::string name = std::string(stamp) + ".mcap";
-  for (int i = 2; std::filesystem::exists(params_.out_dir / name) && i < 1000; ++i)
-    name = std::string(stamp) + "-" + std::to_string(i) + ".mcap";  // two in the same second
-  auto w = std::make_unique<McapWriter>(params_.out_dir / name);
+  std::string stem = stamp;
+  const auto taken = [&](const std::string& s) {
+    return std::filesystem::exists(params_.out_dir / (s + ".mcap")) ||
+           std::filesystem::exists(params_.out_dir / (s + ".csv"));
+  };
+  for (int i = 2; taken(stem) && i < 1000; ++i)
+    stem = std::string(stamp) + "-" + std::to_string(i);  // same second
+  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"));
   const auto schema_id = w->add_schema(platform::kTelemetrySchemaName, "jsonschema",
                                        platform::telemetry_json_schema(live_.channel_count()));
   recording_channel_ = w->add_channel(schema_id, platform::kTelemetryTopic, "json");
+  recording_csv_ = std::make_unique<CsvStreamWriter>(
+      params_.out_dir / (stem + ".csv"),
+      std::vector<std::string>(
+          platform::kTelemetryChannels.begin(),
+          platform::kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(live_.channel_count())));
   recording_ = std::move(w);
-  recording_name_ = name;
+  recording_name_ = stem + ".mcap";
 }
 
 void ConsoleServer::stop_recording() {
   std::unique_ptr<McapWriter> w;
+  std::unique_ptr<CsvStreamWriter> csv;
   {
     std::lock_guard lock(recording_mutex_);
     w = std::move(recording_);
+    csv = std::move(recording_csv_);
     recording_name_.clear();
   }
-  if (w) w->close();  // summary, index, footer; then renamed to its name
+  if (w) w->close();      // summary, index, footer; then renamed to its name
+  if (csv) csv->close();  // (a failed MCAP leaves its CSV abandoned: neither file appears)
 }
 
 std::string ConsoleServer::scene_json() const {
@@ -467,13 +482,13 @@ std::optional<server::HttpReply> ConsoleServer::on_http(std::string_view path) {
     active = recording_name_;
   }
   std::error_code ec;
-  if (ext == ".mcap") {
-    if (file == active)
+  if (ext == ".mcap" || ext == ".csv") {
+    if (stem + ".mcap" == active)
       return html_page(409, "Recording in progress", file + " is being recorded: stop the recording first.",
                        0);
     if (!std::filesystem::is_regular_file(params_.out_dir / file, ec)) return std::nullopt;
     server::HttpReply r;
-    r.content_type = "application/octet-stream";
+    r.content_type = ext == ".csv" ? "text/csv; charset=utf-8" : "application/octet-stream";
     r.file = params_.out_dir / file;
     r.attachment_name = file;
     return r;
@@ -546,10 +561,13 @@ std::string ConsoleServer::recordings_json() const {
     const std::uintmax_t bytes = size_error ? 0 : size;
     const bool has_report =
         std::filesystem::is_regular_file(params_.out_dir / (p.stem().string() + ".html"), report_error);
+    const std::string csv = p.stem().string() + ".csv";
+    const bool has_csv = std::filesystem::is_regular_file(params_.out_dir / csv, report_error);
     list.push_back({{"name", name},
                     {"bytes", bytes},
                     {"recording", false},
                     {"url", "/recordings/" + name},
+                    {"csv_url", has_csv ? json("/recordings/" + csv) : json(nullptr)},
                     {"report_url", "/recordings/" + p.stem().string() + ".html"},
                     {"report_ready", has_report}});
   }
@@ -558,6 +576,7 @@ std::string ConsoleServer::recordings_json() const {
                     {"bytes", 0},
                     {"recording", true},
                     {"url", nullptr},
+                    {"csv_url", nullptr},
                     {"report_url", nullptr},
                     {"report_ready", false}});
   }

@@ -11,7 +11,7 @@
 ///   client /console/action       estop, reset, take/release control, demo, restart, record
 ///
 /// HTTP: `/` the console; `/recordings` the recordings in --out (JSON); `/recordings/<name>.mcap`
-/// a download (not the one being written); `/recordings/<name>.html` its session report, made
+/// and `<name>.csv` downloads (not the one being written); `/recordings/<name>.html` its session report, made
 /// on demand by a worker thread on the first request (the page reloads until it is ready) and
 /// kept beside the recording.
 ///
@@ -41,8 +41,9 @@
 #include "microcobot/server/foxglove_server.h"
 
 namespace mc {
+class CsvStreamWriter;
 class McapWriter;
-}
+}  // namespace mc
 
 namespace mc::live {
 
@@ -70,12 +71,13 @@ class ConsoleServer {
   /// The console's URL, with the token when one is needed.
   std::string url() const;
   std::uint16_t port() const { return server_.port(); }
-  /// Every device to its safe state, the recording closed (a valid MCAP file), connections
-  /// closed. Idempotent.
+  /// Every device to its safe state, the recording closed (a valid MCAP file and its CSV),
+  /// connections closed. Idempotent.
   void stop();
 
-  /// Starts or stops an MCAP recording in out_dir (recording-YYYYmmdd-HHMMSS.mcap). Throws
-  /// mc::InvalidInput when recording is disabled or the file cannot be created.
+  /// Starts or stops a recording in out_dir: recording-YYYYmmdd-HHMMSS.mcap (JSON messages on
+  /// /platform/telemetry) and the same samples as recording-YYYYmmdd-HHMMSS.csv (a column per
+  /// channel). Throws mc::InvalidInput when recording is disabled or a file cannot be created.
   void start_recording();
   void stop_recording();
   server::ServerCounters counters() const { return server_.counters(); }
@@ -119,6 +121,7 @@ class ConsoleServer {
   // Recording: written on the drain thread, opened and closed by the server thread.
   mutable std::mutex recording_mutex_;
   std::unique_ptr<McapWriter> recording_;
+  std::unique_ptr<CsvStreamWriter> recording_csv_;  ///< the same samples beside it
   std::uint16_t recording_channel_ = 0;
   std::string recording_name_;
   std::atomic<double> tick_p99_us_{0.0}, tick_cpu_p99_us_{0.0};
