@@ -182,10 +182,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
       return ++frames >= 30;
     }));
   }
-  ::kill(master2.process.pid, SIGTERM);
-  ::kill(slave2.process.pid, SIGTERM);
-  ASSERT_EQ(test::wait_process(master2.process.pid, 30s), 0) << test::read_text(master2.process.err);
-  ASSERT_EQ(test::wait_process(slave2.process.pid, 30s), 0) << test::read_text(slave2.process.err);
+  test::terminate_cleanly({&master2, &slave2});
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +65,13 @@ inline Server start_serve(const std::string& role, const std::string& domain, co
   const auto colon = url.rfind(':');
   if (colon != std::string::npos) s.port = static_cast<std::uint16_t>(std::atoi(url.c_str() + colon + 1));
   return s;
+}
+
+/// SIGTERM to each server; each must exit 0 (every device in its safe state, recordings closed).
+inline void terminate_cleanly(std::initializer_list<const Server*> servers) {
+  for (const Server* s : servers) ::kill(s->process.pid, SIGTERM);
+  for (const Server* s : servers)
+    EXPECT_EQ(wait_process(s->process.pid, std::chrono::seconds(30)), 0) << read_text(s->process.err);
 }
 
 /// A console subscribed to the telemetry; `next()` reads the next telemetry message.

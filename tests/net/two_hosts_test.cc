@@ -251,10 +251,7 @@ TEST(DistributedServe, OnTwoHostsJoinedByACableThatIsPulledAndPluggedBack) {
 
   m.reset();
   s.reset();
-  ::kill(desk.process.pid, SIGTERM);
-  ::kill(bench.process.pid, SIGTERM);
-  EXPECT_EQ(test::wait_process(desk.process.pid, 30s), 0) << test::read_text(desk.process.err);
-  EXPECT_EQ(test::wait_process(bench.process.pid, 30s), 0) << test::read_text(bench.process.err);
+  test::terminate_cleanly({&desk, &bench});
 }
 
 }  // namespace

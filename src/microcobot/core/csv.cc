@@ -1,6 +1,5 @@
 #include "microcobot/core/csv.h"
 
-#include <sys/stat.h>
 #include <unistd.h>
 #include <charconv>
 #include <cmath>
@@ -14,6 +13,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/core/staged_file.h"
 
 namespace mc {
 
@@ -170,32 +170,9 @@ void ensure_writable_dir(const std::filesystem::path& dir) {
 }
 
 void write_file_atomic(const std::filesystem::path& file, const std::string& text) {
-  const std::filesystem::path dir = file.has_parent_path() ? file.parent_path() : ".";
-  std::string name = ".";
-  name.append(file.filename().string()).append(".XXXXXX");
-  std::string tmpl = (dir / name).string();
-  const int fd = ::mkstemp(tmpl.data());
-  if (fd < 0) throw InvalidInput(file.string(), 0, "cannot write (directory missing or not writable)");
-  std::size_t written = 0;
-  bool ok = true;
-  while (written < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-    if (n <= 0) {
-      ok = false;
-      break;
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  ok = ok && ::fsync(fd) == 0;
-  ok = (::close(fd) == 0) && ok;
-  // mkstemp creates 0600; output files are meant to be shared like any other.
-  ok = ok && ::chmod(tmpl.c_str(), 0644) == 0;
-  std::error_code ec;
-  if (ok) std::filesystem::rename(tmpl, file, ec);
-  if (!ok || ec) {
-    std::filesystem::remove(tmpl, ec);
-    throw InvalidInput(file.string(), 0, "write failed (disk full or not writable)");
-  }
+  StagedFile f(file);
+  f.write(text);
+  f.commit();
 }
 
 void write_csv(const std::filesystem::path& file, const CsvTable& table,

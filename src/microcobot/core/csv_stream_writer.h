@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "microcobot/core/staged_file.h"
+
 namespace mc {
 
 class CsvStreamWriter {
@@ -19,8 +21,7 @@ class CsvStreamWriter {
   /// Creates the temporary file and writes the header. Throws InvalidInput naming `path` when
   /// the directory is missing or not writable, or a name is empty or holds a ',' or a newline.
   CsvStreamWriter(std::filesystem::path path, const std::vector<std::string>& names);
-  /// Without close(): the temporary file is removed.
-  ~CsvStreamWriter();
+  /// Destroyed without close(), the temporary file is removed.
   CsvStreamWriter(const CsvStreamWriter&) = delete;
   CsvStreamWriter& operator=(const CsvStreamWriter&) = delete;
 
@@ -32,21 +33,18 @@ class CsvStreamWriter {
   /// temporary file is then removed). Idempotent.
   void close();
 
-  const std::filesystem::path& path() const { return path_; }
+  const std::filesystem::path& path() const { return file_.path(); }
   std::uint64_t rows() const { return rows_; }
 
  private:
-  void flush();
   [[noreturn]] void fail(const std::string& what);
-  void discard() noexcept;
+  void write_buffer();
 
-  std::filesystem::path path_;
-  std::string tmp_path_;
-  int fd_ = -1;
+  StagedFile file_;
   std::size_t columns_ = 0;
   std::uint64_t rows_ = 0;
-  std::string buffer_;
-  bool closed_ = false;
+  std::string buffer_;  // rows not yet written to the file
+  bool abandoned_ = false;
 };
 
 }  // namespace mc

@@ -1,13 +1,7 @@
 #include "microcobot/core/mcap_writer.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <cerrno>
-#include <cstdlib>
 #include <cstring>
 #include <tuple>
 
@@ -62,13 +56,7 @@ std::uint32_t crc32(std::string_view bytes, std::uint32_t previous) {
 }
 
 McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes)
-    : path_(std::move(path)), chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)) {
-  const std::filesystem::path dir = path_.has_parent_path() ? path_.parent_path() : ".";
-  tmp_path_ = (dir / ("." + path_.filename().string() + ".XXXXXX")).string();
-  fd_ = ::mkstemp(tmp_path_.data());
-  if (fd_ < 0) {
-    throw InvalidInput(path_.string(), 0, "cannot write (directory missing or not writable)");
-  }
+    : path_(std::move(path)), file_(path_), chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)) {
   out_.reserve(kIoBuffer);
   chunk_.reserve(std::min(chunk_target_, std::size_t{64} << 20) + 4096);
   put(kMcapMagic);
@@ -78,30 +66,14 @@ McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_byte
   put_record(McapOpcode::kHeader, scratch_);
 }
 
-McapWriter::~McapWriter() {
-  if (!closed_) discard();
-}
-
-void McapWriter::discard() noexcept {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
-  if (!tmp_path_.empty()) ::unlink(tmp_path_.c_str());
-  tmp_path_.clear();
-  closed_ = true;
-}
-
-void McapWriter::fail(const std::string& what) {
-  discard();
-  throw InvalidInput(path_.string(), 0, what);
-}
+McapWriter::~McapWriter() = default;  // unclosed: the staged file removes its temporary
 
 void McapWriter::flush_buffer() {
-  std::size_t done = 0;
-  while (done < out_.size()) {
-    const ssize_t n = ::write(fd_, out_.data() + done, out_.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail("write failed (disk full or not writable)");
-    done += static_cast<std::size_t>(n);
+  try {
+    file_.write(out_);  // discards the file when it fails
+  } catch (...) {
+    closed_ = true;
+    throw;
   }
   flushed_ += out_.size();
   out_.clear();
@@ -334,15 +306,7 @@ void McapWriter::close() {
   put(summary);
   flush_buffer();
 
-  bool ok = ::fsync(fd_) == 0;
-  ok = (::close(fd_) == 0) && ok;
-  fd_ = -1;
-  // mkstemp creates 0600; output files are meant to be shared like any other.
-  ok = ok && ::chmod(tmp_path_.c_str(), 0644) == 0;
-  std::error_code ec;
-  if (ok) std::filesystem::rename(tmp_path_, path_, ec);
-  if (!ok || ec) fail("write failed (disk full or not writable)");
-  tmp_path_.clear();
+  file_.commit();  // synced, 0644, renamed to its name; discarded when that fails
   closed_ = true;
 }
 

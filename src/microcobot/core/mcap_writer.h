@@ -25,6 +25,8 @@
 #include <utility>
 #include <vector>
 
+#include "microcobot/core/staged_file.h"
+
 namespace mc {
 
 /// CRC-32 as zlib's crc32() and MCAP use (ISO-HDLC: reflected polynomial 0xEDB88320, initial
@@ -110,15 +112,12 @@ class McapWriter {
   void put_record(McapOpcode op, std::string_view content);
   void flush_buffer();
   void close_chunk();
-  void discard() noexcept;
-  [[noreturn]] void fail(const std::string& what);
 
   std::filesystem::path path_;
-  std::string tmp_path_;
-  int fd_ = -1;
+  StagedFile file_;
   std::size_t chunk_target_;
-  std::string out_;            // bytes not yet written to fd_
-  std::uint64_t flushed_ = 0;  // bytes written to fd_
+  std::string out_;            // bytes not yet written to file_
+  std::uint64_t flushed_ = 0;  // bytes written to file_
   bool in_data_ = true;
   std::uint32_t data_crc_ = 0;
 

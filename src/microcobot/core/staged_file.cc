@@ -1,0 +1,65 @@
+#include "microcobot/core/staged_file.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <system_error>
+
+#include "microcobot/core/error.h"
+
+namespace mc {
+
+StagedFile::StagedFile(std::filesystem::path path) : path_(std::move(path)) {
+  const std::filesystem::path dir = path_.has_parent_path() ? path_.parent_path() : ".";
+  tmp_path_ = (dir / ("." + path_.filename().string() + ".XXXXXX")).string();
+  fd_ = ::mkstemp(tmp_path_.data());
+  if (fd_ < 0) {
+    tmp_path_.clear();
+    throw InvalidInput(path_.string(), 0, "cannot write (directory missing or not writable)");
+  }
+}
+
+StagedFile::~StagedFile() { discard(); }
+
+void StagedFile::discard() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!tmp_path_.empty()) ::unlink(tmp_path_.c_str());
+  tmp_path_.clear();
+}
+
+void StagedFile::fail(const std::string& what) {
+  discard();
+  throw InvalidInput(path_.string(), 0, what);
+}
+
+void StagedFile::write(std::string_view bytes) {
+  if (fd_ < 0)
+    throw InvalidInput(path_.string(), 0, committed_ ? "written after it was closed" : "abandoned");
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail("write failed (disk full or not writable)");
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void StagedFile::commit() {
+  if (committed_) return;
+  if (fd_ < 0) throw InvalidInput(path_.string(), 0, "abandoned");
+  bool ok = ::fsync(fd_) == 0;
+  ok = (::close(fd_) == 0) && ok;
+  fd_ = -1;
+  // mkstemp creates 0600; output files are meant to be shared like any other.
+  ok = ok && ::chmod(tmp_path_.c_str(), 0644) == 0;
+  std::error_code ec;
+  if (ok) std::filesystem::rename(tmp_path_, path_, ec);
+  if (!ok || ec) fail("write failed (disk full or not writable)");
+  tmp_path_.clear();
+  committed_ = true;
+}
+
+}  // namespace mc

@@ -1,0 +1,45 @@
+#pragma once
+/// @file
+/// A file written under a temporary name beside its target (`.NAME.XXXXXX`) and renamed into
+/// place by commit(), so that a reader never sees it half-written and one that is abandoned (a
+/// failed write, an exception unwinding, a cut run) leaves nothing. The streaming writers (MCAP,
+/// CSV) and write_file_atomic are built on it.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace mc {
+
+class StagedFile {
+ public:
+  /// Creates the temporary file. Throws InvalidInput naming `path` when the directory is
+  /// missing or not writable.
+  explicit StagedFile(std::filesystem::path path);
+  /// Without commit(): the temporary file is removed.
+  ~StagedFile();
+  StagedFile(const StagedFile&) = delete;
+  StagedFile& operator=(const StagedFile&) = delete;
+
+  /// Writes all of `bytes`. On failure (disk full) the file is discarded and InvalidInput
+  /// naming `path` is thrown; so is writing to a file committed or discarded.
+  void write(std::string_view bytes);
+  /// Syncs, makes the file readable by all (0644, as any output) and renames it to `path`.
+  /// Throws InvalidInput (the file discarded) when any of that fails. Idempotent.
+  void commit();
+  /// Removes the temporary file now. Never throws; idempotent.
+  void discard() noexcept;
+
+  const std::filesystem::path& path() const { return path_; }
+  bool committed() const { return committed_; }
+
+ private:
+  [[noreturn]] void fail(const std::string& what);
+
+  std::filesystem::path path_;
+  std::string tmp_path_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+}  // namespace mc
