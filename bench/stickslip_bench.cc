@@ -2,6 +2,7 @@
 // counter "rtf") and the cost of the odeint reference at equal accuracy (docs/benchmarks.md).
 //   build/<dir>/bench/stickslip_bench --benchmark_counters_tabular=true
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <vector>
@@ -9,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include "microcobot/stickslip/actuator.h"
+#include "microcobot/stickslip/prandtl_ishlinskii.h"
 #include "microcobot/stickslip/reference_solver.h"
 
 namespace {
@@ -125,5 +127,49 @@ void BM_ReferenceEqualAccuracy(benchmark::State& state) {
   state.counters["rtol"] = o.rel_tol;
 }
 BENCHMARK(BM_ReferenceEqualAccuracy)->DenseRange(0, 4)->Unit(benchmark::kMillisecond);
+
+// The PI hysteresis's inverse from a state (the scanning feedforward of the tracking and position
+// controllers): the library's regula falsi against the bisection it replaced (40 halvings), on the
+// same 64 random histories and targets.
+struct PiInverseCase {
+  ss::PiState state;
+  double h;
+};
+std::vector<PiInverseCase> pi_inverse_cases(const ss::PiParams& p) {
+  std::vector<PiInverseCase> cases;
+  ss::PiState s = ss::make_pi_state(p);
+  std::uint64_t x = 88172645463325252ull;  // xorshift: the same cases in both benchmarks
+  const auto uniform = [&] {
+    x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+    return static_cast<double>(x >> 11) * 0x1.0p-53;
+  };
+  for (int k = 0; k < 64; ++k) {
+    ss::pi_update(p, s, 100.0 * uniform());
+    const double lo = ss::pi_peek(p, s, 0.0), hi = ss::pi_peek(p, s, 100.0);
+    cases.push_back({s, lo + (hi - lo) * uniform()});
+  }
+  return cases;
+}
+double pi_inverse_by_bisection(const ss::PiParams& p, const ss::PiState& s, double h, double lo, double hi) {
+  if (h <= ss::pi_peek(p, s, lo)) return lo;
+  if (h >= ss::pi_peek(p, s, hi)) return hi;
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (ss::pi_peek(p, s, mid) < h ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+void BM_PiPeekInverse(benchmark::State& state) {
+  const ss::PiParams p = ss::default_pi_params();
+  const auto cases = pi_inverse_cases(p);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto& c = cases[k++ % cases.size()];
+    benchmark::DoNotOptimize(state.range(0) ? ss::pi_peek_inverse(p, c.state, c.h, 0.0, 100.0)
+                                            : pi_inverse_by_bisection(p, c.state, c.h, 0.0, 100.0));
+  }
+  state.SetLabel(state.range(0) ? "regula falsi (library)" : "bisection (before)");
+}
+BENCHMARK(BM_PiPeekInverse)->Arg(0)->Arg(1);
 
 }  // namespace

@@ -70,7 +70,7 @@ TEST(PrandtlIshlinskii, PeekInverseFindsTheInputOfAGivenOutputFromAnyStateAndCla
     const double lo = pi_peek(p, s, 0.0), hi = pi_peek(p, s, 100.0);
     const double h = lo + (hi - lo) * rng.uniform();
     const double u = pi_peek_inverse(p, s, h, 0.0, 100.0);
-    ASSERT_NEAR(pi_peek(p, s, u), h, 1e-8) << "step " << k;
+    ASSERT_NEAR(pi_peek(p, s, u), h, 1e-10) << "step " << k;  // as 40 halvings of 100 V gave
     EXPECT_EQ(pi_peek_inverse(p, s, lo - 1.0, 0.0, 100.0), 0.0);
     EXPECT_EQ(pi_peek_inverse(p, s, hi + 1.0, 0.0, 100.0), 100.0);
   }

@@ -86,13 +86,30 @@ double pi_peek(const PiParams& p, const PiState& s, double u) noexcept {
 }
 
 double pi_peek_inverse(const PiParams& p, const PiState& s, double h, double u_lo, double u_hi) noexcept {
-  if (h <= pi_peek(p, s, u_lo)) return u_lo;
-  if (h >= pi_peek(p, s, u_hi)) return u_hi;
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (u_lo + u_hi);
-    (pi_peek(p, s, mid) < h ? u_lo : u_hi) = mid;
+  double f_lo = pi_peek(p, s, u_lo) - h;
+  if (f_lo >= 0.0) return u_lo;
+  double f_hi = pi_peek(p, s, u_hi) - h;
+  if (f_hi <= 0.0) return u_hi;
+  const double resolution = std::ldexp(u_hi - u_lo, -40);
+  double best_u = u_lo, best_f = -f_lo;  // the evaluated input nearest the root, |residual|
+  if (f_hi < best_f) best_u = u_hi, best_f = f_hi;
+  int retained = 0;  // the end the last step kept (-1 low, +1 high); kept twice, its residual is halved
+  for (int i = 0; i < 200 && u_hi - u_lo > resolution; ++i) {
+    const double u = std::clamp((u_lo * f_hi - u_hi * f_lo) / (f_hi - f_lo), u_lo, u_hi);
+    const double f = pi_peek(p, s, u) - h;
+    if (std::abs(f) < best_f) best_u = u, best_f = std::abs(f);
+    if (f == 0.0) break;
+    if (f < 0.0) {
+      u_lo = u, f_lo = f;
+      if (retained == 1) f_hi *= 0.5;
+      retained = 1;
+    } else {
+      u_hi = u, f_hi = f;
+      if (retained == -1) f_lo *= 0.5;
+      retained = -1;
+    }
   }
-  return 0.5 * (u_lo + u_hi);
+  return best_u;
 }
 
 double pi_loading_curve(const PiParams& p, double u) noexcept {

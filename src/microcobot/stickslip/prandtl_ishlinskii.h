@@ -48,9 +48,12 @@ double pi_peek(const PiParams& p, const PiState& s, double u) noexcept;
 
 /// The input u in [u_lo, u_hi] at which pi_peek(p, s, u) = h, clamped to the interval's ends when
 /// h lies outside their outputs: the voltage that puts the element at a given extension from its
-/// present state (the controllers' scanning feedforward). pi_peek is continuous and strictly
-/// increasing in u from any state (w_0 > 0), so bisection converges; 40 halvings of a 100 V
-/// interval leave < 1e-10 V. Never allocates.
+/// present state (the controllers' scanning feedforward). pi_peek is continuous, strictly
+/// increasing (w_0 > 0) and piecewise linear in u from any state (each operator's output follows
+/// u or holds), so regula falsi (Illinois) lands on the exact root as soon as its bracket lies on
+/// one linear piece: a few evaluations where bisection needed 42 (the tracking controller's
+/// largest cost in the loop, docs/benchmarks.md). It stops at a zero residual or at the
+/// resolution those 40 halvings gave, (u_hi - u_lo) / 2^40. Never allocates.
 double pi_peek_inverse(const PiParams& p, const PiState& s, double h, double u_lo, double u_hi) noexcept;
 
 /// The exact inverse PI model (Kuhnen / Krejci): another PI operator whose composition with `p`
