@@ -218,10 +218,11 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
       json::parse(test::http_request(port, "GET", "/recordings").body)["recordings"][0]["report_ready"]);
 
   // Nothing else of the disk is reachable.
-  for (const std::string& bad :
-       std::vector<std::string>{"/recordings/../" + name, "/recordings/x.mcap", "/recordings/recording-1.txt",
-                                "/recordings/.recording-1.mcap", "/recordings/recording-1/..%2f..%2fetc.mcap",
-                                "/recordings/recording-99.mcap", "/recordings/"})
+  for (const std::string& bad : std::vector<std::string>{
+           "/recordings/../" + name, "/recordings/x.mcap", "/recordings/recording-1.txt",
+           "/recordings/.recording-1.mcap", "/recordings/recording-1/..%2f..%2fetc.mcap",
+           "/recordings/recording-99.mcap", "/recordings/../" + csv_name, "/recordings/recording-99.csv",
+           "/recordings/.recording-1.csv", "/recordings/"})
     EXPECT_EQ(test::http_request(port, "GET", bad).status, 404) << bad;
 }
 
