@@ -1,7 +1,9 @@
 // Trajectory tracking within one step (issue #15): the reference-phased sawtooth against today's
 // hybrid controller and the thesis's PID on the same model, sensor noise and reference.
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -29,21 +31,21 @@ TrackingRecord trapezoid(TrackerKind kind, double distance_m, double velocity_m_
       trapezoid_duration_s(std::abs(distance_m), lim) + 0.05);
 }
 
-// The issue's goals are RMS <= 100 nm and max <= 250 nm: not reached on this model (each edge
-// leaves a ~300-500 nm transient of the contact, docs/errata.md). These bounds are the measured
-// figures (117-125 nm RMS, 400-650 nm max on the CLI's runs) with a margin; they fail if the
-// controller regresses (159-161 nm before the damping of kp < 0).
+// The issue's goals: RMS <= 100 nm at 200 um/s, <= 150 nm at 50 and 500 um/s, max <= 250 nm. The
+// RMS goals hold (CLI runs on five sensor-noise seeds: 80-88 nm, 84-88 nm, 101-136 nm); the max
+// holds forward at the edge of the goal (236-249 nm) and not at the start of a backward move from
+// power-up (626 nm: the first edge cannot be led, docs/errata.md), hence the bounds below.
 TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
   for (double d : {100e-6, -100e-6}) {
     SCOPED_TRACE(d);
     const auto t = trapezoid(TrackerKind::kTracking, d, 200e-6).metrics;
     const auto h = trapezoid(TrackerKind::kHybrid, d, 200e-6).metrics;
-    EXPECT_LE(t.rms_error_m, 150e-9);
-    EXPECT_LE(t.max_error_m, 900e-9);
+    EXPECT_LE(t.rms_error_m, 100e-9);
+    EXPECT_LE(t.max_error_m, d > 0 ? 300e-9 : 700e-9);
     EXPECT_LE(t.final_error_m, 5e-9);  // issue goal: final error unchanged
     EXPECT_LE(t.lag_s, 0.5e-3);
-    EXPECT_LT(t.rms_error_m, 0.25 * h.rms_error_m);  // >= 4x better than today's controller
-    EXPECT_GT(t.edges, 100);                         // it stepped (~0.5 um per edge)
+    EXPECT_LT(t.rms_error_m, 0.1 * h.rms_error_m);  // >= 10x better than today's controller
+    EXPECT_GT(t.edges, 150);                        // it stepped (~0.3-0.4 um per edge)
   }
 }
 
@@ -51,33 +53,82 @@ TEST(TrackingController, TrapezoidAt50And500umPerSecond) {
   for (double v : {50e-6, 500e-6}) {
     SCOPED_TRACE(v);
     const auto t = trapezoid(TrackerKind::kTracking, 100e-6, v).metrics;
-    EXPECT_LE(t.rms_error_m, 300e-9);
+    EXPECT_LE(t.rms_error_m, 150e-9);
     EXPECT_LE(t.final_error_m, 5e-9);
   }
 }
 
-TEST(TrackingController, SineOf20umAt1Hz) {
-  const MotionLimits lim{200e-6, 2e-3};
-  auto sine = std::make_shared<SineReference>(0.0, 20e-6, 1.0, lim);
-  const auto r = run_tracker(
-      test::model(), test::step_map(), TrackerKind::kTracking, TrackerSetup{}, 0.0,
-      [sine](double t, double) { return sine->at(t); }, 1.0);
-  EXPECT_LE(r.metrics.rms_error_m, 120e-9);  // measured 92-94 nm (issue goal: 100 nm)
-  EXPECT_LE(r.metrics.max_error_m, 1e-6);
+TEST(TrackingController, AFastReferenceIsFollowedOverTheSprintRange) {
+  // 1 mm at 800 um/s, 0.1 m/s^2: beyond what the narrow 30-100 V edges step (~600 um/s); the
+  // controller sprints (7.5-100 V edges) and follows. Without the sprint the axis falls behind.
+  const MotionLimits lim{800e-6, 0.1};
+  const auto run = [&lim](const TrackingParams& p, bool& sprinted) {
+    TrackingController c(p, test::model().params(), test::step_map());
+    auto s = test::model().initial_state();
+    PositionSensor sensor;
+    c.reset(0.0, 0.0);
+    ReferenceLimiter l(lim, 0.0);
+    const int ticks = static_cast<int>((trapezoid_duration_s(1e-3, lim) + 0.05) * 1e4);
+    sprinted = false;
+    double sq = 0.0;
+    int n = 0;
+    for (int k = 0; k < ticks; ++k) {
+      const ReferenceSample r = l.step(1e-3, 1e-4);
+      c.set_reference(r);
+      c.update(sensor.measure(test::model().slider_position(s)));
+      sprinted = sprinted || c.sprinting();
+      test::model().set_operating_point(s, c.operating_point().amplitude_V, c.operating_point().frequency_Hz,
+                                        c.operating_point().direction);
+      for (int i = 0; i < 10; ++i) test::model().step(s, c.next_drive(1e-5));
+      if (r.v_m_s != 0.0) {
+        const double e = r.x_m - test::model().slider_position(s);
+        sq += e * e;
+        ++n;
+      }
+    }
+    return std::pair{std::sqrt(sq / n), std::abs(1e-3 - test::model().slider_position(s))};
+  };
+  bool sprinted = false;
+  const auto [rms, final_error] = run(TrackingParams{}, sprinted);
+  EXPECT_TRUE(sprinted);
+  EXPECT_LE(rms, 500e-9);
+  EXPECT_LE(final_error, 5e-9);
+  TrackingParams narrow;
+  narrow.sprint_velocity_m_s = 1.0;
+  narrow.sprint_lag_m = 1.0;
+  const auto [rms_narrow, final_narrow] = run(narrow, sprinted);
+  EXPECT_FALSE(sprinted);
+  EXPECT_GT(final_narrow, 100e-6);  // it fell behind and had not arrived 50 ms after the reference
 }
 
-TEST(TrackingController, AnAxisThatFellBehindCatchesUp) {
-  // 400 um at 2 mm/s: faster than the edges can step (1.5 mm/s is still followed, docs/errata.md),
-  // so the axis falls behind; once the reference stops it must still arrive, at full stepping
-  // speed. (With the wait disabled, tracking.edge_ready_V = 50, an axis this far behind takes its
-  // edges straight after each unloading and ends this run 351 um short.)
-  const MotionLimits lim{2e-3, 0.1};
-  auto l = std::make_shared<ReferenceLimiter>(lim, -200e-6);
-  const auto r = run_tracker(
-      test::model(), test::step_map(), TrackerKind::kTracking, TrackerSetup{}, -200e-6,
-      [l](double, double dt) { return l->step(200e-6, dt); }, trapezoid_duration_s(400e-6, lim) + 0.3);
-  EXPECT_GT(r.metrics.max_error_m, 5e-6);  // it did fall behind
-  EXPECT_LE(r.metrics.final_error_m, 5e-9);
+TEST(TrackingController, ABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
+  // At power-up the drive is at 0 V, below the range: a backward move needs an edge at once. It
+  // spans the sawtooth's amplitude from 0 V (0 -> 70 V), not 0 -> high_V, and the ramp then uses
+  // the voltages below low_V until it rises through low_V.
+  const TrackingParams p;
+  TrackingController c(p, test::model().params(), test::step_map());
+  auto s = test::model().initial_state();
+  PositionSensor sensor;
+  c.reset(0.0, 0.0);
+  double x_ref = 0.0, first_edge_peak_V = 0.0, lowest_V = p.high_V;
+  for (int k = 0; k < 50 && c.edges() < 2; ++k) {  // 200 um/s backward until the second edge
+    x_ref -= 200e-6 * 1e-4;
+    c.set_reference({x_ref, -200e-6, 0.0});
+    c.update(sensor.measure(test::model().slider_position(s)));
+    for (int i = 0; i < 10; ++i) {
+      const stickslip::DriveSegment seg = c.next_drive(1e-5);
+      if (c.edges() == 1) {
+        for (int j = 0; j < seg.corners; ++j)
+          first_edge_peak_V = std::max(first_edge_peak_V, seg.u_V[static_cast<std::size_t>(j)]);
+        first_edge_peak_V = std::max(first_edge_peak_V, seg.end_V);
+        if (!c.in_edge()) lowest_V = std::min(lowest_V, seg.end_V);
+      }
+      test::model().step(s, seg);
+    }
+  }
+  EXPECT_EQ(c.edges(), 2);
+  EXPECT_NEAR(first_edge_peak_V, p.high_V - p.low_V, 1e-9);
+  EXPECT_LT(lowest_V, p.low_V);  // the ramp ran below low_V before the next edge
 }
 
 TEST(TrackingController, WithinThePeStrokeItOnlyScans) {

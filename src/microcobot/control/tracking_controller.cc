@@ -16,6 +16,9 @@ void TrackingParams::validate() const {
   require_in_range(high_V, 0.0, 100.0, "tracking.high_V");
   require(high_V - low_V >= 20.0, "tracking.high_V", "must exceed low_V by >= 20 V (an edge must slip)",
           high_V - low_V);
+  require_in_range(sprint_low_V, 0.0, low_V, "tracking.sprint_low_V");
+  require_positive(sprint_velocity_m_s, "tracking.sprint_velocity_m_s");
+  require_positive(sprint_lag_m, "tracking.sprint_lag_m");
   require_in_range(guard_V, 0.0, 10.0, "tracking.guard_V");
   require(unload_V >= 0.0 && unload_V <= high_V - low_V - 10.0, "tracking.unload_V",
           "must be in [0, high_V - low_V - 10]", unload_V);
@@ -52,8 +55,8 @@ TrackingController::TrackingController(const TrackingParams& p, const stickslip:
       min_V_(model.drive.min_V),
       dt_c_(1.0 / p.control_rate_Hz),
       obs_(stickslip::make_pi_state(model.hysteresis, 0.0)) {
-  require(p.low_V >= model.drive.min_V && p.high_V <= model.drive.max_V, "tracking.low_V/high_V",
-          "must lie within the amplifier's range (drive.min_V..max_V)");
+  require(p.sprint_low_V >= model.drive.min_V && p.high_V <= model.drive.max_V,
+          "tracking.sprint_low_V/high_V", "must lie within the amplifier's range (drive.min_V..max_V)");
   b_fwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward);
   b_bwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kBackward);
   op_.amplitude_V = p_.high_V - p_.low_V;
@@ -73,9 +76,8 @@ double TrackingController::predicted_backslip_m(double frequency_Hz, Direction d
   return std::max(0.0, map_.reach_m(a, frequency_Hz, d) - map_.step_m(a, frequency_Hz, d));
 }
 
-double TrackingController::flyback_frequency_Hz(double v_m_s, Direction d) const noexcept {
+double TrackingController::flyback_frequency_Hz(double v_m_s, double a, Direction d) const noexcept {
   // f = |v| / s(A, f, d): the step map's inverse at the operating point (a fixed point in f).
-  const double a = p_.high_V - p_.low_V;
   double f = 1000.0;
   for (int i = 0; i < 4; ++i) {
     const double s = map_.step_m(a, f, d);
@@ -103,7 +105,7 @@ void TrackingController::reset(double x_m, double u_V) noexcept {
   integ_ = 0.0;
   x_filt_ = x_m;
   have_x_ = true;
-  edge_ = pending_anchor_ = check_backslip_ = false;
+  edge_ = pending_anchor_ = check_backslip_ = sprint_ = false;
   stopped_ = false;
 }
 
@@ -115,13 +117,19 @@ void TrackingController::emergency_stop() noexcept {
 
 void TrackingController::start_edge(double x, bool forward) noexcept {
   const Direction d = forward ? Direction::kForward : Direction::kBackward;
-  op_.amplitude_V = p_.high_V - p_.low_V;
-  op_.frequency_Hz = flyback_frequency_Hz(ref_.v_m_s, d);
+  const double low = sprint_ ? p_.sprint_low_V : p_.low_V;
+  op_.amplitude_V = p_.high_V - low;
+  op_.frequency_Hz = flyback_frequency_Hz(ref_.v_m_s, op_.amplitude_V, d);
   op_.direction = d;
   edge_ = true;
   edge_forward_ = forward;
-  edge_target_V_ = forward ? p_.low_V : p_.high_V;
-  floor_V_ = p_.low_V;
+  // A backward edge spans the sawtooth's amplitude from the ramp's floor: from the range's bottom
+  // that is high_V; from below it (the amplifier at 0 V after power-up) it stays as wide as every
+  // other edge, and the ramp keeps using the voltages below low_V (a full 0 -> high_V edge would
+  // slip further and ring harder: -0.7 um at the start of a backward move).
+  edge_target_V_ = forward ? low : std::min(p_.high_V, floor_V_ + op_.amplitude_V);
+  if (forward) floor_V_ = low;
+  unload_V_ = p_.unload_V * op_.amplitude_V / (p_.high_V - p_.low_V);
   unloading_ = false;
   x_edge_ = x;
   b_used_ = forward ? b_fwd_ : b_bwd_;
@@ -167,11 +175,20 @@ void TrackingController::update(double x) noexcept {
     corr_to_ += miss;
     since_edge_s_ = 0.0;
   }
+  // Sprint (the wider range) while the reference is fast or the axis has fallen behind it (at
+  // rest: is far from it); the ramp may then run down to the sprint range's bottom.
+  const double lag = ref_.v_m_s > 0.0 ? e : (ref_.v_m_s < 0.0 ? -e : std::abs(e));
+  if (std::abs(ref_.v_m_s) > p_.sprint_velocity_m_s || lag > p_.sprint_lag_m) {
+    sprint_ = true;
+    floor_V_ = std::min(floor_V_, p_.sprint_low_V);
+  } else if (lag < 0.5 * p_.sprint_lag_m) {
+    sprint_ = false;
+  }
   // Lead before an edge: the ramp runs ahead of (forward) or behind (backward) the reference by a
   // growing fraction of the backslip, so the edge's jump is split around zero.
   const double y_base = y_anchor_ + (ref_.x_m - r_anchor_) + corr_ + integ_;
   const double top = pe_displacement_m(p_.high_V - p_.guard_V);
-  const double bottom = pe_displacement_m(p_.low_V + p_.guard_V);
+  const double bottom = pe_displacement_m(floor_V_ + p_.guard_V);
   double lead = 0.0;
   if (ref_.v_m_s > 0.0) {
     lead = (p_.lead_fraction * b_fwd_ + p_.lead_m) *
@@ -194,8 +211,8 @@ void TrackingController::update(double x) noexcept {
     start_edge(x, true);
     return;
   }
-  if (y_des < bottom && v <= 0.0 && (v < 0.0 || y_des < pe_displacement_m(p_.low_V) - p_.edge_margin_m) &&
-      u_ <= p_.low_V + p_.guard_V + p_.edge_ready_V) {
+  if (y_des < bottom && v <= 0.0 && (v < 0.0 || y_des < pe_displacement_m(floor_V_) - p_.edge_margin_m) &&
+      u_ <= floor_V_ + p_.guard_V + p_.edge_ready_V) {
     start_edge(x, false);
     return;
   }
@@ -233,7 +250,7 @@ stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
       }
       if (!unloading_ && p_.unload_V > 0.0) {
         unloading_ = true;
-        edge_target_V_ = edge_forward_ ? p_.low_V + p_.unload_V : p_.high_V - p_.unload_V;
+        edge_target_V_ += edge_forward_ ? unload_V_ : -unload_V_;
       } else {
         edge_ = false;
         pending_anchor_ = true;
@@ -244,13 +261,15 @@ stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
       --seg.corners;
     }
   } else {
-    // The ramp: linear from the last command to this one over the control period.
+    // The ramp: linear from the last command to this one over the control period. Once it rises
+    // into the range from below (power-up), the range's bottom is its floor.
     const double du = std::max(std::abs(u_cmd_ - u_prev_cmd_) / dt_c_, 1.0) * dt_s;
+    const double before = u_;
     u_ += std::clamp(u_cmd_ - u_, -du, du);
+    if (!sprint_ && before < p_.low_V && u_ >= p_.low_V) floor_V_ = p_.low_V;
   }
   for (int j = 0; j < seg.corners; ++j) stickslip::pi_update(pi_, obs_, seg.u_V[static_cast<std::size_t>(j)]);
   u_ = std::clamp(u_, floor_V_, p_.high_V);
-  if (u_ >= p_.low_V) floor_V_ = p_.low_V;
   stickslip::pi_update(pi_, obs_, u_);
   seg.end_V = u_;
   return seg;

@@ -40,9 +40,17 @@ namespace mc::control {
 
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
-  /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low).
-  double low_V = 7.5;
+  /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low). A
+  /// narrower edge rings the contact less (200 um/s trapezoid RMS 118 nm over 7.5-100 V, 81-85 nm
+  /// over 30-100 V) but advances less per edge, so a fast or accelerating reference is followed
+  /// over the wider sprint range below.
+  double low_V = 30.0;
   double high_V = 100.0;
+  /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
+  /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
+  double sprint_low_V = 7.5;
+  double sprint_velocity_m_s = 600e-6;
+  double sprint_lag_m = 1e-6;
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
@@ -50,24 +58,25 @@ struct TrackingParams {
   double edge_ready_V = 10.0;
   /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
   /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
-  /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V].
-  double unload_V = 64.0;
+  /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V]. For the
+  /// low_V..high_V edge; a sprint edge unloads in proportion to its amplitude.
+  double unload_V = 49.2;
   /// Backslip of an unloaded edge assumed before the first edge is measured [m].
   double backslip_m = 0.0;
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
-  double lead_fraction = 0.95;
+  double lead_fraction = 0.837;
   /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
   /// the unloading run, then returns) [m].
   double lead_m = 450e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
-  double lead_window_m = 300e-9;
+  double lead_window_m = 253e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
   double catchup_s = 0.6e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
   double settle_s = 0.55e-3;
-  double ki_1_s = 500.0;  ///< integral gain on the residual error [1/s]
+  double ki_1_s = 1240.0;  ///< integral gain on the residual error [1/s]
   /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
@@ -86,6 +95,9 @@ struct TrackingParams {
     v("control_rate_Hz", control_rate_Hz);
     v("low_V", low_V);
     v("high_V", high_V);
+    v("sprint_low_V", sprint_low_V);
+    v("sprint_velocity_m_s", sprint_velocity_m_s);
+    v("sprint_lag_m", sprint_lag_m);
     v("guard_V", guard_V);
     v("edge_ready_V", edge_ready_V);
     v("unload_V", unload_V);
@@ -135,6 +147,8 @@ class TrackingController {
   /// Edges (steps) since construction, and of them those taken forward.
   std::int64_t edges() const noexcept { return edges_; }
   bool in_edge() const noexcept { return edge_; }
+  /// Edges span the sprint range (sprint_low_V..high_V).
+  bool sprinting() const noexcept { return sprint_; }
   bool stopped() const noexcept { return stopped_; }
   /// |filtered error| < in_position_m with the reference at rest.
   bool in_position() const noexcept { return in_position_; }
@@ -154,7 +168,7 @@ class TrackingController {
  private:
   void start_edge(double x, bool forward) noexcept;
   void anchor_after_edge() noexcept;
-  double flyback_frequency_Hz(double v_m_s, stickslip::Direction d) const noexcept;
+  double flyback_frequency_Hz(double v_m_s, double amplitude_V, stickslip::Direction d) const noexcept;
 
   // Fixed at construction.
   const TrackingParams p_;
@@ -174,10 +188,13 @@ class TrackingController {
   double x_edge_ = 0.0, b_used_ = 0.0;
   double x_filt_ = 0.0;
   double edge_target_V_ = 0.0;
-  double floor_V_ = 0.0;  ///< the ramp's lowest voltage: low_V, or below it until it first gets there
+  double unload_V_ = 0.0;  ///< the present edge's unloading (unload_V scaled to its amplitude)
+  /// The ramp's lowest voltage: low_V, or below it after power-up until the ramp rises through low_V
+  /// or a forward edge lands there.
+  double floor_V_ = 0.0;
   bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
        check_backslip_ = false;
-  bool stopped_ = false, in_position_ = false, have_x_ = false;
+  bool stopped_ = false, in_position_ = false, have_x_ = false, sprint_ = false;
   std::int64_t edges_ = 0;
 };
 
