@@ -83,7 +83,7 @@ struct TrackingParams {
   /// a quarter of that period, so -|kp| e acts on the ringing as velocity feedback, i.e. damping;
   /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
   /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1 with the earlier 0-100 V edge; -0.4 with
-  /// the present edge: 118 nm).
+  /// the 7.5-100 V edge: 118 nm, with the present 30-100 V edge and gains: 82 nm).
   double kp = -0.4;
   double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
