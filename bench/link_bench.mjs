@@ -11,15 +11,17 @@
 // stage holding while the link carries its whole 1 kHz traffic both ways: targets, poses,
 // forces, port energies). The loops' tick
 // times come from each process's recording (every 1 kHz telemetry sample's tick_us, read back
-// with @mcap/core), the first second dropped. 3. `link ping` through `link echo`: 5000 targets at
-// 1 kHz, the round trip master -> slave -> master.
+// with @mcap/core), the first second dropped; and the link's own work on the slave's loop thread,
+// timed there (the remote end's poll and publish in each 1 kHz tick, the console's
+// `link_cost_us`), against the slave's tick p99 of the same run. 4. `link ping` through `link
+// echo`: 5000 targets at 1 kHz, the round trip master -> slave -> master.
 import { spawn, execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readdirSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import foxglove from "@foxglove/ws-protocol";
-import { jogAsOperator, quantile, readTelemetry } from "./serve_common.mjs";
+import { jogAsOperator, nextStatus, quantile, readTelemetry } from "./serve_common.mjs";
 const { FoxgloveClient } = foxglove;
 
 const arg = (name, fallback) => {
@@ -98,6 +100,8 @@ const master = await serve(["--role", "master", "--domain", domain]);
 stop = await operate(master.ws);
 await sleep(phaseS * 1000);
 stop();
+// The link's own work on the slave's loop thread, timed there (poll + publish per 1 kHz tick).
+const slaveLinkCost = (await nextStatus(slave.ws)).link_cost_us;
 const masterTicks = await ticks(master);
 const slaveTicks = await ticks(slave);
 
@@ -110,6 +114,7 @@ log(`slave + master, holding, no client: ${phaseS} s`);
 const idleSlave = await serve(["--role", "slave", "--domain", domain]);
 const idleMaster = await serve(["--role", "master", "--domain", domain]);
 await sleep(phaseS * 1000);
+const idleSlaveLinkCost = (await nextStatus(idleSlave.ws)).link_cost_us;
 await ticks(idleMaster);
 const idleSlaveTicks = await ticks(idleSlave);
 
@@ -129,6 +134,10 @@ const result = {
   tick_cpu_p99_ratio_slave_single: slaveTicks.cpu.p99 / singleTicks.cpu.p99,
   tick_cpu_p99_ratio_slave_single_beside_another: slaveTicks.cpu.p99 / besidePeerTicks.cpu.p99,
   holding_tick_cpu_p99_ratio_slave_single: idleSlaveTicks.cpu.p99 / idleTicks.cpu.p99,
+  // The link's code on the slave's loop thread against the loop's tick p99 in the same run.
+  link_cost_us: { jogging: slaveLinkCost, holding: idleSlaveLinkCost },
+  link_cost_p99_to_slave_tick_p99: slaveLinkCost.p99 / slaveTicks.p99,
+  holding_link_cost_p99_to_slave_tick_p99: idleSlaveLinkCost.p99 / idleSlaveTicks.p99,
   round_trip_ms: { p50: 1e3 * ping.rtt_p50_s, p99: 1e3 * ping.rtt_p99_s, max: 1e3 * ping.rtt_max_s, loss: ping.loss },
 };
 if (asJson) {
@@ -148,6 +157,11 @@ if (asJson) {
               `to beside another ${result.tick_cpu_p99_ratio_slave_single_beside_another.toFixed(3)})`);
   console.log(`loop thread CPU per tick, holding: single ${c(idleTicks)}; slave ${c(idleSlaveTicks)} ` +
               `(p99 ratio ${result.holding_tick_cpu_p99_ratio_slave_single.toFixed(3)})`);
+  const l = (x) => `p50 ${x.p50.toFixed(2)} us, p99 ${x.p99.toFixed(2)} us, max ${x.max.toFixed(1)} us (${x.count} ticks)`;
+  console.log(`the link's code on the slave's loop, jogging: ${l(slaveLinkCost)}; p99 / slave tick p99 ` +
+              `${result.link_cost_p99_to_slave_tick_p99.toFixed(3)}`);
+  console.log(`the link's code on the slave's loop, holding: ${l(idleSlaveLinkCost)}; p99 / slave tick p99 ` +
+              `${result.holding_link_cost_p99_to_slave_tick_p99.toFixed(3)}`);
   const r = result.round_trip_ms;
   console.log(`round trip at 1 kHz: p50 ${r.p50.toFixed(3)} ms, p99 ${r.p99.toFixed(3)} ms, max ${r.max.toFixed(3)} ms, ` +
               `loss ${(100 * r.loss).toFixed(1)} %`);

@@ -2,6 +2,8 @@
 // jog, the telemetry read back from a recording, quantiles.
 import { open } from "node:fs/promises";
 import { McapIndexedReader } from "@mcap/core";
+import foxglove from "@foxglove/ws-protocol";
+const { FoxgloveClient } = foxglove;
 
 // Takes control on a connected FoxgloveClient and jogs the stage back and forth at 20 um/s
 // (deadman held) at 50 Hz, the console's heartbeat. Returns the function that stops it.
@@ -17,6 +19,24 @@ export function jogAsOperator(client) {
     sent++;
   }, 20);
   return () => clearInterval(timer);
+}
+
+// The next /platform/status of the console at `wsUrl` (a client that connects, reads one, leaves).
+export function nextStatus(wsUrl) {
+  return new Promise((resolve, reject) => {
+    const c = new FoxgloveClient({ ws: new WebSocket(wsUrl, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
+    let status = -1;
+    c.on("advertise", (list) => {
+      const ch = list.find((x) => x.topic === "/platform/status");
+      if (ch) status = c.subscribe(ch.id);
+    });
+    c.on("message", ({ subscriptionId, data }) => {
+      if (subscriptionId !== status) return;
+      c.close();
+      resolve(JSON.parse(new TextDecoder().decode(data)));
+    });
+    c.on("error", reject);
+  });
 }
 
 // Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader).

@@ -16,6 +16,7 @@
 #include "microcobot/live/live_platform.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
+#include "microcobot/platform/timing_stats.h"
 #include "net/net_test_support.h"
 #include "support/counting_allocator.h"
 #include "support/test_support.h"
@@ -185,6 +186,15 @@ void moves_the_slave_without_allocating(Pair& pair) {
   }));
   EXPECT_EQ(pair.master_link->link().stats().rejected_total(), 0u);
   EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
+  // The link's work on the slave's loop thread (its remote end's poll and publish) is timed
+  // there at every operator tick; the master's loop has no remote end (its stage is a device).
+  platform::TimingStats slave_cost(1e-8), master_cost(1e-8);
+  pair.slave->live->drain_link_costs(slave_cost);
+  pair.master->live->drain_link_costs(master_cost);
+  EXPECT_GT(slave_cost.count(), 500u);  // one per ms over the drives above (the ring keeps 4096)
+  EXPECT_GT(slave_cost.quantile_s(0.5), 0.0);
+  EXPECT_LT(slave_cost.quantile_s(0.5), 0.5e-3) << "a fraction of the 1 ms operator period";
+  EXPECT_EQ(master_cost.count(), 0u);
 }
 
 // Time-domain passivity across the two ends (issue #17 point 4): over a 200 ms round trip with

@@ -135,6 +135,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"tick_p99_us", number},
                                             {"tick_cpu_p99_us", number},
                                             {"command_latency_ms", {{"type", "object"}}},
+                                            {"link_cost_us", {{"type", "object"}}},
                                             {"clients", number},
                                             {"recording", {{"type", {"string", "null"}}}},
                                             {"last_error", text}})});
@@ -433,6 +434,11 @@ std::string ConsoleServer::status_json() {
               {"p50", 1e3 * latency_.quantile_s(0.5)},
               {"p99", 1e3 * latency_.quantile_s(0.99)},
               {"max", 1e3 * latency_.max_s()}}},
+            {"link_cost_us",
+             {{"count", link_cost_.count()},
+              {"p50", 1e6 * link_cost_.quantile_s(0.5)},
+              {"p99", 1e6 * link_cost_.quantile_s(0.99)},
+              {"max", 1e6 * link_cost_.max_s()}}},
             {"clients", server_.client_count()},
             {"recording", recording.empty() ? json(nullptr) : json(recording)},
             {"last_error", s.last_error}};
@@ -452,6 +458,7 @@ void ConsoleServer::status_thread() {
     std::this_thread::sleep_until(next);
     const auto ns = static_cast<std::uint64_t>(std::llround(live_.status().t_s * 1e9));
     live_.drain_command_latencies(latency_);
+    live_.drain_link_costs(link_cost_);
     server_.publish(status_ch_, ns, status_json());
     if (n++ % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0)
       server_.publish(scene_ch_, ns, scene_json());

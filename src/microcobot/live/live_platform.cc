@@ -71,9 +71,13 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   ConsoleCommand c;
   bool got = false;
   bool remote_fresh = false;
+  // The remote end's work on this thread is timed (steady clock: a vDSO read, no system call).
+  std::chrono::steady_clock::duration link_cost{};
   if (params_.remote) {
     // The master process drives: its e-stop latches ours, its release resets what it latched.
+    const auto t0 = std::chrono::steady_clock::now();
     const RemoteRequest r = params_.remote->poll(t.t_s, latest_);
+    link_cost = std::chrono::steady_clock::now() - t0;
     remote_fresh = r.fresh;
     if (r.estop && !p.faulted()) {
       p.fault_all();
@@ -117,7 +121,12 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.gripper_opening_m = latest_.gripper_opening_m;
   }
   p.set_console_input(in);
-  if (params_.remote) params_.remote->publish(p);
+  if (params_.remote) {
+    const auto t0 = std::chrono::steady_clock::now();
+    params_.remote->publish(p);
+    link_cost += std::chrono::steady_clock::now() - t0;
+    link_costs_.push(std::chrono::duration<double>(link_cost).count());  // a full ring drops it
+  }
 
   t_s_.store(t_offset_s_ + t.t_s, std::memory_order_relaxed);
   estopped_.store(p.faulted(), std::memory_order_relaxed);
@@ -205,6 +214,11 @@ void LivePlatform::stop() {
 void LivePlatform::drain_command_latencies(platform::TimingStats& stats) noexcept {
   double latency_s = 0.0;
   while (latencies_.pop(latency_s)) stats.add(latency_s);
+}
+
+void LivePlatform::drain_link_costs(platform::TimingStats& stats) noexcept {
+  double cost_s = 0.0;
+  while (link_costs_.pop(cost_s)) stats.add(cost_s);
 }
 
 LiveStatus LivePlatform::status() const {

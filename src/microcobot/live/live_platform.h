@@ -95,6 +95,10 @@ class LivePlatform {
   /// server's receipt of a command to the tick that applies it) into `stats`. One consumer
   /// thread.
   void drain_command_latencies(platform::TimingStats& stats) noexcept;
+  /// Moves the remote end's cost to the loop measured since the last call into `stats`: the
+  /// duration of its poll() and publish() in each operator tick (the network link's whole work
+  /// on the loop thread; none without a remote end). One consumer thread.
+  void drain_link_costs(platform::TimingStats& stats) noexcept;
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
@@ -135,6 +139,7 @@ class LivePlatform {
   std::unique_ptr<platform::PickPlaceOperator> demo_;
   platform::SpscRing<ConsoleCommand> commands_{256};
   platform::SpscRing<double> latencies_{4096};  // loop -> status thread [s]
+  platform::SpscRing<double> link_costs_{4096};  // loop -> status thread [s]
   ConsoleCommand latest_;                       // loop thread only
   double last_command_t_ = -1e9;
   double t_offset_s_ = 0.0;
