@@ -49,8 +49,8 @@ struct TrackingParams {
   /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
-  double sprint_velocity_m_s = 600e-6;
-  double sprint_lag_m = 1e-6;
+  double sprint_velocity_m_s = 600e-6;  ///< [m/s]: the 30-100 V edges follow ~600 um/s at 2e-2 m/s^2
+  double sprint_lag_m = 1e-6;           ///< [m]: above the edges' own transients (<= ~0.65 um)
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
