@@ -125,7 +125,7 @@ class ConsoleServer {
   std::uint16_t recording_channel_ = 0;
   std::string recording_name_;
   std::atomic<double> tick_p99_us_{0.0}, tick_cpu_p99_us_{0.0};
-  platform::TimingStats latency_{1e-5};  // status thread: command-to-target, 10 us bins
+  platform::TimingStats latency_{1e-5};    // status thread: command-to-target, 10 us bins
   platform::TimingStats link_cost_{1e-8};  // status thread: the remote end's work per tick, 10 ns bins
 
   // Reports made on demand, one at a time, off the server's I/O thread.

@@ -138,9 +138,9 @@ class LivePlatform {
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<platform::PickPlaceOperator> demo_;
   platform::SpscRing<ConsoleCommand> commands_{256};
-  platform::SpscRing<double> latencies_{4096};  // loop -> status thread [s]
+  platform::SpscRing<double> latencies_{4096};   // loop -> status thread [s]
   platform::SpscRing<double> link_costs_{4096};  // loop -> status thread [s]
-  ConsoleCommand latest_;                       // loop thread only
+  ConsoleCommand latest_;                        // loop thread only
   double last_command_t_ = -1e9;
   double t_offset_s_ = 0.0;
 
