@@ -138,7 +138,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"link_cost_us", {{"type", "object"}}},
                                             {"clients", number},
                                             {"recording", {{"type", {"string", "null"}}}},
-                                            {"last_error", text}})});
+                                            {"last_error", text},
+                                            {"ticks", number},
+                                            {"demo_result", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
   const std::vector<std::string> scene_keys = {"kind",
@@ -153,7 +155,11 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                                "workspace_min_m",
                                                "workspace_max_m",
                                                "max_speed_m_s",
-                                               "force_full_scale_N"};
+                                               "force_full_scale_N",
+                                               "grip_force_limit_N",
+                                               "contact_force_limit_N",
+                                               "demo_available",
+                                               "demo_unavailable_reason"};
   scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                                    schema({{"kind", text},
                                            {"part_side_m", number},
@@ -168,6 +174,10 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                            {"workspace_max_m", vec3},
                                            {"max_speed_m_s", number},
                                            {"force_full_scale_N", number},
+                                           {"grip_force_limit_N", number},
+                                           {"contact_force_limit_N", number},
+                                           {"demo_available", boolean},
+                                           {"demo_unavailable_reason", text},
                                            {"bead_radius_m", number},
                                            {"obstacle_m", {{"type", "array"}, {"items", number}}},
                                            {"obstacle_radius_m", number}},
@@ -395,7 +405,13 @@ std::string ConsoleServer::scene_json() const {
          {"workspace_min_m", c.min_m},
          {"workspace_max_m", c.max_m},
          {"max_speed_m_s", c.max_speed_m_s},
-         {"force_full_scale_N", 50e-6}};
+         // The gauges' full scales are the limits the platform enforces (issue #26).
+         {"force_full_scale_N", live_.contact_force_limit_N()},
+         {"grip_force_limit_N", live_.grip_force_limit_N()},
+         {"contact_force_limit_N", live_.contact_force_limit_N()}};
+  const std::string no_demo = live_.demo_unavailable_reason();
+  j["demo_available"] = no_demo.empty();
+  j["demo_unavailable_reason"] = no_demo;
   if (live_.optical_trap_scene()) {
     // The probe bead (the telemetry's part_* channels) and the stuck bead; forces in piconewtons:
     // the gauge's full scale is the trap's escape force, k times the probe's radius.
@@ -441,7 +457,18 @@ std::string ConsoleServer::status_json() {
               {"max", 1e6 * link_cost_.max_s()}}},
             {"clients", server_.client_count()},
             {"recording", recording.empty() ? json(nullptr) : json(recording)},
-            {"last_error", s.last_error}};
+            {"last_error", s.last_error},
+            {"ticks", s.ticks}};
+  const DemoResult& d = s.demo_result;
+  if (d.outcome == DemoResult::Outcome::kNone) {
+    j["demo_result"] = nullptr;
+  } else {
+    j["demo_result"] = {{"outcome", DemoResult::name(d.outcome)},
+                        {"phase", d.phase},
+                        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
+                        {"reason", d.reason},
+                        {"duration_s", d.duration_s}};
+  }
   return j.dump();
 }
 
