@@ -145,6 +145,11 @@ void serve(const ServeOptions& o) {
     pf::use_optical_trap_scene(lp.platform);
   } else if (o.scene != "pick-place") {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(o.scene, ec))
+      throw mc::InvalidInput("--scene '" + mc::excerpt(o.scene) +
+                             "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
+                             "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
   }
   auto [host, port] = parse_listen(o.listen);
@@ -157,9 +162,12 @@ void serve(const ServeOptions& o) {
                                    sp.server.token.find_first_of(" &#?%/\"'<>") != std::string::npos))
     throw mc::UsageError("--token: must be 8 to 256 characters without spaces or any of &#?%/\"'<>");
   sp.out_dir = o.out;
-  std::filesystem::create_directories(o.out);
-  if (!std::filesystem::is_directory(o.out))
-    throw mc::InvalidInput(o.out.string(), 0, "--out must be a directory");
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec)
+    throw mc::InvalidInput("cannot create --out " + mc::excerpt(o.out.string()) + ": " + ec.message());
+  if (!std::filesystem::is_directory(o.out, ec))
+    throw mc::InvalidInput("--out " + mc::excerpt(o.out.string()) + ": exists and is not a directory");
 
   RemoteEnds ends = attach_role(o, lp);
   mc::cli::set_cooperative_interrupts(true);
@@ -179,6 +187,9 @@ void serve(const ServeOptions& o) {
   // The first line on stdout: what the operator opens.
   std::cout << server.url() << std::endl;
   std::cerr << "serve: console at " << server.url() << " (Ctrl-C stops: devices to their safe state)\n";
+  if (host == "0.0.0.0" || host == "::")
+    std::cerr << "serve: listening on every interface: from another machine, open this machine's address on port "
+              << server.port() << " with the same token\n";
   const auto start = std::chrono::steady_clock::now();
   while (mc::cli::interrupt_signal() == 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

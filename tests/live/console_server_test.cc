@@ -241,5 +241,28 @@ TEST(ConsoleServer, ATokenGuardsTheRecordingsAsItGuardsTheWebSocket) {
   EXPECT_EQ(test::http_request(server.port(), "GET", "/").status, 200) << "the page itself is public";
 }
 
+// Issue #26: a refused message's status names it (its id is the message's topic), and the scene
+// tells the page the force limits and whether the demo can run.
+TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
+  Rig rig;
+  Console c(rig.server.port());
+  ASSERT_TRUE(c.action("take_control"));
+  ASSERT_FALSE(c.ws.read_status("control").is_null());
+  ASSERT_TRUE(c.command({{"deadman", "yes"}}));
+  const json refused = c.ws.read_status("/console/command");
+  ASSERT_FALSE(refused.is_null());
+  EXPECT_EQ(refused.value("level", -1), 2);  // error
+  EXPECT_NE(refused.value("message", "").find("deadman"), std::string::npos) << refused;
+  c.subscribe("/platform/scene", 7);
+  const json scene = json::parse(c.next_on(7));
+  EXPECT_DOUBLE_EQ(scene.at("grip_force_limit_N").get<double>(), 1e-3);
+  EXPECT_DOUBLE_EQ(scene.at("contact_force_limit_N").get<double>(), 2e-3);
+  EXPECT_TRUE(scene.at("demo_available").get<bool>());
+  c.subscribe("/platform/status", 8);
+  const json status = json::parse(c.next_on(8));
+  EXPECT_TRUE(status.at("demo_result").is_null());
+  EXPECT_GT(status.at("ticks").get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace mc::live

@@ -194,6 +194,9 @@ ConsoleServer::~ConsoleServer() { stop(); }
 
 std::string ConsoleServer::url() const {
   std::string host = params_.server.address;
+  // Listening on every interface: this machine opens it on loopback.
+  if (host == "0.0.0.0") host = "127.0.0.1";
+  if (host == "::") host = "::1";
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   std::string u = "http://" + host + ":" + std::to_string(server_.port()) + "/";
   if (!params_.server.token.empty()) u += "?token=" + params_.server.token;
@@ -289,13 +292,14 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
       }
       if (!live_.push_command(c))
         server_.send_status(m.client, StatusLevel::kWarning,
-                            "/console/command: the loop is busy; command dropped");
+                            "/console/command: the loop is busy; command dropped", "/console/command");
       return;
     }
     if (m.topic != "/console/action") {
       server_.send_status(m.client, StatusLevel::kError,
                           "unknown topic '" + std::string(m.topic.substr(0, 80)) +
-                              "': the console publishes /console/command and /console/action");
+                              "': the console publishes /console/command and /console/action",
+                          "unknown-topic");
       return;
     }
     const ConsoleAction a = parse_console_action(m.payload);
@@ -337,7 +341,9 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
         return;
     }
   } catch (const Error& e) {
-    server_.send_status(m.client, StatusLevel::kError, e.what());
+    // The status names what it refuses (its id is the offending message's topic), so a client
+    // can tell which of its messages it concerns.
+    server_.send_status(m.client, StatusLevel::kError, e.what(), std::string(m.topic.substr(0, 80)));
   }
 }
 

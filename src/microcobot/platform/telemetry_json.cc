@@ -51,7 +51,7 @@ std::string telemetry_json_schema(std::size_t channel_count) {
       description = "flag: 1 true, 0 false";
     }
     description += "; null when not finite";
-    props[std::string(name)] = {{"type", "number"}, {"description", description}};
+    props[std::string(name)] = {{"type", {"number", "null"}}, {"description", description}};
   }
   nlohmann::ordered_json schema = {
       {"$schema", "https://json-schema.org/draft/2020-12/schema"},
