@@ -41,6 +41,7 @@ struct Rig {
     p.server.port = 0;
     p.server.token = token;
     p.out_dir = out;
+    p.record_csv = true;  // the CSV download is tested below (serve --record-csv)
     return p;
   }
   Rig() { server.start(); }
