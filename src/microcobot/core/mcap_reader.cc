@@ -259,8 +259,9 @@ class Parser {
     const std::uint32_t crc = fl.u32("uncompressed_crc");
     const std::string compression(fl.prefixed("compression"));
     if (!compression.empty() && compression != "zstd") {
-      fail(name_, r.offset,
-           fmt::format("Chunk compressed with '{}': only uncompressed and zstd chunks are read", compression));
+      fail(
+          name_, r.offset,
+          fmt::format("Chunk compressed with '{}': only uncompressed and zstd chunks are read", compression));
     }
     std::uint64_t records_at = fl.pos() + 8;
     std::string_view records = fl.bytes(fl.u64("records length"), "records");
@@ -279,8 +280,8 @@ class Parser {
       }
     } restore{*this, file};
     if (compression == "zstd") {
-      decompressed =
-          zstd_decompress(records, uncompressed_size, fmt::format("{}: byte {}: zstd Chunk", name_, r.offset));
+      decompressed = zstd_decompress(records, uncompressed_size,
+                                     fmt::format("{}: byte {}: zstd Chunk", name_, r.offset));
       f_ = decompressed;
       name_ = fmt::format("{} (zstd chunk at byte {}, decompressed)", file_name_, r.offset);
       records = f_;
@@ -530,8 +531,9 @@ class Parser {
     }
     if (attachment_indexes_ != attachment_records_.size() || metadata_indexes_ != metadata_records_.size()) {
       fail(name_, summary_start_,
-           fmt::format("summary indexes {} of {} attachments and {} of {} metadata records", attachment_indexes_,
-                       attachment_records_.size(), metadata_indexes_, metadata_records_.size()));
+           fmt::format("summary indexes {} of {} attachments and {} of {} metadata records",
+                       attachment_indexes_, attachment_records_.size(), metadata_indexes_,
+                       metadata_records_.size()));
     }
     if (schemas.size() != out_.schemas.size() || channels.size() != out_.channels.size()) {
       fail(name_, summary_start_,
@@ -596,7 +598,8 @@ class Parser {
     const std::uint32_t actual = crc32(f_.substr(r.content, crc_at - r.content));
     if (crc != 0 && crc != actual) {
       fail(name_, r.offset,
-           fmt::format("Attachment '{}' CRC mismatch (stored 0x{:08x}, computed 0x{:08x})", a.name, crc, actual));
+           fmt::format("Attachment '{}' CRC mismatch (stored 0x{:08x}, computed 0x{:08x})", a.name, crc,
+                       actual));
     }
     attachment_records_.push_back({r.offset, r.end - r.offset, a.name});
     out_.attachments.push_back(std::move(a));
@@ -605,7 +608,8 @@ class Parser {
   // An index record of the summary must point at the next Attachment/Metadata record, by name.
   void check_index(const Record& r, const char* what, std::uint64_t offset, std::uint64_t length,
                    const std::string& name, const std::vector<IndexTarget>& targets, std::size_t& n) {
-    if (n >= targets.size()) fail(name_, r.offset, fmt::format("{} without its record in the data section", what));
+    if (n >= targets.size())
+      fail(name_, r.offset, fmt::format("{} without its record in the data section", what));
     const IndexTarget& t = targets[n++];
     if (offset != t.offset || length != t.length || name != t.name) {
       fail(name_, r.offset,

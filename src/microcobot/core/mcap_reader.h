@@ -94,8 +94,8 @@ struct McapContents {
   std::vector<McapMetadata> metadata;
   std::vector<McapAttachment> attachments;
   std::vector<McapChunkStorage> chunks;  ///< in file order
-  bool has_summary = false;     ///< false for a file without summary (allowed by the spec)
-  bool has_statistics = false;  ///< the summary held a Statistics record
+  bool has_summary = false;              ///< false for a file without summary (allowed by the spec)
+  bool has_statistics = false;           ///< the summary held a Statistics record
   McapStatistics statistics;
   std::size_t chunk_count = 0;
 

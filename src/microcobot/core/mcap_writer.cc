@@ -56,14 +56,15 @@ std::uint32_t crc32(std::string_view bytes, std::uint32_t previous) {
   return c ^ 0xFFFFFFFFu;
 }
 
-McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes, McapCompression compression)
+McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes,
+                       McapCompression compression)
     : path_(std::move(path)),
       file_(path_),
       chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)),
       compression_(compression) {
   if (compression_.zstd)
-    require(compression_.zstd_level >= 1 && compression_.zstd_level <= 19, "zstd_level", "must be within [1, 19]",
-            compression_.zstd_level);
+    require(compression_.zstd_level >= 1 && compression_.zstd_level <= 19, "zstd_level",
+            "must be within [1, 19]", compression_.zstd_level);
   out_.reserve(kIoBuffer);
   chunk_.reserve(std::min(chunk_target_, std::size_t{64} << 20) + 4096);
   put(kMcapMagic);

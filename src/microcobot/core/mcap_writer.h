@@ -63,7 +63,7 @@ inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
 /// How chunks are stored: as they are, or compressed with zstd (core/zstd.h) at a level.
 struct McapCompression {
   bool zstd = false;
-  int zstd_level = 3;  ///< 1..19; 1-3 compress ~1 MB of JSON in a few ms
+  int zstd_level = 3;  ///< 1..19 (fast .. small)
 };
 
 class McapWriter {
@@ -144,7 +144,7 @@ class McapWriter {
   StagedFile file_;
   std::size_t chunk_target_;
   McapCompression compression_;
-  std::string compressed_;  // the chunk's records, compressed
+  std::string compressed_;     // the chunk's records, compressed
   std::string out_;            // bytes not yet written to file_
   std::uint64_t flushed_ = 0;  // bytes written to file_
   bool in_data_ = true;

@@ -15,7 +15,8 @@ void zstd_compress(std::string_view in, int level, std::string& out) {
   // by default), so a reader can check it before it allocates.
   const std::size_t n = ZSTD_compress(out.data(), out.size(), in.data(), in.size(), level);
   if (ZSTD_isError(n))
-    throw Error(ExitCode::kComputationFailed, std::string("zstd: compression failed: ") + ZSTD_getErrorName(n));
+    throw Error(ExitCode::kComputationFailed,
+                std::string("zstd: compression failed: ") + ZSTD_getErrorName(n));
   out.resize(n);
 }
 

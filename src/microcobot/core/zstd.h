@@ -11,8 +11,8 @@
 
 namespace mc {
 
-/// Compresses `in` into one zstd frame at `level` (1 fast .. 19 small; 1-3 is what a live
-/// recording wants: ~1 MB in a few ms). Replaces `out`'s content (reuse it: no allocation once
+/// Compresses `in` into one zstd frame at `level` (1 fast .. 19 small; a live recording uses 1:
+/// live/session_recording.h says why). Replaces `out`'s content (reuse it: no allocation once
 /// it is large enough). Throws InvalidParams for a level outside [1, 19], mc::Error when libzstd
 /// fails (out of memory).
 void zstd_compress(std::string_view in, int level, std::string& out);

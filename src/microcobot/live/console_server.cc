@@ -127,8 +127,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                            {"obstacle_m", {{"type", "array"}, {"items", number}}},
                                            {"obstacle_radius_m", number}},
                                           scene_keys)});
-  feedback_ch_ = server_.add_channel({"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
-                                      schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
+  feedback_ch_ = server_.add_channel(
+      {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
+       schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
   server_.on_disconnect([this](server::ClientId c) { on_disconnect(c); });
   if (!params_.out_dir.empty()) {
@@ -157,9 +158,10 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
         });
     server_.on_http_get([this](std::string_view path) { return files_->on_http(path); });
   }
-  server_.on_reject([this](server::ClientId client, StatusLevel level, std::string_view id, std::string_view message) {
-    note(event_level(level), "protocol", std::string(id) + ": " + std::string(message), client);
-  });
+  server_.on_reject(
+      [this](server::ClientId client, StatusLevel level, std::string_view id, std::string_view message) {
+        note(event_level(level), "protocol", std::string(id) + ": " + std::string(message), client);
+      });
   json_.reserve(4096);
 }
 
@@ -232,7 +234,8 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   publish(feedback_ch_, RecordedTopic::kFeedback, s[0], f.dump());
 }
 
-void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s, const std::string& payload) {
+void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
+                            const std::string& payload) {
   server_.publish(ch, static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9)), payload);
   if (recording_) recording_->published(topic, t_s, payload);
 }
@@ -284,7 +287,8 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
         return;
       }
       if (!live_.push_command(c))
-        tell(m.client, StatusLevel::kWarning, "/console/command: the loop is busy; command dropped", "refused");
+        tell(m.client, StatusLevel::kWarning, "/console/command: the loop is busy; command dropped",
+             "refused");
       return;
     }
     if (m.topic != "/console/action") {
@@ -332,7 +336,9 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
           return;
         }
         note(EventLevel::kInfo,
-             a == ConsoleAction::kReset ? "reset" : a == ConsoleAction::kDemo ? "demo_requested" : "restart_requested",
+             a == ConsoleAction::kReset  ? "reset"
+             : a == ConsoleAction::kDemo ? "demo_requested"
+                                         : "restart_requested",
              a == ConsoleAction::kReset ? "reset requested: the e-stop cleared, devices reactivated"
                                         : "the scene restarts (the control thread rebuilds it)",
              m.client);

@@ -52,9 +52,9 @@ struct ConsoleServerParams {
   double status_rate_Hz = 5.0;
   double rumble_crossover_Hz = 100.0;  ///< the high band of the contact force
   double rumble_full_scale_N = 5e-6;   ///< high-band RMS that drives the rumble fully
-  bool record_csv = false;  ///< recordings also write the telemetry as CSV (`serve --record-csv`)
-  std::string version;      ///< the program's, into each recording's metadata
-  std::string config_yaml;  ///< the platform configuration, into each recording
+  bool record_csv = false;             ///< recordings also write the telemetry as CSV (`serve --record-csv`)
+  std::string version;                 ///< the program's, into each recording's metadata
+  std::string config_yaml;             ///< the platform configuration, into each recording
   void validate() const;
 };
 

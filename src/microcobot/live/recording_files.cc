@@ -225,8 +225,8 @@ std::string RecordingFiles::list_json() const {
   const std::string active = active_();
   json list = json::array();
   std::error_code ec;
-  for (auto it = std::filesystem::directory_iterator(dir_, ec); !ec && it != std::filesystem::directory_iterator();
-       it.increment(ec)) {
+  for (auto it = std::filesystem::directory_iterator(dir_, ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
     const auto& p = it->path();
     if (p.extension() != ".mcap" || !SessionRecording::is_stem(p.stem().string()) || !it->is_regular_file(ec))
       continue;

@@ -67,8 +67,8 @@ class RecordingFiles {
   std::function<void(server::StatusLevel, const std::string&)> notify_;
   std::mutex mutex_;
   std::thread thread_;
-  std::string reporting_;                       // the stem being made, empty when idle
-  std::map<std::string, std::string> errors_;   // stem -> why its report failed
+  std::string reporting_;                      // the stem being made, empty when idle
+  std::map<std::string, std::string> errors_;  // stem -> why its report failed
 };
 
 }  // namespace mc::live

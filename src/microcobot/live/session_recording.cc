@@ -115,10 +115,12 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
     channel_[index(t)] = w->add_channel(w->add_schema(schema_name, "jsonschema", schema), topic, "json");
   };
   add(RecordedTopic::kTelemetry, std::string(platform::kTelemetryTopic),
-      std::string(platform::kTelemetrySchemaName), platform::telemetry_json_schema(params_.telemetry_channels));
+      std::string(platform::kTelemetrySchemaName),
+      platform::telemetry_json_schema(params_.telemetry_channels));
   add(RecordedTopic::kStatus, params_.status.topic, params_.status.schema_name, params_.status.schema);
   add(RecordedTopic::kScene, params_.scene.topic, params_.scene.schema_name, params_.scene.schema);
-  add(RecordedTopic::kFeedback, params_.feedback.topic, params_.feedback.schema_name, params_.feedback.schema);
+  add(RecordedTopic::kFeedback, params_.feedback.topic, params_.feedback.schema_name,
+      params_.feedback.schema);
   const json number = {{"type", "number"}}, text = {{"type", "string"}};
   const json client = {{"type", "number"}, {"description", "the server's id of the client (1, 2, ...)"}};
   const json received = {{"t_s", number}, {"client", client}, {"message", {{"description", "as received"}}}};
@@ -142,7 +144,8 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   std::vector<std::pair<std::string, std::string>> scene;
   const json sj = json::parse(scene_json, nullptr, false);
   if (sj.is_object())
-    for (const auto& [k, v] : sj.items()) scene.emplace_back(k, v.is_string() ? v.get<std::string>() : v.dump());
+    for (const auto& [k, v] : sj.items())
+      scene.emplace_back(k, v.is_string() ? v.get<std::string>() : v.dump());
   w->add_metadata("scene", scene);
   w->add_metadata("configuration", {{"yaml", params_.config_yaml}});
   w->add_attachment("configuration.yaml", "application/yaml", params_.config_yaml,
@@ -152,9 +155,9 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   if (params_.csv) {
     csv = std::make_unique<CsvStreamWriter>(
         params_.out_dir / (stem + ".csv"),
-        std::vector<std::string>(platform::kTelemetryChannels.begin(),
-                                 platform::kTelemetryChannels.begin() +
-                                     static_cast<std::ptrdiff_t>(params_.telemetry_channels)));
+        std::vector<std::string>(
+            platform::kTelemetryChannels.begin(),
+            platform::kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(params_.telemetry_channels)));
   }
   mcap_ = std::move(w);
   csv_ = std::move(csv);
@@ -186,8 +189,8 @@ void SessionRecording::stop() {
   }
   if (dropped > 0)
     event(EventLevel::kWarning, "dropped",
-          fmt::format("{} message(s) dropped: the writer fell {} MB behind", dropped, kMaxQueuedBytes >> 20), 0,
-          t_s);
+          fmt::format("{} message(s) dropped: the writer fell {} MB behind", dropped, kMaxQueuedBytes >> 20),
+          0, t_s);
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;  // the writer empties the queue, then closes the files
@@ -204,7 +207,7 @@ void SessionRecording::stop() {
   std::unique_ptr<McapWriter> mcap = std::move(mcap_);
   std::unique_ptr<CsvStreamWriter> csv = std::move(csv_);
   if (!error.empty() || !mcap) return;  // already abandoned and reported
-  mcap->close();  // summary, index, footer; then renamed to its name
+  mcap->close();                        // summary, index, footer; then renamed to its name
   if (csv) csv->close();
 }
 
@@ -236,7 +239,8 @@ void SessionRecording::published(RecordedTopic topic, double t_s, std::string_vi
   push(Item{topic, 0, t_s, std::string(payload), {}, 0});
 }
 
-void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s, std::string_view payload) {
+void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s,
+                                std::string_view payload) {
   push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0});
 }
 

@@ -226,32 +226,31 @@ void add_recording_figures(report::Report& rep, const Recorder& rec, const std::
   rep.section("Slave stage and microworld",
               "The finger tips (the stage's true position plus the mount offset), the teleoperation target "
               "and the part, in the world frame.");
-  rep.add_figure(
-      {"Slave x",
-       "",
-       {"Time", "s"},
-       {"Position", "um"},
-       {series("target x", "target_x_m", kUm), series("tips x", "slave_x_m", kUm),
-        series("part x", "part_x_m", kUm)}});
-  rep.add_figure(
-      {"Slave z",
-       "",
-       {"Time", "s"},
-       {"Height", "um"},
-       {series("target z", "target_z_m", kUm), series("tips z", "slave_z_m", kUm),
-        series("part z", "part_z_m", kUm)}});
-  rep.add_figure({"Path in the x-z plane",
-                  "Where the tips and the part went (side view).",
-                  {"x", "um"},
-                  {"z", "um"},
-                  {report::Series{"tips", scaled(column(rec, "slave_x_m"), kUm), scaled(column(rec, "slave_z_m"), kUm)},
-                   report::Series{"part", scaled(column(rec, "part_x_m"), kUm), scaled(column(rec, "part_z_m"), kUm)}}});
-  rep.add_figure({"Contact force on the gripper",
+  rep.add_figure({"Slave x",
                   "",
                   {"Time", "s"},
-                  {"Force", "uN"},
-                  {series("x", "contact_x_N", kUN), series("y", "contact_y_N", kUN),
-                   series("z", "contact_z_N", kUN)}});
+                  {"Position", "um"},
+                  {series("target x", "target_x_m", kUm), series("tips x", "slave_x_m", kUm),
+                   series("part x", "part_x_m", kUm)}});
+  rep.add_figure({"Slave z",
+                  "",
+                  {"Time", "s"},
+                  {"Height", "um"},
+                  {series("target z", "target_z_m", kUm), series("tips z", "slave_z_m", kUm),
+                   series("part z", "part_z_m", kUm)}});
+  rep.add_figure(
+      {"Path in the x-z plane",
+       "Where the tips and the part went (side view).",
+       {"x", "um"},
+       {"z", "um"},
+       {report::Series{"tips", scaled(column(rec, "slave_x_m"), kUm), scaled(column(rec, "slave_z_m"), kUm)},
+        report::Series{"part", scaled(column(rec, "part_x_m"), kUm), scaled(column(rec, "part_z_m"), kUm)}}});
+  rep.add_figure(
+      {"Contact force on the gripper",
+       "",
+       {"Time", "s"},
+       {"Force", "uN"},
+       {series("x", "contact_x_N", kUN), series("y", "contact_y_N", kUN), series("z", "contact_z_N", kUN)}});
   rep.add_figure({"Drive voltages (sampled at 1 kHz)",
                   "The axes' drive voltage at the telemetry instants.",
                   {"Time", "s"},
@@ -261,19 +260,19 @@ void add_recording_figures(report::Report& rep, const Recorder& rec, const std::
   rep.section("Gripper and TéléTweez",
               "The TéléTweez tip opening drives the gripper opening (x 0.06); the grip "
               "force comes back to the operator's fingers (x 100).");
-  rep.add_figure({"Openings",
-                  "",
-                  {"Time", "s"},
-                  {"Opening", "um"},
-                  {series("TéléTweez x 0.06", "tweezers_opening_m", 0.06 * kUm),
-                   series("gripper command", "gripper_command_m", kUm),
-                   series("gripper", "gripper_opening_m", kUm)}});
   rep.add_figure(
-      {"Grip forces",
+      {"Openings",
        "",
        {"Time", "s"},
-       {"Force", "uN"},
-       {series("slave grip", "grip_force_N", kUN), series("finger force / 100", "finger_force_N", 0.01 * kUN)}});
+       {"Opening", "um"},
+       {series("TéléTweez x 0.06", "tweezers_opening_m", 0.06 * kUm),
+        series("gripper command", "gripper_command_m", kUm), series("gripper", "gripper_opening_m", kUm)}});
+  rep.add_figure({"Grip forces",
+                  "",
+                  {"Time", "s"},
+                  {"Force", "uN"},
+                  {series("slave grip", "grip_force_N", kUN),
+                   series("finger force / 100", "finger_force_N", 0.01 * kUN)}});
 
   rep.section("Loop timing",
               "Compute time of the 10 kHz loop's ticks that run every task (slave control, telemetry: "
@@ -321,13 +320,13 @@ report::Report recording_report(const Recorder& rec, const std::string& name, co
     if (std::isfinite(v)) tick_max = std::max(tick_max, v);
   std::string text = "The live session recorded by `microcobot serve`" +
                      (story.version.empty() ? std::string() : " (" + story.version + ")") + " in " + name +
-                     (story.scene.empty() ? std::string() : ", scene " + story.scene) + ", from t = " +
-                     fmt::format("{:.1f}", t.front()) + " s to " + fmt::format("{:.1f}", t.back()) +
-                     " s of live time (" + std::to_string(rec.size()) + " samples plotted).";
+                     (story.scene.empty() ? std::string() : ", scene " + story.scene) +
+                     ", from t = " + fmt::format("{:.1f}", t.front()) + " s to " +
+                     fmt::format("{:.1f}", t.back()) + " s of live time (" + std::to_string(rec.size()) +
+                     " samples plotted).";
   if (story.demo && !story.demo_phases.empty()) {
     text += "\n\nThe demo went through: ";
-    for (std::size_t i = 0; i < story.demo_phases.size(); ++i)
-      text += (i ? ", " : "") + story.demo_phases[i];
+    for (std::size_t i = 0; i < story.demo_phases.size(); ++i) text += (i ? ", " : "") + story.demo_phases[i];
     text += ".";
   }
   rep.section("Recording", text);
@@ -346,7 +345,10 @@ report::Report recording_report(const Recorder& rec, const std::string& name, co
     for (std::size_t i = 0; i < shown; ++i) {
       const auto& e = story.events[i];
       events += fmt::format("t = {:.1f} s: {}{}\n\n", e.t_s,
-                            e.level >= 2 ? "error, " : e.level == 1 ? "warning, " : "", e.text);
+                            e.level >= 2   ? "error, "
+                            : e.level == 1 ? "warning, "
+                                           : "",
+                            e.text);
     }
     if (shown < story.events.size()) events += fmt::format("... and {} more.", story.events.size() - shown);
     rep.section("What happened", events);
