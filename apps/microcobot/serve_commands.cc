@@ -38,6 +38,7 @@ struct ServeOptions {
   std::string token;
   std::filesystem::path out = "out/live";
   bool record = false;
+  bool record_csv = false;
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
@@ -162,6 +163,11 @@ void serve(const ServeOptions& o) {
                                    sp.server.token.find_first_of(" &#?%/\"'<>") != std::string::npos))
     throw mc::UsageError("--token: must be 8 to 256 characters without spaces or any of &#?%/\"'<>");
   sp.out_dir = o.out;
+  sp.record_csv = o.record_csv;
+  // Each recording holds the program's version and the configuration it ran (as --print-config
+  // prints it: the keys --config takes), so a recording alone says what was run.
+  sp.version = std::string("microcobot ") + MC_VERSION;
+  sp.config_yaml = mc::params_to_yaml(lp.platform);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
   if (ec)
@@ -226,6 +232,9 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
   cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
+  cmd.add_flag("--record-csv", o->record_csv,
+               "Also write each recording's telemetry as CSV beside its MCAP file (off: the MCAP file "
+               "holds every sample; the console offers the CSV when it exists)");
   cmd.add_option("--duration", o->duration_s,
                  "Stop after this many seconds of wall-clock time (default: never)")
       ->check(mc::cli::Range(0.0, 1e7));

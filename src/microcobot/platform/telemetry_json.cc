@@ -109,7 +109,12 @@ void write_telemetry_mcap(const Recorder& rec, const std::filesystem::path& file
 
 Recorder read_telemetry_mcap(const std::filesystem::path& file, std::size_t max_samples) {
   require(max_samples >= 1, "max_samples", "must be >= 1", static_cast<double>(max_samples));
-  const McapContents m = read_mcap(file);
+  return telemetry_from_mcap(read_mcap(file), file.string(), max_samples);
+}
+
+Recorder telemetry_from_mcap(const McapContents& m, const std::string& name, std::size_t max_samples) {
+  require(max_samples >= 1, "max_samples", "must be >= 1", static_cast<double>(max_samples));
+  const std::filesystem::path file(name);
   const McapChannel* channel = nullptr;
   for (const auto& c : m.channels)
     if (c.topic == kTelemetryTopic && c.message_encoding == "json") channel = &c;
