@@ -31,8 +31,8 @@ void PickPlaceParams::validate() const {
           "grip_force_limit_N", "must be within (0, 1] N", grip_force_limit_N);
   require(std::isfinite(contact_force_limit_N) && contact_force_limit_N > 0 && contact_force_limit_N <= 10.0,
           "contact_force_limit_N", "must be within (0, 10] N", contact_force_limit_N);
-  require(std::isfinite(min_tip_height_m) && min_tip_height_m >= 0 && min_tip_height_m < 1e-3,
-          "min_tip_height_m", "must be within [0, 1 mm)", min_tip_height_m);
+  require(std::isfinite(min_tip_height_m) && min_tip_height_m >= -1e-3 && min_tip_height_m < 1e-3,
+          "min_tip_height_m", "must be within [-1 mm, 1 mm)", min_tip_height_m);
   gripper.validate();
   require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
           gripper.max_opening_m);

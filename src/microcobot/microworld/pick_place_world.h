@@ -65,7 +65,9 @@ struct PickPlaceParams {
   /// Force on the gripper above which the stage holds: above the largest force of a normal
   /// pick-and-place (a held part pressed down slips in the fingers at 2 mu F_grip <= 0.6 mN).
   double contact_force_limit_N = 2e-3;
-  /// Lowest finger-tip height above the substrate the platform lets any input command.
+  /// Lowest finger-tip height above the substrate the platform lets any input command. A
+  /// negative floor lets the tips into the substrate: only for tests of stiff contacts (the
+  /// passivity tests), never on a platform with a customer's parts.
   double min_tip_height_m = 10e-6;
 
   template <class V>
