@@ -190,7 +190,10 @@ TEST(LivePlatform, AFinishedDemoHandsBackWithEveryAxisHoldingAndReportsItsOutcom
   EXPECT_FALSE(s.demo_result.reason.empty());
   EXPECT_LT(s.demo_result.placement_error_m, 10e-6);
   EXPECT_GT(s.demo_result.duration_s, 1.0);
-  // Three seconds of live time later, nothing has moved: no axis drifts, the coupling is off.
+  // Once the last motion has settled (half a second), nothing moves for three seconds: no axis
+  // drifts (the issue saw 3.5 um/s of z after the demo), the coupling is off.
+  const double t_end = get("t_s");
+  ASSERT_TRUE(test::eventually([&] { return get("t_s") > t_end + 0.5; }, std::chrono::seconds(60)));
   const double t0 = get("t_s");
   const std::array<double, 3> p0 = {get("slave_x_m"), get("slave_y_m"), get("slave_z_m")};
   ASSERT_TRUE(test::eventually([&] { return get("t_s") > t0 + 3.0; }, std::chrono::seconds(60)));
