@@ -11,9 +11,10 @@ JOBS ?= $(shell nproc)
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state. It builds only
 # the command line and the libraries it links (not the tests, benchmarks and Python module), so
-# that a fresh machine reaches the console first.
+# that a fresh machine reaches the console first. SERVE_ARGS adds options (`make run
+# SERVE_ARGS="--scene pin-in-hole"`).
 run: cli
-	$(CLI) serve --out out/live
+	$(CLI) serve --out out/live $(SERVE_ARGS)
 
 # The scripted session: the teleoperated pick-and-place run to completion; prints where the
 # session report is.
