@@ -40,7 +40,7 @@ makePlot("Positions against targets", "µm", um, 1, [
   ["measured_z_m", "z"], ["target_z_m", "z target", true]]);
 const forcePlot = makePlot("Forces on the gripper [µN]", "", um, 2, [
   ["contact_x_N", "contact x"], ["contact_y_N", "contact y"], ["contact_z_N", "contact z"], ["grip_force_N", "grip"]]);
-makePlot("Drive amplitude", "V", 1, 1, [["u_x_V", "u x"], ["u_y_V", "u y"], ["u_z_V", "u z"]]);
+makePlot("Drive amplitude", "V", 1, 2, [["u_x_V", "u x"], ["u_y_V", "u y"], ["u_z_V", "u z"]]);
 makePlot("Loop tick", "µs", 1, 1, [["tick_us", "tick (wall clock)"], ["tick_cpu_us", "tick (loop thread CPU)"]]);
 
 // Forces are micronewtons on a watch part, piconewtons on a trapped bead: the force plot's

@@ -171,6 +171,7 @@ listen("/platform/scene", (s) => {
     // A bead a hundred times smaller than a watch part: the tweezers' objective.
     if (optical) $("objective").value = "200";
     setForceUnit(f, optical);
+    $("forces-title").textContent = optical ? "Force on the probe bead" : "Forces on the gripper";
   }
   $("gripper").max = Math.round(s.max_opening_m * um);
   if (!mc.input.gripperTouched) {
