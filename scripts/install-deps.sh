@@ -21,6 +21,7 @@ DEBIAN_PACKAGES=(
   chromium             # headless browser for the report test
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
+  libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
@@ -44,9 +45,10 @@ if ((${#missing[@]})); then
 fi
 
 # npm packages pinned by package-lock.json (uPlot for reports and the console, playwright-core for
-# the browser tests, @mcap/core for the MCAP test, @foxglove/ws-protocol for the protocol test).
+# the browser tests, @mcap/core for the MCAP tests with @foxglove/wasm-zstd to decompress the live
+# recordings' chunks, @foxglove/ws-protocol for the protocol test).
 if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || ! -d node_modules/@mcap/core ||
-      ! -d node_modules/@foxglove/ws-protocol ||
+      ! -d node_modules/@foxglove/ws-protocol || ! -d node_modules/@foxglove/wasm-zstd ||
       package-lock.json -nt node_modules/.package-lock.json ]]; then
   echo "install-deps: npm ci" >&2
   npm ci --no-audit --no-fund --loglevel=error >/dev/null

@@ -57,8 +57,9 @@ function watchLastError(s) {
   lastError = error;
 }
 
-// The demo's result (status.demo_result: null or {outcome, phase, placement_error_m, reason,
-// duration_s}; absent from older servers). A banner when the demo ends while the page watches.
+// The demo's result (status.demo_result: null or {outcome (running, placed, inserted, missed,
+// gave_up), phase, placement_error_m, reason, duration_s}; absent from older servers). A banner
+// when the demo ends while the page watches.
 function demoText(r) {
   const dur = isNum(r.duration_s) ? `${r.duration_s.toFixed(0)} s` : "";
   if (r.outcome === "running") return `Demo: running${r.phase ? " (" + r.phase + ")" : ""}${dur ? ", " + dur : ""}`;
@@ -71,7 +72,7 @@ function watchDemo(s) {
   const r = s.demo_result && typeof s.demo_result === "object" ? s.demo_result : null;
   const key = r ? r.outcome + "/" + r.duration_s : "";
   if (lastDemoKey !== undefined && key !== lastDemoKey && r && r.outcome !== "running")
-    banner(r.outcome === "gave_up" ? "warning" : "ok", demoText(r));
+    banner(r.outcome === "gave_up" || r.outcome === "missed" ? "warning" : "ok", demoText(r));
   lastDemoKey = key;
   return r;
 }
@@ -105,7 +106,7 @@ listen("/platform/status", (s) => {
     ["watchdog", s.console_fresh ? "fresh" : "holding", s.console_fresh],
     ["mode", s.demo ? "demo: " + s.demo_phase : "console", true],
   ];
-  if (demo) rows.push(["demo", demoText(demo), demo.outcome !== "gave_up"]);
+  if (demo) rows.push(["demo", demoText(demo), demo.outcome !== "gave_up" && demo.outcome !== "missed"]);
   for (const [name, state] of Object.entries(s.lifecycle)) rows.push([name, state, state === "active"]);
   const [overruns, ok] = overrunRow(s);
   rows.push(["loop overruns", overruns, ok, kOverrunHelp]);

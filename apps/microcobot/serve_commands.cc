@@ -38,6 +38,7 @@ struct ServeOptions {
   std::string token;
   std::filesystem::path out = "out/live";
   bool record = false;
+  bool record_csv = false;
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
@@ -145,6 +146,11 @@ void serve(const ServeOptions& o) {
     pf::use_optical_trap_scene(lp.platform);
   } else if (o.scene != "pick-place") {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(o.scene, ec))
+      throw mc::InvalidInput("--scene '" + mc::excerpt(o.scene) +
+                             "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
+                             "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
   }
   auto [host, port] = parse_listen(o.listen);
@@ -157,9 +163,17 @@ void serve(const ServeOptions& o) {
                                    sp.server.token.find_first_of(" &#?%/\"'<>") != std::string::npos))
     throw mc::UsageError("--token: must be 8 to 256 characters without spaces or any of &#?%/\"'<>");
   sp.out_dir = o.out;
-  std::filesystem::create_directories(o.out);
-  if (!std::filesystem::is_directory(o.out))
-    throw mc::InvalidInput(o.out.string(), 0, "--out must be a directory");
+  sp.record_csv = o.record_csv;
+  // Each recording holds the program's version and the configuration it ran (as --print-config
+  // prints it: the keys --config takes), so a recording alone says what was run.
+  sp.version = std::string("microcobot ") + MC_VERSION;
+  sp.config_yaml = mc::params_to_yaml(lp.platform);
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec)
+    throw mc::InvalidInput("cannot create --out " + mc::excerpt(o.out.string()) + ": " + ec.message());
+  if (!std::filesystem::is_directory(o.out, ec))
+    throw mc::InvalidInput("--out " + mc::excerpt(o.out.string()) + ": exists and is not a directory");
 
   RemoteEnds ends = attach_role(o, lp);
   mc::cli::set_cooperative_interrupts(true);
@@ -179,6 +193,9 @@ void serve(const ServeOptions& o) {
   // The first line on stdout: what the operator opens.
   std::cout << server.url() << std::endl;
   std::cerr << "serve: console at " << server.url() << " (Ctrl-C stops: devices to their safe state)\n";
+  if (host == "0.0.0.0" || host == "::")
+    std::cerr << "serve: listening on every interface: from another machine, open this machine's address on port "
+              << server.port() << " with the same token\n";
   const auto start = std::chrono::steady_clock::now();
   while (mc::cli::interrupt_signal() == 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -215,6 +232,9 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
   cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
+  cmd.add_flag("--record-csv", o->record_csv,
+               "Also write each recording's telemetry as CSV beside its MCAP file (off: the MCAP file "
+               "holds every sample; the console offers the CSV when it exists)");
   cmd.add_option("--duration", o->duration_s,
                  "Stop after this many seconds of wall-clock time (default: never)")
       ->check(mc::cli::Range(0.0, 1e7));

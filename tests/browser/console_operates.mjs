@@ -9,7 +9,8 @@ import { existsSync, readdirSync, readFileSync } from "node:fs";
 import { join } from "node:path";
 import { startConsole } from "./console_session.mjs";
 
-const s = await startConsole("console_operates", (dir) => ["--out", join(dir, "rec"), "--record"], 240);
+// --record-csv: the CSV beside each recording is opt-in; this test downloads it from the console.
+const s = await startConsole("console_operates", (dir) => ["--out", join(dir, "rec"), "--record", "--record-csv"], 240);
 const { page, t, until, shot, clickTop, clickSide, goWithDeadman, setSlider, fail, log, url, dir } = s;
 try {
   await page.goto(url, { waitUntil: "domcontentloaded" });
@@ -116,6 +117,10 @@ try {
   log(`report on demand: "${title}", ${figures} plots; download ${download}`);
   if (!title.startsWith("microcobot recording: ") || figures < 8) fail(`the report did not render ("${title}", ${figures} plots)`);
   await reportPage.screenshot({ path: join(s.artifacts, "06-report.png") });
+  // The data behind each figure: its link (relative to the report) answers with the CSV.
+  const figCsv = await reportPage.$eval("a.csv", (a) => a.href).catch(() => "");
+  const fig = figCsv ? await reportPage.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, text: await r.text() }; }, figCsv) : { status: 0, text: "" };
+  if (fig.status !== 200 || !fig.text.startsWith("#")) fail(`the report's figure data ${figCsv}: HTTP ${fig.status}`);
   await reportPage.close();
   const res = await page.evaluate(async (u) => { const r = await fetch(u); return { status: r.status, bytes: (await r.arrayBuffer()).byteLength }; }, download);
   if (res.status !== 200 || res.bytes < 1000) fail(`download: HTTP ${res.status}, ${res.bytes} bytes`);

@@ -43,6 +43,30 @@ TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
   }
 }
 
+// Issue #26: a mistyped scene lists the built-in ones; an --out that cannot be created is one
+// line naming it (exit 3, not an internal error); on every interface the URL to open is loopback's.
+TEST(ServeCli, AMistypedSceneOrAnUncreatableOutIsOneHelpfulLine) {
+  test::TempDir dir;
+  auto r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", dir.path().string(), "--scene", "pin-in-hol",
+                    "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  for (const char* name : {"pin-in-hol", "pick-place", "pin-in-hole", "optical-trap"})
+    EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
+  test::write_text(dir / "a-file", "x");
+  for (const std::string& out : {std::string("/proc/nope"), (dir / "a-file" / "sub").string()}) {
+    r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", out, "--duration", "0.3"});
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("cannot create --out " + out), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+  }
+  r = run_cli({"serve", "--listen", "0.0.0.0:0", "--out", dir.path().string(), "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("http://127.0.0.1:", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("?token="), std::string::npos) << "off loopback a token is needed: " << r.out;
+}
+
 TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
   // This build registers no hardware drivers (docs/hardware.md): the simulation is the one known.
   test::TempDir dir;

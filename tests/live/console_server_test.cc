@@ -41,6 +41,7 @@ struct Rig {
     p.server.port = 0;
     p.server.token = token;
     p.out_dir = out;
+    p.record_csv = true;  // the CSV download is tested below (serve --record-csv)
     return p;
   }
   Rig() { server.start(); }
@@ -186,7 +187,16 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   McapContents mcap;
   ASSERT_NO_THROW(mcap = parse_mcap(dl.body, name)) << "a valid MCAP file";
 
-  // Beside it, the same samples as a CSV table: a row per MCAP message, a column per channel.
+  // It holds the session; its telemetry channel holds every sample (1 kHz).
+  std::uint16_t telemetry = 0;
+  for (const auto& c : mcap.channels)
+    if (c.topic == "/platform/telemetry") telemetry = c.id;
+  std::vector<McapMessage> samples;
+  for (const auto& m : mcap.messages)
+    if (m.channel_id == telemetry) samples.push_back(m);
+  EXPECT_GT(mcap.messages.size(), samples.size()) << "status, scene, feedback and events too";
+
+  // Beside it (--record-csv), the same samples as a CSV table: a row per telemetry message.
   const std::string csv_name = name.substr(0, name.size() - 5) + ".csv";
   ASSERT_EQ(list["recordings"][0]["csv_url"], "/recordings/" + csv_name) << list.dump();
   const auto csv_dl = test::http_request(port, "GET", list["recordings"][0]["csv_url"]);
@@ -194,11 +204,11 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   EXPECT_EQ(csv_dl.body, test::read_text(rig.dir / csv_name));
   EXPECT_NE(csv_dl.header("Content-Type").find("text/csv"), std::string::npos);
   const CsvTable table = parse_csv(csv_dl.body, csv_name);
-  ASSERT_EQ(table.rows(), mcap.messages.size());
+  ASSERT_EQ(table.rows(), samples.size());
   ASSERT_GT(table.rows(), 100u);
   EXPECT_EQ(table.cols(), rig.live.channel_count());
   for (std::size_t i = 0; i < table.rows(); i += table.rows() / 7) {
-    const json m = json::parse(mcap.messages[i].data);
+    const json m = json::parse(samples[i].data);
     for (const char* c : {"t_s", "target_x_m", "measured_x_m", "tick_us"}) {
       // The JSON carries 10 significant digits, the CSV every digit.
       const double want = m[c].get<double>();
@@ -219,13 +229,24 @@ TEST(ConsoleServer, RecordingsAreListedDownloadedAndReportedOnDemand) {
   EXPECT_NE(r.body.find("Slave x"), std::string::npos) << "the session's figures";
   EXPECT_TRUE(
       json::parse(test::http_request(port, "GET", "/recordings").body)["recordings"][0]["report_ready"]);
+  // Its figures' data: the links (relative to the report) answer with the CSV files.
+  const std::string fig = stem + "-figures/fig-01-hand-and-handle.csv";
+  EXPECT_NE(r.body.find("\"" + fig + "\""), std::string::npos) << "the report links its figure data";
+  const auto fig_dl = test::http_request(port, "GET", "/recordings/" + fig);
+  EXPECT_EQ(fig_dl.status, 200);
+  EXPECT_EQ(fig_dl.body.substr(0, 1), "#");
+  EXPECT_NE(fig_dl.header("Content-Type").find("text/csv"), std::string::npos);
+  // Who drove: nobody took control in this test.
+  EXPECT_NE(r.body.find("Nobody drove"), std::string::npos);
 
   // Nothing else of the disk is reachable.
   for (const std::string& bad : std::vector<std::string>{
            "/recordings/../" + name, "/recordings/x.mcap", "/recordings/recording-1.txt",
            "/recordings/.recording-1.mcap", "/recordings/recording-1/..%2f..%2fetc.mcap",
            "/recordings/recording-99.mcap", "/recordings/../" + csv_name, "/recordings/recording-99.csv",
-           "/recordings/.recording-1.csv", "/recordings/"})
+           "/recordings/.recording-1.csv", "/recordings/", "/recordings/" + stem + "-figures/x.csv",
+           "/recordings/" + stem + "-figures/fig-01-a.txt", "/recordings/" + stem + "-figures/../" + csv_name,
+           "/recordings/recording-1-figures/fig-01-hand-and-handle.csv", "/recordings/" + stem + "/" + fig})
     EXPECT_EQ(test::http_request(port, "GET", bad).status, 404) << bad;
 }
 
@@ -239,6 +260,29 @@ TEST(ConsoleServer, ATokenGuardsTheRecordingsAsItGuardsTheWebSocket) {
   EXPECT_EQ(test::http_request(server.port(), "GET", "/recordings?token=wrong").status, 401);
   EXPECT_EQ(test::http_request(server.port(), "GET", "/recordings?token=secret-token-1").status, 200);
   EXPECT_EQ(test::http_request(server.port(), "GET", "/").status, 200) << "the page itself is public";
+}
+
+// Issue #26: a refused message's status names it (its id is the message's topic), and the scene
+// tells the page the force limits and whether the demo can run.
+TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
+  Rig rig;
+  Console c(rig.server.port());
+  ASSERT_TRUE(c.action("take_control"));
+  ASSERT_FALSE(c.ws.read_status("control").is_null());
+  ASSERT_TRUE(c.command({{"deadman", "yes"}}));
+  const json refused = c.ws.read_status("/console/command");
+  ASSERT_FALSE(refused.is_null());
+  EXPECT_EQ(refused.value("level", -1), 2);  // error
+  EXPECT_NE(refused.value("message", "").find("deadman"), std::string::npos) << refused;
+  c.subscribe("/platform/scene", 7);
+  const json scene = json::parse(c.next_on(7));
+  EXPECT_DOUBLE_EQ(scene.at("grip_force_limit_N").get<double>(), 1e-3);
+  EXPECT_DOUBLE_EQ(scene.at("contact_force_limit_N").get<double>(), 2e-3);
+  EXPECT_TRUE(scene.at("demo_available").get<bool>());
+  c.subscribe("/platform/status", 8);
+  const json status = json::parse(c.next_on(8));
+  EXPECT_TRUE(status.at("demo_result").is_null());
+  EXPECT_GT(status.at("ticks").get<double>(), 0.0);
 }
 
 }  // namespace

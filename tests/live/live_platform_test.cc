@@ -160,5 +160,57 @@ TEST(LivePlatform, TheDemoRestartsTheSceneWithTheScriptedOperatorAndTimeGoesOn) 
   EXPECT_TRUE(std::isfinite(rig.get("part_x_m")));
 }
 
+// Issue #26: a finished demo hands control back with every axis holding, and says how it ended.
+TEST(LivePlatform, AFinishedDemoHandsBackWithEveryAxisHoldingAndReportsItsOutcome) {
+  LiveParams params;
+  params.paced = false;  // as fast as the machine goes: the whole insertion in seconds
+  params.platform.world = microworld::pin_in_hole_scene();
+  params.platform.world.target_m.x() = 0.3e-3;
+  LivePlatform live(params);
+  std::mutex mutex;
+  platform::TelemetrySample last{};
+  live.start([&](const platform::TelemetrySample& s, std::size_t) {
+    std::lock_guard lock(mutex);
+    last = s;
+  });
+  auto get = [&](const char* name) {
+    std::lock_guard lock(mutex);
+    return last[channel(name)];
+  };
+  live.request(ConsoleAction::kDemo);
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        const auto o = live.status().demo_result.outcome;
+        return o != DemoResult::Outcome::kNone && o != DemoResult::Outcome::kRunning;
+      },
+      std::chrono::seconds(120)));
+  const LiveStatus s = live.status();
+  EXPECT_EQ(s.demo_result.outcome, DemoResult::Outcome::kInserted) << s.demo_result.phase << ": " << s.demo_result.reason;
+  EXPECT_FALSE(s.demo);
+  EXPECT_FALSE(s.demo_result.reason.empty());
+  EXPECT_LT(s.demo_result.placement_error_m, 10e-6);
+  EXPECT_GT(s.demo_result.duration_s, 1.0);
+  // Three seconds of live time later, nothing has moved: no axis drifts, the coupling is off.
+  const double t0 = get("t_s");
+  const std::array<double, 3> p0 = {get("slave_x_m"), get("slave_y_m"), get("slave_z_m")};
+  ASSERT_TRUE(test::eventually([&] { return get("t_s") > t0 + 3.0; }, std::chrono::seconds(60)));
+  EXPECT_NEAR(get("slave_x_m"), p0[0], 50e-9);
+  EXPECT_NEAR(get("slave_y_m"), p0[1], 50e-9);
+  EXPECT_NEAR(get("slave_z_m"), p0[2], 50e-9);
+  EXPECT_EQ(get("engaged"), 0.0);
+  live.stop();
+}
+
+TEST(LivePlatform, ADemoThatCannotWorkInTheSceneIsRefusedWithItsReason) {
+  LiveParams params;
+  params.paced = false;
+  platform::use_optical_trap_scene(params.platform);
+  LivePlatform live(params);
+  EXPECT_NE(live.demo_unavailable_reason().find("optical-trap"), std::string::npos);
+  live.request(ConsoleAction::kDemo);
+  EXPECT_EQ(live.status().last_error, live.demo_unavailable_reason());
+  EXPECT_EQ(live.status().demo_result.outcome, DemoResult::Outcome::kNone);
+}
+
 }  // namespace
 }  // namespace mc::live

@@ -161,7 +161,11 @@ TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
   ASSERT_TRUE(pin.w.inserted(pin.s));
   const auto out = move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 100e-6}, Pin::closed);
   EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-12) << "against the wall";
-  EXPECT_NEAR(out.force_on_gripper_N.x(), -1e5 * 1e-6, 1e-9) << "the last micrometre pressed into the wall";
+  // The wall stops the pin with 1e5 N/m x 1 um = 0.1 N; the fingers feel at most what holds
+  // the pin in them, 2 mu F_grip: beyond it the pin slips between them (issue #26).
+  const double holds = 2 * pin.w.params().finger_friction * out.grip_force_N;
+  ASSERT_GT(out.grip_force_N, 0.0);
+  EXPECT_NEAR(out.force_on_gripper_N.x(), -holds, 1e-12) << "pressed into the wall, the pin slips in the fingers";
   // Pulled out, it is free again.
   move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 600e-6}, Pin::closed);
   EXPECT_FALSE(pin.w.inserted(pin.s));

@@ -67,7 +67,9 @@ struct Pair {
   std::unique_ptr<RemoteMaster> master_link;
   std::unique_ptr<End> master, slave;
 
-  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true) {
+  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true,
+                const microworld::PickPlaceParams& world = {}) {
+    config.world = world;
     const int domain = test::test_domain_id();
     RemoteMasterParams mp;
     mp.link.domain_id = domain;
@@ -77,6 +79,7 @@ struct Pair {
     mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     master_link = std::make_unique<RemoteMaster>(mp);
     live::LiveParams sp;
+    sp.platform.world = config.world;
     sp.remote = master_link.get();
     slave = std::make_unique<End>(sp);
 
@@ -88,6 +91,7 @@ struct Pair {
     rp.sample_period_s = axis.integrator.dt_s;
     slave_link = std::make_unique<RemoteSlave>(rp);
     live::LiveParams lp;
+    lp.platform.world = config.world;
     lp.make_devices = [this] {
       platform::PlatformDevices d = slave_link->make_devices();
       d.haptic = std::make_unique<platform::SimulatedHapticMaster>(
@@ -129,6 +133,18 @@ bool Pair::engage() {
 }
 
 // 100 ms each way, 10 ms of jitter, 20 % loss: the 200 ms round trip of issue #17's goal.
+// The platform's safety limits (issue #26) keep the fingers 10 um above the substrate, the grip
+// under 1 mN and the stage still above a 2 mN contact: the passivity tests below need the stiff
+// contact and the hard grip those limits forbid, so they lift them (a platform with a customer's
+// parts never would).
+microworld::PickPlaceParams without_safety_limits() {
+  microworld::PickPlaceParams w;
+  w.min_tip_height_m = -1e-3;
+  w.grip_force_limit_N = 1.0;
+  w.contact_force_limit_N = 10.0;
+  return w;
+}
+
 control::LinkParams lossy_200ms_round_trip(std::uint64_t seed) {
   control::LinkParams link;
   link.delay_s = 0.1;
@@ -212,7 +228,7 @@ struct Press {
 };
 
 Press press_into_the_substrate(bool passivity) {
-  Pair pair(lossy_200ms_round_trip(5), passivity);
+  Pair pair(lossy_200ms_round_trip(5), passivity, true, without_safety_limits());
   EXPECT_TRUE(pair.engage()) << "the master never engaged with the slave";
   live::ConsoleCommand c;
   c.deadman = true;
@@ -280,7 +296,7 @@ struct Grasp {
 };
 
 Grasp grasp_across_the_link(bool passivity) {
-  Pair pair(lossy_200ms_round_trip(9), passivity);
+  Pair pair(lossy_200ms_round_trip(9), passivity, true, without_safety_limits());
   EXPECT_TRUE(pair.engage()) << "the master never engaged with the slave";
   live::ConsoleCommand c;
   c.deadman = true;

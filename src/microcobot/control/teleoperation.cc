@@ -22,8 +22,9 @@ void TeleoperationParams::validate() const {
 }
 
 Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
-                             const Eigen::Vector3d& slave_start_m, double gripper_start_m)
-    : p_(params), dt_(dt_s) {
+                             const Eigen::Vector3d& slave_start_m, double gripper_start_m,
+                             const SafetyLimitParams& limits)
+    : p_(params), limits_(limits), dt_(dt_s) {
   p_.validate();
   require_positive(dt_s, "dt_s");
   out_.slave_target_m = slave_start_m;
@@ -64,11 +65,35 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
       out_.slave_velocity_m_s[i] = (out_.slave_target_m[i] - before) / dt_;
     }
   }
+  // The gripper moves on the console's command only while the coupling is engaged (deadman
+  // held, commands fresh); otherwise it holds its opening.
+  const double requested = out_.engaged && c.has_gripper && std::isfinite(c.gripper_opening_m)
+                               ? std::max(0.0, c.gripper_opening_m)
+                               : out_.gripper_opening_m;
+  apply_limits(in, requested);
   last_xy_m_ = out_.slave_target_m.head<2>();
-  if (c.has_gripper && std::isfinite(c.gripper_opening_m))
-    out_.gripper_opening_m = std::max(0.0, c.gripper_opening_m);
   out_.finger_force_N = 0.0;
   console_had_control_ = true;
+}
+
+void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_opening_m) noexcept {
+  const Eigen::Vector3d before = out_.slave_target_m;
+  limits_.limit_target(out_.slave_target_m, out_.slave_velocity_m_s, in.slave_position_m, in.contact_force_N);
+  contact_limited_ = limits_.contact_over_limit(in.contact_force_N);
+  // A hand that pushes on into a held contact slips like a clutch: when the force drops, the
+  // slave does not jump to where the hand went meanwhile.
+  offset_m_ += (out_.slave_target_m - before).head<2>();
+  out_.gripper_opening_m =
+      limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N, out_.gripper_opening_m);
+}
+
+void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
+  if (measured_m.allFinite()) out_.slave_target_m = measured_m;
+  out_.slave_velocity_m_s.setZero();
+  out_.engaged = false;
+  out_.haptic_force_N.setZero();
+  force_filtered_N_.setZero();
+  last_xy_m_ = out_.slave_target_m.head<2>();
 }
 
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
@@ -126,9 +151,14 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     out_.haptic_force_N.setZero();
     force_filtered_N_.setZero();
   }
+  // The gripper follows the TéléTweez only while the deadman is held (and its readings are
+  // fresh); otherwise it holds its opening.
+  const bool tweezers_ok = in.tweezers_fresh && std::isfinite(in.tweezers_opening_m);
+  const double requested = in.deadman && tweezers_ok ? p_.grip_position_scale * in.tweezers_opening_m
+                                                     : out_.gripper_opening_m;
+  apply_limits(in, requested);
   last_xy_m_ = out_.slave_target_m.head<2>();
-  if (in.tweezers_fresh && std::isfinite(in.tweezers_opening_m)) {
-    out_.gripper_opening_m = p_.grip_position_scale * in.tweezers_opening_m;
+  if (tweezers_ok) {
     const double f = p_.grip_force_scale * in.grip_force_N;
     out_.finger_force_N = std::isfinite(f) ? std::clamp(f, -p_.max_grip_force_N, p_.max_grip_force_N) : 0.0;
   } else {

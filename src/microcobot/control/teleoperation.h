@@ -17,11 +17,15 @@
 ///  - safety: the coupling is engaged only while the deadman is held, the clutch released and the
 ///    haptic master's (or the console's) commands fresh (the platform's watchdog). Disengaged, the slave
 ///    targets freeze (the stage holds where it is) and the haptic force is zero; the gripper follows the
-///    TéléTweez only while its readings are fresh, and holds otherwise.
+///    TéléTweez (or the console) only while the deadman is held and its readings are fresh, and holds
+///    otherwise (issue #26: nothing of the slave moves without the deadman). Whatever the input, the
+///    grip force, the contact force and the floor are limited (safety_limits.h).
 ///
 /// tick() runs on the real-time path at the haptic rate: no allocation, lock, exception or I/O.
 
 #include <Eigen/Core>
+
+#include "microcobot/control/safety_limits.h"
 
 namespace mc::control {
 
@@ -84,6 +88,7 @@ struct TeleoperationInput {
   Eigen::Vector3d slave_position_m = Eigen::Vector3d::Zero();  ///< measured stage position
   Eigen::Vector3d contact_force_N = Eigen::Vector3d::Zero();   ///< force on the slave gripper
   double grip_force_N = 0.0;                                   ///< slave grip force
+  double gripper_opening_m = 0.0;  ///< measured opening (the part's width while gripping)
   /// The slave's measurements are fresh (a remote slave that went silent is not): while they
   /// are stale the coupling disengages with no force on the masters, and the slave target is
   /// re-taken from the measured position when they return.
@@ -107,17 +112,27 @@ class Teleoperation {
   /// Validates; `dt_s` is the haptic period. The slave starts holding at `slave_start_m`
   /// with the gripper at `gripper_start_m`.
   Teleoperation(const TeleoperationParams& params, double dt_s, const Eigen::Vector3d& slave_start_m,
-                double gripper_start_m);
+                double gripper_start_m, const SafetyLimitParams& limits = {});
   /// One haptic tick. Never allocates.
   const TeleoperationOutput& tick(const TeleoperationInput& in) noexcept;
   const TeleoperationOutput& output() const noexcept { return out_; }
   const TeleoperationParams& params() const noexcept { return p_; }
+  const SafetyLimits& limits() const noexcept { return limits_; }
+  /// True while the last tick held the stage against an over-limit contact.
+  bool contact_limited() const noexcept { return contact_limited_; }
+  /// Holds the slave where it is measured (target = position, zero velocity), disengaged: the
+  /// hand-back after an automatic sequence (issue #26). Real-time safe.
+  void hold_at(const Eigen::Vector3d& measured_m) noexcept;
 
  private:
   double clamp_workspace(double v) const noexcept;
   void console_tick(const TeleoperationInput& in) noexcept;
+  /// The safety limits on this tick's commands (every input path).
+  void apply_limits(const TeleoperationInput& in, double requested_opening_m) noexcept;
 
   TeleoperationParams p_;
+  SafetyLimits limits_;
+  bool contact_limited_ = false;
   double dt_;
   TeleoperationOutput out_;
   double force_alpha_ = 1.0;  // low-pass coefficient per tick

@@ -10,6 +10,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/mcap_writer.h"
+#include "microcobot/core/zstd.h"
 
 namespace mc {
 
@@ -22,6 +23,18 @@ const McapChannel* McapContents::channel(std::uint16_t id) const {
 const McapSchema* McapContents::schema(std::uint16_t id) const {
   for (const auto& s : schemas)
     if (s.id == id) return &s;
+  return nullptr;
+}
+
+const McapMetadata* McapContents::find_metadata(std::string_view name) const {
+  for (const auto& m : metadata)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+const std::string* McapMetadata::find(std::string_view key) const {
+  for (const auto& [k, v] : entries)
+    if (k == key) return &v;
   return nullptr;
 }
 
@@ -97,15 +110,21 @@ struct Record {
 };
 
 struct ChunkInfo {
-  std::uint64_t offset = 0, length = 0, start_ns = 0, end_ns = 0, records_size = 0;
+  std::uint64_t offset = 0, length = 0, start_ns = 0, end_ns = 0, records_size = 0, stored_size = 0;
+  std::string compression;
   std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>> messages;  // time, offset
   std::map<std::uint16_t, std::uint64_t> index_offsets;  // MessageIndex records that followed
   std::uint64_t index_start = 0, index_end = 0;
 };
 
+struct IndexTarget {  // an Attachment or Metadata record that an index must point at
+  std::uint64_t offset, length;
+  std::string name;
+};
+
 class Parser {
  public:
-  Parser(std::string_view bytes, const std::string& name) : f_(bytes), name_(name) {}
+  Parser(std::string_view bytes, const std::string& name) : f_(bytes), name_(name), file_name_(name) {}
 
   McapContents run() {
     const std::uint64_t size = f_.size();
@@ -238,14 +257,36 @@ class Parser {
     ci.end_ns = fl.u64("message_end_time");
     const std::uint64_t uncompressed_size = fl.u64("uncompressed_size");
     const std::uint32_t crc = fl.u32("uncompressed_crc");
-    const std::string_view compression = fl.prefixed("compression");
-    if (!compression.empty()) {
-      fail(name_, r.offset,
-           fmt::format("Chunk compressed with '{}': only uncompressed chunks are read", compression));
+    const std::string compression(fl.prefixed("compression"));
+    if (!compression.empty() && compression != "zstd") {
+      fail(
+          name_, r.offset,
+          fmt::format("Chunk compressed with '{}': only uncompressed and zstd chunks are read", compression));
     }
-    const std::uint64_t records_at = fl.pos() + 8;
-    const std::string_view records = fl.bytes(fl.u64("records length"), "records");
+    std::uint64_t records_at = fl.pos() + 8;
+    std::string_view records = fl.bytes(fl.u64("records length"), "records");
     if (fl.remaining() != 0) fail(name_, fl.pos(), "Chunk record: bytes after its records");
+    out_.chunks.push_back({compression, records.size(), uncompressed_size});
+    // A compressed chunk's records are parsed from their decompressed copy: offsets (the
+    // MessageIndex's, the errors') then count within it, as the spec's message offsets do.
+    std::string decompressed;
+    const std::string_view file = f_;
+    struct Restore {
+      Parser& p;
+      std::string_view file;
+      ~Restore() {
+        p.f_ = file;
+        p.name_ = p.file_name_;
+      }
+    } restore{*this, file};
+    if (compression == "zstd") {
+      decompressed = zstd_decompress(records, uncompressed_size,
+                                     fmt::format("{}: byte {}: zstd Chunk", name_, r.offset));
+      f_ = decompressed;
+      name_ = fmt::format("{} (zstd chunk at byte {}, decompressed)", file_name_, r.offset);
+      records = f_;
+      records_at = 0;
+    }
     if (uncompressed_size != records.size()) {
       fail(name_, r.offset,
            fmt::format("Chunk uncompressed_size {} differs from its {} bytes of records", uncompressed_size,
@@ -257,6 +298,8 @@ class Parser {
                        crc, crc32(records)));
     }
     ci.records_size = records.size();
+    ci.stored_size = out_.chunks.back().compressed_size;
+    ci.compression = compression;
     const std::uint64_t end = records_at + records.size();
     std::optional<std::uint64_t> lo, hi;
     for (std::uint64_t at = records_at; at < end;) {
@@ -360,9 +403,11 @@ class Parser {
           message_index(r, chunks_.back());
           break;
         case Op::kAttachment:
+          attachment(r);
           ++attachments_;
           break;
         case Op::kMetadata:
+          metadata(r);
           ++metadata_;
           break;
         case Op::kDataEnd: {
@@ -460,7 +505,10 @@ class Parser {
           chunk_index(r, chunks_[chunk_indexes++]);
           break;
         case Op::kAttachmentIndex:
+          attachment_index(r);
+          break;
         case Op::kMetadataIndex:
+          metadata_index(r);
           break;
         case Op::kHeader:
         case Op::kFooter:
@@ -480,6 +528,12 @@ class Parser {
     if (chunk_indexes != chunks_.size()) {
       fail(name_, summary_start_,
            fmt::format("summary has {} ChunkIndex records for {} chunks", chunk_indexes, chunks_.size()));
+    }
+    if (attachment_indexes_ != attachment_records_.size() || metadata_indexes_ != metadata_records_.size()) {
+      fail(name_, summary_start_,
+           fmt::format("summary indexes {} of {} attachments and {} of {} metadata records",
+                       attachment_indexes_, attachment_records_.size(), metadata_indexes_,
+                       metadata_records_.size()));
     }
     if (schemas.size() != out_.schemas.size() || channels.size() != out_.channels.size()) {
       fail(name_, summary_start_,
@@ -512,6 +566,74 @@ class Parser {
       }
       at = r.end;
     }
+  }
+
+  void metadata(const Record& r) {
+    Fields fl(f_, name_, r.content, r.end, "Metadata");
+    McapMetadata m;
+    m.name = fl.prefixed("name");
+    const std::uint64_t map_at = fl.pos() + 4;
+    const std::string_view map = fl.prefixed("metadata");
+    Fields e(f_, name_, map_at, map_at + map.size(), "Metadata map");
+    while (e.remaining() > 0) {
+      std::string k(e.prefixed("metadata key"));
+      std::string v(e.prefixed("metadata value"));
+      m.entries.emplace_back(std::move(k), std::move(v));
+    }
+    metadata_records_.push_back({r.offset, r.end - r.offset, m.name});
+    out_.metadata.push_back(std::move(m));
+  }
+
+  void attachment(const Record& r) {
+    Fields fl(f_, name_, r.content, r.end, "Attachment");
+    McapAttachment a;
+    a.log_time_ns = fl.u64("log_time");
+    a.create_time_ns = fl.u64("create_time");
+    a.name = fl.prefixed("name");
+    a.media_type = fl.prefixed("media_type");
+    a.data = fl.bytes(fl.u64("data length"), "data");
+    const std::uint64_t crc_at = fl.pos();
+    const std::uint32_t crc = fl.u32("crc");
+    if (fl.remaining() != 0) fail(name_, fl.pos(), "Attachment record: bytes after its crc");
+    const std::uint32_t actual = crc32(f_.substr(r.content, crc_at - r.content));
+    if (crc != 0 && crc != actual) {
+      fail(name_, r.offset,
+           fmt::format("Attachment '{}' CRC mismatch (stored 0x{:08x}, computed 0x{:08x})", a.name, crc,
+                       actual));
+    }
+    attachment_records_.push_back({r.offset, r.end - r.offset, a.name});
+    out_.attachments.push_back(std::move(a));
+  }
+
+  // An index record of the summary must point at the next Attachment/Metadata record, by name.
+  void check_index(const Record& r, const char* what, std::uint64_t offset, std::uint64_t length,
+                   const std::string& name, const std::vector<IndexTarget>& targets, std::size_t& n) {
+    if (n >= targets.size())
+      fail(name_, r.offset, fmt::format("{} without its record in the data section", what));
+    const IndexTarget& t = targets[n++];
+    if (offset != t.offset || length != t.length || name != t.name) {
+      fail(name_, r.offset,
+           fmt::format("{} ('{}' at byte {}, {} bytes) does not match the record ('{}' at byte {}, {} bytes)",
+                       what, name, offset, length, t.name, t.offset, t.length));
+    }
+  }
+
+  void attachment_index(const Record& r) {
+    Fields fl(f_, name_, r.content, r.end, "AttachmentIndex");
+    const std::uint64_t offset = fl.u64("offset"), length = fl.u64("length");
+    fl.u64("log_time");
+    fl.u64("create_time");
+    fl.u64("data_size");
+    const std::string name(fl.prefixed("name"));
+    fl.prefixed("media_type");
+    check_index(r, "AttachmentIndex", offset, length, name, attachment_records_, attachment_indexes_);
+  }
+
+  void metadata_index(const Record& r) {
+    Fields fl(f_, name_, r.content, r.end, "MetadataIndex");
+    const std::uint64_t offset = fl.u64("offset"), length = fl.u64("length");
+    const std::string name(fl.prefixed("name"));
+    check_index(r, "MetadataIndex", offset, length, name, metadata_records_, metadata_indexes_);
   }
 
   void statistics(const Record& r) {
@@ -592,11 +714,15 @@ class Parser {
     check(length == ci.length, "chunk_length", length, ci.length);
     check(start == ci.start_ns, "message_start_time", start, ci.start_ns);
     check(end == ci.end_ns, "message_end_time", end, ci.end_ns);
-    check(compressed == ci.records_size, "compressed_size", compressed, ci.records_size);
+    check(compressed == ci.stored_size, "compressed_size", compressed, ci.stored_size);
     check(uncompressed == ci.records_size, "uncompressed_size", uncompressed, ci.records_size);
     check(index_length == ci.index_end - ci.index_start, "message_index_length", index_length,
           ci.index_end - ci.index_start);
-    if (!compression.empty()) fail(name_, r.offset, "ChunkIndex names a compression; the chunk has none");
+    if (compression != ci.compression) {
+      fail(name_, r.offset,
+           fmt::format("ChunkIndex names compression '{}', the chunk at byte {} has '{}'", compression,
+                       ci.offset, ci.compression));
+    }
     if (offsets != ci.index_offsets) {
       fail(name_, r.offset,
            fmt::format(
@@ -606,8 +732,11 @@ class Parser {
     }
   }
 
-  std::string_view f_;
-  const std::string& name_;
+  std::string_view f_;  // the file; a decompressed chunk's records while they are parsed
+  std::string name_;    // the file's name; with the chunk's offset while its records are parsed
+  std::string file_name_;
+  std::vector<IndexTarget> attachment_records_, metadata_records_;
+  std::size_t attachment_indexes_ = 0, metadata_indexes_ = 0;
   std::uint64_t footer_ = 0, summary_start_ = 0, summary_offset_start_ = 0;
   std::uint32_t summary_crc_ = 0;
   std::vector<ChunkInfo> chunks_;

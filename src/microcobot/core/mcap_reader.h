@@ -4,8 +4,11 @@
 /// the whole file and checks everything a writer promises, so that a file it accepts is one
 /// that indexed viewers can seek in:
 ///  - both magics, the Header first, the Footer last, every record's framing;
-///  - chunks: uncompressed only ("" compression), sizes, the records' CRC-32, messages within
-///    the chunk's time range, on channels defined before them;
+///  - chunks: uncompressed ("") or zstd-compressed ("zstd", core/zstd.h), sizes, the CRC-32 of
+///    the (decompressed) records, messages within the chunk's time range, on channels defined
+///    before them;
+///  - Attachment records' CRC-32; AttachmentIndex and MetadataIndex records that point at the
+///    data section's Attachment and Metadata records;
 ///  - each MessageIndex: it follows its chunk and lists exactly that chunk's messages of its
 ///    channel (log time and offset);
 ///  - DataEnd's CRC of the data section, the Footer's CRC of the summary;
@@ -48,6 +51,26 @@ struct McapMessage {
   std::string data;
 };
 
+/// A Metadata record: a name and its string map (spec, "Metadata").
+struct McapMetadata {
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> entries;
+  /// The value of `key`, or nullptr.
+  const std::string* find(std::string_view key) const;
+};
+
+/// An Attachment record (spec, "Attachment").
+struct McapAttachment {
+  std::uint64_t log_time_ns = 0, create_time_ns = 0;
+  std::string name, media_type, data;
+};
+
+/// How a chunk was stored: its compression ("" or "zstd") and sizes.
+struct McapChunkStorage {
+  std::string compression;
+  std::uint64_t compressed_size = 0, uncompressed_size = 0;
+};
+
 /// The Statistics record of the summary.
 struct McapStatistics {
   std::uint64_t message_count = 0;
@@ -68,13 +91,18 @@ struct McapContents {
   std::vector<McapSchema> schemas;
   std::vector<McapChannel> channels;
   std::vector<McapMessage> messages;
-  bool has_summary = false;     ///< false for a file without summary (allowed by the spec)
-  bool has_statistics = false;  ///< the summary held a Statistics record
+  std::vector<McapMetadata> metadata;
+  std::vector<McapAttachment> attachments;
+  std::vector<McapChunkStorage> chunks;  ///< in file order
+  bool has_summary = false;              ///< false for a file without summary (allowed by the spec)
+  bool has_statistics = false;           ///< the summary held a Statistics record
   McapStatistics statistics;
   std::size_t chunk_count = 0;
 
   const McapChannel* channel(std::uint16_t id) const;
   const McapSchema* schema(std::uint16_t id) const;
+  /// The first Metadata record named `name`, or nullptr.
+  const McapMetadata* find_metadata(std::string_view name) const;
 };
 
 /// Reads and checks `file`. Throws InvalidInput "<file>: byte <offset>: <what>" on any

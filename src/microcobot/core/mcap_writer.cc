@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/zstd.h"
 
 namespace mc {
 
@@ -55,8 +56,15 @@ std::uint32_t crc32(std::string_view bytes, std::uint32_t previous) {
   return c ^ 0xFFFFFFFFu;
 }
 
-McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes)
-    : path_(std::move(path)), file_(path_), chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)) {
+McapWriter::McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes,
+                       McapCompression compression)
+    : path_(std::move(path)),
+      file_(path_),
+      chunk_target_(std::max<std::size_t>(chunk_target_bytes, 1)),
+      compression_(compression) {
+  if (compression_.zstd)
+    require(compression_.zstd_level >= 1 && compression_.zstd_level <= 19, "zstd_level",
+            "must be within [1, 19]", compression_.zstd_level);
   out_.reserve(kIoBuffer);
   chunk_.reserve(std::min(chunk_target_, std::size_t{64} << 20) + 4096);
   put(kMcapMagic);
@@ -137,6 +145,52 @@ std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, std::string_view 
   return id;
 }
 
+void McapWriter::add_metadata(std::string_view name,
+                              const std::vector<std::pair<std::string, std::string>>& entries) {
+  if (closed_) throw InvalidInput(path_.string(), 0, "add_metadata after close");
+  std::string rec;
+  put_str(rec, name);
+  std::string map;
+  for (const auto& [k, v] : entries) {
+    put_str(map, k);
+    put_str(map, v);
+  }
+  put_str(rec, map);
+  // MetadataIndex: offset, length (of the whole record), name.
+  std::string index;
+  put_u64(index, position());
+  put_u64(index, kRecordPrefix + rec.size());
+  put_str(index, name);
+  put_record(McapOpcode::kMetadata, rec);
+  indexes_.push_back({McapOpcode::kMetadataIndex, std::move(index)});
+  ++metadata_count_;
+}
+
+void McapWriter::add_attachment(std::string_view name, std::string_view media_type, std::string_view data,
+                                std::uint64_t log_time_ns, std::uint64_t create_time_ns) {
+  if (closed_) throw InvalidInput(path_.string(), 0, "add_attachment after close");
+  std::string rec;
+  put_u64(rec, log_time_ns);
+  put_u64(rec, create_time_ns);
+  put_str(rec, name);
+  put_str(rec, media_type);
+  put_u64(rec, data.size());  // Bytes with a uint64 length, unlike the other records' uint32
+  rec.append(data);
+  put_u32(rec, crc32(rec));  // the CRC of every field before it
+  // AttachmentIndex: offset, length, log time, create time, data size, name, media type.
+  std::string index;
+  put_u64(index, position());
+  put_u64(index, kRecordPrefix + rec.size());
+  put_u64(index, log_time_ns);
+  put_u64(index, create_time_ns);
+  put_u64(index, data.size());
+  put_str(index, name);
+  put_str(index, media_type);
+  put_record(McapOpcode::kAttachment, rec);
+  indexes_.push_back({McapOpcode::kAttachmentIndex, std::move(index)});
+  ++attachment_count_;
+}
+
 void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
                        std::span<const std::byte> payload) {
   write(channel_id, log_time_ns, publish_time_ns,
@@ -184,19 +238,31 @@ void McapWriter::close_chunk() {
   ci.end_ns = chunk_end_ns_;
   ci.offset = position();
   ci.records_size = chunk_.size();
-  // Chunk: start, end, uncompressed size, uncompressed CRC, compression "", records (u64 length).
+  // Chunk: start, end, uncompressed size, uncompressed CRC, compression, records (u64 length).
+  // The CRC is of the records before compression (spec, "Chunk"): a reader checks what it
+  // decompressed.
+  const std::uint32_t crc = crc32(chunk_);
+  std::string_view stored = chunk_;
+  const std::string_view compression = compression_.zstd ? "zstd" : "";
+  if (compression_.zstd) {
+    zstd_compress(chunk_, compression_.zstd_level, compressed_);
+    stored = compressed_;
+  }
+  ci.stored_size = stored.size();
   scratch_.clear();
   put_u8(scratch_, static_cast<std::uint8_t>(McapOpcode::kChunk));
-  const std::uint64_t content = 8 + 8 + 8 + 4 + 4 + 8 + chunk_.size();
+  const std::uint64_t content = 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + stored.size();
   put_u64(scratch_, content);
   put_u64(scratch_, chunk_start_ns_);
   put_u64(scratch_, chunk_end_ns_);
   put_u64(scratch_, chunk_.size());
-  put_u32(scratch_, crc32(chunk_));
-  put_str(scratch_, "");
-  put_u64(scratch_, chunk_.size());
+  put_u32(scratch_, crc);
+  put_str(scratch_, compression);
+  put_u64(scratch_, stored.size());
   put(scratch_);
-  put(chunk_);
+  put(stored);
+  records_bytes_ += chunk_.size();
+  stored_bytes_ += stored.size();
   ci.length = kRecordPrefix + content;
   // One MessageIndex per channel present in the chunk, entries in log-time order.
   const std::uint64_t index_start = position();
@@ -255,8 +321,8 @@ void McapWriter::close() {
     put_u64(s, message_count_);
     put_u16(s, static_cast<std::uint16_t>(schemas_.size()));
     put_u32(s, static_cast<std::uint32_t>(channels_.size()));
-    put_u32(s, 0);  // attachments
-    put_u32(s, 0);  // metadata
+    put_u32(s, attachment_count_);
+    put_u32(s, metadata_count_);
     put_u32(s, static_cast<std::uint32_t>(chunk_indexes_.size()));
     put_u64(s, message_count_ ? start_ns_ : 0);
     put_u64(s, message_count_ ? end_ns_ : 0);
@@ -282,12 +348,18 @@ void McapWriter::close() {
       }
       put_str(s, offsets);
       put_u64(s, ci.index_length);
-      put_str(s, "");               // compression
-      put_u64(s, ci.records_size);  // compressed size
+      put_str(s, compression_.zstd ? "zstd" : "");
+      put_u64(s, ci.stored_size);   // compressed size
       put_u64(s, ci.records_size);  // uncompressed size
       add_record(McapOpcode::kChunkIndex, s);
     }
   });
+  for (const McapOpcode op : {McapOpcode::kAttachmentIndex, McapOpcode::kMetadataIndex}) {
+    group(op, [&] {
+      for (const auto& e : indexes_)
+        if (e.op == op) add_record(op, e.content);
+    });
+  }
   const std::uint64_t summary_offset_start = summary_start + summary.size();
   for (const auto& [op, start, length] : groups) {
     std::string s;

@@ -4,17 +4,21 @@
 /// no MCAP package exists for Debian. It writes indexed files that viewers (Foxglove,
 /// Lichtblick, `@mcap/core`'s McapIndexedReader) can seek in:
 ///
-///     magic Header  Schema* Channel*  (Chunk MessageIndex*)*  DataEnd
-///     Summary: Schema* Channel* Statistics ChunkIndex*   SummaryOffset*   Footer magic
+///     magic Header  Schema* Channel*  (Chunk MessageIndex* | Metadata | Attachment)*  DataEnd
+///     Summary: Schema* Channel* Statistics ChunkIndex* AttachmentIndex* MetadataIndex*
+///              SummaryOffset*   Footer magic
 ///
-/// Messages go into uncompressed chunks of about `chunk_target_bytes`; each chunk carries the
-/// CRC-32 of its records and is followed by one MessageIndex per channel it holds. The data
-/// section's and the summary's CRCs are written too.
+/// Messages go into chunks of about `chunk_target_bytes` of records, stored as they are or
+/// compressed with zstd (spec, "Chunk": `compression` "zstd", `uncompressed_size`, and
+/// `uncompressed_crc` the CRC-32 of the records before compression); each chunk is followed by
+/// one MessageIndex per channel it holds, whose offsets count in the uncompressed records. The
+/// data section's and the summary's CRCs are written too.
 ///
 /// The file is written under a temporary name beside the target and renamed at close(), so an
 /// interrupted run never leaves a partial file under the final name (DESIGN.md, "Errors").
-/// Not for the real-time path (it does I/O), but a message costs no allocation once the
-/// chunk buffer has grown to its size.
+/// Not for the real-time path (it does I/O and compresses: a live recording writes it from a
+/// thread of its own, live/session_recording.h), but a message costs no allocation once the
+/// chunk buffers have grown to their size.
 
 #include <cstddef>
 #include <cstdint>
@@ -56,6 +60,12 @@ enum class McapOpcode : std::uint8_t {
 /// The 8 bytes that open and close every MCAP file: "\x89MCAP0\r\n".
 inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
 
+/// How chunks are stored: as they are, or compressed with zstd (core/zstd.h) at a level.
+struct McapCompression {
+  bool zstd = false;
+  int zstd_level = 3;  ///< 1..19 (fast .. small)
+};
+
 class McapWriter {
  public:
   static constexpr std::size_t kDefaultChunkBytes = std::size_t{1} << 20;
@@ -63,7 +73,8 @@ class McapWriter {
   /// Opens a temporary file beside `path` and writes the magic and the Header (profile "",
   /// library "microcobot"). A chunk is closed once its records reach `chunk_target_bytes`.
   /// Throws InvalidInput naming `path` when the directory is missing or not writable.
-  explicit McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes = kDefaultChunkBytes);
+  explicit McapWriter(std::filesystem::path path, std::size_t chunk_target_bytes = kDefaultChunkBytes,
+                      McapCompression compression = {});
   /// Without close() (an exception unwinding, a cut run) the temporary file is removed and
   /// nothing appears under the target name.
   ~McapWriter();
@@ -80,6 +91,14 @@ class McapWriter {
                             std::string_view message_encoding,
                             const std::vector<std::pair<std::string, std::string>>& metadata = {});
 
+  /// Adds a Metadata record (spec, "Metadata": a name and a string map, e.g. the program's
+  /// version), listed in the summary by a MetadataIndex. Throws InvalidInput after close().
+  void add_metadata(std::string_view name, const std::vector<std::pair<std::string, std::string>>& entries);
+  /// Adds an Attachment record (spec, "Attachment": a named file with its media type, e.g. the
+  /// configuration as "application/yaml"), its CRC-32 and an AttachmentIndex in the summary.
+  void add_attachment(std::string_view name, std::string_view media_type, std::string_view data,
+                      std::uint64_t log_time_ns, std::uint64_t create_time_ns);
+
   /// Writes one message on `channel_id`; times in nanoseconds. Throws InvalidInput on an
   /// unknown channel or a failed write.
   void write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::uint64_t publish_time_ns,
@@ -95,10 +114,13 @@ class McapWriter {
   const std::filesystem::path& path() const { return path_; }
   std::uint64_t message_count() const { return message_count_; }
   std::size_t chunk_count() const { return chunk_indexes_.size(); }
+  /// Chunk records written so far, before and after compression (equal when uncompressed).
+  std::uint64_t records_bytes() const { return records_bytes_; }
+  std::uint64_t stored_bytes() const { return stored_bytes_; }
 
  private:
   struct ChunkIndex {
-    std::uint64_t start_ns, end_ns, offset, length, index_length, records_size;
+    std::uint64_t start_ns, end_ns, offset, length, index_length, records_size, stored_size;
     std::vector<std::pair<std::uint16_t, std::uint64_t>> index_offsets;  // channel, file offset
   };
   struct ChannelState {
@@ -113,9 +135,16 @@ class McapWriter {
   void flush_buffer();
   void close_chunk();
 
+  struct IndexEntry {  // an AttachmentIndex or MetadataIndex record's content
+    McapOpcode op;
+    std::string content;
+  };
+
   std::filesystem::path path_;
   StagedFile file_;
   std::size_t chunk_target_;
+  McapCompression compression_;
+  std::string compressed_;     // the chunk's records, compressed
   std::string out_;            // bytes not yet written to file_
   std::uint64_t flushed_ = 0;  // bytes written to file_
   bool in_data_ = true;
@@ -127,6 +156,9 @@ class McapWriter {
   std::string scratch_;                 // record being assembled
   std::uint64_t chunk_start_ns_ = 0, chunk_end_ns_ = 0;
   std::vector<ChunkIndex> chunk_indexes_;
+  std::vector<IndexEntry> indexes_;  // attachments and metadata, in file order
+  std::uint32_t attachment_count_ = 0, metadata_count_ = 0;
+  std::uint64_t records_bytes_ = 0, stored_bytes_ = 0;
   std::uint64_t message_count_ = 0;
   std::uint64_t start_ns_ = 0, end_ns_ = 0;
   bool closed_ = false;

@@ -8,15 +8,12 @@
 #include <system_error>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "microcobot/core/csv.h"
-#include "microcobot/core/csv_stream_writer.h"
 #include "microcobot/core/error.h"
-#include "microcobot/core/mcap_writer.h"
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/live/console_page.h"
-#include "microcobot/platform/session.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::live {
@@ -46,48 +43,7 @@ std::string schema(const json& properties, const std::vector<std::string>& requi
   return json{{"type", "object"}, {"properties", properties}, {"required", required}}.dump();
 }
 
-// A recording's stem: "recording-" then digits and dashes (what start_recording() names), so a
-// request can name nothing else (no path, no hidden or temporary file).
-bool is_recording_stem(std::string_view stem) {
-  constexpr std::string_view prefix = "recording-";
-  if (stem.size() <= prefix.size() || stem.size() > 64 || stem.substr(0, prefix.size()) != prefix)
-    return false;
-  return stem.find_first_not_of("0123456789-", prefix.size()) == std::string_view::npos;
-}
-
-std::string html_escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-server::HttpReply html_page(int status, const std::string& title, const std::string& text, int refresh_s) {
-  server::HttpReply r;
-  r.status = status;
-  r.content_type = "text/html; charset=utf-8";
-  r.refresh_s = refresh_s;
-  r.body = "<!doctype html><meta charset=\"utf-8\"><title>" + html_escape(title) +
-           "</title><body style=\"font-family:sans-serif\"><h1>" + html_escape(title) + "</h1><p>" +
-           html_escape(text) + "</p>";
-  return r;
-}
+EventLevel event_level(StatusLevel level) { return static_cast<EventLevel>(static_cast<int>(level)); }
 
 dsp::SosFilter rumble_filter(double fc_Hz) {
   return dsp::SosFilter(dsp::linkwitz_riley(4, fc_Hz, kTelemetryRate_Hz, dsp::FilterType::kHighPass));
@@ -138,7 +94,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"link_cost_us", {{"type", "object"}}},
                                             {"clients", number},
                                             {"recording", {{"type", {"string", "null"}}}},
-                                            {"last_error", text}})});
+                                            {"last_error", text},
+                                            {"ticks", number},
+                                            {"demo_result", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
   const std::vector<std::string> scene_keys = {"kind",
@@ -153,7 +111,11 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                                "workspace_min_m",
                                                "workspace_max_m",
                                                "max_speed_m_s",
-                                               "force_full_scale_N"};
+                                               "force_full_scale_N",
+                                               "grip_force_limit_N",
+                                               "contact_force_limit_N",
+                                               "demo_available",
+                                               "demo_unavailable_reason"};
   scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                                    schema({{"kind", text},
                                            {"part_side_m", number},
@@ -168,15 +130,49 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                            {"workspace_max_m", vec3},
                                            {"max_speed_m_s", number},
                                            {"force_full_scale_N", number},
+                                           {"grip_force_limit_N", number},
+                                           {"contact_force_limit_N", number},
+                                           {"demo_available", boolean},
+                                           {"demo_unavailable_reason", text},
                                            {"bead_radius_m", number},
                                            {"obstacle_m", {{"type", "array"}, {"items", number}}},
                                            {"obstacle_radius_m", number}},
                                           scene_keys)});
-  feedback_ch_ = server_.add_channel({"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
-                                      schema({{"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
+  feedback_ch_ = server_.add_channel(
+      {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
+       schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
   server_.on_disconnect([this](server::ClientId c) { on_disconnect(c); });
-  server_.on_http_get([this](std::string_view path) { return on_http(path); });
+  if (!params_.out_dir.empty()) {
+    // The recording keeps the channels as the clients see them (their schemas), at full rate.
+    const auto recorded = [this](server::ChannelId id) {
+      const auto spec = server_.channel(id).value();
+      return RecordedSchema{spec.topic, spec.schema_name, spec.schema};
+    };
+    SessionRecordingParams rp;
+    rp.out_dir = params_.out_dir;
+    rp.csv = params_.record_csv;
+    rp.telemetry_channels = live_.channel_count();
+    rp.status = recorded(status_ch_);
+    rp.scene = recorded(scene_ch_);
+    rp.feedback = recorded(feedback_ch_);
+    rp.version = params_.version;
+    rp.config_yaml = params_.config_yaml;
+    rp.on_error = [this](const std::string& why) {
+      server_.broadcast_status(StatusLevel::kError, "recording stopped: " + why);
+    };
+    recording_ = std::make_unique<SessionRecording>(std::move(rp));
+    files_ = std::make_unique<RecordingFiles>(
+        params_.out_dir, [this] { return recording_->name(); },
+        [this](StatusLevel level, const std::string& message) {
+          server_.broadcast_status(level, message, "report");
+        });
+    server_.on_http_get([this](std::string_view path) { return files_->on_http(path); });
+  }
+  server_.on_reject(
+      [this](server::ClientId client, StatusLevel level, std::string_view id, std::string_view message) {
+        note(event_level(level), "protocol", std::string(id) + ": " + std::string(message), client);
+      });
   json_.reserve(4096);
 }
 
@@ -184,6 +180,9 @@ ConsoleServer::~ConsoleServer() { stop(); }
 
 std::string ConsoleServer::url() const {
   std::string host = params_.server.address;
+  // Listening on every interface: this machine opens it on loopback.
+  if (host == "0.0.0.0") host = "127.0.0.1";
+  if (host == "::") host = "::1";
   if (host.find(':') != std::string::npos) host = "[" + host + "]";
   std::string u = "http://" + host + ":" + std::to_string(server_.port()) + "/";
   if (!params_.server.token.empty()) u += "?token=" + params_.server.token;
@@ -210,28 +209,12 @@ void ConsoleServer::stop() {
     // goes on regardless.
   }
   server_.stop();  // no more requests: no new report
-  if (report_thread_.joinable()) report_thread_.join();
+  if (files_) files_->join();
 }
 
 void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t count) {
   const std::span<const double> sample(s.data(), count);
-  {
-    std::lock_guard lock(recording_mutex_);
-    if (recording_) {
-      json_.clear();
-      platform::telemetry_to_json(sample, json_);
-      const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, s[0]) * 1e9));
-      try {
-        recording_->write(recording_channel_, ns, ns, json_);
-        recording_csv_->append(sample);
-      } catch (const std::exception& e) {
-        server_.broadcast_status(StatusLevel::kError, std::string("recording stopped: ") + e.what());
-        recording_.reset();  // removes the temporary files; nothing half-written remains
-        recording_csv_.reset();
-        recording_name_.clear();
-      }
-    }
-  }
+  if (recording_) recording_->telemetry(s, count);  // every sample; encoded by its writer
   ticks_.add(s[kTick] * 1e-6);
   ticks_cpu_.add(s[kTickCpu] * 1e-6);
   if (ticks_.count() >= 1000) {  // the loop's tick p99 over the last second
@@ -252,20 +235,70 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, s[0]) * 1e9));
   json_.clear();
   platform::telemetry_to_json(sample, json_);
-  server_.publish(telemetry_ch_, ns, json_);
+  server_.publish(telemetry_ch_, ns, json_);  // recorded at full rate above
   const double rms = rumble_n_ ? std::sqrt(rumble_sum_ / static_cast<double>(rumble_n_)) : 0.0;
   rumble_sum_ = 0.0;
   rumble_n_ = 0;
   const double rumble = std::isfinite(rms) ? std::min(1.0, rms / params_.rumble_full_scale_N) : 0.0;
   auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
-  const json f = {{"contact_N", {finite(s[kContactX]), finite(s[kContactX + 1]), finite(s[kContactX + 2])}},
+  const json f = {{"t_s", s[0]},
+                  {"contact_N", {finite(s[kContactX]), finite(s[kContactX + 1]), finite(s[kContactX + 2])}},
                   {"grip_N", finite(s[kGrip])},
                   {"rumble", rumble}};
-  server_.publish(feedback_ch_, ns, f.dump());
+  publish(feedback_ch_, RecordedTopic::kFeedback, s[0], f.dump());
+}
+
+void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
+                            const std::string& payload) {
+  server_.publish(ch, static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9)), payload);
+  if (recording_) recording_->published(topic, t_s, payload);
+}
+
+void ConsoleServer::note(EventLevel level, std::string_view kind, const std::string& message,
+                         server::ClientId client) {
+  if (recording_) recording_->event(level, kind, message, client, live_.status().t_s);
+}
+
+void ConsoleServer::tell(server::ClientId client, StatusLevel level, const std::string& message,
+                         std::string_view kind, std::string_view id) {
+  if (client == 0)
+    server_.broadcast_status(level, message, id);
+  else
+    server_.send_status(client, level, message, id);
+  note(event_level(level), kind, message, client);
+}
+
+void ConsoleServer::note_changes(const LiveStatus& s) {
+  const LiveStatus& was = last_status_;
+  if (s.demo && !was.demo) note(EventLevel::kInfo, "demo", "the scripted demo operator drives");
+  if (s.demo && s.demo_phase != was.demo_phase && !s.demo_phase.empty())
+    note(EventLevel::kInfo, "demo_phase", s.demo_phase);
+  if (!s.demo && was.demo) {
+    // How it ended, in the words the console shows (issue #26).
+    const DemoResult& r = s.demo_result;
+    std::string how = "the scripted demo ended: " + std::string(DemoResult::name(r.outcome));
+    if (!r.phase.empty()) how += " (" + r.phase + ")";
+    if (!r.reason.empty()) how += ": " + r.reason;
+    if (std::isfinite(r.placement_error_m)) how += fmt::format(", placement error {:.2f} um", 1e6 * r.placement_error_m);
+    note(r.outcome == DemoResult::Outcome::kGaveUp || r.outcome == DemoResult::Outcome::kMissed ? EventLevel::kWarning
+                                                                                                 : EventLevel::kInfo,
+         "demo_end", how);
+  }
+  if (s.estopped != was.estopped)
+    note(s.estopped ? EventLevel::kWarning : EventLevel::kInfo, "estopped",
+         s.estopped ? "e-stop latched: every device in its safe state" : "e-stop cleared");
+  if (s.last_error != was.last_error && !s.last_error.empty())
+    note(EventLevel::kError, "platform_error", s.last_error);
+  if (s.restarts != was.restarts) note(EventLevel::kInfo, "restart", "the platform was rebuilt");
+  last_status_ = s;
 }
 
 void ConsoleServer::on_message(const server::ClientMessage& m) {
   const server::ClientId controller = controller_.load();
+  if (recording_ && (m.topic == "/console/command" || m.topic == "/console/action")) {
+    recording_->received(m.topic == "/console/command" ? RecordedTopic::kCommand : RecordedTopic::kAction,
+                         m.client, live_.status().t_s, m.payload);
+  }
   try {
     if (m.topic == "/console/command") {
       ConsoleCommand c = parse_console_command(m.payload, live_.limits());
@@ -273,45 +306,48 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
                           std::chrono::steady_clock::now().time_since_epoch())
                           .count();
       if (m.client != controller) {
-        server_.send_status(m.client, StatusLevel::kWarning, "control: take control first; command ignored",
-                            "control");
+        tell(m.client, StatusLevel::kWarning, "control: take control first; command ignored", "refused",
+             "control");
         return;
       }
       if (!live_.push_command(c))
-        server_.send_status(m.client, StatusLevel::kWarning,
-                            "/console/command: the loop is busy; command dropped");
+        tell(m.client, StatusLevel::kWarning, "/console/command: the loop is busy; command dropped",
+             "refused", "/console/command");
       return;
     }
     if (m.topic != "/console/action") {
-      server_.send_status(m.client, StatusLevel::kError,
-                          "unknown topic '" + std::string(m.topic.substr(0, 80)) +
-                              "': the console publishes /console/command and /console/action");
+      tell(m.client, StatusLevel::kError,
+           "unknown topic '" + std::string(m.topic.substr(0, 80)) +
+               "': the console publishes /console/command and /console/action",
+           "refused", "unknown-topic");
       return;
     }
     const ConsoleAction a = parse_console_action(m.payload);
     switch (a) {
       case ConsoleAction::kEstop:  // anyone may stop the platform
         live_.estop();
-        server_.broadcast_status(StatusLevel::kWarning, "e-stop pressed: every device in its safe state");
+        tell(0, StatusLevel::kWarning, "e-stop pressed: every device in its safe state", "estop");
         return;
       case ConsoleAction::kTakeControl: {
         const server::ClientId previous = controller_.exchange(m.client);
         if (previous != 0 && previous != m.client)
-          server_.send_status(previous, StatusLevel::kInfo, "control: taken by another client", "control");
+          tell(previous, StatusLevel::kInfo, "control: taken by another client", "control_lost", "control");
         live_.push_command(ConsoleCommand{});  // the new controller starts from rest
         live_.set_console_in_control(true);
-        server_.send_status(m.client, StatusLevel::kInfo, "control: granted", "control");
+        tell(m.client, StatusLevel::kInfo, "control: granted", "take_control", "control");
         return;
       }
       case ConsoleAction::kReleaseControl:
         if (m.client == controller) on_disconnect(m.client);
-        server_.send_status(m.client, StatusLevel::kInfo, "control: released", "control");
+        tell(m.client, StatusLevel::kInfo, "control: released", "release_control", "control");
         return;
-      case ConsoleAction::kRecordStart:
-        start_recording();
-        server_.broadcast_status(StatusLevel::kInfo, "recording to " + recording_name_);
+      case ConsoleAction::kRecordStart: {
+        const std::string name = start_recording();
+        server_.broadcast_status(StatusLevel::kInfo, "recording to " + name);
         return;
+      }
       case ConsoleAction::kRecordStop:
+        note(EventLevel::kInfo, "record_stop", "recording stopped by a client", m.client);
         stop_recording();
         server_.broadcast_status(StatusLevel::kInfo, "recording stopped");
         return;
@@ -319,15 +355,24 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
       case ConsoleAction::kDemo:
       case ConsoleAction::kRestart:
         if (m.client != controller) {
-          server_.send_status(m.client, StatusLevel::kWarning, "control: take control first; action ignored",
-                              "control");
+          tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
+               "control");
           return;
         }
+        note(EventLevel::kInfo,
+             a == ConsoleAction::kReset  ? "reset"
+             : a == ConsoleAction::kDemo ? "demo_requested"
+                                         : "restart_requested",
+             a == ConsoleAction::kReset ? "reset requested: the e-stop cleared, devices reactivated"
+                                        : "the scene restarts (the control thread rebuilds it)",
+             m.client);
         live_.request(a);
         return;
     }
   } catch (const Error& e) {
-    server_.send_status(m.client, StatusLevel::kError, e.what());
+    // The status names what it refuses (its id is the offending message's topic), so a client
+    // can tell which of its messages it concerns.
+    tell(m.client, StatusLevel::kError, e.what(), "refused", std::string(m.topic.substr(0, 80)));
   }
 }
 
@@ -336,49 +381,21 @@ void ConsoleServer::on_disconnect(server::ClientId client) {
   if (controller_.compare_exchange_strong(expected, 0)) {
     // Nobody controls: the loop's watchdog sees stale commands and the stage holds.
     live_.set_console_in_control(false);
+    note(EventLevel::kInfo, "control_released", "nobody controls: the stage holds", client);
   }
 }
 
-void ConsoleServer::start_recording() {
-  if (params_.out_dir.empty()) throw InvalidInput("recording is disabled: serve was started without --out");
-  std::lock_guard lock(recording_mutex_);
-  if (recording_) return;
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  localtime_r(&now, &tm);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "recording-%Y%m%d-%H%M%S", &tm);
-  std::string stem = stamp;
-  const auto taken = [&](const std::string& s) {
-    return std::filesystem::exists(params_.out_dir / (s + ".mcap")) ||
-           std::filesystem::exists(params_.out_dir / (s + ".csv"));
-  };
-  for (int i = 2; taken(stem) && i < 1000; ++i)
-    stem = std::string(stamp) + "-" + std::to_string(i);  // same second
-  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"));
-  const auto schema_id = w->add_schema(platform::kTelemetrySchemaName, "jsonschema",
-                                       platform::telemetry_json_schema(live_.channel_count()));
-  recording_channel_ = w->add_channel(schema_id, platform::kTelemetryTopic, "json");
-  recording_csv_ = std::make_unique<CsvStreamWriter>(
-      params_.out_dir / (stem + ".csv"),
-      std::vector<std::string>(
-          platform::kTelemetryChannels.begin(),
-          platform::kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(live_.channel_count())));
-  recording_ = std::move(w);
-  recording_name_ = stem + ".mcap";
+std::string ConsoleServer::start_recording() {
+  if (!recording_) throw InvalidInput("recording is disabled: serve was started without --out");
+  const double t_s = live_.status().t_s;
+  const std::string was = recording_->name();
+  const std::string name = recording_->start(t_s, scene_json());
+  if (name != was) note(EventLevel::kInfo, "record_start", "recording to " + name);
+  return name;
 }
 
 void ConsoleServer::stop_recording() {
-  std::unique_ptr<McapWriter> w;
-  std::unique_ptr<CsvStreamWriter> csv;
-  {
-    std::lock_guard lock(recording_mutex_);
-    w = std::move(recording_);
-    csv = std::move(recording_csv_);
-    recording_name_.clear();
-  }
-  if (w) w->close();      // summary, index, footer; then renamed to its name
-  if (csv) csv->close();  // (a failed MCAP leaves its CSV abandoned: neither file appears)
+  if (recording_) recording_->stop();  // summary, index, footer; then renamed to its name
 }
 
 std::string ConsoleServer::scene_json() const {
@@ -395,7 +412,13 @@ std::string ConsoleServer::scene_json() const {
          {"workspace_min_m", c.min_m},
          {"workspace_max_m", c.max_m},
          {"max_speed_m_s", c.max_speed_m_s},
-         {"force_full_scale_N", 50e-6}};
+         // The gauges' full scales are the limits the platform enforces (issue #26).
+         {"force_full_scale_N", live_.contact_force_limit_N()},
+         {"grip_force_limit_N", live_.grip_force_limit_N()},
+         {"contact_force_limit_N", live_.contact_force_limit_N()}};
+  const std::string no_demo = live_.demo_unavailable_reason();
+  j["demo_available"] = no_demo.empty();
+  j["demo_unavailable_reason"] = no_demo;
   if (live_.optical_trap_scene()) {
     // The probe bead (the telemetry's part_* channels) and the stuck bead; forces in piconewtons:
     // the gauge's full scale is the trap's escape force, k times the probe's radius.
@@ -414,11 +437,7 @@ std::string ConsoleServer::status_json() {
   json lifecycle = json::object();
   const char* names[6] = {"axis_x", "axis_y", "axis_z", "gripper", "haptic", "tweezers"};
   for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(platform::to_string(s.lifecycle[i]));
-  std::string recording;
-  {
-    std::lock_guard lock(recording_mutex_);
-    recording = recording_name_;
-  }
+  const std::string recording = recording_ ? recording_->name() : std::string();
   json j = {{"t_s", s.t_s},
             {"estopped", s.estopped},
             {"controlled", controller_.load() != 0},
@@ -441,7 +460,18 @@ std::string ConsoleServer::status_json() {
               {"max", 1e6 * link_cost_.max_s()}}},
             {"clients", server_.client_count()},
             {"recording", recording.empty() ? json(nullptr) : json(recording)},
-            {"last_error", s.last_error}};
+            {"last_error", s.last_error},
+            {"ticks", s.ticks}};
+  const DemoResult& d = s.demo_result;
+  if (d.outcome == DemoResult::Outcome::kNone) {
+    j["demo_result"] = nullptr;
+  } else {
+    j["demo_result"] = {{"outcome", DemoResult::name(d.outcome)},
+                        {"phase", d.phase},
+                        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
+                        {"reason", d.reason},
+                        {"duration_s", d.duration_s}};
+  }
   return j.dump();
 }
 
@@ -456,139 +486,14 @@ void ConsoleServer::status_thread() {
     const auto now = std::chrono::steady_clock::now();
     if (next < now) next = now;
     std::this_thread::sleep_until(next);
-    const auto ns = static_cast<std::uint64_t>(std::llround(live_.status().t_s * 1e9));
+    const LiveStatus now_status = live_.status();
     live_.drain_command_latencies(latency_);
     live_.drain_link_costs(link_cost_);
-    server_.publish(status_ch_, ns, status_json());
+    publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
     if (n++ % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0)
-      server_.publish(scene_ch_, ns, scene_json());
+      publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());
+    note_changes(now_status);
   }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Recordings over HTTP, and their reports on demand.
-
-std::optional<server::HttpReply> ConsoleServer::on_http(std::string_view path) {
-  if (params_.out_dir.empty()) return std::nullopt;
-  if (path == "/recordings") {
-    server::HttpReply r;
-    r.content_type = "application/json";
-    r.body = recordings_json();
-    return r;
-  }
-  constexpr std::string_view prefix = "/recordings/";
-  if (path.substr(0, prefix.size()) != prefix) return std::nullopt;
-  const std::string file(path.substr(prefix.size()));
-  const auto dot = file.rfind('.');
-  if (dot == std::string::npos || !is_recording_stem(std::string_view(file).substr(0, dot)))
-    return std::nullopt;
-  const std::string stem = file.substr(0, dot), ext = file.substr(dot);
-  std::string active;
-  {
-    std::lock_guard lock(recording_mutex_);
-    active = recording_name_;
-  }
-  std::error_code ec;
-  if (ext == ".mcap" || ext == ".csv") {
-    if (stem + ".mcap" == active)
-      return html_page(409, "Recording in progress", file + " is being recorded: stop the recording first.",
-                       0);
-    if (!std::filesystem::is_regular_file(params_.out_dir / file, ec)) return std::nullopt;
-    server::HttpReply r;
-    r.content_type = ext == ".csv" ? "text/csv; charset=utf-8" : "application/octet-stream";
-    r.file = params_.out_dir / file;
-    r.attachment_name = file;
-    return r;
-  }
-  if (ext != ".html") return std::nullopt;
-  if (std::filesystem::is_regular_file(params_.out_dir / file, ec)) {
-    server::HttpReply r;
-    r.content_type = "text/html; charset=utf-8";
-    r.file = params_.out_dir / file;
-    return r;
-  }
-  if (stem + ".mcap" == active)
-    return html_page(409, "Recording in progress",
-                     stem + ".mcap is being recorded: stop the recording first.", 0);
-  if (!std::filesystem::is_regular_file(params_.out_dir / (stem + ".mcap"), ec)) return std::nullopt;
-  return report_reply(stem);
-}
-
-server::HttpReply ConsoleServer::report_reply(const std::string& stem) {
-  std::lock_guard lock(report_mutex_);
-  if (const auto it = report_errors_.find(stem); it != report_errors_.end())
-    return html_page(500, "No report for " + stem + ".mcap", it->second, 0);
-  if (reporting_ == stem)
-    return html_page(202, "Making the report of " + stem + ".mcap", "This page reloads when it is ready.", 1);
-  if (!reporting_.empty())
-    return html_page(503, "Busy", "Making the report of " + reporting_ + ".mcap; this page retries.", 2);
-  if (report_thread_.joinable()) report_thread_.join();  // the previous one has finished
-  reporting_ = stem;
-  report_thread_ = std::thread([this, stem] { make_report(stem); });
-  return html_page(202, "Making the report of " + stem + ".mcap", "This page reloads when it is ready.", 1);
-}
-
-void ConsoleServer::make_report(const std::string& stem) {
-  const auto mcap = params_.out_dir / (stem + ".mcap");
-  std::string error;
-  try {
-    if (std::filesystem::file_size(mcap) > kMaxReportRecordingBytes)
-      throw InvalidInput(mcap.string(), 0,
-                         "larger than " + std::to_string(kMaxReportRecordingBytes >> 20) +
-                             " MB: too long for a report (record shorter sessions)");
-    const Recorder rec = platform::read_telemetry_mcap(mcap, kReportSamples);
-    write_file_atomic(params_.out_dir / (stem + ".html"),
-                      platform::recording_report(rec, stem + ".mcap").html());
-    server_.broadcast_status(StatusLevel::kInfo, "report ready: /recordings/" + stem + ".html", "report");
-  } catch (const std::exception& e) {
-    error = e.what();
-    server_.broadcast_status(StatusLevel::kError, "report of " + stem + ".mcap: " + error, "report");
-  }
-  std::lock_guard lock(report_mutex_);
-  if (!error.empty()) report_errors_[stem] = error;
-  reporting_.clear();
-}
-
-std::string ConsoleServer::recordings_json() const {
-  std::string active;
-  {
-    std::lock_guard lock(recording_mutex_);
-    active = recording_name_;
-  }
-  json list = json::array();
-  std::error_code ec;
-  for (auto it = std::filesystem::directory_iterator(params_.out_dir, ec);
-       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
-    const auto& p = it->path();
-    if (p.extension() != ".mcap" || !is_recording_stem(p.stem().string()) || !it->is_regular_file(ec))
-      continue;
-    const std::string name = p.filename().string();
-    std::error_code size_error, report_error;
-    const auto size = it->file_size(size_error);
-    const std::uintmax_t bytes = size_error ? 0 : size;
-    const bool has_report =
-        std::filesystem::is_regular_file(params_.out_dir / (p.stem().string() + ".html"), report_error);
-    const std::string csv = p.stem().string() + ".csv";
-    const bool has_csv = std::filesystem::is_regular_file(params_.out_dir / csv, report_error);
-    list.push_back({{"name", name},
-                    {"bytes", bytes},
-                    {"recording", false},
-                    {"url", "/recordings/" + name},
-                    {"csv_url", has_csv ? json("/recordings/" + csv) : json(nullptr)},
-                    {"report_url", "/recordings/" + p.stem().string() + ".html"},
-                    {"report_ready", has_report}});
-  }
-  if (!active.empty()) {  // written under a temporary name until it is closed
-    list.push_back({{"name", active},
-                    {"bytes", 0},
-                    {"recording", true},
-                    {"url", nullptr},
-                    {"csv_url", nullptr},
-                    {"report_url", nullptr},
-                    {"report_ready", false}});
-  }
-  std::sort(list.begin(), list.end(), [](const json& a, const json& b) { return a["name"] > b["name"]; });
-  return json{{"recordings", list}}.dump();
 }
 
 }  // namespace mc::live

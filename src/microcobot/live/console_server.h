@@ -10,16 +10,17 @@
 ///   client /console/command      the controlling client's command (~30 Hz heartbeat)
 ///   client /console/action       estop, reset, take/release control, demo, restart, record
 ///
-/// HTTP: `/` the console; `/recordings` the recordings in --out (JSON); `/recordings/<name>.mcap`
-/// and `<name>.csv` downloads (not the one being written); `/recordings/<name>.html` its session report, made
-/// on demand by a worker thread on the first request (the page reloads until it is ready) and
-/// kept beside the recording.
+/// HTTP: `/` the console; `/recordings...` the recordings in --out, their downloads and reports
+/// (live/recording_files.h). A recording (live/session_recording.h) holds every channel above at
+/// full rate, what the clients sent, the events (control, e-stop, demo, refusals, errors) and
+/// the configuration.
 ///
 /// One client controls at a time; the others observe until they take control. Any client may
 /// press the e-stop. Every message is parsed, checked and clamped (console_command.h) before it
 /// reaches the loop, through the live platform's single-producer ring (the server runs one I/O
 /// thread: the one producer). Telemetry leaves the loop through the platform's ring and is
-/// encoded, published and recorded on the drain thread, never on the loop.
+/// encoded and published on the drain thread (never on the loop), which hands it to the
+/// recording's own writer thread (encoding the 1 kHz stream, compressing, writing).
 ///
 /// The vibrotactile channel is the high band of the contact force, as the dual-stage
 /// interface's crossover splits it (ch. 3): an LR4 high-pass at `rumble_crossover_Hz` on the
@@ -37,13 +38,10 @@
 
 #include "microcobot/dsp/sos.h"
 #include "microcobot/live/live_platform.h"
+#include "microcobot/live/recording_files.h"
+#include "microcobot/live/session_recording.h"
 #include "microcobot/platform/timing_stats.h"
 #include "microcobot/server/foxglove_server.h"
-
-namespace mc {
-class CsvStreamWriter;
-class McapWriter;
-}  // namespace mc
 
 namespace mc::live {
 
@@ -54,6 +52,9 @@ struct ConsoleServerParams {
   double status_rate_Hz = 5.0;
   double rumble_crossover_Hz = 100.0;  ///< the high band of the contact force
   double rumble_full_scale_N = 5e-6;   ///< high-band RMS that drives the rumble fully
+  bool record_csv = false;             ///< recordings also write the telemetry as CSV (`serve --record-csv`)
+  std::string version;                 ///< the program's, into each recording's metadata
+  std::string config_yaml;             ///< the platform configuration, into each recording
   void validate() const;
 };
 
@@ -75,17 +76,13 @@ class ConsoleServer {
   /// connections closed. Idempotent.
   void stop();
 
-  /// Starts or stops a recording in out_dir: recording-YYYYmmdd-HHMMSS.mcap (JSON messages on
-  /// /platform/telemetry) and the same samples as recording-YYYYmmdd-HHMMSS.csv (a column per
-  /// channel). Throws mc::InvalidInput when recording is disabled or a file cannot be created.
-  void start_recording();
+  /// Starts or stops a recording in out_dir: recording-YYYYmmdd-HHMMSS.mcap (the session:
+  /// session_recording.h) and, with record_csv, the telemetry as recording-YYYYmmdd-HHMMSS.csv.
+  /// Returns the MCAP file's name. Throws mc::InvalidInput when recording is disabled or a file
+  /// cannot be created.
+  std::string start_recording();
   void stop_recording();
   server::ServerCounters counters() const { return server_.counters(); }
-
-  /// Recordings longer than this are refused a report (the reader holds the file in memory).
-  static constexpr std::uintmax_t kMaxReportRecordingBytes = 512ull << 20;
-  /// Samples a report plots at most (evenly decimated).
-  static constexpr std::size_t kReportSamples = 20000;
 
  private:
   void on_sample(const platform::TelemetrySample& s, std::size_t count);
@@ -94,10 +91,15 @@ class ConsoleServer {
   void status_thread();
   std::string status_json();
   std::string scene_json() const;
-  std::optional<server::HttpReply> on_http(std::string_view path);
-  std::string recordings_json() const;
-  server::HttpReply report_reply(const std::string& stem);
-  void make_report(const std::string& stem);
+  /// Publishes to the clients and records (loop time t_s).
+  void publish(server::ChannelId ch, RecordedTopic topic, double t_s, const std::string& payload);
+  /// A status to one client (0: every client), recorded as an event of `kind`.
+  void tell(server::ClientId client, server::StatusLevel level, const std::string& message,
+            std::string_view kind, std::string_view id = "");
+  /// An event for the recording only.
+  void note(EventLevel level, std::string_view kind, const std::string& message, server::ClientId client = 0);
+  /// Events of what the status shows changing (demo, its phase, e-stop, errors); status thread.
+  void note_changes(const LiveStatus& s);
 
   LivePlatform& live_;
   ConsoleServerParams params_;
@@ -118,21 +120,13 @@ class ConsoleServer {
   platform::TimingStats ticks_;      // the telemetry's tick_us, per second
   platform::TimingStats ticks_cpu_;  // its tick_cpu_us, per second
 
-  // Recording: written on the drain thread, opened and closed by the server thread.
-  mutable std::mutex recording_mutex_;
-  std::unique_ptr<McapWriter> recording_;
-  std::unique_ptr<CsvStreamWriter> recording_csv_;  ///< the same samples beside it
-  std::uint16_t recording_channel_ = 0;
-  std::string recording_name_;
+  // The recording (fed by every thread, written by its own) and the recordings' folder.
+  std::unique_ptr<SessionRecording> recording_;
+  std::unique_ptr<RecordingFiles> files_;
+  LiveStatus last_status_;  // status thread: what note_changes() compares with
   std::atomic<double> tick_p99_us_{0.0}, tick_cpu_p99_us_{0.0};
   platform::TimingStats latency_{1e-5};    // status thread: command-to-target, 10 us bins
   platform::TimingStats link_cost_{1e-8};  // status thread: the remote end's work per tick, 10 ns bins
-
-  // Reports made on demand, one at a time, off the server's I/O thread.
-  std::mutex report_mutex_;
-  std::thread report_thread_;
-  std::string reporting_;                             // the stem being made, empty when idle
-  std::map<std::string, std::string> report_errors_;  // stem -> why its report failed
 };
 
 }  // namespace mc::live

@@ -56,6 +56,11 @@ void LivePlatform::build(bool demo) {
   platform_ = std::move(p);
   demo_ = std::move(op);
   demo_running_.store(demo);
+  demo_finished_ = false;
+  demo_error_m_.store(NAN);
+  demo_duration_s_.store(0.0);
+  demo_outcome_.store(static_cast<int>(demo ? DemoResult::Outcome::kRunning : DemoResult::Outcome::kNone),
+                      std::memory_order_release);
   latest_ = ConsoleCommand{};
   last_command_t_ = -1e9;
   remote_estopped_ = false;
@@ -107,9 +112,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
                                     : in_control_.load(std::memory_order_relaxed) &&
                                           t.t_s - last_command_t_ <= params_.command_timeout_s;
   control::ConsoleInput in;
-  if (demo_) {
-    demo_->act(t);  // the scripted operator drives the simulated masters' hands
-  } else {
+  if (!demo_tick(t)) {
     in.active = true;
     in.fresh = fresh;
     in.deadman = latest_.deadman;
@@ -132,12 +135,67 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   estopped_.store(p.faulted(), std::memory_order_relaxed);
   fresh_.store(fresh, std::memory_order_relaxed);
   demo_phase_.store(demo_ ? static_cast<int>(demo_->phase()) : 0, std::memory_order_relaxed);
+  demo_failed_phase_.store(demo_ ? static_cast<int>(demo_->failed_phase()) : 0, std::memory_order_relaxed);
   for (int i = 0; i < 3; ++i)
     lifecycle_[i].store(static_cast<int>(p.axis(i).state()), std::memory_order_relaxed);
   lifecycle_[3].store(static_cast<int>(p.gripper().state()), std::memory_order_relaxed);
   lifecycle_[4].store(static_cast<int>(p.haptic().state()), std::memory_order_relaxed);
   lifecycle_[5].store(static_cast<int>(p.tweezers().state()), std::memory_order_relaxed);
   overruns_.store(p.loop().overruns(), std::memory_order_relaxed);
+  ticks_.store(p.loop().ticks(), std::memory_order_relaxed);
+}
+
+bool LivePlatform::demo_tick(const platform::TickInfo& t) noexcept {
+  if (!demo_ || demo_finished_) return false;
+  demo_->act(t);  // the scripted operator drives the simulated masters' hands
+  demo_duration_s_.store(t.t_s, std::memory_order_relaxed);
+  const auto* gripper = platform_->simulation().gripper;
+  if (gripper != nullptr)
+    demo_error_m_.store(gripper->world().placement_error_m(gripper->world_state()), std::memory_order_relaxed);
+  if (!demo_->done() && !demo_->gave_up()) return true;
+  // Finished: every axis holds where it is and the console has control again (issue #26).
+  platform_->hold();
+  demo_finished_ = true;
+  demo_running_.store(false, std::memory_order_relaxed);
+  auto outcome = DemoResult::Outcome::kGaveUp;
+  if (demo_->done() && gripper != nullptr) {
+    const auto& w = gripper->world();
+    const bool has_hole = w.params().hole_side_m > 0.0;
+    if (has_hole && w.inserted(gripper->world_state()))
+      outcome = DemoResult::Outcome::kInserted;
+    else if (!has_hole && w.placement_error_m(gripper->world_state()) <= params_.placement_tolerance_m)
+      outcome = DemoResult::Outcome::kPlaced;
+    else
+      outcome = DemoResult::Outcome::kMissed;
+  }
+  demo_outcome_.store(static_cast<int>(outcome), std::memory_order_release);
+  return false;
+}
+
+std::string_view DemoResult::name(Outcome o) {
+  switch (o) {
+    case Outcome::kNone:
+      return "none";
+    case Outcome::kRunning:
+      return "running";
+    case Outcome::kPlaced:
+      return "placed";
+    case Outcome::kInserted:
+      return "inserted";
+    case Outcome::kMissed:
+      return "missed";
+    case Outcome::kGaveUp:
+      return "gave_up";
+  }
+  return "none";
+}
+
+std::string LivePlatform::demo_unavailable_reason() const {
+  if (!whole_simulation())
+    return "demo: the scripted operator needs the whole simulated platform in this process";
+  if (params_.platform.optical_trap_scene())
+    return "demo: the scripted operator is the pick-and-place; the optical-trap scene is operated by hand";
+  return "";
 }
 
 void LivePlatform::start(Sink sink) {
@@ -187,14 +245,11 @@ void LivePlatform::request(ConsoleAction action) {
   if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo && action != ConsoleAction::kRestart)
     return;
   std::lock_guard lock(request_mutex_);
-  if (action == ConsoleAction::kDemo && !whole_simulation()) {
-    last_error_ = "demo: the scripted operator needs the whole simulated platform in this process";
-    return;
-  }
-  if (action == ConsoleAction::kDemo && params_.platform.optical_trap_scene()) {
-    last_error_ =
-        "demo: the scripted operator is the pick-and-place; the optical-trap scene is operated by hand";
-    return;
+  if (action == ConsoleAction::kDemo) {
+    if (std::string why = demo_unavailable_reason(); !why.empty()) {
+      last_error_ = std::move(why);
+      return;
+    }
   }
   pending_ = static_cast<int>(action);
   last_error_.clear();
@@ -232,6 +287,34 @@ LiveStatus LivePlatform::status() const {
   for (std::size_t i = 0; i < 6; ++i) s.lifecycle[i] = static_cast<Lifecycle>(lifecycle_[i].load());
   s.overruns = overruns_.load(std::memory_order_relaxed);
   s.restarts = restarts_.load(std::memory_order_relaxed);
+  s.ticks = ticks_.load(std::memory_order_relaxed);
+  DemoResult& r = s.demo_result;
+  r.outcome = static_cast<DemoResult::Outcome>(demo_outcome_.load(std::memory_order_acquire));
+  r.placement_error_m = demo_error_m_.load(std::memory_order_relaxed);
+  r.duration_s = demo_duration_s_.load(std::memory_order_relaxed);
+  if (r.outcome != DemoResult::Outcome::kNone) {
+    // The operator's phase and failed phase are the loop's; read through its atomic copy.
+    r.phase = std::string(PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_phase_.load())));
+    switch (r.outcome) {
+      case DemoResult::Outcome::kGaveUp:
+        r.reason = std::string(
+            PickPlaceOperator::give_up_reason(static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
+        r.phase = std::string(PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
+        break;
+      case DemoResult::Outcome::kPlaced:
+        r.reason = "the part rests within the placement tolerance of its target";
+        break;
+      case DemoResult::Outcome::kInserted:
+        r.reason = "the pin is down in its hole";
+        break;
+      case DemoResult::Outcome::kMissed:
+        r.reason = params_.platform.world.hole_side_m > 0.0 ? "the pin is not in its hole"
+                                                            : "the part rests outside the placement tolerance";
+        break;
+      default:
+        break;
+    }
+  }
   std::lock_guard lock(request_mutex_);
   s.last_error = last_error_;
   return s;

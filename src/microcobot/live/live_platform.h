@@ -18,6 +18,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -52,6 +53,17 @@ struct LiveParams {
   void validate() const;
 };
 
+/// How the last scripted demo ended (issue #26: every outcome shown).
+struct DemoResult {
+  enum class Outcome { kNone, kRunning, kPlaced, kInserted, kMissed, kGaveUp };
+  Outcome outcome = Outcome::kNone;
+  std::string phase;              ///< the phase it is in, or gave up in
+  double placement_error_m = NAN;  ///< part centre to target, horizontal (NaN: no part)
+  double duration_s = 0.0;        ///< since the demo started
+  std::string reason;             ///< why it gave up, or what it achieved, in words
+  static std::string_view name(Outcome o);
+};
+
 /// What the loop reports, readable from any thread.
 struct LiveStatus {
   double t_s = 0.0;  ///< live time since serve started (continues across scene restarts)
@@ -61,7 +73,9 @@ struct LiveStatus {
   bool console_fresh = false;                      ///< the controlling client's commands are fresh
   std::array<platform::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
   std::uint64_t overruns = 0;
+  std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
   std::uint64_t restarts = 0;
+  DemoResult demo_result;
   std::string last_error;  ///< the last failed request (reset refused, rebuild failed)
 };
 
@@ -121,6 +135,11 @@ class LivePlatform {
     return {c.x(), c.y()};
   }
   double finger_width_m() const { return params_.finger_width_m; }
+  /// Why the scripted demo cannot run here (empty: it can).
+  std::string demo_unavailable_reason() const;
+  /// The force limits the platform enforces (control/safety_limits.h).
+  double grip_force_limit_N() const { return params_.platform.world.grip_force_limit_N; }
+  double contact_force_limit_N() const { return params_.platform.world.contact_force_limit_N; }
   std::size_t channel_count() const { return channel_count_; }
 
  private:
@@ -130,6 +149,9 @@ class LivePlatform {
     return !params_.make_devices && !params_.remote && params_.platform.devices.simulated();
   }
   void operator_tick(const platform::TickInfo& t) noexcept;
+  /// The demo's part of the operator tick: the scripted operator acts until it is done or gives
+  /// up, then every axis holds and the console has control again. Returns true while it drives.
+  bool demo_tick(const platform::TickInfo& t) noexcept;
   void control_thread();
 
   LiveParams params_;
@@ -155,7 +177,12 @@ class LivePlatform {
   // taken by the loop).
   std::atomic<double> t_s_{0.0};
   std::atomic<bool> estopped_{false}, fresh_{false}, demo_running_{false};
-  std::atomic<int> demo_phase_{0};
+  std::atomic<int> demo_phase_{0}, demo_failed_phase_{0};
+  // The demo's result, written by the loop (demo_outcome_ last, with release order).
+  std::atomic<int> demo_outcome_{0};  // DemoResult::Outcome
+  std::atomic<double> demo_error_m_{NAN}, demo_duration_s_{0.0};
+  bool demo_finished_ = false;  // loop thread only: the operator is done, the console has control
+  std::atomic<std::uint64_t> ticks_{0};
   std::array<std::atomic<int>, 6> lifecycle_{};
   std::atomic<std::uint64_t> overruns_{0}, restarts_{0};
   mutable std::mutex request_mutex_;  // control thread and requesters; never the loop

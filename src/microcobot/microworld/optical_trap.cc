@@ -14,6 +14,8 @@ void OpticalTrapParams::validate() const {
   require_positive(trap_stiffness_N_per_m, "trap_stiffness_N_per_m");
   require_positive(obstacle_radius_m, "obstacle_radius_m");
   require_non_negative(contact_stiffness_N_per_m, "contact_stiffness_N_per_m");
+  require(std::isfinite(escape_distance_m) && escape_distance_m >= 0.0 && escape_distance_m <= 1e-3,
+          "escape_distance_m", "must be within [0, 1 mm] (0: the bead radius times e^(1/4))", escape_distance_m);
   // A physical lower bound on the step (the bead's inertia-free dynamics need nothing finer;
   // the work budget of a run is duration / dt_s).
   require(std::isfinite(dt_s) && dt_s >= 1e-9, "dt_s", "must be >= 1e-09 s", dt_s);
@@ -40,6 +42,11 @@ OpticalTrap::OpticalTrap(const OpticalTrapParams& params) : params_(params) {
   gamma_ = 6.0 * std::numbers::pi * params_.viscosity_Pa_s * params_.bead_radius_m;
   decay_ = std::exp(-params_.trap_stiffness_N_per_m * params_.dt_s / gamma_);
   kick_ = std::sqrt(position_variance_m2() * (1.0 - decay_ * decay_));
+  w_ = params_.escape_distance_m > 0.0 ? params_.escape_distance_m : params_.bead_radius_m * std::exp(0.25);
+}
+
+double OpticalTrap::escape_force_N() const {
+  return params_.trap_stiffness_N_per_m * w_ * std::exp(-0.25);
 }
 
 double OpticalTrap::corner_frequency_Hz() const {
@@ -59,13 +66,26 @@ Eigen::Vector2d OpticalTrap::contact_force(const Eigen::Vector2d& bead_m) const 
   return params_.contact_stiffness_N_per_m * overlap * d / dist;
 }
 
+double OpticalTrap::hold_fraction(const Eigen::Vector2d& d) const noexcept {
+  const double u = d.squaredNorm() / (w_ * w_);
+  return std::exp(-0.25 * u * u);
+}
+
 Eigen::Vector2d OpticalTrap::trap_force(const OpticalTrapState& s) const {
-  return -params_.trap_stiffness_N_per_m * (s.bead_m - s.trap_m);
+  const Eigen::Vector2d d = s.bead_m - s.trap_m;
+  return -params_.trap_stiffness_N_per_m * hold_fraction(d) * d;
 }
 
 bool OpticalTrap::try_step(OpticalTrapState& s, Rng& rng) const noexcept {
+  // The linear spring -k d is integrated exactly (Ornstein-Uhlenbeck); the rest of the trap's
+  // force, k d (1 - g(d)), is frozen over the step like the contact: far from
+  // the trap the two cancel and the bead diffuses freely (the kick then tends to
+  // sqrt(2 k_B T dt / gamma)).
+  const Eigen::Vector2d d = s.bead_m - s.trap_m;
+  const double k = params_.trap_stiffness_N_per_m;
+  const Eigen::Vector2d release = k * (1.0 - hold_fraction(d)) * d;
   const Eigen::Vector2d fc = contact_force(s.bead_m);
-  const Eigen::Vector2d eq = s.trap_m + fc / params_.trap_stiffness_N_per_m;
+  const Eigen::Vector2d eq = s.trap_m + (fc + release) / k;
   for (int a = 0; a < 2; ++a) {
     s.bead_m(a) = eq(a) + (s.bead_m(a) - eq(a)) * decay_ + kick_ * rng.normal();
   }

@@ -27,6 +27,12 @@ void PickPlaceParams::validate() const {
             "must be within (0, the part's height): the fingers must hold the part above the substrate",
             hole_depth_m);
   }
+  require(std::isfinite(grip_force_limit_N) && grip_force_limit_N > 0 && grip_force_limit_N <= 1.0,
+          "grip_force_limit_N", "must be within (0, 1] N", grip_force_limit_N);
+  require(std::isfinite(contact_force_limit_N) && contact_force_limit_N > 0 && contact_force_limit_N <= 10.0,
+          "contact_force_limit_N", "must be within (0, 10] N", contact_force_limit_N);
+  require(std::isfinite(min_tip_height_m) && min_tip_height_m >= -1e-3 && min_tip_height_m < 1e-3,
+          "min_tip_height_m", "must be within [-1 mm, 1 mm)", min_tip_height_m);
   gripper.validate();
   require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
           gripper.max_opening_m);
@@ -74,7 +80,8 @@ bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
   return p_.hole_side_m > 0.0 && s.part_m.z() < 0.5 * p_.height_m() - 1e-9;
 }
 
-Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_hole) const noexcept {
+Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_hole,
+                                                double capacity_N) const noexcept {
   if (!in_hole) return Eigen::Vector2d::Zero();
   const double play = 0.5 * (p_.hole_side_m - p_.part_side_m);
   Eigen::Vector2d reaction = Eigen::Vector2d::Zero();
@@ -85,6 +92,10 @@ Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_h
     reaction[i] = p_.substrate_stiffness_N_m * (inside - d);
     part[i] = centre + inside;
   }
+  // The part slips in the fingers once the wall pushes it harder than they hold it: the
+  // fingers feel at most what holds the part (friction of the grip, or the adhesion to a finger).
+  const double n = reaction.norm();
+  if (n > capacity_N) reaction *= capacity_N / n;
   return reaction;
 }
 
@@ -145,7 +156,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
         s.part_m.y() += motion.y();  // dragged along the substrate with the gripper
         out.force_on_gripper_N.head<2>() += rubbing_force(lateral, dt_s, drag_resistance);
       }
-      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, in_hole);
+      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, in_hole, hold_capacity);
       if (motion.z() > 0.0 && g.z() > s.part_m.z() - 0.5 * p_.height_m() - 1e-12) {
         if (hold_capacity >= substrate_hold) {
           s.phase = PartPhase::kGrasped;  // lift-off: the grip beats adhesion + weight
@@ -162,7 +173,8 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       Eigen::Vector3d next = g + s.offset_m;
       // In the hole, its walls hold the part: it slips in the fingers, which feel the wall.
       const Eigen::Vector3d unconfined = next;
-      out.force_on_gripper_N.head<2>() += confine_to_hole(next, in_hole);
+      const double held_by = s.phase == PartPhase::kGrasped ? hold_capacity : p_.finger_pulloff_N;
+      out.force_on_gripper_N.head<2>() += confine_to_hole(next, in_hole, held_by);
       s.offset_m.head<2>() += (next - unconfined).head<2>();
       const double floor = rest_z_m(next.x(), next.y());
       if (next.z() < floor) {  // pressed onto the substrate: the part stops, the fingers slide down

@@ -21,7 +21,8 @@
 /// taller). With hole_side_m > 0 the target is a square hole of that side and hole_depth_m deep
 /// (a pin-in-hole insertion with clearance hole_side_m - part_side_m): the part goes down into
 /// it only when its footprint fits (|x - x_hole| and |y - y_hole| <= clearance / 2), else it
-/// lands on the rim; once in, the hole's walls stop it sideways (a stiff reaction on the fingers).
+/// lands on the rim; once in, the hole's walls stop it sideways (a stiff reaction on the fingers,
+/// up to what holds the part in them: beyond it the part slips between the fingers).
 
 #include <cmath>
 
@@ -57,6 +58,17 @@ struct PickPlaceParams {
   Eigen::Vector3d part_start_m{0.0, 0.0, 0.0};  ///< part centre on the substrate (z ignored)
   Eigen::Vector3d target_m{2e-3, 0.0, 0.0};     ///< where the part must be placed (x, y)
   PiezoGripperParams gripper;
+  /// The platform's limits for this part (issue #26; control/safety_limits.h). 1 mN of grip
+  /// holds a 300 um brass part with a 27x margin (2 mu F >= pull-off + weight needs 60 uN) and
+  /// stays well below what dents a watch part's finish.
+  double grip_force_limit_N = 1e-3;
+  /// Force on the gripper above which the stage holds: above the largest force of a normal
+  /// pick-and-place (a held part pressed down slips in the fingers at 2 mu F_grip <= 0.6 mN).
+  double contact_force_limit_N = 2e-3;
+  /// Lowest finger-tip height above the substrate the platform lets any input command. A
+  /// negative floor lets the tips into the substrate: only for tests of stiff contacts (the
+  /// passivity tests), never on a platform with a customer's parts.
+  double min_tip_height_m = 10e-6;
 
   template <class V>
   void visit(V& v) {
@@ -78,6 +90,9 @@ struct PickPlaceParams {
     v("target_x_m", target_m.x());
     v("target_y_m", target_m.y());
     v("gripper", gripper);
+    v("grip_force_limit_N", grip_force_limit_N);
+    v("contact_force_limit_N", contact_force_limit_N);
+    v("min_tip_height_m", min_tip_height_m);
   }
   void validate() const;
   double part_weight_N() const;
@@ -137,8 +152,9 @@ class PickPlaceWorld {
   bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept;
   Eigen::Vector2d rubbing_force(const Eigen::Vector2d& motion, double dt_s, double coulomb_N) const noexcept;
   /// Keeps a part that was in the hole (`in_hole`, before this step's motion) inside its walls;
-  /// returns the wall's reaction [N].
-  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, bool in_hole) const noexcept;
+  /// returns the wall's reaction on the fingers [N], at most `capacity_N` (what holds the part in
+  /// them: beyond it the part slips).
+  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, bool in_hole, double capacity_N) const noexcept;
   PickPlaceParams p_;
   double weight_;
 };

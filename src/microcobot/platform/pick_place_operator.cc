@@ -23,6 +23,7 @@ void PickPlaceOperatorParams::validate() const {
   require(retract_z_m > grasp_z_m, "retract_z_m", "must be above grasp_z_m", retract_z_m);
   require_positive(pinch_m, "pinch_m");
   require_positive(pinch_s, "pinch_s");
+  require(max_pinch_m >= pinch_m, "max_pinch_m", "must be at least pinch_m", max_pinch_m);
   require_positive(felt_grip_N, "felt_grip_N");
   require_positive(hand_limit_m, "hand_limit_m");
   require_positive(hand_return_speed_m_s, "hand_return_speed_m_s");
@@ -55,6 +56,31 @@ std::string_view PickPlaceOperator::name(Phase p) {
   return "?";
 }
 
+std::string_view PickPlaceOperator::give_up_reason(Phase p) {
+  switch (p) {
+    case Phase::kApproach:
+      return "the open gripper never settled over the part";
+    case Phase::kDescend:
+      return "the finger tips never reached the grasp height";
+    case Phase::kPinch:
+      return "the grip was never felt: the fingers did not close on the part";
+    case Phase::kLift:
+      return "the part could not be lifted to the carrying height";
+    case Phase::kTransport:
+      return "the part never settled over its target";
+    case Phase::kSetDown:
+      return "the part could not be set down";
+    case Phase::kRelease:
+      return "the fingers did not open to release the part";
+    case Phase::kRetract:
+      return "the gripper could not be raised clear of the part";
+    case Phase::kDone:
+    case Phase::kGaveUp:
+      break;
+  }
+  return "";
+}
+
 PickPlaceOperator::PickPlaceOperator(Platform& platform, const PickPlaceOperatorParams& params)
     : platform_(platform),
       sim_(platform.simulation()),
@@ -62,8 +88,17 @@ PickPlaceOperator::PickPlaceOperator(Platform& platform, const PickPlaceOperator
       motion_scale_(platform.config().teleop.motion_scale) {
   p_.validate();
   require(sim_.gripper != nullptr, "microworld", "the scripted pick-and-place needs the pick-place scene");
+  lift_m_ = sim_.gripper->world().params().hole_depth_m;
   std::fill(std::begin(started_), std::end(started_), std::numeric_limits<double>::quiet_NaN());
   started_[0] = 0.0;
+}
+
+void PickPlaceOperator::let_go() noexcept {
+  hand_.deadman = false;
+  hand_.clutch = false;
+  hand_.jog_m_s = 0.0;
+  clutching_ = false;
+  sim_.haptic->set_operator(hand_);
 }
 
 void PickPlaceOperator::enter(Phase p, double t) noexcept {
@@ -120,8 +155,7 @@ void PickPlaceOperator::act(const TickInfo& tick) noexcept {
   if (t - phase_t0_ > p_.phase_timeout_s) {
     failed_phase_ = phase_;
     enter(Phase::kGaveUp, t);
-    hand_.deadman = false;
-    sim_.haptic->set_operator(hand_);
+    let_go();
     return;
   }
   const SimulatedGripper& g = *sim_.gripper;
@@ -141,17 +175,19 @@ void PickPlaceOperator::act(const TickInfo& tick) noexcept {
       if (settle(steer(tip.head<2>(), part.head<2>(), p_.approach_speed_m_s, dt))) enter(Phase::kDescend, t);
       break;
     case Phase::kDescend:
-      hand_.jog_m_s = jog_to(tip.z(), p_.grasp_z_m);
-      if (settle(std::abs(tip.z() - p_.grasp_z_m) < p_.resolution_m)) enter(Phase::kPinch, t);
+      hand_.jog_m_s = jog_to(tip.z(), p_.grasp_z_m + lift_m_);
+      if (settle(std::abs(tip.z() - (p_.grasp_z_m + lift_m_)) < p_.resolution_m)) enter(Phase::kPinch, t);
       break;
-    case Phase::kPinch:
-      pinch_ = std::min(p_.pinch_m, pinch_ + p_.pinch_m * dt / p_.pinch_s);
-      if (settle(pinch_ >= p_.pinch_m && platform_.teleop().finger_force_N >= p_.felt_grip_N))
-        enter(Phase::kLift, t);
+    case Phase::kPinch: {
+      // Closing until the grip is felt, as a person does: how far depends on the part's width.
+      const bool felt = platform_.teleop().finger_force_N >= p_.felt_grip_N;
+      if (!felt) pinch_ = std::min(p_.max_pinch_m, pinch_ + p_.pinch_m * dt / p_.pinch_s);
+      if (settle(felt)) enter(Phase::kLift, t);
       break;
+    }
     case Phase::kLift:
-      hand_.jog_m_s = jog_to(tip.z(), p_.carry_z_m);
-      if (settle(std::abs(tip.z() - p_.carry_z_m) < p_.resolution_m)) enter(Phase::kTransport, t);
+      hand_.jog_m_s = jog_to(tip.z(), p_.carry_z_m + lift_m_);
+      if (settle(std::abs(tip.z() - (p_.carry_z_m + lift_m_)) < p_.resolution_m)) enter(Phase::kTransport, t);
       break;
     case Phase::kTransport:
       if (settle(steer(part.head<2>(), target, p_.transport_speed_m_s, dt))) enter(Phase::kSetDown, t);
@@ -162,14 +198,18 @@ void PickPlaceOperator::act(const TickInfo& tick) noexcept {
         enter(Phase::kRelease, t);
       break;
     case Phase::kRelease:
-      pinch_ = std::max(0.0, pinch_ - p_.pinch_m * dt / p_.pinch_s);
+      pinch_ = std::max(0.0, pinch_ - p_.pinch_m * dt / p_.pinch_s);  // released as fast
       if (settle(pinch_ == 0.0 && g.opening_m() > 0.9 * g.world().params().gripper.max_opening_m)) {
         enter(Phase::kRetract, t);
       }
       break;
     case Phase::kRetract:
-      hand_.jog_m_s = jog_to(tip.z(), p_.retract_z_m);
-      if (settle(std::abs(tip.z() - p_.retract_z_m) < p_.resolution_m)) enter(Phase::kDone, t);
+      hand_.jog_m_s = jog_to(tip.z(), p_.retract_z_m + lift_m_);
+      if (settle(std::abs(tip.z() - (p_.retract_z_m + lift_m_)) < p_.resolution_m)) {
+        enter(Phase::kDone, t);
+        let_go();
+        return;
+      }
       break;
     case Phase::kDone:
     case Phase::kGaveUp:

@@ -6,7 +6,8 @@
 /// turns the Z thumb wheel and pinches the TéléTweez, as a person would:
 ///
 ///   approach  bring the open gripper over the part (XY), then down to the grasp height;
-///   grasp     pinch the TéléTweez until the grip is felt (the rendered finger force);
+///   grasp     pinch the TéléTweez, closing further until the grip is felt (the rendered
+///             finger force), then hold the pinch;
 ///   lift      raise the part off the substrate (the grip must beat its adhesion);
 ///   transport move it to the target at the transport speed, clutching (indexing) whenever
 ///             the hand nears the edge of the Pantograph's workspace;
@@ -14,7 +15,10 @@
 ///             resolution, set it down, open the tweezers (adhesion to the substrate keeps
 ///             the part in place), and retract.
 ///
-/// Each phase has a time limit; an operator who cannot finish a phase gives up (failed()).
+/// Heights are the finger tips' above the part's bottom: with a hole at the target, the part is
+/// grasped higher by the hole's depth, so that the tips stay above the substrate once it is in.
+/// Each phase has a time limit; an operator who cannot finish a phase gives up (gave_up(),
+/// give_up_reason()). Done or given up, the operator lets go of the deadman and the controls.
 /// act() is real-time safe (it runs as a loop task).
 
 #include <string_view>
@@ -36,8 +40,9 @@ struct PickPlaceOperatorParams {
   double carry_z_m = 400e-6;       ///< finger-tip height while transporting
   double set_down_press_m = 5e-6;  ///< how far below the grasp height to set down
   double retract_z_m = 600e-6;
-  double pinch_m = 5e-3;               ///< how far the fingers aim to close the TéléTweez levers
-  double pinch_s = 0.5;                ///< pinch and release durations
+  double pinch_m = 5e-3;               ///< the fingers close the TéléTweez levers by this much ...
+  double pinch_s = 0.5;                ///< ... in this time (and open them as fast)
+  double max_pinch_m = 10e-3;          ///< and never further (the levers' travel)
   double felt_grip_N = 0.05;           ///< finger force that tells the part is held
   double hand_limit_m = 35e-3;         ///< clutch when the hand gets this far from the centre
   double hand_return_speed_m_s = 0.2;  ///< hand speed while clutched
@@ -58,6 +63,7 @@ struct PickPlaceOperatorParams {
     v("retract_z_m", retract_z_m);
     v("pinch_m", pinch_m);
     v("pinch_s", pinch_s);
+    v("max_pinch_m", max_pinch_m);
     v("felt_grip_N", felt_grip_N);
     v("hand_limit_m", hand_limit_m);
     v("hand_return_speed_m_s", hand_return_speed_m_s);
@@ -91,6 +97,8 @@ class PickPlaceOperator {
   bool gave_up() const { return phase_ == Phase::kGaveUp; }
   /// The phase the operator gave up in (meaningful when gave_up()).
   Phase failed_phase() const { return failed_phase_; }
+  /// Why an operator gives up in `phase`, in a person's words.
+  static std::string_view give_up_reason(Phase phase);
   /// Time each phase started [s] (NaN if not reached), indexed by Phase.
   double phase_start_s(Phase p) const { return started_[static_cast<int>(p)]; }
   int clutches() const { return clutches_; }
@@ -101,11 +109,14 @@ class PickPlaceOperator {
   /// clutches near the workspace edge. Returns true once within the resolution.
   bool steer(const Eigen::Vector2d& seen, const Eigen::Vector2d& goal, double speed, double dt) noexcept;
   double jog_to(double z_seen, double z_goal) const noexcept;
+  /// Lets go of the deadman, the clutch and the jog wheel (done or given up).
+  void let_go() noexcept;
 
   Platform& platform_;
   const SimulatedDevices& sim_;  ///< the operator acts on the simulated masters' hands
   PickPlaceOperatorParams p_;
   double motion_scale_;
+  double lift_m_ = 0.0;  ///< the hole's depth: grasp and carry heights are raised by it
   Phase phase_ = Phase::kApproach;
   Phase failed_phase_ = Phase::kApproach;
   double phase_t0_ = 0.0;

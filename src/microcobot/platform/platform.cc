@@ -102,8 +102,13 @@ void Platform::build() {
   stage_ = std::make_unique<StageController>(
       config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
       config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr);
+  control::SafetyLimitParams limits;
+  limits.grip_force_limit_N = world_.params().grip_force_limit_N;
+  limits.contact_force_limit_N = world_.params().contact_force_limit_N;
+  limits.finger_stiffness_N_m = world_.params().gripper.finger_stiffness_N_m;
+  limits.floor_m = world_.params().min_tip_height_m - home_m_.z();  // the substrate is at world z = 0
   teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
-                                                     world_.params().gripper.max_opening_m);
+                                                     world_.params().gripper.max_opening_m, limits);
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
 
   arm_devices(/*fault_on_failure=*/false);
@@ -161,6 +166,7 @@ void Platform::teleoperation_task() noexcept {
   const Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
   in.grip_force_N = devices_.gripper->grip_force_N();
+  in.gripper_opening_m = devices_.gripper->opening_m();
   in.slave_fresh = devices_.axes[0]->measurement_fresh() && devices_.axes[1]->measurement_fresh() &&
                    devices_.axes[2]->measurement_fresh();
   in.console = console_;
@@ -266,6 +272,12 @@ void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
   console_ = in;
   // World coordinates (the telemetry's) to the coupling's, which are relative to home.
   console_.goal_m = in.goal_m - home_m_;
+}
+
+void Platform::hold() noexcept {
+  const Eigen::Vector3d measured(devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
+                                 devices_.axes[2]->position_m());
+  teleop_->hold_at(measured);
 }
 
 void Platform::arm_devices(bool fault_on_failure) {

@@ -146,6 +146,12 @@ class Platform {
   /// runs. Throws mc::Error when a device refuses (every device is then left in its safe state).
   void recover();
   void stop() noexcept { loop_.request_stop(); }
+  /// Every axis holds where it is measured (target = position, zero velocity), the coupling
+  /// disengaged until the next engagement: how an automatic sequence hands control back
+  /// (issue #26). On the loop (the operator task); real-time safe.
+  void hold() noexcept;
+  /// The force and floor limits the coupling enforces (control/safety_limits.h).
+  const control::SafetyLimits& safety_limits() const { return teleop_->limits(); }
 
   /// Every device to its safe state and Fault (a fault injection or an operator's e-stop).
   void fault_all() noexcept;

@@ -21,6 +21,14 @@ std::vector<double> scaled(std::vector<double> v, double k) {
   return v;
 }
 
+const std::string kScriptedHand =
+    "The scripted operator's hand and the handle of the dual-stage interface, relative to the "
+    "Pantograph's workspace centre. The hand travels 100 times the slave's motion; the clutch "
+    "brings it back across the workspace while the slave holds.";
+
+// Plotted in the units a person reads at this scale (the figures' CSVs say which).
+constexpr double kUm = 1e6, kUN = 1e6;
+
 }  // namespace
 
 std::vector<std::string> scenario_names() { return {"pick-place", "stale-master"}; }
@@ -172,15 +180,15 @@ report::Report Session::report(const SessionResult& r) const {
   for (const auto& [name, start] : r.phases)
     phases += name + " at " + std::to_string(start).substr(0, 6) + " s; ";
   rep.section("Outcome", r.verdict + ".\n\nPhases: " + phases);
-  rep.add_result("success", r.success ? 1.0 : 0.0);
+  rep.add_text_result("success", r.success ? "yes" : "no");
   rep.add_result("placement error", r.placement_error_m, "m");
   rep.add_result("operator-to-slave tracking error (RMS, engaged)", r.tracking_error_rms_m, "m");
   rep.add_result("operator-to-slave tracking error (max, engaged)", r.tracking_error_max_m, "m");
   rep.add_result("simulated duration", r.duration_s, "s");
   rep.add_result("clutches (indexing)", r.clutches);
-  rep.add_result("faulted", r.faulted ? 1.0 : 0.0);
+  rep.add_text_result("faulted", r.faulted ? "yes" : "no");
 
-  add_recording_figures(rep, rec);
+  add_recording_figures(rep, rec, kScriptedHand);
   rep.add_result("ticks", static_cast<double>(r.ticks));
   rep.add_result("overruns", static_cast<double>(r.overruns));
   rep.add_result("mean tick", r.tick_mean_us * 1e-6, "s");
@@ -190,21 +198,18 @@ report::Report Session::report(const SessionResult& r) const {
   return rep;
 }
 
-void add_recording_figures(report::Report& rep, const Recorder& rec) {
+void add_recording_figures(report::Report& rep, const Recorder& rec, const std::string& hand) {
   const auto t = column(rec, "t_s");
   auto series = [&](const std::string& name, const std::string& channel, double k = 1.0) {
     return report::Series{name, t, scaled(column(rec, channel), k)};
   };
-  rep.section("Operator and haptic master",
-              "The scripted operator's hand and the handle of the dual-stage interface, relative to the "
-              "Pantograph's workspace centre. The hand travels 100 times the slave's motion; the clutch "
-              "brings it back across the workspace while the slave holds.");
+  rep.section("Operator and haptic master", hand);
   rep.add_figure({"Hand and handle",
                   "x and y of the hand (set by the operator) and of the handle.",
                   {"Time", "s"},
-                  {"Position", "m"},
-                  {series("hand x", "hand_x_m"), series("handle x", "handle_x_m"),
-                   series("hand y", "hand_y_m"), series("handle y", "handle_y_m")}});
+                  {"Position", "mm"},
+                  {series("hand x", "hand_x_m", 1e3), series("handle x", "handle_x_m", 1e3),
+                   series("hand y", "hand_y_m", 1e3), series("handle y", "handle_y_m", 1e3)}});
   rep.add_figure({"Haptic force",
                   "Force commanded to the handle (the slave's contact force x 1e4, capped).",
                   {"Time", "s"},
@@ -221,29 +226,31 @@ void add_recording_figures(report::Report& rep, const Recorder& rec) {
   rep.section("Slave stage and microworld",
               "The finger tips (the stage's true position plus the mount offset), the teleoperation target "
               "and the part, in the world frame.");
-  rep.add_figure(
-      {"Slave x",
-       "",
-       {"Time", "s"},
-       {"Position", "m"},
-       {series("target x", "target_x_m"), series("tips x", "slave_x_m"), series("part x", "part_x_m")}});
-  rep.add_figure(
-      {"Slave z",
-       "",
-       {"Time", "s"},
-       {"Height", "m"},
-       {series("target z", "target_z_m"), series("tips z", "slave_z_m"), series("part z", "part_z_m")}});
-  rep.add_figure({"Path in the x-z plane",
-                  "Where the tips and the part went (side view).",
-                  {"x", "m"},
-                  {"z", "m"},
-                  {report::Series{"tips", column(rec, "slave_x_m"), column(rec, "slave_z_m")},
-                   report::Series{"part", column(rec, "part_x_m"), column(rec, "part_z_m")}}});
-  rep.add_figure({"Contact force on the gripper",
+  rep.add_figure({"Slave x",
                   "",
                   {"Time", "s"},
-                  {"Force", "N"},
-                  {series("x", "contact_x_N"), series("y", "contact_y_N"), series("z", "contact_z_N")}});
+                  {"Position", "um"},
+                  {series("target x", "target_x_m", kUm), series("tips x", "slave_x_m", kUm),
+                   series("part x", "part_x_m", kUm)}});
+  rep.add_figure({"Slave z",
+                  "",
+                  {"Time", "s"},
+                  {"Height", "um"},
+                  {series("target z", "target_z_m", kUm), series("tips z", "slave_z_m", kUm),
+                   series("part z", "part_z_m", kUm)}});
+  rep.add_figure(
+      {"Path in the x-z plane",
+       "Where the tips and the part went (side view).",
+       {"x", "um"},
+       {"z", "um"},
+       {report::Series{"tips", scaled(column(rec, "slave_x_m"), kUm), scaled(column(rec, "slave_z_m"), kUm)},
+        report::Series{"part", scaled(column(rec, "part_x_m"), kUm), scaled(column(rec, "part_z_m"), kUm)}}});
+  rep.add_figure(
+      {"Contact force on the gripper",
+       "",
+       {"Time", "s"},
+       {"Force", "uN"},
+       {series("x", "contact_x_N", kUN), series("y", "contact_y_N", kUN), series("z", "contact_z_N", kUN)}});
   rep.add_figure({"Drive voltages (sampled at 1 kHz)",
                   "The axes' drive voltage at the telemetry instants.",
                   {"Time", "s"},
@@ -253,30 +260,57 @@ void add_recording_figures(report::Report& rep, const Recorder& rec) {
   rep.section("Gripper and TéléTweez",
               "The TéléTweez tip opening drives the gripper opening (x 0.06); the grip "
               "force comes back to the operator's fingers (x 100).");
-  rep.add_figure({"Openings",
-                  "",
-                  {"Time", "s"},
-                  {"Opening", "m"},
-                  {series("TéléTweez x 0.06", "tweezers_opening_m", 0.06),
-                   series("gripper command", "gripper_command_m"), series("gripper", "gripper_opening_m")}});
   rep.add_figure(
-      {"Grip forces",
+      {"Openings",
        "",
        {"Time", "s"},
-       {"Force", "N"},
-       {series("slave grip", "grip_force_N"), series("finger force / 100", "finger_force_N", 0.01)}});
+       {"Opening", "um"},
+       {series("TéléTweez x 0.06", "tweezers_opening_m", 0.06 * kUm),
+        series("gripper command", "gripper_command_m", kUm), series("gripper", "gripper_opening_m", kUm)}});
+  rep.add_figure({"Grip forces",
+                  "",
+                  {"Time", "s"},
+                  {"Force", "uN"},
+                  {series("slave grip", "grip_force_N", kUN),
+                   series("finger force / 100", "finger_force_N", 0.01 * kUN)}});
 
   rep.section("Loop timing",
               "Compute time of the 10 kHz loop's ticks that run every task (slave control, telemetry: "
               "one in ten, the heaviest), on the wall clock and on the loop thread's CPU clock (a "
               "preemption by another thread counts on the wall clock only). An overrun is a tick longer "
               "than the period.");
-  std::vector<report::Series> ticks = {series("tick (wall)", "tick_us", 1e-6)};
-  if (rec.has_channel("tick_cpu_us")) ticks.push_back(series("tick (loop thread CPU)", "tick_cpu_us", 1e-6));
-  rep.add_figure({"Tick compute time", "", {"Time", "s"}, {"Tick", "s"}, std::move(ticks)});
+  std::vector<report::Series> ticks = {series("tick (wall)", "tick_us")};
+  if (rec.has_channel("tick_cpu_us")) ticks.push_back(series("tick (loop thread CPU)", "tick_cpu_us"));
+  rep.add_figure({"Tick compute time", "", {"Time", "s"}, {"Tick", "us"}, std::move(ticks)});
 }
 
-report::Report recording_report(const Recorder& rec, const std::string& name) {
+namespace {
+
+// Who moved the hand, and how the slave followed, as the recording's status and events tell it.
+std::string live_hand_text(const RecordingStory& story) {
+  std::string who;
+  if (story.demo && story.console_control) {
+    who = "Part of this session was driven from the console (a client took control at t = " +
+          fmt::format("{:.1f}", story.console_control_s) +
+          " s) and part by the scripted demo operator, whose hand moves the haptic master.";
+  } else if (story.demo) {
+    who = "The scripted demo operator drove this session: its hand moves the haptic master's handle.";
+  } else if (story.console_control) {
+    who = "This session was hand-operated from the browser console (a client took control at t = " +
+          fmt::format("{:.1f}", story.console_control_s) +
+          " s): the console's commands set the slave's target directly, so the hand and the handle "
+          "below rest where the haptic master sits and its force stays zero.";
+  } else {
+    who = "Nobody drove in this session (no client took control, the demo did not run): the stage held.";
+  }
+  return who + " Hand and handle are relative to the Pantograph's workspace centre.";
+}
+
+std::string yes_no(bool b) { return b ? "yes" : "no"; }
+
+}  // namespace
+
+report::Report recording_report(const Recorder& rec, const std::string& name, const RecordingStory& story) {
   report::Report rep("microcobot recording: " + name);
   const auto t = column(rec, "t_s");
   if (t.empty()) throw InvalidInput(name, 0, "the recording holds no sample");
@@ -284,14 +318,42 @@ report::Report recording_report(const Recorder& rec, const std::string& name) {
   double tick_max = 0.0;
   for (double v : tick)
     if (std::isfinite(v)) tick_max = std::max(tick_max, v);
-  rep.section("Recording", "The live session recorded by `microcobot serve` in " + name + ", from t = " +
-                               fmt::format("{:.3f}", t.front()) + " s to " + fmt::format("{:.3f}", t.back()) +
-                               " s of live time (" + std::to_string(rec.size()) + " samples plotted).");
-  rep.add_result("start", t.front(), "s");
+  std::string text = "The live session recorded by `microcobot serve`" +
+                     (story.version.empty() ? std::string() : " (" + story.version + ")") + " in " + name +
+                     (story.scene.empty() ? std::string() : ", scene " + story.scene) +
+                     ", from t = " + fmt::format("{:.1f}", t.front()) + " s to " +
+                     fmt::format("{:.1f}", t.back()) + " s of live time (" + std::to_string(rec.size()) +
+                     " samples plotted).";
+  if (story.demo && !story.demo_phases.empty()) {
+    text += "\n\nThe demo went through: ";
+    for (std::size_t i = 0; i < story.demo_phases.size(); ++i) text += (i ? ", " : "") + story.demo_phases[i];
+    text += ".";
+  }
+  rep.section("Recording", text);
+  rep.add_text_result("driven from the console", yes_no(story.console_control));
+  rep.add_text_result("scripted demo", yes_no(story.demo));
+  rep.add_result("e-stops", story.estops);
+  rep.add_result("refused messages", story.refusals);
+  rep.add_result("start (live time)", t.front(), "s");
   rep.add_result("duration", t.back() - t.front(), "s");
   rep.add_result("samples plotted", static_cast<double>(rec.size()));
   rep.add_result("max sampled tick", tick_max * 1e-6, "s");
-  add_recording_figures(rep, rec);
+  if (!story.events.empty()) {
+    // One paragraph per event (the page splits paragraphs at blank lines); the first 40.
+    std::string events;
+    const std::size_t shown = std::min<std::size_t>(story.events.size(), 40);
+    for (std::size_t i = 0; i < shown; ++i) {
+      const auto& e = story.events[i];
+      events += fmt::format("t = {:.1f} s: {}{}\n\n", e.t_s,
+                            e.level >= 2   ? "error, "
+                            : e.level == 1 ? "warning, "
+                                           : "",
+                            e.text);
+    }
+    if (shown < story.events.size()) events += fmt::format("... and {} more.", story.events.size() - shown);
+    rep.section("What happened", events);
+  }
+  add_recording_figures(rep, rec, live_hand_text(story));
   return rep;
 }
 

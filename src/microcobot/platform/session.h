@@ -61,12 +61,32 @@ struct SessionResult {
   nlohmann::json to_json() const;
 };
 
+/// What a live recording says happened besides its telemetry, read from its /events and
+/// /platform/status channels (live/recording_files.h): who drove, e-stops, refusals, errors.
+struct RecordingStory {
+  std::string version;             ///< the program that recorded it ("" when the recording does not say)
+  std::string scene;               ///< the scene's kind
+  bool console_control = false;    ///< a console client held control
+  double console_control_s = 0.0;  ///< when it first took it (loop time)
+  bool demo = false;               ///< the scripted demo operator drove
+  std::vector<std::string> demo_phases;  ///< the demo's phases, in order
+  int estops = 0, refusals = 0, errors = 0;
+  struct Event {
+    double t_s;
+    int level;  ///< 0 info, 1 warning, 2 error
+    std::string text;
+  };
+  std::vector<Event> events;  ///< the notable ones, in order
+};
+
 /// The figures of a recording (operator and haptic master, slave stage and microworld, gripper
 /// and TéléTweez, loop timing), shared by the session report and the live recordings' reports.
-void add_recording_figures(report::Report& rep, const Recorder& rec);
-/// The report of a live recording (`serve`, read back with read_telemetry_mcap): its span and
-/// the figures. Throws InvalidInput for an empty recording.
-report::Report recording_report(const Recorder& rec, const std::string& name);
+/// `hand` is the first section's text: who moved the hand (the scripted operator, the console).
+void add_recording_figures(report::Report& rep, const Recorder& rec, const std::string& hand);
+/// The report of a live recording (`serve`, read back with read_telemetry_mcap): what happened
+/// (from `story`), its span and the figures. Throws InvalidInput for an empty recording.
+report::Report recording_report(const Recorder& rec, const std::string& name,
+                                const RecordingStory& story = {});
 
 class Session {
  public:

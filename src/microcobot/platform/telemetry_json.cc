@@ -51,7 +51,7 @@ std::string telemetry_json_schema(std::size_t channel_count) {
       description = "flag: 1 true, 0 false";
     }
     description += "; null when not finite";
-    props[std::string(name)] = {{"type", "number"}, {"description", description}};
+    props[std::string(name)] = {{"type", {"number", "null"}}, {"description", description}};
   }
   nlohmann::ordered_json schema = {
       {"$schema", "https://json-schema.org/draft/2020-12/schema"},
@@ -109,7 +109,12 @@ void write_telemetry_mcap(const Recorder& rec, const std::filesystem::path& file
 
 Recorder read_telemetry_mcap(const std::filesystem::path& file, std::size_t max_samples) {
   require(max_samples >= 1, "max_samples", "must be >= 1", static_cast<double>(max_samples));
-  const McapContents m = read_mcap(file);
+  return telemetry_from_mcap(read_mcap(file), file.string(), max_samples);
+}
+
+Recorder telemetry_from_mcap(const McapContents& m, const std::string& name, std::size_t max_samples) {
+  require(max_samples >= 1, "max_samples", "must be >= 1", static_cast<double>(max_samples));
+  const std::filesystem::path file(name);
   const McapChannel* channel = nullptr;
   for (const auto& c : m.channels)
     if (c.topic == kTelemetryTopic && c.message_encoding == "json") channel = &c;

@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "microcobot/core/mcap_reader.h"
 #include "microcobot/core/recorder.h"
 
 namespace mc::platform {
@@ -48,5 +49,7 @@ void write_telemetry_mcap(const Recorder& rec, const std::filesystem::path& file
 /// read as NaN). Keeps at most `max_samples` samples, evenly decimated (a report's plots need no
 /// more). Throws InvalidInput "<file>: ..." for a file that is not such a recording.
 Recorder read_telemetry_mcap(const std::filesystem::path& file, std::size_t max_samples);
+/// The same from an MCAP file already read (read_mcap); `name` stands for it in errors.
+Recorder telemetry_from_mcap(const McapContents& m, const std::string& name, std::size_t max_samples);
 
 }  // namespace mc::platform

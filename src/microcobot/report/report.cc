@@ -51,11 +51,20 @@ std::string escape_html(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -121,7 +130,29 @@ Section& Report::current() {
 void Report::add_figure(Figure figure) { current().figures.push_back(std::move(figure)); }
 
 void Report::add_result(std::string name, double value, std::string unit) {
-  current().results.push_back(Result{std::move(name), value, std::move(unit)});
+  current().results.push_back(Result{std::move(name), value, std::move(unit), {}});
+}
+
+void Report::add_text_result(std::string name, std::string text) {
+  current().results.push_back(Result{std::move(name), 0.0, {}, std::move(text)});
+}
+
+std::pair<std::string, std::string> human_value(double value, const std::string& unit) {
+  static const char* const kScaled[] = {"m", "N", "s", "V", "A", "m/s"};
+  const bool scaled = std::find(std::begin(kScaled), std::end(kScaled), unit) != std::end(kScaled);
+  const double a = std::abs(value);
+  if (!scaled || !std::isfinite(value) || a == 0.0 || a >= 1.0) return {fmt::format("{:.4g}", value), unit};
+  struct Prefix {
+    double scale;
+    const char* name;
+  };
+  static constexpr Prefix kPrefixes[] = {{1e-3, "m"}, {1e-6, "u"}, {1e-9, "n"}, {1e-12, "p"}};
+  for (const auto& p : kPrefixes) {
+    // 0.99996 mm would print as "1000 um": it goes to the larger unit once rounded.
+    if (std::stod(fmt::format("{:.4g}", a / p.scale)) >= 1.0)
+      return {fmt::format("{:.4g}", value / p.scale), p.name + unit};
+  }
+  return {fmt::format("{:.4g}", value / 1e-12), "p" + unit};
 }
 
 void Report::append(const Report& other) {
@@ -134,7 +165,7 @@ std::size_t Report::figure_count() const {
   return n;
 }
 
-std::string Report::html() const {
+std::string Report::html(const std::string& data_prefix) const {
   nlohmann::json doc;
   doc["title"] = title_;
   doc["sections"] = nlohmann::json::array();
@@ -145,7 +176,8 @@ std::string Report::html() const {
     js["text"] = sec.text;
     js["results"] = nlohmann::json::array();
     for (const auto& r : sec.results) {
-      js["results"].push_back({{"name", r.name}, {"value", fmt::format("{:.6g}", r.value)}, {"unit", r.unit}});
+      const auto [value, unit] = r.text.empty() ? human_value(r.value, r.unit) : std::pair{r.text, r.unit};
+      js["results"].push_back({{"name", r.name}, {"value", value}, {"unit", unit}});
     }
     js["figures"] = nlohmann::json::array();
     for (const auto& f : sec.figures) {
@@ -153,7 +185,7 @@ std::string Report::html() const {
       ++index;
       nlohmann::json jf;
       jf["id"] = fmt::format("fig-{:02d}", index);
-      jf["csv"] = figure_file(index, f);
+      jf["csv"] = data_prefix + figure_file(index, f);
       jf["title"] = f.title;
       jf["caption"] = f.caption;
       jf["x"] = {{"label", f.x.label}, {"unit", f.x.unit}, {"log", f.x.log}};
@@ -188,7 +220,14 @@ std::string Report::html() const {
 }
 
 std::filesystem::path Report::write(const std::filesystem::path& dir) const {
-  const std::string page = html();  // validates every figure before anything is written
+  write_page(dir / "index.html", dir, "");
+  return dir / "index.html";
+}
+
+void Report::write_page(const std::filesystem::path& page_path, const std::filesystem::path& dir,
+                        const std::string& data_prefix) const {
+  const std::string page = html(data_prefix);  // validates every figure before anything is written
+  if (!page_path.parent_path().empty()) ensure_writable_dir(page_path.parent_path());
   ensure_writable_dir(dir);
   std::size_t index = 0;
   for (const auto& sec : sections_) {
@@ -223,9 +262,7 @@ std::filesystem::path Report::write(const std::filesystem::path& dir) const {
       write_csv(dir / figure_file(index, f), table, comment);
     }
   }
-  const auto path = dir / "index.html";
-  write_file_atomic(path, page);
-  return path;
+  write_file_atomic(page_path, page);
 }
 
 }  // namespace mc::report

@@ -37,12 +37,19 @@ struct Figure {
   std::vector<Series> series;
 };
 
-/// A result row shown in the section's table: name, value and unit.
+/// A result row shown in the section's table: name, value and unit, or a text (e.g. "yes").
+/// Values in m, N, s, V are shown with the SI prefix that suits them (0.569 um, not 5.69e-07 m).
 struct Result {
   std::string name;
   double value;
   std::string unit;
+  std::string text;  ///< shown instead of the value when set
 };
+
+/// A value for people: 4 significant digits, with the SI prefix (p, n, u, m) that puts it in
+/// [1, 1000) when the unit is m, N, s, V, A or m/s and the value below 1: (5.6883e-07, "m") ->
+/// {"568.8", "nm"}, (2.5e-5, "s") -> {"25", "us"}. Other units (Hz, %, "") as they are.
+std::pair<std::string, std::string> human_value(double value, const std::string& unit);
 
 struct Section {
   std::string title;
@@ -59,6 +66,8 @@ class Report {
   Section& section(std::string title, std::string text = {});
   void add_figure(Figure figure);
   void add_result(std::string name, double value, std::string unit = {});
+  /// A result that is a word: "yes"/"no", a name.
+  void add_text_result(std::string name, std::string text);
   /// Appends all sections of `other` (used to assemble the full report from modules).
   void append(const Report& other);
 
@@ -70,8 +79,13 @@ class Report {
   /// Throws InvalidInput if DIR cannot be written, InvalidParams for an empty or
   /// inconsistent figure (x/y of different sizes, non-finite values, log axis with values <= 0).
   std::filesystem::path write(const std::filesystem::path& dir) const;
-  /// The page as a string (what write() puts in index.html).
-  std::string html() const;
+  /// Writes the page as `page` and the figures' CSVs into `data_dir`, the page linking to each
+  /// as `data_prefix` + its file name (a path relative to the page, e.g. "run-7-figures/").
+  /// The CSVs are written first, the page last, each atomically. Throws as write().
+  void write_page(const std::filesystem::path& page, const std::filesystem::path& data_dir,
+                  const std::string& data_prefix) const;
+  /// The page as a string (what write() puts in index.html); figure links get `data_prefix`.
+  std::string html(const std::string& data_prefix = {}) const;
 
  private:
   Section& current();

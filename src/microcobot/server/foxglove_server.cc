@@ -163,6 +163,7 @@ struct Core {
   std::function<void(const ClientMessage&)> on_message;
   std::function<void(ClientId)> on_connect;
   std::function<void(ClientId)> on_disconnect;
+  std::function<void(ClientId, StatusLevel, std::string_view, std::string_view)> on_reject;
 
   std::atomic<bool> started{false};
   std::atomic<bool> stopped{false};
@@ -433,6 +434,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void reject(std::string_view id, std::string_view message, StatusLevel level = StatusLevel::kError) {
     srv_.rejected.fetch_add(1, std::memory_order_relaxed);
     send_status(level, message, id);
+    if (srv_.on_reject) srv_.on_reject(id_, level, id, message);
   }
 
   void on_message() {
@@ -944,6 +946,13 @@ ChannelId FoxgloveServer::add_channel(const ChannelSpec& spec) {
   return ch.id;
 }
 
+std::optional<ChannelSpec> FoxgloveServer::channel(ChannelId id) const {
+  std::lock_guard lk(impl_->channels_mu);
+  for (const auto& c : impl_->channels)
+    if (c.id == id) return c.spec;
+  return std::nullopt;
+}
+
 void FoxgloveServer::set_metadata(std::map<std::string, std::string> metadata) {
   std::lock_guard lk(impl_->channels_mu);
   impl_->metadata = std::move(metadata);
@@ -960,6 +969,10 @@ void FoxgloveServer::on_connect(std::function<void(ClientId)> callback) {
 }
 void FoxgloveServer::on_disconnect(std::function<void(ClientId)> callback) {
   impl_->on_disconnect = std::move(callback);
+}
+void FoxgloveServer::on_reject(
+    std::function<void(ClientId, StatusLevel, std::string_view id, std::string_view message)> callback) {
+  impl_->on_reject = std::move(callback);
 }
 
 void FoxgloveServer::start() {

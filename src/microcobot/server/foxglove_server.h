@@ -106,6 +106,8 @@ class FoxgloveServer {
 
   /// Adds a server channel; before start() or after (then advertised to connected clients).
   ChannelId add_channel(const ChannelSpec& spec);
+  /// The spec a channel was added with (nullopt for an unknown id).
+  std::optional<ChannelSpec> channel(ChannelId id) const;
   /// Metadata sent in serverInfo (set before start()).
   void set_metadata(std::map<std::string, std::string> metadata);
 
@@ -120,6 +122,10 @@ class FoxgloveServer {
   void on_connect(std::function<void(ClientId)> callback);
   /// A WebSocket client went away (closed, timed out, failed or stop()).
   void on_disconnect(std::function<void(ClientId)> callback);
+  /// The server refused a client's message (the status it sent: level, id, message), e.g.
+  /// `malformed-json`; the application may log it (the recordings' events).
+  void on_reject(
+      std::function<void(ClientId, StatusLevel, std::string_view id, std::string_view message)> callback);
 
   /// Binds, listens and starts the I/O threads. Throws mc::InvalidParams for a bad address and
   /// mc::InvalidInput (one line, with the address) when the port cannot be bound.

@@ -1,0 +1,304 @@
+#include "microcobot/live/session_recording.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <span>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "microcobot/core/csv_stream_writer.h"
+#include "microcobot/core/error.h"
+#include "microcobot/core/mcap_writer.h"
+#include "microcobot/platform/telemetry_json.h"
+
+namespace mc::live {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::size_t index(RecordedTopic t) { return static_cast<std::size_t>(t); }
+
+std::string object_schema(const json& properties) {
+  return json{{"type", "object"}, {"properties", properties}}.dump();
+}
+
+// What a client sent, as received: the message itself when it is JSON, else its text (a
+// refused, malformed message is worth keeping too).
+std::string received_json(std::uint64_t client, double t_s, std::string_view payload) {
+  json message = json::parse(payload, nullptr, /*allow_exceptions=*/false);
+  if (message.is_discarded()) message = std::string(payload.substr(0, 4096));
+  return json{{"t_s", t_s}, {"client", client}, {"message", std::move(message)}}.dump(
+      -1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string utc_iso(std::int64_t ns) {
+  const std::time_t s = static_cast<std::time_t>(ns / 1000000000);
+  std::tm tm{};
+  gmtime_r(&s, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &tm);
+  return fmt::format("{}.{:03d}Z", text, static_cast<int>((ns / 1000000) % 1000));
+}
+
+}  // namespace
+
+void SessionRecordingParams::validate() const {
+  require(telemetry_channels >= 1 && telemetry_channels <= platform::kTelemetryChannels.size(),
+          "telemetry_channels", "must be within [1, kTelemetryChannels.size()]",
+          static_cast<double>(telemetry_channels));
+  for (const RecordedSchema* s : {&status, &scene, &feedback})
+    require(!s->topic.empty() && !s->schema.empty(), "recorded channels", "need a topic and a schema");
+}
+
+bool SessionRecording::is_stem(std::string_view stem) {
+  constexpr std::string_view prefix = "recording-";
+  if (stem.size() <= prefix.size() || stem.size() > 64 || stem.substr(0, prefix.size()) != prefix)
+    return false;
+  return stem.find_first_not_of("0123456789-", prefix.size()) == std::string_view::npos;
+}
+
+SessionRecording::SessionRecording(SessionRecordingParams params) : params_(std::move(params)) {
+  params_.validate();
+}
+
+SessionRecording::~SessionRecording() {
+  {
+    std::lock_guard lock(mutex_);
+    active_ = false;
+    stopping_ = true;
+    error_ = "abandoned";
+  }
+  wake_.notify_all();
+  if (writer_.joinable()) writer_.join();
+  // mcap_, csv_ destroyed unclosed: their temporary files are removed.
+}
+
+std::string SessionRecording::name() const {
+  std::lock_guard lock(mutex_);
+  return active_ ? name_ : std::string();
+}
+
+std::string SessionRecording::start(double t_s, const std::string& scene_json) {
+  std::lock_guard control(control_mutex_);
+  {
+    std::lock_guard lock(mutex_);
+    if (active_) return name_;
+  }
+  if (writer_.joinable()) writer_.join();  // a writer that gave up (its error was reported)
+  mcap_.reset();
+  csv_.reset();
+
+  const auto wall = std::chrono::system_clock::now();
+  const std::int64_t wall_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(wall.time_since_epoch()).count();
+  const std::time_t now = std::chrono::system_clock::to_time_t(wall);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "recording-%Y%m%d-%H%M%S", &tm);
+  std::string stem = stamp;
+  const auto taken = [&](const std::string& s) {
+    return std::filesystem::exists(params_.out_dir / (s + ".mcap")) ||
+           std::filesystem::exists(params_.out_dir / (s + ".csv"));
+  };
+  for (int i = 2; taken(stem) && i < 1000; ++i) stem = std::string(stamp) + "-" + std::to_string(i);
+
+  // The time base: wall clock at start minus loop time at start.
+  const std::int64_t offset_ns = wall_ns - std::llround(t_s * 1e9);
+  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"), McapWriter::kDefaultChunkBytes,
+                                        McapCompression{true, kZstdLevel});
+  const auto add = [&](RecordedTopic t, const std::string& topic, const std::string& schema_name,
+                       const std::string& schema) {
+    channel_[index(t)] = w->add_channel(w->add_schema(schema_name, "jsonschema", schema), topic, "json");
+  };
+  add(RecordedTopic::kTelemetry, std::string(platform::kTelemetryTopic),
+      std::string(platform::kTelemetrySchemaName),
+      platform::telemetry_json_schema(params_.telemetry_channels));
+  add(RecordedTopic::kStatus, params_.status.topic, params_.status.schema_name, params_.status.schema);
+  add(RecordedTopic::kScene, params_.scene.topic, params_.scene.schema_name, params_.scene.schema);
+  add(RecordedTopic::kFeedback, params_.feedback.topic, params_.feedback.schema_name,
+      params_.feedback.schema);
+  const json number = {{"type", "number"}}, text = {{"type", "string"}};
+  const json client = {{"type", "number"}, {"description", "the server's id of the client (1, 2, ...)"}};
+  const json received = {{"t_s", number}, {"client", client}, {"message", {{"description", "as received"}}}};
+  add(RecordedTopic::kCommand, "/console/command", "microcobot.ReceivedCommand", object_schema(received));
+  add(RecordedTopic::kAction, "/console/action", "microcobot.ReceivedAction", object_schema(received));
+  add(RecordedTopic::kEvents, "/events", "microcobot.Event",
+      object_schema({{"t_s", number},
+                     {"level", {{"type", "number"}, {"description", "0 info, 1 warning, 2 error"}}},
+                     {"kind", text},
+                     {"message", text},
+                     {"client", {{"type", {"number", "null"}}}}}));
+
+  const std::string started = utc_iso(wall_ns);
+  w->add_metadata("microcobot", {{"version", params_.version},
+                                 {"recording", stem + ".mcap"},
+                                 {"started_utc", started},
+                                 {"started_t_s", fmt::format("{:.6f}", t_s)},
+                                 {"log_time", "t_s * 1e9 + time_offset_ns (ns since 1970-01-01 UTC)"},
+                                 {"time_offset_ns", std::to_string(offset_ns)},
+                                 {"telemetry_rate_Hz", "1000"}});
+  std::vector<std::pair<std::string, std::string>> scene;
+  const json sj = json::parse(scene_json, nullptr, false);
+  if (sj.is_object())
+    for (const auto& [k, v] : sj.items())
+      scene.emplace_back(k, v.is_string() ? v.get<std::string>() : v.dump());
+  w->add_metadata("scene", scene);
+  w->add_metadata("configuration", {{"yaml", params_.config_yaml}});
+  w->add_attachment("configuration.yaml", "application/yaml", params_.config_yaml,
+                    static_cast<std::uint64_t>(wall_ns), static_cast<std::uint64_t>(wall_ns));
+
+  std::unique_ptr<CsvStreamWriter> csv;
+  if (params_.csv) {
+    csv = std::make_unique<CsvStreamWriter>(
+        params_.out_dir / (stem + ".csv"),
+        std::vector<std::string>(
+            platform::kTelemetryChannels.begin(),
+            platform::kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(params_.telemetry_channels)));
+  }
+  mcap_ = std::move(w);
+  csv_ = std::move(csv);
+  {
+    std::lock_guard lock(mutex_);
+    active_ = true;
+    stopping_ = false;
+    name_ = stem + ".mcap";
+    queue_.clear();
+    queued_bytes_ = 0;
+    dropped_ = 0;
+    offset_ns_ = offset_ns;
+    last_ns_.fill(0);
+    error_.clear();
+  }
+  writer_ = std::thread([this] { writer_thread(); });
+  return stem + ".mcap";
+}
+
+void SessionRecording::stop() {
+  std::lock_guard control(control_mutex_);
+  std::uint64_t dropped = 0;
+  double t_s = 0.0;
+  {
+    std::lock_guard lock(mutex_);
+    if (!active_ && !writer_.joinable()) return;
+    dropped = dropped_;
+    if (!queue_.empty()) t_s = queue_.back().t_s;
+  }
+  if (dropped > 0)
+    event(EventLevel::kWarning, "dropped",
+          fmt::format("{} message(s) dropped: the writer fell {} MB behind", dropped, kMaxQueuedBytes >> 20),
+          0, t_s);
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;  // the writer empties the queue, then closes the files
+  }
+  wake_.notify_all();
+  if (writer_.joinable()) writer_.join();
+  std::string error;
+  {
+    std::lock_guard lock(mutex_);
+    active_ = false;
+    name_.clear();
+    error = error_;
+  }
+  std::unique_ptr<McapWriter> mcap = std::move(mcap_);
+  std::unique_ptr<CsvStreamWriter> csv = std::move(csv_);
+  if (!error.empty() || !mcap) return;  // already abandoned and reported
+  mcap->close();                        // summary, index, footer; then renamed to its name
+  if (csv) csv->close();
+}
+
+void SessionRecording::push(Item&& item) {
+  const std::size_t bytes = sizeof(Item) + item.payload.size();
+  {
+    std::lock_guard lock(mutex_);
+    if (!active_ || stopping_) return;
+    if (queued_bytes_ + bytes > kMaxQueuedBytes) {
+      ++dropped_;
+      return;
+    }
+    std::uint64_t& last = last_ns_[index(item.topic)];
+    const std::int64_t ns = std::llround(item.t_s * 1e9) + offset_ns_;
+    item.log_ns = std::max(last, static_cast<std::uint64_t>(std::max<std::int64_t>(ns, 0)));
+    last = item.log_ns;
+    queued_bytes_ += bytes;
+    queue_.push_back(std::move(item));
+  }
+  wake_.notify_one();
+}
+
+void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t count) {
+  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry_channels)};
+  push(std::move(item));
+}
+
+void SessionRecording::published(RecordedTopic topic, double t_s, std::string_view payload) {
+  push(Item{topic, 0, t_s, std::string(payload), {}, 0});
+}
+
+void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s,
+                                std::string_view payload) {
+  push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0});
+}
+
+void SessionRecording::event(EventLevel level, std::string_view kind, std::string_view message,
+                             std::uint64_t client, double t_s) {
+  const json j = {{"t_s", t_s},
+                  {"level", static_cast<int>(level)},
+                  {"kind", kind},
+                  {"message", message},
+                  {"client", client ? json(client) : json(nullptr)}};
+  push(Item{RecordedTopic::kEvents, 0, t_s, j.dump(-1, ' ', false, json::error_handler_t::replace), {}, 0});
+}
+
+void SessionRecording::writer_thread() {
+  std::vector<Item> batch;
+  std::string json_text;
+  while (true) {
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [&] { return !queue_.empty() || stopping_; });
+      if (queue_.empty()) return;  // stopping, and everything is written
+      batch.swap(queue_);
+      queued_bytes_ = 0;
+    }
+    try {
+      for (const Item& item : batch) {
+        const std::uint16_t channel = channel_[index(item.topic)];
+        if (item.topic == RecordedTopic::kTelemetry) {
+          const std::span<const double> sample(item.sample.data(), item.count);
+          json_text.clear();
+          platform::telemetry_to_json(sample, json_text);
+          mcap_->write(channel, item.log_ns, item.log_ns, json_text);
+          if (csv_) csv_->append(sample);
+        } else {
+          mcap_->write(channel, item.log_ns, item.log_ns, item.payload);
+        }
+      }
+    } catch (const std::exception& e) {
+      abandon(e.what());
+      return;
+    }
+    batch.clear();
+  }
+}
+
+void SessionRecording::abandon(const std::string& why) {
+  // Destroyed unclosed, the staged files remove their temporaries: nothing half-written stays.
+  mcap_.reset();
+  csv_.reset();
+  {
+    std::lock_guard lock(mutex_);
+    active_ = false;
+    error_ = why;
+    queue_.clear();
+    queued_bytes_ = 0;
+    name_.clear();
+  }
+  if (params_.on_error) params_.on_error(why);
+}
+
+}  // namespace mc::live

@@ -1,0 +1,158 @@
+#pragma once
+/// @file
+/// The recording of a live session (`serve`, docs/console.md "Recordings"): one MCAP file that
+/// holds what the server saw and did, so that a recording alone tells what happened:
+///
+///   /platform/telemetry  every sample of the loop's 1 kHz telemetry (the clients get 60 Hz)
+///   /platform/status, /platform/scene, /console/feedback   what the server published
+///   /console/command, /console/action   what the clients sent: `{"t_s", "client", "message"}`
+///   /events   state changes and errors: `{"t_s", "level", "kind", "message", "client"}`
+///   Metadata "microcobot" (version, start, the time base), "scene", "configuration" (YAML),
+///   and the configuration again as the attachment `configuration.yaml`.
+///
+/// Log times are on the wall clock (UTC, ns since the epoch), as viewers expect: the loop time
+/// `t_s` (kept in every message) plus the offset wall-clock-at-start minus loop-time-at-start,
+/// captured once, so the 1 kHz stream stays evenly spaced and monotonic whatever the wall
+/// clock does later (NTP steps). Each channel's log times never decrease (an event stamped by
+/// a thread that lost a race is stamped with the latest time of its channel).
+///
+/// Threads: the callers (drain thread, server I/O thread, status thread) only append to a
+/// queue under a short lock; a writer thread of the recording's own encodes the telemetry as
+/// JSON, compresses the chunks (zstd, core/mcap_writer.h) and writes, so neither the loop nor
+/// the drain ever waits on a disk or a compressor. The queue is bounded (kMaxQueuedBytes):
+/// beyond it messages are dropped and counted in an event.
+///
+/// Files appear only when complete (temporary name, renamed at stop(): core/staged_file.h);
+/// a failed write abandons the recording and leaves nothing under its name.
+
+#include <array>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "microcobot/platform/platform.h"
+
+namespace mc {
+class CsvStreamWriter;
+class McapWriter;
+}  // namespace mc
+
+namespace mc::live {
+
+/// The channels of a recording, in the order their Channel records are written.
+enum class RecordedTopic : std::uint8_t {
+  kTelemetry,
+  kStatus,
+  kScene,
+  kFeedback,
+  kCommand,
+  kAction,
+  kEvents,
+  kCount
+};
+
+/// A JSON channel's schema, as the server advertises it.
+struct RecordedSchema {
+  std::string topic;
+  std::string schema_name;
+  std::string schema;  ///< JSON Schema text
+};
+
+/// An event's level, as the Foxglove status levels: 0 info, 1 warning, 2 error.
+enum class EventLevel : std::uint8_t { kInfo = 0, kWarning = 1, kError = 2 };
+
+struct SessionRecordingParams {
+  std::filesystem::path out_dir;       ///< where recordings go
+  bool csv = false;                    ///< also the telemetry as <stem>.csv (`serve --record-csv`)
+  std::size_t telemetry_channels = 0;  ///< the first N names of platform::kTelemetryChannels
+  /// /platform/status, /platform/scene, /console/feedback as the server advertises them.
+  RecordedSchema status, scene, feedback;
+  std::string version;      ///< the program's, e.g. "microcobot 0.1.0"
+  std::string config_yaml;  ///< the platform configuration (`run --print-config`'s keys)
+  /// Called on the writer thread when a write fails and the recording is abandoned.
+  std::function<void(const std::string& why)> on_error;
+  void validate() const;
+};
+
+class SessionRecording {
+ public:
+  /// Beyond this many bytes waiting for the writer, messages are dropped (and counted).
+  static constexpr std::size_t kMaxQueuedBytes = std::size_t{64} << 20;
+  /// The zstd level of the chunks. A 1 MiB chunk of a live recording (`zstd -b1e3` on it, the
+  /// 2-core machine): level 1 11.80 times smaller at 993 MB/s (about 1 ms), level 3 11.85 times
+  /// at 232 MB/s: 1 gives the size for a quarter of the time.
+  static constexpr int kZstdLevel = 1;
+
+  explicit SessionRecording(SessionRecordingParams params);
+  /// An unstopped recording is abandoned (its temporary files removed).
+  ~SessionRecording();
+  SessionRecording(const SessionRecording&) = delete;
+  SessionRecording& operator=(const SessionRecording&) = delete;
+
+  /// Opens recording-YYYYmmdd-HHMMSS.mcap (and .csv) in out_dir, writes the metadata and starts
+  /// the writer. `t_s` is the loop time now (the time base), `scene_json` the scene. Returns
+  /// the MCAP file's name; the same when already recording. Throws InvalidInput when a file
+  /// cannot be created.
+  std::string start(double t_s, const std::string& scene_json);
+  /// Writes what is queued, closes and renames the files. Throws InvalidInput when the last
+  /// writes fail (nothing then remains). Idempotent.
+  void stop();
+  /// The MCAP file being written ("" when not recording).
+  std::string name() const;
+
+  /// A telemetry sample (drain thread): no allocation unless the queue grows.
+  void telemetry(const platform::TelemetrySample& s, std::size_t count);
+  /// A message the server published (status, scene, feedback): its payload as sent.
+  void published(RecordedTopic topic, double t_s, std::string_view payload);
+  /// A message a client sent on /console/command or /console/action, accepted or not.
+  void received(RecordedTopic topic, std::uint64_t client, double t_s, std::string_view payload);
+  /// An event (client 0: none).
+  void event(EventLevel level, std::string_view kind, std::string_view message, std::uint64_t client,
+             double t_s);
+
+  /// Whether `stem` is a recording's: "recording-" then digits and dashes (what start() names),
+  /// so that a request can name nothing else (no path, no hidden or temporary file).
+  static bool is_stem(std::string_view stem);
+
+ private:
+  struct Item {
+    RecordedTopic topic;
+    std::uint64_t log_ns = 0;  // stamped by push()
+    double t_s = 0.0;
+    std::string payload;  // empty for telemetry: encoded by the writer
+    platform::TelemetrySample sample;
+    std::size_t count = 0;
+  };
+  void push(Item&& item);
+  void writer_thread();
+  void abandon(const std::string& why);
+
+  SessionRecordingParams params_;
+  std::mutex control_mutex_;  // start/stop
+
+  mutable std::mutex mutex_;  // the queue and the state below
+  std::condition_variable wake_;
+  bool active_ = false, stopping_ = false;
+  std::string name_;
+  std::vector<Item> queue_;
+  std::size_t queued_bytes_ = 0;
+  std::uint64_t dropped_ = 0;
+  std::int64_t offset_ns_ = 0;  // log time = t_s * 1e9 + offset_ns_
+  std::array<std::uint64_t, static_cast<std::size_t>(RecordedTopic::kCount)> last_ns_{};
+
+  // Writer thread (and start/stop while it is not running).
+  std::thread writer_;
+  std::unique_ptr<McapWriter> mcap_;
+  std::unique_ptr<CsvStreamWriter> csv_;
+  std::array<std::uint16_t, static_cast<std::size_t>(RecordedTopic::kCount)> channel_{};
+  std::string error_;  // why the writer gave up
+};
+
+}  // namespace mc::live

@@ -1,0 +1,183 @@
+// The recording of a live session (issue #26): every channel with wall-clock log times that
+// never go back, events, metadata, the optional CSV; and nothing left when writing fails.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "microcobot/core/csv.h"
+#include "microcobot/core/error.h"
+#include "microcobot/core/mcap_reader.h"
+#include "microcobot/live/session_recording.h"
+#include "support/test_support.h"
+
+namespace mc::live {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+constexpr std::size_t kChannels = 20;
+
+SessionRecordingParams params(const fs::path& dir, bool csv) {
+  SessionRecordingParams p;
+  p.out_dir = dir;
+  p.csv = csv;
+  p.telemetry_channels = kChannels;
+  const std::string object = R"({"type":"object"})";
+  p.status = {"/platform/status", "microcobot.Status", object};
+  p.scene = {"/platform/scene", "microcobot.Scene", object};
+  p.feedback = {"/console/feedback", "microcobot.Feedback", object};
+  p.version = "microcobot 9.9.9";
+  p.config_yaml = "loop:\n  base_rate_Hz: 10000\n";
+  return p;
+}
+
+platform::TelemetrySample sample(double t_s) {
+  platform::TelemetrySample s{};
+  s[0] = t_s;
+  for (std::size_t c = 1; c < kChannels; ++c) s[c] = 1e-6 * static_cast<double>(c) + t_s;
+  return s;
+}
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+TEST(SessionRecording, HoldsEveryChannelOnTheWallClockWithEventsAndMetadata) {
+  test::TempDir dir;
+  SessionRecording rec(params(dir.path(), false));
+  const std::uint64_t before = now_ns();
+  const std::string name = rec.start(100.0, R"({"kind":"pick-place","tolerance_m":5e-6})");
+  EXPECT_TRUE(SessionRecording::is_stem(name.substr(0, name.size() - 5)));
+  EXPECT_EQ(rec.name(), name);
+  EXPECT_EQ(rec.start(100.0, "{}"), name);  // already recording
+  for (int i = 0; i < 1500; ++i) rec.telemetry(sample(100.0 + 0.001 * i), kChannels);
+  rec.published(RecordedTopic::kStatus, 100.2, R"({"t_s":100.2,"demo":false})");
+  rec.published(RecordedTopic::kScene, 100.2, R"({"kind":"pick-place"})");
+  rec.received(RecordedTopic::kAction, 3, 100.3, R"({"action":"take_control"})");
+  rec.received(RecordedTopic::kCommand, 3, 100.4, "{not json");
+  rec.event(EventLevel::kInfo, "take_control", "control: granted", 3, 100.3);
+  rec.event(EventLevel::kError, "refused", "late", 4, 100.1);  // stamped before the previous one
+  rec.stop();
+  rec.stop();  // idempotent
+  const std::uint64_t after = now_ns();
+  EXPECT_EQ(rec.name(), "");
+  ASSERT_EQ(fs::directory_iterator(dir.path())->path().filename(), name);  // alone: no CSV, no temporary
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator{}), 1);
+
+  const McapContents m = read_mcap(dir / name);
+  std::map<std::string, std::uint16_t> ids;
+  for (const auto& c : m.channels) ids[c.topic] = c.id;
+  for (const char* t : {"/platform/telemetry", "/platform/status", "/platform/scene", "/console/feedback",
+                        "/console/command", "/console/action", "/events"})
+    EXPECT_EQ(ids.count(t), 1u) << t;
+  for (const auto& c : m.chunks) EXPECT_EQ(c.compression, "zstd");
+  std::map<std::uint16_t, std::uint64_t> last;
+  std::map<std::uint16_t, std::vector<json>> by;
+  for (const auto& msg : m.messages) {
+    EXPECT_GE(msg.log_time_ns, last[msg.channel_id]) << "channel " << msg.channel_id;
+    last[msg.channel_id] = msg.log_time_ns;
+    by[msg.channel_id].push_back(json::parse(msg.data));
+  }
+  const auto& tel = by[ids["/platform/telemetry"]];
+  ASSERT_EQ(tel.size(), 1500u);
+  // The time base: wall clock at start minus loop time at start; 1 ms apart as the loop's.
+  std::vector<std::uint64_t> tel_ns;
+  for (const auto& msg : m.messages)
+    if (msg.channel_id == ids["/platform/telemetry"]) tel_ns.push_back(msg.log_time_ns);
+  EXPECT_GE(tel_ns.front(), before);
+  EXPECT_LE(tel_ns.front(), after);
+  EXPECT_NEAR(static_cast<double>(tel_ns.back() - tel_ns.front()), 1.499e9, 1e3);
+  const auto& events = by[ids["/events"]];
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0]["kind"], "take_control");
+  EXPECT_EQ(events[0]["client"], 3);
+  EXPECT_EQ(events[1]["level"], 2);
+  EXPECT_EQ(events[1]["t_s"], 100.1);  // the loop time as stamped; the log time does not go back
+  const auto& commands = by[ids["/console/command"]];
+  ASSERT_EQ(commands.size(), 1u);
+  EXPECT_EQ(commands[0]["message"], "{not json");  // kept as text
+  EXPECT_EQ(by[ids["/console/action"]][0]["message"]["action"], "take_control");
+  ASSERT_NE(m.find_metadata("microcobot"), nullptr);
+  EXPECT_EQ(*m.find_metadata("microcobot")->find("version"), "microcobot 9.9.9");
+  EXPECT_EQ(*m.find_metadata("scene")->find("kind"), "pick-place");
+  EXPECT_EQ(*m.find_metadata("configuration")->find("yaml"), "loop:\n  base_rate_Hz: 10000\n");
+  ASSERT_EQ(m.attachments.size(), 1u);
+  EXPECT_EQ(m.attachments[0].name, "configuration.yaml");
+}
+
+TEST(SessionRecording, TheCsvIsWrittenOnlyWhenAsked) {
+  test::TempDir dir;
+  SessionRecording rec(params(dir.path(), true));
+  const std::string name = rec.start(0.0, "{}");
+  for (int i = 0; i < 300; ++i) rec.telemetry(sample(0.001 * i), kChannels);
+  rec.stop();
+  const std::string csv = name.substr(0, name.size() - 5) + ".csv";
+  const CsvTable table = read_csv(dir / csv);
+  EXPECT_EQ(table.rows(), 300u);
+  EXPECT_EQ(table.names().size(), kChannels);
+}
+
+TEST(SessionRecording, AFailedWriteLeavesNothingAndIsReported) {
+  test::TempDir dir;
+  std::atomic<int> errors{0};
+  auto p = params(dir.path(), true);
+  p.on_error = [&](const std::string&) { errors.fetch_add(1); };
+  SessionRecording rec(std::move(p));
+  // The disk "full" at 64 KiB per file: writes fail with EFBIG (the signal that would kill the
+  // process instead is ignored), even for root, whom permissions would not stop.
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit small = old;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  rec.start(0.0, "{}");
+  // Enough telemetry for the writer to flush its first MiB: it fails there, abandons the files.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (int i = 0; errors.load() == 0 && std::chrono::steady_clock::now() < deadline; ++i) {
+    rec.telemetry(sample(0.001 * i), kChannels);
+    if (i % 1000 == 999) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(errors.load(), 1);
+  EXPECT_EQ(rec.name(), "");
+  EXPECT_NO_THROW(rec.stop());  // already reported
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+  // No room at all: the files cannot be written when the recording starts or closes; either
+  // throws and nothing remains.
+  small.rlim_cur = 1;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  bool threw = false;
+  try {
+    rec.start(0.0, "{}");
+    rec.telemetry(sample(0.0), kChannels);
+    rec.stop();
+  } catch (const Error& e) {
+    threw = true;
+    EXPECT_THAT(e.what(), HasSubstr(dir.path().string()));
+  }
+  EXPECT_TRUE(threw);
+  setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+  // And it records again once the disk has room.
+  const std::string name = rec.start(0.0, "{}");
+  rec.stop();
+  EXPECT_NO_THROW(read_mcap(dir / name));
+}
+
+}  // namespace
+}  // namespace mc::live
