@@ -70,15 +70,19 @@ function(mc_add_module_tests name)
   endif()
 endfunction()
 
-# Embeds the live console's page, script and style (web/console.*) into `target`, so that
-# `microcobot serve` serves a console that works offline (uPlot comes from the report's assets).
+# Embeds the live console's page, scripts and styles (web/console*.{html,js,css}) into `target`,
+# so that `microcobot serve` serves a console that works offline (uPlot comes from the report's
+# assets). The page names each file it inlines (console_page.cc).
 function(mc_embed_console_assets target)
   set(_out ${PROJECT_BINARY_DIR}/generated/console_assets.cc)
-  set(_files ${PROJECT_SOURCE_DIR}/web/console.html ${PROJECT_SOURCE_DIR}/web/console.js
-             ${PROJECT_SOURCE_DIR}/web/console.css)
+  set(_files)
+  foreach(_f console.html console.css console_link.js console_plots.js console_microscope.js
+             console_controls.js console_positions.js console_status.js)
+    list(APPEND _files ${PROJECT_SOURCE_DIR}/web/${_f})
+  endforeach()
+  string(REPLACE ";" "\\;" _list "${_files}")
   add_custom_command(OUTPUT ${_out}
-    COMMAND ${CMAKE_COMMAND} -DOUT=${_out} -DNAMESPACE=mc::live::assets
-            "-DFILES=kConsoleHtml=${PROJECT_SOURCE_DIR}/web/console.html\;kConsoleJs=${PROJECT_SOURCE_DIR}/web/console.js\;kConsoleCss=${PROJECT_SOURCE_DIR}/web/console.css"
+    COMMAND ${CMAKE_COMMAND} -DOUT=${_out} -DNAMESPACE=mc::live::assets "-DFILES=${_list}"
             -P ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
     DEPENDS ${_files} ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
     COMMENT "Embedding the live console")

@@ -3,8 +3,8 @@
 // objective (behind a 2x tube lens) and piconewtons; the operator takes control and clicks the trap 1 um past where
 // the probe bead touches the stuck bead, holding the deadman: the streamed telemetry must show
 // the probe stopped against the stuck bead and the trap's force opposing the push (the linear
-// spring of Fig. 3.3), the page must show it in pN. The scripted demo is refused with a
-// message; the e-stop latches every device in its safe state; SIGTERM exits 0. Run by CTest
+// spring of Fig. 3.3), the page must show it in pN. The scripted demo is refused with the
+// server's message in a banner; the e-stop latches every device in its safe state; SIGTERM exits 0. Run by CTest
 // (`console_browser_optical_trap`); screenshots to MC_ARTIFACTS.
 import { join } from "node:path";
 import { startConsole } from "./console_session.mjs";
@@ -24,9 +24,25 @@ try {
 
   await page.click("#take-control");
   await until("control granted", () => window.mc.inControl, 5);
-  // The demo is the pick-and-place: refused here, with a message the status shows.
-  await page.click("#demo");
+  // The demo is the pick-and-place: refused here, with the server's message in a banner. A
+  // server that says so in the scene (demo_available false) has the button disabled with the
+  // reason: the action is then sent as a client would, and still refused.
+  if (await page.locator("#demo").isDisabled()) {
+    const title = await page.getAttribute("#demo", "title");
+    log(`Demo disabled: "${title}"`);
+    if (!/unavailable: ./.test(title)) fail(`the disabled Demo button's title: "${title}"`);
+    await page.evaluate(() => action("demo"));
+  } else {
+    await page.click("#demo");
+  }
   await until("the demo refused", () => window.mc.status && /optical-trap/.test(window.mc.status.last_error), 5);
+  await until("the refusal's banner", () => window.mc.banners().some((b) => b === window.mc.status.last_error), 3);
+  const banner = await page.locator("#banners .banner").first().boundingBox();
+  if (!banner || banner.y + banner.height > 1000 || banner.y < 0) fail("the refusal's banner is not on screen");
+  log("banner: " + (await page.textContent("#banners .banner .text")));
+  await shot("trap-01b-demo-refused");
+  await page.click("#banners .banner button");
+  await until("the banner dismissed", () => window.mc.banners().length === 0, 2);
   // Click-to-go (the trap's focus) to 1 um past the contact, along the line of centres (x).
   const touch = scene.obstacle_m[0] - (scene.bead_radius_m + scene.obstacle_radius_m);
   await clickTop(touch + 1e-6, scene.obstacle_m[1]);

@@ -9,7 +9,8 @@ import { join } from "node:path";
 import { createInterface } from "node:readline";
 import { chromium } from "playwright-core";
 
-export async function startConsole(name, serveArgs, timeoutS) {
+// options.viewport: the page's size ({width, height}; 1280x1000 unless given).
+export async function startConsole(name, serveArgs, timeoutS, options = {}) {
   const cli = process.env.MC_CLI;
   if (!cli || !existsSync(cli)) {
     console.error(`${name}: set MC_CLI to the microcobot binary`);
@@ -46,7 +47,7 @@ export async function startConsole(name, serveArgs, timeoutS) {
     args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
            "--disable-background-networking", "--disable-component-update", "--disable-sync"],
   });
-  const page = await s.browser.newPage({ viewport: { width: 1280, height: 1000 } });
+  const page = await s.browser.newPage({ viewport: options.viewport || { width: 1280, height: 1000 } });
   s.page = page;
   page.on("pageerror", (e) => s.pageErrors.push(String(e)));
   page.on("console", (m) => { if (m.type() === "error") s.pageErrors.push(m.text()); });

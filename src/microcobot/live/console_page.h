@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The live console (web/console.html, .js, .css, embedded at build time) as one
-/// self-contained page with uPlot inlined: it opens offline, from the binary alone.
+/// The live console (web/console.html and the scripts and styles it names, embedded at build
+/// time) as one self-contained page with uPlot inlined: it opens offline, from the binary alone.
 
 #include <string>
 
