@@ -25,7 +25,18 @@ using mc::cli::CommonOptions;
 /// The coupling's settings every teleop command takes.
 struct CouplingOptions {
   ctl::DelayedTeleopParams params;
+  std::string mmt_passivity = "on";
+  /// Applies what add() parsed into `params`; throws InvalidParams naming a bad value.
+  const ctl::DelayedTeleopParams& resolve() {
+    mc::require(mmt_passivity == "on" || mmt_passivity == "off", "--mmt-passivity",
+                "must be on or off, got '" + mmt_passivity + "'");
+    params.mmt.passivity = mmt_passivity == "on";
+    params.validate();
+    return params;
+  }
   void add(CLI::App& cmd) {
+    cmd.add_option("--mmt-passivity", mmt_passivity,
+                   "mmt: the model port's passivity controller, on or off (observe only) (default on)");
     cmd.add_option("--duration", params.duration_s, "Simulated time per case [s] (default 6)");
     cmd.add_option("--master-damping", params.master_damping_N_s_m,
                    "A passive damper on the handle [N s/m], any scheme (default 0)");
@@ -63,7 +74,7 @@ nlohmann::json to_json(const ctl::DelayCaseResult& r) {
           {"jitter_s", r.c.jitter_s},
           {"loss", r.c.loss},
           {"scheme", ctl::to_string(r.c.scheme)},
-          {"passivity", r.c.scheme != ctl::Scheme::kNone},
+          {"passivity", r.passivity},
           {"stable", r.stable},
           {"settled", r.settled},
           {"settling_time_s", finite_or_null(r.settling_time_s)},
@@ -94,14 +105,13 @@ std::vector<ctl::Scheme> parse_schemes(const std::vector<std::string>& names) {
   return out;
 }
 
-void run_sweep(const SweepOptions& o) {
+void run_sweep(SweepOptions& o) {
   for (double d : o.delays_s) mc::require_in_range(d, 0.0, 2.0, "--delays");
   for (double l : o.losses) mc::require(l >= 0.0 && l < 1.0, "--losses", "must be within [0, 1)", l);
   mc::require_in_range(o.jitter_fraction, 0.0, 1.0, "--jitter");
   mc::require_in_range(o.wall_prior_error_m, -0.01, 0.01, "--wall-prior-error");
   const std::vector<ctl::Scheme> schemes = parse_schemes(o.schemes);
-  const ctl::DelayedTeleopParams& p = o.coupling.params;
-  p.validate();
+  const ctl::DelayedTeleopParams& p = o.coupling.resolve();
   nlohmann::json cases = nlohmann::json::array();
   double unstable_delay = -1.0;
   nlohmann::json all_settled = nlohmann::json::object();
@@ -215,11 +225,11 @@ struct ValidateOptions {
   std::string scheme = "mmt";
 };
 
-void run_validate(const ValidateOptions& o) {
+void run_validate(ValidateOptions& o) {
   mc::require(o.set == "tuning" || o.set == "validation", "--set",
               "must be tuning or validation, got '" + o.set + "'");
   const ctl::Scheme scheme = ctl::scheme_from_string(o.scheme);
-  o.coupling.params.validate();
+  o.coupling.resolve();
   const auto set = o.set == "tuning" ? ctl::tuning_set() : ctl::validation_set(o.cases, o.seed);
   const ctl::SetSummary s = ctl::run_case_set(o.coupling.params, set, scheme);
   nlohmann::json rows = nlohmann::json::array();
@@ -245,10 +255,10 @@ void run_validate(const ValidateOptions& o) {
         fmt_or(r.contact_force_max_error, 1e2, "diverged"), r.min_observed_energy_J);
   }
   human += fmt::format(
-      "{} set, {}: {}/{} settled; worst handle p-p {} mm, worst force error {} %, worst settling time {} s, "
+      "{} set, {}: {}/{} settled; worst handle p-p {} mm, worst force error {} %, worst settling time {}, "
       "min PO {:.3g} J\n",
       o.set, o.scheme, s.settled, s.cases, fmt_or(s.worst_handle_excursion_m, 1e3, "diverged"),
-      fmt_or(s.worst_force_error, 1e2, "diverged"), fmt_or(s.worst_settling_time_s, 1.0, "never"),
+      fmt_or(s.worst_force_error, 1e2, "diverged"), std::isfinite(s.worst_settling_time_s) ? fmt::format("{:.3f} s", s.worst_settling_time_s) : "never",
       s.min_observed_energy_J);
   nlohmann::json j{{"set", o.set},
                    {"scheme", o.scheme},

@@ -134,6 +134,23 @@ TEST(DelayedTeleoperation, ModelMediatedContactSettlesAt200msWithJitterAndLoss) 
   }
 }
 
+TEST(DelayedTeleoperation, AModelCorrectedTowardsTheHandleIsKeptPassiveByItsController) {
+  // Without the prior's margin, a geometry that puts the wall 1.5 mm too far makes the slave's
+  // correction move the model's wall into the handle: energy the port must not hand out.
+  DelayedTeleopParams p;
+  p.wall_stiffness_N_m = 3000.0;
+  p.mmt.prior_margin_m = 0.0;
+  const DelayCase c{0.2, 0.01, 0.2, Scheme::kMmt, 1, 1.5e-3};
+  const auto on = run_delay_case(p, c);
+  EXPECT_GE(on.min_observed_energy_J, -1e-12);
+  EXPECT_GT(on.dissipated_J, 1e-3) << "the controller absorbed the correction's energy";
+  EXPECT_TRUE(on.settled) << "force error " << on.contact_force_max_error;
+  p.mmt.passivity = false;
+  const auto off = run_delay_case(p, c);
+  EXPECT_LT(off.min_observed_energy_J, -1e-4) << "unprotected, the model generated energy";
+  EXPECT_EQ(off.dissipated_J, 0.0);
+}
+
 TEST(DelayedTeleoperation, ModelMediatedSettlesAtEveryDelayUpTo200ms) {
   for (double d : {0.0, 0.01, 0.02, 0.05, 0.1, 0.2}) {
     for (double loss : {0.0, 0.2}) {

@@ -98,6 +98,7 @@ DelayCaseResult run_delay_case(const DelayedTeleopParams& p, const DelayCase& c,
   DelayCaseResult r;
   r.c = c;
   r.steady_contact_force_N = f_steady;
+  r.passivity = tdpa || (mmt && p.mmt.passivity);
   r.min_observed_energy_J = 0.0;
   std::vector<double> xm_series, fe_series;  // for the settling time
   xm_series.reserve(n);

@@ -81,6 +81,7 @@ struct DelayCase {
 struct DelayCaseResult {
   DelayCase c;
   bool stable = false;
+  bool passivity = false;  ///< a passivity controller was on (tdpa; mmt with mmt.passivity)
   /// stable, and the contact force over the last second within settled_force_tolerance of
   /// steady_contact_force_N.
   bool settled = false;
