@@ -14,6 +14,7 @@
 #include "cli.h"
 #include "microcobot/control/delay_case_sets.h"
 #include "microcobot/control/delayed_teleoperation.h"
+#include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
 
@@ -228,6 +229,7 @@ struct ValidateOptions {
 void run_validate(ValidateOptions& o) {
   mc::require(o.set == "tuning" || o.set == "validation", "--set",
               "must be tuning or validation, got '" + o.set + "'");
+  mc::require(o.cases >= 1 && o.cases <= 1000, "--cases", "must be within [1, 1000]", o.cases);
   const ctl::Scheme scheme = ctl::scheme_from_string(o.scheme);
   o.coupling.resolve();
   const auto set = o.set == "tuning" ? ctl::tuning_set() : ctl::validation_set(o.cases, o.seed);
@@ -258,8 +260,30 @@ void run_validate(ValidateOptions& o) {
       "{} set, {}: {}/{} settled; worst handle p-p {} mm, worst force error {} %, worst settling time {}, "
       "min PO {:.3g} J\n",
       o.set, o.scheme, s.settled, s.cases, fmt_or(s.worst_handle_excursion_m, 1e3, "diverged"),
-      fmt_or(s.worst_force_error, 1e2, "diverged"), std::isfinite(s.worst_settling_time_s) ? fmt::format("{:.3f} s", s.worst_settling_time_s) : "never",
+      fmt_or(s.worst_force_error, 1e2, "diverged"),
+      std::isfinite(s.worst_settling_time_s) ? fmt::format("{:.3f} s", s.worst_settling_time_s) : "never",
       s.min_observed_energy_J);
+  // --out: one row per case (a diverged case's figures as inf would not be numbers: -1).
+  mc::CsvTable table({"delay_s", "jitter_s", "loss", "wall_stiffness_N_m", "wall_prior_error_m",
+                      "force_noise_N", "settled", "settling_time_s", "max_handle_excursion_m",
+                      "contact_force_max_error", "min_observed_energy_J"});
+  for (std::size_t i = 0; i < s.results.size(); ++i) {
+    const auto& r = s.results[i];
+    const auto& sc = s.set[i];
+    auto or_minus_one = [](double v) { return std::isfinite(v) ? v : -1.0; };
+    const double row[] = {sc.c.delay_s,
+                          sc.c.jitter_s,
+                          sc.c.loss,
+                          sc.wall_stiffness_N_m,
+                          sc.c.wall_prior_error_m,
+                          sc.force_noise_N,
+                          r.settled ? 1.0 : 0.0,
+                          or_minus_one(r.settling_time_s),
+                          or_minus_one(r.max_handle_excursion_m),
+                          or_minus_one(r.contact_force_max_error),
+                          r.min_observed_energy_J};
+    table.add_row(row);
+  }
   nlohmann::json j{{"set", o.set},
                    {"scheme", o.scheme},
                    {"seed", o.set == "validation" ? nlohmann::json(o.seed) : nlohmann::json(nullptr)},
@@ -271,6 +295,7 @@ void run_validate(ValidateOptions& o) {
                    {"worst_settling_time_s", finite_or_null(s.worst_settling_time_s)},
                    {"min_observed_energy_J", s.min_observed_energy_J},
                    {"results", rows}};
+  mc::cli::write_result_table(o.common, "cases.csv", table, {{"set", o.set}, {"settled", s.settled}});
   mc::cli::emit(o.common, j, human);
 }
 
