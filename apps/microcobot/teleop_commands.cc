@@ -3,6 +3,7 @@
 // #31; control/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
 // long delay"). `teleop delay-validate`: the tuning and validation sets of issue #31.
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -166,9 +167,14 @@ void run_sweep(SweepOptions& o) {
         fmt_or(num("max_handle_excursion_m"), 1e3, "diverged"),
         fmt_or(num("contact_force_max_error"), 1e2, "diverged"));
   }
-  human += unstable_delay < 0 ? "the unprotected loop stayed stable at every delay\n"
-                              : fmt::format("the unprotected loop is unstable from {:g} ms round trip\n",
-                                            1e3 * unstable_delay);
+  const bool lossless_unprotected =
+      std::find(o.losses.begin(), o.losses.end(), 0.0) != o.losses.end() &&
+      std::find(schemes.begin(), schemes.end(), ctl::Scheme::kNone) != schemes.end();
+  // unstable_delay_s is about the unprotected loop without loss: said only when that was run.
+  if (lossless_unprotected)
+    human += unstable_delay < 0 ? "the unprotected loop stayed stable at every delay\n"
+                                : fmt::format("the unprotected loop is unstable from {:g} ms round trip\n",
+                                              1e3 * unstable_delay);
   if (o.common.out) {
     mc::report::Report rep("teleop delay-sweep: passivity and settling under delay");
     rep.section("Sweep",
@@ -236,7 +242,8 @@ void run_validate(ValidateOptions& o) {
   const ctl::SetSummary s = ctl::run_case_set(o.coupling.params, set, scheme);
   nlohmann::json rows = nlohmann::json::array();
   std::string human =
-      "round trip  jitter  loss  wall [N/m]  geometry err [mm]  noise [mN]  settled  settling [s]  handle "
+      "round trip  jitter  loss  wall [N/m]    n  geometry err [mm]  noise [mN]  settled  settling [s]  "
+      "handle "
       "p-p [mm]  "
       "force err [%]  min PO [J]\n";
   for (std::size_t i = 0; i < s.results.size(); ++i) {
@@ -244,14 +251,16 @@ void run_validate(ValidateOptions& o) {
     const auto& sc = s.set[i];
     nlohmann::json row = to_json(r);
     row["wall_stiffness_N_m"] = sc.wall_stiffness_N_m;
+    row["wall_exponent"] = sc.wall_exponent;
     row["wall_prior_error_m"] = sc.c.wall_prior_error_m;
     row["force_noise_N"] = sc.force_noise_N;
     row["seed"] = sc.c.seed;
     rows.push_back(row);
     human += fmt::format(
-        "{:8.1f} ms  {:4.1f} ms  {:3.0f} %  {:10.0f}  {:17.2f}  {:10.2f}  {:7}  {:>12}  {:>15}  {:>13}  "
+        "{:8.1f} ms  {:4.1f} ms  {:3.0f} %  {:10.0f}  {:3.1f}  {:17.2f}  {:10.2f}  {:7}  {:>12}  {:>15}  "
+        "{:>13}  "
         "{:10.3g}\n",
-        1e3 * sc.c.delay_s, 1e3 * sc.c.jitter_s, 1e2 * sc.c.loss, sc.wall_stiffness_N_m,
+        1e3 * sc.c.delay_s, 1e3 * sc.c.jitter_s, 1e2 * sc.c.loss, sc.wall_stiffness_N_m, sc.wall_exponent,
         1e3 * sc.c.wall_prior_error_m, 1e3 * sc.force_noise_N, r.settled ? "yes" : "NO",
         fmt_or(r.settling_time_s, 1.0, "never"), fmt_or(r.max_handle_excursion_m, 1e3, "diverged"),
         fmt_or(r.contact_force_max_error, 1e2, "diverged"), r.min_observed_energy_J);
@@ -264,9 +273,9 @@ void run_validate(ValidateOptions& o) {
       std::isfinite(s.worst_settling_time_s) ? fmt::format("{:.3f} s", s.worst_settling_time_s) : "never",
       s.min_observed_energy_J);
   // --out: one row per case (a diverged case's figures as inf would not be numbers: -1).
-  mc::CsvTable table({"delay_s", "jitter_s", "loss", "wall_stiffness_N_m", "wall_prior_error_m",
-                      "force_noise_N", "settled", "settling_time_s", "max_handle_excursion_m",
-                      "contact_force_max_error", "min_observed_energy_J"});
+  mc::CsvTable table({"delay_s", "jitter_s", "loss", "wall_stiffness_N_m", "wall_exponent",
+                      "wall_prior_error_m", "force_noise_N", "settled", "settling_time_s",
+                      "max_handle_excursion_m", "contact_force_max_error", "min_observed_energy_J"});
   for (std::size_t i = 0; i < s.results.size(); ++i) {
     const auto& r = s.results[i];
     const auto& sc = s.set[i];
@@ -275,6 +284,7 @@ void run_validate(ValidateOptions& o) {
                           sc.c.jitter_s,
                           sc.c.loss,
                           sc.wall_stiffness_N_m,
+                          sc.wall_exponent,
                           sc.c.wall_prior_error_m,
                           sc.force_noise_N,
                           r.settled ? 1.0 : 0.0,
@@ -313,7 +323,9 @@ void add_teleop(CLI::App& group) {
   cmd->add_option("--wall-prior-error", o->wall_prior_error_m,
                   "mmt: the geometry's error on the wall's position [m] (default 0)");
   cmd->add_option("--wall-stiffness", o->coupling.params.wall_stiffness_N_m,
-                  "The contact's stiffness as the handle feels it [N/m] (default 1000)");
+                  "The contact's stiffness as the handle feels it, at 1 mm deep [N/m] (default 1000)");
+  cmd->add_option("--wall-exponent", o->coupling.params.wall_exponent,
+                  "The wall's force law f = k d (d / 1 mm)^(n-1): 1 a spring, 1.5 Hertz (default 1)");
   o->coupling.add(*cmd);
   mc::cli::add_output_options(*cmd, o->common);
   cmd->callback([o] { run_sweep(*o); });

@@ -151,6 +151,23 @@ TEST(DelayedTeleoperation, AModelCorrectedTowardsTheHandleIsKeptPassiveByItsCont
   EXPECT_EQ(off.dissipated_J, 0.0);
 }
 
+TEST(DelayedTeleoperation, ASpringModelSettlesOnAHertzianWall) {
+  DelayedTeleopParams p;
+  // The steady force: the series formula for a spring, the equilibrium of the chain for Hertz.
+  EXPECT_NEAR(p.steady_contact_force_N(), 0.01 / (1.0 / 200 + 1.0 / 5000 + 1.0 / 1000), 1e-12);
+  p.wall_exponent = 1.5;
+  const double f = p.steady_contact_force_N();
+  const double depth = p.push_depth_m - f / p.hand_stiffness_N_m - f / p.servo_stiffness_N_m;
+  EXPECT_NEAR(p.wall_force_N(depth), f, 1e-9);
+  EXPECT_NEAR(p.wall_force_N(1e-3), p.wall_stiffness_N_m * 1e-3, 1e-12) << "k is the stiffness at 1 mm";
+  // The model is a spring, the wall is not: the estimate's wall absorbs the mismatch at rest.
+  for (std::uint64_t seed : {1u, 2u}) {
+    const auto r = run_delay_case(p, {0.2, 0.01, 0.2, Scheme::kMmt, seed, 0.0});
+    EXPECT_TRUE(r.settled) << seed << ": force error " << r.contact_force_max_error;
+    EXPECT_NEAR(r.steady_contact_force_N, f, 1e-12);
+  }
+}
+
 TEST(DelayedTeleoperation, ModelMediatedSettlesAtEveryDelayUpTo200ms) {
   for (double d : {0.0, 0.01, 0.02, 0.05, 0.1, 0.2}) {
     for (double loss : {0.0, 0.2}) {
@@ -163,8 +180,8 @@ TEST(DelayedTeleoperation, ModelMediatedSettlesAtEveryDelayUpTo200ms) {
 
 TEST(DelayedTeleoperation, ModelMediatedSettlesOnTheValidationSet) {
   // The seeded random set docs/model.md reports (`teleop delay-validate`): delays to 200 ms,
-  // jitter to half each way's delay, loss to 20 %, walls 300-3000 N/m, geometry errors to 1.5 mm,
-  // sensor noise to 5 mN.
+  // jitter to half each way's delay, loss to 20 %, walls 300-3000 N/m, half of them Hertzian,
+  // geometry errors to 1.5 mm, sensor noise to 5 mN.
   const SetSummary s = run_case_set(DelayedTeleopParams{}, validation_set(40, 20261125), Scheme::kMmt);
   EXPECT_EQ(s.settled, s.cases);
   EXPECT_GE(s.min_observed_energy_J, -1e-12);

@@ -15,7 +15,7 @@ std::vector<SetCase> tuning_set() {
     for (double loss : {0.0, 0.2})
       for (double k_e : {300.0, 1000.0, 3000.0})
         for (auto [error, noise] : {std::pair{-1e-3, 0.0}, {1e-3, 4e-3}})
-          set.push_back({{delay, 0.1 * 0.5 * delay, loss, Scheme::kNone, seed++, error}, k_e, noise});
+          set.push_back({{delay, 0.1 * 0.5 * delay, loss, Scheme::kNone, seed++, error}, k_e, 1.0, noise});
   return set;
 }
 
@@ -29,7 +29,9 @@ std::vector<SetCase> validation_set(int n, std::uint64_t seed) {
     const double loss = rng.uniform(0.0, 0.2);
     const double k_e = 300.0 * std::pow(10.0, rng.uniform());  // log-uniform over a decade
     const double error = rng.uniform(-1.5e-3, 1.5e-3), noise = rng.uniform(0.0, 5e-3);
-    set.push_back({{delay, jitter, loss, Scheme::kNone, rng.next_u64(), error}, k_e, noise});
+    const std::uint64_t link_seed = rng.next_u64();
+    const double exponent = rng.uniform() < 0.5 ? 1.0 : 1.5;
+    set.push_back({{delay, jitter, loss, Scheme::kNone, link_seed, error}, k_e, exponent, noise});
   }
   return set;
 }
@@ -40,6 +42,7 @@ SetSummary run_case_set(const DelayedTeleopParams& base, const std::vector<SetCa
   for (const SetCase& sc : set) {
     DelayedTeleopParams p = base;
     p.wall_stiffness_N_m = sc.wall_stiffness_N_m;
+    p.wall_exponent = sc.wall_exponent;
     p.mmt.force_noise_N = sc.force_noise_N;
     DelayCase c = sc.c;
     c.scheme = scheme;

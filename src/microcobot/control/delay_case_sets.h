@@ -16,6 +16,7 @@ namespace mc::control {
 struct SetCase {
   DelayCase c;
   double wall_stiffness_N_m = 1000.0;
+  double wall_exponent = 1.0;  ///< DelayedTeleopParams::wall_exponent
   double force_noise_N = 0.0;
 };
 
@@ -24,7 +25,8 @@ struct SetCase {
 std::vector<SetCase> tuning_set();
 
 /// `n` cases from `seed`: round trip U[0, 200] ms, jitter U[0, 50 %] of each way's delay, loss
-/// U[0, 20 %], wall log-U[300, 3000] N/m, geometry error U[-1.5, 1.5] mm, noise U[0, 5] mN.
+/// U[0, 20 %], wall log-U[300, 3000] N/m, geometry error U[-1.5, 1.5] mm, noise U[0, 5] mN, and
+/// half the walls Hertzian (exponent 1.5), which the tuning set has none of.
 /// Throws InvalidParams unless 1 <= n <= 1000.
 std::vector<SetCase> validation_set(int n, std::uint64_t seed);
 
@@ -36,8 +38,8 @@ struct SetSummary {
   std::vector<DelayCaseResult> results;  ///< in the set's order
 };
 
-/// Runs every case of `set` by `scheme` on `base` (its wall stiffness and noise replaced by the
-/// case's). Throws InvalidParams.
+/// Runs every case of `set` by `scheme` on `base` (its wall stiffness, exponent and noise replaced
+/// by the case's). Throws InvalidParams.
 SetSummary run_case_set(const DelayedTeleopParams& base, const std::vector<SetCase>& set, Scheme scheme);
 
 }  // namespace mc::control

@@ -30,6 +30,7 @@ void DelayedTeleopParams::validate() const {
                          {servo_damping_N_s_m, "servo_damping_N_s_m"}})
     require_non_negative(v, name);
   require_in_range(duration_s, 2.0, 600.0, "duration_s");
+  require_in_range(wall_exponent, 1.0, 3.0, "wall_exponent");
   require(std::isfinite(settled_force_tolerance) && settled_force_tolerance > 0.0 &&
               settled_force_tolerance < 1.0,
           "settled_force_tolerance", "must be within (0, 1)", settled_force_tolerance);
@@ -42,10 +43,24 @@ void DelayedTeleopParams::validate() const {
   require_non_negative(mmt.force_noise_N, "mmt.force_noise_N");
 }
 
+double DelayedTeleopParams::wall_force_N(double depth_m) const noexcept {
+  if (depth_m <= 0.0) return 0.0;
+  constexpr double kReferenceDepth_m = 1e-3;
+  return wall_stiffness_N_m * depth_m *
+         (wall_exponent == 1.0 ? 1.0 : std::pow(depth_m / kReferenceDepth_m, wall_exponent - 1.0));
+}
+
 double DelayedTeleopParams::steady_contact_force_N() const {
-  // Springs in series: 1/k = 1/k_h + 1/k_p + 1/k_e; the hand's target is push_depth_m beyond the
-  // wall, where every spring is relaxed at first touch.
-  return push_depth_m / (1.0 / hand_stiffness_N_m + 1.0 / servo_stiffness_N_m + 1.0 / wall_stiffness_N_m);
+  // The hand's spring, the servo and the wall in series, every one relaxed at first touch: at a
+  // force F the slave is at depth d(F) = push_depth - F/k_h - F/k_p, and the wall must give F
+  // there. wall_force_N(d(F)) - F falls with F from > 0 at F = 0 to < 0 where d = 0: bisection.
+  const double k_hp = 1.0 / (1.0 / hand_stiffness_N_m + 1.0 / servo_stiffness_N_m);
+  double lo = 0.0, hi = push_depth_m * k_hp;
+  for (int i = 0; i < 200 && hi - lo > 1e-15 * hi; ++i) {
+    const double f = 0.5 * (lo + hi);
+    (wall_force_N(push_depth_m - f / k_hp) > f ? lo : hi) = f;
+  }
+  return 0.5 * (lo + hi);
 }
 
 const char* to_string(Scheme s) {
@@ -144,12 +159,12 @@ DelayCaseResult run_delay_case(const DelayedTeleopParams& p, const DelayCase& c,
       const double fd = p.master_damping_N_s_m * vm;
       vm += h * (fh - fm - fd - p.handle_damping_N_s_m * vm) / p.handle_mass_kg;  // semi-implicit Euler
       xm += h * vm;
-      fe = p.wall_stiffness_N_m * std::max(0.0, xs - p.wall_m);
+      fe = p.wall_force_N(xs - p.wall_m);
       const double fs = p.servo_stiffness_N_m * (xsd - xs) + p.servo_damping_N_s_m * (vsd - vs);
       vs += h * (fs - fe) / p.slave_mass_kg;
       xs += h * vs;
     }
-    fe = p.wall_stiffness_N_m * std::max(0.0, xs - p.wall_m);
+    fe = p.wall_force_N(xs - p.wall_m);
     const double po_m = mmt ? model_master.observed_J() : master_pc.observed_J();
     const double po_s = mmt ? 0.0 : slave_pc.observed_J();
     r.min_observed_energy_J = std::min({r.min_observed_energy_J, po_m, po_s});

@@ -53,8 +53,11 @@ struct DelayedTeleopParams {
   double handle_mass_kg = 0.1, handle_damping_N_s_m = 0.5;
   double hand_stiffness_N_m = 200.0, hand_damping_N_s_m = 20.0;
   double slave_mass_kg = 0.1, servo_stiffness_N_m = 5000.0, servo_damping_N_s_m = 100.0;
-  double wall_m = 0.02;                  ///< the contact, 20 mm of hand travel from the start
-  double wall_stiffness_N_m = 1000.0;    ///< as the handle feels it
+  double wall_m = 0.02;                ///< the contact, 20 mm of hand travel from the start
+  double wall_stiffness_N_m = 1000.0;  ///< as the handle feels it (at 1 mm into the wall)
+  /// The wall's force law, f = k d (d / 1 mm)^(n - 1) at a depth d: 1 a spring, 1.5 a Hertz
+  /// contact. The model-mediated master's model is a spring whatever n (a model mismatch).
+  double wall_exponent = 1.0;
   double approach_speed_m_s = 0.02;      ///< the hand's speed towards the wall ...
   double push_depth_m = 0.01;            ///< ... until its target is this far beyond it ...
   double duration_s = 6.0;               ///< ... where it stays until the end
@@ -67,6 +70,8 @@ struct DelayedTeleopParams {
   /// The contact force at rest of the undelayed coupling: the hand's spring, the slave's servo and
   /// the wall in series, pressed by the hand's target push_depth_m beyond the wall.
   double steady_contact_force_N() const;
+  /// The wall's force at a depth `depth_m` (0 outside). Never allocates.
+  double wall_force_N(double depth_m) const noexcept;
 };
 
 struct DelayCase {
