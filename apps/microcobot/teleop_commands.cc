@@ -43,7 +43,7 @@ struct CouplingOptions {
     cmd.add_option("--master-damping", params.master_damping_N_s_m,
                    "A passive damper on the handle [N s/m], any scheme (default 0)");
     cmd.add_option("--mmt-tau", params.mmt.time_constant_s,
-                   "mmt: the master model's lag towards each estimate [s] (default 0.02)");
+                   "mmt: the master model's lag towards each estimate [s] (default 0.005)");
     cmd.add_option(
         "--mmt-prior-margin", params.mmt.prior_margin_m,
         "mmt: the prior wall is placed this much nearer than the geometry says [m] (default 1.5e-3)");
