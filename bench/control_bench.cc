@@ -3,6 +3,9 @@
 // plant is not included except in BM_XyzStageTick (three axes, model included).
 #include <benchmark/benchmark.h>
 
+#include "microcobot/control/contact_estimator.h"
+#include "microcobot/control/delayed_teleoperation.h"
+#include "microcobot/control/model_mediated_master.h"
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/setpoint_stream.h"
 #include "microcobot/control/tracking_controller.h"
@@ -98,5 +101,42 @@ void BM_XyzStageTick(benchmark::State& st) {
   for (auto _ : st) stage.tick();
 }
 BENCHMARK(BM_XyzStageTick)->Iterations(20000);
+
+/// Model-mediated teleoperation (issue #31): the master model's haptic step (eq. 1-3 of
+/// model_mediated_master.h, with its passivity controller) and the slave estimator's sample.
+void BM_ModelMediatedMasterStep(benchmark::State& st) {
+  ct::ModelMediatedMaster m({}, {0.0, 0.02, 1000.0});
+  m.receive({0.0, 0.0201, 1200.0});
+  double x = 0.021, v = 1e-3, acc = 0.0;
+  for (auto _ : st) {
+    acc += m.force(x, v, 1e-4);
+    v = -v;  // in and out: the controller's branch taken as often as not
+    x += v * 1e-4;
+    benchmark::DoNotOptimize(acc);
+  }
+}
+BENCHMARK(BM_ModelMediatedMasterStep);
+
+void BM_ContactEstimatorUpdate(benchmark::State& st) {
+  ct::ContactEstimator e({}, {0.0, 0.02, 1000.0});
+  double x = 0.02, dx = 1e-6;
+  for (auto _ : st) {
+    e.update(x, 1500.0 * (x - 0.0199));
+    x += dx;
+    if (x > 0.0205 || x < 0.02) dx = -dx;
+    benchmark::DoNotOptimize(e.model().stiffness_N_m);
+  }
+}
+BENCHMARK(BM_ContactEstimatorUpdate);
+
+/// One delay-sweep case (6 s of the coupling at 1 kHz, mechanics at 10 kHz), per scheme.
+void BM_DelayCase(benchmark::State& st) {
+  const auto scheme = static_cast<ct::Scheme>(st.range(0));
+  for (auto _ : st) {
+    const auto r = ct::run_delay_case(ct::DelayedTeleopParams{}, {0.2, 0.01, 0.2, scheme, 1, 0.0});
+    benchmark::DoNotOptimize(r.max_handle_excursion_m);
+  }
+}
+BENCHMARK(BM_DelayCase)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace

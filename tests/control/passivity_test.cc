@@ -89,7 +89,8 @@ TEST(PassivityControllers, TheLinkAndTheControllersNeverAllocate) {
 }
 
 DelayCaseResult run(double delay, double loss, bool passivity) {
-  return run_delay_case(DelayedTeleopParams{}, {delay, 0.05 * delay, loss, passivity, 1});
+  return run_delay_case(DelayedTeleopParams{},
+                        {delay, 0.05 * delay, loss, passivity ? Scheme::kTdpa : Scheme::kNone, 1});
 }
 
 TEST(DelayedTeleoperation, TheUnprotectedContactGoesUnstableAsTheDelayGrows) {
