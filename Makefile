@@ -5,24 +5,30 @@ PRESET ?= release
 BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
+# Everything `make test` builds; the sanitizer and fuzz presets leave out what they leave out.
+ifeq ($(filter $(PRESET),asan fuzz),)
+FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_BUILD_BENCH=ON -DMC_BUILD_PYTHON=ON
+else
+FULL_OPTS := -DMC_BUILD_TESTS=ON
+endif
 
-.PHONY: run demo report test deps configure build cli python asan fuzz bench format clean
+.PHONY: run demo report test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state. It builds only
 # the command line and the libraries it links (not the tests, benchmarks and Python module), so
 # that a fresh machine reaches the console first. SERVE_ARGS adds options (`make run
 # SERVE_ARGS="--scene pin-in-hole"`).
-run: cli
+run: cli-only
 	$(CLI) serve --out out/live $(SERVE_ARGS)
 
 # The scripted session: the teleoperated pick-and-place run to completion; prints where the
 # session report is.
-demo: cli
+demo: cli-only
 	$(CLI) run --out out/session
 
 # Every module's figures in one HTML report.
-report: cli
+report: cli-only
 	$(CLI) report --out out/report
 
 test: build
@@ -31,8 +37,20 @@ test: build
 deps:
 	@scripts/install-deps.sh
 
+# What the main job needs, no more: a fresh machine configures without the tests, benchmarks and
+# Python module (nor their packages); a build tree that has them keeps them.
+deps-run:
+	@scripts/install-deps.sh run
+
 configure: deps
-	@cmake --preset $(PRESET) >/dev/null
+	@cmake --preset $(PRESET) $(FULL_OPTS) >/dev/null
+
+configure-run: deps-run
+	@if [ -f $(BUILD)/CMakeCache.txt ]; then cmake --preset $(PRESET) >/dev/null; \
+	 else cmake --preset $(PRESET) -DMC_BUILD_TESTS=OFF -DMC_BUILD_BENCH=OFF -DMC_BUILD_PYTHON=OFF >/dev/null; fi
+
+cli-only: configure-run
+	cmake --build --preset $(PRESET) -j $(JOBS) --target microcobot_cli
 
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)

@@ -1,31 +1,40 @@
 #!/usr/bin/env bash
 # The one list of what microcobot needs on a Debian 12 machine.
 # Idempotent: installs only what is missing and is silent when everything is present.
-# Usage: scripts/install-deps.sh   (python3-scipy also regenerates the reference data of tests/data)
+# Usage: scripts/install-deps.sh [run|test]   run: what `make run` needs; test (default): everything
+#        (python3-scipy also regenerates the reference data of tests/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-DEBIAN_PACKAGES=(
-  build-essential cmake ninja-build pkg-config clang-format
+# What `make run` needs: the toolchain and the libraries the `microcobot` program links.
+RUN_PACKAGES=(
+  build-essential cmake ninja-build pkg-config
   ccache               # compilations cached across build trees (CI rebuilds only what changed)
-  iproute2             # ip netns: the two-machine link test runs each end in its own network stack
   libeigen3-dev        # linear algebra, matrix exponential, FFT, Levenberg-Marquardt
   libyaml-cpp-dev      # parameter files
   libcli11-dev         # command line
   libspdlog-dev libfmt-dev  # logging and formatting
   nlohmann-json3-dev   # --json output
   libboost-dev         # odeint (reference ODE solver); Beast/Asio (HTTP + WebSocket server)
-  libgtest-dev libgmock-dev googletest  # unit tests
-  libbenchmark-dev     # benchmarks
-  nodejs npm           # uPlot (bundled into reports) and playwright-core (browser test)
-  chromium             # headless browser for the report test
-  clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
+  nodejs npm           # uPlot (bundled into reports and the console) and the test clients
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
+)
+# What `make test` needs beside them: test frameworks, the browser, the fuzzers, the Python module
+# and its independent references.
+TEST_PACKAGES=(
+  clang-format
+  iproute2             # ip netns: the two-machine link test runs each end in its own network stack
+  libgtest-dev libgmock-dev googletest  # unit tests
+  libbenchmark-dev     # benchmarks
+  chromium             # headless browser for the report and console tests
+  clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
 )
+DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
+[[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")
 
 missing=()
 for p in "${DEBIAN_PACKAGES[@]}"; do
