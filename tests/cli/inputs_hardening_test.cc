@@ -78,12 +78,19 @@ TEST(InputsHardening, StiffnessesAreCheckedAgainstWhatTheirStepResolves) {
     expect_error({"tweezers", "manual", "--params", (d / "manual.yaml").string(), "--json"}, 3,
                  "object_stiffness_N_per_m");
   }
+  // The dual-stage plant's links (exact ZOH): 1e308 N/m overflowed the exponential ("diverged", exit 4).
+  for (const char* key : {"k_2_N_per_m", "k_d_N_per_m"}) {
+    write_text(d / "plant.yaml", std::string("plant:\n  ") + key + ": 1e308\n");
+    err = expect_error({"haptics", "evaluate", "--params", (d / "plant.yaml").string(), "--json"}, 3, key);
+    EXPECT_THAT(err, HasSubstr("largest value")) << key;
+  }
   // The defaults and the documented study stay accepted.
   for (const std::vector<std::string>& ok :
        {std::vector<std::string>{"tweezers", "virtual-cube", "--json"},
         {"tweezers", "virtual-cube", "--stiffness", "16000", "--no-compensator", "--json"},
         {"tweezers", "manual", "--json"},
-        {"haptics", "tweezers", "--json"}}) {
+        {"haptics", "tweezers", "--json"},
+        {"haptics", "evaluate", "--json"}}) {
     const auto r = run_cli(ok);
     EXPECT_EQ(r.exit_code, 0) << joined(ok) << r.err;
   }
