@@ -95,6 +95,28 @@ CLI::Validator lower_bound(bool strict) {
 const CLI::Validator PositiveNumber = lower_bound(true);
 const CLI::Validator NonNegativeNumber = lower_bound(false);
 
+void naming_flags(const std::vector<std::pair<std::string, std::string>>& field_to_flag,
+                  const std::function<void()>& work) {
+  try {
+    work();
+  } catch (const InvalidParams& e) {
+    std::string text = e.what();
+    const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+    for (const auto& [field, flag] : field_to_flag) {
+      for (std::size_t pos = 0; (pos = text.find(field, pos)) != std::string::npos;) {
+        const std::size_t end = pos + field.size();
+        if ((pos > 0 && word(text[pos - 1])) || (end < text.size() && word(text[end]) && text[end] != '.')) {
+          pos = end;
+          continue;
+        }
+        text.replace(pos, field.size(), flag);
+        pos += flag.size();
+      }
+    }
+    throw Error(e.exit_code(), text);
+  }
+}
+
 void add_output_options(CLI::App& cmd, CommonOptions& opts) {
   cmd.add_flag("--json", opts.json, "Print a machine-readable JSON summary on stdout");
   cmd.add_option("--out", opts.out, "Write CSV artifacts and an index.html report to this directory");

@@ -55,6 +55,12 @@ CLI::Validator Range(double lo, double hi);
 extern const CLI::Validator PositiveNumber;
 extern const CLI::Validator NonNegativeNumber;
 
+/// Runs `work`; an InvalidParams about a parameter the user set by a flag is re-thrown (exit 3)
+/// with each field named in `field_to_flag` replaced by its flag ({"lead_m", "--lead"}): the
+/// message blames what the user typed, not the library's name for it.
+void naming_flags(const std::vector<std::pair<std::string, std::string>>& field_to_flag,
+                  const std::function<void()>& work);
+
 /// Options every command shares.
 struct CommonOptions {
   bool json = false;

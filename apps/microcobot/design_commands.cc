@@ -46,7 +46,9 @@ void add_ballscrew(CLI::App& group) {
   number(cmd, "--mu", c->v[2], "Friction coefficient mu (mu = tan phi)", true, mc::cli::NonNegativeNumber);
   mc::cli::add_output_options(*cmd, c->common);
   cmd->callback([c] {
-    const auto e = tw::ball_screw_efficiency(c->v[0], c->v[1], c->v[2]);
+    tw::BallScrewEfficiency e;
+    mc::cli::naming_flags({{"diameter_m", "--diameter"}, {"lead_m", "--lead"}, {"mu", "--mu"}},
+                          [&] { e = tw::ball_screw_efficiency(c->v[0], c->v[1], c->v[2]); });
     nlohmann::json j{{"lead_angle_rad", e.lead_angle_rad},
                      {"forward_efficiency", e.forward_efficiency},
                      {"backward_efficiency", e.backward_efficiency}};

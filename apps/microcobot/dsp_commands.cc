@@ -13,6 +13,7 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
 #include "microcobot/core/mat_file.h"
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/dsp/octave.h"
@@ -51,6 +52,20 @@ mc::dsp::WelchOptions to_options(const WelchFlags& w) {
   o.detrend = mc::dsp::parse_detrend(w.detrend);
   o.scaling = mc::dsp::parse_scaling(w.scaling);
   return o;
+}
+
+/// Runs a Welch estimate of the columns `x` (and `y`) of `file`: an overflowing spectrum is named by
+/// the file and column the user gave, not by the library's argument (x, y).
+template <class F>
+auto naming_columns(const std::string& file, const std::string& x, const std::string& y, F&& estimate) {
+  try {
+    return estimate();
+  } catch (const mc::dsp::SpectrumOverflow& e) {
+    throw mc::ComputationFailed(fmt::format(
+        "{}: column '{}': the power spectrum overflows (values up to {:g}; their squares exceed the largest "
+        "double)",
+        file, mc::excerpt(e.signal() == "x" ? x : y), e.max_abs()));
+  }
 }
 
 std::vector<std::complex<double>> read_frf(const mc::CsvTable& t) {
@@ -133,7 +148,8 @@ void add_dsp(CLI::App& group) {
     mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->column});
-      const auto p = mc::dsp::welch(table.column(o->column), to_options(o->w));
+      const auto p = naming_columns(o->in, o->column, o->column,
+                                    [&] { return mc::dsp::welch(table.column(o->column), to_options(o->w)); });
       write_two_columns(o->common, "psd.csv", {"f_Hz", p.f_Hz}, {"psd", p.value});
     });
   }
@@ -155,7 +171,9 @@ void add_dsp(CLI::App& group) {
     mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->input, o->output});
-      const auto e = mc::dsp::frf_h1(table.column(o->input), table.column(o->output), to_options(o->w));
+      const auto e = naming_columns(o->in, o->input, o->output, [&] {
+        return mc::dsp::frf_h1(table.column(o->input), table.column(o->output), to_options(o->w));
+      });
       std::vector<double> re(e.h.size()), im(e.h.size());
       for (std::size_t i = 0; i < e.h.size(); ++i) {
         re[i] = e.h[i].real();

@@ -37,6 +37,27 @@ ss::StickSlipParams base_params(const CommonOptions& o) {
   return o.params ? mc::load_params<ss::StickSlipParams>(*o.params) : ss::StickSlipParams{};
 }
 
+/// --save must not replace what the command reads (data loss): the --in file itself, or a
+/// measurement (.csv, .mat) of an --in directory. Checked before any work.
+void refuse_save_onto_input(const Opts& o) {
+  if (o.save.empty()) return;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path save(o.save), in(o.in);
+  if (fs::equivalent(save, in, ec)) {
+    throw mc::UsageError("--save '" + o.save +
+                         "' is the --in file: writing the parameters there would replace the measurement");
+  }
+  const fs::path dir = save.has_parent_path() ? save.parent_path() : fs::path(".");
+  const std::string ext = save.extension().string();
+  if (fs::is_directory(in, ec) && fs::exists(save, ec) && fs::equivalent(dir, in, ec) &&
+      (ext == ".csv" || ext == ".mat")) {
+    throw mc::UsageError("--save '" + o.save +
+                         "' is a measurement in the --in directory: writing the parameters there would "
+                         "replace it");
+  }
+}
+
 /// Writes the identified parameters to --save FILE and/or DIR/params.yaml; returns the paths.
 json save_params(const Opts& o, const ss::StickSlipParams& p) {
   json files = json::array();
@@ -290,6 +311,7 @@ void add_identify(CLI::App& group) {
             "PE modes (frequency, damping, gain split) from a step of the PE without slider", o,
             "CSV t_s,u_V,x_m or .mat with t, u, x (SI): PE step response (~1 MHz)")
         ->callback([o] {
+          refuse_save_onto_input(*o);
           const auto base = base_params(o->common);
           const auto rec = ss::read_record(o->in);
           const auto r = ss::identify_pe_modes(rec, base.pe);
@@ -310,6 +332,7 @@ void add_identify(CLI::App& group) {
             "The two asperities (rho0, rho1 each) from a scanning-mode step response", o,
             "CSV t_s,u_V,x_m or .mat with t, u, x (SI): actuator step response (~25 kHz)")
         ->callback([o] {
+          refuse_save_onto_input(*o);
           const auto base = base_params(o->common);
           const auto rec = ss::read_record(o->in);
           const auto r = ss::identify_friction_modes(rec, base);
@@ -331,6 +354,7 @@ void add_identify(CLI::App& group) {
     cmd->add_option("--operators", o->operators, "Number of play operators (thesis: 35)")
         ->check(mc::cli::Range(1, 200));
     cmd->callback([o] {
+      refuse_save_onto_input(*o);
       auto base = base_params(o->common);
       const auto rec = ss::read_record(o->in);
       const auto r = ss::identify_hysteresis(rec, o->operators, o->common.params ? &base : nullptr);
@@ -351,6 +375,7 @@ void add_identify(CLI::App& group) {
     cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")
         ->check(mc::cli::Range(1, 64));
     cmd->callback([o] {
+      refuse_save_onto_input(*o);
       auto base = base_params(o->common);
       const auto runs = ss::read_sawtooth_runs(o->in);
       const ss::ActuatorModel model(base);
@@ -377,6 +402,7 @@ void add_identify(CLI::App& group) {
     cmd->add_option("--threads", o->threads, "Worker threads (default: all cores)")
         ->check(mc::cli::Range(1, 64));
     cmd->callback([o] {
+      refuse_save_onto_input(*o);
       const auto base = base_params(o->common);
       ss::IdentifyAllOptions io;
       io.operators = o->operators;

@@ -141,6 +141,11 @@ int run_cli(CLI::App& app, int argc, char** argv) {
     check_command_words(app, argc, argv);
     app.parse(argc, argv);
     mc::cli::commit_outputs();
+    // A signal while the outputs were moved into place waited for the last one (signals.h).
+    if (const int sig = mc::cli::interrupt_signal(); sig != 0) {
+      const mc::cli::Interrupted e(sig, true);
+      return fail(static_cast<mc::ExitCode>(e.exit_code()), e.what());
+    }
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

@@ -58,6 +58,9 @@ void run(const RunOptions& o) {
   session.write(dir, result);
   mc::cli::set_cooperative_interrupts(false);
   if (result.interrupted) throw mc::cli::Interrupted(mc::cli::interrupt_signal());
+  // A signal after the session ended, while its recording and report were written: they are
+  // whole, so they are moved into place, and the command still exits 128 + signal (docs/cli.md).
+  if (const int sig = mc::cli::interrupt_signal(); sig != 0) throw mc::cli::Interrupted(sig, true);
   auto summary = result.to_json();
   summary["scenario"] = o.scenario;
   summary["report"] = (dir / "index.html").string();

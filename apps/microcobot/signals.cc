@@ -2,9 +2,12 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 #include <atomic>
+#include <cerrno>
+#include <climits>
 #include <csignal>
 #include <cstring>
 #include <iostream>
@@ -13,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/input_file.h"
+#include "microcobot/core/staged_file.h"
 
 namespace mc::cli {
 
@@ -94,10 +98,13 @@ extern "C" void on_signal(int sig) {
 
 }  // namespace
 
-Interrupted::Interrupted(int signal)
+Interrupted::Interrupted(int signal, bool outputs_complete)
     : mc::Error(mc::ExitCode::kComputationFailed,
-                fmt::format("interrupted ({}); the outputs written so far are marked as interrupted",
-                            signal_name(signal))),
+                outputs_complete
+                    ? fmt::format("interrupted ({}) while writing the outputs; they are complete and in place",
+                                  signal_name(signal))
+                    : fmt::format("interrupted ({}); the outputs written so far are marked as interrupted",
+                                  signal_name(signal))),
       signal_(signal) {}
 
 std::string signal_name(int signal) {
@@ -139,6 +146,12 @@ fs::path stage_output(const fs::path& target_in) {
   }
   Staged s;
   s.target = target;
+  std::string name = fs::absolute(target, ec).lexically_normal().filename().string();
+  if (name.empty()) name = "out";
+  if (name.size() > NAME_MAX) {
+    throw InvalidInput(target.string(), 0,
+                       "cannot create output directory: " + mc::why_not_created(target, ENAMETOOLONG));
+  }
   for (fs::path p = parent; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
     s.created_parents.push_back(p);
     if (p == p.parent_path()) break;
@@ -149,12 +162,22 @@ fs::path stage_output(const fs::path& target_in) {
         target.string(), 0,
         "cannot create output directory: " + (ec ? ec.message() : std::string("not a directory")));
   }
-  std::string name = fs::absolute(target, ec).lexically_normal().filename().string();
-  if (name.empty()) name = "out";
-  std::string tmpl = (parent / ("." + name + ".tmp-XXXXXX")).string();
+  // The staging directory must lie on DIR's file system: the files are renamed into DIR, and a
+  // rename cannot cross devices. A DIR that is a mount point (its parent on another device) is
+  // staged inside itself.
+  fs::path stage_in = parent;
+  struct stat target_st {}, parent_st {};
+  if (::stat(target.c_str(), &target_st) == 0 && S_ISDIR(target_st.st_mode) &&
+      (::stat(parent.c_str(), &parent_st) != 0 || parent_st.st_dev != target_st.st_dev)) {
+    stage_in = target;
+  }
+  // At most 64 bytes of DIR's name: a name near the limit (255) must leave room for the suffix.
+  std::string tmpl = (stage_in / ("." + name.substr(0, 64) + ".tmp-XXXXXX")).string();
   if (::mkdtemp(tmpl.data()) == nullptr) {
+    const int err = errno;
     for (const auto& p : s.created_parents) fs::remove(p, ec);
-    throw InvalidInput(target.string(), 0, "cannot create output directory (parent not writable)");
+    throw InvalidInput(target.string(), 0,
+                       "cannot create output directory: " + mc::why_not_created(stage_in / "x", err));
   }
   s.staging = tmpl;
   if (s.staging.string().size() < sizeof g_staging_paths[0]) {
@@ -193,6 +216,12 @@ void plan(const fs::path& staging, const fs::path& target, const fs::path& rel,
 }  // namespace
 
 void commit_outputs() {
+  // Deferred, not ignored: the caller reads interrupt_signal() once every file is in place.
+  const bool was_cooperative = g_cooperative.exchange(true);
+  struct Restore {
+    bool on;
+    ~Restore() { g_cooperative.store(on); }
+  } restore{was_cooperative};
   for (const auto& s : staged()) {
     std::vector<fs::path> files;
     std::error_code ec;

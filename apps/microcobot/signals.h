@@ -22,9 +22,11 @@
 namespace mc::cli {
 
 /// Thrown by a command that stopped on a signal after writing what it could; exit 128 + signal.
+/// `outputs_complete`: the signal came after the work was done (while its outputs were being
+/// written), so the outputs are whole, not marked as interrupted.
 class Interrupted : public mc::Error {
  public:
-  explicit Interrupted(int signal);
+  explicit Interrupted(int signal, bool outputs_complete = false);
   int exit_code() const { return 128 + signal_; }
 
  private:
@@ -44,7 +46,9 @@ std::string signal_name(int signal);
 /// InvalidInput naming `target` when it cannot be created there.
 std::filesystem::path stage_output(const std::filesystem::path& target);
 /// Moves every staged file into its target directory (refusing first, with nothing moved,
-/// when a target entry is in the way, e.g. a directory where a file goes).
+/// when a target entry is in the way, e.g. a directory where a file goes). A SIGINT/SIGTERM
+/// while the files are moved waits for the last one (a half-moved set would mix new files with
+/// old ones); interrupt_signal() then reports it and the caller exits 128 + signal.
 void commit_outputs();
 /// Removes the staging directories (and the parents stage_output created).
 void discard_outputs() noexcept;

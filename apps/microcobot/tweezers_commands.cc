@@ -123,6 +123,7 @@ void run_cube(const CubeOptions& co) {
   if (co.rate) cfg.cube.control_rate_Hz = *co.rate;
   if (co.rate && std::fmod(cfg.cube.plant_rate_Hz, *co.rate) != 0) cfg.cube.plant_rate_Hz = 20.0 * *co.rate;
   cfg.cube.compensator = !co.no_comp;
+  if (co.rate) mc::cli::naming_flags({{"control_rate_Hz", "--rate"}}, [&] { cfg.cube.validate(); });
   if (co.sweep) {
     auto c = cfg.cube;
     c.compensator = false;
@@ -143,7 +144,12 @@ void run_cube(const CubeOptions& co) {
                     c.control_rate_Hz, bare, comp, comp / bare, bound, tw::tip_damping(cfg.model)));
     return;
   }
-  const auto r = tw::simulate_virtual_cube(cfg.model, cfg.cube);
+  // A limit met by a flag's value is named by the flag.
+  std::vector<std::pair<std::string, std::string>> flags;
+  if (co.stiffness) flags.emplace_back("stiffness_N_per_m", "--stiffness");
+  if (co.rate) flags.emplace_back("control_rate_Hz", "--rate");
+  tw::VirtualCubeResult r;
+  mc::cli::naming_flags(flags, [&] { r = tw::simulate_virtual_cube(cfg.model, cfg.cube); });
   const nlohmann::json j{{"chatter", r.chatter},
                          {"max_penetration_m", r.max_penetration_m},
                          {"oscillation_rms_N", r.oscillation_rms_N},

@@ -105,5 +105,32 @@ TEST(Welch, RejectsBadOptions) {
   EXPECT_THROW(parse_detrend("linear"), UsageError);
 }
 
+// Issue #31: finite data near the largest double overflow the squared spectrum; the H1 estimate
+// read 0 there (Pxx = inf) instead of failing. Both estimates now fail naming the argument.
+TEST(Welch, AnOverflowingSpectrumFailsNamingTheSignal) {
+  std::vector<double> x(512), y(512);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x[i] = std::sin(0.3 * static_cast<double>(i));
+    y[i] = 1e308 * std::sin(0.3 * static_cast<double>(i) + 1.0);
+  }
+  WelchOptions o;
+  o.fs_Hz = 1e3;
+  EXPECT_NO_THROW(frf_h1(x, x, o));
+  try {
+    frf_h1(x, y, o);
+    ADD_FAILURE() << "no overflow reported";
+  } catch (const SpectrumOverflow& e) {
+    EXPECT_EQ(e.signal(), "y");
+    EXPECT_GT(e.max_abs(), 9e307);
+  }
+  try {
+    welch(y, o);
+    ADD_FAILURE() << "no overflow reported";
+  } catch (const SpectrumOverflow& e) {
+    EXPECT_EQ(e.signal(), "x");  // welch's argument
+  }
+  EXPECT_THROW(frf_h1(y, x, o), ComputationFailed);
+}
+
 }  // namespace
 }  // namespace mc::dsp

@@ -12,6 +12,27 @@
 namespace mc::microworld {
 namespace {
 
+// Issue #31: the trap's stiffness is checked against the step like the contact's (a trap
+// stiffer than ~1e-2 N/m at 1e-5 s gave wrong corner frequencies with exit 0).
+TEST(OpticalTrap, ATrapThatRelaxesWithinAStepIsRefused) {
+  OpticalTrapParams p;
+  const double gamma = 6.0 * std::numbers::pi * p.viscosity_Pa_s * p.bead_radius_m;
+  p.trap_stiffness_N_per_m = 0.49 * gamma / p.dt_s;
+  EXPECT_NO_THROW(p.validate());
+  for (double k : {0.51 * gamma / p.dt_s, 1e-2, 1e308}) {
+    p.trap_stiffness_N_per_m = k;
+    try {
+      p.validate();
+      ADD_FAILURE() << "accepted " << k;
+    } catch (const InvalidParams& e) {
+      EXPECT_EQ(e.field(), "trap_stiffness_N_per_m");
+    }
+  }
+  p.dt_s = 1e-7;  // a finer step resolves it
+  p.trap_stiffness_N_per_m = 1e-2;
+  EXPECT_NO_THROW(p.validate());
+}
+
 TEST(OpticalTrap, DragAndCornerFromStokes) {
   const OpticalTrap trap{OpticalTrapParams{}};
   const double gamma = 6 * std::numbers::pi * 0.85e-3 * 1.5e-6;

@@ -120,3 +120,15 @@ def test_bad_inputs_raise_value_error():
         dsp.welch(np.zeros(300), window="hamming")
     with pytest.raises(ValueError, match="h: expected a 1-D array of the same length"):
         dsp.tffit(np.arange(1.0, 10.0), np.ones(5, complex))
+
+
+def test_an_overflowing_spectrum_raises_instead_of_reading_zero():
+    # Issue #31: finite data near 1e308 overflow the squared spectrum; H1 read 0 there.
+    import microcobot
+
+    n = np.arange(512)
+    x, y = np.sin(0.3 * n), 1e308 * np.sin(0.3 * n + 1.0)
+    with pytest.raises(microcobot.ComputationFailed, match="y: the power spectrum overflows"):
+        dsp.tfestimate(x, y, fs=1e3)
+    with pytest.raises(microcobot.ComputationFailed, match="overflows"):
+        dsp.welch(y, fs=1e3)

@@ -86,3 +86,9 @@ def test_teletweez_bandwidth_identification_reproduces_fig_4_25():
     np.testing.assert_allclose(20 * np.log10(r["magnitude"][sel] / r["model_magnitude"][sel]), 0.0, atol=1.0)
     with pytest.raises(ValueError, match="fs_Hz"):
         tweezers.identify_bandwidth(options={"fs_Hz": -1.0})
+
+
+def test_a_lead_whose_angle_rounds_to_90_degrees_is_named_as_the_lead():
+    # Issue #31: the error named the derived lead_angle_rad, not the lead the caller gave.
+    with pytest.raises(ValueError, match="lead_m: too large for diameter_m"):
+        tweezers.ball_screw_efficiency(0.006, 1e20, 0.1)

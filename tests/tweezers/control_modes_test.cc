@@ -54,5 +54,26 @@ TEST(ManualMode, RejectsBadParams) {
   EXPECT_THROW(simulate_manual_mode(TeleTweezParams{}, p), InvalidParams);
 }
 
+// Issue #31: the object's spring acts on the tip explicitly; a stiffness the plant step cannot
+// resolve diverged (exit 4) or held forces hundreds of newtons off (exit 0).
+TEST(ManualMode, AnObjectTooStiffForThePlantStepIsRefused) {
+  const TeleTweezParams mp;
+  ManualModeParams p;
+  const double k_max = 0.25 * mp.tip_mass_kg * p.plant_rate_Hz * p.plant_rate_Hz;
+  for (double k : {1.01 * k_max, 1e308}) {
+    p.object_stiffness_N_per_m = k;
+    try {
+      simulate_manual_mode(mp, p);
+      ADD_FAILURE() << "accepted " << k;
+    } catch (const InvalidParams& e) {
+      EXPECT_EQ(e.field(), "object_stiffness_N_per_m");
+    }
+  }
+  // At the limit the loop still holds its set force (the break starts near 2.4 times it).
+  p.object_stiffness_N_per_m = k_max;
+  const auto r = simulate_manual_mode(mp, p);
+  EXPECT_LT(r.held_force_error_N, 0.05 * p.set_force_N);
+}
+
 }  // namespace
 }  // namespace mc::tweezers

@@ -1,6 +1,7 @@
 // The virtual cube (section 4.5.3): chatter of a stiff sampled wall, its suppression by the lag
 // compensator, the chatter criterion on both sides of its boundary, Colgate's bound.
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -74,6 +75,36 @@ TEST(VirtualCube, CompensatorAtLeastDoublesTheStiffness) {
   c.compensator = false;
   c.control_rate_Hz = 5000;
   EXPECT_GT(max_chatter_free_stiffness(TeleTweezParams{}, c, 500, 1e6, 10), bare);
+}
+
+// Issue #31: a wall beyond the loop's Nyquist frequency is refused where the renderer is made
+// (1e308 N/m reported no chatter with wall forces of 2e303 N), and the sweep stops below it.
+TEST(VirtualCube, AWallBeyondTheLoopsNyquistFrequencyIsRefused) {
+  const TeleTweezParams p;
+  VirtualCubeParams c;
+  c.compensator = false;
+  const double k_max = max_renderable_stiffness(p, c);
+  EXPECT_NEAR(k_max, tip_mass(p) * std::pow(std::numbers::pi * c.control_rate_Hz, 2), 1e-6 * k_max);
+  c.compensator = true;
+  EXPECT_NEAR(max_renderable_stiffness(p, c), k_max * c.lag_zero_Hz / c.lag_pole_Hz, 1e-6 * k_max);
+  c.compensator = false;
+  for (double k : {1.01 * k_max, 1e308}) {
+    c.stiffness_N_per_m = k;
+    EXPECT_THROW(simulate_virtual_cube(p, c), InvalidParams) << k;
+  }
+  c.stiffness_N_per_m = 0.99 * k_max;
+  EXPECT_NO_THROW(VirtualCubeRenderer(p, c));
+  EXPECT_LE(max_chatter_free_stiffness(p, c, 500, 1e12, 4), k_max);
+  // The compensator's zero at the rate's Nyquist frequency: named by the rate.
+  c.compensator = true;
+  c.control_rate_Hz = 2 * c.lag_zero_Hz;
+  c.plant_rate_Hz = 20 * c.control_rate_Hz;
+  try {
+    c.validate();
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidParams& e) {
+    EXPECT_EQ(e.field(), "control_rate_Hz");
+  }
 }
 
 TEST(VirtualCube, ColgateBound) {

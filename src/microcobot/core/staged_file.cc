@@ -4,20 +4,38 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstdlib>
+#include <cstring>
 #include <system_error>
 
 #include "microcobot/core/error.h"
 
 namespace mc {
 
+std::string why_not_created(const std::filesystem::path& path, int err) {
+  const std::size_t name = path.filename().string().size();
+  if (name > NAME_MAX) {
+    return "its name is " + std::to_string(name) + " characters long (the limit is " + std::to_string(NAME_MAX) +
+           ")";
+  }
+  if (err == ENOENT || err == ENOTDIR) return "directory missing";
+  if (err == EACCES || err == EPERM || err == EROFS) return "directory not writable";
+  return std::strerror(err);
+}
+
 StagedFile::StagedFile(std::filesystem::path path) : path_(std::move(path)) {
+  if (path_.filename().string().size() > NAME_MAX)
+    throw InvalidInput(path_.string(), 0, "cannot write: " + why_not_created(path_, ENAMETOOLONG));
   const std::filesystem::path dir = path_.has_parent_path() ? path_.parent_path() : ".";
-  tmp_path_ = (dir / ("." + path_.filename().string() + ".XXXXXX")).string();
+  // The temporary's name holds at most 64 bytes of the target's: a name near the file system's
+  // limit (255) is a valid target, and its temporary must be creatable too.
+  tmp_path_ = (dir / ("." + path_.filename().string().substr(0, 64) + ".XXXXXX")).string();
   fd_ = ::mkstemp(tmp_path_.data());
   if (fd_ < 0) {
+    const int err = errno;
     tmp_path_.clear();
-    throw InvalidInput(path_.string(), 0, "cannot write (directory missing or not writable)");
+    throw InvalidInput(path_.string(), 0, "cannot write: " + why_not_created(path_, err));
   }
 }
 

@@ -11,6 +11,11 @@
 
 namespace mc {
 
+/// Why `path` (a file or directory to create) could not be created, given the errno of the
+/// failed call: "its name is 300 characters long (the limit is 255)", "directory missing",
+/// "directory not writable", else strerror. For one-line errors that name what the user gave.
+std::string why_not_created(const std::filesystem::path& path, int err);
+
 class StagedFile {
  public:
   /// Creates the temporary file. Throws InvalidInput naming `path` when the directory is

@@ -1,5 +1,6 @@
 #include "microcobot/dsp/welch.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -11,6 +12,35 @@
 namespace mc::dsp {
 
 using C = std::complex<double>;
+
+SpectrumOverflow::SpectrumOverflow(std::string signal, double max_abs)
+    : ComputationFailed(fmt::format("{}: the power spectrum overflows (values up to {:g}; their squares exceed "
+                                    "the largest double)",
+                                    signal, max_abs)),
+      signal_(std::move(signal)),
+      max_abs_(max_abs) {}
+
+namespace {
+
+double max_abs(std::span<const double> x) {
+  double m = 0.0;
+  for (double v : x) m = std::max(m, std::abs(v));
+  return m;
+}
+
+// Throws SpectrumOverflow naming `signal` unless every value of the estimate is finite.
+template <class T>
+void require_finite_spectrum(const std::vector<T>& p, const char* signal, std::span<const double> data) {
+  for (const auto& v : p) {
+    if (std::isfinite(std::abs(v))) continue;
+    for (double d : data) {
+      if (!std::isfinite(d)) throw ComputationFailed(std::string(signal) + ": the data hold a non-finite value");
+    }
+    throw SpectrumOverflow(signal, max_abs(data));
+  }
+}
+
+}  // namespace
 
 Detrend parse_detrend(const std::string& text) {
   if (text == "constant") return Detrend::kConstant;
@@ -130,6 +160,7 @@ std::vector<double> WelchEstimator::psd(std::span<const double> x) {
   }
   const double inv = 1.0 / static_cast<double>(m.nseg);
   for (std::size_t k = 0; k < m.nout; ++k) p[k] *= m.factor(k) * inv;
+  require_finite_spectrum(p, "x", x);
   return p;
 }
 
@@ -164,6 +195,10 @@ void WelchEstimator::all(std::span<const double> x, std::span<const double> y, s
     pyy[k] *= g;
     pxy[k] *= g;
   }
+  require_finite_spectrum(pxx, "x", x);
+  require_finite_spectrum(pyy, "y", y);
+  // Both finite, their cross spectrum is bounded by sqrt(Pxx Pyy) up to rounding; checked all the same.
+  require_finite_spectrum(pxy, max_abs(x) >= max_abs(y) ? "x" : "y", max_abs(x) >= max_abs(y) ? x : y);
 }
 
 Spectrum welch(std::span<const double> x, const WelchOptions& options) {

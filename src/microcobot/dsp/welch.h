@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "microcobot/core/error.h"
+
 namespace mc::dsp {
 
 enum class Detrend { kConstant, kNone };
@@ -58,6 +60,20 @@ struct FrfEstimate {
   std::vector<double> coherence;        ///< |Pxy|^2 / (Pxx Pyy), in [0, 1]
 };
 
+/// A spectrum that overflows: data so large (|x| near 1e154 and beyond) that their squares
+/// exceed the largest double, so the estimate would hold infinities (an H1 estimate would read
+/// 0). A failed computation (exit 4); signal() is "x" or "y", the argument that overflowed.
+class SpectrumOverflow : public ComputationFailed {
+ public:
+  SpectrumOverflow(std::string signal, double max_abs);
+  const std::string& signal() const { return signal_; }
+  double max_abs() const { return max_abs_; }
+
+ private:
+  std::string signal_;
+  double max_abs_;
+};
+
 /// A reusable Welch estimator: the window, FFT plan and buffers are made once for a given
 /// options set and signal length, so repeated estimates do not allocate beyond their results.
 class WelchEstimator {
@@ -76,7 +92,8 @@ class WelchEstimator {
   /// The effective options (nperseg clamped, noverlap and nfft resolved).
   const WelchOptions& options() const;
 
-  /// PSD of x (x.size() must equal the signal length given at construction).
+  /// PSD of x (x.size() must equal the signal length given at construction). Throws
+  /// SpectrumOverflow when it is not finite (as all() does).
   std::vector<double> psd(std::span<const double> x);
   /// Cross spectral density Pxy = E[conj(X) Y] (scipy's convention).
   std::vector<std::complex<double>> csd(std::span<const double> x, std::span<const double> y);

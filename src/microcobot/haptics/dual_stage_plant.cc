@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "microcobot/core/error.h"
@@ -47,6 +49,25 @@ void DualStagePlantParams::validate() const {
   const double h = dt_s / substeps;
   require(std::sqrt(stop_k_N_per_m / mu) * h < 0.4 * std::numbers::pi, "stop_k_N_per_m",
           "end-stop contact too stiff for dt_s/substeps (need sqrt(k/mu)*h < 0.4 pi)", stop_k_N_per_m);
+  // The links are discretised exactly (ZOH, matrix exponential), which holds for any stiffness the
+  // exponential can still compute: measured with `haptics evaluate`, k_2 up to 1e12 N/m (omega h =
+  // 870) gives the rigid link's response, 1e15 (omega h = 2.8e4) moves it by 1 dB, 1e308 overflows
+  // (exit 4, "diverged"). Each link's omega h on its two masses stays <= 1e3.
+  const auto reduced = [](double m_a, double m_b) { return m_a * m_b / (m_a + m_b); };
+  const auto link = [&](double k, double mu_ab, const char* field) {
+    const double k_max = mu_ab * (1e3 / h) * (1e3 / h);
+    require(k <= k_max, field,
+            fmt::format("too stiff for dt_s/substeps = {:g} s (omega h = {:.3g} > 1e3 on {:.3g} kg: the exact "
+                        "discretisation loses its accuracy); the largest value this step allows is {:.3g}",
+                        h, std::sqrt(k) / std::sqrt(mu_ab) * h, mu_ab, k_max),
+            k);
+  };
+  link(k_f_N_per_m, m_h_kg, "k_f_N_per_m");  // the finger holds the handle to the (fixed) hand
+  link(k_v_N_per_m, reduced(m_h_kg, m_v_kg), "k_v_N_per_m");
+  link(k_1_N_per_m, reduced(m_h_kg, m_1_kg), "k_1_N_per_m");
+  link(k_2_N_per_m, reduced(m_1_kg, m_2_kg), "k_2_N_per_m");
+  if (m_p_kg > 0.0) link(k_p_N_per_m, reduced(m_2_kg, m_p_kg), "k_p_N_per_m");
+  if (m_d_kg > 0.0) link(k_d_N_per_m, reduced(m_1_kg, m_d_kg), "k_d_N_per_m");
 }
 
 DualStagePlant::DualStagePlant(const DualStagePlantParams& params) : params_(params) {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 
 namespace mc::microworld {
@@ -22,7 +24,19 @@ void OpticalTrapParams::validate() const {
   // The contact force is explicit over a step: its relaxation must be resolved.
   const double gamma = 6.0 * std::numbers::pi * viscosity_Pa_s * bead_radius_m;
   require(contact_stiffness_N_per_m * dt_s / gamma < 0.5, "contact_stiffness_N_per_m",
-          "too stiff for dt_s (need k_c dt / gamma < 0.5)", contact_stiffness_N_per_m);
+          fmt::format("too stiff for dt_s = {:g} s (need k_c dt / gamma < 0.5); the largest value this step "
+                      "allows is {:.3g}",
+                      dt_s, 0.5 * gamma / dt_s),
+          contact_stiffness_N_per_m);
+  // So is the trap's: its linear spring is integrated exactly, but the rest of its force, k d
+  // (1 - g(d)), as large as k d once the bead nears escape, is frozen over the step like the
+  // contact. A trap stiffer than this relaxes within a step: its corner frequency k / (2 pi gamma)
+  // lies beyond what the step resolves (1e-2 N/m at 1e-5 s gave wrong corner frequencies).
+  require(trap_stiffness_N_per_m * dt_s / gamma < 0.5, "trap_stiffness_N_per_m",
+          fmt::format("too stiff for dt_s = {:g} s (need k dt / gamma < 0.5, gamma = 6 pi viscosity "
+                      "bead_radius); the largest value this step allows is {:.3g}",
+                      dt_s, 0.5 * gamma / dt_s),
+          trap_stiffness_N_per_m);
 }
 
 void OpticalTrapSceneParams::validate() const {

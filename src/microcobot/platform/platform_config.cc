@@ -3,6 +3,8 @@
 #include <cmath>
 #include <functional>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
@@ -21,6 +23,27 @@ void in_section(const std::string& section, const std::function<void()>& validat
     const std::string rest = what.rfind(head, 0) == 0 ? what.substr(head.size()) : what;
     throw Error(ExitCode::kInvalidInput, head + section + "." + rest);
   }
+}
+
+// The pick-and-place scene must lie within the stage's reach: the tool is at home + the axes'
+// positions, and each axis travels within +-stroke/2 (a home 1 m away on a 12 mm stroke could only
+// time out). `stroke_m` is the axes' (StickSlipParams::slider).
+void check_reach(const PlatformConfig& c, double stroke_m) {
+  if (c.microworld != "pick-place") return;
+  const double half = 0.5 * stroke_m;
+  const auto reach = [&](double home, const char* home_key, double point, const std::string& point_key) {
+    require(std::abs(point - home) < half, std::string("stage.") + home_key,
+            fmt::format("puts {} = {:g} m out of the stage's reach: the axes travel +-{:g} m (half their "
+                        "stroke_m) around the home",
+                        point_key, point, half),
+            home);
+  };
+  const auto& w = c.world;
+  reach(c.stage.home_x_m, "home_x_m", w.part_start_m.x(), "world.part_start_x_m");
+  reach(c.stage.home_y_m, "home_y_m", w.part_start_m.y(), "world.part_start_y_m");
+  reach(c.stage.home_x_m, "home_x_m", w.target_m.x(), "world.target_x_m");
+  reach(c.stage.home_y_m, "home_y_m", w.target_m.y(), "world.target_y_m");
+  reach(c.stage.home_z_m, "home_z_m", 0.5 * w.height_m(), "the part's mid-height");
 }
 
 }  // namespace
@@ -80,6 +103,13 @@ void PlatformConfig::validate() const {
   in_section("world", [&] { world.validate(); });
   require(microworld == "pick-place" || microworld == "optical-trap", "microworld",
           "must be pick-place or optical-trap, not '" + excerpt(microworld) + "'");
+  // The axes' stroke: the default axis, or its file once its path is resolved (a relative path is
+  // resolved, and the reach checked, by load_platform_config()).
+  if (stickslip_params_file.empty()) {
+    check_reach(*this, stickslip::StickSlipParams{}.slider.stroke_m);
+  } else if (std::filesystem::path(stickslip_params_file).is_absolute()) {
+    check_reach(*this, axis_params(*this).slider.stroke_m);
+  }
   in_section("optical_trap", [&] {
     optical_trap.validate();
     const double ratio = loop.period_s() / optical_trap.trap.dt_s;
@@ -103,7 +133,7 @@ PlatformConfig load_platform_config(const std::filesystem::path& file) {
   if (!c.stickslip_params_file.empty()) {
     const std::filesystem::path p(c.stickslip_params_file);
     if (p.is_relative()) c.stickslip_params_file = (file.parent_path() / p).string();
-    axis_params(c);  // read now: a bad axis file is a configuration error
+    check_reach(c, axis_params(c).slider.stroke_m);  // read now: a bad axis file is a configuration error
   }
   return c;
 }

@@ -107,6 +107,18 @@ ModePeaks dynamic_response_peaks(const MeasuredRecord& rec, const std::vector<do
   const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(rec.x_m.data(), n);
   const Eigen::VectorXd c = a.colPivHouseholderQr().solve(y);
   const Eigen::VectorXd r = y - a * c;
+  // Positions near the largest double (1e308 is finite, and no measured position) overflow the
+  // static fit or the spectrum: named by the record's column, not by the peak finder that
+  // would meet the infinities.
+  const auto overflow = [&] {
+    double top = 0.0;
+    for (double x : rec.x_m) top = std::max(top, std::abs(x));
+    return InvalidInput(rec.source, 0,
+                        fmt::format("column 'x_m': the response's power spectrum overflows (values up to {:g} m): "
+                                    "not a measured position",
+                                    top));
+  };
+  if (!r.allFinite()) throw overflow();
   std::vector<double> seg(r.data(), r.data() + r.size());
   dsp::WelchOptions o;
   o.fs_Hz = rec.fs_Hz();
@@ -115,7 +127,11 @@ ModePeaks dynamic_response_peaks(const MeasuredRecord& rec, const std::vector<do
   o.nfft = 8 * o.nperseg;
   o.detrend = dsp::Detrend::kConstant;
   ModePeaks out;
-  out.psd = dsp::welch(seg, o);
+  try {
+    out.psd = dsp::welch(seg, o);
+  } catch (const dsp::SpectrumOverflow&) {
+    throw overflow();
+  }
   std::vector<double> logp(out.psd.value.size());
   for (std::size_t i = 0; i < logp.size(); ++i) logp[i] = std::log(std::max(out.psd.value[i], 1e-300));
   dsp::PeakOptions po;

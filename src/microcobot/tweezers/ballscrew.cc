@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 
 namespace mc::tweezers {
@@ -10,7 +12,12 @@ namespace mc::tweezers {
 double lead_angle(double diameter_m, double lead_m) {
   require_positive(diameter_m, "diameter_m");
   require_positive(lead_m, "lead_m");
-  return std::atan(lead_m / (std::numbers::pi * diameter_m));
+  const double theta = std::atan(lead_m / (std::numbers::pi * diameter_m));
+  // A lead beyond ~1e16 diameters makes the angle round to 90 deg, which no screw has (and which
+  // the efficiencies refuse): blamed on the lead the caller gave, not on the derived angle.
+  require(theta < std::numbers::pi / 2, "lead_m",
+          fmt::format("too large for diameter_m = {:g} (the lead angle rounds to 90 deg)", diameter_m), lead_m);
+  return theta;
 }
 
 double forward_efficiency(double lead_angle_rad, double mu) {

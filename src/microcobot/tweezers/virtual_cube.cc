@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
 
 #include "microcobot/core/error.h"
 
@@ -17,6 +20,15 @@ void VirtualCubeParams::validate() const {
           "must be a multiple of control_rate_Hz", plant_rate_Hz);
   require_positive(lag_pole_Hz, "lag_pole_Hz");
   require(lag_zero_Hz > lag_pole_Hz, "lag_zero_Hz", "must be above lag_pole_Hz", lag_zero_Hz);
+  // The compensator's zero must lie below the loop's Nyquist frequency: named by the rate, which is
+  // what a caller changes (the CLI's --rate), not by the compensator's internal zero_Hz.
+  if (compensator) {
+    require(control_rate_Hz > 2.0 * lag_zero_Hz, "control_rate_Hz",
+            fmt::format("must exceed 2 x lag_zero_Hz = {:g} Hz (the lag compensator's zero must lie below "
+                        "the loop's Nyquist frequency)",
+                        2.0 * lag_zero_Hz),
+            control_rate_Hz);
+  }
   require_positive(ramp_s, "ramp_s");
   require_positive(duration_s, "duration_s");
   require(hold_window_s > 0 && hold_window_s < duration_s - ramp_s, "hold_window_s",
@@ -36,6 +48,12 @@ VirtualCubeRenderer::VirtualCubeRenderer(const TeleTweezParams& model, const Vir
   cube.validate();
   require(cube.cube_width_m < model.static_opening_tip_m, "cube_width_m",
           "must be narrower than the static opening", cube.cube_width_m);
+  const double k_max = max_renderable_stiffness(model, cube);
+  require(cube.stiffness_N_per_m <= k_max, "stiffness_N_per_m",
+          fmt::format("too stiff for control_rate_Hz = {:g} Hz (the wall's frequency on the {:.3g} kg tip mass "
+                      "must stay below the loop's Nyquist frequency); the largest value this rate allows is {:.3g}",
+                      cube.control_rate_Hz, tip_mass(model), k_max),
+          cube.stiffness_N_per_m);
   if (cube.compensator) lag_.emplace(cube.lag_pole_Hz, cube.lag_zero_Hz, cube.control_rate_Hz);
 }
 
@@ -112,7 +130,13 @@ VirtualCubeResult simulate_virtual_cube(const TeleTweezParams& model_params, con
 
 double max_chatter_free_stiffness(const TeleTweezParams& model, VirtualCubeParams cube, double lo, double hi,
                                   int iterations) {
+  // Nothing above what the loop can render is simulated (max_renderable_stiffness()).
   require(lo > 0 && hi > lo, "stiffness range", "needs 0 < lo < hi", lo);
+  hi = std::min(hi, max_renderable_stiffness(model, cube));
+  require(hi > lo, "stiffness range",
+          fmt::format("starts above the stiffest wall control_rate_Hz = {:g} Hz can render ({:.3g} N/m)",
+                      cube.control_rate_Hz, hi),
+          lo);
   auto chatters = [&](double k) {
     cube.stiffness_N_per_m = k;
     return simulate_virtual_cube(model, cube).chatter;
@@ -130,6 +154,17 @@ double tip_damping(const TeleTweezParams& p) {
   const double r = p.lever_per_motor_rad();
   // Motor damping c_m seen at x_l (generalized, both levers) is c_m / r^2; per tip, half.
   return p.motor_damping_N_m_s / (2.0 * r * r) + p.clamping_damping_N_s_per_m;
+}
+
+double tip_mass(const TeleTweezParams& p) {
+  const double r = p.lever_per_motor_rad();
+  return p.motor_inertia_kg_m2 / (2.0 * r * r) + p.lever_mass_kg;
+}
+
+double max_renderable_stiffness(const TeleTweezParams& p, const VirtualCubeParams& cube) {
+  const double nyquist = std::numbers::pi * cube.control_rate_Hz;
+  const double hf_gain = cube.compensator ? cube.lag_pole_Hz / cube.lag_zero_Hz : 1.0;
+  return tip_mass(p) * nyquist * nyquist / hf_gain;
 }
 
 double colgate_stiffness_bound(const TeleTweezParams& p, double control_rate_Hz, double virtual_damping) {

@@ -82,7 +82,8 @@ struct VirtualCubeResult {
 VirtualCubeResult simulate_virtual_cube(const TeleTweezParams& model, const VirtualCubeParams& cube);
 
 /// Largest chatter-free stiffness in [lo, hi] (bisection on a log scale, `iterations` halvings),
-/// with the cube's other settings. Returns lo if even lo chatters, hi if hi does not.
+/// with the cube's other settings; hi is capped at max_renderable_stiffness(). Returns lo if even
+/// lo chatters, the (capped) hi if it does not.
 double max_chatter_free_stiffness(const TeleTweezParams& model, VirtualCubeParams cube, double lo, double hi,
                                   int iterations = 14);
 
@@ -94,5 +95,17 @@ double colgate_stiffness_bound(const TeleTweezParams& model, double control_rate
                                double virtual_damping = 0.0);
 /// The physical damping b of the device at each tip [N s/m].
 double tip_damping(const TeleTweezParams& model);
+/// The mass the rendered torque moves at each tip [kg]: the motor's inertia reflected to a tip
+/// (as tip_damping() reflects its damping) plus the lever. A lower bound (the screw, support and
+/// tip are left out), so the stiffness limit below errs on the safe side.
+double tip_mass(const TeleTweezParams& model);
+/// The stiffest wall the sampled renderer can represent: the wall's frequency on tip_mass(),
+/// sqrt(K_hf / m), must stay below the loop's Nyquist frequency pi f_control, where K_hf is the
+/// stiffness rendered at high frequencies (K, or K omega_p / omega_z through the lag
+/// compensator). Beyond it a simulated wall's motion is an artefact of the sampling (aliased),
+/// and the wall force grows without bound (1e308 N/m gave forces of 2e303 N and a false
+/// "no chatter"). VirtualCubeRenderer refuses a stiffer wall (InvalidParams naming
+/// stiffness_N_per_m and this limit).
+double max_renderable_stiffness(const TeleTweezParams& model, const VirtualCubeParams& cube);
 
 }  // namespace mc::tweezers
