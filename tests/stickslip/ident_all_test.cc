@@ -51,7 +51,8 @@ TEST(IdentAll, RoundTripRecoversAnotherAxis) {
   EXPECT_NEAR(r.friction.b.damping_ratio / zeta(f.rho1_b_N_s_m, f.rho0_b_N_m, ms), 1.0, 0.1);
   // Step 2: PI loop within 2% of the stroke.
   EXPECT_LT(r.hysteresis.rms_fraction, 0.02);
-  // Step 3: the 40 V runs at 100 and 200 Hz never step: reported and skipped, their cells filled.
+  // Step 3: the 40 V runs at 100 and 200 Hz never step: reported and skipped, their cells
+  // extrapolated (below every fitted cell of their column), none interpolated.
   std::size_t skipped = 0;
   for (const auto& run : r.breakaway.runs) {
     if (run.amplitude_V == 40 && run.frequency_Hz < 300) {
@@ -65,7 +66,8 @@ TEST(IdentAll, RoundTripRecoversAnotherAxis) {
   }
   EXPECT_EQ(skipped, 4u);
   EXPECT_EQ(r.breakaway.skipped, 4u);
-  EXPECT_FALSE(r.breakaway.filled.empty());
+  EXPECT_TRUE(r.breakaway.filled.empty());
+  EXPECT_EQ(r.breakaway.extrapolated.size(), 4u);
   // Held-out runs (amplitudes and a frequency, 300 Hz, not in the campaign): the identified axis
   // moves as the truth does, within 5%, in both directions.
   const ActuatorModel mt(truth), mi(r.params);
