@@ -195,6 +195,17 @@ TEST(Integrator, EveryDriveOfTheSeed7StudyStepsWithinTwoPercentAtTheSteadyState)
   std::printf("largest step error %.2f %% (%s), %d periodic drives\n", 100 * worst, worst_drive.c_str(), steady);
   EXPECT_LE(worst, 0.02) << worst_drive;
   EXPECT_GE(steady, 150);
+  // The drive, judged raw (its 115 nm step is under a tenth of its range, so the study's
+  // normalisation would judge it against the range): still above 2 % (docs/errata.md), bounded
+  // here so that it cannot grow unnoticed.
+  const AccuracyDrive fast{make_waveform(WaveKind::kSawtooth, 85, 730, Direction::kBackward, m.params().drive),
+                           4.0 / 730};
+  const DriveAccuracy a = check_drive(m, fast);
+  const double raw = std::abs(a.step_m / a.step_ref_m - 1.0);
+  std::printf("85 V 730 Hz backward: %.2f nm vs %.2f nm per steady period (raw %.2f %%, study %.2f %%)\n",
+              a.step_m * 1e9, a.step_ref_m * 1e9, 100 * raw, 100 * a.step_error);
+  EXPECT_LT(raw, 0.03);
+  EXPECT_LE(a.step_error, 0.02);
 }
 
 TEST(Integrator, TheStudysStepExcludesThePowerUpPeriod) {
