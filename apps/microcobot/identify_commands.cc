@@ -187,13 +187,14 @@ void breakaway_section(mc::report::Report& rep, const ss::BreakawayResult& r) {
       zf.push_back(t.forward_m[i][j]);
       zb.push_back(t.backward_m[i][j]);
     }
-    rep.add_figure({fmt::format("z_ba versus amplitude at {:g} Hz", t.frequencies_Hz[j]),
-                    "Identified table (cells without a stepping run: interpolated between fitted cells of their "
-                    "frequency, extrapolated along amplitude below them).",
-                    {"Sawtooth amplitude", "V"},
-                    {"z_ba", "m"},
-                    {series("z_ba(+) forward", t.amplitudes_V, zf, 1.0, 4000, true),
-                     series("z_ba(-) backward", t.amplitudes_V, zb, 1.0, 4000, true)}});
+    rep.add_figure(
+        {fmt::format("z_ba versus amplitude at {:g} Hz", t.frequencies_Hz[j]),
+         "Identified table (cells without a stepping run: interpolated between fitted cells of their "
+         "frequency, extrapolated along amplitude below them).",
+         {"Sawtooth amplitude", "V"},
+         {"z_ba", "m"},
+         {series("z_ba(+) forward", t.amplitudes_V, zf, 1.0, 4000, true),
+          series("z_ba(-) backward", t.amplitudes_V, zb, 1.0, 4000, true)}});
   }
   std::vector<double> vm, vs;
   for (const auto& run : r.runs) {
@@ -252,18 +253,19 @@ json friction_json(const ss::FrictionModesResult& r) {
           {"rms_m", r.rms_m}};
 }
 json hysteresis_json(const ss::HysteresisResult& r) {
-  return {{"thresholds_V", r.pi.thresholds_V},
-          {"weights", r.pi.weights},
-          {"static_gain_m_V", r.static_gain_m_V},
-          {"rms_m", r.rms_m},
-          {"stroke_m", r.stroke_m},
-          {"rms_fraction_of_stroke", r.rms_fraction},
-          {"inverse", {{"thresholds_V", r.inverse.thresholds_V}, {"weights", r.inverse.weights}}},
-          {"inverse_max_error_V", r.inverse_max_error_V},
-          {"from_rest", r.from_rest},
-          {"rms_from_rest_m", std::isfinite(r.rms_from_rest_m) ? json(r.rms_from_rest_m) : json(nullptr)},
-          {"rms_steady_loop_m", std::isfinite(r.rms_steady_loop_m) ? json(r.rms_steady_loop_m) : json(nullptr)},
-          {"voltage_noise_V", r.voltage_noise_V}};
+  return {
+      {"thresholds_V", r.pi.thresholds_V},
+      {"weights", r.pi.weights},
+      {"static_gain_m_V", r.static_gain_m_V},
+      {"rms_m", r.rms_m},
+      {"stroke_m", r.stroke_m},
+      {"rms_fraction_of_stroke", r.rms_fraction},
+      {"inverse", {{"thresholds_V", r.inverse.thresholds_V}, {"weights", r.inverse.weights}}},
+      {"inverse_max_error_V", r.inverse_max_error_V},
+      {"from_rest", r.from_rest},
+      {"rms_from_rest_m", std::isfinite(r.rms_from_rest_m) ? json(r.rms_from_rest_m) : json(nullptr)},
+      {"rms_steady_loop_m", std::isfinite(r.rms_steady_loop_m) ? json(r.rms_steady_loop_m) : json(nullptr)},
+      {"voltage_noise_V", r.voltage_noise_V}};
 }
 
 void finish(const Opts& o, const std::string& title, const ss::StickSlipParams& p, json j,
@@ -369,7 +371,10 @@ void add_identify(CLI::App& group) {
       base.breakaway = r.table;
       mc::report::Report rep("identify breakaway");
       breakaway_section(rep, r);
-      json j{{"runs", runs_json(r)}, {"skipped", r.skipped}, {"filled_cells", r.filled}, {"extrapolated_cells", r.extrapolated}};
+      json j{{"runs", runs_json(r)},
+             {"skipped", r.skipped},
+             {"filled_cells", r.filled},
+             {"extrapolated_cells", r.extrapolated}};
       finish(*o, "breakaway", base, j, rep,
              fmt::format("z_ba identified for {} of {} runs ({} skipped)", r.runs.size() - r.skipped,
                          r.runs.size(), r.skipped));
@@ -430,7 +435,8 @@ void add_identify(CLI::App& group) {
     cmd->add_option("--voltage-noise", o->voltage_noise_V,
                     "RMS noise on the recorded voltage [V] (default: 1 % of each drive's amplitude)")
         ->check(CLI::Range(0.0, 10.0));
-    cmd->add_option("--position-noise", o->position_noise_m, "RMS noise on the recorded position [m] (default 1e-9)")
+    cmd->add_option("--position-noise", o->position_noise_m,
+                    "RMS noise on the recorded position [m] (default 1e-9)")
         ->check(CLI::Range(0.0, 1e-6));
     mc::cli::add_params_option(*cmd, o->common);
     cmd->add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");

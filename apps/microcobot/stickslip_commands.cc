@@ -236,7 +236,9 @@ void run_simulate(const SimulateOptions& o) {
     std::array<double, 2> ts{}, xs{};
     double x() const { return xs[0] + std::clamp((t - ts[0]) / (ts[1] - ts[0]), 0.0, 1.0) * (xs[1] - xs[0]); }
   };
-  auto instant = [&](double t) { return Instant{t, std::min(steps - 1, static_cast<std::size_t>(t / m.dt_s()))}; };
+  auto instant = [&](double t) {
+    return Instant{t, std::min(steps - 1, static_cast<std::size_t>(t / m.dt_s()))};
+  };
   Instant first = instant(period), last = instant(whole_periods * period);
   // Only --out needs the whole trajectory (CSV, .mat, plots): without it the run is streamed and
   // only what the summary needs is kept (issue #12: `simulate --duration 10` at >= 40x real time).
@@ -322,7 +324,8 @@ void run_simulate(const SimulateOptions& o) {
           ? fmt::format("final position {:.6g} m after {:g} s", xf, dur)
           : fmt::format("final position {:.6g} m after {:g} s; first period {:.6g} m, then mean velocity "
                         "{:.6g} m/s over {:g} whole periods",
-                        xf, dur, first_period.get<double>(), mean_velocity.get<double>(), whole_periods - 1.0));
+                        xf, dur, first_period.get<double>(), mean_velocity.get<double>(),
+                        whole_periods - 1.0));
 }
 
 struct AccuracyOptions {

@@ -101,7 +101,8 @@ TEST(IdentHysteresis, FromRestIsDecidedFromTheWholeRecordUnderRealisticNoise) {
       id.pe.static_gain_m_V = r.static_gain_m_V;
       const MeasuredRecord got = measure(ActuatorModel(id), w, 2 / 50.0, 25e3, clean);
       double ss = 0.0;
-      for (std::size_t i = 0; i < got.size(); ++i) ss += (got.x_m[i] - want.x_m[i]) * (got.x_m[i] - want.x_m[i]);
+      for (std::size_t i = 0; i < got.size(); ++i)
+        ss += (got.x_m[i] - want.x_m[i]) * (got.x_m[i] - want.x_m[i]);
       worst = std::max(worst, std::sqrt(ss / static_cast<double>(got.size())) / (*hi - *lo));
     } catch (const Error& e) {
       ++failures;
@@ -114,8 +115,8 @@ TEST(IdentHysteresis, FromRestIsDecidedFromTheWholeRecordUnderRealisticNoise) {
       ADD_FAILURE() << "steady loop, seed " << seed << ": " << e.what();
     }
   }
-  std::printf("from rest decided right %d/40, steady loop %d/40, failures %d, worst sine RMS %.2f %%\n", rest_right,
-              loop_right, failures, 100 * worst);
+  std::printf("from rest decided right %d/40, steady loop %d/40, failures %d, worst sine RMS %.2f %%\n",
+              rest_right, loop_right, failures, 100 * worst);
   EXPECT_GE(rest_right, 38);
   EXPECT_GE(loop_right, 38);
   EXPECT_EQ(failures, 0);

@@ -192,14 +192,15 @@ TEST(Integrator, EveryDriveOfTheSeed7StudyStepsWithinTwoPercentAtTheSteadyState)
                     std::to_string(a.step_m * 1e9) + " nm vs " + std::to_string(a.step_ref_m * 1e9) + " nm";
     }
   }
-  std::printf("largest step error %.2f %% (%s), %d periodic drives\n", 100 * worst, worst_drive.c_str(), steady);
+  std::printf("largest step error %.2f %% (%s), %d periodic drives\n", 100 * worst, worst_drive.c_str(),
+              steady);
   EXPECT_LE(worst, 0.02) << worst_drive;
   EXPECT_GE(steady, 150);
   // The drive, judged raw as well (its 115 nm step is under a tenth of its range, so the
   // study's normalisation judges it against the range): 2.7 % before the damping's impulse took
   // this step's PE velocity (docs/benchmarks.md).
-  const AccuracyDrive fast{make_waveform(WaveKind::kSawtooth, 85, 730, Direction::kBackward, m.params().drive),
-                           4.0 / 730};
+  const AccuracyDrive fast{
+      make_waveform(WaveKind::kSawtooth, 85, 730, Direction::kBackward, m.params().drive), 4.0 / 730};
   const DriveAccuracy a = check_drive(m, fast);
   const double raw = std::abs(a.step_m / a.step_ref_m - 1.0);
   std::printf("85 V 730 Hz backward: %.2f nm vs %.2f nm per steady period (raw %.2f %%, study %.2f %%)\n",

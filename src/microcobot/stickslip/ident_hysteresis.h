@@ -43,8 +43,8 @@ struct HysteresisResult {
   /// lowest voltage; their RMS residuals [m] (NaN when the record starts elsewhere: a steady loop).
   bool from_rest = false;
   double rms_from_rest_m = 0.0, rms_steady_loop_m = 0.0;
-  double voltage_noise_V = 0.0;      ///< RMS voltage noise estimated from the record
-  std::vector<double> fitted_m;      ///< x0 + g H(U) at every sample
+  double voltage_noise_V = 0.0;  ///< RMS voltage noise estimated from the record
+  std::vector<double> fitted_m;  ///< x0 + g H(U) at every sample
 };
 
 /// Identifies the PI model from `rec` (x_m = slider position) with `operators` play operators.

@@ -68,7 +68,8 @@ DriveAccuracy check_drive(const ActuatorModel& model, const AccuracyDrive& drive
   } else {
     const double period = 1.0 / drive.wave.frequency_Hz;
     const double periods = std::floor(drive.duration_s / period + 1e-9);
-    require(periods >= 2.0, "duration_s", "must hold at least two whole periods of the drive", drive.duration_s);
+    require(periods >= 2.0, "duration_s", "must hold at least two whole periods of the drive",
+            drive.duration_s);
     r.steady_periods = static_cast<int>(periods) - 1;
     r.first_period_m = at(fixed, period) - fixed.x2_m[0];
     r.first_period_ref_m = at(ref, period) - ref.x2_m[0];
