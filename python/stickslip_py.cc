@@ -361,11 +361,17 @@ py::dict friction_dict(const ss::FrictionModesResult& r) {
 }
 
 py::dict hysteresis_dict(const ss::HysteresisResult& r) {
-  return py::dict("pi"_a = params_dict(r.pi), "inverse"_a = params_dict(r.inverse),
-                  "static_gain_m_V"_a = r.static_gain_m_V, "offset_m"_a = r.offset_m, "rms_m"_a = r.rms_m,
-                  "stroke_m"_a = r.stroke_m, "rms_fraction"_a = r.rms_fraction,
-                  "inverse_max_error_V"_a = r.inverse_max_error_V, "first_fitted"_a = r.first_fitted,
-                  "fitted_m"_a = to_array(r.fitted_m));
+  return py::dict(
+      "pi"_a = params_dict(r.pi), "inverse"_a = params_dict(r.inverse),
+      "static_gain_m_V"_a = r.static_gain_m_V, "offset_m"_a = r.offset_m, "rms_m"_a = r.rms_m,
+      "stroke_m"_a = r.stroke_m, "rms_fraction"_a = r.rms_fraction,
+      "inverse_max_error_V"_a = r.inverse_max_error_V, "first_fitted"_a = r.first_fitted,
+      "from_rest"_a = r.from_rest,
+      "rms_from_rest_m"_a = std::isfinite(r.rms_from_rest_m) ? py::object(py::float_(r.rms_from_rest_m))
+                                                             : py::object(py::none()),
+      "rms_steady_loop_m"_a = std::isfinite(r.rms_steady_loop_m) ? py::object(py::float_(r.rms_steady_loop_m))
+                                                                 : py::object(py::none()),
+      "voltage_noise_V"_a = r.voltage_noise_V, "fitted_m"_a = to_array(r.fitted_m));
 }
 
 py::dict breakaway_dict(const ss::BreakawayResult& r) {
@@ -378,7 +384,7 @@ py::dict breakaway_dict(const ss::BreakawayResult& r) {
                          "skipped"_a = x.skipped));
   }
   return py::dict("runs"_a = runs, "table"_a = params_dict(r.table), "filled"_a = r.filled,
-                  "skipped"_a = r.skipped);
+                  "extrapolated"_a = r.extrapolated, "skipped"_a = r.skipped);
 }
 
 }  // namespace

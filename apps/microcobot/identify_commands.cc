@@ -31,6 +31,8 @@ struct Opts {
   unsigned threads = 0;
   std::string grid = "small";
   std::uint64_t seed = 1;
+  double voltage_noise_V = -1.0;   ///< synth: RMS voltage noise [V] (< 0: 1 % of each drive's amplitude)
+  double position_noise_m = 1e-9;  ///< synth: RMS position noise [m]
 };
 
 ss::StickSlipParams base_params(const CommonOptions& o) {
@@ -206,12 +208,14 @@ void breakaway_section(mc::report::Report& rep, const ss::BreakawayResult& r) {
       zf.push_back(t.forward_m[i][j]);
       zb.push_back(t.backward_m[i][j]);
     }
-    rep.add_figure({fmt::format("z_ba versus amplitude at {:g} Hz", t.frequencies_Hz[j]),
-                    "Identified table (cells without a stepping run are filled from neighbours).",
-                    {"Sawtooth amplitude", "V"},
-                    {"z_ba", "m"},
-                    {series("z_ba(+) forward", t.amplitudes_V, zf, 1.0, 4000, true),
-                     series("z_ba(-) backward", t.amplitudes_V, zb, 1.0, 4000, true)}});
+    rep.add_figure(
+        {fmt::format("z_ba versus amplitude at {:g} Hz", t.frequencies_Hz[j]),
+         "Identified table (cells without a stepping run: interpolated between fitted cells of their "
+         "frequency, extrapolated along amplitude below them).",
+         {"Sawtooth amplitude", "V"},
+         {"z_ba", "m"},
+         {series("z_ba(+) forward", t.amplitudes_V, zf, 1.0, 4000, true),
+          series("z_ba(-) backward", t.amplitudes_V, zb, 1.0, 4000, true)}});
   }
   std::vector<double> vm, vs;
   for (const auto& run : r.runs) {
@@ -270,14 +274,19 @@ json friction_json(const ss::FrictionModesResult& r) {
           {"rms_m", r.rms_m}};
 }
 json hysteresis_json(const ss::HysteresisResult& r) {
-  return {{"thresholds_V", r.pi.thresholds_V},
-          {"weights", r.pi.weights},
-          {"static_gain_m_V", r.static_gain_m_V},
-          {"rms_m", r.rms_m},
-          {"stroke_m", r.stroke_m},
-          {"rms_fraction_of_stroke", r.rms_fraction},
-          {"inverse", {{"thresholds_V", r.inverse.thresholds_V}, {"weights", r.inverse.weights}}},
-          {"inverse_max_error_V", r.inverse_max_error_V}};
+  return {
+      {"thresholds_V", r.pi.thresholds_V},
+      {"weights", r.pi.weights},
+      {"static_gain_m_V", r.static_gain_m_V},
+      {"rms_m", r.rms_m},
+      {"stroke_m", r.stroke_m},
+      {"rms_fraction_of_stroke", r.rms_fraction},
+      {"inverse", {{"thresholds_V", r.inverse.thresholds_V}, {"weights", r.inverse.weights}}},
+      {"inverse_max_error_V", r.inverse_max_error_V},
+      {"from_rest", r.from_rest},
+      {"rms_from_rest_m", std::isfinite(r.rms_from_rest_m) ? json(r.rms_from_rest_m) : json(nullptr)},
+      {"rms_steady_loop_m", std::isfinite(r.rms_steady_loop_m) ? json(r.rms_steady_loop_m) : json(nullptr)},
+      {"voltage_noise_V", r.voltage_noise_V}};
 }
 
 void finish(const Opts& o, const std::string& title, const ss::StickSlipParams& p, json j,
@@ -387,7 +396,10 @@ void add_identify(CLI::App& group) {
       base.breakaway = r.table;
       mc::report::Report rep("identify breakaway");
       breakaway_section(rep, r);
-      json j{{"runs", runs_json(r)}, {"skipped", r.skipped}, {"filled_cells", r.filled}};
+      json j{{"runs", runs_json(r)},
+             {"skipped", r.skipped},
+             {"filled_cells", r.filled},
+             {"extrapolated_cells", r.extrapolated}};
       finish(*o, "breakaway", base, j, rep,
              fmt::format("z_ba identified for {} of {} runs ({} skipped)", r.runs.size() - r.skipped,
                          r.runs.size(), r.skipped));
@@ -421,7 +433,8 @@ void add_identify(CLI::App& group) {
              {"breakaway",
               {{"runs", runs_json(r.breakaway)},
                {"skipped", r.breakaway.skipped},
-               {"filled_cells", r.breakaway.filled}}},
+               {"filled_cells", r.breakaway.filled},
+               {"extrapolated_cells", r.breakaway.extrapolated}}},
              {"notes", r.notes},
              {"elapsed_s", secs}};
       if (r.pe) j["pe_modes"] = pe_json(*r.pe);
@@ -445,6 +458,12 @@ void add_identify(CLI::App& group) {
                     "small (4x3x2 runs) or full (10 amplitudes x 5 frequencies x 2 directions)")
         ->check(CLI::IsMember({"small", "full"}));
     cmd->add_option("--seed", o->seed, "Noise seed");
+    cmd->add_option("--voltage-noise", o->voltage_noise_V,
+                    "RMS noise on the recorded voltage [V] (default: 1 % of each drive's amplitude)")
+        ->check(CLI::Range(0.0, 10.0));
+    cmd->add_option("--position-noise", o->position_noise_m,
+                    "RMS noise on the recorded position [m] (default 1e-9)")
+        ->check(CLI::Range(0.0, 1e-6));
     mc::cli::add_params_option(*cmd, o->common);
     cmd->add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");
     cmd->add_option("--out", o->common.out, "Directory to write the campaign to")->required();
@@ -457,6 +476,8 @@ void add_identify(CLI::App& group) {
       }
       ss::SensorEffects sensor;
       sensor.seed = o->seed;
+      sensor.voltage_noise_rms_V = o->voltage_noise_V;
+      sensor.position_noise_rms_m = o->position_noise_m;
       const std::size_t n = ss::write_campaign(
           *o->common.out, truth, plan, sensor,
           [](std::size_t d, std::size_t t) { progress_cb("identify synth (sawtooth runs)", d, t); });

@@ -118,7 +118,11 @@ TEST(VelocityControl, EndStopIsDetectedWithoutWindUpAndEmergencyStopZeroesTheDri
     EXPECT_LE(a, 100.0);
     if (a >= 99.0) ++at_max;
   }
-  EXPECT_LE(at_max, VelocityControlParams{}.stall_periods + 2);
+  // stall_periods consecutive stalled periods end it; a slider part that still creeps into the
+  // stop (the modal parts are microns apart, docs/errata.md) restarts the count once or twice:
+  // 19 periods at full amplitude in all with the model before issue #31, 26 after its friction
+  // impulse change (a part advanced 0.44 um after the first stalled periods).
+  EXPECT_LE(at_max, VelocityControlParams{}.stall_periods + 8);
 
   VelocityController c(VelocityControlParams{}, VelocityMode::kModelBased, &test::step_map());
   c.set_reference(100e-6);

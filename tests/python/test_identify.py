@@ -55,12 +55,28 @@ def test_all_from_arrays_equals_all_from_the_directory(campaign):
     assert any("no pe_step record" in n for n in no_pe["notes"])
 
 
+def test_hysteresis_says_how_it_took_the_record(campaign):
+    """The sine record starts at rest: both fits' residuals are returned and the smaller wins; cut
+    at its second period's start (its lowest voltage, a steady loop) it is taken as a loop."""
+    d, _ = campaign
+    sine = load(d / "sine.csv")
+    r = identify.hysteresis(sine["t"], sine["u"], sine["x"])
+    assert r["from_rest"] is True and r["first_fitted"] == 0
+    assert r["rms_from_rest_m"] < r["rms_steady_loop_m"]
+    assert r["voltage_noise_V"] == pytest.approx(0.4, rel=0.15)  # synth's 1 % of 40 V
+    k = len(sine["t"]) // 2  # two periods: the second starts here, at the lowest voltage
+    loop = identify.hysteresis(sine["t"][k:] - sine["t"][k], sine["u"][k:], sine["x"][k:])
+    assert loop["from_rest"] is False and loop["first_fitted"] > 0
+
+
 def test_breakaway_from_arrays_equals_breakaway_from_the_directory(campaign):
     d, runs = campaign
     a = identify.breakaway(runs)
     b = identify.breakaway(d)
     assert a["table"] == b["table"]
     assert len(a["runs"]) == 24 and a["runs"][0]["name"] == "runs[0]"
+    # 40 V never steps below 1 kHz: those cells lie below their columns' fitted ones.
+    assert "forward 40 V 100 Hz" in a["extrapolated"] and a["filled"] == b["filled"]
 
 
 @pytest.mark.parametrize(

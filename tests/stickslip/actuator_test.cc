@@ -240,6 +240,24 @@ TEST(Cli, ParamsSimulateAndErrors) {
   const auto s = nlohmann::json::parse(r.out);
   EXPECT_LT(s["final_position_m"].get<double>(), 0.0);
   EXPECT_LT(s["mean_velocity_m_s"].get<double>(), 0.0);
+  // Issue #31: a 20 V drive does not step. Its power-up slip (~0.26 um in the first period) is
+  // first_period_displacement_m; the mean velocity is over the whole periods after it (~0; it
+  // was 9.1 um/s when the first period counted).
+  r = test::run_cli({"stickslip", "simulate", "--wave", "sawtooth", "--amplitude", "20", "--frequency", "200",
+                     "--duration", "0.03", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto z = nlohmann::json::parse(r.out);
+  EXPECT_EQ(z["whole_periods"].get<double>(), 6.0);
+  EXPECT_EQ(z["steady_periods"].get<double>(), 5.0);
+  EXPECT_GT(z["first_period_displacement_m"].get<double>(), 2e-7);
+  EXPECT_LT(std::abs(z["mean_velocity_m_s"].get<double>()), 1e-6);
+  // Shorter than two periods: no steady-state velocity (null), the first period still reported.
+  r = test::run_cli({"stickslip", "simulate", "--wave", "sawtooth", "--amplitude", "20", "--frequency", "200",
+                     "--duration", "0.007", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto one = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(one["mean_velocity_m_s"].is_null());
+  EXPECT_GT(one["first_period_displacement_m"].get<double>(), 2e-7);
   const std::string csv = test::read_text(dir / "sim" / "trajectory.csv");
   EXPECT_NE(csv.find("t_s,u_V,x1_m,x2_m"), std::string::npos);
   EXPECT_EQ(csv.find("nan"), std::string::npos);

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "ident_truth.h"
 #include "microcobot/core/error.h"
@@ -51,7 +52,8 @@ TEST(IdentAll, RoundTripRecoversAnotherAxis) {
   EXPECT_NEAR(r.friction.b.damping_ratio / zeta(f.rho1_b_N_s_m, f.rho0_b_N_m, ms), 1.0, 0.1);
   // Step 2: PI loop within 2% of the stroke.
   EXPECT_LT(r.hysteresis.rms_fraction, 0.02);
-  // Step 3: the 40 V runs at 100 and 200 Hz never step: reported and skipped, their cells filled.
+  // Step 3: the 40 V runs at 100 and 200 Hz never step: reported and skipped, their cells
+  // extrapolated (below every fitted cell of their column), none interpolated.
   std::size_t skipped = 0;
   for (const auto& run : r.breakaway.runs) {
     if (run.amplitude_V == 40 && run.frequency_Hz < 300) {
@@ -65,7 +67,8 @@ TEST(IdentAll, RoundTripRecoversAnotherAxis) {
   }
   EXPECT_EQ(skipped, 4u);
   EXPECT_EQ(r.breakaway.skipped, 4u);
-  EXPECT_FALSE(r.breakaway.filled.empty());
+  EXPECT_TRUE(r.breakaway.filled.empty());
+  EXPECT_EQ(r.breakaway.extrapolated.size(), 4u);
   // Held-out runs (amplitudes and a frequency, 300 Hz, not in the campaign): the identified axis
   // moves as the truth does, within 5%, in both directions.
   const ActuatorModel mt(truth), mi(r.params);
@@ -89,6 +92,41 @@ TEST(IdentAll, RoundTripRecoversAnotherAxis) {
   EXPECT_EQ(back.breakaway.forward_m, r.params.breakaway.forward_m);
   EXPECT_DOUBLE_EQ(back.friction.rho0_a_N_m, r.params.friction.rho0_a_N_m);
   EXPECT_EQ(back.hysteresis.weights, r.params.hysteresis.weights);
+}
+
+/// Steady step per period of `m` at a sawtooth drive: over periods 1..n after the power-up one.
+double steady_step(const ActuatorModel& m, double amplitude, double frequency, Direction d, int n) {
+  const auto w = make_waveform(WaveKind::kSawtooth, amplitude, frequency, d, m.params().drive);
+  const Trajectory tr = simulate(m, w, (n + 1) / frequency);
+  auto at = [&](int k) { return tr.x2_m[static_cast<std::size_t>(std::llround(k / frequency / m.dt_s()))]; };
+  return (at(n + 1) - at(1)) / n;
+}
+
+TEST(IdentAll, NearThresholdDrivesRelyOnExtrapolatedNotCopiedCells) {
+  // Issue #31: the default axis's full campaign (`identify synth --grid full`, realistic noise:
+  // 0.3 nm, 0.5 V). The backward runs below ~45 V never step at 50-100 Hz; their cells used to
+  // take the nearest stepping cell's z_ba (50 V: too high by the slope x 10 V), so the 45 V
+  // 150 Hz backward drive, just above the threshold, stepped 17 % short of the truth. Now those
+  // cells are extrapolated along the stepping cells' line in amplitude and reported as such.
+  const StickSlipParams truth;
+  CampaignPlan plan;
+  plan.amplitudes_V = {10, 20, 30, 40, 50, 60, 70, 80, 90, 100};
+  plan.frequencies_Hz = {50, 100, 500, 1000, 2000};
+  SensorEffects sensor;
+  sensor.position_noise_rms_m = 0.3e-9;
+  sensor.voltage_noise_rms_V = 0.5;
+  mc::test::TempDir dir;
+  write_campaign(dir.path(), truth, plan, sensor);
+  const IdentifyAllResult r = identify_all(dir.path(), StickSlipParams{});
+  bool backward_40V_100Hz = false;
+  for (const auto& c : r.breakaway.extrapolated) backward_40V_100Hz |= c == "backward 40 V 100 Hz";
+  EXPECT_TRUE(backward_40V_100Hz);
+  const double want = steady_step(ActuatorModel(truth), 45, 150, Direction::kBackward, 14);
+  const double got = steady_step(ActuatorModel(r.params), 45, 150, Direction::kBackward, 14);
+  std::printf("45 V 150 Hz backward: %.2f nm per period identified, %.2f nm true (%+.1f %%)\n", got * 1e9,
+              want * 1e9, 100 * (got / want - 1));
+  EXPECT_LT(want, -20e-9);  // it does step
+  EXPECT_NEAR(got / want, 1.0, 0.10);
 }
 
 TEST(IdentAll, ThreadsDoNotChangeTheResult) {
@@ -132,6 +170,33 @@ TEST(IdentAll, RecordsWithoutASawtoothRunAreRefusedBeforeAnyComputation) {
   } catch (const InvalidInput& e) {
     EXPECT_STREQ(e.what(), "sawtooth: no run (step 3 needs at least one)");
   }
+}
+
+TEST(IdentAll, SynthTakesTheSensorNoiseAndHysteresisReportsItsDecision) {
+  // `identify synth --voltage-noise V --position-noise M`: RMS values in volts and metres, the
+  // same for every record; `identify hysteresis` estimates the voltage noise and says how it
+  // took the sine record (from rest, by the two fits' residuals).
+  mc::test::TempDir dir;
+  auto r = mc::test::run_cli({"identify", "synth", "--out", (dir / "c").string(), "--voltage-noise", "0.5",
+                              "--position-noise", "3e-10", "--seed", "7", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const MeasuredRecord sine = read_record(dir / "c" / "sine.csv");
+  double s2 = 0.0;  // second differences: 6 sigma^2 for white noise
+  for (std::size_t i = 1; i + 1 < sine.size(); ++i) {
+    const double d2 = sine.u_V[i + 1] - 2 * sine.u_V[i] + sine.u_V[i - 1];
+    s2 += d2 * d2;
+  }
+  EXPECT_NEAR(std::sqrt(s2 / 6.0 / static_cast<double>(sine.size() - 2)), 0.5, 0.03);
+  r = mc::test::run_cli({"identify", "hysteresis", "--in", (dir / "c" / "sine.csv").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["from_rest"].get<bool>());
+  EXPECT_LT(j["rms_from_rest_m"].get<double>(), j["rms_steady_loop_m"].get<double>());
+  EXPECT_NEAR(j["voltage_noise_V"].get<double>(), 0.5, 0.05);
+  // Out of range: a usage error naming the flag (exit 2).
+  r = mc::test::run_cli({"identify", "synth", "--out", (dir / "d").string(), "--voltage-noise", "-1"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--voltage-noise"), std::string::npos) << r.err;
 }
 
 TEST(IdentAll, BadDirectoriesGiveOneLineErrors) {

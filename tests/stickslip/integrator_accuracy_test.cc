@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -164,6 +166,61 @@ TEST(Integrator, DefaultStepMatchesTheReferenceOnRandomDrives) {
   EXPECT_GE(step, 3);
   EXPECT_GE(forward, 8);
   EXPECT_GE(backward, 8);
+}
+
+TEST(Integrator, EveryDriveOfTheSeed7StudyStepsWithinTwoPercentAtTheSteadyState) {
+  // Issue #31: `stickslip accuracy --drives 200 --seed 7`, the net step per period over the
+  // periods after the power-up one (DriveAccuracy), within 2 % of the reference for every drive
+  // (release build: ~2.5 s of CPU). Measured from the start, the first period's slip diluted a
+  // fast backward drive's error (85 V 730 Hz: 1.06 % over 7 periods from rest, 2.7 % per steady
+  // period).
+  const ActuatorModel m{StickSlipParams{}};
+  const auto drives = accuracy_drives(200, 7, m.params().drive);
+  double worst = 0.0;
+  std::string worst_drive;
+  int steady = 0;
+  for (const auto& d : drives) {
+    const DriveAccuracy a = check_drive(m, d);
+    if (d.wave.kind != WaveKind::kStep) {
+      EXPECT_GE(a.steady_periods, 3) << d.wave.frequency_Hz;
+      ++steady;
+    }
+    if (a.step_error > worst) {
+      worst = a.step_error;
+      worst_drive = to_string(d.wave.kind) + " " + std::to_string(d.wave.amplitude_V) + " V " +
+                    std::to_string(d.wave.frequency_Hz) + " Hz " + to_string(d.wave.direction) + ": " +
+                    std::to_string(a.step_m * 1e9) + " nm vs " + std::to_string(a.step_ref_m * 1e9) + " nm";
+    }
+  }
+  std::printf("largest step error %.2f %% (%s), %d periodic drives\n", 100 * worst, worst_drive.c_str(),
+              steady);
+  EXPECT_LE(worst, 0.02) << worst_drive;
+  EXPECT_GE(steady, 150);
+  // The issue's drive, judged raw as well (its 115 nm step is under a tenth of its range, so the
+  // study's normalisation judges it against the range): 2.7 % before the damping's impulse took
+  // this step's PE velocity (docs/benchmarks.md).
+  const AccuracyDrive fast{
+      make_waveform(WaveKind::kSawtooth, 85, 730, Direction::kBackward, m.params().drive), 4.0 / 730};
+  const DriveAccuracy a = check_drive(m, fast);
+  const double raw = std::abs(a.step_m / a.step_ref_m - 1.0);
+  std::printf("85 V 730 Hz backward: %.2f nm vs %.2f nm per steady period (raw %.2f %%, study %.2f %%)\n",
+              a.step_m * 1e9, a.step_ref_m * 1e9, 100 * raw, 100 * a.step_error);
+  EXPECT_LT(raw, 0.02);
+  EXPECT_LE(a.step_error, 0.02);
+}
+
+TEST(Integrator, TheStudysStepExcludesThePowerUpPeriod) {
+  // A 20 V sawtooth does not step: from rest it slips ~0.26 um in its first period (the initial
+  // loading), then stays. The study reports that apart; its step per period is ~0.
+  const ActuatorModel m{StickSlipParams{}};
+  const AccuracyDrive d{make_waveform(WaveKind::kSawtooth, 20, 200, Direction::kForward, m.params().drive),
+                        6.0 / 200};
+  const DriveAccuracy a = check_drive(m, d);
+  EXPECT_EQ(a.steady_periods, 5);
+  EXPECT_GT(a.first_period_m, 2e-7);
+  EXPECT_NEAR(a.first_period_m, a.first_period_ref_m, 0.02 * a.first_period_ref_m);
+  EXPECT_LT(std::abs(a.step_m), 0.02 * a.first_period_m);
+  EXPECT_LT(std::abs(a.step_ref_m), 0.02 * a.first_period_ref_m);
 }
 
 }  // namespace

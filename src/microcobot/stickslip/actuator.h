@@ -11,8 +11,10 @@
 ///  2. the PE's two modes by exact discretisation with a first-order hold on g H(U) and a
 ///     zero-order hold on the friction reaction (which is < 1e-8 of the modal forces);
 ///  3. each slider part by velocity Verlet, its strain z by advance_strain() along the relative
-///     path increment (exact in the elastic phase, so the stick phase has no drift), the
-///     friction force F = rho0 z + rho1 dz/h + rho2 dx/h (the impulse-consistent mean);
+///     path increment (exact in the elastic phase, so the stick phase has no drift); the velocity
+///     takes the step's impulse of F = rho0 z + (rho1 dz/dx + rho2)(x1' - x2') (eq. 2.10-2.11):
+///     rho0 z by the trapezoid of its ends, the damping with the PE's mean velocity over the step
+///     against the trapezoid of x2' (implicit);
 ///  4. the end stops as inelastic contacts (position clamped, inward velocity removed).
 ///
 /// One ActuatorModel (immutable: params + precomputed matrices) drives any number of

@@ -82,7 +82,9 @@ IdentifyAllResult identify_all(const IdentificationRecords& records, const Stick
     if (!r.ok) out.notes.push_back("skipped run " + r.name + ": " + r.skipped);
   }
   for (const auto& c : out.breakaway.filled)
-    out.notes.push_back("z_ba cell without a fitted run, filled: " + c);
+    out.notes.push_back("z_ba cell without a fitted run, interpolated: " + c);
+  for (const auto& c : out.breakaway.extrapolated)
+    out.notes.push_back("z_ba cell without a fitted run, extrapolated: " + c);
   return out;
 }
 

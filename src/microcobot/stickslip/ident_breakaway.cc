@@ -129,11 +129,42 @@ RunFit fit_run(const SawtoothRun& run, const ActuatorModel& model, const Breakaw
   return r;
 }
 
-/// Fills missing cells of one direction's grid: linear along amplitude, else nearest frequency.
-void fill_grid(std::vector<std::vector<double>>& g, std::vector<std::vector<bool>>& have,
+/// The value at `a` of the least-squares line through the (amplitude, z_ba) points of the fitted
+/// cells of column j (one cell: its value). All of them, not the nearest few: a run just above the
+/// threshold steps erratically and its z_ba is the least certain, so a line through the nearest
+/// ones alone tilted with it (2 kHz column of `identify synth --grid full`: 10 V at -61 %).
+double column_line(const std::vector<std::vector<double>>& g, const std::vector<std::vector<bool>>& have,
+                   const std::vector<double>& amps, std::size_t j, double a) {
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < amps.size(); ++i)
+    if (have[i][j]) rows.push_back(i);
+  if (rows.size() == 1) return g[rows[0]][j];
+  double ma = 0.0, mz = 0.0;
+  for (std::size_t i : rows) ma += amps[i] / static_cast<double>(rows.size());
+  for (std::size_t i : rows) mz += g[i][j] / static_cast<double>(rows.size());
+  double saa = 0.0, saz = 0.0;
+  for (std::size_t i : rows) {
+    saa += (amps[i] - ma) * (amps[i] - ma);
+    saz += (amps[i] - ma) * (g[i][j] - mz);
+  }
+  return mz + (saa > 0.0 ? saz / saa : 0.0) * (a - ma);
+}
+
+/// Fills missing cells of one direction's grid. Between two fitted cells of a frequency column:
+/// linear along amplitude (`filled`). Beyond the column's fitted cells (runs below the stepping
+/// threshold never step, so they carry no z_ba): extrapolated along the line of the column's
+/// fitted cells (z_ba is close to affine in amplitude, thesis Fig. 2.13), not copied from the
+/// nearest one, which put z_ba of the near-threshold cells too high by the slope times the gap
+/// (`extrapolated`, floored at half the direction's smallest fitted z_ba). A column without any
+/// fitted cell takes the nearest frequency's values (`extrapolated`).
+void fill_grid(std::vector<std::vector<double>>& g, const std::vector<std::vector<bool>>& have,
                const std::vector<double>& amps, const std::string& dir, std::vector<std::string>& filled,
-               const std::vector<double>& freqs) {
+               std::vector<std::string>& extrapolated, const std::vector<double>& freqs) {
   const std::size_t na = amps.size(), nf = freqs.size();
+  double z_min = HUGE_VAL;
+  for (std::size_t i = 0; i < na; ++i)
+    for (std::size_t j = 0; j < nf; ++j)
+      if (have[i][j]) z_min = std::min(z_min, g[i][j]);
   for (std::size_t j = 0; j < nf; ++j) {
     for (std::size_t i = 0; i < na; ++i) {
       if (have[i][j]) continue;
@@ -150,20 +181,16 @@ void fill_grid(std::vector<std::vector<double>>& g, std::vector<std::vector<bool
           break;
         }
       }
-      double v = 0.0;
+      const std::string cell = fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]);
       if (lo >= 0 && hi >= 0) {
         const auto l = static_cast<std::size_t>(lo), h = static_cast<std::size_t>(hi);
         const double t = (amps[i] - amps[l]) / (amps[h] - amps[l]);
-        v = g[l][j] * (1.0 - t) + g[h][j] * t;
-      } else if (lo >= 0) {
-        v = g[static_cast<std::size_t>(lo)][j];
-      } else if (hi >= 0) {
-        v = g[static_cast<std::size_t>(hi)][j];
-      } else {
-        continue;  // whole column missing: second pass along frequency
-      }
-      g[i][j] = v;
-      filled.push_back(fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]));
+        g[i][j] = g[l][j] * (1.0 - t) + g[h][j] * t;
+        filled.push_back(cell);
+      } else if (lo >= 0 || hi >= 0) {
+        g[i][j] = std::max(column_line(g, have, amps, j, amps[i]), 0.5 * z_min);
+        extrapolated.push_back(cell);
+      }  // else: the whole column is missing, second pass along frequency
     }
   }
   for (std::size_t i = 0; i < na; ++i) {
@@ -178,11 +205,10 @@ void fill_grid(std::vector<std::vector<double>>& g, std::vector<std::vector<bool
       }
       if (best > 0.0) {
         g[i][j] = best;
-        filled.push_back(fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]));
+        extrapolated.push_back(fmt::format("{} {:g} V {:g} Hz", dir, amps[i], freqs[j]));
       }
     }
   }
-  (void)have;
 }
 
 }  // namespace
@@ -253,7 +279,7 @@ BreakawayResult identify_breakaway(const std::vector<SawtoothRun>& runs, const A
       throw ComputationFailed(fmt::format("no usable {} sawtooth run: cannot identify z_ba({})", to_string(d),
                                           d == Direction::kForward ? "+" : "-"));
     }
-    fill_grid(g, have, amps, to_string(d), out.filled, freqs);
+    fill_grid(g, have, amps, to_string(d), out.filled, out.extrapolated, freqs);
     (d == Direction::kForward ? tb.forward_m : tb.backward_m) = g;
   }
   for (const auto& r : out.runs) out.skipped += r.ok ? 0 : 1;

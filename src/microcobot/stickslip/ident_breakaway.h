@@ -62,7 +62,10 @@ struct RunFit {
 struct BreakawayResult {
   std::vector<RunFit> runs;
   BreakawayTable table;
-  std::vector<std::string> filled;  ///< table cells without a fitted run, filled from neighbours
+  /// Table cells without a fitted run: between fitted cells of their frequency, interpolated
+  /// linearly along amplitude (`filled`); beyond them (below the stepping threshold), or in a
+  /// column without any fitted run, extrapolated from the fitted cells (`extrapolated`).
+  std::vector<std::string> filled, extrapolated;
   std::size_t skipped = 0;
 };
 

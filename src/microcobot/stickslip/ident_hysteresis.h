@@ -13,7 +13,10 @@
 ///    whole range (the initial loading identifies the wide operators) and the offset fixed to the
 ///    rest position; otherwise only samples after the input has visited its minimum and maximum
 ///    are fitted (from then on every operator's state is set by the input alone: wiping-out), with
-///    thresholds over half the range and a free offset.
+///    thresholds over half the range and a free offset. "At rest" is decided from the whole record
+///    (voltage noise makes its first samples useless for it): a record starting near its lowest
+///    voltage is fitted both as from rest and as a steady loop over all samples, the smaller RMS
+///    residual wins.
 /// The weights are split as w'_i = g w_i, with g (the PE's static gain, m/V) chosen so that the
 /// loading curve maps the top of the input range to itself (the convention of the defaults).
 
@@ -34,8 +37,14 @@ struct HysteresisResult {
   double stroke_m = 0.0;             ///< peak-to-peak of the measured loop
   double rms_fraction = 0.0;         ///< rms_m / stroke_m
   double inverse_max_error_V = 0.0;  ///< max |H^-1(H(U)) - U| over the record
-  std::size_t first_fitted = 0;      ///< first sample used (after the wiping-out)
-  std::vector<double> fitted_m;      ///< x0 + g H(U) at every sample
+  std::size_t first_fitted = 0;      ///< first sample used (after the wiping-out; 0 from rest)
+  /// Whether the record was taken as starting at rest (virgin operators, the initial loading
+  /// fitted), decided by fitting both hypotheses over the whole record when it starts near its
+  /// lowest voltage; their RMS residuals [m] (NaN when the record starts elsewhere: a steady loop).
+  bool from_rest = false;
+  double rms_from_rest_m = 0.0, rms_steady_loop_m = 0.0;
+  double voltage_noise_V = 0.0;  ///< RMS voltage noise estimated from the record
+  std::vector<double> fitted_m;  ///< x0 + g H(U) at every sample
 };
 
 /// Identifies the PI model from `rec` (x_m = slider position) with `operators` play operators.

@@ -91,7 +91,8 @@ MeasuredRecord measure(const ActuatorModel& model, const Waveform& wave, double 
   r.t_s.reserve(n);
   r.u_V.reserve(n);
   r.x_m.reserve(n);
-  const double u_sigma = sensor.voltage_noise_fraction * wave.amplitude_V;
+  const double u_sigma = sensor.voltage_noise_rms_V >= 0.0 ? sensor.voltage_noise_rms_V
+                                                           : sensor.voltage_noise_fraction * wave.amplitude_V;
   auto record = [&] {
     r.t_s.push_back(st.t_s);
     r.u_V.push_back(st.u_V + u_sigma * rng.normal());

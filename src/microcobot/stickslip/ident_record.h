@@ -50,6 +50,9 @@ struct SensorEffects {
   double position_noise_rms_m = 1e-9;    ///< white position noise, RMS
   double voltage_noise_fraction = 0.01;  ///< RMS voltage noise / drive amplitude
   std::uint64_t seed = 1;
+  /// When >= 0: the RMS voltage noise in volts, whatever the amplitude (replaces the fraction;
+  /// `identify synth --voltage-noise`).
+  double voltage_noise_rms_V = -1.0;
 };
 
 /// What the interferometer looks at.

@@ -28,7 +28,8 @@ std::vector<AccuracyDrive> accuracy_drives(int n, std::uint64_t seed, const Driv
     const Direction direction = rng.uniform() < 0.5 ? Direction::kForward : Direction::kBackward;
     AccuracyDrive d;
     d.wave = make_waveform(kind, amplitude, frequency, direction, limits, limits.min_V);
-    d.duration_s = kind == WaveKind::kStep ? 5e-3 : std::clamp(3.0 / frequency, 3e-3, 60e-3);
+    // The power-up period, then at least three at the steady state (at least 3 ms).
+    d.duration_s = kind == WaveKind::kStep ? 5e-3 : std::max(4.0 / frequency, 3e-3);
     out.push_back(d);
   }
   return out;
@@ -53,19 +54,28 @@ DriveAccuracy check_drive(const ActuatorModel& model, const AccuracyDrive& drive
   }
   r.rms_error = std::sqrt(sq / static_cast<double>(n)) / r.range_m;
   r.max_error /= r.range_m;
-  // Net motion over whole periods (same phase to same phase), on the common grid.
-  std::size_t last = n - 1;
-  double periods = 1.0;
-  if (drive.wave.kind != WaveKind::kStep) {
+  // Net motion per period over the whole periods after the first (same phase to same phase; the
+  // first holds the power-up transient), x interpolated at t = kT on the common grid.
+  const double dt = model.dt_s();
+  auto at = [&](const Trajectory& tr, double t) {
+    const std::size_t k = std::min(n - 2, static_cast<std::size_t>(t / dt));
+    const double f = std::clamp((t - tr.t_s[k]) / (tr.t_s[k + 1] - tr.t_s[k]), 0.0, 1.0);
+    return tr.x2_m[k] + f * (tr.x2_m[k + 1] - tr.x2_m[k]);
+  };
+  if (drive.wave.kind == WaveKind::kStep) {
+    r.step_m = fixed.x2_m[n - 1] - fixed.x2_m[0];
+    r.step_ref_m = ref.x2_m[n - 1] - ref.x2_m[0];
+  } else {
     const double period = 1.0 / drive.wave.frequency_Hz;
-    periods = std::floor(drive.duration_s / period + 1e-9);
-    if (periods >= 1.0)
-      last = std::min(n - 1, static_cast<std::size_t>(std::llround(periods * period / model.dt_s())));
-    else
-      periods = drive.duration_s / period;
+    const double periods = std::floor(drive.duration_s / period + 1e-9);
+    require(periods >= 2.0, "duration_s", "must hold at least two whole periods of the drive",
+            drive.duration_s);
+    r.steady_periods = static_cast<int>(periods) - 1;
+    r.first_period_m = at(fixed, period) - fixed.x2_m[0];
+    r.first_period_ref_m = at(ref, period) - ref.x2_m[0];
+    r.step_m = (at(fixed, periods * period) - at(fixed, period)) / (periods - 1.0);
+    r.step_ref_m = (at(ref, periods * period) - at(ref, period)) / (periods - 1.0);
   }
-  r.step_m = (fixed.x2_m[last] - fixed.x2_m[0]) / periods;
-  r.step_ref_m = (ref.x2_m[last] - ref.x2_m[0]) / periods;
   r.step_error =
       std::abs(r.step_m - r.step_ref_m) / std::max(std::abs(r.step_ref_m), kStepFloorOfRange * r.range_m);
   r.model = std::move(fixed);

@@ -22,17 +22,21 @@ struct AccuracyDrive {
 
 /// `n` drives drawn with a seeded generator (the same set on every machine): 70 % sawtooth
 /// (amplitude uniform in [10, 100] V, frequency log-uniform in [20, 2000] Hz, either direction),
-/// 15 % sine, 15 % step (amplitude in [10, 100] V). Periodic drives run 3 periods (at least
-/// 3 ms, at most 60 ms: the slowest drives run over part of a period), steps 5 ms.
+/// 15 % sine, 15 % step (amplitude in [10, 100] V). Periodic drives run 4 periods (the power-up
+/// period and three at the steady state; at least 3 ms), steps 5 ms.
 std::vector<AccuracyDrive> accuracy_drives(int n, std::uint64_t seed, const DriveParams& limits);
 
 struct DriveAccuracy {
   double rms_error = 0.0;  ///< RMS of (x2 - x2_ref) / range of x2_ref
   double max_error = 0.0;  ///< max |x2 - x2_ref| / range of x2_ref
   double range_m = 0.0;    ///< range of the reference's slider position
-  /// Net slider motion per period (periodic drives; over whole periods from the first period's
-  /// start) or over the run (step), by the model and by the reference [m].
+  /// Net slider motion per period (periodic drives: over the whole periods after the first, same
+  /// phase to same phase) or over the run (step), by the model and by the reference [m].
   double step_m = 0.0, step_ref_m = 0.0;
+  /// Periodic drives: the first period's (power-up) displacement, model and reference [m], and
+  /// the number of periods step_m is the mean of.
+  double first_period_m = 0.0, first_period_ref_m = 0.0;
+  int steady_periods = 0;
   /// |step - step_ref| / max(|step_ref|, 0.1 range_m): a drive that does not step (its net step
   /// below a tenth of its range: creep below the threshold, a sine, a backward drive whose two
   /// slips nearly cancel) is judged against a tenth of its range, not against ~0.
