@@ -15,12 +15,13 @@
  *
  * The configuration, from ros2/rmw_cyclonedds, rmw_cyclonedds_cpp/src/rmw_node.cpp,
  * check_create_domain():
- *   humble (branch humble, 7cb3b38, lines 1052-1075): localhost-only is the one fragment
+ *   humble (branch humble, 7cb3b38, lines 1052-1077): localhost-only is the one fragment
  *     <CycloneDDS><Domain><General><Interfaces><NetworkInterface address="127.0.0.1"/>
  *     </Interfaces></General></Domain></CycloneDDS>,   then $CYCLONEDDS_URI.
  *     Everything else is Cyclone's default: AllowMulticast "default" (multicast whenever the
  *     interface's flags say it can), ParticipantIndex "none" (random unicast ports), no peers.
- *   jazzy (branch jazzy, 2ec6f21, lines 1114-1214): range LOCALHOST is
+ *   jazzy (branch jazzy, 2ec6f21, lines 1114-1241; rcl 9.2.0 init.c 157-194 maps
+ *     ROS_LOCALHOST_ONLY=1 to this range): range LOCALHOST is
  *     <CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast></General>
  *     <Discovery><ParticipantIndex>auto</ParticipantIndex>
  *     <MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>
