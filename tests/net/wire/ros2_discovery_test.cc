@@ -66,7 +66,8 @@ class Machine {
     const std::string eth = "eth" + name_.substr(5), peer = "veth" + name_.substr(5);
     ok_ = ip({"-n", name_, "link", "set", "lo", "up"}) &&
           ip({"-n", name_, "link", "set", "lo", "multicast", lo_multicast ? "on" : "off"}) &&
-          ip({"-n", name_, "link", "add", eth.substr(0, 15), "type", "veth", "peer", "name", peer.substr(0, 15)}) &&
+          ip({"-n", name_, "link", "add", eth.substr(0, 15), "type", "veth", "peer", "name",
+              peer.substr(0, 15)}) &&
           ip({"-n", name_, "addr", "add", "198.18.0.1/30", "dev", eth.substr(0, 15)}) &&
           ip({"-n", name_, "link", "set", eth.substr(0, 15), "up"}) &&
           ip({"-n", name_, "link", "set", peer.substr(0, 15), "up"});
@@ -83,9 +84,19 @@ class Machine {
 
   /// `argv` run inside the namespace with only `env` of the ROS/Cyclone variables set (the
   /// caller's CYCLONEDDS_URI or ROS_LOCALHOST_ONLY must not leak into a case).
-  std::vector<std::string> run(const std::vector<std::string>& env, const std::vector<std::string>& argv) const {
-    std::vector<std::string> cmd{ip_, "netns", "exec", name_, "env", "-u", "CYCLONEDDS_URI", "-u",
-                                 "ROS_LOCALHOST_ONLY", "-u", "ROS_AUTOMATIC_DISCOVERY_RANGE"};
+  std::vector<std::string> run(const std::vector<std::string>& env,
+                               const std::vector<std::string>& argv) const {
+    std::vector<std::string> cmd{ip_,
+                                 "netns",
+                                 "exec",
+                                 name_,
+                                 "env",
+                                 "-u",
+                                 "CYCLONEDDS_URI",
+                                 "-u",
+                                 "ROS_LOCALHOST_ONLY",
+                                 "-u",
+                                 "ROS_AUTOMATIC_DISCOVERY_RANGE"};
     cmd.insert(cmd.end(), env.begin(), env.end());
     cmd.insert(cmd.end(), argv.begin(), argv.end());
     return cmd;
@@ -94,8 +105,8 @@ class Machine {
   /// Whether `lo` in the namespace has the MULTICAST flag (what Cyclone reads).
   bool lo_multicast() {
     TempDir tmp;
-    const pid_t pid = test::spawn_process({ip_, "-n", name_, "-j", "link", "show", "dev", "lo"}, tmp / "out",
-                                          tmp / "err");
+    const pid_t pid =
+        test::spawn_process({ip_, "-n", name_, "-j", "link", "show", "dev", "lo"}, tmp / "out", tmp / "err");
     if (test::wait_process(pid, 10s) != 0) return false;
     const json j = json::parse(test::read_text(tmp / "out"), nullptr, false);
     if (!j.is_array() || j.empty()) return false;
@@ -181,13 +192,21 @@ NodeRun slave_and_node(const Machine& machine, const std::string& distro, const 
                        "--out", (dir / "slave").string(), "--duration", "60"}),
       dir / "slave.out", dir / "slave.err");
   reaper.pids.push_back(slave);
-  std::vector<std::string> argv{MC_ROS2_NODE_PATH, "--distro", distro, "--domain", domain, "--timeout",
-                                std::to_string(timeout_s), "--echo", "/microcobot/slave/pose"};
+  std::vector<std::string> argv{MC_ROS2_NODE_PATH,
+                                "--distro",
+                                distro,
+                                "--domain",
+                                domain,
+                                "--timeout",
+                                std::to_string(timeout_s),
+                                "--echo",
+                                "/microcobot/slave/pose"};
   for (const std::string& t : kSlaveTopics) argv.insert(argv.end(), {"--expect", t});
   const pid_t node = test::spawn_process(machine.run(env, argv), dir / "node.out", dir / "node.err");
   reaper.pids.push_back(node);
   NodeRun r;
-  r.exit_code = test::wait_process(node, std::chrono::milliseconds(static_cast<int>(timeout_s * 1000) + 15000));
+  r.exit_code =
+      test::wait_process(node, std::chrono::milliseconds(static_cast<int>(timeout_s * 1000) + 15000));
   r.lines = json_lines(test::read_text(dir / "node.out"));
   r.err = test::read_text(dir / "node.err");
   ::kill(slave, SIGTERM);
@@ -209,7 +228,8 @@ void expect_found_the_slave(const NodeRun& r, const std::string& config) {
     if (l.contains("echo")) {
       echoed = true;
       EXPECT_EQ(l["frame_id"], "microcobot_stage") << l;
-      for (double x : l["position"].get<std::vector<double>>()) EXPECT_LT(std::abs(x), 1e-6) << "at home: " << l;
+      for (double x : l["position"].get<std::vector<double>>())
+        EXPECT_LT(std::abs(x), 1e-6) << "at home: " << l;
     }
   }
   EXPECT_TRUE(pose_type) << "rt/microcobot/slave/pose with ROS 2's type name";
@@ -253,10 +273,12 @@ TEST(Ros2Discovery, AJazzyNodeWithRosLocalhostOnlyFindsThePlatformOnlyWithItsInt
   Machine m(/*lo_multicast=*/true);
   MC_NEEDS_MACHINE(m);
   const NodeRun alone = slave_and_node(m, "jazzy", {"ROS_LOCALHOST_ONLY=1"}, 5);
-  EXPECT_EQ(alone.exit_code, 1) << "Jazzy's LOCALHOST range alone found the platform: update docs/distributed.md";
+  EXPECT_EQ(alone.exit_code, 1)
+      << "Jazzy's LOCALHOST range alone found the platform: update docs/distributed.md";
   EXPECT_NE(alone.err.find("not discovered: rt/microcobot/slave/pose"), std::string::npos) << alone.err;
 
-  const NodeRun pinned = slave_and_node(m, "jazzy", {"ROS_LOCALHOST_ONLY=1", std::string("CYCLONEDDS_URI=") + kLoopbackInterfaceUri}, 20);
+  const NodeRun pinned = slave_and_node(
+      m, "jazzy", {"ROS_LOCALHOST_ONLY=1", std::string("CYCLONEDDS_URI=") + kLoopbackInterfaceUri}, 20);
   expect_found_the_slave(pinned, std::string(kJazzyLocalhost) + kLoopbackInterfaceUri);
 }
 

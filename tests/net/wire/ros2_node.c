@@ -274,7 +274,8 @@ static int run(struct Options* o) {
   }
   dds_entity_t echo = 0;
   if (o->echo[0] != '\0') {
-    const dds_entity_t topic = dds_create_topic(pp, &geometry_msgs_msg_dds__PoseStamped__desc, o->echo, NULL, NULL);
+    const dds_entity_t topic =
+        dds_create_topic(pp, &geometry_msgs_msg_dds__PoseStamped__desc, o->echo, NULL, NULL);
     dds_qos_t* qos = dds_create_qos();
     dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
