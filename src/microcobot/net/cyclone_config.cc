@@ -42,13 +42,30 @@ void NetworkConfig::validate() const {
     check_host(peers[i], "network.peers[" + std::to_string(i) + "]");
 }
 
+bool on_loopback(const NetworkConfig& network) {
+  const std::string& i = network.interface;
+  return i == "lo" || i == "::1" || (is_address(i) && i.rfind("127.", 0) == 0);
+}
+
 std::string cyclone_config(const NetworkConfig& network) {
   network.validate();
-  // Without multicast, discovery goes by unicast to the peers' participant indices 0..Max: a
-  // handful of processes per domain and machine is what the link needs.
+  const bool loopback = on_loopback(network);
   std::string xml = "<General><Interfaces><NetworkInterface ";
   xml += is_address(network.interface) ? "address" : "name";
-  xml += "=\"" + network.interface + "\"/></Interfaces><AllowMulticast>false</AllowMulticast></General>";
+  xml += "=\"" + network.interface + "\"";
+  // On loopback, discovery also goes by multicast (SPDP only: endpoints and data stay unicast),
+  // because that is all a ROS 2 node with ROS_LOCALHOST_ONLY=1 (Humble's rmw_cyclonedds: interface
+  // 127.0.0.1, Cyclone's defaults otherwise) sends once `lo` has the MULTICAST flag, and it then
+  // listens on random unicast ports the peers below cannot reach. multicast="true": Linux delivers
+  // multicast on lo whether or not the flag is set, and Cyclone, which reads the flag, would
+  // otherwise switch multicast off with a warning on every start. Off loopback multicast stays off:
+  // a lab network is reached only through the peers named (docs/distributed.md).
+  if (loopback) xml += " multicast=\"true\"";
+  xml += "/></Interfaces><AllowMulticast>";
+  xml += loopback ? "spdp" : "false";
+  xml += "</AllowMulticast></General>";
+  // Unicast discovery goes to the peers' participant indices 0..Max: a handful of processes per
+  // domain and machine is what the link needs.
   xml +=
       "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
       "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex><Peers>";

@@ -1,10 +1,12 @@
 #pragma once
 /// @file
-/// The Cyclone DDS configuration of the link: one local interface, no multicast, unicast
-/// discovery towards a list of peers (participant indices picked automatically). The default is
+/// The Cyclone DDS configuration of the link: one local interface, unicast discovery towards a
+/// list of peers (participant indices picked automatically), data by unicast. The default is
 /// loopback (interface and peer 127.0.0.1): tests and two processes on one machine never reach
-/// outside it, and parallel runs are kept apart by their domain ids. Two machines name their own
-/// interface and the other machine as peer (docs/distributed.md).
+/// outside it, and parallel runs are kept apart by their domain ids. On loopback, participant
+/// discovery (SPDP) also goes by multicast, so that a ROS 2 node on the same machine with
+/// ROS_LOCALHOST_ONLY=1 finds the platform without further configuration. Two machines name their
+/// own interface and the other machine as peer, without multicast (docs/distributed.md).
 
 #include <string>
 #include <vector>
@@ -29,10 +31,15 @@ struct NetworkConfig {
   bool operator==(const NetworkConfig&) const = default;
 };
 
+/// Whether `network` keeps to this machine's loopback: its interface is `lo`, ::1 or an address in
+/// 127.0.0.0/8 (the peers then can only be reached through loopback too).
+bool on_loopback(const NetworkConfig& network);
+
 /// The XML fragment given to dds_create_domain (Cyclone DDS 0.10 configuration elements:
-/// General/Interfaces/NetworkInterface (address= for an address, name= for a name),
-/// General/AllowMulticast, Discovery/ParticipantIndex, Discovery/Peers,
-/// Discovery/MaxAutoParticipantIndex). Validates `network` first.
+/// General/Interfaces/NetworkInterface (address= for an address, name= for a name; on loopback
+/// multicast="true"), General/AllowMulticast (spdp on loopback, false elsewhere),
+/// Discovery/ParticipantIndex, Discovery/Peers, Discovery/MaxAutoParticipantIndex). Validates
+/// `network` first.
 std::string cyclone_config(const NetworkConfig& network);
 
 }  // namespace mc::net

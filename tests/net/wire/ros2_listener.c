@@ -12,8 +12,8 @@
  * exit 2 with one line on stderr. --ready-file: the file is created once the reader exists (a
  * test starts the publisher after it).
  *
- * Same middleware configuration as the platform (loopback, no multicast, unicast discovery on
- * 127.0.0.1), same QoS as its publishers: state topics best effort, volatile, keep last 1; the
+ * Same middleware configuration as the platform (loopback, unicast discovery on 127.0.0.1 and
+ * multicast participant discovery on lo), same QoS as its publishers: state topics best effort, volatile, keep last 1; the
  * latched topics (bool: /microcobot/estop, /microcobot/master/engaged) reliable, transient
  * local, keep last 1 so that the current state arrives even when published before the start;
  * /diagnostics (diag) reliable, volatile, keep last 1.
@@ -34,8 +34,8 @@
 /* The platform's Cyclone configuration (docs/distributed.md, "Middleware configuration"). */
 static const char kLoopbackConfig[] =
     "<General>"
-    "<Interfaces><NetworkInterface address=\"127.0.0.1\"/></Interfaces>"
-    "<AllowMulticast>false</AllowMulticast>"
+    "<Interfaces><NetworkInterface address=\"127.0.0.1\" multicast=\"true\"/></Interfaces>"
+    "<AllowMulticast>spdp</AllowMulticast>"
     "</General>"
     "<Discovery>"
     "<ParticipantIndex>auto</ParticipantIndex>"
