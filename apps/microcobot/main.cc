@@ -140,9 +140,12 @@ int run_cli(CLI::App& app, int argc, char** argv) {
   try {
     check_command_words(app, argc, argv);
     app.parse(argc, argv);
+    // A signal the command itself took as its end (serve, link echo: stopped by SIGINT/SIGTERM
+    // on purpose, exit 0) is not an interruption of the outputs.
+    const int before_commit = mc::cli::interrupt_signal();
     mc::cli::commit_outputs();
     // A signal while the outputs were moved into place waited for the last one (signals.h).
-    if (const int sig = mc::cli::interrupt_signal(); sig != 0) {
+    if (const int sig = mc::cli::interrupt_signal(); sig != 0 && before_commit == 0) {
       const mc::cli::Interrupted e(sig, true);
       return fail(static_cast<mc::ExitCode>(e.exit_code()), e.what());
     }
