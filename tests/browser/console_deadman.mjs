@@ -17,7 +17,7 @@ const still = (a, b, what) => {
   }
 };
 
-try {
+await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
   await page.click("#take-control");
@@ -56,14 +56,4 @@ try {
     await page.keyboard.up(" ");
   }
   log(`with the deadman: opening ${((await t()).gripper_opening_m * 1e6).toFixed(1)} um`);
-} catch (e) {
-  fail(String(e.stack || e));
-  await s.diagnose();
-}
-await s.closeBrowser();
-await s.terminate();
-if (s.failures) {
-  console.error(`console_deadman: ${s.failures} failure(s)`);
-  process.exit(1);
-}
-log("console_deadman: nothing moved without the deadman");
+}, "nothing moved without the deadman");

@@ -16,7 +16,7 @@ const s = await startConsole("console_demo", (dir) => {
 }, 240);
 const { page, t, until, shot, fail, log } = s;
 
-try {
+await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
   await page.click("#take-control");
@@ -46,14 +46,4 @@ try {
   const status = await page.evaluate(() => window.mc.status);
   if (status.demo) fail("the status still says the demo drives");
   log(`held: z ${(a.slave_z_m * 1e6).toFixed(3)} -> ${(b.slave_z_m * 1e6).toFixed(3)} um over 3 s`);
-} catch (e) {
-  fail(String(e.stack || e));
-  await s.diagnose();
-}
-await s.closeBrowser();
-await s.terminate();
-if (s.failures) {
-  console.error(`console_demo: ${s.failures} failure(s)`);
-  process.exit(1);
-}
-log("console_demo: the pin inserted, the result shown, every axis holding afterwards");
+}, "the pin inserted, the result shown, every axis holding afterwards");

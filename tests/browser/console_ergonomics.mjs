@@ -44,7 +44,7 @@ async function plotsFill(what) {
   return plots.map((p) => p.plot);
 }
 
-try {
+await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
   await page.waitForTimeout(1000);  // a second of plotted samples
@@ -136,14 +136,4 @@ try {
   if (!injected.demo || !/no demo here/.test(injected.title)) fail("the Demo button is not disabled with its reason");
   if (!/0\.3 % of 2010000 ticks/.test(injected.overruns || "")) fail(`overruns shown as "${injected.overruns}"`);
   await shot("ergo-05-injected-fields");
-} catch (e) {
-  fail(String(e.stack || e));
-  await s.diagnose();
-}
-await s.closeBrowser();
-await s.terminate();
-if (s.failures) {
-  console.error(`console_ergonomics: ${s.failures} failure(s)`);
-  process.exit(1);
-}
-log("console_ergonomics: tablet layout, plots, banners, readout, step jog, go-to, saved positions and the lead's fields held");
+}, "tablet layout, plots, banners, readout, step jog, go-to, saved positions and the lead's fields held");

@@ -11,7 +11,7 @@ import { startConsole } from "./console_session.mjs";
 
 const s = await startConsole("console_optical_trap", (dir) => ["--scene", "optical-trap", "--out", join(dir, "rec")], 150);
 const { page, t, until, shot, clickTop, goWithDeadman, fail, log } = s;
-try {
+await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
   const scene = await page.evaluate(() => window.mc.scene);
@@ -64,14 +64,4 @@ try {
   // The laser stays on: the probe is still held near its trap.
   if (!(Math.abs(stopped.part_x_m - stopped.measured_x_m) < 3e-6)) fail("the probe left its trap at the e-stop");
   await shot("trap-03-estop");
-} catch (e) {
-  fail(String(e.stack || e));
-  await s.diagnose();
-}
-await s.closeBrowser();
-await s.terminate();
-if (s.failures) {
-  console.error(`console_optical_trap: ${s.failures} failure(s)`);
-  process.exit(1);
-}
-log("console_optical_trap: the probe pushed against the stuck bead through the console, felt in pN; e-stop and SIGTERM held");
+}, "the probe pushed against the stuck bead through the console, felt in pN; e-stop and SIGTERM held");

@@ -121,5 +121,22 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     if (code !== 0) s.fail(`serve exited with ${code} (${signal}) on SIGTERM`);
     clearTimeout(s.guard);
   };
+  // Runs the test's body, then closes the browser and the server and exits: 1 with the count of
+  // failures (a throw counts, with the page's state and a screenshot), else 0 after `okMessage`.
+  s.run = async (body, okMessage) => {
+    try {
+      await body();
+    } catch (e) {
+      s.fail(String(e.stack || e));
+      await s.diagnose();
+    }
+    await s.closeBrowser();
+    await s.terminate();
+    if (s.failures) {
+      console.error(`${name}: ${s.failures} failure(s)`);
+      process.exit(1);
+    }
+    s.log(`${name}: ${okMessage}`);
+  };
   return s;
 }

@@ -9,6 +9,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/live/session_recording.h"
 #include "microcobot/platform/telemetry_json.h"
+#include "microcobot/report/report.h"
 
 namespace mc::live {
 namespace {
@@ -18,37 +19,15 @@ using server::StatusLevel;
 
 constexpr std::string_view kFigures = "-figures";
 
-std::string html_escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 server::HttpReply html_page(int status, const std::string& title, const std::string& text, int refresh_s) {
   server::HttpReply r;
   r.status = status;
   r.content_type = "text/html; charset=utf-8";
   r.refresh_s = refresh_s;
-  r.body = "<!doctype html><meta charset=\"utf-8\"><title>" + html_escape(title) +
-           "</title><body style=\"font-family:sans-serif\"><h1>" + html_escape(title) + "</h1><p>" +
-           html_escape(text) + "</p>";
+  r.body = "<!doctype html><meta charset=\"utf-8\"><title>" + report::escape_html(title) +
+           "</title><body style=\"font-family:sans-serif\"><h1>" + report::escape_html(title) + "</h1><p>" +
+           report::escape_html(text) + "</p>";
   return r;
 }
 

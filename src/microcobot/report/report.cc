@@ -47,7 +47,24 @@ std::string axis_column(const Axis& a) {
   return a.unit.empty() ? s : s + "_" + a.unit;
 }
 
-std::string escape_html(const std::string& s) {
+
+// JSON inside <script>: "</" must not appear.
+std::string script_safe(std::string json) {
+  std::size_t pos = 0;
+  while ((pos = json.find("</", pos)) != std::string::npos) {
+    json.replace(pos, 2, "<\\/");
+    pos += 3;
+  }
+  return json;
+}
+
+std::string figure_file(std::size_t index, const Figure& f) {
+  return fmt::format("fig-{:02d}-{}.csv", index, slug(f.title));
+}
+
+}  // namespace
+
+std::string escape_html(std::string_view s) {
   std::string out;
   for (char c : s) {
     switch (c) {
@@ -69,22 +86,6 @@ std::string escape_html(const std::string& s) {
   }
   return out;
 }
-
-// JSON inside <script>: "</" must not appear.
-std::string script_safe(std::string json) {
-  std::size_t pos = 0;
-  while ((pos = json.find("</", pos)) != std::string::npos) {
-    json.replace(pos, 2, "<\\/");
-    pos += 3;
-  }
-  return json;
-}
-
-std::string figure_file(std::size_t index, const Figure& f) {
-  return fmt::format("fig-{:02d}-{}.csv", index, slug(f.title));
-}
-
-}  // namespace
 
 std::string slug(const std::string& title) {
   std::string out;

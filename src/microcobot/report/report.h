@@ -7,12 +7,16 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 namespace mc::report {
+
+/// `text` with < > & " as HTML entities (for text inside an element or an attribute).
+std::string escape_html(std::string_view text);
 
 /// One axis: a label with its unit, and its scale.
 struct Axis {
