@@ -101,7 +101,9 @@ void naming_flags(const std::vector<std::pair<std::string, std::string>>& field_
     work();
   } catch (const InvalidParams& e) {
     std::string text = e.what();
-    const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+    const auto word = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.';
+    };
     for (const auto& [field, flag] : field_to_flag) {
       for (std::size_t pos = 0; (pos = text.find(field, pos)) != std::string::npos;) {
         const std::size_t end = pos + field.size();

@@ -148,8 +148,9 @@ void add_dsp(CLI::App& group) {
     mc::cli::add_format_option(*cmd, o->common);
     cmd->callback([o] {
       const auto table = mc::read_columns(o->in, {o->column});
-      const auto p = naming_columns(o->in, o->column, o->column,
-                                    [&] { return mc::dsp::welch(table.column(o->column), to_options(o->w)); });
+      const auto p = naming_columns(o->in, o->column, o->column, [&] {
+        return mc::dsp::welch(table.column(o->column), to_options(o->w));
+      });
       write_two_columns(o->common, "psd.csv", {"f_Hz", p.f_Hz}, {"psd", p.value});
     });
   }

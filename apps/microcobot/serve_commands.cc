@@ -148,9 +148,10 @@ void serve(const ServeOptions& o) {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
     std::error_code ec;
     if (!std::filesystem::is_regular_file(o.scene, ec))
-      throw mc::InvalidInput("--scene '" + mc::excerpt(o.scene) +
-                             "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
-                             "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
+      throw mc::InvalidInput(
+          "--scene '" + mc::excerpt(o.scene) +
+          "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
+          "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
     lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
   }
   auto [host, port] = parse_listen(o.listen);
@@ -170,8 +171,7 @@ void serve(const ServeOptions& o) {
   sp.config_yaml = mc::params_to_yaml(lp.platform);
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
-  if (ec)
-    throw mc::InvalidInput("cannot create --out " + mc::excerpt(o.out.string()) + ": " + ec.message());
+  if (ec) throw mc::InvalidInput("cannot create --out " + mc::excerpt(o.out.string()) + ": " + ec.message());
   if (!std::filesystem::is_directory(o.out, ec))
     throw mc::InvalidInput("--out " + mc::excerpt(o.out.string()) + ": exists and is not a directory");
 
@@ -194,8 +194,9 @@ void serve(const ServeOptions& o) {
   std::cout << server.url() << std::endl;
   std::cerr << "serve: console at " << server.url() << " (Ctrl-C stops: devices to their safe state)\n";
   if (host == "0.0.0.0" || host == "::")
-    std::cerr << "serve: listening on every interface: from another machine, open this machine's address on port "
-              << server.port() << " with the same token\n";
+    std::cerr
+        << "serve: listening on every interface: from another machine, open this machine's address on port "
+        << server.port() << " with the same token\n";
   const auto start = std::chrono::steady_clock::now();
   while (mc::cli::interrupt_signal() == 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

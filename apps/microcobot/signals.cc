@@ -99,12 +99,13 @@ extern "C" void on_signal(int sig) {
 }  // namespace
 
 Interrupted::Interrupted(int signal, bool outputs_complete)
-    : mc::Error(mc::ExitCode::kComputationFailed,
-                outputs_complete
-                    ? fmt::format("interrupted ({}) while writing the outputs; they are complete and in place",
-                                  signal_name(signal))
-                    : fmt::format("interrupted ({}); the outputs written so far are marked as interrupted",
-                                  signal_name(signal))),
+    : mc::Error(
+          mc::ExitCode::kComputationFailed,
+          outputs_complete
+              ? fmt::format("interrupted ({}) while writing the outputs; they are complete and in place",
+                            signal_name(signal))
+              : fmt::format("interrupted ({}); the outputs written so far are marked as interrupted",
+                            signal_name(signal))),
       signal_(signal) {}
 
 std::string signal_name(int signal) {
@@ -166,7 +167,8 @@ fs::path stage_output(const fs::path& target_in) {
   // rename cannot cross devices. A DIR that is a mount point (its parent on another device) is
   // staged inside itself.
   fs::path stage_in = parent;
-  struct stat target_st {}, parent_st {};
+  struct stat target_st {
+  }, parent_st{};
   if (::stat(target.c_str(), &target_st) == 0 && S_ISDIR(target_st.st_mode) &&
       (::stat(parent.c_str(), &parent_st) != 0 || parent_st.st_dev != target_st.st_dev)) {
     stage_in = target;

@@ -130,7 +130,8 @@ TEST(InputsHardening, SaveOntoTheMeasurementIsRefused) {
   // A measurement of an --in directory.
   fs::create_directory(d / "campaign");
   write_text(d / "campaign" / "step.csv", rec);
-  expect_error({"identify", "all", "--in", (d / "campaign").string(), "--save", (d / "campaign" / "step.csv").string()},
+  expect_error({"identify", "all", "--in", (d / "campaign").string(), "--save",
+                (d / "campaign" / "step.csv").string()},
                2, "measurement in the --in directory");
   EXPECT_EQ(test::read_text(d / "campaign" / "step.csv"), rec);
 }
@@ -219,7 +220,8 @@ TEST(InputsHardening, ASignalWhileARunWritesItsOutputsExits130WithThemWhole) {
   EXPECT_EQ(line_count(err), 1u) << err;
   EXPECT_THAT(err, HasSubstr("SIGINT"));
   // All of it, whole: the session had finished, so nothing is marked as interrupted.
-  for (const char* f : {"recording.csv", "recording.mcap", "index.html"}) EXPECT_TRUE(fs::exists(d / "s" / f)) << f;
+  for (const char* f : {"recording.csv", "recording.mcap", "index.html"})
+    EXPECT_TRUE(fs::exists(d / "s" / f)) << f;
   EXPECT_THAT(test::read_text(d / "s" / "recording.csv").substr(0, 200), Not(HasSubstr("interrupted")));
   EXPECT_EQ(entries(d.path()), 3u);  // s, run.out, run.err: no staging directory
 }

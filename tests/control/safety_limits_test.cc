@@ -112,7 +112,7 @@ TEST(Teleoperation, AHandPushingIntoAHeldContactDoesNotJumpTheSlaveWhenTheForceD
   TeleoperationInput in;
   in.deadman = true;
   in.tweezers_opening_m = 10e-3;
-  t.tick(in);  // engaged at the origin
+  t.tick(in);                          // engaged at the origin
   in.contact_force_N = {-3e-3, 0, 0};  // a wall at +x pushes back with 3 mN
   for (int i = 1; i <= 100; ++i) {
     in.handle_m.x() = 1e-4 * i;  // the hand goes on into the wall: 10 mm -> 100 um of slave

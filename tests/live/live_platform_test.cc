@@ -185,7 +185,8 @@ TEST(LivePlatform, AFinishedDemoHandsBackWithEveryAxisHoldingAndReportsItsOutcom
       },
       std::chrono::seconds(120)));
   const LiveStatus s = live.status();
-  EXPECT_EQ(s.demo_result.outcome, DemoResult::Outcome::kInserted) << s.demo_result.phase << ": " << s.demo_result.reason;
+  EXPECT_EQ(s.demo_result.outcome, DemoResult::Outcome::kInserted)
+      << s.demo_result.phase << ": " << s.demo_result.reason;
   EXPECT_FALSE(s.demo);
   EXPECT_FALSE(s.demo_result.reason.empty());
   EXPECT_LT(s.demo_result.placement_error_m, 10e-6);

@@ -165,7 +165,8 @@ TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
   // the pin in them, 2 mu F_grip: beyond it the pin slips between them (issue #26).
   const double holds = 2 * pin.w.params().finger_friction * out.grip_force_N;
   ASSERT_GT(out.grip_force_N, 0.0);
-  EXPECT_NEAR(out.force_on_gripper_N.x(), -holds, 1e-12) << "pressed into the wall, the pin slips in the fingers";
+  EXPECT_NEAR(out.force_on_gripper_N.x(), -holds, 1e-12)
+      << "pressed into the wall, the pin slips in the fingers";
   // Pulled out, it is free again.
   move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 600e-6}, Pin::closed);
   EXPECT_FALSE(pin.w.inserted(pin.s));

@@ -94,7 +94,8 @@ TEST(Safety, ASliderSlammedShutOnAPartGripsAtTheLimitAndPressingItDownStaysUnder
   rig.platform->run(0.5);
   const double limit = w.grip_force_limit_N;
   EXPECT_LE(peak(*rig.platform, "grip_force_N", from), limit * (1 + 1e-9));
-  EXPECT_GT(last(*rig.platform, "grip_force_N"), 0.95 * limit) << "a force-controlled close, not an open hand";
+  EXPECT_GT(last(*rig.platform, "grip_force_N"), 0.95 * limit)
+      << "a force-controlled close, not an open hand";
   // Lift, then press the held part into the substrate and drag it sideways at full speed.
   rig.go_to({0, 0, 300e-6}, 0.5);
   ASSERT_EQ(rig.platform->simulation().gripper->world_state().phase, microworld::PartPhase::kGrasped);

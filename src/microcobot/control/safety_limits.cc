@@ -28,8 +28,8 @@ double SafetyLimits::limit_opening_m(double requested_m, double measured_opening
     // limit when o >= w - 2 F_max / k.
     command = std::max(command, measured_opening_m - 2.0 * p_.grip_force_limit_N / p_.finger_stiffness_N_m);
     if (grip_force_N > p_.grip_force_limit_N && std::isfinite(last_command_m))
-      command = std::max(command, last_command_m + 2.0 * (grip_force_N - p_.grip_force_limit_N) /
-                                                       p_.finger_stiffness_N_m);
+      command = std::max(
+          command, last_command_m + 2.0 * (grip_force_N - p_.grip_force_limit_N) / p_.finger_stiffness_N_m);
   }
   return command;
 }
@@ -38,8 +38,8 @@ bool SafetyLimits::contact_over_limit(const Eigen::Vector3d& f) const noexcept {
   return f.allFinite() && f.norm() > p_.contact_force_limit_N;
 }
 
-void SafetyLimits::limit_target(Eigen::Vector3d& target, Eigen::Vector3d& velocity, const Eigen::Vector3d& measured,
-                                const Eigen::Vector3d& f) const noexcept {
+void SafetyLimits::limit_target(Eigen::Vector3d& target, Eigen::Vector3d& velocity,
+                                const Eigen::Vector3d& measured, const Eigen::Vector3d& f) const noexcept {
   if (contact_over_limit(f) && measured.allFinite()) {
     // The force pushes the tool out of the contact: keep the target no further along -f than
     // where the tool is now, and no feedforward into it.

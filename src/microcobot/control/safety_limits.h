@@ -50,8 +50,8 @@ class SafetyLimits {
   bool contact_over_limit(const Eigen::Vector3d& contact_force_N) const noexcept;
   /// Limits a new slave target (and its velocity feedforward) for the measured contact force and
   /// position: nothing further into an over-limit contact, nothing below the floor.
-  void limit_target(Eigen::Vector3d& target_m, Eigen::Vector3d& velocity_m_s, const Eigen::Vector3d& measured_m,
-                    const Eigen::Vector3d& contact_force_N) const noexcept;
+  void limit_target(Eigen::Vector3d& target_m, Eigen::Vector3d& velocity_m_s,
+                    const Eigen::Vector3d& measured_m, const Eigen::Vector3d& contact_force_N) const noexcept;
 
  private:
   SafetyLimitParams p_;

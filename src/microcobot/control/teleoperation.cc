@@ -83,8 +83,8 @@ void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_
   // A hand that pushes on into a held contact slips like a clutch: when the force drops, the
   // slave does not jump to where the hand went meanwhile.
   offset_m_ += (out_.slave_target_m - before).head<2>();
-  out_.gripper_opening_m =
-      limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N, out_.gripper_opening_m);
+  out_.gripper_opening_m = limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N,
+                                                   out_.gripper_opening_m);
 }
 
 void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
@@ -154,8 +154,8 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   // The gripper follows the TéléTweez only while the deadman is held (and its readings are
   // fresh); otherwise it holds its opening.
   const bool tweezers_ok = in.tweezers_fresh && std::isfinite(in.tweezers_opening_m);
-  const double requested = in.deadman && tweezers_ok ? p_.grip_position_scale * in.tweezers_opening_m
-                                                     : out_.gripper_opening_m;
+  const double requested =
+      in.deadman && tweezers_ok ? p_.grip_position_scale * in.tweezers_opening_m : out_.gripper_opening_m;
   apply_limits(in, requested);
   last_xy_m_ = out_.slave_target_m.head<2>();
   if (tweezers_ok) {

@@ -16,8 +16,8 @@ namespace mc {
 std::string why_not_created(const std::filesystem::path& path, int err) {
   const std::size_t name = path.filename().string().size();
   if (name > NAME_MAX) {
-    return "its name is " + std::to_string(name) + " characters long (the limit is " + std::to_string(NAME_MAX) +
-           ")";
+    return "its name is " + std::to_string(name) + " characters long (the limit is " +
+           std::to_string(NAME_MAX) + ")";
   }
   if (err == ENOENT || err == ENOTDIR) return "directory missing";
   if (err == EACCES || err == EPERM || err == EROFS) return "directory not writable";

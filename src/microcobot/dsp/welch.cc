@@ -14,9 +14,10 @@ namespace mc::dsp {
 using C = std::complex<double>;
 
 SpectrumOverflow::SpectrumOverflow(std::string signal, double max_abs)
-    : ComputationFailed(fmt::format("{}: the power spectrum overflows (values up to {:g}; their squares exceed "
-                                    "the largest double)",
-                                    signal, max_abs)),
+    : ComputationFailed(
+          fmt::format("{}: the power spectrum overflows (values up to {:g}; their squares exceed "
+                      "the largest double)",
+                      signal, max_abs)),
       signal_(std::move(signal)),
       max_abs_(max_abs) {}
 
@@ -34,7 +35,8 @@ void require_finite_spectrum(const std::vector<T>& p, const char* signal, std::s
   for (const auto& v : p) {
     if (std::isfinite(std::abs(v))) continue;
     for (double d : data) {
-      if (!std::isfinite(d)) throw ComputationFailed(std::string(signal) + ": the data hold a non-finite value");
+      if (!std::isfinite(d))
+        throw ComputationFailed(std::string(signal) + ": the data hold a non-finite value");
     }
     throw SpectrumOverflow(signal, max_abs(data));
   }

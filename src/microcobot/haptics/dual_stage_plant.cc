@@ -56,11 +56,12 @@ void DualStagePlantParams::validate() const {
   const auto reduced = [](double m_a, double m_b) { return m_a * m_b / (m_a + m_b); };
   const auto link = [&](double k, double mu_ab, const char* field) {
     const double k_max = mu_ab * (1e3 / h) * (1e3 / h);
-    require(k <= k_max, field,
-            fmt::format("too stiff for dt_s/substeps = {:g} s (omega h = {:.3g} > 1e3 on {:.3g} kg: the exact "
-                        "discretisation loses its accuracy); the largest value this step allows is {:.3g}",
-                        h, std::sqrt(k) / std::sqrt(mu_ab) * h, mu_ab, k_max),
-            k);
+    require(
+        k <= k_max, field,
+        fmt::format("too stiff for dt_s/substeps = {:g} s (omega h = {:.3g} > 1e3 on {:.3g} kg: the exact "
+                    "discretisation loses its accuracy); the largest value this step allows is {:.3g}",
+                    h, std::sqrt(k) / std::sqrt(mu_ab) * h, mu_ab, k_max),
+        k);
   };
   link(k_f_N_per_m, m_h_kg, "k_f_N_per_m");  // the finger holds the handle to the (fixed) hand
   link(k_v_N_per_m, reduced(m_h_kg, m_v_kg), "k_v_N_per_m");

@@ -279,9 +279,11 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
     std::string how = "the scripted demo ended: " + std::string(DemoResult::name(r.outcome));
     if (!r.phase.empty()) how += " (" + r.phase + ")";
     if (!r.reason.empty()) how += ": " + r.reason;
-    if (std::isfinite(r.placement_error_m)) how += fmt::format(", placement error {:.2f} um", 1e6 * r.placement_error_m);
-    note(r.outcome == DemoResult::Outcome::kGaveUp || r.outcome == DemoResult::Outcome::kMissed ? EventLevel::kWarning
-                                                                                                 : EventLevel::kInfo,
+    if (std::isfinite(r.placement_error_m))
+      how += fmt::format(", placement error {:.2f} um", 1e6 * r.placement_error_m);
+    note(r.outcome == DemoResult::Outcome::kGaveUp || r.outcome == DemoResult::Outcome::kMissed
+             ? EventLevel::kWarning
+             : EventLevel::kInfo,
          "demo_end", how);
   }
   if (s.estopped != was.estopped)
@@ -466,11 +468,12 @@ std::string ConsoleServer::status_json() {
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;
   } else {
-    j["demo_result"] = {{"outcome", DemoResult::name(d.outcome)},
-                        {"phase", d.phase},
-                        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
-                        {"reason", d.reason},
-                        {"duration_s", d.duration_s}};
+    j["demo_result"] = {
+        {"outcome", DemoResult::name(d.outcome)},
+        {"phase", d.phase},
+        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
+        {"reason", d.reason},
+        {"duration_s", d.duration_s}};
   }
   return j.dump();
 }

@@ -151,7 +151,8 @@ bool LivePlatform::demo_tick(const platform::TickInfo& t) noexcept {
   demo_duration_s_.store(t.t_s, std::memory_order_relaxed);
   const auto* gripper = platform_->simulation().gripper;
   if (gripper != nullptr)
-    demo_error_m_.store(gripper->world().placement_error_m(gripper->world_state()), std::memory_order_relaxed);
+    demo_error_m_.store(gripper->world().placement_error_m(gripper->world_state()),
+                        std::memory_order_relaxed);
   if (!demo_->done() && !demo_->gave_up()) return true;
   // Finished: every axis holds where it is and the console has control again (issue #26).
   platform_->hold();
@@ -297,9 +298,10 @@ LiveStatus LivePlatform::status() const {
     r.phase = std::string(PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_phase_.load())));
     switch (r.outcome) {
       case DemoResult::Outcome::kGaveUp:
-        r.reason = std::string(
-            PickPlaceOperator::give_up_reason(static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
-        r.phase = std::string(PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
+        r.reason = std::string(PickPlaceOperator::give_up_reason(
+            static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
+        r.phase = std::string(
+            PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_failed_phase_.load())));
         break;
       case DemoResult::Outcome::kPlaced:
         r.reason = "the part rests within the placement tolerance of its target";
@@ -308,8 +310,9 @@ LiveStatus LivePlatform::status() const {
         r.reason = "the pin is down in its hole";
         break;
       case DemoResult::Outcome::kMissed:
-        r.reason = params_.platform.world.hole_side_m > 0.0 ? "the pin is not in its hole"
-                                                            : "the part rests outside the placement tolerance";
+        r.reason = params_.platform.world.hole_side_m > 0.0
+                       ? "the pin is not in its hole"
+                       : "the part rests outside the placement tolerance";
         break;
       default:
         break;

@@ -57,10 +57,10 @@ struct LiveParams {
 struct DemoResult {
   enum class Outcome { kNone, kRunning, kPlaced, kInserted, kMissed, kGaveUp };
   Outcome outcome = Outcome::kNone;
-  std::string phase;              ///< the phase it is in, or gave up in
+  std::string phase;               ///< the phase it is in, or gave up in
   double placement_error_m = NAN;  ///< part centre to target, horizontal (NaN: no part)
-  double duration_s = 0.0;        ///< since the demo started
-  std::string reason;             ///< why it gave up, or what it achieved, in words
+  double duration_s = 0.0;         ///< since the demo started
+  std::string reason;              ///< why it gave up, or what it achieved, in words
   static std::string_view name(Outcome o);
 };
 

@@ -19,7 +19,6 @@ using server::StatusLevel;
 
 constexpr std::string_view kFigures = "-figures";
 
-
 server::HttpReply html_page(int status, const std::string& title, const std::string& text, int refresh_s) {
   server::HttpReply r;
   r.status = status;

@@ -17,7 +17,8 @@ void OpticalTrapParams::validate() const {
   require_positive(obstacle_radius_m, "obstacle_radius_m");
   require_non_negative(contact_stiffness_N_per_m, "contact_stiffness_N_per_m");
   require(std::isfinite(escape_distance_m) && escape_distance_m >= 0.0 && escape_distance_m <= 1e-3,
-          "escape_distance_m", "must be within [0, 1 mm] (0: the bead radius times e^(1/4))", escape_distance_m);
+          "escape_distance_m", "must be within [0, 1 mm] (0: the bead radius times e^(1/4))",
+          escape_distance_m);
   // A physical lower bound on the step (the bead's inertia-free dynamics need nothing finer;
   // the work budget of a run is duration / dt_s).
   require(std::isfinite(dt_s) && dt_s >= 1e-9, "dt_s", "must be >= 1e-09 s", dt_s);
@@ -59,9 +60,7 @@ OpticalTrap::OpticalTrap(const OpticalTrapParams& params) : params_(params) {
   w_ = params_.escape_distance_m > 0.0 ? params_.escape_distance_m : params_.bead_radius_m * std::exp(0.25);
 }
 
-double OpticalTrap::escape_force_N() const {
-  return params_.trap_stiffness_N_per_m * w_ * std::exp(-0.25);
-}
+double OpticalTrap::escape_force_N() const { return params_.trap_stiffness_N_per_m * w_ * std::exp(-0.25); }
 
 double OpticalTrap::corner_frequency_Hz() const {
   return params_.trap_stiffness_N_per_m / (2.0 * std::numbers::pi * gamma_);

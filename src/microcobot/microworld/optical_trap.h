@@ -35,7 +35,7 @@ struct OpticalTrapParams {
   /// Distance from the trap's centre where its force peaks (w above); 0: r e^(1/4), which puts
   /// the escape force at k r.
   double escape_distance_m = 0.0;
-  double dt_s = 1.0e-5;                       ///< integration step (exact Ornstein-Uhlenbeck update)
+  double dt_s = 1.0e-5;  ///< integration step (exact Ornstein-Uhlenbeck update)
 
   template <class V>
   void visit(V& v) {

@@ -41,12 +41,13 @@ void PickPlaceParams::validate() const {
   // A part the fingers cannot hold at their force limit (friction on both sides plus adhesion) can
   // never be lifted: refused before a session that could only time out (gravity 1e308 did).
   const double hold_N = 2.0 * (finger_friction * grip_force_limit_N + finger_pulloff_N);
-  require(part_weight_N() <= hold_N, "gravity_m_s2",
-          fmt::format("makes the part weigh {:.3g} N (part_density_kg_m3 x volume x gravity_m_s2), more than the "
-                      "fingers hold at grip_force_limit_N, 2 (finger_friction x grip_force_limit_N + "
-                      "finger_pulloff_N) = {:.3g} N",
-                      part_weight_N(), hold_N),
-          gravity_m_s2);
+  require(
+      part_weight_N() <= hold_N, "gravity_m_s2",
+      fmt::format("makes the part weigh {:.3g} N (part_density_kg_m3 x volume x gravity_m_s2), more than the "
+                  "fingers hold at grip_force_limit_N, 2 (finger_friction x grip_force_limit_N + "
+                  "finger_pulloff_N) = {:.3g} N",
+                  part_weight_N(), hold_N),
+      gravity_m_s2);
 }
 
 double PickPlaceParams::part_weight_N() const {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "microcobot/core/error.h"
 #include "microcobot/dsp/welch.h"
@@ -24,12 +24,13 @@ TweezersRecord simulate_tweezers(const OpticalTrapParams& params, TweezersScenar
   OpticalTrap trap(params);
   // The record must resolve the bead's corner frequency, or the PSD read from it (and the corner
   // fitted to it) is aliased: 1e-3 N/m at the 10 kHz haptic rate fitted a corner 7 % low.
-  require(trap.corner_frequency_Hz() < 0.5 * o.record_rate_Hz, "trap.trap_stiffness_N_per_m",
-          fmt::format("too stiff for record_rate_Hz = {:g} Hz: the corner frequency k / (2 pi gamma) = {:.3g} Hz "
-                      "must lie below the record's Nyquist frequency; the largest value this rate allows is {:.3g}",
-                      o.record_rate_Hz, trap.corner_frequency_Hz(),
-                      std::numbers::pi * trap.drag() * o.record_rate_Hz),
-          params.trap_stiffness_N_per_m);
+  require(
+      trap.corner_frequency_Hz() < 0.5 * o.record_rate_Hz, "trap.trap_stiffness_N_per_m",
+      fmt::format(
+          "too stiff for record_rate_Hz = {:g} Hz: the corner frequency k / (2 pi gamma) = {:.3g} Hz "
+          "must lie below the record's Nyquist frequency; the largest value this rate allows is {:.3g}",
+          o.record_rate_Hz, trap.corner_frequency_Hz(), std::numbers::pi * trap.drag() * o.record_rate_Hz),
+      params.trap_stiffness_N_per_m);
   const double dt = params.dt_s;
   const auto every = static_cast<long>(std::llround(1.0 / (o.record_rate_Hz * dt)));
   require(every >= 1, "record_rate_Hz", "must not exceed 1/dt_s", o.record_rate_Hz);

@@ -47,7 +47,6 @@ std::string axis_column(const Axis& a) {
   return a.unit.empty() ? s : s + "_" + a.unit;
 }
 
-
 // JSON inside <script>: "</" must not appear.
 std::string script_safe(std::string json) {
   std::size_t pos = 0;

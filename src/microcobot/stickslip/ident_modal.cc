@@ -113,10 +113,11 @@ ModePeaks dynamic_response_peaks(const MeasuredRecord& rec, const std::vector<do
   const auto overflow = [&] {
     double top = 0.0;
     for (double x : rec.x_m) top = std::max(top, std::abs(x));
-    return InvalidInput(rec.source, 0,
-                        fmt::format("column 'x_m': the response's power spectrum overflows (values up to {:g} m): "
-                                    "not a measured position",
-                                    top));
+    return InvalidInput(
+        rec.source, 0,
+        fmt::format("column 'x_m': the response's power spectrum overflows (values up to {:g} m): "
+                    "not a measured position",
+                    top));
   };
   if (!r.allFinite()) throw overflow();
   std::vector<double> seg(r.data(), r.data() + r.size());

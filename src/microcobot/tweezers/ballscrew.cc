@@ -16,7 +16,8 @@ double lead_angle(double diameter_m, double lead_m) {
   // A lead beyond ~1e16 diameters makes the angle round to 90 deg, which no screw has (and which
   // the efficiencies refuse): blamed on the lead the caller gave, not on the derived angle.
   require(theta < std::numbers::pi / 2, "lead_m",
-          fmt::format("too large for diameter_m = {:g} (the lead angle rounds to 90 deg)", diameter_m), lead_m);
+          fmt::format("too large for diameter_m = {:g} (the lead angle rounds to 90 deg)", diameter_m),
+          lead_m);
   return theta;
 }
 

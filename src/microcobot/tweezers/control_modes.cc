@@ -103,12 +103,13 @@ ManualModeResult simulate_manual_mode(const TeleTweezParams& mp, const ManualMod
   // damping 5 N s/m): the held force breaks from omega h ~ 0.7 (1.2e5 N/m at 10 kHz, 4.8e5 at
   // 40 kHz) and diverges by 2e6 N/m at 10 kHz; 0.5 keeps a factor of 2 in stiffness.
   const double k_max = 0.25 * mp.tip_mass_kg * p.plant_rate_Hz * p.plant_rate_Hz;
-  require(p.object_stiffness_N_per_m <= k_max, "object_stiffness_N_per_m",
-          fmt::format("too stiff for plant_rate_Hz = {:g} Hz on the {:g} kg tip (omega h = {:.3g} > 0.5); the "
-                      "largest value this rate allows is {:.3g}",
-                      p.plant_rate_Hz, mp.tip_mass_kg,
-                      std::sqrt(p.object_stiffness_N_per_m) / std::sqrt(mp.tip_mass_kg) / p.plant_rate_Hz, k_max),
-          p.object_stiffness_N_per_m);
+  require(
+      p.object_stiffness_N_per_m <= k_max, "object_stiffness_N_per_m",
+      fmt::format("too stiff for plant_rate_Hz = {:g} Hz on the {:g} kg tip (omega h = {:.3g} > 0.5); the "
+                  "largest value this rate allows is {:.3g}",
+                  p.plant_rate_Hz, mp.tip_mass_kg,
+                  std::sqrt(p.object_stiffness_N_per_m) / std::sqrt(mp.tip_mass_kg) / p.plant_rate_Hz, k_max),
+      p.object_stiffness_N_per_m);
   const int sub = substeps(p.plant_rate_Hz, p.control_rate_Hz);
   const double dt = 1.0 / p.plant_rate_Hz;
   const TeleTweez model(mp, dt);

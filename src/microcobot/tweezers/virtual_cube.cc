@@ -50,9 +50,10 @@ VirtualCubeRenderer::VirtualCubeRenderer(const TeleTweezParams& model, const Vir
           "must be narrower than the static opening", cube.cube_width_m);
   const double k_max = max_renderable_stiffness(model, cube);
   require(cube.stiffness_N_per_m <= k_max, "stiffness_N_per_m",
-          fmt::format("too stiff for control_rate_Hz = {:g} Hz (the wall's frequency on the {:.3g} kg tip mass "
-                      "must stay below the loop's Nyquist frequency); the largest value this rate allows is {:.3g}",
-                      cube.control_rate_Hz, tip_mass(model), k_max),
+          fmt::format(
+              "too stiff for control_rate_Hz = {:g} Hz (the wall's frequency on the {:.3g} kg tip mass "
+              "must stay below the loop's Nyquist frequency); the largest value this rate allows is {:.3g}",
+              cube.control_rate_Hz, tip_mass(model), k_max),
           cube.stiffness_N_per_m);
   if (cube.compensator) lag_.emplace(cube.lag_pole_Hz, cube.lag_zero_Hz, cube.control_rate_Hz);
 }
