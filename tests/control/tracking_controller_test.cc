@@ -101,15 +101,17 @@ TEST(TrackingController, AFastReferenceIsFollowedOverTheSprintRange) {
   EXPECT_GT(final_narrow, 100e-6);  // it fell behind and had not arrived 50 ms after the reference
 }
 
-TEST(TrackingController, ABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
-  // At power-up the drive is at 0 V, below the range: a backward move needs an edge at once. It
-  // spans the sawtooth's amplitude from 0 V (0 -> 70 V), not 0 -> high_V, and the ramp then uses
-  // the voltages below low_V until it rises through low_V.
-  const TrackingParams p;
+TEST(TrackingController, WithoutTheRampInABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
+  // With the power-up ramp-in off the drive stays at 0 V, below the range: a backward move needs
+  // an edge at once. It spans the sawtooth's amplitude from 0 V (0 -> 70 V), not 0 -> high_V, and
+  // the ramp then uses the voltages below low_V until it rises through low_V.
+  TrackingParams p;
+  p.powerup_V = 0.0;
   TrackingController c(p, test::model().params(), test::step_map());
   auto s = test::model().initial_state();
   PositionSensor sensor;
   c.reset(0.0, 0.0);
+  EXPECT_TRUE(c.ready());
   double x_ref = 0.0, first_edge_peak_V = 0.0, lowest_V = p.high_V;
   for (int k = 0; k < 50 && c.edges() < 2; ++k) {  // 200 um/s backward until the second edge
     x_ref -= 200e-6 * 1e-4;
@@ -129,6 +131,32 @@ TEST(TrackingController, ABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
   EXPECT_EQ(c.edges(), 2);
   EXPECT_NEAR(first_edge_peak_V, p.high_V - p.low_V, 1e-9);
   EXPECT_LT(lowest_V, p.low_V);  // the ramp ran below low_V before the next edge
+}
+
+TEST(TrackingController, AtPowerUpTheDriveIsLiftedToMidRangeWhileThePositionHolds) {
+  // Issue #31: from 0 V a backward move's first edge could not be led (626 nm). The ramp-in lifts
+  // the drive to powerup_V by one (uncounted) edge and holds the position until ready().
+  const TrackingParams p;
+  TrackingController c(p, test::model().params(), test::step_map());
+  auto s = test::model().initial_state();
+  PositionSensor sensor;
+  c.reset(0.0, 0.0);
+  EXPECT_FALSE(c.ready());
+  double worst = 0.0;
+  int k = 0;
+  for (; k < 1000 && !c.ready(); ++k) {
+    c.set_reference({0.0, 0.0, 0.0});
+    c.update(sensor.measure(test::model().slider_position(s)));
+    for (int i = 0; i < 10; ++i) test::model().step(s, c.next_drive(1e-5));
+    worst = std::max(worst, std::abs(test::model().slider_position(s)));
+  }
+  EXPECT_TRUE(c.ready());
+  EXPECT_LE(k * 1e-4, p.powerup_settle_s + 1e-3);  // ready after the edge and the settling
+  EXPECT_EQ(c.edges(), 0);                         // not a step of a move
+  EXPECT_GT(c.voltage_V(), p.low_V + 10.0);        // ramp left both ways
+  EXPECT_LT(c.voltage_V(), p.high_V - 10.0);
+  EXPECT_LE(std::abs(test::model().slider_position(s)), 50e-9);
+  EXPECT_LE(worst, 300e-9);
 }
 
 TEST(TrackingController, WithinThePeStrokeItOnlyScans) {
@@ -194,6 +222,12 @@ TEST(TrackingController, InvalidParamsAreRejected) {
   EXPECT_THROW(p.validate(), InvalidParams);
   p = TrackingParams{};
   p.unload_V = 95.0;
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = TrackingParams{};
+  p.powerup_V = 10.0;  // below the range
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = TrackingParams{};
+  p.powerup_unload_V = p.high_V;
   EXPECT_THROW(p.validate(), InvalidParams);
 }
 

@@ -86,6 +86,16 @@ struct TrackingParams {
   /// the 7.5-100 V edge: 118 nm, with the present 30-100 V edge and gains: 82 nm).
   double kp = -0.4;
   double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
+  /// Power-up ramp-in (issue #31): the amplifier starts at 0 V, the bottom of the range, so a
+  /// backward move's first edge would come at once, with no lead to split its dip (626 nm at
+  /// 200 um/s). Instead the controller's first act after a reset below low_V is one edge that
+  /// lifts the drive to powerup_V (mid-range: both directions then have ramp left to lead their
+  /// first edge), overshooting by powerup_unload_V and turning back at the slew limit like every
+  /// edge's unloading; the ramp then holds the position for powerup_settle_s, after which ready()
+  /// reports true and a move may start. 0 V: off (the first edge spans the amplitude from 0 V).
+  double powerup_V = 65.0;
+  double powerup_unload_V = 20.0;  ///< [V]
+  double powerup_settle_s = 3e-3;  ///< [s]
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
   double filter_s = 1e-3;  ///< time constant of the in-position filter [s]
@@ -111,6 +121,9 @@ struct TrackingParams {
     v("ki_1_s", ki_1_s);
     v("kp", kp);
     v("backslip_gain", backslip_gain);
+    v("powerup_V", powerup_V);
+    v("powerup_unload_V", powerup_unload_V);
+    v("powerup_settle_s", powerup_settle_s);
     v("in_position_m", in_position_m);
     v("filter_s", filter_s);
   }
@@ -150,6 +163,9 @@ class TrackingController {
   /// Edges span the sprint range (sprint_low_V..high_V).
   bool sprinting() const noexcept { return sprint_; }
   bool stopped() const noexcept { return stopped_; }
+  /// False from a reset below low_V until the power-up ramp-in has settled (see powerup_V): a
+  /// reference should rest until then. Always true with powerup_V = 0.
+  bool ready() const noexcept { return !powering_up_; }
   /// |filtered error| < in_position_m with the reference at rest.
   bool in_position() const noexcept { return in_position_; }
   /// Present backslip estimate [m] per direction (model prediction refined by the edges).
@@ -167,6 +183,7 @@ class TrackingController {
 
  private:
   void start_edge(double x, bool forward) noexcept;
+  void start_ramp_in(double x) noexcept;
   void anchor_after_edge() noexcept;
   double flyback_frequency_Hz(double v_m_s, double amplitude_V, stickslip::Direction d) const noexcept;
 
@@ -195,6 +212,9 @@ class TrackingController {
   bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
        check_backslip_ = false;
   bool stopped_ = false, in_position_ = false, have_x_ = false, sprint_ = false;
+  /// Power-up: ramp_in_ while its edge and catch-up run, powering_up_ until ready().
+  bool powering_up_ = false, ramp_in_ = false, ramp_in_started_ = false;
+  double powerup_t_ = 0.0;
   std::int64_t edges_ = 0;
 };
 
