@@ -39,6 +39,7 @@ void TrackingParams::validate() const {
   require(powerup_unload_V >= 0.0 && powerup_V + powerup_unload_V <= high_V, "tracking.powerup_unload_V",
           "must be >= 0 with powerup_V + powerup_unload_V <= high_V", powerup_unload_V);
   require_non_negative(powerup_settle_s, "tracking.powerup_settle_s");
+  require_positive(powerup_ready_m, "tracking.powerup_ready_m");
 }
 
 namespace {
@@ -190,8 +191,12 @@ void TrackingController::update(double x) noexcept {
       start_ramp_in(x);
       return;
     }
-    powerup_t_ += dt_c_;
-    if (!edge_ && powerup_t_ >= p_.powerup_settle_s) powering_up_ = false;
+    // Ready once the ramp-in and any edge the hold took after it to catch the drag up are
+    // powerup_settle_s past, and the filtered error is small.
+    powerup_t_ = edge_ || pending_anchor_ ? 0.0 : powerup_t_ + dt_c_;
+    if (powerup_t_ >= p_.powerup_settle_s && std::abs(ref_.x_m - x_filt_) < p_.powerup_ready_m) {
+      powering_up_ = false;
+    }
   }
   if (edge_) return;  // the edge runs in next_drive()
   if (pending_anchor_) {

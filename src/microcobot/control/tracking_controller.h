@@ -93,9 +93,13 @@ struct TrackingParams {
   /// first edge), overshooting by powerup_unload_V and turning back at the slew limit like every
   /// edge's unloading; the ramp then holds the position for powerup_settle_s, after which ready()
   /// reports true and a move may start. 0 V: off (the first edge spans the amplitude from 0 V).
-  double powerup_V = 65.0;
-  double powerup_unload_V = 20.0;  ///< [V]
-  double powerup_settle_s = 3e-3;  ///< [s]
+  double powerup_V = 40.0;
+  double powerup_unload_V = 30.0;  ///< [V]
+  /// Ready once the ramp-in's edge (and any edge the hold takes after it: the fast rise drags the
+  /// slider forward by up to ~1 um, which the hold catches up) is this long past and the filtered
+  /// error is within powerup_ready_m; a move that starts before carries the rest.
+  double powerup_settle_s = 6e-3;  ///< [s]
+  double powerup_ready_m = 10e-9;  ///< [m]
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
   double filter_s = 1e-3;  ///< time constant of the in-position filter [s]
@@ -124,6 +128,7 @@ struct TrackingParams {
     v("powerup_V", powerup_V);
     v("powerup_unload_V", powerup_unload_V);
     v("powerup_settle_s", powerup_settle_s);
+    v("powerup_ready_m", powerup_ready_m);
     v("in_position_m", in_position_m);
     v("filter_s", filter_s);
   }

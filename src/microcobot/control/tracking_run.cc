@@ -132,8 +132,13 @@ struct NewTracker final : Tracker {
     f = c.operating_point().frequency_Hz;
     d = c.operating_point().direction;
   }
-  long edges() const noexcept override { return static_cast<long>(c.edges()); }
-  bool ready() const noexcept override { return c.ready(); }
+  /// The steps of the move: those the hold took at power-up before ready() are not counted.
+  long edges() const noexcept override { return static_cast<long>(c.edges()) - edges_at_ready; }
+  bool ready() const noexcept override {
+    if (!c.ready()) edges_at_ready = static_cast<long>(c.edges());
+    return c.ready();
+  }
+  mutable long edges_at_ready = 0;
 };
 
 struct HybridTracker final : Tracker {

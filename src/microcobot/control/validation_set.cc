@@ -149,7 +149,7 @@ std::vector<ValidationCase> make_case_set(CaseSet set, std::uint64_t seed, int r
   require(random_cases >= 0 && random_cases <= 1000, "cases", "must lie in [0, 1000]", random_cases);
   // The validation set is judged only: its draws must not be the tuning set's.
   require(set == CaseSet::kTuning || seed != kTuningSeed, "seed",
-          fmt::format("must differ from the tuning seed {} (the sets are kept apart)", kTuningSeed),
+          fmt::format("must differ from the tuning set's ({}): the sets are kept apart", kTuningSeed),
           static_cast<double>(seed));
   std::vector<ValidationCase> cases;
   if (set == CaseSet::kTuning) {
