@@ -119,7 +119,7 @@ void add_control_validate(CLI::App& group) {
   cmd->add_option("--set", o->set, "tuning | validation")->check(CLI::IsMember({"tuning", "validation"}));
   cmd->add_option("--seed", o->seed, "Random draw's seed (default: tuning 15, validation 31)")
       ->check(CLI::Range(0LL, 1LL << 53));
-  cmd->add_option("--cases", o->cases, "Number of random cases (default: tuning 16 + 9 named, validation 32)")
+  cmd->add_option("--cases", o->cases, "Number of random cases (default: tuning 32 + 9 named, validation 32)")
       ->check(CLI::Range(0, 1000));
   add_output_options(*cmd, o->common);
   add_params_option(*cmd, o->common);

@@ -1,6 +1,7 @@
 // Tracking that generalises (issue #31 point 1): the seeded tuning and validation sets, and the
 // tracking controller judged on the validation set (never tuned on it).
 #include <algorithm>
+#include <cstdio>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include "control_fixture.h"
 #include "microcobot/control/validation_set.h"
 #include "microcobot/core/error.h"
+#include "microcobot/core/rng.h"
 
 namespace mc::control {
 namespace {
@@ -71,6 +73,42 @@ TEST(ValidationSet, ThePowerUpBackwardGoalIsJudgedOnlyWhereItApplies) {
   c.power_up = true;
   c.profile = CaseProfile::kLine;
   EXPECT_FALSE(starts_backward_from_power_up(c));
+}
+
+// The tracking goals on a reduced random subset of the validation set (12 of its 32 cases, chosen
+// by a seeded shuffle; the full table is `microcobot control validate`, docs/benchmarks.md). The
+// controller was tuned on the tuning set only. Goals that hold on the full validation set are
+// asserted as goals; those that do not (docs/benchmarks.md names the cases) are asserted at the
+// level measured, so that a regression fails.
+TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
+  const auto all = make_case_set(CaseSet::kValidation, kValidationSeed, kValidationCases);
+  std::vector<std::size_t> idx(all.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  Rng rng(20261125);
+  for (std::size_t i = idx.size() - 1; i > 0; --i) std::swap(idx[i], idx[rng.next_u64() % (i + 1)]);
+  idx.resize(12);
+  std::vector<ValidationCase> cases;
+  std::vector<CaseResult> results;
+  const TrackerSetup su;
+  const TrackingGoals goals;
+  for (std::size_t i : idx) {
+    cases.push_back(all[i]);
+    results.push_back(run_case(test::model(), test::step_map(), su, all[i], goals));
+    SCOPED_TRACE(all[i].name + ": " + describe(all[i]));
+    if (all[i].profile != CaseProfile::kSine) EXPECT_LE(results.back().final_m, 5e-9);  // at rest: #15's goal
+  }
+  const ValidationSummary s = summarise(cases, results, goals);
+  std::printf("subset: %d/%d pass, median RMS %.0f nm, worst RMS %.0f, max %.0f, path %.0f, power-up backward %.0f nm\n",
+              s.passed, s.cases, s.median_rms_m * 1e9, s.worst_rms_m * 1e9, s.worst_max_m * 1e9,
+              s.worst_path_deviation_m * 1e9, s.worst_powerup_backward_m * 1e9);
+  // Holds on the full validation set (92 nm): the goal itself.
+  EXPECT_TRUE(s.median_ok) << s.median_rms_m;
+  // Do not hold on the full validation set (worst RMS 403 nm, max 916 nm, path deviation 547 nm,
+  // power-up backward 306 nm: docs/benchmarks.md); bounded at the measured level with ~10 % margin.
+  EXPECT_LE(s.worst_rms_m, 450e-9);
+  EXPECT_LE(s.worst_max_m, 1000e-9);
+  EXPECT_LE(s.worst_path_deviation_m, 600e-9);
+  EXPECT_LE(s.worst_powerup_backward_m, 340e-9);
 }
 
 }  // namespace

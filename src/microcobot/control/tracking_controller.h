@@ -44,18 +44,18 @@ struct TrackingParams {
   /// narrower edge rings the contact less (200 um/s trapezoid RMS 118 nm over 7.5-100 V, 81-85 nm
   /// over 30-100 V) but advances less per edge, so a fast or accelerating reference is followed
   /// over the wider sprint range below.
-  double low_V = 30.0;
+  double low_V = 31.62;
   double high_V = 100.0;
   /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
-  double sprint_velocity_m_s = 600e-6;  ///< [m/s]: the 30-100 V edges follow ~600 um/s at 2e-2 m/s^2
-  double sprint_lag_m = 1e-6;           ///< [m]: above the edges' own transients (<= ~0.65 um)
+  double sprint_velocity_m_s = 910.2e-6;  ///< [m/s]: the 30-100 V edges follow ~600 um/s at 2e-2 m/s^2
+  double sprint_lag_m = 0.7183e-6;           ///< [m]: above the edges' own transients (<= ~0.65 um)
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
   /// before an edge (an axis that fell behind catches up instead of stalling) [V].
-  double edge_ready_V = 10.0;
+  double edge_ready_V = 11.31;
   /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
   /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
   /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V]. For the
@@ -66,17 +66,17 @@ struct TrackingParams {
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
-  double lead_fraction = 0.837;
+  double lead_fraction = 1.0;
   /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
   /// the unloading run, then returns) [m].
-  double lead_m = 450e-9;
+  double lead_m = 689.8e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
-  double lead_window_m = 253e-9;
+  double lead_window_m = 239.3e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
-  double catchup_s = 0.6e-3;
+  double catchup_s = 0.6204e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
-  double settle_s = 0.55e-3;
-  double ki_1_s = 1240.0;  ///< integral gain on the residual error [1/s]
+  double settle_s = 0.553e-3;
+  double ki_1_s = 1581.0;  ///< integral gain on the residual error [1/s]
   /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
@@ -84,8 +84,8 @@ struct TrackingParams {
   /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
   /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1 with the earlier 0-100 V edge; -0.4 with
   /// the 7.5-100 V edge: 118 nm, with the present 30-100 V edge and gains: 82 nm).
-  double kp = -0.4;
-  double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
+  double kp = -0.2819;
+  double backslip_gain = 0.3636;  ///< update rate of the backslip estimate per edge (0: model only)
   /// Power-up ramp-in (issue #31): the amplifier starts at 0 V, the bottom of the range, so a
   /// backward move's first edge would come at once, with no lead to split its dip (626 nm at
   /// 200 um/s). Instead the controller's first act after a reset below low_V is one edge that
@@ -93,7 +93,7 @@ struct TrackingParams {
   /// first edge), overshooting by powerup_unload_V and turning back at the slew limit like every
   /// edge's unloading; the ramp then holds the position for powerup_settle_s, after which ready()
   /// reports true and a move may start. 0 V: off (the first edge spans the amplitude from 0 V).
-  double powerup_V = 40.0;
+  double powerup_V = 59.73;
   double powerup_unload_V = 30.0;  ///< [V]
   /// Ready once the ramp-in's edge (and any edge the hold takes after it: the fast rise drags the
   /// slider forward by up to ~1 um, which the hold catches up) is this long past and the filtered

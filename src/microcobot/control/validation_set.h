@@ -33,7 +33,7 @@ CaseSet parse_case_set(const std::string& name, const std::string& field = "set"
 inline constexpr std::uint64_t kTuningSeed = 15;
 inline constexpr std::uint64_t kValidationSeed = 31;
 /// The default sizes: the validation set >= 30 references (issue #31).
-inline constexpr int kTuningRandomCases = 16;
+inline constexpr int kTuningRandomCases = 32;
 inline constexpr int kValidationCases = 32;
 /// Longest reference drawn [s]: a draw whose move would last longer is drawn again, so that a
 /// 2 mm move at 20 um/s (100 s of simulation) does not dominate the run time; the sine runs one
