@@ -38,6 +38,9 @@
 
 namespace mc::control {
 
+/// The gains (low_V, sprint_*, edge_ready_V, lead_*, catchup_s, settle_s, ki_1_s, kp, backslip_gain,
+/// powerup_V) were chosen on the tuning set of `microcobot control validate --set tuning` only and are
+/// judged on its validation set (issue #31; docs/parameters.md, docs/benchmarks.md).
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
   /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low). A
@@ -49,8 +52,10 @@ struct TrackingParams {
   /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
-  double sprint_velocity_m_s = 910.2e-6;  ///< [m/s]: the 30-100 V edges follow ~600 um/s at 2e-2 m/s^2
-  double sprint_lag_m = 0.7183e-6;           ///< [m]: above the edges' own transients (<= ~0.65 um)
+  /// [m/s]: retuned from 600 um/s; fast, strongly accelerating moves (510-660 um/s at > 0.05 m/s^2) now
+  /// lag ~0.9 um before the lag trigger starts the sprint (docs/benchmarks.md).
+  double sprint_velocity_m_s = 910.2e-6;
+  double sprint_lag_m = 0.7183e-6;  ///< [m]: just above the edges' own transients
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
