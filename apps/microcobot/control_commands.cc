@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "control_validate.h"
 #include "microcobot/control/closed_loop.h"
 #include "microcobot/control/control_params.h"
 #include "microcobot/control/setpoint_stream.h"
@@ -499,6 +500,7 @@ void add_control(CLI::App& group) {
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_trajectory_cmd(*o); });
   }
+  mc::cli::add_control_validate(group);
 }
 
 void control_part(Report& r) {

@@ -163,6 +163,13 @@ TEST(Hardening, WorkBudgetsAreCheckedBeforeTheRun) {
   expect_error({"stickslip", "simulate", "--duration", "1e4"}, 3, "work budget", kPromptly_s);
 }
 
+TEST(Hardening, ControlValidateNamesItsFlags) {
+  // Issue #31: the validation set cannot be drawn with the tuning set's seed (the sets are kept apart).
+  expect_error({"control", "validate", "--seed", "15"}, 3, "--seed", kPromptly_s);
+  expect_error({"control", "validate", "--set", "all"}, 2, "--set", kPromptly_s);
+  expect_error({"control", "validate", "--cases", "0"}, 2, "--cases", kPromptly_s);
+}
+
 TEST(Hardening, WideCsvHeaderIsLinear) {
   TempDir d;
   std::string header, row;

@@ -31,17 +31,17 @@ TrackingRecord trapezoid(TrackerKind kind, double distance_m, double velocity_m_
       trapezoid_duration_s(std::abs(distance_m), lim) + 0.05);
 }
 
-// The issue's goals: RMS <= 100 nm at 200 um/s, <= 150 nm at 50 and 500 um/s, max <= 250 nm. The
-// RMS goals hold (CLI runs on five sensor-noise seeds: 80-88 nm, 84-88 nm, 101-136 nm); the max
-// holds forward at the edge of the goal (236-249 nm) and not at the start of a backward move from
-// power-up (626 nm: the first edge cannot be led, docs/errata.md), hence the bounds below.
+// The issue's goals: RMS <= 100 nm at 200 um/s, <= 150 nm at 50 and 500 um/s, max <= 250 nm. With
+// the gains retuned on the tuning set of issue #31 (`control trajectory`): RMS 86 nm forward, 89 nm
+// backward; max 274 nm forward and 296 nm backward from power-up (626 nm before the power-up
+// ramp-in): neither max meets 250 nm (docs/benchmarks.md), hence the bounds below.
 TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
   for (double d : {100e-6, -100e-6}) {
     SCOPED_TRACE(d);
     const auto t = trapezoid(TrackerKind::kTracking, d, 200e-6).metrics;
     const auto h = trapezoid(TrackerKind::kHybrid, d, 200e-6).metrics;
     EXPECT_LE(t.rms_error_m, 100e-9);
-    EXPECT_LE(t.max_error_m, d > 0 ? 300e-9 : 700e-9);
+    EXPECT_LE(t.max_error_m, d > 0 ? 300e-9 : 330e-9);
     EXPECT_LE(t.final_error_m, 5e-9);  // issue goal: final error unchanged
     EXPECT_LE(t.lag_s, 0.5e-3);
     EXPECT_LT(t.rms_error_m, 0.1 * h.rms_error_m);  // >= 10x better than today's controller
@@ -101,15 +101,17 @@ TEST(TrackingController, AFastReferenceIsFollowedOverTheSprintRange) {
   EXPECT_GT(final_narrow, 100e-6);  // it fell behind and had not arrived 50 ms after the reference
 }
 
-TEST(TrackingController, ABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
-  // At power-up the drive is at 0 V, below the range: a backward move needs an edge at once. It
-  // spans the sawtooth's amplitude from 0 V (0 -> 70 V), not 0 -> high_V, and the ramp then uses
-  // the voltages below low_V until it rises through low_V.
-  const TrackingParams p;
+TEST(TrackingController, WithoutTheRampInABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
+  // With the power-up ramp-in off the drive stays at 0 V, below the range: a backward move needs
+  // an edge at once. It spans the sawtooth's amplitude from 0 V (0 -> 70 V), not 0 -> high_V, and
+  // the ramp then uses the voltages below low_V until it rises through low_V.
+  TrackingParams p;
+  p.powerup_V = 0.0;
   TrackingController c(p, test::model().params(), test::step_map());
   auto s = test::model().initial_state();
   PositionSensor sensor;
   c.reset(0.0, 0.0);
+  EXPECT_TRUE(c.ready());
   double x_ref = 0.0, first_edge_peak_V = 0.0, lowest_V = p.high_V;
   for (int k = 0; k < 50 && c.edges() < 2; ++k) {  // 200 um/s backward until the second edge
     x_ref -= 200e-6 * 1e-4;
@@ -129,6 +131,40 @@ TEST(TrackingController, ABackwardMoveFromPowerUpStepsWithTheUsualAmplitude) {
   EXPECT_EQ(c.edges(), 2);
   EXPECT_NEAR(first_edge_peak_V, p.high_V - p.low_V, 1e-9);
   EXPECT_LT(lowest_V, p.low_V);  // the ramp ran below low_V before the next edge
+}
+
+TEST(TrackingController, AtPowerUpTheDriveIsLiftedToMidRangeWhileThePositionHolds) {
+  // Issue #31: from 0 V a backward move's first edge could not be led (626 nm). The ramp-in lifts
+  // the drive into the range by one edge at rest; its drag (the fast rise pulls the slider forward)
+  // is caught up by the hold before ready().
+  const TrackingParams p;
+  TrackingController c(p, test::model().params(), test::step_map());
+  auto s = test::model().initial_state();
+  PositionSensor sensor;
+  c.reset(0.0, 0.0);
+  EXPECT_FALSE(c.ready());
+  double drag = 0.0;
+  int k = 0, ready_at = -1;
+  for (; k < 300 && (ready_at < 0 || k < ready_at + 50); ++k) {  // until 5 ms after ready()
+    c.set_reference({0.0, 0.0, 0.0});
+    c.update(sensor.measure(test::model().slider_position(s)));
+    for (int i = 0; i < 10; ++i) test::model().step(s, c.next_drive(1e-5));
+    drag = std::max(drag, std::abs(test::model().slider_position(s)));
+    if (c.ready() && ready_at < 0) ready_at = k;
+  }
+  ASSERT_GE(ready_at, 0);
+  EXPECT_GE(ready_at * 1e-4, p.powerup_settle_s);  // not before the settling
+  EXPECT_LE(ready_at * 1e-4, 0.015);
+  EXPECT_GT(drag, 50e-9);   // the edge did move the slider (the test would pass without a ramp-in otherwise)
+  EXPECT_LE(drag, 600e-9);
+  EXPECT_GE(c.voltage_V(), p.low_V);  // in range: both directions have ramp to lead their first edge
+  EXPECT_LT(c.voltage_V(), p.high_V - 10.0);
+  EXPECT_LE(std::abs(test::model().slider_position(s)), 20e-9);  // held 5 ms after ready()
+  TrackingParams off = p;
+  off.powerup_V = 0.0;
+  TrackingController c0(off, test::model().params(), test::step_map());
+  c0.reset(0.0, 0.0);
+  EXPECT_TRUE(c0.ready());
 }
 
 TEST(TrackingController, WithinThePeStrokeItOnlyScans) {
@@ -194,6 +230,12 @@ TEST(TrackingController, InvalidParamsAreRejected) {
   EXPECT_THROW(p.validate(), InvalidParams);
   p = TrackingParams{};
   p.unload_V = 95.0;
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = TrackingParams{};
+  p.powerup_V = 10.0;  // below the range
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = TrackingParams{};
+  p.powerup_unload_V = p.high_V;
   EXPECT_THROW(p.validate(), InvalidParams);
 }
 

@@ -34,6 +34,12 @@ void TrackingParams::validate() const {
   require_in_range(backslip_gain, 0.0, 1.0, "tracking.backslip_gain");
   require_positive(in_position_m, "tracking.in_position_m");
   require_positive(filter_s, "tracking.filter_s");
+  require(powerup_V == 0.0 || (powerup_V >= low_V && powerup_V <= high_V), "tracking.powerup_V",
+          "must be 0 (off) or within low_V..high_V", powerup_V);
+  require(powerup_unload_V >= 0.0 && powerup_V + powerup_unload_V <= high_V, "tracking.powerup_unload_V",
+          "must be >= 0 with powerup_V + powerup_unload_V <= high_V", powerup_unload_V);
+  require_non_negative(powerup_settle_s, "tracking.powerup_settle_s");
+  require_positive(powerup_ready_m, "tracking.powerup_ready_m");
 }
 
 namespace {
@@ -107,6 +113,9 @@ void TrackingController::reset(double x_m, double u_V) noexcept {
   have_x_ = true;
   edge_ = pending_anchor_ = check_backslip_ = sprint_ = false;
   stopped_ = false;
+  ramp_in_ = ramp_in_started_ = false;
+  powering_up_ = p_.powerup_V > 0.0 && u_V < p_.low_V;
+  powerup_t_ = 0.0;
 }
 
 void TrackingController::emergency_stop() noexcept {
@@ -137,6 +146,24 @@ void TrackingController::start_edge(double x, bool forward) noexcept {
   ++edges_;
 }
 
+void TrackingController::start_ramp_in(double x) noexcept {
+  // One backward-type edge (the voltage rises at the slew limit, the slider slips and stays but
+  // for a small drag) from the power-up voltage to powerup_V + powerup_unload_V, then the
+  // unloading back to powerup_V. The slider's displacement is measured and caught up by the ramp
+  // while the reference rests. It is not a step of the move: edges() does not count it, nor does
+  // its outcome refine the backslip estimates.
+  op_.amplitude_V = p_.powerup_V + p_.powerup_unload_V - u_;
+  op_.direction = Direction::kBackward;
+  edge_ = true;
+  edge_forward_ = false;
+  edge_target_V_ = p_.powerup_V + p_.powerup_unload_V;
+  unload_V_ = p_.powerup_unload_V;
+  unloading_ = false;
+  x_edge_ = x;
+  b_used_ = 0.0;
+  ramp_in_ = ramp_in_started_ = true;
+}
+
 void TrackingController::anchor_after_edge() noexcept {
   // The slider kept its place but for the backslip: anchor the ramp there. The error the plan
   // now has (the reference moved on, the lead, the backslip) is caught up smoothly.
@@ -159,8 +186,23 @@ void TrackingController::update(double x) noexcept {
   }
   x_filt_ += dt_c_ / (p_.filter_s + dt_c_) * (x - x_filt_);
   in_position_ = ref_.v_m_s == 0.0 && std::abs(ref_.x_m - x_filt_) < p_.in_position_m;
+  if (powering_up_) {
+    if (!ramp_in_started_) {
+      start_ramp_in(x);
+      return;
+    }
+    // Ready once the ramp-in and any edge the hold took after it to catch the drag up are
+    // powerup_settle_s past, and the filtered error is small.
+    powerup_t_ = edge_ || pending_anchor_ ? 0.0 : powerup_t_ + dt_c_;
+    if (powerup_t_ >= p_.powerup_settle_s && std::abs(ref_.x_m - x_filt_) < p_.powerup_ready_m) {
+      powering_up_ = false;
+    }
+  }
   if (edge_) return;  // the edge runs in next_drive()
-  if (pending_anchor_) anchor_after_edge();
+  if (pending_anchor_) {
+    anchor_after_edge();
+    if (ramp_in_) floor_V_ = p_.low_V;  // the drive is in range now
+  }
   since_edge_s_ += dt_c_;
   corr_ = corr_from_ + (corr_to_ - corr_from_) * blend(since_edge_s_ / p_.catchup_s);
   const double e = ref_.x_m - x;
@@ -171,7 +213,8 @@ void TrackingController::update(double x) noexcept {
     check_backslip_ = false;
     const double miss = e - e_plan;
     double& b = edge_forward_ ? b_fwd_ : b_bwd_;
-    b = std::max(0.0, b + p_.backslip_gain * (edge_forward_ ? miss : -miss));
+    if (!ramp_in_) b = std::max(0.0, b + p_.backslip_gain * (edge_forward_ ? miss : -miss));
+    ramp_in_ = false;
     corr_from_ = corr_;
     corr_to_ += miss;
     since_edge_s_ = 0.0;
@@ -249,7 +292,7 @@ stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
         seg.at[static_cast<std::size_t>(seg.corners)] = (dt_s - left) / dt_s;
         ++seg.corners;
       }
-      if (!unloading_ && p_.unload_V > 0.0) {
+      if (!unloading_ && unload_V_ > 0.0) {
         unloading_ = true;
         edge_target_V_ += edge_forward_ ? unload_V_ : -unload_V_;
       } else {

@@ -38,24 +38,29 @@
 
 namespace mc::control {
 
+/// The gains (low_V, sprint_*, edge_ready_V, lead_*, catchup_s, settle_s, ki_1_s, kp, backslip_gain,
+/// powerup_V) were chosen on the tuning set of `microcobot control validate --set tuning` only and are
+/// judged on its validation set (issue #31; docs/parameters.md, docs/benchmarks.md).
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
   /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low). A
   /// narrower edge rings the contact less (200 um/s trapezoid RMS 118 nm over 7.5-100 V, 81-85 nm
   /// over 30-100 V) but advances less per edge, so a fast or accelerating reference is followed
   /// over the wider sprint range below.
-  double low_V = 30.0;
+  double low_V = 31.62;
   double high_V = 100.0;
   /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
-  double sprint_velocity_m_s = 600e-6;  ///< [m/s]: the 30-100 V edges follow ~600 um/s at 2e-2 m/s^2
-  double sprint_lag_m = 1e-6;           ///< [m]: above the edges' own transients (<= ~0.65 um)
+  /// [m/s]: retuned from 600 um/s; fast, strongly accelerating moves (510-660 um/s at > 0.05 m/s^2) now
+  /// lag ~0.9 um before the lag trigger starts the sprint (docs/benchmarks.md).
+  double sprint_velocity_m_s = 910.2e-6;
+  double sprint_lag_m = 0.7183e-6;  ///< [m]: just above the edges' own transients
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
   /// before an edge (an axis that fell behind catches up instead of stalling) [V].
-  double edge_ready_V = 10.0;
+  double edge_ready_V = 11.31;
   /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
   /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
   /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V]. For the
@@ -66,17 +71,17 @@ struct TrackingParams {
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
-  double lead_fraction = 0.837;
+  double lead_fraction = 1.0;
   /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
   /// the unloading run, then returns) [m].
-  double lead_m = 450e-9;
+  double lead_m = 689.8e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
-  double lead_window_m = 253e-9;
+  double lead_window_m = 239.3e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
-  double catchup_s = 0.6e-3;
+  double catchup_s = 0.6204e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
-  double settle_s = 0.55e-3;
-  double ki_1_s = 1240.0;  ///< integral gain on the residual error [1/s]
+  double settle_s = 0.553e-3;
+  double ki_1_s = 1581.0;  ///< integral gain on the residual error [1/s]
   /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
@@ -84,8 +89,22 @@ struct TrackingParams {
   /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
   /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1 with the earlier 0-100 V edge; -0.4 with
   /// the 7.5-100 V edge: 118 nm, with the present 30-100 V edge and gains: 82 nm).
-  double kp = -0.4;
-  double backslip_gain = 0.3;  ///< update rate of the backslip estimate per edge (0: model only)
+  double kp = -0.2819;
+  double backslip_gain = 0.3636;  ///< update rate of the backslip estimate per edge (0: model only)
+  /// Power-up ramp-in (issue #31): the amplifier starts at 0 V, the bottom of the range, so a
+  /// backward move's first edge would come at once, with no lead to split its dip (626 nm at
+  /// 200 um/s). Instead the controller's first act after a reset below low_V is one edge that
+  /// lifts the drive to powerup_V (mid-range: both directions then have ramp left to lead their
+  /// first edge), overshooting by powerup_unload_V and turning back at the slew limit like every
+  /// edge's unloading; the ramp then holds the position for powerup_settle_s, after which ready()
+  /// reports true and a move may start. 0 V: off (the first edge spans the amplitude from 0 V).
+  double powerup_V = 59.73;
+  double powerup_unload_V = 30.0;  ///< [V]
+  /// Ready once the ramp-in's edge (and any edge the hold takes after it: the fast rise drags the
+  /// slider forward by up to ~1 um, which the hold catches up) is this long past and the filtered
+  /// error is within powerup_ready_m; a move that starts before carries the rest.
+  double powerup_settle_s = 6e-3;  ///< [s]
+  double powerup_ready_m = 10e-9;  ///< [m]
   /// In position: |filtered error| below this with the reference at rest [m] (reported only).
   double in_position_m = 3e-9;
   double filter_s = 1e-3;  ///< time constant of the in-position filter [s]
@@ -111,6 +130,10 @@ struct TrackingParams {
     v("ki_1_s", ki_1_s);
     v("kp", kp);
     v("backslip_gain", backslip_gain);
+    v("powerup_V", powerup_V);
+    v("powerup_unload_V", powerup_unload_V);
+    v("powerup_settle_s", powerup_settle_s);
+    v("powerup_ready_m", powerup_ready_m);
     v("in_position_m", in_position_m);
     v("filter_s", filter_s);
   }
@@ -150,6 +173,9 @@ class TrackingController {
   /// Edges span the sprint range (sprint_low_V..high_V).
   bool sprinting() const noexcept { return sprint_; }
   bool stopped() const noexcept { return stopped_; }
+  /// False from a reset below low_V until the power-up ramp-in has settled (see powerup_V): a
+  /// reference should rest until then. Always true with powerup_V = 0.
+  bool ready() const noexcept { return !powering_up_; }
   /// |filtered error| < in_position_m with the reference at rest.
   bool in_position() const noexcept { return in_position_; }
   /// Present backslip estimate [m] per direction (model prediction refined by the edges).
@@ -167,6 +193,7 @@ class TrackingController {
 
  private:
   void start_edge(double x, bool forward) noexcept;
+  void start_ramp_in(double x) noexcept;
   void anchor_after_edge() noexcept;
   double flyback_frequency_Hz(double v_m_s, double amplitude_V, stickslip::Direction d) const noexcept;
 
@@ -195,6 +222,9 @@ class TrackingController {
   bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
        check_backslip_ = false;
   bool stopped_ = false, in_position_ = false, have_x_ = false, sprint_ = false;
+  /// Power-up: ramp_in_ while its edge and catch-up run, powering_up_ until ready().
+  bool powering_up_ = false, ramp_in_ = false, ramp_in_started_ = false;
+  double powerup_t_ = 0.0;
   std::int64_t edges_ = 0;
 };
 

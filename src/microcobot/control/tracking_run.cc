@@ -112,6 +112,8 @@ struct Tracker {
   virtual stickslip::DriveSegment next_drive(double dt) noexcept = 0;
   virtual void operating_point(double& a, double& f, stickslip::Direction& d) const noexcept = 0;
   virtual long edges() const noexcept = 0;
+  /// Power-up done: the reference may move.
+  virtual bool ready() const noexcept { return true; }
 };
 
 struct NewTracker final : Tracker {
@@ -130,7 +132,13 @@ struct NewTracker final : Tracker {
     f = c.operating_point().frequency_Hz;
     d = c.operating_point().direction;
   }
-  long edges() const noexcept override { return static_cast<long>(c.edges()); }
+  /// The steps of the move: those the hold took at power-up before ready() are not counted.
+  long edges() const noexcept override { return static_cast<long>(c.edges()) - edges_at_ready; }
+  bool ready() const noexcept override {
+    if (!c.ready()) edges_at_ready = static_cast<long>(c.edges());
+    return c.ready();
+  }
+  mutable long edges_at_ready = 0;
 };
 
 struct HybridTracker final : Tracker {
@@ -190,15 +198,29 @@ std::unique_ptr<Tracker> make_tracker(TrackerKind kind, const TrackerSetup& setu
 }  // namespace
 
 PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind kind,
-                    const TrackerSetup& setup, const PathGenerator& path, double hold_s, int max_records) {
+                    const TrackerSetup& setup, const PathGenerator& path, double hold_s, int max_records,
+                    const PathLeadIn& lead_in) {
   require_non_negative(hold_s, "hold_s");
   require(max_records >= 10, "max_records", "must be >= 10", max_records);
+  require_non_negative(lead_in.dwell_s, "lead_in.dwell_s");
+  const double lead_s = lead_in.path ? lead_in.path->duration_s() + lead_in.dwell_s : 0.0;
+  if (lead_in.path) {
+    require((lead_in.path->sample(lead_in.path->duration_s()).x_m - path.sample(0.0).x_m).norm() < 1e-12,
+            "lead_in.path", "must end where the path starts");
+  }
+  // The reference at time t since the axes were ready: the lead-in, its rest, then the path.
+  const auto reference = [&](double t) {
+    if (!lead_in.path) return path.sample(t);
+    if (t < lead_in.path->duration_s()) return lead_in.path->sample(t);
+    if (t < lead_s) return path.sample(0.0);
+    return path.sample(t - lead_s);
+  };
   const int ratio = steps_per_tick(model, 10000.0);
   const double tick = static_cast<double>(ratio) * model.dt_s();
-  const double duration = path.duration_s() + hold_s;
+  const double duration = lead_s + path.duration_s() + hold_s;
   const long ticks = std::lround(duration / tick);
   const long every = std::max(1L, ticks / max_records);
-  const PathSample p0 = path.sample(0.0);
+  const PathSample p0 = reference(0.0);
   std::array<std::unique_ptr<Tracker>, 3> tr;
   std::array<ActuatorState, 3> st;
   std::vector<PositionSensor> sensors;
@@ -215,9 +237,15 @@ PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind 
   long n = 0;
   const double dt = model.dt_s();
   Eigen::Vector3d x = p0.x_m, r = p0.x_m;
-  for (long k = 0; k < ticks; ++k) {
-    const double t = static_cast<double>(k) * tick;
-    const PathSample ps = path.sample(t);
+  // Power-up: the reference rests at its start until every axis is ready (bounded: 0.1 s).
+  long wait = 0;
+  const long max_wait = std::lround(0.1 / tick);
+  for (long k = 0; k < ticks + wait; ++k) {
+    const bool ready = std::all_of(tr.begin(), tr.end(), [](const auto& t) { return t->ready(); });
+    if (!ready && k == wait && wait < max_wait) ++wait;
+    const double t = static_cast<double>(k - wait) * tick;
+    PathSample ps = k < wait ? p0 : reference(t);
+    if (k < wait) ps.v_m_s.setZero(), ps.a_m_s2.setZero();
     for (int i = 0; i < 3; ++i) {
       const auto iu = static_cast<std::size_t>(i);
       ActuatorState& s = st[iu];
@@ -235,9 +263,10 @@ PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind 
       x[i] = model.slider_position(s);
     }
     r = ps.x_m;
-    const double dev = path.distance_to_path(x);
+    const bool measured = k >= wait && t >= lead_s && t <= lead_s + path.duration_s();
+    const double dev = measured ? path.distance_to_path(x) : 0.0;
     const double err = (x - r).norm();
-    if (t <= path.duration_s()) {
+    if (measured) {
       sq_dev += dev * dev;
       sq_err += err * err;
       ++n;
@@ -245,7 +274,7 @@ PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind 
       rec.metrics.max_error_m = std::max(rec.metrics.max_error_m, err);
     }
     if (k % every == 0) {
-      rec.t_s.push_back(t + tick);
+      rec.t_s.push_back(static_cast<double>(k + 1) * tick);
       rec.deviation_m.push_back(dev);
       for (std::size_t i = 0; i < 3; ++i) {
         rec.x_m[i].push_back(x[static_cast<Eigen::Index>(i)]);
@@ -262,9 +291,11 @@ PathRecord run_path(const ActuatorModel& model, const StepMap& map, TrackerKind 
 
 TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, TrackerKind kind,
                            const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
-                           double duration_s, int max_records) {
+                           double duration_s, int max_records, double metrics_from_s) {
   require_positive(duration_s, "duration_s");
   require(max_records >= 10, "max_records", "must be >= 10", max_records);
+  require(metrics_from_s >= 0.0 && metrics_from_s < duration_s, "metrics_from_s", "must lie in [0, duration_s)",
+          metrics_from_s);
   std::unique_ptr<Tracker> tr = make_tracker(kind, setup, model, map, start_m);
   PositionSensor sensor(setup.sensor);
   ActuatorState s = start_state(model, start_m);
@@ -272,12 +303,21 @@ TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, Track
   const double tick = static_cast<double>(ratio) * model.dt_s();
   const long ticks = std::lround(duration_s / tick);
   const long every = std::max(1L, ticks / max_records);
-  std::vector<double> ref(static_cast<std::size_t>(ticks)), xs(static_cast<std::size_t>(ticks));
-  std::vector<char> moving(static_cast<std::size_t>(ticks));
+  std::vector<double> ref, xs;
+  std::vector<char> moving;
+  ref.reserve(static_cast<std::size_t>(ticks));
+  xs.reserve(static_cast<std::size_t>(ticks));
+  moving.reserve(static_cast<std::size_t>(ticks));
   TrackingRecord rec;
   const double dt = model.dt_s();
-  for (long k = 0; k < ticks; ++k) {
-    const ReferenceSample r = reference(static_cast<double>(k) * tick, tick);
+  // Power-up: the reference rests at start_m until the tracker is ready (bounded: 0.1 s); its
+  // clock starts then.
+  long wait = 0;
+  const long max_wait = std::lround(0.1 / tick);
+  for (long k = 0; k < ticks + wait; ++k) {
+    if (!tr->ready() && k == wait && wait < max_wait) ++wait;
+    const double t_ref = static_cast<double>(k - wait) * tick;
+    const ReferenceSample r = k < wait ? ReferenceSample{start_m, 0.0, 0.0} : reference(t_ref, tick);
     tr->update(r, sensor.measure(model.slider_position(s)));
     double a = 0.0, f = 1000.0;
     stickslip::Direction d = stickslip::Direction::kForward;
@@ -294,10 +334,9 @@ TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, Track
                               " s");
     }
     const double x = model.slider_position(s);
-    const auto ku = static_cast<std::size_t>(k);
-    ref[ku] = r.x_m;
-    xs[ku] = x;
-    moving[ku] = r.v_m_s != 0.0 ? 1 : 0;
+    ref.push_back(r.x_m);
+    xs.push_back(x);
+    moving.push_back(k >= wait && t_ref >= metrics_from_s && r.v_m_s != 0.0 ? 1 : 0);
     if (k % every == 0) {
       rec.t_s.push_back(static_cast<double>(k + 1) * tick);
       rec.ref_m.push_back(r.x_m);

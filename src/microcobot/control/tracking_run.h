@@ -58,10 +58,14 @@ TrackerSetup tracker_setup(const ControlParams& p);
 using ReferenceFn = std::function<ReferenceSample(double t_s, double dt_s)>;
 
 /// Tracks `reference` (called once per 10 kHz control tick in time order) from `start_m` for
-/// `duration_s` with tracker `kind`. Divergence throws mc::ComputationFailed.
+/// `duration_s` with tracker `kind`. The axis starts from power-up (drive at 0 V); the reference
+/// rests at `start_m` until the tracker is ready (the tracking controller's power-up ramp-in) and
+/// its time starts then. The metrics count the ticks whose reference time is >= `metrics_from_s`
+/// (a lead-in move before it leaves the drive where a previous move would). Divergence throws
+/// mc::ComputationFailed.
 TrackingRecord run_tracker(const stickslip::ActuatorModel& model, const StepMap& map, TrackerKind kind,
                            const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
-                           double duration_s, int max_records = 20000);
+                           double duration_s, int max_records = 20000, double metrics_from_s = 0.0);
 
 /// The metrics of per-tick records: `moving[k]` marks ticks where the reference moves.
 TrackingMetrics tracking_metrics(const std::vector<double>& ref_m, const std::vector<double>& x_m,
@@ -82,10 +86,18 @@ struct PathRecord {
   PathMetrics metrics;
 };
 
+/// A move before the measured path (it must end where the path starts), then a rest: the drives
+/// are then where a previous move left them rather than at power-up.
+struct PathLeadIn {
+  const PathGenerator* path = nullptr;
+  double dwell_s = 0.0;
+};
+
 /// The three axes of the XYZ stage (one model, three states, per-axis sensor noise streams:
-/// seed + axis) follow `path` with tracker `kind`, then `hold_s` at rest.
+/// seed + axis) follow `path` with tracker `kind`, then `hold_s` at rest. From power-up the path
+/// (or the lead-in) starts once every axis is ready; the metrics cover `path` only.
 PathRecord run_path(const stickslip::ActuatorModel& model, const StepMap& map, TrackerKind kind,
                     const TrackerSetup& setup, const PathGenerator& path, double hold_s = 0.03,
-                    int max_records = 20000);
+                    int max_records = 20000, const PathLeadIn& lead_in = {});
 
 }  // namespace mc::control
