@@ -38,8 +38,9 @@ std::string csv_field(const std::string& s) {
 void run_validate(const ValidateOptions& o) {
   const auto p = o.common.params ? mc::load_params<ct::ControlParams>(*o.common.params) : ct::ControlParams{};
   const ct::CaseSet set = ct::parse_case_set(o.set, "--set");
-  const std::uint64_t seed = o.seed >= 0 ? static_cast<std::uint64_t>(o.seed)
-                                         : (set == ct::CaseSet::kTuning ? ct::kTuningSeed : ct::kValidationSeed);
+  const std::uint64_t seed = o.seed >= 0
+                                 ? static_cast<std::uint64_t>(o.seed)
+                                 : (set == ct::CaseSet::kTuning ? ct::kTuningSeed : ct::kValidationSeed);
   const int n =
       o.cases >= 0 ? o.cases : (set == ct::CaseSet::kTuning ? ct::kTuningRandomCases : ct::kValidationCases);
   std::vector<ct::ValidationCase> cases;
@@ -59,54 +60,61 @@ void run_validate(const ValidateOptions& o) {
   for (const auto& c : cases) {
     const ct::CaseResult r = ct::run_case(model, map, su, c, goals);
     results.push_back(r);
-    nlohmann::json row = {{"case", c.name},        {"description", ct::describe(c)}, {"profile", ct::to_string(c.profile)},
-                          {"power_up", c.power_up}, {"rms_error_m", r.rms_m},         {"max_error_m", r.max_m},
-                          {"final_error_m", r.final_m}, {"steps", r.edges},           {"pass", r.pass}};
+    nlohmann::json row = {{"case", c.name},
+                          {"description", ct::describe(c)},
+                          {"profile", ct::to_string(c.profile)},
+                          {"power_up", c.power_up},
+                          {"rms_error_m", r.rms_m},
+                          {"max_error_m", r.max_m},
+                          {"final_error_m", r.final_m},
+                          {"steps", r.edges},
+                          {"pass", r.pass}};
     if (r.path_deviation_m >= 0.0) row["path_deviation_m"] = r.path_deviation_m;
     rows.push_back(row);
-    csv << fmt::format("{},{},{:.6g},{:.6g},{},{:.6g},{},{}\n", c.name, csv_field(ct::describe(c)), r.rms_m, r.max_m,
+    csv << fmt::format("{},{},{:.6g},{:.6g},{},{:.6g},{},{}\n", c.name, csv_field(ct::describe(c)), r.rms_m,
+                       r.max_m,
                        r.path_deviation_m >= 0.0 ? fmt::format("{:.6g}", r.path_deviation_m) : std::string(),
                        r.final_m, r.edges, r.pass ? 1 : 0);
     human << fmt::format("{:<22} {:>7} {:>7} {:>8} {:>7}  {:<4} {}\n", c.name, nm(r.rms_m), nm(r.max_m),
                          nm(r.path_deviation_m), nm(r.final_m), r.pass ? "yes" : "NO", ct::describe(c));
   }
   const ct::ValidationSummary s = ct::summarise(cases, results, goals);
-  nlohmann::json j = {
-      {"set", ct::to_string(set)},
-      {"seed", seed},
-      {"cases", rows},
-      {"summary",
-       {{"cases", s.cases},
-        {"passed", s.passed},
-        {"median_rms_m", s.median_rms_m},
-        {"worst_rms_m", s.worst_rms_m},
-        {"worst_max_m", s.worst_max_m},
-        {"worst_path_deviation_m", s.worst_path_deviation_m},
-        {"worst_powerup_backward_m", s.worst_powerup_backward_m},
-        {"goals_hold",
-         {{"rms", s.rms_ok},
-          {"median", s.median_ok},
-          {"max", s.max_ok},
-          {"path_deviation", s.path_ok},
-          {"powerup_backward", s.powerup_ok}}}}},
-      {"goals_m",
-       {{"rms", goals.rms_m},
-        {"median_rms", goals.median_rms_m},
-        {"max", goals.max_m},
-        {"path_deviation", goals.path_deviation_m},
-        {"powerup_backward", goals.powerup_backward_m}}}};
+  nlohmann::json j = {{"set", ct::to_string(set)},
+                      {"seed", seed},
+                      {"cases", rows},
+                      {"summary",
+                       {{"cases", s.cases},
+                        {"passed", s.passed},
+                        {"median_rms_m", s.median_rms_m},
+                        {"worst_rms_m", s.worst_rms_m},
+                        {"worst_max_m", s.worst_max_m},
+                        {"worst_path_deviation_m", s.worst_path_deviation_m},
+                        {"worst_powerup_backward_m", s.worst_powerup_backward_m},
+                        {"goals_hold",
+                         {{"rms", s.rms_ok},
+                          {"median", s.median_ok},
+                          {"max", s.max_ok},
+                          {"path_deviation", s.path_ok},
+                          {"powerup_backward", s.powerup_ok}}}}},
+                      {"goals_m",
+                       {{"rms", goals.rms_m},
+                        {"median_rms", goals.median_rms_m},
+                        {"max", goals.max_m},
+                        {"path_deviation", goals.path_deviation_m},
+                        {"powerup_backward", goals.powerup_backward_m}}}};
   if (o.common.out) {
     std::ostringstream head;
-    head << fmt::format("# microcobot control validate --set {} --seed {}: {} cases, {} pass; median RMS {} nm\n",
-                        ct::to_string(set), seed, s.cases, s.passed, nm(s.median_rms_m));
+    head << fmt::format(
+        "# microcobot control validate --set {} --seed {}: {} cases, {} pass; median RMS {} nm\n",
+        ct::to_string(set), seed, s.cases, s.passed, nm(s.median_rms_m));
     mc::write_file_atomic(*o.common.out / (ct::to_string(set) + ".csv"), head.str() + csv.str());
   }
   human << fmt::format(
       "{} set (seed {}): {}/{} cases pass; median RMS {} nm (goal {}), worst RMS {} nm ({}), worst max {} nm "
       "({}), worst path deviation {} nm ({}), power-up backward max {} nm ({})",
-      ct::to_string(set), seed, s.passed, s.cases, nm(s.median_rms_m), nm(goals.median_rms_m), nm(s.worst_rms_m),
-      nm(goals.rms_m), nm(s.worst_max_m), nm(goals.max_m), nm(s.worst_path_deviation_m), nm(goals.path_deviation_m),
-      nm(s.worst_powerup_backward_m), nm(goals.powerup_backward_m));
+      ct::to_string(set), seed, s.passed, s.cases, nm(s.median_rms_m), nm(goals.median_rms_m),
+      nm(s.worst_rms_m), nm(goals.rms_m), nm(s.worst_max_m), nm(goals.max_m), nm(s.worst_path_deviation_m),
+      nm(goals.path_deviation_m), nm(s.worst_powerup_backward_m), nm(goals.powerup_backward_m));
   emit(o.common, j, human.str());
 }
 
@@ -115,7 +123,8 @@ void run_validate(const ValidateOptions& o) {
 void add_control_validate(CLI::App& group) {
   auto o = std::make_shared<ValidateOptions>();
   auto* cmd = group.add_subcommand(
-      "validate", "Tracking controller on a seeded random tuning or validation set of references (issue #31)");
+      "validate",
+      "Tracking controller on a seeded random tuning or validation set of references (issue #31)");
   cmd->add_option("--set", o->set, "tuning | validation")->check(CLI::IsMember({"tuning", "validation"}));
   cmd->add_option("--seed", o->seed, "Random draw's seed (default: tuning 15, validation 31)")
       ->check(CLI::Range(0LL, 1LL << 53));

@@ -155,7 +155,7 @@ TEST(TrackingController, AtPowerUpTheDriveIsLiftedToMidRangeWhileThePositionHold
   ASSERT_GE(ready_at, 0);
   EXPECT_GE(ready_at * 1e-4, p.powerup_settle_s);  // not before the settling
   EXPECT_LE(ready_at * 1e-4, 0.015);
-  EXPECT_GT(drag, 50e-9);   // the edge did move the slider (the test would pass without a ramp-in otherwise)
+  EXPECT_GT(drag, 50e-9);  // the edge did move the slider (the test would pass without a ramp-in otherwise)
   EXPECT_LE(drag, 600e-9);
   EXPECT_GE(c.voltage_V(), p.low_V);  // in range: both directions have ramp to lead their first edge
   EXPECT_LT(c.voltage_V(), p.high_V - 10.0);

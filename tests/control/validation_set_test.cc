@@ -15,9 +15,9 @@ namespace mc::control {
 namespace {
 
 bool same(const ValidationCase& a, const ValidationCase& b) {
-  return a.profile == b.profile && a.power_up == b.power_up && a.sign == b.sign && a.distance_m == b.distance_m &&
-         a.velocity_m_s == b.velocity_m_s && a.amplitude_m == b.amplitude_m && a.frequency_Hz == b.frequency_Hz &&
-         a.radius_m == b.radius_m && a.sensor_seed == b.sensor_seed;
+  return a.profile == b.profile && a.power_up == b.power_up && a.sign == b.sign &&
+         a.distance_m == b.distance_m && a.velocity_m_s == b.velocity_m_s && a.amplitude_m == b.amplitude_m &&
+         a.frequency_Hz == b.frequency_Hz && a.radius_m == b.radius_m && a.sensor_seed == b.sensor_seed;
 }
 
 TEST(ValidationSet, IsSeededCoversTheEnvelopeAndIsKeptApartFromTheTuningSet) {
@@ -98,9 +98,11 @@ TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
     if (all[i].profile != CaseProfile::kSine) EXPECT_LE(results.back().final_m, 5e-9);  // at rest: #15's goal
   }
   const ValidationSummary s = summarise(cases, results, goals);
-  std::printf("subset: %d/%d pass, median RMS %.0f nm, worst RMS %.0f, max %.0f, path %.0f, power-up backward %.0f nm\n",
-              s.passed, s.cases, s.median_rms_m * 1e9, s.worst_rms_m * 1e9, s.worst_max_m * 1e9,
-              s.worst_path_deviation_m * 1e9, s.worst_powerup_backward_m * 1e9);
+  std::printf(
+      "subset: %d/%d pass, median RMS %.0f nm, worst RMS %.0f, max %.0f, path %.0f, power-up backward %.0f "
+      "nm\n",
+      s.passed, s.cases, s.median_rms_m * 1e9, s.worst_rms_m * 1e9, s.worst_max_m * 1e9,
+      s.worst_path_deviation_m * 1e9, s.worst_powerup_backward_m * 1e9);
   // Holds on the full validation set (92 nm): the goal itself.
   EXPECT_TRUE(s.median_ok) << s.median_rms_m;
   // Do not hold on the full validation set (worst RMS 403 nm, max 916 nm, path deviation 547 nm,

@@ -294,8 +294,8 @@ TrackingRecord run_tracker(const ActuatorModel& model, const StepMap& map, Track
                            double duration_s, int max_records, double metrics_from_s) {
   require_positive(duration_s, "duration_s");
   require(max_records >= 10, "max_records", "must be >= 10", max_records);
-  require(metrics_from_s >= 0.0 && metrics_from_s < duration_s, "metrics_from_s", "must lie in [0, duration_s)",
-          metrics_from_s);
+  require(metrics_from_s >= 0.0 && metrics_from_s < duration_s, "metrics_from_s",
+          "must lie in [0, duration_s)", metrics_from_s);
   std::unique_ptr<Tracker> tr = make_tracker(kind, setup, model, map, start_m);
   PositionSensor sensor(setup.sensor);
   ActuatorState s = start_state(model, start_m);

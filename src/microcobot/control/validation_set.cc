@@ -24,7 +24,9 @@ constexpr double kTail_s = 0.05;
 // Jerk limit of the 3-D paths: a_max / 10 ms, the path generator's default ramp time.
 constexpr double kJerkRamp_s = 0.01;
 
-double log_uniform(Rng& rng, double lo, double hi) { return std::exp(rng.uniform(std::log(lo), std::log(hi))); }
+double log_uniform(Rng& rng, double lo, double hi) {
+  return std::exp(rng.uniform(std::log(lo), std::log(hi)));
+}
 
 Eigen::Vector3d random_unit(Rng& rng) {
   Eigen::Vector3d v;
@@ -44,9 +46,11 @@ PathLimits path_limits(const ValidationCase& c) {
 
 PathGenerator make_path(const ValidationCase& c) {
   if (c.profile == CaseProfile::kLine) {
-    return PathGenerator::line(-0.5 * c.distance_m * c.direction, 0.5 * c.distance_m * c.direction, path_limits(c));
+    return PathGenerator::line(-0.5 * c.distance_m * c.direction, 0.5 * c.distance_m * c.direction,
+                               path_limits(c));
   }
-  return PathGenerator::arc(c.radius_m * c.radial, Eigen::Vector3d::Zero(), c.direction, c.angle_rad, path_limits(c));
+  return PathGenerator::arc(c.radius_m * c.radial, Eigen::Vector3d::Zero(), c.direction, c.angle_rad,
+                            path_limits(c));
 }
 
 double sine_duration_s(const ValidationCase& c) { return std::min(1.0 / c.frequency_Hz, kMaxCaseDuration_s); }
@@ -86,7 +90,8 @@ ValidationCase draw_case(Rng& rng, CaseProfile profile, int index) {
     c.sensor_seed = 1 + static_cast<int>(rng.next_u64() % 100000);
     // A sine within the trapezoids' envelope: peak velocity <= 800 um/s, acceleration <= 0.1 m/s^2.
     const double w = 2.0 * kPi * c.frequency_Hz;
-    if (profile == CaseProfile::kSine && (c.amplitude_m * w > 800e-6 || c.amplitude_m * w * w > 0.1)) continue;
+    if (profile == CaseProfile::kSine && (c.amplitude_m * w > 800e-6 || c.amplitude_m * w * w > 0.1))
+      continue;
     if (profile == CaseProfile::kArc && c.radius_m * std::abs(c.angle_rad) < 5e-6) continue;
     if (move_duration_s(c) <= kMaxCaseDuration_s) break;
   }
@@ -113,7 +118,8 @@ ReferenceFn one_d_reference(const ValidationCase& c, double& start_m, double& du
     };
   }
   const double w = 2.0 * kPi * c.frequency_Hz;
-  const MotionLimits lim{std::max(1.01 * c.amplitude_m * w, 1e-9), std::max(1.01 * c.amplitude_m * w * w, 1e-9)};
+  const MotionLimits lim{std::max(1.01 * c.amplitude_m * w, 1e-9),
+                         std::max(1.01 * c.amplitude_m * w * w, 1e-9)};
   auto sine = std::make_shared<SineReference>(case_start, c.sign * c.amplitude_m, c.frequency_Hz, lim);
   return [lead_in, sine, t0, case_start](double t, double dt) {
     if (t < t0) return lead_in->step(case_start, dt);
@@ -196,15 +202,16 @@ std::vector<ValidationCase> make_case_set(CaseSet set, std::uint64_t seed, int r
   }
   // Every kind in fixed proportions (4 trapezoids, 2 sines, 1 line, 1 arc in 8), drawn at random.
   Rng rng(seed);
-  constexpr CaseProfile kCycle[8] = {CaseProfile::kTrapezoid, CaseProfile::kTrapezoid, CaseProfile::kSine,
-                                     CaseProfile::kLine,      CaseProfile::kTrapezoid, CaseProfile::kTrapezoid,
-                                     CaseProfile::kSine,      CaseProfile::kArc};
+  constexpr CaseProfile kCycle[8] = {
+      CaseProfile::kTrapezoid, CaseProfile::kTrapezoid, CaseProfile::kSine, CaseProfile::kLine,
+      CaseProfile::kTrapezoid, CaseProfile::kTrapezoid, CaseProfile::kSine, CaseProfile::kArc};
   for (int k = 0; k < random_cases; ++k) cases.push_back(draw_case(rng, kCycle[k % 8], k));
   return cases;
 }
 
 bool starts_backward_from_power_up(const ValidationCase& c) {
-  return c.power_up && (c.profile == CaseProfile::kTrapezoid || c.profile == CaseProfile::kSine) && c.sign < 0.0;
+  return c.power_up && (c.profile == CaseProfile::kTrapezoid || c.profile == CaseProfile::kSine) &&
+         c.sign < 0.0;
 }
 
 CaseResult run_case(const stickslip::ActuatorModel& model, const StepMap& map, const TrackerSetup& setup,
@@ -259,7 +266,8 @@ ValidationSummary summarise(const std::vector<ValidationCase>& cases, const std:
     s.worst_rms_m = std::max(s.worst_rms_m, r.rms_m);
     s.worst_max_m = std::max(s.worst_max_m, r.max_m);
     s.worst_path_deviation_m = std::max(s.worst_path_deviation_m, r.path_deviation_m);
-    if (starts_backward_from_power_up(cases[i])) s.worst_powerup_backward_m = std::max(s.worst_powerup_backward_m, r.max_m);
+    if (starts_backward_from_power_up(cases[i]))
+      s.worst_powerup_backward_m = std::max(s.worst_powerup_backward_m, r.max_m);
   }
   std::sort(rms.begin(), rms.end());
   const std::size_t n = rms.size();
@@ -283,12 +291,13 @@ std::string describe(const ValidationCase& c) {
       return fmt::format("trapezoid {} {:.3g} m, <= {:.3g} m/s, <= {:.3g} m/s^2, from {}", dir, c.distance_m,
                          c.velocity_m_s, c.acceleration_m_s2, from);
     case CaseProfile::kSine:
-      return fmt::format("sine {} {:.3g} m at {:.3g} Hz ({:.3g} s), from {}", dir, c.amplitude_m, c.frequency_Hz,
-                         sine_duration_s(c), from);
+      return fmt::format("sine {} {:.3g} m at {:.3g} Hz ({:.3g} s), from {}", dir, c.amplitude_m,
+                         c.frequency_Hz, sine_duration_s(c), from);
     case CaseProfile::kLine:
-      return fmt::format("line {:.3g} m along ({:.2f}, {:.2f}, {:.2f}), <= {:.3g} m/s, <= {:.3g} m/s^2, from {}",
-                         c.distance_m, c.direction.x(), c.direction.y(), c.direction.z(), c.velocity_m_s,
-                         c.acceleration_m_s2, from);
+      return fmt::format(
+          "line {:.3g} m along ({:.2f}, {:.2f}, {:.2f}), <= {:.3g} m/s, <= {:.3g} m/s^2, from {}",
+          c.distance_m, c.direction.x(), c.direction.y(), c.direction.z(), c.velocity_m_s,
+          c.acceleration_m_s2, from);
     case CaseProfile::kArc:
       return fmt::format("arc R {:.3g} m, {:.3g} rad, <= {:.3g} m/s, <= {:.3g} m/s^2, from {}", c.radius_m,
                          c.angle_rad, c.velocity_m_s, c.acceleration_m_s2, from);

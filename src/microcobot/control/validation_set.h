@@ -46,9 +46,9 @@ struct ValidationCase {
   bool power_up = true;   ///< from power-up (drive at 0 V), else from rest after a lead-in move
   double sign = 1.0;      ///< 1-D: +1 forward, -1 backward
   double distance_m = 0;  ///< trapezoid, line: length
-  double velocity_m_s = 0, acceleration_m_s2 = 0;  ///< trapezoid, line, arc: limits
-  double amplitude_m = 0, frequency_Hz = 0;        ///< sine
-  double radius_m = 0, angle_rad = 0;              ///< arc
+  double velocity_m_s = 0, acceleration_m_s2 = 0;        ///< trapezoid, line, arc: limits
+  double amplitude_m = 0, frequency_Hz = 0;              ///< sine
+  double radius_m = 0, angle_rad = 0;                    ///< arc
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  ///< line direction, arc axis
   Eigen::Vector3d radial = Eigen::Vector3d::UnitY();     ///< arc: start point = centre + R radial
   /// From rest: the lead-in move, ending where the case starts (1-D: signed length; 3-D: vector).
@@ -63,11 +63,11 @@ std::vector<ValidationCase> make_case_set(CaseSet set, std::uint64_t seed, int r
 
 /// The goals of issue #31 [m].
 struct TrackingGoals {
-  double rms_m = 150e-9;              ///< every case's RMS error in motion
-  double median_rms_m = 100e-9;       ///< the median of the cases' RMS
-  double max_m = 300e-9;              ///< every case's max error in motion
-  double path_deviation_m = 200e-9;   ///< every 3-D case's max distance to the path
-  double powerup_backward_m = 250e-9; ///< max error of a 1-D case that starts backward from power-up
+  double rms_m = 150e-9;               ///< every case's RMS error in motion
+  double median_rms_m = 100e-9;        ///< the median of the cases' RMS
+  double max_m = 300e-9;               ///< every case's max error in motion
+  double path_deviation_m = 200e-9;    ///< every 3-D case's max distance to the path
+  double powerup_backward_m = 250e-9;  ///< max error of a 1-D case that starts backward from power-up
 };
 
 struct CaseResult {
