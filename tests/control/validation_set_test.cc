@@ -95,7 +95,9 @@ TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
     cases.push_back(all[i]);
     results.push_back(run_case(test::model(), test::step_map(), su, all[i], goals));
     SCOPED_TRACE(all[i].name + ": " + describe(all[i]));
-    if (all[i].profile != CaseProfile::kSine) EXPECT_LE(results.back().final_m, 5e-9);  // at rest: #15's goal
+    if (all[i].profile != CaseProfile::kSine) {
+      EXPECT_LE(results.back().final_m, 5e-9);  // at rest: #15's goal
+    }
   }
   const ValidationSummary s = summarise(cases, results, goals);
   std::printf(
