@@ -25,16 +25,7 @@ double phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 }  // namespace
 
-enum class Kind { kHole, kPart, kBead, kFinger };
-
-struct Renderer::Layer {
-  Kind kind;
-  std::size_t index;
-  int segment;  ///< finger segment
-  double z_m;
-  double sigma_px;
-  bool analytic;  ///< a bead smaller than a pixel: its blurred image is drawn exactly
-};
+using Kind = detail::LayerKind;
 
 Renderer::Renderer(const CameraParams& camera)
     : camera_((camera.validate(), camera)),

@@ -29,6 +29,19 @@
 
 namespace mc::vision {
 
+namespace detail {
+enum class LayerKind { kHole, kPart, kBead, kFinger };
+/// One object (a finger: one segment) at its height, with its blur.
+struct Layer {
+  LayerKind kind;
+  std::size_t index;
+  int segment;
+  double z_m;
+  double sigma_px;
+  bool analytic;  ///< a bead smaller than a pixel: its blurred image is drawn exactly
+};
+}  // namespace detail
+
 /// What the camera's controls are set to for a frame.
 struct CameraControls {
   double focus_z_m = 0.0;  ///< height of the focal plane above the substrate
@@ -60,7 +73,7 @@ class Renderer {
   double v_of_y(double y_m) const { return 0.5 * (height_ - 1) - (y_m - camera_.view_center_y_m) / pixel_m_; }
 
  private:
-  struct Layer;
+  using Layer = detail::Layer;
   void render_substrate(const Substrate& s, double sigma_px);
   void draw_point_bead(const Bead& bead, double sigma_px, double exposure_s);
   void composite_group(const SceneSnapshot& scene, const std::vector<Layer>& layers, std::size_t begin,
