@@ -77,28 +77,10 @@ struct RenderOptions {
   std::uint64_t frame = 0;
 };
 
-pf::PlatformConfig scene_config(const std::string& scene) {
-  pf::PlatformConfig c;
-  if (scene == "pin-in-hole") {
-    c.world = mc::microworld::pin_in_hole_scene();
-  } else if (scene == "optical-trap") {
-    pf::use_optical_trap_scene(c);
-  } else if (scene != "pick-place") {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(scene, ec))
-      throw mc::InvalidInput(
-          "--scene '" + mc::excerpt(scene) +
-          "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
-          "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
-    c.world = mc::load_params<mc::microworld::PickPlaceParams>(scene, c.world);
-  }
-  return c;
-}
-
 void run_render(const RenderOptions& o) {
   if (!o.common.out)
     throw mc::UsageError("--out: required (the directory the frame and its camera state go to)");
-  const pf::PlatformConfig config = scene_config(o.scene);
+  const pf::PlatformConfig config = pf::scene_config(o.scene);
   vs::CameraParams cam;
   cam.objective = vs::objective_by_name(o.objective);
   cam.sensor.bit_depth = o.bit_depth;

@@ -1,7 +1,12 @@
 #include "microcobot/platform/camera_scene.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <string_view>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
+#include "microcobot/core/params.h"
 
 namespace mc::platform {
 
@@ -15,6 +20,23 @@ double channel(const TelemetrySample& s, std::string_view name) {
 }
 
 }  // namespace
+
+PlatformConfig scene_config(const std::string& scene) {
+  PlatformConfig c;
+  if (scene == "pin-in-hole") {
+    c.world = microworld::pin_in_hole_scene();
+  } else if (scene == "optical-trap") {
+    use_optical_trap_scene(c);
+  } else if (scene != "pick-place") {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(scene, ec))
+      throw InvalidInput("--scene '" + excerpt(scene) +
+                         "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
+                         "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
+    c.world = load_params<microworld::PickPlaceParams>(scene, c.world);
+  }
+  return c;
+}
 
 CameraScenePose initial_pose(const PlatformConfig& c) {
   CameraScenePose p;

@@ -6,11 +6,17 @@
 /// one snapshot from each telemetry sample it receives (the tool and part channels, or the
 /// probe bead's in the optical-trap scene); velocities (motion blur) come from two samples.
 
+#include <string>
+
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/vision/scene_snapshot.h"
 
 namespace mc::platform {
+
+/// The configuration of a scene by name: "pick-place", "pin-in-hole", "optical-trap", or a YAML
+/// file of the microworld's keys (as `serve --scene`). Throws InvalidInput naming `scene`.
+PlatformConfig scene_config(const std::string& scene);
 
 /// Where the moving things are (world frame, the telemetry's ground-truth channels).
 struct CameraScenePose {

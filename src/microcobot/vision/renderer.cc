@@ -355,6 +355,19 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
 
   const int j0 = std::max(0, bx0), j1 = std::min(width_ - 1, bx1);
   const int i0 = std::max(0, by0), i1 = std::min(height_ - 1, by1);
+  if (f > 1) {
+    // Column positions in the cell grid, once per group (x0 + 1 always valid: one spare cell).
+    col_x0_.resize(static_cast<std::size_t>(j1 - j0 + 1));
+    col_tx_.resize(col_x0_.size());
+    row_cover_.assign(static_cast<std::size_t>(nx) + 1, 0.0f);
+    row_premult_.assign(static_cast<std::size_t>(nx) + 1, 0.0f);
+    for (int j = j0; j <= j1; ++j) {
+      const double cxf = std::clamp((j - bx0 + 0.5) / f - 0.5, 0.0, nx - 1.0);
+      const int x0 = std::min(static_cast<int>(cxf), std::max(nx - 2, 0));
+      col_x0_[j - j0] = x0;
+      col_tx_[j - j0] = nx > 1 ? static_cast<float>(cxf - x0) : 0.0f;
+    }
+  }
   for (int i = i0; i <= i1; ++i) {
     float* row = &image_[static_cast<std::size_t>(i) * width_];
     if (f == 1) {
@@ -364,22 +377,22 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
       continue;
     }
     const double cyf = std::clamp((i - by0 + 0.5) / f - 0.5, 0.0, ny - 1.0);
-    const int y0 = std::min(static_cast<int>(cyf), ny - 2 < 0 ? 0 : ny - 2);
-    const float ty = static_cast<float>(cyf - y0);
+    const int y0 = std::min(static_cast<int>(cyf), std::max(ny - 2, 0));
     const int y1 = std::min(y0 + 1, ny - 1);
+    const float ty = static_cast<float>(cyf - y0);
+    // The group's two cell rows blended once, then each pixel interpolates along x.
+    for (int cx = 0; cx < nx; ++cx) {
+      const std::size_t q0 = static_cast<std::size_t>(y0) * nx + cx,
+                        q1 = static_cast<std::size_t>(y1) * nx + cx;
+      row_cover_[cx] = cover_[q0] + ty * (cover_[q1] - cover_[q0]);
+      row_premult_[cx] = premult_[q0] + ty * (premult_[q1] - premult_[q0]);
+    }
     for (int j = j0; j <= j1; ++j) {
-      const double cxf = std::clamp((j - bx0 + 0.5) / f - 0.5, 0.0, nx - 1.0);
-      const int x0 = std::min(static_cast<int>(cxf), nx - 2 < 0 ? 0 : nx - 2);
-      const int x1 = std::min(x0 + 1, nx - 1);
-      const float tx = static_cast<float>(cxf - x0);
-      const auto bil = [&](const std::vector<float>& g) {
-        const float top = g[static_cast<std::size_t>(y0) * nx + x0] * (1 - tx) +
-                          g[static_cast<std::size_t>(y0) * nx + x1] * tx;
-        const float bot = g[static_cast<std::size_t>(y1) * nx + x0] * (1 - tx) +
-                          g[static_cast<std::size_t>(y1) * nx + x1] * tx;
-        return top * (1 - ty) + bot * ty;
-      };
-      row[j] = row[j] * (1.0f - bil(cover_)) + bil(premult_);
+      const int x0 = col_x0_[j - j0];
+      const float tx = col_tx_[j - j0];
+      const float a = row_cover_[x0] + tx * (row_cover_[x0 + 1] - row_cover_[x0]);
+      const float p = row_premult_[x0] + tx * (row_premult_[x0 + 1] - row_premult_[x0]);
+      row[j] = row[j] * (1.0f - a) + p;
     }
   }
 }

@@ -94,6 +94,9 @@ class Renderer {
   double substrate_sigma_px_ = -1.0;
   std::vector<float> cover_, premult_;          ///< a layer group's coverage and premultiplied radiance
   std::vector<float> obj_cover_, obj_premult_;  ///< one object's, averaged over its motion
+  std::vector<float> row_cover_, row_premult_;  ///< a coarse group's rows blended for one image row
+  std::vector<int> col_x0_;                     ///< a coarse group's cell column left of each pixel
+  std::vector<float> col_tx_;                   ///< and the weight of the one right of it
   std::vector<Layer> layers_;
   BlurScratch scratch_;
 };
