@@ -41,6 +41,15 @@ nlohmann::json figures_json(const vs::ObjectiveParams& o, const vs::OpticsFigure
           {"airy_fwhm_m", f.airy_fwhm_m}};
 }
 
+// The objective named by --objective (exit 2 naming the flag and the value).
+vs::ObjectiveParams objective_flag(const std::string& name) {
+  try {
+    return vs::objective_by_name(name);
+  } catch (const mc::UsageError& e) {
+    throw mc::UsageError(std::string("--objective: ") + e.what());
+  }
+}
+
 // ---- model ------------------------------------------------------------------------------
 struct ModelOptions {
   CommonOptions common;
@@ -48,7 +57,7 @@ struct ModelOptions {
 };
 
 void run_model(const ModelOptions& o) {
-  const vs::ObjectiveParams obj = vs::objective_by_name(o.objective);
+  const vs::ObjectiveParams obj = objective_flag(o.objective);
   const vs::SensorParams sensor;
   const vs::OpticsFigures f = vs::optics_figures(obj, sensor);
   mc::cli::emit(o.common, figures_json(obj, f),
@@ -82,7 +91,7 @@ void run_render(const RenderOptions& o) {
     throw mc::UsageError("--out: required (the directory the frame and its camera state go to)");
   const pf::PlatformConfig config = pf::scene_config(o.scene);
   vs::CameraParams cam;
-  cam.objective = vs::objective_by_name(o.objective);
+  cam.objective = objective_flag(o.objective);
   cam.sensor.bit_depth = o.bit_depth;
   if (o.exposure_ms) cam.sensor.exposure_s = *o.exposure_ms * 1e-3;
   if (o.gain) cam.sensor.gain = *o.gain;
