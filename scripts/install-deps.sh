@@ -32,6 +32,7 @@ TEST_PACKAGES=(
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
+  python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins (issue #30)
 )
 DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
 [[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")
