@@ -65,7 +65,8 @@ void BM_TwinPollingCost(benchmark::State& state) {
     mc::live::LivePlatform live(lp);
     const std::size_t tick_channel = channel("tick_us");
     std::atomic<int> phase{-1};  // -1 warm-up; even: idle; odd: polled
-    std::array<mc::platform::TimingStats, 2> ticks{};  // drain thread only until the end
+    std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
+                                                   mc::platform::TimingStats(1e-7)};  // drain thread only
     live.start([&](const mc::platform::TelemetrySample& s, std::size_t) {
       const int p = phase.load(std::memory_order_relaxed);
       if (p >= 0) ticks[static_cast<std::size_t>(p % 2)].add(1e-6 * s[tick_channel]);
@@ -91,7 +92,8 @@ void BM_TwinPollingCost(benchmark::State& state) {
           if (!polling.load()) continue;
           const auto t0 = Clock::now();
           if (!pos_query(fd)) break;
-          samples[static_cast<std::size_t>(k)].push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+          samples[static_cast<std::size_t>(k)].push_back(
+              std::chrono::duration<double>(Clock::now() - t0).count());
         }
         ::close(fd);
       });

@@ -44,9 +44,9 @@ struct ServeOptions {
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
-  mc::cli::NetworkOptions network;  // where the DDS link goes (master and slave roles)
-  mc::control::LinkParams link;     // the emulated impairment of what this end receives
-  std::string passivity = "on";     // time-domain passivity control at this end's ports
+  mc::cli::NetworkOptions network;   // where the DDS link goes (master and slave roles)
+  mc::control::LinkParams link;      // the emulated impairment of what this end receives
+  std::string passivity = "on";      // time-domain passivity control at this end's ports
   std::vector<std::string> emulate;  // vendor-protocol twins (issue #30): gcs2[=ADDR:PORT], anc300[=...]
 };
 
@@ -258,10 +258,11 @@ void add_serve(CLI::App& cmd) {
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");
   cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
-  cmd.add_option("--emulate", o->emulate,
-                 "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "
-                 "127.0.0.1:50000) or anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230); "
-                 "docs/hardware.md");
+  cmd.add_option(
+      "--emulate", o->emulate,
+      "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "
+      "127.0.0.1:50000) or anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230); "
+      "docs/hardware.md");
   cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
   cmd.add_flag("--record-csv", o->record_csv,

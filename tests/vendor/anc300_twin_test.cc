@@ -34,7 +34,9 @@ struct Anc300Rig {
     twin.on_password(session, "123456", true);
     session.echo = false;
   }
-  std::string ask(const std::string& line, ClientId c = 1) { return twin.on_line(c, session, line).value_or("<wait>"); }
+  std::string ask(const std::string& line, ClientId c = 1) {
+    return twin.on_line(c, session, line).value_or("<wait>");
+  }
 };
 
 TEST(Anc300Twin, LoginAndEchoAsPymeasureReadsThem) {
@@ -48,7 +50,7 @@ TEST(Anc300Twin, LoginAndEchoAsPymeasureReadsThem) {
   EXPECT_EQ(twin.on_line(1, s, "echo off").value(), "echo off\r\nOK\r\n");
   EXPECT_EQ(twin.on_line(1, s, "getm 1").value(), "mode = gnd\r\nOK\r\n");
   Anc300Session bad;
-  EXPECT_EQ(twin.on_password(bad, "0000", false), "\r\nAuthorization failed\r\n");
+  EXPECT_EQ(twin.on_password(bad, "0000", false), "\r\nAuthorization failed\r\nAuthorization code: ");
   EXPECT_FALSE(bad.authorized);
 }
 

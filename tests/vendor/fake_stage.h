@@ -42,7 +42,8 @@ struct FakeStage : TwinStage {
     const Refusal r = claim(c);
     if (r == Refusal::kNone) {
       log.push_back("step " + std::to_string(i) + " " + std::to_string(static_cast<int>(a)) + " " +
-                    std::to_string(static_cast<int>(f)) + " " + std::to_string(dir) + " " + std::to_string(n));
+                    std::to_string(static_cast<int>(f)) + " " + std::to_string(dir) + " " +
+                    std::to_string(n));
       axes[static_cast<std::size_t>(i)].stepping = true;
     }
     return r;

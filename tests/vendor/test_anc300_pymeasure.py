@@ -7,18 +7,21 @@ import json
 import os
 import socket
 import subprocess
+import time
 
 import pytest
 from pymeasure.instruments.attocube import anc300 as anc300_module
 
 from twin_clients import Serve
 
-N, FREQUENCY_HZ, VOLTAGE_V = 200, 500, 40
-# The tolerance on the displacement (justified in docs/hardware.md): the platform's axis starts
-# from its hold (the PE's static deflection, the hysteresis' state after the stage settled) and
-# reads a 1 nm RMS sensor, where `simulate` starts from rest at 0 V; the first period's power-up
-# transient differs by up to a few hundred nm (simulate's first_period_displacement_m).
-REL_TOL, ABS_TOL_M = 0.05, 0.5e-6
+N, FREQUENCY_HZ, VOLTAGE_V = 200, 500, 60
+# The model's figure is `simulate`'s steady stepping: (displacement_m - first_period_displacement_m)
+# x N / (N - 1). `simulate` starts from rest, and its first period holds the power-up transient
+# (the hysteresis' initial loading, the contact's first strain: 0.83 um up at 60 V) that an axis
+# which has been holding does not go through. The tolerance (docs/hardware.md) covers the axis'
+# own state when the run starts (the hysteresis after holding, the entry edge from the hold
+# voltage), the 1 nm RMS sensor and the position loop taking over at the end.
+REL_TOL = 0.10
 
 
 @pytest.fixture(scope="module")
@@ -55,11 +58,13 @@ def position_m(port, axis):
 
 
 def simulated_displacement_m(direction):
+    """`stickslip simulate`'s steady stepping over N periods (its first period's transient aside)."""
     out = subprocess.run([os.environ["MC_CLI"], "stickslip", "simulate", "--wave", "sawtooth",
                           "--amplitude", str(VOLTAGE_V), "--frequency", str(FREQUENCY_HZ),
                           "--direction", direction, "--duration", str(N / FREQUENCY_HZ), "--json"],
                          capture_output=True, text=True, check=True)
-    return json.loads(out.stdout)["displacement_m"]
+    j = json.loads(out.stdout)
+    return (j["displacement_m"] - j["first_period_displacement_m"]) * N / (N - 1)
 
 
 def test_pymeasure_steps_the_twin_as_the_model_moves(serve):
@@ -79,17 +84,19 @@ def test_pymeasure_steps_the_twin_as_the_model_moves(serve):
 
     x0 = position_m(port, 1)
     ctrl.x.move(N)  # setm stp, stepu N, stepw (returns when done), setm gnd
+    time.sleep(0.2)  # the position loop holds the axis again
     x1 = position_m(port, 1)
     assert ctrl.x.mode == "gnd"
     ctrl.x.move(-N)
+    time.sleep(0.2)
     x2 = position_m(port, 1)
 
     up, down = x1 - x0, x2 - x1
     model_up, model_down = simulated_displacement_m("forward"), simulated_displacement_m("backward")
     print(f"up {up:.4e} m (model {model_up:.4e}), down {down:.4e} m (model {model_down:.4e})")
     assert up > 0 > down
-    assert abs(up - model_up) <= REL_TOL * abs(model_up) + ABS_TOL_M
-    assert abs(down - model_down) <= REL_TOL * abs(model_down) + ABS_TOL_M
+    assert abs(up - model_up) <= REL_TOL * abs(model_up)
+    assert abs(down - model_down) <= REL_TOL * abs(model_down)
 
 
 def test_a_wrong_password_is_refused(serve):

@@ -176,11 +176,14 @@ TEST(TwinServer, AWrongAnc300PasswordIsRefusedAndClosed) {
   TwinRig rig;
   Client a(rig.anc_port());
   a.read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
-  a.send("letmein\r\n");
-  EXPECT_NE(a.read_until([](const std::string& t) { return t.find("failed\r\n") != std::string::npos; })
-                .find("Authorization failed"),
-            std::string::npos);
-  EXPECT_TRUE(a.closed_by_server());
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    a.send("letmein\r\n");
+    EXPECT_NE(a.read_until([](const std::string& t) {
+                 return t.find("failed\r\n") != std::string::npos;
+               }).find("Authorization failed"),
+              std::string::npos);
+  }
+  EXPECT_TRUE(a.closed_by_server());  // the third failure closes
 }
 
 TEST(TwinServer, HostileClientsAreSurvived) {

@@ -23,8 +23,8 @@ void LiveParams::validate() const {
           "must be within (0, 1 mm)", placement_tolerance_m);
   require(std::isfinite(on_target_tolerance_m) && on_target_tolerance_m > 0 && on_target_tolerance_m < 1e-3,
           "on_target_tolerance_m", "must be within (0, 1 mm)", on_target_tolerance_m);
-  require(std::isfinite(settle_window_s) && settle_window_s >= 0 && settle_window_s <= 10.0, "settle_window_s",
-          "must be within [0, 10] s", settle_window_s);
+  require(std::isfinite(settle_window_s) && settle_window_s >= 0 && settle_window_s <= 10.0,
+          "settle_window_s", "must be within [0, 10] s", settle_window_s);
   require(finger_width_m > 0 && finger_width_m < 1e-3, "finger_width_m", "must be within (0, 1 mm)",
           finger_width_m);
 }
@@ -238,7 +238,8 @@ void LivePlatform::protocol_publish(const platform::TickInfo& t) noexcept {
     const double x = p.axis(static_cast<int>(i)).position_m();
     const bool running = p.open_loop_running(static_cast<int>(i));
     const double goal = protocol_has_goal_ ? protocol_goal_m_[i] : target[static_cast<Eigen::Index>(i)];
-    settled_s_[i] = !running && std::abs(x - goal) <= params_.on_target_tolerance_m ? settled_s_[i] + dt : 0.0;
+    settled_s_[i] =
+        !running && std::abs(x - goal) <= params_.on_target_tolerance_m ? settled_s_[i] + dt : 0.0;
     axis_position_m_[i].store(x, std::memory_order_relaxed);
     on_target_[i].store(settled_s_[i] >= params_.settle_window_s, std::memory_order_relaxed);
     stepping_[i].store(running, std::memory_order_relaxed);

@@ -189,7 +189,7 @@ class LivePlatform {
   std::array<std::atomic<bool>, 3> on_target_{}, stepping_{};
   std::atomic<bool> protocol_driving_{false};
   std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
-  std::uint64_t popped_seq_ = 0;  // loop thread only
+  std::uint64_t popped_seq_ = 0;                 // loop thread only
   platform::SpscRing<double> latencies_{4096};   // loop -> status thread [s]
   platform::SpscRing<double> link_costs_{4096};  // loop -> status thread [s]
   ConsoleCommand latest_;                        // loop thread only

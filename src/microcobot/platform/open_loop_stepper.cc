@@ -1,11 +1,13 @@
 #include "microcobot/platform/open_loop_stepper.h"
 
+#include <algorithm>
+
 #include "microcobot/core/error.h"
 
 namespace mc::platform {
 
 OpenLoopStepper::OpenLoopStepper(int samples_per_tick, double sample_period_s, double slew_rate_V_s)
-    : generator_(slew_rate_V_s), sample_period_s_(sample_period_s) {
+    : generator_(slew_rate_V_s), sample_period_s_(sample_period_s), slew_rate_V_s_(slew_rate_V_s) {
   require(samples_per_tick >= 1, "samples_per_tick", "must be at least 1", samples_per_tick);
   require_positive(sample_period_s, "sample_period_s");
   samples_.assign(static_cast<std::size_t>(samples_per_tick), stickslip::DriveSegment{});
@@ -20,12 +22,18 @@ void OpenLoopStepper::start(double amplitude_V, double frequency_Hz, int directi
   if (!running_) return;
   generator_.command(amplitude_V, frequency_Hz,
                      direction_ < 0 ? stickslip::Direction::kBackward : stickslip::Direction::kForward);
-  generator_.start(u_V);
+  // The axis rarely rests at 0 V (the position controller holds it with the PE's static
+  // deflection). Up, the run first falls to 0 V along the abrupt edge (a forward period's own
+  // fall: the slider slips, it is not pulled back), then plays whole periods from 0 V as
+  // `stickslip simulate` does; down, the generator's abrupt rise from there is that edge already.
+  entry_V_ = direction_ > 0 ? std::max(0.0, u_V) : 0.0;
+  generator_.start(direction_ > 0 ? 0.0 : std::max(0.0, u_V));
   start_periods_ = generator_.periods();
 }
 
 void OpenLoopStepper::halt() noexcept {
   generator_.halt();
+  entry_V_ = 0.0;
   running_ = false;
 }
 
@@ -33,6 +41,11 @@ DriveBlock OpenLoopStepper::drive() noexcept {
   for (auto& s : samples_) {
     if (!running_) {
       s = stickslip::DriveSegment::to(0.0);
+      continue;
+    }
+    if (entry_V_ > 0.0) {
+      entry_V_ = std::max(0.0, entry_V_ - slew_rate_V_s_ * sample_period_s_);
+      s = stickslip::DriveSegment::to(entry_V_);
       continue;
     }
     // The last period ends at its boundary (0 V): the generator stops there by itself.

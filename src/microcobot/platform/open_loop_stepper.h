@@ -5,9 +5,10 @@
 /// aside, as an open-loop controller (Attocube ANC300 `stepu`/`stepd`) drives its positioner.
 /// The waveform is the control::SawtoothGenerator's (thesis §2.2.2, Fig. 2.3: slow ramp, edge at
 /// the amplifier's slew rate), so the axis sees exactly what `stickslip simulate --wave sawtooth`
-/// feeds the model. Entry is bumpless (the first period starts from the voltage the stage
-/// controller left on the axis); the run ends at a period boundary (0 V). Real-time safe:
-/// the drive buffer is allocated at construction.
+/// feeds the model. Entry follows the run's own abrupt edge from the voltage the stage
+/// controller left on the axis (up: a fall to 0 V first; down: the first abrupt rise starts
+/// there), so the slider is not dragged back by it; the run ends at a period boundary (0 V).
+/// Real-time safe: the drive buffer is allocated at construction.
 
 #include <cstdint>
 #include <vector>
@@ -33,7 +34,9 @@ class OpenLoopStepper {
   /// +1 forward, -1 backward (the last run's).
   int drive_direction() const noexcept { return direction_; }
   /// The voltage on the axis now [V].
-  double output_V() const noexcept { return running_ ? generator_.output_V() : 0.0; }
+  double output_V() const noexcept {
+    return !running_ ? 0.0 : entry_V_ > 0.0 ? entry_V_ : generator_.output_V();
+  }
   /// Periods completed since start().
   std::int64_t periods_done() const noexcept { return generator_.periods() - start_periods_; }
   /// The next loop tick's drive; after the last period, 0 V and running() turns false.
@@ -42,7 +45,8 @@ class OpenLoopStepper {
  private:
   control::SawtoothGenerator generator_;
   std::vector<stickslip::DriveSegment> samples_;
-  double sample_period_s_;
+  double sample_period_s_, slew_rate_V_s_;
+  double entry_V_ = 0.0;  ///< the abrupt fall to 0 V still to play before an up run
   std::int64_t start_periods_ = 0, periods_ = 0;
   int direction_ = 1;
   bool running_ = false;

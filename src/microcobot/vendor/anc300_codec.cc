@@ -8,7 +8,7 @@ namespace mc::vendor::anc300 {
 namespace {
 
 constexpr std::pair<Mode, std::string_view> kModes[] = {
-    {Mode::kGnd, "gnd"}, {Mode::kInp, "inp"},       {Mode::kCap, "cap"},        {Mode::kStp, "stp"},
+    {Mode::kGnd, "gnd"}, {Mode::kInp, "inp"},      {Mode::kCap, "cap"},       {Mode::kStp, "stp"},
     {Mode::kOff, "off"}, {Mode::kStpPlus, "stp+"}, {Mode::kStpMinus, "stp-"},
 };
 

@@ -41,10 +41,12 @@ std::string Anc300Twin::on_password(Anc300Session& s, std::string_view /*line*/,
   out += accepted ? anc300::kAuthorized : anc300::kNotAuthorized;
   out += anc300::kEol;
   if (accepted && s.echo) out += anc300::kPrompt;
+  if (!accepted) out += anc300::kPasswordPrompt;  // asked again
   return out;
 }
 
-std::string Anc300Twin::finish(const Anc300Session& s, std::string_view echoed, const std::string& body) const {
+std::string Anc300Twin::finish(const Anc300Session& s, std::string_view echoed,
+                               const std::string& body) const {
   if (!s.echo) return body;
   std::string out(echoed);
   out += anc300::kEol;
@@ -88,7 +90,10 @@ std::optional<std::string> Anc300Twin::on_line(ClientId client, Anc300Session& s
     return out;
   }
   if (r->command == "stepw") {
-    const int axis = r->args.size() == 1 ? (r->args[0] == "1" ? 0 : r->args[0] == "2" ? 1 : r->args[0] == "3" ? 2 : -1)
+    const int axis = r->args.size() == 1 ? (r->args[0] == "1"   ? 0
+                                            : r->args[0] == "2" ? 1
+                                            : r->args[0] == "3" ? 2
+                                                                : -1)
                                          : -1;
     if (axis < 0) return finish(s, line, reply_error("Invalid axis"));
     if (stage_.axis(axis).stepping) {
@@ -130,9 +135,11 @@ std::string Anc300Twin::execute(ClientId client, const anc300::Request& r) {
   if (c == "getm") return reply_ok({value_line("mode", anc300::mode_name(mode_[k]))});
   if (c == "getf") return reply_ok({value_line("frequency", fmt::format("{:.0f}", frequency_Hz_[k]), "Hz")});
   if (c == "getv") return reply_ok({value_line("voltage", fmt::format("{:.6f}", voltage_V_[k]), "V")});
-  if (c == "getc") return reply_ok({value_line("capacitance", fmt::format("{:.1f}", params_.capacitance_nF), "nF")});
+  if (c == "getc")
+    return reply_ok({value_line("capacitance", fmt::format("{:.1f}", params_.capacitance_nF), "nF")});
   if (c == "capw") return reply_ok();
-  if (c == "getpos") return reply_ok({value_line("position", fmt::format("{:.9e}", stage_.axis(axis).position_m), "m")});
+  if (c == "getpos")
+    return reply_ok({value_line("position", fmt::format("{:.9e}", stage_.axis(axis).position_m), "m")});
   if (c == "setm") {
     const auto m = nargs == 1 ? anc300::parse_mode(r.args[1]) : std::nullopt;
     if (!m) return reply_error("Usage: setm N gnd|inp|cap|stp|off|stp+|stp-");
@@ -151,7 +158,8 @@ std::string Anc300Twin::execute(ClientId client, const anc300::Request& r) {
   if (c == "setv") {
     const auto v = one_value();
     if (!v || *v < 0.0 || *v > stage_.max_voltage_V())
-      return reply_error(fmt::format("Value out of range (voltage: 0 to {:g} V, the amplifier's)", stage_.max_voltage_V()));
+      return reply_error(
+          fmt::format("Value out of range (voltage: 0 to {:g} V, the amplifier's)", stage_.max_voltage_V()));
     voltage_V_[k] = *v;
     return reply_ok();
   }

@@ -39,7 +39,8 @@ class Anc300Twin {
   Anc300Twin(TwinStage& stage, Anc300TwinParams params);
   /// What a new connection is sent: the banner and the password prompt.
   std::string greeting() const;
-  /// The reply to the password line: success (and the prompt) or failure (then close).
+  /// The reply to the password line: success (and the prompt) or failure (and the password
+  /// prompt again; the server closes after the third).
   std::string on_password(Anc300Session& s, std::string_view line, bool accepted);
   /// The reply bytes to one command line. A `stepw` on a stepping axis returns nullopt: the
   /// caller asks again with poll_wait() until it answers.

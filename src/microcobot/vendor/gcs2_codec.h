@@ -24,23 +24,23 @@ namespace mc::vendor::gcs2 {
 /// Controller error codes (PI's table, PIPython gcserror.py).
 enum Error : int {
   kNoError = 0,
-  kParameterSyntax = 1,      ///< parameter syntax error
-  kUnknownCommand = 2,       ///< unknown command
-  kCommandTooLong = 3,       ///< command length out of limits or command buffer overrun
-  kUnallowableMove = 5,      ///< move on an unreferenced axis, or with servo off
-  kPositionOutOfLimits = 7,  ///< position out of limits
-  kVelocityOutOfLimits = 8,  ///< velocity out of limits
-  kStopped = 10,             ///< controller was stopped by command (HLT, STP, #24; the e-stop)
-  kInvalidAxis = 15,         ///< invalid axis identifier
-  kParameterOutOfRange = 17, ///< parameter out of range
+  kParameterSyntax = 1,       ///< parameter syntax error
+  kUnknownCommand = 2,        ///< unknown command
+  kCommandTooLong = 3,        ///< command length out of limits or command buffer overrun
+  kUnallowableMove = 5,       ///< move on an unreferenced axis, or with servo off
+  kPositionOutOfLimits = 7,   ///< position out of limits
+  kVelocityOutOfLimits = 8,   ///< velocity out of limits
+  kStopped = 10,              ///< controller was stopped by command (HLT, STP, #24; the e-stop)
+  kInvalidAxis = 15,          ///< invalid axis identifier
+  kParameterOutOfRange = 17,  ///< parameter out of range
 };
 /// The controller's text of an error code ("Unknown command"); "Unknown error" otherwise.
 std::string_view error_text(int code);
 
 /// The single-byte commands (sent without LF).
-inline constexpr char kMotionStatus = 5;   ///< #5: hex mask of the moving axes
-inline constexpr char kReadyStatus = 7;    ///< #7: 0xB1 ready, 0xB0 busy
-inline constexpr char kStopAll = 24;       ///< #24: stop every axis (error 10)
+inline constexpr char kMotionStatus = 5;  ///< #5: hex mask of the moving axes
+inline constexpr char kReadyStatus = 7;   ///< #7: 0xB1 ready, 0xB0 busy
+inline constexpr char kStopAll = 24;      ///< #24: stop every axis (error 10)
 inline constexpr unsigned char kReady = 0xB1, kBusy = 0xB0;
 
 /// The longest command line the twin accepts (PI's controllers refuse longer ones with error 3).

@@ -18,7 +18,8 @@ constexpr double kMmPerM = 1e3;
 
 void Gcs2TwinParams::validate() const {
   require(address >= 1 && address <= 254, "gcs2.address", "must be within [1, 254]", address);
-  require(std::isfinite(velocity_mm_s) && velocity_mm_s > 0, "gcs2.velocity_mm_s", "must be > 0", velocity_mm_s);
+  require(std::isfinite(velocity_mm_s) && velocity_mm_s > 0, "gcs2.velocity_mm_s", "must be > 0",
+          velocity_mm_s);
   require(!idn.empty() && idn.size() < 200 && idn.find('\n') == std::string::npos, "gcs2.idn",
           "must be one line of fewer than 200 characters");
 }
@@ -26,7 +27,8 @@ void Gcs2TwinParams::validate() const {
 Gcs2Twin::Gcs2Twin(TwinStage& stage, Gcs2TwinParams params) : stage_(stage), params_(std::move(params)) {
   params_.validate();
   for (int i = 0; i < 3; ++i) {
-    velocity_mm_s_[static_cast<std::size_t>(i)] = std::min(params_.velocity_mm_s, stage_.max_speed_m_s() * kMmPerM);
+    velocity_mm_s_[static_cast<std::size_t>(i)] =
+        std::min(params_.velocity_mm_s, stage_.max_speed_m_s() * kMmPerM);
     target_mm_[static_cast<std::size_t>(i)] = stage_.axis(i).position_m * kMmPerM;
   }
 }
@@ -158,18 +160,31 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
   } else if (m == "CSV?") {
     reply.push_back("2.0");
   } else if (m == "HLP?") {
-    for (const char* h :
-         {"The following commands are valid:", "*IDN? Get Device Identification", "CSV? Get Current Syntax Version",
-          "ERR? Get Error Number", "FRF [{<AxisID>}] Fast Reference Move To Reference Switch",
-          "FRF? [{<AxisID>}] Get Referencing Result", "HLP? Get List Of Available Commands",
-          "HLT [{<AxisID>}] Halt Motion Smoothly", "MOV {<AxisID> <Position>} Set Target Position",
-          "MOV? [{<AxisID>}] Get Target Position", "MVR {<AxisID> <Distance>} Set Target Relative To Current Target",
-          "ONT? [{<AxisID>}] Get On Target State", "POS? [{<AxisID>}] Get Real Position",
-          "SAI? [ALL] Get List Of Current Axis Identifiers", "STP Stop All Axes",
-          "SVO {<AxisID> <ServoState>} Set Servo Mode", "SVO? [{<AxisID>}] Get Servo Mode",
-          "TMN? [{<AxisID>}] Get Minimum Commandable Position", "TMX? [{<AxisID>}] Get Maximum Commandable Position",
-          "VEL {<AxisID> <Velocity>} Set Closed-Loop Velocity", "VEL? [{<AxisID>}] Get Closed-Loop Velocity",
-          "#5 Request Motion Status", "#7 Request Controller Ready Status", "#24 Stop All Axes", "end of help"})
+    for (const char* h : {"The following commands are valid:",
+                          "*IDN? Get Device Identification",
+                          "CSV? Get Current Syntax Version",
+                          "ERR? Get Error Number",
+                          "FRF [{<AxisID>}] Fast Reference Move To Reference Switch",
+                          "FRF? [{<AxisID>}] Get Referencing Result",
+                          "HLP? Get List Of Available Commands",
+                          "HLT [{<AxisID>}] Halt Motion Smoothly",
+                          "MOV {<AxisID> <Position>} Set Target Position",
+                          "MOV? [{<AxisID>}] Get Target Position",
+                          "MVR {<AxisID> <Distance>} Set Target Relative To Current Target",
+                          "ONT? [{<AxisID>}] Get On Target State",
+                          "POS? [{<AxisID>}] Get Real Position",
+                          "SAI? [ALL] Get List Of Current Axis Identifiers",
+                          "STP Stop All Axes",
+                          "SVO {<AxisID> <ServoState>} Set Servo Mode",
+                          "SVO? [{<AxisID>}] Get Servo Mode",
+                          "TMN? [{<AxisID>}] Get Minimum Commandable Position",
+                          "TMX? [{<AxisID>}] Get Maximum Commandable Position",
+                          "VEL {<AxisID> <Velocity>} Set Closed-Loop Velocity",
+                          "VEL? [{<AxisID>}] Get Closed-Loop Velocity",
+                          "#5 Request Motion Status",
+                          "#7 Request Controller Ready Status",
+                          "#24 Stop All Axes",
+                          "end of help"})
       reply.emplace_back(h);
   } else if (m == "SAI?") {
     if (!r.args.empty() && !(r.args.size() == 1 && (r.args[0] == "ALL" || r.args[0] == "all"))) {
@@ -183,16 +198,19 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
   } else if (m == "POS?") {
     return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).position_m * kMmPerM); });
   } else if (m == "MOV?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], target_mm_[static_cast<std::size_t>(i)]); });
+    return per_axis(
+        [&](int i) { return axis_value(kAxisNames[i], target_mm_[static_cast<std::size_t>(i)]); });
   } else if (m == "ONT?") {
     return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).on_target ? 1 : 0); });
   } else if (m == "SVO?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], servo_[static_cast<std::size_t>(i)] ? 1 : 0); });
+    return per_axis(
+        [&](int i) { return axis_value(kAxisNames[i], servo_[static_cast<std::size_t>(i)] ? 1 : 0); });
   } else if (m == "FRF?") {
     return per_axis(
         [&](int i) { return axis_value(kAxisNames[i], referenced_[static_cast<std::size_t>(i)] ? 1 : 0); });
   } else if (m == "VEL?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], velocity_mm_s_[static_cast<std::size_t>(i)]); });
+    return per_axis(
+        [&](int i) { return axis_value(kAxisNames[i], velocity_mm_s_[static_cast<std::size_t>(i)]); });
   } else if (m == "TMN?") {
     return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.min_m(i) * kMmPerM); });
   } else if (m == "TMX?") {
@@ -211,7 +229,8 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
   } else if (m == "VEL") {
     if (!pairs(r.args, values)) return false;
     for (auto [i, v] : values)
-      if (!(v > 0.0 && v <= stage_.max_speed_m_s() * kMmPerM)) return set_error(gcs2::kParameterOutOfRange), false;
+      if (!(v > 0.0 && v <= stage_.max_speed_m_s() * kMmPerM))
+        return set_error(gcs2::kParameterOutOfRange), false;
     for (auto [i, v] : values) velocity_mm_s_[static_cast<std::size_t>(i)] = v;
   } else if (m == "MOV" || m == "MVR") {
     if (!pairs(r.args, values)) return false;

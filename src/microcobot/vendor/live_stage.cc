@@ -45,6 +45,7 @@ TwinStage::Refusal LiveStage::claim(ClientId client) {
     owner_ = 0;  // the console took control: the loop holds the stage
     return Refusal::kOtherOperator;
   }
+  if (live_.params().remote != nullptr) return Refusal::kOtherOperator;  // a slave: its master drives
   if (owner_ != 0 && owner_ != client) return Refusal::kOtherOperator;
   owner_ = client;
   return Refusal::kNone;
@@ -55,7 +56,8 @@ bool LiveStage::push(live::ProtocolCommand c) {
   return live_.push_protocol_command(c);
 }
 
-TwinStage::Refusal LiveStage::move_to(ClientId client, const std::array<double, 3>& goal_m, double speed_m_s) {
+TwinStage::Refusal LiveStage::move_to(ClientId client, const std::array<double, 3>& goal_m,
+                                      double speed_m_s) {
   if (const Refusal r = claim(client); r != Refusal::kNone) return r;
   live::ProtocolCommand c;
   c.kind = live::ProtocolCommand::Kind::kMoveTo;

@@ -37,7 +37,7 @@ class LiveStage : public TwinStage {
   double max_speed_m_s_ = 0.0, max_voltage_V_ = 0.0;
   ClientId owner_ = 0;
   std::uint64_t seq_ = 0;
-  std::uint64_t move_seq_ = 0;                // the last goal's command
+  std::uint64_t move_seq_ = 0;               // the last goal's command
   std::array<std::uint64_t, 3> step_seq_{};  // each axis' last open-loop run's command
 };
 

@@ -44,12 +44,15 @@ TwinEndpoint parse_emulate(const std::string& text) {
   const std::string where = text.substr(eq + 1);
   const auto colon = where.rfind(':');
   if (colon == std::string::npos || colon == 0 || colon + 1 == where.size())
-    throw UsageError("--emulate: '" + excerpt(text) + "': the address must be ADDR:PORT (e.g. 127.0.0.1:50000)");
+    throw UsageError("--emulate: '" + excerpt(text) +
+                     "': the address must be ADDR:PORT (e.g. 127.0.0.1:50000)");
   std::string host = where.substr(0, colon);
   if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   const std::string port = where.substr(colon + 1);
-  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos || std::stoul(port) > 65535)
-    throw UsageError("--emulate: '" + excerpt(text) + "': port '" + excerpt(port) + "' must be within [0, 65535]");
+  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoul(port) > 65535)
+    throw UsageError("--emulate: '" + excerpt(text) + "': port '" + excerpt(port) +
+                     "' must be within [0, 65535]");
   e.address = host;
   e.port = static_cast<std::uint16_t>(std::stoul(port));
   return e;
@@ -63,7 +66,8 @@ void TwinServerParams::validate() const {
           "is required off loopback (8 to 256 characters)");
   require(max_clients >= 1 && max_clients <= 1024, "twin.max_clients", "must be within [1, 1024]",
           static_cast<double>(max_clients));
-  require(std::isfinite(line_timeout_s) && line_timeout_s > 0, "twin.line_timeout_s", "must be > 0", line_timeout_s);
+  require(std::isfinite(line_timeout_s) && line_timeout_s > 0, "twin.line_timeout_s", "must be > 0",
+          line_timeout_s);
   require(std::isfinite(login_timeout_s) && login_timeout_s > 0, "twin.login_timeout_s", "must be > 0",
           login_timeout_s);
   require(max_output_bytes >= 1024, "twin.max_output_bytes", "must be at least 1024",
@@ -93,6 +97,7 @@ struct TwinServer::Impl {
     std::size_t out_bytes = 0;
     bool writing = false, reading_done = false, closing = false, closed = false;
     int waiting_axis = -1;  // an ANC300 stepw in progress
+    int failed_logins = 0;
   };
 
   Impl(TwinStage& st, TwinServerParams p)
@@ -138,7 +143,8 @@ struct TwinServer::Impl {
     boost::system::error_code ec;
     sock.set_option(tcp::no_delay(true), ec);
     count(&TwinServerCounters::accepted);
-    auto s = std::make_shared<Session>(*this, std::move(sock), acceptor_protocols[k], next_id++, acceptor_tokened[k]);
+    auto s = std::make_shared<Session>(*this, std::move(sock), acceptor_protocols[k], next_id++,
+                                       acceptor_tokened[k]);
     sessions[s->id] = s;
     if (s->protocol == Protocol::kAnc300) {
       send(*s, anc300.greeting());
@@ -150,18 +156,20 @@ struct TwinServer::Impl {
 
   void read(const std::shared_ptr<Session>& s) {
     if (s->closed || s->reading_done) return;
-    s->socket.async_read_some(asio::buffer(s->buffer), [this, s](boost::system::error_code ec, std::size_t n) {
-      if (s->closed) return;
-      if (ec) {
-        // EOF (a half-closed socket) or an error: what was asked is answered, then closed.
-        s->reading_done = true;
-        flush_then_close(*s);
-        return;
-      }
-      s->unprocessed.append(s->buffer.data(), n);
-      process(*s);
-      if (!s->closed && s->waiting_axis < 0) read(s);
-    });
+    s->socket.async_read_some(asio::buffer(s->buffer),
+                              [this, s](boost::system::error_code ec, std::size_t n) {
+                                if (s->closed) return;
+                                if (ec) {
+                                  // EOF (a half-closed socket) or an error: what was asked is answered, then
+                                  // closed.
+                                  s->reading_done = true;
+                                  flush_then_close(*s);
+                                  return;
+                                }
+                                s->unprocessed.append(s->buffer.data(), n);
+                                process(*s);
+                                if (!s->closed && s->waiting_axis < 0) read(s);
+                              });
   }
 
   void flush_then_close(Session& s) {
@@ -201,15 +209,16 @@ struct TwinServer::Impl {
 
   void write(const std::shared_ptr<Session>& s) {
     s->writing = true;
-    asio::async_write(s->socket, asio::buffer(s->out.front()), [this, s](boost::system::error_code ec, std::size_t) {
-      s->writing = false;
-      if (s->closed) return;
-      if (ec) return close(*s);
-      s->out_bytes -= s->out.front().size();
-      s->out.pop_front();
-      if (!s->out.empty()) return write(s);
-      if (s->closing) close(*s);
-    });
+    asio::async_write(s->socket, asio::buffer(s->out.front()),
+                      [this, s](boost::system::error_code ec, std::size_t) {
+                        s->writing = false;
+                        if (s->closed) return;
+                        if (ec) return close(*s);
+                        s->out_bytes -= s->out.front().size();
+                        s->out.pop_front();
+                        if (!s->out.empty()) return write(s);
+                        if (s->closing) close(*s);
+                      });
   }
 
   /// Consumes the received bytes, line by line, until a stepw waits or they run out.
@@ -259,7 +268,9 @@ struct TwinServer::Impl {
       const bool ok = (!params.token.empty() && line == params.token) ||
                       (!s.needs_token && line == anc300::kFactoryPassword);
       send(s, anc300.on_password(s.anc, line, ok));
-      if (!ok) flush_then_close(s);
+      // A wrong password is asked again (pymeasure reads the failure before it gives up); the
+      // third closes the connection.
+      if (!ok && ++s.failed_logins >= 3) flush_then_close(s);
       return;
     }
     if (overlong) return send(s, anc300.on_overlong_line(s.anc));
@@ -299,7 +310,8 @@ struct TwinServer::Impl {
         }
       }
     }
-    timer.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params.heartbeat_s)));
+    timer.expires_after(
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params.heartbeat_s)));
     timer.async_wait([this](boost::system::error_code ec) {
       if (!ec) housekeeping();
     });
@@ -320,7 +332,9 @@ void TwinServer::start() {
     boost::system::error_code ec;
     const auto address = asio::ip::make_address(e.address == "localhost" ? "127.0.0.1" : e.address, ec);
     const char* name = e.protocol == Protocol::kGcs2 ? "gcs2" : "anc300";
-    if (ec) throw InvalidInput(std::string("--emulate ") + name + ": '" + excerpt(e.address) + "' is not an IP address");
+    if (ec)
+      throw InvalidInput(std::string("--emulate ") + name + ": '" + excerpt(e.address) +
+                         "' is not an IP address");
     auto acc = std::make_unique<tcp::acceptor>(m.io);
     const tcp::endpoint ep(address, e.port);
     acc->open(ep.protocol(), ec);
