@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "microcobot/platform/platform.h"
 #include "microcobot/stickslip/actuator.h"
@@ -29,62 +30,64 @@ struct SteppingRig {
   double true_x() const { return platform->simulation().axes[0]->true_position_m(); }
 };
 
-// What the model alone moves for `periods` periods of the sawtooth, as `stickslip simulate` runs
-// it from rest, without its first period: that one holds the power-up transient (the hysteresis'
-// initial loading, the contact's first strain) that an axis which has been holding does not go
-// through. Returns the steady displacement per period times `periods`.
-double model_steady_displacement(const PlatformConfig& config, double amplitude_V, double frequency_Hz,
-                                 stickslip::Direction dir, int periods) {
+// The slider's position after each of `periods` periods of the sawtooth, as `stickslip simulate`
+// runs it from rest (index 0: before the first).
+std::vector<double> model_positions(const PlatformConfig& config, double amplitude_V, double frequency_Hz,
+                                    stickslip::Direction dir, int periods) {
   const stickslip::ActuatorModel m(axis_params(config));
   const auto w = stickslip::make_waveform(stickslip::WaveKind::kSawtooth, amplitude_V, frequency_Hz, dir,
                                           m.params().drive);
   stickslip::ActuatorState s = m.initial_state();
-  double x = 0.0, x_first = 0.0;
-  const double first_end = 1.0 / frequency_Hz;
-  stickslip::simulate_each(m, w, periods / frequency_Hz, 1, s, [&](const stickslip::ActuatorState& st) {
-    x = m.slider_position(st);
-    if (st.t_s <= first_end) x_first = x;
-  });
-  return (x - x_first) * periods / (periods - 1);
+  std::vector<double> x(static_cast<std::size_t>(periods) + 1, m.slider_position(s));
+  std::size_t next = 1;  // x[k]: the first sample at or after k periods
+  stickslip::simulate_each(
+      m, w, periods / frequency_Hz + m.dt_s(), 1, s, [&](const stickslip::ActuatorState& st) {
+        while (next < x.size() && st.t_s >= static_cast<double>(next) / frequency_Hz - 1e-12)
+          x[next++] = m.slider_position(st);
+      });
+  return x;
 }
 
 constexpr double kAmplitude_V = 60.0, kFrequency_Hz = 500.0;
-constexpr int kPeriods = 100;
-constexpr double kRelativeTolerance = 0.10;
+constexpr int kPeriods = 100, kTransient = 10;
 
-TEST(OpenLoop, NPeriodsUpMoveWhatTheModelMovesAndEndHolding) {
+// The steady stepping (periods 10 to 100) is what the model steps: the first periods differ by
+// construction (the model starts from rest with its power-up transient, the axis from its hold
+// voltage through the entry edge). 15%: the two runs' hysteresis and contact states differ.
+void expect_steps_like_the_model(int axis, int direction) {
   SteppingRig rig;
-  const double x0 = rig.true_x();
-  ASSERT_TRUE(rig.platform->start_open_loop_steps(0, kAmplitude_V, kFrequency_Hz, +1, kPeriods));
-  EXPECT_TRUE(rig.platform->open_loop_running(0));
-  rig.platform->run(kPeriods / kFrequency_Hz + 0.005);
-  EXPECT_FALSE(rig.platform->open_loop_running(0));
-  const double moved = rig.true_x() - x0;
-  const double model = model_steady_displacement(rig.config, kAmplitude_V, kFrequency_Hz,
-                                                 stickslip::Direction::kForward, kPeriods);
-  std::printf("open loop up: moved %.4g m, model %.4g m\n", moved, model);
-  EXPECT_GT(moved, 0.0);
-  EXPECT_NEAR(moved, model, kRelativeTolerance * std::abs(model));
-  // Holding: the target where the axis ended, and it stays there.
-  const double end = rig.true_x();
+  const auto& sim = *rig.platform->simulation().axes[static_cast<std::size_t>(axis)];
+  const double x0 = sim.true_position_m();
+  ASSERT_TRUE(rig.platform->start_open_loop_steps(axis, kAmplitude_V, kFrequency_Hz, direction, kPeriods));
+  EXPECT_TRUE(rig.platform->open_loop_running(axis));
+  rig.platform->run(kTransient / kFrequency_Hz);
+  const double x_transient = sim.true_position_m();
+  rig.platform->run((kPeriods - kTransient) / kFrequency_Hz + 0.005);
+  EXPECT_FALSE(rig.platform->open_loop_running(axis));
+  const double x_end = sim.true_position_m();
+  const auto model = model_positions(
+      rig.config, kAmplitude_V, kFrequency_Hz,
+      direction > 0 ? stickslip::Direction::kForward : stickslip::Direction::kBackward, kPeriods);
+  const double steady = x_end - x_transient, model_steady = model[kPeriods] - model[kTransient];
+  std::printf(
+      "open loop axis %d dir %+d: first %d periods %.4g m (model %.4g), periods %d-%d %.4g m (model %.4g)\n",
+      axis, direction, kTransient, x_transient - x0, model[kTransient] - model[0], kTransient, kPeriods,
+      steady, model_steady);
+  EXPECT_GT(steady * direction, 0.0);
+  EXPECT_NEAR(steady, model_steady, 0.15 * std::abs(model_steady));
+  // Holding where it stopped: once the position loop took over (0.2 s), it stays.
   rig.platform->run(0.2);
-  EXPECT_NEAR(rig.true_x(), end, 50e-9);
+  const double held = sim.true_position_m();
+  rig.platform->run(0.3);
+  EXPECT_NEAR(sim.true_position_m(), held, 20e-9);
+  for (int other = 0; other < 3; ++other)
+    if (other != axis)
+      EXPECT_NEAR(rig.platform->simulation().axes[static_cast<std::size_t>(other)]->true_position_m(), 0.0,
+                  50e-9);
 }
 
-TEST(OpenLoop, StepsDownMoveBackward) {
-  SteppingRig rig;
-  const double x0 = rig.true_x();
-  const double y0 = rig.platform->simulation().axes[1]->true_position_m();
-  ASSERT_TRUE(rig.platform->start_open_loop_steps(1, kAmplitude_V, kFrequency_Hz, -1, kPeriods));
-  rig.platform->run(kPeriods / kFrequency_Hz + 0.005);
-  const double moved = rig.platform->simulation().axes[1]->true_position_m() - y0;
-  const double model = model_steady_displacement(rig.config, kAmplitude_V, kFrequency_Hz,
-                                                 stickslip::Direction::kBackward, kPeriods);
-  std::printf("open loop down: moved %.4g m, model %.4g m\n", moved, model);
-  EXPECT_LT(moved, 0.0);
-  EXPECT_NEAR(moved, model, kRelativeTolerance * std::abs(model));
-  EXPECT_NEAR(rig.true_x(), x0, 50e-9);  // the other axes held
-}
+TEST(OpenLoop, PeriodsUpStepWhatTheModelStepsAndEndHolding) { expect_steps_like_the_model(0, +1); }
+TEST(OpenLoop, PeriodsDownStepWhatTheModelStepsAndEndHolding) { expect_steps_like_the_model(1, -1); }
 
 TEST(OpenLoop, NothingStepsWithoutTheDeadmanAndReleasingItStopsAtOnce) {
   SteppingRig rig;

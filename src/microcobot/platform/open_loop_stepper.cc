@@ -1,6 +1,7 @@
 #include "microcobot/platform/open_loop_stepper.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "microcobot/core/error.h"
 
@@ -23,17 +24,18 @@ void OpenLoopStepper::start(double amplitude_V, double frequency_Hz, int directi
   generator_.command(amplitude_V, frequency_Hz,
                      direction_ < 0 ? stickslip::Direction::kBackward : stickslip::Direction::kForward);
   // The axis rarely rests at 0 V (the position controller holds it with the PE's static
-  // deflection). Up, the run first falls to 0 V along the abrupt edge (a forward period's own
-  // fall: the slider slips, it is not pulled back), then plays whole periods from 0 V as
-  // `stickslip simulate` does; down, the generator's abrupt rise from there is that edge already.
-  entry_V_ = direction_ > 0 ? std::max(0.0, u_V) : 0.0;
-  generator_.start(direction_ > 0 ? 0.0 : std::max(0.0, u_V));
+  // deflection, anywhere in 0..100 V). The run first goes from there to where its slow edge
+  // starts (up: 0 V, down: the amplitude) along the abrupt edge, at the amplifier's slew rate:
+  // the slider slips there, it is not dragged (a slow fall from a hold voltage above the
+  // amplitude would pull it back by the PE's deflection). Then whole periods follow, as
+  // `stickslip simulate` plays them from 0 V.
+  entry_V_ = std::max(0.0, u_V);
   start_periods_ = generator_.periods();
 }
 
 void OpenLoopStepper::halt() noexcept {
   generator_.halt();
-  entry_V_ = 0.0;
+  entry_V_ = -1.0;
   running_ = false;
 }
 
@@ -43,9 +45,16 @@ DriveBlock OpenLoopStepper::drive() noexcept {
       s = stickslip::DriveSegment::to(0.0);
       continue;
     }
-    if (entry_V_ > 0.0) {
-      entry_V_ = std::max(0.0, entry_V_ - slew_rate_V_s_ * sample_period_s_);
+    if (entry_V_ >= 0.0) {
+      const double target = direction_ > 0 ? 0.0 : generator_.amplitude_V();
+      const double step = slew_rate_V_s_ * sample_period_s_;
+      entry_V_ = std::abs(target - entry_V_) <= step ? target : entry_V_ + (target > entry_V_ ? step : -step);
       s = stickslip::DriveSegment::to(entry_V_);
+      if (entry_V_ == target) {
+        generator_.start(target);  // from the start of its slow edge
+        start_periods_ = generator_.periods();
+        entry_V_ = -1.0;
+      }
       continue;
     }
     // The last period ends at its boundary (0 V): the generator stops there by itself.

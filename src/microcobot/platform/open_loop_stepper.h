@@ -6,8 +6,9 @@
 /// The waveform is the control::SawtoothGenerator's (thesis §2.2.2, Fig. 2.3: slow ramp, edge at
 /// the amplifier's slew rate), so the axis sees exactly what `stickslip simulate --wave sawtooth`
 /// feeds the model. Entry follows the run's own abrupt edge from the voltage the stage
-/// controller left on the axis (up: a fall to 0 V first; down: the first abrupt rise starts
-/// there), so the slider is not dragged back by it; the run ends at a period boundary (0 V).
+/// controller left on the axis to where the run's slow edge starts (up: 0 V; down: the
+/// amplitude), so the slider slips there and is not dragged; the run ends at a period boundary
+/// (0 V).
 /// Real-time safe: the drive buffer is allocated at construction.
 
 #include <cstdint>
@@ -46,7 +47,7 @@ class OpenLoopStepper {
   control::SawtoothGenerator generator_;
   std::vector<stickslip::DriveSegment> samples_;
   double sample_period_s_, slew_rate_V_s_;
-  double entry_V_ = 0.0;  ///< the abrupt fall to 0 V still to play before an up run
+  double entry_V_ = -1.0;  ///< the entry edge's voltage while it plays (< 0: none)
   std::int64_t start_periods_ = 0, periods_ = 0;
   int direction_ = 1;
   bool running_ = false;
