@@ -22,6 +22,7 @@
 #include "microcobot/vendor/gcs2_codec.h"
 #include "microcobot/vendor/live_stage.h"
 #include "microcobot/vendor/twin_server.h"
+#include "support/counting_allocator.h"
 
 namespace mc::vendor {
 namespace {
@@ -230,6 +231,42 @@ TEST(TwinServer, HostileClientsAreSurvived) {
   const auto counts = rig.server->counters();
   EXPECT_GE(counts.closed_hostile, 2u);  // the slowloris and the deaf client
   EXPECT_GE(counts.refused, 1u);         // beyond max_clients
+}
+
+TEST(TwinServer, TheLoopThreadNeverAllocatesWhileProtocolClientsMoveTheStage) {
+  TwinRig rig;
+  Client gcs(rig.gcs_port());
+  rig.reference(gcs);  // warm-up: every path touched once
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard(rig.live->loop_thread_id());
+    gcs.send("MOV 1 0.02 2 -0.02\n");
+    ASSERT_TRUE(TwinRig::wait_on_target(gcs, 5.0));
+    gcs.send("MOV 3 0.05\n");
+    std::this_thread::sleep_for(20ms);
+    gcs.send("HLT\n");
+    EXPECT_EQ(gcs.gcs("ERR?"), "10\n");
+    {
+      Client a(rig.anc_port());
+      a.read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
+      a.send("123456\r\necho off\r\nsetm 1 stp\r\nsetf 1 500\r\nsetv 1 60\r\n");
+      a.read_until(
+          [](const std::string& t) { return t.find("OK\r\nOK\r\nOK\r\nOK\r\n") != std::string::npos; });
+      // gcs still holds control: the ANC300 client is refused; once gcs leaves, it steps.
+      a.send("stepu 1 20\r\n");
+      EXPECT_EQ(a.read_until([](const std::string& t) { return t.find("ERROR\r\n") != std::string::npos; }),
+                "Another operator controls the stage\r\nERROR\r\n");
+      ::shutdown(gcs.fd, SHUT_RDWR);
+      std::this_thread::sleep_for(100ms);
+      a.send("stepu 1 20\r\nstepw 1\r\n");
+      EXPECT_EQ(
+          a.read_until([](const std::string& t) { return t.find("OK\r\nOK\r\n") != std::string::npos; }),
+          "OK\r\nOK\r\n");
+    }  // leaves: the stage holds
+    std::this_thread::sleep_for(50ms);
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
 }
 
 TEST(TwinServer, ParsesEmulateOptions) {
