@@ -115,6 +115,20 @@ TEST(OpenLoop, AFaultHaltsTheRunAndRefusesNewOnes) {
   EXPECT_FALSE(rig.platform->start_open_loop_steps(2, 40.0, 500.0, +1, 10));
 }
 
+TEST(OpenLoop, SteppingDownStopsAtTheFloorWhateverTheCountAsked) {
+  SteppingRig rig;
+  const double floor_tip_m = rig.config.world.min_tip_height_m;
+  ASSERT_GT(rig.platform->simulation().gripper->tip_position_m().z(), floor_tip_m + 100e-6);
+  ASSERT_TRUE(rig.platform->start_open_loop_steps(2, 100.0, 2000.0, -1, 1'000'000));  // far below the floor
+  for (int i = 0; i < 200 && rig.platform->open_loop_running(2); ++i) rig.platform->run(0.05);
+  EXPECT_FALSE(rig.platform->open_loop_running(2)) << "stopped by the floor, long before its periods";
+  const double stopped = rig.platform->simulation().gripper->tip_position_m().z();
+  std::printf("stopped at tip height %.3g m (floor %.3g m)\n", stopped, floor_tip_m);
+  EXPECT_GT(stopped, floor_tip_m - 1e-6);  // at most a tick's stepping past it
+  rig.platform->run(0.3);
+  EXPECT_NEAR(rig.platform->simulation().gripper->tip_position_m().z(), stopped, 0.5e-6);  // holding
+}
+
 TEST(OpenLoop, OutOfRangeDrivesAreRefused) {
   SteppingRig rig;
   EXPECT_FALSE(rig.platform->start_open_loop_steps(3, 40.0, 500.0, +1, 10));
