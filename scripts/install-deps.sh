@@ -34,6 +34,7 @@ TEST_PACKAGES=(
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
+  python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins (issue #30)
 )
 DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
 [[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")

@@ -24,6 +24,8 @@
 #include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/driver_registry.h"
 #include "microcobot/platform/platform_config.h"
+#include "microcobot/vendor/live_stage.h"
+#include "microcobot/vendor/twin_server.h"
 #include "network_options.h"
 #include "signals.h"
 
@@ -42,9 +44,10 @@ struct ServeOptions {
   double duration_s = 0.0;
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
-  mc::cli::NetworkOptions network;  // where the DDS link goes (master and slave roles)
-  mc::control::LinkParams link;     // the emulated impairment of what this end receives
-  std::string passivity = "on";     // time-domain passivity control at this end's ports
+  mc::cli::NetworkOptions network;   // where the DDS link goes (master and slave roles)
+  mc::control::LinkParams link;      // the emulated impairment of what this end receives
+  std::string passivity = "on";      // time-domain passivity control at this end's ports
+  std::vector<std::string> emulate;  // vendor-protocol twins (issue #30): gcs2[=ADDR:PORT], anc300[=...]
 };
 
 // The distributed platform's far end (issue #17): the master process sees the slave stage as
@@ -175,6 +178,11 @@ void serve(const ServeOptions& o) {
   if (!std::filesystem::is_directory(o.out, ec))
     throw mc::InvalidInput("--out " + mc::excerpt(o.out.string()) + ": exists and is not a directory");
 
+  std::vector<mc::vendor::TwinEndpoint> twins;
+  for (const auto& e : o.emulate) twins.push_back(mc::vendor::parse_emulate(e));
+  std::string twin_token = sp.server.token;
+  for (const auto& t : twins)
+    if (twin_token.empty() && !is_loopback(t.address)) twin_token = random_token();
   RemoteEnds ends = attach_role(o, lp);
   mc::cli::set_cooperative_interrupts(true);
   std::cerr << "serve: building the platform (the stick-slip step map takes about a second) on "
@@ -189,9 +197,27 @@ void serve(const ServeOptions& o) {
   mc::live::LivePlatform live(lp);
   mc::live::ConsoleServer server(live, sp);
   server.start();
+  // The vendor-protocol twins: their own thread, the live platform reached through its ring.
+  std::unique_ptr<mc::vendor::LiveStage> twin_stage;
+  std::unique_ptr<mc::vendor::TwinServer> twin_server;
+  if (!twins.empty()) {
+    mc::vendor::TwinServerParams tp;
+    tp.endpoints = twins;
+    tp.token = twin_token;
+    tp.gcs2.idn = std::string("microcobot, E-873 digital twin, 0, ") + MC_VERSION;
+    twin_stage = std::make_unique<mc::vendor::LiveStage>(live);
+    twin_server = std::make_unique<mc::vendor::TwinServer>(*twin_stage, tp);
+    twin_server->start();
+  }
   if (o.record) server.start_recording();
-  // The first line on stdout: what the operator opens.
+  // The first line on stdout: what the operator opens; then one line per twin.
   std::cout << server.url() << std::endl;
+  for (std::size_t k = 0; k < twins.size(); ++k) {
+    const char* name = twins[k].protocol == mc::vendor::Protocol::kGcs2 ? "gcs2" : "anc300";
+    std::cout << "emulate " << name << " " << twins[k].address << ":" << twin_server->ports()[k] << std::endl;
+    std::cerr << "serve: " << name << " twin on " << twins[k].address << ":" << twin_server->ports()[k]
+              << (is_loopback(twins[k].address) ? "" : " (token " + twin_token + ")") << "\n";
+  }
   std::cerr << "serve: console at " << server.url() << " (Ctrl-C stops: devices to their safe state)\n";
   if (host == "0.0.0.0" || host == "::")
     std::cerr
@@ -204,6 +230,7 @@ void serve(const ServeOptions& o) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration_s)
       break;
   }
+  if (twin_server) twin_server->stop();  // its clients gone: the stage holds
   server.stop();
   mc::cli::set_cooperative_interrupts(false);
   if (ends.slave || ends.master) {
@@ -231,6 +258,11 @@ void add_serve(CLI::App& cmd) {
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");
   cmd.add_option("--token", o->token, "Token the WebSocket clients must give (generated off loopback)");
+  cmd.add_option(
+      "--emulate", o->emulate,
+      "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "
+      "127.0.0.1:50000) or anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230); "
+      "docs/hardware.md");
   cmd.add_option("--out", o->out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->record, "Start recording at once (else from the console)");
   cmd.add_flag("--record-csv", o->record_csv,

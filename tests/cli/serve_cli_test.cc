@@ -21,6 +21,27 @@ TEST(ServeCli, TheSceneFileOfTheRepositoryAndTheBuiltInScenesStart) {
   }
 }
 
+TEST(ServeCli, TheVendorTwinsPrintTheirPortsAndABadEmulateIsOneLine) {
+  test::TempDir dir;
+  auto r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", dir.path().string(), "--emulate",
+                    "gcs2=127.0.0.1:0", "--emulate", "anc300=127.0.0.1:0", "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nemulate gcs2 127.0.0.1:"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nemulate anc300 127.0.0.1:"), std::string::npos) << r.out;
+  for (const std::string bad : {"smaract", "gcs2=127.0.0.1", "anc300=127.0.0.1:99999"}) {
+    r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", dir.path().string(), "--emulate", bad,
+                 "--duration", "0.3"});
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  }
+  // A port that cannot be bound (an address of no interface here): invalid input, named.
+  r = run_cli({"serve", "--listen", "127.0.0.1:0", "--out", dir.path().string(), "--token",
+               "0123456789abcdef", "--emulate", "gcs2=192.0.2.1:0", "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("--emulate gcs2: cannot listen on 192.0.2.1:0"), std::string::npos) << r.err;
+}
+
 TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
   test::TempDir dir;
   const struct {

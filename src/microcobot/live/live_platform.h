@@ -28,6 +28,7 @@
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
+#include "microcobot/live/protocol_command.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/spsc_ring.h"
@@ -43,6 +44,10 @@ struct LiveParams {
   /// Drawn width of a finger tip in the microscope view (the model's fingers are lines).
   double finger_width_m = 40e-6;
   bool paced = true;  ///< false: as fast as possible (tests that need no wall clock)
+  /// A protocol client's axis is on target (GCS ONT?) once within this distance of its goal...
+  double on_target_tolerance_m = 1e-6;
+  /// ...for this long (the settle window).
+  double settle_window_s = 0.02;
   /// The devices of each scene (re)build; empty: the simulated platform. A master process of a
   /// distributed platform gives the remote slave stage here (net/remote_slave.h); the scripted
   /// demo needs the simulation and is refused then.
@@ -98,6 +103,12 @@ class LivePlatform {
   bool push_command(const ConsoleCommand& c) noexcept;
   /// Whether a client holds control (its commands count; otherwise the stage holds).
   void set_console_in_control(bool in_control) noexcept { in_control_.store(in_control); }
+  bool console_in_control() const noexcept { return in_control_.load(); }
+  /// A vendor-protocol client's command (issue #30; one producer thread: the protocol thread).
+  /// Wait-free; false when the ring is full. It counts only while no console client holds control.
+  bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_.push(c); }
+  /// What the loop last published for the protocol clients. Any thread.
+  ProtocolView protocol_view() const noexcept;
   /// Latches the e-stop at the next operator tick (at most 1 ms). Any thread, async-signal-safe.
   void estop() noexcept { estop_.store(true); }
   /// Reset, demo or restart, done by the control thread between two loop runs; other actions
@@ -116,6 +127,7 @@ class LivePlatform {
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
+  const LiveParams& params() const { return params_; }
   /// The scene's geometry, for the microscope view (world coordinates).
   double part_side_m() const { return params_.platform.world.part_side_m; }
   double part_height_m() const { return params_.platform.world.height_m(); }
@@ -153,6 +165,12 @@ class LivePlatform {
   /// up, then every axis holds and the console has control again. Returns true while it drives.
   bool demo_tick(const platform::TickInfo& t) noexcept;
   void control_thread();
+  /// The protocol clients' part of the operator tick: their commands drained, their freshness (a
+  /// client that went away or lost control leaves every axis holding). Returns true while a
+  /// protocol client drives the coupling, and then fills `in`.
+  bool protocol_tick(const platform::TickInfo& t, bool console_control, control::ConsoleInput& in) noexcept;
+  /// After the console input is set: a pending open-loop run started (or refused), the view published.
+  void protocol_publish(const platform::TickInfo& t) noexcept;
 
   LiveParams params_;
   ConsoleLimits limits_;
@@ -160,6 +178,18 @@ class LivePlatform {
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<platform::PickPlaceOperator> demo_;
   platform::SpscRing<ConsoleCommand> commands_{256};
+  platform::SpscRing<ProtocolCommand> protocol_{256};
+  // Protocol state (loop thread only).
+  double protocol_last_t_ = -1e9, protocol_speed_m_s_ = 0.0, last_operator_t_ = 0.0;
+  bool protocol_fresh_ = false, protocol_has_goal_ = false, protocol_steps_pending_ = false;
+  std::array<double, 3> protocol_goal_m_{}, settled_s_{};
+  ProtocolCommand pending_steps_;
+  // Published for the protocol thread.
+  std::array<std::atomic<double>, 3> axis_position_m_{};
+  std::array<std::atomic<bool>, 3> on_target_{}, stepping_{};
+  std::atomic<bool> protocol_driving_{false};
+  std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
+  std::uint64_t popped_seq_ = 0;                 // loop thread only
   platform::SpscRing<double> latencies_{4096};   // loop -> status thread [s]
   platform::SpscRing<double> link_costs_{4096};  // loop -> status thread [s]
   ConsoleCommand latest_;                        // loop thread only

@@ -102,6 +102,9 @@ void Platform::build() {
   stage_ = std::make_unique<StageController>(
       config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
       config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr);
+  for (auto& st : steppers_)
+    st = std::make_unique<OpenLoopStepper>(static_cast<int>(std::lround(ratio)), model_->dt_s(),
+                                           model_->params().drive.slew_rate_V_s);
   control::SafetyLimitParams limits;
   limits.grip_force_limit_N = world_.params().grip_force_limit_N;
   limits.contact_force_limit_N = world_.params().contact_force_limit_N;
@@ -142,6 +145,7 @@ const SimulatedDevices& Platform::simulation() const {
 void Platform::fault_all() noexcept {
   for (Device* d : devices()) d->fault();
   stage_->emergency_stop();
+  for (auto& st : steppers_) st->halt();
   faulted_ = true;
 }
 
@@ -198,16 +202,38 @@ void Platform::slave_control_task() noexcept {
                                          out.slave_velocity_m_s[static_cast<Eigen::Index>(i)]);
     return;
   }
-  stage_->update(out.slave_target_m, out.slave_velocity_m_s, measured);
+  // An axis stepping open loop is not the controller's: it idles there (target = measured), so
+  // that it takes over bumplessly when the run ends.
+  Eigen::Vector3d target = out.slave_target_m, velocity = out.slave_velocity_m_s;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (steppers_[i]->running()) {
+      target[static_cast<Eigen::Index>(i)] = measured[i];
+      velocity[static_cast<Eigen::Index>(i)] = 0.0;
+    }
+  }
+  stage_->update(target, velocity, measured);
 }
 
 void Platform::devices_task(double dt_s) noexcept {
+  bool stepping_ended = false;
   for (std::size_t i = 0; i < 3; ++i) {
+    OpenLoopStepper& st = *steppers_[i];
+    const bool was_running = st.running();
+    if (was_running && open_loop_must_stop(i)) st.halt();
     if (!faulted_ && !position_controlled_) {
-      devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m()));
+      if (st.running()) {
+        const DriveBlock open_loop = st.drive();
+        stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m());  // keeps the controller's clock
+        devices_.axes[i]->command_drive(open_loop);
+      } else {
+        devices_.axes[i]->command_drive(stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m()));
+      }
     }
     devices_.axes[i]->update(dt_s);
+    stepping_ended |= was_running && !st.running();
   }
+  // Every automatic move ends holding (issue #26): the targets re-taken where the axes are.
+  if (stepping_ended) hold();
   devices_.gripper->update(dt_s);
   devices_.haptic->update(dt_s);
   devices_.tweezers->update(dt_s);
@@ -235,7 +261,10 @@ void Platform::telemetry_task(double t_s) noexcept {
   for (int i = 0; i < 3; ++i) put(home_m_[i] + o.slave_target_m[i]);
   for (std::size_t i = 0; i < 3; ++i)
     put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->position_m());
-  for (int i = 0; i < 3; ++i) put(faulted_ ? 0.0 : stage_->last_voltage_V(i));
+  for (std::size_t i = 0; i < 3; ++i)
+    put(faulted_                  ? 0.0
+        : steppers_[i]->running() ? steppers_[i]->output_V()
+                                  : stage_->last_voltage_V(static_cast<int>(i)));
   put(o.haptic_force_N.x()), put(o.haptic_force_N.y());
   put(devices_.tweezers->opening_m()), put(o.finger_force_N);
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
@@ -272,6 +301,40 @@ void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
   console_ = in;
   // World coordinates (the telemetry's) to the coupling's, which are relative to home.
   console_.goal_m = in.goal_m - home_m_;
+}
+
+bool Platform::start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
+                                     std::int64_t periods) noexcept {
+  if (faulted_ || position_controlled_ || axis < 0 || axis > 2) return false;
+  if (!(amplitude_V > 0.0 && amplitude_V <= model_->params().drive.max_V)) return false;
+  if (!(frequency_Hz > 0.0 && frequency_Hz <= 10e3) || periods < 1 || periods > 1'000'000'000) return false;
+  if (!(console_.active && console_.fresh && console_.deadman)) return false;
+  const auto i = static_cast<std::size_t>(axis);
+  steppers_[i]->start(amplitude_V, frequency_Hz, direction, periods, stage_->last_voltage_V(axis));
+  return true;
+}
+
+void Platform::stop_open_loop() noexcept {
+  bool any = false;
+  for (auto& st : steppers_) {
+    any |= st->running();
+    st->halt();
+  }
+  if (any) hold();
+}
+
+bool Platform::open_loop_must_stop(std::size_t i) const noexcept {
+  if (faulted_ || !(console_.active && console_.fresh && console_.deadman)) return true;
+  const Vec3 f = devices_.gripper->contact_force_N();
+  if (std::hypot(f.x, f.y, f.z) > world_.params().contact_force_limit_N) return true;
+  // Leaving the workspace (or going below the floor) in the direction of travel.
+  const double x = devices_.axes[i]->position_m();
+  const int dir = steppers_[i]->drive_direction();
+  const auto& tp = config_.teleop;
+  if (dir > 0 && x >= tp.workspace_max_m) return true;
+  if (dir < 0 && x <= tp.workspace_min_m) return true;
+  if (i == 2 && dir < 0 && x <= teleop_->limits().params().floor_m) return true;
+  return false;
 }
 
 void Platform::hold() noexcept {

@@ -30,6 +30,7 @@
 #include "microcobot/core/recorder.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/fixed_rate_loop.h"
+#include "microcobot/platform/open_loop_stepper.h"
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/platform/simulated_gripper.h"
 #include "microcobot/platform/simulated_haptic_master.h"
@@ -150,6 +151,23 @@ class Platform {
   /// disengaged until the next engagement: how an automatic sequence hands control back
   /// (issue #26). On the loop (the operator task); real-time safe.
   void hold() noexcept;
+  /// Open-loop stepping (issue #30, the ANC300's `stepu`/`stepd`): `periods` sawtooth periods
+  /// of `amplitude_V` at `frequency_Hz` played straight to axis `axis` (0..2), forward
+  /// (`direction` +1) or backward (-1), the stage controller set aside on that axis; the coupling's
+  /// target follows nothing meanwhile and the axis holds where it ends (hold()). On the loop
+  /// (the operator task); real-time safe. Refused (false, nothing moves) when faulted, on
+  /// position-controlled axes, or with an axis, amplitude (0..drive.max_V], frequency
+  /// (0, 10 kHz] or period count (1..1e9) out of range. Safety: the run stops at once (0 V, every
+  /// axis holding) as soon as the console input that drives the coupling is no longer active,
+  /// fresh and with its deadman held, on a fault, on a contact force over the limit, or when the
+  /// axis leaves the workspace (or, on Z, goes below the floor) in its direction of travel.
+  bool start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
+                             std::int64_t periods) noexcept;
+  /// Stops every open-loop run at once (0 V) and holds every axis. Real-time safe.
+  void stop_open_loop() noexcept;
+  bool open_loop_running(int axis) const noexcept {
+    return steppers_[static_cast<std::size_t>(axis)] && steppers_[static_cast<std::size_t>(axis)]->running();
+  }
   /// The force and floor limits the coupling enforces (control/safety_limits.h).
   const control::SafetyLimits& safety_limits() const { return teleop_->limits(); }
 
@@ -193,6 +211,8 @@ class Platform {
   void teleoperation_task() noexcept;
   void slave_control_task() noexcept;
   void devices_task(double dt_s) noexcept;
+  /// Whether axis i's open-loop run must stop now (the safety rules of start_open_loop_steps).
+  bool open_loop_must_stop(std::size_t i) const noexcept;
   void telemetry_task(double t_s) noexcept;
   void drain() noexcept;
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
@@ -207,6 +227,7 @@ class Platform {
   PlatformDevices devices_;
   SimulatedDevices sim_;  ///< all null unless simulated
   std::unique_ptr<StageController> stage_;
+  std::array<std::unique_ptr<OpenLoopStepper>, 3> steppers_;
   TrackingErrorStats tracking_;
   std::unique_ptr<control::Teleoperation> teleop_;
   Watchdog haptic_watchdog_;

@@ -1,0 +1,128 @@
+// Issue #30: the GCS 2.0 twin's cost, on the live platform (paced loop) in one run:
+//  - command-to-reply latency of `POS?` over loopback TCP (four clients polling at 100 Hz);
+//  - the loop's tick time p99 (the telemetry's tick_us) while those four clients poll, against
+//    the same loop with no client, in alternating 2 s phases (three of each).
+// `build/release/bench/twin_bench` (docs/benchmarks.md). One iteration: the figures are counters.
+
+#include <benchmark/benchmark.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "microcobot/live/live_platform.h"
+#include "microcobot/platform/timing_stats.h"
+#include "microcobot/vendor/live_stage.h"
+#include "microcobot/vendor/twin_server.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::size_t channel(const char* name) {
+  for (std::size_t i = 0; i < mc::platform::kTelemetryChannels.size(); ++i)
+    if (std::string_view(mc::platform::kTelemetryChannels[i]) == name) return i;
+  return 0;
+}
+
+int connect_loopback(std::uint16_t port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(port);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  int one = 1;
+  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+  return fd;
+}
+
+// One POS? round trip: the reply ends with a line that does not end in a space.
+bool pos_query(int fd) {
+  static const std::string q = "POS?\n";
+  if (::send(fd, q.data(), q.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(q.size())) return false;
+  std::string text;
+  char buf[512];
+  while (text.size() < 2 || text.back() != '\n' || text[text.size() - 2] == ' ') {
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) return false;
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+void BM_TwinPollingCost(benchmark::State& state) {
+  for (auto _ : state) {
+    mc::live::LiveParams lp;
+    mc::live::LivePlatform live(lp);
+    const std::size_t tick_channel = channel("tick_us");
+    std::atomic<int> phase{-1};  // -1 warm-up; even: idle; odd: polled
+    std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
+                                                   mc::platform::TimingStats(1e-7)};  // drain thread only
+    live.start([&](const mc::platform::TelemetrySample& s, std::size_t) {
+      const int p = phase.load(std::memory_order_relaxed);
+      if (p >= 0) ticks[static_cast<std::size_t>(p % 2)].add(1e-6 * s[tick_channel]);
+    });
+    mc::vendor::LiveStage stage(live);
+    mc::vendor::TwinServerParams tp;
+    tp.endpoints = {{mc::vendor::Protocol::kGcs2, "127.0.0.1", 0}};
+    mc::vendor::TwinServer server(stage, tp);
+    server.start();
+    const std::uint16_t port = server.ports()[0];
+
+    mc::platform::TimingStats latency(1e-6);  // 1 us bins
+    std::atomic<bool> polling{false}, quit{false};
+    std::vector<std::vector<double>> samples(4);
+    std::vector<std::thread> clients;
+    for (int k = 0; k < 4; ++k) {
+      clients.emplace_back([&, k] {
+        const int fd = connect_loopback(port);
+        auto next = Clock::now();
+        while (!quit.load()) {
+          next += std::chrono::milliseconds(10);  // 100 Hz
+          std::this_thread::sleep_until(next);
+          if (!polling.load()) continue;
+          const auto t0 = Clock::now();
+          if (!pos_query(fd)) break;
+          samples[static_cast<std::size_t>(k)].push_back(
+              std::chrono::duration<double>(Clock::now() - t0).count());
+        }
+        ::close(fd);
+      });
+    }
+    std::this_thread::sleep_for(std::chrono::seconds(1));  // warm-up
+    for (int p = 0; p < 6; ++p) {
+      polling.store(p % 2 == 1);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the clients switch
+      phase.store(p);
+      std::this_thread::sleep_for(std::chrono::seconds(2));
+      phase.store(-1);
+    }
+    quit.store(true);
+    for (auto& t : clients) t.join();
+    server.stop();
+    live.stop();
+    for (const auto& v : samples)
+      for (double s : v) latency.add(s);
+    state.counters["pos_latency_p50_ms"] = 1e3 * latency.quantile_s(0.5);
+    state.counters["pos_latency_p99_ms"] = 1e3 * latency.quantile_s(0.99);
+    state.counters["pos_latency_max_ms"] = 1e3 * latency.max_s();
+    state.counters["pos_queries"] = static_cast<double>(latency.count());
+    state.counters["tick_p99_idle_us"] = 1e6 * ticks[0].quantile_s(0.99);
+    state.counters["tick_p99_polled_us"] = 1e6 * ticks[1].quantile_s(0.99);
+    state.counters["tick_p99_ratio"] = ticks[1].quantile_s(0.99) / ticks[0].quantile_s(0.99);
+    state.counters["tick_samples_idle"] = static_cast<double>(ticks[0].count());
+    state.counters["overruns"] = static_cast<double>(live.status().overruns);
+  }
+}
+BENCHMARK(BM_TwinPollingCost)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace

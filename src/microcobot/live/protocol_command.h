@@ -1,0 +1,45 @@
+#pragma once
+/// @file
+/// What a vendor-protocol client (the GCS 2.0 and ANC300 twins, vendor/) asks of the live
+/// platform (issue #30), checked and clamped by the protocol thread before it is pushed: plain
+/// data copied into the loop through the live platform's protocol ring (one producer: the
+/// protocol thread). The loop is the arbiter of who controls the stage: a protocol command counts
+/// only while no console client holds control, and the protocol's heartbeat is its deadman.
+
+#include <array>
+#include <cstdint>
+
+namespace mc::live {
+
+struct ProtocolCommand {
+  enum class Kind : std::uint8_t {
+    kHeartbeat,  ///< the controlling client is still connected (sent every ~20 ms)
+    kMoveTo,     ///< closed loop: every axis to goal_m at speed_m_s (GCS MOV/MVR/FRF)
+    kSteps,      ///< open loop: `periods` sawtooth periods on `axis` (ANC300 stepu/stepd)
+    kStop,       ///< stop every motion at once, every axis holding (HLT, STP, #24, stop)
+    kRelease,    ///< the controlling client is gone: stop, hold, control free
+  };
+  Kind kind = Kind::kHeartbeat;
+  std::array<double, 3> goal_m{};  ///< stage coordinates (relative to home) [m]
+  double speed_m_s = 0.0;
+  int axis = 0;  ///< 0..2
+  double amplitude_V = 0.0;
+  double frequency_Hz = 0.0;
+  int direction = 1;  ///< +1 up (forward), -1 down
+  std::int64_t periods = 0;
+  std::uint64_t seq = 0;  ///< increasing per command: the view says which the loop applied
+};
+
+/// What the loop publishes for the protocol clients (atomics, any thread).
+struct ProtocolView {
+  std::array<double, 3> position_m{};  ///< measured, stage coordinates
+  std::array<bool, 3> on_target{};     ///< within the tolerance of the goal for the settle window
+  std::array<bool, 3> stepping{};      ///< an open-loop run is in progress
+  bool protocol_fresh = false;         ///< the protocol drives the coupling now
+  bool console_in_control = false;     ///< a console client holds control
+  bool halted = false;                 ///< the e-stop latched (or a device faulted)
+  std::uint64_t refused_steps = 0;     ///< open-loop runs the platform refused
+  std::uint64_t applied_seq = 0;       ///< the last command the loop applied (its seq)
+};
+
+}  // namespace mc::live

@@ -1,0 +1,65 @@
+#pragma once
+/// @file
+/// The stage answering PI GCS 2.0 (issue #30): an E-873-like controller of three closed-loop
+/// axes "1", "2", "3" (X, Y, Z), positions in mm, velocities in mm/s, over the platform's own
+/// position control (vendor/twin_stage.h). Every line is parsed by gcs2_codec.h; every value is
+/// checked (axis, number, limits) before it reaches the stage. Commands (docs/hardware.md):
+/// *IDN?, CSV?, HLP?, SAI?, SVO, SVO?, FRF, FRF?, MOV, MOV?, MVR, POS?, ONT?, VEL, VEL?, TMN?,
+/// TMX?, HLT, STP, ERR?, and the single bytes #5, #7, #24. The controller's state (servo,
+/// reference, targets, velocities, the error register) is shared by every connection, as one
+/// controller's is. Protocol thread only.
+
+#include <array>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "microcobot/vendor/gcs2_codec.h"
+#include "microcobot/vendor/twin_stage.h"
+
+namespace mc::vendor {
+
+struct Gcs2TwinParams {
+  int address = 1;  ///< the daisy-chain address (1..254); lines for another address get no reply
+  std::string idn = "microcobot, E-873 digital twin, 0, 1.0";  ///< the *IDN? reply
+  double velocity_mm_s = 0.1;  ///< each axis' VEL at power-up (clamped to the stage's cap)
+  void validate() const;
+};
+
+class Gcs2Twin {
+ public:
+  Gcs2Twin(TwinStage& stage, Gcs2TwinParams params);
+  /// The reply bytes to one line from `client` (empty: none is due: a set command, an error, or a
+  /// line for another controller address).
+  std::string on_line(ClientId client, std::string_view line);
+  /// The reply bytes to a single-byte command (#5, #7, #24).
+  std::string on_byte(ClientId client, char byte);
+  /// A line longer than gcs2::kMaxLineLength arrived (its rest discarded): error 3.
+  void on_overlong_line() { set_error(gcs2::kCommandTooLong); }
+  void on_disconnect(ClientId client) { stage_.release(client); }
+  int last_error() const { return error_; }
+
+ private:
+  using Lines = std::vector<std::string>;
+  /// The axes a query names (all without arguments); false (error 15) on an unknown one.
+  bool query_axes(const std::vector<std::string>& args, std::vector<int>& axes);
+  /// "AXIS VALUE" pairs; false and the error set on a bad axis or number.
+  bool pairs(const std::vector<std::string>& args, std::vector<std::pair<int, double>>& out);
+  bool execute(ClientId client, const gcs2::Request& r, Lines& reply);
+  /// The goal to the stage; the error set on a refusal.
+  /// The speed is the slowest VEL among `moved` (a bit per axis): the axes move as one, straight.
+  bool send_goal(ClientId client, unsigned moved);
+  void stop_all(ClientId client);
+  /// The register holds the last error until ERR? reads it (PIPython qERR: "the last occurred error").
+  void set_error(int code) { error_ = code; }
+  void update_referencing();
+  static int axis_index(std::string_view word);
+
+  TwinStage& stage_;
+  Gcs2TwinParams params_;
+  std::array<bool, 3> servo_{}, referenced_{}, referencing_{};
+  std::array<double, 3> target_mm_{}, velocity_mm_s_{};
+  int error_ = gcs2::kNoError;
+};
+
+}  // namespace mc::vendor

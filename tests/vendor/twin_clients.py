@@ -1,0 +1,116 @@
+"""Shared helpers of the twins' client tests (issue #30): a `microcobot serve --emulate` process on
+loopback port 0, and the golden-transcript player (tests/data/gcs2/*.txt, syntax in their headers)."""
+
+import os
+import re
+import signal
+import socket
+import subprocess
+import tempfile
+import time
+
+
+class Serve:
+    """`microcobot serve` with both twins on loopback, free ports; stop() ends it (SIGINT)."""
+
+    def __init__(self):
+        cli = os.environ.get("MC_CLI")
+        if not cli:
+            raise RuntimeError("MC_CLI not set (run through ctest)")
+        self.out = tempfile.mkdtemp(prefix="mc_twin_")
+        self.proc = subprocess.Popen(
+            [cli, "serve", "--listen", "127.0.0.1:0", "--out", self.out,
+             "--emulate", "gcs2=127.0.0.1:0", "--emulate", "anc300=127.0.0.1:0"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.url = self.proc.stdout.readline().strip()
+        self.ports = {}
+        for _ in range(2):
+            words = self.proc.stdout.readline().split()
+            assert len(words) == 3 and words[0] == "emulate", words
+            self.ports[words[1]] = int(words[2].rsplit(":", 1)[1])
+
+    def stop(self):
+        self.proc.send_signal(signal.SIGINT)
+        try:
+            self.proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            raise
+        assert self.proc.returncode == 0, self.proc.stderr.read()
+
+
+class RawGcs:
+    """A GCS 2.0 client over a plain socket (no library): LF lines, replies read until a line
+    that does not end in a space."""
+
+    def __init__(self, port):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=5)
+        self.buf = b""
+
+    def write(self, line):
+        if line in ("#5", "#7", "#24"):
+            self.sock.sendall(bytes([int(line[1:])]))
+        else:
+            self.sock.sendall(line.encode("latin-1") + b"\n")
+
+    def read_line(self):
+        while b"\n" not in self.buf:
+            chunk = self.sock.recv(4096)
+            if not chunk:
+                raise EOFError("the twin closed the connection")
+            self.buf += chunk
+        line, self.buf = self.buf.split(b"\n", 1)
+        return line.decode("latin-1")
+
+    def close(self):
+        self.sock.close()
+
+
+def read_transcript(path):
+    """The transcript's steps: ('send', line) | ('reply', [regex, ...]) | ('poll', query, regex)."""
+    steps = []
+    with open(path, encoding="utf-8") as f:
+        for raw in f:
+            line = raw.rstrip("\n")
+            if not line or line.startswith("#"):
+                continue
+            kind, text = line[0], line[2:]
+            if kind == ">":
+                steps.append(("send", text))
+            elif kind == "<":
+                if steps and steps[-1][0] == "reply":
+                    steps[-1][1].append(text)
+                else:
+                    steps.append(("reply", [text]))
+            elif kind == "~":
+                query, expected = text.split(" => ")
+                steps.append(("poll", query, expected))
+            else:
+                raise ValueError(f"{path}: bad line {line!r}")
+    return steps
+
+
+def replay(path, write, read_line, timeout_s=10.0):
+    """Plays a transcript through write(line) / read_line(); asserts every reply."""
+    for step in read_transcript(path):
+        if step[0] == "send":
+            write(step[1])
+        elif step[0] == "reply":
+            expected = step[1]
+            for k, pattern in enumerate(expected):
+                got = read_line()
+                last = k + 1 == len(expected)
+                # Multi-line replies: every line but the last ends in a space (PI's GCS 2.0).
+                assert got.endswith(" ") != last, (path, pattern, got)
+                pattern = pattern.replace("\\xb1", "\xb1")
+                assert re.fullmatch(pattern, got.rstrip(" ")), (path, pattern, got)
+        else:
+            _, query, pattern = step
+            end = time.monotonic() + timeout_s
+            while True:
+                write(query)
+                got = read_line()
+                if re.fullmatch(pattern, got):
+                    break
+                assert time.monotonic() < end, (path, query, got)
+                time.sleep(0.02)
