@@ -88,6 +88,7 @@ void bind_control(py::module_& m);
 void bind_platform(py::module_& m);
 void bind_haptics(py::module_& m);
 void bind_tweezers(py::module_& m);
+void bind_vision(py::module_& m);
 
 }  // namespace mc::py
 

@@ -19,6 +19,7 @@ RUN_PACKAGES=(
   nodejs npm           # uPlot (bundled into reports and the console) and the test clients
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
+  libpng-dev           # the camera's PNG frames (vision/png_file; zlib comes with it)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
 )
 # What `make test` needs beside them: test frameworks, the browser, the fuzzers, the Python module
@@ -32,6 +33,7 @@ TEST_PACKAGES=(
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
+  python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
 )
 DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
 [[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")

@@ -12,6 +12,7 @@ Submodules:
     platform   scenario runs and recordings (CSV, MCAP, .mat)
     haptics    the dual-stage interface's rendering pipeline (thesis ch. 3), per tick and per block
     tweezers   TéléTweez design calculators (thesis ch. 4, app. A-B)
+    vision     the microscope camera: render() a frame as a numpy array, camera_model() its optics
 
 Errors: invalid parameters or inputs raise ``ValueError`` with the command line's one-line
 message; a computation that fails (divergence, no convergence) raises
@@ -21,14 +22,14 @@ message; a computation that fails (divergence, no convergence) raises
 import sys as _sys
 
 from ._microcobot import (ComputationFailed, __version__, control, dsp, haptics, identify, platform, stickslip,
-                          tweezers)
+                          tweezers, vision)
 
 # `import microcobot.dsp` and `from microcobot.dsp import butter` work like for a package.
-for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers"):
+for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision"):
     _sys.modules[__name__ + "." + _name] = globals()[_name]
 del _name
 
 __all__ = [
-    "ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers"
+    "ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers", "vision"
 ]
 ComputationFailed.__module__ = __name__

@@ -5,6 +5,7 @@ from . import identify as identify
 from . import platform as platform
 from . import stickslip as stickslip
 from . import tweezers as tweezers
+from . import vision as vision
 
 __version__: str
 
@@ -12,4 +13,4 @@ class ComputationFailed(RuntimeError):
     """A computation could not produce a valid result (divergence, no convergence): CLI exit 4."""
 
 __all__ = ["ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip",
-           "tweezers"]
+           "tweezers", "vision"]

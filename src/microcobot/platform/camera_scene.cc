@@ -1,0 +1,128 @@
+#include "microcobot/platform/camera_scene.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <string_view>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
+#include "microcobot/core/params.h"
+
+namespace mc::platform {
+
+namespace {
+
+double channel(const TelemetrySample& s, std::string_view name) {
+  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i) {
+    if (name == kTelemetryChannels[i]) return s[i];
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+PlatformConfig scene_config(const std::string& scene) {
+  PlatformConfig c;
+  if (scene == "pin-in-hole") {
+    c.world = microworld::pin_in_hole_scene();
+  } else if (scene == "optical-trap") {
+    use_optical_trap_scene(c);
+  } else if (scene != "pick-place") {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(scene, ec))
+      throw InvalidInput("--scene '" + excerpt(scene) +
+                         "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
+                         "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
+    c.world = load_params<microworld::PickPlaceParams>(scene, c.world);
+  }
+  return c;
+}
+
+CameraScenePose initial_pose(const PlatformConfig& c) {
+  CameraScenePose p;
+  p.tool_x_m = c.stage.home_x_m;
+  p.tool_y_m = c.stage.home_y_m;
+  p.tool_z_m = c.stage.home_z_m;
+  if (c.optical_trap_scene()) {
+    p.part_x_m = c.stage.home_x_m;
+    p.part_y_m = c.stage.home_y_m;
+    p.part_z_m = c.optical_trap.trap.bead_radius_m;  // the probe bead just above the dish
+  } else {
+    p.opening_m = c.world.gripper.max_opening_m;
+    p.part_x_m = c.world.part_start_m.x();
+    p.part_y_m = c.world.part_start_m.y();
+    p.part_z_m = 0.5 * c.world.height_m();
+  }
+  return p;
+}
+
+CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetrySample* previous,
+                                    double dt_s) {
+  CameraScenePose p;
+  p.tool_x_m = channel(now, "slave_x_m");
+  p.tool_y_m = channel(now, "slave_y_m");
+  p.tool_z_m = channel(now, "slave_z_m");
+  p.opening_m = channel(now, "gripper_opening_m");
+  p.part_x_m = channel(now, "part_x_m");
+  p.part_y_m = channel(now, "part_y_m");
+  p.part_z_m = channel(now, "part_z_m");
+  if (previous && dt_s > 0.0) {
+    p.vx_m_s = (p.tool_x_m - channel(*previous, "slave_x_m")) / dt_s;
+    p.vy_m_s = (p.tool_y_m - channel(*previous, "slave_y_m")) / dt_s;
+    p.part_vx_m_s = (p.part_x_m - channel(*previous, "part_x_m")) / dt_s;
+    p.part_vy_m_s = (p.part_y_m - channel(*previous, "part_y_m")) / dt_s;
+  }
+  return p;
+}
+
+void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vision::SceneSnapshot& s,
+                       double finger_width_m) {
+  s.clear_objects();
+  if (c.optical_trap_scene()) {
+    // A Petri dish seen in transmitted or reflected light: a glass bottom, faint texture.
+    const auto& trap = c.optical_trap.trap;
+    s.substrate.reflectance = 0.35;
+    s.substrate.texture_contrast = 0.03;
+    s.substrate.texture_grain_m = 0.5e-6;
+    vision::Bead probe;
+    probe.x_m = pose.part_x_m, probe.y_m = pose.part_y_m, probe.z_m = pose.part_z_m;
+    probe.radius_m = trap.bead_radius_m;
+    probe.vx_m_s = pose.part_vx_m_s, probe.vy_m_s = pose.part_vy_m_s;
+    s.beads.push_back(probe);
+    const Eigen::Vector2d o = c.optical_trap.obstacle_m({c.stage.home_x_m, c.stage.home_y_m});
+    vision::Bead stuck;
+    stuck.x_m = o.x(), stuck.y_m = o.y(), stuck.z_m = trap.obstacle_radius_m;
+    stuck.radius_m = trap.obstacle_radius_m;
+    s.beads.push_back(stuck);
+    return;
+  }
+  // Pick-and-place (and pin-in-hole): a lapped steel substrate, the brass part, the hole at the
+  // target, the two fingers closing along x.
+  const auto& w = c.world;
+  if (w.hole_side_m > 0.0) {
+    vision::Hole h;
+    h.x_m = w.target_m.x(), h.y_m = w.target_m.y();
+    h.size_x_m = h.size_y_m = w.hole_side_m;
+    h.depth_m = w.hole_depth_m;
+    s.holes.push_back(h);
+  }
+  vision::Part part;
+  part.x_m = pose.part_x_m, part.y_m = pose.part_y_m;
+  part.z_top_m = pose.part_z_m + 0.5 * w.height_m();
+  part.size_x_m = part.size_y_m = w.part_side_m;
+  part.vx_m_s = pose.part_vx_m_s, part.vy_m_s = pose.part_vy_m_s;
+  s.parts.push_back(part);
+  for (int side : {-1, 1}) {
+    vision::Finger f;
+    f.width_m = finger_width_m;
+    f.tip_x_m = pose.tool_x_m + side * 0.5 * (std::max(pose.opening_m, 0.0) + finger_width_m);
+    f.tip_y_m = pose.tool_y_m - 0.5 * finger_width_m;  // the end of the bar covers the tool point
+    f.z_tip_m = pose.tool_z_m;
+    f.length_m = w.gripper.finger_length_m;
+    f.rise = 0.5;  // the benders come down to the part at about 27 degrees from the substrate
+    f.vx_m_s = pose.vx_m_s, f.vy_m_s = pose.vy_m_s;
+    s.fingers.push_back(f);
+  }
+}
+
+}  // namespace mc::platform

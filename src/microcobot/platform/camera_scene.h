@@ -1,0 +1,42 @@
+#pragma once
+/// @file
+/// What the microscope camera sees of the platform's scene (issue #27): the configuration's
+/// microworld (the pick-and-place part, the pin-in-hole's pin and hole, the optical trap's
+/// beads) and the slave's gripper, as the vision module's SceneSnapshot. The camera thread fills
+/// one snapshot from each telemetry sample it receives (the tool and part channels, or the
+/// probe bead's in the optical-trap scene); velocities (motion blur) come from two samples.
+
+#include <string>
+
+#include "microcobot/platform/platform.h"
+#include "microcobot/platform/platform_config.h"
+#include "microcobot/vision/scene_snapshot.h"
+
+namespace mc::platform {
+
+/// The configuration of a scene by name: "pick-place", "pin-in-hole", "optical-trap", or a YAML
+/// file of the microworld's keys (as `serve --scene`). Throws InvalidInput naming `scene`.
+PlatformConfig scene_config(const std::string& scene);
+
+/// Where the moving things are (world frame, the telemetry's ground-truth channels).
+struct CameraScenePose {
+  double tool_x_m = 0.0, tool_y_m = 0.0, tool_z_m = 0.0;  ///< finger tips' centre (slave_*_m)
+  double opening_m = 0.0;                                 ///< gripper opening
+  double part_x_m = 0.0, part_y_m = 0.0, part_z_m = 0.0;  ///< part centre, or the probe bead's
+  double vx_m_s = 0.0, vy_m_s = 0.0;                      ///< the tool's velocity
+  double part_vx_m_s = 0.0, part_vy_m_s = 0.0;
+};
+
+/// The pose at the scene's start: the tool at the stage's home, the gripper open, the part at
+/// its start (the probe bead in the trap at the home).
+CameraScenePose initial_pose(const PlatformConfig& config);
+/// The pose in a telemetry sample (velocities from `previous`, taken `dt_s` before; zero
+/// without it).
+CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetrySample* previous, double dt_s);
+
+/// Fills `snapshot` (object lists cleared, their capacity kept) with the scene of `config` at
+/// `pose`. `finger_width_m`: the gripper fingers' width along x (the console's 40 um).
+void fill_camera_scene(const PlatformConfig& config, const CameraScenePose& pose,
+                       vision::SceneSnapshot& snapshot, double finger_width_m = 40e-6);
+
+}  // namespace mc::platform
