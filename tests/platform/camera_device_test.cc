@@ -25,9 +25,10 @@ PlatformConfig camera_config() {
   test::register_test_camera();
   PlatformConfig c;
   c.devices.camera.driver = "test-pattern";
-  c.camera.width_px = 320;
-  c.camera.height_px = 256;
-  c.camera.objective = 1;  // 5x: 1.1 um a pixel, a 352 um wide field
+  c.camera.sensor.width_px = 320;
+  c.camera.sensor.height_px = 256;
+  c.camera.sensor.bit_depth = 8;
+  c.camera.objective = 1;  // 5x: 1.06 um a pixel, a 339 um wide field
   c.camera.view_center_x_m = c.world.part_start_m.x();
   c.camera.view_center_y_m = c.world.part_start_m.y();
   return c;
@@ -56,7 +57,7 @@ TEST(Camera, FramesCarryTheLoopTimeAtMidExposureAndTheObjectiveAndFocusState) {
   platform.camera()->set_sink([&](const CameraFrame& f) { got.add(f); });
   // Unpaced, the loop would outrun the camera: run it in steps shorter than a frame period and
   // let the camera form each frame due before going on.
-  const double period = 1.0 / config.camera.frame_rate_Hz, dt = config.loop.period_s();
+  const double period = 1.0 / config.camera.frame_rate_Hz(), dt = config.loop.period_s();
   for (std::uint64_t ticks = 100; ticks <= 3400; ticks += 100) {
     platform.loop().run_for(100);
     const auto due =
@@ -73,9 +74,9 @@ TEST(Camera, FramesCarryTheLoopTimeAtMidExposureAndTheObjectiveAndFocusState) {
     EXPECT_LT(f.t_mid_s, static_cast<double>(k) * period + dt + 1e-12);
     EXPECT_EQ(f.objective, 1);
     EXPECT_EQ(f.objective_name, "5x");
-    EXPECT_NEAR(f.m_per_px, 5.5e-6 / 5.0, 1e-15);
+    EXPECT_NEAR(f.m_per_px, 5.3e-6 / 5.0, 1e-15);
     EXPECT_DOUBLE_EQ(f.focus_z_m, config.camera.focus_start_m);
-    EXPECT_DOUBLE_EQ(f.exposure_s, config.camera.exposure_s);
+    EXPECT_DOUBLE_EQ(f.exposure_s, config.camera.sensor.exposure_s);
     EXPECT_EQ(f.image.width, 320);
     // The JPEG decodes to the frame's image (lossy: the square stays where it was drawn).
     const JpegImage decoded = decode_jpeg(f.jpeg);
@@ -105,7 +106,7 @@ TEST(Camera, TheFocusDriveMovesAtItsSpeedWithinItsLimitsAndTheTurretChangesTheSc
   std::lock_guard lock(got.mutex);
   const CameraFrame& f = got.frames.back();
   EXPECT_EQ(f.objective_name, "20x");
-  EXPECT_NEAR(f.m_per_px, 5.5e-6 / 20.0, 1e-15);
+  EXPECT_NEAR(f.m_per_px, 5.3e-6 / 20.0, 1e-15);
   EXPECT_GT(f.focus_z_m, 100e-6);
   EXPECT_LE(f.focus_z_m, 100e-6 + 334 * 1e-4 * 1e-3 + 1e-12) << "never faster than its speed";
 
@@ -215,7 +216,8 @@ TEST(Camera, ACameraThatFailsPutsEveryDeviceInItsSafeState) {
 
 TEST(Camera, NoCameraWhenNoneIsConfiguredAndBadSettingsAreNamed) {
   PlatformConfig none;
-  EXPECT_EQ(none.devices.camera.driver, "none");
+  EXPECT_EQ(none.devices.camera.driver, "simulated");
+  none.devices.camera.driver = "none";
   Platform platform(none);
   EXPECT_EQ(platform.camera(), nullptr);
   EXPECT_EQ(platform.focus(), nullptr);
@@ -231,7 +233,7 @@ TEST(Camera, NoCameraWhenNoneIsConfiguredAndBadSettingsAreNamed) {
     EXPECT_NE(std::string(e.what()).find("webcam9000"), std::string::npos) << e.what();
   }
   bad = camera_config();
-  bad.camera.exposure_s = 0.1;  // longer than a frame at 30 fps
+  bad.camera.sensor.exposure_s = 0.1;  // longer than a frame at 30 fps
   EXPECT_THROW(bad.validate(), Error);
   bad = camera_config();
   bad.camera.objective = 5;

@@ -41,12 +41,13 @@ class TestPatternSource final : public platform::FrameSource {
     while (c.stall.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (c.fail.load()) throw std::runtime_error("test camera: unplugged");
     c.captures.fetch_add(1);
-    out.resize(params_.width_px, params_.height_px, 1, 8);
+    out.resize(params_.sensor.width_px, params_.sensor.height_px, 1, 8);
     std::fill(out.data.begin(), out.data.end(), std::uint8_t{16});
     const double scale = params_.m_per_px(scene.objective);
     const double* p = scene.has_beads ? scene.probe_bead_m : scene.part_m;
-    const double cx = (p[0] - params_.view_center_x_m) / scale + 0.5 * params_.width_px;
-    const double cy = 0.5 * params_.height_px - (p[1] - params_.view_center_y_m) / scale;  // image y down
+    const double cx = (p[0] - params_.view_center_x_m) / scale + 0.5 * params_.sensor.width_px;
+    const double cy =
+        0.5 * params_.sensor.height_px - (p[1] - params_.view_center_y_m) / scale;  // image y down
     const double half = 0.5 * 300e-6 / scale;
     const double defocus = std::abs(scene.focus_z_m - c.part_top_m);
     const auto level = static_cast<std::uint8_t>(std::clamp(240.0 - defocus * 2e5, 40.0, 240.0));

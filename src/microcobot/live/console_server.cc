@@ -269,7 +269,7 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   publish(image_ch_, RecordedTopic::kCameraImage, t_s, image_cdr_);
   publish(info_ch_, RecordedTopic::kCameraInfo, t_s, info_cdr_);
   publish(camera_state_ch_, RecordedTopic::kCameraState, t_s,
-          camera_state_json(f, live_.camera_params().frame_rate_Hz, s.camera_dropped));
+          camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
@@ -450,14 +450,14 @@ std::string ConsoleServer::scene_json() const {
     for (const auto& o : cam.objectives)
       objectives.push_back({{"name", o.name},
                             {"magnification", o.magnification},
-                            {"m_per_px", cam.pixel_pitch_m / o.magnification}});
+                            {"m_per_px", cam.sensor.pixel_pitch_m / o.magnification}});
     j["camera"] = {{"objectives", objectives},
                    {"focus_min_m", c.focus_min_m},
                    {"focus_max_m", c.focus_max_m},
                    {"focus_speed_m_s", cam.focus_speed_m_s},
-                   {"width_px", cam.width_px},
-                   {"height_px", cam.height_px},
-                   {"frame_rate_Hz", cam.frame_rate_Hz},
+                   {"width_px", cam.sensor.width_px},
+                   {"height_px", cam.sensor.height_px},
+                   {"frame_rate_Hz", cam.frame_rate_Hz()},
                    {"exposure_range_s", {c.min_exposure_s, c.max_exposure_s}},
                    {"gain_range", {c.min_gain, c.max_gain}},
                    {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}}};

@@ -41,7 +41,7 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   limits_.focus_min_m = cam.focus_min_m;
   limits_.focus_max_m = cam.focus_max_m;
   limits_.objective_count = has_camera_ ? static_cast<int>(cam.objectives.size()) : 0;
-  limits_.max_exposure_s = 1.0 / cam.frame_rate_Hz;
+  limits_.max_exposure_s = 1.0 / cam.frame_rate_Hz();
 }
 
 LivePlatform::~LivePlatform() { stop(); }

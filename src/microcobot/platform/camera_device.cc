@@ -21,37 +21,18 @@ constexpr double kMinExposure_s = 10e-6;
 
 }  // namespace
 
-std::vector<ObjectiveParams> CameraDeviceParams::default_objectives() {
-  // A brightfield turret for micro-assembly, 2x (the whole travel) to 50x (a 5 um bead); the
-  // working distances of long-working-distance plan apochromats (Mitutoyo M Plan Apo series).
-  return {{"2x", 2.0, 34.0e-3},
-          {"5x", 5.0, 34.0e-3},
-          {"10x", 10.0, 33.5e-3},
-          {"20x", 20.0, 20.0e-3},
-          {"50x", 50.0, 13.0e-3}};
-}
-
 void CameraDeviceParams::validate() const {
-  require(std::isfinite(frame_rate_Hz) && frame_rate_Hz >= 1.0 && frame_rate_Hz <= 1000.0, "frame_rate_Hz",
-          "must be within [1, 1000] Hz", frame_rate_Hz);
-  require(std::isfinite(exposure_s) && exposure_s >= kMinExposure_s && exposure_s <= 1.0 / frame_rate_Hz,
-          "exposure_s", "must be within [10 us, one frame period]", exposure_s);
-  require(std::isfinite(gain) && gain >= kMinGain && gain <= kMaxGain, "gain", "must be within [1, 16]",
-          gain);
-  require(width_px >= 16 && width_px <= 8192, "width_px", "must be within [16, 8192]", width_px);
-  require(height_px >= 16 && height_px <= 8192, "height_px", "must be within [16, 8192]", height_px);
-  require(std::isfinite(pixel_pitch_m) && pixel_pitch_m > 0.5e-6 && pixel_pitch_m < 50e-6, "pixel_pitch_m",
-          "must be within (0.5, 50) um", pixel_pitch_m);
-  require(bit_depth == 8 || bit_depth == 10 || bit_depth == 12 || bit_depth == 16, "bit_depth",
-          "must be 8, 10, 12 or 16", bit_depth);
+  sensor.validate();
+  illumination.validate();
+  require(sensor.frame_rate_Hz >= 1.0 && sensor.frame_rate_Hz <= 1000.0, "sensor.frame_rate_Hz",
+          "must be within [1, 1000] Hz", sensor.frame_rate_Hz);
+  require(sensor.exposure_s >= kMinExposure_s && sensor.exposure_s <= 1.0 / sensor.frame_rate_Hz,
+          "sensor.exposure_s", "must be within [10 us, one frame period]", sensor.exposure_s);
+  require(sensor.gain >= kMinGain && sensor.gain <= kMaxGain, "sensor.gain", "must be within [1, 16]",
+          sensor.gain);
   require(!objectives.empty() && objectives.size() <= 8, "objectives", "must hold 1 to 8 objectives",
           static_cast<double>(objectives.size()));
-  for (const ObjectiveParams& o : objectives)
-    require(std::isfinite(o.magnification) && o.magnification >= 0.5 && o.magnification <= 200.0,
-            "objectives.magnification", "must be within [0.5, 200]", o.magnification);
-  for (const ObjectiveParams& o : objectives)
-    require(std::isfinite(o.working_distance_m) && o.working_distance_m > 0 && o.working_distance_m < 1.0,
-            "objectives.working_distance_m", "must be within (0, 1) m", o.working_distance_m);
+  for (const ObjectiveParams& o : objectives) o.validate();
   require(objective >= 0 && objective < static_cast<int>(objectives.size()), "objective",
           "must index one of the objectives", objective);
   require(std::isfinite(view_center_x_m) && std::isfinite(view_center_y_m), "view_center_x_m",
@@ -70,7 +51,7 @@ void CameraDeviceParams::validate() const {
 double CameraDeviceParams::m_per_px(int i) const {
   const auto& o =
       objectives.at(static_cast<std::size_t>(std::clamp(i, 0, static_cast<int>(objectives.size()) - 1)));
-  return pixel_pitch_m / o.magnification;
+  return sensor.pixel_pitch_m / o.magnification;
 }
 
 Camera::Camera(std::string name, CameraDeviceParams params, std::unique_ptr<FrameSource> source)
@@ -78,8 +59,8 @@ Camera::Camera(std::string name, CameraDeviceParams params, std::unique_ptr<Fram
       params_((params.validate(), std::move(params))),
       source_(std::move(source)),
       ring_(params_.ring_frames),
-      exposure_s_(params_.exposure_s),
-      gain_(params_.gain) {
+      exposure_s_(params_.sensor.exposure_s),
+      gain_(params_.sensor.gain) {
   if (!source_) throw InvalidParams("camera", "has no frame source");
 }
 
@@ -96,7 +77,7 @@ void Camera::set_sink(Sink sink) {
 
 void Camera::set_exposure_s(double exposure_s) noexcept {
   if (!std::isfinite(exposure_s)) return;
-  exposure_s_.store(std::clamp(exposure_s, kMinExposure_s, 1.0 / params_.frame_rate_Hz),
+  exposure_s_.store(std::clamp(exposure_s, kMinExposure_s, 1.0 / params_.sensor.frame_rate_Hz),
                     std::memory_order_relaxed);
 }
 
@@ -108,7 +89,7 @@ void Camera::set_gain(double gain) noexcept {
 bool Camera::frame_due(double t_s) noexcept {
   if (t_s + 1e-12 < next_frame_t_s_) return false;
   // After a pause (a scene rebuilt, a slow start) the next frame is the next one on the grid.
-  const double period = 1.0 / params_.frame_rate_Hz;
+  const double period = 1.0 / params_.sensor.frame_rate_Hz;
   ++next_frame_;
   next_frame_t_s_ = static_cast<double>(next_frame_) * period;
   if (next_frame_t_s_ <= t_s) {
@@ -164,8 +145,9 @@ void Camera::on_deactivate() {
 
 void Camera::thread_main() {
   CameraFrame frame;
-  frame.image.data.reserve(static_cast<std::size_t>(params_.width_px) *
-                           static_cast<std::size_t>(params_.height_px) * (params_.bit_depth > 8 ? 2u : 1u));
+  frame.image.data.reserve(static_cast<std::size_t>(params_.sensor.width_px) *
+                           static_cast<std::size_t>(params_.sensor.height_px) *
+                           (params_.sensor.bit_depth > 8 ? 2u : 1u));
   SceneSnapshot scene, newer;
   bool have_scene = false;
   try {
@@ -233,7 +215,7 @@ void Camera::deliver(CameraFrame& frame, const SceneSnapshot& scene, std::int64_
   frame.objective_name = o.name;
   frame.magnification = o.magnification;
   frame.working_distance_m = o.working_distance_m;
-  frame.m_per_px = params_.pixel_pitch_m / o.magnification;
+  frame.m_per_px = params_.sensor.pixel_pitch_m / o.magnification;
   frame.focus_z_m = scene.focus_z_m;
   frame.view_center_m[0] = params_.view_center_x_m;
   frame.view_center_m[1] = params_.view_center_y_m;

@@ -39,6 +39,7 @@
 #include "microcobot/platform/camera_frame.h"
 #include "microcobot/platform/device.h"
 #include "microcobot/platform/spsc_ring.h"
+#include "microcobot/vision/camera_params.h"
 
 namespace mc {
 class JpegEncoder;
@@ -46,32 +47,21 @@ class JpegEncoder;
 
 namespace mc::platform {
 
-/// One objective of the turret.
-struct ObjectiveParams {
-  std::string name = "10x";
-  double magnification = 10.0;
-  double working_distance_m = 33.5e-3;  ///< front lens to focal plane
+/// One objective of the turret (vision's: magnification, NA, working distance, wavelength).
+using ObjectiveParams = vision::ObjectiveParams;
 
-  template <class V>
-  void visit(V& v) {
-    v("name", name);
-    v("magnification", magnification);
-    v("working_distance_m", working_distance_m);
-  }
-};
-
-/// The camera as the platform drives it (the image formation's own parameters are vision's).
+/// The microscope camera of the platform: its sensor and illumination (vision's parameters: the
+/// image formation's, and a real camera's settings), the objectives of its turret, where it
+/// looks, its focus drive, and how its frames are encoded.
 struct CameraDeviceParams {
-  bool enabled = true;          ///< false: no camera, no focus drive
-  double frame_rate_Hz = 30.0;  ///< frames per second of loop time
-  double exposure_s = 10e-3;    ///< at most one frame period
-  double gain = 1.0;            ///< analog gain, [1, 16]
-  int width_px = 1280;          ///< sensor (a 1.3 Mpx machine-vision camera, 5.5 um pixels)
-  int height_px = 1024;
-  double pixel_pitch_m = 5.5e-6;
-  int bit_depth = 8;  ///< 8, 10, 12 or 16
-  /// Objectives on the turret; the pixel size in the object is pixel_pitch_m / magnification.
-  std::vector<ObjectiveParams> objectives = default_objectives();
+  bool enabled = true;  ///< false: no camera, no focus drive
+  /// Sensor: size, pixel pitch, bit depth, exposure (at most one frame period), gain in [1, 16],
+  /// noise, frame rate (frames per second of loop time).
+  vision::SensorParams sensor;
+  vision::IlluminationParams illumination;
+  /// Objectives on the turret (vision::objective_table(): 2x to 50x); the pixel size in the
+  /// object is pixel_pitch_m / magnification.
+  std::vector<ObjectiveParams> objectives = vision::objective_table();
   int objective = 0;  ///< the turret's position at power-up
   /// World x, y under the optical axis (the image's centre): the middle of the main scenario's
   /// travel, from the gripper's home (-0.2 mm) to the target (2 mm).
@@ -83,18 +73,14 @@ struct CameraDeviceParams {
   double focus_max_m = 2e-3;
   double focus_speed_m_s = 1e-3;
   int jpeg_quality = 85;        ///< 1..100 (libjpeg-turbo's scale)
+  int seed = 1;                 ///< the simulated sensor's noise (frame k: seed and k)
   std::size_t ring_frames = 8;  ///< snapshots the loop may queue ahead of the camera thread
 
   template <class V>
   void visit(V& v) {
     v("enabled", enabled);
-    v("frame_rate_Hz", frame_rate_Hz);
-    v("exposure_s", exposure_s);
-    v("gain", gain);
-    v("width_px", width_px);
-    v("height_px", height_px);
-    v("pixel_pitch_m", pixel_pitch_m);
-    v("bit_depth", bit_depth);
+    v("sensor", sensor);
+    v("illumination", illumination);
     v("objective", objective);
     v("view_center_x_m", view_center_x_m);
     v("view_center_y_m", view_center_y_m);
@@ -103,12 +89,13 @@ struct CameraDeviceParams {
     v("focus_max_m", focus_max_m);
     v("focus_speed_m_s", focus_speed_m_s);
     v("jpeg_quality", jpeg_quality);
+    v("seed", seed);
   }
   /// Throws mc::InvalidParams naming the field.
   void validate() const;
   /// Object-side size of a pixel through objective `i` [m].
   double m_per_px(int i) const;
-  static std::vector<ObjectiveParams> default_objectives();
+  double frame_rate_Hz() const { return sensor.frame_rate_Hz; }
 };
 
 /// What makes the pixels: a renderer of the scene (the simulated microscope) or a real camera.

@@ -8,6 +8,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/platform/opencv_camera.h"
+#include "microcobot/platform/simulated_camera.h"
 
 namespace mc::platform {
 namespace {
@@ -99,7 +100,7 @@ void register_camera(const std::string& name, CameraSourceFactory factory) {
 }
 
 std::vector<std::string> camera_driver_names() {
-  std::vector<std::string> names{kNoCamera};
+  std::vector<std::string> names{kNoCamera, kSimulated};
   if (opencv_camera_available()) names.emplace_back(kOpenCv);
   std::lock_guard lock(entries_mutex());
   for (const auto& entry : cameras()) names.push_back(entry.first);
@@ -114,6 +115,7 @@ bool is_camera_driver(const std::string& name) {
 std::unique_ptr<FrameSource> make_camera_source(const PlatformConfig& config) {
   const std::string& name = config.devices.camera.driver;
   if (name == kNoCamera) return nullptr;
+  if (name == kSimulated) return make_simulated_camera(config);
   if (name == kOpenCv && opencv_camera_available()) return make_opencv_camera(config.devices.camera.source);
   CameraSourceFactory factory;
   {

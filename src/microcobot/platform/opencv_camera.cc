@@ -49,12 +49,12 @@ class OpenCvCamera final : public FrameSource {
                          ")");
     if (!file_) {
       // A live camera is asked for the configured sensor and rate (best effort: it may refuse).
-      capture_.set(cv::CAP_PROP_FRAME_WIDTH, params.width_px);
-      capture_.set(cv::CAP_PROP_FRAME_HEIGHT, params.height_px);
-      capture_.set(cv::CAP_PROP_FPS, params.frame_rate_Hz);
+      capture_.set(cv::CAP_PROP_FRAME_WIDTH, params.sensor.width_px);
+      capture_.set(cv::CAP_PROP_FRAME_HEIGHT, params.sensor.height_px);
+      capture_.set(cv::CAP_PROP_FPS, params.sensor.frame_rate_Hz);
     }
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-        std::chrono::duration<double>(1.0 / params.frame_rate_Hz));
+        std::chrono::duration<double>(1.0 / params.sensor.frame_rate_Hz));
     next_ = std::chrono::steady_clock::now();
   }
 

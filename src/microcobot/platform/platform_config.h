@@ -106,7 +106,7 @@ struct HapticMasterParams {
 /// formation of vision/ rendering the microworld) or a registered camera driver ("opencv": a
 /// camera OpenCV's VideoCapture opens, a V4L2 device, a GStreamer pipeline or a video file).
 struct CameraSelection {
-  std::string driver = "none";
+  std::string driver = "simulated";
   /// What the driver opens: for "opencv" a device index ("0"), a device file, a file name or a
   /// GStreamer pipeline ending in "appsink".
   std::string source;
