@@ -123,8 +123,8 @@ if (infos.length > 0 && states.length > 0) {
 }
 
 server.kill("SIGTERM");
-const { code } = await exited;
-if (code !== 0) fail(`serve exited ${code}`);
+const { code, signal } = await exited;
+if (code !== 0) fail(`serve exited ${code} (${signal})`);
 
 // The recording: the image channel, every frame in sequence.
 const mcaps = readdirSync(dir).filter((f) => /^recording-[0-9-]+\.mcap$/.test(f));

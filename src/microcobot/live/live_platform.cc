@@ -304,6 +304,9 @@ void LivePlatform::stop() {
   thread_.join();
   // Safe state now; the devices are deactivated when the platform goes.
   platform_->fault_all();
+  // No frame reaches the sink after stop() (its owner may go first): set_sink waits for one
+  // being delivered.
+  if (platform_->camera() != nullptr) platform_->camera()->set_sink(nullptr);
   estopped_.store(true);
 }
 
