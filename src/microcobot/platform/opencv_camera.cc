@@ -47,8 +47,9 @@ class OpenCvCamera final : public FrameSource {
     if (!ok || !capture_.isOpened())
       throw InvalidInput("camera: OpenCV cannot open '" + excerpt(source_) + "' (backends: " + backends() +
                          ")");
-    if (!file_) {
-      // A live camera is asked for the configured sensor and rate (best effort: it may refuse).
+    if (!file_ && source_.find('!') == std::string::npos) {
+      // A live camera is asked for the configured sensor and rate (best effort: it may refuse);
+      // a GStreamer pipeline says its own caps (setting them restarts it).
       capture_.set(cv::CAP_PROP_FRAME_WIDTH, params.sensor.width_px);
       capture_.set(cv::CAP_PROP_FRAME_HEIGHT, params.sensor.height_px);
       capture_.set(cv::CAP_PROP_FPS, params.sensor.frame_rate_Hz);
