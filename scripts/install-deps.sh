@@ -19,6 +19,8 @@ RUN_PACKAGES=(
   nodejs npm           # uPlot (bundled into reports and the console) and the test clients
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
+  libturbojpeg0-dev    # the camera's JPEG frames (core/jpeg)
+  libopencv-videoio-dev  # the real-camera driver (platform/opencv_camera.cc; CMake MC_WITH_OPENCV)
   libpng-dev           # the camera's PNG frames (vision/png_file; zlib comes with it)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
 )
@@ -33,6 +35,7 @@ TEST_PACKAGES=(
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
+  gstreamer1.0-plugins-base  # videotestsrc: the OpenCV driver's synthetic source in its test
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
   python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins (issue #30)
 )
@@ -61,6 +64,7 @@ fi
 # recordings' chunks, @foxglove/ws-protocol for the protocol test).
 if [[ ! -d node_modules/uplot || ! -d node_modules/playwright-core || ! -d node_modules/@mcap/core ||
       ! -d node_modules/@foxglove/ws-protocol || ! -d node_modules/@foxglove/wasm-zstd ||
+      ! -d node_modules/@foxglove/rosmsg2-serialization ||
       package-lock.json -nt node_modules/.package-lock.json ]]; then
   echo "install-deps: npm ci" >&2
   npm ci --no-audit --no-fund --loglevel=error >/dev/null

@@ -122,6 +122,7 @@ function currentCommand() {
     cmd.goal_speed_m_s = v;
   }
   if (mc.input.gripperTouched) cmd.gripper_opening_m = mc.input.gripper;
+  Object.assign(cmd, mc.microscopeCommand ? mc.microscopeCommand() : {});  // focus, objective, exposure, gain
   return cmd;
 }
 setInterval(() => {

@@ -46,7 +46,9 @@ class FoxgloveClient {
     if (view.byteLength < 13 || view.getUint8(0) !== 1) return;  // messageData only
     const topic = this.subscriptions.get(view.getUint32(1, true));
     if (topic === undefined) return;
-    const payload = JSON.parse(new TextDecoder().decode(new Uint8Array(data, 13)));
+    // CDR channels (the camera's ROS 2 messages) are handed over as bytes, JSON ones parsed.
+    const channel = this.channels.get(topic), bytes = new Uint8Array(data, 13);
+    const payload = channel && channel.encoding === "cdr" ? bytes : JSON.parse(new TextDecoder().decode(bytes));
     this.h.message && this.h.message(topic, payload);
   }
   subscribe(topic) {

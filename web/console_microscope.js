@@ -1,4 +1,7 @@
-// The microscope: top view through an objective (field of view, numerical aperture), focused on
+// The microscope. With a camera (scene.camera), the panel is the camera's image
+// (console_camera.js) with the graticule (target, goal, scale bar, arrows toward what is off the
+// field); the simulation's ground truth is only an overlay, labelled, off by default. Without a
+// camera, a schematic: top view through an objective (field of view, numerical aperture), focused on
 // the finger tips; what lies off the focal plane is blurred by defocus, detail finer than the
 // optical resolution (0.61 lambda / NA) is not shown. Plus a side view (x, z), click-to-go on
 // both, and arrows at the field's edge toward what lies outside it (part, target, goal): at
@@ -56,8 +59,73 @@ function drawBlurred(g, x, y, w, h, blur, color) {
   g.drawImage(blurCanvas, x - margin, y - margin, bw * k, bh * k);
 }
 
+// The camera's image, the graticule over it and, when asked for, the ground truth's outlines.
+function drawCameraPanel(c, g, t, sc) {
+  g.filter = "none";
+  g.fillStyle = "#111";
+  g.fillRect(0, 0, c.width, c.height);
+  const cv = mc.cameraView();
+  if (cv) {
+    view.center = cv.center;
+    view.fov = cv.fov;
+  }
+  const shown = mc.drawCameraImage(g, c);
+  if (!t || !cv || !shown) return;
+  const s = c.width / view.fov;
+  if ($("overlay").checked) drawGroundTruth(g, c, t, sc, s);
+  if (sc.kind !== "optical-trap") {
+    const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
+    g.strokeStyle = "#46c47e";
+    g.lineWidth = 2;
+    g.beginPath(); g.arc(tx, ty, Math.max(3, sc.tolerance_m * s), 0, 2 * Math.PI);
+    g.moveTo(tx - 20, ty); g.lineTo(tx + 20, ty); g.moveTo(tx, ty - 20); g.lineTo(tx, ty + 20); g.stroke();
+  }
+  if (mc.input.goal) {
+    const [gx, gy] = worldToCanvas(mc.input.goal[0], mc.input.goal[1]);
+    g.strokeStyle = "#4fa3ff";
+    g.lineWidth = 2;
+    g.beginPath(); g.arc(gx, gy, 6, 0, 2 * Math.PI); g.stroke();
+  }
+  drawScaleBar(g, c, s);
+  drawOffField(g, c);
+}
+
+// The simulation's ground truth as outlines (part or beads, fingers), labelled as such.
+function drawGroundTruth(g, c, t, sc, s) {
+  g.save();
+  g.strokeStyle = "#ff5bd1";
+  g.fillStyle = "#ff5bd1";
+  g.lineWidth = 1.5;
+  g.setLineDash([5, 4]);
+  if (sc.kind === "optical-trap") {
+    const ring = (x, y, r) => { const [px, py] = worldToCanvas(x, y); g.beginPath(); g.arc(px, py, r * s, 0, 2 * Math.PI); g.stroke(); };
+    ring(sc.obstacle_m[0], sc.obstacle_m[1], sc.obstacle_radius_m);
+    if (isNum(t.part_x_m)) ring(t.part_x_m, t.part_y_m, sc.bead_radius_m);
+  } else {
+    const side = sc.part_side_m;
+    if (isNum(t.part_x_m)) {
+      const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
+      g.strokeRect(px, py, side * s, side * s);
+    }
+    const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
+    for (const sign of [-1, 1]) {
+      const cx = t.measured_x_m + sign * (half + w / 2);
+      const [fx, fy] = worldToCanvas(cx - w / 2, t.measured_y_m + w);
+      g.strokeRect(fx, fy, w * s, 2 * w * s);
+    }
+  }
+  g.setLineDash([]);
+  g.font = "bold 12px system-ui";
+  g.fillText("GROUND-TRUTH OVERLAY (simulation)", 10, 18);
+  g.restore();
+}
+
 function drawMicroscope() {
   const c = $("microscope"), g = c.getContext("2d"), t = mc.telemetry, sc = mc.scene;
+  if (sc && sc.camera && mc.cameraView) {
+    drawCameraPanel(c, g, t, sc);
+    return;
+  }
   const o = optics();
   view.fov = o.fov;
   if (t && $("follow").checked) view.center = [t.measured_x_m, t.measured_y_m];
@@ -236,6 +304,7 @@ $("microscope").addEventListener("wheel", (e) => {
   mc.input.zJog = Math.max(-1, Math.min(1, mc.input.zJog - Math.sign(e.deltaY)));
 }, {passive: false});
 $("objective").addEventListener("change", () => { drawMicroscope(); drawSide(); });
+$("overlay").addEventListener("change", () => drawMicroscope());
 
 // What lies outside the field among the part, the target (or the stuck bead) and the pending
 // goal: [{name, x, y, px, py, color}] (world and canvas coordinates).
@@ -245,7 +314,8 @@ function offField() {
   if (sc.kind === "optical-trap") {
     if (Array.isArray(sc.obstacle_m)) marks.push(["stuck bead", sc.obstacle_m[0], sc.obstacle_m[1], "#d8d2c2"]);
   } else {
-    if (isNum(t.part_x_m)) marks.push(["part", t.part_x_m, t.part_y_m, "#c9a04a"]);
+    // With a camera the part is what the image shows; its ground truth only with the overlay.
+    if (isNum(t.part_x_m) && (!sc.camera || $("overlay").checked)) marks.push(["part", t.part_x_m, t.part_y_m, "#c9a04a"]);
     marks.push(["target", sc.target_m[0], sc.target_m[1], "#46c47e"]);
   }
   if (mc.input.goal) marks.push(["goal", mc.input.goal[0], mc.input.goal[1], "#4fa3ff"]);

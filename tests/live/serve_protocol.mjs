@@ -45,6 +45,7 @@ const subs = new Map();
 observer.on("advertise", (list) => {
   for (const c of list) {
     channels.set(c.topic, c);
+    if (c.encoding !== "json") continue;  // the camera's CDR channels: tests/live/camera_foxglove.mjs
     counts.set(c.topic, 0);
     subs.set(observer.subscribe(c.id), c);
   }

@@ -24,13 +24,13 @@ struct Console {
   explicit Console(std::uint16_t port, const std::string& target = "/") {
     EXPECT_EQ(ws.connect(port, target), 101);
     // serverInfo, then the advertisement of the server's channels.
-    for (int i = 0; i < 10 && channels.size() < 4; ++i) {
+    for (int i = 0; i < 10 && channels.empty(); ++i) {
       const nlohmann::json j = ws.read_json();
       if (j.is_null()) break;
       if (j.value("op", "") == "advertise")
         for (const auto& c : j["channels"]) channels[c["topic"]] = c["id"];
     }
-    EXPECT_EQ(channels.size(), 4u);
+    EXPECT_GE(channels.size(), 4u);  // and the camera's three when there is one
     EXPECT_TRUE(ws.send_json({{"op", "advertise"},
                               {"channels",
                                {{{"id", 1},

@@ -58,9 +58,27 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else if (key == "gripper_opening_m") {
       c.gripper_opening_m = finite(kChannel, value, key);
       c.has_gripper = true;
+    } else if (key == "focus_z_m") {
+      c.focus_z_m = std::clamp(finite(kChannel, value, key), limits.focus_min_m, limits.focus_max_m);
+      c.has_focus = true;
+    } else if (key == "objective") {
+      if (!value.is_number_integer()) refuse(kChannel, key, "must be an integer");
+      const auto i = value.get<std::int64_t>();
+      if (i < 0 || i >= limits.objective_count)
+        refuse(kChannel, key,
+               limits.objective_count == 0
+                   ? std::string("there is no camera")
+                   : "must be within [0, " + std::to_string(limits.objective_count - 1) + "], not " +
+                         std::to_string(i));
+      c.objective = static_cast<int>(i);
+    } else if (key == "exposure_s") {
+      c.exposure_s = std::clamp(finite(kChannel, value, key), limits.min_exposure_s, limits.max_exposure_s);
+    } else if (key == "gain") {
+      c.gain = std::clamp(finite(kChannel, value, key), limits.min_gain, limits.max_gain);
     } else {
       refuse(kChannel, key,
-             "is not a known key (deadman, velocity_m_s, goal_m, goal_speed_m_s, gripper_opening_m)");
+             "is not a known key (deadman, velocity_m_s, goal_m, goal_speed_m_s, gripper_opening_m, "
+             "focus_z_m, objective, exposure_s, gain)");
     }
   }
   // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.

@@ -19,6 +19,15 @@ struct ConsoleLimits {
   std::array<double, 3> min_m = {-6e-3, -6e-3, -6e-3};
   std::array<double, 3> max_m = {6e-3, 6e-3, 6e-3};
   double max_opening_m = 600e-6;
+  /// The microscope's focus travel (focal plane height) and turret positions (0: no camera).
+  double focus_min_m = -0.5e-3;
+  double focus_max_m = 2e-3;
+  int objective_count = 0;
+  /// The camera's exposure and gain ranges.
+  double min_exposure_s = 10e-6;
+  double max_exposure_s = 33e-3;
+  double min_gain = 1.0;
+  double max_gain = 16.0;
 };
 
 /// The console's continuous command (sent at ~30 Hz by the client in control: also its
@@ -31,6 +40,14 @@ struct ConsoleCommand {
   double goal_speed_m_s = 100e-6;
   bool has_gripper = false;
   double gripper_opening_m = 0.0;
+  /// The microscope (issue #27): focal plane height to go to, objective to turn in, the camera's
+  /// exposure and gain. Each optional; they need control but not the deadman (nothing of the
+  /// slave moves).
+  bool has_focus = false;
+  double focus_z_m = 0.0;
+  int objective = -1;       ///< -1: unchanged
+  double exposure_s = 0.0;  ///< 0: unchanged
+  double gain = 0.0;        ///< 0: unchanged
   /// When the server received it (steady clock, ns; 0: unknown): the loop measures the
   /// command-to-target latency from it.
   std::int64_t received_ns = 0;
@@ -49,8 +66,10 @@ enum class ConsoleAction {
 };
 
 /// Parses `{"deadman": bool, "velocity_m_s": [vx, vy, vz], "goal_m": [x, y, z] (optional),
-/// "goal_speed_m_s": v (optional), "gripper_opening_m": o (optional)}`; unknown keys are
-/// refused. Values are checked finite and clamped to `limits`. Throws mc::InvalidInput
+/// "goal_speed_m_s": v (optional), "gripper_opening_m": o (optional), "focus_z_m": z,
+/// "objective": i, "exposure_s": e, "gain": g (optional; the microscope)}`; unknown keys are
+/// refused. Values are checked finite and clamped to `limits`; an objective that is not on the
+/// turret is refused. Throws mc::InvalidInput
 /// ("/console/command: velocity_m_s[1]: must be a finite number").
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
 

@@ -13,6 +13,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/dsp/butterworth.h"
+#include "microcobot/live/camera_messages.h"
 #include "microcobot/live/console_page.h"
 #include "microcobot/platform/telemetry_json.h"
 
@@ -96,6 +97,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"recording", {{"type", {"string", "null"}}}},
                                             {"last_error", text},
                                             {"ticks", number},
+                                            {"camera", {{"type", {"object", "null"}}}},
                                             {"demo_result", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
@@ -136,11 +138,21 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                            {"demo_unavailable_reason", text},
                                            {"bead_radius_m", number},
                                            {"obstacle_m", {{"type", "array"}, {"items", number}}},
-                                           {"obstacle_radius_m", number}},
+                                           {"obstacle_radius_m", number},
+                                           {"camera", {{"type", {"object", "null"}}}}},
                                           scene_keys)});
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
+  if (live_.has_camera()) {
+    image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
+                                     "ros2msg", std::string(compressed_image_schema())});
+    info_ch_ = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
+                                    "ros2msg", std::string(camera_info_schema())});
+    camera_state_ch_ = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",
+                                            "jsonschema", camera_state_schema()});
+    live_.set_frame_sink([this](const platform::CameraFrame& f, double t_s) { on_frame(f, t_s); });
+  }
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
   server_.on_disconnect([this](server::ClientId c) { on_disconnect(c); });
   if (!params_.out_dir.empty()) {
@@ -158,6 +170,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     rp.feedback = recorded(feedback_ch_);
     rp.version = params_.version;
     rp.config_yaml = params_.config_yaml;
+    rp.camera = live_.has_camera();
     rp.on_error = [this](const std::string& why) {
       server_.broadcast_status(StatusLevel::kError, "recording stopped: " + why);
     };
@@ -246,6 +259,17 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
                   {"grip_N", finite(s[kGrip])},
                   {"rumble", rumble}};
   publish(feedback_ch_, RecordedTopic::kFeedback, s[0], f.dump());
+}
+
+void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
+  const RosTime stamp = ros_time(t_s);
+  encode_compressed_image(f, stamp, image_cdr_);
+  encode_camera_info(f, stamp, info_cdr_);
+  const LiveStatus s = live_.status();
+  publish(image_ch_, RecordedTopic::kCameraImage, t_s, image_cdr_);
+  publish(info_ch_, RecordedTopic::kCameraInfo, t_s, info_cdr_);
+  publish(camera_state_ch_, RecordedTopic::kCameraState, t_s,
+          camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
@@ -418,6 +442,28 @@ std::string ConsoleServer::scene_json() const {
          {"force_full_scale_N", live_.contact_force_limit_N()},
          {"grip_force_limit_N", live_.grip_force_limit_N()},
          {"contact_force_limit_N", live_.contact_force_limit_N()}};
+  if (live_.has_camera()) {
+    // What the microscope panel needs: the turret, the focus travel, the sensor, the settings'
+    // ranges (the current state comes with each frame on /camera/state).
+    const platform::CameraDeviceParams& cam = live_.camera_params();
+    json objectives = json::array();
+    for (const auto& o : cam.objectives)
+      objectives.push_back({{"name", o.name},
+                            {"magnification", o.magnification},
+                            {"m_per_px", cam.sensor.pixel_pitch_m / o.magnification}});
+    j["camera"] = {{"objectives", objectives},
+                   {"focus_min_m", c.focus_min_m},
+                   {"focus_max_m", c.focus_max_m},
+                   {"focus_speed_m_s", cam.focus_speed_m_s},
+                   {"width_px", cam.sensor.width_px},
+                   {"height_px", cam.sensor.height_px},
+                   {"frame_rate_Hz", cam.frame_rate_Hz()},
+                   {"exposure_range_s", {c.min_exposure_s, c.max_exposure_s}},
+                   {"gain_range", {c.min_gain, c.max_gain}},
+                   {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}}};
+  } else {
+    j["camera"] = nullptr;
+  }
   const std::string no_demo = live_.demo_unavailable_reason();
   j["demo_available"] = no_demo.empty();
   j["demo_unavailable_reason"] = no_demo;
@@ -464,6 +510,12 @@ std::string ConsoleServer::status_json() {
             {"recording", recording.empty() ? json(nullptr) : json(recording)},
             {"last_error", s.last_error},
             {"ticks", s.ticks}};
+  j["camera"] = s.camera ? json{{"frames", s.camera_frames},
+                                {"dropped", s.camera_dropped},
+                                {"focus_z_m", s.focus_z_m},
+                                {"focus_target_m", s.focus_target_m},
+                                {"objective", s.objective}}
+                         : json(nullptr);
   const DemoResult& d = s.demo_result;
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;

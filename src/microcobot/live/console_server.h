@@ -7,6 +7,9 @@
 ///   /platform/status      5 Hz   e-stop, control, watchdog, lifecycles, tick p99, recording
 ///   /platform/scene       1 Hz   geometry and limits the microscope view needs
 ///   /console/feedback    60 Hz   contact and grip forces, the vibrotactile channel
+///   /camera/image/compressed     every camera frame, sensor_msgs/msg/CompressedImage (CDR, JPEG)
+///   /camera/camera_info          every frame, sensor_msgs/msg/CameraInfo (CDR)
+///   /camera/state                every frame, objective, focus, exposure, gain, scale (JSON)
 ///   client /console/command      the controlling client's command (~30 Hz heartbeat)
 ///   client /console/action       estop, reset, take/release control, demo, restart, record
 ///
@@ -86,6 +89,8 @@ class ConsoleServer {
 
  private:
   void on_sample(const platform::TelemetrySample& s, std::size_t count);
+  /// A camera frame (camera thread): encoded, published and recorded.
+  void on_frame(const platform::CameraFrame& f, double t_s);
   void on_message(const server::ClientMessage& m);
   void on_disconnect(server::ClientId client);
   void status_thread();
@@ -105,6 +110,8 @@ class ConsoleServer {
   ConsoleServerParams params_;
   server::FoxgloveServer server_;
   server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
+  server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0;
+  std::string image_cdr_, info_cdr_;  // camera thread only
 
   std::atomic<server::ClientId> controller_{0};
   std::atomic<bool> quit_{false};

@@ -42,6 +42,11 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
     limits_.max_m[i] = home[i] + tp.workspace_max_m;
   }
   limits_.max_opening_m = params_.platform.world.gripper.max_opening_m;
+  const platform::CameraDeviceParams& cam = params_.platform.camera;
+  limits_.focus_min_m = cam.focus_min_m;
+  limits_.focus_max_m = cam.focus_max_m;
+  limits_.objective_count = has_camera_ ? static_cast<int>(cam.objectives.size()) : 0;
+  limits_.max_exposure_s = 1.0 / cam.frame_rate_Hz();
 }
 
 LivePlatform::~LivePlatform() { stop(); }
@@ -58,6 +63,9 @@ void LivePlatform::build(bool demo) {
   if (demo) op = std::make_unique<PickPlaceOperator>(*p, params_.demo);
   p->set_operator([this](const platform::TickInfo& t) { operator_tick(t); });
   channel_count_ = p->telemetry_channel_count();
+  has_camera_ = p->camera() != nullptr;
+  camera_frames_.store(0);
+  attach_camera(*p);
   platform_ = std::move(p);
   demo_ = std::move(op);
   demo_running_.store(demo);
@@ -72,6 +80,21 @@ void LivePlatform::build(bool demo) {
   protocol_fresh_ = protocol_has_goal_ = protocol_steps_pending_ = false;
   settled_s_ = {};
   remote_estopped_ = false;
+}
+
+void LivePlatform::set_frame_sink(FrameSink sink) {
+  if (started_.load()) throw InvalidInput("live platform: set the frame sink before start()");
+  frame_sink_ = std::move(sink);
+  attach_camera(*platform_);
+}
+
+void LivePlatform::attach_camera(Platform& p) {
+  // Without a sink the camera forms no frame (camera_device.h).
+  if (p.camera() == nullptr || !frame_sink_) return;
+  p.camera()->set_sink([this, offset = t_offset_s_](const platform::CameraFrame& f) {
+    camera_frames_.fetch_add(1, std::memory_order_relaxed);  // for the status
+    frame_sink_(f, offset + f.t_mid_s);
+  });
 }
 
 bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return commands_.push(c); }
@@ -104,6 +127,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   }
   while (!params_.remote && commands_.pop(c)) {
     got = true;
+    apply_microscope(p, c);
     if (c.received_ns > 0) {
       // Applied in this tick: the command-to-target latency (a full ring drops the sample).
       const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -154,6 +178,12 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   lifecycle_[4].store(static_cast<int>(p.haptic().state()), std::memory_order_relaxed);
   lifecycle_[5].store(static_cast<int>(p.tweezers().state()), std::memory_order_relaxed);
   overruns_.store(p.loop().overruns(), std::memory_order_relaxed);
+  if (const platform::FocusDrive* focus = p.focus()) {
+    focus_z_m_.store(focus->z_m(), std::memory_order_relaxed);
+    focus_target_m_.store(focus->target_z_m(), std::memory_order_relaxed);
+    objective_.store(focus->objective(), std::memory_order_relaxed);
+    camera_dropped_.store(p.camera()->dropped(), std::memory_order_relaxed);
+  }
   ticks_.store(p.loop().ticks(), std::memory_order_relaxed);
 }
 
@@ -261,6 +291,16 @@ ProtocolView LivePlatform::protocol_view() const noexcept {
   v.halted = estopped_.load(std::memory_order_relaxed);
   v.refused_steps = refused_steps_.load(std::memory_order_relaxed);
   return v;
+}
+
+void LivePlatform::apply_microscope(Platform& p, const ConsoleCommand& c) noexcept {
+  // Every command's microscope part counts (a later command without it changes nothing).
+  platform::FocusDrive* focus = p.focus();
+  if (focus == nullptr) return;
+  if (c.has_focus) focus->command_z_m(c.focus_z_m);
+  if (c.objective >= 0) focus->command_objective(c.objective);
+  if (c.exposure_s > 0.0) p.camera()->set_exposure_s(c.exposure_s);
+  if (c.gain > 0.0) p.camera()->set_gain(c.gain);
 }
 
 bool LivePlatform::demo_tick(const platform::TickInfo& t) noexcept {
@@ -382,6 +422,9 @@ void LivePlatform::stop() {
   thread_.join();
   // Safe state now; the devices are deactivated when the platform goes.
   platform_->fault_all();
+  // No frame reaches the sink after stop() (its owner may go first): set_sink waits for one
+  // being delivered.
+  if (platform_->camera() != nullptr) platform_->camera()->set_sink(nullptr);
   estopped_.store(true);
 }
 
@@ -407,6 +450,12 @@ LiveStatus LivePlatform::status() const {
   s.overruns = overruns_.load(std::memory_order_relaxed);
   s.restarts = restarts_.load(std::memory_order_relaxed);
   s.ticks = ticks_.load(std::memory_order_relaxed);
+  s.camera = has_camera_;
+  s.camera_frames = camera_frames_.load(std::memory_order_relaxed);
+  s.camera_dropped = camera_dropped_.load(std::memory_order_relaxed);
+  s.focus_z_m = focus_z_m_.load(std::memory_order_relaxed);
+  s.focus_target_m = focus_target_m_.load(std::memory_order_relaxed);
+  s.objective = objective_.load(std::memory_order_relaxed);
   DemoResult& r = s.demo_result;
   r.outcome = static_cast<DemoResult::Outcome>(demo_outcome_.load(std::memory_order_acquire));
   r.placement_error_m = demo_error_m_.load(std::memory_order_relaxed);

@@ -80,6 +80,12 @@ struct LiveStatus {
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
   std::uint64_t restarts = 0;
+  /// The camera (issue #27): frames delivered and dropped (the loop could not hand them over)
+  /// since the scene (re)started; the focal plane and the objective.
+  bool camera = false;
+  std::uint64_t camera_frames = 0, camera_dropped = 0;
+  double focus_z_m = 0.0, focus_target_m = 0.0;
+  int objective = 0;
   DemoResult demo_result;
   std::string last_error;  ///< the last failed request (reset refused, rebuild failed)
 };
@@ -92,6 +98,15 @@ class LivePlatform {
   ~LivePlatform();
   LivePlatform(const LivePlatform&) = delete;
   LivePlatform& operator=(const LivePlatform&) = delete;
+
+  /// Where the camera's frames go, with their mid-exposure time in live time (the camera thread;
+  /// keep it quick: a slow sink only costs frames, never the loop). Set before start(); kept
+  /// across scene rebuilds.
+  using FrameSink = std::function<void(const platform::CameraFrame&, double t_live_s)>;
+  void set_frame_sink(FrameSink sink);
+  /// Whether the platform images (devices.camera.driver is not "none"), and its parameters.
+  bool has_camera() const { return has_camera_; }
+  const platform::CameraDeviceParams& camera_params() const { return params_.platform.camera; }
 
   /// Starts the control thread, which runs the loop; telemetry samples reach `sink` on the
   /// drain thread (keep it quick). Times are shifted to live time.
@@ -164,6 +179,8 @@ class LivePlatform {
   /// The demo's part of the operator tick: the scripted operator acts until it is done or gives
   /// up, then every axis holds and the console has control again. Returns true while it drives.
   bool demo_tick(const platform::TickInfo& t) noexcept;
+  /// The focus, objective, exposure and gain of a console command (loop thread).
+  void apply_microscope(platform::Platform& p, const ConsoleCommand& c) noexcept;
   void control_thread();
   /// The protocol clients' part of the operator tick: their commands drained, their freshness (a
   /// client that went away or lost control leaves every axis holding). Returns true while a
@@ -171,6 +188,7 @@ class LivePlatform {
   bool protocol_tick(const platform::TickInfo& t, bool console_control, control::ConsoleInput& in) noexcept;
   /// After the console input is set: a pending open-loop run started (or refused), the view published.
   void protocol_publish(const platform::TickInfo& t) noexcept;
+  void attach_camera(platform::Platform& p);
 
   LiveParams params_;
   ConsoleLimits limits_;
@@ -201,6 +219,8 @@ class LivePlatform {
   bool remote_estopped_ = false;       // loop thread only: the far end latched our e-stop
   std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;
+  FrameSink frame_sink_;
+  bool has_camera_ = false;
   std::thread thread_;
 
   // Status written by the loop (atomics) and by the control thread (under status_mutex_, never
@@ -215,6 +235,9 @@ class LivePlatform {
   std::atomic<std::uint64_t> ticks_{0};
   std::array<std::atomic<int>, 6> lifecycle_{};
   std::atomic<std::uint64_t> overruns_{0}, restarts_{0};
+  std::atomic<std::uint64_t> camera_frames_{0}, camera_dropped_{0};
+  std::atomic<double> focus_z_m_{0.0}, focus_target_m_{0.0};
+  std::atomic<int> objective_{0};
   mutable std::mutex request_mutex_;  // control thread and requesters; never the loop
   int pending_ = -1;                  // a ConsoleAction, or -1
   std::string last_error_;

@@ -12,6 +12,7 @@
 #include "microcobot/core/csv_stream_writer.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/mcap_writer.h"
+#include "microcobot/live/camera_messages.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::live {
@@ -108,7 +109,8 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
 
   // The time base: wall clock at start minus loop time at start.
   const std::int64_t offset_ns = wall_ns - std::llround(t_s * 1e9);
-  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"), McapWriter::kDefaultChunkBytes,
+  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"),
+                                        params_.camera ? kCameraChunkBytes : McapWriter::kDefaultChunkBytes,
                                         McapCompression{true, kZstdLevel});
   const auto add = [&](RecordedTopic t, const std::string& topic, const std::string& schema_name,
                        const std::string& schema) {
@@ -132,6 +134,16 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
                      {"kind", text},
                      {"message", text},
                      {"client", {{"type", {"number", "null"}}}}}));
+  if (params_.camera) {
+    channel_[index(RecordedTopic::kCameraImage)] =
+        w->add_channel(w->add_schema("sensor_msgs/msg/CompressedImage", "ros2msg", compressed_image_schema()),
+                       std::string(kCameraImageTopic), "cdr");
+    channel_[index(RecordedTopic::kCameraInfo)] =
+        w->add_channel(w->add_schema("sensor_msgs/msg/CameraInfo", "ros2msg", camera_info_schema()),
+                       std::string(kCameraInfoTopic), "cdr");
+    add(RecordedTopic::kCameraState, std::string(kCameraStateTopic), "microcobot.CameraState",
+        camera_state_schema());
+  }
 
   const std::string started = utc_iso(wall_ns);
   w->add_metadata("microcobot", {{"version", params_.version},
@@ -236,6 +248,9 @@ void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t
 }
 
 void SessionRecording::published(RecordedTopic topic, double t_s, std::string_view payload) {
+  const bool camera_topic = topic == RecordedTopic::kCameraImage || topic == RecordedTopic::kCameraInfo ||
+                            topic == RecordedTopic::kCameraState;
+  if (camera_topic && !params_.camera) return;
   push(Item{topic, 0, t_s, std::string(payload), {}, 0});
 }
 

@@ -7,6 +7,8 @@
 ///   /platform/status, /platform/scene, /console/feedback   what the server published
 ///   /console/command, /console/action   what the clients sent: `{"t_s", "client", "message"}`
 ///   /events   state changes and errors: `{"t_s", "level", "kind", "message", "client"}`
+///   /camera/image/compressed, /camera/camera_info (CDR, ros2msg schemas), /camera/state (JSON):
+///             every frame of the camera, when the platform has one (live/camera_messages.h)
 ///   Metadata "microcobot" (version, start, the time base), "scene", "configuration" (YAML),
 ///   and the configuration again as the attachment `configuration.yaml`.
 ///
@@ -55,6 +57,9 @@ enum class RecordedTopic : std::uint8_t {
   kCommand,
   kAction,
   kEvents,
+  kCameraImage,
+  kCameraInfo,
+  kCameraState,
   kCount
 };
 
@@ -76,6 +81,8 @@ struct SessionRecordingParams {
   RecordedSchema status, scene, feedback;
   std::string version;      ///< the program's, e.g. "microcobot 0.1.0"
   std::string config_yaml;  ///< the platform configuration (`run --print-config`'s keys)
+  /// Record the camera's channels (chunks then hold several frames: kCameraChunkBytes).
+  bool camera = false;
   /// Called on the writer thread when a write fails and the recording is abandoned.
   std::function<void(const std::string& why)> on_error;
   void validate() const;
@@ -89,6 +96,9 @@ class SessionRecording {
   /// 2-core machine): level 1 11.80 times smaller at 993 MB/s (about 1 ms), level 3 11.85 times
   /// at 232 MB/s: 1 gives the size for a quarter of the time.
   static constexpr int kZstdLevel = 1;
+  /// Chunks of a recording with images: several JPEG frames each (a 1280x1024 frame is a few
+  /// hundred kB), so that a chunk is never a single frame.
+  static constexpr std::size_t kCameraChunkBytes = std::size_t{8} << 20;
 
   explicit SessionRecording(SessionRecordingParams params);
   /// An unstopped recording is abandoned (its temporary files removed).

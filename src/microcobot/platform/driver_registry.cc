@@ -7,6 +7,8 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/platform/opencv_camera.h"
+#include "microcobot/platform/simulated_camera.h"
 
 namespace mc::platform {
 namespace {
@@ -22,6 +24,13 @@ std::mutex& entries_mutex() {
   static std::mutex m;
   return m;
 }
+std::map<std::string, CameraSourceFactory>& cameras() {
+  static std::map<std::string, CameraSourceFactory> c;
+  return c;
+}
+
+constexpr const char* kNoCamera = "none";
+constexpr const char* kOpenCv = "opencv";
 
 bool valid_name(const std::string& name) {
   return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
@@ -30,6 +39,15 @@ bool valid_name(const std::string& name) {
 }
 
 }  // namespace
+
+#ifndef MC_HAVE_OPENCV
+// Built without OpenCV (MC_WITH_OPENCV off): the driver is not there, and says so.
+bool opencv_camera_available() { return false; }
+std::unique_ptr<FrameSource> make_opencv_camera(const std::string&) {
+  throw InvalidParams("devices.camera.driver",
+                      "'opencv': this build has no OpenCV (cmake -DMC_WITH_OPENCV=ON)");
+}
+#endif
 
 void register_devices(const std::string& name, DeviceFactory factory) {
   if (!valid_name(name))
@@ -65,6 +83,52 @@ PlatformDevices make_driver_devices(const PlatformConfig& config) {
   if (!factory) {
     config.validate();  // names the key and the known drivers
     throw InvalidParams("devices.driver", "'simulated' is built by the platform itself");
+  }
+  return factory(config);
+}
+
+void register_camera(const std::string& name, CameraSourceFactory factory) {
+  if (!valid_name(name))
+    throw InvalidParams("devices.camera.driver",
+                        "a driver's name is 1-64 letters, digits, '-' or '_', not '" + excerpt(name) + "'");
+  if (name == kNoCamera || name == kSimulated || name == kOpenCv)
+    throw InvalidParams("devices.camera.driver", "'" + name + "' is built in");
+  if (!factory) throw InvalidParams("devices.camera.driver", "'" + name + "' has no factory");
+  std::lock_guard lock(entries_mutex());
+  if (!cameras().emplace(name, std::move(factory)).second)
+    throw InvalidParams("devices.camera.driver", "'" + name + "' is registered twice");
+}
+
+std::vector<std::string> camera_driver_names() {
+  std::vector<std::string> names{kNoCamera, kSimulated};
+  if (opencv_camera_available()) names.emplace_back(kOpenCv);
+  std::lock_guard lock(entries_mutex());
+  for (const auto& entry : cameras()) names.push_back(entry.first);
+  return names;
+}
+
+bool is_camera_driver(const std::string& name) {
+  const auto names = camera_driver_names();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::unique_ptr<FrameSource> make_camera_source(const PlatformConfig& config) {
+  const std::string& name = config.devices.camera.driver;
+  if (name == kNoCamera) return nullptr;
+  if (name == kSimulated) return make_simulated_camera(config);
+  if (name == kOpenCv && opencv_camera_available()) return make_opencv_camera(config.devices.camera.source);
+  CameraSourceFactory factory;
+  {
+    std::lock_guard lock(entries_mutex());
+    const auto it = cameras().find(name);
+    if (it != cameras().end()) factory = it->second;
+  }
+  if (!factory) {
+    std::string known;
+    for (const std::string& n : camera_driver_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InvalidParams(
+        "devices.camera.driver",
+        "'" + excerpt(name) + "' is not a camera driver of this build (known: " + known + ")");
   }
   return factory(config);
 }

@@ -45,6 +45,20 @@ PlatformDevices make_driver_devices(const PlatformConfig& config);
 /// The platform `config` asks for: simulated, or on the selected driver's devices.
 std::unique_ptr<Platform> make_platform(const PlatformConfig& config);
 
+/// Builds a camera's frame source (unopened) from the configuration (`devices.camera.source`
+/// says what to open). Throws mc::Error.
+using CameraSourceFactory = std::function<std::unique_ptr<FrameSource>(const PlatformConfig& config)>;
+
+/// Registers a camera driver under `name` (as register_devices; not "none" or "simulated").
+void register_camera(const std::string& name, CameraSourceFactory factory);
+/// The names `devices.camera.driver` accepts: "none", "simulated" when this build renders
+/// images (vision/), "opencv" when built with OpenCV (MC_WITH_OPENCV), then the registered ones.
+std::vector<std::string> camera_driver_names();
+bool is_camera_driver(const std::string& name);
+/// The frame source `config.devices.camera` selects; null for "none". Throws mc::InvalidParams
+/// naming `devices.camera.driver` for an unknown one, mc::Error when the driver cannot be built.
+std::unique_ptr<FrameSource> make_camera_source(const PlatformConfig& config);
+
 /// Registers a driver set at static initialisation, in a source file compiled into the program
 /// itself (a static library's object nobody references would be left out by the linker):
 ///     const mc::platform::DriverRegistration kLabBench{"lab-bench", make_lab_bench};

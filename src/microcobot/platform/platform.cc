@@ -7,6 +7,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/platform/driver_registry.h"
 
 namespace mc::platform {
 namespace {
@@ -74,9 +75,11 @@ Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
       home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
       loop_(config_.loop.base_rate_Hz),
       ring_(kRingCapacity) {
-  const char* names[6] = {"axes[0]", "axes[1]", "axes[2]", "gripper", "haptic", "tweezers"};
+  const char* names[8] = {"axes[0]", "axes[1]",  "axes[2]", "gripper",
+                          "haptic",  "tweezers", "camera",  "focus"};
   const auto d = devices();
   for (std::size_t i = 0; i < d.size(); ++i) {
+    if (i >= 6 && d[i] == nullptr) continue;  // optional
     if (d[i] == nullptr) throw InvalidParams(std::string("devices.") + names[i], "is missing");
     if (d[i]->state() != Lifecycle::kUnconfigured)
       throw InvalidParams(std::string("devices.") + names[i], "must be handed over unconfigured");
@@ -113,6 +116,12 @@ void Platform::build() {
   teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                      world_.params().gripper.max_opening_m, limits);
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
+  if (!devices_.camera && config_.camera.enabled) {
+    if (auto source = make_camera_source(config_))
+      devices_.camera = std::make_unique<Camera>("camera", config_.camera, std::move(source));
+  }
+  if (devices_.camera && !devices_.focus)
+    devices_.focus = std::make_unique<FocusDrive>("focus", config_.camera);
 
   arm_devices(/*fault_on_failure=*/false);
 
@@ -125,16 +134,18 @@ void Platform::build() {
   loop_.add_task("devices", 1, [this](const TickInfo& t) { devices_task(t.dt_s); });
   loop_.add_task("telemetry", config_.loop.telemetry_divisor,
                  [this](const TickInfo& t) { telemetry_task(t.t_s); });
+  if (devices_.camera) loop_.add_task("camera", 1, [this](const TickInfo& t) { camera_task(t); });
   loop_.sample_ticks_every(config_.loop.telemetry_divisor);
 }
 
 Platform::~Platform() {
-  for (Device* d : devices()) d->deactivate();
+  for (Device* d : devices())
+    if (d != nullptr) d->deactivate();
 }
 
-std::array<Device*, 6> Platform::devices() {
-  return {devices_.axes[0].get(), devices_.axes[1].get(), devices_.axes[2].get(),
-          devices_.gripper.get(), devices_.haptic.get(),  devices_.tweezers.get()};
+std::array<Device*, 8> Platform::devices() {
+  return {devices_.axes[0].get(), devices_.axes[1].get(),  devices_.axes[2].get(), devices_.gripper.get(),
+          devices_.haptic.get(),  devices_.tweezers.get(), devices_.camera.get(),  devices_.focus.get()};
 }
 
 const SimulatedDevices& Platform::simulation() const {
@@ -143,7 +154,8 @@ const SimulatedDevices& Platform::simulation() const {
 }
 
 void Platform::fault_all() noexcept {
-  for (Device* d : devices()) d->fault();
+  for (Device* d : devices())
+    if (d != nullptr) d->fault();
   stage_->emergency_stop();
   for (auto& st : steppers_) st->halt();
   faulted_ = true;
@@ -237,9 +249,13 @@ void Platform::devices_task(double dt_s) noexcept {
   devices_.gripper->update(dt_s);
   devices_.haptic->update(dt_s);
   devices_.tweezers->update(dt_s);
+  if (devices_.camera) {
+    devices_.camera->update(dt_s);
+    devices_.focus->update(dt_s);
+  }
   if (!faulted_) {
     for (Device* d : devices()) {
-      if (d->state() == Lifecycle::kFault) {
+      if (d != nullptr && d->state() == Lifecycle::kFault) {
         fault_all();
         break;
       }
@@ -290,6 +306,56 @@ void Platform::telemetry_task(double t_s) noexcept {
     }
   }
   ring_.push(s);
+}
+
+void Platform::camera_task(const TickInfo& t) noexcept {
+  // The tool's and the part's positions over the last ticks give their mean velocities (the
+  // motion blur of the exposure); the camera sees the true scene, not the sensors' readings.
+  Eigen::Vector3d tool, part = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double axis = simulated() ? sim_.axes[i]->true_position_m() : devices_.axes[i]->position_m();
+    tool[static_cast<Eigen::Index>(i)] = home_m_[static_cast<Eigen::Index>(i)] + axis;
+  }
+  if (sim_.gripper != nullptr) part = sim_.gripper->world_state().part_m;
+  if (sim_.optical_tweezers != nullptr) part = sim_.optical_tweezers->bead_m();
+  const std::size_t oldest = history_index_;  // the entry written kVelocityTicks ticks ago
+  const Eigen::Vector3d tool_then = tool_history_[oldest], part_then = part_history_[oldest];
+  tool_history_[history_index_] = tool;
+  part_history_[history_index_] = part;
+  history_index_ = (history_index_ + 1) % kVelocityTicks;
+  if (!devices_.camera->frame_due(t.t_s)) return;
+
+  SceneSnapshot s;
+  s.t_s = t.t_s;
+  s.steady_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::steady_clock::now().time_since_epoch())
+                    .count();
+  const bool history = loop_.ticks() > kVelocityTicks;
+  const double span_s = static_cast<double>(kVelocityTicks) * t.dt_s;
+  for (int i = 0; i < 3; ++i) {
+    s.tool_m[i] = tool[i];
+    s.tool_velocity_m_s[i] = history ? (tool[i] - tool_then[i]) / span_s : 0.0;
+  }
+  s.gripper_opening_m = devices_.gripper->opening_m();
+  if (sim_.gripper != nullptr) {
+    s.has_part = true;
+    s.part_phase = static_cast<int>(sim_.gripper->world_state().phase);
+  }
+  if (sim_.optical_tweezers != nullptr) {
+    s.has_beads = true;
+    const Eigen::Vector2d obstacle = sim_.optical_tweezers->obstacle_m();
+    s.obstacle_bead_m[0] = obstacle.x();
+    s.obstacle_bead_m[1] = obstacle.y();
+  }
+  for (int i = 0; i < 3; ++i) {
+    (s.has_beads ? s.probe_bead_m : s.part_m)[i] = part[i];
+    s.part_velocity_m_s[i] = history ? (part[i] - part_then[i]) / span_s : 0.0;
+  }
+  s.focus_z_m = devices_.focus->z_m();
+  s.objective = devices_.focus->objective();
+  s.exposure_s = devices_.camera->exposure_s();
+  s.gain = devices_.camera->gain();
+  devices_.camera->publish(s);  // a full ring drops the frame (counted); the loop goes on
 }
 
 void Platform::drain() noexcept {
@@ -346,10 +412,13 @@ void Platform::hold() noexcept {
 void Platform::arm_devices(bool fault_on_failure) {
   // Configure, then activate; a device that throws leaves none of them armed.
   try {
-    for (Device* d : devices()) d->configure();
-    for (Device* d : devices()) d->activate();
+    for (Device* d : devices())
+      if (d != nullptr) d->configure();
+    for (Device* d : devices())
+      if (d != nullptr) d->activate();
   } catch (...) {
-    for (Device* d : devices()) fault_on_failure ? d->fault() : d->deactivate();
+    for (Device* d : devices())
+      if (d != nullptr) fault_on_failure ? d->fault() : d->deactivate();
     throw;
   }
 }

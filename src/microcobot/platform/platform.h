@@ -10,6 +10,7 @@
 ///   every slave tick (1 kHz) the stage controller on the measured positions and the targets
 ///   every operator tick      the (scripted) operator acts, if one is attached
 ///   every telemetry tick     one sample into a single-producer ring, drained off the loop
+///   every frame (camera rate) the scene's snapshot into the camera's ring (camera_device.h)
 ///
 /// The devices are reached through their interfaces only (device.h): the default platform
 /// builds the simulated ones, another constructor takes hardware drivers (docs/hardware.md).
@@ -29,6 +30,7 @@
 #include "microcobot/control/teleoperation.h"
 #include "microcobot/core/recorder.h"
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/platform/camera_device.h"
 #include "microcobot/platform/fixed_rate_loop.h"
 #include "microcobot/platform/open_loop_stepper.h"
 #include "microcobot/platform/platform_config.h"
@@ -99,6 +101,10 @@ struct PlatformDevices {
   std::unique_ptr<Gripper> gripper;
   std::unique_ptr<HapticMaster> haptic;
   std::unique_ptr<TweezersMaster> tweezers;
+  /// The microscope camera and its focus drive (optional: absent, the platform builds the ones
+  /// `camera` and `devices.camera` ask for; none when devices.camera.driver is "none").
+  std::unique_ptr<Camera> camera;
+  std::unique_ptr<FocusDrive> focus;
 };
 
 /// The simulated devices of a simulated platform, by their concrete types (non-owning): the
@@ -182,6 +188,10 @@ class Platform {
   TweezersMaster& tweezers() { return *devices_.tweezers; }
   const SlaveAxis& axis(int i) const { return *devices_.axes[static_cast<std::size_t>(i)]; }
   const Gripper& gripper() const { return *devices_.gripper; }
+  /// The camera and its focus drive; null when the platform has none.
+  Camera* camera() { return devices_.camera.get(); }
+  FocusDrive* focus() { return devices_.focus.get(); }
+  const FocusDrive* focus() const { return devices_.focus.get(); }
   /// True when the platform runs its simulated devices.
   bool simulated() const { return sim_.haptic != nullptr; }
   /// The simulated devices; throws mc::InvalidParams on a platform built on other devices.
@@ -214,11 +224,13 @@ class Platform {
   /// Whether axis i's open-loop run must stop now (the safety rules of start_open_loop_steps).
   bool open_loop_must_stop(std::size_t i) const noexcept;
   void telemetry_task(double t_s) noexcept;
+  void camera_task(const TickInfo& t) noexcept;
   void drain() noexcept;
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
   void arm_devices(bool fault_on_failure);
-  std::array<Device*, 6> devices();
+  /// Every device; the camera and focus drive last, null when absent.
+  std::array<Device*, 8> devices();
 
   PlatformConfig config_;
   std::unique_ptr<stickslip::ActuatorModel> model_;
@@ -241,6 +253,11 @@ class Platform {
   control::ConsoleInput console_;
   bool faulted_ = false;
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)
+  /// The camera's scene (loop thread): tool and part positions of the last ticks, for velocities
+  /// over the last kVelocityTicks ticks.
+  static constexpr std::size_t kVelocityTicks = 10;
+  std::array<Eigen::Vector3d, kVelocityTicks> tool_history_{}, part_history_{};
+  std::size_t history_index_ = 0;
 };
 
 }  // namespace mc::platform

@@ -64,6 +64,14 @@ void PlatformConfig::validate() const {
     throw InvalidParams(
         "driver", "'" + excerpt(devices.driver) + "' is not a registered driver (known: " + known + ")");
   });
+  in_section("devices.camera", [&] {
+    if (is_camera_driver(devices.camera.driver)) return;
+    std::string known;
+    for (const std::string& n : camera_driver_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InvalidParams("driver", "'" + excerpt(devices.camera.driver) +
+                                      "' is not a camera driver of this build (known: " + known + ")");
+  });
+  in_section("camera", [&] { camera.validate(); });
   in_section("loop", [&] { loop.validate(); });
   in_section("teleop", [&] { teleop.validate(); });
   in_section("stage", [&] {

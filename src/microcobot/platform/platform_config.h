@@ -25,6 +25,7 @@
 #include "microcobot/haptics/render_pipeline.h"
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/platform/camera_device.h"
 #include "microcobot/stickslip/stickslip_params.h"
 #include "microcobot/tweezers/teletweez.h"
 
@@ -101,6 +102,22 @@ struct HapticMasterParams {
   }
 };
 
+/// Which camera the platform images with (docs/hardware.md): "none", "simulated" (the image
+/// formation of vision/ rendering the microworld) or a registered camera driver ("opencv": a
+/// camera OpenCV's VideoCapture opens, a V4L2 device, a GStreamer pipeline or a video file).
+struct CameraSelection {
+  std::string driver = "simulated";
+  /// What the driver opens: for "opencv" a device index ("0"), a device file, a file name or a
+  /// GStreamer pipeline ending in "appsink".
+  std::string source;
+
+  template <class V>
+  void visit(V& v) {
+    v("driver", driver);
+    v("source", source);
+  }
+};
+
 /// Which devices the platform runs on (docs/hardware.md): "simulated", the digital twin, or a
 /// driver set registered under that name (platform/driver_registry.h).
 struct DeviceSelection {
@@ -108,11 +125,13 @@ struct DeviceSelection {
   /// What the driver opens, in the driver's own syntax (a device file, HOST:PORT, a bus id);
   /// unused by the simulation.
   std::string connection;
+  CameraSelection camera;
 
   template <class V>
   void visit(V& v) {
     v("driver", driver);
     v("connection", connection);
+    v("camera", camera);
   }
   bool simulated() const { return driver == "simulated"; }
 };
@@ -130,6 +149,8 @@ struct PlatformConfig {
   std::string microworld = "pick-place";
   microworld::PickPlaceParams world;
   microworld::OpticalTrapSceneParams optical_trap;
+  /// The microscope camera and its focus drive (issue #27); which camera: devices.camera.
+  CameraDeviceParams camera;
 
   template <class V>
   void visit(V& v) {
@@ -143,6 +164,7 @@ struct PlatformConfig {
     v("microworld", microworld);
     v("world", world);
     v("optical_trap", optical_trap);
+    v("camera", camera);
   }
   bool optical_trap_scene() const { return microworld == "optical-trap"; }
   /// Validates every section and their consistency (rates); errors name the key path.

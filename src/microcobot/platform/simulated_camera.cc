@@ -1,0 +1,94 @@
+#include "microcobot/platform/simulated_camera.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include "microcobot/platform/camera_scene.h"
+#include "microcobot/vision/renderer.h"
+
+namespace mc::platform {
+namespace {
+
+class SimulatedCamera final : public FrameSource {
+ public:
+  SimulatedCamera(PlatformConfig config, double finger_width_m)
+      : config_(std::move(config)), finger_width_m_(finger_width_m) {}
+
+  void open(const CameraDeviceParams& params) override {
+    params_ = params;
+    // One renderer per objective, made when first turned in (each caches its blurred substrate).
+    renderers_.clear();
+    renderers_.resize(params_.objectives.size());
+  }
+
+  bool renders_scene() const override { return true; }
+
+  void capture(const SceneSnapshot& scene, Image& out) override {
+    CameraScenePose pose;
+    pose.tool_x_m = scene.tool_m[0];
+    pose.tool_y_m = scene.tool_m[1];
+    pose.tool_z_m = scene.tool_m[2];
+    pose.opening_m = scene.gripper_opening_m;
+    const double* part = scene.has_beads ? scene.probe_bead_m : scene.part_m;
+    pose.part_x_m = part[0];
+    pose.part_y_m = part[1];
+    pose.part_z_m = part[2];
+    pose.vx_m_s = scene.tool_velocity_m_s[0];
+    pose.vy_m_s = scene.tool_velocity_m_s[1];
+    pose.part_vx_m_s = scene.part_velocity_m_s[0];
+    pose.part_vy_m_s = scene.part_velocity_m_s[1];
+    fill_camera_scene(config_, pose, snapshot_, finger_width_m_);
+    snapshot_.t_s = scene.t_s;
+
+    vision::Renderer& r = renderer(scene.objective);
+    vision::CameraControls controls;
+    controls.focus_z_m = scene.focus_z_m;
+    controls.exposure_s = scene.exposure_s;
+    controls.gain = scene.gain;
+    r.render(snapshot_, controls, static_cast<std::uint64_t>(params_.seed), frame_index_++, frame_);
+
+    out.resize(frame_.width, frame_.height, 1, frame_.bit_depth);
+    if (frame_.bit_depth <= 8) {
+      for (std::size_t i = 0; i < frame_.pixels.size(); ++i)
+        out.data[i] = static_cast<std::uint8_t>(frame_.pixels[i]);
+    } else {
+      for (std::size_t i = 0; i < frame_.pixels.size(); ++i) {  // little-endian samples
+        out.data[2 * i] = static_cast<std::uint8_t>(frame_.pixels[i] & 0xFF);
+        out.data[2 * i + 1] = static_cast<std::uint8_t>(frame_.pixels[i] >> 8);
+      }
+    }
+  }
+
+ private:
+  vision::Renderer& renderer(int objective) {
+    const auto i =
+        static_cast<std::size_t>(std::clamp(objective, 0, static_cast<int>(renderers_.size()) - 1));
+    if (!renderers_[i]) {
+      vision::CameraParams cp;
+      cp.sensor = params_.sensor;
+      cp.objective = params_.objectives[i];
+      cp.illumination = params_.illumination;
+      cp.view_center_x_m = params_.view_center_x_m;
+      cp.view_center_y_m = params_.view_center_y_m;
+      renderers_[i] = std::make_unique<vision::Renderer>(cp);
+    }
+    return *renderers_[i];
+  }
+
+  PlatformConfig config_;
+  double finger_width_m_;
+  CameraDeviceParams params_;
+  std::vector<std::unique_ptr<vision::Renderer>> renderers_;
+  vision::SceneSnapshot snapshot_;
+  vision::Frame frame_;
+  std::uint64_t frame_index_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config, double finger_width_m) {
+  return std::make_unique<SimulatedCamera>(config, finger_width_m);
+}
+
+}  // namespace mc::platform

@@ -1,0 +1,171 @@
+// The camera's frames through the live server (issue #27): every frame in the recording as a
+// CDR sensor_msgs/msg/CompressedImage (with its CameraInfo and state), none dropped; focus and
+// objective commands through the console's command path.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "microcobot/core/jpeg.h"
+#include "microcobot/core/mcap_reader.h"
+#include "microcobot/live/camera_messages.h"
+#include "microcobot/live/console_server.h"
+#include "support/console_client.h"
+#include "support/test_camera.h"
+#include "support/test_support.h"
+
+namespace mc::live {
+namespace {
+
+using namespace std::chrono_literals;
+using nlohmann::json;
+
+// A little-endian CDR reader, written from the CDR rules (not the encoder's code).
+struct Cdr {
+  std::string_view b;
+  std::size_t at = 4;
+  void align(std::size_t n) { at += (n - (at - 4) % n) % n; }
+  template <class T>
+  T get() {
+    align(sizeof(T));
+    T v{};
+    EXPECT_LE(at + sizeof(T), b.size());
+    if (at + sizeof(T) <= b.size()) std::memcpy(&v, b.data() + at, sizeof(T));
+    at += sizeof(T);
+    return v;
+  }
+  std::string str() {
+    const auto n = get<std::uint32_t>();
+    std::string s(b.substr(at, n ? n - 1 : 0));
+    at += n;
+    return s;
+  }
+};
+
+LiveParams camera_params() {
+  test::register_test_camera();
+  LiveParams p;
+  p.platform.devices.camera.driver = "test-pattern";
+  p.platform.camera.sensor.width_px = 320;
+  p.platform.camera.sensor.height_px = 256;
+  p.platform.camera.sensor.bit_depth = 8;
+  p.platform.camera.view_center_x_m = p.platform.world.part_start_m.x();
+  p.platform.camera.view_center_y_m = p.platform.world.part_start_m.y();
+  return p;
+}
+
+ConsoleServerParams server_params(const std::filesystem::path& out) {
+  ConsoleServerParams p;
+  p.server.port = 0;
+  p.out_dir = out;
+  return p;
+}
+
+TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraInfo) {
+  test::TempDir dir;
+  LivePlatform live(camera_params());
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  ASSERT_TRUE(test::eventually([&] { return live.status().camera_frames >= 3; }, 10s));
+  const std::string name = server.start_recording();
+  const std::uint64_t at_start = live.status().camera_frames;
+  constexpr std::uint64_t kFrames = 90;  // 3 s at 30 fps
+  ASSERT_TRUE(test::eventually([&] { return live.status().camera_frames >= at_start + kFrames; }, 30s));
+  server.stop_recording();
+  const LiveStatus s = live.status();
+  server.stop();
+  EXPECT_EQ(s.camera_dropped, 0u) << "the camera kept up";
+
+  const McapContents mcap = read_mcap(dir.path() / name);
+  std::map<std::string, std::uint16_t> ids;
+  for (const McapChannel& c : mcap.channels) ids[c.topic] = c.id;
+  ASSERT_TRUE(ids.count("/camera/image/compressed"));
+  const McapChannel& image_channel = *mcap.channel(ids["/camera/image/compressed"]);
+  EXPECT_EQ(image_channel.message_encoding, "cdr");
+  EXPECT_EQ(mcap.schema(image_channel.schema_id)->name, "sensor_msgs/msg/CompressedImage");
+  EXPECT_EQ(mcap.schema(image_channel.schema_id)->encoding, "ros2msg");
+  std::vector<const McapMessage*> images, infos, states;
+  for (const McapMessage& m : mcap.messages) {
+    if (m.channel_id == ids["/camera/image/compressed"]) images.push_back(&m);
+    if (m.channel_id == ids["/camera/camera_info"]) infos.push_back(&m);
+    if (m.channel_id == ids["/camera/state"]) states.push_back(&m);
+  }
+  // Every frame between start and stop, in sequence, none missing.
+  ASSERT_GE(images.size(), kFrames);
+  EXPECT_EQ(infos.size(), images.size());
+  ASSERT_EQ(states.size(), images.size());
+  const auto first = json::parse(states.front()->data)["sequence"].get<std::uint64_t>();
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    const json st = json::parse(states[k]->data);
+    EXPECT_EQ(st["sequence"].get<std::uint64_t>(), first + k) << "frame " << k << " missing";
+  }
+  for (std::size_t k = 1; k < images.size(); ++k)
+    EXPECT_NEAR(1e-9 * static_cast<double>(images[k]->log_time_ns - images[k - 1]->log_time_ns), 1.0 / 30.0,
+                1.5e-3)
+        << "frames at the camera's rate in loop time";
+  // Chunks larger than a frame: several frames in each.
+  EXPECT_LT(mcap.chunk_count, images.size() / 2);
+
+  // The CDR decodes by the rules, its JPEG to the sensor's size, its stamp the loop time.
+  Cdr cdr{images.back()->data};
+  EXPECT_EQ(std::string(cdr.b.substr(0, 4)), std::string("\x00\x01\x00\x00", 4));
+  const auto sec = cdr.get<std::int32_t>();
+  const auto nanosec = cdr.get<std::uint32_t>();
+  EXPECT_EQ(cdr.str(), "camera_optical_frame");
+  EXPECT_EQ(cdr.str(), "jpeg");
+  const auto n = cdr.get<std::uint32_t>();
+  ASSERT_EQ(cdr.at + n, cdr.b.size());
+  const JpegImage jpeg =
+      decode_jpeg(std::span(reinterpret_cast<const std::uint8_t*>(cdr.b.data() + cdr.at), n));
+  EXPECT_EQ(jpeg.width, 320);
+  EXPECT_EQ(jpeg.height, 256);
+  EXPECT_NEAR(sec + 1e-9 * nanosec, json::parse(states.back()->data)["t_s"].get<double>(), 1e-8);
+
+  // CameraInfo: K from the objective's scale at its working distance.
+  Cdr info{infos.back()->data};
+  info.get<std::int32_t>(), info.get<std::uint32_t>(), info.str();
+  EXPECT_EQ(info.get<std::uint32_t>(), 256u);
+  EXPECT_EQ(info.get<std::uint32_t>(), 320u);
+  EXPECT_EQ(info.str(), "plumb_bob");
+  const auto nd = info.get<std::uint32_t>();
+  for (std::uint32_t i = 0; i < nd; ++i) EXPECT_EQ(info.get<double>(), 0.0);
+  const double fx = info.get<double>();
+  const auto& objective = LiveParams().platform.camera.objectives.front();  // the power-up turret
+  EXPECT_NEAR(fx, objective.working_distance_m / (5.3e-6 / objective.magnification), 1e-6 * fx);
+}
+
+TEST(CameraStream, FocusAndObjectiveAreConsoleCommandsThatNeedControlButNotTheDeadman) {
+  test::TempDir dir;
+  LivePlatform live(camera_params());
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  test::Console console(server.port());
+  EXPECT_EQ(console.channels.count("/camera/image/compressed"), 1u);
+  EXPECT_EQ(console.channels.count("/camera/camera_info"), 1u);
+  // Without control: refused.
+  EXPECT_TRUE(console.command({{"focus_z_m", 200e-6}}));
+  EXPECT_FALSE(console.ws.read_status("control").is_null());
+  EXPECT_TRUE(console.action("take_control"));
+  // Deadman released: the microscope still obeys (it is not the slave).
+  const json c = {{"deadman", false}, {"focus_z_m", 150e-6}, {"objective", 2}, {"gain", 2.0}};
+  EXPECT_TRUE(test::eventually(
+      [&] {
+        console.command(c);
+        const LiveStatus s = live.status();
+        return s.objective == 2 && std::abs(s.focus_z_m - 150e-6) < 1e-9;
+      },
+      10s));
+  // An objective that is not on the turret is refused, naming it.
+  EXPECT_TRUE(console.command({{"objective", 9}}));
+  const json refusal = console.ws.read_status("/console/command");
+  EXPECT_NE(refusal.dump().find("objective"), std::string::npos) << refusal.dump();
+  server.stop();
+}
+
+}  // namespace
+}  // namespace mc::live
