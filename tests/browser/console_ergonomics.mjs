@@ -12,7 +12,7 @@ import { startConsole } from "./console_session.mjs";
 
 const tablet = { width: 1024, height: 768 };
 const s = await startConsole("console_ergonomics", (dir) => ["--out", join(dir, "rec")], 200, { viewport: tablet });
-const { page, t, until, shot, goWithDeadman, setSlider, fail, log } = s;
+const { page, t, until, shot, goWithDeadman, setSlider, selectObjective, fail, log } = s;
 const um = (v) => (v * 1e6).toFixed(1);
 
 // Everything named is inside the viewport, and the page does not scroll.
@@ -102,7 +102,7 @@ await s.run(async () => {
   const goal = await page.evaluate(() => window.mc.input.goal);
   if (goal.some((v, i) => Math.abs(v - go[i]) > 0.1e-6)) fail(`go-to set the goal ${goal} for ${go}`);
   await goWithDeadman("go to", 20);
-  await page.selectOption("#objective", "50");  // 240 um field: the target lies outside it
+  await selectObjective("50x");  // a 136 um field: the target lies outside it
   await until("an arrow toward the target", () => window.mc.offField().includes("target"), 3);
   await shot("ergo-04-goto-arrow");
   await page.click("#saved button:has-text('Go')");

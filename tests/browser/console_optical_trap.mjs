@@ -16,7 +16,10 @@ await s.run(async () => {
   await until("connected, telemetry and scene", () => window.mc.connected && window.mc.telemetry && window.mc.scene, 20);
   const scene = await page.evaluate(() => window.mc.scene);
   if (scene.kind !== "optical-trap") fail(`scene kind ${scene.kind}`);
-  await until("the tweezers' objective", () => document.getElementById("objective").value === "200", 5);
+  await until("the camera on the beads at 50x", () => {
+    const sel = document.getElementById("objective");
+    return sel.selectedIndex >= 0 && sel.options[sel.selectedIndex].textContent.startsWith("50x ");
+  }, 10);
   await shot("trap-01-connected");
   const start = await t();
   log(`probe bead at (${(start.part_x_m * 1e6).toFixed(3)}, ${(start.part_y_m * 1e6).toFixed(3)}) um, trap at ` +

@@ -89,6 +89,14 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     }
   };
   s.setSlider = (id, value) => page.locator(id).fill(String(value));
+  // The objective turret by name ("20x"): the options are the camera's objectives, by index.
+  s.selectObjective = async (name) => {
+    await s.until(`the ${name} objective offered`, (n) =>
+      [...document.getElementById("objective").options].some((o) => o.textContent.startsWith(n + " ")), 10, name);
+    const value = await page.evaluate((n) =>
+      [...document.getElementById("objective").options].find((o) => o.textContent.startsWith(n + " ")).value, name);
+    await page.selectOption("#objective", value);
+  };
   // The e-stop button: latched, every device in fault (its safe state), the drives at 0 V.
   // Returns the telemetry after it.
   s.estopAndCheck = async () => {

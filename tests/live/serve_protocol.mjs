@@ -69,7 +69,9 @@ function check(schema, value, path) {
                                (t === "boolean" && typeof value === "boolean") ||
                                (t === "string" && typeof value === "string") ||
                                (t === "null" && value === null) ||
-                               (t === "array" && Array.isArray(value)) || t === undefined);
+                               (t === "array" && Array.isArray(value)) ||
+                               (t === "object" && typeof value === "object" && value !== null && !Array.isArray(value)) ||
+                               t === undefined);
   return ok ? null : `${path}: ${JSON.stringify(value)} is not ${types.join("|")}`;
 }
 observer.on("message", ({ subscriptionId, data }) => {

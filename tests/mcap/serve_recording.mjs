@@ -116,11 +116,19 @@ try {
 
   const topics = new Map([...reader.channelsById.values()].map((c) => [c.id, c.topic]));
   const expected = ["/platform/telemetry", "/platform/status", "/platform/scene", "/console/feedback",
-                    "/console/command", "/console/action", "/events"];
+                    "/console/command", "/console/action", "/events", "/camera/image/compressed",
+                    "/camera/camera_info", "/camera/state"];
   for (const t of expected) if (![...topics.values()].includes(t)) fail(`no channel ${t}`);
+  // The camera's images and calibration are ROS 2 messages in CDR (tests/live/camera_foxglove.mjs
+  // decodes them); every other channel is JSON with its JSON Schema.
+  const cdr = new Map([["/camera/image/compressed", "sensor_msgs/msg/CompressedImage"],
+                       ["/camera/camera_info", "sensor_msgs/msg/CameraInfo"]]);
   for (const c of reader.channelsById.values()) {
     const s = reader.schemasById.get(c.schemaId);
-    if (c.messageEncoding !== "json" || s?.encoding !== "jsonschema") fail(`${c.topic}: ${c.messageEncoding}/${s?.encoding}`);
+    const ok = cdr.has(c.topic)
+      ? c.messageEncoding === "cdr" && s?.encoding === "ros2msg" && s?.name === cdr.get(c.topic)
+      : c.messageEncoding === "json" && s?.encoding === "jsonschema";
+    if (!ok) fail(`${c.topic}: ${c.messageEncoding}/${s?.encoding} (${s?.name})`);
   }
 
   // Chunks: zstd, each smaller than its records.
@@ -155,6 +163,7 @@ try {
     if (ms < started - 60000 || ms > now + 60000) badTime++;
     if (last.has(topic) && m.logTime < last.get(topic)) backwards++;
     last.set(topic, m.logTime);
+    if (cdr.has(topic)) continue;
     const j = decode(m);
     if (topic !== "/platform/scene" && typeof j.t_s !== "number") badTs++;  // the scene is geometry
     else if (topic === "/platform/telemetry" && Math.abs(Number(m.logTime - offset) - j.t_s * 1e9) > 1000) badTs++;

@@ -133,6 +133,12 @@ void use_optical_trap_scene(PlatformConfig& config) {
   config.teleop.force_filter_Hz = 1000.0;
   config.teleop.console_max_speed_m_s = 20e-6;
   config.stage.tracking_enabled = false;
+  // The camera on the beads: the turret's strongest objective (the 3 um probe bead ~ 28 px at
+  // 50x), centred on the trap's home, focused on the dish plane where both beads lie.
+  config.camera.objective = static_cast<int>(config.camera.objectives.size()) - 1;
+  config.camera.view_center_x_m = config.stage.home_x_m;
+  config.camera.view_center_y_m = config.stage.home_y_m;
+  config.camera.focus_start_m = config.optical_trap.trap.bead_radius_m;
 }
 
 PlatformConfig load_platform_config(const std::filesystem::path& file) {

@@ -33,7 +33,9 @@ class SimulatedCamera final : public FrameSource {
     const double* part = scene.has_beads ? scene.probe_bead_m : scene.part_m;
     pose.part_x_m = part[0];
     pose.part_y_m = part[1];
-    pose.part_z_m = part[2];
+    // The trap's model is planar: the probe bead stays in the dish plane (camera_scene's
+    // initial_pose), whatever height the stage's z reports.
+    pose.part_z_m = scene.has_beads ? config_.optical_trap.trap.bead_radius_m : part[2];
     pose.vx_m_s = scene.tool_velocity_m_s[0];
     pose.vy_m_s = scene.tool_velocity_m_s[1];
     pose.part_vx_m_s = scene.part_velocity_m_s[0];
