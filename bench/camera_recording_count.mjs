@@ -2,24 +2,13 @@
 // docs/benchmarks.md): frames, gaps in their sequence, the camera's own dropped count (frames
 // due the loop could not hand over), the span and rate, and the file's size per minute.
 //   node bench/camera_recording_count.mjs out/live/recording-*.mcap
-import { open, stat } from "node:fs/promises";
-import { McapIndexedReader } from "@mcap/core";
+import { stat } from "node:fs/promises";
 import zstd from "@foxglove/wasm-zstd";
+import { openMcap } from "./serve_common.mjs";
 
 await zstd.isLoaded;
 const path = process.argv[2];
-const file = await open(path, "r");
-const reader = await McapIndexedReader.Initialize({
-  readable: {
-    size: async () => BigInt((await file.stat()).size),
-    read: async (offset, size) => {
-      const buf = Buffer.alloc(Number(size));
-      await file.read(buf, 0, buf.length, Number(offset));
-      return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
-    },
-  },
-  decompressHandlers: { zstd: (data, size) => zstd.decompress(data, Number(size)) },
-});
+const { reader, file } = await openMcap(path, { zstd: (data, size) => zstd.decompress(data, Number(size)) });
 const topic = new Map([...reader.channelsById.values()].map((c) => [c.topic, c.id]));
 const counts = reader.statistics.channelMessageCounts;
 const images = Number(counts.get(topic.get("/camera/image/compressed")) || 0n);

@@ -39,8 +39,9 @@ export function nextStatus(wsUrl) {
   });
 }
 
-// Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader).
-export async function readTelemetry(path) {
+// An MCAP file opened with @mcap/core's indexed reader; `decompressHandlers` for compressed
+// chunks (e.g. zstd). Returns { reader, file }: close the file when done.
+export async function openMcap(path, decompressHandlers = {}) {
   const file = await open(path, "r");
   const reader = await McapIndexedReader.Initialize({
     readable: {
@@ -51,7 +52,14 @@ export async function readTelemetry(path) {
         return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
       },
     },
+    decompressHandlers,
   });
+  return { reader, file };
+}
+
+// Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader).
+export async function readTelemetry(path) {
+  const { reader, file } = await openMcap(path);
   const samples = [];
   for await (const msg of reader.readMessages()) samples.push(JSON.parse(new TextDecoder().decode(msg.data)));
   await file.close();
