@@ -7,9 +7,9 @@ CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
 # Everything `make test` builds; the sanitizer and fuzz presets leave out what they leave out.
 ifeq ($(filter $(PRESET),asan fuzz),)
-FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_BUILD_BENCH=ON -DMC_BUILD_PYTHON=ON
+FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_BUILD_BENCH=ON -DMC_BUILD_PYTHON=ON -DMC_WITH_OPENCV=ON
 else
-FULL_OPTS := -DMC_BUILD_TESTS=ON
+FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_WITH_OPENCV=ON
 endif
 
 .PHONY: run demo report test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean

@@ -45,7 +45,8 @@ bool valid_name(const std::string& name) {
 bool opencv_camera_available() { return false; }
 std::unique_ptr<FrameSource> make_opencv_camera(const std::string&) {
   throw InvalidParams("devices.camera.driver",
-                      "'opencv': this build has no OpenCV (cmake -DMC_WITH_OPENCV=ON)");
+                      "'opencv': this build has no OpenCV (install libopencv-videoio-dev, then cmake "
+                      "-DMC_WITH_OPENCV=ON; make test does both)");
 }
 #endif
 
