@@ -67,11 +67,11 @@ py::array render(const std::string& scene, const std::string& objective, double 
     py::array_t<std::uint8_t> out(shape);
     auto* d = out.mutable_data();
     for (std::size_t i = 0; i < f.pixels.size(); ++i) d[i] = static_cast<std::uint8_t>(f.pixels[i]);
-    return std::move(out);
+    return out;
   }
   py::array_t<std::uint16_t> out(shape);
   std::copy(f.pixels.begin(), f.pixels.end(), out.mutable_data());
-  return std::move(out);
+  return out;
 }
 
 }  // namespace

@@ -80,10 +80,12 @@ void expect_steps_like_the_model(int axis, int direction) {
   const double held = sim.true_position_m();
   rig.platform->run(0.3);
   EXPECT_NEAR(sim.true_position_m(), held, 20e-9);
-  for (int other = 0; other < 3; ++other)
-    if (other != axis)
+  for (int other = 0; other < 3; ++other) {
+    if (other != axis) {
       EXPECT_NEAR(rig.platform->simulation().axes[static_cast<std::size_t>(other)]->true_position_m(), 0.0,
                   50e-9);
+    }
+  }
 }
 
 TEST(OpenLoop, PeriodsUpStepWhatTheModelStepsAndEndHolding) { expect_steps_like_the_model(0, +1); }

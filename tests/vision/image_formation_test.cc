@@ -42,7 +42,7 @@ double spot_sigma_px(const std::vector<float>& img, int w, int h, double backgro
     for (int j = pj - half; j <= pj + half; ++j) {
       if (i < 0 || j < 0 || i >= h || j >= w) continue;
       profile[along_x ? j - pj + half : i - pi + half] +=
-          img[static_cast<std::size_t>(i) * w + j] - background;
+          double(img[static_cast<std::size_t>(i) * w + j]) - background;
     }
   double m0 = 0, m1 = 0, m2 = 0;
   for (int k = 0; k < 2 * half + 1; ++k) {
@@ -164,7 +164,7 @@ TEST(ImageFormation, ScaleIsPixelPitchOverMagnification) {
     const double dy = 0.5 * 512 * px;
     SceneSnapshot s = dark_flat_scene();
     s.substrate.reflectance = 0.1;
-    for (const auto [x, y] :
+    for (const auto& [x, y] :
          {std::pair{-0.5 * d, 0.3 * dy}, std::pair{0.5 * d, 0.3 * dy}, std::pair{-0.5 * d, -0.7 * dy}}) {
       Part dot;
       dot.disc = true;
@@ -233,7 +233,7 @@ TEST(ImageFormation, DefocusSoftensAnEdgeAndMotionSmearsIt) {
   const auto edge_slope = [&](const std::vector<float>& img) {
     double best = 0;
     for (int j = 1; j < 320; ++j)
-      best = std::max(best, std::abs(double(img[128 * 320 + j]) - img[128 * 320 + j - 1]));
+      best = std::max(best, std::abs(double(img[128 * 320 + j]) - double(img[128 * 320 + j - 1])));
     return best;
   };
   c.focus_z_m = 10e-6;
