@@ -71,8 +71,11 @@ TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraI
   LivePlatform live(camera_params());
   ConsoleServer server(live, server_params(dir.path()));
   server.start();
-  ASSERT_TRUE(test::eventually([&] { return live.status().camera_frames >= 3; }, 10s));
+  // Nobody looks yet: the camera forms no frame. The recording is a viewer: frames flow.
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(live.status().camera_frames, 0u);
   const std::string name = server.start_recording();
+  ASSERT_TRUE(test::eventually([&] { return live.status().camera_frames >= 3; }, 10s));
   const std::uint64_t at_start = live.status().camera_frames;
   constexpr std::uint64_t kFrames = 90;  // 3 s at 30 fps
   ASSERT_TRUE(test::eventually([&] { return live.status().camera_frames >= at_start + kFrames; }, 30s));
@@ -137,6 +140,26 @@ TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraI
   const double fx = info.get<double>();
   const auto& objective = LiveParams().platform.camera.objectives.front();  // the power-up turret
   EXPECT_NEAR(fx, objective.working_distance_m / (5.3e-6 / objective.magnification), 1e-6 * fx);
+}
+
+TEST(CameraStream, TheCameraFormsFramesOnlyWhileAClientSubscribesToThem) {
+  test::TempDir dir;
+  LivePlatform live(camera_params());
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  test::Console console(server.port());
+  console.subscribe("/platform/status", 1);  // watching the status is not watching the camera
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(live.status().camera_frames, 0u);
+  console.subscribe("/camera/image/compressed", 2);
+  EXPECT_FALSE(console.next_on(2).empty()) << "a subscriber gets frames";
+  EXPECT_GT(live.status().camera_frames, 0u);
+  ASSERT_TRUE(console.ws.send_json({{"op", "unsubscribe"}, {"subscriptionIds", {2}}}));
+  std::this_thread::sleep_for(500ms);  // the demand is read at the status rate (5 Hz)
+  const std::uint64_t after = live.status().camera_frames;
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(live.status().camera_frames, after) << "nobody looks again: the camera stops";
+  server.stop();
 }
 
 TEST(CameraStream, FocusAndObjectiveAreConsoleCommandsThatNeedControlButNotTheDeadman) {

@@ -204,6 +204,7 @@ std::string ConsoleServer::url() const {
 
 void ConsoleServer::start() {
   server_.start();
+  update_camera_demand();  // nobody looks yet: the camera forms frames once someone does
   live_.start([this](const platform::TelemetrySample& s, std::size_t count) { on_sample(s, count); });
   status_ = std::thread([this] { status_thread(); });
   started_ = true;
@@ -417,6 +418,7 @@ std::string ConsoleServer::start_recording() {
   const std::string was = recording_->name();
   const std::string name = recording_->start(t_s, scene_json());
   if (name != was) note(EventLevel::kInfo, "record_start", "recording to " + name);
+  update_camera_demand();
   return name;
 }
 
@@ -530,6 +532,15 @@ std::string ConsoleServer::status_json() {
   return j.dump();
 }
 
+void ConsoleServer::update_camera_demand() {
+  if (!live_.has_camera()) return;
+  const bool recording = recording_ && !recording_->name().empty();
+  const bool watched = server_.subscriber_count(image_ch_) + server_.subscriber_count(info_ch_) +
+                           server_.subscriber_count(camera_state_ch_) >
+                       0;
+  live_.set_camera_wanted(recording || watched);
+}
+
 void ConsoleServer::status_thread() {
   const auto period = std::chrono::duration<double>(1.0 / params_.status_rate_Hz);
   auto next = std::chrono::steady_clock::now();
@@ -544,6 +555,7 @@ void ConsoleServer::status_thread() {
     const LiveStatus now_status = live_.status();
     live_.drain_command_latencies(latency_);
     live_.drain_link_costs(link_cost_);
+    update_camera_demand();
     publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
     if (n++ % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0)
       publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());

@@ -94,6 +94,8 @@ class ConsoleServer {
   void on_message(const server::ClientMessage& m);
   void on_disconnect(server::ClientId client);
   void status_thread();
+  /// The camera forms frames only while a client subscribes to them or a recording runs.
+  void update_camera_demand();
   std::string status_json();
   std::string scene_json() const;
   /// Publishes to the clients and records (loop time t_s).

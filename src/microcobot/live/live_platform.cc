@@ -102,6 +102,7 @@ bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return comma
 void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   Platform& p = *platform_;
   if (estop_.exchange(false) && !p.faulted()) p.fault_all();
+  if (p.camera() != nullptr) p.camera()->set_wanted(camera_wanted_.load(std::memory_order_relaxed));
   if (interrupt_.load(std::memory_order_acquire)) p.stop();
 
   ConsoleCommand c;

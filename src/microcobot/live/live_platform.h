@@ -104,6 +104,10 @@ class LivePlatform {
   /// across scene rebuilds.
   using FrameSink = std::function<void(const platform::CameraFrame&, double t_live_s)>;
   void set_frame_sink(FrameSink sink);
+  /// Whether anyone looks at the frames (a subscribed client, a recording); while not, the
+  /// camera forms none (platform::Camera::set_wanted). Any thread; applied by the loop, kept
+  /// across scene rebuilds.
+  void set_camera_wanted(bool wanted) noexcept { camera_wanted_.store(wanted, std::memory_order_relaxed); }
   /// Whether the platform images (devices.camera.driver is not "none"), and its parameters.
   bool has_camera() const { return has_camera_; }
   const platform::CameraDeviceParams& camera_params() const { return params_.platform.camera; }
@@ -215,7 +219,7 @@ class LivePlatform {
   double t_offset_s_ = 0.0;
 
   std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false}, in_control_{false};
-  std::atomic<bool> started_{false};
+  std::atomic<bool> started_{false}, camera_wanted_{true};
   bool remote_estopped_ = false;       // loop thread only: the far end latched our e-stop
   std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;

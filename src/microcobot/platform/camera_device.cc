@@ -101,6 +101,7 @@ bool Camera::frame_due(double t_s) noexcept {
 
 bool Camera::publish(const SceneSnapshot& scene) noexcept {
   if (!active()) return false;
+  if (!wanted()) return true;  // nobody looks: nothing to hand over, nothing dropped
   return ring_.push(scene);
 }
 
@@ -153,8 +154,8 @@ void Camera::thread_main() {
   try {
     JpegEncoder encoder;
     while (running_.load(std::memory_order_acquire)) {
-      if (!has_sink_.load(std::memory_order_acquire)) {
-        // Nobody looks: no frame is formed (a batch run pays nothing for its camera).
+      if (!has_sink_.load(std::memory_order_acquire) || !wanted()) {
+        // Nobody looks: no frame is formed (a batch run, a server without viewers pay nothing).
         while (ring_.pop(newer)) {
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));

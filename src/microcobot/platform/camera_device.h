@@ -136,6 +136,11 @@ class Camera : public Device {
   /// Where frames go (called on the camera thread; may be set or changed at any time, but not
   /// from the sink itself). Without a sink no frame is formed: the snapshots are discarded.
   void set_sink(Sink sink);
+  /// Whether anyone looks (a client subscribed to the images, a recording): while false no
+  /// frame is formed, as without a sink, so that a server nobody watches pays nothing for its
+  /// camera. True by default (any thread).
+  void set_wanted(bool wanted) noexcept { wanted_.store(wanted, std::memory_order_release); }
+  bool wanted() const noexcept { return wanted_.load(std::memory_order_acquire); }
   /// Settings for the next frames, clamped to their ranges (any thread).
   void set_exposure_s(double exposure_s) noexcept;
   void set_gain(double gain) noexcept;
@@ -172,7 +177,7 @@ class Camera : public Device {
   double next_frame_t_s_ = 0.0;  // loop thread
   std::uint64_t next_frame_ = 0;
 
-  std::atomic<bool> running_{false}, failed_{false}, has_sink_{false};
+  std::atomic<bool> running_{false}, failed_{false}, has_sink_{false}, wanted_{true};
   std::thread thread_;
   std::mutex sink_mutex_;  // the sink (held while it runs: do not set_sink from it)
   Sink sink_;

@@ -323,7 +323,7 @@ void Platform::camera_task(const TickInfo& t) noexcept {
   tool_history_[history_index_] = tool;
   part_history_[history_index_] = part;
   history_index_ = (history_index_ + 1) % kVelocityTicks;
-  if (!devices_.camera->frame_due(t.t_s)) return;
+  if (!devices_.camera->frame_due(t.t_s) || !devices_.camera->wanted()) return;
 
   SceneSnapshot s;
   s.t_s = t.t_s;

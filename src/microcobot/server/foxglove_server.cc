@@ -233,6 +233,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     ws_.async_accept(req_, [self = shared_from_this()](const error_code& ec) { self->on_accept(ec); });
   }
 
+  bool subscribed(ChannelId channel) const {
+    std::lock_guard lk(mu_);
+    return !closed_ && subs_by_channel_.count(channel) != 0;
+  }
+
   /// Queues messageData for `channel` when subscribed; copies `payload` into `shared` on first use.
   /// Any thread.
   void offer(ChannelId channel, std::uint64_t log_time_ns, std::string_view payload,
@@ -582,7 +587,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   Outgoing current_;  // being written (guarded by writing_)
 
   // Shared with publishers (any thread).
-  std::mutex mu_;
+  mutable std::mutex mu_;
   std::unordered_map<SubscriptionId, ChannelId> subs_;
   std::unordered_map<ChannelId, SubscriptionId> subs_by_channel_;
   std::deque<Outgoing> queue_;
@@ -1044,6 +1049,13 @@ void FoxgloveServer::broadcast_status(StatusLevel level, std::string_view messag
 std::size_t FoxgloveServer::client_count() const {
   std::lock_guard lk(impl_->sessions_mu);
   return impl_->sessions.size();
+}
+
+std::size_t FoxgloveServer::subscriber_count(ChannelId channel) const {
+  std::lock_guard lk(impl_->sessions_mu);
+  std::size_t n = 0;
+  for (const auto& [id, session] : impl_->sessions) n += session->subscribed(channel) ? 1 : 0;
+  return n;
 }
 
 ServerCounters FoxgloveServer::counters() const {

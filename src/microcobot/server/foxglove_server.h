@@ -91,7 +91,8 @@ struct ServerCounters {
 
 /// A Foxglove WebSocket + HTTP server (docs/console.md, "Protocol").
 ///
-/// Threading: publish(), send_status(), add_channel(), client_count(), counters() and stop()
+/// Threading: publish(), send_status(), add_channel(), client_count(), subscriber_count(),
+/// counters() and stop()
 /// may be called from any thread. The callbacks run on server threads (one session's callbacks
 /// are serialised; with threads > 1 different sessions' may run concurrently); they must be
 /// quick, must not throw (an exception is caught and reported as a status error) and must be set
@@ -143,6 +144,8 @@ class FoxgloveServer {
 
   /// Connected WebSocket clients.
   std::size_t client_count() const;
+  /// Clients subscribed to `channel` (0 for an unknown one).
+  std::size_t subscriber_count(ChannelId channel) const;
   /// A snapshot of the counters.
   ServerCounters counters() const;
 
