@@ -19,6 +19,7 @@
 #include "microcobot/core/params.h"
 #include "microcobot/live/console_server.h"
 #include "microcobot/live/live_platform.h"
+#include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
@@ -195,7 +196,18 @@ void serve(const ServeOptions& o) {
               << mc::cli::describe(mc::cli::network_config(o.network)) << "; the peer: serve --role "
               << (o.role == "master" ? "slave" : "master") << " --domain " << o.domain << ")\n";
   mc::live::LivePlatform live(lp);
+  // The slave's camera on DDS as a ROS 2 image topic (declared before the server that calls it).
+  std::unique_ptr<mc::net::CameraImagePublisher> images;
+  if (o.role == "slave" && live.has_camera())
+    images = std::make_unique<mc::net::CameraImagePublisher>(o.domain, mc::cli::network_config(o.network));
   mc::live::ConsoleServer server(live, sp);
+  if (images) {
+    server.add_frame_consumer(
+        {[p = images.get()](const pf::CameraFrame& f, double t_s) { p->publish(f, t_s); },
+         [p = images.get()] { return p->wanted(); }});
+    std::cerr << "serve: camera images on DDS, ROS 2 topic " << mc::net::kCameraImageRosName << " ("
+              << mc::net::kCameraImageTypeName << ")\n";
+  }
   server.start();
   // The vendor-protocol twins: their own thread, the live platform reached through its ring.
   std::unique_ptr<mc::vendor::LiveStage> twin_stage;

@@ -271,6 +271,12 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   publish(info_ch_, RecordedTopic::kCameraInfo, t_s, info_cdr_);
   publish(camera_state_ch_, RecordedTopic::kCameraState, t_s,
           camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped));
+  for (const FrameConsumer& c : frame_consumers_) c.on_frame(f, t_s);
+}
+
+void ConsoleServer::add_frame_consumer(FrameConsumer consumer) {
+  if (started_) throw InvalidInput("console server: add frame consumers before start()");
+  frame_consumers_.push_back(std::move(consumer));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
@@ -538,7 +544,9 @@ void ConsoleServer::update_camera_demand() {
   const bool watched = server_.subscriber_count(image_ch_) + server_.subscriber_count(info_ch_) +
                            server_.subscriber_count(camera_state_ch_) >
                        0;
-  live_.set_camera_wanted(recording || watched);
+  bool consumed = false;
+  for (const FrameConsumer& c : frame_consumers_) consumed = consumed || c.wanted();
+  live_.set_camera_wanted(recording || watched || consumed);
 }
 
 void ConsoleServer::status_thread() {

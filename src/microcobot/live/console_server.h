@@ -32,12 +32,14 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "microcobot/dsp/sos.h"
 #include "microcobot/live/live_platform.h"
@@ -71,6 +73,14 @@ class ConsoleServer {
 
   /// Binds (throws mc::InvalidInput when the address cannot be bound), starts the live platform
   /// and the status thread.
+  /// Another consumer of the camera's frames (e.g. the DDS image topic, net/camera_image_publisher):
+  /// `on_frame` runs on the camera thread after the console's channels; `wanted` (any thread)
+  /// counts in the camera's demand. Before start().
+  struct FrameConsumer {
+    std::function<void(const platform::CameraFrame&, double t_s)> on_frame;
+    std::function<bool()> wanted;
+  };
+  void add_frame_consumer(FrameConsumer consumer);
   void start();
   /// The console's URL, with the token when one is needed.
   std::string url() const;
@@ -113,7 +123,8 @@ class ConsoleServer {
   server::FoxgloveServer server_;
   server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
   server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0;
-  std::string image_cdr_, info_cdr_;  // camera thread only
+  std::string image_cdr_, info_cdr_;            // camera thread only
+  std::vector<FrameConsumer> frame_consumers_;  // set before start()
 
   std::atomic<server::ClientId> controller_{0};
   std::atomic<bool> quit_{false};

@@ -4,7 +4,7 @@
  * name, and prints what it reads. The wire-compatibility test (wire_compat_test.cc) checks the
  * values against what `microcobot link ping` publishes.
  *
- *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag
+ *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag|image
  *                 [--count K] [--timeout S] [--ready-file PATH]
  *
  * Waits for K samples (default 1) and prints each as one JSON line on stdout, then exits 0.
@@ -16,7 +16,9 @@
  * multicast participant discovery on lo), same QoS as its publishers: state topics best effort, volatile, keep last 1; the
  * latched topics (bool: /microcobot/estop, /microcobot/master/engaged) reliable, transient
  * local, keep last 1 so that the current state arrives even when published before the start;
- * /diagnostics (diag) reliable, volatile, keep last 1.
+ * /diagnostics (diag) reliable, volatile, keep last 1. Images (sensor_msgs/msg/CompressedImage,
+ * the camera's frames) are best effort like the state topics; their JPEG is decoded here
+ * (libjpeg-turbo's C API) and printed as its width, height and mean grey level.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -27,6 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include <turbojpeg.h>
 
 #include "dds/dds.h"
 #include "ros2_wire.h"
@@ -43,7 +47,7 @@ static const char kLoopbackConfig[] =
     "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
     "</Discovery>";
 
-enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag };
+enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag, kImage };
 
 struct Options {
   long domain;
@@ -56,7 +60,7 @@ struct Options {
 
 static int usage(const char* msg, const char* arg) {
   fprintf(stderr,
-          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|vector3|joint|bool|diag "
+          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|vector3|joint|bool|diag|image "
           "[--count K] [--timeout S] [--ready-file PATH])\n",
           msg, arg ? ": " : "", arg ? arg : "");
   return 2;
@@ -111,8 +115,10 @@ static int parse_args(int argc, char** argv, struct Options* o, int* rc) {
         o->type = kBool;
       } else if (strcmp(value, "diag") == 0) {
         o->type = kDiag;
+      } else if (strcmp(value, "image") == 0) {
+        o->type = kImage;
       } else {
-        *rc = usage("--type must be pose, wrench, vector3, joint, bool or diag", value);
+        *rc = usage("--type must be pose, wrench, vector3, joint, bool, diag or image", value);
         return 0;
       }
       have_type = 1;
@@ -193,6 +199,32 @@ static void put_header(const char* topic, const char* type_name, const std_msgs_
   put_string(h->frame_id_);
 }
 
+/* The JPEG of a CompressedImage decoded: its size and mean level (grey: one byte a pixel). */
+static void put_jpeg(const sensor_msgs_msg_dds__CompressedImage_* m) {
+  int width = 0, height = 0, subsamp = 0, colorspace = 0;
+  tjhandle tj = tjInitDecompress();
+  unsigned char* pixels = NULL;
+  int ok = tj != NULL && m->data_._length > 0 &&
+           tjDecompressHeader3(tj, m->data_._buffer, m->data_._length, &width, &height, &subsamp, &colorspace) == 0 &&
+           width > 0 && height > 0;
+  if (ok) {
+    pixels = malloc((size_t)width * (size_t)height);
+    ok = pixels != NULL && tjDecompress2(tj, m->data_._buffer, m->data_._length, pixels, width, 0, height,
+                                         TJPF_GRAY, 0) == 0;
+  }
+  if (ok) {
+    double sum = 0.0;
+    for (size_t i = 0; i < (size_t)width * (size_t)height; ++i) sum += pixels[i];
+    printf(",\"jpeg\":{\"width\":%d,\"height\":%d,\"mean\":", width, height);
+    put_double(sum / ((double)width * (double)height));
+    putchar('}');
+  } else {
+    fputs(",\"jpeg\":null", stdout);
+  }
+  free(pixels);
+  if (tj) tjDestroy(tj);
+}
+
 static void print_sample(const struct Options* o, const char* type_name, const void* sample) {
   switch (o->type) {
     case kPose: {
@@ -259,6 +291,15 @@ static void print_sample(const struct Options* o, const char* type_name, const v
       putchar(']');
       break;
     }
+    case kImage: {
+      const sensor_msgs_msg_dds__CompressedImage_* m = sample;
+      put_header(o->topic, type_name, &m->header_);
+      fputs(",\"format\":", stdout);
+      put_string(m->format_);
+      printf(",\"bytes\":%lu", (unsigned long)m->data_._length);
+      put_jpeg(m);
+      break;
+    }
     case kBool: {
       const std_msgs_msg_dds__Bool_* m = sample;
       fputs("{\"topic\":", stdout);
@@ -289,6 +330,8 @@ static const dds_topic_descriptor_t* descriptor(enum MsgType t) {
       return &std_msgs_msg_dds__Bool__desc;
     case kDiag:
       return &diagnostic_msgs_msg_dds__DiagnosticArray__desc;
+    case kImage:
+      return &sensor_msgs_msg_dds__CompressedImage__desc;
   }
   return NULL;
 }

@@ -1,0 +1,57 @@
+#include "microcobot/net/camera_image_publisher.h"
+
+#include <string>
+
+#include "microcobot/live/camera_messages.h"
+#include "ros2_messages.h"
+
+namespace mc::net {
+
+CameraImagePublisher::CameraImagePublisher(int domain_id, const NetworkConfig& network)
+    : participant_(domain_id, network) {
+  const dds_entity_t pp = participant_.handle();
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  topic_ = dds_create_topic(pp, &sensor_msgs_msg_dds__CompressedImage__desc,
+                            std::string(kCameraImageDdsName).c_str(), qos, nullptr);
+  if (topic_ >= 0) writer_ = dds_create_writer(pp, topic_, qos, nullptr);
+  dds_delete_qos(qos);
+  check_dds(topic_, "camera images: cannot create the topic");
+  check_dds(writer_, "camera images: cannot create the writer");
+  // The publication-matched status is read by wanted(); it need not wake anyone.
+  check_dds(dds_set_status_mask(writer_, DDS_PUBLICATION_MATCHED_STATUS), "camera images: status mask");
+}
+
+// The participant's deletion (its destructor) deletes the topic and the writer with it.
+CameraImagePublisher::~CameraImagePublisher() = default;
+
+bool CameraImagePublisher::wanted() const {
+  dds_publication_matched_status_t status{};
+  if (dds_get_publication_matched_status(writer_, &status) < 0) return false;
+  return status.current_count > 0;
+}
+
+bool CameraImagePublisher::publish(const platform::CameraFrame& frame, double t_s) {
+  if (frame.jpeg.empty()) return true;
+  const live::RosTime stamp = live::ros_time(t_s);
+  sensor_msgs_msg_dds__CompressedImage_ m{};
+  m.header_.stamp_.sec_ = stamp.sec;
+  m.header_.stamp_.nanosec_ = stamp.nanosec;
+  // The generated type holds non-const pointers; dds_write only reads them.
+  m.header_.frame_id_ = const_cast<char*>(live::kCameraFrameId.data());
+  m.format_ = const_cast<char*>("jpeg");
+  m.data_._buffer = const_cast<std::uint8_t*>(frame.jpeg.data());
+  m.data_._length = static_cast<std::uint32_t>(frame.jpeg.size());
+  m.data_._maximum = m.data_._length;
+  m.data_._release = false;
+  if (dds_write(writer_, &m) < 0) {
+    ++failures_;
+    return false;
+  }
+  ++published_;
+  return true;
+}
+
+}  // namespace mc::net
