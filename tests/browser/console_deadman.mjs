@@ -6,9 +6,9 @@
 // platform enforces it, not the page: the page sends these commands all the same. Run by CTest
 // (`console_browser_deadman`); screenshots to MC_ARTIFACTS.
 import { join } from "node:path";
-import { startConsole } from "./console_session.mjs";
+import { startConsole, withoutCamera } from "./console_session.mjs";
 
-const s = await startConsole("console_deadman", (dir) => ["--out", join(dir, "rec")], 120);
+const s = await startConsole("console_deadman", (dir) => ["--out", join(dir, "rec"), ...withoutCamera(dir)], 120);
 const { page, t, until, shot, setSlider, fail, log } = s;
 const still = (a, b, what) => {
   for (const k of ["target_x_m", "target_y_m", "target_z_m", "measured_x_m", "measured_y_m", "measured_z_m", "gripper_opening_m"]) {

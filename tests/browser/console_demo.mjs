@@ -6,13 +6,13 @@
 // CTest (`console_browser_demo`); screenshots to MC_ARTIFACTS.
 import { writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { startConsole } from "./console_session.mjs";
+import { startConsole, withoutCamera } from "./console_session.mjs";
 
 const s = await startConsole("console_demo", (dir) => {
   writeFileSync(join(dir, "scene.yaml"),
                 "part_side_m: 200.0e-6\npart_height_m: 600.0e-6\nhole_side_m: 220.0e-6\nhole_depth_m: 300.0e-6\n" +
                 "target_x_m: 0.3e-3\ntarget_y_m: 0.0\n");
-  return ["--out", join(dir, "rec"), "--scene", join(dir, "scene.yaml")];
+  return ["--out", join(dir, "rec"), "--scene", join(dir, "scene.yaml"), ...withoutCamera(dir)];
 }, 240);
 const { page, t, until, shot, fail, log } = s;
 

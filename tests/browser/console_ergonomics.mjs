@@ -8,10 +8,10 @@
 // (injected into the page: the page must work with or without them). Run by CTest
 // (`console_browser_ergonomics`); screenshots to MC_ARTIFACTS.
 import { join } from "node:path";
-import { startConsole } from "./console_session.mjs";
+import { startConsole, withoutCamera } from "./console_session.mjs";
 
 const tablet = { width: 1024, height: 768 };
-const s = await startConsole("console_ergonomics", (dir) => ["--out", join(dir, "rec")], 200, { viewport: tablet });
+const s = await startConsole("console_ergonomics", (dir) => ["--out", join(dir, "rec"), ...withoutCamera(dir)], 200, { viewport: tablet });
 const { page, t, until, shot, goWithDeadman, setSlider, selectObjective, fail, log } = s;
 const um = (v) => (v * 1e6).toFixed(1);
 

@@ -5,18 +5,16 @@
 // that the part ends within 10 um of its target, presses the e-stop and checks the safe state,
 // and stops the server with SIGTERM (exit 0, a closed MCAP recording). Screenshots go to
 // MC_ARTIFACTS (default: a temporary directory). Run by CTest (`console_browser`).
-import { existsSync, readdirSync, readFileSync, writeFileSync } from "node:fs";
+import { existsSync, readdirSync, readFileSync } from "node:fs";
 import { join } from "node:path";
-import { startConsole } from "./console_session.mjs";
+import { startConsole, withoutCamera } from "./console_session.mjs";
 
 // --record-csv: the CSV beside each recording is opt-in; this test downloads it from the console.
 // Without a camera (`devices.camera.driver: none`): the operation through the schematic view,
 // whose field follows the gripper; the camera's own panel is console_browser_camera's (the
 // simulated camera looks at a fixed field, where the 20x approach over the part is off-field).
-const s = await startConsole("console_operates", (dir) => {
-  writeFileSync(join(dir, "no-camera.yaml"), "devices:\n  camera:\n    driver: none\n");
-  return ["--out", join(dir, "rec"), "--record", "--record-csv", "--config", join(dir, "no-camera.yaml")];
-}, 240);
+const s = await startConsole("console_operates",
+  (dir) => ["--out", join(dir, "rec"), "--record", "--record-csv", ...withoutCamera(dir)], 240);
 const { page, t, until, shot, clickTop, clickSide, goWithDeadman, setSlider, selectObjective, fail, log, url, dir } = s;
 try {
   await page.goto(url, { waitUntil: "domcontentloaded" });

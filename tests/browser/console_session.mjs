@@ -3,13 +3,23 @@
 // and the operator's gestures as the page's own controls take them (click-to-go through the
 // page's world-to-canvas mapping, the Space deadman, sliders). Failures are counted, not thrown.
 import { spawn } from "node:child_process";
-import { mkdtempSync, mkdirSync, existsSync } from "node:fs";
+import { mkdtempSync, mkdirSync, existsSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
 import { chromium } from "playwright-core";
 
 // options.viewport: the page's size ({width, height}; 1280x1000 unless given).
+// serve's options for a platform without a camera (`devices.camera.driver: none`): the tests
+// that are not about the camera leave it out. A 1280x1024 stream at 30 fps costs the server
+// a core and headless Chromium (software rendering) its main thread on a 2-core machine, enough
+// to starve the page's command heartbeat; the camera's panel is console_browser_camera's.
+export function withoutCamera(dir) {
+  const file = join(dir, "no-camera.yaml");
+  writeFileSync(file, "devices:\n  camera:\n    driver: none\n");
+  return ["--config", file];
+}
+
 export async function startConsole(name, serveArgs, timeoutS, options = {}) {
   const cli = process.env.MC_CLI;
   if (!cli || !existsSync(cli)) {

@@ -32,6 +32,7 @@ struct DemoParams {
   std::vector<double> weights{1.0, 2.0};
   std::vector<std::vector<double>> table{{1.0, 2.0}, {3.0, 4.0}};
   ModeParams mode;
+  std::vector<ModeParams> modes{ModeParams{}, ModeParams{200.0, 0.1}};
   template <class V>
   void visit(V& v) {
     v("mass_kg", mass_kg);
@@ -41,10 +42,12 @@ struct DemoParams {
     v("weights", weights);
     v("table", table);
     v("mode", mode);
+    v("modes", modes);
   }
   void validate() const {
     require_positive(mass_kg, "mass_kg");
     mode.validate();
+    for (const ModeParams& m : modes) m.validate();
   }
 };
 
@@ -122,6 +125,32 @@ TEST(Params, ValidateRunsAfterLoadingAndNamesTheConstraint) {
     EXPECT_EQ(e.field(), "mode.damping");
     EXPECT_THAT(e.what(), HasSubstr("must be in [0, 1] (got 1.5)"));
   }
+}
+
+TEST(Params, AListOfStructsReplacesTheDefaultListElementByElementOverTheirDefaults) {
+  const auto p = params_from_yaml_text<DemoParams>("modes:\n  - {damping: 0.3}\n  - {frequency_Hz: 7}\n  - {}\n");
+  ASSERT_EQ(p.modes.size(), 3u);
+  EXPECT_DOUBLE_EQ(p.modes[0].damping, 0.3);
+  EXPECT_DOUBLE_EQ(p.modes[0].frequency_Hz, 100.0);  // the element's default, not the old list's
+  EXPECT_DOUBLE_EQ(p.modes[1].frequency_Hz, 7.0);
+  EXPECT_DOUBLE_EQ(p.modes[2].damping, 0.05);
+  EXPECT_EQ(params_to_json(p)["modes"].size(), 3u);
+  EXPECT_EQ(params_to_json(params_from_yaml_text<DemoParams>(params_to_yaml(p))), params_to_json(p));
+  const auto untouched = params_from_yaml_text<DemoParams>("mass_kg: 1\n");
+  EXPECT_EQ(untouched.modes.size(), 2u);
+  const auto expect_refusal = [](const std::string& yaml, const std::string& what, std::size_t line) {
+    try {
+      params_from_yaml_text<DemoParams>(yaml);
+      FAIL() << "expected InvalidInput for " << yaml;
+    } catch (const InvalidInput& e) {
+      EXPECT_THAT(e.what(), HasSubstr(what));
+      EXPECT_EQ(e.line(), line) << e.what();
+    }
+  };
+  expect_refusal("modes:\n  - {damping: 0.3}\n  - {dampnig: 0.1}\n", "unknown key 'modes[1].dampnig'", 3u);
+  expect_refusal("modes: 3\n", "'modes' must be a list of maps", 1u);
+  expect_refusal("modes:\n  - 3\n", "'modes[0]' must be a map", 2u);
+  EXPECT_THROW(params_from_yaml_text<DemoParams>("modes:\n  - {damping: 2}\n"), InvalidParams);
 }
 
 TEST(Params, MissingFileIsInvalidInput) {

@@ -240,5 +240,36 @@ TEST(Camera, NoCameraWhenNoneIsConfiguredAndBadSettingsAreNamed) {
   EXPECT_THROW(bad.validate(), Error);
 }
 
+TEST(Camera, TheTurretsObjectivesComeFromTheConfigurationFile) {
+  test::TempDir dir;
+  test::write_text(dir / "turret.yaml",
+                   "camera:\n"
+                   "  objectives:\n"
+                   "    - {name: 10x, magnification: 10, numerical_aperture: 0.28, working_distance_m: 33.5e-3}\n"
+                   "    - {name: 100x, magnification: 100, numerical_aperture: 0.7, working_distance_m: 6e-3}\n"
+                   "  objective: 1\n");
+  const PlatformConfig c = load_platform_config(dir / "turret.yaml");
+  ASSERT_EQ(c.camera.objectives.size(), 2u);
+  EXPECT_EQ(c.camera.objectives[1].name, "100x");
+  EXPECT_DOUBLE_EQ(c.camera.objectives[1].wavelength_m, 550e-9);  // the element's default
+  EXPECT_NEAR(c.camera.m_per_px(1), 5.3e-6 / 100.0, 1e-15);
+  // An objective the turret does not hold, and a bad objective, are named.
+  test::write_text(dir / "bad.yaml",
+                   "camera:\n  objectives:\n    - {name: 10x, magnification: 10}\n  objective: 1\n");
+  try {
+    load_platform_config(dir / "bad.yaml");
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("objective"), std::string::npos) << e.what();
+  }
+  test::write_text(dir / "typo.yaml", "camera:\n  objectives:\n    - {name: 10x, magnificaton: 10}\n");
+  try {
+    load_platform_config(dir / "typo.yaml");
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("camera.objectives[0].magnificaton"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mc::platform

@@ -17,7 +17,9 @@
 ///   };
 /// @endcode
 /// Supported field types: double, int, bool, std::string, std::vector<double>,
-/// std::vector<std::vector<double>>, and nested structs with `visit`.
+/// std::vector<std::vector<double>>, nested structs with `visit`, and lists of them
+/// (std::vector<S>: a YAML list of maps that replaces the whole list, each element read over
+/// S's defaults, e.g. a turret's objectives).
 /// load_params() starts from the defaults and overrides the keys present in the file; an
 /// unknown key, a wrong type or a malformed file throws mc::InvalidInput "file:line: ...".
 /// params_to_json() prints exactly the keys load_params() accepts.
@@ -46,6 +48,11 @@ template <class T>
 struct HasVisit<T, std::void_t<decltype(std::declval<T&>().visit(std::declval<NullVisitor&>()))>>
     : std::true_type {};
 
+template <class T>
+struct IsParamsList : std::false_type {};
+template <class S>
+struct IsParamsList<std::vector<S>> : HasVisit<S> {};
+
 template <class T, class = void>
 struct HasValidate : std::false_type {};
 template <class T>
@@ -72,6 +79,21 @@ class YamlReader {
       YamlReader sub(child, source_, path(key));
       value.visit(sub);
       sub.reject_unknown_keys();
+    } else if constexpr (IsParamsList<T>::value) {
+      const YAML::Node list = lookup(key);
+      if (!list) return;
+      if (!list.IsSequence()) fail(list, "'" + path(key) + "' must be a list of maps");
+      T out;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string at = path(key) + "[" + std::to_string(i) + "]";
+        if (!list[i].IsMap()) fail(list[i], "'" + at + "' must be a map");
+        typename T::value_type element{};
+        YamlReader sub(list[i], source_, at);
+        element.visit(sub);
+        sub.reject_unknown_keys();
+        out.push_back(std::move(element));
+      }
+      value = std::move(out);
     } else {
       read(key, value);
     }
@@ -102,6 +124,15 @@ class JsonWriter {
       JsonWriter sub(child);
       value.visit(sub);
       out_[key] = std::move(child);
+    } else if constexpr (IsParamsList<T>::value) {
+      nlohmann::json list = nlohmann::json::array();
+      for (auto& element : value) {
+        nlohmann::json child = nlohmann::json::object();
+        JsonWriter sub(child);
+        element.visit(sub);
+        list.push_back(std::move(child));
+      }
+      out_[key] = std::move(list);
     } else {
       out_[key] = value;
     }

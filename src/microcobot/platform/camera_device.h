@@ -81,6 +81,7 @@ struct CameraDeviceParams {
     v("enabled", enabled);
     v("sensor", sensor);
     v("illumination", illumination);
+    v("objectives", objectives);
     v("objective", objective);
     v("view_center_x_m", view_center_x_m);
     v("view_center_y_m", view_center_y_m);

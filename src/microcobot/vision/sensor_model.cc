@@ -47,7 +47,7 @@ double SensorModel::normal(std::uint32_t u32) const noexcept {
   const double u = (static_cast<double>(u32) + 0.5) * 0x1.0p-32;
   if (bin == 0 || bin == (1u << kTableBits) - 1) return normal_quantile(u);
   const double t = static_cast<double>(u32 & ((1u << (32 - kTableBits)) - 1)) * 0x1.0p-20;
-  const double lo = inverse_cdf_[bin], hi = inverse_cdf_[bin + 1];
+  const double lo = double(inverse_cdf_[bin]), hi = double(inverse_cdf_[bin + 1]);
   return lo + t * (hi - lo);
 }
 
