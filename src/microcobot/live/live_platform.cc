@@ -70,7 +70,7 @@ void LivePlatform::build(bool demo) {
   demo_ = std::move(op);
   demo_running_.store(demo);
   demo_finished_ = false;
-  demo_error_m_.store(NAN);
+  demo_error_m_.store(std::numeric_limits<double>::quiet_NaN());
   demo_duration_s_.store(0.0);
   demo_outcome_.store(static_cast<int>(demo ? DemoResult::Outcome::kRunning : DemoResult::Outcome::kNone),
                       std::memory_order_release);

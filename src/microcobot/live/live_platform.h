@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -62,10 +63,11 @@ struct LiveParams {
 struct DemoResult {
   enum class Outcome { kNone, kRunning, kPlaced, kInserted, kMissed, kGaveUp };
   Outcome outcome = Outcome::kNone;
-  std::string phase;               ///< the phase it is in, or gave up in
-  double placement_error_m = NAN;  ///< part centre to target, horizontal (NaN: no part)
-  double duration_s = 0.0;         ///< since the demo started
-  std::string reason;              ///< why it gave up, or what it achieved, in words
+  std::string phase;  ///< the phase it is in, or gave up in
+  double placement_error_m =
+      std::numeric_limits<double>::quiet_NaN();  ///< part centre to target, horizontal (NaN: no part)
+  double duration_s = 0.0;                       ///< since the demo started
+  std::string reason;                            ///< why it gave up, or what it achieved, in words
   static std::string_view name(Outcome o);
 };
 
@@ -234,7 +236,7 @@ class LivePlatform {
   std::atomic<int> demo_phase_{0}, demo_failed_phase_{0};
   // The demo's result, written by the loop (demo_outcome_ last, with release order).
   std::atomic<int> demo_outcome_{0};  // DemoResult::Outcome
-  std::atomic<double> demo_error_m_{NAN}, demo_duration_s_{0.0};
+  std::atomic<double> demo_error_m_{std::numeric_limits<double>::quiet_NaN()}, demo_duration_s_{0.0};
   bool demo_finished_ = false;  // loop thread only: the operator is done, the console has control
   std::atomic<std::uint64_t> ticks_{0};
   std::array<std::atomic<int>, 6> lifecycle_{};
