@@ -128,7 +128,8 @@ TEST(Params, ValidateRunsAfterLoadingAndNamesTheConstraint) {
 }
 
 TEST(Params, AListOfStructsReplacesTheDefaultListElementByElementOverTheirDefaults) {
-  const auto p = params_from_yaml_text<DemoParams>("modes:\n  - {damping: 0.3}\n  - {frequency_Hz: 7}\n  - {}\n");
+  const auto p =
+      params_from_yaml_text<DemoParams>("modes:\n  - {damping: 0.3}\n  - {frequency_Hz: 7}\n  - {}\n");
   ASSERT_EQ(p.modes.size(), 3u);
   EXPECT_DOUBLE_EQ(p.modes[0].damping, 0.3);
   EXPECT_DOUBLE_EQ(p.modes[0].frequency_Hz, 100.0);  // the element's default, not the old list's

@@ -138,7 +138,7 @@ TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraI
   const auto nd = info.get<std::uint32_t>();
   for (std::uint32_t i = 0; i < nd; ++i) EXPECT_EQ(info.get<double>(), 0.0);
   const double fx = info.get<double>();
-  const auto& objective = LiveParams().platform.camera.objectives.front();  // the power-up turret
+  const auto objective = LiveParams().platform.camera.objectives.front();  // the power-up turret (a copy)
   EXPECT_NEAR(fx, objective.working_distance_m / (5.3e-6 / objective.magnification), 1e-6 * fx);
 }
 

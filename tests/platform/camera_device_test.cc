@@ -242,12 +242,13 @@ TEST(Camera, NoCameraWhenNoneIsConfiguredAndBadSettingsAreNamed) {
 
 TEST(Camera, TheTurretsObjectivesComeFromTheConfigurationFile) {
   test::TempDir dir;
-  test::write_text(dir / "turret.yaml",
-                   "camera:\n"
-                   "  objectives:\n"
-                   "    - {name: 10x, magnification: 10, numerical_aperture: 0.28, working_distance_m: 33.5e-3}\n"
-                   "    - {name: 100x, magnification: 100, numerical_aperture: 0.7, working_distance_m: 6e-3}\n"
-                   "  objective: 1\n");
+  test::write_text(
+      dir / "turret.yaml",
+      "camera:\n"
+      "  objectives:\n"
+      "    - {name: 10x, magnification: 10, numerical_aperture: 0.28, working_distance_m: 33.5e-3}\n"
+      "    - {name: 100x, magnification: 100, numerical_aperture: 0.7, working_distance_m: 6e-3}\n"
+      "  objective: 1\n");
   const PlatformConfig c = load_platform_config(dir / "turret.yaml");
   ASSERT_EQ(c.camera.objectives.size(), 2u);
   EXPECT_EQ(c.camera.objectives[1].name, "100x");
