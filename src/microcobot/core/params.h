@@ -29,8 +29,8 @@
 #include <type_traits>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
+#include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
 
@@ -56,8 +56,7 @@ struct IsParamsList<std::vector<S>> : HasVisit<S> {};
 template <class T, class = void>
 struct HasValidate : std::false_type {};
 template <class T>
-struct HasValidate<T, std::void_t<decltype(std::declval<const T&>().validate())>>
-    : std::true_type {};
+struct HasValidate<T, std::void_t<decltype(std::declval<const T&>().validate())>> : std::true_type {};
 
 /// Reads fields from one YAML map, remembering which keys were used.
 class YamlReader {

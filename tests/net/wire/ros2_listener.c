@@ -13,8 +13,8 @@
  * test starts the publisher after it).
  *
  * Same middleware configuration as the platform (loopback, unicast discovery on 127.0.0.1 and
- * multicast participant discovery on lo), same QoS as its publishers: state topics best effort, volatile, keep last 1; the
- * latched topics (bool: /microcobot/estop, /microcobot/master/engaged) reliable, transient
+ * multicast participant discovery on lo), same QoS as its publishers: state topics best effort, volatile,
+ * keep last 1; the latched topics (bool: /microcobot/estop, /microcobot/master/engaged) reliable, transient
  * local, keep last 1 so that the current state arrives even when published before the start;
  * /diagnostics (diag) reliable, volatile, keep last 1. Images (sensor_msgs/msg/CompressedImage,
  * the camera's frames) are best effort like the state topics; their JPEG is decoded here
@@ -60,7 +60,8 @@ struct Options {
 
 static int usage(const char* msg, const char* arg) {
   fprintf(stderr,
-          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type pose|wrench|vector3|joint|bool|diag|image "
+          "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type "
+          "pose|wrench|vector3|joint|bool|diag|image "
           "[--count K] [--timeout S] [--ready-file PATH])\n",
           msg, arg ? ": " : "", arg ? arg : "");
   return 2;
@@ -205,12 +206,13 @@ static void put_jpeg(const sensor_msgs_msg_dds__CompressedImage_* m) {
   tjhandle tj = tjInitDecompress();
   unsigned char* pixels = NULL;
   int ok = tj != NULL && m->data_._length > 0 &&
-           tjDecompressHeader3(tj, m->data_._buffer, m->data_._length, &width, &height, &subsamp, &colorspace) == 0 &&
+           tjDecompressHeader3(tj, m->data_._buffer, m->data_._length, &width, &height, &subsamp,
+                               &colorspace) == 0 &&
            width > 0 && height > 0;
   if (ok) {
     pixels = malloc((size_t)width * (size_t)height);
-    ok = pixels != NULL && tjDecompress2(tj, m->data_._buffer, m->data_._length, pixels, width, 0, height,
-                                         TJPF_GRAY, 0) == 0;
+    ok = pixels != NULL &&
+         tjDecompress2(tj, m->data_._buffer, m->data_._length, pixels, width, 0, height, TJPF_GRAY, 0) == 0;
   }
   if (ok) {
     double sum = 0.0;
