@@ -267,10 +267,12 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   encode_compressed_image(f, stamp, image_cdr_);
   encode_camera_info(f, stamp, info_cdr_);
   const LiveStatus s = live_.status();
-  publish(image_ch_, RecordedTopic::kCameraImage, t_s, image_cdr_);
-  publish(info_ch_, RecordedTopic::kCameraInfo, t_s, info_cdr_);
-  publish(camera_state_ch_, RecordedTopic::kCameraState, t_s,
-          camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped));
+  const std::string state = camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped);
+  const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
+  server_.publish(image_ch_, ns, image_cdr_);
+  server_.publish(info_ch_, ns, info_cdr_);
+  server_.publish(camera_state_ch_, ns, state);
+  if (recording_) recording_->published_frame(t_s, image_cdr_, info_cdr_, state);
   for (const FrameConsumer& c : frame_consumers_) c.on_frame(f, t_s);
 }
 

@@ -223,21 +223,24 @@ void SessionRecording::stop() {
   if (csv) csv->close();
 }
 
-void SessionRecording::push(Item&& item) {
-  const std::size_t bytes = sizeof(Item) + item.payload.size();
+void SessionRecording::push(std::span<Item> items) {
+  std::size_t bytes = 0;
+  for (const Item& item : items) bytes += sizeof(Item) + item.payload.size();
   {
     std::lock_guard lock(mutex_);
     if (!active_ || stopping_) return;
     if (queued_bytes_ + bytes > kMaxQueuedBytes) {
-      ++dropped_;
+      dropped_ += items.size();
       return;
     }
-    std::uint64_t& last = last_ns_[index(item.topic)];
-    const std::int64_t ns = std::llround(item.t_s * 1e9) + offset_ns_;
-    item.log_ns = std::max(last, static_cast<std::uint64_t>(std::max<std::int64_t>(ns, 0)));
-    last = item.log_ns;
+    for (Item& item : items) {
+      std::uint64_t& last = last_ns_[index(item.topic)];
+      const std::int64_t ns = std::llround(item.t_s * 1e9) + offset_ns_;
+      item.log_ns = std::max(last, static_cast<std::uint64_t>(std::max<std::int64_t>(ns, 0)));
+      last = item.log_ns;
+      queue_.push_back(std::move(item));
+    }
     queued_bytes_ += bytes;
-    queue_.push_back(std::move(item));
   }
   wake_.notify_one();
 }
@@ -248,10 +251,16 @@ void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t
 }
 
 void SessionRecording::published(RecordedTopic topic, double t_s, std::string_view payload) {
-  const bool camera_topic = topic == RecordedTopic::kCameraImage || topic == RecordedTopic::kCameraInfo ||
-                            topic == RecordedTopic::kCameraState;
-  if (camera_topic && !params_.camera) return;
   push(Item{topic, 0, t_s, std::string(payload), {}, 0});
+}
+
+void SessionRecording::published_frame(double t_s, std::string_view image, std::string_view info,
+                                       std::string_view state) {
+  if (!params_.camera) return;
+  std::array<Item, 3> frame{Item{RecordedTopic::kCameraImage, 0, t_s, std::string(image), {}, 0},
+                            Item{RecordedTopic::kCameraInfo, 0, t_s, std::string(info), {}, 0},
+                            Item{RecordedTopic::kCameraState, 0, t_s, std::string(state), {}, 0}};
+  push(frame);
 }
 
 void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s,

@@ -34,6 +34,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -121,6 +122,9 @@ class SessionRecording {
   void telemetry(const platform::TelemetrySample& s, std::size_t count);
   /// A message the server published (status, scene, feedback): its payload as sent.
   void published(RecordedTopic topic, double t_s, std::string_view payload);
+  /// A camera frame's three messages (image, camera info, state), recorded together or not at
+  /// all: a stop between them never leaves a frame without its info or state.
+  void published_frame(double t_s, std::string_view image, std::string_view info, std::string_view state);
   /// A message a client sent on /console/command or /console/action, accepted or not.
   void received(RecordedTopic topic, std::uint64_t client, double t_s, std::string_view payload);
   /// An event (client 0: none).
@@ -140,7 +144,8 @@ class SessionRecording {
     platform::TelemetrySample sample;
     std::size_t count = 0;
   };
-  void push(Item&& item);
+  void push(Item&& item) { push(std::span<Item>(&item, 1)); }
+  void push(std::span<Item> items);  // all or none
   void writer_thread();
   void abandon(const std::string& why);
 
