@@ -21,6 +21,7 @@ RUN_PACKAGES=(
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
   libturbojpeg0-dev    # the camera's JPEG frames (core/jpeg)
   libpng-dev           # the camera's PNG frames (vision/png_file; zlib comes with it)
+  libopencv-imgproc-dev libopencv-video-dev  # vision processing: template matching, ECC (vision/template_tracker)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
 )
 # What `make test` needs beside them: test frameworks, the browser, the fuzzers, the Python module

@@ -15,6 +15,7 @@
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/png_file.h"
 #include "microcobot/vision/renderer.h"
+#include "vision_processing_commands.h"
 
 namespace {
 
@@ -186,9 +187,11 @@ void add_vision(CLI::App& group) {
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] { run_render(*o); });
   }
+  mc::cli::add_vision_processing(group);
 }
 
 const bool kRegistered = mc::cli::register_group(
-    {"vision", "The microscope camera: optics figures and rendered frames (issue #27)", 45, &add_vision});
+    {"vision", "The microscope camera: optics, rendered frames, calibration and tracking (issues #27, #28)",
+     45, &add_vision});
 
 }  // namespace

@@ -9,13 +9,25 @@ namespace mc::vision {
 
 namespace {
 
-constexpr int kMargin = 32;              // substrate texture beyond the image (px), for its blur
-constexpr int kFingerSegments = 4;       // an inclined finger: heights along its length
+constexpr int kMargin = 32;  // substrate texture beyond the image (px), for its blur
+// An inclined finger: heights along its length, in segments doubling in length from the tip, so
+// that the tip (what the microscope focuses on) is drawn at its own height: 2 mm at a rise of 0.5
+// puts the first segment within 4 um of the tip's height (under a 10x objective's depth of field).
+constexpr int kFingerSegments = 8;
 constexpr double kGroupRatio = 1.15;     // layers whose blurs are within 15 % share one blur
 constexpr double kDecimateFrom = 6.0;    // sigma [px] from which a group is blurred on a coarser grid
 constexpr double kBeadDiffuse = 0.15;    // a bead's surface outside the specular cap: diffuse part
 constexpr double kFingerOutline = 0.08;  // an outline's radiance relative to the finger's face
 constexpr int kMaxMotionSamples = 64;
+
+// Segment k of a finger: from start_m to start_m + length_m along the bar, from the tip.
+struct FingerSpan {
+  double start_m, length_m;
+};
+FingerSpan finger_span(const Finger& f, int k) {
+  const double first = f.length_m / static_cast<double>((1 << kFingerSegments) - 1);
+  return {first * ((1 << k) - 1), first * (1 << k)};
+}
 
 double overlap(double a0, double a1, double b0, double b1) {
   return std::max(0.0, std::min(a1, b1) - std::max(a0, b0));
@@ -93,7 +105,8 @@ const std::vector<float>& Renderer::render_expected(const SceneSnapshot& scene, 
   for (std::size_t i = 0; i < scene.fingers.size(); ++i) {
     const Finger& f = scene.fingers[i];
     for (int k = 0; k < kFingerSegments; ++k) {
-      const double z = f.z_tip_m + f.rise * (k + 0.5) * f.length_m / kFingerSegments;
+      const FingerSpan span = finger_span(f, k);
+      const double z = f.z_tip_m + f.rise * (span.start_m + 0.5 * span.length_m);
       layers_.push_back({Kind::kFinger, i, k, z, sigma_px(z), false});
     }
   }
@@ -175,9 +188,10 @@ Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment
       return bead_shape(scene.beads[i], transmitted, cap);
     case Kind::kFinger: {
       const Finger& f = scene.fingers[i];
-      const double len = f.length_m / kFingerSegments;
+      const FingerSpan span = finger_span(f, segment);
+      const double len = span.length_m;
       s.type = Shape::kBox;
-      s.x = f.tip_x_m, s.y = f.tip_y_m + (segment + 0.5) * len;
+      s.x = f.tip_x_m, s.y = f.tip_y_m + span.start_m + 0.5 * len;
       s.hx = 0.5 * f.width_m, s.hy = 0.5 * len;
       s.radiance = transmitted ? 0.0 : f.reflectance;
       s.edge_radiance = transmitted ? 0.0 : kFingerOutline * f.reflectance;

@@ -1,0 +1,8 @@
+#pragma once
+// `microcobot vision calibrate|track` (issue #28), added to the `vision` group.
+
+#include <CLI/CLI.hpp>
+
+namespace mc::cli {
+void add_vision_processing(CLI::App& group);
+}

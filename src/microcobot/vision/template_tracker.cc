@@ -1,0 +1,206 @@
+#include "microcobot/vision/template_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <string>
+
+#include "microcobot/core/error.h"
+
+namespace mc::vision {
+
+namespace {
+
+// Pixels of margin around the coarse match that ECC may move within.
+constexpr int kFineMargin = 4;
+// A refinement further than this from the coarse match is a divergence, not a correction [px].
+constexpr double kMaxRefinement = 2.0;
+
+cv::Mat view16(const Frame& f) {
+  // matchTemplate/ECC read; the frame's buffer is not written.
+  return cv::Mat(f.height, f.width, CV_16U, const_cast<std::uint16_t*>(f.pixels.data()));
+}
+
+std::string roi_text(const PixelRoi& r) {
+  return "ROI x " + std::to_string(r.x) + ", y " + std::to_string(r.y) + ", " + std::to_string(r.width) +
+         "x" + std::to_string(r.height);
+}
+
+}  // namespace
+
+void TrackerParams::validate() const {
+  require(search_margin_px >= 2 && search_margin_px <= 4096, "search_margin_px", "must be within [2, 4096]",
+          search_margin_px);
+  require(lost_below > -1.0 && lost_below < 1.0, "lost_below", "must be within (-1, 1)", lost_below);
+  require(min_contrast_ratio > 0.0 && min_contrast_ratio <= 1.0, "min_contrast_ratio",
+          "must be within (0, 1]", min_contrast_ratio);
+  require(ecc_iterations >= 1 && ecc_iterations <= 1000, "ecc_iterations", "must be within [1, 1000]",
+          ecc_iterations);
+  require(ecc_epsilon > 0.0 && ecc_epsilon < 1.0, "ecc_epsilon", "must be within (0, 1)", ecc_epsilon);
+  require(ecc_blur_px >= 1 && ecc_blur_px <= 31 && ecc_blur_px % 2 == 1, "ecc_blur_px",
+          "must be odd, within [1, 31]", ecc_blur_px);
+}
+
+struct TemplateTracker::Images {
+  cv::Mat templ;             // float
+  cv::Mat templ_half;        // 2x-decimated, for the whole-frame search
+  cv::Mat window, response;  // scratch
+  double templ_stddev = 0.0;
+  int frame_width = 0, frame_height = 0;
+};
+
+TemplateTracker::TemplateTracker(const TrackerParams& params) : params_(params) { params_.validate(); }
+TemplateTracker::~TemplateTracker() = default;
+TemplateTracker::TemplateTracker(TemplateTracker&&) noexcept = default;
+TemplateTracker& TemplateTracker::operator=(TemplateTracker&&) noexcept = default;
+
+bool TemplateTracker::has_template() const { return images_ != nullptr; }
+
+void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
+  if (roi.width < 8 || roi.height < 8)
+    throw InvalidInput(roi_text(roi) + ": a template needs at least 8x8 pixels");
+  if (roi.x < 0 || roi.y < 0 || roi.x + roi.width > frame.width || roi.y + roi.height > frame.height)
+    throw InvalidInput(roi_text(roi) + ": not inside the " + std::to_string(frame.width) + "x" +
+                       std::to_string(frame.height) + " frame");
+  auto images = std::make_unique<Images>();
+  view16(frame)(cv::Rect(roi.x, roi.y, roi.width, roi.height)).convertTo(images->templ, CV_32F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(images->templ, mean, stddev);
+  if (!(stddev[0] > 0.5))  // under half a grey level: noise, no feature
+    throw InvalidInput(roi_text(roi) + ": the patch has no contrast to track (rms " +
+                       std::to_string(stddev[0]) + " grey levels)");
+  images->templ_stddev = stddev[0];
+  cv::pyrDown(images->templ, images->templ_half);
+  images->frame_width = frame.width;
+  images->frame_height = frame.height;
+  images_ = std::move(images);
+  last_ = {};
+  last_.u_px = roi.x + 0.5 * (roi.width - 1);
+  last_.v_px = roi.y + 0.5 * (roi.height - 1);
+  last_.confidence = 1.0;
+  last_.found = true;
+  du_ = dv_ = 0.0;
+  lost_ = false;
+}
+
+TrackEstimate TemplateTracker::track(const Frame& frame) {
+  return track_around(frame, last_.u_px + du_, last_.v_px + dv_, lost_);
+}
+
+TrackEstimate TemplateTracker::track_near(const Frame& frame, double u_px, double v_px) {
+  if (!std::isfinite(u_px) || !std::isfinite(v_px))
+    throw InvalidInput("template tracker: the predicted position (" + std::to_string(u_px) + ", " +
+                       std::to_string(v_px) + ") px is not finite");
+  return track_around(frame, u_px, v_px, false);
+}
+
+TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, double pv, bool whole) {
+  if (!images_) throw InvalidInput("template tracker: no template (set_template first)");
+  Images& im = *images_;
+  if (frame.width != im.frame_width || frame.height != im.frame_height)
+    throw InvalidInput("template tracker: a " + std::to_string(frame.width) + "x" +
+                       std::to_string(frame.height) + " frame, the template came from " +
+                       std::to_string(im.frame_width) + "x" + std::to_string(im.frame_height));
+  const cv::Mat full = view16(frame);
+  const int tw = im.templ.cols, th = im.templ.rows;
+  const double cx = 0.5 * (tw - 1), cy = 0.5 * (th - 1);
+  const cv::Rect bounds(0, 0, frame.width, frame.height);
+
+  // 1. Coarse: the integer-pixel top-left corner of the best match.
+  cv::Point corner;
+  double peak = -1.0;
+  const auto search = [&](const cv::Rect& area) {
+    full(area).convertTo(im.window, CV_32F);
+    cv::matchTemplate(im.window, im.templ, im.response, cv::TM_CCOEFF_NORMED);
+    cv::Point at;
+    cv::minMaxLoc(im.response, nullptr, &peak, nullptr, &at);
+    corner = area.tl() + at;
+  };
+  const int m = params_.search_margin_px;
+  const double far = 1e6;  // a prediction outside any frame
+  const cv::Rect predicted(static_cast<int>(std::lround(std::clamp(pu - cx, -far, far))) - m,
+                           static_cast<int>(std::lround(std::clamp(pv - cy, -far, far))) - m, tw + 2 * m,
+                           th + 2 * m);
+  const cv::Rect window = predicted & bounds;
+  if (!whole && window.width >= tw && window.height >= th) search(window);
+  // Correlation is blind to contrast: a faint patch of texture shaped like the target correlates
+  // well. A match must also carry the template's contrast.
+  const auto is_match = [&] {
+    if (peak < params_.lost_below) return false;
+    const cv::Rect at(corner.x, corner.y, tw, th);
+    if ((at & bounds) != at) return false;
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(full(at), mean, stddev);
+    const double ratio = stddev[0] / im.templ_stddev;
+    return ratio >= params_.min_contrast_ratio && ratio <= 1.0 / params_.min_contrast_ratio;
+  };
+  const bool searched_whole = !is_match();
+  if (searched_whole) {
+    // Lost (or predicted out of the frame): the whole frame, decimated 2x, then the
+    // full-resolution peak within a pixel or two of it.
+    cv::Mat half;
+    full.convertTo(im.window, CV_32F);
+    cv::pyrDown(im.window, half);
+    if (half.cols >= im.templ_half.cols && half.rows >= im.templ_half.rows) {
+      cv::matchTemplate(half, im.templ_half, im.response, cv::TM_CCOEFF_NORMED);
+      cv::Point at;
+      cv::minMaxLoc(im.response, nullptr, &peak, nullptr, &at);
+      const cv::Rect near(2 * at.x - 3, 2 * at.y - 3, tw + 6, th + 6);
+      const cv::Rect area = near & bounds;
+      if (area.width >= tw && area.height >= th) search(area);
+    }
+  }
+  TrackEstimate e = last_;
+  e.reacquired = false;
+  if (searched_whole && !is_match()) {
+    e.found = false;
+    e.confidence = peak;
+    lost_ = true;
+    last_ = e;
+    return e;
+  }
+
+  // 2. Fine: ECC from the coarse match, on a window a few pixels larger than the template.
+  const cv::Rect fine_area =
+      cv::Rect(corner.x - kFineMargin, corner.y - kFineMargin, tw + 2 * kFineMargin, th + 2 * kFineMargin) &
+      bounds;
+  full(fine_area).convertTo(im.window, CV_32F);
+  const double a0 = params_.rotation ? -last_.angle_rad : 0.0;  // image axes: rows go down
+  cv::Mat warp = (cv::Mat_<float>(2, 3) << std::cos(a0), -std::sin(a0), corner.x - fine_area.x, std::sin(a0),
+                  std::cos(a0), corner.y - fine_area.y);
+  // Rotation about the template's centre: shift the translation so the centre stays put.
+  warp.at<float>(0, 2) += static_cast<float>(cx - (std::cos(a0) * cx - std::sin(a0) * cy));
+  warp.at<float>(1, 2) += static_cast<float>(cy - (std::sin(a0) * cx + std::cos(a0) * cy));
+  double u = corner.x + cx, v = corner.y + cy, angle = last_.angle_rad, rho = peak;
+  try {
+    rho = cv::findTransformECC(im.templ, im.window, warp,
+                               params_.rotation ? cv::MOTION_EUCLIDEAN : cv::MOTION_TRANSLATION,
+                               cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
+                                                params_.ecc_iterations, params_.ecc_epsilon),
+                               cv::noArray(), params_.ecc_blur_px);
+    const auto w = [&](int r, int c) { return static_cast<double>(warp.at<float>(r, c)); };
+    const double fu = fine_area.x + w(0, 0) * cx + w(0, 1) * cy + w(0, 2);
+    const double fv = fine_area.y + w(1, 0) * cx + w(1, 1) * cy + w(1, 2);
+    if (std::hypot(fu - u, fv - v) <= kMaxRefinement) {
+      u = fu, v = fv;
+      angle = -std::atan2(w(1, 0), w(0, 0));
+    }
+  } catch (const cv::Exception&) {
+    // ECC did not converge (a flat or saturated window): the coarse match stands.
+  }
+  e.u_px = u;
+  e.v_px = v;
+  e.angle_rad = params_.rotation ? angle : 0.0;
+  e.confidence = rho;
+  e.found = true;
+  e.reacquired = searched_whole && lost_;
+  du_ = lost_ ? 0.0 : u - last_.u_px;
+  dv_ = lost_ ? 0.0 : v - last_.v_px;
+  lost_ = false;
+  last_ = e;
+  return e;
+}
+
+}  // namespace mc::vision

@@ -1,0 +1,110 @@
+#pragma once
+/// @file
+/// Sub-pixel template tracking (issue #28 point 2): a patch of a first frame (a part, a hole, a
+/// pin, the gripper's tip) found again in each later frame.
+///
+///  1. Coarse: normalised cross-correlation (OpenCV matchTemplate, TM_CCOEFF_NORMED) over a
+///     window around the predicted position (last position + last displacement); its peak is the
+///     integer-pixel match and the confidence.
+///  2. Fine: the enhanced correlation coefficient (ECC) maximised from that match (Evangelidis &
+///     Psarakis, "Parametric image alignment using enhanced correlation coefficient
+///     maximization", IEEE TPAMI 30(10), 2008; OpenCV findTransformECC): a Gauss-Newton
+///     alignment of the intensities, invariant to brightness and contrast, so the estimate is
+///     continuous in the shift (no pixel locking of a peak fit). With `rotation` the warp is
+///     Euclidean and the in-plane angle comes with the position.
+///  3. Lost: a correlation below `lost_below`, or a contrast far from the template's (occluded,
+///     out of the field, defocused) around the
+///     prediction: the frame is then searched whole, on a 2x-decimated image; still below, the
+///     target is lost and later frames are searched whole until it is re-acquired.
+///
+/// The position reported is the template's centre in the frame's continuous pixel coordinates
+/// (pixel (row i, column j) spans [j - 1/2, j + 1/2] x [i - 1/2, i + 1/2]: its centre is (j, i)),
+/// as vision::Renderer's u_of_x/v_of_y. Not thread-safe: one tracker per camera thread. OpenCV
+/// stays inside template_tracker.cc.
+
+#include <memory>
+
+#include "microcobot/vision/sensor_model.h"
+
+namespace mc::vision {
+
+/// A rectangle of pixels: columns [x, x + width), rows [y, y + height).
+struct PixelRoi {
+  int x = 0;
+  int y = 0;
+  int width = 0;
+  int height = 0;
+};
+
+struct TrackerParams {
+  /// Pixels searched beyond the template on each side around the predicted position [px].
+  int search_margin_px = 24;
+  /// Below this normalised correlation the target is lost (and searched in the whole frame).
+  double lost_below = 0.5;
+  /// ... or when the match's contrast (rms) is under this fraction of the template's, or over its
+  /// inverse: correlation alone would take a faint texture of the same shape for the target.
+  double min_contrast_ratio = 0.5;
+  int ecc_iterations = 50;
+  double ecc_epsilon = 1e-6;  ///< ECC stops when the warp changes by less than this [px]
+  /// Gaussian pre-filter of both images in ECC [px, odd; 1: none]: band-limits sharp edges, which
+  /// the bilinear interpolation of the warp would otherwise bias toward whole pixels.
+  int ecc_blur_px = 5;
+  bool rotation = false;  ///< also estimate the in-plane angle (Euclidean warp)
+
+  template <class V>
+  void visit(V& v) {
+    v("search_margin_px", search_margin_px);
+    v("lost_below", lost_below);
+    v("min_contrast_ratio", min_contrast_ratio);
+    v("ecc_iterations", ecc_iterations);
+    v("ecc_epsilon", ecc_epsilon);
+    v("ecc_blur_px", ecc_blur_px);
+    v("rotation", rotation);
+  }
+  void validate() const;
+};
+
+/// One frame's estimate.
+struct TrackEstimate {
+  double u_px = 0.0;        ///< the template centre's column (continuous)
+  double v_px = 0.0;        ///< ... and row
+  double angle_rad = 0.0;   ///< in-plane rotation from the template (image axes, counter-clockwise as seen)
+  double confidence = 0.0;  ///< the match's normalised correlation, [-1, 1]
+  bool found = false;       ///< false: lost (the position is the last known one)
+  bool reacquired = false;  ///< found by a whole-frame search after being lost
+};
+
+class TemplateTracker {
+ public:
+  explicit TemplateTracker(const TrackerParams& params = {});
+  ~TemplateTracker();
+  TemplateTracker(TemplateTracker&&) noexcept;
+  TemplateTracker& operator=(TemplateTracker&&) noexcept;
+
+  const TrackerParams& params() const { return params_; }
+
+  /// Takes the template from `frame` inside `roi` and tracks from there. Throws mc::InvalidInput
+  /// naming the ROI when it is empty, smaller than 8x8 or not inside the frame, or when the patch
+  /// has no contrast (nothing to track).
+  void set_template(const Frame& frame, const PixelRoi& roi);
+  bool has_template() const;
+  /// Where the template is in `frame` (same size as the template's frame, else InvalidInput),
+  /// searched around the last position plus the last frame-to-frame displacement.
+  TrackEstimate track(const Frame& frame);
+  /// The same, searched around a caller's prediction of the template centre (a commanded stage
+  /// move seen through the calibration, a servo's expected motion). Non-finite: InvalidInput.
+  TrackEstimate track_near(const Frame& frame, double u_px, double v_px);
+  /// The last estimate (the template's own position before the first track()).
+  const TrackEstimate& last() const { return last_; }
+
+ private:
+  struct Images;  // OpenCV's matrices, kept out of this header
+  TrackEstimate track_around(const Frame& frame, double u_px, double v_px, bool whole);
+  TrackerParams params_;
+  std::unique_ptr<Images> images_;
+  TrackEstimate last_;
+  double du_ = 0.0, dv_ = 0.0;  // the last frame-to-frame displacement (prediction)
+  bool lost_ = false;
+};
+
+}  // namespace mc::vision

@@ -1,0 +1,157 @@
+// The template tracker on rendered frames (issue #28 point 2): a part's corner followed with
+// sub-pixel error at the default sensor's noise, no pull toward whole pixels, lost when the part
+// leaves the field and re-acquired when it returns; bad templates refused in one line.
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "microcobot/core/error.h"
+#include "microcobot/vision/renderer.h"
+#include "microcobot/vision/template_tracker.h"
+
+namespace mc::vision {
+namespace {
+
+constexpr int kW = 320, kH = 256;
+constexpr double kTop = 100e-6;
+
+CameraParams small_camera() {
+  CameraParams c;
+  c.objective = objective_by_name("10x");
+  c.sensor.width_px = kW;
+  c.sensor.height_px = kH;
+  return c;
+}
+
+// A 300 um brass part 100 um thick, its top in focus, on the textured steel substrate (which is
+// then out of focus: a template that also holds a sharp static background is pulled toward it).
+SceneSnapshot part_at(double x_m, double y_m) {
+  SceneSnapshot s;
+  s.substrate.texture_seed = 7;
+  Part p;
+  p.x_m = x_m;
+  p.y_m = y_m;
+  p.size_x_m = p.size_y_m = 300e-6;
+  p.z_top_m = kTop;
+  s.parts.push_back(p);
+  return s;
+}
+
+// The part's upper-left corner at the image's centre when the part is at (x0, y0).
+constexpr double kX0 = 150e-6, kY0 = -150e-6;
+
+struct Fixture {
+  Renderer renderer{small_camera()};
+  Frame frame;
+  void render(double x_m, double y_m, std::uint64_t index) {
+    CameraControls c = renderer.default_controls();
+    c.focus_z_m = kTop;
+    renderer.render(part_at(x_m, y_m), c, 11, index, frame);
+  }
+  TemplateTracker start(const TrackerParams& params = {}) {
+    render(kX0, kY0, 0);
+    TemplateTracker t(params);
+    t.set_template(frame, PixelRoi{kW / 2 - 40, kH / 2 - 40, 80, 80});
+    return t;
+  }
+};
+
+TEST(TemplateTracker, FollowsAPartWithSubPixelErrorAndNoPullTowardWholePixels) {
+  Fixture f;
+  TemplateTracker tracker = f.start();
+  const double u0 = tracker.last().u_px, v0 = tracker.last().v_px;
+  const double pixel_m = f.renderer.camera().pixel_size_m();
+  // Sub-pixel phases across one pixel (0.1 px apart) along a diagonal: the error must not depend
+  // on the phase (pixel locking would pull it toward 0 and 1, a sawtooth of the phase).
+  double sum2 = 0.0, mean_first_half = 0.0, mean_second_half = 0.0;
+  constexpr int kSteps = 20;
+  for (int k = 1; k <= kSteps; ++k) {
+    const double shift_px = 0.1 * k;
+    f.render(kX0 + shift_px * pixel_m, kY0 - shift_px * pixel_m, static_cast<std::uint64_t>(k));
+    const TrackEstimate e = tracker.track(f.frame);
+    ASSERT_TRUE(e.found) << "frame " << k;
+    EXPECT_GT(e.confidence, 0.95);
+    const double eu = e.u_px - (u0 + shift_px), ev = e.v_px - (v0 + shift_px);
+    sum2 += eu * eu + ev * ev;
+    const double phase = shift_px - std::floor(shift_px);
+    (phase < 0.5 ? mean_first_half : mean_second_half) += 0.5 * (eu + ev) / (kSteps / 2.0);
+  }
+  const double rms = std::sqrt(sum2 / kSteps);
+  EXPECT_LT(rms, 0.05) << "px (issue #28: <= 0.05 px at the default noise)";
+  // Pixel locking biases phases below 1/2 backwards and above 1/2 forwards (toward the nearest
+  // whole pixel): the halves' mean errors would differ by a sizeable fraction of a pixel.
+  EXPECT_LT(std::abs(mean_first_half - mean_second_half), 0.02) << "px";
+}
+
+TEST(TemplateTracker, LosesAPartThatLeavesTheFieldAndReacquiresItWhenItReturns) {
+  Fixture f;
+  TemplateTracker tracker = f.start();
+  const double u0 = tracker.last().u_px;
+  // Far out of the field: not found, and the last known position is kept.
+  f.render(kX0 + 2e-3, kY0, 1);
+  const TrackEstimate gone = tracker.track(f.frame);
+  EXPECT_FALSE(gone.found);
+  // Back 30 px from where it was lost (beyond the search window's reach from a lost state).
+  const double back_px = 30.0;
+  f.render(kX0 - back_px * f.renderer.camera().pixel_size_m(), kY0, 2);
+  const TrackEstimate back = tracker.track(f.frame);
+  ASSERT_TRUE(back.found);
+  EXPECT_TRUE(back.reacquired);
+  // Found again (within a quarter pixel: 30 px from where it was taken, the blurred substrate
+  // behind the corner, which does not move with the part, pulls the estimate by ~0.1 px).
+  EXPECT_NEAR(back.u_px, u0 - back_px, 0.25);
+  // And followed normally afterwards.
+  f.render(kX0 - (back_px + 0.5) * f.renderer.camera().pixel_size_m(), kY0, 3);
+  const TrackEstimate next = tracker.track(f.frame);
+  ASSERT_TRUE(next.found);
+  EXPECT_FALSE(next.reacquired);
+  EXPECT_NEAR(next.u_px, u0 - back_px - 0.5, 0.25);
+}
+
+TEST(TemplateTracker, APredictionFindsAJumpBeyondTheSearchWindow) {
+  Fixture f;
+  TrackerParams p;
+  p.search_margin_px = 8;
+  TemplateTracker tracker = f.start(p);
+  const double u0 = tracker.last().u_px, v0 = tracker.last().v_px;
+  const double jump_px = 60.0;
+  f.render(kX0 + jump_px * f.renderer.camera().pixel_size_m(), kY0, 1);
+  const TrackEstimate e = tracker.track_near(f.frame, u0 + jump_px + 3.0, v0 - 2.0);
+  ASSERT_TRUE(e.found);
+  EXPECT_FALSE(e.reacquired) << "found in the window around the prediction";
+  EXPECT_NEAR(e.u_px, u0 + jump_px, 0.05);
+  EXPECT_NEAR(e.v_px, v0, 0.05);
+}
+
+TEST(TemplateTracker, RefusesBadTemplatesAndInputsInOneLine) {
+  Fixture f;
+  f.render(kX0, kY0, 0);
+  TemplateTracker tracker;
+  const auto message = [&](const PixelRoi& roi) {
+    try {
+      tracker.set_template(f.frame, roi);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message({0, 0, 0, 0}).find("at least 8x8"), std::string::npos);
+  EXPECT_NE(message({300, 10, 40, 40}).find("not inside the 320x256 frame"), std::string::npos);
+  EXPECT_NE(message({-1, 10, 40, 40}).find("ROI x -1, y 10, 40x40"), std::string::npos);
+  // A flat patch: no contrast to follow.
+  Frame flat = f.frame;
+  std::fill(flat.pixels.begin(), flat.pixels.end(), std::uint16_t{1000});
+  EXPECT_THROW(tracker.set_template(flat, {10, 10, 40, 40}), InvalidInput);
+  EXPECT_THROW(tracker.track(f.frame), InvalidInput) << "no template yet";
+  tracker.set_template(f.frame, {100, 80, 64, 64});
+  EXPECT_THROW(tracker.track_near(f.frame, std::nan(""), 10.0), InvalidInput);
+  TrackerParams bad;
+  bad.ecc_blur_px = 4;
+  EXPECT_THROW(TemplateTracker{bad}, InvalidParams);
+}
+
+}  // namespace
+}  // namespace mc::vision
