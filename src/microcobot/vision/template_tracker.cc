@@ -23,6 +23,18 @@ cv::Mat view16(const Frame& f) {
   return cv::Mat(f.height, f.width, CV_16U, const_cast<std::uint16_t*>(f.pixels.data()));
 }
 
+// `area` of the frame as float, low-passed by a Gaussian of `ksize` computed with the frame's own
+// pixels around it (not a replicated border: where a bar crosses the template's edge, a blur
+// padded differently in the template and in the window biased the alignment by 0.14 px).
+void blurred(const cv::Mat& full, const cv::Rect& area, int ksize, cv::Mat& scratch, cv::Mat& out) {
+  const int pad = ksize / 2 + 1;
+  const cv::Rect grown = cv::Rect(area.x - pad, area.y - pad, area.width + 2 * pad, area.height + 2 * pad) &
+                         cv::Rect(0, 0, full.cols, full.rows);
+  full(grown).convertTo(scratch, CV_32F);
+  if (ksize > 1) cv::GaussianBlur(scratch, scratch, cv::Size(ksize, ksize), 0.0, 0.0, cv::BORDER_REPLICATE);
+  scratch(cv::Rect(area.tl() - grown.tl(), area.size())).copyTo(out);
+}
+
 std::string roi_text(const PixelRoi& r) {
   return "ROI x " + std::to_string(r.x) + ", y " + std::to_string(r.y) + ", " + std::to_string(r.width) +
          "x" + std::to_string(r.height);
@@ -45,6 +57,7 @@ void TrackerParams::validate() const {
 
 struct TemplateTracker::Images {
   cv::Mat templ;             // float
+  cv::Mat templ_smooth;      // low-passed with its surroundings, for ECC
   cv::Mat templ_half;        // 2x-decimated, for the whole-frame search
   cv::Mat window, response;  // scratch
   double templ_stddev = 0.0;
@@ -73,6 +86,11 @@ void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
                        std::to_string(stddev[0]) + " grey levels)");
   images->templ_stddev = stddev[0];
   cv::pyrDown(images->templ, images->templ_half);
+  {
+    cv::Mat scratch;
+    blurred(view16(frame), cv::Rect(roi.x, roi.y, roi.width, roi.height), params_.ecc_blur_px, scratch,
+            images->templ_smooth);
+  }
   images->frame_width = frame.width;
   images->frame_height = frame.height;
   images_ = std::move(images);
@@ -166,7 +184,7 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, doubl
   const cv::Rect fine_area =
       cv::Rect(corner.x - kFineMargin, corner.y - kFineMargin, tw + 2 * kFineMargin, th + 2 * kFineMargin) &
       bounds;
-  full(fine_area).convertTo(im.window, CV_32F);
+  blurred(full, fine_area, params_.ecc_blur_px, im.response, im.window);
   const double a0 = params_.rotation ? -last_.angle_rad : 0.0;  // image axes: rows go down
   cv::Mat warp = (cv::Mat_<float>(2, 3) << std::cos(a0), -std::sin(a0), corner.x - fine_area.x, std::sin(a0),
                   std::cos(a0), corner.y - fine_area.y);
@@ -175,11 +193,11 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, doubl
   warp.at<float>(1, 2) += static_cast<float>(cy - (std::sin(a0) * cx + std::cos(a0) * cy));
   double u = corner.x + cx, v = corner.y + cy, angle = last_.angle_rad, rho = peak;
   try {
-    rho = cv::findTransformECC(im.templ, im.window, warp,
+    rho = cv::findTransformECC(im.templ_smooth, im.window, warp,
                                params_.rotation ? cv::MOTION_EUCLIDEAN : cv::MOTION_TRANSLATION,
                                cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
                                                 params_.ecc_iterations, params_.ecc_epsilon),
-                               cv::noArray(), params_.ecc_blur_px);
+                               cv::noArray(), 1);  // both already low-passed
     const auto w = [&](int r, int c) { return static_cast<double>(warp.at<float>(r, c)); };
     const double fu = fine_area.x + w(0, 0) * cx + w(0, 1) * cy + w(0, 2);
     const double fv = fine_area.y + w(1, 0) * cx + w(1, 1) * cy + w(1, 2);
