@@ -83,13 +83,20 @@ struct AutofocusParams {
 /// The last stage's spacing in depths of field (autofocus_params_for()).
 inline constexpr double kFinalStepDof = 1.0;
 inline constexpr double kFinalStepDofGradient = 0.5;
+/// A gradient measure refines only where the in-focus PSF is sampled finely enough for pixel
+/// differences to carry it: Gaussian sigma <= this many pixels (10x: 0.87, 20x: 1.16, 50x: 2.2).
+inline constexpr double kGradientMaxPsfSigmaPx = 1.5;
+/// The fine metric autofocus_params_for() picks: Tenengrad when the PSF's sigma is at most
+/// kGradientMaxPsfSigmaPx pixels, else the normalised variance (tuning set, docs/benchmarks.md).
+FocusMetric default_fine_metric(const OpticsFigures& figures);
 /// The defaults for an objective, starting at `start_m` (the range widened to hold it), refined
 /// with `fine_metric`: final_step_m = kFinalStepDof (normalised variance) or kFinalStepDofGradient
 /// (Tenengrad, Brenner: narrower peaks) x its depth of field. The coarse step is the same for every
 /// objective: far from focus the measure's slope comes from the texture's coarse octaves, not
 /// from the depth of field (docs/model.md, "Autofocus").
-AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m,
-                                     FocusMetric fine_metric = FocusMetric::kTenengrad);
+AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m, FocusMetric fine_metric);
+/// The same with default_fine_metric(figures).
+AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m);
 
 class Autofocus {
  public:
