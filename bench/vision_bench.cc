@@ -10,7 +10,8 @@
 //   BM_AutofocusTuning/<variant>/<objective>   the TUNING set the parameters were chosen on
 //     (texture seeds 7, 8; the substrate and a 300 um part's top; offsets +100, -100, +63, -37,
 //     +20 um; range the true focus +- 300 um), for the chosen parameters (variant 0) and the
-//     alternatives they were chosen against;
+//     alternatives they were chosen against (kVariants: Tenengrad or the variance throughout,
+//     refinement 3, a final spacing of 1 DOF, Brenner);
 //   BM_AutofocusValidation/<set>/<objective>   VALIDATION sets, 30 cases per objective drawn
 //     from a seeded Rng, never used to choose a parameter: substrate or part (top 100-400 um,
 //     its edge anywhere in the ROI's middle 60 %), texture and noise seeds, offsets
@@ -102,8 +103,8 @@ struct Variant {
 const Variant kVariants[] = {{"chosen", "", 0.0, 5.0},
                              {"tenengrad", "tenengrad", vs::kFinalStepDofGradient, 5.0},
                              {"nv-only", "normalized-variance", vs::kFinalStepDof, 5.0},
-                             {"refine-3", "tenengrad", vs::kFinalStepDofGradient, 3.0},
-                             {"final-1dof", "tenengrad", 1.0, 5.0},
+                             {"refine-3", "", 0.0, 3.0},
+                             {"final-1dof", "", 1.0, 5.0},
                              {"brenner", "brenner", vs::kFinalStepDofGradient, 5.0}};
 
 struct FocusResult {
