@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
-#include <utility>
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
@@ -169,10 +169,12 @@ void Autofocus::start_stage(double centre, double spacing, bool budget_used) {
   centre_ = clamp_z(centre);
   spacing_ = spacing;
   n_todo_ = i_todo_ = n_stage_ = 0;
+  double previous = std::numeric_limits<double>::quiet_NaN();
   for (double z : {centre_ - spacing, centre_, centre_ + spacing}) {
     z = clamp_z(z);
-    if (n_todo_ > 0 && z == todo_[n_todo_ - 1]) continue;  // clamped onto the range's end twice
-    const FocusSample* seen = nullptr;                     // a sample of the fine metric there
+    if (z == previous) continue;  // clamped onto the range's end twice
+    previous = z;
+    const FocusSample* seen = nullptr;  // a sample of the fine metric there
     for (std::size_t i = 0; i < samples_.size(); ++i)
       if (sample_metrics_[i] == fine_metric_ && std::abs(samples_[i].z_m - z) <= 1e-3 * p_.final_step_m)
         seen = &samples_[i];

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Autofocus (issue #28, point 3; docs/model.md, "Autofocus"): a search for the focus height that
-/// maximises a focus measure F (sharpness.h), stepped by its caller one frame at a time, as a
+/// Autofocus (issue #28, point 3; docs/model.md, "Autofocus and depth from focus"): a search for the focus
+/// height that maximises a focus measure F (sharpness.h), stepped by its caller one frame at a time, as a
 /// tracker or a servo task is: the search says where to set the focus (next_focus_m()), the
 /// caller takes a frame there, measures its sharpness and hands it back (observe()).
 ///
@@ -12,9 +12,9 @@
 ///     neighbour on, until the sharpest sample has a neighbour on either side (a bracket
 ///     b - h, b, b + h with F(b) the largest) or is the range's end.
 ///  2. Refinement, with the fine metric (fine_metric; the coarse one when empty), by successive
-///     three-point fits (a coarse-to-fine parabolic interpolation,
-///     Brent, "Algorithms for Minimization without Derivatives", 1973, ch. 5, with the sample
-///     spacing set instead of chosen): the bracket's vertex is the first centre z_1; stage k
+///     three-point fits (a coarse-to-fine parabolic interpolation, Brent, "Algorithms for
+///     Minimization without Derivatives", 1973, ch. 5, with the sample spacing set instead of
+///     chosen): the bracket's vertex is the first centre z_1; stage k
 ///     samples z_k - d_k, z_k, z_k + d_k with d_k = max(h / r^k, final_step_m) (r = refinement)
 ///     and its vertex is z_{k+1}. Symmetric samples make the vertex unbiased whatever the
 ///     peak's exact shape (the model's F is even in z - z*). When the sharpest of the three is an
@@ -54,7 +54,8 @@ struct AutofocusParams {
   double final_step_m = 4.5e-6;  ///< the last stage's spacing (half the 10x objective's depth of field)
   int max_frames = 15;           ///< frame budget (the search ends when it is used)
   /// The coarse scan's focus measure: the normalised variance keeps a slope far from focus (its
-  /// coarse texture octaves), where gradient measures are flat (docs/model.md, "Autofocus").
+  /// coarse texture octaves), where gradient measures are flat (docs/model.md, "Autofocus and depth from
+  /// focus").
   std::string metric = "normalized-variance";
   /// The refinement's ("" = metric): a gradient measure's peak is narrower and, on edges, the
   /// one at the surface's height (the variance of a step hardly changes with focus).
@@ -93,7 +94,7 @@ FocusMetric default_fine_metric(const OpticsFigures& figures);
 /// with `fine_metric`: final_step_m = kFinalStepDof (normalised variance) or kFinalStepDofGradient
 /// (Tenengrad, Brenner: narrower peaks) x its depth of field. The coarse step is the same for every
 /// objective: far from focus the measure's slope comes from the texture's coarse octaves, not
-/// from the depth of field (docs/model.md, "Autofocus").
+/// from the depth of field (docs/model.md, "Autofocus and depth from focus").
 AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m, FocusMetric fine_metric);
 /// The same with default_fine_metric(figures).
 AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m);

@@ -22,12 +22,12 @@ namespace {
 // Weighted least-squares parabola y = c0 + c1 u + c2 u^2 (u = z - z0) by its 3 x 3 normal
 // equations (Cramer's rule); returns false when they are singular or the parabola opens the
 // wrong way (no maximum of F).
-bool fit_vertex(std::span<const FocusSample> samples, double z0, double lo, double hi, double f_min,
-                PeakModel model, double& vertex, int& count) {
+bool fit_vertex(std::span<const FocusSample> samples, double z0, double lo, double hi, PeakModel model,
+                double& vertex, int& count) {
   double s[5] = {0, 0, 0, 0, 0}, t[3] = {0, 0, 0};
   count = 0;
   for (const FocusSample& x : samples) {
-    if (x.z_m < lo || x.z_m > hi || x.sharpness < f_min || x.sharpness <= 0.0) continue;
+    if (x.z_m < lo || x.z_m > hi || x.sharpness <= 0.0) continue;
     const double f = x.sharpness;
     const double y = model == PeakModel::kLorentzian ? 1.0 / f : std::log(f);
     const double w = model == PeakModel::kLorentzian ? f * f * f * f : f * f;
@@ -112,7 +112,7 @@ FocusPeak focus_peak(std::span<const FocusSample> samples, const FocusPeakParams
   }
   double z = b.z_m;
   int count = 0;
-  if (!fit_vertex(samples, b.z_m, z_lo, z_hi, 0.0, params.model, z, count)) {
+  if (!fit_vertex(samples, b.z_m, z_lo, z_hi, params.model, z, count)) {
     // The three around the peak always bracket it.
     const auto y = [&](double f) {
       return params.model == PeakModel::kLorentzian ? -1.0 / std::max(f, 1e-300)

@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// Depth from focus (issue #28, point 3; docs/model.md, "Autofocus"): the height of the plane of
-/// best focus of a region, from the focus measures of frames taken at known focus heights (a
-/// sweep, or an Autofocus search's observations). With the focus set on it, a surface's image is
-/// sharpest, so the height of the sharpness peak is the surface's height: the top of a part, the
-/// tips of the gripper (Nayar & Nakagawa, "Shape from focus", IEEE PAMI 16:824, 1994).
+/// Depth from focus (issue #28, point 3; docs/model.md, "Autofocus and depth from focus"): the height of the
+/// plane of best focus of a region, from the focus measures of frames taken at known focus heights (a sweep,
+/// or an Autofocus search's observations). With the focus set on it, a surface's image is sharpest, so the
+/// height of the sharpness peak is the surface's height: the top of a part, the tips of the gripper (Nayar &
+/// Nakagawa, "Shape from focus", IEEE PAMI 16:824, 1994).
 ///
 /// The peak: a least-squares parabola y(z) = c0 + c1 z + c2 z^2 through the samples around the
 /// sharpest one (those whose measure is at least `peak_fraction` of the largest, and at least its
