@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -19,6 +20,8 @@ namespace mc::vision {
 namespace {
 
 using testing::FocusCamera;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Runs the search on `cam`, each frame measured with the metric the search asks for.
 Autofocus run(FocusCamera& cam, const AutofocusParams& p, const Roi& roi = testing::kFocusRoi) {
@@ -152,17 +155,17 @@ void expect_invalid(const std::function<void(AutofocusParams&)>& edit, const std
 }
 
 TEST(Autofocus, InvalidParamsNameTheField) {
-  expect_invalid([](AutofocusParams& p) { p.coarse_step_m = NAN; }, "coarse_step_m");
+  expect_invalid([](AutofocusParams& p) { p.coarse_step_m = kNaN; }, "coarse_step_m");
   expect_invalid([](AutofocusParams& p) { p.coarse_step_m = -1e-6; }, "coarse_step_m");
-  expect_invalid([](AutofocusParams& p) { p.final_step_m = NAN; }, "final_step_m");
+  expect_invalid([](AutofocusParams& p) { p.final_step_m = kNaN; }, "final_step_m");
   expect_invalid([](AutofocusParams& p) { p.final_step_m = 1e-3; }, "final_step_m");
   expect_invalid([](AutofocusParams& p) { p.refinement = 0.5; }, "refinement");
-  expect_invalid([](AutofocusParams& p) { p.range_min_m = NAN; }, "range_min_m");
+  expect_invalid([](AutofocusParams& p) { p.range_min_m = kNaN; }, "range_min_m");
   expect_invalid([](AutofocusParams& p) { p.range_max_m = p.range_min_m; }, "range_max_m");
   expect_invalid([](AutofocusParams& p) { p.start_m = 1.0; }, "start_m");
-  expect_invalid([](AutofocusParams& p) { p.start_m = NAN; }, "start_m");
+  expect_invalid([](AutofocusParams& p) { p.start_m = kNaN; }, "start_m");
   expect_invalid([](AutofocusParams& p) { p.max_frames = -1; }, "max_frames");
-  expect_invalid([](AutofocusParams& p) { p.min_contrast = NAN; }, "min_contrast");
+  expect_invalid([](AutofocusParams& p) { p.min_contrast = kNaN; }, "min_contrast");
   expect_invalid([](AutofocusParams& p) { p.metric = "sharpest"; }, "metric");
   expect_invalid([](AutofocusParams& p) { p.fine_metric = "sharpest"; }, "fine_metric");
   expect_invalid([](AutofocusParams& p) { p.peak_model = "cauchy"; }, "peak_model");
@@ -170,7 +173,7 @@ TEST(Autofocus, InvalidParamsNameTheField) {
 
 TEST(Autofocus, BadMeasuresAndObservingAfterTheEndAreErrors) {
   Autofocus af{AutofocusParams{}};
-  EXPECT_THROW(af.observe(NAN), InvalidInput);
+  EXPECT_THROW(af.observe(kNaN), InvalidInput);
   EXPECT_THROW(af.observe(-1.0), InvalidInput);
   EXPECT_EQ(af.frames_used(), 0);
   AutofocusParams p;

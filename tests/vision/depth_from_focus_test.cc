@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,9 @@ namespace mc::vision {
 namespace {
 
 using testing::FocusCamera;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Unevenly spaced samples of the curve each model is exact for: the vertex comes back exactly.
 TEST(DepthFromFocus, EachModelIsExactOnItsCurve) {
@@ -64,7 +68,7 @@ TEST(DepthFromFocus, NoPeakIsReportedNotInvented) {
 }
 
 TEST(DepthFromFocus, BadSamplesAreOneLineErrors) {
-  for (const FocusSample bad : {FocusSample{NAN, 1.0}, FocusSample{0.0, -1.0}, FocusSample{0.0, INFINITY}}) {
+  for (const FocusSample bad : {FocusSample{kNaN, 1.0}, FocusSample{0.0, -1.0}, FocusSample{0.0, kInf}}) {
     const std::vector<FocusSample> s = {{-1e-6, 1.0}, bad, {1e-6, 1.0}};
     try {
       focus_peak(s);
