@@ -13,6 +13,7 @@
 
 #include "focus_scenes.h"
 #include "microcobot/core/error.h"
+#include "microcobot/vision/autofocus.h"
 
 namespace mc::vision {
 namespace {
@@ -107,6 +108,23 @@ TEST(DepthFromFocus, HeightOfAPartsTopFromASweep) {
                 z_top * 1e6, z * 1e6, (z - z_top) * 1e6, goal_tolerance(cam.figures()) * 1e6);
     EXPECT_NEAR(z, z_top, goal_tolerance(cam.figures()));
   }
+}
+
+// The search's own observations (those of its fine measure) are a sweep too.
+TEST(DepthFromFocus, HeightOfAPartsTopFromAnAutofocusSearch) {
+  const double z_top = 205e-6;
+  FocusCamera cam("10x", testing::part_scene(9, z_top), 33);
+  Autofocus af(autofocus_params_for(cam.figures(), z_top - 80e-6));
+  while (!af.done()) af.observe(cam.measure(af.next_focus_m(), af.next_metric()));
+  ASSERT_TRUE(af.converged()) << af.status();
+  std::vector<FocusSample> fine;
+  for (std::size_t i = 0; i < af.observations().size(); ++i)
+    if (af.observation_metrics()[i] == FocusMetric::kTenengrad) fine.push_back(af.observations()[i]);
+  const FocusPeak peak = focus_peak(fine);
+  ASSERT_TRUE(peak.found) << peak.reason;
+  std::printf("part top at %.1f um from the search's %zu Tenengrad frames: %.3f um (search: %.3f um)\n",
+              z_top * 1e6, fine.size(), peak.z_m * 1e6, af.best_focus_m() * 1e6);
+  EXPECT_NEAR(peak.z_m, z_top, goal_tolerance(cam.figures()));
 }
 
 TEST(DepthFromFocus, HeightOfTheGrippersTips) {

@@ -50,8 +50,9 @@ struct FocusPeak {
   const char* reason = "";  ///< why no peak was found ("" when found)
 };
 
-/// The plane of best focus from `samples` (any order; allocation-free). Throws InvalidInput for
-/// a non-finite height or a negative or non-finite measure.
+/// The plane of best focus from `samples` (any order; allocation-free), all of one focus measure
+/// (of an Autofocus's observations, those whose observation_metrics() is its fine metric). Throws
+/// InvalidInput for a non-finite height or a negative or non-finite measure.
 FocusPeak focus_peak(std::span<const FocusSample> samples, const FocusPeakParams& params = {});
 
 /// The vertex of the parabola through (z_i, y_i), i = a, b, c (distinct heights); the middle
