@@ -1,0 +1,189 @@
+// Autofocus (issue #28, point 3): the goal (from 100 um out of focus, within 15 frames, the focus
+// error under a fifth of the depth of field and 0.3 um at 10x) on rendered frames with the
+// sensor's noise; a textureless region, the peak at the range's end or beyond it, dim (noisier)
+// frames; the parameters' and the inputs' validation.
+
+#include "microcobot/vision/autofocus.h"
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "focus_scenes.h"
+#include "microcobot/core/error.h"
+
+namespace mc::vision {
+namespace {
+
+using testing::FocusCamera;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Runs the search on `cam`, each frame measured with the metric the search asks for.
+Autofocus run(FocusCamera& cam, const AutofocusParams& p, const Roi& roi = testing::kFocusRoi) {
+  Autofocus af(p);
+  while (!af.done()) af.observe(cam.measure(af.next_focus_m(), af.next_metric(), roi));
+  return af;
+}
+
+double goal_tolerance(const OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
+
+void expect_goal(FocusCamera& cam, double z_true, double offset, const char* what) {
+  const AutofocusParams p = autofocus_params_for(cam.figures(), z_true + offset);
+  const Autofocus af = run(cam, p);
+  const double err = af.best_focus_m() - z_true;
+  std::printf("%s from %+.0f um: error %+.3f um (%.4f DOF), %d frames, %s\n", what, offset * 1e6, err * 1e6,
+              err / cam.figures().dof_m, af.frames_used(), af.status());
+  EXPECT_TRUE(af.converged()) << what << ": " << af.status();
+  EXPECT_LE(af.frames_used(), 15) << what;
+  EXPECT_LE(std::abs(err), goal_tolerance(cam.figures())) << what << " from " << offset * 1e6 << " um";
+}
+
+TEST(Autofocus, MeetsTheGoalOnATexturedSubstrateAt10x) {
+  for (const double offset : {100e-6, -100e-6}) {
+    FocusCamera cam("10x", testing::substrate_scene(11), 41);
+    expect_goal(cam, 0.0, offset, "10x substrate");
+  }
+}
+
+TEST(Autofocus, MeetsTheGoalOnAPartsTopAt10x) {
+  const double z_top = 240e-6;
+  for (const double offset : {100e-6, -100e-6}) {
+    FocusCamera cam("10x", testing::part_scene(12, z_top), 42);
+    expect_goal(cam, z_top, offset, "10x part top");
+  }
+}
+
+// The other objectives, held to a fifth of their depth of field.
+TEST(Autofocus, FindsTheSubstrateWithEveryObjective) {
+  for (const char* objective : {"5x", "20x", "50x"}) {
+    FocusCamera cam(objective, testing::substrate_scene(13), 43);
+    const Autofocus af = run(cam, autofocus_params_for(cam.figures(), -100e-6));
+    const double dof = cam.figures().dof_m;
+    std::printf("%s substrate from -100 um: error %+.3f um (%.4f DOF), %d frames\n", objective,
+                af.best_focus_m() * 1e6, af.best_focus_m() / dof, af.frames_used());
+    EXPECT_TRUE(af.converged()) << objective << ": " << af.status();
+    EXPECT_LE(af.frames_used(), 15) << objective;
+    EXPECT_LE(std::abs(af.best_focus_m()), 0.2 * dof) << objective;
+  }
+}
+
+// A tenth of the light (exposure 1 ms, gain 10: the same grey levels, sqrt(10) times the shot
+// noise relative to the signal).
+TEST(Autofocus, DimNoisyFramesStillWithinAFifthOfTheDepthOfField) {
+  FocusCamera cam("10x", testing::substrate_scene(14), 44);
+  cam.controls().exposure_s = 1e-3;
+  cam.controls().gain = 10.0;
+  const Autofocus af = run(cam, autofocus_params_for(cam.figures(), 100e-6));
+  std::printf("10x dim frames: error %+.3f um, %d frames\n", af.best_focus_m() * 1e6, af.frames_used());
+  EXPECT_TRUE(af.converged()) << af.status();
+  EXPECT_LE(std::abs(af.best_focus_m()), 0.2 * cam.figures().dof_m);
+}
+
+// No texture: the measures differ by the noise only. The search says so and leaves the focus
+// where it was, instead of returning the noisiest frame's height.
+TEST(Autofocus, AFlatTexturelessRegionIsNotConverged) {
+  SceneSnapshot s;
+  s.substrate.texture_contrast = 0.0;
+  FocusCamera cam("10x", s, 45);
+  AutofocusParams p = autofocus_params_for(cam.figures(), 37e-6);
+  const Autofocus af = run(cam, p);
+  EXPECT_FALSE(af.converged());
+  EXPECT_DOUBLE_EQ(af.best_focus_m(), 37e-6);
+  EXPECT_LE(af.frames_used(), p.max_frames);
+  EXPECT_NE(std::string(af.status()).find("flat"), std::string::npos) << af.status();
+}
+
+TEST(Autofocus, APeakAtTheRangesEnd) {
+  FocusCamera cam("10x", testing::substrate_scene(15), 46);
+  AutofocusParams p = autofocus_params_for(cam.figures(), -90e-6);
+  p.range_min_m = -250e-6;
+  p.range_max_m = 0.0;  // the substrate's height
+  const Autofocus af = run(cam, p);
+  std::printf("peak at the range's end: error %+.3f um, %d frames, %s\n", af.best_focus_m() * 1e6,
+              af.frames_used(), af.status());
+  EXPECT_TRUE(af.converged()) << af.status();
+  EXPECT_LE(std::abs(af.best_focus_m()), 0.2 * cam.figures().dof_m);
+  EXPECT_LE(af.best_focus_m(), 0.0);
+}
+
+TEST(Autofocus, APeakBeyondTheRangeIsNotConverged) {
+  FocusCamera cam("10x", testing::substrate_scene(16), 47);
+  AutofocusParams p = autofocus_params_for(cam.figures(), -150e-6);
+  p.range_min_m = -300e-6;
+  p.range_max_m = -40e-6;  // the substrate 40 um above the highest focus
+  const Autofocus af = run(cam, p);
+  std::printf("peak beyond the range: best %+.3f um, %d frames, %s\n", af.best_focus_m() * 1e6,
+              af.frames_used(), af.status());
+  EXPECT_FALSE(af.converged()) << af.status();
+  EXPECT_DOUBLE_EQ(af.best_focus_m(), -40e-6);  // the end the measure rises to
+}
+
+// The search itself, on an exact curve: a Lorentzian peak 1 / (1 + (z / w)^2) plus a floor.
+TEST(Autofocus, FindsAnExactLorentzianPeakAnywhereInTheRange) {
+  for (const double z0 : {-213e-6, -31e-6, 0.0, 77.7e-6, 260e-6}) {
+    AutofocusParams p;
+    p.fine_metric = "normalized-variance";
+    p.final_step_m = 5e-6;
+    Autofocus af(p);
+    while (!af.done()) {
+      const double u = (af.next_focus_m() - z0) / 10e-6;
+      af.observe(0.5 + 100.0 / (1.0 + u * u));
+    }
+    EXPECT_TRUE(af.converged()) << z0 << ": " << af.status();
+    EXPECT_NEAR(af.best_focus_m(), z0, 0.05e-6)
+        << "peak at " << z0 * 1e6 << " um, " << af.frames_used() << " frames";
+  }
+}
+
+void expect_invalid(const std::function<void(AutofocusParams&)>& edit, const std::string& field) {
+  AutofocusParams p;
+  edit(p);
+  try {
+    Autofocus af(p);
+    FAIL() << "no error for " << field;
+  } catch (const InvalidParams& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.field(), field) << what;
+    EXPECT_NE(what.find(field), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST(Autofocus, InvalidParamsNameTheField) {
+  expect_invalid([](AutofocusParams& p) { p.coarse_step_m = kNaN; }, "coarse_step_m");
+  expect_invalid([](AutofocusParams& p) { p.coarse_step_m = -1e-6; }, "coarse_step_m");
+  expect_invalid([](AutofocusParams& p) { p.final_step_m = kNaN; }, "final_step_m");
+  expect_invalid([](AutofocusParams& p) { p.final_step_m = 1e-3; }, "final_step_m");
+  expect_invalid([](AutofocusParams& p) { p.refinement = 0.5; }, "refinement");
+  expect_invalid([](AutofocusParams& p) { p.range_min_m = kNaN; }, "range_min_m");
+  expect_invalid([](AutofocusParams& p) { p.range_max_m = p.range_min_m; }, "range_max_m");
+  expect_invalid([](AutofocusParams& p) { p.start_m = 1.0; }, "start_m");
+  expect_invalid([](AutofocusParams& p) { p.start_m = kNaN; }, "start_m");
+  expect_invalid([](AutofocusParams& p) { p.max_frames = -1; }, "max_frames");
+  expect_invalid([](AutofocusParams& p) { p.min_contrast = kNaN; }, "min_contrast");
+  expect_invalid([](AutofocusParams& p) { p.metric = "sharpest"; }, "metric");
+  expect_invalid([](AutofocusParams& p) { p.fine_metric = "sharpest"; }, "fine_metric");
+  expect_invalid([](AutofocusParams& p) { p.peak_model = "cauchy"; }, "peak_model");
+}
+
+TEST(Autofocus, BadMeasuresAndObservingAfterTheEndAreErrors) {
+  Autofocus af{AutofocusParams{}};
+  EXPECT_THROW(af.observe(kNaN), InvalidInput);
+  EXPECT_THROW(af.observe(-1.0), InvalidInput);
+  EXPECT_EQ(af.frames_used(), 0);
+  AutofocusParams p;
+  p.max_frames = 3;
+  Autofocus small(p);
+  while (!small.done()) small.observe(1.0);
+  EXPECT_EQ(small.frames_used(), 3);
+  EXPECT_FALSE(small.converged());
+  EXPECT_THROW(small.observe(1.0), InvalidInput);
+}
+
+}  // namespace
+}  // namespace mc::vision
