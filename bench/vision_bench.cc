@@ -82,7 +82,7 @@ namespace {
 // ---- Autofocus -------------------------------------------------------------------------------
 
 const char* kFocusObjectives[] = {"5x", "10x", "20x", "50x"};
-constexpr vs::Roi kFocusRoi{64, 64, 256, 192};
+constexpr vs::PixelRoi kFocusRoi{64, 64, 256, 192};
 
 struct FocusCase {
   bool part = false;
@@ -239,7 +239,7 @@ void BM_FocusMetric(benchmark::State& state) {
   vs::Frame frame;
   r.render(s, r.default_controls(), 1, 0, frame);
   const auto metric = static_cast<vs::FocusMetric>(state.range(0));
-  const vs::Roi roi = vs::full_roi(frame);
+  const vs::PixelRoi roi = vs::full_roi(frame);
   for (auto _ : state) benchmark::DoNotOptimize(vs::sharpness(frame, roi, metric));
   state.SetLabel(vs::focus_metric_name(metric));
   state.counters["Mpx_per_s"] =

@@ -24,7 +24,7 @@ using testing::FocusCamera;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Runs the search on `cam`, each frame measured with the metric the search asks for.
-Autofocus run(FocusCamera& cam, const AutofocusParams& p, const Roi& roi = testing::kFocusRoi) {
+Autofocus run(FocusCamera& cam, const AutofocusParams& p, const PixelRoi& roi = testing::kFocusRoi) {
   Autofocus af(p);
   while (!af.done()) af.observe(cam.measure(af.next_focus_m(), af.next_metric(), roi));
   return af;

@@ -84,7 +84,7 @@ TEST(DepthFromFocus, BadSamplesAreOneLineErrors) {
 
 // A sweep of `n` frames at `step` around `z_guess` (the height a part is expected at, off by
 // `guess_error`), measured with Tenengrad: the estimate against the true height.
-double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, const Roi& roi) {
+double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, const PixelRoi& roi) {
   std::vector<FocusSample> sweep;
   for (int k = -n / 2; k <= n / 2; ++k) {
     const double z = z_guess + k * step;

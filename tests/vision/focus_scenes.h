@@ -19,7 +19,7 @@ inline CameraParams focus_camera(const std::string& objective) {
 }
 
 /// The central 256 x 192 pixels of the 320 x 256 frame.
-inline constexpr Roi kFocusRoi{32, 32, 256, 192};
+inline constexpr PixelRoi kFocusRoi{32, 32, 256, 192};
 
 /// The default lapped substrate (texture grain 2 um, 4 octaves), surface at z = 0.
 inline SceneSnapshot substrate_scene(std::uint64_t texture_seed) {
@@ -54,7 +54,7 @@ class FocusCamera {
     renderer_.render(scene_, controls_, seed_, index_++, frame_);
     return frame_;
   }
-  double measure(double focus_z_m, FocusMetric metric, const Roi& roi = kFocusRoi) {
+  double measure(double focus_z_m, FocusMetric metric, const PixelRoi& roi = kFocusRoi) {
     return sharpness(frame_at(focus_z_m), roi, metric);
   }
   int frames() const { return static_cast<int>(index_); }

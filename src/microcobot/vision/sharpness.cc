@@ -18,7 +18,7 @@ const struct {
               {FocusMetric::kTenengrad, "tenengrad"},
               {FocusMetric::kBrenner, "brenner"}};
 
-std::string roi_text(const Roi& r) {
+std::string roi_text(const PixelRoi& r) {
   return "ROI x=" + std::to_string(r.x) + " y=" + std::to_string(r.y) + " width=" + std::to_string(r.width) +
          " height=" + std::to_string(r.height);
 }
@@ -40,7 +40,7 @@ FocusMetric parse_focus_metric(const std::string& name) {
   throw InvalidInput("focus metric '" + excerpt(name) + "' is not one of " + known);
 }
 
-void validate_roi(const Roi& roi, int width, int height, int min_side) {
+void validate_roi(const PixelRoi& roi, int width, int height, int min_side) {
   const std::string image = " of the " + std::to_string(width) + " x " + std::to_string(height) + " image";
   if (roi.width <= 0 || roi.height <= 0)
     throw InvalidInput(roi_text(roi) + " is empty (width and height must be > 0)");
@@ -66,7 +66,7 @@ const std::uint16_t* row(const Frame& f, int i) {
 
 }  // namespace
 
-double normalized_variance(const Frame& frame, const Roi& roi) {
+double normalized_variance(const Frame& frame, const PixelRoi& roi) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height);
   // Integer sums are exact (16-bit values, < 2^32 pixels); the variance from the two-pass form.
@@ -93,7 +93,7 @@ double normalized_variance(const Frame& frame, const Roi& roi) {
   return ss / (n * mean);
 }
 
-double tenengrad(const Frame& frame, const Roi& roi, double threshold) {
+double tenengrad(const Frame& frame, const PixelRoi& roi, double threshold) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height, 3);
   double sum = 0.0;
@@ -112,7 +112,7 @@ double tenengrad(const Frame& frame, const Roi& roi, double threshold) {
   return sum / (static_cast<double>(roi.width - 2) * (roi.height - 2));
 }
 
-double brenner(const Frame& frame, const Roi& roi) {
+double brenner(const Frame& frame, const PixelRoi& roi) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height, 3);
   double sum = 0.0;
@@ -137,7 +137,7 @@ void SharpnessParams::validate() const {
           "must be finite and >= 0", tenengrad_threshold);
 }
 
-double sharpness(const Frame& frame, const Roi& roi, FocusMetric metric, double tenengrad_threshold) {
+double sharpness(const Frame& frame, const PixelRoi& roi, FocusMetric metric, double tenengrad_threshold) {
   switch (metric) {
     case FocusMetric::kTenengrad:
       return tenengrad(frame, roi, tenengrad_threshold);

@@ -22,6 +22,7 @@
 
 #include <string>
 
+#include "microcobot/vision/pixel_roi.h"
 #include "microcobot/vision/sensor_model.h"
 
 namespace mc::vision {
@@ -33,28 +34,17 @@ const char* focus_metric_name(FocusMetric metric);
 /// Parses a metric's name; throws InvalidInput listing the known names.
 FocusMetric parse_focus_metric(const std::string& name);
 
-/// A rectangle of pixels: columns [x, x + width), rows [y, y + height), row 0 at the top.
-struct Roi {
-  int x = 0;
-  int y = 0;
-  int width = 0;
-  int height = 0;
-};
-
-/// The whole frame.
-inline Roi full_roi(const Frame& frame) { return Roi{0, 0, frame.width, frame.height}; }
-
 /// Throws InvalidInput (one line naming the ROI and the image's size) unless `roi` is non-empty,
 /// at least `min_side` pixels on each side and lies inside a `width` x `height` image.
-void validate_roi(const Roi& roi, int width, int height, int min_side = 1);
+void validate_roi(const PixelRoi& roi, int width, int height, int min_side = 1);
 
 /// Normalised variance of the region (see above); 0 for a black region.
-double normalized_variance(const Frame& frame, const Roi& roi);
+double normalized_variance(const Frame& frame, const PixelRoi& roi);
 /// Tenengrad with the threshold `threshold` on the squared Sobel magnitude [DN^2]; needs a region
 /// of at least 3 x 3 pixels.
-double tenengrad(const Frame& frame, const Roi& roi, double threshold = 0.0);
+double tenengrad(const Frame& frame, const PixelRoi& roi, double threshold = 0.0);
 /// Brenner gradient; needs a region at least 3 pixels wide.
-double brenner(const Frame& frame, const Roi& roi);
+double brenner(const Frame& frame, const PixelRoi& roi);
 
 /// The options of a focus measure evaluated by name.
 struct SharpnessParams {
@@ -70,6 +60,7 @@ struct SharpnessParams {
 };
 
 /// The measure `metric` of `roi` in `frame` (validates the region).
-double sharpness(const Frame& frame, const Roi& roi, FocusMetric metric, double tenengrad_threshold = 0.0);
+double sharpness(const Frame& frame, const PixelRoi& roi, FocusMetric metric,
+                 double tenengrad_threshold = 0.0);
 
 }  // namespace mc::vision

@@ -24,17 +24,10 @@
 
 #include <memory>
 
+#include "microcobot/vision/pixel_roi.h"
 #include "microcobot/vision/sensor_model.h"
 
 namespace mc::vision {
-
-/// A rectangle of pixels: columns [x, x + width), rows [y, y + height).
-struct PixelRoi {
-  int x = 0;
-  int y = 0;
-  int width = 0;
-  int height = 0;
-};
 
 struct TrackerParams {
   /// Pixels searched beyond the template on each side around the predicted position [px].
