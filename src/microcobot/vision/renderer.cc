@@ -12,8 +12,9 @@ namespace {
 constexpr int kMargin = 32;  // substrate texture beyond the image (px), for its blur
 // An inclined finger: heights along its length, in segments doubling in length from the tip, so
 // that the tip (what the microscope focuses on) is drawn at its own height: 2 mm at a rise of 0.5
-// puts the first segment within 4 um of the tip's height (under a 10x objective's depth of field).
-constexpr int kFingerSegments = 8;
+// puts the first segment within 0.13 um of the tip's height (a depth-from-focus of the tips reads
+// the first segment's mean height: with 8 segments it read 1.9 um high).
+constexpr int kFingerSegments = 12;
 constexpr double kGroupRatio = 1.15;     // layers whose blurs are within 15 % share one blur
 constexpr double kDecimateFrom = 6.0;    // sigma [px] from which a group is blurred on a coarser grid
 constexpr double kBeadDiffuse = 0.15;    // a bead's surface outside the specular cap: diffuse part

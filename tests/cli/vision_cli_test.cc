@@ -1,0 +1,77 @@
+// `microcobot vision calibrate|track|autofocus` (issue #28) as a user runs them: the goals on the
+// simulation's truth, the files under --out, and one-line errors with their exit codes.
+
+#include <filesystem>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.h"
+
+namespace mc {
+namespace {
+
+using test::run_cli;
+using ::testing::HasSubstr;
+
+TEST(VisionCli, CalibrateRecoversAMisalignedStageWithinTheGoals) {
+  test::TempDir dir;
+  const auto r =
+      run_cli({"vision", "calibrate", "--axis-angle-deg", "-1.7", "--skew-deg", "0.4", "--scale-x", "1.012",
+               "--scale-y", "0.993", "--seed", "4", "--json", "--out", dir.path().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_LT(j["residual_rms_px"].get<double>(), 0.1);
+  EXPECT_LT(std::abs(j["scale_error_x"].get<double>()), 2e-3);
+  EXPECT_LT(std::abs(j["scale_error_y"].get<double>()), 2e-3);
+  EXPECT_NEAR(j["map"]["rotation_deg"].get<double>(), -1.7, 0.02);
+  EXPECT_NEAR(j["map"]["shear_deg"].get<double>(), 0.4, 0.02);
+  EXPECT_EQ(j["points"].get<int>(), 25);
+  for (const char* f : {"calibration.json", "points.csv", "frame-home.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / f)) << f;
+}
+
+TEST(VisionCli, TrackFollowsAPartWithinTheGoal) {
+  const auto r = run_cli({"vision", "track", "--frames", "30", "--speed-um-s", "35", "--direction-deg",
+                          "-120", "--seed", "9", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["found"].get<int>(), 30);
+  EXPECT_LT(j["rms_error_px"].get<double>(), 0.05);
+}
+
+TEST(VisionCli, AutofocusFindsThePartsTopFrom100UmAway) {
+  for (const char* offset : {"100", "-100"}) {
+    const auto r = run_cli({"vision", "autofocus", "--offset-um", offset, "--seed", "3", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j["converged"].get<bool>()) << offset;
+    EXPECT_LE(j["frames"].get<int>(), 15) << offset;
+    EXPECT_LT(std::abs(j["error_m"].get<double>()), 0.3e-6) << offset << " (10x: 0.3 um and DOF/5)";
+    EXPECT_LT(std::abs(j["error_dof"].get<double>()), 0.2) << offset;
+  }
+}
+
+TEST(VisionCli, BadInputsGetOneLineAndTheirExitCode) {
+  auto r = run_cli({"vision", "track", "--objective", "7x"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--objective"));
+  r = run_cli({"vision", "calibrate", "--template-px", "1000"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_THAT(r.err, HasSubstr("--template-px 1000"));
+  r = run_cli({"vision", "calibrate", "--pitch-um", "5000"});
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_THAT(r.err, HasSubstr("lost at grid point 0"));
+  r = run_cli({"vision", "autofocus", "--metric", "sharpest"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--metric: focus metric 'sharpest'"));
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+  r = run_cli({"vision", "track", "--scene", "optical-trap"});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_THAT(r.err, HasSubstr("has no part"));
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+}
+
+}  // namespace
+}  // namespace mc
