@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "microcobot/vision/polygon_coverage.h"
 #include "microcobot/vision/substrate_texture.h"
 
 namespace mc::vision {
@@ -151,6 +152,14 @@ struct Shape {
   double cap = 0;  // sphere: fraction of the radius inside the bright cap
   double cap_radiance = 0, rim_radiance = 0;
   double vx = 0, vy = 0;
+  double angle = 0;  // a box turned counter-clockwise as seen from the top [rad]
+  // Half extents of the (turned) box's axis-aligned bounding box.
+  double ex() const {
+    return type == kBox ? std::abs(std::cos(angle)) * hx + std::abs(std::sin(angle)) * hy : hx;
+  }
+  double ey() const {
+    return type == kBox ? std::abs(std::sin(angle)) * hx + std::abs(std::cos(angle)) * hy : hy;
+  }
 };
 
 Shape bead_shape(const Bead& b, bool transmitted, double cap) {
@@ -183,6 +192,7 @@ Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment
       s.x = p.x_m, s.y = p.y_m, s.hx = 0.5 * p.size_x_m, s.hy = p.disc ? s.hx : 0.5 * p.size_y_m;
       s.radiance = s.edge_radiance = transmitted ? 0.0 : p.reflectance;
       s.vx = p.vx_m_s, s.vy = p.vy_m_s;
+      s.angle = p.disc ? 0.0 : p.angle_rad;
       break;
     }
     case Kind::kBead:
@@ -273,10 +283,10 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
   for (std::size_t l = begin; l < end; ++l) {
     const Shape s = shape_of(scene, layers[l].kind, layers[l].index, layers[l].segment, transmitted, cap);
     const double mx = std::abs(s.vx) * exposure_s * 0.5, my = std::abs(s.vy) * exposure_s * 0.5;
-    u_lo = std::min(u_lo, u_of_x(s.x - s.hx - mx));
-    u_hi = std::max(u_hi, u_of_x(s.x + s.hx + mx));
-    v_lo = std::min(v_lo, v_of_y(s.y + s.hy + my));
-    v_hi = std::max(v_hi, v_of_y(s.y - s.hy - my));
+    u_lo = std::min(u_lo, u_of_x(s.x - s.ex() - mx));
+    u_hi = std::max(u_hi, u_of_x(s.x + s.ex() + mx));
+    v_lo = std::min(v_lo, v_of_y(s.y + s.ey() + my));
+    v_hi = std::max(v_hi, v_of_y(s.y - s.ey() - my));
   }
   const int bx0 = std::max(static_cast<int>(std::floor(u_lo - pad)), -static_cast<int>(pad));
   const int bx1 = std::min(static_cast<int>(std::ceil(u_hi + pad)), width_ - 1 + static_cast<int>(pad));
@@ -299,7 +309,7 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
     const int samples =
         std::clamp(static_cast<int>(std::ceil(std::hypot(du, dv) / f)) + 1, 1, kMaxMotionSamples);
     // The object's cells (all samples).
-    const double hu = s.hx / pixel_m_, hv = s.hy / pixel_m_;
+    const double hu = s.ex() / pixel_m_, hv = s.ey() / pixel_m_;
     const double uc0 = u_of_x(s.x), vc0 = v_of_y(s.y);
     const int cx0 = std::max(0, static_cast<int>(std::floor((uc0 - hu - 0.5 * std::abs(du) - gx0) / f)) - 1);
     const int cx1 =
@@ -321,7 +331,14 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
       for (int cy = cy0; cy <= cy1; ++cy) {
         for (int cx = cx0; cx <= cx1; ++cx) {
           double a = 0.0, p = 0.0;
-          if (s.type == Shape::kBox) {
+          if (s.type == Shape::kBox && s.angle != 0.0) {
+            // Turned: the exact area of the polygon in the cell. Rows go down, so the
+            // counter-clockwise turn seen from the top is clockwise in the cells' frame.
+            const RotatedRect r{
+                cu, cv, s.hx / pixel_m_ / f, s.hy / pixel_m_ / f, std::cos(s.angle), -std::sin(s.angle)};
+            a = cell_coverage(r, cx, cy);
+            p = a * s.radiance;
+          } else if (s.type == Shape::kBox) {
             const double ox = overlap(cx, cx + 1.0, cu - ax, cu + ax);
             const double oy = overlap(cy, cy + 1.0, cv - ay, cv + ay);
             a = ox * oy;

@@ -28,6 +28,7 @@ struct Part {
   bool disc = false;
   double reflectance = 0.8;           ///< top face (brass); in transmitted light parts are opaque
   double vx_m_s = 0.0, vy_m_s = 0.0;  ///< velocity during the exposure (motion blur)
+  double angle_rad = 0.0;             ///< a box turned about its centre, counter-clockwise seen from the top
 };
 
 /// A hole (a bore into the substrate): dark, its rim at the substrate's surface.

@@ -59,6 +59,7 @@ struct TemplateTracker::Images {
   cv::Mat templ;             // float
   cv::Mat templ_smooth;      // low-passed with its surroundings, for ECC
   cv::Mat templ_half;        // 2x-decimated, for the whole-frame search
+  cv::Mat templ_turned;      // turned by the last angle, for the coarse search (scratch)
   cv::Mat window, response;  // scratch
   double templ_stddev = 0.0;
   int frame_width = 0, frame_height = 0;
@@ -129,9 +130,20 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, doubl
   // 1. Coarse: the integer-pixel top-left corner of the best match.
   cv::Point corner;
   double peak = -1.0;
+  // A turned target is searched with the template turned by its last angle (a template matched
+  // unturned slid 2 px off the corner of a part turned 3.6 degrees).
+  const double turn = params_.rotation ? last_.angle_rad : 0.0;
+  const cv::Mat* coarse_templ = &im.templ;
+  if (turn != 0.0) {
+    // Image axes (rows down): the turn seen counter-clockwise is cv's positive angle.
+    const cv::Mat m = cv::getRotationMatrix2D(cv::Point2f(static_cast<float>(cx), static_cast<float>(cy)),
+                                              turn * 180.0 / M_PI, 1.0);
+    cv::warpAffine(im.templ, im.templ_turned, m, im.templ.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    coarse_templ = &im.templ_turned;
+  }
   const auto search = [&](const cv::Rect& area) {
     full(area).convertTo(im.window, CV_32F);
-    cv::matchTemplate(im.window, im.templ, im.response, cv::TM_CCOEFF_NORMED);
+    cv::matchTemplate(im.window, *coarse_templ, im.response, cv::TM_CCOEFF_NORMED);
     cv::Point at;
     cv::minMaxLoc(im.response, nullptr, &peak, nullptr, &at);
     corner = area.tl() + at;
@@ -180,12 +192,15 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, doubl
     return e;
   }
 
-  // 2. Fine: ECC from the coarse match, on a window a few pixels larger than the template.
+  // 2. Fine: ECC from the coarse match, on a window a few pixels larger than the template (and
+  // than its turned corners).
+  const int fine_margin =
+      kFineMargin + static_cast<int>(std::ceil(0.5 * std::hypot(tw, th) * std::abs(std::sin(turn))));
   const cv::Rect fine_area =
-      cv::Rect(corner.x - kFineMargin, corner.y - kFineMargin, tw + 2 * kFineMargin, th + 2 * kFineMargin) &
+      cv::Rect(corner.x - fine_margin, corner.y - fine_margin, tw + 2 * fine_margin, th + 2 * fine_margin) &
       bounds;
   blurred(full, fine_area, params_.ecc_blur_px, im.response, im.window);
-  const double a0 = params_.rotation ? -last_.angle_rad : 0.0;  // image axes: rows go down
+  const double a0 = -turn;  // image axes: rows go down
   cv::Mat warp = (cv::Mat_<float>(2, 3) << std::cos(a0), -std::sin(a0), corner.x - fine_area.x, std::sin(a0),
                   std::cos(a0), corner.y - fine_area.y);
   // Rotation about the template's centre: shift the translation so the centre stays put.
