@@ -1,12 +1,18 @@
 // microcobot.vision: the microscope camera (issue #27): render() a frame of a scene as an H x W
-// numpy array (uint8 for 8-bit frames, else uint16), camera_model() the optics figures. The same
-// library calls as `microcobot vision render|model` (vision/, platform/camera_scene).
+// numpy array (uint8 for 8-bit frames, else uint16), camera_model() the optics figures; and what
+// the frames measure (issue #28): TemplateTracker, Autofocus and sharpness() steppable from a
+// Python loop on those arrays, fit_affine() for the pixel <-> stage calibration. The same library
+// calls as `microcobot vision ...` (vision/, platform/camera_scene).
 
 #include <optional>
 
 #include "common.h"
 #include "microcobot/platform/camera_scene.h"
+#include "microcobot/vision/affine_calibration.h"
+#include "microcobot/vision/autofocus.h"
 #include "microcobot/vision/renderer.h"
+#include "microcobot/vision/sharpness.h"
+#include "microcobot/vision/template_tracker.h"
 
 namespace mc::py {
 namespace {
@@ -74,6 +80,94 @@ py::array render(const std::string& scene, const std::string& objective, double 
   return out;
 }
 
+// A frame from a caller's 2-D uint8 or uint16 array (copied: the tracker keeps no reference).
+vision::Frame frame_of(const py::array& a) {
+  const bool u8 = py::isinstance<py::array_t<std::uint8_t>>(a),
+             u16 = py::isinstance<py::array_t<std::uint16_t>>(a);
+  if (a.ndim() != 2 || (!u8 && !u16))
+    throw InvalidInput("frame: a 2-D uint8 or uint16 array is needed (got " + std::to_string(a.ndim()) +
+                       "-D of dtype " + std::string(py::str(a.dtype())) + ")");
+  vision::Frame f;
+  f.height = static_cast<int>(a.shape(0));
+  f.width = static_cast<int>(a.shape(1));
+  f.bit_depth = u8 ? 8 : 16;
+  f.pixels.resize(static_cast<std::size_t>(f.width) * static_cast<std::size_t>(f.height));
+  if (u8) {
+    const auto v = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    std::copy(v.data(), v.data() + f.pixels.size(), f.pixels.begin());
+  } else {
+    const auto v = py::array_t<std::uint16_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    std::copy(v.data(), v.data() + f.pixels.size(), f.pixels.begin());
+  }
+  return f;
+}
+
+vision::PixelRoi roi_of(const std::optional<std::array<int, 4>>& roi, const vision::Frame& f) {
+  return roi ? vision::PixelRoi{(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]} : vision::full_roi(f);
+}
+
+py::dict estimate_dict(const vision::TrackEstimate& e) {
+  py::dict d;
+  d["u_px"] = e.u_px;
+  d["v_px"] = e.v_px;
+  d["angle_rad"] = e.angle_rad;
+  d["confidence"] = e.confidence;
+  d["found"] = e.found;
+  d["reacquired"] = e.reacquired;
+  return d;
+}
+
+std::vector<Eigen::Vector2d> points_of(const py::array_t<double>& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(1) != 2)
+    throw InvalidInput(std::string(name) + ": an N x 2 array is needed (got " + std::to_string(a.ndim()) +
+                       "-D)");
+  const auto v = a.unchecked<2>();
+  std::vector<Eigen::Vector2d> p;
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) p.emplace_back(v(i, 0), v(i, 1));
+  return p;
+}
+
+py::dict fit_affine_py(const py::array_t<double>& stage_m, const py::array_t<double>& pixel) {
+  const vision::AffineFit fit = vision::fit_affine(points_of(stage_m, "stage_m"), points_of(pixel, "pixel"));
+  const vision::AffineFigures f = vision::affine_figures(fit.map);
+  py::array_t<double> a({2, 2}),
+      residuals({static_cast<py::ssize_t>(fit.residuals_px.size()), py::ssize_t{2}});
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) a.mutable_at(i, j) = fit.map.A(i, j);
+  for (std::size_t k = 0; k < fit.residuals_px.size(); ++k) {
+    residuals.mutable_at(static_cast<py::ssize_t>(k), 0) = fit.residuals_px[k].x();
+    residuals.mutable_at(static_cast<py::ssize_t>(k), 1) = fit.residuals_px[k].y();
+  }
+  py::dict d;
+  d["A_px_per_m"] = a;
+  d["b_px"] = py::make_tuple(fit.map.b.x(), fit.map.b.y());
+  d["um_per_px_x"] = f.um_per_px_x;
+  d["um_per_px_y"] = f.um_per_px_y;
+  d["rotation_rad"] = f.rotation_rad;
+  d["shear_rad"] = f.shear_rad;
+  d["mirrored"] = f.mirrored;
+  d["residual_rms_px"] = fit.residual_rms_px;
+  d["residual_max_px"] = fit.residual_max_px;
+  d["residuals_px"] = residuals;
+  return d;
+}
+
+vision::Autofocus make_autofocus(const std::string& objective, double start_um,
+                                 std::optional<std::array<double, 2>> range_um,
+                                 std::optional<std::string> metric) {
+  if (!std::isfinite(start_um)) throw InvalidInput("start_um: must be finite");
+  const vision::OpticsFigures figures =
+      vision::optics_figures(vision::objective_by_name(objective), vision::SensorParams{});
+  vision::AutofocusParams p =
+      metric ? vision::autofocus_params_for(figures, start_um * 1e-6, vision::parse_focus_metric(*metric))
+             : vision::autofocus_params_for(figures, start_um * 1e-6);
+  if (range_um) {
+    p.range_min_m = (*range_um)[0] * 1e-6;
+    p.range_max_m = (*range_um)[1] * 1e-6;
+  }
+  return vision::Autofocus(p);  // validates: ValueError naming the field
+}
+
 }  // namespace
 
 void bind_vision(py::module_& m) {
@@ -87,6 +181,86 @@ void bind_vision(py::module_& m) {
       "One camera frame of a scene (pick-place, pin-in-hole, optical-trap or a YAML file) seen from the top, "
       "centred on the part: an H x W array, uint8 for 8-bit frames, else uint16. Deterministic in (seed, "
       "frame).");
+  m.def(
+      "sharpness",
+      [](const py::array& frame, std::optional<std::array<int, 4>> roi, const std::string& metric) {
+        const vision::Frame f = frame_of(frame);
+        return vision::sharpness(f, roi_of(roi, f), vision::parse_focus_metric(metric));
+      },
+      "frame"_a, "roi"_a = py::none(), "metric"_a = "normalized-variance",
+      "A focus measure of the frame (a 2-D uint8/uint16 array) over roi = (x, y, width, height) (default: "
+      "all): "
+      "normalized-variance, tenengrad or brenner.");
+  m.def(
+      "fit_affine", &fit_affine_py, "stage_m"_a, "pixel"_a,
+      "Least-squares pixel = A stage + b through N x 2 arrays of stage points [m] and tracked pixels: A, b, "
+      "um_per_px_x/_y, rotation_rad, shear_rad, mirrored, residual_rms_px/_max_px, residuals_px.");
+  py::class_<vision::TemplateTracker>(
+      m, "TemplateTracker",
+      "Sub-pixel template tracker (NCC coarse match, ECC refinement; vision/template_tracker.h). Frames are "
+      "2-D "
+      "uint8/uint16 arrays; positions in continuous pixel coordinates (a pixel's centre at its column, row).")
+      .def(py::init([](int search_margin_px, double lost_below, double min_contrast_ratio, int ecc_blur_px,
+                       bool rotation) {
+             vision::TrackerParams p;
+             p.search_margin_px = search_margin_px;
+             p.lost_below = lost_below;
+             p.min_contrast_ratio = min_contrast_ratio;
+             p.ecc_blur_px = ecc_blur_px;
+             p.rotation = rotation;
+             return vision::TemplateTracker(p);  // validates: ValueError naming the field
+           }),
+           "search_margin_px"_a = 24, "lost_below"_a = 0.5, "min_contrast_ratio"_a = 0.5, "ecc_blur_px"_a = 3,
+           "rotation"_a = false)
+      .def(
+          "set_template",
+          [](vision::TemplateTracker& t, const py::array& frame, std::array<int, 4> roi) {
+            t.set_template(frame_of(frame), vision::PixelRoi{roi[0], roi[1], roi[2], roi[3]});
+            return estimate_dict(t.last());
+          },
+          "frame"_a, "roi"_a, "Takes the template from roi = (x, y, width, height); returns its position.")
+      .def(
+          "track",
+          [](vision::TemplateTracker& t, const py::array& frame) {
+            const vision::Frame f = frame_of(frame);
+            py::gil_scoped_release release;
+            return t.track(f);
+          },
+          "frame"_a, "Where the template is: u_px, v_px, angle_rad, confidence, found, reacquired.")
+      .def(
+          "track_near",
+          [](vision::TemplateTracker& t, const py::array& frame, double u_px, double v_px) {
+            const vision::Frame f = frame_of(frame);
+            py::gil_scoped_release release;
+            return t.track_near(f, u_px, v_px);
+          },
+          "frame"_a, "u_px"_a, "v_px"_a, "The same, searched around a predicted position.");
+  py::class_<vision::TrackEstimate>(m, "TrackEstimate", "One frame's estimate of a template tracker.")
+      .def_readonly("u_px", &vision::TrackEstimate::u_px)
+      .def_readonly("v_px", &vision::TrackEstimate::v_px)
+      .def_readonly("angle_rad", &vision::TrackEstimate::angle_rad)
+      .def_readonly("confidence", &vision::TrackEstimate::confidence)
+      .def_readonly("found", &vision::TrackEstimate::found)
+      .def_readonly("reacquired", &vision::TrackEstimate::reacquired);
+  py::class_<vision::Autofocus>(m, "Autofocus",
+                                "Steppable coarse-to-fine autofocus (vision/autofocus.h): set the focus to "
+                                "next_focus_um, measure the frame with sharpness(frame, roi, next_metric), "
+                                "observe() it, until done.")
+      .def(py::init(&make_autofocus), "objective"_a = "10x", "start_um"_a = 0.0, "range_um"_a = py::none(),
+           "metric"_a = py::none())
+      .def_property_readonly("done", &vision::Autofocus::done)
+      .def_property_readonly("converged", &vision::Autofocus::converged)
+      .def_property_readonly("next_focus_um",
+                             [](const vision::Autofocus& a) { return a.next_focus_m() * 1e6; })
+      .def_property_readonly(
+          "next_metric",
+          [](const vision::Autofocus& a) { return vision::focus_metric_name(a.next_metric()); })
+      .def_property_readonly("best_focus_um",
+                             [](const vision::Autofocus& a) { return a.best_focus_m() * 1e6; })
+      .def_property_readonly("frames_used", &vision::Autofocus::frames_used)
+      .def_property_readonly("status", [](const vision::Autofocus& a) { return std::string(a.status()); })
+      .def("observe", &vision::Autofocus::observe, "sharpness"_a,
+           "The measure of the frame taken at next_focus_um with next_metric.");
 }
 
 }  // namespace mc::py

@@ -9,7 +9,7 @@ import pytest
 import microcobot
 
 PKG = pathlib.Path(microcobot.__file__).parent
-MODULES = ["stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers"]
+MODULES = ["stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision"]
 
 
 def stub_names(tree):

@@ -57,3 +57,68 @@ def test_bad_input_names_what_was_given(cli, tmp_path):
     code, _, err = cli("vision", "render", "--scene", "nowhere.yaml", "--out", tmp_path / "bad")
     assert code == 3 and "nowhere.yaml" in cli_error(err)
     assert not (tmp_path / "bad").exists()
+
+
+# ---- what the frames measure (issue #28) --------------------------------------------------------
+
+def _tool_frame(x_um, y_um, seed_frame):
+    # 10x, the focus on the gripper's tips (450 um above the substrate), the tool at (x, y).
+    return microcobot.vision.render("pick-place", "10x", focus_um=450, tool_um=(x_um, y_um, 450),
+                                    seed=3, frame=seed_frame)
+
+
+def test_tracker_follows_the_tool_by_its_commanded_move():
+    um_per_px = microcobot.vision.camera_model("10x")["um_per_px"]
+    first = _tool_frame(-200, 0, 0)
+    t = microcobot.vision.TemplateTracker()
+    # The open gripper's right finger is in this view (the part's centre): its tip's end at about
+    # column 832, row 549.
+    start = t.set_template(first, (784, 482, 96, 96))
+    assert start["found"] and start["u_px"] == pytest.approx(831.5)
+    moved = _tool_frame(-194.0, 3.0, 1)  # 6 um right, 3 um up (rows go down)
+    e = t.track(moved)
+    assert e.found and e.confidence > 0.9
+    assert e.u_px - start["u_px"] == pytest.approx(6.0 / um_per_px, abs=0.1)
+    assert e.v_px - start["v_px"] == pytest.approx(-3.0 / um_per_px, abs=0.1)
+    near = t.track_near(moved, e.u_px + 5, e.v_px - 5)
+    assert near.u_px == pytest.approx(e.u_px, abs=0.02)
+
+
+def test_autofocus_steps_from_python_to_the_tips_height():
+    af = microcobot.vision.Autofocus("10x", start_um=380.0, range_um=(-500, 2000))
+    roi = (784, 537, 96, 24)  # a strip across the right finger's tip end
+    while not af.done:
+        frame = microcobot.vision.render("pick-place", "10x", focus_um=af.next_focus_um, seed=4,
+                                         frame=af.frames_used)
+        af.observe(microcobot.vision.sharpness(frame, roi, af.next_metric))
+    assert af.converged, af.status
+    assert af.frames_used <= 15
+    dof_um = microcobot.vision.camera_model("10x")["dof_m"] * 1e6
+    assert abs(af.best_focus_um - 450.0) < dof_um / 5
+
+
+def test_fit_affine_recovers_a_known_map():
+    rng = np.random.default_rng(8)
+    a = np.array([[1.9e6, -0.08e6], [-0.07e6, -1.88e6]])
+    stage = rng.uniform(-1e-4, 1e-4, size=(20, 2))
+    pixel = stage @ a.T + np.array([640.0, 512.0]) + rng.normal(0, 0.02, size=(20, 2))
+    fit = microcobot.vision.fit_affine(stage, pixel)
+    np.testing.assert_allclose(fit["A_px_per_m"], a, rtol=2e-3)
+    assert fit["residual_rms_px"] < 0.04 and fit["residuals_px"].shape == (20, 2)
+
+
+def test_vision_measures_refuse_bad_input():
+    frame = _tool_frame(-200, 0, 0)
+    with pytest.raises(ValueError, match="2-D uint8 or uint16"):
+        microcobot.vision.sharpness(frame.astype(np.float32))
+    with pytest.raises(ValueError, match="sharpest"):
+        microcobot.vision.sharpness(frame, None, "sharpest")
+    t = microcobot.vision.TemplateTracker()
+    with pytest.raises(ValueError, match="not inside"):
+        t.set_template(frame, (1250, 10, 64, 64))
+    with pytest.raises(ValueError, match="ecc_blur_px"):
+        microcobot.vision.TemplateTracker(ecc_blur_px=4)
+    with pytest.raises(ValueError, match="line"):
+        microcobot.vision.fit_affine(np.zeros((4, 2)), np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="start_um"):
+        microcobot.vision.Autofocus("10x", start_um=float("nan"))
