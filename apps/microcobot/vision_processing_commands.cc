@@ -6,6 +6,7 @@
 #include "vision_processing_commands.h"
 
 #include <cmath>
+#include <filesystem>
 #include <optional>
 
 #include <fmt/format.h>
@@ -92,6 +93,7 @@ nlohmann::json map_json(const vs::AffineMap& m) {
 // ---- calibrate ----------------------------------------------------------------------------
 struct CalibrateOptions {
   CommonOptions common;
+  std::optional<std::filesystem::path> save;
   CameraOptions camera;
   int grid = 5;
   std::optional<double> pitch_um;
@@ -190,6 +192,18 @@ void run_calibrate(const CalibrateOptions& o) {
                         {"scale_x", o.geometry.scale_x},
                         {"scale_y", o.geometry.scale_y}}},
                       {"seed", o.camera.seed}};
+  if (o.save) {
+    // The configuration's form (platform configuration: camera.calibrations), for --config/--params.
+    const vs::StageCalibration c = vs::StageCalibration::of(cam.objective.name, fit);
+    write_file_atomic(
+        *o.save,
+        fmt::format("# microcobot vision calibrate: {} points, residual {:.4f} px rms\n"
+                    "camera:\n  calibrations:\n    - objective: {}\n"
+                    "      px_per_m: [[{:.10g}, {:.10g}], [{:.10g}, {:.10g}]]\n"
+                    "      offset_px: [{:.10g}, {:.10g}]\n      residual_rms_px: {:.6g}\n",
+                    stage.size(), fit.residual_rms_px, c.objective, c.px_per_m[0][0], c.px_per_m[0][1],
+                    c.px_per_m[1][0], c.px_per_m[1][1], c.offset_px[0], c.offset_px[1], c.residual_rms_px));
+  }
   if (o.common.out) {
     ensure_writable_dir(*o.common.out);
     write_csv(*o.common.out / "points.csv", points,
@@ -420,6 +434,9 @@ void add_vision_processing(CLI::App& group) {
     cmd->add_option("--scale-y", o->geometry.scale_y,
                     "Simulated stage: y travel per commanded metre (default 1)")
         ->check(mc::cli::Range(0.5, 2.0));
+    cmd->add_option(
+        "--save", o->save,
+        "Write the calibration as a platform configuration fragment (camera.calibrations) to FILE");
     add_output_options(*cmd, o->common);
     cmd->callback([o] { run_calibrate(*o); });
   }

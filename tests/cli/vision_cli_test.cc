@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "microcobot/platform/platform_config.h"
 #include "support/test_support.h"
 
 namespace mc {
@@ -30,6 +31,29 @@ TEST(VisionCli, CalibrateRecoversAMisalignedStageWithinTheGoals) {
   EXPECT_EQ(j["points"].get<int>(), 25);
   for (const char* f : {"calibration.json", "points.csv", "frame-home.png"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / f)) << f;
+}
+
+// The calibration saved as a configuration fragment loads into the platform's camera and maps
+// stage points to the pixels the fit found.
+TEST(VisionCli, ASavedCalibrationLoadsIntoThePlatformsCamera) {
+  test::TempDir dir;
+  const auto r = run_cli({"vision", "calibrate", "--objective", "20x", "--axis-angle-deg", "2.5", "--grid",
+                          "3", "--save", (dir / "calibration.yaml").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const platform::PlatformConfig c = platform::load_platform_config(dir / "calibration.yaml");
+  int twenty = -1;
+  for (std::size_t i = 0; i < c.camera.objectives.size(); ++i)
+    if (c.camera.objectives[i].name == "20x") twenty = static_cast<int>(i);
+  ASSERT_GE(twenty, 0);
+  const vision::StageCalibration* cal = c.camera.calibration(twenty);
+  ASSERT_NE(cal, nullptr);
+  EXPECT_EQ(c.camera.calibration((twenty + 1) % static_cast<int>(c.camera.objectives.size())), nullptr);
+  const vision::AffineMap m = cal->map();
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      EXPECT_NEAR(m.A(a, b), j["map"]["A_px_per_m"][a][b].get<double>(), 1e-6 * std::abs(m.A(0, 0)));
+  EXPECT_NEAR(vision::affine_figures(m).rotation_rad * 180.0 / M_PI, 2.5, 0.02);
 }
 
 TEST(VisionCli, TrackFollowsAPartWithinTheGoal) {

@@ -56,6 +56,13 @@ LiveParams camera_params() {
   p.platform.camera.sensor.bit_depth = 8;
   p.platform.camera.view_center_x_m = p.platform.world.part_start_m.x();
   p.platform.camera.view_center_y_m = p.platform.world.part_start_m.y();
+  // A calibration of the power-up objective: published with every frame's state.
+  vision::StageCalibration cal;
+  cal.objective = p.platform.camera.objectives.at(static_cast<std::size_t>(p.platform.camera.objective)).name;
+  cal.px_per_m = {{1.0e6, 2.0e3}, {-1.0e3, -1.0e6}};
+  cal.offset_px = {160.0, 128.0};
+  cal.residual_rms_px = 0.03;
+  p.platform.camera.calibrations = {cal};
   return p;
 }
 
@@ -103,6 +110,9 @@ TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraI
   EXPECT_EQ(infos.size(), images.size());
   ASSERT_EQ(states.size(), images.size());
   const auto first = json::parse(states.front()->data)["sequence"].get<std::uint64_t>();
+  const json calibration = json::parse(states.front()->data)["calibration"];
+  EXPECT_EQ(calibration["px_per_m"], json::parse("[[1.0e6, 2.0e3], [-1.0e3, -1.0e6]]"));
+  EXPECT_EQ(calibration["offset_px"], json::parse("[160.0, 128.0]"));
   for (std::size_t k = 0; k < states.size(); ++k) {
     const json st = json::parse(states[k]->data);
     EXPECT_EQ(st["sequence"].get<std::uint64_t>(), first + k) << "frame " << k << " missing";

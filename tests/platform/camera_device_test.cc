@@ -272,5 +272,31 @@ TEST(Camera, TheTurretsObjectivesComeFromTheConfigurationFile) {
   }
 }
 
+TEST(Camera, CalibrationsInTheConfigurationAreCheckedAndFoundByObjective) {
+  test::TempDir dir;
+  test::write_text(dir / "cal.yaml",
+                   "camera:\n  calibrations:\n"
+                   "    - {objective: 10x, px_per_m: [[1.9e6, 0], [0, -1.9e6]], offset_px: [640, 512]}\n");
+  const PlatformConfig c = load_platform_config(dir / "cal.yaml");
+  int ten = -1;
+  for (std::size_t i = 0; i < c.camera.objectives.size(); ++i)
+    if (c.camera.objectives[i].name == "10x") ten = static_cast<int>(i);
+  ASSERT_NE(c.camera.calibration(ten), nullptr);
+  EXPECT_EQ(c.camera.calibration(ten)->map().pixel_of({1e-6, 0}), Eigen::Vector2d(641.9, 512));
+  const auto refused = [&](const std::string& item, const std::string& named) {
+    test::write_text(dir / "bad.yaml", "camera:\n  calibrations:\n    - " + item + "\n");
+    try {
+      load_platform_config(dir / "bad.yaml");
+      ADD_FAILURE() << item << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
+  refused("{objective: 7x, px_per_m: [[1e6, 0], [0, 1e6]], offset_px: [0, 0]}", "calibrations[0].objective");
+  refused("{objective: 10x, px_per_m: [[1e6, 0], [0, 0]], offset_px: [0, 0]}", "calibrations[0].px_per_m");
+  refused("{objective: 10x, px_per_m: [[1e6, 0]], offset_px: [0, 0]}", "calibrations[0].px_per_m");
+  refused("{objective: 10x, px_per_m: [[1e6, 0], [0, 1e6]], offset_px: [0]}", "calibrations[0].offset_px");
+}
+
 }  // namespace
 }  // namespace mc::platform

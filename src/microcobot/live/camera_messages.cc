@@ -116,30 +116,43 @@ void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::
 std::string camera_state_schema() {
   const nlohmann::json number = {{"type", "number"}}, text = {{"type", "string"}};
   const nlohmann::json pair = {{"type", "array"}, {"items", number}, {"minItems", 2}, {"maxItems", 2}};
-  return nlohmann::json{{"type", "object"},
-                        {"properties",
-                         {{"t_s", number},
-                          {"sequence", number},
-                          {"width", number},
-                          {"height", number},
-                          {"objective", number},
-                          {"objective_name", text},
-                          {"magnification", number},
-                          {"m_per_px", number},
-                          {"view_center_m", pair},
-                          {"focus_z_m", number},
-                          {"exposure_s", number},
-                          {"gain", number},
-                          {"frame_rate_Hz", number},
-                          {"jpeg_bytes", number},
-                          {"capture_ms", number},
-                          {"encode_ms", number},
-                          {"latency_ms", number},
-                          {"dropped", number}}}}
+  return nlohmann::json{
+      {"type", "object"},
+      {"properties",
+       {{"t_s", number},
+        {"sequence", number},
+        {"width", number},
+        {"height", number},
+        {"objective", number},
+        {"objective_name", text},
+        {"magnification", number},
+        {"m_per_px", number},
+        {"view_center_m", pair},
+        {"focus_z_m", number},
+        {"exposure_s", number},
+        {"gain", number},
+        {"frame_rate_Hz", number},
+        {"jpeg_bytes", number},
+        {"capture_ms", number},
+        {"encode_ms", number},
+        {"latency_ms", number},
+        {"dropped", number},
+        {"calibration",
+         {{"type", {"object", "null"}},
+          {"properties",
+           {{"px_per_m", {{"type", "array"}, {"items", pair}, {"minItems", 2}, {"maxItems", 2}}},
+            {"offset_px", pair},
+            {"residual_rms_px", number}}}}}}}}
       .dump();
 }
 
-std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_Hz, std::uint64_t dropped) {
+std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_Hz, std::uint64_t dropped,
+                              const vision::StageCalibration* calibration) {
+  nlohmann::json cal = nullptr;
+  if (calibration)
+    cal = {{"px_per_m", calibration->px_per_m},
+           {"offset_px", calibration->offset_px},
+           {"residual_rms_px", calibration->residual_rms_px}};
   return nlohmann::json{{"t_s", f.t_mid_s},
                         {"sequence", f.sequence},
                         {"width", f.image.width},
@@ -157,7 +170,8 @@ std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_
                         {"capture_ms", 1e3 * f.capture_s},
                         {"encode_ms", 1e3 * f.encode_s},
                         {"latency_ms", 1e3 * f.latency_s},
-                        {"dropped", dropped}}
+                        {"dropped", dropped},
+                        {"calibration", cal}}
       .dump();
 }
 

@@ -25,6 +25,7 @@
 #include <string_view>
 
 #include "microcobot/platform/camera_frame.h"
+#include "microcobot/vision/affine_calibration.h"
 
 namespace mc::live {
 
@@ -50,8 +51,9 @@ RosTime ros_time(double t_s);
 void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out);
 /// sensor_msgs/msg/CameraInfo of `frame` (its objective's scale and working distance).
 void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::string& out);
-/// /camera/state's JSON of `frame`.
-std::string camera_state_json(const platform::CameraFrame& frame, double frame_rate_Hz,
-                              std::uint64_t dropped);
+/// /camera/state's JSON of `frame`, with the pixel <-> stage calibration of its objective when
+/// the configuration holds one ("calibration": px_per_m, offset_px, residual_rms_px; else null).
+std::string camera_state_json(const platform::CameraFrame& frame, double frame_rate_Hz, std::uint64_t dropped,
+                              const vision::StageCalibration* calibration);
 
 }  // namespace mc::live

@@ -267,7 +267,8 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   encode_compressed_image(f, stamp, image_cdr_);
   encode_camera_info(f, stamp, info_cdr_);
   const LiveStatus s = live_.status();
-  const std::string state = camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped);
+  const std::string state = camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped,
+                                              live_.camera_params().calibration(f.objective));
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
   server_.publish(image_ch_, ns, image_cdr_);
   server_.publish(info_ch_, ns, info_cdr_);

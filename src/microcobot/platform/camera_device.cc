@@ -43,9 +43,36 @@ void CameraDeviceParams::validate() const {
           "must be within [focus_min_m, focus_max_m]", focus_start_m);
   require(std::isfinite(focus_speed_m_s) && focus_speed_m_s > 0 && focus_speed_m_s <= 0.1, "focus_speed_m_s",
           "must be within (0, 0.1] m/s", focus_speed_m_s);
+  for (std::size_t i = 0; i < calibrations.size(); ++i) {
+    const std::string at = "calibrations[" + std::to_string(i) + "]";
+    try {
+      calibrations[i].validate();
+    } catch (const InvalidParams& e) {
+      // The item's field, with the list's name before it (the message's constraint kept).
+      const std::string what = e.what();
+      const auto colon = what.find(": ");
+      throw InvalidParams(at + "." + e.field(), colon == std::string::npos ? what : what.substr(colon + 2));
+    }
+    const bool known = std::any_of(objectives.begin(), objectives.end(), [&](const ObjectiveParams& o) {
+      return o.name == calibrations[i].objective;
+    });
+    require(known, at + ".objective",
+            "must name an objective of the turret (" + calibrations[i].objective + ")");
+    for (std::size_t j = 0; j < i; ++j)
+      require(calibrations[j].objective != calibrations[i].objective, at + ".objective",
+              "must not repeat an earlier calibration's objective (" + calibrations[i].objective + ")");
+  }
   require(jpeg_quality >= 1 && jpeg_quality <= 100, "jpeg_quality", "must be within [1, 100]", jpeg_quality);
   require(ring_frames >= 2 && ring_frames <= 1024, "ring_frames", "must be within [2, 1024]",
           static_cast<double>(ring_frames));
+}
+
+const vision::StageCalibration* CameraDeviceParams::calibration(int i) const {
+  if (i < 0 || i >= static_cast<int>(objectives.size())) return nullptr;
+  const std::string& name = objectives[static_cast<std::size_t>(i)].name;
+  for (const vision::StageCalibration& c : calibrations)
+    if (c.objective == name) return &c;
+  return nullptr;
 }
 
 double CameraDeviceParams::m_per_px(int i) const {

@@ -39,6 +39,7 @@
 #include "microcobot/platform/camera_frame.h"
 #include "microcobot/platform/device.h"
 #include "microcobot/platform/spsc_ring.h"
+#include "microcobot/vision/affine_calibration.h"
 #include "microcobot/vision/camera_params.h"
 
 namespace mc {
@@ -72,6 +73,9 @@ struct CameraDeviceParams {
   double focus_min_m = -0.5e-3;
   double focus_max_m = 2e-3;
   double focus_speed_m_s = 1e-3;
+  /// Pixel <-> stage calibrations measured by `microcobot vision calibrate --save` (at most one
+  /// per objective of the turret); published with each frame's state (/camera/state).
+  std::vector<vision::StageCalibration> calibrations;
   int jpeg_quality = 85;        ///< 1..100 (libjpeg-turbo's scale)
   int seed = 1;                 ///< the simulated sensor's noise (frame k: seed and k)
   std::size_t ring_frames = 8;  ///< snapshots the loop may queue ahead of the camera thread
@@ -89,6 +93,7 @@ struct CameraDeviceParams {
     v("focus_min_m", focus_min_m);
     v("focus_max_m", focus_max_m);
     v("focus_speed_m_s", focus_speed_m_s);
+    v("calibrations", calibrations);
     v("jpeg_quality", jpeg_quality);
     v("seed", seed);
   }
@@ -96,6 +101,8 @@ struct CameraDeviceParams {
   void validate() const;
   /// Object-side size of a pixel through objective `i` [m].
   double m_per_px(int i) const;
+  /// The calibration measured with objective `i`, or null.
+  const vision::StageCalibration* calibration(int i) const;
   double frame_rate_Hz() const { return sensor.frame_rate_Hz; }
 };
 

@@ -64,6 +64,36 @@ AffineFit fit_affine(std::span<const Eigen::Vector2d> stage_m, std::span<const E
   return fit;
 }
 
+void StageCalibration::validate() const {
+  require(!objective.empty(), "objective", "must name the objective the calibration was measured with");
+  require(px_per_m.size() == 2 && px_per_m[0].size() == 2 && px_per_m[1].size() == 2, "px_per_m",
+          "must be a 2 x 2 matrix [[a, b], [c, d]]");
+  require(offset_px.size() == 2, "offset_px", "must be two numbers (u, v)");
+  for (const auto& row : px_per_m)
+    for (double a : row) require(std::isfinite(a), "px_per_m", "must be finite", a);
+  for (double b : offset_px) require(std::isfinite(b), "offset_px", "must be finite", b);
+  const double det = px_per_m[0][0] * px_per_m[1][1] - px_per_m[0][1] * px_per_m[1][0];
+  require(std::abs(det) > 1.0, "px_per_m", "must be invertible (|det| > 1 px^2/m^2)", det);
+  require(residual_rms_px >= 0.0 && std::isfinite(residual_rms_px), "residual_rms_px",
+          "must be finite and >= 0", residual_rms_px);
+}
+
+AffineMap StageCalibration::map() const {
+  AffineMap m;
+  m.A << px_per_m[0][0], px_per_m[0][1], px_per_m[1][0], px_per_m[1][1];
+  m.b << offset_px[0], offset_px[1];
+  return m;
+}
+
+StageCalibration StageCalibration::of(const std::string& objective, const AffineFit& fit) {
+  StageCalibration c;
+  c.objective = objective;
+  c.px_per_m = {{fit.map.A(0, 0), fit.map.A(0, 1)}, {fit.map.A(1, 0), fit.map.A(1, 1)}};
+  c.offset_px = {fit.map.b.x(), fit.map.b.y()};
+  c.residual_rms_px = fit.residual_rms_px;
+  return c;
+}
+
 std::vector<Eigen::Vector2d> calibration_grid(const Eigen::Vector2d& centre_m, int n, double pitch_m) {
   require(n >= 2 && n <= 101, "grid points per side", "must be within [2, 101]", n);
   require(pitch_m > 0.0 && std::isfinite(pitch_m), "grid pitch_m", "must be finite and > 0", pitch_m);

@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace mc::vision {
@@ -52,6 +53,27 @@ struct AffineFit {
 /// the lengths differ, a value is not finite, or the stage points do not span the plane (fewer than
 /// three, or all on a line).
 AffineFit fit_affine(std::span<const Eigen::Vector2d> stage_m, std::span<const Eigen::Vector2d> pixel);
+
+/// A calibration as the configuration stores it (`camera.calibrations`, one per objective;
+/// written by `microcobot vision calibrate --save FILE`): pixel = A stage + b.
+struct StageCalibration {
+  std::string objective;                      ///< the turret's objective it was measured with
+  std::vector<std::vector<double>> px_per_m;  ///< A, 2 x 2, rows (u, v) [px/m]
+  std::vector<double> offset_px;              ///< b, (u, v) [px]
+  double residual_rms_px = 0.0;               ///< the fit's residual when measured
+
+  template <class V>
+  void visit(V& v) {
+    v("objective", objective);
+    v("px_per_m", px_per_m);
+    v("offset_px", offset_px);
+    v("residual_rms_px", residual_rms_px);
+  }
+  /// Throws mc::InvalidParams naming the field: a name, a 2 x 2 finite invertible A, a finite b.
+  void validate() const;
+  AffineMap map() const;
+  static StageCalibration of(const std::string& objective, const AffineFit& fit);
+};
 
 /// The stage points of an n x n grid of `pitch_m` centred on `centre_m`, in serpentine order (each
 /// row reversed from the last: no long return moves). n >= 2.
