@@ -110,7 +110,8 @@ struct TrackingParams {
   /// phase), is added to the wanted PE extension; with the loop's ~1.5-tick delay (about a quarter period) a
   /// positive gain moves the PE against the ringing's velocity, i.e. damps it, like kp's negative
   /// gain but without acting below or above the mode (200 um/s trapezoid, steady part: error
-  /// peak-to-peak 554 nm without, ~400 nm at gain 0.4, phase 0). 0: off.
+  /// peak-to-peak 554 nm without, 401 nm at gain 0.4, phase 0, lead on the plan, issue #31's first gains). 0:
+  /// off.
   double damp_gain = 0.4837;
   double damp_Hz = 1640.0;      ///< [Hz]
   double damp_q = 1.317;        ///< quality factor of the band-pass
