@@ -101,18 +101,20 @@ TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
   }
   const ValidationSummary s = summarise(cases, results, goals);
   std::printf(
-      "subset: %d/%d pass, median RMS %.0f nm, worst RMS %.0f, max %.0f, path %.0f, power-up backward %.0f "
+      "subset: %d/%d pass, median RMS %.1f nm, worst RMS %.0f, max %.0f, path %.0f, power-up backward %.0f "
       "nm\n",
       s.passed, s.cases, s.median_rms_m * 1e9, s.worst_rms_m * 1e9, s.worst_max_m * 1e9,
       s.worst_path_deviation_m * 1e9, s.worst_powerup_backward_m * 1e9);
-  // Holds on the full validation set (92 nm): the goal itself.
+  // Hold on the full validation set (median 99 nm, power-up backward 208 nm; branch track3's
+  // lead on the plan and resonant damping): the goals themselves.
   EXPECT_TRUE(s.median_ok) << s.median_rms_m;
-  // Do not hold on the full validation set (worst RMS 403 nm, max 916 nm, path deviation 547 nm,
-  // power-up backward 306 nm: docs/benchmarks.md); bounded at the measured level with ~10 % margin.
-  EXPECT_LE(s.worst_rms_m, 450e-9);
-  EXPECT_LE(s.worst_max_m, 1000e-9);
-  EXPECT_LE(s.worst_path_deviation_m, 600e-9);
-  EXPECT_LE(s.worst_powerup_backward_m, 340e-9);
+  EXPECT_TRUE(s.powerup_ok) << s.worst_powerup_backward_m;
+  // Do not hold on the full validation set (worst RMS 219 nm, max 642 nm, path deviation 382 nm:
+  // docs/benchmarks.md; before track3 403, 916 and 547 nm); bounded at the measured level with
+  // ~10 % margin, so that a regression fails.
+  EXPECT_LE(s.worst_rms_m, 240e-9);
+  EXPECT_LE(s.worst_max_m, 700e-9);
+  EXPECT_LE(s.worst_path_deviation_m, 420e-9);
 }
 
 }  // namespace

@@ -19,6 +19,12 @@ void TrackingParams::validate() const {
   require_in_range(sprint_low_V, 0.0, low_V, "tracking.sprint_low_V");
   require_positive(sprint_velocity_m_s, "tracking.sprint_velocity_m_s");
   require_positive(sprint_lag_m, "tracking.sprint_lag_m");
+  require_in_range(sprint_horizon_s, 0.0, 0.1, "tracking.sprint_horizon_s");
+  require_in_range(damp_gain, 0.0, 2.0, "tracking.damp_gain");
+  require(damp_Hz > 0.0 && damp_Hz < 0.45 * control_rate_Hz, "tracking.damp_Hz",
+          "must lie in (0, 0.45 control_rate_Hz)", damp_Hz);
+  require_in_range(damp_q, 0.2, 20.0, "tracking.damp_q");
+  require_in_range(damp_lag_ticks, -1.0, 1.0, "tracking.damp_lag_ticks");
   require_in_range(guard_V, 0.0, 10.0, "tracking.guard_V");
   require(unload_V >= 0.0 && unload_V <= high_V - low_V - 10.0, "tracking.unload_V",
           "must be in [0, high_V - low_V - 10]", unload_V);
@@ -61,6 +67,12 @@ TrackingController::TrackingController(const TrackingParams& p, const stickslip:
       min_V_(model.drive.min_V),
       dt_c_(1.0 / p.control_rate_Hz),
       obs_(stickslip::make_pi_state(model.hysteresis, 0.0)) {
+  // The damping's band-pass (RBJ cookbook, constant 0 dB peak gain), normalised by a0.
+  const double w0 = 2.0 * std::numbers::pi * p_.damp_Hz / p_.control_rate_Hz;
+  const double alpha = std::sin(w0) / (2.0 * p_.damp_q);
+  bp_b0_ = alpha / (1.0 + alpha);
+  bp_a1_ = -2.0 * std::cos(w0) / (1.0 + alpha);
+  bp_a2_ = (1.0 - alpha) / (1.0 + alpha);
   require(p.sprint_low_V >= model.drive.min_V && p.high_V <= model.drive.max_V,
           "tracking.sprint_low_V/high_V", "must lie within the amplifier's range (drive.min_V..max_V)");
   b_fwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward);
@@ -116,6 +128,7 @@ void TrackingController::reset(double x_m, double u_V) noexcept {
   ramp_in_ = ramp_in_started_ = false;
   powering_up_ = p_.powerup_V > 0.0 && u_V < p_.low_V;
   powerup_t_ = 0.0;
+  bp_init_ = false;
 }
 
 void TrackingController::emergency_stop() noexcept {
@@ -185,6 +198,17 @@ void TrackingController::update(double x) noexcept {
     have_x_ = true;
   }
   x_filt_ += dt_c_ / (p_.filter_s + dt_c_) * (x - x_filt_);
+  // The damping's band-pass runs on every sample (also during edges: it sees the slip).
+  if (!bp_init_) {
+    bp_x1_ = bp_x2_ = x;
+    bp_y1_ = bp_y2_ = 0.0;
+    bp_init_ = true;
+  }
+  const double bp = bp_b0_ * (x - bp_x2_) - bp_a1_ * bp_y1_ - bp_a2_ * bp_y2_;
+  bp_x2_ = bp_x1_;
+  bp_x1_ = x;
+  bp_y2_ = bp_y1_;
+  bp_y1_ = bp;
   in_position_ = ref_.v_m_s == 0.0 && std::abs(ref_.x_m - x_filt_) < p_.in_position_m;
   if (powering_up_) {
     if (!ramp_in_started_) {
@@ -220,9 +244,12 @@ void TrackingController::update(double x) noexcept {
     since_edge_s_ = 0.0;
   }
   // Sprint (the wider range) while the reference is fast or the axis has fallen behind it (at
-  // rest: is far from it); the ramp may then run down to the sprint range's bottom.
+  // rest: is far from it); the ramp may then run down to the sprint range's bottom. The velocity
+  // trigger looks sprint_horizon_s ahead while the reference speeds up.
   const double lag = ref_.v_m_s > 0.0 ? e : (ref_.v_m_s < 0.0 ? -e : std::abs(e));
-  if (std::abs(ref_.v_m_s) > p_.sprint_velocity_m_s || lag > p_.sprint_lag_m) {
+  const double speeding_up =
+      ref_.a_m_s2 * ref_.v_m_s > 0.0 ? std::abs(ref_.a_m_s2) * p_.sprint_horizon_s : 0.0;
+  if (std::abs(ref_.v_m_s) + speeding_up > p_.sprint_velocity_m_s || lag > p_.sprint_lag_m) {
     sprint_ = true;
     floor_V_ = std::min(floor_V_, p_.sprint_low_V);
   } else if (lag < 0.5 * p_.sprint_lag_m) {
@@ -233,17 +260,24 @@ void TrackingController::update(double x) noexcept {
   const double y_base = y_anchor_ + (ref_.x_m - r_anchor_) + corr_ + integ_;
   const double top = pe_displacement_m(p_.high_V - p_.guard_V);
   const double bottom = pe_displacement_m(floor_V_ + p_.guard_V);
+  // Where the lead stands is judged on the plan (anchor, reference, catch-up) when lead_on_plan
+  // is set, not on y_base with its feedback (integral): in the lead window the lead grows by
+  // (b + lead_m) / lead_window_m ~ 4 m per metre of y, which multiplied the feedback's own swing
+  // by ~5 there and rang the loop at ~400 Hz (+-280 nm at 23 um/s backward, issue #31).
+  const double y_lead = p_.lead_on_plan ? y_anchor_ + (ref_.x_m - r_anchor_) + corr_ : y_base;
   double lead = 0.0;
   if (ref_.v_m_s > 0.0) {
     lead = (p_.lead_fraction * b_fwd_ + p_.lead_m) *
-           std::clamp(1.0 - (top - y_base) / p_.lead_window_m, 0.0, 1.0);
+           std::clamp(1.0 - (top - y_lead) / p_.lead_window_m, 0.0, 1.0);
   } else if (ref_.v_m_s < 0.0) {
     lead = -(p_.lead_fraction * b_bwd_ + p_.lead_m) *
-           std::clamp(1.0 - (y_base - bottom) / p_.lead_window_m, 0.0, 1.0);
+           std::clamp(1.0 - (y_lead - bottom) / p_.lead_window_m, 0.0, 1.0);
   }
+  // Resonant damping of the contact's 1.64 kHz mode (see TrackingParams::damp_gain).
+  const double damp = p_.damp_gain * ((1.0 - p_.damp_lag_ticks) * bp + p_.damp_lag_ticks * bp_y2_);
   // The residual: the measured error minus the error the plan expects (catch-up still to go, lead).
   const double e_res = e - (corr_to_ - corr_) + lead;
-  const double y_des = y_base + lead + p_.kp * e_res;
+  const double y_des = y_base + lead + p_.kp * e_res + damp;
   // An edge when the ramp runs out of range in the direction the reference moves, or, at rest,
   // when the wanted position lies beyond the range by more than the edge margin; never against
   // the reference's motion; and only once the drive has used its range (within edge_ready_V of

@@ -38,9 +38,10 @@
 
 namespace mc::control {
 
-/// The gains (low_V, sprint_*, edge_ready_V, lead_*, catchup_s, settle_s, ki_1_s, kp, backslip_gain,
-/// powerup_V) were chosen on the tuning set of `microcobot control validate --set tuning` only and are
-/// judged on its validation set (issue #31; docs/parameters.md, docs/benchmarks.md).
+/// The gains (sprint_*, unload_V, edge_ready_V, lead_*, catchup_s, settle_s, ki_1_s, kp, backslip_gain,
+/// damp_*; low_V and powerup_V earlier) were chosen by scripts/tune_tracking.py on the tuning set of
+/// `microcobot control validate --set tuning` only and are judged on its validation set (issue #31;
+/// docs/parameters.md, docs/benchmarks.md).
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
   /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low). A
@@ -52,45 +53,69 @@ struct TrackingParams {
   /// The range's bottom while sprinting: the reference faster than sprint_velocity_m_s, or the
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
-  /// [m/s]: retuned from 600 um/s; fast, strongly accelerating moves (510-660 um/s at > 0.05 m/s^2) now
-  /// lag ~0.9 um before the lag trigger starts the sprint (docs/benchmarks.md).
-  double sprint_velocity_m_s = 910.2e-6;
-  double sprint_lag_m = 0.7183e-6;  ///< [m]: just above the edges' own transients
+  /// [m/s]: above the envelope's 800 um/s, so the sprint starts on the lag trigger: with the edge
+  /// transients damped (damp_gain) that trigger could come down to 0.42 um (from 0.72 um), and the
+  /// fast, strongly accelerating moves sprint earlier (docs/benchmarks.md).
+  double sprint_velocity_m_s = 1191.0e-6;
+  double sprint_lag_m = 422.8e-9;  ///< [m]
+  /// Anticipation (issue #31): the velocity trigger looks at the reference's speed this far ahead,
+  /// |v| + |a| h while the reference speeds up (a v > 0), so that a strongly accelerating move
+  /// sprints before the narrow edges fall behind rather than once the lag says they have. 0: off [s].
+  double sprint_horizon_s = 0.0;
   /// An edge starts when the wanted ramp would pass this close to the end of the range [V].
   double guard_V = 0.5;
   /// ...and only when the drive is already within this much of that end: the ramp uses its range
   /// before an edge (an axis that fell behind catches up instead of stalling) [V].
-  double edge_ready_V = 11.31;
+  double edge_ready_V = 5.861;
   /// Unloading: right after the edge the voltage turns back by this much at the slew limit, which
   /// releases the contact's strain (|z| ~ z_ss after the slip) before it pulls the slider back;
   /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V]. For the
   /// low_V..high_V edge; a sprint edge unloads in proportion to its amplitude.
-  double unload_V = 49.2;
+  double unload_V = 49.16;
   /// Backslip of an unloaded edge assumed before the first edge is measured [m].
   double backslip_m = 0.0;
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
   double edge_margin_m = 20e-9;
   /// Fraction of the predicted backslip the ramp leads by at the edge (0: none, 0.5: split).
-  double lead_fraction = 1.0;
+  double lead_fraction = 0.9603;
   /// A further lead for the edge's transient dip (the slider slides back ~0.5 um while the edge and
   /// the unloading run, then returns) [m].
-  double lead_m = 689.8e-9;
+  double lead_m = 923.8e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
-  double lead_window_m = 239.3e-9;
+  /// ...judged on the plan (anchor + reference travel + catch-up), not on the wanted extension
+  /// with its feedback (false: the issue #15 design, for comparison; docs/benchmarks.md).
+  bool lead_on_plan = true;
+  double lead_window_m = 238.8e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
-  double catchup_s = 0.6204e-3;
+  double catchup_s = 0.6018e-3;
   /// After an edge: the integral is frozen while the slip rings [s].
-  double settle_s = 0.553e-3;
-  double ki_1_s = 1581.0;  ///< integral gain on the residual error [1/s]
+  double settle_s = 0.5285e-3;
+  double ki_1_s = 872.2;  ///< integral gain on the residual error [1/s]
   /// Proportional correction of the residual (fraction per tick). Negative on purpose: while the
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
   /// a quarter of that period, so -|kp| e acts on the ringing as velocity feedback, i.e. damping;
   /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
   /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1 with the earlier 0-100 V edge; -0.4 with
-  /// the 7.5-100 V edge: 118 nm, with the present 30-100 V edge and gains: 82 nm).
-  double kp = -0.2819;
-  double backslip_gain = 0.3636;  ///< update rate of the backslip estimate per edge (0: model only)
+  /// the 7.5-100 V edge: 118 nm, with the 30-100 V edge and the issue #31 gains: 82 nm). Beyond
+  /// |kp| ~ 0.45 the loop rings (100 um/s: max 262 nm at -0.4, 721 nm at -0.5); damp_gain adds
+  /// damping at the contact mode only.
+  double kp = -0.2794;
+  double backslip_gain = 0.402;  ///< update rate of the backslip estimate per edge (0: model only)
+  /// Resonant damping of the contact's stiff mode (issue #31): the edges leave the slider ringing
+  /// on asperity b at sqrt(rho0_b / M_s) = 1.64 kHz (thesis Table 2.8, docs/model.md "two
+  /// asperities"), with a damping ratio of rho1_b / (2 sqrt(rho0_b c_b M_s)) ~ 0.04 only. The
+  /// measured position is band-passed around damp_Hz (RBJ biquad, peak gain 1, quality damp_q) and
+  /// damp_gain times it, delayed by damp_lag_ticks (-1..1, linear between ticks, < 0 extrapolates: the
+  /// phase), is added to the wanted PE extension; with the loop's ~1.5-tick delay (about a quarter period) a
+  /// positive gain moves the PE against the ringing's velocity, i.e. damps it, like kp's negative
+  /// gain but without acting below or above the mode (200 um/s trapezoid, steady part: error
+  /// peak-to-peak 554 nm without, 401 nm at gain 0.4, phase 0, lead on the plan, issue #31's first gains). 0:
+  /// off.
+  double damp_gain = 0.4837;
+  double damp_Hz = 1640.0;      ///< [Hz]
+  double damp_q = 1.317;        ///< quality factor of the band-pass
+  double damp_lag_ticks = 0.0;  ///< [ticks]
   /// Power-up ramp-in (issue #31): the amplifier starts at 0 V, the bottom of the range, so a
   /// backward move's first edge would come at once, with no lead to split its dip (626 nm at
   /// 200 um/s). Instead the controller's first act after a reset below low_V is one edge that
@@ -117,6 +142,7 @@ struct TrackingParams {
     v("sprint_low_V", sprint_low_V);
     v("sprint_velocity_m_s", sprint_velocity_m_s);
     v("sprint_lag_m", sprint_lag_m);
+    v("sprint_horizon_s", sprint_horizon_s);
     v("guard_V", guard_V);
     v("edge_ready_V", edge_ready_V);
     v("unload_V", unload_V);
@@ -125,11 +151,16 @@ struct TrackingParams {
     v("lead_fraction", lead_fraction);
     v("lead_m", lead_m);
     v("lead_window_m", lead_window_m);
+    v("lead_on_plan", lead_on_plan);
     v("catchup_s", catchup_s);
     v("settle_s", settle_s);
     v("ki_1_s", ki_1_s);
     v("kp", kp);
     v("backslip_gain", backslip_gain);
+    v("damp_gain", damp_gain);
+    v("damp_Hz", damp_Hz);
+    v("damp_q", damp_q);
+    v("damp_lag_ticks", damp_lag_ticks);
     v("powerup_V", powerup_V);
     v("powerup_unload_V", powerup_unload_V);
     v("powerup_settle_s", powerup_settle_s);
@@ -226,6 +257,10 @@ class TrackingController {
   bool powering_up_ = false, ramp_in_ = false, ramp_in_started_ = false;
   double powerup_t_ = 0.0;
   std::int64_t edges_ = 0;
+  /// Resonant damping: the band-pass's coefficients and state (direct form I), last two outputs.
+  double bp_b0_ = 0.0, bp_a1_ = 0.0, bp_a2_ = 0.0;
+  double bp_x1_ = 0.0, bp_x2_ = 0.0, bp_y1_ = 0.0, bp_y2_ = 0.0;
+  bool bp_init_ = false;
 };
 
 }  // namespace mc::control
