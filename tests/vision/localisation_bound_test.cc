@@ -12,20 +12,15 @@
 #include "microcobot/vision/localisation_bound.h"
 #include "microcobot/vision/renderer.h"
 #include "microcobot/vision/template_tracker.h"
+#include "tracking_scenes.h"
 
 namespace mc::vision {
 namespace {
 
-constexpr int kW = 320, kH = 256;
-constexpr double kTop = 100e-6;
-
-CameraParams small_camera() {
-  CameraParams c;
-  c.objective = objective_by_name("10x");
-  c.sensor.width_px = kW;
-  c.sensor.height_px = kH;
-  return c;
-}
+using testing::kH;
+using testing::kTop;
+using testing::kW;
+using testing::small_camera;
 
 // A 300 um part, 100 um thick, its upper left corner at the image's centre plus (du, dv) px.
 SceneSnapshot corner_at(double du_px, double dv_px, double pixel_m) {
