@@ -6,6 +6,7 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -79,13 +80,25 @@ struct Watch {
   static constexpr std::uint32_t kTelemetrySub = 10;
   Console console;
   nlohmann::json last;
+  /// The lowest lag seen between a frame's loop time (`t_s`) and its arrival here (s): the
+  /// watched loop's clock on this process's steady clock, plus the fastest delivery. A loaded
+  /// machine delivers the telemetry late (frames queue in the socket), so when a frame arrives
+  /// says little about when the loop produced it; its `t_s` does.
+  double min_lag_s = INFINITY;
   explicit Watch(std::uint16_t port) : console(port) {
     console.subscribe("/platform/telemetry", kTelemetrySub);
   }
   const nlohmann::json& next() {
     const std::string payload = console.next_on(kTelemetrySub);
     last = payload.empty() ? nlohmann::json() : nlohmann::json::parse(payload);
+    const double t = last.is_object() ? last.value("t_s", NAN) : NAN;
+    if (std::isfinite(t)) min_lag_s = std::min(min_lag_s, steady_s(std::chrono::steady_clock::now()) - t);
     return last;
+  }
+  /// The watched loop's time at `when`, early by the fastest delivery at most.
+  double loop_time_at(std::chrono::steady_clock::time_point when) const { return steady_s(when) - min_lag_s; }
+  static double steady_s(std::chrono::steady_clock::time_point when) {
+    return std::chrono::duration<double>(when.time_since_epoch()).count();
   }
 };
 

@@ -44,6 +44,12 @@ struct NetSample {
   std::int64_t received_ns = 0;  ///< steady clock when the link thread took it (0 when sending)
   std::array<double, 3> xyz{};   ///< m or N
   double scalar = 0.0;           ///< m, or 0/1
+
+  /// Its transit (s): arrival (this end's steady clock) minus stamp (the sender's ROS time), the
+  /// network's delay plus the clocks' offset (transit_estimate.h compares them).
+  double transit_s() const noexcept { return 1e-9 * static_cast<double>(received_ns - stamp_ns); }
+  /// Its arrival on this end's steady clock (s).
+  double received_s() const noexcept { return 1e-9 * static_cast<double>(received_ns); }
 };
 
 /// The network side's refusal reasons (counted per reason, never applied).

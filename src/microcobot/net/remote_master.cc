@@ -56,7 +56,8 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::RemoteRequest& r)
         asked_m_ = s.xyz;
       }
       has_target_ = true;
-      last_target_t_ = t_s;
+      // As old as it is: a backlog arriving after an outage does not refresh the master.
+      last_target_t_ = std::max(last_target_t_, t_s - target_transit_.observe(s.transit_s(), s.received_s()));
       break;
     case Channel::kMasterPortEnergy:
       ports_.arrived(s.xyz);

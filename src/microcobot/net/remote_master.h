@@ -9,6 +9,8 @@
 /// and gripper opening, and its devices' states on /diagnostics (10 Hz, and at once on a change).
 ///
 /// The master is fresh while it is engaged, its last target is at most `stale_timeout_s` old
+/// (counted from when it was sent, beyond the fastest delivery seen (transit_estimate.h): targets
+/// queued while the cable was out do not look new when they arrive)
 /// and DDS sees it (Link::peer_alive(): matched, alive, within its deadlines) (issue #17 point 6:
 /// a dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
 /// target). Its e-stop latches the slave's; releasing it resets it.
@@ -28,6 +30,7 @@
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
 #include "microcobot/net/target_stream.h"
+#include "microcobot/net/transit_estimate.h"
 #include "microcobot/net/wire_emulator.h"
 
 namespace mc::net {
@@ -89,7 +92,8 @@ class RemoteMaster final : public live::CommandSource {
   std::unique_ptr<Link> link_;
   std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
   double stale_timeout_s_ = 0.0;
-  double last_target_t_ = -1e9;
+  double last_target_t_ = -1e9;  // poll time at which the newest target was sent
+  TransitEstimate target_transit_;  // the targets' route: how late each one arrives
   bool engaged_ = false;
   bool estop_ = false;
   std::array<double, 4> states_sent_{-1, -1, -1, -1};  // lifecycles last put on /diagnostics

@@ -1,5 +1,6 @@
 #include "microcobot/net/remote_slave.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -132,7 +133,8 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
   switch (s.channel) {
     case Channel::kMeasuredPose:
       state_.position_m = s.xyz;
-      state_.age_s = 0.0;
+      // As old as it is: a backlog arriving after an outage does not refresh the slave.
+      state_.age_s = std::min(state_.age_s, pose_transit_.observe(s.transit_s(), s.received_s()));
       break;
     case Channel::kContactForce:
       received_contact_N_ = s.xyz;  // out through the ports in exchange()

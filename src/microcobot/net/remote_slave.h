@@ -16,7 +16,9 @@
 ///   safe state          the e-stop topic latched on (reliable, transient local), the coupling's
 ///                       engaged flag off; activate() releases both
 ///
-/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave), DDS no
+/// When no pose has come from the slave for `stale_timeout_s` (a dead or cut-off slave; a pose's
+/// age counts from when it was measured, beyond the fastest delivery seen (transit_estimate.h),
+/// so that poses queued while the cable was out do not look new when they arrive), DDS no
 /// longer sees it (Link::peer_alive(): a state topic unmatched, its liveliness lost or its deadline
 /// missed), or its /diagnostics report a device that is not active (its own e-stop, a fault), the
 /// axes report stale measurements: the coupling disengages with zero force on the masters at
@@ -32,6 +34,7 @@
 
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
+#include "microcobot/net/transit_estimate.h"
 #include "microcobot/net/wire_emulator.h"
 #include "microcobot/platform/platform.h"
 
@@ -116,6 +119,7 @@ class RemoteSlave {
   std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
   double stale_timeout_s_ = 0.0;
   double now_s_ = 0.0;  // loop time, from the ticks' dt
+  TransitEstimate pose_transit_;  // the poses' route: how late each one arrives
   RemoteSlaveState state_;
   std::array<double, 3> target_m_{};
   unsigned target_mask_ = 0;    // bit i: axis i's target of this slave tick is in

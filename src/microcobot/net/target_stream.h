@@ -9,16 +9,17 @@
 /// look-ahead) behind; a target later than that holds the goal, which rejoins at the stream's
 /// speed limit, never by a jump.
 ///
-/// The transit (this end's clock minus the sender's stamp at arrival) is estimated as its
-/// lowest value over the last one to two `window_s`: the fastest the network has carried a
-/// target, clock offset included, so the two ends' clocks need no synchronisation; a route that
-/// became slower is followed within two windows (a minimum over two buckets: it never creeps,
-/// which would shift the read time, and the goal with it, between new minima). Never allocates
-/// after construction.
+/// The transit (this end's clock minus the sender's stamp at arrival) is estimated by a
+/// TransitEstimate (transit_estimate.h): its lowest value over the last one to two `window_s`,
+/// the fastest the network has carried a target, clock offset included, so the two ends' clocks
+/// need no synchronisation; a route that became slower is followed within two windows (a
+/// minimum over two buckets: it never creeps, which would shift the read time, and the goal with
+/// it, between new minima). Never allocates after construction.
 
 #include <array>
 
 #include "microcobot/control/setpoint_stream.h"
+#include "microcobot/net/transit_estimate.h"
 
 namespace mc::net {
 
@@ -41,14 +42,11 @@ class TargetStream {
   /// The last sample() held because the targets were late or missing.
   bool holding() const noexcept { return holding_; }
   /// The transit estimate (s); infinite before the first target.
-  double transit_s() const noexcept { return transit_s_; }
+  double transit_s() const noexcept { return transit_.estimate_s(); }
 
  private:
   std::array<control::SetpointStream, 3> axes_;
-  double window_s_;
-  double transit_s_;                      // the estimate
-  double bucket_min_s_, previous_min_s_;  // lowest transit in this window and the one before
-  double bucket_start_s_ = 0.0;
+  TransitEstimate transit_;
   bool holding_ = true;
 };
 
