@@ -1,0 +1,67 @@
+#include "microcobot/cell/assembly_batch.h"
+
+#include <cmath>
+#include <random>
+
+#include "microcobot/core/error.h"
+
+namespace mc::cell {
+
+void AssemblyBatchParams::validate() const {
+  require(parts >= 1 && parts <= 10000, "parts", "must be within [1, 10000]", parts);
+  require(seed >= 0, "seed", "must be >= 0", seed);
+  require_positive(min_side_m, "min_side_m");
+  require(max_side_m >= min_side_m, "max_side_m", "must be at least min_side_m", max_side_m);
+  require(part_height_m > hole_depth_m + 100e-6, "part_height_m",
+          "must stand at least 100 um above a full bore (hole_depth_m) to be held", part_height_m);
+  require_positive(min_clearance_m, "min_clearance_m");
+  require(max_clearance_m >= min_clearance_m, "max_clearance_m", "must be at least min_clearance_m",
+          max_clearance_m);
+  require_positive(hole_depth_m, "hole_depth_m");
+  require_non_negative(slot_error_m, "slot_error_m");
+  // A pin off its slot by more than a quarter of its side along y is no longer between the
+  // fingers' flats (microworld: |dy| < side / 2): 4 sigma must stay within it.
+  require(4.0 * slot_error_m < 0.25 * min_side_m, "slot_error_m", "must be below min_side_m / 16",
+          slot_error_m);
+  // The open fingers must pass around the pin with its slot error on either side.
+  require(max_side_m + 8.0 * slot_error_m < world.gripper.max_opening_m, "max_side_m",
+          "must leave the open gripper (world.gripper.max_opening_m) 4 slot errors each side", max_side_m);
+  require_positive(half_size_m, "half_size_m");
+  for (const auto& [key, v] : {std::pair{"tray_x_m", tray_x_m}, std::pair{"tray_y_m", tray_y_m},
+                               std::pair{"plate_x_m", plate_x_m}, std::pair{"plate_y_m", plate_y_m}})
+    require(std::isfinite(v) && std::abs(v) + half_size_m <= 4e-3, key,
+            "must keep the area (half_size_m) within 4 mm of the stage's home", v);
+  world.validate();
+}
+
+std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
+  params.validate();
+  std::mt19937_64 rng(static_cast<std::uint64_t>(params.seed));
+  std::uniform_real_distribution<double> side(params.min_side_m, params.max_side_m);
+  std::uniform_real_distribution<double> clearance(params.min_clearance_m, params.max_clearance_m);
+  std::uniform_real_distribution<double> area(-params.half_size_m, params.half_size_m);
+  std::normal_distribution<double> slot(0.0, 1.0);
+  std::vector<AssemblyJob> jobs;
+  jobs.reserve(static_cast<std::size_t>(params.parts));
+  for (int i = 0; i < params.parts; ++i) {
+    AssemblyJob j;
+    j.index = i;
+    j.side_m = side(rng);
+    j.clearance_m = clearance(rng);
+    j.nominal_part_m = {params.tray_x_m + area(rng), params.tray_y_m + area(rng)};
+    j.target_m = {params.plate_x_m + area(rng), params.plate_y_m + area(rng)};
+    const Eigen::Vector2d error(params.slot_error_m * slot(rng), params.slot_error_m * slot(rng));
+    j.world = params.world;
+    j.world.part_side_m = j.side_m;
+    j.world.part_height_m = params.part_height_m;
+    j.world.hole_side_m = j.side_m + 2.0 * j.clearance_m;
+    j.world.hole_depth_m = params.hole_depth_m;
+    j.world.part_start_m = {j.nominal_part_m.x() + error.x(), j.nominal_part_m.y() + error.y(), 0.0};
+    j.world.target_m = {j.target_m.x(), j.target_m.y(), 0.0};
+    j.world.validate();
+    jobs.push_back(j);
+  }
+  return jobs;
+}
+
+}  // namespace mc::cell

@@ -1,0 +1,274 @@
+#include "microcobot/cell/assembly_task.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "microcobot/core/error.h"
+
+namespace mc::cell {
+
+void AssemblyTaskParams::validate() const {
+  require_positive(travel_speed_m_s, "travel_speed_m_s");
+  require_positive(z_speed_m_s, "z_speed_m_s");
+  require_positive(insert_speed_m_s, "insert_speed_m_s");
+  require_positive(clearance_height_m, "clearance_height_m");
+  require_positive(grip_above_m, "grip_above_m");
+  require_positive(grip_force_N, "grip_force_N");
+  require_positive(close_rate_m_s, "close_rate_m_s");
+  require_positive(contact_threshold_N, "contact_threshold_N");
+  require_positive(search_retreat_m, "search_retreat_m");
+  // Steps of at most twice the clearance leave no gap between the fits (|dy| <= clearance).
+  require(search_step_factor > 0.0 && search_step_factor < 2.0, "search_step_factor",
+          "must be within (0, 2): the fits of |dy| <= clearance must overlap", search_step_factor);
+  require_non_negative(search_range_m, "search_range_m");
+  require_positive(position_tolerance_m, "position_tolerance_m");
+  require_non_negative(settle_s, "settle_s");
+  require_positive(step_timeout_s, "step_timeout_s");
+}
+
+AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal)
+    : p_(params), goal_(goal) {
+  p_.validate();
+  require(goal.part_m.allFinite() && goal.target_m.allFinite(), "goal", "positions must be finite");
+  require_positive(goal.part_height_m, "goal.part_height_m");
+  require_positive(goal.hole_depth_m, "goal.hole_depth_m");
+  require_positive(goal.clearance_m, "goal.clearance_m");
+  require_positive(goal.open_m, "goal.open_m");
+  grasp_z_ = goal.hole_depth_m + p_.grip_above_m;
+  require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
+          p_.grip_above_m);
+  safe_z_ = goal.part_height_m + p_.clearance_height_m;
+  carry_z_ = grasp_z_ + p_.clearance_height_m;
+  opening_command_ = goal.open_m;
+  out_.active = true;
+  out_.fresh = true;
+  out_.has_gripper = true;
+  out_.gripper_opening_m = opening_command_;
+  autonomy_.fill(Autonomy::kAuto);
+  enter(Step::kApproach);
+}
+
+std::string_view AssemblyTask::name(Step s) noexcept {
+  static constexpr std::array<std::string_view, kStepCount> names = {
+      "approach", "descend", "grasp", "lift", "transport", "insert", "release", "retract", "done"};
+  return names[index(s)];
+}
+
+std::string_view AssemblyTask::name(Status s) noexcept {
+  switch (s) {
+    case Status::kRunning:
+      return "running";
+    case Status::kPaused:
+      return "paused";
+    case Status::kAwaitingConfirm:
+      return "awaiting confirmation";
+    case Status::kOperator:
+      return "operator";
+    case Status::kSucceeded:
+      return "succeeded";
+    case Status::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+void AssemblyTask::enter(Step s) noexcept {
+  step_ = s;
+  step_s_ = 0.0;
+  settled_s_ = 0.0;
+  insert_ = Insert::kDescend;
+  if (s == Step::kDone) {
+    status_ = Status::kSucceeded;
+    return;
+  }
+  begin_step();
+}
+
+void AssemblyTask::begin_step() noexcept {
+  switch (autonomy_[index(step_)]) {
+    case Autonomy::kAuto:
+      status_ = Status::kRunning;
+      break;
+    case Autonomy::kConfirm:
+      status_ = Status::kAwaitingConfirm;
+      break;
+    case Autonomy::kManual:
+      status_ = Status::kOperator;
+      break;
+  }
+}
+
+void AssemblyTask::fail(const char* why) noexcept {
+  failure_ = why;
+  status_ = Status::kFailed;
+}
+
+void AssemblyTask::pause() noexcept {
+  if (status_ == Status::kRunning) status_ = Status::kPaused;
+}
+
+void AssemblyTask::resume() noexcept {
+  if (status_ == Status::kPaused) status_ = Status::kRunning;
+}
+
+void AssemblyTask::confirm() noexcept {
+  if (status_ == Status::kAwaitingConfirm) status_ = Status::kRunning;
+}
+
+void AssemblyTask::take_over() noexcept {
+  if (!finished()) status_ = Status::kOperator;
+}
+
+void AssemblyTask::hand_back(bool step_done) noexcept {
+  if (status_ != Status::kOperator) return;
+  if (step_done) {
+    enter(static_cast<Step>(index(step_) + 1));
+  } else {
+    // The step again, from where the operator left the stage: its goals are absolute, and a
+    // move starts from the coupling's current target.
+    step_s_ = 0.0;
+    settled_s_ = 0.0;
+    if (step_ == Step::kInsert) {  // clear of the rim before searching on
+      insert_ = Insert::kRetreat;
+      retreat_z_ = std::numeric_limits<double>::quiet_NaN();
+    }
+    status_ = Status::kRunning;
+  }
+}
+
+bool AssemblyTask::move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s,
+                           double dt) noexcept {
+  out_.has_goal = true;
+  out_.goal_m = goal;
+  out_.goal_speed_m_s = speed;
+  settled_s_ = (s.tip_m - goal).norm() <= p_.position_tolerance_m ? settled_s_ + dt : 0.0;
+  return settled_s_ >= p_.settle_s;
+}
+
+const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {
+  out_.deadman = false;
+  out_.has_goal = false;
+  out_.velocity_m_s.setZero();
+  out_.gripper_opening_m = opening_command_;
+  if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
+  step_s_ += dt_s;
+  if (step_s_ > p_.step_timeout_s) {
+    fail("a step took longer than step_timeout_s");
+    return out_;
+  }
+  out_.deadman = true;
+  const Eigen::Vector3d over_part(goal_.part_m.x(), goal_.part_m.y(), safe_z_);
+  switch (step_) {
+    case Step::kApproach:
+      // Up first where the tips are, then across: the open fingers never sweep into the pin.
+      if (s.tip_m.z() < safe_z_ - p_.position_tolerance_m &&
+          (s.tip_m.head<2>() - goal_.part_m).norm() > 1e-6) {
+        move_to({s.tip_m.x(), s.tip_m.y(), safe_z_}, p_.z_speed_m_s, s, dt_s);
+        settled_s_ = 0.0;
+      } else if (move_to(over_part, p_.travel_speed_m_s, s, dt_s)) {
+        enter(Step::kDescend);
+      }
+      break;
+    case Step::kDescend:
+      if (move_to({goal_.part_m.x(), goal_.part_m.y(), grasp_z_}, p_.z_speed_m_s, s, dt_s))
+        enter(Step::kGrasp);
+      break;
+    case Step::kGrasp: {
+      move_to({goal_.part_m.x(), goal_.part_m.y(), grasp_z_}, p_.z_speed_m_s, s, dt_s);
+      if (s.grip_N < p_.grip_force_N) {
+        settled_s_ = 0.0;
+        opening_command_ = std::max(0.0, opening_command_ - p_.close_rate_m_s * dt_s);
+        if (opening_command_ <= 0.0 && s.grip_N <= 0.0) fail("the fingers closed on nothing");
+      } else if (settled_s_ >= p_.settle_s) {
+        enter(Step::kLift);
+      }
+      out_.gripper_opening_m = opening_command_;
+      break;
+    }
+    case Step::kLift:
+      if (move_to({goal_.part_m.x(), goal_.part_m.y(), carry_z_}, p_.z_speed_m_s, s, dt_s))
+        enter(Step::kTransport);
+      break;
+    case Step::kTransport:
+      if (move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s)) {
+        tries_ = 0;
+        offset_y_ = 0.0;
+        enter(Step::kInsert);
+      }
+      break;
+    case Step::kInsert:
+      insert_tick(s, dt_s);
+      break;
+    case Step::kRelease:
+      opening_command_ = goal_.open_m;
+      out_.gripper_opening_m = opening_command_;
+      move_to(s.tip_m, p_.z_speed_m_s, s, dt_s);  // stay
+      settled_s_ = s.opening_m >= 0.9 * goal_.open_m ? settled_s_ : 0.0;
+      if (settled_s_ >= p_.settle_s) enter(Step::kRetract);
+      break;
+    case Step::kRetract:
+      if (move_to({goal_.target_m.x(), goal_.target_m.y() + offset_y_, safe_z_}, p_.z_speed_m_s, s, dt_s))
+        enter(Step::kDone);
+      break;
+    case Step::kDone:
+      break;
+  }
+  return out_;
+}
+
+void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
+  const Eigen::Vector2d xy = goal_.target_m + Eigen::Vector2d(0.0, offset_y_);
+  const double floor_z = grasp_z_ - goal_.hole_depth_m;  // tips when the pin's bottom is on the bore's floor
+  switch (insert_) {
+    case Insert::kDescend: {
+      // Aim below the floor: the descent ends on a contact, on the rim or on the floor. Slowly
+      // only where a contact may come: the last 20 um to the surface and to the floor.
+      const double z = s.tip_m.z(), near = 20e-6;
+      const bool free = z > grasp_z_ + near || (z < grasp_z_ - near && z > floor_z + near);
+      move_to({xy.x(), xy.y(), floor_z - near}, free ? p_.z_speed_m_s : p_.insert_speed_m_s, s, dt);
+      if (s.contact_N.z() <= p_.contact_threshold_N) {
+        if (settled_s_ > 0.0) fail("no contact below the bore's floor: the pin is not in the fingers");
+        break;
+      }
+      contact_z_ = s.tip_m.z();
+      if (contact_z_ < grasp_z_ - 0.5 * goal_.hole_depth_m) {
+        enter(Step::kRelease);  // down in the bore
+        break;
+      }
+      // On the rim: the next point of the search along y (0, +s, -s, +2s, -2s, ...).
+      ++tries_;
+      const double step = p_.search_step_factor * goal_.clearance_m;
+      const int k = (tries_ + 1) / 2;
+      offset_y_ = (tries_ % 2 == 1 ? 1.0 : -1.0) * k * step;
+      if (std::abs(offset_y_) > p_.search_range_m + 1e-12) {
+        fail("jammed: no fit within search_range_m");
+        break;
+      }
+      retreat_xy_ = s.tip_m.head<2>();
+      retreat_z_ = std::min(contact_z_ + p_.search_retreat_m, carry_z_);
+      insert_ = Insert::kRetreat;
+      settled_s_ = 0.0;
+      break;
+    }
+    case Insert::kRetreat:
+      // Straight up from where the descent stopped (or from where the operator handed back).
+      if (!std::isfinite(retreat_z_)) {
+        retreat_xy_ = s.tip_m.head<2>();
+        retreat_z_ = std::min(s.tip_m.z() + p_.search_retreat_m, carry_z_);
+      }
+      if (move_to({retreat_xy_.x(), retreat_xy_.y(), retreat_z_}, p_.z_speed_m_s, s, dt)) {
+        insert_ = Insert::kShift;
+        settled_s_ = 0.0;
+      }
+      break;
+    case Insert::kShift:
+      if (move_to({xy.x(), xy.y(), retreat_z_}, p_.insert_speed_m_s, s, dt)) {
+        insert_ = Insert::kDescend;
+        settled_s_ = 0.0;
+      }
+      break;
+  }
+}
+
+}  // namespace mc::cell

@@ -1,0 +1,162 @@
+#pragma once
+/// @file
+/// The automatic pick-and-insert of one pin (issue #29 point 5, a first step): a sequence of
+/// steps with behaviour-tree semantics, run by the robot while the operator supervises, pauses,
+/// confirms, takes over and hands back. Like a ros2_control controller it is a pure object: each
+/// tick it reads the slave's sensors (TaskSensors: measured tip position, contact and grip
+/// forces, opening) and returns the console input the platform follows (control::ConsoleInput:
+/// a straight move to a goal at a speed, a gripper opening, the deadman), so that the platform's
+/// own limits (control/safety_limits.h: grip, contact, floor) apply to it as to any operator.
+///
+///   approach   over the pin's nominal slot, the finger tips clear of its top
+///   descend    to the grasp height: the tips `grip_above_m` above a full bore's depth
+///   grasp      close until the grip force reaches `grip_force_N` (the closing fingers centre
+///              the pin along x; its slot error along y stays unknown)
+///   lift       the pin's bottom `clearance_height_m` above the substrate
+///   transport  over the bore
+///   insert     force-guarded: down at `insert_speed_m_s` until the contact force exceeds
+///              `contact_threshold_N`. Reached near the bore's depth: inserted. Reached at the
+///              surface: jammed on the rim; up by `search_retreat_m`, over to the next point of
+///              the search along y (0, +s, -s, +2s, ... with s = search_step_factor x the bore's
+///              radial clearance; a pin fits when |dy| <= clearance), down again; beyond
+///              `search_range_m`: failed
+///   release    open the fingers (the substrate's adhesion keeps the pin in its bore)
+///   retract    up clear of the pin
+///
+/// Status: running; paused (pause(): the deadman is let go, so the coupling stops the stage's
+/// target at the next tick and the stage holds; resume() goes on from where the stage is);
+/// awaiting confirmation (a step whose autonomy is kConfirm waits before it starts, holding);
+/// operator (take_over(), or a step whose autonomy is kManual: the task sends nothing and the
+/// operator's master drives; hand_back() resumes the current step, re-planned from where the
+/// stage is, or the next one when the operator says the step is done); succeeded; failed (a step's
+/// timeout, a jam beyond the search). Every goal is a move from the coupling's current target
+/// at a bounded speed, so resuming and handing back never jump. Never allocates; noexcept.
+
+#include <array>
+#include <limits>
+#include <string_view>
+
+#include <Eigen/Dense>
+
+#include "microcobot/control/teleoperation.h"
+
+namespace mc::cell {
+
+struct AssemblyTaskParams {
+  double travel_speed_m_s = 500e-6;      ///< XY moves at a safe height
+  double z_speed_m_s = 200e-6;           ///< vertical moves
+  double insert_speed_m_s = 20e-6;       ///< the force-guarded descent and the search's moves
+  double clearance_height_m = 150e-6;    ///< tips above a pin's top, a carried pin above the plate
+  double grip_above_m = 100e-6;          ///< grasp: tips this far above a full bore's depth
+  double grip_force_N = 0.3e-3;          ///< grasp force (the platform's limit: world.grip_force_limit_N)
+  double close_rate_m_s = 200e-6;        ///< the fingers' closing speed while grasping
+  double contact_threshold_N = 60e-6;    ///< a contact force above this stops a descent
+  double search_retreat_m = 20e-6;       ///< lift before moving to the next search point
+  double search_step_factor = 1.5;       ///< search step / the bore's radial clearance (< 2)
+  double search_range_m = 25e-6;         ///< the search's extent along y, either side
+  double position_tolerance_m = 0.5e-6;  ///< a goal is reached within this ...
+  double settle_s = 0.05;                ///< ... for this long
+  double step_timeout_s = 20.0;          ///< a step that takes longer fails the task
+
+  template <class V>
+  void visit(V& v) {
+    v("travel_speed_m_s", travel_speed_m_s);
+    v("z_speed_m_s", z_speed_m_s);
+    v("insert_speed_m_s", insert_speed_m_s);
+    v("clearance_height_m", clearance_height_m);
+    v("grip_above_m", grip_above_m);
+    v("grip_force_N", grip_force_N);
+    v("close_rate_m_s", close_rate_m_s);
+    v("contact_threshold_N", contact_threshold_N);
+    v("search_retreat_m", search_retreat_m);
+    v("search_step_factor", search_step_factor);
+    v("search_range_m", search_range_m);
+    v("position_tolerance_m", position_tolerance_m);
+    v("settle_s", settle_s);
+    v("step_timeout_s", step_timeout_s);
+  }
+  void validate() const;
+};
+
+/// What the cell is told about one insertion (assembly_batch.h's AssemblyJob), world frame.
+struct AssemblyGoal {
+  Eigen::Vector2d part_m{0, 0};    ///< the pin's nominal position
+  Eigen::Vector2d target_m{0, 0};  ///< the bore
+  double part_height_m = 600e-6;
+  double hole_depth_m = 300e-6;
+  double clearance_m = 10e-6;  ///< the bore's radial clearance
+  double open_m = 600e-6;      ///< the gripper fully open
+};
+
+/// The slave's sensors at one tick, world frame.
+struct TaskSensors {
+  Eigen::Vector3d tip_m = Eigen::Vector3d::Zero();      ///< measured finger-tip position
+  Eigen::Vector3d contact_N = Eigen::Vector3d::Zero();  ///< force on the gripper
+  double grip_N = 0.0;
+  double opening_m = 0.0;
+};
+
+class AssemblyTask {
+ public:
+  enum class Step { kApproach, kDescend, kGrasp, kLift, kTransport, kInsert, kRelease, kRetract, kDone };
+  static constexpr int kStepCount = 9;
+  enum class Status { kRunning, kPaused, kAwaitingConfirm, kOperator, kSucceeded, kFailed };
+  enum class Autonomy { kAuto, kConfirm, kManual };
+
+  /// Throws mc::InvalidParams (parameters, goal).
+  AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal);
+
+  /// One tick of `dt_s`: the console input to hand the platform (drives() says whether to).
+  const control::ConsoleInput& tick(const TaskSensors& s, double dt_s) noexcept;
+  /// False while the operator drives (taken over, a manual step) and once finished.
+  bool drives() const noexcept { return status_ != Status::kOperator && !finished(); }
+  bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
+
+  void pause() noexcept;
+  void resume() noexcept;
+  void confirm() noexcept;
+  void take_over() noexcept;
+  /// The operator hands back: the current step again from where the stage is, or, with
+  /// `step_done`, the next one.
+  void hand_back(bool step_done = false) noexcept;
+  void set_autonomy(Step step, Autonomy a) noexcept { autonomy_[index(step)] = a; }
+
+  Step step() const noexcept { return step_; }
+  Status status() const noexcept { return status_; }
+  /// Why the task failed ("" otherwise); a static string.
+  std::string_view failure() const noexcept { return failure_; }
+  int search_tries() const noexcept { return tries_; }
+  /// Tip height at which the inserting descent met its stop (NaN before).
+  double insert_contact_z_m() const noexcept { return contact_z_; }
+  static std::string_view name(Step s) noexcept;
+  static std::string_view name(Status s) noexcept;
+
+ private:
+  enum class Insert { kDescend, kRetreat, kShift };
+  static std::size_t index(Step s) noexcept { return static_cast<std::size_t>(s); }
+  void enter(Step s) noexcept;
+  void begin_step() noexcept;
+  void fail(const char* why) noexcept;
+  /// Heads for `goal` at `speed`; true once the tip has been within tolerance for settle_s.
+  bool move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s, double dt) noexcept;
+  void insert_tick(const TaskSensors& s, double dt) noexcept;
+
+  AssemblyTaskParams p_;
+  AssemblyGoal goal_;
+  std::array<Autonomy, kStepCount> autonomy_{};
+  control::ConsoleInput out_;
+  Step step_ = Step::kApproach;
+  Status status_ = Status::kRunning;
+  const char* failure_ = "";
+  double step_s_ = 0.0, settled_s_ = 0.0;
+  double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
+  double opening_command_ = 0.0;
+  Insert insert_ = Insert::kDescend;
+  int tries_ = 0;                                                // search points tried
+  double offset_y_ = 0.0;                                        // the current search point
+  double contact_z_ = std::numeric_limits<double>::quiet_NaN();  // where the last descent stopped
+  Eigen::Vector2d retreat_xy_{0, 0};                             // the search's way up: from here ...
+  double retreat_z_ = 0.0;                                       // ... to here (NaN: from where the tip is)
+};
+
+}  // namespace mc::cell

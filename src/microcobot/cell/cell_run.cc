@@ -1,0 +1,293 @@
+#include "microcobot/cell/cell_run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "microcobot/core/error.h"
+#include "microcobot/platform/simulated_gripper.h"
+
+namespace mc::cell {
+
+std::vector<std::string> cell_modes() { return {"auto", "manual"}; }
+
+void CellRunParams::validate() const {
+  const auto modes = cell_modes();
+  require(std::find(modes.begin(), modes.end(), mode) != modes.end(), "mode", "must be auto or manual");
+  require(std::isfinite(max_cycle_s) && max_cycle_s >= 1.0 && max_cycle_s <= 3600.0, "max_cycle_s",
+          "must be within [1, 3600] s", max_cycle_s);
+  task.validate();
+  manual.validate();
+}
+
+nlohmann::json CycleResult::to_json() const {
+  return {{"index", index},
+          {"mode", mode},
+          {"success", success},
+          {"verdict", verdict},
+          {"cycle_s", cycle_s},
+          {"placement_error_m", placement_error_m},
+          {"peak_grip_N", peak_grip_N},
+          {"mean_grip_N", mean_grip_N},
+          {"peak_contact_N", peak_contact_N},
+          {"grip_violations", grip_violations},
+          {"contact_violations", contact_violations},
+          {"clutches", clutches},
+          {"search_tries", search_tries},
+          {"path_m", path_m},
+          {"side_m", side_m},
+          {"clearance_m", clearance_m},
+          {"wall_s", wall_s},
+          {"ended_holding", ended_holding}};
+}
+
+nlohmann::json BatchSummary::to_json() const {
+  return {{"mode", mode},
+          {"cycles", cycles},
+          {"successes", successes},
+          {"success_rate", success_rate},
+          {"success_rate_95ci", {success_low, success_high}},
+          {"cycle_median_s", cycle_median_s},
+          {"cycle_iqr_s", {cycle_q1_s, cycle_q3_s}},
+          {"placement_median_m", placement_median_m},
+          {"peak_grip_max_N", peak_grip_max_N},
+          {"peak_contact_max_N", peak_contact_max_N},
+          {"force_violations", force_violations},
+          {"simulated_s", simulated_s},
+          {"wall_s", wall_s}};
+}
+
+/// What the cycle measures at every operator tick (on the loop: arithmetic only).
+struct CellCycle::Meter {
+  double grip_limit_N = 0.0, contact_limit_N = 0.0;
+  double peak_grip = 0.0, grip_sum = 0.0, peak_contact = 0.0, path = 0.0;
+  long gripped_ticks = 0;
+  int grip_over = 0, contact_over = 0;
+  Eigen::Vector3d last_tip = Eigen::Vector3d::Constant(NAN);
+
+  void sample(const TaskSensors& s) {
+    const double contact = s.contact_N.norm();
+    peak_grip = std::max(peak_grip, s.grip_N);
+    peak_contact = std::max(peak_contact, contact);
+    if (s.grip_N > 0.0) {
+      grip_sum += s.grip_N;
+      ++gripped_ticks;
+    }
+    // Over the limit by more than rounding: the limits clamp the command at the limit itself.
+    if (s.grip_N > grip_limit_N * (1.0 + 1e-6)) ++grip_over;
+    if (contact > contact_limit_N * (1.0 + 1e-6)) ++contact_over;
+    if (last_tip.allFinite()) path += (s.tip_m - last_tip).norm();
+    last_tip = s.tip_m;
+  }
+};
+
+namespace {
+
+TaskSensors read_sensors(const platform::Platform& p, const Eigen::Vector3d& home_m) {
+  TaskSensors s;
+  for (int i = 0; i < 3; ++i) s.tip_m[i] = home_m[i] + p.axis(i).position_m();
+  const platform::Vec3 f = p.gripper().contact_force_N();
+  s.contact_N = {f.x, f.y, f.z};
+  s.grip_N = p.gripper().grip_force_N();
+  s.opening_m = p.gripper().opening_m();
+  return s;
+}
+
+platform::PlatformConfig with_world(platform::PlatformConfig c, const AssemblyJob& job) {
+  c.microworld = "pick-place";
+  c.world = job.world;
+  c.validate();
+  return c;
+}
+
+}  // namespace
+
+CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platform::PlatformConfig base)
+    : job_(job),
+      params_(params),
+      start_(std::chrono::steady_clock::now()),
+      meter_(std::make_unique<Meter>()) {
+  params_.validate();
+  base = with_world(std::move(base), job);
+  platform_ = std::make_unique<platform::Platform>(base);
+  home_m_ = {base.stage.home_x_m, base.stage.home_y_m, base.stage.home_z_m};
+  meter_->grip_limit_N = job.world.grip_force_limit_N;
+  meter_->contact_limit_N = job.world.contact_force_limit_N;
+  platform::Platform& p = *platform_;
+  if (params_.mode == "auto") {
+    AssemblyGoal goal;
+    goal.part_m = job.nominal_part_m;
+    goal.target_m = job.target_m;
+    goal.part_height_m = job.world.height_m();
+    goal.hole_depth_m = job.world.hole_depth_m;
+    goal.clearance_m = job.clearance_m;
+    goal.open_m = job.world.gripper.max_opening_m;
+    task_ = std::make_unique<AssemblyTask>(params_.task, goal);
+    p.set_operator([this](const platform::TickInfo& t) {
+      const TaskSensors s = read_sensors(*platform_, home_m_);
+      meter_->sample(s);
+      // Holding (deadman off) whenever the task does not drive: paused, awaiting, finished.
+      // Taken over, the operator's master drives: the console lets go.
+      control::ConsoleInput in = task_->tick(s, t.dt_s);
+      if (task_->status() == AssemblyTask::Status::kOperator) in.active = false;
+      platform_->set_console_input(in);
+      if (task_->finished() && !finished_) {
+        finished_ = true;
+        finished_at_s_ = t.t_s;
+        platform_->hold();  // the sequence ends with every axis holding
+        held_ = true;
+      }
+      if (observer_) observer_(t.t_s);
+    });
+  } else {
+    manual_ = std::make_unique<platform::PickPlaceOperator>(p, params_.manual);
+    p.set_operator([this](const platform::TickInfo& t) {
+      meter_->sample(read_sensors(*platform_, home_m_));
+      manual_->act(t);
+      if ((manual_->done() || manual_->gave_up()) && !finished_) {
+        finished_ = true;
+        finished_at_s_ = t.t_s;
+      }
+      if (observer_) observer_(t.t_s);
+    });
+  }
+}
+
+CellCycle::~CellCycle() = default;
+
+void CellCycle::run_for(double duration_s) {
+  platform::Platform& p = *platform_;
+  const double end = std::min(p.loop().time_s() + duration_s, params_.max_cycle_s);
+  while (!finished_ && !p.faulted() && p.loop().time_s() < end - 1e-9)
+    p.run(std::min(1.0, end - p.loop().time_s()));
+  if (finished_ && !settled_) {
+    p.run(0.2);  // the stage settles where it was left, and is seen holding there
+    settled_ = true;
+  }
+}
+
+void CellCycle::run_to_end() { run_for(params_.max_cycle_s); }
+
+CycleResult CellCycle::result() const {
+  const platform::Platform& p = *platform_;
+  const Meter& meter = *meter_;
+  CycleResult r;
+  r.index = job_.index;
+  r.mode = params_.mode;
+  r.side_m = job_.side_m;
+  r.clearance_m = job_.clearance_m;
+  r.cycle_s = finished_ ? finished_at_s_ : p.loop().time_s();
+  const auto& gripper = *p.simulation().gripper;
+  const auto& w = gripper.world_state();
+  const bool inserted = gripper.world().inserted(w) && w.phase == microworld::PartPhase::kOnSubstrate;
+  r.placement_error_m = gripper.world().placement_error_m(w);
+  r.peak_grip_N = meter.peak_grip;
+  r.mean_grip_N = meter.gripped_ticks > 0 ? meter.grip_sum / static_cast<double>(meter.gripped_ticks) : 0.0;
+  r.peak_contact_N = meter.peak_contact;
+  r.grip_violations = meter.grip_over;
+  r.contact_violations = meter.contact_over;
+  r.path_m = meter.path;
+  const auto& teleop = p.teleop();
+  Eigen::Vector3d measured;
+  for (int i = 0; i < 3; ++i) measured[i] = p.axis(i).position_m();
+  r.ended_holding = !teleop.engaged && (teleop.slave_target_m - measured).norm() < 1e-6;
+  if (task_) {
+    r.search_tries = task_->search_tries();
+    r.success = task_->status() == AssemblyTask::Status::kSucceeded && inserted;
+    if (p.faulted()) {
+      r.verdict = "a device faulted";
+    } else if (!finished_) {
+      r.verdict =
+          "not finished within max_cycle_s (in step " + std::string(AssemblyTask::name(task_->step())) + ")";
+    } else if (task_->status() == AssemblyTask::Status::kFailed) {
+      r.verdict = "failed in step " + std::string(AssemblyTask::name(task_->step())) + ": " +
+                  std::string(task_->failure());
+    } else {
+      r.verdict = inserted ? "inserted and released" : "the task ended but the pin is not down in its bore";
+    }
+    r.ended_holding = r.ended_holding && held_;
+  } else {
+    r.clutches = manual_->clutches();
+    r.success = manual_->done() && inserted;
+    if (p.faulted()) {
+      r.verdict = "a device faulted";
+    } else if (manual_->gave_up()) {
+      r.verdict = "the operator gave up in phase " +
+                  std::string(platform::PickPlaceOperator::name(manual_->failed_phase()));
+    } else if (!finished_) {
+      r.verdict = "not finished within max_cycle_s";
+    } else {
+      r.verdict =
+          inserted ? "inserted and released" : "the operator finished but the pin is not down in its bore";
+    }
+  }
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  return r;
+}
+
+CycleResult run_cycle(const AssemblyJob& job, const CellRunParams& params, platform::PlatformConfig base) {
+  CellCycle c(job, params, std::move(base));
+  c.run_to_end();
+  return c.result();
+}
+
+std::vector<CycleResult> run_batch(const std::vector<AssemblyJob>& jobs, const CellRunParams& params,
+                                   const platform::PlatformConfig& base,
+                                   const std::function<void(const CycleResult&)>& progress) {
+  params.validate();
+  std::vector<CycleResult> out;
+  out.reserve(jobs.size());
+  for (const AssemblyJob& j : jobs) {
+    out.push_back(run_cycle(j, params, base));
+    if (progress) progress(out.back());
+  }
+  return out;
+}
+
+namespace {
+
+// The q-quantile of sorted values, linearly interpolated (type 7, numpy's default).
+double quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return NAN;
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+}
+
+}  // namespace
+
+BatchSummary summarize(const std::vector<CycleResult>& cycles) {
+  BatchSummary s;
+  s.cycles = static_cast<int>(cycles.size());
+  if (cycles.empty()) return s;
+  s.mode = cycles.front().mode;
+  std::vector<double> times, placement;
+  for (const CycleResult& c : cycles) {
+    s.successes += c.success ? 1 : 0;
+    times.push_back(c.cycle_s);
+    placement.push_back(c.placement_error_m);
+    s.peak_grip_max_N = std::max(s.peak_grip_max_N, c.peak_grip_N);
+    s.peak_contact_max_N = std::max(s.peak_contact_max_N, c.peak_contact_N);
+    s.force_violations += c.grip_violations + c.contact_violations;
+    s.simulated_s += c.cycle_s;
+    s.wall_s += c.wall_s;
+  }
+  std::sort(times.begin(), times.end());
+  std::sort(placement.begin(), placement.end());
+  s.cycle_median_s = quantile(times, 0.5);
+  s.cycle_q1_s = quantile(times, 0.25);
+  s.cycle_q3_s = quantile(times, 0.75);
+  s.placement_median_m = quantile(placement, 0.5);
+  // Wilson's score interval at 95 % (z = 1.96): sound at 0 and at n successes, unlike Wald's.
+  const double n = s.cycles, p = s.successes / n, z = 1.959964;
+  s.success_rate = p;
+  const double centre = (p + z * z / (2 * n)) / (1 + z * z / n);
+  const double half = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n);
+  s.success_low = std::max(0.0, centre - half);
+  s.success_high = std::min(1.0, centre + half);
+  return s;
+}
+
+}  // namespace mc::cell

@@ -1,0 +1,138 @@
+#pragma once
+/// @file
+/// A batch of the assembly cell run headless (issue #29 point 6, a first step): each part of an
+/// AssemblyBatch picked from its slot and inserted into its bore on a fresh simulated platform,
+/// by the robot (mode "auto": AssemblyTask through the console input, the platform's limits in
+/// force) or by the scripted watchmaker (mode "manual": platform::PickPlaceOperator on the haptic
+/// master and the TéléTweez, who sees the pin through the microscope to within 1 um and has none
+/// of a person's reaction time or tremor yet). Each cycle is measured from the platform's own
+/// sensors and the simulation's truth: time, success (the pin down in its bore, released),
+/// placement error, grip and contact forces and the ticks over their limits, path length, clutch
+/// presses, the search's tries. An automatic cycle ends with every axis holding
+/// (Platform::hold()).
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "microcobot/cell/assembly_batch.h"
+#include "microcobot/cell/assembly_task.h"
+#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/platform/platform.h"
+#include "microcobot/platform/platform_config.h"
+
+namespace mc::cell {
+
+struct CellRunParams {
+  std::string mode = "auto";   ///< "auto" or "manual"
+  double max_cycle_s = 120.0;  ///< simulated; a cycle not finished by then fails
+  AssemblyTaskParams task;
+  /// The scripted watchmaker, with time for the batch's longer transports (up to ~5 mm at
+  /// 100 um/s, where the main scenario's is 2 mm).
+  platform::PickPlaceOperatorParams manual = manual_defaults();
+
+  template <class V>
+  void visit(V& v) {
+    v("mode", mode);
+    v("max_cycle_s", max_cycle_s);
+    v("task", task);
+    v("manual", manual);
+  }
+  void validate() const;
+  static platform::PickPlaceOperatorParams manual_defaults() {
+    platform::PickPlaceOperatorParams m;
+    m.phase_timeout_s = 90.0;
+    return m;
+  }
+};
+
+/// The modes, for --help and errors.
+std::vector<std::string> cell_modes();
+
+struct CycleResult {
+  int index = 0;
+  std::string mode;
+  bool success = false;
+  std::string verdict;   ///< one line
+  double cycle_s = 0.0;  ///< simulated time to the end of the task (or the limit)
+  double placement_error_m = 0.0;
+  double peak_grip_N = 0.0, mean_grip_N = 0.0;  ///< mean over the ticks the pin was gripped
+  double peak_contact_N = 0.0;
+  int grip_violations = 0, contact_violations = 0;  ///< ticks over the platform's limits
+  int clutches = 0;
+  int search_tries = 0;
+  double path_m = 0.0;  ///< length of the measured tip's path
+  double side_m = 0.0, clearance_m = 0.0;
+  double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
+  bool ended_holding = false;  ///< every axis' target at its measured position, the coupling off
+  nlohmann::json to_json() const;
+};
+
+/// Median, quartiles and the success rate with its 95 % Wilson interval.
+struct BatchSummary {
+  std::string mode;
+  int cycles = 0, successes = 0;
+  double success_rate = 0.0, success_low = 0.0, success_high = 0.0;
+  double cycle_median_s = 0.0, cycle_q1_s = 0.0, cycle_q3_s = 0.0;
+  double placement_median_m = 0.0;
+  double peak_grip_max_N = 0.0, peak_contact_max_N = 0.0;
+  int force_violations = 0;
+  double simulated_s = 0.0, wall_s = 0.0;
+  nlohmann::json to_json() const;
+};
+
+/// One part's cycle on its own simulated platform, steppable: the operator's controls (pause,
+/// take over, ...) reach its task between steps (tests, the console).
+class CellCycle {
+ public:
+  /// `base` is the platform's configuration (its world is replaced by the job's). Throws
+  /// mc::Error (parameters, a platform that cannot be built).
+  CellCycle(const AssemblyJob& job, const CellRunParams& params, platform::PlatformConfig base);
+  ~CellCycle();
+  CellCycle(const CellCycle&) = delete;
+  CellCycle& operator=(const CellCycle&) = delete;
+
+  /// Runs for `duration_s` of simulated time, or to the end of the cycle (then 0.2 s more, the
+  /// stage seen holding where it was left).
+  void run_for(double duration_s);
+  /// To the end, or to params.max_cycle_s.
+  void run_to_end();
+  bool finished() const noexcept { return finished_; }
+  /// Called at the end of every operator tick with its time, on the loop (real-time rules):
+  /// an observer, or an operator's hand on the task's controls at a given moment.
+  void set_observer(std::function<void(double t_s)> observer) { observer_ = std::move(observer); }
+  /// The automatic task (null in manual mode).
+  AssemblyTask* task() noexcept { return task_.get(); }
+  platform::Platform& platform() noexcept { return *platform_; }
+  CycleResult result() const;
+
+ private:
+  struct Meter;
+  AssemblyJob job_;
+  CellRunParams params_;
+  std::chrono::steady_clock::time_point start_;
+  std::unique_ptr<platform::Platform> platform_;
+  std::unique_ptr<AssemblyTask> task_;
+  std::unique_ptr<platform::PickPlaceOperator> manual_;
+  std::unique_ptr<Meter> meter_;
+  std::function<void(double)> observer_;
+  Eigen::Vector3d home_m_;
+  bool finished_ = false, held_ = false, settled_ = false;
+  double finished_at_s_ = 0.0;
+};
+
+/// One part, run to its end.
+CycleResult run_cycle(const AssemblyJob& job, const CellRunParams& params, platform::PlatformConfig base);
+
+/// Every part in order; `progress(i, result)` after each.
+std::vector<CycleResult> run_batch(const std::vector<AssemblyJob>& jobs, const CellRunParams& params,
+                                   const platform::PlatformConfig& base,
+                                   const std::function<void(const CycleResult&)>& progress = {});
+
+BatchSummary summarize(const std::vector<CycleResult>& cycles);
+
+}  // namespace mc::cell

@@ -1,0 +1,62 @@
+// The batch of insertions (issue #29 point 1): seeded, within its ranges, the pins off their
+// slots by what the robot is not told, and bad scenes refused with the key named.
+#include "microcobot/cell/assembly_batch.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "microcobot/core/error.h"
+#include "microcobot/core/params.h"
+
+namespace mc::cell {
+namespace {
+
+TEST(AssemblyBatch, TheSameSeedGivesTheSameBatchWithinItsRanges) {
+  AssemblyBatchParams p;
+  p.parts = 200;
+  p.seed = 29;
+  const auto a = assembly_jobs(p), b = assembly_jobs(p);
+  ASSERT_EQ(a.size(), 200u);
+  double sum_sq = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].world.part_start_m, b[i].world.part_start_m);
+    EXPECT_EQ(a[i].side_m, b[i].side_m);
+    EXPECT_GE(a[i].side_m, p.min_side_m);
+    EXPECT_LE(a[i].side_m, p.max_side_m);
+    EXPECT_GE(a[i].clearance_m, p.min_clearance_m);
+    EXPECT_LE(a[i].clearance_m, p.max_clearance_m);
+    EXPECT_NEAR(a[i].world.hole_side_m - a[i].world.part_side_m, 2.0 * a[i].clearance_m, 1e-15);
+    EXPECT_LE(std::abs(a[i].nominal_part_m.x() - p.tray_x_m), p.half_size_m);
+    EXPECT_LE(std::abs(a[i].target_m.y() - p.plate_y_m), p.half_size_m);
+    EXPECT_EQ(a[i].world.target_m.head<2>(), a[i].target_m) << "the bores are where the cell is told";
+    sum_sq += (a[i].world.part_start_m.head<2>() - a[i].nominal_part_m).squaredNorm();
+  }
+  // The slot error: sigma per axis as asked (400 draws: within 15 %).
+  EXPECT_NEAR(std::sqrt(sum_sq / (2.0 * a.size())), p.slot_error_m, 0.15 * p.slot_error_m);
+  p.seed = 30;
+  EXPECT_NE(assembly_jobs(p)[0].side_m, a[0].side_m);
+}
+
+TEST(AssemblyBatch, BadScenesAreRefusedWithTheKeyNamed) {
+  const auto refused = [](const std::string& yaml, const std::string& key) {
+    try {
+      (void)assembly_jobs(params_from_yaml_text<AssemblyBatchParams>(yaml));
+      ADD_FAILURE() << yaml << ": accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  refused("parts: 0", "parts");
+  refused("max_side_m: 590.0e-6", "max_side_m");  // the open gripper is 600 um
+  refused("min_clearance_m: 10.0e-6\nmax_clearance_m: 5.0e-6", "max_clearance_m");
+  refused("slot_error_m: 10.0e-6", "slot_error_m");     // 4 sigma beyond a 100 um pin's flats
+  refused("part_height_m: 350.0e-6", "part_height_m");  // nothing to hold above a 300 um bore
+  refused("plate_x_m: 3.9e-3", "plate_x_m");            // beyond the stage's reach
+  refused("bore_depth: 1", "bore_depth");               // an unknown key
+  refused("world:\n  finger_friction: -1", "finger_friction");
+}
+
+}  // namespace
+}  // namespace mc::cell

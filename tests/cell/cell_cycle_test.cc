@@ -1,0 +1,157 @@
+// The automatic insertion on the simulated platform (issue #29 point 5): a cycle inserts its pin
+// under the platform's limits and ends with every axis holding; pausing stops the commanded
+// motion at the next tick; confirming, taking over and handing back never jump; a jam the
+// search cannot clear fails and holds.
+#include "microcobot/cell/cell_run.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::cell {
+namespace {
+
+// The default platform (named: GCC 12 sees its temporaries' members as maybe uninitialised).
+const platform::PlatformConfig& base() {
+  static const platform::PlatformConfig c;
+  return c;
+}
+
+using Status = AssemblyTask::Status;
+using Step = AssemblyTask::Step;
+
+// One pin of a batch seeded apart from the ones the defaults were chosen on (seeds 1-2).
+AssemblyJob job(int seed = 41, double clearance_m = 0.0) {
+  AssemblyBatchParams p;
+  p.parts = 1;
+  p.seed = seed;
+  if (clearance_m > 0.0) p.min_clearance_m = p.max_clearance_m = clearance_m;
+  return assembly_jobs(p).front();
+}
+
+Eigen::Vector3d target(platform::Platform& p) { return p.teleop().slave_target_m; }
+
+TEST(CellCycle, TheRobotInsertsAPinUnderTheLimitsAndEndsHolding) {
+  CellCycle c(job(), CellRunParams{}, base());
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+  EXPECT_LE(r.peak_grip_N, c.platform().config().world.grip_force_limit_N);
+  EXPECT_TRUE(r.ended_holding);
+  EXPECT_LE(r.placement_error_m, r.clearance_m * std::sqrt(2.0) + 1e-9) << "inside its bore";
+  EXPECT_LT(r.cycle_s, 30.0);
+  // Holding: the stage stays where it ended.
+  const Eigen::Vector3d before = target(c.platform());
+  c.platform().run(0.5);
+  EXPECT_LT((target(c.platform()) - before).norm(), 1e-12);
+}
+
+TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {
+  CellCycle c(job(), CellRunParams{}, base());
+  // Mid-transport the operator pauses for a second, then resumes.
+  double paused_at = -1.0, transport_at = -1.0;
+  Eigen::Vector3d at_pause, last = target(c.platform());
+  double moved_while_paused = 0.0, step_before = 0.0;
+  bool was_paused = false;
+  c.set_observer([&](double t) {
+    const Eigen::Vector3d now = target(c.platform());
+    AssemblyTask& task = *c.task();
+    if (task.step() == Step::kTransport && transport_at < 0.0) transport_at = t;
+    if (transport_at >= 0.0 && paused_at < 0.0 && t >= transport_at + 0.5) {
+      step_before = (now - last).norm();  // moving at the travel speed
+      task.pause();
+      paused_at = t;
+    } else if (paused_at >= 0.0 && t <= paused_at + 1e-3 + 1e-9) {
+      at_pause = now;  // the tick that sees the pause
+      was_paused = task.status() == Status::kPaused;
+    } else if (paused_at >= 0.0 && t < paused_at + 1.0) {
+      moved_while_paused = std::max(moved_while_paused, (now - at_pause).norm());
+    } else if (paused_at >= 0.0 && task.status() == Status::kPaused) {
+      task.resume();
+    }
+    last = now;
+  });
+  c.run_to_end();
+  ASSERT_GE(paused_at, 0.0);
+  EXPECT_GT(step_before, 1e-7) << "moving before the pause";
+  EXPECT_TRUE(was_paused);
+  EXPECT_EQ(moved_while_paused, 0.0) << "the target stopped within one tick and stayed";
+  EXPECT_TRUE(c.result().success) << c.result().verdict;
+  EXPECT_TRUE(c.result().ended_holding);
+}
+
+TEST(CellCycle, ConfirmTakeOverAndHandBackNeverJump) {
+  CellCycle c(job(), CellRunParams{}, base());
+  c.task()->set_autonomy(Step::kInsert, AssemblyTask::Autonomy::kConfirm);
+  // The operator confirms the insertion after half a second, takes over 0.3 s into it and hands
+  // back 0.2 s later (the simulated haptic master's deadman is not pressed: the stage holds);
+  // the insertion then goes on from where the stage is.
+  double waiting_at = -1.0, confirmed_at = -1.0, taken_at = -1.0, largest = 0.0, moved_waiting = 0.0;
+  bool saw_operator = false;
+  Eigen::Vector3d last = target(c.platform()), waiting;
+  c.set_observer([&](double t) {
+    AssemblyTask& task = *c.task();
+    const Eigen::Vector3d now = target(c.platform());
+    largest = std::max(largest, (now - last).norm());
+    last = now;
+    if (task.status() == Status::kAwaitingConfirm) {
+      if (waiting_at < 0.0) waiting_at = t, waiting = now;
+      moved_waiting = std::max(moved_waiting, (now - waiting).norm());
+      if (t >= waiting_at + 0.5) task.confirm(), confirmed_at = t;
+    } else if (confirmed_at >= 0.0 && taken_at < 0.0 && t >= confirmed_at + 0.3) {
+      task.take_over();
+      taken_at = t;
+    } else if (taken_at >= 0.0 && task.status() == Status::kOperator) {
+      saw_operator = true;
+      if (t >= taken_at + 0.2) task.hand_back();
+    }
+  });
+  c.run_to_end();
+  ASSERT_GE(taken_at, 0.0);
+  EXPECT_TRUE(saw_operator);
+  EXPECT_EQ(moved_waiting, 0.0) << "holds until confirmed";
+  // At most the fastest move's step per 1 ms operator tick (every goal move is speed-bounded).
+  EXPECT_LE(largest, CellRunParams{}.task.travel_speed_m_s * 1e-3 * 1.001);
+  EXPECT_TRUE(c.result().success) << c.result().verdict;
+  EXPECT_TRUE(c.result().ended_holding);
+}
+
+TEST(CellCycle, AJamTheSearchCannotClearFailsAndHolds) {
+  CellRunParams params;
+  params.task.search_range_m = 0.0;  // no search: a pin off its bore jams for good
+  // A pin far off its slot (|dy| > clearance), by moving its true start.
+  AssemblyJob j = job(43, 4e-6);
+  j.world.part_start_m.y() = j.nominal_part_m.y() + 12e-6;
+  CellCycle c(j, params, base());
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.verdict.find("jammed"), std::string::npos) << r.verdict;
+  EXPECT_TRUE(r.ended_holding);
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+  // With the search, the same pin goes in.
+  CellCycle searched(j, CellRunParams{}, base());
+  searched.run_to_end();
+  EXPECT_TRUE(searched.result().success) << searched.result().verdict;
+  EXPECT_GE(searched.result().search_tries, 2);
+}
+
+TEST(CellCycle, BadParametersAreRefusedWithTheKeyNamed) {
+  CellRunParams p;
+  p.mode = "remote";
+  EXPECT_THROW(CellCycle(job(), p, base()), InvalidParams);
+  p = CellRunParams{};
+  p.task.search_step_factor = 2.5;
+  try {
+    CellCycle(job(), p, base());
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("search_step_factor"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mc::cell

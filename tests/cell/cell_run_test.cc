@@ -1,0 +1,51 @@
+// A small campaign (issue #29 tests): the robot and the scripted watchmaker on the same seeded
+// parts, the goals' directions asserted; the summary's statistics.
+#include "microcobot/cell/cell_run.h"
+
+#include <gtest/gtest.h>
+
+namespace mc::cell {
+namespace {
+
+// The default platform (named: GCC 12 sees its temporaries' members as maybe uninitialised).
+const platform::PlatformConfig& base() {
+  static const platform::PlatformConfig c;
+  return c;
+}
+
+TEST(CellRun, OnTheSamePartsTheRobotIsFasterThanTheScriptedWatchmakerAndBothStayUnderTheLimits) {
+  AssemblyBatchParams scene;
+  scene.parts = 3;
+  scene.seed = 47;  // not a seed the defaults were chosen on
+  const auto jobs = assembly_jobs(scene);
+  CellRunParams a;
+  const auto robot = summarize(run_batch(jobs, a, base()));
+  a.mode = "manual";
+  const auto person = summarize(run_batch(jobs, a, base()));
+  EXPECT_EQ(robot.successes, 3);
+  EXPECT_EQ(person.successes, 3);
+  EXPECT_EQ(robot.force_violations + person.force_violations, 0);
+  EXPECT_LT(robot.cycle_median_s, 30.0);
+  EXPECT_LT(robot.cycle_median_s, 0.7 * person.cycle_median_s);
+  std::printf("3 parts (seed 47): robot %.1f s median, scripted watchmaker %.1f s\n", robot.cycle_median_s,
+              person.cycle_median_s);
+}
+
+TEST(CellRun, TheSummaryHasQuartilesAndAWilsonInterval) {
+  std::vector<CycleResult> c(10);
+  for (int i = 0; i < 10; ++i) {
+    c[static_cast<std::size_t>(i)].cycle_s = i + 1;  // 1..10 s
+    c[static_cast<std::size_t>(i)].success = i < 8;
+  }
+  const BatchSummary s = summarize(c);
+  EXPECT_DOUBLE_EQ(s.cycle_median_s, 5.5);
+  EXPECT_DOUBLE_EQ(s.cycle_q1_s, 3.25);  // numpy.percentile([1..10], 25)
+  EXPECT_DOUBLE_EQ(s.cycle_q3_s, 7.75);
+  EXPECT_DOUBLE_EQ(s.success_rate, 0.8);
+  // Wilson 95 % for 8/10: scipy.stats.binomtest(8, 10).proportion_ci(method="wilson").
+  EXPECT_NEAR(s.success_low, 0.4902, 1e-4);
+  EXPECT_NEAR(s.success_high, 0.9433, 1e-4);
+}
+
+}  // namespace
+}  // namespace mc::cell

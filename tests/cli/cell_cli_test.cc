@@ -1,0 +1,58 @@
+// `microcobot cell run|params` (issue #29) as a user runs them: the batch's summary and files, and
+// one-line errors with their exit codes.
+
+#include <filesystem>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "microcobot/core/csv.h"
+#include "support/test_support.h"
+
+namespace mc {
+namespace {
+
+using test::run_cli;
+using ::testing::HasSubstr;
+
+TEST(CellCli, RunsABatchAndWritesItsCyclesAndSummary) {
+  test::TempDir dir;
+  const auto r =
+      run_cli({"cell", "run", "--batch", "2", "--seed", "53", "--json", "--out", dir.path().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["cycles"].get<int>(), 2);
+  EXPECT_EQ(j["successes"].get<int>(), 2);
+  EXPECT_EQ(j["force_violations"].get<int>(), 0);
+  EXPECT_EQ(j["seed"].get<int>(), 53);
+  const CsvTable t = read_csv(dir / "cycles.csv");
+  EXPECT_EQ(t.rows(), 2u);
+  EXPECT_EQ(t.column("success"), (std::vector<double>{1.0, 1.0}));
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "summary.json"))["cycles"].get<int>(), 2);
+}
+
+TEST(CellCli, BadInputGetsOneLineAndItsExitCode) {
+  test::TempDir dir;
+  auto r = run_cli({"cell", "run", "--batch", "0"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--batch"));
+  r = run_cli({"cell", "run", "--mode", "telepathy"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("telepathy"));
+  test::write_text(dir / "scene.yaml", "parts: 2\nbore_depth_m: 1.0\n");
+  r = run_cli({"cell", "run", "--scene", (dir / "scene.yaml").string(), "--out", (dir / "o").string()});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("bore_depth_m"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "o")) << "nothing half-written";
+  test::write_text(dir / "scene.yaml", "slot_error_m: 1.0e-3\n");
+  r = run_cli({"cell", "run", "--scene", (dir / "scene.yaml").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_THAT(r.err, HasSubstr("slot_error_m"));
+  const auto p = run_cli({"cell", "params", "--json"});
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_EQ(nlohmann::json::parse(p.out)["scene"]["parts"].get<int>(), 10);
+}
+
+}  // namespace
+}  // namespace mc
