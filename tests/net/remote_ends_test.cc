@@ -469,8 +469,18 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   live::ConsoleCommand c;
   deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(0.0, c), c.deadman; });
   deliver(peer, Channel::kTarget, {10e-6, 0, 0}, 0.0, [&] { return remote.poll(1.0, c).fresh; });
+  // The master (re)appeared: the jitter buffer starts a new session, without the targets of the poll
+  // that saw it. A master sends on (every ms): the target again until the goal moves. (With every
+  // copy taken in that one poll, as a loaded machine may batch them, the goal had nothing to join.)
+  double largest_step = 0.0, last = c.goal_m[0];
+  deliver(peer, Channel::kTarget, {10e-6, 0, 0}, 0.0, [&] {
+    remote.poll(1.0, c);
+    largest_step = std::max(largest_step, std::abs(c.goal_m[0] - last));
+    last = c.goal_m[0];
+    return c.goal_m[0] > config.stage.home_x_m;
+  });
   // A lone target is joined at the target stream's speed limit (1 mm/s: 1 um a poll), not by a jump.
-  EXPECT_LT(c.goal_m[0], config.stage.home_x_m + 10e-6);
+  EXPECT_LE(largest_step, 1e-6 + 1e-12);
   for (int i = 0; i < 20; ++i) remote.poll(1.0, c);
   EXPECT_TRUE(c.has_goal);
   EXPECT_NEAR(c.goal_m[0], config.stage.home_x_m + 10e-6, 1e-12) << "targets are relative to home";
@@ -490,7 +500,8 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
 // stamp says, beyond the fastest delivery seen (transit_estimate.h): a burst of poses measured
 // 40 to 11 ms ago does not take the slave back, nor does a burst of old targets the master.
 std::int64_t sent_ns(double ago_s) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
              .count() -
          static_cast<std::int64_t>(ago_s * 1e9);
 }
@@ -566,15 +577,18 @@ TEST(RemoteEnds, ASlaveDoesNotFollowTargetsQueuedWhileItsMasterWasCutOff) {
   double t = 0.0;  // the operator loop's time: a tick per sample sent
   deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(t, c), c.deadman; });
   bool fresh_on_time = false;
-  stream(peer, Channel::kTarget, 200, 0.0, true, [&] { fresh_on_time = remote.poll(t += 1e-3, c).fresh || fresh_on_time; });
+  stream(peer, Channel::kTarget, 200, 0.0, true,
+         [&] { fresh_on_time = remote.poll(t += 1e-3, c).fresh || fresh_on_time; });
   ASSERT_TRUE(fresh_on_time) << "targets on time take the slave";
   t += 0.010;  // 10 ms without a target: the slave holds
   ASSERT_FALSE(remote.poll(t, c).fresh);
   bool fresh_on_backlog = false;
-  stream(peer, Channel::kTarget, 30, 0.040, false, [&] { fresh_on_backlog = remote.poll(t, c).fresh || fresh_on_backlog; });
+  stream(peer, Channel::kTarget, 30, 0.040, false,
+         [&] { fresh_on_backlog = remote.poll(t, c).fresh || fresh_on_backlog; });
   EXPECT_FALSE(fresh_on_backlog) << "targets 11 ms old or more are stale on arrival (timeout 8 ms)";
   bool fresh_again = false;
-  stream(peer, Channel::kTarget, 20, 0.0, true, [&] { fresh_again = remote.poll(t += 1e-3, c).fresh || fresh_again; });
+  stream(peer, Channel::kTarget, 20, 0.0, true,
+         [&] { fresh_again = remote.poll(t += 1e-3, c).fresh || fresh_again; });
   EXPECT_TRUE(fresh_again);
 }
 
