@@ -30,6 +30,8 @@ TEST(CellCli, RunsABatchAndWritesItsCyclesAndSummary) {
   EXPECT_EQ(t.rows(), 2u);
   EXPECT_EQ(t.column("success"), (std::vector<double>{1.0, 1.0}));
   EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "summary.json"))["cycles"].get<int>(), 2);
+  EXPECT_THAT(test::read_text(dir / "index.html"), HasSubstr("Placement against clearance"));
+  EXPECT_EQ(read_csv(dir / "fig-01-cycle-time.csv").rows(), 2u);
 }
 
 TEST(CellCli, BadInputGetsOneLineAndItsExitCode) {
