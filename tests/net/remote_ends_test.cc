@@ -406,6 +406,15 @@ TEST(RemoteEnds, TheSlaveRetracesTheMastersMotionThroughAJitteryLossyLine) {
   EXPECT_LT(buffered, 0.3 * raw);
 }
 
+// A bare peer of `end`'s link (the other role, the same domain) that a test publishes through.
+template <class EndParams>
+LinkConfig peer_of(const EndParams& end, Role role) {
+  LinkConfig c;
+  c.domain_id = end.link.domain_id;
+  c.role = role;
+  return c;
+}
+
 // A sample from the peer's side of the link, once the two links have matched. It is sent until
 // `received()` sees it; the copies still in flight then are given time to land and taken by one
 // more `received()`, so that none arrives later, in the middle of a test's timed ticks.
@@ -427,10 +436,7 @@ TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
   rp.link.domain_id = test::test_domain_id();
   rp.watch_dds = false;  // the peer sends one pose: the loop-time timeout alone is under test
   RemoteSlave remote(rp);
-  LinkConfig peer_config;
-  peer_config.domain_id = rp.link.domain_id;
-  peer_config.role = Role::kSlave;
-  Link peer(peer_config);
+  Link peer(peer_of(rp, Role::kSlave));
   auto devices = remote.make_devices();
   EXPECT_FALSE(devices.axes[0]->measurement_fresh()) << "no pose yet";
   constexpr double kActive = static_cast<double>(platform::Lifecycle::kActive);
@@ -462,10 +468,7 @@ TEST(RemoteEnds, ASlaveHoldsWhenItsMastersTargetsAre8msOldInLoopTime) {
   mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
   mp.watch_dds = false;  // the peer sends single samples: the loop-time timeout alone is under test
   RemoteMaster remote(mp);
-  LinkConfig peer_config;
-  peer_config.domain_id = mp.link.domain_id;
-  peer_config.role = Role::kMaster;
-  Link peer(peer_config);
+  Link peer(peer_of(mp, Role::kMaster));
   live::ConsoleCommand c;
   deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(0.0, c), c.deadman; });
   deliver(peer, Channel::kTarget, {10e-6, 0, 0}, 0.0, [&] { return remote.poll(1.0, c).fresh; });
@@ -529,10 +532,7 @@ TEST(RemoteEnds, AMasterDoesNotTakeBackASlaveOnPosesQueuedWhileItWasCutOff) {
   rp.link.domain_id = test::test_domain_id();
   rp.watch_dds = false;  // the peer sends poses only: the age of the poses is under test
   RemoteSlave remote(rp);
-  LinkConfig peer_config;
-  peer_config.domain_id = rp.link.domain_id;
-  peer_config.role = Role::kSlave;
-  Link peer(peer_config);
+  Link peer(peer_of(rp, Role::kSlave));
   constexpr double kActive = static_cast<double>(platform::Lifecycle::kActive);
   deliver(peer, Channel::kSlaveDiagnostics, {kActive, kActive, kActive}, kActive, [&] {
     remote.exchange(0.0);
@@ -569,10 +569,7 @@ TEST(RemoteEnds, ASlaveDoesNotFollowTargetsQueuedWhileItsMasterWasCutOff) {
   mp.link.domain_id = test::test_domain_id();
   mp.watch_dds = false;  // the peer sends targets only: their age is under test
   RemoteMaster remote(mp);
-  LinkConfig peer_config;
-  peer_config.domain_id = mp.link.domain_id;
-  peer_config.role = Role::kMaster;
-  Link peer(peer_config);
+  Link peer(peer_of(mp, Role::kMaster));
   live::ConsoleCommand c;
   double t = 0.0;  // the operator loop's time: a tick per sample sent
   deliver(peer, Channel::kEngaged, {}, 1.0, [&] { return remote.poll(t, c), c.deadman; });
