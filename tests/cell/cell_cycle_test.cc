@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "microcobot/core/error.h"
+#include "support/counting_allocator.h"
 
 namespace mc::cell {
 namespace {
@@ -137,6 +138,20 @@ TEST(CellCycle, AJamTheSearchCannotClearFailsAndHolds) {
   searched.run_to_end();
   EXPECT_TRUE(searched.result().success) << searched.result().verdict;
   EXPECT_GE(searched.result().search_tries, 2);
+}
+
+// The task and the cycle's meter run on the loop (the operator task): they never allocate.
+TEST(CellCycle, TheTaskAndItsMeterDoNotAllocateOnTheLoop) {
+  CellCycle c(job(), CellRunParams{}, base());
+  c.platform().loop().run_for(1000);  // warm-up: 0.1 s of base ticks
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    c.platform().loop().run_for(250000);  // 25 s: every step of the cycle
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(c.finished()) << "in step " << AssemblyTask::name(c.task()->step());
 }
 
 TEST(CellCycle, BadParametersAreRefusedWithTheKeyNamed) {
