@@ -24,7 +24,39 @@ struct CellOptions {
   std::optional<std::filesystem::path> config;  // the platform
   std::optional<int> batch, seed;
   std::optional<std::string> mode;
+  std::vector<std::string> modes{"auto", "manual"};  // compare
 };
+
+struct Inputs {
+  cell::AssemblyBatchParams scene;
+  cell::CellRunParams params;
+  pf::PlatformConfig config;
+};
+
+// The scene, the run's parameters and the platform, with the flags over the files.
+Inputs load_inputs(const CellOptions& o) {
+  Inputs in;
+  if (o.scene) in.scene = mc::load_params<cell::AssemblyBatchParams>(*o.scene);
+  if (o.batch) in.scene.parts = *o.batch;
+  if (o.seed) in.scene.seed = *o.seed;
+  if (o.common.params) in.params = mc::load_params<cell::CellRunParams>(*o.common.params);
+  if (o.mode) in.params.mode = *o.mode;
+  mc::cli::naming_flags({{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}}, [&] {
+    in.scene.validate();
+    in.params.validate();
+  });
+  if (o.config) in.config = pf::load_platform_config(*o.config);
+  return in;
+}
+
+std::vector<cell::CycleResult> run_mode(const Inputs& in, const std::vector<cell::AssemblyJob>& jobs,
+                                        const std::string& mode) {
+  cell::CellRunParams params = in.params;
+  params.mode = mode;
+  return cell::run_batch(jobs, params, in.config, [&](const cell::CycleResult& c) {
+    mc::cli::progress("cell " + mode, static_cast<std::size_t>(c.index + 1), jobs.size());
+  });
+}
 
 mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
   mc::CsvTable t({"index", "success", "cycle_s", "placement_error_m", "peak_grip_N", "mean_grip_N",
@@ -114,22 +146,9 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
 }
 
 void run(const CellOptions& o) {
-  auto scene = o.scene ? mc::load_params<cell::AssemblyBatchParams>(*o.scene) : cell::AssemblyBatchParams{};
-  if (o.batch) scene.parts = *o.batch;
-  if (o.seed) scene.seed = *o.seed;
-  auto params =
-      o.common.params ? mc::load_params<cell::CellRunParams>(*o.common.params) : cell::CellRunParams{};
-  if (o.mode) params.mode = *o.mode;
-  mc::cli::naming_flags({{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}}, [&] {
-    scene.validate();
-    params.validate();
-  });
-  pf::PlatformConfig config;
-  if (o.config) config = pf::load_platform_config(*o.config);
-  const auto jobs = cell::assembly_jobs(scene);
-  const auto cycles = cell::run_batch(jobs, params, config, [&](const cell::CycleResult& c) {
-    mc::cli::progress("cell run " + params.mode, static_cast<std::size_t>(c.index + 1), jobs.size());
-  });
+  const Inputs in = load_inputs(o);
+  const auto& scene = in.scene;
+  const auto cycles = run_mode(in, cell::assembly_jobs(scene), in.params.mode);
   const cell::BatchSummary s = cell::summarize(cycles);
   nlohmann::json summary = s.to_json();
   summary["seed"] = scene.seed;
@@ -154,6 +173,49 @@ void run(const CellOptions& o) {
                   s.wall_s, failures));
 }
 
+// Several modes on the same parts: each one's summary, and its ratios to the last mode's.
+void compare(const CellOptions& o) {
+  const Inputs in = load_inputs(o);
+  const auto jobs = cell::assembly_jobs(in.scene);
+  nlohmann::json summary = {
+      {"seed", in.scene.seed}, {"parts", in.scene.parts}, {"modes", nlohmann::json::object()}};
+  std::vector<cell::BatchSummary> summaries;
+  std::vector<mc::CsvTable> tables;
+  std::vector<std::vector<cell::CycleResult>> all;
+  for (const std::string& mode : o.modes) {
+    all.push_back(run_mode(in, jobs, mode));
+    summaries.push_back(cell::summarize(all.back()));
+    summary["modes"][mode] = summaries.back().to_json();
+    tables.push_back(cycles_table(all.back()));
+  }
+  const cell::BatchSummary& ref = summaries.back();
+  std::string human = fmt::format("cell compare (seed {}, {} parts):", in.scene.seed, in.scene.parts);
+  for (const auto& s : summaries) {
+    const double time_ratio = s.cycle_median_s / ref.cycle_median_s;
+    const double placement_ratio =
+        ref.placement_median_m > 0.0 ? s.placement_median_m / ref.placement_median_m : 1.0;
+    summary["ratios"][s.mode + "/" + ref.mode] = {{"cycle_median", time_ratio},
+                                                  {"placement_median", placement_ratio}};
+    human += fmt::format(
+        "\n  {:7} {}/{} inserted, cycle median {:.1f} s ({:.2f} x {}), placement median {:.2f} um "
+        "({:.2f} x), {} ticks over a force limit",
+        s.mode, s.successes, s.cycles, s.cycle_median_s, time_ratio, ref.mode, 1e6 * s.placement_median_m,
+        placement_ratio, s.force_violations);
+  }
+  std::vector<mc::cli::ResultTable> results;
+  for (std::size_t i = 0; i < o.modes.size(); ++i)
+    results.push_back({"cycles-" + o.modes[i] + ".csv", tables[i], o.modes[i] + "_", {}});
+  mc::cli::write_result_tables(o.common, results, summary);
+  if (o.common.out) {
+    mc::write_file_atomic(*o.common.out / "summary.json", summary.dump(2) + "\n");
+    mc::report::Report rep("cell compare");
+    for (std::size_t i = 0; i < all.size(); ++i)
+      rep.append(batch_report(all[i], summaries[i], in.scene.seed));
+    rep.write(*o.common.out);
+  }
+  mc::cli::emit(o.common, summary, human);
+}
+
 void add_cell(CLI::App& group) {
   auto o = std::make_shared<CellOptions>();
   auto* cmd = group.add_subcommand(
@@ -168,6 +230,20 @@ void add_cell(CLI::App& group) {
   mc::cli::add_output_options(*cmd, o->common);
   mc::cli::add_format_option(*cmd, o->common);
   cmd->callback([o] { run(*o); });
+
+  auto* cmp = group.add_subcommand("compare", "Several modes on the same parts, with their ratios");
+  cmp->add_option("--scene", o->scene, "The batch (YAML; keys as `cell params --json` shows under scene)");
+  cmp->add_option("--config", o->config, "Platform configuration (YAML; as `run --print-config`)");
+  cmp->add_option("--batch", o->batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
+  cmp->add_option("--seed", o->seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
+  cmp->add_option("--modes", o->modes,
+                  "Modes to run, comma-separated; ratios are to the last (default auto,manual)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(cell::cell_modes()));
+  mc::cli::add_params_option(*cmp, o->common);
+  mc::cli::add_output_options(*cmp, o->common);
+  mc::cli::add_format_option(*cmp, o->common);
+  cmp->callback([o] { compare(*o); });
 
   auto* params = group.add_subcommand("params", "Print the default batch and run parameters");
   auto po = std::make_shared<mc::cli::CommonOptions>();

@@ -34,6 +34,21 @@ TEST(CellCli, RunsABatchAndWritesItsCyclesAndSummary) {
   EXPECT_EQ(read_csv(dir / "fig-01-cycle-time.csv").rows(), 2u);
 }
 
+TEST(CellCli, CompareRunsTheModesOnTheSamePartsWithTheirRatios) {
+  test::TempDir dir;
+  const auto r =
+      run_cli({"cell", "compare", "--batch", "1", "--seed", "59", "--json", "--out", dir.path().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const double robot = j["modes"]["auto"]["cycle_median_s"].get<double>();
+  const double person = j["modes"]["manual"]["cycle_median_s"].get<double>();
+  EXPECT_NEAR(j["ratios"]["auto/manual"]["cycle_median"].get<double>(), robot / person, 1e-12);
+  EXPECT_EQ(j["ratios"]["manual/manual"]["cycle_median"].get<double>(), 1.0);
+  for (const char* f : {"cycles-auto.csv", "cycles-manual.csv", "summary.json", "index.html"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  EXPECT_EQ(run_cli({"cell", "compare", "--modes", "auto,psychic"}).exit_code, 2);
+}
+
 TEST(CellCli, BadInputGetsOneLineAndItsExitCode) {
   test::TempDir dir;
   auto r = run_cli({"cell", "run", "--batch", "0"});
