@@ -59,6 +59,14 @@ function(mc_add_module_tests name)
     MC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     MC_CLI_PATH="$<TARGET_FILE:microcobot_cli>")
   add_dependencies(${name}_tests microcobot_cli)
+  # Unity build (MC_UNITY_TESTS, CMakeLists.txt): the test files of a module are compiled a few at a
+  # time in one translation unit, so gtest, gmock, nlohmann::json and Eigen are parsed once per
+  # batch rather than once per file. Each file's helpers must therefore have names of their own
+  # (two files' anonymous namespaces are one namespace in a batch).
+  if(MC_UNITY_TESTS)
+    set_target_properties(${name}_tests PROPERTIES UNITY_BUILD ON
+      UNITY_BUILD_BATCH_SIZE ${MC_UNITY_TESTS_BATCH_SIZE})
+  endif()
   if(ARG_SERIAL)
     gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "-${ARG_SERIAL}"
       PROPERTIES LABELS "${name};${ARG_LABELS}")

@@ -17,6 +17,9 @@
 #include "support/test_support.h"
 
 namespace mc {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace inputs_hardening_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -227,4 +230,5 @@ TEST(InputsHardening, ASignalWhileARunWritesItsOutputsExits130WithThemWhole) {
 }
 
 }  // namespace
+}  // namespace inputs_hardening_test
 }  // namespace mc

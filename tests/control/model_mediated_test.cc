@@ -93,7 +93,7 @@ TEST(ModelMediatedMaster, TheModelsPortIsPassiveWhateverTheUpdates) {
 TEST(ModelMediatedMaster, TheEstimatorAndTheModelNeverAllocate) {
   ContactEstimator est({}, {0.0, 0.02, 1000.0});
   ModelMediatedMaster m({}, {0.0, 0.02, 1000.0});
-  test::AllocationGuard guard;
+  mc::test::AllocationGuard guard;
   double acc = 0.0;
   for (int k = 0; k < 5000; ++k) {
     const double x = 0.02 + 1e-3 * std::sin(1e-3 * k);
@@ -203,7 +203,7 @@ TEST(DelayedTeleoperation, SchemeNamesAndBadInput) {
 }
 
 TEST(TeleopCli, DelaySweepReportsSettlingPerCaseAndRefusesAnUnknownScheme) {
-  auto r = test::run_cli({"teleop", "delay-sweep", "--delays", "0.2", "--losses", "0.2", "--json"});
+  auto r = mc::test::run_cli({"teleop", "delay-sweep", "--delays", "0.2", "--losses", "0.2", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["cases"].size(), 3u);
@@ -214,10 +214,10 @@ TEST(TeleopCli, DelaySweepReportsSettlingPerCaseAndRefusesAnUnknownScheme) {
     EXPECT_EQ(c["settled"].get<bool>(), c["scheme"] == "mmt") << c.dump();
   }
   EXPECT_TRUE(j["all_settled"]["mmt"].get<bool>());
-  r = test::run_cli({"teleop", "delay-sweep", "--schemes", "mmt", "wave"});
+  r = mc::test::run_cli({"teleop", "delay-sweep", "--schemes", "mmt", "wave"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("'wave'"), std::string::npos) << r.err;
-  r = test::run_cli({"teleop", "delay-validate", "--set", "training"});
+  r = mc::test::run_cli({"teleop", "delay-validate", "--set", "training"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("'training'"), std::string::npos) << r.err;
 }

@@ -13,6 +13,9 @@
 #include "support/counting_allocator.h"
 
 namespace mc::control {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace passivity_test {
 namespace {
 
 TEST(EmulatedLink, DelaysHoldsTheLatestAndLosesItsShare) {
@@ -77,7 +80,7 @@ TEST(PassivityControllers, TheLinkAndTheControllersNeverAllocate) {
   MasterPassivityController master(true);
   SlavePassivityController slave(true);
   LinkSample got;
-  test::AllocationGuard guard;
+  mc::test::AllocationGuard guard;
   double acc = 0.0;
   for (int k = 0; k < 5000; ++k) {
     link.send({k * 1e-3, std::sin(k * 1e-2), 1e-3 * k});
@@ -121,4 +124,5 @@ TEST(DelayedTeleoperation, PassivityControlKeepsTheChannelPassiveAtEveryDelayJit
 }
 
 }  // namespace
+}  // namespace passivity_test
 }  // namespace mc::control

@@ -5,6 +5,9 @@
 #include "microcobot/core/error.h"
 
 namespace mc::control {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace teleoperation_test {
 namespace {
 
 constexpr double kDt = 1e-4;
@@ -213,4 +216,5 @@ TEST(Teleoperation, HandingControlBackToTheHapticMasterNeverMovesTheSlave) {
 }
 
 }  // namespace
+}  // namespace teleoperation_test
 }  // namespace mc::control

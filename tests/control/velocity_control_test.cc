@@ -11,6 +11,9 @@
 #include "support/counting_allocator.h"
 
 namespace mc::control {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace velocity_control_test {
 namespace {
 
 const PositionSensorParams kSensor{};  // 0.1 nm resolution, 1 nm RMS noise
@@ -144,4 +147,5 @@ TEST(VelocityControl, InvalidParamsAreRejected) {
 }
 
 }  // namespace
+}  // namespace velocity_control_test
 }  // namespace mc::control

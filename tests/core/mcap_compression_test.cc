@@ -13,6 +13,9 @@
 #include "support/test_support.h"
 
 namespace mc {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace mcap_compression_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -156,4 +159,5 @@ TEST(Mcap, ABadZstdLevelIsRefusedAndLeavesNothing) {
 }
 
 }  // namespace
+}  // namespace mcap_compression_test
 }  // namespace mc

@@ -11,6 +11,9 @@
 #include "support/test_support.h"
 
 namespace mc {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace staged_file_test {
 namespace {
 
 using ::testing::HasSubstr;
@@ -62,4 +65,5 @@ TEST(StagedFile, AnAbandonedFileLeavesNothingAndAnExistingFileIsKept) {
 }
 
 }  // namespace
+}  // namespace staged_file_test
 }  // namespace mc

@@ -11,6 +11,9 @@
 #include "support/counting_allocator.h"
 
 namespace mc::haptics {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace render_pipeline_test {
 namespace {
 
 double db(std::complex<double> z) { return 20.0 * std::log10(std::abs(z)); }
@@ -136,4 +139,5 @@ TEST(RenderPipeline, RejectsBadParameters) {
 }
 
 }  // namespace
+}  // namespace render_pipeline_test
 }  // namespace mc::haptics

@@ -9,9 +9,9 @@
 namespace mc::live {
 namespace {
 
-std::string message_of(const std::string& json) {
+std::string message_of(const std::string& payload) {
   try {
-    parse_console_command(json, ConsoleLimits{});
+    parse_console_command(payload, ConsoleLimits{});
   } catch (const InvalidInput& e) {
     return e.what();
   }

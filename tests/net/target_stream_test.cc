@@ -13,6 +13,9 @@
 #include "support/counting_allocator.h"
 
 namespace mc::net {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace target_stream_test {
 namespace {
 
 constexpr double kDt = 1e-3;
@@ -41,7 +44,7 @@ Followed follow_ramp(const control::LinkParams& line, bool buffered) {
   Followed r;
   double previous = 0.0, last_sent = -1.0;
   {
-    test::AllocationGuard guard;
+    mc::test::AllocationGuard guard;
     for (int k = 0; k < 3000; ++k) {
       const double now = k * kDt;
       wire.send({now, kSpeed * now, 0.0});  // sent at, position
@@ -136,4 +139,5 @@ TEST(TargetStream, AStampFromTheFutureIsDroppedAndDoesNotFreezeTheGoal) {
 }
 
 }  // namespace
+}  // namespace target_stream_test
 }  // namespace mc::net

@@ -14,6 +14,9 @@
 #include "microcobot/platform/platform.h"
 
 namespace mc::platform {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace safety_test {
 namespace {
 
 std::size_t channel(const char* name) {
@@ -149,4 +152,5 @@ TEST(Safety, TheScriptedPinInHoleInsertsThePinUnderTheLimitsAndEndsHolding) {
 }
 
 }  // namespace
+}  // namespace safety_test
 }  // namespace mc::platform

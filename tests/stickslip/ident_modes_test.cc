@@ -11,6 +11,9 @@
 #include "microcobot/stickslip/ident_pe_modes.h"
 
 namespace mc::stickslip {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace ident_modes_test {
 namespace {
 
 double freq(double k, double m) { return std::sqrt(k / m) / (2 * M_PI); }
@@ -110,4 +113,5 @@ TEST(IdentRecord, StepReconstructionIgnoresVoltageNoise) {
 }
 
 }  // namespace
+}  // namespace ident_modes_test
 }  // namespace mc::stickslip

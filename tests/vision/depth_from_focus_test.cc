@@ -16,6 +16,9 @@
 #include "microcobot/vision/autofocus.h"
 
 namespace mc::vision {
+// The file's own namespace: its helpers keep their names beside the other test files of the
+// module in a unity build (MC_UNITY_TESTS).
+namespace depth_from_focus_test {
 namespace {
 
 using testing::FocusCamera;
@@ -146,4 +149,5 @@ TEST(DepthFromFocus, HeightOfTheGrippersTips) {
 }
 
 }  // namespace
+}  // namespace depth_from_focus_test
 }  // namespace mc::vision
