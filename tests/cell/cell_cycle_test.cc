@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cell/cell_test_support.h"
+
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -14,11 +16,7 @@
 namespace mc::cell {
 namespace {
 
-// The default platform (named: GCC 12 sees its temporaries' members as maybe uninitialised).
-const platform::PlatformConfig& base() {
-  static const platform::PlatformConfig c;
-  return c;
-}
+using test::default_platform;
 
 using Status = AssemblyTask::Status;
 using Step = AssemblyTask::Step;
@@ -35,7 +33,7 @@ AssemblyJob job(int seed = 41, double clearance_m = 0.0) {
 Eigen::Vector3d target(platform::Platform& p) { return p.teleop().slave_target_m; }
 
 TEST(CellCycle, TheRobotInsertsAPinUnderTheLimitsAndEndsHolding) {
-  CellCycle c(job(), CellRunParams{}, base());
+  CellCycle c(job(), CellRunParams{}, default_platform());
   c.run_to_end();
   const CycleResult r = c.result();
   EXPECT_TRUE(r.success) << r.verdict;
@@ -51,7 +49,7 @@ TEST(CellCycle, TheRobotInsertsAPinUnderTheLimitsAndEndsHolding) {
 }
 
 TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {
-  CellCycle c(job(), CellRunParams{}, base());
+  CellCycle c(job(), CellRunParams{}, default_platform());
   // Mid-transport the operator pauses for a second, then resumes.
   double paused_at = -1.0, transport_at = -1.0;
   Eigen::Vector3d at_pause, last = target(c.platform());
@@ -85,7 +83,7 @@ TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {
 }
 
 TEST(CellCycle, ConfirmTakeOverAndHandBackNeverJump) {
-  CellCycle c(job(), CellRunParams{}, base());
+  CellCycle c(job(), CellRunParams{}, default_platform());
   c.task()->set_autonomy(Step::kInsert, AssemblyTask::Autonomy::kConfirm);
   // The operator confirms the insertion after half a second, takes over 0.3 s into it and hands
   // back 0.2 s later (the simulated haptic master's deadman is not pressed: the stage holds);
@@ -126,7 +124,7 @@ TEST(CellCycle, AJamTheSearchCannotClearFailsAndHolds) {
   // A pin far off its slot (|dy| > clearance), by moving its true start.
   AssemblyJob j = job(43, 4e-6);
   j.world.part_start_m.y() = j.nominal_part_m.y() + 12e-6;
-  CellCycle c(j, params, base());
+  CellCycle c(j, params, default_platform());
   c.run_to_end();
   const CycleResult r = c.result();
   EXPECT_FALSE(r.success);
@@ -134,7 +132,7 @@ TEST(CellCycle, AJamTheSearchCannotClearFailsAndHolds) {
   EXPECT_TRUE(r.ended_holding);
   EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
   // With the search, the same pin goes in.
-  CellCycle searched(j, CellRunParams{}, base());
+  CellCycle searched(j, CellRunParams{}, default_platform());
   searched.run_to_end();
   EXPECT_TRUE(searched.result().success) << searched.result().verdict;
   EXPECT_GE(searched.result().search_tries, 2);
@@ -142,11 +140,11 @@ TEST(CellCycle, AJamTheSearchCannotClearFailsAndHolds) {
 
 // The task and the cycle's meter run on the loop (the operator task): they never allocate.
 TEST(CellCycle, TheTaskAndItsMeterDoNotAllocateOnTheLoop) {
-  CellCycle c(job(), CellRunParams{}, base());
+  CellCycle c(job(), CellRunParams{}, default_platform());
   c.platform().loop().run_for(1000);  // warm-up: 0.1 s of base ticks
   std::size_t allocations = 0;
   {
-    test::AllocationGuard guard;
+    mc::test::AllocationGuard guard;
     c.platform().loop().run_for(250000);  // 25 s: every step of the cycle
     allocations = guard.allocations();
   }
@@ -157,11 +155,11 @@ TEST(CellCycle, TheTaskAndItsMeterDoNotAllocateOnTheLoop) {
 TEST(CellCycle, BadParametersAreRefusedWithTheKeyNamed) {
   CellRunParams p;
   p.mode = "remote";
-  EXPECT_THROW(CellCycle(job(), p, base()), InvalidParams);
+  EXPECT_THROW(CellCycle(job(), p, default_platform()), InvalidParams);
   p = CellRunParams{};
   p.task.search_step_factor = 2.5;
   try {
-    CellCycle(job(), p, base());
+    CellCycle(job(), p, default_platform());
     ADD_FAILURE();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("search_step_factor"), std::string::npos);

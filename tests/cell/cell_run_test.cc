@@ -4,14 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include "cell/cell_test_support.h"
+
 namespace mc::cell {
 namespace {
 
-// The default platform (named: GCC 12 sees its temporaries' members as maybe uninitialised).
-const platform::PlatformConfig& base() {
-  static const platform::PlatformConfig c;
-  return c;
-}
+using test::default_platform;
 
 TEST(CellRun, OnTheSamePartsTheRobotIsFasterThanTheScriptedWatchmakerAndBothStayUnderTheLimits) {
   AssemblyBatchParams scene;
@@ -19,9 +17,9 @@ TEST(CellRun, OnTheSamePartsTheRobotIsFasterThanTheScriptedWatchmakerAndBothStay
   scene.seed = 47;  // not a seed the defaults were chosen on
   const auto jobs = assembly_jobs(scene);
   CellRunParams a;
-  const auto robot = summarize(run_batch(jobs, a, base()));
+  const auto robot = summarize(run_batch(jobs, a, default_platform()));
   a.mode = "manual";
-  const auto person = summarize(run_batch(jobs, a, base()));
+  const auto person = summarize(run_batch(jobs, a, default_platform()));
   EXPECT_EQ(robot.successes, 3);
   EXPECT_EQ(person.successes, 3);
   EXPECT_EQ(robot.force_violations + person.force_violations, 0);
