@@ -208,7 +208,8 @@ TEST(DistributedServe, OnTwoHostsJoinedByACableThatIsPulledAndPluggedBack) {
   };
   ASSERT_TRUE(drive(*m, s.get(), jog(100e-6),
                     [&](const json& mt, const json& st) {
-                      return since_pull_s(mt, st) >= 0.0 && at(mt, "engaged") == 0.0 && at(st, "engaged") == 0.0;
+                      return since_pull_s(mt, st) >= 0.0 && at(mt, "engaged") == 0.0 &&
+                             at(st, "engaged") == 0.0;
                     }))
       << "engaged across a pulled cable: desk " << m->last.dump() << "\nbench " << s->last.dump();
   std::printf("both ends disengaged on the first frames %.0f ms (loop time) after the pull (60 Hz frames)\n",

@@ -92,7 +92,7 @@ class RemoteMaster final : public live::CommandSource {
   std::unique_ptr<Link> link_;
   std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
   double stale_timeout_s_ = 0.0;
-  double last_target_t_ = -1e9;  // poll time at which the newest target was sent
+  double last_target_t_ = -1e9;     // poll time at which the newest target was sent
   TransitEstimate target_transit_;  // the targets' route: how late each one arrives
   bool engaged_ = false;
   bool estop_ = false;

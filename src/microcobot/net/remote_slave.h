@@ -118,7 +118,7 @@ class RemoteSlave {
   std::unique_ptr<Link> link_;
   std::unique_ptr<WireEmulator> emulator_;  // null: no emulation
   double stale_timeout_s_ = 0.0;
-  double now_s_ = 0.0;  // loop time, from the ticks' dt
+  double now_s_ = 0.0;            // loop time, from the ticks' dt
   TransitEstimate pose_transit_;  // the poses' route: how late each one arrives
   RemoteSlaveState state_;
   std::array<double, 3> target_m_{};
