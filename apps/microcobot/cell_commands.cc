@@ -216,33 +216,32 @@ void compare(const CellOptions& o) {
   mc::cli::emit(o.common, summary, human);
 }
 
+// What `run` and `compare` share: the batch, the platform, the run's parameters, the outputs.
+void add_batch_options(CLI::App& cmd, CellOptions& o) {
+  cmd.add_option("--scene", o.scene, "The batch (YAML; keys as `cell params --json` shows under scene)");
+  cmd.add_option("--config", o.config, "Platform configuration (YAML; as `run --print-config`)");
+  cmd.add_option("--batch", o.batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
+  cmd.add_option("--seed", o.seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
+  mc::cli::add_params_option(cmd, o.common);
+  mc::cli::add_output_options(cmd, o.common);
+  mc::cli::add_format_option(cmd, o.common);
+}
+
 void add_cell(CLI::App& group) {
   auto o = std::make_shared<CellOptions>();
   auto* cmd = group.add_subcommand(
       "run", "A batch of pin insertions, each cycle measured (time, success, placement, forces)");
-  cmd->add_option("--scene", o->scene, "The batch (YAML; keys as `cell params --json` shows under scene)");
-  cmd->add_option("--config", o->config, "Platform configuration (YAML; as `run --print-config`)");
-  cmd->add_option("--batch", o->batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
-  cmd->add_option("--seed", o->seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
+  add_batch_options(*cmd, *o);
   cmd->add_option("--mode", o->mode, "auto (the robot) or manual (the scripted watchmaker)")
       ->check(CLI::IsMember(cell::cell_modes()));
-  mc::cli::add_params_option(*cmd, o->common);
-  mc::cli::add_output_options(*cmd, o->common);
-  mc::cli::add_format_option(*cmd, o->common);
   cmd->callback([o] { run(*o); });
 
   auto* cmp = group.add_subcommand("compare", "Several modes on the same parts, with their ratios");
-  cmp->add_option("--scene", o->scene, "The batch (YAML; keys as `cell params --json` shows under scene)");
-  cmp->add_option("--config", o->config, "Platform configuration (YAML; as `run --print-config`)");
-  cmp->add_option("--batch", o->batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
-  cmp->add_option("--seed", o->seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
+  add_batch_options(*cmp, *o);
   cmp->add_option("--modes", o->modes,
                   "Modes to run, comma-separated; ratios are to the last (default auto,manual)")
       ->delimiter(',')
       ->check(CLI::IsMember(cell::cell_modes()));
-  mc::cli::add_params_option(*cmp, o->common);
-  mc::cli::add_output_options(*cmp, o->common);
-  mc::cli::add_format_option(*cmp, o->common);
   cmp->callback([o] { compare(*o); });
 
   auto* params = group.add_subcommand("params", "Print the default batch and run parameters");
