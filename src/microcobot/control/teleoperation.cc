@@ -19,17 +19,20 @@ void TeleoperationParams::validate() const {
   require_positive(console_max_speed_m_s, "console_max_speed_m_s");
   require(workspace_min_m < workspace_max_m, "workspace_min_m", "must be below workspace_max_m",
           workspace_min_m);
+  fixtures.validate();
 }
 
 Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
                              const Eigen::Vector3d& slave_start_m, double gripper_start_m,
                              const SafetyLimitParams& limits)
-    : p_(params), limits_(limits), dt_(dt_s) {
+    : p_(params), limits_(limits), dt_(dt_s), fixtures_(params.fixtures) {
   p_.validate();
   require_positive(dt_s, "dt_s");
   out_.slave_target_m = slave_start_m;
   out_.gripper_opening_m = gripper_start_m;
   last_xy_m_ = slave_start_m.head<2>();
+  raw_xy_m_ = last_xy_m_;
+  scale_ = p_.motion_scale;
   force_alpha_ = 1.0 - std::exp(-2.0 * M_PI * p_.force_filter_Hz * dt_s);
 }
 
@@ -45,25 +48,31 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
   out_.haptic_force_N.setZero();
   force_filtered_N_.setZero();
   if (out_.engaged) {
+    // The console moves the master's own target (before the fixtures), from where it is.
+    const Eigen::Vector3d base(raw_xy_m_.x(), raw_xy_m_.y(), out_.slave_target_m.z());
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
     if (c.has_goal && c.goal_m.allFinite()) {
       // Straight to the goal at the requested speed, landing on it exactly.
       const double speed = std::clamp(c.goal_speed_m_s, 0.0, p_.console_max_speed_m_s);
       Eigen::Vector3d goal = c.goal_m;
       for (int i = 0; i < 3; ++i) goal[i] = clamp_workspace(goal[i]);
-      const Eigen::Vector3d d = goal - out_.slave_target_m;
+      const Eigen::Vector3d d = goal - base;
       const double n = d.norm();
       v = n <= speed * dt_ ? Eigen::Vector3d(d / dt_) : Eigen::Vector3d(d * (speed / n));
     } else if (c.velocity_m_s.allFinite()) {
+      // A joystick is a rate control: the fixtures' scaling gain is on its speed in the plane.
       v = c.velocity_m_s;
+      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_);
       const double n = v.norm();
       if (n > p_.console_max_speed_m_s) v *= p_.console_max_speed_m_s / n;
     }
-    for (int i = 0; i < 3; ++i) {
-      const double before = out_.slave_target_m[i];
-      out_.slave_target_m[i] = clamp_workspace(before + v[i] * dt_);
-      out_.slave_velocity_m_s[i] = (out_.slave_target_m[i] - before) / dt_;
-    }
+    Eigen::Vector3d raw;
+    for (int i = 0; i < 3; ++i) raw[i] = clamp_workspace(base[i] + v[i] * dt_);
+    raw_xy_m_ = raw.head<2>();
+    const Eigen::Vector3d before = out_.slave_target_m;
+    out_.slave_target_m.head<2>() = fixtures_.guided(raw_xy_m_);
+    out_.slave_target_m.z() = std::max(raw.z(), fixtures_.lowest_z(out_.slave_target_m.head<2>()));
+    out_.slave_velocity_m_s = (out_.slave_target_m - before) / dt_;
   }
   // The gripper moves on the console's command only while the coupling is engaged (deadman
   // held, commands fresh); otherwise it holds its opening.
@@ -71,6 +80,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
                                ? std::max(0.0, c.gripper_opening_m)
                                : out_.gripper_opening_m;
   apply_limits(in, requested);
+  if (!out_.engaged) raw_xy_m_ = out_.slave_target_m.head<2>();
   last_xy_m_ = out_.slave_target_m.head<2>();
   out_.finger_force_N = 0.0;
   console_had_control_ = true;
@@ -83,6 +93,7 @@ void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_
   // A hand that pushes on into a held contact slips like a clutch: when the force drops, the
   // slave does not jump to where the hand went meanwhile.
   offset_m_ += (out_.slave_target_m - before).head<2>();
+  raw_xy_m_ += (out_.slave_target_m - before).head<2>();
   out_.gripper_opening_m = limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N,
                                                    out_.gripper_opening_m);
 }
@@ -94,9 +105,11 @@ void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
   out_.haptic_force_N.setZero();
   force_filtered_N_.setZero();
   last_xy_m_ = out_.slave_target_m.head<2>();
+  raw_xy_m_ = last_xy_m_;
 }
 
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
+  fixtures_.tick(dt_);
   if (!in.slave_fresh) {
     // A silent slave (a remote one whose link went quiet): nothing to couple to. No force on
     // either master; the target is re-taken from the slave once it reports again.
@@ -114,6 +127,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     // re-engaging never moves it (the haptic path below re-indexes its offset on engagement).
     out_.slave_target_m = in.slave_position_m;
     last_xy_m_ = out_.slave_target_m.head<2>();
+    raw_xy_m_ = last_xy_m_;
     out_.engaged = false;
     slave_was_stale_ = false;
   }
@@ -122,21 +136,33 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     return out_;
   }
   const bool engage = in.deadman && !in.clutch && in.haptic_fresh && in.handle_m.allFinite();
+  // The fixtures' scaling gain at the master's target; the offset absorbs a change of scale, so
+  // that the slave never jumps with it (the increments are scaled, not the handle's position).
+  const double scale = p_.motion_scale * fixtures_.scale_gain(raw_xy_m_);
   if (engage && (!out_.engaged || console_had_control_)) {
     // Re-index: the slave target stays where it is whatever the hand position.
-    offset_m_ = out_.slave_target_m.head<2>() - p_.motion_scale * in.handle_m;
+    scale_ = scale;
+    offset_m_ = raw_xy_m_ - scale_ * in.handle_m;
+    fixtures_.rebase_energy(raw_xy_m_, scale_);
+  } else if (engage) {
+    offset_m_ += (scale_ - scale) * in.handle_m;
+    scale_ = scale;
   }
+  const Eigen::Vector2d handle_v = (in.handle_m - last_handle_m_) / dt_;
+  if (in.handle_m.allFinite()) last_handle_m_ = in.handle_m;
   console_had_control_ = false;
   out_.engaged = engage;
   out_.stale = !in.haptic_fresh || !in.tweezers_fresh;
   out_.slave_velocity_m_s.setZero();
   if (engage) {
-    const Eigen::Vector2d xy = offset_m_ + p_.motion_scale * in.handle_m;
-    for (int i = 0; i < 2; ++i) out_.slave_target_m[i] = clamp_workspace(xy[i]);
+    const Eigen::Vector2d raw = offset_m_ + scale_ * in.handle_m;
+    for (int i = 0; i < 2; ++i) raw_xy_m_[i] = clamp_workspace(raw[i]);
+    out_.slave_target_m.head<2>() = fixtures_.guided(raw_xy_m_);
     out_.slave_velocity_m_s.head<2>() = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
     const double jog =
         std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;
-    out_.slave_target_m.z() = clamp_workspace(out_.slave_target_m.z() + jog * dt_);
+    const double z = clamp_workspace(out_.slave_target_m.z() + jog * dt_);
+    out_.slave_target_m.z() = std::max(z, fixtures_.lowest_z(out_.slave_target_m.head<2>()));
     out_.slave_velocity_m_s.z() = jog;
     // Slave forces back to the hand, in the handle's plane (slave XY = handle xy).
     Eigen::Vector2d f = p_.force_scale * in.contact_force_N.head<2>();
@@ -146,10 +172,13 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     const double n = f.norm();
     if (!(n <= p_.max_force_N))
       f = n > 0 && std::isfinite(n) ? Eigen::Vector2d(f * (p_.max_force_N / n)) : Eigen::Vector2d::Zero();
+    // The guidance felt, under its own passivity controller and its own cap.
+    f += fixtures_.display_force(raw_xy_m_, out_.slave_target_m.head<2>(), handle_v, scale_, dt_);
     out_.haptic_force_N = f;
   } else {
     out_.haptic_force_N.setZero();
     force_filtered_N_.setZero();
+    raw_xy_m_ = out_.slave_target_m.head<2>();
   }
   // The gripper follows the TéléTweez only while the deadman is held (and its readings are
   // fresh); otherwise it holds its opening.

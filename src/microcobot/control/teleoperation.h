@@ -26,6 +26,7 @@
 #include <Eigen/Core>
 
 #include "microcobot/control/safety_limits.h"
+#include "microcobot/control/virtual_fixtures.h"
 
 namespace mc::control {
 
@@ -44,6 +45,9 @@ struct TeleoperationParams {
   double workspace_min_m = -5.5e-3;
   double workspace_max_m = 5.5e-3;
   double console_max_speed_m_s = 1e-3;  ///< stage speed limit of the console's commands
+  /// Shared control (issue #29): the virtual fixtures' shape; which fixtures act, and how
+  /// strongly, is set at run time (Teleoperation::set_fixtures).
+  VirtualFixtureParams fixtures;
 
   template <class V>
   void visit(V& v) {
@@ -58,6 +62,7 @@ struct TeleoperationParams {
     v("workspace_min_m", workspace_min_m);
     v("workspace_max_m", workspace_max_m);
     v("console_max_speed_m_s", console_max_speed_m_s);
+    v("fixtures", fixtures);
   }
   void validate() const;
 };
@@ -123,6 +128,12 @@ class Teleoperation {
   /// Holds the slave where it is measured (target = position, zero velocity), disengaged: the
   /// hand-back after an automatic sequence (issue #26). Real-time safe.
   void hold_at(const Eigen::Vector3d& measured_m) noexcept;
+  /// The virtual fixtures for the coming ticks (stage coordinates; virtual_fixtures.h), on every
+  /// input path. Real-time safe.
+  void set_fixtures(const FixtureSet& set) noexcept { fixtures_.set(set); }
+  const VirtualFixtures& fixtures() const noexcept { return fixtures_; }
+  /// The motion scale in force (the configured one times the fixtures' gain).
+  double motion_scale() const noexcept { return scale_; }
 
  private:
   double clamp_workspace(double v) const noexcept;
@@ -139,6 +150,10 @@ class Teleoperation {
   Eigen::Vector2d force_filtered_N_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
+  VirtualFixtures fixtures_;
+  Eigen::Vector2d raw_xy_m_ = Eigen::Vector2d::Zero();  // the master's target before the fixtures
+  Eigen::Vector2d last_handle_m_ = Eigen::Vector2d::Zero();
+  double scale_ = 0.0;                // motion scale in force
   bool console_had_control_ = false;  // the haptic path re-indexes when it takes over
   bool slave_was_stale_ = false;      // re-take the target from the slave when it returns
 };

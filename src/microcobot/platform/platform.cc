@@ -369,6 +369,13 @@ void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
   console_.goal_m = in.goal_m - home_m_;
 }
 
+void Platform::set_fixtures(const control::FixtureSet& set) noexcept {
+  control::FixtureSet stage = set;
+  stage.guide_xy_m = set.guide_xy_m - home_m_.head<2>();
+  stage.rim_z_m = set.rim_z_m - home_m_.z();
+  teleop_->set_fixtures(stage);
+}
+
 bool Platform::start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
                                      std::int64_t periods) noexcept {
   if (faulted_ || position_controlled_ || axis < 0 || axis > 2) return false;

@@ -148,6 +148,9 @@ class Platform {
   /// The operator console's command for the next ticks (issue #14), in world coordinates (the
   /// telemetry's): set from the operator task, on the loop. Real-time safe.
   void set_console_input(const control::ConsoleInput& in) noexcept;
+  /// Shared control (issue #29): the virtual fixtures on the coupling for the next ticks, in world
+  /// coordinates (control/virtual_fixtures.h). On the loop (the operator task); real-time safe.
+  void set_fixtures(const control::FixtureSet& set) noexcept;
   /// After an e-stop (fault_all), the explicit reset: every device configured and activated
   /// again, the stage holding where it is. Off the loop only (it may allocate): call it between
   /// runs. Throws mc::Error when a device refuses (every device is then left in its safe state).

@@ -1,0 +1,114 @@
+#include "microcobot/control/virtual_fixtures.h"
+
+#include <algorithm>
+
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+
+void VirtualFixtureParams::validate() const {
+  require_positive(capture_radius_m, "capture_radius_m");
+  require(far_gain >= 1.0 && far_gain <= 50.0, "far_gain", "must be within [1, 50]", far_gain);
+  require(far_distance_m > capture_radius_m, "far_distance_m", "must be beyond capture_radius_m",
+          far_distance_m);
+  require_non_negative(display_stiffness_N_m, "display_stiffness_N_m");
+  require_positive(max_display_N, "max_display_N");
+  require(funnel_half_angle_deg > 0.0 && funnel_half_angle_deg < 89.0, "funnel_half_angle_deg",
+          "must be within (0, 89) degrees", funnel_half_angle_deg);
+  require_positive(funnel_height_m, "funnel_height_m");
+  require_positive(level_rate_1_s, "level_rate_1_s");
+}
+
+VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params) {
+  p_.validate();
+  tan_cone_ = std::tan(p_.funnel_half_angle_deg * M_PI / 180.0);
+}
+
+void VirtualFixtures::set(const FixtureSet& set) noexcept {
+  const bool valid = std::isfinite(set.level) && set.level >= 0.0 && set.level <= 1.0 &&
+                     set.guide_xy_m.allFinite() && std::isfinite(set.rim_z_m) &&
+                     std::isfinite(set.funnel_radius_m) && set.funnel_radius_m >= 0.0;
+  const FixtureSet next = valid ? set : FixtureSet{};
+  if (next == set_) return;
+  // A new guide moves the field under the handle: its energy is booked afresh. A new level alone
+  // is slewed, and what it would add is the passivity controller's to dissipate.
+  if (next.guide != set_.guide || next.guide_xy_m != set_.guide_xy_m) rebase_ = true;
+  set_ = next;
+  if (!set_.guide) level_ = 0.0;
+}
+
+void VirtualFixtures::tick(double dt_s) noexcept {
+  const double step = p_.level_rate_1_s * dt_s;
+  level_ += std::clamp(set_.level - level_, -step, step);
+}
+
+double VirtualFixtures::weight(double d) const noexcept {
+  const double r = p_.capture_radius_m;
+  return std::clamp((2.0 * r - d) / r, 0.0, 1.0);
+}
+
+double VirtualFixtures::potential_J(double d, double a, double s) const noexcept {
+  const double r = p_.capture_radius_m;
+  double integral;  // int_0^d w(x) x dx
+  if (d <= r) {
+    integral = 0.5 * d * d;
+  } else if (d < 2.0 * r) {
+    integral = 0.5 * r * r + d * d - d * d * d / (3.0 * r) - 2.0 * r * r / 3.0;
+  } else {
+    integral = 7.0 * r * r / 6.0;
+  }
+  return p_.display_stiffness_N_m * a / (s * s) * integral;
+}
+
+double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy) const noexcept {
+  if (!set_.guide) return 1.0;
+  const double d = (xy - set_.guide_xy_m).norm();
+  const double x =
+      std::clamp((d - p_.capture_radius_m) / (p_.far_distance_m - p_.capture_radius_m), 0.0, 1.0);
+  return 1.0 + level_ * (p_.far_gain - 1.0) * x;
+}
+
+Eigen::Vector2d VirtualFixtures::guided(const Eigen::Vector2d& raw_xy) const noexcept {
+  if (!set_.guide || level_ <= 0.0) return raw_xy;
+  const Eigen::Vector2d e = raw_xy - set_.guide_xy_m;
+  return set_.guide_xy_m + (1.0 - level_ * weight(e.norm())) * e;
+}
+
+double VirtualFixtures::lowest_z(const Eigen::Vector2d& xy) const noexcept {
+  if (!set_.guide || !set_.funnel) return -std::numeric_limits<double>::infinity();
+  const double d = (xy - set_.guide_xy_m).norm();
+  if (d <= set_.funnel_radius_m) return -std::numeric_limits<double>::infinity();
+  // Off the axis: no lower than the cone, and never below the rim.
+  return set_.rim_z_m + std::min(p_.funnel_height_m, (d - set_.funnel_radius_m) / tan_cone_);
+}
+
+void VirtualFixtures::rebase_energy(const Eigen::Vector2d& raw_xy, double scale) noexcept {
+  observed_J_ = set_.guide ? potential_J((raw_xy - set_.guide_xy_m).norm(), level_, scale) : 0.0;
+  rebase_ = false;
+}
+
+Eigen::Vector2d VirtualFixtures::display_force(const Eigen::Vector2d& raw_xy,
+                                               const Eigen::Vector2d& guided_xy,
+                                               const Eigen::Vector2d& handle_v_m_s, double scale,
+                                               double dt_s) noexcept {
+  if (rebase_) rebase_energy(raw_xy, scale);
+  if (!set_.guide) return Eigen::Vector2d::Zero();
+  Eigen::Vector2d f = -p_.display_stiffness_N_m * (raw_xy - guided_xy) / scale;
+  const double n = f.norm();
+  if (n > p_.max_display_N) f *= p_.max_display_N / n;
+  const Eigen::Vector2d v = handle_v_m_s.allFinite() ? handle_v_m_s : Eigen::Vector2d::Zero();
+  // Passivity observer: the energy the hand has put into the fixture, from the field's energy
+  // when it was installed; the controller dissipates what would take it below zero.
+  double e = observed_J_ - f.dot(v) * dt_s;
+  const double v2 = v.squaredNorm();
+  if (e < 0.0 && v2 > 0.0) {
+    const double b = -e / (v2 * dt_s);
+    f -= b * v;
+    dissipated_J_ -= e;
+    e = 0.0;
+  }
+  observed_J_ = e;
+  return f.allFinite() ? f : Eigen::Vector2d::Zero();
+}
+
+}  // namespace mc::control

@@ -1,0 +1,129 @@
+#pragma once
+/// @file
+/// Shared control on the teleoperation coupling (issue #29 point 4): virtual fixtures that
+/// guide the slave and keep it out of forbidden regions, whatever the master.
+///
+/// The fixtures act on the slave target the operator commands (the coupling's stage
+/// coordinates), not on the operator's hand, so that they hold with any master and cannot be
+/// pushed through (Rosenberg's virtual fixtures, "perceptual overlays", 1993, applied on the
+/// slave side as in micro-manipulation's virtual guides: Bolopion and Regnier, IEEE T-ASE 10(3),
+/// 2013, §IV). With `raw` the target the master asks for and `e` = raw - guide in the plane:
+///
+///   guidance   guided = guide + (1 - a w(|e|)) e,  w = 1 within the capture radius R and
+///              falling linearly to 0 at 2R (continuous: no jump on entering), a = the
+///              assistance level. At a = 1 the slave sits on the insertion axis however the
+///              hand trembles within R; outside 2R the master moves it as without fixture.
+///   scaling    the motion scale grows with the distance to the guide (coarse far, fine near):
+///              g(d) = 1 + a (far_gain - 1) clamp((d - R) / (far_distance - R), 0, 1). The
+///              coupling applies it to the master's increments, so changing it never moves the
+///              slave (bumpless).
+///   funnel     a forbidden region: the hole's edge. Below `rim_z + cone height` the target's
+///              z is kept above the cone z >= rim_z + (d - r0) / tan(half angle) (d: distance to
+///              the axis, r0: the allowed radius at the rim), so that a carried part reaches the
+///              rim only on the axis, whatever the input. Hard, like the safety limits.
+///   display    on a haptic master the operator feels the guidance as a spring from the handle
+///              to where the guided slave is: F = -k (raw - guided) / s (hand newtons, s the
+///              motion scale). It is a radial field, F = -grad Phi with
+///              Phi(d) = k a / s^2 int_0^d w(r) r dr, passive as long as the fixture is still.
+///              A one-port passivity observer (Hannaford and Ryu, IEEE T-RO 18(1), 2002)
+///              books the energy the hand puts in, starting from the field's energy at the
+///              handle when the fixture set is installed, E = Phi(h0) + int -F.v dt; when the
+///              level rises or the coupling re-indexes, E would go negative and the passivity
+///              controller adds the damping that dissipates exactly the excess (f' = f + b v,
+///              control/passivity.h's rule).
+///
+/// The assistance level follows its set value at a bounded rate (no jump in the target).
+/// Everything here is real-time safe: no allocation, lock, exception or I/O.
+
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Core>
+
+namespace mc::control {
+
+struct VirtualFixtureParams {
+  double capture_radius_m = 25e-6;      ///< R: full guidance within it, none beyond 2R
+  double far_gain = 4.0;                ///< motion-scale gain at far_distance_m and beyond (level 1)
+  double far_distance_m = 600e-6;       ///< distance to the guide where the gain is full
+  double display_stiffness_N_m = 60.0;  ///< k: hand newtons per hand metre (below the finger's 228 N/m)
+  double max_display_N = 1.0;           ///< cap on the guidance force on the handle
+  double funnel_half_angle_deg = 60.0;  ///< the funnel's cone, from the vertical
+  double funnel_height_m = 60e-6;       ///< above the rim, where the funnel begins
+  double level_rate_1_s = 2.0;          ///< the assistance level's largest rate of change
+
+  template <class V>
+  void visit(V& v) {
+    v("capture_radius_m", capture_radius_m);
+    v("far_gain", far_gain);
+    v("far_distance_m", far_distance_m);
+    v("display_stiffness_N_m", display_stiffness_N_m);
+    v("max_display_N", max_display_N);
+    v("funnel_half_angle_deg", funnel_half_angle_deg);
+    v("funnel_height_m", funnel_height_m);
+    v("level_rate_1_s", level_rate_1_s);
+  }
+  /// Throws mc::InvalidParams naming the field.
+  void validate() const;
+};
+
+/// The fixtures for the coming ticks, in the coupling's coordinates (stage, relative to home).
+struct FixtureSet {
+  double level = 0.0;  ///< assistance level in [0, 1] (0: none)
+  bool guide = false;  ///< a vertical insertion axis at guide_xy_m
+  Eigen::Vector2d guide_xy_m = Eigen::Vector2d::Zero();
+  bool funnel = false;           ///< the forbidden region round the axis' rim (needs `guide`)
+  double rim_z_m = 0.0;          ///< tool-point height at which the part meets the rim
+  double funnel_radius_m = 0.0;  ///< r0: the allowed distance to the axis at the rim
+  bool operator==(const FixtureSet& o) const noexcept {
+    return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && funnel == o.funnel &&
+           rim_z_m == o.rim_z_m && funnel_radius_m == o.funnel_radius_m;
+  }
+};
+
+class VirtualFixtures {
+ public:
+  /// Validates (throws mc::InvalidParams).
+  explicit VirtualFixtures(const VirtualFixtureParams& params);
+
+  /// Installs `set` for the coming ticks (its level is reached at level_rate_1_s). Invalid
+  /// numbers (NaN, a level outside [0, 1]) remove the fixtures instead. Real-time safe.
+  void set(const FixtureSet& set) noexcept;
+  const FixtureSet& fixtures() const noexcept { return set_; }
+  /// The assistance level in force now.
+  double level() const noexcept { return level_; }
+  /// Slews the level for one tick of `dt_s`.
+  void tick(double dt_s) noexcept;
+  bool active() const noexcept { return set_.guide && (level_ > 0.0 || set_.funnel); }
+
+  /// The motion-scale gain g(d) at the target `xy` (1 without a guide).
+  double scale_gain(const Eigen::Vector2d& xy) const noexcept;
+  /// The guided target for the master's raw target.
+  Eigen::Vector2d guided(const Eigen::Vector2d& raw_xy) const noexcept;
+  /// The lowest z allowed at `xy` (-inf without a funnel).
+  double lowest_z(const Eigen::Vector2d& xy) const noexcept;
+  /// The guidance felt on a haptic handle moving at `handle_v` (hand frame), with the passivity
+  /// controller; `scale` is the motion scale in force.
+  Eigen::Vector2d display_force(const Eigen::Vector2d& raw_xy, const Eigen::Vector2d& guided_xy,
+                                const Eigen::Vector2d& handle_v_m_s, double scale, double dt_s) noexcept;
+  /// Re-books the field's energy at the handle (a new fixture set, an engagement): the start of
+  /// the passivity observer's account.
+  void rebase_energy(const Eigen::Vector2d& raw_xy, double scale) noexcept;
+  /// The passivity observer E (>= 0 up to rounding) and what the controller dissipated [J].
+  double observed_J() const noexcept { return observed_J_; }
+  double dissipated_J() const noexcept { return dissipated_J_; }
+
+ private:
+  double weight(double d) const noexcept;
+  /// Phi(d) at level `a` and scale `s`.
+  double potential_J(double d, double a, double s) const noexcept;
+
+  VirtualFixtureParams p_;
+  FixtureSet set_;
+  double level_ = 0.0;
+  double tan_cone_ = 1.0;
+  double observed_J_ = 0.0, dissipated_J_ = 0.0;
+  bool rebase_ = true;
+};
+
+}  // namespace mc::control

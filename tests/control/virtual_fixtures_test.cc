@@ -1,0 +1,214 @@
+#include "microcobot/control/virtual_fixtures.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "microcobot/control/teleoperation.h"
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+// The file's own namespace (unity builds, MC_UNITY_TESTS).
+namespace virtual_fixtures_test {
+namespace {
+
+constexpr double kDt = 1e-4;
+
+FixtureSet axis_at(double x, double y, double level) {
+  FixtureSet f;
+  f.level = level;
+  f.guide = true;
+  f.guide_xy_m = {x, y};
+  return f;
+}
+
+VirtualFixtures settled(const FixtureSet& set) {
+  VirtualFixtures v{VirtualFixtureParams{}};
+  v.set(set);
+  for (int i = 0; i < 20000; ++i) v.tick(kDt);  // the level reached
+  return v;
+}
+
+TeleoperationInput hand_at(const Eigen::Vector2d& h) {
+  TeleoperationInput in;
+  in.handle_m = h;
+  in.deadman = true;
+  in.tweezers_opening_m = 10e-3;
+  return in;
+}
+
+TEST(VirtualFixtures, BadParametersAreNamed) {
+  VirtualFixtureParams p;
+  p.far_distance_m = 1e-6;  // inside the capture radius
+  try {
+    VirtualFixtures v(p);
+    FAIL() << "accepted";
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("far_distance_m"), std::string::npos) << e.what();
+  }
+}
+
+TEST(VirtualFixtures, GuidanceHoldsTheAxisWithinTheCaptureRadiusAndFadesWithoutAJump) {
+  const VirtualFixtures v = settled(axis_at(1e-3, 2e-3, 1.0));
+  const double r = VirtualFixtureParams{}.capture_radius_m;
+  // Within R the slave sits on the axis whatever the hand does; beyond 2R it is the hand's.
+  EXPECT_LT((v.guided({1e-3 + 0.9 * r, 2e-3 - 0.3 * r}) - Eigen::Vector2d(1e-3, 2e-3)).norm(), 1e-15);
+  const Eigen::Vector2d far(1e-3 + 2.5 * r, 2e-3);
+  EXPECT_LT((v.guided(far) - far).norm(), 1e-15);
+  // Continuous and monotonic along a ray: no step as the target enters or leaves the field.
+  double last = 0.0;
+  for (double d = 0.0; d <= 3.0 * r; d += r / 1000) {
+    const double g = (v.guided({1e-3 + d, 2e-3}) - Eigen::Vector2d(1e-3, 2e-3)).norm();
+    EXPECT_GE(g, last - 1e-18);
+    // Its slope is at most 3 (at 2R, where d (d - R) / R meets d).
+    EXPECT_LE(g - last, 3.0 * r / 1000 * 1.0001) << "jump at d = " << d;
+    last = g;
+  }
+}
+
+TEST(VirtualFixtures, TheLevelIsSlewedAndBadSetsRemoveTheFixtures) {
+  VirtualFixtures v{VirtualFixtureParams{}};
+  v.set(axis_at(0, 0, 1.0));
+  v.tick(kDt);
+  EXPECT_NEAR(v.level(), VirtualFixtureParams{}.level_rate_1_s * kDt, 1e-15);
+  FixtureSet bad = axis_at(0, 0, 1.5);
+  v.set(bad);
+  EXPECT_FALSE(v.fixtures().guide);
+  EXPECT_EQ(v.level(), 0.0);
+  bad = axis_at(std::nan(""), 0, 1.0);
+  v.set(bad);
+  EXPECT_FALSE(v.active());
+}
+
+TEST(VirtualFixtures, TheFunnelKeepsThePartOffTheRim) {
+  FixtureSet f = axis_at(0, 0, 0.0);
+  f.funnel = true;
+  f.rim_z_m = 100e-6;
+  f.funnel_radius_m = 5e-6;
+  const VirtualFixtures v = settled(f);
+  const VirtualFixtureParams p;
+  EXPECT_EQ(v.lowest_z({4e-6, 0}), -std::numeric_limits<double>::infinity());  // on the axis: free
+  const double tan_cone = std::tan(p.funnel_half_angle_deg * M_PI / 180);
+  EXPECT_NEAR(v.lowest_z({0, 10e-6}), 100e-6 + 5e-6 / tan_cone, 1e-15);   // on the cone
+  EXPECT_NEAR(v.lowest_z({1e-3, 0}), 100e-6 + p.funnel_height_m, 1e-15);  // far: above it all
+}
+
+TEST(TeleoperationWithFixtures, WithoutFixturesTheCouplingIsUnchanged) {
+  // A set at level 0 without a funnel guides nothing: the same targets as no set at all.
+  Teleoperation plain(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  Teleoperation idle(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  idle.set_fixtures(axis_at(0, 0, 0.0));
+  std::mt19937 rng(4);
+  std::normal_distribution<double> step(0, 1e-4);
+  Eigen::Vector2d h(0, 0);
+  for (int i = 0; i < 5000; ++i) {
+    h += Eigen::Vector2d(step(rng), step(rng));
+    auto in = hand_at(h);
+    in.z_jog_m_s = 1e-4 * std::sin(i * 1e-3);
+    const auto a = plain.tick(in).slave_target_m;
+    const auto b = idle.tick(in).slave_target_m;
+    ASSERT_EQ(a, b) << "tick " << i;
+  }
+}
+
+TEST(TeleoperationWithFixtures, RaisingTheAssistanceNeverJumpsTheTarget) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  const Eigen::Vector2d h(0.01, -0.005);
+  t.tick(hand_at(h));  // engaged, the slave at 0
+  // A guide 20 um away (within R) and 300 um away (the scaling's range); the hand still.
+  for (const double gx : {20e-6, 300e-6}) {
+    t.set_fixtures(axis_at(gx, 0, 1.0));
+    Eigen::Vector3d last = t.output().slave_target_m;
+    double largest = 0.0;
+    for (int i = 0; i < 10000; ++i) {
+      const auto& out = t.tick(hand_at(h));
+      largest = std::max(largest, (out.slave_target_m - last).norm());
+      last = out.slave_target_m;
+    }
+    // The guided target moves by at most the level's rate times the guide's distance per tick.
+    EXPECT_LE(largest, VirtualFixtureParams{}.level_rate_1_s * kDt * gx * 1.0001) << gx;
+    t.set_fixtures({});
+    for (int i = 0; i < 10000; ++i) t.tick(hand_at(h));
+  }
+  // The scale changed with the assistance, the target did not follow the hand's position.
+  EXPECT_LT(t.output().slave_target_m.norm(), 1e-12);
+}
+
+TEST(TeleoperationWithFixtures, ScalingIsCoarseFarAndFineNear) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  t.set_fixtures(axis_at(2e-3, 0, 1.0));
+  Eigen::Vector2d h(0, 0);
+  for (int i = 0; i < 10000; ++i) t.tick(hand_at(h));
+  const VirtualFixtureParams p;
+  EXPECT_NEAR(t.motion_scale(), TeleoperationParams{}.motion_scale * p.far_gain, 1e-12);
+  // Toward the guide the scale falls to the configured one near it, continuously.
+  double last_scale = t.motion_scale();
+  while (t.output().slave_target_m.x() < 2e-3 - 1e-12) {  // until the guidance holds it on the axis
+    h.x() += 1e-5;
+    t.tick(hand_at(h));
+    EXPECT_LE(t.motion_scale(), last_scale + 1e-15);
+    last_scale = t.motion_scale();
+    ASSERT_LT(h.x(), 1.0);
+  }
+  t.tick(hand_at(h));
+  EXPECT_NEAR(t.motion_scale(), TeleoperationParams{}.motion_scale, 1e-15);
+}
+
+TEST(TeleoperationWithFixtures, TheGuidanceDisplayIsPassiveUnderTremor) {
+  // A hand trembling round a path that crosses the guide while the level ramps up and down:
+  // the fixture's observed energy never goes below zero, its controller dissipating the rest.
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0, 1e-3);
+  t.tick(hand_at({0, 0}));
+  double lowest = 0.0, force = 0.0;
+  for (int i = 0; i < 60000; ++i) {
+    const double s = i * kDt;
+    if (i % 15000 == 0) t.set_fixtures(axis_at(30e-6, 0, (i / 15000) % 2 == 0 ? 1.0 : 0.3));
+    const Eigen::Vector2d h(6e-3 * std::sin(2 * M_PI * 0.5 * s) + noise(rng) * 0.1,
+                            1e-3 * std::sin(2 * M_PI * 10 * s) + noise(rng) * 0.1);
+    const auto& out = t.tick(hand_at(h));
+    lowest = std::min(lowest, t.fixtures().observed_J());
+    force = std::max(force, out.haptic_force_N.norm());
+  }
+  EXPECT_GT(force, 0.05);  // the guidance was felt
+  EXPECT_GE(lowest, -1e-12);
+  EXPECT_GT(t.fixtures().dissipated_J(), 0.0);  // and the level's ramps were paid for
+}
+
+TEST(TeleoperationWithFixtures, TheFunnelIsNeverEnteredWhateverTheInput) {
+  // A console joystick and a haptic hand driving down onto the rim beside the axis, with noise:
+  // the target never goes below the funnel, and reaches the bore's depth only on the axis.
+  FixtureSet f = axis_at(0, 0, 1.0);
+  f.funnel = true;
+  f.rim_z_m = 0.0;
+  f.funnel_radius_m = 4e-6;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0, 1.0);
+  for (const bool console : {true, false}) {
+    Teleoperation t(TeleoperationParams{}, kDt, {80e-6, 10e-6, 200e-6}, 600e-6);
+    t.set_fixtures(f);
+    Eigen::Vector2d h(0, 0);
+    for (int i = 0; i < 40000; ++i) {
+      TeleoperationInput in = hand_at(h);
+      if (console) {
+        in.console.active = in.console.fresh = in.console.deadman = true;
+        in.console.velocity_m_s = {-2e-4 + 2e-4 * noise(rng), 2e-4 * noise(rng), -3e-4};
+      } else {
+        h += Eigen::Vector2d(-1e-6 + 3e-5 * noise(rng), 3e-5 * noise(rng));
+        in.handle_m = h;
+        in.z_jog_m_s = -3e-4;
+      }
+      const auto& out = t.tick(in);
+      const Eigen::Vector3d& x = out.slave_target_m;
+      ASSERT_GE(x.z(), t.fixtures().lowest_z(x.head<2>()) - 1e-15) << (console ? "console" : "haptic") << i;
+      if (x.z() < 0.0) {
+        ASSERT_LE(x.head<2>().norm(), f.funnel_radius_m + 1e-12);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace virtual_fixtures_test
+}  // namespace mc::control
