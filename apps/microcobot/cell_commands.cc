@@ -1,5 +1,6 @@
-// `microcobot cell run` (issue #29): a batch of pin insertions run headless by the robot (auto) or
-// by the scripted watchmaker (manual), each cycle measured; cycles.csv and the summary under --out.
+// `microcobot cell run` (issue #29): a batch of pin insertions run headless by the robot (auto), a
+// simulated person (manual), the person with shared control (assisted) or the scripted watchmaker
+// (scripted), each cycle measured; cycles.csv and the summary under --out.
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +24,7 @@ struct CellOptions {
   std::optional<std::filesystem::path> scene;   // AssemblyBatchParams
   std::optional<std::filesystem::path> config;  // the platform
   std::optional<int> batch, seed;
-  std::optional<std::string> mode;
+  std::optional<std::string> mode, master;
   std::vector<std::string> modes{"auto", "manual"};  // compare
 };
 
@@ -41,10 +42,12 @@ Inputs load_inputs(const CellOptions& o) {
   if (o.seed) in.scene.seed = *o.seed;
   if (o.common.params) in.params = mc::load_params<cell::CellRunParams>(*o.common.params);
   if (o.mode) in.params.mode = *o.mode;
-  mc::cli::naming_flags({{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}}, [&] {
-    in.scene.validate();
-    in.params.validate();
-  });
+  if (o.master) in.params.person.master = *o.master;
+  mc::cli::naming_flags(
+      {{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}, {"master", "--master"}}, [&] {
+        in.scene.validate();
+        in.params.validate();
+      });
   if (o.config) in.config = pf::load_platform_config(*o.config);
   return in;
 }
@@ -84,6 +87,13 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
   return t;
 }
 
+std::string who(const std::string& mode) {
+  if (mode == "auto") return "the robot";
+  if (mode == "manual") return "a simulated person";
+  if (mode == "assisted") return "a simulated person with shared control";
+  return "the scripted watchmaker";
+}
+
 // The batch's page: its figures per part (cycle time, placement against clearance, forces).
 mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, const cell::BatchSummary& s,
                                 int seed) {
@@ -92,7 +102,7 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
       "Batch",
       fmt::format("{} parts (seed {}) inserted by {}; each on a fresh simulated platform. Success: the pin "
                   "down in its bore and released (the simulation's truth). docs/cell.md.",
-                  s.cycles, seed, s.mode == "auto" ? "the robot" : "the scripted watchmaker"));
+                  s.cycles, seed, who(s.mode)));
   rep.add_result("inserted", s.successes);
   rep.add_result("success rate", 100.0 * s.success_rate, "%");
   rep.add_result("95 % Wilson interval, low", 100.0 * s.success_low, "%");
@@ -222,6 +232,10 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
   cmd.add_option("--config", o.config, "Platform configuration (YAML; as `run --print-config`)");
   cmd.add_option("--batch", o.batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
   cmd.add_option("--seed", o.seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
+  cmd.add_option("--master", o.master,
+                 "The simulated person's master in manual and assisted modes: haptic (handle, thumb wheel, "
+                 "TéléTweez; default) or console (joystick, gripper slider)")
+      ->check(CLI::IsMember({"haptic", "console"}));
   mc::cli::add_params_option(cmd, o.common);
   mc::cli::add_output_options(cmd, o.common);
   mc::cli::add_format_option(cmd, o.common);
@@ -232,7 +246,9 @@ void add_cell(CLI::App& group) {
   auto* cmd = group.add_subcommand(
       "run", "A batch of pin insertions, each cycle measured (time, success, placement, forces)");
   add_batch_options(*cmd, *o);
-  cmd->add_option("--mode", o->mode, "auto (the robot) or manual (the scripted watchmaker)")
+  cmd->add_option("--mode", o->mode,
+                  "auto (the robot), manual (a simulated person), assisted (the person with shared control) "
+                  "or scripted (the scripted watchmaker)")
       ->check(CLI::IsMember(cell::cell_modes()));
   cmd->callback([o] { run(*o); });
 

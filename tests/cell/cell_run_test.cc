@@ -18,7 +18,7 @@ TEST(CellRun, OnTheSamePartsTheRobotIsFasterThanTheScriptedWatchmakerAndBothStay
   const auto jobs = assembly_jobs(scene);
   CellRunParams a;
   const auto robot = summarize(run_batch(jobs, a, default_platform()));
-  a.mode = "manual";
+  a.mode = "scripted";
   const auto person = summarize(run_batch(jobs, a, default_platform()));
   EXPECT_EQ(robot.successes, 3);
   EXPECT_EQ(person.successes, 3);

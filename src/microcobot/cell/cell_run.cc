@@ -10,20 +10,24 @@
 
 namespace mc::cell {
 
-std::vector<std::string> cell_modes() { return {"auto", "manual"}; }
+std::vector<std::string> cell_modes() { return {"auto", "manual", "assisted", "scripted"}; }
 
 void CellRunParams::validate() const {
   const auto modes = cell_modes();
-  require(std::find(modes.begin(), modes.end(), mode) != modes.end(), "mode", "must be auto or manual");
+  require(std::find(modes.begin(), modes.end(), mode) != modes.end(), "mode",
+          "must be auto, manual, assisted or scripted, got '" + mode + "'");
   require(std::isfinite(max_cycle_s) && max_cycle_s >= 1.0 && max_cycle_s <= 3600.0, "max_cycle_s",
           "must be within [1, 3600] s", max_cycle_s);
   task.validate();
+  person.validate();
+  require(person_seed >= 0, "person_seed", "must be non-negative", person_seed);
   manual.validate();
 }
 
 nlohmann::json CycleResult::to_json() const {
   return {{"index", index},
           {"mode", mode},
+          {"master", master},
           {"success", success},
           {"verdict", verdict},
           {"cycle_s", cycle_s},
@@ -35,6 +39,7 @@ nlohmann::json CycleResult::to_json() const {
           {"contact_violations", contact_violations},
           {"clutches", clutches},
           {"search_tries", search_tries},
+          {"submovements", submovements},
           {"path_m", path_m},
           {"side_m", side_m},
           {"clearance_m", clearance_m},
@@ -115,14 +120,14 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   meter_->grip_limit_N = job.world.grip_force_limit_N;
   meter_->contact_limit_N = job.world.contact_force_limit_N;
   platform::Platform& p = *platform_;
+  AssemblyGoal goal;
+  goal.part_m = job.nominal_part_m;
+  goal.target_m = job.target_m;
+  goal.part_height_m = job.world.height_m();
+  goal.hole_depth_m = job.world.hole_depth_m;
+  goal.clearance_m = job.clearance_m;
+  goal.open_m = job.world.gripper.max_opening_m;
   if (params_.mode == "auto") {
-    AssemblyGoal goal;
-    goal.part_m = job.nominal_part_m;
-    goal.target_m = job.target_m;
-    goal.part_height_m = job.world.height_m();
-    goal.hole_depth_m = job.world.hole_depth_m;
-    goal.clearance_m = job.clearance_m;
-    goal.open_m = job.world.gripper.max_opening_m;
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
     p.set_operator([this](const platform::TickInfo& t) {
       const TaskSensors s = read_sensors(*platform_, home_m_);
@@ -137,6 +142,20 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
         finished_at_s_ = t.t_s;
         platform_->hold();  // the sequence ends with every axis holding
         held_ = true;
+      }
+      if (observer_) observer_(t.t_s);
+    });
+  } else if (params_.mode == "manual" || params_.mode == "assisted") {
+    const std::uint64_t seed =
+        static_cast<std::uint64_t>(params_.person_seed) * 1000003ULL + static_cast<std::uint64_t>(job.index);
+    person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal,
+                                               params_.mode == "assisted", seed);
+    p.set_operator([this](const platform::TickInfo& t) {
+      meter_->sample(read_sensors(*platform_, home_m_));
+      person_->act(t);
+      if ((person_->done() || person_->gave_up()) && !finished_) {
+        finished_ = true;
+        finished_at_s_ = t.t_s;
       }
       if (observer_) observer_(t.t_s);
     });
@@ -207,6 +226,24 @@ CycleResult CellCycle::result() const {
       r.verdict = inserted ? "inserted and released" : "the task ended but the pin is not down in its bore";
     }
     r.ended_holding = r.ended_holding && held_;
+  } else if (person_) {
+    r.master = params_.person.master;
+    r.clutches = person_->clutches();
+    r.search_tries = person_->jams();
+    r.submovements = person_->submovements();
+    r.success = person_->done() && inserted;
+    if (p.faulted()) {
+      r.verdict = "a device faulted";
+    } else if (person_->gave_up()) {
+      r.verdict = "the person gave up in step " + std::string(AssemblyTask::name(person_->step())) + ": " +
+                  std::string(person_->give_up_reason());
+    } else if (!finished_) {
+      r.verdict = "not finished within max_cycle_s (in step " +
+                  std::string(AssemblyTask::name(person_->step())) + ")";
+    } else {
+      r.verdict =
+          inserted ? "inserted and released" : "the person finished but the pin is not down in its bore";
+    }
   } else {
     r.clutches = manual_->clutches();
     r.success = manual_->done() && inserted;

@@ -21,6 +21,7 @@
 
 #include "microcobot/cell/assembly_batch.h"
 #include "microcobot/cell/assembly_task.h"
+#include "microcobot/cell/person_operator.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
@@ -28,11 +29,15 @@
 namespace mc::cell {
 
 struct CellRunParams {
-  std::string mode = "auto";   ///< "auto" or "manual"
+  std::string mode = "auto";   ///< cell_modes()
   double max_cycle_s = 120.0;  ///< simulated; a cycle not finished by then fails
   AssemblyTaskParams task;
-  /// The scripted watchmaker, with time for the batch's longer transports (up to ~5 mm at
-  /// 100 um/s, where the main scenario's is 2 mm).
+  /// The simulated person of the manual and assisted modes (their master: person.master).
+  PersonOperatorParams person;
+  /// The person's seed: part i gets person_seed * 1000003 + i, the same in every mode.
+  int person_seed = 1;
+  /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up
+  /// to ~5 mm at 100 um/s, where the main scenario's is 2 mm).
   platform::PickPlaceOperatorParams manual = manual_defaults();
 
   template <class V>
@@ -40,6 +45,8 @@ struct CellRunParams {
     v("mode", mode);
     v("max_cycle_s", max_cycle_s);
     v("task", task);
+    v("person", person);
+    v("person_seed", person_seed);
     v("manual", manual);
   }
   void validate() const;
@@ -50,12 +57,15 @@ struct CellRunParams {
   }
 };
 
-/// The modes, for --help and errors.
+/// The modes, for --help and errors: "auto" (the robot: AssemblyTask), "manual" (the simulated
+/// person alone), "assisted" (the same person with shared control), "scripted" (the main
+/// scenario's scripted watchmaker: none of a person's limits, a reference).
 std::vector<std::string> cell_modes();
 
 struct CycleResult {
   int index = 0;
   std::string mode;
+  std::string master;  ///< the person's master ("" for auto and scripted)
   bool success = false;
   std::string verdict;   ///< one line
   double cycle_s = 0.0;  ///< simulated time to the end of the task (or the limit)
@@ -64,8 +74,9 @@ struct CycleResult {
   double peak_contact_N = 0.0;
   int grip_violations = 0, contact_violations = 0;  ///< ticks over the platform's limits
   int clutches = 0;
-  int search_tries = 0;
-  double path_m = 0.0;  ///< length of the measured tip's path
+  int search_tries = 0;  ///< the task's search points, or the times the person's pin met the rim
+  int submovements = 0;  ///< the person's aimed movements
+  double path_m = 0.0;   ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
   double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
   bool ended_holding = false;  ///< every axis' target at its measured position, the coupling off
@@ -105,8 +116,10 @@ class CellCycle {
   /// Called at the end of every operator tick with its time, on the loop (real-time rules):
   /// an observer, or an operator's hand on the task's controls at a given moment.
   void set_observer(std::function<void(double t_s)> observer) { observer_ = std::move(observer); }
-  /// The automatic task (null in manual mode).
+  /// The automatic task (null in the other modes).
   AssemblyTask* task() noexcept { return task_.get(); }
+  /// The simulated person (null in the other modes).
+  const PersonOperator* person() const noexcept { return person_.get(); }
   platform::Platform& platform() noexcept { return *platform_; }
   CycleResult result() const;
 
@@ -118,6 +131,7 @@ class CellCycle {
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<AssemblyTask> task_;
   std::unique_ptr<platform::PickPlaceOperator> manual_;
+  std::unique_ptr<PersonOperator> person_;
   std::unique_ptr<Meter> meter_;
   std::function<void(double)> observer_;
   Eigen::Vector3d home_m_;

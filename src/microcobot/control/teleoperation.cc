@@ -62,7 +62,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
     } else if (c.velocity_m_s.allFinite()) {
       // A joystick is a rate control: the fixtures' scaling gain is on its speed in the plane.
       v = c.velocity_m_s;
-      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_);
+      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_, v.head<2>().norm());
       const double n = v.norm();
       if (n > p_.console_max_speed_m_s) v *= p_.console_max_speed_m_s / n;
     }
@@ -70,7 +70,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
     for (int i = 0; i < 3; ++i) raw[i] = clamp_workspace(base[i] + v[i] * dt_);
     raw_xy_m_ = raw.head<2>();
     const Eigen::Vector3d before = out_.slave_target_m;
-    out_.slave_target_m.head<2>() = fixtures_.guided(raw_xy_m_);
+    out_.slave_target_m.head<2>() = follow_fixtures(before.head<2>());
     out_.slave_target_m.z() = std::max(raw.z(), fixtures_.lowest_z(out_.slave_target_m.head<2>()));
     out_.slave_velocity_m_s = (out_.slave_target_m - before) / dt_;
   }
@@ -108,8 +108,35 @@ void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
   raw_xy_m_ = last_xy_m_;
 }
 
+void Teleoperation::set_fixtures(const FixtureSet& set) noexcept {
+  const FixtureSet before = fixtures_.fixtures();
+  fixtures_.set(set);
+  const FixtureSet& now = fixtures_.fixtures();
+  if (now.guide != before.guide || now.guide_xy_m != before.guide_xy_m) reindex_ = true;
+}
+
+Eigen::Vector2d Teleoperation::follow_fixtures(const Eigen::Vector2d& from) noexcept {
+  const Eigen::Vector2d want = fixtures_.guided(raw_xy_m_);
+  if (!fixtures_.active() && !slewing_) return want;
+  // Where the fixtures act, the target moves toward the guided one no faster than the stage
+  // follows: the guidance's map is steep at the capture radius' edge, and a target that steps
+  // far ahead of the stick-slip stage makes its tracking controller overshoot.
+  const Eigen::Vector2d d = want - from;
+  const double step = p_.fixtures.max_speed_m_s * dt_, n = d.norm();
+  slewing_ = n > step;
+  return slewing_ ? Eigen::Vector2d(from + d * (step / n)) : want;
+}
+
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
   fixtures_.tick(dt_);
+  if (reindex_) {
+    // The master's own target becomes where the slave is sent now (like a clutch), so that the
+    // new field starts from the slave's target, not from where the hand's mapping would put it.
+    const Eigen::Vector2d shift = out_.slave_target_m.head<2>() - raw_xy_m_;
+    raw_xy_m_ += shift;
+    offset_m_ += shift;
+    reindex_ = false;
+  }
   if (!in.slave_fresh) {
     // A silent slave (a remote one whose link went quiet): nothing to couple to. No force on
     // either master; the target is re-taken from the slave once it reports again.
@@ -138,18 +165,23 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   const bool engage = in.deadman && !in.clutch && in.haptic_fresh && in.handle_m.allFinite();
   // The fixtures' scaling gain at the master's target; the offset absorbs a change of scale, so
   // that the slave never jumps with it (the increments are scaled, not the handle's position).
-  const double scale = p_.motion_scale * fixtures_.scale_gain(raw_xy_m_);
+  const Eigen::Vector2d last_handle = last_handle_m_;
+  const Eigen::Vector2d handle_v = (in.handle_m - last_handle) / dt_;
+  if (in.handle_m.allFinite()) last_handle_m_ = in.handle_m;
+  // The hand's speed over ~10 ms: a master read at a lower rate than this loop moves in steps.
+  if (handle_v.allFinite())
+    hand_speed_m_s_ += std::min(1.0, dt_ / 0.01) * (handle_v.norm() - hand_speed_m_s_);
+  const double scale = p_.motion_scale * fixtures_.scale_gain(raw_xy_m_, p_.motion_scale * hand_speed_m_s_);
   if (engage && (!out_.engaged || console_had_control_)) {
     // Re-index: the slave target stays where it is whatever the hand position.
     scale_ = scale;
     offset_m_ = raw_xy_m_ - scale_ * in.handle_m;
     fixtures_.rebase_energy(raw_xy_m_, scale_);
   } else if (engage) {
-    offset_m_ += (scale_ - scale) * in.handle_m;
+    // Re-indexed at the last handle position: this tick's increment moves at the new scale.
+    offset_m_ += (scale_ - scale) * last_handle;
     scale_ = scale;
   }
-  const Eigen::Vector2d handle_v = (in.handle_m - last_handle_m_) / dt_;
-  if (in.handle_m.allFinite()) last_handle_m_ = in.handle_m;
   console_had_control_ = false;
   out_.engaged = engage;
   out_.stale = !in.haptic_fresh || !in.tweezers_fresh;
@@ -157,7 +189,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   if (engage) {
     const Eigen::Vector2d raw = offset_m_ + scale_ * in.handle_m;
     for (int i = 0; i < 2; ++i) raw_xy_m_[i] = clamp_workspace(raw[i]);
-    out_.slave_target_m.head<2>() = fixtures_.guided(raw_xy_m_);
+    out_.slave_target_m.head<2>() = follow_fixtures(last_xy_m_);
     out_.slave_velocity_m_s.head<2>() = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
     const double jog =
         std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;

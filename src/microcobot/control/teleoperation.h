@@ -130,7 +130,9 @@ class Teleoperation {
   void hold_at(const Eigen::Vector3d& measured_m) noexcept;
   /// The virtual fixtures for the coming ticks (stage coordinates; virtual_fixtures.h), on every
   /// input path. Real-time safe.
-  void set_fixtures(const FixtureSet& set) noexcept { fixtures_.set(set); }
+  /// A guide that moves starts again from level 0 (slewed up), and the master's target is
+  /// re-taken from the slave's: a new guide never moves the slave at once.
+  void set_fixtures(const FixtureSet& set) noexcept;
   const VirtualFixtures& fixtures() const noexcept { return fixtures_; }
   /// The motion scale in force (the configured one times the fixtures' gain).
   double motion_scale() const noexcept { return scale_; }
@@ -138,6 +140,8 @@ class Teleoperation {
  private:
   double clamp_workspace(double v) const noexcept;
   void console_tick(const TeleoperationInput& in) noexcept;
+  /// The target in the plane under the fixtures, from `from` (slewed where they act).
+  Eigen::Vector2d follow_fixtures(const Eigen::Vector2d& from) noexcept;
   /// The safety limits on this tick's commands (every input path).
   void apply_limits(const TeleoperationInput& in, double requested_opening_m) noexcept;
 
@@ -154,6 +158,9 @@ class Teleoperation {
   Eigen::Vector2d raw_xy_m_ = Eigen::Vector2d::Zero();  // the master's target before the fixtures
   Eigen::Vector2d last_handle_m_ = Eigen::Vector2d::Zero();
   double scale_ = 0.0;                // motion scale in force
+  bool slewing_ = false;              // the target catching up with the fixtures' output
+  double hand_speed_m_s_ = 0.0;       // the handle's speed, low-passed (~10 ms)
+  bool reindex_ = false;              // a new guide: the master's target re-taken from the slave's
   bool console_had_control_ = false;  // the haptic path re-indexes when it takes over
   bool slave_was_stale_ = false;      // re-take the target from the slave when it returns
 };

@@ -11,6 +11,7 @@ void VirtualFixtureParams::validate() const {
   require(far_gain >= 1.0 && far_gain <= 50.0, "far_gain", "must be within [1, 50]", far_gain);
   require(far_distance_m > capture_radius_m, "far_distance_m", "must be beyond capture_radius_m",
           far_distance_m);
+  require_positive(max_speed_m_s, "max_speed_m_s");
   require_non_negative(display_stiffness_N_m, "display_stiffness_N_m");
   require_positive(max_display_N, "max_display_N");
   require(funnel_half_angle_deg > 0.0 && funnel_half_angle_deg < 89.0, "funnel_half_angle_deg",
@@ -32,9 +33,11 @@ void VirtualFixtures::set(const FixtureSet& set) noexcept {
   if (next == set_) return;
   // A new guide moves the field under the handle: its energy is booked afresh. A new level alone
   // is slewed, and what it would add is the passivity controller's to dissipate.
-  if (next.guide != set_.guide || next.guide_xy_m != set_.guide_xy_m) rebase_ = true;
+  if (next.guide != set_.guide || next.guide_xy_m != set_.guide_xy_m) {
+    rebase_ = true;
+    level_ = 0.0;  // from nothing again: the new field comes in at level_rate_1_s
+  }
   set_ = next;
-  if (!set_.guide) level_ = 0.0;
 }
 
 void VirtualFixtures::tick(double dt_s) noexcept {
@@ -60,12 +63,15 @@ double VirtualFixtures::potential_J(double d, double a, double s) const noexcept
   return p_.display_stiffness_N_m * a / (s * s) * integral;
 }
 
-double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy) const noexcept {
+double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy, double base_speed_m_s) const noexcept {
   if (!set_.guide) return 1.0;
   const double d = (xy - set_.guide_xy_m).norm();
   const double x =
       std::clamp((d - p_.capture_radius_m) / (p_.far_distance_m - p_.capture_radius_m), 0.0, 1.0);
-  return 1.0 + level_ * (p_.far_gain - 1.0) * x;
+  double g = 1.0 + level_ * (p_.far_gain - 1.0) * x;
+  if (std::isfinite(base_speed_m_s) && g * base_speed_m_s > p_.max_speed_m_s)
+    g = std::max(1.0, p_.max_speed_m_s / base_speed_m_s);
+  return g;
 }
 
 Eigen::Vector2d VirtualFixtures::guided(const Eigen::Vector2d& raw_xy) const noexcept {

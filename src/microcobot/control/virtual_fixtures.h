@@ -16,7 +16,8 @@
 ///   scaling    the motion scale grows with the distance to the guide (coarse far, fine near):
 ///              g(d) = 1 + a (far_gain - 1) clamp((d - R) / (far_distance - R), 0, 1). The
 ///              coupling applies it to the master's increments, so changing it never moves the
-///              slave (bumpless).
+///              slave (bumpless), and lowers it for a fast hand so that the slave's speed stays
+///              under max_speed_m_s (never below 1: without fixtures nothing changes).
 ///   funnel     a forbidden region: the hole's edge. Below `rim_z + cone height` the target's
 ///              z is kept above the cone z >= rim_z + (d - r0) / tan(half angle) (d: distance to
 ///              the axis, r0: the allowed radius at the rim), so that a carried part reaches the
@@ -32,7 +33,8 @@
 ///              controller adds the damping that dissipates exactly the excess (f' = f + b v,
 ///              control/passivity.h's rule).
 ///
-/// The assistance level follows its set value at a bounded rate (no jump in the target).
+/// The assistance level follows its set value at a bounded rate, from 0 whenever the guide moves
+/// (no jump in the target).
 /// Everything here is real-time safe: no allocation, lock, exception or I/O.
 
 #include <cmath>
@@ -43,9 +45,12 @@
 namespace mc::control {
 
 struct VirtualFixtureParams {
-  double capture_radius_m = 25e-6;      ///< R: full guidance within it, none beyond 2R
-  double far_gain = 4.0;                ///< motion-scale gain at far_distance_m and beyond (level 1)
-  double far_distance_m = 600e-6;       ///< distance to the guide where the gain is full
+  double capture_radius_m = 25e-6;  ///< R: full guidance within it, none beyond 2R
+  double far_gain = 4.0;            ///< motion-scale gain at far_distance_m and beyond (level 1)
+  double far_distance_m = 600e-6;   ///< distance to the guide where the gain is full
+  /// The gain never drives the slave faster than this (a fast hand gets the plain scale): a
+  /// target running ahead of the stick-slip stage (~1.2 mm/s at most) makes it overshoot.
+  double max_speed_m_s = 1e-3;
   double display_stiffness_N_m = 60.0;  ///< k: hand newtons per hand metre (below the finger's 228 N/m)
   double max_display_N = 1.0;           ///< cap on the guidance force on the handle
   double funnel_half_angle_deg = 60.0;  ///< the funnel's cone, from the vertical
@@ -57,6 +62,7 @@ struct VirtualFixtureParams {
     v("capture_radius_m", capture_radius_m);
     v("far_gain", far_gain);
     v("far_distance_m", far_distance_m);
+    v("max_speed_m_s", max_speed_m_s);
     v("display_stiffness_N_m", display_stiffness_N_m);
     v("max_display_N", max_display_N);
     v("funnel_half_angle_deg", funnel_half_angle_deg);
@@ -86,7 +92,8 @@ class VirtualFixtures {
   /// Validates (throws mc::InvalidParams).
   explicit VirtualFixtures(const VirtualFixtureParams& params);
 
-  /// Installs `set` for the coming ticks (its level is reached at level_rate_1_s). Invalid
+  /// Installs `set` for the coming ticks (its level is reached at level_rate_1_s; a guide that
+  /// moves starts again from level 0). Invalid
   /// numbers (NaN, a level outside [0, 1]) remove the fixtures instead. Real-time safe.
   void set(const FixtureSet& set) noexcept;
   const FixtureSet& fixtures() const noexcept { return set_; }
@@ -96,8 +103,9 @@ class VirtualFixtures {
   void tick(double dt_s) noexcept;
   bool active() const noexcept { return set_.guide && (level_ > 0.0 || set_.funnel); }
 
-  /// The motion-scale gain g(d) at the target `xy` (1 without a guide).
-  double scale_gain(const Eigen::Vector2d& xy) const noexcept;
+  /// The motion-scale gain g(d) at the target `xy` (1 without a guide), for a master moving the
+  /// slave at `base_speed_m_s` with the plain scale.
+  double scale_gain(const Eigen::Vector2d& xy, double base_speed_m_s = 0.0) const noexcept;
   /// The guided target for the master's raw target.
   Eigen::Vector2d guided(const Eigen::Vector2d& raw_xy) const noexcept;
   /// The lowest z allowed at `xy` (-inf without a funnel).

@@ -151,6 +151,8 @@ class Platform {
   /// Shared control (issue #29): the virtual fixtures on the coupling for the next ticks, in world
   /// coordinates (control/virtual_fixtures.h). On the loop (the operator task); real-time safe.
   void set_fixtures(const control::FixtureSet& set) noexcept;
+  /// The haptic master's motion scale in force (the configured one times the fixtures' gain).
+  double motion_scale() const noexcept { return teleop_->motion_scale(); }
   /// After an e-stop (fault_all), the explicit reset: every device configured and activated
   /// again, the stage holding where it is. Off the loop only (it may allocate): call it between
   /// runs. Throws mc::Error when a device refuses (every device is then left in its safe state).

@@ -1,0 +1,327 @@
+#include "microcobot/cell/person_operator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::cell {
+
+void PersonOperatorParams::validate() const {
+  require(master == "haptic" || master == "console", "master",
+          "must be haptic or console, got '" + master + "'");
+  person.validate();
+  require_positive(pin_tolerance_m, "pin_tolerance_m");
+  require_positive(bore_tolerance_m, "bore_tolerance_m");
+  require_positive(assisted_tolerance_m, "assisted_tolerance_m");
+  require_positive(z_tolerance_m, "z_tolerance_m");
+  require_positive(still_m, "still_m");
+  require(still_window_s > 0.0 && still_window_s <= 0.2, "still_window_s", "must be within (0, 0.2] s",
+          still_window_s);
+  require_positive(jam_margin_m, "jam_margin_m");
+  require_positive(jam_retreat_m, "jam_retreat_m");
+  require_positive(press_m, "press_m");
+  require_positive(hand_limit_m, "hand_limit_m");
+  require_positive(pinch_m_s, "pinch_m_s");
+  require_positive(max_pinch_m, "max_pinch_m");
+  require_positive(felt_grip_N, "felt_grip_N");
+  require_positive(slider_m_s, "slider_m_s");
+  require_positive(grip_seen_N, "grip_seen_N");
+  require_positive(joystick_travel_m, "joystick_travel_m");
+  require_positive(step_timeout_s, "step_timeout_s");
+  require(max_jams >= 1, "max_jams", "must be at least 1", max_jams);
+}
+
+namespace {
+
+double operator_rate_Hz(const platform::PlatformConfig& c) {
+  return c.loop.base_rate_Hz / c.loop.operator_divisor;
+}
+
+}  // namespace
+
+PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperatorParams& params,
+                               const AssemblyTaskParams& task, const AssemblyGoal& goal, bool assisted,
+                               std::uint64_t seed)
+    : platform_(platform),
+      sim_(platform.simulation()),
+      p_(params),
+      goal_(goal),
+      assisted_(assisted),
+      haptic_(params.master == "haptic"),
+      rng_(seed),
+      xy_(params.person, rng_),
+      z_(params.person, rng_),
+      tremor_(params.person, operator_rate_Hz(platform.config()), seed ^ 0x7472656d6f72ULL),
+      base_scale_(platform.config().teleop.motion_scale) {
+  p_.validate();
+  task.validate();
+  require(sim_.gripper != nullptr && sim_.haptic != nullptr && sim_.tweezers != nullptr, "microworld",
+          "the simulated person needs the pick-and-place scene's simulated devices");
+  grasp_z_ = goal.hole_depth_m + task.grip_above_m;
+  safe_z_ = goal.part_height_m + task.clearance_height_m;
+  carry_z_ = grasp_z_ + task.clearance_height_m;
+  inserted_z_ = grasp_z_ - goal.hole_depth_m;
+  const Eigen::Vector3d tip = sim_.gripper->tip_position_m();
+  xy_.reset(
+      haptic_ ? Eigen::Vector2d(sim_.haptic->operator_hand().hand_m.x, sim_.haptic->operator_hand().hand_m.y)
+              : Eigen::Vector2d(tip.head<2>()),
+      0.0);
+  z_.reset({tip.z(), 0.0}, 0.0);
+  slider_ = goal.open_m;
+  window_ticks_ =
+      std::clamp(static_cast<int>(std::lround(p_.still_window_s * operator_rate_Hz(platform.config()))), 1,
+                 kHistory - 1);
+  // The cell's vision finds the pin on the tray (assisted): where the guidance takes the tips.
+  pin_seen_ = seen(sim_.gripper->world_state().part_m.head<2>());
+}
+
+void PersonOperator::enter(Step s, double t) noexcept {
+  step_ = s;
+  step_t0_ = t;
+  rising_ = false;
+  held_since_ = -1.0;
+}
+
+void PersonOperator::give_up(const char* why) noexcept {
+  gave_up_ = true;
+  reason_ = why;
+  let_go();
+}
+
+void PersonOperator::let_go() noexcept {
+  hand_.deadman = false;
+  hand_.clutch = false;
+  hand_.jog_m_s = 0.0;
+  sim_.haptic->set_operator(hand_);
+  console_ = {};
+  if (!haptic_) platform_.set_console_input(console_);
+  platform_.set_fixtures({});
+}
+
+Eigen::Vector2d PersonOperator::seen(const Eigen::Vector2d& p) noexcept {
+  const double sd = p_.person.vision_sd_m;
+  return p + Eigen::Vector2d(rng_.normal(0.0, sd), rng_.normal(0.0, sd));
+}
+
+bool PersonOperator::tool_still() const noexcept {
+  if (tip_count_ <= window_ticks_) return false;
+  const Eigen::Vector3d& now = tips_[static_cast<std::size_t>((tip_count_ - 1) % kHistory)];
+  const Eigen::Vector3d& then = tips_[static_cast<std::size_t>((tip_count_ - 1 - window_ticks_) % kHistory)];
+  return (now - then).norm() < p_.still_m;
+}
+
+bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept {
+  if (clutching_) {
+    if (xy_.moving(t)) return false;
+    clutching_ = false;  // the hand back: clutch released, and a look before going on
+    hand_.clutch = false;
+    xy_.reset(xy_.end(), t);
+    return false;
+  }
+  if (!xy_.ready(t) || !tool_still()) return false;
+  const Eigen::Vector2d e = seen(error_m);
+  // The person knows how the master maps to the stage: the motion scale in force (the shared
+  // control's gain included), as they see the stage answer.
+  const double scale = platform_.motion_scale();
+  if (!haptic_) {
+    const double gain = scale / base_scale_;
+    const double v_max = platform_.config().teleop.console_max_speed_m_s / gain;
+    return xy_.aim(e / gain, tolerance_m / gain, t, v_max);
+  }
+  // A person learns the stage's pace: the hand no faster than the stage follows.
+  const double hand_max = platform_.config().teleop.console_max_speed_m_s / scale;
+  Eigen::Vector2d move = e / scale;
+  const Eigen::Vector2d from = xy_.end();
+  const Eigen::Vector2d to = from + move;
+  if (to.cwiseAbs().maxCoeff() > p_.hand_limit_m) {
+    bool at_edge = false;
+    for (int i = 0; i < 2; ++i)
+      at_edge |= std::abs(to[i]) > p_.hand_limit_m && std::abs(from[i]) > 0.7 * p_.hand_limit_m;
+    if (at_edge) {
+      // Clutch: the slave holds while the hand goes back across the workspace.
+      Eigen::Vector2d back = from;
+      for (int i = 0; i < 2; ++i)
+        if (std::abs(to[i]) > p_.hand_limit_m) back[i] = -std::copysign(0.5 * p_.hand_limit_m, move[i]);
+      hand_.clutch = true;
+      clutching_ = true;
+      ++clutches_;
+      xy_.move(back, p_.person.movement_time_s((back - from).norm(), 5e-3), t);
+      return false;
+    }
+    // As far as the workspace lets the hand go.
+    double f = 1.0;
+    for (int i = 0; i < 2; ++i)
+      if (std::abs(to[i]) > p_.hand_limit_m)
+        f = std::min(f, (std::copysign(0.95 * p_.hand_limit_m, move[i]) - from[i]) / move[i]);
+    move *= std::max(f, 0.0);
+    xy_.aim(move, tolerance_m / scale, t, hand_max);
+    return false;
+  }
+  return xy_.aim(move, tolerance_m / scale, t, hand_max);
+}
+
+bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept {
+  if (!z_.ready(t) || !tool_still()) return false;
+  const double e = z_goal - tip_z + rng_.normal(0.0, p_.person.vision_sd_m);
+  const double v_max =
+      haptic_ ? platform_.config().teleop.max_jog_m_s : platform_.config().teleop.console_max_speed_m_s;
+  return z_.aim({e, 0.0}, tolerance_m, t, v_max);
+}
+
+void PersonOperator::assist() noexcept {
+  control::FixtureSet f;
+  f.level = 1.0;
+  f.guide = true;
+  switch (step_) {
+    case Step::kApproach:
+    case Step::kDescend:
+    case Step::kGrasp:
+    case Step::kLift:
+      f.guide_xy_m = pin_seen_;  // the tips onto the pin vision found
+      break;
+    case Step::kTransport:
+    case Step::kInsert:
+      // The carried pin onto its bore's axis, and the funnel round the rim.
+      f.guide_xy_m = goal_.target_m - pin_offset_seen_;
+      f.funnel = true;
+      f.rim_z_m = rim_z_;
+      f.funnel_radius_m = 0.5 * goal_.clearance_m;
+      break;
+    default:
+      f = {};
+      break;
+  }
+  platform_.set_fixtures(f);
+}
+
+void PersonOperator::act(const platform::TickInfo& tick) noexcept {
+  const double t = tick.t_s, dt = tick.dt_s;
+  if (step_ == Step::kDone || gave_up_) return;
+  if (t - step_t0_ > p_.step_timeout_s) {
+    give_up("a step took the person longer than step_timeout_s");
+    return;
+  }
+  const platform::SimulatedGripper& g = *sim_.gripper;
+  const Eigen::Vector3d tip = g.tip_position_m();
+  const Eigen::Vector3d part = g.world_state().part_m;
+  const platform::Vec3 c = g.contact_force_N();
+  const Eigen::Vector3d contact(c.x, c.y, c.z);
+  tips_[static_cast<std::size_t>(tip_count_ % kHistory)] = tip;
+  ++tip_count_;
+  hand_.deadman = true;
+  switch (step_) {
+    case Step::kApproach:
+      if (tip.z() < safe_z_ - p_.z_tolerance_m) {
+        climb(safe_z_, tip.z(), p_.z_tolerance_m, t);
+      } else if (steer(part.head<2>() - tip.head<2>(),
+                       assisted_ ? p_.assisted_tolerance_m : p_.pin_tolerance_m, t)) {
+        enter(Step::kDescend, t);
+      }
+      break;
+    case Step::kDescend:
+      if (climb(grasp_z_, tip.z(), p_.z_tolerance_m, t)) enter(Step::kGrasp, t);
+      break;
+    case Step::kGrasp: {
+      const bool held =
+          haptic_ ? platform_.teleop().finger_force_N >= p_.felt_grip_N : g.grip_force_N() >= p_.grip_seen_N;
+      if (held && held_since_ < 0.0) held_since_ = t;
+      // Closing until the grip is told, and a reaction time more before the fingers stop.
+      const bool closing = held_since_ < 0.0 || t < held_since_ + p_.person.reaction_time_s;
+      if (closing) {
+        if (haptic_) {
+          pinch_ = std::min(p_.max_pinch_m, pinch_ + p_.pinch_m_s * dt);
+        } else {
+          slider_ = std::max(0.0, slider_ - p_.slider_m_s * dt);
+        }
+      }
+      if (held_since_ >= 0.0 && t >= held_since_ + 2.0 * p_.person.reaction_time_s) {
+        pin_offset_seen_ = seen((part - tip).head<2>());
+        rim_z_ = tip.z() - (part.z() - 0.5 * goal_.part_height_m);
+        enter(Step::kLift, t);
+      } else if (!held && (haptic_ ? pinch_ >= p_.max_pinch_m : slider_ <= 0.0)) {
+        give_up("the fingers closed on nothing");
+      }
+      break;
+    }
+    case Step::kLift:
+      if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t)) enter(Step::kTransport, t);
+      break;
+    case Step::kTransport:
+      if (steer(goal_.target_m - part.head<2>(), assisted_ ? p_.assisted_tolerance_m : p_.bore_tolerance_m,
+                t))
+        enter(Step::kInsert, t);
+      break;
+    case Step::kInsert: {
+      if (rising_) {
+        // Off the rim: up, then a fresh look and aim before going down again.
+        if (climb(rim_z_ + p_.jam_retreat_m, tip.z(), p_.z_tolerance_m, t) &&
+            steer(goal_.target_m - part.head<2>(), assisted_ ? p_.assisted_tolerance_m : p_.bore_tolerance_m,
+                  t))
+          rising_ = false;
+        break;
+      }
+      // The plate pushing the pin up, felt (haptic: through the handle's force; console: on the
+      // display) well above the bore's depth: the pin is on the rim. The person stops rolling
+      // down at once and, a reaction later, backs off and looks again.
+      const bool touching = contact.z() >= p_.person.feel_contact_N;
+      if (touching && tip.z() > inserted_z_ + p_.jam_margin_m) {
+        if (++jams_ > p_.max_jams) {
+          give_up("the pin kept landing on the rim");
+          return;
+        }
+        z_.reset({tip.z(), 0.0}, t);
+        rising_ = true;
+        break;
+      }
+      // Down onto the bore's floor: aimed a press below it, done when the floor is felt there.
+      climb(inserted_z_ - p_.press_m, tip.z(), p_.z_tolerance_m, t);
+      if (touching && tip.z() <= inserted_z_ + p_.jam_margin_m) enter(Step::kRelease, t);
+      break;
+    }
+    case Step::kRelease:
+      if (haptic_) {
+        pinch_ = std::max(0.0, pinch_ - p_.pinch_m_s * dt);
+      } else {
+        slider_ = std::min(goal_.open_m, slider_ + p_.slider_m_s * dt);
+      }
+      if (g.opening_m() > 0.9 * goal_.open_m) enter(Step::kRetract, t);
+      break;
+    case Step::kRetract:
+      if (climb(safe_z_, tip.z(), p_.z_tolerance_m, t)) {
+        enter(Step::kDone, t);
+        let_go();
+        return;
+      }
+      break;
+    default:
+      break;
+  }
+  if (assisted_) assist();
+  apply(t);
+}
+
+void PersonOperator::apply(double t) noexcept {
+  const Eigen::Vector2d tremor = tremor_.next();
+  if (haptic_) {
+    const Eigen::Vector2d h = xy_.position(t) + tremor;
+    hand_.hand_m = {h.x(), h.y()};
+    hand_.jog_m_s = z_.velocity(t).x();
+    sim_.haptic->set_operator(hand_);
+    sim_.tweezers->set_operator_closing(pinch_);
+    return;
+  }
+  // The joystick: the person's intended motion as a rate, its deflection trembling too.
+  // (The platform scales the joystick's speed by the shared control's gain; the person planned
+  // for it, steer().)
+  const double per_m = platform_.config().teleop.console_max_speed_m_s / p_.joystick_travel_m;
+  console_.active = console_.fresh = console_.deadman = true;
+  console_.has_goal = false;
+  console_.velocity_m_s.head<2>() = xy_.velocity(t) + per_m * tremor;
+  console_.velocity_m_s.z() = z_.velocity(t).x();
+  console_.has_gripper = true;
+  console_.gripper_opening_m = slider_;
+  platform_.set_console_input(console_);
+}
+
+}  // namespace mc::cell

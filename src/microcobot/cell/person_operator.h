@@ -1,0 +1,157 @@
+#pragma once
+/// @file
+/// A simulated person doing one insertion of the assembly cell through the platform's own
+/// inputs (issue #29 point 3), manually or with shared control (point 4):
+///
+///   master "haptic"   the dual-stage haptic handle (x, y; the slave follows at the motion
+///                     scale, clutching near the workspace's edge), the Z thumb wheel and the
+///                     TéléTweez, whose finger force tells the grip;
+///   master "console"  the console's joystick (a rate control: stage velocity in x, y, z) and
+///                     its gripper slider, the grip force read off the console's display.
+///
+/// The person looks through the microscope (the true positions, made out within vision_sd_m),
+/// moves in minimum-jerk sub-movements timed by Fitts' law with the endpoint noise, reaction
+/// time and tremor of person_model.h, and goes through the steps of the automatic task
+/// (assembly_task.h) so that the modes compare step by step: approach over the pin, descend,
+/// grasp, lift, transport the pin over its bore, insert (down; a contact felt above the bore's
+/// depth means the pin sits on the rim: up a little, look again, re-aim, down again), release,
+/// retract.
+///
+/// Assisted (shared control): the cell's vision gives the pin's position and, once it is held,
+/// its offset from the finger tips (within vision_sd_m, measured once per step); the platform
+/// then guides the slave to the pin, and the carried pin to its bore's axis, with the insertion
+/// funnel round the rim and the coarse-far/fine-near scaling (control/virtual_fixtures.h). The
+/// person trusts the guidance: they aim within the fixture's capture radius, not at the last
+/// micrometre. Everything else (the person, the seeds, the parts) is the manual run's.
+///
+/// act() runs as the platform's operator task: real-time safe (no allocation, lock, exception,
+/// I/O). The person lets go of everything when done or when a step times out (gave up).
+
+#include <array>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "microcobot/cell/assembly_task.h"
+#include "microcobot/cell/person_model.h"
+#include "microcobot/platform/platform.h"
+
+namespace mc::cell {
+
+struct PersonOperatorParams {
+  std::string master = "haptic";  ///< "haptic" or "console"
+  PersonParams person;
+  double pin_tolerance_m = 10e-6;       ///< over the pin before descending
+  double bore_tolerance_m = 2e-6;       ///< manual: the pin over its bore before inserting
+  double assisted_tolerance_m = 15e-6;  ///< assisted: within the guidance's capture
+  double z_tolerance_m = 10e-6;         ///< heights judged by eye (the depth of field)
+  double still_m = 5e-6;                ///< the tool seen still: it moved less than this ...
+  double still_window_s = 0.1;          ///< ... over this (one tremor period: tremor averages out)
+  double jam_margin_m = 20e-6;          ///< a contact this far above the bore's depth: on the rim
+  double jam_retreat_m = 30e-6;         ///< up by this before looking again
+  double press_m = 10e-6;               ///< inserting: aimed this far below the bore's floor
+  double hand_limit_m = 35e-3;          ///< haptic: clutch before the hand passes this
+  double pinch_m_s = 10e-3;             ///< TéléTweez lever closing speed
+  double max_pinch_m = 10e-3;           ///< the levers' travel
+  double felt_grip_N = 0.03;            ///< TéléTweez finger force that tells the part is held
+  double slider_m_s = 600e-6;           ///< console gripper slider speed (opening units)
+  double grip_seen_N = 0.25e-3;         ///< console: a grip force read as held
+  double joystick_travel_m = 15e-3;     ///< console: the joystick's half travel (tremor scale)
+  double step_timeout_s = 60.0;         ///< a step not done by then: the person gives up
+  int max_jams = 12;                    ///< rim contacts before the person gives up
+
+  template <class V>
+  void visit(V& v) {
+    v("master", master);
+    v("person", person);
+    v("pin_tolerance_m", pin_tolerance_m);
+    v("bore_tolerance_m", bore_tolerance_m);
+    v("assisted_tolerance_m", assisted_tolerance_m);
+    v("z_tolerance_m", z_tolerance_m);
+    v("still_m", still_m);
+    v("still_window_s", still_window_s);
+    v("jam_margin_m", jam_margin_m);
+    v("jam_retreat_m", jam_retreat_m);
+    v("press_m", press_m);
+    v("hand_limit_m", hand_limit_m);
+    v("pinch_m_s", pinch_m_s);
+    v("max_pinch_m", max_pinch_m);
+    v("felt_grip_N", felt_grip_N);
+    v("slider_m_s", slider_m_s);
+    v("grip_seen_N", grip_seen_N);
+    v("joystick_travel_m", joystick_travel_m);
+    v("step_timeout_s", step_timeout_s);
+    v("max_jams", max_jams);
+  }
+  /// Throws mc::InvalidParams naming the field.
+  void validate() const;
+};
+
+class PersonOperator {
+ public:
+  using Step = AssemblyTask::Step;
+  /// `task` gives the geometry (heights, speeds' limits); `goal` what the cell knows of the part.
+  /// Throws mc::InvalidParams.
+  PersonOperator(platform::Platform& platform, const PersonOperatorParams& params,
+                 const AssemblyTaskParams& task, const AssemblyGoal& goal, bool assisted, std::uint64_t seed);
+
+  /// One operator tick (the platform's operator task). Real-time safe.
+  void act(const platform::TickInfo& tick) noexcept;
+
+  Step step() const noexcept { return step_; }
+  bool done() const noexcept { return step_ == Step::kDone; }
+  bool gave_up() const noexcept { return gave_up_; }
+  std::string_view give_up_reason() const noexcept { return reason_; }
+  int clutches() const noexcept { return clutches_; }
+  int jams() const noexcept { return jams_; }
+  int submovements() const noexcept { return xy_.submovements() + z_.submovements(); }
+
+ private:
+  void enter(Step s, double t) noexcept;
+  void give_up(const char* why) noexcept;
+  void let_go() noexcept;
+  /// Steers the tip (or the carried pin) by the seen error in the plane; true once there.
+  bool steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept;
+  /// Brings the tip to height `z_goal`; true once seen there.
+  bool climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept;
+  void apply(double t) noexcept;
+  /// Shared control: the fixtures for the current step (assisted runs).
+  void assist() noexcept;
+  Eigen::Vector2d seen(const Eigen::Vector2d& p) noexcept;
+  /// The tool seen still: moved less than still_m over the last still_window_s (a person waits
+  /// for the stage to arrive before judging where it is).
+  bool tool_still() const noexcept;
+
+  platform::Platform& platform_;
+  const platform::SimulatedDevices& sim_;
+  PersonOperatorParams p_;
+  AssemblyGoal goal_;
+  bool assisted_;
+  bool haptic_;
+  Rng rng_;
+  Reach xy_, z_;  // the hand in the plane (haptic: hand metres; console: stage metres), the height
+  Tremor tremor_;
+  double base_scale_;
+  double grasp_z_, safe_z_, carry_z_, inserted_z_;
+  Step step_ = Step::kApproach;
+  double step_t0_ = 0.0;
+  bool gave_up_ = false;
+  const char* reason_ = "";
+  platform::OperatorHand hand_;
+  control::ConsoleInput console_;
+  bool clutching_ = false;
+  int clutches_ = 0, jams_ = 0;
+  bool rising_ = false;       // insert: backing off the rim
+  double pinch_ = 0.0;        // TéléTweez lever closing [m]
+  double slider_ = 0.0;       // console gripper opening [m]
+  double held_since_ = -1.0;  // grip first felt (the person stops closing a reaction later)
+  Eigen::Vector2d pin_offset_seen_ = Eigen::Vector2d::Zero();  // pin - tips, as vision saw it
+  Eigen::Vector2d pin_seen_ = Eigen::Vector2d::Zero();         // the pin on the tray, seen
+  double rim_z_ = 0.0;                  // tip height at which the carried pin meets the plate
+  static constexpr int kHistory = 256;  // tip positions, one per operator tick (ring)
+  std::array<Eigen::Vector3d, kHistory> tips_{};
+  int tip_count_ = 0, window_ticks_ = 1;
+};
+
+}  // namespace mc::cell
