@@ -29,7 +29,10 @@ TEST(Teleoperation, EngagingNeverMovesTheSlaveThenMotionIsScaled) {
   out = t.tick(engaged_at(0.021, 0.008));  // +1 mm, -2 mm of hand
   EXPECT_NEAR(out.slave_target_m.x(), 1e-3 + 10e-6, 1e-15);
   EXPECT_NEAR(out.slave_target_m.y(), -2e-3 - 20e-6, 1e-15);
-  EXPECT_NEAR(out.slave_velocity_m_s.x(), 10e-6 / kDt, 1e-9);  // feedforward of the moving target
+  // Feedforward of the moving target, low-passed (velocity_filter_s): one tick's step counts by
+  // 1 - exp(-dt / tau) of its speed.
+  const double alpha = 1.0 - std::exp(-kDt / TeleoperationParams{}.velocity_filter_s);
+  EXPECT_NEAR(out.slave_velocity_m_s.x(), alpha * 10e-6 / kDt, 1e-9);
   EXPECT_DOUBLE_EQ(out.slave_target_m.z(), 0.5e-3);
 }
 

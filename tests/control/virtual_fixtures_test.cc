@@ -150,7 +150,7 @@ TEST(TeleoperationWithFixtures, ScalingIsCoarseFarAndFineNear) {
   // Toward the guide the scale falls to the configured one near it, continuously.
   double last_scale = t.motion_scale();
   while (t.output().slave_target_m.x() < 2e-3 - 1e-12) {  // until the guidance holds it on the axis
-    h.x() += 1e-6;  // 10 mm/s of hand: the slave under the gain's speed limit
+    h.x() += 1e-6;
     t.tick(hand_at(h));
     EXPECT_LE(t.motion_scale(), last_scale * (1 + 1e-12));
     last_scale = t.motion_scale();

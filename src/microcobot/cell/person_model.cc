@@ -20,6 +20,7 @@ void PersonParams::validate() const {
   require(tremor_high_Hz > tremor_low_Hz, "tremor_high_Hz", "must be above tremor_low_Hz", tremor_high_Hz);
   require_non_negative(vision_sd_m, "vision_sd_m");
   require_positive(feel_contact_N, "feel_contact_N");
+  require_positive(stage_pace_m_s, "stage_pace_m_s");
 }
 
 double PersonParams::movement_time_s(double d, double w) const noexcept {
@@ -32,7 +33,8 @@ void Reach::reset(const Eigen::Vector2d& at, double t_s) noexcept {
   duration_ = 0.0;
 }
 
-bool Reach::aim(const Eigen::Vector2d& error, double tolerance, double t_s, double max_speed) noexcept {
+bool Reach::aim(const Eigen::Vector2d& error, double tolerance, double t_s, double max_speed,
+                double width) noexcept {
   // The last movement's end is seen after the display's delay, and acted on a reaction later.
   if (!ready(t_s) || !error.allFinite()) return false;
   const double d = error.norm();
@@ -41,7 +43,7 @@ bool Reach::aim(const Eigen::Vector2d& error, double tolerance, double t_s, doub
   x0_ = x1_;
   x1_ = x0_ + error + Eigen::Vector2d(rng_.normal(0.0, sd), rng_.normal(0.0, sd));
   t0_ = t_s;
-  duration_ = std::max(p_.movement_time_s(d, tolerance), 1.875 * d / max_speed);
+  duration_ = std::max(p_.movement_time_s(d, std::max(tolerance, width)), 1.875 * d / max_speed);
   ++count_;
   return false;
 }
@@ -70,8 +72,8 @@ Eigen::Vector2d Reach::velocity(double t_s) const noexcept {
 namespace {
 
 dsp::Sos tremor_band(const PersonParams& p, double rate_Hz) {
-  dsp::Sos sos = dsp::butter(2, p.tremor_low_Hz, rate_Hz, dsp::FilterType::kHighPass);
-  const dsp::Sos low = dsp::butter(2, p.tremor_high_Hz, rate_Hz, dsp::FilterType::kLowPass);
+  dsp::Sos sos = dsp::butter(4, p.tremor_low_Hz, rate_Hz, dsp::FilterType::kHighPass);
+  const dsp::Sos low = dsp::butter(4, p.tremor_high_Hz, rate_Hz, dsp::FilterType::kLowPass);
   sos.insert(sos.end(), low.begin(), low.end());
   return sos;
 }

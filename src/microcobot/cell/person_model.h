@@ -18,7 +18,7 @@
 ///    1998). A miss beyond W calls for a corrective sub-movement, smaller, after the reaction
 ///    time: the primary movement and its corrections together give Fitts' law's total time.
 ///  - **Tremor.** Physiological tremor is added to the hand's position: white noise through a
-///    band-pass of 8-12 Hz (Butterworth, 2nd order each side), scaled to `tremor_rms_m` per axis
+///    band-pass of 8-12 Hz (Butterworth, 4th order each side), scaled to `tremor_rms_m` per axis
 ///    (~100 um RMS at the hand: Elble and Koller, Tremor, 1990; Riviere, Rader and Thakor, IEEE
 ///    T-BME 45(5), 1998, measured 50-100 um in microsurgery).
 ///
@@ -44,8 +44,9 @@ struct PersonParams {
   double tremor_rms_m = 100e-6;        ///< hand tremor, per axis
   double tremor_low_Hz = 8.0;
   double tremor_high_Hz = 12.0;
-  double vision_sd_m = 1.0e-6;    ///< what the person makes out through the microscope (SD)
-  double feel_contact_N = 60e-6;  ///< a contact force the person notices (seen or felt)
+  double vision_sd_m = 1.0e-6;     ///< what the person makes out through the microscope (SD)
+  double feel_contact_N = 60e-6;   ///< a contact force the person notices (seen or felt)
+  double stage_pace_m_s = 0.5e-3;  ///< the stage speed the person has learned not to outrun
 
   template <class V>
   void visit(V& v) {
@@ -59,6 +60,7 @@ struct PersonParams {
     v("tremor_high_Hz", tremor_high_Hz);
     v("vision_sd_m", vision_sd_m);
     v("feel_contact_N", feel_contact_N);
+    v("stage_pace_m_s", stage_pace_m_s);
   }
   /// Throws mc::InvalidParams naming the field.
   void validate() const;
@@ -81,8 +83,10 @@ class Reach {
   /// from where the last one ended, missing by the endpoint noise, no faster than `max_speed`
   /// at its peak (1.875 D / T for a minimum-jerk profile). Returns true when the person, ready,
   /// sees the error within the tolerance.
+  /// `width`, when given, is the target's width the person plans the movement for (Fitts' W)
+  /// where it differs from the tolerance they check (a guided target is caught from further).
   bool aim(const Eigen::Vector2d& error, double tolerance, double t_s,
-           double max_speed = std::numeric_limits<double>::infinity()) noexcept;
+           double max_speed = std::numeric_limits<double>::infinity(), double width = 0.0) noexcept;
   /// The person has seen the last movement end and may act again.
   bool ready(double t_s) const noexcept {
     return t_s >= t0_ + duration_ + p_.display_delay_s + p_.reaction_time_s;

@@ -111,7 +111,8 @@ bool PersonOperator::tool_still() const noexcept {
   return (now - then).norm() < p_.still_m;
 }
 
-bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept {
+bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, double t,
+                           double width_m) noexcept {
   if (clutching_) {
     if (xy_.moving(t)) return false;
     clutching_ = false;  // the hand back: clutch released, and a look before going on
@@ -121,16 +122,17 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
   }
   if (!xy_.ready(t) || !tool_still()) return false;
   const Eigen::Vector2d e = seen(error_m);
-  // The person knows how the master maps to the stage: the motion scale in force (the shared
-  // control's gain included), as they see the stage answer.
-  const double scale = platform_.motion_scale();
+  // The person knows how the master maps to the stage, the shared control's coarse-far,
+  // fine-near scaling included: over a move from scale s0 to s1 (linear in the distance) the
+  // hand travels D ln(s0/s1) / (s0 - s1), the scale's log-mean.
+  const double s0 = platform_.motion_scale(), s1 = platform_.motion_scale_at(tool_xy_ + e);
+  const double scale = std::abs(s0 - s1) < 1e-9 * s0 ? s0 : (s0 - s1) / std::log(s0 / s1);
+  const double pace = p_.person.stage_pace_m_s;
   if (!haptic_) {
     const double gain = scale / base_scale_;
-    const double v_max = platform_.config().teleop.console_max_speed_m_s / gain;
-    return xy_.aim(e / gain, tolerance_m / gain, t, v_max);
+    return xy_.aim(e / gain, tolerance_m / gain, t, pace / gain, width_m / gain);
   }
-  // A person learns the stage's pace: the hand no faster than the stage follows.
-  const double hand_max = platform_.config().teleop.console_max_speed_m_s / scale;
+  const double hand_max = pace / scale;
   Eigen::Vector2d move = e / scale;
   const Eigen::Vector2d from = xy_.end();
   const Eigen::Vector2d to = from + move;
@@ -155,10 +157,10 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
       if (std::abs(to[i]) > p_.hand_limit_m)
         f = std::min(f, (std::copysign(0.95 * p_.hand_limit_m, move[i]) - from[i]) / move[i]);
     move *= std::max(f, 0.0);
-    xy_.aim(move, tolerance_m / scale, t, hand_max);
+    xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
     return false;
   }
-  return xy_.aim(move, tolerance_m / scale, t, hand_max);
+  return xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
 }
 
 bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept {
@@ -182,7 +184,11 @@ void PersonOperator::assist() noexcept {
       break;
     case Step::kTransport:
     case Step::kInsert:
-      // The carried pin onto its bore's axis, and the funnel round the rim.
+    case Step::kRelease:
+    case Step::kRetract:
+      // The carried pin onto its bore's axis, and the funnel round the rim; held through the
+      // release and the retract, so that the fingers open and rise on the axis (the guidance's
+      // pull on the handle, let go, would spring the hand back by micrometres of slave).
       f.guide_xy_m = goal_.target_m - pin_offset_seen_;
       f.funnel = true;
       f.rim_z_m = rim_z_;
@@ -207,6 +213,7 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
   const Eigen::Vector3d part = g.world_state().part_m;
   const platform::Vec3 c = g.contact_force_N();
   const Eigen::Vector3d contact(c.x, c.y, c.z);
+  tool_xy_ = tip.head<2>();
   tips_[static_cast<std::size_t>(tip_count_ % kHistory)] = tip;
   ++tip_count_;
   hand_.deadman = true;
@@ -214,8 +221,8 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
     case Step::kApproach:
       if (tip.z() < safe_z_ - p_.z_tolerance_m) {
         climb(safe_z_, tip.z(), p_.z_tolerance_m, t);
-      } else if (steer(part.head<2>() - tip.head<2>(),
-                       assisted_ ? p_.assisted_tolerance_m : p_.pin_tolerance_m, t)) {
+      } else if (steer(part.head<2>() - tip.head<2>(), p_.pin_tolerance_m, t,
+                       aim_width(p_.pin_tolerance_m))) {
         enter(Step::kDescend, t);
       }
       break;
@@ -236,7 +243,6 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
         }
       }
       if (held_since_ >= 0.0 && t >= held_since_ + 2.0 * p_.person.reaction_time_s) {
-        pin_offset_seen_ = seen((part - tip).head<2>());
         rim_z_ = tip.z() - (part.z() - 0.5 * goal_.part_height_m);
         enter(Step::kLift, t);
       } else if (!held && (haptic_ ? pinch_ >= p_.max_pinch_m : slider_ <= 0.0)) {
@@ -245,19 +251,21 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
       break;
     }
     case Step::kLift:
-      if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t)) enter(Step::kTransport, t);
+      if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t)) {
+        // The pin's place in the fingers once it is up, as vision sees it (assisted).
+        pin_offset_seen_ = seen((part - tip).head<2>());
+        enter(Step::kTransport, t);
+      }
       break;
     case Step::kTransport:
-      if (steer(goal_.target_m - part.head<2>(), assisted_ ? p_.assisted_tolerance_m : p_.bore_tolerance_m,
-                t))
+      if (steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)))
         enter(Step::kInsert, t);
       break;
     case Step::kInsert: {
       if (rising_) {
         // Off the rim: up, then a fresh look and aim before going down again.
         if (climb(rim_z_ + p_.jam_retreat_m, tip.z(), p_.z_tolerance_m, t) &&
-            steer(goal_.target_m - part.head<2>(), assisted_ ? p_.assisted_tolerance_m : p_.bore_tolerance_m,
-                  t))
+            steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)))
           rising_ = false;
         break;
       }

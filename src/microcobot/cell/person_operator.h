@@ -44,7 +44,7 @@ struct PersonOperatorParams {
   PersonParams person;
   double pin_tolerance_m = 10e-6;       ///< over the pin before descending
   double bore_tolerance_m = 2e-6;       ///< manual: the pin over its bore before inserting
-  double assisted_tolerance_m = 15e-6;  ///< assisted: within the guidance's capture
+  double assisted_tolerance_m = 15e-6;  ///< assisted: the target width planned for (in the capture)
   double z_tolerance_m = 10e-6;         ///< heights judged by eye (the depth of field)
   double still_m = 5e-6;                ///< the tool seen still: it moved less than this ...
   double still_window_s = 0.1;          ///< ... over this (one tremor period: tremor averages out)
@@ -111,8 +111,14 @@ class PersonOperator {
   void enter(Step s, double t) noexcept;
   void give_up(const char* why) noexcept;
   void let_go() noexcept;
-  /// Steers the tip (or the carried pin) by the seen error in the plane; true once there.
-  bool steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept;
+  /// Steers the tip (or the carried pin) by the seen error in the plane, planning for a target
+  /// `width_m` wide; true once seen within `tolerance_m`.
+  bool steer(const Eigen::Vector2d& error_m, double tolerance_m, double t, double width_m) noexcept;
+  /// What the person aims at: the tolerance alone, or with shared control the guidance's
+  /// capture (assisted_tolerance_m), which pulls the slave the rest of the way.
+  double aim_width(double tolerance_m) const noexcept {
+    return assisted_ ? std::max(tolerance_m, p_.assisted_tolerance_m) : tolerance_m;
+  }
   /// Brings the tip to height `z_goal`; true once seen there.
   bool climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept;
   void apply(double t) noexcept;
@@ -152,6 +158,7 @@ class PersonOperator {
   static constexpr int kHistory = 256;  // tip positions, one per operator tick (ring)
   std::array<Eigen::Vector3d, kHistory> tips_{};
   int tip_count_ = 0, window_ticks_ = 1;
+  Eigen::Vector2d tool_xy_ = Eigen::Vector2d::Zero();  // the finger tips, this tick
 };
 
 }  // namespace mc::cell

@@ -17,6 +17,7 @@ void TeleoperationParams::validate() const {
   require_positive(max_grip_force_N, "max_grip_force_N");
   require_positive(max_jog_m_s, "max_jog_m_s");
   require_positive(console_max_speed_m_s, "console_max_speed_m_s");
+  require_positive(velocity_filter_s, "velocity_filter_s");
   require(workspace_min_m < workspace_max_m, "workspace_min_m", "must be below workspace_max_m",
           workspace_min_m);
   fixtures.validate();
@@ -34,6 +35,7 @@ Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
   raw_xy_m_ = last_xy_m_;
   scale_ = p_.motion_scale;
   force_alpha_ = 1.0 - std::exp(-2.0 * M_PI * p_.force_filter_Hz * dt_s);
+  velocity_alpha_ = 1.0 - std::exp(-dt_s / p_.velocity_filter_s);
 }
 
 double Teleoperation::clamp_workspace(double v) const noexcept {
@@ -62,7 +64,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
     } else if (c.velocity_m_s.allFinite()) {
       // A joystick is a rate control: the fixtures' scaling gain is on its speed in the plane.
       v = c.velocity_m_s;
-      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_, v.head<2>().norm());
+      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_);
       const double n = v.norm();
       if (n > p_.console_max_speed_m_s) v *= p_.console_max_speed_m_s / n;
     }
@@ -168,10 +170,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   const Eigen::Vector2d last_handle = last_handle_m_;
   const Eigen::Vector2d handle_v = (in.handle_m - last_handle) / dt_;
   if (in.handle_m.allFinite()) last_handle_m_ = in.handle_m;
-  // The hand's speed over ~10 ms: a master read at a lower rate than this loop moves in steps.
-  if (handle_v.allFinite())
-    hand_speed_m_s_ += std::min(1.0, dt_ / 0.01) * (handle_v.norm() - hand_speed_m_s_);
-  const double scale = p_.motion_scale * fixtures_.scale_gain(raw_xy_m_, p_.motion_scale * hand_speed_m_s_);
+  const double scale = p_.motion_scale * fixtures_.scale_gain(raw_xy_m_);
   if (engage && (!out_.engaged || console_had_control_)) {
     // Re-index: the slave target stays where it is whatever the hand position.
     scale_ = scale;
@@ -190,7 +189,12 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     const Eigen::Vector2d raw = offset_m_ + scale_ * in.handle_m;
     for (int i = 0; i < 2; ++i) raw_xy_m_[i] = clamp_workspace(raw[i]);
     out_.slave_target_m.head<2>() = follow_fixtures(last_xy_m_);
-    out_.slave_velocity_m_s.head<2>() = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
+    // The target's velocity, low-passed: a master read slower than this loop moves the target
+    // in steps, and a feedforward of one tick's step (ten times the hand's speed for one tick
+    // in ten) threw the stick-slip tracking controller into a limit cycle of millimetres.
+    const Eigen::Vector2d v_tick = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
+    velocity_ff_ += velocity_alpha_ * (v_tick - velocity_ff_);
+    out_.slave_velocity_m_s.head<2>() = velocity_ff_;
     const double jog =
         std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;
     const double z = clamp_workspace(out_.slave_target_m.z() + jog * dt_);
@@ -210,6 +214,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   } else {
     out_.haptic_force_N.setZero();
     force_filtered_N_.setZero();
+    velocity_ff_.setZero();
     raw_xy_m_ = out_.slave_target_m.head<2>();
   }
   // The gripper follows the TéléTweez only while the deadman is held (and its readings are

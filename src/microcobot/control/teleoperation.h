@@ -45,6 +45,9 @@ struct TeleoperationParams {
   double workspace_min_m = -5.5e-3;
   double workspace_max_m = 5.5e-3;
   double console_max_speed_m_s = 1e-3;  ///< stage speed limit of the console's commands
+  /// Time constant of the haptic target's velocity feedforward (the handle is read at the
+  /// operator's rate, the coupling runs ten times faster).
+  double velocity_filter_s = 0.005;
   /// Shared control (issue #29): the virtual fixtures' shape; which fixtures act, and how
   /// strongly, is set at run time (Teleoperation::set_fixtures).
   VirtualFixtureParams fixtures;
@@ -62,6 +65,7 @@ struct TeleoperationParams {
     v("workspace_min_m", workspace_min_m);
     v("workspace_max_m", workspace_max_m);
     v("console_max_speed_m_s", console_max_speed_m_s);
+    v("velocity_filter_s", velocity_filter_s);
     v("fixtures", fixtures);
   }
   void validate() const;
@@ -136,6 +140,10 @@ class Teleoperation {
   const VirtualFixtures& fixtures() const noexcept { return fixtures_; }
   /// The motion scale in force (the configured one times the fixtures' gain).
   double motion_scale() const noexcept { return scale_; }
+  /// The motion scale the fixtures would give at the target `xy` (stage coordinates).
+  double motion_scale_at(const Eigen::Vector2d& xy) const noexcept {
+    return p_.motion_scale * fixtures_.scale_gain(xy);
+  }
 
  private:
   double clamp_workspace(double v) const noexcept;
@@ -150,7 +158,9 @@ class Teleoperation {
   bool contact_limited_ = false;
   double dt_;
   TeleoperationOutput out_;
-  double force_alpha_ = 1.0;  // low-pass coefficient per tick
+  double force_alpha_ = 1.0;     // low-pass coefficient per tick
+  double velocity_alpha_ = 1.0;  // the feedforward's
+  Eigen::Vector2d velocity_ff_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d force_filtered_N_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
@@ -159,7 +169,6 @@ class Teleoperation {
   Eigen::Vector2d last_handle_m_ = Eigen::Vector2d::Zero();
   double scale_ = 0.0;                // motion scale in force
   bool slewing_ = false;              // the target catching up with the fixtures' output
-  double hand_speed_m_s_ = 0.0;       // the handle's speed, low-passed (~10 ms)
   bool reindex_ = false;              // a new guide: the master's target re-taken from the slave's
   bool console_had_control_ = false;  // the haptic path re-indexes when it takes over
   bool slave_was_stale_ = false;      // re-take the target from the slave when it returns

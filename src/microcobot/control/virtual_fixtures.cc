@@ -63,15 +63,12 @@ double VirtualFixtures::potential_J(double d, double a, double s) const noexcept
   return p_.display_stiffness_N_m * a / (s * s) * integral;
 }
 
-double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy, double base_speed_m_s) const noexcept {
+double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy) const noexcept {
   if (!set_.guide) return 1.0;
   const double d = (xy - set_.guide_xy_m).norm();
   const double x =
       std::clamp((d - p_.capture_radius_m) / (p_.far_distance_m - p_.capture_radius_m), 0.0, 1.0);
-  double g = 1.0 + level_ * (p_.far_gain - 1.0) * x;
-  if (std::isfinite(base_speed_m_s) && g * base_speed_m_s > p_.max_speed_m_s)
-    g = std::max(1.0, p_.max_speed_m_s / base_speed_m_s);
-  return g;
+  return 1.0 + level_ * (p_.far_gain - 1.0) * x;
 }
 
 Eigen::Vector2d VirtualFixtures::guided(const Eigen::Vector2d& raw_xy) const noexcept {

@@ -16,8 +16,9 @@
 ///   scaling    the motion scale grows with the distance to the guide (coarse far, fine near):
 ///              g(d) = 1 + a (far_gain - 1) clamp((d - R) / (far_distance - R), 0, 1). The
 ///              coupling applies it to the master's increments, so changing it never moves the
-///              slave (bumpless), and lowers it for a fast hand so that the slave's speed stays
-///              under max_speed_m_s (never below 1: without fixtures nothing changes).
+///              slave (bumpless).
+///   pace       where the fixtures act, the target moves toward the guided one at most at
+///              max_speed_m_s: the guidance's map is steep at the capture radius' edge.
 ///   funnel     a forbidden region: the hole's edge. Below `rim_z + cone height` the target's
 ///              z is kept above the cone z >= rim_z + (d - r0) / tan(half angle) (d: distance to
 ///              the axis, r0: the allowed radius at the rim), so that a carried part reaches the
@@ -48,9 +49,9 @@ struct VirtualFixtureParams {
   double capture_radius_m = 25e-6;  ///< R: full guidance within it, none beyond 2R
   double far_gain = 4.0;            ///< motion-scale gain at far_distance_m and beyond (level 1)
   double far_distance_m = 600e-6;   ///< distance to the guide where the gain is full
-  /// The gain never drives the slave faster than this (a fast hand gets the plain scale): a
-  /// target running ahead of the stick-slip stage (~1.2 mm/s at most) makes it overshoot.
-  double max_speed_m_s = 1e-3;
+  /// Where the fixtures act the target moves no faster than this: a target running far ahead
+  /// of the stick-slip stage (0.5-1.2 mm/s at most, by axis and load) makes it overshoot.
+  double max_speed_m_s = 0.5e-3;
   double display_stiffness_N_m = 60.0;  ///< k: hand newtons per hand metre (below the finger's 228 N/m)
   double max_display_N = 1.0;           ///< cap on the guidance force on the handle
   double funnel_half_angle_deg = 60.0;  ///< the funnel's cone, from the vertical
@@ -103,9 +104,8 @@ class VirtualFixtures {
   void tick(double dt_s) noexcept;
   bool active() const noexcept { return set_.guide && (level_ > 0.0 || set_.funnel); }
 
-  /// The motion-scale gain g(d) at the target `xy` (1 without a guide), for a master moving the
-  /// slave at `base_speed_m_s` with the plain scale.
-  double scale_gain(const Eigen::Vector2d& xy, double base_speed_m_s = 0.0) const noexcept;
+  /// The motion-scale gain g(d) at the target `xy` (1 without a guide).
+  double scale_gain(const Eigen::Vector2d& xy) const noexcept;
   /// The guided target for the master's raw target.
   Eigen::Vector2d guided(const Eigen::Vector2d& raw_xy) const noexcept;
   /// The lowest z allowed at `xy` (-inf without a funnel).

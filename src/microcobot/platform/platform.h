@@ -153,6 +153,12 @@ class Platform {
   void set_fixtures(const control::FixtureSet& set) noexcept;
   /// The haptic master's motion scale in force (the configured one times the fixtures' gain).
   double motion_scale() const noexcept { return teleop_->motion_scale(); }
+  /// The fixtures in force (stage coordinates: world minus the stage's home).
+  const control::VirtualFixtures& fixtures() const noexcept { return teleop_->fixtures(); }
+  /// The motion scale the fixtures would give with the tool at `world_xy`.
+  double motion_scale_at(const Eigen::Vector2d& world_xy) const noexcept {
+    return teleop_->motion_scale_at(world_xy - home_m_.head<2>());
+  }
   /// After an e-stop (fault_all), the explicit reset: every device configured and activated
   /// again, the stage holding where it is. Off the loop only (it may allocate): call it between
   /// runs. Throws mc::Error when a device refuses (every device is then left in its safe state).
