@@ -15,6 +15,7 @@
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/live/camera_messages.h"
 #include "microcobot/live/console_page.h"
+#include "microcobot/live/console_task.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::live {
@@ -98,7 +99,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"last_error", text},
                                             {"ticks", number},
                                             {"camera", {{"type", {"object", "null"}}}},
-                                            {"demo_result", {{"type", {"object", "null"}}}}})});
+                                            {"demo_result", {{"type", {"object", "null"}}}},
+                                            {"task", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
   const std::vector<std::string> scene_keys = {"kind",
@@ -326,6 +328,9 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
   if (s.last_error != was.last_error && !s.last_error.empty())
     note(EventLevel::kError, "platform_error", s.last_error);
   if (s.restarts != was.restarts) note(EventLevel::kInfo, "restart", "the platform was rebuilt");
+  for (const auto& [kind, message] : task_changes(was.task, s.task))
+    note(kind == "task_end" && s.task->inserted != 1 ? EventLevel::kWarning : EventLevel::kInfo, kind,
+         message);
   last_status_ = s;
 }
 
@@ -404,6 +409,29 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
              m.client);
         live_.request(a);
         return;
+      case ConsoleAction::kTaskStart:
+      case ConsoleAction::kTaskPause:
+      case ConsoleAction::kTaskResume:
+      case ConsoleAction::kTaskConfirm:
+      case ConsoleAction::kTaskTakeOver:
+      case ConsoleAction::kTaskHandBack:
+      case ConsoleAction::kTaskStepDone:
+      case ConsoleAction::kTaskSkip: {
+        // Pausing only stops the stage: anyone may (as the e-stop); the rest needs control.
+        if (a != ConsoleAction::kTaskPause && m.client != controller) {
+          tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
+               "control");
+          return;
+        }
+        if (const std::string why = task_action_refusal(a, live_.status().task); !why.empty()) {
+          tell(m.client, StatusLevel::kWarning, why, "refused", "task");
+          return;
+        }
+        note(EventLevel::kInfo, "task_action", task_action_name(a), m.client);
+        if (!live_.push_task_action(task_action(a)))
+          tell(m.client, StatusLevel::kWarning, "task: the loop is busy; action dropped", "refused", "task");
+        return;
+      }
     }
   } catch (const Error& e) {
     // The status names what it refuses (its id is the offending message's topic), so a client
@@ -527,6 +555,7 @@ std::string ConsoleServer::status_json() {
                                 {"focus_target_m", s.focus_target_m},
                                 {"objective", s.objective}}
                          : json(nullptr);
+  j["task"] = task_status_json(s.task);
   const DemoResult& d = s.demo_result;
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;
