@@ -47,6 +47,7 @@ function handOverToTheConsole() {
 function taskHint(t) {
   if (!t.started) return "Press Start: the robot picks the pin and inserts it; you supervise.";
   if (t.status === "running") return `The robot is in “${t.step}”.`;
+  if (t.status === "paused" && t.heartbeat_gap) return "Paused while the console's commands are late: the stage holds; the task goes on when they return.";
   if (t.status === "paused")
     return t.supervisor_lost ? "Paused by the platform: control or the console's heartbeat was lost. Resume to go on."
                              : "Paused: the stage holds. Resume, take over or skip.";

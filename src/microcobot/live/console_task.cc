@@ -55,6 +55,7 @@ nlohmann::json task_status_json(const std::optional<LiveTaskStatus>& task) {
           {"elapsed_s", s.elapsed_s},
           {"failure", s.failure},
           {"supervisor_lost", s.supervisor_lost},
+          {"heartbeat_gap", s.heartbeat_gap},
           {"inserted", s.inserted < 0 ? nlohmann::json(nullptr) : nlohmann::json(s.inserted == 1)}};
 }
 
@@ -68,10 +69,14 @@ std::vector<std::pair<std::string, std::string>> task_changes(const std::optiona
   if (!was_started) out.emplace_back("task", "the task started");
   if (!was_started || was->step != s.step)
     out.emplace_back("task_step", std::string(AssemblyTask::name(s.step)));
-  if (!was_started || was->status != s.status || was->supervisor_lost != s.supervisor_lost)
-    out.emplace_back("task_status", s.status_name() + (s.supervisor_lost && s.status == Status::kPaused
-                                                           ? " (the console lost control or its heartbeat)"
-                                                           : ""));
+  if (!was_started || was->status != s.status || was->supervisor_lost != s.supervisor_lost ||
+      was->heartbeat_gap != s.heartbeat_gap) {
+    std::string why;
+    if (s.status == Status::kPaused && s.supervisor_lost)
+      why = " (the console lost control or its heartbeat)";
+    if (s.status == Status::kPaused && s.heartbeat_gap) why = " (a gap in the console's heartbeat)";
+    out.emplace_back("task_status", s.status_name() + why);
+  }
   if (s.ended && !(was && was->ended)) {
     std::string how = fmt::format("the task ended: {} in step {} after {:.1f} s", s.status_name(),
                                   AssemblyTask::name(s.step), s.elapsed_s);

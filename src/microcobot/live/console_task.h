@@ -28,8 +28,8 @@ std::string task_action_refusal(ConsoleAction a, const std::optional<LiveTaskSta
 
 /// `null` without a task, else `{"steps": [{"name", "autonomy"}...], "started", "step",
 /// "step_index", "status" (idle, running, paused, awaiting confirmation, operator, succeeded,
-/// failed), "search_tries", "elapsed_s", "failure", "supervisor_lost", "inserted" (null, true,
-/// false)}` (docs/console.md).
+/// failed), "search_tries", "elapsed_s", "failure", "supervisor_lost", "heartbeat_gap", "inserted" (null,
+/// true, false)}` (docs/console.md).
 nlohmann::json task_status_json(const std::optional<LiveTaskStatus>& task);
 
 /// What changed from `was` to `now`, as (event kind, message) pairs: the task started, its step,

@@ -168,7 +168,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.has_gripper = latest_.has_gripper;
     in.gripper_opening_m = latest_.gripper_opening_m;
     // The task, supervised by the console in control: it drives or holds in the console's place.
-    if (task_) task_->tick(p, home_m_, t.dt_s, console_control && fresh && !p.faulted(), in);
+    if (task_) task_->tick(p, home_m_, t.dt_s, console_control && !p.faulted(), fresh, in);
   }
   p.set_console_input(in);
   protocol_publish(t);

@@ -15,6 +15,8 @@ void LiveTaskParams::validate() const {
   AssemblyTask check(task, goal);  // the goal's checks are the task's constructor's
   require(std::isfinite(gripper_pickup_m) && gripper_pickup_m > 0.0 && gripper_pickup_m < 100e-6,
           "gripper_pickup_m", "must be within (0, 100 um)", gripper_pickup_m);
+  require(std::isfinite(heartbeat_gap_s) && heartbeat_gap_s >= 0.0 && heartbeat_gap_s <= 10.0,
+          "heartbeat_gap_s", "must be within [0, 10] s", heartbeat_gap_s);
 }
 
 std::string LiveTaskStatus::status_name() const {
@@ -36,11 +38,13 @@ void LiveTask::reset() {
   while (actions_.pop(dropped)) {
   }
   started_ = ended_ = operator_had_stage_ = false;
-  rearm_deadman_ = pickup_gripper_ = false;
+  rearm_deadman_ = pickup_gripper_ = gap_paused_ = false;
+  gap_s_ = 0.0;
   elapsed_s_ = 0.0;
   started_pub_.store(false);
   ended_pub_.store(false);
   supervisor_lost_.store(false);
+  gap_pub_.store(false);
   step_.store(static_cast<int>(task_->step()));
   status_.store(static_cast<int>(task_->status()));
   tries_.store(0);
@@ -56,6 +60,7 @@ void LiveTask::apply(TaskAction a) noexcept {
     return;
   }
   if (!in_progress()) return;
+  gap_paused_ = false;  // the operator decides from here
   switch (a) {
     case TaskAction::kStart:
       break;
@@ -90,15 +95,33 @@ void LiveTask::console_takes_the_stage() noexcept {
   pickup_side_ = 0.0;
 }
 
-void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool supervised,
-                    control::ConsoleInput& in) noexcept {
+void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool in_control,
+                    bool fresh, control::ConsoleInput& in) noexcept {
   TaskAction a;
   while (actions_.pop(a)) apply(a);
   if (in_progress()) {
     AssemblyTask& task = *task_;
-    if (!supervised && task.status() == Status::kRunning) {
-      task.pause();  // stays paused: the operator resumes once back in control
+    auto latch = [&] {  // stays paused: the operator resumes once back in control
+      gap_paused_ = false;
       supervisor_lost_.store(true, std::memory_order_relaxed);
+    };
+    if (task.status() == Status::kRunning && !(in_control && fresh)) {
+      task.pause();
+      if (in_control) {
+        gap_paused_ = true;  // the controlling client's heartbeat is late: perhaps only a while
+        gap_s_ = 0.0;
+      } else {
+        latch();
+      }
+    }
+    if (gap_paused_) {
+      gap_s_ += dt_s;
+      if (!in_control || gap_s_ > params_.heartbeat_gap_s) {
+        latch();
+      } else if (fresh) {
+        task.resume();
+        gap_paused_ = false;
+      }
     }
     const control::ConsoleInput& out = task.tick(cell::read_task_sensors(p, home_m), dt_s);
     elapsed_s_ += dt_s;
@@ -140,6 +163,7 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
   tries_.store(task.search_tries(), std::memory_order_relaxed);
   elapsed_pub_.store(elapsed_s_, std::memory_order_relaxed);
   failure_.store(task.failure().data(), std::memory_order_relaxed);
+  gap_pub_.store(gap_paused_, std::memory_order_relaxed);
   ended_pub_.store(ended_, std::memory_order_release);  // last: the rest is read after it
 }
 
@@ -153,6 +177,7 @@ LiveTaskStatus LiveTask::status() const {
   s.elapsed_s = elapsed_pub_.load(std::memory_order_relaxed);
   s.failure = failure_.load(std::memory_order_relaxed);
   s.supervisor_lost = supervisor_lost_.load(std::memory_order_relaxed);
+  s.heartbeat_gap = gap_pub_.load(std::memory_order_relaxed);
   s.inserted = inserted_.load(std::memory_order_relaxed);
   s.autonomy = params_.autonomy;
   return s;

@@ -10,8 +10,10 @@
 ///
 /// Rules, the platform's (not the page's):
 ///  - the task drives only while supervised: a console client holds control, its commands are
-///    fresh (the heartbeat) and no device is faulted; otherwise it pauses (and stays paused: the
-///    operator resumes), so a closed or stalled page, a released control or an e-stop stops it;
+///    fresh (the heartbeat) and no device is faulted; otherwise it pauses. A gap in the heartbeat
+///    of the client in control (a busy browser) pauses it only while it lasts, up to
+///    `heartbeat_gap_s`; a longer gap, a released control (a closed page) or an e-stop latches
+///    the pause: the operator resumes;
 ///  - paused, awaiting a confirmation or ended, it sends no deadman: the coupling's target stops
 ///    at the tick that applies the action and the stage holds;
 ///  - an ended task (succeeded or failed) leaves every axis holding (Platform::hold()) and the
@@ -58,6 +60,9 @@ struct LiveTaskParams {
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy = all_auto();
   /// The console's gripper command counts again once within this of the held opening.
   double gripper_pickup_m = 5e-6;
+  /// A heartbeat gap of the client in control up to this long (after the commands went stale)
+  /// pauses the task while it lasts; longer, the pause latches.
+  double heartbeat_gap_s = 1.0;
   /// Throws mc::InvalidParams (the task's parameters and goal).
   void validate() const;
   static std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> all_auto() {
@@ -76,7 +81,8 @@ struct LiveTaskStatus {
   int search_tries = 0;
   double elapsed_s = 0.0;        ///< live time since it started (to its end)
   std::string failure;           ///< why it failed
-  bool supervisor_lost = false;  ///< paused by the platform: control, heartbeat or a fault lost
+  bool supervisor_lost = false;  ///< paused by the platform, latched: control, heartbeat or a fault lost
+  bool heartbeat_gap = false;    ///< paused by the platform while the console's commands are stale
   int inserted = -1;  ///< at its end, the simulation's truth: 1 the pin is in its bore, 0 not, -1 unknown
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy{};
   /// "idle" before the start, else the task's status name.
@@ -98,8 +104,9 @@ class LiveTask {
   /// The operator tick's part (loop thread): applies the pending actions, pauses an unsupervised
   /// task, ticks it on the sensors and, while it drives or holds, replaces the console's input
   /// `in` with its own; while the console drives (before the start, taken over, ended) applies
-  /// the re-take rules to `in`. `home_m`: the stage's home (world frame).
-  void tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool supervised,
+  /// the re-take rules to `in`. `home_m`: the stage's home (world frame); `in_control`: a console
+  /// client holds control and no device is faulted; `fresh`: its commands are fresh.
+  void tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool in_control, bool fresh,
             control::ConsoleInput& in) noexcept;
   /// Started and not ended (loop thread).
   bool in_progress() const noexcept { return started_ && !ended_; }
@@ -117,10 +124,12 @@ class LiveTask {
   // Loop thread only.
   bool started_ = false, ended_ = false, operator_had_stage_ = false;
   bool rearm_deadman_ = false, pickup_gripper_ = false;
+  bool gap_paused_ = false;  // paused for a heartbeat gap: resumes by itself when it ends soon
+  double gap_s_ = 0.0;
   double pickup_side_ = 0.0;  // the sign of the console's gripper command less the held opening
   double elapsed_s_ = 0.0;
   // Published by the loop.
-  std::atomic<bool> started_pub_{false}, ended_pub_{false}, supervisor_lost_{false};
+  std::atomic<bool> started_pub_{false}, ended_pub_{false}, supervisor_lost_{false}, gap_pub_{false};
   std::atomic<int> step_{0}, status_{0}, tries_{0}, inserted_{-1};
   std::atomic<double> elapsed_pub_{0.0};
   std::atomic<const char*> failure_{""};
