@@ -237,6 +237,17 @@ TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kRunning; }));
   EXPECT_FALSE(rig.task().heartbeat_gap);
   EXPECT_FALSE(rig.task().supervisor_lost);
+  // The operator pauses during a gap: it stays paused when the heartbeat returns.
+  rig.beating.store(false);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.heartbeat_gap; }));
+  rig.live->push_task_action(TaskAction::kPause);
+  rig.beating.store(true);
+  ASSERT_TRUE(rig.run_for(0.5));
+  EXPECT_EQ(rig.task().status, Status::kPaused);
+  EXPECT_FALSE(rig.task().heartbeat_gap);
+  EXPECT_FALSE(rig.task().supervisor_lost);
+  rig.live->push_task_action(TaskAction::kResume);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kRunning; }));
   // Away for longer: the pause latches; the heartbeat's return does not resume it.
   rig.beating.store(false);
   ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.supervisor_lost; }));

@@ -25,8 +25,10 @@ std::string task_action_refusal(ConsoleAction a, const std::optional<LiveTaskSta
   if (a == ConsoleAction::kTaskStart) return s.started ? "task: already started" : "";
   if (!s.started) return "task: not started; press Start";
   switch (a) {
-    case ConsoleAction::kTaskPause:
-      return s.status == Status::kRunning ? "" : "task: pause: it is not running (" + s.status_name() + ")";
+    case ConsoleAction::kTaskPause:  // also while the platform holds it for a heartbeat gap: it stays paused
+      return s.status == Status::kRunning || s.heartbeat_gap
+                 ? ""
+                 : "task: pause: it is not running (" + s.status_name() + ")";
     case ConsoleAction::kTaskResume:
       return s.status == Status::kPaused ? "" : "task: resume: it is not paused (" + s.status_name() + ")";
     case ConsoleAction::kTaskConfirm:

@@ -60,7 +60,7 @@ void LiveTask::apply(TaskAction a) noexcept {
     return;
   }
   if (!in_progress()) return;
-  gap_paused_ = false;  // the operator decides from here
+  gap_paused_ = false;  // the operator decides from here (a pause keeps a heartbeat gap's pause)
   switch (a) {
     case TaskAction::kStart:
       break;
