@@ -35,9 +35,10 @@ const kTaskButtons = [
   }
 })();
 
-// Taking over: the page drops a pending click-to-go and puts its gripper slider where the
-// gripper holds, so that what it sends next moves nothing (the platform also re-takes the
-// deadman and the slider before they count).
+// Taking over, and when the task ends: the page drops a pending click-to-go and puts its gripper
+// slider where the gripper holds, and sends that, so that what it sends next moves nothing (the
+// platform also re-takes the deadman and the slider before they count: a slider that never came
+// back to the held opening would leave the gripper deaf).
 function handOverToTheConsole() {
   mc.input.goal = null;
   const t = mc.telemetry;
@@ -45,7 +46,8 @@ function handOverToTheConsole() {
 }
 
 function taskHint(t) {
-  if (!t.started) return "Press Start: the robot picks the pin and inserts it; you supervise.";
+  if (!t.started) return (mc.inControl ? "" : "Take control, then ") +
+                         (mc.inControl ? "Press Start" : "press Start") + ": the robot picks the pin and inserts it; you supervise.";
   if (t.status === "running") return `The robot is in “${t.step}”.`;
   if (t.status === "paused" && t.heartbeat_gap) return "Paused while the console's commands are late: the stage holds; the task goes on when they return.";
   if (t.status === "paused")
@@ -58,7 +60,7 @@ function taskHint(t) {
   return `Failed in “${t.step}”: ${t.failure || "no reason given"}${truth}. Restart scene for another cycle.`;
 }
 
-let lastTaskKey = "";
+let lastTaskKey = "", lastTaskEnded = null;
 listen("/platform/status", (s) => {
   const t = s.task && typeof s.task === "object" ? s.task : null;
   $("task-group").hidden = !t;
@@ -85,6 +87,9 @@ listen("/platform/status", (s) => {
       list.append(li);
     });
   }
+  const ended = ["succeeded", "failed"].includes(t.status);
+  if (ended && lastTaskEnded === false) handOverToTheConsole();  // the console has the stage again
+  lastTaskEnded = ended;
   $("task-hint").textContent = taskHint(t);
   for (const [id, , name, , enabled] of kTaskButtons) {
     // Pausing needs no control (it only stops); the rest does.

@@ -140,6 +140,9 @@ await s.run(async () => {
   if (driveStep > 9e-6) fail(`a step of ${um(driveStep)} um in the commanded position after the hand-back`);
   if (xs[xs.length - 1].engaged !== 0) fail("the stage is not holding after the task's end");
   await until("the panel says it succeeded", () => /Succeeded/.test(document.getElementById("task-hint").textContent), 3);
+  // The console has the stage again: its gripper slider where the gripper holds (so that it moves nothing).
+  await until("the gripper slider at the held opening", () =>
+    Math.abs(window.mc.input.gripper - window.mc.telemetry.gripper_command_m) < 2e-6, 3);
   await shot("task-04-succeeded");
   const gaps = await page.evaluate(() => window.timerGaps);
   log(`the page's timers: largest gap ${gaps.max.toFixed(0)} ms, ${gaps.over200} over 200 ms; ${resumed} latched pauses resumed`);
