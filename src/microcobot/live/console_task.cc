@@ -7,6 +7,10 @@ namespace mc::live {
 using cell::AssemblyTask;
 using Status = AssemblyTask::Status;
 
+// The task's console actions are TaskAction's, in its order.
+static_assert(static_cast<int>(ConsoleAction::kTaskSkip) - static_cast<int>(ConsoleAction::kTaskStart) ==
+              static_cast<int>(TaskAction::kSkip));
+
 TaskAction task_action(ConsoleAction a) {
   return static_cast<TaskAction>(static_cast<int>(a) - static_cast<int>(ConsoleAction::kTaskStart));
 }
