@@ -244,8 +244,8 @@ bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_contr
     protocol_has_goal_ = false;
     protocol_steps_pending_ = false;
   }
-  // The heartbeat is the protocol client's deadman; a console client in control, the demo or a
-  // remote master outrank it.
+  // The heartbeat is the protocol client's deadman; a console client in control, the demo, a
+  // started task or a remote master outrank it.
   const bool fresh = !console_control && !params_.remote && !(demo_ && !demo_finished_) &&
                      !(task_ && task_->in_progress()) &&
                      t.t_s - protocol_last_t_ <= params_.command_timeout_s;
