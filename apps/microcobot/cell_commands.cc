@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "microcobot/cell/cell_run.h"
+#include "microcobot/cell/task_file.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 
@@ -23,6 +24,7 @@ struct CellOptions {
   mc::cli::CommonOptions common;
   std::optional<std::filesystem::path> scene;   // AssemblyBatchParams
   std::optional<std::filesystem::path> config;  // the platform
+  std::optional<std::filesystem::path> task;    // a task file: autonomy per step, the task's parameters
   std::optional<int> batch, seed;
   std::optional<std::string> mode, master;
   std::vector<std::string> modes{"auto", "manual"};  // compare
@@ -42,6 +44,19 @@ Inputs load_inputs(const CellOptions& o) {
   if (o.seed) in.scene.seed = *o.seed;
   if (o.common.params) in.params = mc::load_params<cell::CellRunParams>(*o.common.params);
   if (o.mode) in.params.mode = *o.mode;
+  if (o.task) {
+    // Over the run's `task` keys; a step no headless operator can do is refused naming the file.
+    const cell::AssemblyTaskFile f = cell::load_task_file(*o.task, in.params.task);
+    in.params.task = f.params;
+    in.params.autonomy = f.steps.autonomy();
+    try {
+      cell::CellRunParams check = in.params;
+      check.mode = "auto";
+      check.validate();
+    } catch (const mc::InvalidParams& e) {
+      throw mc::InvalidInput(o.task->string(), 0, e.what());
+    }
+  }
   if (o.master) in.params.person.master = *o.master;
   mc::cli::naming_flags(
       {{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}, {"master", "--master"}}, [&] {
@@ -64,7 +79,8 @@ std::vector<cell::CycleResult> run_mode(const Inputs& in, const std::vector<cell
 mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
   mc::CsvTable t({"index", "success", "cycle_s", "placement_error_m", "peak_grip_N", "mean_grip_N",
                   "peak_contact_N", "grip_violations", "contact_violations", "clutches", "search_tries",
-                  "path_m", "side_m", "clearance_m", "ended_holding", "wall_s"});
+                  "confirmations", "submovements", "path_m", "side_m", "clearance_m", "ended_holding",
+                  "wall_s"});
   for (const auto& c : cycles) {
     const double row[] = {static_cast<double>(c.index),
                           c.success ? 1.0 : 0.0,
@@ -77,6 +93,8 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                           static_cast<double>(c.contact_violations),
                           static_cast<double>(c.clutches),
                           static_cast<double>(c.search_tries),
+                          static_cast<double>(c.confirmations),
+                          static_cast<double>(c.submovements),
                           c.path_m,
                           c.side_m,
                           c.clearance_m,
@@ -236,6 +254,10 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
                  "The simulated person's master in manual and assisted modes: haptic (handle, thumb wheel, "
                  "TéléTweez; default) or console (joystick, gripper slider)")
       ->check(CLI::IsMember({"haptic", "console"}));
+  cmd.add_option("--task", o.task,
+                 "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
+                 "confirmed after confirm_delay_s, manual ones refused headless) and the task's parameters "
+                 "(`params: {insert_speed_m_s: 1e-5}`); docs/cell.md");
   mc::cli::add_params_option(cmd, o.common);
   mc::cli::add_output_options(cmd, o.common);
   mc::cli::add_format_option(cmd, o.common);

@@ -14,6 +14,9 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "microcobot/cell/assembly_batch.h"
+#include "microcobot/cell/task_file.h"
+#include "microcobot/cell/task_io.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
@@ -36,7 +39,10 @@ namespace pf = mc::platform;
 
 struct ServeOptions {
   std::optional<std::filesystem::path> config;
-  std::string scene = "pick-place";
+  std::optional<std::string> scene;  // default pick-place; with --cell, the batch (AssemblyBatchParams)
+  bool cell = false;                 // the automatic insertion supervised from the console (issue #29)
+  std::optional<int> seed, part;     // --cell: the batch's seed, the part of it
+  std::optional<std::filesystem::path> task;  // --cell: a task file (cell/task_file.h)
   std::string listen = "127.0.0.1:8080";
   std::string token;
   std::filesystem::path out = "out/live";
@@ -141,22 +147,64 @@ std::string random_token() {
   return t;
 }
 
+// `--cell`: one part of a batch (its microworld becomes the scene) and the task the console
+// supervises on it, with the task file's autonomy and parameters.
+void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
+  if (o.role != "single") throw mc::UsageError("--cell: runs where the console drives: not with --role");
+  mc::cell::AssemblyBatchParams batch;
+  if (o.scene) batch = mc::load_params<mc::cell::AssemblyBatchParams>(*o.scene);
+  if (o.seed) batch.seed = *o.seed;
+  const int part = o.part.value_or(0);
+  if (part >= batch.parts)
+    throw mc::UsageError("--part " + std::to_string(part) + ": the batch has " + std::to_string(batch.parts) +
+                         " parts (0 to " + std::to_string(batch.parts - 1) + ")");
+  mc::cli::naming_flags({{"seed", "--seed"}}, [&] { batch.validate(); });
+  const mc::cell::AssemblyJob job = mc::cell::assembly_jobs(batch)[static_cast<std::size_t>(part)];
+  mc::live::LiveTaskParams tp;
+  tp.goal = mc::cell::assembly_goal(job);
+  if (o.task) {
+    const mc::cell::AssemblyTaskFile f = mc::cell::load_task_file(*o.task);
+    tp.task = f.params;
+    tp.autonomy = f.steps.autonomy();
+  }
+  lp.platform.microworld = "pick-place";
+  lp.platform.world = job.world;
+  lp.platform.validate();
+  lp.task = tp;
+  std::string levels;
+  for (int i = 0; i + 1 < mc::cell::AssemblyTask::kStepCount; ++i)
+    if (tp.autonomy[static_cast<std::size_t>(i)] != mc::cell::AssemblyTask::Autonomy::kAuto)
+      levels += fmt::format("{}{} {}", levels.empty() ? "" : ", ",
+                            mc::cell::AssemblyTask::name(static_cast<mc::cell::AssemblyTask::Step>(i)),
+                            mc::cell::AssemblyTask::name(tp.autonomy[static_cast<std::size_t>(i)]));
+  std::cerr << fmt::format(
+      "serve: cell part {} of the batch of seed {}: a {:.0f} um pin into a bore with {:.1f} um of radial "
+      "clearance; steps {}; the task waits for Start in the console\n",
+      part, batch.seed, 1e6 * job.side_m, 1e6 * job.clearance_m,
+      levels.empty() ? "all auto" : levels + " (the rest auto)");
+}
+
 void serve(const ServeOptions& o) {
   mc::live::LiveParams lp;
   if (o.config) lp.platform = pf::load_platform_config(*o.config);
-  if (o.scene == "pin-in-hole") {
+  if (!o.cell && (o.seed || o.part || o.task))
+    throw mc::UsageError(std::string(o.task ? "--task" : o.seed ? "--seed" : "--part") + ": needs --cell");
+  const std::string scene = o.scene.value_or("pick-place");
+  if (o.cell) {
+    use_cell(o, lp);
+  } else if (scene == "pin-in-hole") {
     lp.platform.world = mc::microworld::pin_in_hole_scene();
-  } else if (o.scene == "optical-trap") {
+  } else if (scene == "optical-trap") {
     pf::use_optical_trap_scene(lp.platform);
-  } else if (o.scene != "pick-place") {
+  } else if (scene != "pick-place") {
     // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(o.scene, ec))
+    if (!std::filesystem::is_regular_file(scene, ec))
       throw mc::InvalidInput(
-          "--scene '" + mc::excerpt(o.scene) +
+          "--scene '" + mc::excerpt(scene) +
           "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
           "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
-    lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(o.scene, lp.platform.world);
+    lp.platform.world = mc::load_params<mc::microworld::PickPlaceParams>(scene, lp.platform.world);
   }
   auto [host, port] = parse_listen(o.listen);
   mc::live::ConsoleServerParams sp;
@@ -262,10 +310,23 @@ void serve(const ServeOptions& o) {
 void add_serve(CLI::App& cmd) {
   auto o = std::make_shared<ServeOptions>();
   cmd.add_option("--config", o->config, "Platform configuration (YAML; keys as `run --print-config` shows)");
-  cmd.add_option("--scene", o->scene,
-                 "Scene: pick-place (default: the 300 um part), pin-in-hole (a 200 um pin into a hole with "
-                 "20 um of clearance), optical-trap (a 3 um bead in optical tweezers, touching a stuck "
-                 "bead) or a YAML file of the microworld's keys (scenes/*.yaml)");
+  cmd.add_option(
+      "--scene", o->scene,
+      "Scene: pick-place (default: the 300 um part), pin-in-hole (a 200 um pin into a hole with "
+      "20 um of clearance), optical-trap (a 3 um bead in optical tweezers, touching a stuck "
+      "bead) or a YAML file of the microworld's keys (scenes/*.yaml); with --cell, the batch (YAML; "
+      "`cell params` shows its keys under scene)");
+  cmd.add_flag("--cell", o->cell,
+               "The assembly cell: one part of a batch (--scene, --seed, --part) inserted by the automatic "
+               "task, which the console starts, pauses, takes over and hands back (docs/cell.md)");
+  cmd.add_option("--seed", o->seed, "With --cell: the batch's seed (default 1)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--part", o->part, "With --cell: which part of the batch (default 0)")
+      ->check(CLI::Range(0, 9999));
+  cmd.add_option(
+      "--task", o->task,
+      "With --cell: a task file (YAML: `steps` autonomy auto|confirm|manual, `params` of the task; "
+      "docs/cell.md)");
   cmd.add_option("--listen", o->listen,
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");

@@ -152,6 +152,53 @@ TEST(CellCycle, TheTaskAndItsMeterDoNotAllocateOnTheLoop) {
   EXPECT_TRUE(c.finished()) << "in step " << AssemblyTask::name(c.task()->step());
 }
 
+// A step the operator skips on the platform: the retract, as it starts (the pin is released in
+// its bore); the task succeeds from there, without a jump, and ends holding.
+TEST(CellCycle, SkippingAStepGoesOnFromWhereTheStageIsWithoutAJump) {
+  CellCycle c(job(), CellRunParams{}, default_platform());
+  bool skipped = false;
+  double largest = 0.0;
+  Eigen::Vector3d last = target(c.platform());
+  c.set_observer([&](double) {
+    const Eigen::Vector3d now = target(c.platform());
+    largest = std::max(largest, (now - last).norm());
+    last = now;
+    if (!skipped && c.task()->step() == Step::kRetract) {
+      c.task()->skip();
+      skipped = true;
+    }
+  });
+  c.run_to_end();
+  EXPECT_TRUE(skipped);
+  EXPECT_EQ(c.task()->status(), Status::kSucceeded);
+  EXPECT_TRUE(c.result().success) << c.result().verdict;
+  EXPECT_TRUE(c.result().ended_holding);
+  EXPECT_LE(largest, CellRunParams{}.task.travel_speed_m_s * 1e-3 * 1.001);
+}
+
+// Headless, the supervisor confirms a `confirm` step after confirm_delay_s: the cycle is longer by
+// about that; a `manual` step has nobody to do it and is refused.
+TEST(CellCycle, AConfirmStepCostsTheSupervisorsDelayAndAManualStepIsRefusedHeadless) {
+  const CycleResult plain = run_cycle(job(), CellRunParams{}, default_platform());
+  CellRunParams confirmed;
+  confirmed.confirm_delay_s = 2.0;
+  confirmed.autonomy[static_cast<std::size_t>(Step::kInsert)] = AssemblyTask::Autonomy::kConfirm;
+  const CycleResult r = run_cycle(job(), confirmed, default_platform());
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_EQ(r.confirmations, 1);
+  EXPECT_EQ(plain.confirmations, 0);
+  EXPECT_NEAR(r.cycle_s - plain.cycle_s, 2.0, 0.1);
+
+  CellRunParams manual;
+  manual.autonomy[static_cast<std::size_t>(Step::kGrasp)] = AssemblyTask::Autonomy::kManual;
+  try {
+    CellCycle(job(), manual, default_platform());
+    ADD_FAILURE() << "a manual step headless";
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("steps.grasp"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CellCycle, BadParametersAreRefusedWithTheKeyNamed) {
   CellRunParams p;
   p.mode = "remote";

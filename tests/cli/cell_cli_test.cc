@@ -71,5 +71,57 @@ TEST(CellCli, BadInputGetsOneLineAndItsExitCode) {
   EXPECT_EQ(nlohmann::json::parse(p.out)["scene"]["parts"].get<int>(), 10);
 }
 
+// Tasks in YAML (issue #29 point 5): a confirm step costs the supervisor's delay and is counted;
+// a manual step, a misspelt step or key is refused naming the file and the key (exit 3).
+TEST(CellCli, ATaskFileSetsTheStepsAutonomyAndBadOnesAreOneLineNamingTheKey) {
+  test::TempDir dir;
+  test::write_text(dir / "task.yaml", "steps: {insert: confirm}\nparams: {insert_speed_m_s: 1.5e-5}\n");
+  auto r = run_cli({"cell", "run", "--batch", "1", "--seed", "53", "--task", (dir / "task.yaml").string(),
+                    "--json", "--out", (dir / "o").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["successes"].get<int>(), 1);
+  EXPECT_EQ(j["cycles_detail"][0]["confirmations"].get<int>(), 1);
+  EXPECT_EQ(read_csv(dir / "o" / "cycles.csv").column("confirmations"), (std::vector<double>{1.0}));
+  const struct {
+    std::string yaml, expected;
+  } bad[] = {{"steps: {grasp: manual}\n", "steps.grasp"},
+             {"steps: {inserting: confirm}\n", "steps.inserting"},
+             {"steps: {insert: later}\n", "later"},
+             {"params: {insert_speed_m_s: -1}\n", "params.insert_speed_m_s"}};
+  for (const auto& b : bad) {
+    test::write_text(dir / "bad.yaml", b.yaml);
+    r = run_cli({"cell", "run", "--batch", "1", "--task", (dir / "bad.yaml").string()});
+    EXPECT_EQ(r.exit_code, 3) << b.yaml << r.err;
+    EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+    EXPECT_THAT(r.err, HasSubstr(b.expected));
+    EXPECT_THAT(r.err, HasSubstr("bad.yaml"));
+  }
+}
+
+TEST(CellCli, ServeCellStartsAndItsFlagsAreCheckedLikeAnyOther) {
+  test::TempDir dir;
+  test::write_text(dir / "task.yaml", "steps: {insert: confirm}\n");
+  auto r = run_cli({"serve", "--cell", "--seed", "3", "--part", "1", "--task", (dir / "task.yaml").string(),
+                    "--listen", "127.0.0.1:0", "--out", (dir / "out").string(), "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("http://127.0.0.1:", 0), 0u) << r.out;
+  EXPECT_THAT(r.err, HasSubstr("cell part 1 of the batch of seed 3"));
+  EXPECT_THAT(r.err, HasSubstr("insert confirm"));
+  r = run_cli(
+      {"serve", "--task", (dir / "task.yaml").string(), "--listen", "127.0.0.1:0", "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--task: needs --cell"));
+  r = run_cli({"serve", "--cell", "--part", "10", "--listen", "127.0.0.1:0", "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--part 10"));
+  test::write_text(dir / "bad.yaml", "steps: {grab: auto}\n");
+  r = run_cli({"serve", "--cell", "--task", (dir / "bad.yaml").string(), "--listen", "127.0.0.1:0",
+               "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("steps.grab"));
+}
+
 }  // namespace
 }  // namespace mc

@@ -1,4 +1,5 @@
 #include "microcobot/live/console_command.h"
+#include "microcobot/live/console_task.h"
 
 #include <gtest/gtest.h>
 
@@ -58,6 +59,15 @@ TEST(ConsoleCommand, ParsesActionsAndRefusesUnknownOnes) {
   EXPECT_EQ(parse_console_action(R"({"action": "estop"})"), ConsoleAction::kEstop);
   EXPECT_EQ(parse_console_action(R"({"action": "reset"})"), ConsoleAction::kReset);
   EXPECT_EQ(parse_console_action(R"({"action": "demo"})"), ConsoleAction::kDemo);
+  // The supervised task's controls (serve --cell), in the loop's TaskAction order.
+  EXPECT_EQ(parse_console_action(R"({"action": "task_start"})"), ConsoleAction::kTaskStart);
+  EXPECT_EQ(parse_console_action(R"({"action": "task_take_over"})"), ConsoleAction::kTaskTakeOver);
+  EXPECT_EQ(parse_console_action(R"({"action": "task_step_done"})"), ConsoleAction::kTaskStepDone);
+  EXPECT_EQ(parse_console_action(R"({"action": "task_skip"})"), ConsoleAction::kTaskSkip);
+  EXPECT_TRUE(is_task_action(ConsoleAction::kTaskSkip));
+  EXPECT_FALSE(is_task_action(ConsoleAction::kRecordStop));
+  EXPECT_EQ(task_action(ConsoleAction::kTaskStepDone), TaskAction::kStepDone);
+  EXPECT_EQ(task_action_name(ConsoleAction::kTaskHandBack), "task_hand_back");
   EXPECT_THROW(parse_console_action(R"({"action": "self_destruct"})"), InvalidInput);
   EXPECT_THROW(parse_console_action(R"({"action": 3})"), InvalidInput);
   EXPECT_THROW(parse_console_action(R"({"action": "estop", "x": 1})"), InvalidInput);

@@ -73,11 +73,27 @@ std::string_view AssemblyTask::name(Status s) noexcept {
   return "?";
 }
 
+std::string_view AssemblyTask::name(Autonomy a) noexcept {
+  switch (a) {
+    case Autonomy::kAuto:
+      return "auto";
+    case Autonomy::kConfirm:
+      return "confirm";
+    case Autonomy::kManual:
+      return "manual";
+  }
+  return "?";
+}
+
 void AssemblyTask::enter(Step s) noexcept {
   step_ = s;
   step_s_ = 0.0;
   settled_s_ = 0.0;
   insert_ = Insert::kDescend;
+  if (s == Step::kInsert) {  // a fresh search, however the insertion was reached
+    tries_ = 0;
+    offset_y_ = 0.0;
+  }
   if (s == Step::kDone) {
     status_ = Status::kSucceeded;
     return;
@@ -137,6 +153,21 @@ void AssemblyTask::hand_back(bool step_done) noexcept {
   }
 }
 
+void AssemblyTask::set_autonomy(Step step, Autonomy a) noexcept {
+  if (step == Step::kDone) return;
+  autonomy_[index(step)] = a;
+  const bool fresh = step_s_ == 0.0 && (status_ == Status::kRunning || status_ == Status::kAwaitingConfirm ||
+                                        status_ == Status::kOperator);
+  if (step == step_ && fresh) begin_step();
+}
+
+void AssemblyTask::skip() noexcept {
+  if (finished()) return;
+  const bool paused = status_ == Status::kPaused;
+  enter(static_cast<Step>(index(step_) + 1));
+  if (paused && status_ == Status::kRunning) status_ = Status::kPaused;
+}
+
 bool AssemblyTask::move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s,
                            double dt) noexcept {
   out_.has_goal = true;
@@ -191,11 +222,8 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
         enter(Step::kTransport);
       break;
     case Step::kTransport:
-      if (move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s)) {
-        tries_ = 0;
-        offset_y_ = 0.0;
+      if (move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s))
         enter(Step::kInsert);
-      }
       break;
     case Step::kInsert:
       insert_tick(s, dt_s);

@@ -29,8 +29,10 @@
 /// operator (take_over(), or a step whose autonomy is kManual: the task sends nothing and the
 /// operator's master drives; hand_back() resumes the current step, re-planned from where the
 /// stage is, or the next one when the operator says the step is done); succeeded; failed (a step's
-/// timeout, a jam beyond the search). Every goal is a move from the coupling's current target
-/// at a bounded speed, so resuming and handing back never jump. Never allocates; noexcept.
+/// timeout, a jam beyond the search). skip() leaves the current step for the next one, from where
+/// the stage is (the operator judged it done or needless: e.g. a pin already in the fingers).
+/// Every goal is a move from the coupling's current target at a bounded speed, so resuming,
+/// handing back and skipping never jump. Never allocates; noexcept.
 
 #include <array>
 #include <limits>
@@ -119,7 +121,13 @@ class AssemblyTask {
   /// The operator hands back: the current step again from where the stage is, or, with
   /// `step_done`, the next one.
   void hand_back(bool step_done = false) noexcept;
-  void set_autonomy(Step step, Autonomy a) noexcept { autonomy_[index(step)] = a; }
+  /// The next step, from where the stage is, whatever the task's status (finished: nothing). A
+  /// paused task stays paused in the next step (resume() goes on); a task the operator drives
+  /// hands back into it. The next step's autonomy applies as on any entry (confirm: it waits).
+  void skip() noexcept;
+  /// A step's level counts from its next entry, and for the current step at once while it has
+  /// not run a tick (so that a task file's level for the first step applies).
+  void set_autonomy(Step step, Autonomy a) noexcept;
 
   Step step() const noexcept { return step_; }
   Status status() const noexcept { return status_; }
@@ -130,6 +138,8 @@ class AssemblyTask {
   double insert_contact_z_m() const noexcept { return contact_z_; }
   static std::string_view name(Step s) noexcept;
   static std::string_view name(Status s) noexcept;
+  static std::string_view name(Autonomy a) noexcept;
+  Autonomy autonomy(Step step) const noexcept { return autonomy_[index(step)]; }
 
  private:
   enum class Insert { kDescend, kRetreat, kShift };

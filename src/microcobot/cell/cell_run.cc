@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 
+#include "microcobot/cell/task_io.h"
 #include "microcobot/core/error.h"
 #include "microcobot/platform/simulated_gripper.h"
 
@@ -21,6 +22,12 @@ void CellRunParams::validate() const {
   task.validate();
   person.validate();
   require(person_seed >= 0, "person_seed", "must be non-negative", person_seed);
+  require(std::isfinite(confirm_delay_s) && confirm_delay_s >= 0.0 && confirm_delay_s <= 60.0,
+          "confirm_delay_s", "must be within [0, 60] s", confirm_delay_s);
+  for (std::size_t i = 0; i < autonomy.size(); ++i)
+    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kManual,
+            "steps." + std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i))),
+            "is manual: a headless run has no operator to do it (serve --cell runs it with one)");
   manual.validate();
 }
 
@@ -40,6 +47,7 @@ nlohmann::json CycleResult::to_json() const {
           {"clutches", clutches},
           {"search_tries", search_tries},
           {"submovements", submovements},
+          {"confirmations", confirmations},
           {"path_m", path_m},
           {"side_m", side_m},
           {"clearance_m", clearance_m},
@@ -89,16 +97,6 @@ struct CellCycle::Meter {
 
 namespace {
 
-TaskSensors read_sensors(const platform::Platform& p, const Eigen::Vector3d& home_m) {
-  TaskSensors s;
-  for (int i = 0; i < 3; ++i) s.tip_m[i] = home_m[i] + p.axis(i).position_m();
-  const platform::Vec3 f = p.gripper().contact_force_N();
-  s.contact_N = {f.x, f.y, f.z};
-  s.grip_N = p.gripper().grip_force_N();
-  s.opening_m = p.gripper().opening_m();
-  return s;
-}
-
 platform::PlatformConfig with_world(platform::PlatformConfig c, const AssemblyJob& job) {
   c.microworld = "pick-place";
   c.world = job.world;
@@ -120,18 +118,24 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   meter_->grip_limit_N = job.world.grip_force_limit_N;
   meter_->contact_limit_N = job.world.contact_force_limit_N;
   platform::Platform& p = *platform_;
-  AssemblyGoal goal;
-  goal.part_m = job.nominal_part_m;
-  goal.target_m = job.target_m;
-  goal.part_height_m = job.world.height_m();
-  goal.hole_depth_m = job.world.hole_depth_m;
-  goal.clearance_m = job.clearance_m;
-  goal.open_m = job.world.gripper.max_opening_m;
+  const AssemblyGoal goal = assembly_goal(job);
   if (params_.mode == "auto") {
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
+    for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
+      task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
     p.set_operator([this](const platform::TickInfo& t) {
-      const TaskSensors s = read_sensors(*platform_, home_m_);
+      const TaskSensors s = read_task_sensors(*platform_, home_m_);
       meter_->sample(s);
+      // The supervisor confirms a waiting step after confirm_delay_s (the task holds meanwhile).
+      if (task_->status() == AssemblyTask::Status::kAwaitingConfirm) {
+        waiting_s_ += t.dt_s;
+        if (waiting_s_ >= params_.confirm_delay_s - 1e-9) {
+          task_->confirm();
+          ++confirmations_;
+        }
+      } else {
+        waiting_s_ = 0.0;
+      }
       // Holding (deadman off) whenever the task does not drive: paused, awaiting, finished.
       // Taken over, the operator's master drives: the console lets go.
       control::ConsoleInput in = task_->tick(s, t.dt_s);
@@ -151,7 +155,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal,
                                                params_.mode == "assisted", seed);
     p.set_operator([this](const platform::TickInfo& t) {
-      meter_->sample(read_sensors(*platform_, home_m_));
+      meter_->sample(read_task_sensors(*platform_, home_m_));
       person_->act(t);
       if ((person_->done() || person_->gave_up()) && !finished_) {
         finished_ = true;
@@ -162,7 +166,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   } else {
     manual_ = std::make_unique<platform::PickPlaceOperator>(p, params_.manual);
     p.set_operator([this](const platform::TickInfo& t) {
-      meter_->sample(read_sensors(*platform_, home_m_));
+      meter_->sample(read_task_sensors(*platform_, home_m_));
       manual_->act(t);
       if ((manual_->done() || manual_->gave_up()) && !finished_) {
         finished_ = true;
@@ -213,6 +217,7 @@ CycleResult CellCycle::result() const {
   r.ended_holding = !teleop.engaged && (teleop.slave_target_m - measured).norm() < 1e-6;
   if (task_) {
     r.search_tries = task_->search_tries();
+    r.confirmations = confirmations_;
     r.success = task_->status() == AssemblyTask::Status::kSucceeded && inserted;
     if (p.faulted()) {
       r.verdict = "a device faulted";

@@ -11,6 +11,7 @@
 /// presses, the search's tries. An automatic cycle ends with every axis holding
 /// (Platform::hold()).
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -36,8 +37,15 @@ struct CellRunParams {
   PersonOperatorParams person;
   /// The person's seed: part i gets person_seed * 1000003 + i, the same in every mode.
   int person_seed = 1;
-  /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up
-  /// to ~5 mm at 100 um/s, where the main scenario's is 2 mm).
+  /// Headless, a step whose autonomy is `confirm` is confirmed by the supervisor this long after
+  /// it started waiting (a stand-in for the operator's glance and click until the simulated
+  /// person of issue #29 point 3): its cost shows in the cycle time.
+  double confirm_delay_s = 1.0;
+  /// Each step's autonomy (a task file's `steps`, task_file.h; not a --params key). Headless
+  /// runs have no operator for a `manual` step: refused.
+  std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> autonomy = all_auto();
+  /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up to ~5 mm at
+  /// 100 um/s, where the main scenario's is 2 mm).
   platform::PickPlaceOperatorParams manual = manual_defaults();
 
   template <class V>
@@ -47,9 +55,15 @@ struct CellRunParams {
     v("task", task);
     v("person", person);
     v("person_seed", person_seed);
+    v("confirm_delay_s", confirm_delay_s);
     v("manual", manual);
   }
   void validate() const;
+  static std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> all_auto() {
+    std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> a{};
+    a.fill(AssemblyTask::Autonomy::kAuto);
+    return a;
+  }
   static platform::PickPlaceOperatorParams manual_defaults() {
     platform::PickPlaceOperatorParams m;
     m.phase_timeout_s = 90.0;
@@ -74,9 +88,10 @@ struct CycleResult {
   double peak_contact_N = 0.0;
   int grip_violations = 0, contact_violations = 0;  ///< ticks over the platform's limits
   int clutches = 0;
-  int search_tries = 0;  ///< the task's search points, or the times the person's pin met the rim
-  int submovements = 0;  ///< the person's aimed movements
-  double path_m = 0.0;   ///< length of the measured tip's path
+  int search_tries = 0;   ///< the task's search points, or the times the person's pin met the rim
+  int submovements = 0;   ///< the person's aimed movements
+  int confirmations = 0;  ///< steps the supervisor confirmed (autonomy `confirm`)
+  double path_m = 0.0;    ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
   double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
   bool ended_holding = false;  ///< every axis' target at its measured position, the coupling off
@@ -137,6 +152,8 @@ class CellCycle {
   Eigen::Vector3d home_m_;
   bool finished_ = false, held_ = false, settled_ = false;
   double finished_at_s_ = 0.0;
+  double waiting_s_ = 0.0;  // how long the task has awaited confirmation
+  int confirmations_ = 0;
 };
 
 /// One part, run to its end.

@@ -14,6 +14,7 @@ void PersonOperatorParams::validate() const {
   require_positive(pin_tolerance_m, "pin_tolerance_m");
   require_positive(bore_tolerance_m, "bore_tolerance_m");
   require_positive(assisted_tolerance_m, "assisted_tolerance_m");
+  require_non_negative(assist_vision_sd_m, "assist_vision_sd_m");
   require_positive(z_tolerance_m, "z_tolerance_m");
   require_positive(still_m, "still_m");
   require(still_window_s > 0.0 && still_window_s <= 0.2, "still_window_s", "must be within (0, 0.2] s",
@@ -73,7 +74,7 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
       std::clamp(static_cast<int>(std::lround(p_.still_window_s * operator_rate_Hz(platform.config()))), 1,
                  kHistory - 1);
   // The cell's vision finds the pin on the tray (assisted): where the guidance takes the tips.
-  pin_seen_ = seen(sim_.gripper->world_state().part_m.head<2>());
+  pin_seen_ = seen(sim_.gripper->world_state().part_m.head<2>(), p_.assist_vision_sd_m);
 }
 
 void PersonOperator::enter(Step s, double t) noexcept {
@@ -99,8 +100,8 @@ void PersonOperator::let_go() noexcept {
   platform_.set_fixtures({});
 }
 
-Eigen::Vector2d PersonOperator::seen(const Eigen::Vector2d& p) noexcept {
-  const double sd = p_.person.vision_sd_m;
+Eigen::Vector2d PersonOperator::seen(const Eigen::Vector2d& p, double sd_m) noexcept {
+  const double sd = sd_m >= 0.0 ? sd_m : p_.person.vision_sd_m;
   return p + Eigen::Vector2d(rng_.normal(0.0, sd), rng_.normal(0.0, sd));
 }
 
@@ -253,7 +254,7 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
     case Step::kLift:
       if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t)) {
         // The pin's place in the fingers once it is up, as vision sees it (assisted).
-        pin_offset_seen_ = seen((part - tip).head<2>());
+        pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);
         enter(Step::kTransport, t);
       }
       break;

@@ -63,8 +63,11 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
       v = n <= speed * dt_ ? Eigen::Vector3d(d / dt_) : Eigen::Vector3d(d * (speed / n));
     } else if (c.velocity_m_s.allFinite()) {
       // A joystick is a rate control: the fixtures' scaling gain is on its speed in the plane.
+      // A rate control: the stage's pace, not a hand's workspace, limits coarse motion, so the
+      // fixtures' coarse-far gain does not apply (a gain the person cannot see at the joystick
+      // only made them overshoot); guidance and forbidden regions do.
       v = c.velocity_m_s;
-      v.head<2>() *= fixtures_.scale_gain(raw_xy_m_);
+      scale_ = p_.motion_scale;
       const double n = v.norm();
       if (n > p_.console_max_speed_m_s) v *= p_.console_max_speed_m_s / n;
     }

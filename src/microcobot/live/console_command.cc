@@ -106,13 +106,22 @@ ConsoleAction parse_console_action(std::string_view text) {
       {"restart", ConsoleAction::kRestart},
       {"record_start", ConsoleAction::kRecordStart},
       {"record_stop", ConsoleAction::kRecordStop},
+      {"task_start", ConsoleAction::kTaskStart},
+      {"task_pause", ConsoleAction::kTaskPause},
+      {"task_resume", ConsoleAction::kTaskResume},
+      {"task_confirm", ConsoleAction::kTaskConfirm},
+      {"task_take_over", ConsoleAction::kTaskTakeOver},
+      {"task_hand_back", ConsoleAction::kTaskHandBack},
+      {"task_step_done", ConsoleAction::kTaskStepDone},
+      {"task_skip", ConsoleAction::kTaskSkip},
   };
   const std::string name = a.get<std::string>();
   for (const auto& [n, action] : kNames)
     if (n == name) return action;
   refuse(kChannel, "action",
          "must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
-         "record_stop");
+         "record_stop, task_start, task_pause, task_resume, task_confirm, task_take_over, task_hand_back, "
+         "task_step_done, task_skip");
 }
 
 }  // namespace mc::live

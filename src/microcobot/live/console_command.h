@@ -63,7 +63,21 @@ enum class ConsoleAction {
   kRestart,         ///< restart the scene, console in control
   kRecordStart,     ///< start an MCAP recording in --out
   kRecordStop,
+  // The supervised task (`serve --cell`, live_task.h): its controls, in TaskAction's order.
+  kTaskStart,
+  kTaskPause,
+  kTaskResume,
+  kTaskConfirm,
+  kTaskTakeOver,
+  kTaskHandBack,  ///< this step again, from where the stage is
+  kTaskStepDone,  ///< hand back: the operator did this step, the next one
+  kTaskSkip,
 };
+
+/// Whether `a` is one of the task's controls.
+inline bool is_task_action(ConsoleAction a) {
+  return static_cast<int>(a) >= static_cast<int>(ConsoleAction::kTaskStart);
+}
 
 /// Parses `{"deadman": bool, "velocity_m_s": [vx, vy, vz], "goal_m": [x, y, z] (optional),
 /// "goal_speed_m_s": v (optional), "gripper_opening_m": o (optional), "focus_z_m": z,
@@ -74,7 +88,9 @@ enum class ConsoleAction {
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
 
 /// Parses `{"action": "estop" | "reset" | "take_control" | "release_control" | "demo" |
-/// "restart" | "record_start" | "record_stop"}`. Throws mc::InvalidInput.
+/// "restart" | "record_start" | "record_stop" | "task_start" | "task_pause" | "task_resume" |
+/// "task_confirm" | "task_take_over" | "task_hand_back" | "task_step_done" | "task_skip"}`.
+/// Throws mc::InvalidInput.
 ConsoleAction parse_console_action(std::string_view json);
 
 }  // namespace mc::live

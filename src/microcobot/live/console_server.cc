@@ -15,6 +15,7 @@
 #include "microcobot/dsp/butterworth.h"
 #include "microcobot/live/camera_messages.h"
 #include "microcobot/live/console_page.h"
+#include "microcobot/live/console_task.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::live {
@@ -98,7 +99,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"last_error", text},
                                             {"ticks", number},
                                             {"camera", {{"type", {"object", "null"}}}},
-                                            {"demo_result", {{"type", {"object", "null"}}}}})});
+                                            {"demo_result", {{"type", {"object", "null"}}}},
+                                            {"task", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
   const std::vector<std::string> scene_keys = {"kind",
@@ -302,33 +304,6 @@ void ConsoleServer::tell(server::ClientId client, StatusLevel level, const std::
   note(event_level(level), kind, message, client);
 }
 
-void ConsoleServer::note_changes(const LiveStatus& s) {
-  const LiveStatus& was = last_status_;
-  if (s.demo && !was.demo) note(EventLevel::kInfo, "demo", "the scripted demo operator drives");
-  if (s.demo && s.demo_phase != was.demo_phase && !s.demo_phase.empty())
-    note(EventLevel::kInfo, "demo_phase", s.demo_phase);
-  if (!s.demo && was.demo) {
-    // How it ended, in the words the console shows (issue #26).
-    const DemoResult& r = s.demo_result;
-    std::string how = "the scripted demo ended: " + std::string(DemoResult::name(r.outcome));
-    if (!r.phase.empty()) how += " (" + r.phase + ")";
-    if (!r.reason.empty()) how += ": " + r.reason;
-    if (std::isfinite(r.placement_error_m))
-      how += fmt::format(", placement error {:.2f} um", 1e6 * r.placement_error_m);
-    note(r.outcome == DemoResult::Outcome::kGaveUp || r.outcome == DemoResult::Outcome::kMissed
-             ? EventLevel::kWarning
-             : EventLevel::kInfo,
-         "demo_end", how);
-  }
-  if (s.estopped != was.estopped)
-    note(s.estopped ? EventLevel::kWarning : EventLevel::kInfo, "estopped",
-         s.estopped ? "e-stop latched: every device in its safe state" : "e-stop cleared");
-  if (s.last_error != was.last_error && !s.last_error.empty())
-    note(EventLevel::kError, "platform_error", s.last_error);
-  if (s.restarts != was.restarts) note(EventLevel::kInfo, "restart", "the platform was rebuilt");
-  last_status_ = s;
-}
-
 void ConsoleServer::on_message(const server::ClientMessage& m) {
   const server::ClientId controller = controller_.load();
   if (recording_ && (m.topic == "/console/command" || m.topic == "/console/action")) {
@@ -404,6 +379,29 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
              m.client);
         live_.request(a);
         return;
+      case ConsoleAction::kTaskStart:
+      case ConsoleAction::kTaskPause:
+      case ConsoleAction::kTaskResume:
+      case ConsoleAction::kTaskConfirm:
+      case ConsoleAction::kTaskTakeOver:
+      case ConsoleAction::kTaskHandBack:
+      case ConsoleAction::kTaskStepDone:
+      case ConsoleAction::kTaskSkip: {
+        // Pausing only stops the stage: anyone may (as the e-stop); the rest needs control.
+        if (a != ConsoleAction::kTaskPause && m.client != controller) {
+          tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
+               "control");
+          return;
+        }
+        if (const std::string why = task_action_refusal(a, live_.status().task); !why.empty()) {
+          tell(m.client, StatusLevel::kWarning, why, "refused", "task");
+          return;
+        }
+        note(EventLevel::kInfo, "task_action", task_action_name(a), m.client);
+        if (!live_.push_task_action(task_action(a)))
+          tell(m.client, StatusLevel::kWarning, "task: the loop is busy; action dropped", "refused", "task");
+        return;
+      }
     }
   } catch (const Error& e) {
     // The status names what it refuses (its id is the offending message's topic), so a client
@@ -433,112 +431,6 @@ std::string ConsoleServer::start_recording() {
 
 void ConsoleServer::stop_recording() {
   if (recording_) recording_->stop();  // summary, index, footer; then renamed to its name
-}
-
-std::string ConsoleServer::scene_json() const {
-  const auto& c = live_.limits();
-  json j{{"kind", "pick-place"},
-         {"part_side_m", live_.part_side_m()},
-         {"part_height_m", live_.part_height_m()},
-         {"hole_side_m", live_.hole_side_m()},
-         {"hole_depth_m", live_.hole_depth_m()},
-         {"target_m", live_.target_m()},
-         {"tolerance_m", live_.placement_tolerance_m()},
-         {"max_opening_m", c.max_opening_m},
-         {"finger_width_m", live_.finger_width_m()},
-         {"workspace_min_m", c.min_m},
-         {"workspace_max_m", c.max_m},
-         {"max_speed_m_s", c.max_speed_m_s},
-         // The gauges' full scales are the limits the platform enforces (issue #26).
-         {"force_full_scale_N", live_.contact_force_limit_N()},
-         {"grip_force_limit_N", live_.grip_force_limit_N()},
-         {"contact_force_limit_N", live_.contact_force_limit_N()}};
-  if (live_.has_camera()) {
-    // What the microscope panel needs: the turret, the focus travel, the sensor, the settings'
-    // ranges (the current state comes with each frame on /camera/state).
-    const platform::CameraDeviceParams& cam = live_.camera_params();
-    json objectives = json::array();
-    for (const auto& o : cam.objectives)
-      objectives.push_back({{"name", o.name},
-                            {"magnification", o.magnification},
-                            {"m_per_px", cam.sensor.pixel_pitch_m / o.magnification}});
-    j["camera"] = {{"objectives", objectives},
-                   {"focus_min_m", c.focus_min_m},
-                   {"focus_max_m", c.focus_max_m},
-                   {"focus_speed_m_s", cam.focus_speed_m_s},
-                   {"width_px", cam.sensor.width_px},
-                   {"height_px", cam.sensor.height_px},
-                   {"frame_rate_Hz", cam.frame_rate_Hz()},
-                   {"exposure_range_s", {c.min_exposure_s, c.max_exposure_s}},
-                   {"gain_range", {c.min_gain, c.max_gain}},
-                   {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}}};
-  } else {
-    j["camera"] = nullptr;
-  }
-  const std::string no_demo = live_.demo_unavailable_reason();
-  j["demo_available"] = no_demo.empty();
-  j["demo_unavailable_reason"] = no_demo;
-  if (live_.optical_trap_scene()) {
-    // The probe bead (the telemetry's part_* channels) and the stuck bead; forces in piconewtons:
-    // the gauge's full scale is the trap's escape force, k times the probe's radius.
-    const auto& trap = live_.optical_trap().trap;
-    j["kind"] = "optical-trap";
-    j["bead_radius_m"] = trap.bead_radius_m;
-    j["obstacle_m"] = live_.obstacle_m();
-    j["obstacle_radius_m"] = trap.obstacle_radius_m;
-    j["force_full_scale_N"] = trap.trap_stiffness_N_per_m * trap.bead_radius_m;
-  }
-  return j.dump();
-}
-
-std::string ConsoleServer::status_json() {
-  const LiveStatus s = live_.status();
-  json lifecycle = json::object();
-  const char* names[6] = {"axis_x", "axis_y", "axis_z", "gripper", "haptic", "tweezers"};
-  for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(platform::to_string(s.lifecycle[i]));
-  const std::string recording = recording_ ? recording_->name() : std::string();
-  json j = {{"t_s", s.t_s},
-            {"estopped", s.estopped},
-            {"controlled", controller_.load() != 0},
-            {"console_fresh", s.console_fresh},
-            {"demo", s.demo},
-            {"demo_phase", s.demo_phase},
-            {"lifecycle", lifecycle},
-            {"overruns", s.overruns},
-            {"tick_p99_us", tick_p99_us_.load()},
-            {"tick_cpu_p99_us", tick_cpu_p99_us_.load()},
-            {"command_latency_ms",
-             {{"count", latency_.count()},
-              {"p50", 1e3 * latency_.quantile_s(0.5)},
-              {"p99", 1e3 * latency_.quantile_s(0.99)},
-              {"max", 1e3 * latency_.max_s()}}},
-            {"link_cost_us",
-             {{"count", link_cost_.count()},
-              {"p50", 1e6 * link_cost_.quantile_s(0.5)},
-              {"p99", 1e6 * link_cost_.quantile_s(0.99)},
-              {"max", 1e6 * link_cost_.max_s()}}},
-            {"clients", server_.client_count()},
-            {"recording", recording.empty() ? json(nullptr) : json(recording)},
-            {"last_error", s.last_error},
-            {"ticks", s.ticks}};
-  j["camera"] = s.camera ? json{{"frames", s.camera_frames},
-                                {"dropped", s.camera_dropped},
-                                {"focus_z_m", s.focus_z_m},
-                                {"focus_target_m", s.focus_target_m},
-                                {"objective", s.objective}}
-                         : json(nullptr);
-  const DemoResult& d = s.demo_result;
-  if (d.outcome == DemoResult::Outcome::kNone) {
-    j["demo_result"] = nullptr;
-  } else {
-    j["demo_result"] = {
-        {"outcome", DemoResult::name(d.outcome)},
-        {"phase", d.phase},
-        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
-        {"reason", d.reason},
-        {"duration_s", d.duration_s}};
-  }
-  return j.dump();
 }
 
 void ConsoleServer::update_camera_demand() {

@@ -27,11 +27,19 @@ void LiveParams::validate() const {
           "settle_window_s", "must be within [0, 10] s", settle_window_s);
   require(finger_width_m > 0 && finger_width_m < 1e-3, "finger_width_m", "must be within (0, 1 mm)",
           finger_width_m);
+  if (task) {
+    require(remote == nullptr, "task",
+            "the console supervises a task only where it drives (not a slave process)");
+    task->validate();
+  }
 }
 
 LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   params_.platform.loop.realtime = params_.paced;
   params_.validate();
+  home_m_ = {params_.platform.stage.home_x_m, params_.platform.stage.home_y_m,
+             params_.platform.stage.home_z_m};
+  if (params_.task) task_ = std::make_unique<LiveTask>(*params_.task);
   build(/*demo=*/false);
   const auto& tp = params_.platform.teleop;
   limits_.max_speed_m_s = tp.console_max_speed_m_s;
@@ -80,6 +88,7 @@ void LivePlatform::build(bool demo) {
   protocol_fresh_ = protocol_has_goal_ = protocol_steps_pending_ = false;
   settled_s_ = {};
   remote_estopped_ = false;
+  if (task_) task_->reset();  // a new scene, a new cycle (not started)
 }
 
 void LivePlatform::set_frame_sink(FrameSink sink) {
@@ -158,6 +167,8 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.goal_speed_m_s = latest_.goal_speed_m_s;
     in.has_gripper = latest_.has_gripper;
     in.gripper_opening_m = latest_.gripper_opening_m;
+    // The task, supervised by the console in control: it drives or holds in the console's place.
+    if (task_) task_->tick(p, home_m_, t.dt_s, console_control && !p.faulted(), fresh, in);
   }
   p.set_console_input(in);
   protocol_publish(t);
@@ -233,9 +244,10 @@ bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_contr
     protocol_has_goal_ = false;
     protocol_steps_pending_ = false;
   }
-  // The heartbeat is the protocol client's deadman; a console client in control, the demo or a
-  // remote master outrank it.
+  // The heartbeat is the protocol client's deadman; a console client in control, the demo, a
+  // started task or a remote master outrank it.
   const bool fresh = !console_control && !params_.remote && !(demo_ && !demo_finished_) &&
+                     !(task_ && task_->in_progress()) &&
                      t.t_s - protocol_last_t_ <= params_.command_timeout_s;
   if (protocol_fresh_ && !fresh) stop_and_hold();  // gone, stale or outranked: every axis holds
   protocol_fresh_ = fresh;
@@ -486,6 +498,7 @@ LiveStatus LivePlatform::status() const {
         break;
     }
   }
+  if (task_) s.task = task_->status();
   std::lock_guard lock(request_mutex_);
   s.last_error = last_error_;
   return s;

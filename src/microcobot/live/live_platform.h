@@ -14,7 +14,8 @@
 /// devices reconfigured and re-activated off the loop (like ros2_control's lifecycle
 /// transitions, which never run inside update()). "demo" and "restart" rebuild the scene
 /// (about a second: the step map) with the scripted pick-and-place operator or the console in
-/// control. Nothing on the loop path allocates, locks, throws or does I/O.
+/// control. With a task (`serve --cell`, live_task.h) the loop also runs the automatic insertion,
+/// supervised from the console. Nothing on the loop path allocates, locks, throws or does I/O.
 
 #include <array>
 #include <atomic>
@@ -24,11 +25,13 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
+#include "microcobot/live/live_task.h"
 #include "microcobot/live/protocol_command.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
@@ -56,6 +59,9 @@ struct LiveParams {
   /// Commands from the far end instead of the console (a slave process: net/remote_master.h);
   /// not owned, must outlive the live platform. The console then observes (and may e-stop).
   CommandSource* remote = nullptr;
+  /// The automatic insertion the console supervises (`serve --cell`; live_task.h), on the scene
+  /// of `platform.world` (its job's). Not with a remote command source.
+  std::optional<LiveTaskParams> task;
   void validate() const;
 };
 
@@ -89,7 +95,8 @@ struct LiveStatus {
   double focus_z_m = 0.0, focus_target_m = 0.0;
   int objective = 0;
   DemoResult demo_result;
-  std::string last_error;  ///< the last failed request (reset refused, rebuild failed)
+  std::string last_error;              ///< the last failed request (reset refused, rebuild failed)
+  std::optional<LiveTaskStatus> task;  ///< the supervised task (none without one)
 };
 
 class LivePlatform {
@@ -130,6 +137,10 @@ class LivePlatform {
   bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_.push(c); }
   /// What the loop last published for the protocol clients. Any thread.
   ProtocolView protocol_view() const noexcept;
+  /// The operator's control of the task (one producer thread: the server's). Wait-free; false
+  /// without a task or when its ring is full.
+  bool push_task_action(TaskAction a) noexcept { return task_ && task_->push(a); }
+  bool has_task() const noexcept { return task_ != nullptr; }
   /// Latches the e-stop at the next operator tick (at most 1 ms). Any thread, async-signal-safe.
   void estop() noexcept { estop_.store(true); }
   /// Reset, demo or restart, done by the control thread between two loop runs; other actions
@@ -201,6 +212,8 @@ class LivePlatform {
   std::size_t channel_count_ = 0;
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<platform::PickPlaceOperator> demo_;
+  std::unique_ptr<LiveTask> task_;  // kept across scene rebuilds (its ring is the server's)
+  Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
   platform::SpscRing<ConsoleCommand> commands_{256};
   platform::SpscRing<ProtocolCommand> protocol_{256};
   // Protocol state (loop thread only).

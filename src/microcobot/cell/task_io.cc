@@ -1,0 +1,30 @@
+#include "microcobot/cell/task_io.h"
+
+namespace mc::cell {
+
+TaskSensors read_task_sensors(const platform::Platform& p, const Eigen::Vector3d& home_m) noexcept {
+  TaskSensors s;
+  for (int i = 0; i < 3; ++i) s.tip_m[i] = home_m[i] + p.axis(i).position_m();
+  const platform::Vec3 f = p.gripper().contact_force_N();
+  s.contact_N = {f.x, f.y, f.z};
+  s.grip_N = p.gripper().grip_force_N();
+  s.opening_m = p.gripper().opening_m();
+  return s;
+}
+
+AssemblyGoal assembly_goal(const AssemblyJob& job) {
+  AssemblyGoal goal;
+  goal.part_m = job.nominal_part_m;
+  goal.target_m = job.target_m;
+  goal.part_height_m = job.world.height_m();
+  goal.hole_depth_m = job.world.hole_depth_m;
+  goal.clearance_m = job.clearance_m;
+  goal.open_m = job.world.gripper.max_opening_m;
+  return goal;
+}
+
+Eigen::Vector3d stage_home_m(const platform::PlatformConfig& c) {
+  return {c.stage.home_x_m, c.stage.home_y_m, c.stage.home_z_m};
+}
+
+}  // namespace mc::cell

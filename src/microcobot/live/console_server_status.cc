@@ -1,0 +1,155 @@
+// What the console server says about the platform (docs/console.md, Channels): the JSON of the
+// scene and status channels, and the recording's events of what the status shows changing.
+// console_server.cc serves the clients and the channels.
+#include "microcobot/live/console_server.h"
+
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "microcobot/live/console_task.h"
+
+namespace mc::live {
+
+using nlohmann::json;
+
+void ConsoleServer::note_changes(const LiveStatus& s) {
+  const LiveStatus& was = last_status_;
+  if (s.demo && !was.demo) note(EventLevel::kInfo, "demo", "the scripted demo operator drives");
+  if (s.demo && s.demo_phase != was.demo_phase && !s.demo_phase.empty())
+    note(EventLevel::kInfo, "demo_phase", s.demo_phase);
+  if (!s.demo && was.demo) {
+    // How it ended, in the words the console shows (issue #26).
+    const DemoResult& r = s.demo_result;
+    std::string how = "the scripted demo ended: " + std::string(DemoResult::name(r.outcome));
+    if (!r.phase.empty()) how += " (" + r.phase + ")";
+    if (!r.reason.empty()) how += ": " + r.reason;
+    if (std::isfinite(r.placement_error_m))
+      how += fmt::format(", placement error {:.2f} um", 1e6 * r.placement_error_m);
+    note(r.outcome == DemoResult::Outcome::kGaveUp || r.outcome == DemoResult::Outcome::kMissed
+             ? EventLevel::kWarning
+             : EventLevel::kInfo,
+         "demo_end", how);
+  }
+  if (s.estopped != was.estopped)
+    note(s.estopped ? EventLevel::kWarning : EventLevel::kInfo, "estopped",
+         s.estopped ? "e-stop latched: every device in its safe state" : "e-stop cleared");
+  if (s.last_error != was.last_error && !s.last_error.empty())
+    note(EventLevel::kError, "platform_error", s.last_error);
+  if (s.restarts != was.restarts) note(EventLevel::kInfo, "restart", "the platform was rebuilt");
+  for (const auto& [kind, message] : task_changes(was.task, s.task))
+    note(kind == "task_end" && s.task->inserted != 1 ? EventLevel::kWarning : EventLevel::kInfo, kind,
+         message);
+  last_status_ = s;
+}
+
+std::string ConsoleServer::scene_json() const {
+  const auto& c = live_.limits();
+  json j{{"kind", "pick-place"},
+         {"part_side_m", live_.part_side_m()},
+         {"part_height_m", live_.part_height_m()},
+         {"hole_side_m", live_.hole_side_m()},
+         {"hole_depth_m", live_.hole_depth_m()},
+         {"target_m", live_.target_m()},
+         {"tolerance_m", live_.placement_tolerance_m()},
+         {"max_opening_m", c.max_opening_m},
+         {"finger_width_m", live_.finger_width_m()},
+         {"workspace_min_m", c.min_m},
+         {"workspace_max_m", c.max_m},
+         {"max_speed_m_s", c.max_speed_m_s},
+         // The gauges' full scales are the limits the platform enforces (issue #26).
+         {"force_full_scale_N", live_.contact_force_limit_N()},
+         {"grip_force_limit_N", live_.grip_force_limit_N()},
+         {"contact_force_limit_N", live_.contact_force_limit_N()}};
+  if (live_.has_camera()) {
+    // What the microscope panel needs: the turret, the focus travel, the sensor, the settings'
+    // ranges (the current state comes with each frame on /camera/state).
+    const platform::CameraDeviceParams& cam = live_.camera_params();
+    json objectives = json::array();
+    for (const auto& o : cam.objectives)
+      objectives.push_back({{"name", o.name},
+                            {"magnification", o.magnification},
+                            {"m_per_px", cam.sensor.pixel_pitch_m / o.magnification}});
+    j["camera"] = {{"objectives", objectives},
+                   {"focus_min_m", c.focus_min_m},
+                   {"focus_max_m", c.focus_max_m},
+                   {"focus_speed_m_s", cam.focus_speed_m_s},
+                   {"width_px", cam.sensor.width_px},
+                   {"height_px", cam.sensor.height_px},
+                   {"frame_rate_Hz", cam.frame_rate_Hz()},
+                   {"exposure_range_s", {c.min_exposure_s, c.max_exposure_s}},
+                   {"gain_range", {c.min_gain, c.max_gain}},
+                   {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}}};
+  } else {
+    j["camera"] = nullptr;
+  }
+  const std::string no_demo = live_.demo_unavailable_reason();
+  j["demo_available"] = no_demo.empty();
+  j["demo_unavailable_reason"] = no_demo;
+  if (live_.optical_trap_scene()) {
+    // The probe bead (the telemetry's part_* channels) and the stuck bead; forces in piconewtons:
+    // the gauge's full scale is the trap's escape force, k times the probe's radius.
+    const auto& trap = live_.optical_trap().trap;
+    j["kind"] = "optical-trap";
+    j["bead_radius_m"] = trap.bead_radius_m;
+    j["obstacle_m"] = live_.obstacle_m();
+    j["obstacle_radius_m"] = trap.obstacle_radius_m;
+    j["force_full_scale_N"] = trap.trap_stiffness_N_per_m * trap.bead_radius_m;
+  }
+  return j.dump();
+}
+
+std::string ConsoleServer::status_json() {
+  const LiveStatus s = live_.status();
+  json lifecycle = json::object();
+  const char* names[6] = {"axis_x", "axis_y", "axis_z", "gripper", "haptic", "tweezers"};
+  for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(platform::to_string(s.lifecycle[i]));
+  const std::string recording = recording_ ? recording_->name() : std::string();
+  json j = {{"t_s", s.t_s},
+            {"estopped", s.estopped},
+            {"controlled", controller_.load() != 0},
+            {"console_fresh", s.console_fresh},
+            {"demo", s.demo},
+            {"demo_phase", s.demo_phase},
+            {"lifecycle", lifecycle},
+            {"overruns", s.overruns},
+            {"tick_p99_us", tick_p99_us_.load()},
+            {"tick_cpu_p99_us", tick_cpu_p99_us_.load()},
+            {"command_latency_ms",
+             {{"count", latency_.count()},
+              {"p50", 1e3 * latency_.quantile_s(0.5)},
+              {"p99", 1e3 * latency_.quantile_s(0.99)},
+              {"max", 1e3 * latency_.max_s()}}},
+            {"link_cost_us",
+             {{"count", link_cost_.count()},
+              {"p50", 1e6 * link_cost_.quantile_s(0.5)},
+              {"p99", 1e6 * link_cost_.quantile_s(0.99)},
+              {"max", 1e6 * link_cost_.max_s()}}},
+            {"clients", server_.client_count()},
+            {"recording", recording.empty() ? json(nullptr) : json(recording)},
+            {"last_error", s.last_error},
+            {"ticks", s.ticks}};
+  j["camera"] = s.camera ? json{{"frames", s.camera_frames},
+                                {"dropped", s.camera_dropped},
+                                {"focus_z_m", s.focus_z_m},
+                                {"focus_target_m", s.focus_target_m},
+                                {"objective", s.objective}}
+                         : json(nullptr);
+  j["task"] = task_status_json(s.task);
+  const DemoResult& d = s.demo_result;
+  if (d.outcome == DemoResult::Outcome::kNone) {
+    j["demo_result"] = nullptr;
+  } else {
+    j["demo_result"] = {
+        {"outcome", DemoResult::name(d.outcome)},
+        {"phase", d.phase},
+        {"placement_error_m", std::isfinite(d.placement_error_m) ? json(d.placement_error_m) : json(nullptr)},
+        {"reason", d.reason},
+        {"duration_s", d.duration_s}};
+  }
+  return j.dump();
+}
+
+}  // namespace mc::live

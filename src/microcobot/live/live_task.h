@@ -1,0 +1,138 @@
+#pragma once
+/// @file
+/// The automatic insertion run live, supervised from the console (issue #29 point 5,
+/// `microcobot serve --cell`): the live platform's loop ticks a cell::AssemblyTask on the
+/// slave's sensors and hands its console input to the coupling, so that the platform's limits
+/// (grip, contact, floor: control/safety_limits.h) apply to it as to the operator. The
+/// operator's controls (start, pause, resume, confirm, take over, hand back, step done, skip)
+/// reach the loop as console actions through a single-producer ring; the task's state leaves it
+/// through atomics for the status channel.
+///
+/// Rules, the platform's (not the page's):
+///  - the task drives only while supervised: a console client holds control, its commands are
+///    fresh (the heartbeat) and no device is faulted; otherwise it pauses. A gap in the heartbeat
+///    of the client in control (a busy browser) pauses it only while it lasts, up to
+///    `heartbeat_gap_s`; a longer gap, a released control (a closed page) or an e-stop latches
+///    the pause: the operator resumes;
+///  - paused, awaiting a confirmation or ended, it sends no deadman: the coupling's target stops
+///    at the tick that applies the action and the stage holds;
+///  - an ended task (succeeded or failed) leaves every axis holding (Platform::hold()) and the
+///    console in control again;
+///  - taken over (or a manual step), the console drives from where the coupling's target is (the
+///    console's moves integrate from it: no step), and two of its inputs are re-taken before they
+///    count, so that nothing the page held before the hand-over moves the stage: the deadman
+///    must be seen released once, and the gripper slider must come within `gripper_pickup_m` of
+///    the opening the gripper holds, or cross it (a "soft take-over", as a MIDI fader's pick-up);
+///  - a started task outranks the vendor-protocol clients until it ends.
+/// The loop's part never allocates, locks or throws (the task object is allocation-free).
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <Eigen/Dense>
+
+#include "microcobot/cell/assembly_task.h"
+#include "microcobot/control/teleoperation.h"
+#include "microcobot/platform/platform.h"
+#include "microcobot/platform/spsc_ring.h"
+
+namespace mc::live {
+
+/// The operator's controls of the live task (`/console/action` task_*).
+enum class TaskAction : std::uint8_t {
+  kStart,  ///< start the task (once per scene: Restart scene for another cycle)
+  kPause,  ///< hold; resume goes on from there
+  kResume,
+  kConfirm,   ///< the go for a step whose autonomy is confirm
+  kTakeOver,  ///< the console drives; the task waits
+  kHandBack,  ///< the task again: the current step from where the stage is
+  kStepDone,  ///< the task again: the next step (the operator did this one)
+  kSkip,      ///< the next step, from where the stage is
+};
+
+struct LiveTaskParams {
+  cell::AssemblyGoal goal;
+  cell::AssemblyTaskParams task;
+  /// Indexed by cell::AssemblyTask::Step (a task file's `steps`, cell/task_file.h).
+  std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy = all_auto();
+  /// The console's gripper command counts again once within this of the held opening.
+  double gripper_pickup_m = 5e-6;
+  /// A heartbeat gap of the client in control up to this long (after the commands went stale)
+  /// pauses the task while it lasts; longer, the pause latches.
+  double heartbeat_gap_s = 1.0;
+  /// Throws mc::InvalidParams (the task's parameters and goal).
+  void validate() const;
+  static std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> all_auto() {
+    std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> a{};
+    a.fill(cell::AssemblyTask::Autonomy::kAuto);
+    return a;
+  }
+};
+
+/// The task as the loop last published it.
+struct LiveTaskStatus {
+  bool started = false;
+  bool ended = false;  ///< succeeded or failed; the console has control again
+  cell::AssemblyTask::Step step = cell::AssemblyTask::Step::kApproach;
+  cell::AssemblyTask::Status status = cell::AssemblyTask::Status::kRunning;
+  int search_tries = 0;
+  double elapsed_s = 0.0;        ///< live time since it started (to its end)
+  std::string failure;           ///< why it failed
+  bool supervisor_lost = false;  ///< paused by the platform, latched: control, heartbeat or a fault lost
+  bool heartbeat_gap = false;    ///< paused by the platform while the console's commands are stale
+  int inserted = -1;  ///< at its end, the simulation's truth: 1 the pin is in its bore, 0 not, -1 unknown
+  std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy{};
+  /// "idle" before the start, else the task's status name.
+  std::string status_name() const;
+};
+
+class LiveTask {
+ public:
+  /// Validates; the task is built, not started. Throws mc::Error.
+  explicit LiveTask(LiveTaskParams params);
+  ~LiveTask();
+
+  /// A fresh task, not started; pending actions dropped. The loop's thread only, between loop
+  /// runs (scene (re)builds): it allocates.
+  void reset();
+  /// One producer thread (the server's). Wait-free; false when the ring is full.
+  bool push(TaskAction a) noexcept { return actions_.push(a); }
+
+  /// The operator tick's part (loop thread): applies the pending actions, pauses an unsupervised
+  /// task, ticks it on the sensors and, while it drives or holds, replaces the console's input
+  /// `in` with its own; while the console drives (before the start, taken over, ended) applies
+  /// the re-take rules to `in`. `home_m`: the stage's home (world frame); `in_control`: a console
+  /// client holds control and no device is faulted; `fresh`: its commands are fresh.
+  void tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool in_control, bool fresh,
+            control::ConsoleInput& in) noexcept;
+  /// Started and not ended (loop thread).
+  bool in_progress() const noexcept { return started_ && !ended_; }
+
+  /// Any thread.
+  LiveTaskStatus status() const;
+
+ private:
+  void apply(TaskAction a) noexcept;
+  void console_takes_the_stage() noexcept;
+
+  LiveTaskParams params_;
+  std::unique_ptr<cell::AssemblyTask> task_;
+  platform::SpscRing<TaskAction> actions_{64};
+  // Loop thread only.
+  bool started_ = false, ended_ = false, operator_had_stage_ = false;
+  bool rearm_deadman_ = false, pickup_gripper_ = false;
+  bool gap_paused_ = false;  // paused for a heartbeat gap: resumes by itself when it ends soon
+  double gap_s_ = 0.0;
+  double pickup_side_ = 0.0;  // the sign of the console's gripper command less the held opening
+  double elapsed_s_ = 0.0;
+  // Published by the loop.
+  std::atomic<bool> started_pub_{false}, ended_pub_{false}, supervisor_lost_{false}, gap_pub_{false};
+  std::atomic<int> step_{0}, status_{0}, tries_{0}, inserted_{-1};
+  std::atomic<double> elapsed_pub_{0.0};
+  std::atomic<const char*> failure_{""};
+};
+
+}  // namespace mc::live

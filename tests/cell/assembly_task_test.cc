@@ -1,0 +1,126 @@
+// The task object alone (issue #29 point 5): skip() leaves the current step for the next one
+// from where the stage is, whatever the task's status, on an ideal stage that follows the task's
+// goal moves exactly (the platform's part is cell_cycle_test.cc's).
+#include "microcobot/cell/assembly_task.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace mc::cell {
+namespace {
+
+using Step = AssemblyTask::Step;
+using Status = AssemblyTask::Status;
+using Autonomy = AssemblyTask::Autonomy;
+
+// An ideal stage: the tip moves along the task's straight goal moves at their speed; the
+// gripper closes on a 200 um pin (grip force once the command is below its width).
+struct IdealStage {
+  TaskSensors s;
+  Eigen::Vector3d start_m{0.0, 0.0, 900e-6};
+  IdealStage() {
+    s.tip_m = start_m;
+    s.opening_m = 600e-6;
+  }
+  // One 1 ms tick of `task`; returns the distance the tip moved.
+  double tick(AssemblyTask& task) {
+    const control::ConsoleInput& in = task.tick(s, 1e-3);
+    const Eigen::Vector3d before = s.tip_m;
+    if (in.deadman && in.has_goal) {
+      const Eigen::Vector3d d = in.goal_m - s.tip_m;
+      const double step = in.goal_speed_m_s * 1e-3;
+      s.tip_m = d.norm() <= step ? in.goal_m : Eigen::Vector3d(s.tip_m + d * (step / d.norm()));
+    }
+    if (in.has_gripper) s.opening_m = std::max(200e-6, in.gripper_opening_m);
+    s.grip_N = in.gripper_opening_m < 200e-6 ? 0.5e-3 : 0.0;
+    return (s.tip_m - before).norm();
+  }
+  // Ticks until `step` is entered (or `max_s` of ticks).
+  bool run_to(AssemblyTask& task, Step step, double max_s = 30.0) {
+    for (int i = 0; i < static_cast<int>(max_s * 1e3); ++i) {
+      if (task.step() == step) return true;
+      tick(task);
+    }
+    return task.step() == step;
+  }
+};
+
+AssemblyGoal skip_goal() {
+  AssemblyGoal g;
+  g.part_m = {-1e-3, 0.0};
+  g.target_m = {1e-3, 0.2e-3};
+  return g;
+}
+
+TEST(AssemblyTask, SkipGoesOnToTheNextStepFromWhereTheStageIs) {
+  AssemblyTask task({}, skip_goal());
+  IdealStage stage;
+  for (int i = 0; i < 500; ++i) stage.tick(task);  // 0.5 s into the approach
+  ASSERT_EQ(task.step(), Step::kApproach);
+  const Eigen::Vector3d here = stage.s.tip_m;
+  ASSERT_GT((here - stage.start_m).norm(), 50e-6) << "on its way";
+  task.skip();
+  EXPECT_EQ(task.step(), Step::kDescend);
+  EXPECT_EQ(task.status(), Status::kRunning);
+  // The descent to the grasp height starts from where the stage was left: one tick's travel at
+  // the vertical speed, no jump.
+  const double moved = stage.tick(task);
+  EXPECT_LE(moved, AssemblyTaskParams{}.z_speed_m_s * 1e-3 * 1.001);
+  EXPECT_GT(moved, 0.0);
+  // And it goes on to the grasp from there.
+  EXPECT_TRUE(stage.run_to(task, Step::kGrasp));
+}
+
+TEST(AssemblyTask, APausedTaskSkipsIntoThePausedNextStepAndHolds) {
+  AssemblyTask task({}, skip_goal());
+  IdealStage stage;
+  ASSERT_TRUE(stage.run_to(task, Step::kLift));
+  task.pause();
+  task.skip();
+  EXPECT_EQ(task.step(), Step::kTransport);
+  EXPECT_EQ(task.status(), Status::kPaused);
+  for (int i = 0; i < 200; ++i) EXPECT_EQ(stage.tick(task), 0.0) << "holds while paused";
+  task.resume();
+  EXPECT_EQ(task.status(), Status::kRunning);
+  EXPECT_GT(stage.tick(task), 0.0);
+}
+
+TEST(AssemblyTask, SkipLeavesAWaitingOrManualStepAndTheNextStepsAutonomyApplies) {
+  AssemblyTask task({}, skip_goal());
+  task.set_autonomy(Step::kApproach, Autonomy::kConfirm);
+  task.set_autonomy(Step::kDescend, Autonomy::kManual);
+  task.set_autonomy(Step::kGrasp, Autonomy::kConfirm);
+  IdealStage stage;
+  stage.tick(task);
+  ASSERT_EQ(task.status(), Status::kAwaitingConfirm);
+  task.skip();  // not confirmed: skipped
+  EXPECT_EQ(task.step(), Step::kDescend);
+  EXPECT_EQ(task.status(), Status::kOperator) << "descend is manual";
+  EXPECT_FALSE(task.drives());
+  task.skip();  // the operator says: no descent needed
+  EXPECT_EQ(task.step(), Step::kGrasp);
+  EXPECT_EQ(task.status(), Status::kAwaitingConfirm) << "grasp waits for its confirmation";
+  EXPECT_EQ(stage.tick(task), 0.0);
+}
+
+TEST(AssemblyTask, SkippingIntoTheInsertionStartsAFreshSearchAndSkippingTheLastStepSucceeds) {
+  AssemblyTask task({}, skip_goal());
+  IdealStage stage;
+  ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+  task.skip();
+  EXPECT_EQ(task.step(), Step::kInsert);
+  EXPECT_EQ(task.search_tries(), 0);
+  task.skip();
+  task.skip();
+  EXPECT_EQ(task.step(), Step::kRetract);
+  task.skip();
+  EXPECT_EQ(task.step(), Step::kDone);
+  EXPECT_EQ(task.status(), Status::kSucceeded);
+  task.skip();  // finished: nothing
+  EXPECT_EQ(task.status(), Status::kSucceeded);
+  EXPECT_EQ(stage.tick(task), 0.0) << "a finished task holds";
+}
+
+}  // namespace
+}  // namespace mc::cell

@@ -1,0 +1,287 @@
+// The automatic insertion supervised live (issue #29 point 5, `serve --cell`): pausing stops the
+// commanded motion at the tick that applies it; taking over is bumpless (the deadman and the
+// gripper the console held before are re-taken first) and the task goes on to insert the pin
+// after the hand-back, ending with every axis holding; a task that loses its supervisor pauses;
+// the loop allocates nothing meanwhile.
+#include "microcobot/live/live_platform.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "microcobot/cell/assembly_batch.h"
+#include "microcobot/cell/task_io.h"
+#include "support/counting_allocator.h"
+#include "support/test_support.h"
+
+namespace mc::live {
+namespace {
+
+using namespace std::chrono_literals;
+using cell::AssemblyTask;
+using Status = AssemblyTask::Status;
+using Step = AssemblyTask::Step;
+
+std::size_t task_channel(const char* name) {
+  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
+    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
+  throw std::logic_error(name);
+}
+
+struct TaskSample {
+  double t_s = 0.0;
+  Eigen::Vector3d target, measured;
+  bool engaged = false;
+  double gripper_command_m = 0.0;
+};
+
+// A live platform with the task on one part (as fast as the machine goes), every telemetry sample
+// kept, and a console client in control whose heartbeat (`command`) a thread sends at 50 Hz.
+struct TaskRig {
+  LiveParams params;
+  std::unique_ptr<LivePlatform> live;
+  std::mutex mutex;
+  std::vector<TaskSample> samples;
+  ConsoleCommand command;  // under mutex
+  std::atomic<bool> beating{true}, quit{false};
+  std::thread heart;
+
+  // `paced`: the loop on the wall clock, the console's 0.2 s heartbeat timeout (the test of the
+  // heartbeat's gaps); else as fast as the machine goes, with a 10 s timeout.
+  explicit TaskRig(bool paced = false) {
+    cell::AssemblyBatchParams batch;
+    batch.parts = 1;
+    batch.seed = 41;
+    const cell::AssemblyJob job = cell::assembly_jobs(batch).front();
+    params.paced = paced;
+    // Unpaced, loop time runs faster than the 50 Hz heartbeat's wall clock.
+    if (!paced) params.command_timeout_s = 10.0;
+    params.platform.microworld = "pick-place";
+    params.platform.world = job.world;
+    params.platform.devices.camera.driver = "none";
+    LiveTaskParams tp;
+    tp.goal = cell::assembly_goal(job);
+    params.task = tp;
+    live = std::make_unique<LivePlatform>(params);
+    samples.reserve(200000);
+    const std::size_t tx = task_channel("target_x_m"), mx = task_channel("measured_x_m"),
+                      en = task_channel("engaged"), gc = task_channel("gripper_command_m");
+    live->start([=, this](const platform::TelemetrySample& s, std::size_t) {
+      TaskSample x;
+      x.t_s = s[0];
+      x.target = {s[tx], s[tx + 1], s[tx + 2]};
+      x.measured = {s[mx], s[mx + 1], s[mx + 2]};
+      x.engaged = s[en] > 0.5;
+      x.gripper_command_m = s[gc];
+      std::lock_guard lock(mutex);
+      samples.push_back(x);
+    });
+    live->set_console_in_control(true);
+    heart = std::thread([this] {
+      while (!quit.load()) {
+        if (beating.load()) {
+          ConsoleCommand c;
+          {
+            std::lock_guard lock(mutex);
+            c = command;
+          }
+          live->push_command(c);
+        }
+        std::this_thread::sleep_for(20ms);
+      }
+    });
+    // Supervised from the first tick of the test: a task started unsupervised pauses at once.
+    if (!test::eventually([&] { return live->status().console_fresh; }))
+      throw std::runtime_error("the heartbeat never reached the loop");
+  }
+  // Sets the heartbeat's command and waits until the loop has it (a few heartbeats).
+  void hold_command(const ConsoleCommand& c) {
+    set_command(c);
+    std::this_thread::sleep_for(100ms);
+  }
+  ~TaskRig() {
+    quit.store(true);
+    heart.join();
+    live->stop();
+  }
+  void set_command(const ConsoleCommand& c) {
+    std::lock_guard lock(mutex);
+    command = c;
+  }
+  LiveTaskStatus task() const { return *live->status().task; }
+  bool wait_for(const std::function<bool(const LiveTaskStatus&)>& f, std::chrono::seconds limit = 60s) {
+    return test::eventually([&] { return f(task()); }, limit);
+  }
+  std::vector<TaskSample> copy() {
+    std::lock_guard lock(mutex);
+    return samples;
+  }
+  // Waits until the telemetry holds `duration_s` of loop time after now.
+  bool run_for(double duration_s) {
+    const double t = live->status().t_s + duration_s;
+    return test::eventually([&] {
+      std::lock_guard lock(mutex);
+      return !samples.empty() && samples.back().t_s > t;
+    });
+  }
+};
+
+// The largest change of the commanded position from one 1 ms sample to the next over [from, to).
+double largest_step(const std::vector<TaskSample>& s, std::size_t from, std::size_t to) {
+  double largest = 0.0;
+  for (std::size_t i = from + 1; i < to && i < s.size(); ++i)
+    largest = std::max(largest, (s[i].target - s[i - 1].target).norm());
+  return largest;
+}
+
+TEST(LiveTask, PauseHoldsAtTheTickTakeOverIsBumplessAndTheHandedBackTaskInserts) {
+  TaskRig rig;
+  EXPECT_EQ(rig.task().status_name(), "idle");
+  ASSERT_TRUE(rig.run_for(0.2));
+  EXPECT_EQ(rig.copy().back().engaged, false) << "nothing moves before the start";
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kStart));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.step == Step::kTransport; }));
+  ASSERT_TRUE(rig.run_for(0.3));  // carrying the pin across at the travel speed
+
+  // Pause: the target stops at the tick that applies it and stays; the stage settles onto it.
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kPause));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kPaused; }));
+  ASSERT_TRUE(rig.run_for(0.5));
+  std::vector<TaskSample> s = rig.copy();
+  std::size_t pause = s.size() - 1;
+  while (pause > 0 && !s[pause - 1].engaged) --pause;  // the first sample of the pause
+  ASSERT_GT(pause, 2u);
+  EXPECT_GT((s[pause - 1].target - s[pause - 2].target).norm(), 0.2e-6) << "moving up to the pause";
+  const Eigen::Vector3d held = s[pause].target;
+  for (std::size_t i = pause; i < s.size(); ++i) ASSERT_EQ(s[i].target, held) << "at " << s[i].t_s << " s";
+  EXPECT_LT((s.back().measured - held).norm(), 2e-6) << "the stage holds at the target";
+  const double gripping = s.back().gripper_command_m;
+
+  // Take over while the console holds the deadman and the gripper slider wide open (as a page
+  // would before the hand-over): neither counts until re-taken, so nothing moves, the pin stays.
+  ConsoleCommand c;
+  c.deadman = true;
+  c.velocity_m_s = {50e-6, 0, 0};
+  c.has_gripper = true;
+  c.gripper_opening_m = 600e-6;
+  rig.hold_command(c);
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kTakeOver));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kOperator; }));
+  ASSERT_TRUE(rig.run_for(0.3));
+  s = rig.copy();
+  EXPECT_EQ(s.back().target, held) << "a deadman held through the take-over does not move the stage";
+  EXPECT_EQ(s.back().gripper_command_m, gripping) << "nor does the slider drop the pin";
+  // Released and pressed again, the deadman jogs the stage from where it is, at the jog's speed.
+  c.deadman = false;
+  rig.hold_command(c);
+  const std::size_t jog_from = rig.copy().size();
+  c.deadman = true;
+  c.has_gripper = false;  // the page leaves the slider alone
+  rig.hold_command(c);
+  ASSERT_TRUE(rig.run_for(0.4));
+  c.deadman = false;
+  rig.hold_command(c);
+  s = rig.copy();
+  EXPECT_GT(s.back().target.x() - held.x(), 10e-6) << "the operator moved the stage";
+  EXPECT_LE(largest_step(s, jog_from - 1, s.size()), 50e-6 * 1e-3 * 1.01) << "no step at the take-over";
+  EXPECT_EQ(s.back().gripper_command_m, gripping);
+
+  // Hand back: the transport again from where the operator left the stage, then the rest.
+  const std::size_t back_from = s.size();
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kHandBack));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 120s));
+  const LiveTaskStatus end = rig.task();
+  EXPECT_EQ(end.status, Status::kSucceeded) << end.failure;
+  EXPECT_EQ(end.inserted, 1) << "the pin is in its bore (the simulation's truth)";
+  ASSERT_TRUE(rig.run_for(0.3));
+  s = rig.copy();
+  std::size_t last_drive = s.size() - 1;
+  while (last_drive > back_from && !s[last_drive].engaged) --last_drive;
+  EXPECT_LE(largest_step(s, back_from - 1, last_drive + 1),
+            cell::AssemblyTaskParams{}.travel_speed_m_s * 1e-3 * 1.01)
+      << "no step at the hand-back nor after";
+  EXPECT_FALSE(s.back().engaged) << "ended holding";
+  EXPECT_LT((s.back().measured - s.back().target).norm(), 1e-6);
+}
+
+TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
+  TaskRig rig(/*paced=*/true);
+  rig.live->push_task_action(TaskAction::kStart);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.step == Step::kDescend; }));
+  rig.live->set_console_in_control(false);  // the page released control (or closed)
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kPaused; }));
+  EXPECT_TRUE(rig.task().supervisor_lost);
+  ASSERT_TRUE(rig.run_for(0.3));
+  const auto s = rig.copy();
+  EXPECT_FALSE(s.back().engaged);
+  EXPECT_EQ(s.back().target, s[s.size() - 200].target) << "held";
+  // Back in control, the task stays paused until the operator resumes it.
+  rig.live->set_console_in_control(true);
+  ASSERT_TRUE(rig.run_for(0.2));
+  EXPECT_EQ(rig.task().status, Status::kPaused);
+  rig.live->push_task_action(TaskAction::kResume);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kRunning; }));
+  EXPECT_FALSE(rig.task().supervisor_lost);
+  // The heartbeat stops for a while (a busy browser): paused while it is away, on by itself when
+  // it returns within the gap (1 s after the commands went stale).
+  rig.beating.store(false);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.heartbeat_gap; }));
+  EXPECT_EQ(rig.task().status, Status::kPaused);
+  EXPECT_FALSE(rig.task().supervisor_lost);
+  rig.beating.store(true);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kRunning; }));
+  EXPECT_FALSE(rig.task().heartbeat_gap);
+  EXPECT_FALSE(rig.task().supervisor_lost);
+  // The operator pauses during a gap: it stays paused when the heartbeat returns.
+  rig.beating.store(false);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.heartbeat_gap; }));
+  rig.live->push_task_action(TaskAction::kPause);
+  rig.beating.store(true);
+  ASSERT_TRUE(rig.run_for(0.5));
+  EXPECT_EQ(rig.task().status, Status::kPaused);
+  EXPECT_FALSE(rig.task().heartbeat_gap);
+  EXPECT_FALSE(rig.task().supervisor_lost);
+  rig.live->push_task_action(TaskAction::kResume);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kRunning; }));
+  // Away for longer: the pause latches; the heartbeat's return does not resume it.
+  rig.beating.store(false);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.supervisor_lost; }));
+  EXPECT_FALSE(rig.task().heartbeat_gap);
+  rig.beating.store(true);
+  ASSERT_TRUE(rig.run_for(1.0));
+  EXPECT_EQ(rig.task().status, Status::kPaused);
+
+  rig.live->request(ConsoleAction::kRestart);
+  ASSERT_TRUE(test::eventually([&] { return rig.live->status().restarts == 1; }));
+  EXPECT_EQ(rig.task().status_name(), "idle") << "a new scene, a new cycle";
+  EXPECT_EQ(rig.task().step, Step::kApproach);
+}
+
+TEST(LiveTask, TheLoopAllocatesNothingWhileTheTaskRunsPausesAndIsTakenOver) {
+  TaskRig rig;
+  rig.live->push_task_action(TaskAction::kStart);
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.step == Step::kDescend; }));
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard(rig.live->loop_thread_id());
+    ASSERT_TRUE(rig.run_for(1.0));
+    rig.live->push_task_action(TaskAction::kPause);
+    ASSERT_TRUE(rig.run_for(0.3));
+    rig.live->push_task_action(TaskAction::kResume);
+    rig.live->push_task_action(TaskAction::kTakeOver);
+    ASSERT_TRUE(rig.run_for(0.3));
+    rig.live->push_task_action(TaskAction::kStepDone);
+    rig.live->push_task_action(TaskAction::kSkip);
+    ASSERT_TRUE(rig.run_for(1.0));
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+}
+
+}  // namespace
+}  // namespace mc::live
