@@ -8,6 +8,7 @@
 #include "cell/cell_test_support.h"
 #include "microcobot/cell/cell_run.h"
 #include "microcobot/core/error.h"
+#include "support/counting_allocator.h"
 
 namespace mc::cell {
 namespace person_operator_test {
@@ -67,6 +68,22 @@ TEST(PersonOperator, TheConsoleJoystickDoesTheSameCycle) {
   EXPECT_EQ(r.master, "console");
   EXPECT_EQ(r.clutches, 0);  // a rate control has no workspace to index
   EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+}
+
+// The person, the fixtures and the coupling run on the loop: a whole assisted cycle, no allocation.
+TEST(PersonOperator, ThePersonAndTheFixturesDoNotAllocateOnTheLoop) {
+  CellRunParams params;
+  params.mode = "assisted";
+  CellCycle c(person_job(), params, default_platform());
+  c.platform().loop().run_for(1000);  // warm-up: 0.1 s of base ticks
+  std::size_t allocations = 0;
+  {
+    mc::test::AllocationGuard guard;
+    c.platform().loop().run_for(400000);  // 40 s: every step of the cycle
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_TRUE(c.person()->done()) << "in step " << AssemblyTask::name(c.person()->step());
 }
 
 TEST(PersonOperator, BadParametersAreNamed) {
