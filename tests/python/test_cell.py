@@ -4,6 +4,8 @@ LocalCluster of 2 worker processes on loopback), the serial run itself equal to 
 
 import json
 import pickle
+import threading
+import time
 
 import distributed  # python3-distributed (scripts/install-deps.sh)
 import pytest
@@ -75,6 +77,22 @@ def test_the_mode_is_passed_through_to_the_library():
     for m in cell.modes():
         assert cell.run_params(mode=m)["mode"] == m
     assert cell.run_params({"mode": "manual", "max_cycle_s": 60})["max_cycle_s"] == 60
+
+
+def test_the_gil_is_released_while_a_cycle_simulates():
+    # This thread wakes every millisecond while the cycle runs; a cycle holding the GIL for its
+    # whole run (seconds) would keep it from waking more than once or twice.
+    b = cell.Batch(parts=1, seed=8)
+    out = []
+    t = threading.Thread(target=lambda: out.append(b.run_cycle(0)))
+    t.start()
+    wakes = 0
+    while t.is_alive():
+        time.sleep(0.001)
+        wakes += 1
+    t.join()
+    assert out[0]["success"] and out[0]["wall_s"] > 0.5
+    assert wakes > 100, wakes
 
 
 def test_the_serial_run_is_the_clis(cli, serial):
