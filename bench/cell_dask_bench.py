@@ -2,7 +2,7 @@
 goal >= 1.7x), the same campaign, in the same run.
 
 Workload: SEEDS x PARTS automatic cycles (one Dask task per part, ~2-3 s of wall time each). Each
-cluster (processes=True, threads_per_worker=1, 127.0.0.1, no dashboard) is started before its
+cluster (processes=True, threads_per_worker=1, loopback only, no dashboard) is started before its
 timing and warmed up (every worker imports microcobot); a round times one batch() call on each,
 rounds alternate 1 worker / 2 workers and the best round of each is kept (the machine is shared:
 the best is the least disturbed). The results of every round are checked equal to the first's
@@ -40,8 +40,11 @@ def main():
     load0 = os.getloadavg()
     clusters = {}
     for n in (1, 2):
+        # Every socket on 127.0.0.1, ports picked by the system (tests/python/test_cell.py says why
+        # the HTTP servers need their own addresses).
         cluster = LocalCluster(n_workers=n, processes=True, threads_per_worker=1, host="127.0.0.1",
-                               dashboard_address=None)
+                               dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                               worker_dashboard_address="127.0.0.1:0")
         clusters[n] = (cluster, Client(cluster))
         warm(clusters[n][1])
     best = {1: float("inf"), 2: float("inf")}

@@ -17,6 +17,13 @@ CONFIG = {"parts": 2, "mode": "auto"}
 SEEDS = [5, 6]
 
 
+# Two worker processes of one thread, every socket on 127.0.0.1 at a port the system picks. With the
+# dashboard off (dashboard_address=None) the scheduler's HTTP server (health, metrics) still listens,
+# on port 8787 unless told; the workers' HTTP servers listen on every interface unless told.
+LOOPBACK_CLUSTER = dict(n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+                        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, worker_dashboard_address="127.0.0.1:0")
+
+
 def without_wall(cycles):
     """Every field but wall_s (the wall-clock time a cycle took, the one thing a rerun changes)."""
     return [{k: v for k, v in c.items() if k != "wall_s"} for c in cycles]
@@ -122,11 +129,12 @@ def test_the_local_process_pool_gives_the_serial_results(serial):
 
 
 def test_a_local_cluster_of_two_worker_processes_gives_the_serial_results(serial):
-    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1, host="127.0.0.1",
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+    with distributed.LocalCluster(**LOOPBACK_CLUSTER) as cluster, distributed.Client(cluster) as client:
         with distributed.get_task_stream(client) as ts:
             result = cell.batch(CONFIG, SEEDS, client=client)
         ran = [t for t in ts.data if "_run_part" in t["key"]]
+        addresses = [cluster.scheduler_address, *client.scheduler_info()["workers"]]
+    assert all(a.startswith("tcp://127.0.0.1:") for a in addresses), addresses
     check_campaign(result, serial)
     assert len(ran) == CONFIG["parts"] * len(SEEDS)
     assert len({t["worker"] for t in ran}) == 2, "both workers ran parts"
