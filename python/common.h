@@ -18,6 +18,10 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 
+namespace mc::platform {
+struct PlatformConfig;
+}
+
 namespace mc::py {
 
 namespace py = pybind11;
@@ -80,6 +84,11 @@ inline std::span<const double> span_of(const DoubleArray& a, const std::string& 
 /// Raises ComputationFailed unless every value of `v` is finite (no call returns NaN).
 void require_finite_result(std::span<const double> v, const std::string& what);
 
+/// A platform configuration from None (the defaults), a dict (keys of `microcobot run
+/// --print-config`) or a file: a file goes through load_platform_config (its stickslip_params_file
+/// is relative to it), as `microcobot run --config`. Defined in control_py.cc.
+platform::PlatformConfig config_from(py::handle c);
+
 // The submodules, one function per translation unit.
 void bind_stickslip(py::module_& m);
 void bind_identify(py::module_& m);
@@ -89,6 +98,7 @@ void bind_platform(py::module_& m);
 void bind_haptics(py::module_& m);
 void bind_tweezers(py::module_& m);
 void bind_vision(py::module_& m);
+void bind_cell(py::module_& m);
 
 }  // namespace mc::py
 

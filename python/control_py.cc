@@ -30,19 +30,20 @@
 #include "microcobot/tweezers/transmission.h"
 
 namespace mc::py {
+
+// Shared with cell_py.cc (common.h).
+platform::PlatformConfig config_from(py::handle c) {
+  if (py::isinstance<py::str>(c) || py::hasattr(c, "__fspath__")) {
+    return platform::load_platform_config(
+        py::str(py::module_::import("os").attr("fspath")(c)).cast<std::string>());
+  }
+  return params_from<platform::PlatformConfig>(c);
+}
+
 namespace {
 
 namespace ct = mc::control;
 namespace pf = mc::platform;
-
-/// A configuration from None, a dict, or a file: a file goes through load_platform_config (its
-/// stickslip_params_file is relative to it), as `microcobot run --config`.
-pf::PlatformConfig config_from(py::handle c) {
-  if (py::isinstance<py::str>(c) || py::hasattr(c, "__fspath__")) {
-    return pf::load_platform_config(py::str(py::module_::import("os").attr("fspath")(c)).cast<std::string>());
-  }
-  return params_from<pf::PlatformConfig>(c);
-}
 
 namespace ss = mc::stickslip;
 using namespace pybind11::literals;

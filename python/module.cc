@@ -1,5 +1,5 @@
 // The extension module `microcobot._microcobot`: error translation and the shared conversions;
-// the submodules are bound in stickslip_py.cc, dsp_py.cc and control_py.cc.
+// the submodules are bound in stickslip_py.cc, dsp_py.cc, control_py.cc, vision_py.cc and cell_py.cc.
 
 #include <sstream>
 
@@ -129,4 +129,8 @@ PYBIND11_MODULE(_microcobot, m) {
   auto vs =
       m.def_submodule("vision", "The microscope camera: rendered frames and optics figures (issue #27)");
   mc::py::bind_vision(vs);
+  auto cl = m.def_submodule(
+      "cell",
+      "The assembly cell: batches of pin insertions by mode, their results and summaries (issue #29)");
+  mc::py::bind_cell(cl);
 }

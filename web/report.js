@@ -5,6 +5,7 @@
   "use strict";
   const doc = JSON.parse(document.getElementById("report-data").textContent);
   const root = document.getElementById("report");
+  // The box plots' first colours are also in tests/browser/report_renders.mjs (it counts each box's pixels).
   const palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"];
 
   function el(tag, attrs, text) {
@@ -97,6 +98,80 @@
     new uPlot(opts, data, container);
   }
 
+  // Box plots (figures with "box": each series one group, its Tukey statistics computed by the
+  // library, report/box_plot.h). uPlot has no box series: it draws the axes, grid and scales, and
+  // a draw hook paints each group's box (IQR), median, whiskers (1.5 IQR) and outliers. The
+  // container gets data-boxes (the groups painted, in order) for the browser test.
+  function plotBox(fig, container) {
+    const groups = fig.series;
+    const n = groups.length;
+    let lo = Infinity, hi = -Infinity;
+    for (const g of groups) {
+      lo = Math.min(lo, g.box.low, ...g.box.outliers);
+      hi = Math.max(hi, g.box.high, ...g.box.outliers);
+    }
+    const pad = hi > lo ? 0.08 * (hi - lo) : Math.max(0.1 * Math.abs(hi), 1e-12);
+    const xs = groups.map((g, i) => i + 1);
+    function drawBoxes(u) {
+      const ctx = u.ctx, px = uPlot.pxRatio;
+      const X = v => u.valToPos(v, "x", true), Y = v => u.valToPos(v, "y", true);
+      const half = Math.min(40 * px, 0.3 * (X(2) - X(1)));
+      ctx.save();
+      groups.forEach((g, i) => {
+        const b = g.box, x = X(i + 1), color = palette[i % palette.length];
+        ctx.strokeStyle = color;
+        ctx.lineWidth = 1.5 * px;
+        ctx.beginPath();  // whiskers and their caps
+        for (const [from, to] of [[b.low, b.q1], [b.q3, b.high]]) {
+          ctx.moveTo(x, Y(from));
+          ctx.lineTo(x, Y(to));
+        }
+        for (const v of [b.low, b.high]) {
+          ctx.moveTo(x - half / 2, Y(v));
+          ctx.lineTo(x + half / 2, Y(v));
+        }
+        ctx.stroke();
+        const top = Y(b.q3), height = Math.max(Y(b.q1) - top, 1 * px);
+        ctx.globalAlpha = 0.25;
+        ctx.fillStyle = color;
+        ctx.fillRect(x - half, top, 2 * half, height);
+        ctx.globalAlpha = 1;
+        ctx.strokeRect(x - half, top, 2 * half, height);
+        ctx.lineWidth = 3 * px;
+        ctx.beginPath();
+        ctx.moveTo(x - half, Y(b.median));
+        ctx.lineTo(x + half, Y(b.median));
+        ctx.stroke();
+        ctx.lineWidth = 1.5 * px;
+        for (const v of b.outliers) {
+          ctx.beginPath();
+          ctx.arc(x, Y(v), 3.5 * px, 0, 2 * Math.PI);
+          ctx.stroke();
+        }
+      });
+      ctx.restore();
+      container.setAttribute("data-boxes", JSON.stringify(groups.map(g => g.name)));
+      container.setAttribute("data-drawn", "1");
+    }
+    const opts = {
+      title: fig.title,
+      width: Math.min(1000, root.clientWidth - 20),
+      height: 340,
+      scales: { x: { time: false, range: [0.5, n + 0.5] }, y: { range: [lo - pad, hi + pad] } },
+      axes: [
+        { label: fig.x.label, splits: () => xs, values: () => groups.map(g => g.name + " (n = " + g.box.n + ")"),
+          grid: { show: false } },
+        axisOpts(fig.y, true),
+      ],
+      // The medians as an invisible series: uPlot needs one; the boxes are the hook's.
+      series: [{}, { label: "median", paths: () => null, points: { show: false } }],
+      legend: { show: false },
+      hooks: { draw: [drawBoxes] },
+    };
+    container.setAttribute("data-points", String(groups.reduce((k, g) => k + g.box.n, 0)));
+    new uPlot(opts, [xs, groups.map(g => g.box.median)], container);
+  }
+
   document.title = doc.title;
   root.appendChild(el("h1", {}, doc.title));
   const nav = el("nav");
@@ -130,7 +205,7 @@
       const link = el("a", { href: fig.csv, class: "csv" }, "data: " + fig.csv);
       box.appendChild(link);
       section.appendChild(box);
-      plot(fig, chart);
+      if (fig.box) plotBox(fig, chart); else plot(fig, chart);
     });
     root.appendChild(section);
   });

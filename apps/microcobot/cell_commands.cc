@@ -14,6 +14,7 @@
 #include "microcobot/cell/task_file.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
+#include "microcobot/report/box_plot.h"
 
 namespace {
 
@@ -173,6 +174,42 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
   return rep;
 }
 
+// The modes side by side (issue #29 point 6): box plots of each mode's cycles, one box per mode.
+mc::report::Report modes_report(const std::vector<std::vector<cell::CycleResult>>& by_mode) {
+  using Groups = std::vector<std::pair<std::string, std::vector<double>>>;
+  Groups time, placement, grip, contact;
+  for (const auto& cycles : by_mode) {
+    const std::string mode = cycles.empty() ? std::string() : cycles.front().mode;
+    for (Groups* g : {&time, &placement, &grip, &contact}) g->push_back({mode, {}});
+    for (const auto& c : cycles) {
+      time.back().second.push_back(c.cycle_s);
+      placement.back().second.push_back(1e6 * c.placement_error_m);
+      grip.back().second.push_back(1e3 * c.peak_grip_N);
+      contact.back().second.push_back(1e3 * c.peak_contact_N);
+    }
+  }
+  mc::report::Report rep("modes");
+  rep.section("Modes side by side",
+              "Box plots of each mode's cycles on the same parts: the box spans the quartiles, the thick "
+              "line is the median, the whiskers reach the furthest cycle within 1.5 IQR of the box, "
+              "circles are the cycles beyond.");
+  const auto box = [&](std::string title, std::string caption, mc::report::Axis y, Groups g) {
+    rep.add_figure(
+        mc::report::box_figure(std::move(title), std::move(caption), "Mode", std::move(y), std::move(g)));
+  };
+  box("Cycle time by mode", "Each cycle, from the start to every axis holding (simulated).",
+      {"Cycle time", "s"}, std::move(time));
+  box("Placement error by mode", "The pin's distance from its bore's axis at the end of the cycle.",
+      {"Placement error", "um"}, std::move(placement));
+  box("Peak grip force by mode",
+      "The largest grip force of each cycle (the scene's limit world.grip_force_limit_N: 1 mN by default).",
+      {"Peak grip force", "mN"}, std::move(grip));
+  box("Peak contact force by mode",
+      "The largest contact force of each cycle (world.contact_force_limit_N: 2 mN by default).",
+      {"Peak contact force", "mN"}, std::move(contact));
+  return rep;
+}
+
 void run(const CellOptions& o) {
   const Inputs in = load_inputs(o);
   const auto& scene = in.scene;
@@ -185,7 +222,9 @@ void run(const CellOptions& o) {
   mc::cli::write_result_table(o.common, "cycles.csv", cycles_table(cycles), summary);
   if (o.common.out) {
     mc::write_file_atomic(*o.common.out / "summary.json", summary.dump(2) + "\n");
-    batch_report(cycles, s, scene.seed).write(*o.common.out);
+    mc::report::Report rep = batch_report(cycles, s, scene.seed);
+    rep.append(modes_report({cycles}));
+    rep.write(*o.common.out);
   }
   std::string failures;
   for (const auto& c : cycles)
@@ -237,6 +276,7 @@ void compare(const CellOptions& o) {
   if (o.common.out) {
     mc::write_file_atomic(*o.common.out / "summary.json", summary.dump(2) + "\n");
     mc::report::Report rep("cell compare");
+    rep.append(modes_report(all));
     for (std::size_t i = 0; i < all.size(); ++i)
       rep.append(batch_report(all[i], summaries[i], in.scene.seed));
     rep.write(*o.common.out);

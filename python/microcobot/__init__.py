@@ -13,6 +13,8 @@ Submodules:
     haptics    the dual-stage interface's rendering pipeline (thesis ch. 3), per tick and per block
     tweezers   TéléTweez design calculators (thesis ch. 4, app. A-B)
     vision     the microscope camera: render() a frame as a numpy array, camera_model() its optics
+    cell       the assembly cell: Batch(scene, parts, seed).run(mode), summarize(), and batch(config,
+               seeds, client) for campaigns of many seeds on Dask
 
 Errors: invalid parameters or inputs raise ``ValueError`` with the command line's one-line
 message; a computation that fails (divergence, no convergence) raises
@@ -29,7 +31,10 @@ for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", 
     _sys.modules[__name__ + "." + _name] = globals()[_name]
 del _name
 
+from . import cell  # noqa: E402  (pure Python over _microcobot.cell: the Dask campaigns)
+
 __all__ = [
-    "ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers", "vision"
+    "ComputationFailed", "__version__", "cell", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers",
+    "vision"
 ]
 ComputationFailed.__module__ = __name__

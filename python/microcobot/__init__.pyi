@@ -1,3 +1,4 @@
+from . import cell as cell
 from . import control as control
 from . import dsp as dsp
 from . import haptics as haptics
@@ -12,5 +13,5 @@ __version__: str
 class ComputationFailed(RuntimeError):
     """A computation could not produce a valid result (divergence, no convergence): CLI exit 4."""
 
-__all__ = ["ComputationFailed", "__version__", "control", "dsp", "haptics", "identify", "platform", "stickslip",
+__all__ = ["ComputationFailed", "__version__", "cell", "control", "dsp", "haptics", "identify", "platform", "stickslip",
            "tweezers", "vision"]

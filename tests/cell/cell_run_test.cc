@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "cell/cell_test_support.h"
+#include "microcobot/core/error.h"
 
 namespace mc::cell {
 namespace {
@@ -64,6 +65,45 @@ TEST(CellRun, TheSummaryHasQuartilesAndAWilsonInterval) {
   // Wilson 95 % for 8/10: scipy.stats.binomtest(8, 10).proportion_ci(method="wilson").
   EXPECT_NEAR(s.success_low, 0.4902, 1e-4);
   EXPECT_NEAR(s.success_high, 0.9433, 1e-4);
+}
+
+TEST(CellRun, ACycleResultComesBackFromItsJsonWholeOrIsRefusedNamingTheKey) {
+  CycleResult c;
+  c.index = 3;
+  c.mode = "manual";
+  c.success = true;
+  c.verdict = "inserted and released";
+  c.cycle_s = 41.5;
+  c.placement_error_m = 0.9e-6;
+  c.peak_grip_N = 0.6e-3;
+  c.mean_grip_N = 0.5e-3;
+  c.peak_contact_N = 0.2e-3;
+  c.grip_violations = 1;
+  c.contact_violations = 2;
+  c.clutches = 4;
+  c.search_tries = 5;
+  c.path_m = 7.8e-3;
+  c.side_m = 200e-6;
+  c.clearance_m = 6e-6;
+  c.wall_s = 4.2;
+  c.ended_holding = true;
+  EXPECT_EQ(CycleResult::from_json(c.to_json()).to_json(), c.to_json());
+  nlohmann::json j = c.to_json();
+  j.erase("cycle_s");
+  EXPECT_THROW(
+      {
+        try {
+          CycleResult::from_json(j);
+        } catch (const InvalidInput& e) {
+          EXPECT_STREQ(e.what(), "cycle result: missing 'cycle_s'");
+          throw;
+        }
+      },
+      InvalidInput);
+  j = c.to_json();
+  j["success"] = "yes";
+  EXPECT_THROW(CycleResult::from_json(j), InvalidInput);
+  EXPECT_THROW(CycleResult::from_json(nlohmann::json::array()), InvalidInput);
 }
 
 }  // namespace

@@ -46,6 +46,14 @@ TEST(CellCli, CompareRunsTheModesOnTheSamePartsWithTheirRatios) {
   EXPECT_EQ(j["ratios"]["manual/manual"]["cycle_median"].get<double>(), 1.0);
   for (const char* f : {"cycles-auto.csv", "cycles-manual.csv", "summary.json", "index.html"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  // The page opens with the modes' box plots (issue #29 point 6), one box (series) per mode, the
+  // cycles' own values behind them.
+  const CsvTable box = read_csv(dir / "fig-01-cycle-time-by-mode.csv");
+  EXPECT_EQ(box.column("series"), (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(box.column("cycle_time_s"), (std::vector<double>{robot, person}));
+  for (const char* title :
+       {"Placement error by mode", "Peak grip force by mode", "Peak contact force by mode"})
+    EXPECT_THAT(test::read_text(dir / "index.html"), HasSubstr(title));
   EXPECT_EQ(run_cli({"cell", "compare", "--modes", "auto,psychic"}).exit_code, 2);
 }
 

@@ -15,8 +15,11 @@ std::vector<std::string> cell_modes() { return {"auto", "manual", "assisted", "s
 
 void CellRunParams::validate() const {
   const auto modes = cell_modes();
-  require(std::find(modes.begin(), modes.end(), mode) != modes.end(), "mode",
-          "must be auto, manual, assisted or scripted, got '" + mode + "'");
+  if (std::find(modes.begin(), modes.end(), mode) == modes.end()) {
+    std::string names;
+    for (const auto& m : modes) names += (names.empty() ? "" : ", ") + m;
+    throw InvalidParams("mode", "must be one of " + names + " (got '" + mode + "')");
+  }
   require(std::isfinite(max_cycle_s) && max_cycle_s >= 1.0 && max_cycle_s <= 3600.0, "max_cycle_s",
           "must be within [1, 3600] s", max_cycle_s);
   task.validate();
@@ -53,6 +56,45 @@ nlohmann::json CycleResult::to_json() const {
           {"clearance_m", clearance_m},
           {"wall_s", wall_s},
           {"ended_holding", ended_holding}};
+}
+
+CycleResult CycleResult::from_json(const nlohmann::json& j) {
+  if (!j.is_object())
+    throw InvalidInput("cycle result: expected an object (got " + std::string(j.type_name()) + ")");
+  CycleResult r;
+  // Every key to_json() writes, with its type: a result from elsewhere is read whole or refused.
+  const auto get = [&j](const char* key, auto& field) {
+    const auto it = j.find(key);
+    if (it == j.end()) throw InvalidInput(std::string("cycle result: missing '") + key + "'");
+    try {
+      it->get_to(field);
+    } catch (const nlohmann::json::exception&) {
+      throw InvalidInput(std::string("cycle result: '") + key + "' has the wrong type (" + it->type_name() +
+                         ")");
+    }
+  };
+  get("index", r.index);
+  get("mode", r.mode);
+  get("master", r.master);
+  get("success", r.success);
+  get("verdict", r.verdict);
+  get("cycle_s", r.cycle_s);
+  get("placement_error_m", r.placement_error_m);
+  get("peak_grip_N", r.peak_grip_N);
+  get("mean_grip_N", r.mean_grip_N);
+  get("peak_contact_N", r.peak_contact_N);
+  get("grip_violations", r.grip_violations);
+  get("contact_violations", r.contact_violations);
+  get("clutches", r.clutches);
+  get("search_tries", r.search_tries);
+  get("submovements", r.submovements);
+  get("confirmations", r.confirmations);
+  get("path_m", r.path_m);
+  get("side_m", r.side_m);
+  get("clearance_m", r.clearance_m);
+  get("wall_s", r.wall_s);
+  get("ended_holding", r.ended_holding);
+  return r;
 }
 
 nlohmann::json BatchSummary::to_json() const {

@@ -96,6 +96,10 @@ struct CycleResult {
   double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
   bool ended_holding = false;  ///< every axis' target at its measured position, the coupling off
   nlohmann::json to_json() const;
+  /// Back from to_json()'s object (results gathered from other processes, e.g. the Python
+  /// module's Dask campaigns, then summarized). Throws mc::InvalidInput naming a missing or
+  /// mistyped key.
+  static CycleResult from_json(const nlohmann::json& j);
 };
 
 /// Median, quartiles and the success rate with its 95 % Wilson interval.

@@ -8,6 +8,7 @@
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/report/assets.h"
+#include "microcobot/report/box_plot.h"
 
 namespace mc::report {
 
@@ -102,6 +103,7 @@ std::string slug(const std::string& title) {
 void validate_figure(const Figure& f) {
   const std::string where = "figure '" + f.title + "'";
   require(!f.series.empty(), where, "has no series");
+  require(!f.box || (!f.x.log && !f.y.log), where, "is a box plot: its axes are linear");
   for (const auto& s : f.series) {
     const std::string w = where + " series '" + s.name + "'";
     require(!s.x.empty(), w, "is empty");
@@ -195,7 +197,18 @@ std::string Report::html(const std::string& data_prefix) const {
         std::vector<double> x, y;
         reduce_for_plot(s, x, y);
         jf["series"].push_back({{"name", s.name}, {"x", x}, {"y", y}, {"points", s.points}});
+        if (f.box) {
+          const BoxStats b = box_stats(s.y);  // every sample, not the reduced ones
+          jf["series"].back()["box"] = {{"n", b.n},
+                                        {"q1", b.q1},
+                                        {"median", b.median},
+                                        {"q3", b.q3},
+                                        {"low", b.whisker_low},
+                                        {"high", b.whisker_high},
+                                        {"outliers", b.outliers}};
+        }
       }
+      jf["box"] = f.box;
       js["figures"].push_back(std::move(jf));
     }
     doc["sections"].push_back(std::move(js));

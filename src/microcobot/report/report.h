@@ -39,6 +39,9 @@ struct Figure {
   Axis x;
   Axis y;
   std::vector<Series> series;
+  /// A box plot (box_plot.h, box_figure()): each series is one group of samples (y), drawn as
+  /// one box at x = its position; the page gets each box's statistics from BoxStats.
+  bool box = false;
 };
 
 /// A result row shown in the section's table: name, value and unit, or a text (e.g. "yes").

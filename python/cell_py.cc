@@ -1,0 +1,224 @@
+// `microcobot.cell` (issue #29 points 6-7): the assembly cell's batches made from a scene and run
+// by mode, each cycle's result as a dict (CycleResult::to_json) and the summary of a list of them
+// (summarize). The campaign over many seeds with Dask is pure Python over these calls
+// (microcobot/cell.py).
+//
+// A translation unit of its own: the cell pulls in the platform's headers, and a change to the cell
+// then recompiles this file alone rather than the control/platform bindings beside it (pybind11
+// compiles slowly; one more TU costs one more parse of its headers, ~15 s, once).
+
+#include <climits>
+#include <optional>
+
+#include "common.h"
+#include "microcobot/cell/assembly_batch.h"
+#include "microcobot/cell/cell_run.h"
+#include "microcobot/platform/platform_config.h"
+
+namespace mc::py {
+namespace {
+
+namespace cl = mc::cell;
+using namespace pybind11::literals;
+
+std::string type_name(py::handle v) { return py::str(py::type::of(v).attr("__name__")).cast<std::string>(); }
+
+/// What the user gave, for messages: its type and repr (cut to keep the message one line).
+std::string given(py::handle v) {
+  std::string r = py::repr(v).cast<std::string>();
+  if (r.size() > 60) r = r.substr(0, 57) + "...";
+  return type_name(v) + " " + r;
+}
+
+/// None, or a Python int (a bool is refused) that fits an int. pybind11's own conversion error
+/// lists every signature on several lines: the arguments are checked here, one line each.
+std::optional<int> optional_int(py::handle v, const std::string& name) {
+  if (v.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(v) || !py::isinstance<py::int_>(v))
+    throw py::type_error(name + ": expected an int (got " + given(v) + ")");
+  int overflow = 0;
+  const long long x = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+  if (overflow != 0 || x < INT_MIN || x > INT_MAX)
+    throw InvalidInput(name + ": " + py::repr(v).cast<std::string>() + " is out of range");
+  return static_cast<int>(x);
+}
+
+/// Parameters of type P from `arg` (params_from), a dict's errors named after the argument: "scene:
+/// unknown key 'x'" rather than the generic "<dict>: ...".
+template <class P>
+P named_params(py::handle arg, const std::string& name) {
+  try {
+    return params_from<P>(arg);
+  } catch (const InvalidInput& e) {
+    std::string what = e.what();
+    if (what.rfind("<dict>", 0) == 0) throw InvalidInput(name + what.substr(6));
+    throw;
+  }
+}
+
+/// The run's parameters: `params` (None, dict or YAML file, as --params) with `mode` over them (a
+/// str passed through as it is: the library knows the modes, so a new one needs no change here).
+cl::CellRunParams run_params_from(py::handle params, py::handle mode) {
+  cl::CellRunParams p = named_params<cl::CellRunParams>(params, "params");
+  if (!mode.is_none()) {
+    if (!py::isinstance<py::str>(mode))
+      throw py::type_error("mode: expected a str (got " + given(mode) + ")");
+    p.mode = mode.cast<std::string>();
+  }
+  p.validate();
+  return p;
+}
+
+/// A Python value (dict, list, str, bool, int, float, None) as JSON.
+nlohmann::json to_json_value(py::handle v, const std::string& where) {
+  if (v.is_none()) return nullptr;
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+  if (py::isinstance<py::int_>(v)) return v.cast<long long>();
+  if (py::isinstance<py::float_>(v)) return v.cast<double>();
+  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  if (py::isinstance<py::dict>(v)) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [k, x] : v.cast<py::dict>()) {
+      const std::string key = py::str(k).cast<std::string>();
+      j[key] = to_json_value(x, where + "." + key);
+    }
+    return j;
+  }
+  if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& x : v) j.push_back(to_json_value(x, where));
+    return j;
+  }
+  if (py::hasattr(v, "item")) return to_json_value(v.attr("item")(), where);  // numpy scalars
+  throw InvalidInput(where + ": unsupported value " + given(v));
+}
+
+/// One batch: the scene's parameters and the parts they give (assembly_jobs), made once.
+struct Batch {
+  cl::AssemblyBatchParams scene;
+  std::vector<cl::AssemblyJob> jobs;
+
+  Batch(py::handle scene_arg, py::handle parts, py::handle seed) {
+    scene = named_params<cl::AssemblyBatchParams>(scene_arg, "scene");
+    if (const auto n = optional_int(parts, "parts")) scene.parts = *n;
+    if (const auto s = optional_int(seed, "seed")) scene.seed = *s;
+    jobs = cl::assembly_jobs(scene);  // validates
+  }
+
+  const cl::AssemblyJob& job(py::handle index) const {
+    const auto i = optional_int(index, "index");
+    if (!i) throw py::type_error("index: expected an int (got None)");
+    if (*i < 0 || *i >= static_cast<int>(jobs.size()))
+      throw InvalidInput("index: " + std::to_string(*i) + " is not a part of this batch of " +
+                         std::to_string(jobs.size()) + " (0-" + std::to_string(jobs.size() - 1) + ")");
+    return jobs[static_cast<std::size_t>(*i)];
+  }
+};
+
+py::dict job_dict(const cl::AssemblyJob& j) {
+  return py::dict("index"_a = j.index, "side_m"_a = j.side_m, "clearance_m"_a = j.clearance_m,
+                  "nominal_part_m"_a = py::make_tuple(j.nominal_part_m.x(), j.nominal_part_m.y()),
+                  "target_m"_a = py::make_tuple(j.target_m.x(), j.target_m.y()));
+}
+
+}  // namespace
+
+void bind_cell(py::module_& m) {
+  m.def("modes", &cl::cell_modes, "The modes a batch runs in (the library's list: auto, manual, ...).");
+  m.def(
+      "params",
+      [] {
+        return py::dict("scene"_a = params_dict(cl::AssemblyBatchParams{}),
+                        "run"_a = params_dict(cl::CellRunParams{}));
+      },
+      "The default scene and run parameters, as `microcobot cell params --json`:\n"
+      "{'scene': AssemblyBatchParams keys, 'run': CellRunParams keys}.");
+  m.def(
+      "run_params",
+      [](py::handle params, py::handle mode) { return params_dict(run_params_from(params, mode)); },
+      "params"_a = py::none(), "mode"_a = py::none(),
+      "The complete, validated run parameters: `params` (None, a dict of overrides or a YAML file, as\n"
+      "`cell run --params`) with `mode` over them. ValueError names a bad key or mode.");
+  m.def(
+      "summarize",
+      [](const py::list& cycles) {
+        if (cycles.empty()) throw InvalidInput("cycles: an empty list (summarize needs at least one cycle)");
+        std::vector<cl::CycleResult> results;
+        for (std::size_t i = 0; i < cycles.size(); ++i) {
+          const std::string where = "cycles[" + std::to_string(i) + "]";
+          if (!py::isinstance<py::dict>(cycles[i]))
+            throw py::type_error(where + ": expected a dict (got " + given(cycles[i]) + ")");
+          try {
+            results.push_back(cl::CycleResult::from_json(to_json_value(cycles[i], where)));
+          } catch (const InvalidInput& e) {
+            throw InvalidInput(where + ": " + e.what());
+          }
+        }
+        return from_json(cl::summarize(results).to_json());
+      },
+      "cycles"_a,
+      "The summary of cycle results (dicts as run() returns them), as `microcobot cell run --json`:\n"
+      "cycles, successes, success rate with its 95 % Wilson interval, cycle time median and IQR,\n"
+      "placement median, peak forces, ticks over a force limit, simulated and wall time.");
+
+  py::class_<Batch>(
+      m, "Batch",
+      "A batch of pin insertions (`microcobot cell run --scene --batch --seed`): the parts a\n"
+      "seeded scene gives, each run on a fresh simulated platform. The same scene and seed give\n"
+      "the same parts and the same results.")
+      .def(py::init<py::handle, py::handle, py::handle>(), "scene"_a = py::none(), "parts"_a = py::none(),
+           "seed"_a = py::none(),
+           "scene: None (the defaults), a dict of AssemblyBatchParams keys or a YAML file (as --scene);\n"
+           "parts (as --batch) and seed (as --seed) over it. ValueError names a bad key or value.")
+      .def("__len__", [](const Batch& b) { return b.jobs.size(); })
+      .def_property_readonly(
+          "scene", [](const Batch& b) { return params_dict(b.scene); },
+          "The complete scene parameters (a dict that Batch(scene=...) takes back).")
+      .def_property_readonly(
+          "jobs",
+          [](const Batch& b) {
+            py::list l;
+            for (const auto& j : b.jobs) l.append(job_dict(j));
+            return l;
+          },
+          "Each part as the cell is told it: index, side_m, clearance_m, nominal_part_m, target_m.")
+      .def(
+          "run_cycle",
+          [](const Batch& b, py::handle index, py::handle mode, py::handle params, py::handle config) {
+            const cl::AssemblyJob& job = b.job(index);
+            const cl::CellRunParams p = run_params_from(params, mode);
+            platform::PlatformConfig c = config_from(config);
+            const cl::CycleResult r = nogil([&] { return cl::run_cycle(job, p, std::move(c)); });
+            return from_json(r.to_json());
+          },
+          "index"_a, "mode"_a = py::none(), "params"_a = py::none(), "config"_a = py::none(),
+          "Runs part `index` to its end in `mode` (a str: 'auto', 'manual', ... as modes() lists; None:\n"
+          "the params' mode), with `params` (run parameters, as run_params) on the platform `config`\n"
+          "(None, dict or YAML file, as --config). Returns its result dict (CycleResult). The GIL is\n"
+          "released while it simulates.")
+      .def(
+          "run",
+          [](const Batch& b, py::handle mode, py::handle params, py::handle config, py::handle indices) {
+            const cl::CellRunParams p = run_params_from(params, mode);
+            const platform::PlatformConfig c = config_from(config);
+            std::vector<cl::AssemblyJob> jobs;
+            if (indices.is_none()) {
+              jobs = b.jobs;
+            } else {
+              if (!py::isinstance<py::sequence>(indices) || py::isinstance<py::str>(indices))
+                throw py::type_error("indices: expected a list of ints (got " + given(indices) + ")");
+              for (const auto& i : indices) jobs.push_back(b.job(i));
+            }
+            const auto results = nogil([&] { return cl::run_batch(jobs, p, c); });
+            py::list out;
+            for (const auto& r : results) out.append(from_json(r.to_json()));
+            return out;
+          },
+          "mode"_a = py::none(), "params"_a = py::none(), "config"_a = py::none(), "indices"_a = py::none(),
+          "Runs every part in order (or the parts `indices`) as run_cycle does; a list of result dicts,\n"
+          "the cycles of `microcobot cell run --json` ('cycles_detail'). The GIL is released.")
+      .def(py::pickle([](const Batch& b) { return params_dict(b.scene); },
+                      [](const py::dict& scene) { return Batch(scene, py::none(), py::none()); }));
+}
+
+}  // namespace mc::py
