@@ -197,6 +197,9 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     // in ten) threw the stick-slip tracking controller into a limit cycle of millimetres.
     const Eigen::Vector2d v_tick = (out_.slave_target_m.head<2>() - last_xy_m_) / dt_;
     velocity_ff_ += velocity_alpha_ * (v_tick - velocity_ff_);
+    // A still target is still: the filter's tail would otherwise keep the stage's controller
+    // in its moving mode (its lead, no in-position hold) for ever.
+    if (v_tick.isZero(0.0) && velocity_ff_.norm() < 1e-7) velocity_ff_.setZero();
     out_.slave_velocity_m_s.head<2>() = velocity_ff_;
     const double jog =
         std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;
