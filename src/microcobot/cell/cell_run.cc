@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "microcobot/cell/task_io.h"
@@ -119,7 +120,7 @@ struct CellCycle::Meter {
   double peak_grip = 0.0, grip_sum = 0.0, peak_contact = 0.0, path = 0.0;
   long gripped_ticks = 0;
   int grip_over = 0, contact_over = 0;
-  Eigen::Vector3d last_tip = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d last_tip = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 
   void sample(const TaskSensors& s) {
     const double contact = s.contact_N.norm();
@@ -333,7 +334,7 @@ namespace {
 
 // The q-quantile of sorted values, linearly interpolated (type 7, numpy's default).
 double quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return NAN;
+  if (sorted.empty()) return std::numeric_limits<double>::quiet_NaN();
   const double pos = q * static_cast<double>(sorted.size() - 1);
   const auto lo = static_cast<std::size_t>(std::floor(pos));
   const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
