@@ -3,6 +3,8 @@
 // is never entered under tremor, the person lets go at the end.
 #include "microcobot/cell/person_operator.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "cell/cell_test_support.h"
@@ -68,6 +70,31 @@ TEST(PersonOperator, TheConsoleJoystickDoesTheSameCycle) {
   EXPECT_EQ(r.master, "console");
   EXPECT_EQ(r.clutches, 0);  // a rate control has no workspace to index
   EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+}
+
+// The person aims the tips a press below the height where the pin would bottom, judged by eye
+// (z_tolerance_m: the depth of field). When the pin was taken a little high in the fingers, the
+// hand arrives within that tolerance with the pin a micrometre short of the bore's floor: no
+// contact to feel, and nothing left to aim at. The person sees the pin go no lower, well into its
+// bore, and lets go (part 9 of seed 4111, where the person used to wait until the step's timeout).
+TEST(PersonOperator, APinThatStopsShortOfTheFloorUnfeltIsReleased) {
+  AssemblyBatchParams batch;
+  batch.parts = 10;
+  batch.seed = 4111;
+  CellRunParams params;
+  params.mode = "manual";
+  CellCycle c(assembly_jobs(batch).at(9), params, default_platform());
+  double felt_in_insert = 0.0;
+  c.set_observer([&](double) {
+    if (c.person()->step() == AssemblyTask::Step::kInsert)
+      felt_in_insert = std::max(felt_in_insert, c.platform().gripper().contact_force_N().z);
+  });
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_LT(felt_in_insert, params.person.person.feel_contact_N) << "the case this test is about: no floor felt";
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_LT(r.cycle_s, 60.0);
+  EXPECT_TRUE(r.ended_holding);
 }
 
 // The person, the fixtures and the coupling run on the loop: a whole assisted cycle, no allocation.

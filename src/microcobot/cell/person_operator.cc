@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "microcobot/core/error.h"
 
@@ -29,6 +30,7 @@ void PersonOperatorParams::validate() const {
   require_positive(slider_m_s, "slider_m_s");
   require_positive(grip_seen_N, "grip_seen_N");
   require_positive(joystick_travel_m, "joystick_travel_m");
+  require_positive(stalled_s, "stalled_s");
   require_positive(step_timeout_s, "step_timeout_s");
   require(max_jams >= 1, "max_jams", "must be at least 1", max_jams);
 }
@@ -82,6 +84,8 @@ void PersonOperator::enter(Step s, double t) noexcept {
   step_t0_ = t;
   rising_ = false;
   held_since_ = -1.0;
+  lowest_z_ = std::numeric_limits<double>::infinity();
+  lowest_t_ = t;
 }
 
 void PersonOperator::give_up(const char* why) noexcept {
@@ -281,11 +285,19 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
         }
         z_.reset({tip.z(), 0.0}, t);
         rising_ = true;
+        lowest_z_ = std::numeric_limits<double>::infinity();
         break;
       }
-      // Down onto the bore's floor: aimed a press below it, done when the floor is felt there.
+      // Down onto the bore's floor: aimed a press below it, done when the floor is felt there,
+      // or when the pin, well into its bore, is seen going no lower.
       climb(inserted_z_ - p_.press_m, tip.z(), p_.z_tolerance_m, t);
-      if (touching && tip.z() <= inserted_z_ + p_.jam_margin_m) enter(Step::kRelease, t);
+      if (tip.z() < lowest_z_ - p_.still_m) {
+        lowest_z_ = tip.z();
+        lowest_t_ = t;
+      }
+      const bool in_bore = tip.z() < rim_z_ - 0.5 * goal_.hole_depth_m;
+      if ((touching && tip.z() <= inserted_z_ + p_.jam_margin_m) || (in_bore && t - lowest_t_ > p_.stalled_s))
+        enter(Step::kRelease, t);
       break;
     }
     case Step::kRelease:

@@ -61,6 +61,10 @@ struct PersonOperatorParams {
   double slider_m_s = 600e-6;           ///< console gripper slider speed (opening units)
   double grip_seen_N = 0.25e-3;         ///< console: a grip force read as held
   double joystick_travel_m = 15e-3;     ///< console: the joystick's half travel (tremor scale)
+  /// Inserting: the pin seen no lower for this long, well into its bore (half its depth): it is
+  /// at the bottom, felt or not. The hand may arrive at its aimed height (within z_tolerance_m)
+  /// with the pin a micrometre short of the floor, no contact to feel (seed 4111, part 9).
+  double stalled_s = 1.0;
   double step_timeout_s = 60.0;         ///< a step not done by then: the person gives up
   int max_jams = 12;                    ///< rim contacts before the person gives up
 
@@ -85,6 +89,7 @@ struct PersonOperatorParams {
     v("slider_m_s", slider_m_s);
     v("grip_seen_N", grip_seen_N);
     v("joystick_travel_m", joystick_travel_m);
+    v("stalled_s", stalled_s);
     v("step_timeout_s", step_timeout_s);
     v("max_jams", max_jams);
   }
@@ -154,6 +159,8 @@ class PersonOperator {
   bool clutching_ = false;
   int clutches_ = 0, jams_ = 0;
   bool rising_ = false;       // insert: backing off the rim
+  double lowest_z_ = 0.0;     // insert: the lowest tip height seen ...
+  double lowest_t_ = 0.0;     // ... and since when
   double pinch_ = 0.0;        // TéléTweez lever closing [m]
   double slider_ = 0.0;       // console gripper opening [m]
   double held_since_ = -1.0;  // grip first felt (the person stops closing a reaction later)
