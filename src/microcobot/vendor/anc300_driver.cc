@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "microcobot/control/step_map.h"
 #include "microcobot/core/error.h"
@@ -34,6 +35,9 @@ void Anc300DriverParams::validate() const {
           "devices.connection option frequency_Hz", "must be within [1, 10000] Hz", frequency_Hz);
   require(std::isfinite(max_run_s) && max_run_s >= 1.0 / frequency_Hz && max_run_s <= 1.0,
           "devices.connection option max_run_s", "must be within [1/frequency_Hz, 1] s", max_run_s);
+  require(std::isfinite(deadband_m) && deadband_m >= 0 && deadband_m < 1e-4,
+          "devices.connection option deadband_nm", "must be within [0, 100000) nm (0: half a step)",
+          deadband_m * 1e9);
   require(std::isfinite(step_up_m) && step_up_m > 0 && step_up_m < 1e-5, "step_up_nm",
           "must be within (0, 10000) nm (or left to the model)", step_up_m * 1e9);
   require(std::isfinite(step_down_m) && step_down_m > 0 && step_down_m < 1e-5, "step_down_nm",
@@ -43,7 +47,7 @@ void Anc300DriverParams::validate() const {
 Anc300DriverParams anc300_driver_params(const Connection& c) {
   check_connection_options(c,
                            "timeout_s, connect_timeout_s, poll_s, stale_s, password, axes, voltage_V, "
-                           "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm");
+                           "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm, deadband_nm");
   Anc300DriverParams p;
   p.timing.reply_timeout_s = connection_number(c, "timeout_s", p.timing.reply_timeout_s, 0.001, 10.0);
   p.timing.connect_timeout_s =
@@ -55,6 +59,7 @@ Anc300DriverParams anc300_driver_params(const Connection& c) {
   p.max_run_s = connection_number(c, "max_run_s", p.max_run_s, 1e-4, 1.0);
   p.step_up_m = 1e-9 * connection_number(c, "step_up_nm", 0.0, 1e-3, 1e4);
   p.step_down_m = 1e-9 * connection_number(c, "step_down_nm", 0.0, 1e-3, 1e4);
+  p.deadband_m = 1e-9 * connection_number(c, "deadband_nm", 0.0, 0.0, 1e5);
   if (const auto it = c.options.find("password"); it != c.options.end()) p.password = it->second;
   if (const auto it = c.options.find("position"); it != c.options.end()) {
     if (it->second != "counted" && it->second != "getpos")
@@ -172,7 +177,9 @@ void Anc300Controller::cycle(LineClient& bus) {
     }
     const double e = t.m[i] - est_m_[i];
     const double s = e >= 0.0 ? params_.step_up_m : params_.step_down_m;
-    const long long n = std::llround(std::abs(e) / s);  // 0 within half a step: the dead band
+    const double band = params_.deadband_m > 0.0 ? params_.deadband_m : 0.5 * s;
+    if (std::abs(e) <= band) continue;
+    const long long n = std::max(1LL, std::llround(std::abs(e) / s));
     if (n > std::abs(best_n)) {
       best = static_cast<int>(i);
       best_n = e >= 0.0 ? n : -n;
@@ -222,6 +229,8 @@ platform::PlatformDevices make_anc300_devices(const platform::PlatformConfig& co
       p.step_down_m = std::abs(
           control::measure_step(model, v, p.frequency_Hz, stickslip::Direction::kBackward, 3, 6).step_m);
   }
+  spdlog::info("anc300 driver: {:.1f} nm up, {:.1f} nm down per period at {:g} V, {:g} Hz", 1e9 * p.step_up_m,
+               1e9 * p.step_down_m, p.voltage_V, p.frequency_Hz);
   auto controller = std::make_shared<Anc300Controller>(c, p);  // validates (a model step of 0 is refused)
   platform::PlatformDevices d = make_sim_companions(config);
   const char* names[3] = {"anc300_axis_x", "anc300_axis_y", "anc300_axis_z"};

@@ -6,8 +6,9 @@
 /// (`setf`) and knows nothing of where the slider is. So the driver closes the platform's
 /// position loop itself, in its bus thread, at the step level (docs/hardware.md, "anc300"):
 ///
-///   error e = target - position; n = round(|e| / s) periods (s: the step of one period at the
-///   set amplitude and frequency, up or down), none while |e| < s/2 (the dead band: half a step),
+///   error e = target - position; n = max(1, round(|e| / s)) periods (s: the step of one period at
+///   the set amplitude and frequency, up or down), none while |e| is within the dead band (half a
+///   step unless given: option deadband_nm),
 ///   at most frequency * max_run_s per command so that a moving target is followed; one axis per
 ///   cycle, the one furthest from its target (in steps): `stepu|stepd AXIS n`, then `stepw AXIS`
 ///   (answers once the run is over)
@@ -44,11 +45,15 @@ struct Anc300DriverParams {
   double max_run_s = 0.02;                    ///< the longest run of one command
   bool sensor = false;                        ///< position=getpos (the twin's sensor) instead of counted
   double step_up_m = 0.0, step_down_m = 0.0;  ///< s per period; 0: from the model
+  /// No step while |e| is below it; 0: half a step (the count's own resolution). A controller whose
+  /// runs start with a slip of their own (the twin: docs/hardware.md) needs it wider than that slip.
+  double deadband_m = 0.0;
   void validate() const;
 };
 
 /// `connection` options: timeout_s, connect_timeout_s, poll_s, stale_s, password, axes ("1+2+3"),
-/// voltage_V, frequency_Hz, max_run_s, position (counted|getpos), step_up_nm, step_down_nm.
+/// voltage_V, frequency_Hz, max_run_s, position (counted|getpos), step_up_nm, step_down_nm,
+/// deadband_nm.
 Anc300DriverParams anc300_driver_params(const Connection& connection);
 
 class Anc300Controller final : public BusController {
