@@ -19,6 +19,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/platform/driver_registry.h"
+#include "microcobot/vendor/anc300_codec.h"
 #include "microcobot/vendor/anc300_driver.h"
 #include "microcobot/vendor/gcs2_codec.h"
 #include "microcobot/vendor/gcs2_driver.h"
@@ -137,6 +138,56 @@ double run_paced(Platform& p, double s, Done done) {
 }
 double run_paced(Platform& p, double s) {
   return run_paced(p, s, [] { return false; });
+}
+
+TEST(VendorDriverCodec, TheClientSideParsesRepliesAndRefusesWhatIsNotOne) {
+  // GCS: a reply ends at the first LF not preceded by a space; what follows stays for the next.
+  EXPECT_EQ(gcs2::reply_end("1=0.5 \n2=1\n3=2\n"), 11u);
+  EXPECT_EQ(gcs2::reply_end("1=0.5 \n2=1"), 0u);
+  EXPECT_EQ(gcs2::reply_lines("0 1 1=0.5 \n0 1 2=1\n"), (std::vector<std::string>{"1=0.5", "2=1"}));
+  EXPECT_EQ(gcs2::parse_error_reply("7\n"), 7);
+  EXPECT_EQ(gcs2::parse_error_reply("0 1 10\n"), 10);
+  EXPECT_FALSE(gcs2::parse_error_reply("7.5\n"));
+  EXPECT_FALSE(gcs2::parse_error_reply("1=0\n"));
+  EXPECT_FALSE(gcs2::parse_error_reply("1 \n2\n"));
+  // ANC300: a reply ends with its OK or ERROR line (a prompt before it tolerated).
+  bool ok = false;
+  const std::string r = "frequency = 500 Hz\r\nOK\r\nnext";
+  EXPECT_EQ(anc300::reply_end(r, &ok), r.size() - 4);
+  EXPECT_TRUE(ok);
+  const std::string e = "> Axis in wrong mode\r\nERROR\r\n";
+  EXPECT_EQ(anc300::reply_end(e, &ok), e.size());
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(anc300::reply_end("OKAY\r\nOK"), 0u);
+  EXPECT_EQ(anc300::reply_lines("> echo off\r\nOK\r\n"), (std::vector<std::string>{"echo off"}));
+}
+
+TEST(VendorDriverCodec, TheConnectionIsHostPortAndOptionsEachCheckedInOneLine) {
+  const Connection c = parse_connection("127.0.0.1:50000,timeout_s=0.2,axes=A+B+C", "pi-gcs2");
+  EXPECT_EQ(c.host, "127.0.0.1");
+  EXPECT_EQ(c.port, 50000);
+  EXPECT_EQ(c.options.at("axes"), "A+B+C");
+  EXPECT_DOUBLE_EQ(gcs2_driver_params(c).timing.reply_timeout_s, 0.2);
+  EXPECT_EQ(gcs2_driver_params(c).axes[2], "C");
+  EXPECT_EQ(parse_connection("[::1]:7230", "anc300").host, "::1");
+  for (const char* bad : {"/dev/ttyUSB0", "COM3", "localhost", "127.0.0.1:", "127.0.0.1:0", "127.0.0.1:70000",
+                          "127.0.0.1:5x", "127.0.0.1:50000,timeout_s", "127.0.0.1:1,a=1,a=2"})
+    EXPECT_THROW(parse_connection(bad, "pi-gcs2"), InvalidParams) << bad;
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=-1", "pi-gcs2")), InvalidParams);
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=abc", "pi-gcs2")), InvalidParams);
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,axes=1+1+2", "pi-gcs2")), InvalidParams);
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,stale_s=0.001", "pi-gcs2")),
+               InvalidParams);  // < poll
+  EXPECT_THROW(anc300_driver_params(parse_connection("h:1,position=sensor", "anc300")), InvalidParams);
+  EXPECT_THROW(anc300_driver_params(parse_connection("h:1,axes=1+2", "anc300")), InvalidParams);
+  EXPECT_TRUE(anc300_driver_params(parse_connection("h:1,position=getpos", "anc300")).sensor);
+  try {
+    gcs2_driver_params(parse_connection("h:1,speed=3", "pi-gcs2"));
+    FAIL();
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown option 'speed' (known: timeout_s"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Gcs2Driver, RunsThePlatformMovesEachAxisAndPollsWithoutAllocatingInTheLoop) {
