@@ -201,5 +201,30 @@ TEST(DriverTwin, Anc300CountingStepsDriftsByTheModelsStepError) {
   }
 }
 
+TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableControllerIsOneLine) {
+  // The worked example of docs/hardware.md: `serve --config` with the driver set, a second process.
+  TwinProcess twin;
+  ASSERT_NE(twin.gcs2_port, 0) << test::read_text(twin.cli.err);
+  test::TempDir dir;
+  test::write_text(
+      dir / "gcs2.yaml",
+      fmt::format("devices: {{driver: pi-gcs2, connection: \"127.0.0.1:{}\"}}\n", twin.gcs2_port));
+  auto r = test::run_cli({"serve", "--config", (dir / "gcs2.yaml").string(), "--listen", "127.0.0.1:0",
+                          "--out", (dir / "out").string(), "--duration", "1"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("on the drivers 'pi-gcs2' (127.0.0.1:{})", twin.gcs2_port)),
+            std::string::npos)
+      << r.err;
+  // A closed port: one line naming the address, exit 3.
+  test::write_text(dir / "closed.yaml", "devices: {driver: anc300, connection: \"127.0.0.1:1\"}\n");
+  r = test::run_cli({"serve", "--config", (dir / "closed.yaml").string(), "--listen", "127.0.0.1:0", "--out",
+                     (dir / "out").string(), "--duration", "1"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("microcobot: error: cannot connect to the controller at 127.0.0.1:1"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("microcobot: error:"), r.err.rfind("microcobot: error:"));
+}
+
 }  // namespace driver_twin_test
 }  // namespace mc::vendor
