@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses of the input parsers (CSV reader, YAML parameter parser,
-# platform configuration parser, console commands) with clang (preset `fuzz`) and runs each.
+# platform configuration parser, console commands, vendor controllers' replies) with clang (preset `fuzz`) and runs each.
 # Usage: scripts/fuzz.sh [SECONDS]     explore for SECONDS each (default 30; `make fuzz`: 600),
 #                                      new inputs kept in build/fuzz/corpus-*
 #        scripts/fuzz.sh --runs N      the test suite's run (ctest fuzz_parsers): N inputs each
@@ -32,7 +32,7 @@ if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_
   exit 1
 fi
 status=0
-for h in csv params config console; do
+for h in csv params config console vendor; do
   work="${fresh:-build/fuzz}/corpus-$h"   # new inputs go here; the seed corpus stays untouched
   mkdir -p "$work" build/fuzz/findings
   echo "fuzz: $h (${limit[*]})" >&2
