@@ -25,7 +25,7 @@ fi
 cmake --preset fuzz >/dev/null
 mkdir -p build/fuzz
 # The build's log is shown when it fails (CI=true makes warnings errors, clang's included).
-if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console -j "${JOBS:-2}" \
+if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console fuzz_vendor -j "${JOBS:-2}" \
     >build/fuzz/build.log 2>&1; then
   echo "fuzz: the clang build failed (build/fuzz/build.log):" >&2
   grep -E "error|FAILED" build/fuzz/build.log | head -20 >&2
