@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses of the input parsers (CSV reader, YAML parameter parser,
-# platform configuration parser, console commands) with clang (preset `fuzz`) and runs each.
+# platform configuration parser, console commands, vendor controllers' replies) with clang (preset `fuzz`) and runs each.
 # Usage: scripts/fuzz.sh [SECONDS]     explore for SECONDS each (default 30; `make fuzz`: 600),
 #                                      new inputs kept in build/fuzz/corpus-*
 #        scripts/fuzz.sh --runs N      the test suite's run (ctest fuzz_parsers): N inputs each
@@ -25,14 +25,14 @@ fi
 cmake --preset fuzz >/dev/null
 mkdir -p build/fuzz
 # The build's log is shown when it fails (CI=true makes warnings errors, clang's included).
-if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console -j "${JOBS:-2}" \
+if ! cmake --build --preset fuzz --target fuzz_csv fuzz_params fuzz_config fuzz_console fuzz_vendor -j "${JOBS:-2}" \
     >build/fuzz/build.log 2>&1; then
   echo "fuzz: the clang build failed (build/fuzz/build.log):" >&2
   grep -E "error|FAILED" build/fuzz/build.log | head -20 >&2
   exit 1
 fi
 status=0
-for h in csv params config console; do
+for h in csv params config console vendor; do
   work="${fresh:-build/fuzz}/corpus-$h"   # new inputs go here; the seed corpus stays untouched
   mkdir -p "$work" build/fuzz/findings
   echo "fuzz: $h (${limit[*]})" >&2

@@ -89,7 +89,7 @@ TEST(ServeCli, AMistypedSceneOrAnUncreatableOutIsOneHelpfulLine) {
 }
 
 TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
-  // This build registers no hardware drivers (docs/hardware.md): the simulation is the one known.
+  // The program registers the vendor drivers (issue #30) beside the simulation (docs/hardware.md).
   test::TempDir dir;
   test::write_text(dir / "bench.yaml", "devices: {driver: smaract, connection: \"usb:0\"}\n");
   for (const std::string command : {"serve", "run"}) {
@@ -97,7 +97,8 @@ TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
         run_cli({command, "--config", (dir / "bench.yaml").string(), "--out", (dir / "out").string()});
     EXPECT_EQ(r.exit_code, 3) << command << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
-    EXPECT_NE(r.err.find("devices.driver: 'smaract' is not a registered driver (known: simulated)"),
+    EXPECT_NE(r.err.find(
+                  "devices.driver: 'smaract' is not a registered driver (known: simulated, anc300, pi-gcs2)"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.out, "") << "nothing served or run";

@@ -101,4 +101,44 @@ std::optional<std::string> value_of(std::string_view line) {
   return std::string(rest);
 }
 
+namespace {
+
+std::string_view trimmed(std::string_view line) {
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
+  while (line.size() >= 2 && line.substr(0, 2) == kPrompt) line.remove_prefix(2);
+  while (!line.empty() && line.front() == ' ') line.remove_prefix(1);
+  return line;
+}
+
+}  // namespace
+
+std::size_t reply_end(std::string_view text, bool* ok) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) return 0;
+    const std::string_view line = trimmed(text.substr(start, end - start));
+    if (line == kOk || line == kError) {
+      if (ok != nullptr) *ok = line == kOk;
+      return end + 1;
+    }
+    start = end + 1;
+  }
+  return 0;
+}
+
+std::vector<std::string> reply_lines(std::string_view reply) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < reply.size()) {
+    std::size_t end = reply.find('\n', start);
+    if (end == std::string_view::npos) end = reply.size();
+    const std::string_view line = trimmed(reply.substr(start, end - start));
+    start = end + 1;
+    if (line == kOk || line == kError) break;
+    if (!line.empty()) out.emplace_back(line);
+  }
+  return out;
+}
+
 }  // namespace mc::vendor::anc300

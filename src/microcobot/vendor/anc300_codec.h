@@ -55,4 +55,13 @@ std::optional<long long> parse_count(std::string_view word);
 /// Driver side: the value of a "name = value [unit]" line (nullopt when the line is not one).
 std::optional<std::string> value_of(std::string_view line);
 
+/// Driver side (echo off): the length of the first whole reply at the start of `text`, through its
+/// `OK` or `ERROR` line and that line's CR LF (a prompt "> " before it is tolerated), 0 while it
+/// is incomplete; `*ok` says which line ended it.
+std::size_t reply_end(std::string_view text, bool* ok = nullptr);
+
+/// Driver side: the lines of a whole reply before its OK/ERROR line, CR LF removed, blank lines
+/// and prompts dropped (an ERROR reply's message is its last line).
+std::vector<std::string> reply_lines(std::string_view reply);
+
 }  // namespace mc::vendor::anc300

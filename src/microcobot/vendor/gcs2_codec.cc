@@ -123,4 +123,35 @@ bool reply_complete(std::string_view text) {
   return !text.empty() && text.back() == '\n' && (text.size() < 2 || text[text.size() - 2] != ' ');
 }
 
+std::size_t reply_end(std::string_view text) {
+  for (std::size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '\n' && (i == 0 || text[i - 1] != ' ')) return i + 1;
+  return 0;
+}
+
+std::vector<std::string> reply_lines(std::string_view reply) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < reply.size()) {
+    std::size_t end = reply.find('\n', start);
+    if (end == std::string_view::npos) end = reply.size();
+    std::string_view line = reply.substr(start, end - start);
+    start = end + 1;
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.remove_suffix(1);
+    auto w = words(line);
+    if (w.size() >= 3 && all_digits(w[0]) && all_digits(w[1])) line = line.substr(w[2].data() - line.data());
+    out.emplace_back(line);
+  }
+  return out;
+}
+
+std::optional<int> parse_error_reply(std::string_view reply) {
+  const auto lines = reply_lines(reply);
+  if (lines.size() != 1) return std::nullopt;
+  const auto v = parse_number(lines[0]);
+  if (!v || *v != std::floor(*v) || std::abs(*v) > 1e6 || lines[0].find_first_of(".eE") != std::string::npos)
+    return std::nullopt;
+  return static_cast<int>(*v);
+}
+
 }  // namespace mc::vendor::gcs2

@@ -76,4 +76,16 @@ std::vector<std::pair<std::string, double>> parse_axis_values(std::string_view r
 /// True once `text` (what arrived so far) holds a whole reply: ends in LF not preceded by a space.
 bool reply_complete(std::string_view text);
 
+/// Driver side: the length of the first whole reply at the start of `text` (through the LF of its
+/// last line: the first LF not preceded by a space), 0 while it is incomplete.
+std::size_t reply_end(std::string_view text);
+
+/// Driver side: the code of an `ERR?` reply ("7", or "0 1 7" from a daisy-chained controller);
+/// nullopt when the reply is not one integer in [-1e6, 1e6] (GCS codes are small, some negative).
+std::optional<int> parse_error_reply(std::string_view reply);
+
+/// Driver side: the lines of a reply, each without its trailing space, CR and LF and without the
+/// host and sender addresses of a daisy-chained reply ("0 1 ").
+std::vector<std::string> reply_lines(std::string_view reply);
+
 }  // namespace mc::vendor::gcs2

@@ -1,0 +1,114 @@
+// Issue #30: does a driver-backed platform keep its 1 kHz slave control rate against the twin?
+// One run: the GCS 2.0 twin (the live platform, paced, with its TCP server) runs throughout; in
+// alternating 2 s phases (three of each) this process runs, paced to the wall clock, either the
+// simulated platform (no driver) or a platform whose axes are `pi-gcs2` on that twin, the console
+// moving the stage between two goals 20 um apart every 0.5 s (MOV traffic). Per phase: loop ticks
+// per wall second, slave-control ticks per second (ticks / loop.slave_divisor), the loop's tick
+// time p99 and overruns; for the driver, its bus cycles per second (MOV + ERR? + POS?) and the
+// share of operator ticks (1 kHz) whose measurement was fresh.
+// `build/release/bench/driver_bench` (docs/benchmarks.md). One iteration: the figures are counters.
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "microcobot/live/live_platform.h"
+#include "microcobot/platform/driver_registry.h"
+#include "microcobot/vendor/bus_controller.h"
+#include "microcobot/vendor/live_stage.h"
+#include "microcobot/vendor/twin_server.h"
+#include "microcobot/vendor/vendor_drivers.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Phase {
+  double ticks_per_s = 0, slave_per_s = 0, tick_p99_us = 0, overruns = 0, bus_cycles_per_s = 0, fresh = 0;
+};
+
+Phase run_phase(mc::platform::Platform& p, double seconds) {
+  const auto& s = p.config().stage;
+  const Eigen::Vector3d home(s.home_x_m, s.home_y_m, s.home_z_m);
+  mc::control::ConsoleInput in;
+  in.active = in.fresh = in.deadman = in.has_goal = true;
+  in.goal_speed_m_s = 1e-3;
+  std::uint64_t slave_ticks = 0, fresh_ticks = 0;
+  const int divisor = p.config().loop.slave_divisor;
+  p.set_operator([&](const mc::platform::TickInfo& t) {
+    const bool right = static_cast<long long>(t.t_s / 0.5) % 2 == 0;
+    in.goal_m = home + Eigen::Vector3d(right ? 10e-6 : -10e-6, 0, 0);
+    p.set_console_input(in);
+    ++slave_ticks;  // the operator task's rate (1 kHz, as the slave's)
+    fresh_ticks += p.axis(0).measurement_fresh() ? 1 : 0;
+  });
+  const auto* bus = dynamic_cast<const mc::vendor::BusAxis*>(&p.axis(0));
+  const std::uint64_t cycles0 = bus != nullptr ? bus->controller().cycles() : 0;
+  const std::uint64_t ticks0 = p.loop().ticks(), over0 = p.loop().overruns();
+  const auto t0 = Clock::now();
+  p.run(seconds);
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  Phase r;
+  r.ticks_per_s = static_cast<double>(p.loop().ticks() - ticks0) / wall;
+  r.slave_per_s = r.ticks_per_s / divisor;
+  r.tick_p99_us = 1e6 * p.loop().tick_stats().quantile_s(0.99);
+  r.overruns = static_cast<double>(p.loop().overruns() - over0);
+  if (bus != nullptr) r.bus_cycles_per_s = static_cast<double>(bus->controller().cycles() - cycles0) / wall;
+  r.fresh = slave_ticks > 0 ? static_cast<double>(fresh_ticks) / static_cast<double>(slave_ticks) : 0.0;
+  return r;
+}
+
+void BM_DriverBackedPlatformRate(benchmark::State& state) {
+  mc::vendor::register_vendor_drivers();
+  for (auto _ : state) {
+    mc::live::LiveParams lp;
+    mc::live::LivePlatform live(lp);
+    live.start([](const mc::platform::TelemetrySample&, std::size_t) {});
+    mc::vendor::LiveStage stage(live);
+    mc::vendor::TwinServerParams tp;
+    tp.endpoints = {{mc::vendor::Protocol::kGcs2, "127.0.0.1", 0}};
+    mc::vendor::TwinServer server(stage, tp);
+    server.start();
+    mc::platform::PlatformConfig sim;
+    sim.loop.realtime = true;
+    mc::platform::PlatformConfig drv = sim;
+    drv.devices.driver = "pi-gcs2";
+    drv.devices.connection = fmt::format("127.0.0.1:{},velocity_mm_s=1", server.ports()[0]);
+    std::array<Phase, 2> sum{};  // [0] simulated, [1] driver
+    for (int k = 0; k < 6; ++k) {
+      const bool with_driver = k % 2 == 1;
+      // A new platform each phase: its loop's statistics are that phase's.
+      auto p = mc::platform::make_platform(with_driver ? drv : sim);
+      const Phase r = run_phase(*p, 2.0);
+      Phase& a = sum[with_driver ? 1 : 0];
+      a.ticks_per_s += r.ticks_per_s / 3;
+      a.slave_per_s += r.slave_per_s / 3;
+      a.tick_p99_us += r.tick_p99_us / 3;
+      a.overruns += r.overruns;
+      a.bus_cycles_per_s += r.bus_cycles_per_s / 3;
+      a.fresh += r.fresh / 3;
+      if (with_driver && p->faulted()) state.SkipWithError("the driver faulted");
+    }
+    server.stop();
+    live.stop();
+    state.counters["sim_ticks_per_s"] = sum[0].ticks_per_s;
+    state.counters["drv_ticks_per_s"] = sum[1].ticks_per_s;
+    state.counters["sim_slave_ticks_per_s"] = sum[0].slave_per_s;
+    state.counters["drv_slave_ticks_per_s"] = sum[1].slave_per_s;
+    state.counters["rate_ratio"] = sum[1].ticks_per_s / sum[0].ticks_per_s;
+    state.counters["sim_tick_p99_us"] = sum[0].tick_p99_us;
+    state.counters["drv_tick_p99_us"] = sum[1].tick_p99_us;
+    state.counters["tick_p99_ratio"] = sum[1].tick_p99_us / sum[0].tick_p99_us;
+    state.counters["sim_overruns"] = sum[0].overruns;
+    state.counters["drv_overruns"] = sum[1].overruns;
+    state.counters["drv_bus_cycles_per_s"] = sum[1].bus_cycles_per_s;
+    state.counters["drv_fresh_share"] = sum[1].fresh;
+  }
+}
+BENCHMARK(BM_DriverBackedPlatformRate)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace

@@ -1,0 +1,76 @@
+#pragma once
+/// @file
+/// The `pi-gcs2` driver (issue #30): the platform's three stage axes on a PI controller speaking
+/// GCS 2.0 over TCP (E-873 Q-Motion, E-871, C-867; or `microcobot serve --emulate gcs2`). The
+/// controller closes each axis' position loop: the axes are position-controlled
+/// (platform/device.h), the platform sends them the coupling's targets, the bus thread sends the
+/// latest as `MOV` and polls `POS?` (bus_controller.h). Commands (docs/hardware.md, "Drivers"):
+///
+///   configure  *IDN?, CSV? (2.x), SAI? ALL (every configured axis listed, else an error naming
+///              what was found), ERR? (a stale error cleared), TMN?/TMX? (the targets are clamped
+///              to them), SVO a 1 ..., [VEL a v ...], FRF? and, for an unreferenced axis, FRF then
+///              FRF? until referenced; ERR? after every set command (non-zero: the configuration
+///              fails naming the code and its text), POS? (the first positions)
+///   each cycle MOV a x ... of the targets that changed (then ERR?, which must read 0), POS?
+///   safe state HLT, ERR? (0 or 10, "stopped by command")
+///
+/// Positions are in mm on the wire (%.6f: 1 nm), m in the platform; the controller's zero is the
+/// platform's stage zero (its home).
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "microcobot/platform/platform.h"
+#include "microcobot/vendor/bus_controller.h"
+
+namespace mc::vendor {
+
+struct Gcs2DriverParams {
+  BusTiming timing;
+  std::array<std::string, 3> axes = {"1", "2", "3"};  ///< the controller's axis ids for X, Y, Z
+  bool reference = true;              ///< FRF the axes that FRF? reports unreferenced (else refuse them)
+  double reference_timeout_s = 60.0;  ///< FRF's longest wait (a switch search on a long stage)
+  double velocity_mm_s = 0.0;         ///< VEL sent at configure; 0 keeps the controller's
+  void validate() const;
+};
+
+/// `connection` options: timeout_s, connect_timeout_s, poll_s, stale_s, axes (three ids joined by
+/// '+', "1+2+3"), reference (0|1), reference_timeout_s, velocity_mm_s.
+Gcs2DriverParams gcs2_driver_params(const Connection& connection);
+
+class Gcs2Controller final : public BusController {
+ public:
+  Gcs2Controller(Connection connection, Gcs2DriverParams params);
+  ~Gcs2Controller() override { shutdown(); }
+  const Gcs2DriverParams& params() const { return params_; }
+  /// TMN?/TMX? read at configure [m].
+  double min_m(int axis) const { return min_m_[static_cast<std::size_t>(axis)]; }
+  double max_m(int axis) const { return max_m_[static_cast<std::size_t>(axis)]; }
+  /// MOV lines sent (tests, benchmarks).
+  std::uint64_t moves_sent() const { return moves_.load(std::memory_order_relaxed); }
+
+ protected:
+  void handshake(LineClient& bus) override;
+  void cycle(LineClient& bus) override;
+  void safe_state(LineClient& bus) override;
+
+ private:
+  /// Sends `line` and returns its reply (queries) within the reply timeout. Throws BusFault.
+  std::string query(LineClient& bus, const std::string& line, double timeout_s = 0.0);
+  /// Sends a set command, then ERR?: throws BusFault naming the code unless it is 0 (or `also_ok`).
+  void command(LineClient& bus, const std::string& line, int also_ok = 0);
+  std::array<double, 3> read_axes(LineClient& bus, const std::string& mnemonic);
+  std::string axis_list() const;
+
+  Gcs2DriverParams params_;
+  std::array<double, 3> min_m_{}, max_m_{}, sent_m_{};
+  std::array<bool, 3> sent_{};
+  std::atomic<std::uint64_t> moves_{0};
+};
+
+/// The driver set `pi-gcs2`: the three axes on one Gcs2Controller (`config.devices.connection`),
+/// the gripper and the masters simulated (vendor/sim_companions.h). Builds, opens nothing.
+platform::PlatformDevices make_gcs2_devices(const platform::PlatformConfig& config);
+
+}  // namespace mc::vendor

@@ -1,0 +1,49 @@
+// libFuzzer harness: what a controller sends the vendor drivers (issue #30), and the connection
+// text of the configuration. A reply is either parsed (finite values, whole lines) or refused with
+// one line (mc::Error); the reply framing never reads past its input; never a crash.
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+#include "microcobot/core/error.h"
+#include "microcobot/vendor/anc300_codec.h"
+#include "microcobot/vendor/gcs2_codec.h"
+#include "microcobot/vendor/line_client.h"
+
+namespace {
+
+void one_line(const mc::Error& e) {
+  if (std::string(e.what()).find('\n') != std::string::npos) std::abort();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  namespace gcs2 = mc::vendor::gcs2;
+  namespace anc300 = mc::vendor::anc300;
+  if (gcs2::reply_end(text) > text.size()) std::abort();
+  (void)gcs2::reply_lines(text);
+  (void)gcs2::parse_error_reply(text);
+  try {
+    for (const auto& [axis, v] : gcs2::parse_axis_values(text))
+      if (!std::isfinite(v) || axis.empty()) std::abort();
+  } catch (const mc::Error& e) {
+    one_line(e);
+  }
+  bool ok = false;
+  if (anc300::reply_end(text, &ok) > text.size()) std::abort();
+  for (const auto& line : anc300::reply_lines(text)) {
+    if (line.find('\n') != std::string::npos) std::abort();
+    if (const auto v = anc300::value_of(line); v && v->empty()) std::abort();
+  }
+  try {
+    const auto c = mc::vendor::parse_connection(text, "pi-gcs2");
+    if (c.port == 0 || c.host.empty()) std::abort();
+  } catch (const mc::Error& e) {
+    one_line(e);
+  }
+  return 0;
+}
