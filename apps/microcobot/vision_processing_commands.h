@@ -5,4 +5,6 @@
 
 namespace mc::cli {
 void add_vision_processing(CLI::App& group);
-}
+/// `vision servo` (vision_servo_commands.cc).
+void add_vision_servo(CLI::App& group);
+}  // namespace mc::cli
