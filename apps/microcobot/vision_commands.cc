@@ -188,6 +188,8 @@ void add_vision(CLI::App& group) {
     cmd->callback([o] { run_render(*o); });
   }
   mc::cli::add_vision_processing(group);
+  mc::cli::add_vision_force(group);
+  mc::cli::add_vision_servo(group);
 }
 
 const bool kRegistered = mc::cli::register_group(

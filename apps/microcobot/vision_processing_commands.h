@@ -5,4 +5,7 @@
 
 namespace mc::cli {
 void add_vision_processing(CLI::App& group);
-}
+/// `vision force` and `vision servo` (vision_force_servo_commands.cc).
+void add_vision_force(CLI::App& group);
+void add_vision_servo(CLI::App& group);
+}  // namespace mc::cli
