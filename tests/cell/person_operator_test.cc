@@ -91,7 +91,8 @@ TEST(PersonOperator, APinThatStopsShortOfTheFloorUnfeltIsReleased) {
   });
   c.run_to_end();
   const CycleResult r = c.result();
-  EXPECT_LT(felt_in_insert, params.person.person.feel_contact_N) << "the case this test is about: no floor felt";
+  EXPECT_LT(felt_in_insert, params.person.person.feel_contact_N)
+      << "the case this test is about: no floor felt";
   EXPECT_TRUE(r.success) << r.verdict;
   EXPECT_LT(r.cycle_s, 60.0);
   EXPECT_TRUE(r.ended_holding);

@@ -65,8 +65,8 @@ struct PersonOperatorParams {
   /// at the bottom, felt or not. The hand may arrive at its aimed height (within z_tolerance_m)
   /// with the pin a micrometre short of the floor, no contact to feel (seed 4111, part 9).
   double stalled_s = 1.0;
-  double step_timeout_s = 60.0;         ///< a step not done by then: the person gives up
-  int max_jams = 12;                    ///< rim contacts before the person gives up
+  double step_timeout_s = 60.0;  ///< a step not done by then: the person gives up
+  int max_jams = 12;             ///< rim contacts before the person gives up
 
   template <class V>
   void visit(V& v) {

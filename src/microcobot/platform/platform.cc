@@ -472,7 +472,10 @@ void Platform::run(double duration_s) {
   const std::size_t need =
       recorder_->size() + ticks / static_cast<std::uint64_t>(config_.loop.telemetry_divisor) + 2;
   if (need > recorder_->capacity()) {
-    auto bigger = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), need);
+    // Grown geometrically: a caller stepping the platform by short runs (the cell's cycles, one
+    // second at a time) would otherwise copy the whole recording at every run.
+    auto bigger = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()),
+                                             std::max(need, 2 * recorder_->capacity()));
     TelemetrySample s;
     for (std::size_t i = 0; i < recorder_->size(); ++i) {
       for (std::size_t c = 0; c < telemetry_channel_count(); ++c) s[c] = recorder_->at(i, c);
