@@ -190,6 +190,7 @@ void add_vision(CLI::App& group) {
   mc::cli::add_vision_processing(group);
   mc::cli::add_vision_force(group);
   mc::cli::add_vision_servo(group);
+  mc::cli::add_vision_pick_place(group);
 }
 
 const bool kRegistered = mc::cli::register_group(
