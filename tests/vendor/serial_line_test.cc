@@ -3,7 +3,8 @@
 // without flow control unless asked; every read has its deadline; the pi-gcs2 driver configures
 // the platform and moves its axes over the line without allocating in the loop; a path that does
 // not exist and a file that is not a tty are refused in one line (exit 3); unplugging the line
-// (closing the master) puts the platform in its safe state within one reply timeout.
+// (closing the master) puts the platform in its safe state within one reply timeout; the anc300
+// driver steps over the line without the telnet console's password.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -242,6 +245,49 @@ TEST(SerialLine, UnpluggingTheLineMidMovePutsThePlatformInItsSafeStateWithinOneT
   const auto t0 = Clock::now();
   p.reset();  // shut down: nothing hangs
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - t0).count(), 1.0);
+}
+
+// An ANC300 serial console (no password prompt: that is the telnet console's) counting the periods
+// axis 1 is sent.
+struct SerialAnc300 {
+  std::mutex m;
+  long long periods = 0;
+  test::FakeController server{
+      [this](const std::string& line) { return answer(line); }, {}, test::FakeController::Transport::kPty};
+  test::FakeController::Answer answer(const std::string& line) {
+    std::lock_guard lock(m);
+    std::istringstream in(line);
+    std::string c;
+    int axis = 0;
+    long long n = 1;
+    in >> c >> axis >> n;
+    if (c == "ver") return {"attocube ANC300 fake\r\nOK\r\n"};
+    if (c == "getser") return {"serial number = ANM-FAKE\r\nOK\r\n"};
+    if (axis == 1 && (c == "stepu" || c == "stepd")) periods += c == "stepu" ? n : -n;
+    return {"OK\r\n"};
+  }
+  long long count() {
+    std::lock_guard lock(m);
+    return periods;
+  }
+};
+
+TEST(SerialLine, TheAnc300DriverSendsNoPasswordAndStepsOverTheLine) {
+  SerialAnc300 fake;
+  register_vendor_drivers();
+  PlatformConfig c;
+  c.devices.driver = "anc300";
+  c.devices.connection = fake.server.tty_path() + ",step_up_nm=20,step_down_nm=25";
+  auto p = platform::make_platform(c);
+  Console console(*p, {1e-6, 0, 0});
+  run_paced(*p, 1.0);
+  ASSERT_FALSE(p->faulted());
+  EXPECT_EQ(fake.count(), 50);  // 1 um at 20 nm a period
+  const auto lines = fake.server.lines();
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines.front(), "echo off");  // no password line before it
+  p->fault_all();
+  EXPECT_TRUE(test::eventually([&] { return fake.server.count("setm 1 gnd") > 0; }, 1000ms));
 }
 
 }  // namespace serial_line_test
