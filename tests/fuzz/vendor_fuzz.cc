@@ -41,7 +41,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     const auto c = mc::vendor::parse_connection(text, "pi-gcs2");
-    if (c.port == 0 || c.host.empty()) std::abort();
+    if (c.is_serial() ? c.serial.path.front() != '/' || c.serial.baud == 0 : c.port == 0 || c.host.empty())
+      std::abort();
   } catch (const mc::Error& e) {
     one_line(e);
   }

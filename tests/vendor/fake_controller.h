@@ -4,14 +4,22 @@
 /// one connection at a time, every line handed to the test's `answer` (what to send back, or to
 /// close, or to say nothing), every line received kept. The thread polls, so that stop() returns
 /// at once whatever the client does.
+///
+/// With Transport::kPty the controller sits on the master of a pseudo-terminal instead and the
+/// driver opens its slave (`tty_path()`) as it would /dev/ttyUSB0: the serial transport's stand-in
+/// (no USB adapter is involved). Closing (`Answer::close`) closes the master: the line is unplugged
+/// for good (the slave reads EIO, its path disappears).
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <cstdlib>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -29,8 +37,21 @@ class FakeController {
   };
   /// `answer(line)` runs on the server's thread; `greeting` is sent on each connection;
   /// `eol` ends the lines ("\n" for GCS, "\r\n" for the ANC300: CR is stripped either way).
-  FakeController(std::function<Answer(const std::string&)> answer, std::string greeting = {})
-      : answer_(std::move(answer)), greeting_(std::move(greeting)) {
+  enum class Transport { kTcp, kPty };
+  FakeController(std::function<Answer(const std::string&)> answer, std::string greeting = {},
+                 Transport transport = Transport::kTcp)
+      : answer_(std::move(answer)), greeting_(std::move(greeting)), pty_(transport == Transport::kPty) {
+    if (pty_) {
+      master_fd_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
+      if (master_fd_ < 0 || ::grantpt(master_fd_) != 0 || ::unlockpt(master_fd_) != 0)
+        throw std::runtime_error("fake controller: no pseudo-terminal");
+      char name[128];
+      if (::ptsname_r(master_fd_, name, sizeof name) != 0)
+        throw std::runtime_error("fake controller: ptsname");
+      tty_path_ = name;
+      thread_ = std::thread([this] { run_pty(); });
+      return;
+    }
     listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
     int one = 1;
     ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
@@ -47,9 +68,14 @@ class FakeController {
   ~FakeController() {
     stop_ = true;
     thread_.join();
-    ::close(listen_fd_);
+    if (listen_fd_ >= 0) ::close(listen_fd_);
+    if (master_fd_ >= 0) ::close(master_fd_);
   }
   std::uint16_t port() const { return port_; }
+  /// The slave's path (Transport::kPty): what the driver's connection names.
+  const std::string& tty_path() const { return tty_path_; }
+  /// The line unplugged (Transport::kPty: the master was closed).
+  bool unplugged() const { return unplugged_.load(); }
   std::vector<std::string> lines() const {
     std::lock_guard lock(mutex_);
     return lines_;
@@ -75,15 +101,34 @@ class FakeController {
       ::close(fd);
     }
   }
-  void serve(int fd) {
-    if (!greeting_.empty()) ::send(fd, greeting_.data(), greeting_.size(), MSG_NOSIGNAL);
+  // The master end: a session per opening of the slave (the master reads EIO while none is open).
+  void run_pty() {
+    while (!stop_ && master_fd_ >= 0) {
+      if (serve(master_fd_)) {
+        ::close(master_fd_);
+        master_fd_ = -1;
+        unplugged_ = true;
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  void put(int fd, const std::string& bytes) {
+    if (pty_)
+      (void)!::write(fd, bytes.data(), bytes.size());
+    else
+      ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  }
+  // True when the answer closed the connection (or unplugged the line).
+  bool serve(int fd) {
+    if (!greeting_.empty()) put(fd, greeting_);
     std::string buffer;
     char buf[4096];
     while (!stop_) {
       pollfd p{fd, POLLIN, 0};
       if (::poll(&p, 1, 20) <= 0) continue;
-      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-      if (n <= 0) return;
+      const ssize_t n = pty_ ? ::read(fd, buf, sizeof buf) : ::recv(fd, buf, sizeof buf, 0);
+      if (n <= 0) return false;
       buffer.append(buf, static_cast<std::size_t>(n));
       std::size_t eol;
       while ((eol = buffer.find('\n')) != std::string::npos) {
@@ -95,15 +140,19 @@ class FakeController {
           lines_.push_back(line);
         }
         const Answer a = answer_(line);
-        if (!a.bytes.empty()) ::send(fd, a.bytes.data(), a.bytes.size(), MSG_NOSIGNAL);
-        if (a.close) return;
+        if (!a.bytes.empty()) put(fd, a.bytes);
+        if (a.close) return true;
       }
     }
+    return false;
   }
 
   std::function<Answer(const std::string&)> answer_;
   std::string greeting_;
-  int listen_fd_ = -1;
+  bool pty_ = false;
+  int listen_fd_ = -1, master_fd_ = -1;
+  std::string tty_path_;
+  std::atomic<bool> unplugged_{false};
   std::uint16_t port_ = 0;
   std::atomic<bool> stop_{false};
   std::atomic<int> connections_{0};

@@ -27,6 +27,7 @@
 #include "support/counting_allocator.h"
 #include "support/test_support.h"
 #include "vendor/fake_controller.h"
+#include "vendor/gcs2_test_rig.h"
 
 namespace mc::vendor {
 namespace vendor_driver_test {
@@ -36,109 +37,7 @@ using Clock = std::chrono::steady_clock;
 using platform::Platform;
 using platform::PlatformConfig;
 
-enum class Mode { kNormal, kSlow, kTruncated, kGarbage, kDisconnect, kError };
-
-// An E-873-like controller whose axes reach every MOV at once.
-struct FakeGcs2 {
-  std::atomic<Mode> mode{Mode::kNormal};
-  std::string axes_reply = "1 \n2 \n3\n";
-  std::mutex m;
-  double pos_mm[3] = {0, 0, 0};
-  int error = 0;
-  std::atomic<int> halts{0};
-  test::FakeController server{[this](const std::string& line) { return answer(line); }};
-
-  test::FakeController::Answer answer(const std::string& line) {
-    std::lock_guard lock(m);
-    const auto r = gcs2::parse_line(line);
-    if (!r) return {};
-    const std::string& c = r->mnemonic;
-    auto per_axis = [&](auto value) {
-      std::string out;
-      for (int i = 0; i < 3; ++i) out += fmt::format("{}={}{}", i + 1, value(i), i < 2 ? " \n" : "\n");
-      return out;
-    };
-    if (c == "*IDN?") return {"(c)2026 Physik Instrumente (PI) fake E-873\n"};
-    if (c == "CSV?") return {"2.0\n"};
-    if (c == "SAI?") return {axes_reply};
-    if (c == "ERR?") {
-      const int e = error;
-      error = 0;
-      return {fmt::format("{}\n", e)};
-    }
-    if (c == "TMN?") return {per_axis([](int) { return "-5.000000"; })};
-    if (c == "TMX?") return {per_axis([](int) { return "5.000000"; })};
-    if (c == "FRF?") return {per_axis([](int) { return 1; })};
-    if (c == "HLT") {
-      ++halts;
-      error = 10;
-      return {};
-    }
-    if (c == "MOV") {
-      for (std::size_t k = 0; k + 1 < r->args.size(); k += 2)
-        pos_mm[r->args[k][0] - '1'] = *gcs2::parse_number(r->args[k + 1]);
-      if (mode == Mode::kError) error = gcs2::kPositionOutOfLimits;
-      return {};
-    }
-    if (c == "POS?") {
-      switch (mode.load()) {
-        case Mode::kSlow:
-          return {};  // never answered
-        case Mode::kTruncated:
-          return {"1=0.000000 \n2=0.0"};  // the rest never comes
-        case Mode::kGarbage:
-          return {"\x01\x7f@@ garbage\n"};
-        case Mode::kDisconnect:
-          return {"", true};
-        default:
-          return {per_axis([this](int i) { return fmt::format("{:.6f}", pos_mm[i]); })};
-      }
-    }
-    return {};  // SVO, VEL, FRF: set commands have no reply
-  }
-  double x_mm(int i) {
-    std::lock_guard lock(m);
-    return pos_mm[i];
-  }
-};
-
-PlatformConfig gcs2_config(std::uint16_t port, const std::string& options = "") {
-  register_vendor_drivers();
-  PlatformConfig c;
-  c.devices.driver = "pi-gcs2";
-  c.devices.connection = fmt::format("127.0.0.1:{}{}", port, options);
-  return c;
-}
-
-// The console holding control with its deadman, going to `goal` (stage coordinates).
-struct Console {
-  control::ConsoleInput in;
-  Eigen::Vector3d home;
-  explicit Console(Platform& p, const Eigen::Vector3d& goal) {
-    const auto& s = p.config().stage;
-    home = {s.home_x_m, s.home_y_m, s.home_z_m};
-    in.active = in.fresh = in.deadman = true;
-    in.has_goal = true;
-    in.goal_m = home + goal;
-    in.goal_speed_m_s = 1e-3;
-    p.set_operator([this, &p](const platform::TickInfo&) { p.set_console_input(in); });
-  }
-};
-
-// The loop at wall-clock pace (10 ticks a millisecond) on this thread, until `done` or `s`.
-template <class Done>
-double run_paced(Platform& p, double s, Done done) {
-  const auto start = Clock::now();
-  for (int ms = 0; ms < static_cast<int>(s * 1e3); ++ms) {
-    p.loop().run_for(10);
-    if (done()) break;
-    std::this_thread::sleep_until(start + std::chrono::milliseconds(ms + 1));
-  }
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-double run_paced(Platform& p, double s) {
-  return run_paced(p, s, [] { return false; });
-}
+using namespace gcs2_test_rig;
 
 TEST(VendorDriverCodec, TheClientSideParsesRepliesAndRefusesWhatIsNotOne) {
   // GCS: a reply ends at the first LF not preceded by a space; what follows stays for the next.
@@ -170,8 +69,8 @@ TEST(VendorDriverCodec, TheConnectionIsHostPortAndOptionsEachCheckedInOneLine) {
   EXPECT_DOUBLE_EQ(gcs2_driver_params(c).timing.reply_timeout_s, 0.2);
   EXPECT_EQ(gcs2_driver_params(c).axes[2], "C");
   EXPECT_EQ(parse_connection("[::1]:7230", "anc300").host, "::1");
-  for (const char* bad : {"/dev/ttyUSB0", "COM3", "localhost", "127.0.0.1:", "127.0.0.1:0", "127.0.0.1:70000",
-                          "127.0.0.1:5x", "127.0.0.1:50000,timeout_s", "127.0.0.1:1,a=1,a=2"})
+  for (const char* bad : {"COM3", "localhost", "127.0.0.1:", "127.0.0.1:0", "127.0.0.1:70000", "127.0.0.1:5x",
+                          "127.0.0.1:50000,timeout_s", "127.0.0.1:1,a=1,a=2"})
     EXPECT_THROW(parse_connection(bad, "pi-gcs2"), InvalidParams) << bad;
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=-1", "pi-gcs2")), InvalidParams);
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=abc", "pi-gcs2")), InvalidParams);
@@ -241,16 +140,16 @@ TEST(Gcs2Driver, AControllerWithoutTheConfiguredAxesIsRefusedNamingWhatItHas) {
   EXPECT_THROW(platform::make_platform(gcs2_config(fake.server.port(), ",poll=1")), InvalidParams);
 }
 
-TEST(Gcs2Driver, ASerialPathIsRefusedInOneLine) {
+TEST(Gcs2Driver, AWindowsPortNameIsRefusedInOneLine) {
   register_vendor_drivers();
   PlatformConfig c;
   c.devices.driver = "pi-gcs2";
-  c.devices.connection = "/dev/ttyUSB0";
+  c.devices.connection = "COM3";
   try {
     platform::make_platform(c);
     FAIL();
   } catch (const InvalidParams& e) {
-    EXPECT_NE(std::string(e.what()).find("serial is not supported yet"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'COM3': a Windows port name"), std::string::npos) << e.what();
   }
 }
 

@@ -121,25 +121,31 @@ void Anc300Controller::handshake(LineClient& bus) {
       return at == std::string::npos ? 0 : at + what.size();
     };
   };
-  if (!bus.read_until(text, has("Authorization code"), deadline_in(login_s)))
-    throw BusFault("no password prompt ('Authorization code:'): " + bus.error() +
-                   (text.empty() ? std::string() : " (got '" + excerpt(text, 60) + "')"));
-  bus.discard_input();
-  if (!bus.send(params_.password + kEol, deadline_in(login_s))) throw BusFault("password: " + bus.error());
-  text.clear();
-  const auto verdict = [](const std::string& t) -> std::size_t {
-    for (std::string_view w : {anc300::kAuthorized, anc300::kNotAuthorized}) {
-      const auto at = t.find(w);
-      if (at != std::string::npos) {
-        const auto eol = t.find('\n', at);
-        if (eol != std::string::npos) return eol + 1;
+  // The password prompt is the telnet console's; the serial (USB/RS-232) console has none, and
+  // the line may hold what a previous session left: dropped before the first command.
+  if (connection().is_serial()) {
+    bus.discard_input();
+  } else {
+    if (!bus.read_until(text, has("Authorization code"), deadline_in(login_s)))
+      throw BusFault("no password prompt ('Authorization code:'): " + bus.error() +
+                     (text.empty() ? std::string() : " (got '" + excerpt(text, 60) + "')"));
+    bus.discard_input();
+    if (!bus.send(params_.password + kEol, deadline_in(login_s))) throw BusFault("password: " + bus.error());
+    text.clear();
+    const auto verdict = [](const std::string& t) -> std::size_t {
+      for (std::string_view w : {anc300::kAuthorized, anc300::kNotAuthorized}) {
+        const auto at = t.find(w);
+        if (at != std::string::npos) {
+          const auto eol = t.find('\n', at);
+          if (eol != std::string::npos) return eol + 1;
+        }
       }
-    }
-    return 0;
-  };
-  if (!bus.read_until(text, verdict, deadline_in(login_s))) throw BusFault("password: " + bus.error());
-  if (text.find(anc300::kAuthorized) == std::string::npos)
-    throw BusFault("the controller refused the password (Authorization failed; option password=...)");
+      return 0;
+    };
+    if (!bus.read_until(text, verdict, deadline_in(login_s))) throw BusFault("password: " + bus.error());
+    if (text.find(anc300::kAuthorized) == std::string::npos)
+      throw BusFault("the controller refused the password (Authorization failed; option password=...)");
+  }
   request(bus, "echo off", login_s);
   const auto ver = request(bus, "ver");
   set_identity(ver.empty() ? std::string("ANC300") : ver[0]);
@@ -214,7 +220,7 @@ void Anc300Controller::safe_state(LineClient& bus) {
 }
 
 platform::PlatformDevices make_anc300_devices(const platform::PlatformConfig& config) {
-  const Connection c = parse_connection(config.devices.connection, "anc300");
+  const Connection c = parse_connection(config.devices.connection, "anc300", kAnc300DefaultBaud);
   Anc300DriverParams p = anc300_driver_params(c);
   const stickslip::StickSlipParams axis = platform::axis_params(config);
   if (p.step_up_m == 0.0 || p.step_down_m == 0.0) {

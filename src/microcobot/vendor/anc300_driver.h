@@ -36,6 +36,11 @@
 
 namespace mc::vendor {
 
+/// The ANC300's serial rate as lab scripts driving it over RS-232/USB set it (38400 baud, 8N1).
+/// Attocube's manual was not at hand: the value is from those scripts (docs/parameters.md), not
+/// from the vendor; `baud=` overrides it.
+inline constexpr int kAnc300DefaultBaud = 38400;
+
 struct Anc300DriverParams {
   BusTiming timing{2.0, 0.2, 0.005, 0.1};     ///< a step run blocks a cycle: slower than GCS's
   std::string password = "123456";            ///< the controller's factory password

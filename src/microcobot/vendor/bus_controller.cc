@@ -41,9 +41,8 @@ BusController::~BusController() { shutdown(); }
 void BusController::configure() {
   if (running_.load(std::memory_order_acquire) && !faulted()) return;  // up and healthy
   shutdown();
-  const std::string where =
-      driver_ + " controller at " + connection_.host + ":" + std::to_string(connection_.port);
-  bus_.connect(connection_.host, connection_.port, timing_.connect_timeout_s);
+  const std::string where = driver_ + " controller at " + connection_.where();
+  bus_.open(connection_, timing_.connect_timeout_s);
   try {
     handshake(bus_);
   } catch (const BusFault& e) {

@@ -8,7 +8,8 @@
 ///   bus thread    every poll period: a pending safe-state request first (the controller's stop),
 ///                 then the controller's cycle (send the latest targets, poll the positions),
 ///                 positions and their wall-clock stamp published through atomics
-///   configure()   off the loop: (re)connects and runs the controller's handshake unless the bus
+///   configure()   off the loop: (re)connects (TCP or serial line, LineClient::open) and runs the
+///   controller's handshake unless the bus
 ///                 is up and healthy; a bus that faulted is reconnected here (Platform::recover)
 ///
 /// Any failure on the bus (a reply later than the timeout, a truncated or garbled reply, a
@@ -35,10 +36,11 @@ namespace mc::vendor {
 
 /// The timing of a bus (docs/parameters.md, "Vendor drivers").
 struct BusTiming {
-  double connect_timeout_s = 2.0;  ///< TCP connect and the login/handshake's first reply
-  double reply_timeout_s = 0.1;    ///< every reply; a later one faults the bus
-  double poll_period_s = 0.002;    ///< one bus cycle: targets out, positions in
-  double stale_timeout_s = 0.05;   ///< positions older than this are stale
+  double connect_timeout_s =
+      2.0;                       ///< TCP connect (a serial open is immediate) and the handshake's first reply
+  double reply_timeout_s = 0.1;  ///< every reply; a later one faults the bus
+  double poll_period_s = 0.002;  ///< one bus cycle: targets out, positions in
+  double stale_timeout_s = 0.05;  ///< positions older than this are stale
   void validate() const;
 };
 

@@ -205,7 +205,7 @@ void Gcs2Controller::safe_state(LineClient& bus) {
 }
 
 platform::PlatformDevices make_gcs2_devices(const platform::PlatformConfig& config) {
-  const Connection c = parse_connection(config.devices.connection, "pi-gcs2");
+  const Connection c = parse_connection(config.devices.connection, "pi-gcs2", kGcs2DefaultBaud);
   auto controller = std::make_shared<Gcs2Controller>(c, gcs2_driver_params(c));
   platform::PlatformDevices d = make_sim_companions(config);
   const char* names[3] = {"gcs2_axis_x", "gcs2_axis_y", "gcs2_axis_z"};

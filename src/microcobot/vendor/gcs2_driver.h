@@ -26,6 +26,10 @@
 
 namespace mc::vendor {
 
+/// The serial rate of a PI GCS 2.0 controller out of the box (E-873/C-867: RS-232 and USB at
+/// 115200 baud, 8N1, as issue #30 quotes PI's manuals); `baud=` overrides it.
+inline constexpr int kGcs2DefaultBaud = 115200;
+
 struct Gcs2DriverParams {
   BusTiming timing;
   std::array<std::string, 3> axes = {"1", "2", "3"};  ///< the controller's axis ids for X, Y, Z

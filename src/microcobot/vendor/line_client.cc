@@ -8,9 +8,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 
 #include <fmt/format.h>
 
@@ -31,28 +33,66 @@ int remaining_ms(LineClient::Clock::time_point deadline) {
 
 }  // namespace
 
-Connection parse_connection(const std::string& text, std::string_view driver) {
+std::string Connection::where() const {
+  return is_serial() ? serial.path : host + ":" + std::to_string(port);
+}
+
+namespace {
+
+// The serial line's own options, taken out of `c.options` (the driver never sees them).
+void take_serial_options(Connection& c, const std::string& text, int default_baud) {
+  c.serial.baud = default_baud;
+  if (const auto it = c.options.find("baud"); it != c.options.end()) {
+    const auto v = gcs2::parse_number(it->second);
+    const bool known =
+        v && std::find(std::begin(kSerialBauds), std::end(kSerialBauds), *v) != std::end(kSerialBauds);
+    if (!known)
+      throw InvalidParams(
+          std::string(kField) + " option baud",
+          "'" + excerpt(it->second) +
+              "' must be one of 1200 2400 4800 9600 19200 38400 57600 115200 230400 460800 921600");
+    c.serial.baud = static_cast<int>(*v);
+    c.options.erase(it);
+  }
+  if (const auto it = c.options.find("flow"); it != c.options.end()) {
+    if (it->second != "none" && it->second != "rtscts")
+      throw InvalidParams(std::string(kField) + " option flow",
+                          "'" + excerpt(it->second) + "' must be none or rtscts (" + excerpt(text) + ")");
+    c.serial.rtscts = it->second == "rtscts";
+    c.options.erase(it);
+  }
+}
+
+}  // namespace
+
+Connection parse_connection(const std::string& text, std::string_view driver, int default_baud) {
   const std::string d(driver);
-  if (!text.empty() && (text.front() == '/' || text.rfind("COM", 0) == 0))
-    throw InvalidParams(kField, "'" + excerpt(text) + "': a serial port; the " + d +
-                                    " driver speaks TCP only (serial is not supported yet): give HOST:PORT");
+  if (text.rfind("COM", 0) == 0)
+    throw InvalidParams(kField, "'" + excerpt(text) + "': a Windows port name; the " + d +
+                                    " driver takes a device path (/dev/ttyUSB0, /dev/ttyS0) or HOST:PORT");
   Connection c;
   std::string_view rest(text);
   const auto comma = rest.find(',');
   const std::string_view address = rest.substr(0, comma);
-  const auto colon = address.rfind(':');
-  if (address.empty() || colon == std::string_view::npos || colon == 0 || colon + 1 == address.size())
-    throw InvalidParams(
-        kField, "'" + excerpt(text) + "': the " + d + " driver needs HOST:PORT (e.g. 127.0.0.1:50000)");
-  std::string host(address.substr(0, colon));
-  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
-  const std::string_view port = address.substr(colon + 1);
-  const auto number = gcs2::parse_number(port);
-  if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string_view::npos || !number ||
-      *number < 1 || *number > 65535)
-    throw InvalidParams(kField, "'" + excerpt(text) + "': the port must be 1 to 65535");
-  c.host = host;
-  c.port = static_cast<std::uint16_t>(*number);
+  const bool serial = !address.empty() && address.front() == '/';
+  if (serial) {
+    c.serial.path = std::string(address);
+  } else {
+    const auto colon = address.rfind(':');
+    if (address.empty() || colon == std::string_view::npos || colon == 0 || colon + 1 == address.size())
+      throw InvalidParams(kField, "'" + excerpt(text) + "': the " + d +
+                                      " driver needs HOST:PORT (e.g. 127.0.0.1:50000) or a device path "
+                                      "(/dev/ttyUSB0)");
+    std::string host(address.substr(0, colon));
+    if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+    const std::string_view port = address.substr(colon + 1);
+    const auto number = gcs2::parse_number(port);
+    if (port.size() > 5 || port.find_first_not_of("0123456789") != std::string_view::npos || !number ||
+        *number < 1 || *number > 65535)
+      throw InvalidParams(kField, "'" + excerpt(text) + "': the port must be 1 to 65535");
+    c.host = host;
+    c.port = static_cast<std::uint16_t>(*number);
+  }
   while (comma != std::string_view::npos && !rest.empty()) {
     rest = rest.substr(rest.find(',') + 1);
     const auto next = rest.find(',');
@@ -65,6 +105,14 @@ Connection parse_connection(const std::string& text, std::string_view driver) {
       throw InvalidParams(
           kField, "'" + excerpt(text) + "': option '" + excerpt(item.substr(0, eq)) + "' given twice");
     if (next == std::string_view::npos) break;
+  }
+  if (serial) {
+    take_serial_options(c, text, default_baud);
+  } else {
+    for (const char* key : {"baud", "flow"})
+      if (c.options.count(key) != 0)
+        throw InvalidParams(kField, "'" + excerpt(text) + "': option '" + key +
+                                        "' is a serial line's; this connection is TCP (HOST:PORT)");
   }
   return c;
 }
@@ -144,9 +192,17 @@ void LineClient::connect(const std::string& host, std::uint16_t port, double tim
   error_.clear();
 }
 
+void LineClient::open(const Connection& c, double timeout_s) {
+  if (c.is_serial())
+    open_serial(c.serial);
+  else
+    connect(c.host, c.port, timeout_s);
+}
+
 void LineClient::close() noexcept {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
+  tty_ = false;
   pending_.clear();
 }
 
@@ -154,7 +210,8 @@ bool LineClient::send(std::string_view bytes, Clock::time_point deadline) {
   if (fd_ < 0) return error_ = "not connected", false;
   std::size_t done = 0;
   while (done < bytes.size()) {
-    const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    const ssize_t n = tty_ ? ::write(fd_, bytes.data() + done, bytes.size() - done)
+                           : ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
     if (n > 0) {
       done += static_cast<std::size_t>(n);
       continue;
@@ -174,12 +231,16 @@ bool LineClient::read_some(Clock::time_point deadline) {
   if (fd_ < 0) return error_ = "not connected", false;
   char buf[4096];
   while (true) {
-    const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+    const ssize_t n = tty_ ? ::read(fd_, buf, sizeof buf) : ::recv(fd_, buf, sizeof buf, 0);
     if (n > 0) {
       pending_.append(buf, static_cast<std::size_t>(n));
       return true;
     }
-    if (n == 0) return error_ = "the controller closed the connection", false;
+    // A tty reads 0 (VMIN=1, O_NONBLOCK) only once hung up: a closed pty master does that
+    // (serial_line_test.cc); a device that went away may fail with an error (EIO) instead, which
+    // lands below as "connection lost". Either faults the bus.
+    if (n == 0)
+      return error_ = tty_ ? "the serial line hung up" : "the controller closed the connection", false;
     if (errno == EINTR) continue;
     if (errno != EAGAIN && errno != EWOULDBLOCK)
       return error_ = std::string("connection lost (") + std::strerror(errno) + ")", false;
@@ -194,6 +255,11 @@ void LineClient::discard_input() {
   pending_.clear();
   if (fd_ < 0) return;
   char buf[4096];
+  if (tty_) {
+    while (::read(fd_, buf, sizeof buf) > 0) {  // O_NONBLOCK: never waits
+    }
+    return;
+  }
   while (::recv(fd_, buf, sizeof buf, MSG_DONTWAIT) > 0) {
   }
 }
