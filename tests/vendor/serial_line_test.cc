@@ -219,7 +219,9 @@ TEST(SerialLine, ThePiGcs2DriverConfiguresAndMovesTheAxesOverTheLine) {
     EXPECT_TRUE(p->axis(i).measurement_fresh());
   }
   const double poll_Hz = (fake.server.count("POS?") - polls_before) / elapsed;
-  EXPECT_GT(poll_Hz, 150.0);  // every 2 ms asked: a third of it on a loaded machine
+  // Asked every 2 ms; the contract is a reading within every stale window (50 ms), whatever the
+  // machine's load (the rate itself is measured by bench/driver_bench).
+  EXPECT_GT(poll_Hz, 20.0);
   std::cout << "[ gcs2 over a pty ] POS? polled at " << poll_Hz << " Hz, " << fake.server.count("MOV")
             << " MOV\n";
 }

@@ -115,7 +115,9 @@ TEST(Gcs2Driver, RunsThePlatformMovesEachAxisAndPollsWithoutAllocatingInTheLoop)
   }
   // POS? every 2 ms (the poll period): at least a third of that rate on a loaded machine.
   const double poll_Hz = (fake.server.count("POS?") - polls_before) / elapsed;
-  EXPECT_GT(poll_Hz, 150.0);
+  // Asked every 2 ms; the contract is a reading within every stale window (50 ms), whatever the
+  // machine's load (the rate itself is measured by bench/driver_bench).
+  EXPECT_GT(poll_Hz, 20.0);
   std::cout << "[ gcs2 ] POS? polled at " << poll_Hz << " Hz, " << fake.server.count("MOV") << " MOV\n";
   // Each MOV was followed by ERR? (the error register drained after every set command).
   const auto lines = fake.server.lines();
