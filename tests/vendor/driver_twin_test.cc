@@ -111,7 +111,10 @@ Move move_to(const std::string& driver, const std::string& connection, std::uint
   register_vendor_drivers();
   PlatformConfig c;
   c.devices.driver = driver;
-  c.devices.connection = connection;
+  // The twin is another process, sanitized too under ASan and sharing two loaded cores with the
+  // other tests: its replies may take longer than a controller's. These tests are about driving
+  // it; the fault timing has its own tests against an in-process controller (vendor_driver_test).
+  c.devices.connection = connection + ",timeout_s=1,stale_s=0.5";
   auto p = platform::make_platform(c);
   const auto& s = p->config().stage;
   control::ConsoleInput in;
