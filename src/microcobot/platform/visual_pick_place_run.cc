@@ -77,24 +77,9 @@ void VisualPickPlaceParams::validate() const {
 
 namespace {
 
-// A cross of +-`arm` pixels at (u, v) in `value` (the report's overlays).
-void pick_place_cross(vs::Frame& f, double u, double v, int arm, std::uint16_t value) {
-  const int cu = static_cast<int>(std::lround(u)), cv = static_cast<int>(std::lround(v));
-  for (int d = -arm; d <= arm; ++d) {
-    if (cv >= 0 && cv < f.height && cu + d >= 0 && cu + d < f.width)
-      f.pixels[static_cast<std::size_t>(cv) * f.width + cu + d] = value;
-    if (cu >= 0 && cu < f.width && cv + d >= 0 && cv + d < f.height)
-      f.pixels[static_cast<std::size_t>(cv + d) * f.width + cu] = value;
-  }
-}
-
 std::string marked_png(const vs::Frame& frame, const Eigen::Vector2d& feature,
                        const Eigen::Vector2d& target) {
-  vs::Frame marked = frame;
-  pick_place_cross(marked, target.x(), target.y(), 12,
-                   static_cast<std::uint16_t>((1 << marked.bit_depth) - 1));
-  pick_place_cross(marked, feature.x(), feature.y(), 8, 0);
-  return vs::encode_png(marked);
+  return vs::encode_marked_png(frame, feature.x(), feature.y(), target.x(), target.y());
 }
 
 // A square ROI of `side` pixels centred on (u, v); InvalidInput naming `what` when it leaves the frame.

@@ -32,21 +32,6 @@ void ServoRunParams::validate() const {
   tracker.validate();
 }
 
-namespace {
-
-// A cross of +-`arm` pixels at (u, v), drawn in `value` (the report's overlay).
-void draw_cross(vs::Frame& f, double u, double v, int arm, std::uint16_t value) {
-  const int cu = static_cast<int>(std::lround(u)), cv = static_cast<int>(std::lround(v));
-  for (int d = -arm; d <= arm; ++d) {
-    if (cv >= 0 && cv < f.height && cu + d >= 0 && cu + d < f.width)
-      f.pixels[static_cast<std::size_t>(cv) * f.width + cu + d] = value;
-    if (cu >= 0 && cu < f.width && cv + d >= 0 && cv + d < f.height)
-      f.pixels[static_cast<std::size_t>(cv + d) * f.width + cu] = value;
-  }
-}
-
-}  // namespace
-
 ServoRunResult run_visual_servo(const ServoRunParams& p) {
   p.validate();
   const PlatformConfig config = scene_config(p.scene);
@@ -153,11 +138,8 @@ ServoRunResult run_visual_servo(const ServoRunParams& p) {
     rec.v_px = feature.v_px;
     rec.found = feature.found;
     if (k == 0) {
-      vs::Frame marked = frame;
-      draw_cross(marked, r.target_px.x(), r.target_px.y(), 12,
-                 static_cast<std::uint16_t>(marked.pixels.empty() ? 0 : (1 << marked.bit_depth) - 1));
-      draw_cross(marked, feature.u_px, feature.v_px, 8, 0);
-      r.first_png = vs::encode_png(marked);
+      r.first_png =
+          vs::encode_marked_png(frame, feature.u_px, feature.v_px, r.target_px.x(), r.target_px.y());
     }
 
     // The command, from the frame's end plus the processing latency.
@@ -176,11 +158,7 @@ ServoRunResult run_visual_servo(const ServoRunParams& p) {
     rec.periods_y = stage.last_periods(1);
     r.frames.push_back(rec);
     if (k == p.max_frames - 1) {
-      vs::Frame marked = frame;
-      draw_cross(marked, r.target_px.x(), r.target_px.y(), 12,
-                 static_cast<std::uint16_t>((1 << marked.bit_depth) - 1));
-      draw_cross(marked, feature.u_px, feature.v_px, 8, 0);
-      r.last_png = vs::encode_png(marked);
+      r.last_png = vs::encode_marked_png(frame, feature.u_px, feature.v_px, r.target_px.x(), r.target_px.y());
     }
   }
   // The last command's run completes; the stage at rest is judged.

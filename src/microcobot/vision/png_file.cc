@@ -1,6 +1,8 @@
 #include "microcobot/vision/png_file.h"
 
+#include <cmath>
 #include <csetjmp>
+#include <cstdint>
 #include <vector>
 
 #include <png.h>
@@ -19,7 +21,27 @@ void append(png_structp png, png_bytep data, png_size_t length) {
 
 void flush(png_structp) {}
 
+// A cross of +-`arm` pixels at (u, v), drawn in `value`, clipped to the frame.
+void draw_cross(Frame& f, double u, double v, int arm, std::uint16_t value) {
+  const int cu = static_cast<int>(std::lround(u)), cv = static_cast<int>(std::lround(v));
+  for (int d = -arm; d <= arm; ++d) {
+    if (cv >= 0 && cv < f.height && cu + d >= 0 && cu + d < f.width)
+      f.pixels[static_cast<std::size_t>(cv) * f.width + cu + d] = value;
+    if (cu >= 0 && cu < f.width && cv + d >= 0 && cv + d < f.height)
+      f.pixels[static_cast<std::size_t>(cv + d) * f.width + cu] = value;
+  }
+}
+
 }  // namespace
+
+std::string encode_marked_png(const Frame& frame, double feature_u_px, double feature_v_px,
+                              double target_u_px, double target_v_px) {
+  Frame marked = frame;
+  draw_cross(marked, target_u_px, target_v_px, 12,
+             static_cast<std::uint16_t>(marked.pixels.empty() ? 0 : (1 << marked.bit_depth) - 1));
+  draw_cross(marked, feature_u_px, feature_v_px, 8, 0);
+  return encode_png(marked);
+}
 
 std::string encode_png(const Frame& frame) {
   const bool eight = frame.bit_depth <= 8;

@@ -13,6 +13,11 @@ namespace mc::vision {
 
 /// The PNG bytes of `frame`. Throws ComputationFailed if libpng fails.
 std::string encode_png(const Frame& frame);
+/// The PNG bytes of `frame` with a servoed feature marked by a dark cross (+-8 px) at
+/// `feature_px` and its target by a bright one (+-12 px) at `target_px` (u, v: column, row): the
+/// overlays of the visual servo's reports. Marks outside the frame are clipped.
+std::string encode_marked_png(const Frame& frame, double feature_u_px, double feature_v_px,
+                              double target_u_px, double target_v_px);
 /// Writes `frame` to `path` (temporary name, renamed when complete). Throws InvalidInput naming
 /// `path` when it cannot be written.
 void write_png(const std::filesystem::path& path, const Frame& frame);
