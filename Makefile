@@ -5,8 +5,8 @@ PRESET ?= release
 BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
-# Everything `make test` builds; the sanitizer and fuzz presets leave out what they leave out.
-ifeq ($(filter $(PRESET),asan fuzz),)
+# Everything `make test` builds; the sanitizer preset leaves out what it leaves out.
+ifeq ($(filter $(PRESET),asan),)
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_BUILD_BENCH=ON -DMC_BUILD_PYTHON=ON -DMC_WITH_OPENCV=ON
 else
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_WITH_OPENCV=ON

@@ -176,7 +176,8 @@ std::vector<FocusCase> validation_cases(int set, int objective) {
     c.noise_seed = rng.next_u64();
     c.z_true_m = c.part ? rng.uniform(100e-6, 400e-6) : 0.0;
     c.part_x_m = 150e-6 + rng.uniform(-0.3, 0.3) * roi_w_m;  // the edge within the ROI's middle 60 %
-    c.offset_m = (rng.uniform() < 0.5 ? -1.0 : 1.0) * rng.uniform(20e-6, 100e-6);
+    const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;  // sequenced: the same cases whatever the compiler
+    c.offset_m = sign * rng.uniform(20e-6, 100e-6);
     c.range_around_truth = false;
     out.push_back(c);
   }

@@ -19,7 +19,16 @@ function(mc_add_module name)
   add_library(mc_${name} STATIC ${_sources})
   target_include_directories(mc_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(mc_${name} PUBLIC ${_deps} ${ARG_LIBS} PRIVATE mc_warnings)
+  mc_unity_build(mc_${name})
   set_property(GLOBAL APPEND PROPERTY MC_MODULES mc_${name})
+endfunction()
+
+# Unity build of a library or of the command line (MC_UNITY_LIBS): as for the tests, a file's
+# helpers in its anonymous namespace must have names of their own within its module.
+function(mc_unity_build target)
+  if(MC_UNITY_LIBS)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${MC_UNITY_LIBS_BATCH_SIZE})
+  endif()
 endfunction()
 
 # Embeds the charting library (uPlot, pinned by package-lock.json) into the binary so that

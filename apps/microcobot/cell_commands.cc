@@ -16,6 +16,7 @@
 #include "microcobot/core/params.h"
 #include "microcobot/report/box_plot.h"
 
+namespace cell_commands {
 namespace {
 
 namespace cell = mc::cell;
@@ -338,3 +339,4 @@ const bool kRegistered = mc::cli::register_group(
      &add_cell});
 
 }  // namespace
+}  // namespace cell_commands

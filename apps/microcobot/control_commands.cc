@@ -19,6 +19,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 
+namespace control_commands {
 namespace {
 
 namespace ct = mc::control;
@@ -534,3 +535,4 @@ const bool kRegistered = mc::cli::register_group(
 const bool kPart = mc::cli::register_report_part({"control", 50, &control_part});
 
 }  // namespace
+}  // namespace control_commands

@@ -17,6 +17,7 @@
 #include "microcobot/tweezers/specs.h"
 #include "microcobot/tweezers/transmission.h"
 
+namespace design_commands {
 namespace {
 
 namespace tw = mc::tweezers;
@@ -222,3 +223,4 @@ const bool kRegistered = mc::cli::register_group(
     {"design", "TéléTweez design calculators (ch. 4, app. A, B, eq. 3.2)", 60, &add_design});
 
 }  // namespace
+}  // namespace design_commands

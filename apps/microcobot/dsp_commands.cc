@@ -21,6 +21,7 @@
 #include "microcobot/dsp/welch.h"
 #include "microcobot/ident/tf_fit.h"
 
+namespace dsp_commands {
 namespace {
 
 using mc::cli::CommonOptions;
@@ -376,3 +377,4 @@ const bool kRegistered =
 const bool kReportRegistered = mc::cli::register_report_part({"dsp", 20, &dsp_part});
 
 }  // namespace
+}  // namespace dsp_commands

@@ -18,6 +18,7 @@
 #include "microcobot/microworld/tweezers_scenario.h"
 #include "microcobot/report/report.h"
 
+namespace haptics_commands {
 namespace {
 
 namespace hp = mc::haptics;
@@ -395,3 +396,4 @@ const bool kRegistered = mc::cli::register_group(
 const bool kReportRegistered = mc::cli::register_report_part({"haptics", 40, &build_part});
 
 }  // namespace
+}  // namespace haptics_commands

@@ -17,6 +17,7 @@
 #include "microcobot/stickslip/ident_all.h"
 #include "microcobot/stickslip/ident_synthetic.h"
 
+namespace identify_commands {
 namespace {
 
 namespace ss = mc::stickslip;
@@ -523,3 +524,4 @@ const bool kRegistered = mc::cli::register_group(
 const bool kReport = mc::cli::register_report_part({"identify", 35, &build_report});
 
 }  // namespace
+}  // namespace identify_commands

@@ -20,6 +20,7 @@
 #include "network_options.h"
 #include "signals.h"
 
+namespace link_commands {
 namespace {
 
 namespace net = mc::net;
@@ -296,3 +297,4 @@ const bool kRegistered = mc::cli::register_group(
      &add_link});
 
 }  // namespace
+}  // namespace link_commands

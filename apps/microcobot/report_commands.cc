@@ -9,6 +9,7 @@
 #include "microcobot/report/report.h"
 #include "signals.h"
 
+namespace report_commands {
 namespace {
 
 struct ReportOptions {
@@ -56,11 +57,13 @@ const bool kRegistered = mc::cli::register_group(
     {"report", "Build the full HTML report (every module's figures) into --out DIR", 100, &add_report});
 
 }  // namespace
+}  // namespace report_commands
 
 // The generator every simulation draws its noise from, checked against the density it
 // promises: a histogram of 200 000 draws over the standard normal density.
 #include <cmath>
 #include "microcobot/core/rng.h"
+namespace report_commands {
 namespace {
 void rng_part(mc::report::Report& r) {
   r.section("Random number generator",
@@ -97,3 +100,4 @@ void rng_part(mc::report::Report& r) {
 }
 const bool kRngPart = mc::cli::register_report_part({"rng", 5, &rng_part});
 }  // namespace
+}  // namespace report_commands

@@ -13,6 +13,7 @@
 #include "microcobot/platform/session.h"
 #include "signals.h"
 
+namespace run_commands {
 namespace {
 
 namespace pf = mc::platform;
@@ -95,3 +96,4 @@ const bool kRegistered = mc::cli::register_group(
     {"run", "Run the platform: a teleoperated pick-and-place scenario with its session report", 5, &add_run});
 
 }  // namespace
+}  // namespace run_commands

@@ -33,6 +33,7 @@
 #include "network_options.h"
 #include "signals.h"
 
+namespace serve_commands {
 namespace {
 
 namespace pf = mc::platform;
@@ -380,3 +381,4 @@ const bool kRegistered = mc::cli::register_group(
      &add_serve});
 
 }  // namespace
+}  // namespace serve_commands

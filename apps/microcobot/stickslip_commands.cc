@@ -16,6 +16,7 @@
 #include "microcobot/stickslip/experiments.h"
 #include "microcobot/stickslip/integrator_accuracy.h"
 
+namespace stickslip_commands {
 namespace {
 
 namespace ss = mc::stickslip;
@@ -503,3 +504,4 @@ const bool kRegistered = mc::cli::register_group(
 const bool kPart = mc::cli::register_report_part({"stickslip", 30, &stickslip_part});
 
 }  // namespace
+}  // namespace stickslip_commands

@@ -19,6 +19,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
 
+namespace teleop_commands {
 namespace {
 
 namespace ctl = mc::control;
@@ -347,3 +348,4 @@ const bool kRegistered = mc::cli::register_group(
     {"teleop", "The coupling system over a network link: delay, jitter, loss, passivity", 7, &add_teleop});
 
 }  // namespace
+}  // namespace teleop_commands

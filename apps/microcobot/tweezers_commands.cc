@@ -12,6 +12,7 @@
 #include "microcobot/core/params.h"
 #include "microcobot/tweezers/config.h"
 
+namespace tweezers_commands {
 namespace {
 
 namespace tw = mc::tweezers;
@@ -361,3 +362,4 @@ const bool kRegistered = mc::cli::register_group(
 const bool kPart = mc::cli::register_report_part({"tweezers", 70, &tweezers_part});
 
 }  // namespace
+}  // namespace tweezers_commands

@@ -17,6 +17,7 @@
 #include "microcobot/vision/renderer.h"
 #include "vision_processing_commands.h"
 
+namespace vision_commands {
 namespace {
 
 namespace vs = mc::vision;
@@ -198,3 +199,4 @@ const bool kRegistered = mc::cli::register_group(
      45, &add_vision});
 
 }  // namespace
+}  // namespace vision_commands

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "microcobot/control/teleoperation.h"
 #include "microcobot/core/error.h"
 #include "microcobot/microworld/piezo_gripper.h"
@@ -66,7 +68,8 @@ TEST(SafetyLimits, OverTheContactLimitTheTargetGoesNoFurtherInButMayBackOff) {
 }
 
 TEST(SafetyLimits, RejectsBadLimits) {
-  for (double bad : {0.0, -1.0, double(NAN), double(INFINITY)}) {
+  for (double bad : {0.0, -1.0, double(std::numeric_limits<double>::quiet_NaN()),
+                     double(std::numeric_limits<double>::infinity())}) {
     SafetyLimitParams p;
     p.grip_force_limit_N = bad;
     EXPECT_THROW(SafetyLimits{p}, InvalidParams);
@@ -75,7 +78,7 @@ TEST(SafetyLimits, RejectsBadLimits) {
     EXPECT_THROW(SafetyLimits{p}, InvalidParams);
   }
   SafetyLimitParams p;
-  p.floor_m = NAN;
+  p.floor_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(SafetyLimits{p}, InvalidParams);
 }
 

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -62,7 +63,7 @@ TEST(CsvStreamWriter, AnAbandonedOrFailedFileLeavesNothing) {
   CsvStreamWriter nan(dir / "nan.csv", {"t_s", "x_m"});
   nan.append(std::array<double, 2>{0.0, 1.0});
   try {
-    nan.append(std::array<double, 2>{1.0, NAN});
+    nan.append(std::array<double, 2>{1.0, std::numeric_limits<double>::quiet_NaN()});
     FAIL() << "a NaN is refused (the reader refuses it too)";
   } catch (const InvalidInput& e) {
     EXPECT_THAT(e.what(), HasSubstr("nan.csv"));

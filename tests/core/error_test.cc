@@ -1,7 +1,8 @@
 #include "microcobot/core/error.h"
 
-#include <cmath>
 #include <gtest/gtest.h>
+#include <cmath>
+#include <limits>
 
 namespace mc {
 namespace {
@@ -24,7 +25,7 @@ TEST(Error, RequireHelpersRejectNonFiniteAndOutOfRange) {
   EXPECT_THROW(require_non_negative(-1e-300, "x"), InvalidParams);
   EXPECT_NO_THROW(require_in_range(100.0, 0.0, 100.0, "u_V"));
   EXPECT_THROW(require_in_range(100.5, 0.0, 100.0, "u_V"), InvalidParams);
-  EXPECT_THROW(require_in_range(INFINITY, 0.0, 100.0, "u_V"), InvalidParams);
+  EXPECT_THROW(require_in_range(std::numeric_limits<double>::infinity(), 0.0, 100.0, "u_V"), InvalidParams);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -164,7 +165,7 @@ TEST(SosFilter, SteadyStateResetGivesNoTransient) {
 
 TEST(SosFilter, RejectsEmptyAndNonFinite) {
   EXPECT_THROW(SosFilter(Sos{}), InvalidParams);
-  EXPECT_THROW(SosFilter(Sos{Biquad{NAN, 0, 0, 0, 0}}), InvalidParams);
+  EXPECT_THROW(SosFilter(Sos{Biquad{std::numeric_limits<double>::quiet_NaN(), 0, 0, 0, 0}}), InvalidParams);
   EXPECT_THROW(Biquad::from_row({1, 0, 0, 0, 0, 0}), InvalidParams);
   SosFilter f(Sos{Biquad{}});
   std::vector<double> a(3), b(2);

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -34,7 +35,8 @@ TEST(LiveDrivers, TheConsoleJogsTheStageThroughTheSelectedDriversAndTheDemoIsRef
   LivePlatform live(params);
   ASSERT_TRUE(g_bench);
   std::mutex mutex;
-  double measured_x = NAN;  // the driver's encoder, as the telemetry carries it
+  double measured_x =
+      std::numeric_limits<double>::quiet_NaN();  // the driver's encoder, as the telemetry carries it
   const std::size_t x_channel = 10;
   ASSERT_STREQ(platform::kTelemetryChannels[x_channel], "measured_x_m");
   live.start([&](const platform::TelemetrySample& s, std::size_t) {

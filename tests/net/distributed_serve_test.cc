@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -49,7 +50,7 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
 
   // 1. A teleoperated move: the master's console jogs +x at 100 um/s; the slave's stage follows
   //    and the master sees the slave's measured position.
-  double x0 = NAN;
+  double x0 = std::numeric_limits<double>::quiet_NaN();
   {
     Watch m(master1.port), s(slave1.port);
     ASSERT_TRUE(m.console.action("take_control"));

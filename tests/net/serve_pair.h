@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -84,14 +85,15 @@ struct Watch {
   /// watched loop's clock on this process's steady clock, plus the fastest delivery. A loaded
   /// machine delivers the telemetry late (frames queue in the socket), so when a frame arrives
   /// says little about when the loop produced it; its `t_s` does.
-  double min_lag_s = INFINITY;
+  double min_lag_s = std::numeric_limits<double>::infinity();
   explicit Watch(std::uint16_t port) : console(port) {
     console.subscribe("/platform/telemetry", kTelemetrySub);
   }
   const nlohmann::json& next() {
     const std::string payload = console.next_on(kTelemetrySub);
     last = payload.empty() ? nlohmann::json() : nlohmann::json::parse(payload);
-    const double t = last.is_object() ? last.value("t_s", NAN) : NAN;
+    const double t = last.is_object() ? last.value("t_s", std::numeric_limits<double>::quiet_NaN())
+                                      : std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(t)) min_lag_s = std::min(min_lag_s, steady_s(std::chrono::steady_clock::now()) - t);
     return last;
   }
@@ -103,7 +105,10 @@ struct Watch {
 };
 
 /// A telemetry value (NaN when the message or the key is missing).
-inline double at(const nlohmann::json& t, const char* key) { return t.is_object() ? t.value(key, NAN) : NAN; }
+inline double at(const nlohmann::json& t, const char* key) {
+  return t.is_object() ? t.value(key, std::numeric_limits<double>::quiet_NaN())
+                       : std::numeric_limits<double>::quiet_NaN();
+}
 
 /// Drives the master's console (a heartbeat at every telemetry frame, ~60 Hz) until `done`
 /// holds on the telemetry of both ends (`slave` may be null: the master's only), or `timeout`

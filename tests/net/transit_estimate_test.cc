@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "microcobot/core/error.h"
@@ -73,13 +74,13 @@ TEST(TransitEstimate, ResetForgetsTheRouteAndBadInputIsNeverOnTime) {
   EXPECT_TRUE(std::isinf(e.estimate_s()));
   EXPECT_EQ(e.observe(0.5, 0.0), 0.0) << "the first sample of a stream cannot be judged";
   EXPECT_NEAR(e.observe(0.6, 0.001), 0.1, 1e-12);
-  EXPECT_TRUE(std::isinf(e.observe(NAN, 0.002)));
-  EXPECT_TRUE(std::isinf(e.observe(0.5, INFINITY)));
+  EXPECT_TRUE(std::isinf(e.observe(std::numeric_limits<double>::quiet_NaN(), 0.002)));
+  EXPECT_TRUE(std::isinf(e.observe(0.5, std::numeric_limits<double>::infinity())));
   e.reset();
   EXPECT_TRUE(std::isinf(e.estimate_s()));
   EXPECT_EQ(e.observe(0.6, 0.003), 0.0);
   EXPECT_THROW(TransitEstimate(0.0), Error);
-  EXPECT_THROW(TransitEstimate(NAN), Error);
+  EXPECT_THROW(TransitEstimate{std::numeric_limits<double>::quiet_NaN()}, Error);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -107,9 +108,11 @@ class TwoHosts {
     const pid_t pid =
         test::spawn_process({ip_, "-n", names_[kDesk], "-s", "-j", "link", "show", "dev", names_[kDesk]},
                             tmp / "out", tmp / "err");
-    if (test::wait_process(pid, 10s) != 0) return {NAN, NAN};
+    if (test::wait_process(pid, 10s) != 0)
+      return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
     const json j = json::parse(test::read_text(tmp / "out"), nullptr, false);
-    if (!j.is_array() || j.empty() || !j[0].contains("stats64")) return {NAN, NAN};
+    if (!j.is_array() || j.empty() || !j[0].contains("stats64"))
+      return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
     const json& s = j[0]["stats64"];
     return {s["tx"]["packets"].get<double>(), s["rx"]["packets"].get<double>()};
   }
@@ -214,7 +217,7 @@ TEST(DistributedServe, OnTwoHostsJoinedByACableThatIsPulledAndPluggedBack) {
       << "engaged across a pulled cable: desk " << m->last.dump() << "\nbench " << s->last.dump();
   std::printf("both ends disengaged on the first frames %.0f ms (loop time) after the pull (60 Hz frames)\n",
               1e3 * since_pull_s(m->last, s->last));
-  double held = NAN;
+  double held = std::numeric_limits<double>::quiet_NaN();
   int resting = 0;
   ASSERT_TRUE(drive(*m, s.get(), jog(100e-6),
                     [&](const json& mt, const json& st) {

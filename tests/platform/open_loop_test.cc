@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "microcobot/platform/platform.h"
@@ -137,7 +138,8 @@ TEST(OpenLoop, OutOfRangeDrivesAreRefused) {
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 150.0, 500.0, +1, 10));
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 40.0, 0.0, +1, 10));
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 40.0, 500.0, +1, 0));
-  EXPECT_FALSE(rig.platform->start_open_loop_steps(0, NAN, 500.0, +1, 10));
+  EXPECT_FALSE(
+      rig.platform->start_open_loop_steps(0, std::numeric_limits<double>::quiet_NaN(), 500.0, +1, 10));
 }
 
 }  // namespace

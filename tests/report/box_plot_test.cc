@@ -2,6 +2,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/csv.h"
@@ -29,7 +31,7 @@ TEST(BoxPlot, TukeysBoxWithQuartilesAsNumpyAndOutliersBeyondOneAndAHalfIqr) {
   EXPECT_EQ(one.whisker_low, 2.5);
   EXPECT_TRUE(one.outliers.empty());
   EXPECT_THROW(box_stats({}), InvalidParams);
-  EXPECT_THROW(box_stats({1.0, NAN}), InvalidParams);
+  EXPECT_THROW(box_stats({1.0, std::numeric_limits<double>::quiet_NaN()}), InvalidParams);
 }
 
 TEST(BoxPlot, TheFigureCarriesEachGroupsStatisticsToThePageAndEverySampleToItsCsv) {

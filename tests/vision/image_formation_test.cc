@@ -104,7 +104,7 @@ double normalised_variance(const std::vector<float>& img, int w, int h) {
   std::size_t n = 0;
   for (int i = 40; i < h - 40; ++i)
     for (int j = 40; j < w - 40; ++j) {
-      const double v = img[static_cast<std::size_t>(i) * w + j];
+      const auto v = static_cast<double>(img[static_cast<std::size_t>(i) * w + j]);
       s += v, s2 += v * v, ++n;
     }
   const double mean = s / n;

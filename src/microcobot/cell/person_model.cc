@@ -41,7 +41,10 @@ bool Reach::aim(const Eigen::Vector2d& error, double tolerance, double t_s, doub
   if (d <= tolerance) return true;
   const double sd = p_.endpoint_sd_fraction * d;
   x0_ = x1_;
-  x1_ = x0_ + error + Eigen::Vector2d(rng_.normal(0.0, sd), rng_.normal(0.0, sd));
+  // One draw per statement (a call's arguments have no order, GCC's was y first): a seed gives the
+  // same person whatever the compiler.
+  const double miss_y = rng_.normal(0.0, sd), miss_x = rng_.normal(0.0, sd);
+  x1_ = x0_ + error + Eigen::Vector2d(miss_x, miss_y);
   t0_ = t_s;
   duration_ = std::max(p_.movement_time_s(d, std::max(tolerance, width)), 1.875 * d / max_speed);
   ++count_;

@@ -106,7 +106,10 @@ void PersonOperator::let_go() noexcept {
 
 Eigen::Vector2d PersonOperator::seen(const Eigen::Vector2d& p, double sd_m) noexcept {
   const double sd = sd_m >= 0.0 ? sd_m : p_.person.vision_sd_m;
-  return p + Eigen::Vector2d(rng_.normal(0.0, sd), rng_.normal(0.0, sd));
+  // One draw per statement (a call's arguments have no order, GCC's was y first): a seed gives the
+  // same person whatever the compiler.
+  const double seen_y = rng_.normal(0.0, sd), seen_x = rng_.normal(0.0, sd);
+  return p + Eigen::Vector2d(seen_x, seen_y);
 }
 
 bool PersonOperator::tool_still() const noexcept {

@@ -31,7 +31,11 @@ double log_uniform(Rng& rng, double lo, double hi) {
 Eigen::Vector3d random_unit(Rng& rng) {
   Eigen::Vector3d v;
   do {
-    v = Eigen::Vector3d(rng.normal(), rng.normal(), rng.normal());
+    // One draw per statement: a call's arguments are evaluated in an unspecified order (GCC right
+    // to left, clang left to right), and a seeded set must be the same whatever the compiler. The
+    // order is the one GCC gave, so that the sets measured before keep their cases.
+    const double z = rng.normal(), y = rng.normal(), x = rng.normal();
+    v = Eigen::Vector3d(x, y, z);
   } while (v.norm() < 1e-3);
   return v.normalized();
 }
@@ -85,8 +89,10 @@ ValidationCase draw_case(Rng& rng, CaseProfile profile, int index) {
     c.direction = random_unit(rng);
     const Eigen::Vector3d any = random_unit(rng);
     c.radial = (any - any.dot(c.direction) * c.direction).normalized();
-    c.lead_in_m = (rng.uniform() < 0.5 ? -1.0 : 1.0) * rng.uniform(5e-6, 40e-6);
-    c.lead_in_vec_m = rng.uniform(5e-6, 40e-6) * random_unit(rng);
+    const double lead_in_sign = rng.uniform() < 0.5 ? -1.0 : 1.0;  // sequenced: see random_unit()
+    c.lead_in_m = lead_in_sign * rng.uniform(5e-6, 40e-6);
+    const Eigen::Vector3d lead_in_direction = random_unit(rng);  // GCC drew the direction first
+    c.lead_in_vec_m = rng.uniform(5e-6, 40e-6) * lead_in_direction;
     c.sensor_seed = 1 + static_cast<int>(rng.next_u64() % 100000);
     // A sine within the trapezoids' envelope: peak velocity <= 800 um/s, acceleration <= 0.1 m/s^2.
     const double w = 2.0 * kPi * c.frequency_Hz;

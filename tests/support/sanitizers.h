@@ -1,0 +1,14 @@
+#pragma once
+/// MC_UNDER_ASAN: 1 when the test is built with AddressSanitizer (GCC defines
+/// __SANITIZE_ADDRESS__, clang answers __has_feature), for the few tests whose rates or timings
+/// are properties of an optimised build and get a wider bound under the sanitizer presets.
+#if defined(__SANITIZE_ADDRESS__)
+#define MC_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MC_UNDER_ASAN 1
+#endif
+#endif
+#ifndef MC_UNDER_ASAN
+#define MC_UNDER_ASAN 0
+#endif
