@@ -38,6 +38,7 @@ enum Error : int {
 std::string_view error_text(int code);
 
 /// The single-byte commands (sent without LF).
+inline constexpr double kMmPerM = 1e3;    ///< GCS 2.0 positions and velocities are in mm (mm/s)
 inline constexpr char kMotionStatus = 5;  ///< #5: hex mask of the moving axes
 inline constexpr char kReadyStatus = 7;   ///< #7: 0xB1 ready, 0xB0 busy
 inline constexpr char kStopAll = 24;      ///< #24: stop every axis (error 10)

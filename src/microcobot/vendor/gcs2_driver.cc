@@ -14,8 +14,6 @@
 namespace mc::vendor {
 namespace {
 
-constexpr double kMmPerM = 1e3;
-
 bool valid_axis_id(const std::string& id) {
   return !id.empty() && id.size() <= 16 && std::all_of(id.begin(), id.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
@@ -141,8 +139,8 @@ void Gcs2Controller::handshake(LineClient& bus) {
   if (!gcs2::parse_error_reply(query(bus, "ERR?"))) throw BusFault("ERR?: not an error code");
   const auto tmn = read_axes(bus, "TMN?"), tmx = read_axes(bus, "TMX?");
   for (std::size_t i = 0; i < 3; ++i) {
-    min_m_[i] = tmn[i] / kMmPerM;
-    max_m_[i] = tmx[i] / kMmPerM;
+    min_m_[i] = tmn[i] / gcs2::kMmPerM;
+    max_m_[i] = tmx[i] / gcs2::kMmPerM;
     if (!(min_m_[i] <= 0.0 && max_m_[i] >= 0.0))
       throw BusFault(fmt::format("axis {}: TMN?..TMX? = {}..{} mm does not hold the stage's home (0)",
                                  params_.axes[i], tmn[i], tmx[i]));
@@ -171,7 +169,7 @@ void Gcs2Controller::handshake(LineClient& bus) {
     }
   }
   const auto pos = read_axes(bus, "POS?");
-  for (int i = 0; i < 3; ++i) publish_position(i, pos[static_cast<std::size_t>(i)] / kMmPerM);
+  for (int i = 0; i < 3; ++i) publish_position(i, pos[static_cast<std::size_t>(i)] / gcs2::kMmPerM);
   publish_stamp();
   sent_ = {};
 }
@@ -186,7 +184,7 @@ void Gcs2Controller::cycle(LineClient& bus) {
     }
     const double target = std::clamp(t.m[i], min_m_[i], max_m_[i]);
     if (sent_[i] && std::abs(target - sent_m_[i]) < 0.5e-9) continue;  // the wire's resolution: 1 nm
-    mov += fmt::format(" {} {:.6f}", params_.axes[i], target * kMmPerM);
+    mov += fmt::format(" {} {:.6f}", params_.axes[i], target * gcs2::kMmPerM);
     sent_m_[i] = target;
     sent_[i] = true;
   }
@@ -195,7 +193,7 @@ void Gcs2Controller::cycle(LineClient& bus) {
     moves_.fetch_add(1, std::memory_order_relaxed);
   }
   const auto pos = read_axes(bus, "POS?");
-  for (int i = 0; i < 3; ++i) publish_position(i, pos[static_cast<std::size_t>(i)] / kMmPerM);
+  for (int i = 0; i < 3; ++i) publish_position(i, pos[static_cast<std::size_t>(i)] / gcs2::kMmPerM);
   publish_stamp();
 }
 

@@ -13,7 +13,6 @@ using gcs2::axis_value;
 
 namespace {
 constexpr const char* kAxisNames[3] = {"1", "2", "3"};
-constexpr double kMmPerM = 1e3;
 }  // namespace
 
 void Gcs2TwinParams::validate() const {
@@ -28,8 +27,8 @@ Gcs2Twin::Gcs2Twin(TwinStage& stage, Gcs2TwinParams params) : stage_(stage), par
   params_.validate();
   for (int i = 0; i < 3; ++i) {
     velocity_mm_s_[static_cast<std::size_t>(i)] =
-        std::min(params_.velocity_mm_s, stage_.max_speed_m_s() * kMmPerM);
-    target_mm_[static_cast<std::size_t>(i)] = stage_.axis(i).position_m * kMmPerM;
+        std::min(params_.velocity_mm_s, stage_.max_speed_m_s() * gcs2::kMmPerM);
+    target_mm_[static_cast<std::size_t>(i)] = stage_.axis(i).position_m * gcs2::kMmPerM;
   }
 }
 
@@ -93,8 +92,8 @@ bool Gcs2Twin::send_goal(ClientId client, unsigned moved) {
   double speed = 1e9;
   for (std::size_t i = 0; i < 3; ++i) {
     // An axis with its servo off is not commanded: it holds where it is.
-    goal[i] = servo_[i] ? target_mm_[i] / kMmPerM : stage_.axis(static_cast<int>(i)).position_m;
-    if (moved & (1u << i)) speed = std::min(speed, velocity_mm_s_[i] / kMmPerM);
+    goal[i] = servo_[i] ? target_mm_[i] / gcs2::kMmPerM : stage_.axis(static_cast<int>(i)).position_m;
+    if (moved & (1u << i)) speed = std::min(speed, velocity_mm_s_[i] / gcs2::kMmPerM);
   }
   switch (stage_.move_to(client, goal, speed)) {
     case TwinStage::Refusal::kNone:
@@ -112,7 +111,7 @@ void Gcs2Twin::stop_all(ClientId client) {
   stage_.stop(client);
   for (int i = 0; i < 3; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    target_mm_[k] = stage_.axis(i).position_m * kMmPerM;
+    target_mm_[k] = stage_.axis(i).position_m * gcs2::kMmPerM;
     referencing_[k] = false;
   }
   set_error(gcs2::kStopped);
@@ -196,7 +195,8 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
     reply.push_back(std::to_string(error_));
     error_ = gcs2::kNoError;
   } else if (m == "POS?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).position_m * kMmPerM); });
+    return per_axis(
+        [&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).position_m * gcs2::kMmPerM); });
   } else if (m == "MOV?") {
     return per_axis(
         [&](int i) { return axis_value(kAxisNames[i], target_mm_[static_cast<std::size_t>(i)]); });
@@ -212,9 +212,9 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
     return per_axis(
         [&](int i) { return axis_value(kAxisNames[i], velocity_mm_s_[static_cast<std::size_t>(i)]); });
   } else if (m == "TMN?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.min_m(i) * kMmPerM); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.min_m(i) * gcs2::kMmPerM); });
   } else if (m == "TMX?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.max_m(i) * kMmPerM); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.max_m(i) * gcs2::kMmPerM); });
   } else if (m == "SVO") {
     if (!pairs(r.args, values)) return false;
     for (auto [i, v] : values)
@@ -222,14 +222,14 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
     for (auto [i, v] : values) {
       const auto k = static_cast<std::size_t>(i);
       // Servo on: the target becomes the present position (as the controller's does).
-      if (v == 1.0 && !servo_[k]) target_mm_[k] = stage_.axis(i).position_m * kMmPerM;
+      if (v == 1.0 && !servo_[k]) target_mm_[k] = stage_.axis(i).position_m * gcs2::kMmPerM;
       servo_[k] = v == 1.0;
       if (!servo_[k]) referencing_[k] = false;
     }
   } else if (m == "VEL") {
     if (!pairs(r.args, values)) return false;
     for (auto [i, v] : values)
-      if (!(v > 0.0 && v <= stage_.max_speed_m_s() * kMmPerM))
+      if (!(v > 0.0 && v <= stage_.max_speed_m_s() * gcs2::kMmPerM))
         return set_error(gcs2::kParameterOutOfRange), false;
     for (auto [i, v] : values) velocity_mm_s_[static_cast<std::size_t>(i)] = v;
   } else if (m == "MOV" || m == "MVR") {
@@ -240,7 +240,8 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
       const auto k = static_cast<std::size_t>(i);
       if (!servo_[k] || !referenced_[k]) return set_error(gcs2::kUnallowableMove), false;
       target[k] = m == "MOV" ? v : target_mm_[k] + v;
-      if (target[k] < stage_.min_m(i) * kMmPerM - 1e-9 || target[k] > stage_.max_m(i) * kMmPerM + 1e-9)
+      if (target[k] < stage_.min_m(i) * gcs2::kMmPerM - 1e-9 ||
+          target[k] > stage_.max_m(i) * gcs2::kMmPerM + 1e-9)
         return set_error(gcs2::kPositionOutOfLimits), false;
     }
     unsigned moved = 0;
