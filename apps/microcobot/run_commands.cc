@@ -73,7 +73,11 @@ void run(const RunOptions& o) {
                             o.scenario, result.verdict, 1e6 * result.placement_error_m, result.duration_s,
                             result.wall_s, result.ticks, result.tick_mean_us, result.tick_p99_us,
                             result.overruns, (dir / "index.html").string()));
-  if (!result.success) throw mc::ComputationFailed("scenario " + o.scenario + " failed: " + result.verdict);
+  if (!result.success) {
+    // The report of a failed session is what tells why: it is kept (whole), and then exit 4.
+    mc::cli::commit_outputs();
+    throw mc::ComputationFailed("scenario " + o.scenario + " failed: " + result.verdict);
+  }
 }
 
 void add_run(CLI::App& cmd) {

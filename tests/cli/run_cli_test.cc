@@ -65,5 +65,22 @@ TEST(RunCli, BadFlagsExitTwo) {
   EXPECT_EQ(line_count(r.err), 1u) << r.err;
 }
 
+TEST(RunCli, AFailedScenarioExitsFourAndKeepsItsReport) {
+  // One simulated second is too short for the pick-and-place: the scenario fails, and what it
+  // recorded is what the user needs to see why (docs/cli.md).
+  test::TempDir dir;
+  const auto out = dir / "session";
+  const auto r = run_cli({"run", "--duration", "1", "--json", "--out", out.string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("maximum duration"));
+  EXPECT_EQ(line_count(r.err), 1u) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j.at("success").get<bool>());
+  EXPECT_EQ(j.at("report").get<std::string>(), (out / "index.html").string());
+  EXPECT_TRUE(std::filesystem::exists(out / "index.html"));
+  EXPECT_TRUE(std::filesystem::exists(out / "recording.csv"));
+  EXPECT_TRUE(std::filesystem::exists(out / "recording.mcap"));
+}
+
 }  // namespace
 }  // namespace mc

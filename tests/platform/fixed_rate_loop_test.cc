@@ -1,13 +1,16 @@
 #include "microcobot/platform/fixed_rate_loop.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <time.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 #include <vector>
 
 #include "microcobot/core/error.h"
+#include "microcobot/platform/cpu_affinity.h"
 #include "support/counting_allocator.h"
 
 namespace mc::platform {
@@ -149,6 +152,62 @@ TEST(FixedRateLoop, RejectsBadRatesAndDivisors) {
   EXPECT_THROW(loop.add_task("x", 0, [](const TickInfo&) {}), InvalidParams);
   EXPECT_THROW(loop.add_task("x", 1, TaskFn{}), InvalidParams);
   EXPECT_THROW(loop.sample_ticks_every(0), InvalidParams);
+  EXPECT_THROW(loop.pin_to_core(-2), InvalidParams);
+  try {
+    loop.pin_to_core(CPU_SETSIZE);  // no such core
+    FAIL();
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("loop.cpu"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(allowed_cores()), std::string::npos) << e.what();
+  }
+}
+
+bool has_core(const cpu_set_t& set, int cpu) { return CPU_ISSET(cpu, &set); }
+
+TEST(FixedRateLoop, APinnedLoopRunsOnItsCoreAndTheProcessKeepsOffItWhileItRuns) {
+  cpu_set_t mine;
+  ASSERT_EQ(sched_getaffinity(0, sizeof mine, &mine), 0);
+  if (CPU_COUNT(&mine) < 2) GTEST_SKIP() << "one core: nowhere to move the other threads";
+  int core = -1;
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &mine)) core = c;  // the last allowed core
+  FixedRateLoop loop(2000.0);
+  loop.pin_to_core(core);
+  EXPECT_EQ(loop.pinned_core(), core);
+  // A thread started before the run, as a server is: while the loop runs it keeps off the core.
+  std::atomic<bool> quit{false}, off_during{true};
+  std::atomic<int> checks{0};
+  std::atomic<bool> running{false};
+  std::thread server([&] {
+    while (!quit.load()) {
+      if (running.load()) {
+        cpu_set_t s;
+        sched_getaffinity(0, sizeof s, &s);
+        if (has_core(s, core)) off_during = false;
+        ++checks;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  });
+  std::atomic<int> elsewhere{0}, ticks{0};
+  loop.add_task("where", 1, [&](const TickInfo& t) {
+    if (t.index == 100) running = true;   // the pinning is done before the first tick ...
+    if (t.index == 380) running = false;  // ... and undone after the last
+    if (sched_getcpu() != core) ++elsewhere;
+    ++ticks;
+  });
+  loop.run_realtime(400);  // 0.2 s
+  const int checked = checks.load();
+  EXPECT_EQ(ticks.load(), 400);
+  EXPECT_EQ(elsewhere.load(), 0) << "ticks run off core " << core;
+  EXPECT_GT(checked, 0);
+  EXPECT_TRUE(off_during.load()) << "a thread of the process ran on the loop's core";
+  // Stopped: the core is given back to the process's threads.
+  cpu_set_t after;
+  ASSERT_EQ(sched_getaffinity(0, sizeof after, &after), 0);
+  EXPECT_TRUE(has_core(after, core));
+  quit = true;
+  server.join();
 }
 
 }  // namespace

@@ -101,6 +101,45 @@ TEST(HardwareDriver, ThePlatformRunsOnDriversHandedToIt) {
   EXPECT_DOUBLE_EQ(hand.force_N.x, 0.0);
 }
 
+TEST(HardwareDriver, ASimulatedGripperRidesTheDriversStageWhereItsSensorsSayItIs) {
+  // Hardware in the loop (devices.gripper: simulated): the microworld and its gripper are this
+  // process's, carried by the driver's axes; the driver set's own gripper is not used.
+  PlatformConfig config;
+  config.devices.gripper = "simulated";
+  SkeletonBench bench(config);
+  Platform p(config, bench.devices());
+  EXPECT_FALSE(p.simulated());
+  ASSERT_NE(p.simulated_gripper(), nullptr);
+  EXPECT_EQ(&p.gripper(), p.simulated_gripper());
+  auto& hand = *bench.hand;
+  p.loop().run_for(1000);
+  hand.handle_m.x = 1e-3;
+  p.loop().run_for(5000);
+  const Eigen::Vector3d tip = p.simulated_gripper()->tip_position_m();
+  const auto& s = config.stage;
+  EXPECT_NEAR(tip.x(), s.home_x_m + p.axis(0).position_m(), 1e-12);
+  EXPECT_NEAR(tip.z(), s.home_z_m + p.axis(2).position_m(), 1e-12);
+  EXPECT_GT(p.axis(0).position_m(), 5e-6);  // the handle moved the stage, and the tips with it
+  // The TéléTweez closes this gripper, not the driver set's.
+  EXPECT_NEAR(p.gripper().opening_m(), config.teleop.grip_position_scale * 4e-3, 2e-6);
+  EXPECT_DOUBLE_EQ(bench.gripper->commanded_m, 0.0);
+  // Without simulated masters there is no operator's hand to record: the loop's channels.
+  p.run(0.01);
+  EXPECT_EQ(p.recording().channels(), kLoopChannelCount);
+
+  config.devices.gripper = "claw";
+  EXPECT_THROW(config.validate(), Error);
+  config.devices.gripper = "simulated";
+  config.devices.driver = "lab-bench";
+  config.microworld = "optical-trap";
+  try {
+    config.validate();
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("devices.gripper"), std::string::npos) << e.what();
+  }
+}
+
 TEST(HardwareDriver, APlatformRefusesMissingOrAlreadyConfiguredDevices) {
   PlatformConfig config;
   PlatformDevices none;

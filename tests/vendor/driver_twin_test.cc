@@ -20,6 +20,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "microcobot/platform/driver_registry.h"
 #include "microcobot/vendor/anc300_driver.h"
@@ -204,6 +205,48 @@ TEST(DriverTwin, Anc300CountingStepsDriftsByTheModelsStepError) {
   }
 }
 
+TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnPiGcs2UnderASimulatedGripper) {
+  // Hardware in the loop (docs/hardware.md): `microcobot run` with its axes behind pi-gcs2 on the
+  // twin of another process, and this process's simulated gripper and part carried where the
+  // controller's sensors say the stage is. The scripted watchmaker picks the part and places it
+  // 0.4 mm away; the twin's stage, read through its own port, ends over the target.
+  TwinProcess twin;
+  ASSERT_NE(twin.gcs2_port, 0) << test::read_text(twin.cli.err);
+  test::TempDir dir;
+  test::write_text(
+      dir / "hil.yaml",
+      fmt::format("devices: {{driver: pi-gcs2, connection: \"127.0.0.1:{},velocity_mm_s=1,timeout_s=1,"
+                  "stale_s=0.5\", gripper: simulated}}\nworld: {{target_x_m: 0.4e-3}}\n",
+                  twin.gcs2_port));
+  const auto r = test::run_cli({"run", "--config", (dir / "hil.yaml").string(), "--realtime", "--json",
+                                "--out", (dir / "out").string(), "--duration", "60"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::cout << fmt::format(
+      "[ pick-and-place on pi-gcs2 ] {}: placed {:.2f} um from the target in {:.1f} s "
+      "(wall {:.1f} s), tracking RMS {:.0f} nm\n",
+      j.at("verdict").get<std::string>(), 1e6 * j.at("placement_error_m").get<double>(),
+      j.at("duration_s").get<double>(), j.at("wall_s").get<double>(),
+      1e9 * j.at("tracking_error_rms_m").get<double>());
+  EXPECT_TRUE(j.at("success").get<bool>()) << j.dump();
+  EXPECT_FALSE(j.at("faulted").get<bool>());
+  EXPECT_LE(j.at("placement_error_m").get<double>(), 5e-6);
+  // The session retracts the gripper over the target: the twin's stage is there (stage x = the
+  // target's x minus the tips' home x), not where the part was picked.
+  PlatformConfig c;
+  const auto x = twin_position_m(twin.gcs2_port);
+  EXPECT_NEAR(x[0], 0.4e-3 - c.stage.home_x_m, 10e-6);
+  EXPECT_NEAR(x[1], 0.0 - c.stage.home_y_m, 10e-6);
+  // Without a part to pick, the scripted session is refused in one line before connecting.
+  test::write_text(
+      dir / "stand_in.yaml",
+      fmt::format("devices: {{driver: pi-gcs2, connection: \"127.0.0.1:{}\"}}\n", twin.gcs2_port));
+  const auto refused = test::run_cli({"run", "--config", (dir / "stand_in.yaml").string(), "--json", "--out",
+                                      (dir / "out2").string(), "--duration", "1"});
+  EXPECT_EQ(refused.exit_code, 3) << refused.err;
+  EXPECT_NE(refused.err.find("devices.gripper"), std::string::npos) << refused.err;
+}
+
 TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableControllerIsOneLine) {
   // The worked example of docs/hardware.md: `serve --config` with the driver set, a second process.
   TwinProcess twin;
@@ -218,6 +261,8 @@ TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableController
   EXPECT_NE(r.err.find(fmt::format("on the drivers 'pi-gcs2' (127.0.0.1:{})", twin.gcs2_port)),
             std::string::npos)
       << r.err;
+  // The twin's axes power up at VEL 0.1 mm/s, slower than the operator's Z jog: said at configure.
+  EXPECT_NE(r.err.find("slower than the operator's 0.5 mm/s"), std::string::npos) << r.err;
   // A closed port: one line naming the address, exit 3.
   test::write_text(dir / "closed.yaml", "devices: {driver: anc300, connection: \"127.0.0.1:1\"}\n");
   r = test::run_cli({"serve", "--config", (dir / "closed.yaml").string(), "--listen", "127.0.0.1:0", "--out",

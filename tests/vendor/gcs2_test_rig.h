@@ -61,6 +61,7 @@ struct FakeGcs2 {
     if (c == "TMN?") return {per_axis([](int) { return "-5.000000"; })};
     if (c == "TMX?") return {per_axis([](int) { return "5.000000"; })};
     if (c == "FRF?") return {per_axis([](int) { return 1; })};
+    if (c == "VEL?") return {per_axis([](int) { return "1.000000"; })};
     if (c == "HLT") {
       ++halts;
       error = 10;

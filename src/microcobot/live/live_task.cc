@@ -133,7 +133,7 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
       p.hold();  // the sequence ends with every axis holding ...
       ended_ = true;
       console_takes_the_stage();  // ... and the console in control again
-      const auto* gripper = p.simulated() ? p.simulation().gripper : nullptr;
+      const auto* gripper = p.simulated_gripper();
       inserted_.store(gripper == nullptr                                  ? -1
                       : gripper->world().inserted(gripper->world_state()) ? 1
                                                                           : 0,

@@ -133,6 +133,10 @@ class SlaveAxis : public Device {
   virtual void command_drive(const DriveBlock& block) noexcept = 0;
   /// Sensor reading of the carriage position [m].
   virtual double position_m() const = 0;
+  /// Where the carriage is, for what it carries [m]: a simulated gripper's finger tips follow
+  /// it. The truth in a simulation; for hardware the best knowledge there is, the sensor
+  /// (a simulated gripper on a real stage: hardware in the loop, docs/hardware.md).
+  virtual double carried_position_m() const { return position_m(); }
   /// True while the carriage rests against one of its end stops.
   virtual bool at_end_stop() const = 0;
 

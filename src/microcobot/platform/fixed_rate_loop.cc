@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "microcobot/core/error.h"
+#include "microcobot/platform/cpu_affinity.h"
 
 namespace mc::platform {
 
@@ -33,6 +34,12 @@ void FixedRateLoop::add_task(std::string name, int divisor, TaskFn fn) {
   require(divisor >= 1, "loop.task." + name + ".divisor", "must be >= 1", divisor);
   require(static_cast<bool>(fn), "loop.task." + name, "needs a function");
   tasks_.push_back(Task{std::move(name), divisor, std::move(fn)});
+}
+
+void FixedRateLoop::pin_to_core(int cpu) {
+  require(cpu == -1 || core_allowed(cpu), "loop.cpu",
+          "must be -1 (not pinned) or a core this process may use (" + allowed_cores() + ")", cpu);
+  cpu_ = cpu;
 }
 
 void FixedRateLoop::sample_ticks_every(int divisor) {
@@ -88,6 +95,8 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
     sched_param param{};
     param.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10;
     fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+    // Before the first tick: the pinning walks /proc and makes system calls.
+    if (cpu_ >= 0 && pin_calling_thread(cpu_)) move_other_threads_off(cpu_);
     thread_id_.store(std::this_thread::get_id());
     timespec next{};
     clock_gettime(CLOCK_MONOTONIC, &next);
@@ -113,6 +122,7 @@ bool FixedRateLoop::run_realtime(std::uint64_t ticks) {
     }
   });
   worker.join();
+  if (cpu_ >= 0) give_core_back(cpu_);
   return fifo;
 }
 

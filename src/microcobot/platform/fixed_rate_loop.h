@@ -68,6 +68,11 @@ class FixedRateLoop {
   /// (~1.3 us on the 2-core VM of docs/benchmarks.md: reading it at every 10 kHz tick would
   /// cost the loop more than a tenth of its tick).
   void sample_ticks_every(int divisor);
+  /// Real time only: the loop's thread runs on core `cpu` and, while it runs, the process's
+  /// other non-real-time threads keep off that core (platform/cpu_affinity.h); -1 (the default)
+  /// leaves placement to the kernel. Configuration phase only.
+  void pin_to_core(int cpu);
+  int pinned_core() const { return cpu_; }
   /// Compute time of the last finished sampled tick [s], on the wall clock.
   double sampled_tick_s() const { return sampled_tick_s_; }
   /// The same tick's CPU time on the loop thread's clock [s]: a preemption (another thread,
@@ -103,6 +108,7 @@ class FixedRateLoop {
   std::atomic<std::thread::id> thread_id_{};
   double last_tick_s_ = 0.0;
   std::uint64_t sample_every_ = 1;
+  int cpu_ = -1;
   double sampled_tick_s_ = 0.0;
   double sampled_tick_cpu_s_ = 0.0;
   TimingStats tick_stats_;

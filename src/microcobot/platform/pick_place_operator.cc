@@ -88,6 +88,8 @@ PickPlaceOperator::PickPlaceOperator(Platform& platform, const PickPlaceOperator
       motion_scale_(platform.config().teleop.motion_scale) {
   p_.validate();
   require(sim_.gripper != nullptr, "microworld", "the scripted pick-and-place needs the pick-place scene");
+  require(sim_.haptic != nullptr, "devices.haptic",
+          "the scripted operator moves a simulated haptic master's hand");
   lift_m_ = sim_.gripper->world().params().hole_depth_m;
   std::fill(std::begin(started_), std::end(started_), std::numeric_limits<double>::quiet_NaN());
   started_[0] = 0.0;

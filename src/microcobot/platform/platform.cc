@@ -52,7 +52,8 @@ Platform::Platform(const PlatformConfig& config)
     sim_.optical_tweezers = trap.get();
     devices_.gripper = std::move(trap);
   } else {
-    auto gripper = std::make_unique<SimulatedGripper>("gripper", world_, carriers, home);
+    auto gripper = std::make_unique<SimulatedGripper>(
+        "gripper", world_, std::array<const SlaveAxis*, 3>{carriers[0], carriers[1], carriers[2]}, home);
     sim_.gripper = gripper.get();
     devices_.gripper = std::move(gripper);
   }
@@ -75,6 +76,25 @@ Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
       home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
       loop_(config_.loop.base_rate_Hz),
       ring_(kRingCapacity) {
+  if (config_.devices.gripper == "simulated") {
+    // Hardware in the loop: this process's microworld under the driver's stage, the finger tips
+    // where its sensors say the stage is (the driver set's own gripper is not used).
+    require(!config_.optical_trap_scene(), "devices.gripper", "simulated needs the pick-place microworld");
+    for (std::size_t i = 0; i < 3; ++i)
+      if (devices_.axes[i] == nullptr)
+        throw InvalidParams("devices.axes[" + std::to_string(i) + "]", "is missing");
+    auto gripper = std::make_unique<SimulatedGripper>(
+        "gripper", world_,
+        std::array<const SlaveAxis*, 3>{devices_.axes[0].get(), devices_.axes[1].get(),
+                                        devices_.axes[2].get()},
+        Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
+    sim_.gripper = gripper.get();
+    devices_.gripper = std::move(gripper);
+  }
+  // A driver set's companions may be the simulated masters (vendor/sim_companions.h): the
+  // scripted operator moves their hands as on the simulated platform.
+  sim_.haptic = dynamic_cast<SimulatedHapticMaster*>(devices_.haptic.get());
+  sim_.tweezers = dynamic_cast<SimulatedTweezersMaster*>(devices_.tweezers.get());
   const char* names[8] = {"axes[0]", "axes[1]",  "axes[2]", "gripper",
                           "haptic",  "tweezers", "camera",  "focus"};
   const auto d = devices();
@@ -136,6 +156,7 @@ void Platform::build() {
                  [this](const TickInfo& t) { telemetry_task(t.t_s); });
   if (devices_.camera) loop_.add_task("camera", 1, [this](const TickInfo& t) { camera_task(t); });
   loop_.sample_ticks_every(config_.loop.telemetry_divisor);
+  loop_.pin_to_core(config_.loop.cpu);
 }
 
 Platform::~Platform() {
@@ -149,7 +170,8 @@ std::array<Device*, 8> Platform::devices() {
 }
 
 const SimulatedDevices& Platform::simulation() const {
-  if (!simulated()) throw InvalidParams("platform", "runs on hardware drivers, not on the simulation");
+  if (sim_.haptic == nullptr && sim_.gripper == nullptr)
+    throw InvalidParams("platform", "runs on hardware drivers, not on the simulation");
   return sim_;
 }
 
@@ -289,12 +311,12 @@ void Platform::telemetry_task(double t_s) noexcept {
   // one sample late: this tick is not over yet.
   put(1e6 * loop_.sampled_tick_s());
   put(1e6 * loop_.sampled_tick_cpu_s());
-  // Simulation channels: the ground truth.
-  if (simulated()) {
+  // Simulation channels: the ground truth (on a driver's stage, the tips are where its sensors say).
+  if (records_simulation()) {
     const OperatorHand& hand = sim_.haptic->operator_hand();
     put(hand.hand_m.x), put(hand.hand_m.y);
     for (std::size_t i = 0; i < 3; ++i)
-      put(home_m_[static_cast<Eigen::Index>(i)] + sim_.axes[i]->true_position_m());
+      put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->carried_position_m());
     put(sim_.haptic->channels().f_m_N), put(sim_.haptic->channels().u_V);
     if (sim_.gripper != nullptr) {
       const auto& w = sim_.gripper->world_state();
@@ -313,8 +335,8 @@ void Platform::camera_task(const TickInfo& t) noexcept {
   // motion blur of the exposure); the camera sees the true scene, not the sensors' readings.
   Eigen::Vector3d tool, part = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < 3; ++i) {
-    const double axis = simulated() ? sim_.axes[i]->true_position_m() : devices_.axes[i]->position_m();
-    tool[static_cast<Eigen::Index>(i)] = home_m_[static_cast<Eigen::Index>(i)] + axis;
+    tool[static_cast<Eigen::Index>(i)] =
+        home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->carried_position_m();
   }
   if (sim_.gripper != nullptr) part = sim_.gripper->world_state().part_m;
   if (sim_.optical_tweezers != nullptr) part = sim_.optical_tweezers->bead_m();

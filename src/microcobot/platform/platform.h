@@ -107,8 +107,8 @@ struct PlatformDevices {
   std::unique_ptr<FocusDrive> focus;
 };
 
-/// The simulated devices of a simulated platform, by their concrete types (non-owning): the
-/// scripted operator moves their hands, the session report reads their ground truth.
+/// The simulated devices of a platform, by their concrete types (non-owning; null for a driver's
+/// device): the scripted operator moves their hands, the session report reads their ground truth.
 struct SimulatedDevices {
   std::array<SimulatedSlaveAxis*, 3> axes{};
   SimulatedGripper* gripper = nullptr;  ///< the pick-and-place's (null in the optical-trap scene)
@@ -203,10 +203,14 @@ class Platform {
   Camera* camera() { return devices_.camera.get(); }
   FocusDrive* focus() { return devices_.focus.get(); }
   const FocusDrive* focus() const { return devices_.focus.get(); }
-  /// True when the platform runs its simulated devices.
-  bool simulated() const { return sim_.haptic != nullptr; }
-  /// The simulated devices; throws mc::InvalidParams on a platform built on other devices.
+  /// True when the platform runs its simulated devices (the whole digital twin).
+  bool simulated() const { return sim_.axes[0] != nullptr; }
+  /// The simulated devices, null where the platform runs a driver's (on a driver set: the
+  /// simulated masters of vendor/sim_companions.h, the gripper of `devices.gripper: simulated`).
+  /// Throws mc::InvalidParams when none is simulated.
   const SimulatedDevices& simulation() const;
+  /// The simulated gripper in its microworld, or null (a driver's gripper, the optical trap).
+  const SimulatedGripper* simulated_gripper() const { return sim_.gripper; }
   const StageController& stage_controller() const { return *stage_; }
   /// Operator-to-slave tracking error: |slave target - measured slave position| (3-D) at every
   /// slave tick while the teleoperation coupling is engaged (issue #15).
@@ -218,9 +222,15 @@ class Platform {
   const TrackingErrorStats& tracking_error() const { return tracking_; }
   const control::TeleoperationOutput& teleop() const { return teleop_->output(); }
   const Recorder& recording() const { return *recorder_; }
-  /// Channels recorded: all of kTelemetryChannels when simulated, the loop channels otherwise.
+  /// True when the telemetry carries the simulation's channels (the operator's hand, the finger
+  /// tips, the part): a simulated haptic master and a simulated microworld (the whole twin, or a
+  /// driver set under `devices.gripper: simulated`, whose tips follow the stage's sensors).
+  bool records_simulation() const {
+    return sim_.haptic != nullptr && (sim_.gripper != nullptr || sim_.optical_tweezers != nullptr);
+  }
+  /// Channels recorded: all of kTelemetryChannels with the simulation's, the loop channels otherwise.
   std::size_t telemetry_channel_count() const {
-    return simulated() ? kTelemetryChannels.size() : kLoopChannelCount;
+    return records_simulation() ? kTelemetryChannels.size() : kLoopChannelCount;
   }
   /// Telemetry samples lost because the ring was full (0 when the drain keeps up).
   std::size_t telemetry_dropped() const { return ring_.dropped() + recorder_->dropped(); }

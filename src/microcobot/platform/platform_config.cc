@@ -8,6 +8,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
+#include "microcobot/platform/cpu_affinity.h"
 #include "microcobot/platform/driver_registry.h"
 
 namespace mc::platform {
@@ -54,9 +55,17 @@ void LoopParams::validate() const {
   require(operator_divisor >= 1, "operator_divisor", "must be >= 1", operator_divisor);
   require(telemetry_divisor >= 1, "telemetry_divisor", "must be >= 1", telemetry_divisor);
   require(watchdog_ticks >= 1, "watchdog_ticks", "must be >= 1", watchdog_ticks);
+  require(cpu == -1 || core_allowed(cpu), "cpu",
+          "must be -1 (not pinned) or a core this process may use (" + allowed_cores() + ")", cpu);
 }
 
 void PlatformConfig::validate() const {
+  in_section("devices", [&] {
+    if (devices.gripper != "driver" && devices.gripper != "simulated")
+      throw InvalidParams("gripper", "'" + excerpt(devices.gripper) + "' is not driver or simulated");
+    if (devices.gripper == "simulated" && !devices.simulated() && optical_trap_scene())
+      throw InvalidParams("gripper", "simulated needs the pick-place microworld (microworld: optical-trap)");
+  });
   in_section("devices", [&] {
     if (is_device_driver(devices.driver)) return;
     std::string known;

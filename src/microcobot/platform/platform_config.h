@@ -38,6 +38,10 @@ struct LoopParams {
   int telemetry_divisor = 10;   ///< telemetry recorded at 1 kHz
   int watchdog_ticks = 5;       ///< masters stale after this many ticks without a fresh reading
   bool realtime = false;        ///< pace to the wall clock (else as fast as possible)
+  /// Real time: the core the loop's thread is pinned to, the process's other threads kept off it
+  /// (-1: not pinned). With `isolcpus=` or a cpuset keeping other processes off that core too,
+  /// the tick no longer pays for the servers' cache and TLB traffic (docs/hardware.md).
+  int cpu = -1;
 
   template <class V>
   void visit(V& v) {
@@ -47,6 +51,7 @@ struct LoopParams {
     v("telemetry_divisor", telemetry_divisor);
     v("watchdog_ticks", watchdog_ticks);
     v("realtime", realtime);
+    v("cpu", cpu);
   }
   void validate() const;
   double period_s() const { return 1.0 / base_rate_Hz; }
@@ -125,12 +130,17 @@ struct DeviceSelection {
   /// What the driver opens, in the driver's own syntax (a device file, HOST:PORT, a bus id);
   /// unused by the simulation.
   std::string connection;
+  /// On a driver set: "driver" (its own gripper) or "simulated", a simulated gripper and
+  /// microworld carried by the driver's stage (hardware in the loop: the finger tips follow its
+  /// sensors). Ignored by the simulation, whose gripper is always simulated.
+  std::string gripper = "driver";
   CameraSelection camera;
 
   template <class V>
   void visit(V& v) {
     v("driver", driver);
     v("connection", connection);
+    v("gripper", gripper);
     v("camera", camera);
   }
   bool simulated() const { return driver == "simulated"; }

@@ -9,6 +9,7 @@
 
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/platform/driver_registry.h"
 #include "microcobot/platform/telemetry_json.h"
 
 namespace mc::platform {
@@ -74,7 +75,9 @@ Session::Session(const PlatformConfig& config, const SessionParams& params) : pa
   params_.validate();
   require(!config.optical_trap_scene(), "microworld",
           "the scripted session is the pick-and-place: run it on the pick-place scene");
-  platform_ = std::make_unique<Platform>(config);
+  require(config.devices.simulated() || config.devices.gripper == "simulated", "devices.gripper",
+          "the scripted pick-and-place on a driver set needs `gripper: simulated` (a part to pick)");
+  platform_ = make_platform(config);  // the simulation, or a driver set under a simulated gripper
   operator_ = std::make_unique<PickPlaceOperator>(*platform_, params_.operator_params);
   const bool stale = params_.scenario == "stale-master";
   SimulatedHapticMaster* haptic = platform_->simulation().haptic;

@@ -7,7 +7,7 @@
 namespace mc::platform {
 
 SimulatedGripper::SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
-                                   std::array<const SimulatedSlaveAxis*, 3> axes, const Vec3& home_m)
+                                   std::array<const SlaveAxis*, 3> axes, const Vec3& home_m)
     : Gripper(std::move(name)),
       world_(world),
       axes_(axes),
@@ -26,8 +26,8 @@ void SimulatedGripper::on_configure() {
 }
 
 Eigen::Vector3d SimulatedGripper::tip_position_m() const {
-  return home_m_ + Eigen::Vector3d(axes_[0]->true_position_m(), axes_[1]->true_position_m(),
-                                   axes_[2]->true_position_m());
+  return home_m_ + Eigen::Vector3d(axes_[0]->carried_position_m(), axes_[1]->carried_position_m(),
+                                   axes_[2]->carried_position_m());
 }
 
 void SimulatedGripper::command_opening_m(double opening) noexcept {

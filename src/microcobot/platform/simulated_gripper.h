@@ -2,15 +2,15 @@
 /// @file
 /// The slave micro-gripper in its microworld: a PiezoGripper carried by the XYZ stage over a
 /// substrate with a micro-part (microworld::PickPlaceWorld, thesis §1.1.1 surface forces).
-/// The gripper's position is the stage's true position plus the mount offset `home_m` (where
-/// the finger tips are when every axis is at 0). The safe state keeps the last opening
-/// command: a gripper that let go of the part on a fault would drop it.
+/// The gripper's position is where the stage carries it (SlaveAxis::carried_position_m: the
+/// simulated axes' truth, a driver's sensor) plus the mount offset `home_m` (where the finger
+/// tips are when every axis is at 0). The safe state keeps the last opening command: a gripper
+/// that let go of the part on a fault would drop it.
 
 #include <array>
 
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/device.h"
-#include "microcobot/platform/simulated_slave_axis.h"
 
 namespace mc::platform {
 
@@ -18,7 +18,7 @@ class SimulatedGripper final : public Gripper {
  public:
   /// `world` and the axes must outlive the gripper.
   SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
-                   std::array<const SimulatedSlaveAxis*, 3> axes, const Vec3& home_m);
+                   std::array<const SlaveAxis*, 3> axes, const Vec3& home_m);
 
   void command_opening_m(double opening) noexcept override;
   double opening_m() const override { return out_.opening_m; }
@@ -40,7 +40,7 @@ class SimulatedGripper final : public Gripper {
 
  private:
   const microworld::PickPlaceWorld& world_;
-  std::array<const SimulatedSlaveAxis*, 3> axes_;
+  std::array<const SlaveAxis*, 3> axes_;
   Eigen::Vector3d home_m_;
   microworld::PickPlaceState state_;
   microworld::PickPlaceOutput out_;

@@ -28,6 +28,7 @@ class SimulatedSlaveAxis final : public SlaveAxis {
 
   /// The model's true carriage position (what the simulation knows and a sensor approximates).
   double true_position_m() const { return model_.slider_position(state_); }
+  double carried_position_m() const override { return true_position_m(); }
   double voltage_V() const { return state_.u_V; }
   const stickslip::ActuatorState& model_state() const { return state_; }
 

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
@@ -149,6 +150,13 @@ void Gcs2Controller::handshake(LineClient& bus) {
   if (params_.velocity_mm_s > 0.0)
     command(bus, fmt::format("VEL {0} {3:.6f} {1} {3:.6f} {2} {3:.6f}", params_.axes[0], params_.axes[1],
                              params_.axes[2], params_.velocity_mm_s));
+  const auto vel = read_axes(bus, "VEL?");
+  for (std::size_t i = 0; i < 3; ++i)
+    if (vel[i] < params_.operator_speed_mm_s)
+      spdlog::warn(
+          "pi-gcs2: axis {} moves at VEL {:g} mm/s, slower than the operator's {:g} mm/s: the stage will lag "
+          "the coupling's target (option velocity_mm_s=1 sets VEL at configure)",
+          params_.axes[i], vel[i], params_.operator_speed_mm_s);
   auto referenced = read_axes(bus, "FRF?");
   std::string unreferenced;
   for (std::size_t i = 0; i < 3; ++i)
@@ -204,7 +212,9 @@ void Gcs2Controller::safe_state(LineClient& bus) {
 
 platform::PlatformDevices make_gcs2_devices(const platform::PlatformConfig& config) {
   const Connection c = parse_connection(config.devices.connection, "pi-gcs2", kGcs2DefaultBaud);
-  auto controller = std::make_shared<Gcs2Controller>(c, gcs2_driver_params(c));
+  Gcs2DriverParams params = gcs2_driver_params(c);
+  params.operator_speed_mm_s = config.teleop.max_jog_m_s * gcs2::kMmPerM;
+  auto controller = std::make_shared<Gcs2Controller>(c, params);
   platform::PlatformDevices d = make_sim_companions(config);
   const char* names[3] = {"gcs2_axis_x", "gcs2_axis_y", "gcs2_axis_z"};
   const stickslip::StickSlipParams axis = platform::axis_params(config);

@@ -36,6 +36,9 @@ struct Gcs2DriverParams {
   bool reference = true;              ///< FRF the axes that FRF? reports unreferenced (else refuse them)
   double reference_timeout_s = 60.0;  ///< FRF's longest wait (a switch search on a long stage)
   double velocity_mm_s = 0.0;         ///< VEL sent at configure; 0 keeps the controller's
+  /// The operator's fastest stage move (the platform's teleop.max_jog_m_s, in mm/s): an axis
+  /// whose VEL? is slower lags the coupling's target, and a warning says so at configure.
+  double operator_speed_mm_s = 0.0;
   void validate() const;
 };
 
