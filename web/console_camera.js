@@ -16,7 +16,20 @@ mc.camera = {
   pending: null,
   decodeMs: 0,
   receivedAt: 0,   // performance.now() when the last frame arrived
+  // How old the scene of each decoded frame was when the page could show it [s]: from the
+  // frame's stamp (mid-exposure, live time) to its bitmap, on the page's clock (the last 4000).
+  shownAges: [],
 };
+
+// Live time on this page's clock: the smallest (arrival - t_s) of the telemetry of the last
+// two seconds (60 Hz), the least delayed sample bounding the offset from above.
+const liveClock = {offsets: [], offset: NaN};
+listen("/platform/telemetry", (t) => {
+  const o = performance.now() / 1e3 - t.t_s;
+  liveClock.offsets.push(o);
+  if (liveClock.offsets.length > 120) liveClock.offsets.shift();
+  liveClock.offset = Math.min(...liveClock.offsets);
+});
 
 // CDR (little-endian, after the 4-byte encapsulation header): std_msgs/Header, string format,
 // uint8[] data. Returns {stamp, format, data} or throws on a truncated message.
@@ -55,6 +68,10 @@ function decodeFrame(bytes) {
       cam.stamp = msg.stamp;
       cam.frames += 1;
       cam.decodeMs = performance.now() - t0;
+      if (isNum(liveClock.offset)) {
+        cam.shownAges.push(performance.now() / 1e3 - liveClock.offset - msg.stamp);
+        if (cam.shownAges.length > 4000) cam.shownAges.shift();
+      }
     })
     .catch((e) => note("camera: cannot decode a frame: " + e.message))
     .finally(() => {

@@ -15,6 +15,7 @@
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/png_file.h"
 #include "microcobot/vision/renderer.h"
+#include "microcobot/vision/tiff_file.h"
 #include "vision_processing_commands.h"
 
 namespace vision_commands {
@@ -86,6 +87,7 @@ struct RenderOptions {
   std::string illumination = "reflected";
   std::uint64_t seed = 1;
   std::uint64_t frame = 0;
+  std::string format = "png";
 };
 
 void run_render(const RenderOptions& o) {
@@ -131,17 +133,21 @@ void run_render(const RenderOptions& o) {
   j["tool_m"] = {pose.tool_x_m, pose.tool_y_m, pose.tool_z_m};
   j["seed"] = o.seed;
   j["frame_index"] = o.frame;
-  j["image"] = "frame.png";
+  const std::string image_name = "frame." + o.format;
+  j["image"] = image_name;
   // Everything computed before anything is written; each file staged and renamed when complete.
-  const std::string png = vs::encode_png(frame);
+  // A TIFF carries the scale (pixels per cm, object side) and this JSON (ImageJ/Fiji read both).
+  const std::string image = o.format == "tiff"
+                                ? vs::encode_tiff(frame, f.um_per_px * 1e-6, j.dump(-1, ' ', true))
+                                : vs::encode_png(frame);
   mc::ensure_writable_dir(*o.common.out);
-  mc::write_file_atomic(*o.common.out / "frame.png", png);
+  mc::write_file_atomic(*o.common.out / image_name, image);
   mc::write_file_atomic(*o.common.out / "camera.json", j.dump(2) + "\n");
   mc::cli::emit(
       o.common, j,
       fmt::format("{} at {}, focus {:g} um: {}x{} {}-bit frame ({:.4f} um/px, DOF {:.2f} um) in {}", o.scene,
                   cam.objective.name, o.focus_um, frame.width, frame.height, frame.bit_depth, f.um_per_px,
-                  f.dof_m * 1e6, (*o.common.out / "frame.png").string()));
+                  f.dof_m * 1e6, (*o.common.out / image_name).string()));
 }
 
 void add_vision(CLI::App& group) {
@@ -157,8 +163,8 @@ void add_vision(CLI::App& group) {
   }
   {
     auto o = std::make_shared<RenderOptions>();
-    auto* cmd =
-        group.add_subcommand("render", "One camera frame of a scene: DIR/frame.png and DIR/camera.json");
+    auto* cmd = group.add_subcommand(
+        "render", "One camera frame of a scene: DIR/frame.png (or .tiff) and DIR/camera.json");
     cmd->add_option(
         "--scene", o->scene,
         "pick-place (default), pin-in-hole, optical-trap, or a YAML file of the microworld's keys");
@@ -185,6 +191,10 @@ void add_vision(CLI::App& group) {
         ->check(mc::cli::Range(-1e5, 1e5));
     cmd->add_option("--seed", o->seed, "Seed of the sensor noise (default 1)");
     cmd->add_option("--frame", o->frame, "Frame index (the noise of frame k of a seed; default 0)");
+    cmd->add_option(
+           "--format", o->format,
+           "png (default) or tiff (16-bit for frames over 8 bits, with the pixel size and the camera state)")
+        ->check(CLI::IsMember({"png", "tiff"}));
     mc::cli::add_output_options(*cmd, o->common);
     cmd->callback([o] { run_render(*o); });
   }

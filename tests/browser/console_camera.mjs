@@ -131,6 +131,14 @@ await s.run(async () => {
   await s.clickTop(now.measured_x_m + 100e-6, now.measured_y_m - 50e-6);
   await s.goWithDeadman("the stage at the clicked point", 20, 3e-6);
   await shot("camera-05-after-click-to-go");
+  // How old each frame's scene was when the page had it decoded (web/console_camera.js): never
+  // before the scene (5 ms: the clock mapping's own error); the figures are the benchmark's
+  // (bench/console_camera_bench.mjs), printed here.
+  const ages = await page.evaluate(() => window.mc.camera.shownAges.slice().sort((a, b) => a - b));
+  if (ages.length < 10) fail(`only ${ages.length} frames stamped with their age`);
+  const q = (p) => 1e3 * ages[Math.min(ages.length - 1, Math.floor(p * ages.length))];
+  log(`scene to decoded image in the page: p50 ${q(0.5).toFixed(1)} ms, p95 ${q(0.95).toFixed(1)} ms over ${ages.length} frames`);
+  if (!(q(0) > -5)) fail(`a frame was shown ${(-q(0)).toFixed(1)} ms before its scene: the page's clock mapping is wrong`);
   const st = await cameraState();
   log(`camera: ${st.objective_name}, ${(st.m_per_px * 1e6).toFixed(3)} um/px, capture ${st.capture_ms.toFixed(1)} ms, ` +
       `JPEG ${st.encode_ms.toFixed(1)} ms, scene-to-JPEG ${st.latency_ms.toFixed(1)} ms, page decode ` +

@@ -34,6 +34,32 @@ def test_cli_png_reads_back_and_equals_the_python_frame(cli, tmp_path, bits, dty
     assert sorted(os.listdir(out)) == ["camera.json", "frame.png"]
 
 
+@pytest.mark.parametrize("bits,mode", [(8, "L"), (12, "I;16")])
+def test_cli_tiff_reads_back_with_its_scale_and_state(cli, tmp_path, bits, mode):
+    # The same frame as the PNG, as a baseline TIFF read by Pillow's own decoder: the pixels, the
+    # object-side scale in the resolution tags (pixels per cm) and the camera state as JSON.
+    out = tmp_path / f"tiff{bits}"
+    code, _, err = cli("vision", "render", "--scene", "pin-in-hole", "--objective", "10x", "--focus-um", "600",
+                       "--bit-depth", bits, "--seed", 5, "--frame", 2, "--format", "tiff", "--out", out)
+    assert code == 0, err
+    assert sorted(os.listdir(out)) == ["camera.json", "frame.tiff"]
+    state = json.loads((out / "camera.json").read_text())
+    assert state["image"] == "frame.tiff"
+    with Image.open(out / "frame.tiff") as im:
+        assert im.format == "TIFF" and im.size == (1280, 1024) and im.mode == mode
+        pixels = np.array(im)
+        tags = im.tag_v2
+        assert tags[296] == 3  # ResolutionUnit: centimetre
+        assert float(tags[282]) == pytest.approx(1e4 / state["um_per_px"], rel=1e-6)
+        assert float(tags[283]) == pytest.approx(1e4 / state["um_per_px"], rel=1e-6)
+        assert tuple(np.atleast_1d(tags[281])) == ((1 << bits) - 1,)  # MaxSampleValue, one per sample
+        assert json.loads(tags[270]) == state
+    frame = microcobot.vision.render("pin-in-hole", "10x", focus_um=600, bit_depth=bits, seed=5, frame=2)
+    np.testing.assert_array_equal(pixels.astype(np.int64), frame.astype(np.int64))
+    code, _, err = cli("vision", "render", "--format", "bmp", "--out", tmp_path / "bmp")
+    assert code == 2 and "bmp" in err and not (tmp_path / "bmp").exists()
+
+
 def test_camera_model_matches_the_cli(cli):
     code, out, err = cli("vision", "model", "--objective", "50x", "--json")
     assert code == 0, err

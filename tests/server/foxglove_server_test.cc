@@ -329,6 +329,39 @@ TEST(FoxgloveServer, SlowClientDoesNotBlockPublish) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 2.0);
 }
 
+TEST(FoxgloveServer, ALatestOnlyChannelGivesASlowClientTheNewestMessageNotAQueue) {
+  // A camera's images: a slow viewer should see the newest one. With the client reading nothing,
+  // each new message replaces the one still queued for it; once it reads, what comes is the
+  // tail of the stream (the sockets' buffers, then the newest), never the whole backlog.
+  FoxgloveServer server(loopback(), "s");
+  ChannelSpec images = spec("/camera");
+  images.latest_only = true;
+  const ChannelId ch = server.add_channel(images);
+  server.start();
+  Client slow;
+  ASSERT_EQ(slow.connect(server.port()), 101);
+  ASSERT_TRUE(slow.send_json({{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", ch}}}}}));
+  ASSERT_TRUE(slow.sync());
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) server.publish(ch, static_cast<std::uint64_t>(i), std::string(10 * 1024, 'a'));
+  const ServerCounters k = server.counters();
+  EXPECT_GT(k.messages_superseded, 1000u) << "the queue held more than one image";
+  EXPECT_EQ(k.messages_dropped, 0u) << "the queue never reached its byte limit";
+  // Read until the newest arrives: it does, and fewer than half the messages came before it.
+  int got = 0;
+  std::uint64_t last = 0;
+  while (last != static_cast<std::uint64_t>(n - 1)) {
+    const auto m = slow.read();
+    ASSERT_TRUE(m);
+    const auto d = decode_message_data(m->data);
+    ASSERT_TRUE(std::holds_alternative<MessageData>(d));
+    last = std::get<MessageData>(d).log_time_ns;
+    ++got;
+  }
+  EXPECT_LT(got, n / 2);
+  server.stop();
+}
+
 TEST(FoxgloveServer, HttpResources) {
   FoxgloveServer server(loopback(), "s",
                         {{"/", {"text/html; charset=utf-8", "<!doctype html><p>console</p>"}},

@@ -147,8 +147,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
   if (live_.has_camera()) {
+    // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
     image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
-                                     "ros2msg", std::string(compressed_image_schema())});
+                                     "ros2msg", std::string(compressed_image_schema()), true});
     info_ch_ = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
                                     "ros2msg", std::string(camera_info_schema())});
     camera_state_ch_ = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",

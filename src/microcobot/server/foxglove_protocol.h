@@ -39,6 +39,10 @@ struct ChannelSpec {
   std::string schema_name;
   std::string schema_encoding = "jsonschema";
   std::string schema;
+  /// A live view wants only the newest message (a camera's images): a new one replaces the
+  /// message of this channel still queued for a client (never one being written), so a slow
+  /// client gets fewer messages, not older ones. Not advertised: the server's own policy.
+  bool latest_only = false;
 };
 
 /// A server channel with its id.

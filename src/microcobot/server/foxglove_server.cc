@@ -19,6 +19,7 @@
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <unordered_map>
 #include <vector>
@@ -142,6 +143,7 @@ struct Outgoing {
   std::shared_ptr<const std::string> data;
   std::array<char, kMessageDataHeaderBytes> header{};
   bool binary = false;
+  ChannelId channel = 0;  ///< of a messageData
   std::size_t size() const { return (binary ? header.size() : 0) + (data ? data->size() : 0); }
 };
 
@@ -171,6 +173,7 @@ struct Core {
 
   // Lock order: channels_mu, then sessions_mu, then a session's mutex.
   mutable std::mutex channels_mu;
+  std::set<ChannelId> latest_only;  ///< channels whose queued message a newer one replaces
   std::vector<Channel> channels;
   std::atomic<ChannelId> next_channel{1};
   mutable std::mutex sessions_mu;
@@ -179,8 +182,8 @@ struct Core {
 
   std::atomic<std::size_t> open_connections{0};
   std::atomic<std::size_t> refusing{0};
-  std::atomic<std::uint64_t> received{0}, rejected{0}, dropped{0}, sent{0}, bytes_sent{0}, accepted{0},
-      refused{0};
+  std::atomic<std::uint64_t> received{0}, rejected{0}, dropped{0}, superseded{0}, sent{0}, bytes_sent{0},
+      accepted{0}, refused{0};
 
   // Declared last so that it (and the sessions its handlers own) goes first; stop() resets it
   // explicitly while everything above is alive.
@@ -241,11 +244,21 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   /// Queues messageData for `channel` when subscribed; copies `payload` into `shared` on first use.
   /// Any thread.
   void offer(ChannelId channel, std::uint64_t log_time_ns, std::string_view payload,
-             std::shared_ptr<const std::string>& shared) {
+             std::shared_ptr<const std::string>& shared, bool latest_only) {
     std::lock_guard lk(mu_);
     if (closed_) return;
     const auto it = subs_by_channel_.find(channel);
     if (it == subs_by_channel_.end()) return;
+    if (latest_only) {
+      const auto queued = std::find_if(queue_.begin(), queue_.end(), [channel](const Outgoing& o) {
+        return o.binary && o.channel == channel;
+      });
+      if (queued != queue_.end()) {
+        queued_bytes_ -= queued->size();
+        queue_.erase(queued);
+        srv_.superseded.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
     const std::size_t size = kMessageDataHeaderBytes + payload.size();
     const std::size_t limit = srv_.opt.max_queued_bytes_per_client;
     // Oldest telemetry goes first: the newest sample is what a live view wants.
@@ -265,6 +278,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     o.data = shared;
     o.header = message_data_header(it->second, log_time_ns);
     o.binary = true;
+    o.channel = channel;
     queued_bytes_ += o.size();
     queue_.push_back(std::move(o));
     schedule_flush_locked();
@@ -944,6 +958,7 @@ ChannelId FoxgloveServer::add_channel(const ChannelSpec& spec) {
   std::lock_guard ch_lock(s.channels_mu);
   const Channel ch{s.next_channel.load(), spec};
   s.channels.push_back(ch);
+  if (spec.latest_only) s.latest_only.insert(ch.id);
   s.next_channel.fetch_add(1);  // after the push: channel_exists() never sees a missing channel
   const std::string text = advertise_json({ch});
   std::lock_guard lk(s.sessions_mu);
@@ -1027,8 +1042,13 @@ void FoxgloveServer::publish(ChannelId channel, std::uint64_t log_time_ns, std::
   Impl& s = *impl_;
   if (!s.started || s.stopped) return;
   std::shared_ptr<const std::string> shared;  // made on the first subscriber, shared by the rest
+  bool latest_only = false;
+  {
+    std::lock_guard ch_lock(s.channels_mu);
+    latest_only = s.latest_only.count(channel) != 0;
+  }
   std::lock_guard lk(s.sessions_mu);
-  for (auto& [id, session] : s.sessions) session->offer(channel, log_time_ns, payload, shared);
+  for (auto& [id, session] : s.sessions) session->offer(channel, log_time_ns, payload, shared, latest_only);
 }
 
 void FoxgloveServer::send_status(ClientId client, StatusLevel level, std::string_view message,
@@ -1064,6 +1084,7 @@ ServerCounters FoxgloveServer::counters() const {
   c.messages_received = s.received.load();
   c.messages_rejected = s.rejected.load();
   c.messages_dropped = s.dropped.load();
+  c.messages_superseded = s.superseded.load();
   c.messages_sent = s.sent.load();
   c.bytes_sent = s.bytes_sent.load();
   c.connections_accepted = s.accepted.load();

@@ -80,11 +80,12 @@ struct ClientMessage {
 
 /// Counters for tests and metrics (monotonic since construction).
 struct ServerCounters {
-  std::uint64_t messages_received = 0;  ///< client WebSocket messages read (any kind)
-  std::uint64_t messages_rejected = 0;  ///< client messages refused (malformed, unknown, oversized, rate)
-  std::uint64_t messages_dropped = 0;   ///< messageData dropped for slow clients
-  std::uint64_t messages_sent = 0;      ///< WebSocket messages written to clients
-  std::uint64_t bytes_sent = 0;         ///< WebSocket payload bytes written to clients
+  std::uint64_t messages_received = 0;    ///< client WebSocket messages read (any kind)
+  std::uint64_t messages_rejected = 0;    ///< client messages refused (malformed, unknown, oversized, rate)
+  std::uint64_t messages_dropped = 0;     ///< messageData dropped for slow clients
+  std::uint64_t messages_superseded = 0;  ///< latest-only messageData replaced by a newer one while queued
+  std::uint64_t messages_sent = 0;        ///< WebSocket messages written to clients
+  std::uint64_t bytes_sent = 0;           ///< WebSocket payload bytes written to clients
   std::uint64_t connections_accepted = 0;
   std::uint64_t connections_refused = 0;  ///< over max_connections (503 or closed)
 };
