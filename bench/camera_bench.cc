@@ -22,16 +22,11 @@
 
 #include "microcobot/live/live_platform.h"
 #include "microcobot/platform/timing_stats.h"
+#include "telemetry_channel.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < mc::platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(mc::platform::kTelemetryChannels[i]) == name) return i;
-  return 0;
-}
 
 void BM_CameraCostOnTheLoop(benchmark::State& state) {
   const bool pinned = state.range(0) != 0;
@@ -40,7 +35,7 @@ void BM_CameraCostOnTheLoop(benchmark::State& state) {
     // Pinned: the loop on the last core, the camera thread (and the rest of the process) off it.
     if (pinned) lp.platform.loop.cpu = static_cast<int>(std::thread::hardware_concurrency()) - 1;
     mc::live::LivePlatform live(lp);
-    const std::size_t tick_channel = channel("tick_us");
+    const std::size_t tick_channel = mc::bench::telemetry_channel("tick_us");
     std::atomic<int> phase{-1};  // -1 not counted; 0 camera idle; 1 camera forming frames
     std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
                                                    mc::platform::TimingStats(1e-7)};  // drain thread only

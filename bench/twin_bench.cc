@@ -30,16 +30,11 @@
 #include "microcobot/platform/timing_stats.h"
 #include "microcobot/vendor/live_stage.h"
 #include "microcobot/vendor/twin_server.h"
+#include "telemetry_channel.h"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < mc::platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(mc::platform::kTelemetryChannels[i]) == name) return i;
-  return 0;
-}
 
 int connect_loopback(std::uint16_t port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -82,7 +77,7 @@ void BM_TwinPollingCost(benchmark::State& state) {
     mc::live::LiveParams lp;
     if (placement > 0) lp.platform.loop.cpu = last_core;
     mc::live::LivePlatform live(lp);
-    const std::size_t tick_channel = channel("tick_us");
+    const std::size_t tick_channel = mc::bench::telemetry_channel("tick_us");
     std::atomic<int> phase{-1};  // -1 not counted; 0 idle; 1 polled
     std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
                                                    mc::platform::TimingStats(1e-7)};  // drain thread only
