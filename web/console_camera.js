@@ -1,5 +1,6 @@
-// The microscope camera (issue #27): the image of /camera/image/compressed (a ROS 2
-// sensor_msgs/msg/CompressedImage in CDR, its JPEG decoded by the browser), scaled into the
+// The microscope camera (issue #27): the image of /camera/preview/compressed (a ROS 2
+// sensor_msgs/msg/CompressedImage in CDR: the frame binned to the panel's 640 px by the server,
+// live/camera_preview.h; its JPEG decoded by the browser), scaled into the
 // microscope panel; the objective turret, the focus drive, exposure and gain, sent with the
 // console's command while in control. The image is fixed to the microscope's optical axis: a
 // pixel (u, v) of the W x H sensor (u right, v down) is the world point
@@ -79,7 +80,7 @@ function decodeFrame(bytes) {
       if (cam.pending) { const next = cam.pending; cam.pending = null; decodeFrame(next); }
     });
 }
-listen("/camera/image/compressed", (bytes) => { mc.camera.receivedAt = performance.now(); decodeFrame(bytes); });
+listen("/camera/preview/compressed", (bytes) => { mc.camera.receivedAt = performance.now(); decodeFrame(bytes); });
 listen("/camera/state", (s) => { mc.camera.state = s; showCameraState(); });
 
 // The controls follow the scene's camera (its turret, travel and ranges) once it is known.

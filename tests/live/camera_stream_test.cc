@@ -192,6 +192,68 @@ TEST(CameraStream, TheCameraFormsFramesOnlyWhileAClientSubscribesToThem) {
   server.stop();
 }
 
+// The console's panel subscribes to the preview: the same frame (same stamp) binned to 640 px.
+TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
+  test::TempDir dir;
+  LiveParams params = camera_params();
+  params.platform.camera.sensor.width_px = 1280;
+  params.platform.camera.sensor.height_px = 512;
+  LivePlatform live(params);
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  test::Console console(server.port());
+  ASSERT_EQ(console.channels.count(std::string(kCameraPreviewTopic)), 1u);
+  console.subscribe(std::string(kCameraPreviewTopic), 3);
+  const std::string preview = console.next_on(3);
+  ASSERT_FALSE(preview.empty()) << "the preview alone makes the camera form frames";
+  console.subscribe("/camera/image/compressed", 4);
+  // Frames of both channels by stamp, until one stamp has both.
+  std::map<std::pair<std::int32_t, std::uint32_t>, std::string> previews, fulls;
+  const auto stamp_of = [](const std::string& m) {
+    Cdr c{m};
+    const auto sec = c.get<std::int32_t>();
+    return std::make_pair(sec, c.get<std::uint32_t>());
+  };
+  std::pair<std::int32_t, std::uint32_t> both{-1, 0};
+  for (int i = 0; i < 400 && both.first < 0; ++i) {
+    const auto m = console.ws.read();
+    ASSERT_TRUE(m.has_value());
+    if (m->text) continue;
+    const auto d = server::decode_message_data(m->data);
+    const auto* md = std::get_if<server::MessageData>(&d);
+    if (!md || (md->subscription != 3 && md->subscription != 4)) continue;
+    const std::string payload(md->payload);
+    auto& mine = md->subscription == 3 ? previews : fulls;
+    const auto& other = md->subscription == 3 ? fulls : previews;
+    mine[stamp_of(payload)] = payload;
+    if (other.count(stamp_of(payload))) both = stamp_of(payload);
+  }
+  ASSERT_GE(both.first, 0) << "no frame seen on both channels";
+  const auto jpeg_of = [](const std::string& m) {
+    Cdr c{m};
+    c.get<std::int32_t>(), c.get<std::uint32_t>(), c.str();
+    EXPECT_EQ(c.str(), "jpeg");
+    const auto n = c.get<std::uint32_t>();
+    return decode_jpeg(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(m.data()) + c.at, n), 1);
+  };
+  const JpegImage small = jpeg_of(previews[both]), big = jpeg_of(fulls[both]);
+  ASSERT_EQ(big.width, 1280);
+  ASSERT_EQ(small.width, 640);
+  ASSERT_EQ(small.height, 256);
+  // Each preview pixel is its 2 x 2 block of the full frame (both through JPEG: a few DN).
+  double sum = 0;
+  for (int y = 0; y < small.height; ++y)
+    for (int x = 0; x < small.width; ++x) {
+      double block = 0;
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx)
+          block += big.pixels[static_cast<std::size_t>(2 * y + dy) * 1280 + static_cast<std::size_t>(2 * x + dx)];
+      sum += std::abs(0.25 * block - small.pixels[static_cast<std::size_t>(y) * 640 + static_cast<std::size_t>(x)]);
+    }
+  EXPECT_LT(sum / (640.0 * 256.0), 2.0) << "mean |preview - binned frame| in DN";
+  server.stop();
+}
+
 TEST(CameraStream, FocusAndObjectiveAreConsoleCommandsThatNeedControlButNotTheDeadman) {
   test::TempDir dir;
   LivePlatform live(camera_params());

@@ -84,12 +84,16 @@ RosTime ros_time(double t_s) {
   return {static_cast<std::int32_t>(std::min<std::int64_t>(s, 2147483647)), static_cast<std::uint32_t>(ns)};
 }
 
-void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out) {
-  out.reserve(frame.jpeg.size() + 64);
+void encode_compressed_image(std::span<const std::uint8_t> jpeg, RosTime stamp, std::string& out) {
+  out.reserve(jpeg.size() + 64);
   CdrWriter w(out);
   w.header(stamp);
   w.string("jpeg");
-  w.bytes(frame.jpeg.data(), frame.jpeg.size());
+  w.bytes(jpeg.data(), jpeg.size());
+}
+
+void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out) {
+  encode_compressed_image(std::span<const std::uint8_t>(frame.jpeg), stamp, out);
 }
 
 void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::string& out) {

@@ -21,6 +21,7 @@
 /// ("plumb_bob", d = 0), R the identity, P = [K | 0].
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -30,6 +31,8 @@
 namespace mc::live {
 
 inline constexpr std::string_view kCameraImageTopic = "/camera/image/compressed";
+/// The same frames binned to the console's panel (live/camera_preview.h), same schema.
+inline constexpr std::string_view kCameraPreviewTopic = "/camera/preview/compressed";
 inline constexpr std::string_view kCameraInfoTopic = "/camera/camera_info";
 inline constexpr std::string_view kCameraStateTopic = "/camera/state";
 inline constexpr std::string_view kCameraFrameId = "camera_optical_frame";
@@ -48,6 +51,8 @@ struct RosTime {
 RosTime ros_time(double t_s);
 
 /// sensor_msgs/msg/CompressedImage of `frame`'s JPEG, stamped `stamp`, into `out` (replaced).
+/// sensor_msgs/msg/CompressedImage of a JPEG (format "jpeg").
+void encode_compressed_image(std::span<const std::uint8_t> jpeg, RosTime stamp, std::string& out);
 void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out);
 /// sensor_msgs/msg/CameraInfo of `frame` (its objective's scale and working distance).
 void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::string& out);

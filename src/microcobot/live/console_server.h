@@ -8,6 +8,8 @@
 ///   /platform/scene       1 Hz   geometry and limits the microscope view needs
 ///   /console/feedback    60 Hz   contact and grip forces, the vibrotactile channel
 ///   /camera/image/compressed     every camera frame, sensor_msgs/msg/CompressedImage (CDR, JPEG)
+///   /camera/preview/compressed   the same frames binned to the console's 640 px panel
+///                                (live/camera_preview.h), encoded only while someone watches
 ///   /camera/camera_info          every frame, sensor_msgs/msg/CameraInfo (CDR)
 ///   /camera/state                every frame, objective, focus, exposure, gain, scale (JSON)
 ///   client /console/command      the controlling client's command (~30 Hz heartbeat)
@@ -15,7 +17,7 @@
 ///
 /// HTTP: `/` the console; `/recordings...` the recordings in --out, their downloads and reports
 /// (live/recording_files.h). A recording (live/session_recording.h) holds every channel above at
-/// full rate, what the clients sent, the events (control, e-stop, demo, refusals, errors) and
+/// full rate (the preview excepted: it holds the full frames), what the clients sent, the events (control, e-stop, demo, refusals, errors) and
 /// the configuration.
 ///
 /// One client controls at a time; the others observe until they take control. Any client may
@@ -42,6 +44,7 @@
 #include <vector>
 
 #include "microcobot/dsp/sos.h"
+#include "microcobot/live/camera_preview.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
 #include "microcobot/live/session_recording.h"
@@ -122,8 +125,9 @@ class ConsoleServer {
   ConsoleServerParams params_;
   server::FoxgloveServer server_;
   server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
-  server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0;
-  std::string image_cdr_, info_cdr_;            // camera thread only
+  server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0, preview_ch_ = 0;
+  std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
+  std::unique_ptr<CameraPreview> preview_;          // camera thread only
   std::vector<FrameConsumer> frame_consumers_;  // set before start()
 
   std::atomic<server::ClientId> controller_{0};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstring>
 
 #include "microcobot/platform/camera_scene.h"
@@ -55,10 +56,9 @@ class SimulatedCamera final : public FrameSource {
       for (std::size_t i = 0; i < frame_.pixels.size(); ++i)
         out.data[i] = static_cast<std::uint8_t>(frame_.pixels[i]);
     } else {
-      for (std::size_t i = 0; i < frame_.pixels.size(); ++i) {  // little-endian samples
-        out.data[2 * i] = static_cast<std::uint8_t>(frame_.pixels[i] & 0xFF);
-        out.data[2 * i + 1] = static_cast<std::uint8_t>(frame_.pixels[i] >> 8);
-      }
+      // Image keeps deeper samples little-endian: this host's order, one copy.
+      static_assert(std::endian::native == std::endian::little);
+      std::memcpy(out.data.data(), frame_.pixels.data(), 2 * frame_.pixels.size());
     }
   }
 

@@ -46,9 +46,11 @@ class SensorModel {
 
  private:
   double normal(std::uint32_t u) const noexcept;
+  double lower_tail_normal(std::uint32_t u) const noexcept;
 
   SensorParams p_;
   std::vector<float> inverse_cdf_;  ///< standard normal quantiles on a uniform grid of u
+  std::vector<float> tail_cdf_;     ///< the same on a 4096 times finer grid of the lowest bin
 };
 
 }  // namespace mc::vision
