@@ -1,9 +1,11 @@
 // microcobot.vision: the microscope camera (issue #27): render() a frame of a scene as an H x W
 // numpy array (uint8 for 8-bit frames, else uint16), camera_model() the optics figures; and what
 // the frames measure (issue #28): TemplateTracker, Autofocus and sharpness() steppable from a
-// Python loop on those arrays, fit_affine() for the pixel <-> stage calibration. The same library
+// Python loop on those arrays, fit_affine() for the pixel <-> stage calibration, VisualServo
+// stepped frame by frame (a tracked feature in, the stage's velocity out). The same library
 // calls as `microcobot vision ...` (vision/, platform/camera_scene).
 
+#include <limits>
 #include <optional>
 
 #include "common.h"
@@ -13,6 +15,7 @@
 #include "microcobot/vision/renderer.h"
 #include "microcobot/vision/sharpness.h"
 #include "microcobot/vision/template_tracker.h"
+#include "microcobot/vision/visual_servo.h"
 
 namespace mc::py {
 namespace {
@@ -168,6 +171,33 @@ vision::Autofocus make_autofocus(const std::string& objective, double start_um,
   return vision::Autofocus(p);  // validates: ValueError naming the field
 }
 
+vision::VisualServo make_servo(const py::array_t<double>& a_px_per_m, std::array<double, 2> b_px, int width_px,
+                               int height_px, double gain_per_s, double max_speed_m_s, double deadband_m,
+                               double converged_m, double max_feature_age_s) {
+  if (a_px_per_m.ndim() != 2 || a_px_per_m.shape(0) != 2 || a_px_per_m.shape(1) != 2)
+    throw InvalidInput("A_px_per_m: a 2 x 2 array is needed (got " + std::to_string(a_px_per_m.ndim()) + "-D)");
+  vision::AffineMap map;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) map.A(i, j) = a_px_per_m.at(i, j);
+  map.b = {b_px[0], b_px[1]};
+  vision::VisualServoParams p;
+  p.gain_per_s = gain_per_s;
+  p.max_speed_m_s = max_speed_m_s;
+  p.deadband_m = deadband_m;
+  p.converged_m = converged_m;
+  p.max_feature_age_s = max_feature_age_s;
+  return vision::VisualServo(p, map, width_px, height_px);  // validates: ValueError naming the field
+}
+
+py::dict servo_command_dict(const vision::ServoCommand& c) {
+  py::dict d;
+  d["velocity_m_s"] = py::make_tuple(c.velocity_m_s.x(), c.velocity_m_s.y());
+  d["error_px"] = py::make_tuple(c.error_px.x(), c.error_px.y());
+  d["error_m"] = py::make_tuple(c.error_m.x(), c.error_m.y());
+  d["status"] = std::string(vision::to_string(c.status));
+  return d;
+}
+
 }  // namespace
 
 void bind_vision(py::module_& m) {
@@ -261,6 +291,39 @@ void bind_vision(py::module_& m) {
       .def_property_readonly("status", [](const vision::Autofocus& a) { return std::string(a.status()); })
       .def("observe", &vision::Autofocus::observe, "sharpness"_a,
            "The measure of the frame taken at next_focus_um with next_metric.");
+  py::class_<vision::VisualServo>(
+      m, "VisualServo",
+      "Image-based visual servoing of the stage (vision/visual_servo.h, ViSP's vpServo law v = -lambda L+ e "
+      "with L = A, the calibration's px/m): a feature's pixel in, the stage (x, y) velocity out, latency "
+      "compensated from each frame's mid-exposure time; a lost or stale feature holds.")
+      .def(py::init(&make_servo), "A_px_per_m"_a, "b_px"_a, "width_px"_a, "height_px"_a,
+           "gain_per_s"_a = vision::VisualServoParams{}.gain_per_s,
+           "max_speed_m_s"_a = vision::VisualServoParams{}.max_speed_m_s,
+           "deadband_m"_a = vision::VisualServoParams{}.deadband_m,
+           "converged_m"_a = vision::VisualServoParams{}.converged_m,
+           "max_feature_age_s"_a = vision::VisualServoParams{}.max_feature_age_s)
+      .def("set_target", &vision::VisualServo::set_target, "u_px"_a, "v_px"_a,
+           "The pixel the feature is to reach (inside the frame); forgets the past commands.")
+      .def_property_readonly("has_target", &vision::VisualServo::has_target)
+      .def(
+          "step",
+          [](vision::VisualServo& s, double u_px, double v_px, bool found, double t_mid_exposure_s, double t_now_s,
+             std::optional<double> hold_s) {
+            if (!std::isfinite(t_mid_exposure_s) || !std::isfinite(t_now_s))
+              throw InvalidInput("step: t_mid_exposure_s and t_now_s must be finite");
+            if (hold_s && !(*hold_s >= 0.0)) throw InvalidInput("step: hold_s must be >= 0");
+            const vision::ServoFeature f{u_px, v_px, found && std::isfinite(u_px) && std::isfinite(v_px),
+                                         t_mid_exposure_s};
+            return servo_command_dict(
+                s.step(f, t_now_s, hold_s ? *hold_s : std::numeric_limits<double>::infinity()));
+          },
+          "u_px"_a, "v_px"_a, "found"_a, "t_mid_exposure_s"_a, "t_now_s"_a, "hold_s"_a = py::none(),
+          "One frame: the feature where its frame (exposed at t_mid_exposure_s) saw it; the stage velocity to "
+          "apply from t_now_s for hold_s (or until the next step): velocity_m_s, error_px, error_m (the "
+          "error predicted for now), status (moving, converged, hold (target lost), hold (stale frame), no "
+          "target).")
+      .def("clear_history", &vision::VisualServo::clear_history,
+           "Forgets the past commands (the stage was stopped by someone else).");
 }
 
 }  // namespace mc::py

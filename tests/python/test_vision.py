@@ -148,3 +148,56 @@ def test_vision_measures_refuse_bad_input():
         microcobot.vision.fit_affine(np.zeros((4, 2)), np.zeros((4, 2)))
     with pytest.raises(ValueError, match="start_um"):
         microcobot.vision.Autofocus("10x", start_um=float("nan"))
+
+
+def _servo_run(believed_scale, start_um, seed):
+    """A stage point seen through the true map, servoed through the believed one: 30 fps frames,
+    10 ms from mid-exposure to the command, each command held 13 ms (a stick-slip stage moves
+    between exposures). Returns the true distance to the target after each frame [m]."""
+    rng = np.random.default_rng(seed)
+    a_true = np.array([[1.88e6, 0.03e6], [0.02e6, -1.89e6]])  # px/m, y mirrored (rows go down)
+    b = np.array([640.0, 512.0])
+    servo = microcobot.vision.VisualServo(a_true * believed_scale, tuple(b), 1280, 1024)
+    target_m = np.zeros(2)
+    servo.set_target(*(a_true @ target_m + b))
+    angle = rng.uniform(0, 2 * np.pi)
+    stage = start_um * 1e-6 * np.array([np.cos(angle), np.sin(angle)])
+    period, latency, hold = 1 / 30, 10e-3, 13e-3
+    errors = []
+    for k in range(40):
+        t_mid = k * period
+        pixel = a_true @ stage + b + rng.normal(0, 0.02, 2)  # the tracker's noise
+        cmd = servo.step(pixel[0], pixel[1], True, t_mid, t_mid + latency, hold)
+        stage = stage + np.array(cmd["velocity_m_s"]) * hold  # done before the next exposure
+        errors.append(np.linalg.norm(stage - target_m))
+    return errors, cmd
+
+
+@pytest.mark.parametrize("scale", [1.0, 1.05, 0.95])
+def test_visual_servo_steps_from_python_to_the_target(scale):
+    for seed in (21, 22):  # directions no parameter was chosen on
+        errors, last = _servo_run(scale, 50.0, seed)
+        converged = next(k for k in range(len(errors)) if max(errors[k:]) <= 0.3e-6)
+        assert converged < 30, (scale, seed, errors[:10])
+        assert errors[-1] <= 0.3e-6
+        assert last["status"] == "converged"
+
+
+def test_visual_servo_holds_when_the_feature_is_lost_and_refuses_bad_input():
+    a = np.array([[1.9e6, 0.0], [0.0, -1.9e6]])
+    servo = microcobot.vision.VisualServo(a, (640.0, 512.0), 1280, 1024)
+    servo.set_target(700.0, 500.0)
+    cmd = servo.step(600.0, 520.0, False, 0.0, 0.01)
+    assert cmd["velocity_m_s"] == (0.0, 0.0) and cmd["status"] == "hold (target lost)"
+    moving = servo.step(600.0, 520.0, True, 0.1, 0.11)
+    assert moving["status"] == "moving" and moving["velocity_m_s"][0] > 0
+    with pytest.raises(ValueError, match="gain_per_s"):
+        microcobot.vision.VisualServo(a, (640.0, 512.0), 1280, 1024, gain_per_s=float("nan"))
+    with pytest.raises(ValueError, match="2 x 2"):
+        microcobot.vision.VisualServo(np.zeros(3), (640.0, 512.0), 1280, 1024)
+    with pytest.raises(ValueError):
+        microcobot.vision.VisualServo(np.zeros((2, 2)), (640.0, 512.0), 1280, 1024)
+    with pytest.raises(ValueError, match="inside"):
+        servo.set_target(1300.0, 10.0)
+    with pytest.raises(ValueError, match="finite"):
+        servo.step(600.0, 520.0, True, float("nan"), 0.0)
