@@ -13,6 +13,7 @@
 #include "microcobot/core/jpeg.h"
 #include "microcobot/platform/platform.h"
 #include "support/counting_allocator.h"
+#include "support/sanitizers.h"
 #include "support/test_camera.h"
 #include "support/test_support.h"
 
@@ -165,9 +166,12 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   EXPECT_LE(delivered.load(), 1) << "the camera thread was stuck";
   // 30 frames were due: the ring held ring_frames of them, the others were dropped, counted.
   EXPECT_GE(s.dropped, 30u - config.camera.ring_frames - 2);
-  EXPECT_LE(stalled_s, 1.05 * static_cast<double>(ticks) * config.loop.period_s())
+  // Under AddressSanitizer a tick costs about a period (p99 95-120 us seen): the rate is a
+  // property of the optimised build; there the bound only says the loop was not held up.
+  const double slack = MC_UNDER_ASAN ? 0.5 : 0.05;
+  EXPECT_LE(stalled_s, (1.0 + slack) * static_cast<double>(ticks) * config.loop.period_s())
       << "the loop kept its rate";
-  EXPECT_LE(stalled_s, flowing_s + 0.05);
+  EXPECT_LE(stalled_s, flowing_s + slack);
   const double stalled_p99 = stalled.loop().tick_stats().quantile_s(0.99);
   RecordProperty("tick_p99_flowing_us", std::to_string(1e6 * flowing_p99));
   RecordProperty("tick_p99_stalled_us", std::to_string(1e6 * stalled_p99));

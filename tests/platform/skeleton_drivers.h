@@ -118,18 +118,32 @@ class FakeTweezersDriver final : public TweezersMaster {
   std::uint64_t readings_ = 0;
 };
 
+/// What the fake gripper was asked, kept by the bench (the platform may drop the driver).
+struct FakeGripperLog {
+  double commanded_m = 0.0;  ///< the last opening commanded while active
+  bool destroyed = false;
+};
+
 class FakeGripperDriver final : public Gripper {
  public:
-  FakeGripperDriver() : Gripper("fake_gripper") {}
+  explicit FakeGripperDriver(FakeGripperLog* log = nullptr) : Gripper("fake_gripper"), log_(log) {}
+  ~FakeGripperDriver() override {
+    if (log_) log_->destroyed = true;
+  }
   double commanded_m = 0.0;
   void command_opening_m(double opening) noexcept override {
-    if (active()) commanded_m = opening;
+    if (!active()) return;
+    commanded_m = opening;
+    if (log_) log_->commanded_m = opening;
   }
   double opening_m() const override { return commanded_m; }
   double grip_force_N() const override { return 0.0; }
   Vec3 contact_force_N() const override { return {}; }
   void update(double) noexcept override {}
   void enter_safe_state() noexcept override {}
+
+ private:
+  FakeGripperLog* log_;
 };
 
 /// A bench of skeleton drivers: three axes on their buses (the model behind them), fake masters
@@ -149,7 +163,7 @@ struct SkeletonBench {
     hand = h.get();
     d.haptic = std::move(h);
     d.tweezers = std::make_unique<FakeTweezersDriver>();
-    auto g = std::make_unique<FakeGripperDriver>();
+    auto g = std::make_unique<FakeGripperDriver>(&gripper_log);
     gripper = g.get();
     d.gripper = std::move(g);
     return d;
@@ -157,7 +171,8 @@ struct SkeletonBench {
   const stickslip::ActuatorModel model;
   std::array<FakeBus, 3> buses;
   FakeHapticDriver* hand = nullptr;
-  FakeGripperDriver* gripper = nullptr;
+  FakeGripperDriver* gripper = nullptr;  ///< valid while the platform keeps it
+  FakeGripperLog gripper_log;
 };
 
 }  // namespace mc::test
