@@ -137,7 +137,7 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   flowing.loop().run_for(100);
   const double flowing_s = run(flowing);
   const double flowing_p99 = flowing.loop().tick_stats().quantile_s(0.99);
-  EXPECT_GE(got.size(), 20u) << "about 30 frames in the second";
+  EXPECT_GE(got.size(), MC_UNDER_ASAN ? 5u : 20u) << "about 30 frames in the second";
 
   // The camera thread stalls in its first frame (a slow consumer) and the loop runs on.
   Platform stalled(config);
