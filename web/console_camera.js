@@ -88,6 +88,8 @@ let cameraControlsFor = null;
 listen("/platform/scene", (sc) => {
   const cam = sc.camera;
   $("camera-controls").hidden = !cam;
+  $("snapshot").hidden = !cam;
+  $("snapshot").href = "/camera/snapshot.tiff" + location.search;  // the token, when the server needs one
   $("follow-label").hidden = !!cam;
   $("overlay-label").hidden = !cam;
   if (!cam || cameraControlsFor === JSON.stringify(cam)) return;

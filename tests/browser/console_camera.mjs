@@ -120,6 +120,24 @@ await s.run(async () => {
   if (!(Math.abs(ratio - 2.5) < 0.2)) fail(`the 5x image scales the part by ${ratio.toFixed(2)}`);
   if (!(Math.hypot(at5.cx - exp5[0], at5.cy - exp5[1]) <= 2)) fail("5x: the part's centre is off the calibration");
 
+  // The snapshot link: the latest full frame, lossless, the sensor's size (TIFF tags 256, 257).
+  if (!(await page.isVisible("#snapshot"))) fail("no snapshot link beside the camera");
+  const snap = await page.evaluate(async () => {
+    const r = await fetch(document.getElementById("snapshot").href);
+    const b = new DataView(await r.arrayBuffer());
+    const ifd = b.getUint32(4, true), tags = {};
+    for (let i = 0; i < b.getUint16(ifd, true); ++i) {
+      const e = ifd + 2 + 12 * i;
+      tags[b.getUint16(e, true)] = b.getUint16(e + 2, true) === 3 ? b.getUint16(e + 8, true) : b.getUint32(e + 8, true);
+    }
+    return {status: r.status, type: r.headers.get("content-type"), width: tags[256], height: tags[257], bits: tags[258]};
+  });
+  const cam5 = await cameraState();
+  log(`snapshot: ${snap.status} ${snap.type}, ${snap.width} x ${snap.height}, ${snap.bits} bits`);
+  if (snap.status !== 200 || snap.type !== "image/tiff") fail(`the snapshot answered ${snap.status} ${snap.type}`);
+  if (snap.width !== cam5.width || snap.height !== cam5.height)
+    fail(`the snapshot is ${snap.width} x ${snap.height}, the sensor ${cam5.width} x ${cam5.height}`);
+
   // The overlay, labelled.
   await page.check("#overlay");
   await page.waitForTimeout(300);

@@ -20,6 +20,7 @@
 #include "support/sanitizers.h"
 #include "support/test_camera.h"
 #include "support/test_support.h"
+#include "support/ws_client.h"
 
 namespace mc::live {
 namespace {
@@ -251,6 +252,69 @@ TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
       sum += std::abs(0.25 * block - small.pixels[static_cast<std::size_t>(y) * 640 + static_cast<std::size_t>(x)]);
     }
   EXPECT_LT(sum / (640.0 * 256.0), 2.0) << "mean |preview - binned frame| in DN";
+  server.stop();
+}
+
+// A baseline TIFF's first IFD entries by tag (SHORT or LONG values), read from the
+// specification (TIFF 6.0 Part 1: header "II*\0", IFD offset, 12-byte entries).
+std::map<int, std::uint32_t> tiff_tags(const std::string& b) {
+  const auto u16 = [&](std::size_t at) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at]) | (static_cast<unsigned char>(b[at + 1]) << 8));
+  };
+  const auto u32 = [&](std::size_t at) { return u16(at) | (u16(at + 2) << 16); };
+  std::map<int, std::uint32_t> tags;
+  const std::uint32_t ifd = u32(4);
+  for (std::uint32_t i = 0; i < u16(ifd); ++i) {
+    const std::size_t e = ifd + 2 + 12 * i;
+    tags[static_cast<int>(u16(e))] = u16(e + 2) == 3 ? u16(e + 8) : u32(e + 8);
+  }
+  return tags;
+}
+
+// GET /camera/snapshot.tiff|.png: the latest full frame, lossless, as a download named after
+// the objective and the time; before any frame, 503 in one line.
+TEST(CameraStream, TheSnapshotIsTheLatestFullFrameLosslessWithItsScaleAndState) {
+  test::TempDir dir;
+  LivePlatform live(camera_params());
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  const test::HttpResult none = test::http_request(server.port(), "GET", "/camera/snapshot.tiff");
+  EXPECT_EQ(none.status, 503);
+  EXPECT_NE(none.body.find("no camera frame yet"), std::string::npos) << none.body;
+  test::Console console(server.port());
+  console.subscribe(std::string(kCameraPreviewTopic), 3);
+  ASSERT_FALSE(console.next_on(3).empty());
+  ASSERT_FALSE(console.next_on(3).empty());  // the snapshot is kept as the frame is published
+
+  const test::HttpResult tiff = test::http_request(server.port(), "GET", "/camera/snapshot.tiff");
+  ASSERT_EQ(tiff.status, 200) << tiff.body.substr(0, 200);
+  EXPECT_EQ(tiff.header("content-type"), "image/tiff");
+  const std::string disposition = tiff.header("content-disposition");
+  EXPECT_NE(disposition.find("attachment; filename=\"snapshot-"), std::string::npos) << disposition;
+  EXPECT_NE(disposition.find(".tiff\""), std::string::npos) << disposition;
+  ASSERT_GT(tiff.body.size(), 320u * 256u);
+  ASSERT_EQ(tiff.body.substr(0, 4), std::string("II*\0", 4));
+  std::map<int, std::uint32_t> tags = tiff_tags(tiff.body);
+  EXPECT_EQ(tags[256], 320u);  // ImageWidth
+  EXPECT_EQ(tags[257], 256u);  // ImageLength
+  EXPECT_EQ(tags[258], 8u);    // BitsPerSample: the 8-bit test sensor's, as it gave them
+  EXPECT_EQ(tags.count(282), 1u) << "XResolution: the object-side scale";
+  EXPECT_EQ(tags[296], 3u) << "ResolutionUnit: centimetre";
+  // The samples as the source drew them: its dark field (16) and its bright square, nothing else
+  // (a JPEG would have rung at the square's edges).
+  const std::size_t strip = tags[273];
+  ASSERT_LE(strip + 320u * 256u, tiff.body.size());
+  std::map<int, int> values;
+  for (std::size_t i = 0; i < 320u * 256u; ++i) ++values[static_cast<unsigned char>(tiff.body[strip + i])];
+  EXPECT_EQ(values.size(), 2u);
+  EXPECT_GT(values[16], 0);
+  EXPECT_NE(tiff.body.find("\"objective\""), std::string::npos) << "the camera's state as ImageDescription";
+
+  const test::HttpResult png = test::http_request(server.port(), "GET", "/camera/snapshot.png");
+  ASSERT_EQ(png.status, 200);
+  EXPECT_EQ(png.header("content-type"), "image/png");
+  EXPECT_EQ(png.body.substr(1, 3), "PNG");
+  EXPECT_EQ(test::http_request(server.port(), "GET", "/camera/snapshot.jpg").status, 404);
   server.stop();
 }
 

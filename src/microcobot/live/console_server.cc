@@ -153,6 +153,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     preview_ch_ = server_.add_channel({std::string(kCameraPreviewTopic), "cdr", "sensor_msgs/msg/CompressedImage",
                                        "ros2msg", std::string(compressed_image_schema()), true});
     preview_ = std::make_unique<CameraPreview>();
+    snapshot_ = std::make_unique<CameraSnapshot>();
     info_ch_ = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
                                     "ros2msg", std::string(camera_info_schema())});
     camera_state_ch_ = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",
@@ -186,8 +187,13 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
         [this](StatusLevel level, const std::string& message) {
           server_.broadcast_status(level, message, "report");
         });
-    server_.on_http_get([this](std::string_view path) { return files_->on_http(path); });
   }
+  server_.on_http_get([this](std::string_view path) -> std::optional<server::HttpReply> {
+    if (snapshot_)
+      if (auto r = snapshot_->reply(path)) return r;
+    if (files_) return files_->on_http(path);
+    return std::nullopt;
+  });
   server_.on_reject(
       [this](server::ClientId client, StatusLevel level, std::string_view id, std::string_view message) {
         note(event_level(level), "protocol", std::string(id) + ": " + std::string(message), client);
@@ -283,6 +289,7 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   }
   server_.publish(info_ch_, ns, info_cdr_);
   server_.publish(camera_state_ch_, ns, state);
+  snapshot_->offer(f, state, t_s);
   if (recording_) recording_->published_frame(t_s, image_cdr_, info_cdr_, state);
   for (const FrameConsumer& c : frame_consumers_) c.on_frame(f, t_s);
 }

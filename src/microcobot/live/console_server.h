@@ -16,7 +16,8 @@
 ///   client /console/action       estop, reset, take/release control, demo, restart, record
 ///
 /// HTTP: `/` the console; `/recordings...` the recordings in --out, their downloads and reports
-/// (live/recording_files.h). A recording (live/session_recording.h) holds every channel above at
+/// (live/recording_files.h); `/camera/snapshot.tiff|.png` the latest full frame, lossless
+/// (live/camera_snapshot.h). A recording (live/session_recording.h) holds every channel above at
 /// full rate (the preview excepted: it holds the full frames), what the clients sent, the events (control, e-stop, demo, refusals, errors) and
 /// the configuration.
 ///
@@ -45,6 +46,7 @@
 
 #include "microcobot/dsp/sos.h"
 #include "microcobot/live/camera_preview.h"
+#include "microcobot/live/camera_snapshot.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
 #include "microcobot/live/session_recording.h"
@@ -128,6 +130,7 @@ class ConsoleServer {
   server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0, preview_ch_ = 0;
   std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
   std::unique_ptr<CameraPreview> preview_;          // camera thread only
+  std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera
   std::vector<FrameConsumer> frame_consumers_;  // set before start()
 
   std::atomic<server::ClientId> controller_{0};
