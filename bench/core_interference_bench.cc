@@ -91,7 +91,7 @@ void BM_CoreInterference(benchmark::State& state) {
       sched_param sp{};
       sp.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10;
       pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);  // best effort (unprivileged: not)
-      std::vector<double> working(64 * 1024, 1.0);                // 512 kB
+      std::vector<double> working(64 * 1024, 1.0);             // 512 kB
       double next = mono_s();
       for (int cycle = 0; cycle < 25; ++cycle) {
         for (int k = 0; k < kKinds; ++k) {
@@ -121,7 +121,9 @@ void BM_CoreInterference(benchmark::State& state) {
     for (int k = 0; k < kKinds; ++k) {
       std::vector<double>& v = ticks[static_cast<std::size_t>(k)];
       std::sort(v.begin(), v.end());
-      const auto at = [&](double q) { return 1e6 * v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]; };
+      const auto at = [&](double q) {
+        return 1e6 * v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+      };
       state.counters[std::string("p99_us_") + kNames[static_cast<std::size_t>(k)]] = at(0.99);
       state.counters[std::string("p50_us_") + kNames[static_cast<std::size_t>(k)]] = at(0.5);
     }

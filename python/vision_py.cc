@@ -171,11 +171,12 @@ vision::Autofocus make_autofocus(const std::string& objective, double start_um,
   return vision::Autofocus(p);  // validates: ValueError naming the field
 }
 
-vision::VisualServo make_servo(const py::array_t<double>& a_px_per_m, std::array<double, 2> b_px, int width_px,
-                               int height_px, double gain_per_s, double max_speed_m_s, double deadband_m,
-                               double converged_m, double max_feature_age_s) {
+vision::VisualServo make_servo(const py::array_t<double>& a_px_per_m, std::array<double, 2> b_px,
+                               int width_px, int height_px, double gain_per_s, double max_speed_m_s,
+                               double deadband_m, double converged_m, double max_feature_age_s) {
   if (a_px_per_m.ndim() != 2 || a_px_per_m.shape(0) != 2 || a_px_per_m.shape(1) != 2)
-    throw InvalidInput("A_px_per_m: a 2 x 2 array is needed (got " + std::to_string(a_px_per_m.ndim()) + "-D)");
+    throw InvalidInput("A_px_per_m: a 2 x 2 array is needed (got " + std::to_string(a_px_per_m.ndim()) +
+                       "-D)");
   vision::AffineMap map;
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) map.A(i, j) = a_px_per_m.at(i, j);
@@ -307,8 +308,8 @@ void bind_vision(py::module_& m) {
       .def_property_readonly("has_target", &vision::VisualServo::has_target)
       .def(
           "step",
-          [](vision::VisualServo& s, double u_px, double v_px, bool found, double t_mid_exposure_s, double t_now_s,
-             std::optional<double> hold_s) {
+          [](vision::VisualServo& s, double u_px, double v_px, bool found, double t_mid_exposure_s,
+             double t_now_s, std::optional<double> hold_s) {
             if (!std::isfinite(t_mid_exposure_s) || !std::isfinite(t_now_s))
               throw InvalidInput("step: t_mid_exposure_s and t_now_s must be finite");
             if (hold_s && !(*hold_s >= 0.0)) throw InvalidInput("step: hold_s must be >= 0");
@@ -318,10 +319,10 @@ void bind_vision(py::module_& m) {
                 s.step(f, t_now_s, hold_s ? *hold_s : std::numeric_limits<double>::infinity()));
           },
           "u_px"_a, "v_px"_a, "found"_a, "t_mid_exposure_s"_a, "t_now_s"_a, "hold_s"_a = py::none(),
-          "One frame: the feature where its frame (exposed at t_mid_exposure_s) saw it; the stage velocity to "
-          "apply from t_now_s for hold_s (or until the next step): velocity_m_s, error_px, error_m (the "
-          "error predicted for now), status (moving, converged, hold (target lost), hold (stale frame), no "
-          "target).")
+          "One frame: the feature where its frame (exposed at t_mid_exposure_s) saw it; the stage "
+          "velocity to apply from t_now_s for hold_s (or until the next step): velocity_m_s, error_px, "
+          "error_m (the error predicted for now), status (moving, converged, hold (target lost), hold "
+          "(stale frame), no target).")
       .def("clear_history", &vision::VisualServo::clear_history,
            "Forgets the past commands (the stage was stopped by someone else).");
 }

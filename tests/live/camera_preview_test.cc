@@ -50,7 +50,8 @@ TEST(CameraPreview, ATwelveBitFrameBecomesTheMeansOfItsBlocksAtEightBits) {
           sum += static_cast<unsigned>(pattern(xx, yy)) * 16u + static_cast<unsigned>((xx + yy) % 16);
         }
       const unsigned expected = ((sum + 2) / 4) >> 4;
-      EXPECT_EQ(preview.binned().data[static_cast<std::size_t>(y) * 639 + static_cast<std::size_t>(x)], expected)
+      EXPECT_EQ(preview.binned().data[static_cast<std::size_t>(y) * 639 + static_cast<std::size_t>(x)],
+                expected)
           << x << "," << y;
     }
   // The JPEG is that image, by an independent decode.

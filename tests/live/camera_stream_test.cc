@@ -235,7 +235,8 @@ TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
     c.get<std::int32_t>(), c.get<std::uint32_t>(), c.str();
     EXPECT_EQ(c.str(), "jpeg");
     const auto n = c.get<std::uint32_t>();
-    return decode_jpeg(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(m.data()) + c.at, n), 1);
+    return decode_jpeg(
+        std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(m.data()) + c.at, n), 1);
   };
   const JpegImage small = jpeg_of(previews[both]), big = jpeg_of(fulls[both]);
   ASSERT_EQ(big.width, 1280);
@@ -248,8 +249,10 @@ TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
       double block = 0;
       for (int dy = 0; dy < 2; ++dy)
         for (int dx = 0; dx < 2; ++dx)
-          block += big.pixels[static_cast<std::size_t>(2 * y + dy) * 1280 + static_cast<std::size_t>(2 * x + dx)];
-      sum += std::abs(0.25 * block - small.pixels[static_cast<std::size_t>(y) * 640 + static_cast<std::size_t>(x)]);
+          block +=
+              big.pixels[static_cast<std::size_t>(2 * y + dy) * 1280 + static_cast<std::size_t>(2 * x + dx)];
+      sum += std::abs(0.25 * block -
+                      small.pixels[static_cast<std::size_t>(y) * 640 + static_cast<std::size_t>(x)]);
     }
   EXPECT_LT(sum / (640.0 * 256.0), 2.0) << "mean |preview - binned frame| in DN";
   server.stop();
@@ -259,7 +262,8 @@ TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
 // specification (TIFF 6.0 Part 1: header "II*\0", IFD offset, 12-byte entries).
 std::map<int, std::uint32_t> tiff_tags(const std::string& b) {
   const auto u16 = [&](std::size_t at) {
-    return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at]) | (static_cast<unsigned char>(b[at + 1]) << 8));
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at]) |
+                                      (static_cast<unsigned char>(b[at + 1]) << 8));
   };
   const auto u32 = [&](std::size_t at) { return u16(at) | (u16(at + 2) << 16); };
   std::map<int, std::uint32_t> tags;

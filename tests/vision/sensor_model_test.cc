@@ -70,7 +70,8 @@ TEST(SensorModel, TheNoiseHasTheNormalsTails) {
   Frame f;
   r.render(s, r.default_controls(), 5, 3, f);
   const SensorParams& p = cam.sensor;
-  const double mu = 0.8 * cam.illumination.electrons_per_s * p.exposure_s + p.dark_current_e_per_s * p.exposure_s;
+  const double mu =
+      0.8 * cam.illumination.electrons_per_s * p.exposure_s + p.dark_current_e_per_s * p.exposure_s;
   const double k = p.system_gain_dn_per_e();
   const double mean = k * mu, sd = std::sqrt(k * k * (mu + p.read_noise_e * p.read_noise_e) + 1.0 / 12.0);
   const double n = static_cast<double>(f.pixels.size());

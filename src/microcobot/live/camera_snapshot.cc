@@ -44,7 +44,8 @@ void CameraSnapshot::offer(const platform::CameraFrame& frame, const std::string
         sum += img.bit_depth > 8 ? (img.data[2 * at] | (static_cast<unsigned>(img.data[2 * at + 1]) << 8))
                                  : img.data[at];
       }
-      f.pixels[i] = static_cast<std::uint16_t>((sum + static_cast<unsigned>(c) / 2) / static_cast<unsigned>(c));
+      f.pixels[i] =
+          static_cast<std::uint16_t>((sum + static_cast<unsigned>(c) / 2) / static_cast<unsigned>(c));
     }
   }
   kept_.m_per_px = frame.m_per_px;

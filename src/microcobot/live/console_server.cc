@@ -150,8 +150,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
     image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
                                      "ros2msg", std::string(compressed_image_schema()), true});
-    preview_ch_ = server_.add_channel({std::string(kCameraPreviewTopic), "cdr", "sensor_msgs/msg/CompressedImage",
-                                       "ros2msg", std::string(compressed_image_schema()), true});
+    preview_ch_ =
+        server_.add_channel({std::string(kCameraPreviewTopic), "cdr", "sensor_msgs/msg/CompressedImage",
+                             "ros2msg", std::string(compressed_image_schema()), true});
     preview_ = std::make_unique<CameraPreview>();
     snapshot_ = std::make_unique<CameraSnapshot>();
     info_ch_ = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
@@ -284,7 +285,8 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
   server_.publish(image_ch_, ns, image_cdr_);
   if (server_.subscriber_count(preview_ch_) > 0) {
-    encode_compressed_image(preview_->encode(f.image, live_.camera_params().jpeg_quality), stamp, preview_cdr_);
+    encode_compressed_image(preview_->encode(f.image, live_.camera_params().jpeg_quality), stamp,
+                            preview_cdr_);
     server_.publish(preview_ch_, ns, preview_cdr_);
   }
   server_.publish(info_ch_, ns, info_cdr_);
@@ -452,8 +454,7 @@ void ConsoleServer::update_camera_demand() {
   if (!live_.has_camera()) return;
   const bool recording = recording_ && !recording_->name().empty();
   const bool watched = server_.subscriber_count(image_ch_) + server_.subscriber_count(preview_ch_) +
-                           server_.subscriber_count(info_ch_) +
-                           server_.subscriber_count(camera_state_ch_) >
+                           server_.subscriber_count(info_ch_) + server_.subscriber_count(camera_state_ch_) >
                        0;
   bool consumed = false;
   for (const FrameConsumer& c : frame_consumers_) consumed = consumed || c.wanted();

@@ -18,8 +18,8 @@
 /// HTTP: `/` the console; `/recordings...` the recordings in --out, their downloads and reports
 /// (live/recording_files.h); `/camera/snapshot.tiff|.png` the latest full frame, lossless
 /// (live/camera_snapshot.h). A recording (live/session_recording.h) holds every channel above at
-/// full rate (the preview excepted: it holds the full frames), what the clients sent, the events (control, e-stop, demo, refusals, errors) and
-/// the configuration.
+/// full rate (the preview excepted: it holds the full frames), what the clients sent, the events (control,
+/// e-stop, demo, refusals, errors) and the configuration.
 ///
 /// One client controls at a time; the others observe until they take control. Any client may
 /// press the e-stop. Every message is parsed, checked and clamped (console_command.h) before it
@@ -131,7 +131,7 @@ class ConsoleServer {
   std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
   std::unique_ptr<CameraPreview> preview_;          // camera thread only
   std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera
-  std::vector<FrameConsumer> frame_consumers_;  // set before start()
+  std::vector<FrameConsumer> frame_consumers_;      // set before start()
 
   std::atomic<server::ClientId> controller_{0};
   std::atomic<bool> quit_{false};
