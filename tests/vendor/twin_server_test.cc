@@ -198,12 +198,6 @@ TEST(TwinServer, HostileClientsAreSurvived) {
   }
   std::this_thread::sleep_for(200ms);  // its lines are done (they set errors in the shared register)
   {
-    Client huge(rig.gcs_port());
-    huge.send(std::string(1 << 20, 'A'));  // 1 MB without LF: capped, the rest discarded
-    huge.send("\nERR?\n");
-    EXPECT_EQ(huge.read_until([](const std::string& t) { return gcs2::reply_complete(t); }), "3\n");
-  }
-  {
     Client slow(rig.gcs_port());
     slow.send("*ID");  // never finished
     EXPECT_TRUE(slow.closed_by_server());
@@ -231,6 +225,18 @@ TEST(TwinServer, HostileClientsAreSurvived) {
   const auto counts = rig.server->counters();
   EXPECT_GE(counts.closed_hostile, 2u);  // the slowloris and the deaf client
   EXPECT_GE(counts.refused, 1u);         // beyond max_clients
+}
+
+// Apart from the slowloris rule's short timeout: a megabyte takes the server longer than 0.3 s to
+// consume on a loaded machine under ASan, and the line would then be closed as never ending.
+TEST(TwinServer, AHugeLineIsCappedItsRestDiscardedAndTheClientStillServed) {
+  TwinRig rig;
+  Client huge(rig.gcs_port());
+  huge.send(std::string(1 << 20, 'A'));  // 1 MB without LF: capped, the rest discarded
+  huge.send("\nERR?\n");
+  EXPECT_EQ(huge.read_until([](const std::string& t) { return gcs2::reply_complete(t); }), "3\n");
+  EXPECT_EQ(huge.gcs("CSV?"), "2.0\n");
+  EXPECT_EQ(rig.server->counters().closed_hostile, 0u);
 }
 
 TEST(TwinServer, TheLoopThreadNeverAllocatesWhileProtocolClientsMoveTheStage) {
