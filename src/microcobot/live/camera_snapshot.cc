@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "microcobot/platform/grey_frame.h"
 #include "microcobot/vision/png_file.h"
 #include "microcobot/vision/tiff_file.h"
 
@@ -20,34 +21,8 @@ bool printable_ascii(const std::string& s) {
 }  // namespace
 
 void CameraSnapshot::offer(const platform::CameraFrame& frame, const std::string& state_json, double t_s) {
-  const platform::Image& img = frame.image;
-  if (img.width <= 0 || img.height <= 0 || img.data.size() != img.size_bytes()) return;
   std::lock_guard lock(mutex_);
-  vision::Frame& f = kept_.frame;
-  f.width = img.width;
-  f.height = img.height;
-  f.bit_depth = img.bit_depth;
-  f.frame_index = frame.sequence;
-  const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
-  f.pixels.resize(n);
-  const auto c = static_cast<std::size_t>(img.channels);
-  if (img.channels == 1 && img.bit_depth > 8) {
-    static_assert(std::endian::native == std::endian::little);  // Image keeps them little-endian
-    std::memcpy(f.pixels.data(), img.data.data(), 2 * n);
-  } else if (img.channels == 1) {
-    std::copy(img.data.begin(), img.data.end(), f.pixels.begin());
-  } else {
-    for (std::size_t i = 0; i < n; ++i) {
-      unsigned sum = 0;
-      for (std::size_t k = 0; k < c; ++k) {
-        const std::size_t at = i * c + k;
-        sum += img.bit_depth > 8 ? (img.data[2 * at] | (static_cast<unsigned>(img.data[2 * at + 1]) << 8))
-                                 : img.data[at];
-      }
-      f.pixels[i] =
-          static_cast<std::uint16_t>((sum + static_cast<unsigned>(c) / 2) / static_cast<unsigned>(c));
-    }
-  }
+  if (!platform::to_grey_frame(frame.image, frame.sequence, kept_.frame)) return;
   kept_.m_per_px = frame.m_per_px;
   kept_.objective = frame.objective_name;
   kept_.state = state_json;

@@ -52,6 +52,18 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else if (key == "goal_m") {
       c.goal_m = vec3(kChannel, value, key);
       c.has_goal = true;
+    } else if (key == "goal_px") {
+      if (!value.is_array() || value.size() != 2) refuse(kChannel, key, "must be an array of 2 numbers");
+      for (std::size_t i = 0; i < 2; ++i) {
+        c.goal_px[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
+        if (c.goal_px[i] < 0.0 || c.goal_px[i] > limits.max_goal_px[i])
+          refuse(kChannel, key + "[" + std::to_string(i) + "]",
+                 limits.max_goal_px[i] <= 0.0
+                     ? std::string("there is no camera")
+                     : "must be within the frame [0, " +
+                           std::to_string(static_cast<int>(limits.max_goal_px[i])) + "]");
+      }
+      c.has_goal_px = true;
     } else if (key == "goal_speed_m_s") {
       c.goal_speed_m_s = finite(kChannel, value, key);
       if (c.goal_speed_m_s <= 0.0) refuse(kChannel, key, "must be > 0");
@@ -77,7 +89,7 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
       c.gain = std::clamp(finite(kChannel, value, key), limits.min_gain, limits.max_gain);
     } else {
       refuse(kChannel, key,
-             "is not a known key (deadman, velocity_m_s, goal_m, goal_speed_m_s, gripper_opening_m, "
+             "is not a known key (deadman, velocity_m_s, goal_m, goal_px, goal_speed_m_s, gripper_opening_m, "
              "focus_z_m, objective, exposure_s, gain)");
     }
   }

@@ -23,6 +23,8 @@ struct ConsoleLimits {
   double focus_min_m = -0.5e-3;
   double focus_max_m = 2e-3;
   int objective_count = 0;
+  /// The camera frame's last column and row (goal_px); 0 without a camera.
+  std::array<double, 2> max_goal_px{};
   /// The camera's exposure and gain ranges.
   double min_exposure_s = 10e-6;
   double max_exposure_s = 33e-3;
@@ -38,6 +40,10 @@ struct ConsoleCommand {
   bool has_goal = false;                 ///< click-to-go
   std::array<double, 3> goal_m{};        ///< world coordinates (the telemetry's)
   double goal_speed_m_s = 100e-6;
+  /// Click-to-go on the camera's image (`stage.xy_sensor: vision`, issue #28): the pixel the
+  /// tool point is to be brought to, in the full frame's pixels (a binned preview's scaled up).
+  bool has_goal_px = false;
+  std::array<double, 2> goal_px{};
   bool has_gripper = false;
   double gripper_opening_m = 0.0;
   /// The microscope (issue #27): focal plane height to go to, objective to turn in, the camera's
@@ -80,10 +86,10 @@ inline bool is_task_action(ConsoleAction a) {
 }
 
 /// Parses `{"deadman": bool, "velocity_m_s": [vx, vy, vz], "goal_m": [x, y, z] (optional),
-/// "goal_speed_m_s": v (optional), "gripper_opening_m": o (optional), "focus_z_m": z,
-/// "objective": i, "exposure_s": e, "gain": g (optional; the microscope)}`; unknown keys are
-/// refused. Values are checked finite and clamped to `limits`; an objective that is not on the
-/// turret is refused. Throws mc::InvalidInput
+/// "goal_px": [u, v] (optional: a camera pixel, within the frame), "goal_speed_m_s": v (optional),
+/// "gripper_opening_m": o (optional), "focus_z_m": z, "objective": i, "exposure_s": e, "gain": g (optional;
+/// the microscope)}`; unknown keys are refused. Values are checked finite and clamped to `limits`; an
+/// objective that is not on the turret is refused. Throws mc::InvalidInput
 /// ("/console/command: velocity_m_s[1]: must be a finite number").
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
 

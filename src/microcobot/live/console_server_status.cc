@@ -138,6 +138,26 @@ std::string ConsoleServer::status_json() {
                                 {"objective", s.objective}}
                          : json(nullptr);
   j["task"] = task_status_json(s.task);
+  if (s.vision) {
+    // The stage positioned by vision: what the camera thread's tracker and servo see and do.
+    const platform::PositionerStatus& v = *s.vision;
+    j["vision"] = {{"taught", v.taught},
+                   {"found", v.found},
+                   {"has_goal", v.has_goal},
+                   {"state", v.state},
+                   {"error", v.error},
+                   {"tool_px", {v.tool_u_px, v.tool_v_px}},
+                   {"goal_px", v.has_goal ? json::array({v.goal_u_px, v.goal_v_px}) : json(nullptr)},
+                   {"error_m", v.error_m},
+                   {"confidence", v.confidence},
+                   {"stage_m", {v.stage_x_m, v.stage_y_m}},
+                   {"m_per_px", v.m_per_px},
+                   {"calibrated", v.calibrated},
+                   {"frames", v.frames},
+                   {"commands", v.commands}};
+  } else {
+    j["vision"] = nullptr;
+  }
   const DemoResult& d = s.demo_result;
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;

@@ -27,6 +27,12 @@ void LiveParams::validate() const {
           "settle_window_s", "must be within [0, 10] s", settle_window_s);
   require(finger_width_m > 0 && finger_width_m < 1e-3, "finger_width_m", "must be within (0, 1 mm)",
           finger_width_m);
+  if (platform.stage.vision_xy()) {
+    require(!task, "platform.stage.xy_sensor",
+            "vision positions the console's click-to-go; the supervised task needs encoders", 1.0);
+    require(remote == nullptr, "platform.stage.xy_sensor",
+            "vision runs where the camera is: the master process, not a slave", 1.0);
+  }
   if (task) {
     require(remote == nullptr, "task",
             "the console supervises a task only where it drives (not a slave process)");
@@ -40,6 +46,8 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   home_m_ = {params_.platform.stage.home_x_m, params_.platform.stage.home_y_m,
              params_.platform.stage.home_z_m};
   if (params_.task) task_ = std::make_unique<LiveTask>(*params_.task);
+  if (params_.platform.stage.vision_xy())
+    positioner_ = std::make_unique<platform::VisionPositioner>(params_.platform);
   build(/*demo=*/false);
   const auto& tp = params_.platform.teleop;
   limits_.max_speed_m_s = tp.console_max_speed_m_s;
@@ -55,9 +63,31 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   limits_.focus_max_m = cam.focus_max_m;
   limits_.objective_count = has_camera_ ? static_cast<int>(cam.objectives.size()) : 0;
   limits_.max_exposure_s = 1.0 / cam.frame_rate_Hz();
+  if (has_camera_) limits_.max_goal_px = {cam.sensor.width_px - 1.0, cam.sensor.height_px - 1.0};
 }
 
 LivePlatform::~LivePlatform() { stop(); }
+
+void LivePlatform::vision_tick(Platform& p, const platform::TickInfo& t, const control::ConsoleInput& in,
+                               bool console_drives) noexcept {
+  // A jog run: long enough for a few sawtooth periods, short enough to stop with the stick.
+  constexpr double kJogRun_s = 0.02;
+  const bool enabled = console_drives && in.active && in.fresh && in.deadman && !p.faulted();
+  positioner_->set_enabled(enabled);
+  const double now = t_offset_s_ + t.t_s;
+  platform::PositionerCommand c;
+  while (vision_.pop(c)) {
+    const double interval = c.interval_s - (now - c.t_issue_s);  // what is left of it
+    if (!enabled || interval <= 0.0) continue;
+    for (int i = 0; i < 2; ++i) p.command_open_loop_velocity(i, c.velocity_m_s[i], interval);
+  }
+  // The joystick in the plane (no goal pending): open-loop runs while it asks.
+  if (!enabled || latest_.has_goal || latest_.has_goal_px) return;
+  for (int i = 0; i < 2; ++i) {
+    const double v = in.velocity_m_s[i];
+    if (v != 0.0 && !p.open_loop_running(i)) p.command_open_loop_velocity(i, v, kJogRun_s);
+  }
+}
 
 void LivePlatform::build(bool demo) {
   // A new scene: the old platform's devices are deactivated (safe state) by its destructor.
@@ -89,6 +119,10 @@ void LivePlatform::build(bool demo) {
   settled_s_ = {};
   remote_estopped_ = false;
   if (task_) task_->reset();  // a new scene, a new cycle (not started)
+  if (positioner_) positioner_->reset();
+  platform::PositionerCommand stale;
+  while (vision_.pop(stale)) {
+  }
 }
 
 void LivePlatform::set_frame_sink(FrameSink sink) {
@@ -98,11 +132,16 @@ void LivePlatform::set_frame_sink(FrameSink sink) {
 }
 
 void LivePlatform::attach_camera(Platform& p) {
-  // Without a sink the camera forms no frame (camera_device.h).
-  if (p.camera() == nullptr || !frame_sink_) return;
+  // Without a sink the camera forms no frame (camera_device.h); vision positioning needs them.
+  if (p.camera() == nullptr || (!frame_sink_ && !positioner_)) return;
   p.camera()->set_sink([this, offset = t_offset_s_](const platform::CameraFrame& f) {
     camera_frames_.fetch_add(1, std::memory_order_relaxed);  // for the status
-    frame_sink_(f, offset + f.t_mid_s);
+    if (positioner_) {
+      // Measured before the frame is shown: the command's latency is the servo's, not the page's.
+      const double now = t_s_.load(std::memory_order_relaxed);
+      if (auto c = positioner_->on_frame(f, offset + f.t_mid_s, now)) vision_.push(*c);
+    }
+    if (frame_sink_) frame_sink_(f, offset + f.t_mid_s);
   });
 }
 
@@ -111,7 +150,8 @@ bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return comma
 void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   Platform& p = *platform_;
   if (estop_.exchange(false) && !p.faulted()) p.fault_all();
-  if (p.camera() != nullptr) p.camera()->set_wanted(camera_wanted_.load(std::memory_order_relaxed));
+  if (p.camera() != nullptr)
+    p.camera()->set_wanted(positioner_ != nullptr || camera_wanted_.load(std::memory_order_relaxed));
   if (interrupt_.load(std::memory_order_acquire)) p.stop();
 
   ConsoleCommand c;
@@ -170,7 +210,19 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     // The task, supervised by the console in control: it drives or holds in the console's place.
     if (task_) task_->tick(p, home_m_, t.dt_s, console_control && !p.faulted(), fresh, in);
   }
+  const bool console_drives = !protocol && !demo_running_.load(std::memory_order_relaxed);
+  if (positioner_ && console_drives) {
+    // The goal is the positioner's: the coupling's x and y loops are open.
+    if (in.has_goal)
+      positioner_->request_goal_world(in.goal_m.x(), in.goal_m.y());
+    else if (latest_.has_goal_px)
+      positioner_->request_goal_pixel(latest_.goal_px[0], latest_.goal_px[1]);
+    else
+      positioner_->clear_goal();
+    in.has_goal = false;
+  }
   p.set_console_input(in);
+  if (positioner_) vision_tick(p, t, in, console_drives);
   protocol_publish(t);
   if (params_.remote) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -260,6 +312,9 @@ std::string LivePlatform::demo_unavailable_reason() const {
     return "demo: the scripted operator needs the whole simulated platform in this process";
   if (params_.platform.optical_trap_scene())
     return "demo: the scripted operator is the pick-and-place; the optical-trap scene is operated by hand";
+  if (positioner_)
+    return "demo: the scripted operator needs the stage's encoders (stage.xy_sensor is vision: use "
+           "click-to-go)";
   return "";
 }
 
@@ -392,6 +447,7 @@ LiveStatus LivePlatform::status() const {
     }
   }
   if (task_) s.task = task_->status();
+  if (positioner_) s.vision = positioner_->status();
   std::lock_guard lock(request_mutex_);
   s.last_error = last_error_;
   return s;

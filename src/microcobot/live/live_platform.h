@@ -37,6 +37,7 @@
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/spsc_ring.h"
 #include "microcobot/platform/timing_stats.h"
+#include "microcobot/platform/vision_positioner.h"
 
 namespace mc::live {
 
@@ -97,6 +98,8 @@ struct LiveStatus {
   DemoResult demo_result;
   std::string last_error;              ///< the last failed request (reset refused, rebuild failed)
   std::optional<LiveTaskStatus> task;  ///< the supervised task (none without one)
+  /// The stage positioned by vision (`stage.xy_sensor: vision`; none otherwise).
+  std::optional<platform::PositionerStatus> vision;
 };
 
 class LivePlatform {
@@ -206,6 +209,11 @@ class LivePlatform {
   /// After the console input is set: a pending open-loop run started (or refused), the view published.
   void protocol_publish(const platform::TickInfo& t) noexcept;
   void attach_camera(platform::Platform& p);
+  /// With x and y positioned by vision: the operator's goal handed to the positioner (the
+  /// coupling does not chase it), its runs and the joystick's played open loop. After the
+  /// console input is set (the runs check its deadman).
+  void vision_tick(platform::Platform& p, const platform::TickInfo& t, const control::ConsoleInput& in,
+                   bool console_drives) noexcept;
 
   LiveParams params_;
   ConsoleLimits limits_;
@@ -226,10 +234,12 @@ class LivePlatform {
   std::array<std::atomic<bool>, 3> on_target_{}, stepping_{};
   std::atomic<bool> protocol_driving_{false};
   std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
-  std::uint64_t popped_seq_ = 0;                 // loop thread only
-  platform::SpscRing<double> latencies_{4096};   // loop -> status thread [s]
-  platform::SpscRing<double> link_costs_{4096};  // loop -> status thread [s]
-  ConsoleCommand latest_;                        // loop thread only
+  std::uint64_t popped_seq_ = 0;                                // loop thread only
+  std::unique_ptr<platform::VisionPositioner> positioner_;      // stage.xy_sensor: vision
+  platform::SpscRing<platform::PositionerCommand> vision_{16};  // camera thread -> loop
+  platform::SpscRing<double> latencies_{4096};                  // loop -> status thread [s]
+  platform::SpscRing<double> link_costs_{4096};                 // loop -> status thread [s]
+  ConsoleCommand latest_;                                       // loop thread only
   double last_command_t_ = -1e9;
   double t_offset_s_ = 0.0;
 

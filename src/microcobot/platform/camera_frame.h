@@ -73,6 +73,7 @@ struct CameraFrame {
   double focus_z_m = 0.0;           ///< focal plane height
   double view_center_m[2] = {};     ///< world x, y at the image's centre (the microscope's axis)
   double tool_m[3] = {};            ///< where the gripper's point was
+  double gripper_opening_m = 0.0;   ///< the gripper's opening (its own sensor) at the frame
   Image image;
   std::vector<std::uint8_t> jpeg;
   double capture_s = 0.0;  ///< time to form or grab the image (wall)

@@ -33,37 +33,40 @@ EncoderlessStage::EncoderlessStage(const stickslip::ActuatorModel& model, const 
 
 double EncoderlessStage::tick_s() const noexcept { return p_.samples_per_tick * model_.dt_s(); }
 
+OpenLoopRun plan_open_loop_run(const control::StepMap& map, const EncoderlessDriveParams& p, double d,
+                               double interval_s) noexcept {
+  OpenLoopRun run;
+  if (!std::isfinite(d) || !(interval_s > 0.0) || !std::isfinite(interval_s) || d == 0.0) return run;
+  const auto dir = d >= 0.0 ? stickslip::Direction::kForward : stickslip::Direction::kBackward;
+  // Periods: as many as the largest step needs at the nominal 1 kHz, then spread over T.
+  const double ref_f = std::clamp(1000.0, p.min_frequency_Hz, p.max_frequency_Hz);
+  const double big = map.step_m(map.params().amplitudes_V.back(), ref_f, dir);
+  const double smallest_A = map.min_stepping_amplitude_V(ref_f, dir);
+  const double small = map.step_m(smallest_A, ref_f, dir);
+  if (!(big > 0.0) || std::abs(d) < 0.5 * small) return run;  // under half the finest step
+  const auto max_periods = static_cast<std::int64_t>(std::floor(p.max_frequency_Hz * interval_s));
+  std::int64_t n = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(std::abs(d) / big)));
+  n = std::min(n, std::max<std::int64_t>(1, max_periods));
+  run.frequency_Hz = std::clamp(static_cast<double>(n) / interval_s, p.min_frequency_Hz, p.max_frequency_Hz);
+  run.amplitude_V = std::max(
+      map.amplitude_for_step(std::abs(d) / static_cast<double>(n), run.frequency_Hz, dir), smallest_A);
+  run.direction = d >= 0.0 ? 1 : -1;
+  run.periods = n;
+  return run;
+}
+
 void EncoderlessStage::command(const Eigen::Vector2d& velocity_m_s, double interval_s) noexcept {
   for (std::size_t i = 0; i < 2; ++i) {
     OpenLoopStepper& st = *steppers_[i];
-    const double d = velocity_m_s[static_cast<Eigen::Index>(i)] * interval_s;
-    const auto dir = d >= 0.0 ? stickslip::Direction::kForward : stickslip::Direction::kBackward;
     const double u_now = states_[i].u_V;
-    last_periods_[i] = 0;
-    last_amplitude_[i] = 0.0;
-    if (!std::isfinite(d) || !(interval_s > 0.0) || d == 0.0) {
+    const OpenLoopRun run =
+        plan_open_loop_run(map_, p_, velocity_m_s[static_cast<Eigen::Index>(i)] * interval_s, interval_s);
+    last_periods_[i] = static_cast<int>(run.periods);
+    last_amplitude_[i] = run.amplitude_V;
+    if (run.periods == 0)
       st.start(0.0, p_.min_frequency_Hz, 1, 0, u_now);  // no run: the axis holds at rest
-      continue;
-    }
-    // Periods: as many as the largest step needs at the nominal 1 kHz, then spread over T.
-    const double ref_f = std::clamp(1000.0, p_.min_frequency_Hz, p_.max_frequency_Hz);
-    const double big = map_.step_m(map_.params().amplitudes_V.back(), ref_f, dir);
-    const double smallest_A = map_.min_stepping_amplitude_V(ref_f, dir);
-    const double small = map_.step_m(smallest_A, ref_f, dir);
-    if (!(big > 0.0) || std::abs(d) < 0.5 * small) {
-      st.start(0.0, p_.min_frequency_Hz, 1, 0, u_now);  // under half the finest step: nothing to do
-      continue;
-    }
-    const auto max_periods = static_cast<std::int64_t>(std::floor(p_.max_frequency_Hz * interval_s));
-    std::int64_t n = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(std::abs(d) / big)));
-    n = std::min(n, std::max<std::int64_t>(1, max_periods));
-    const double f =
-        std::clamp(static_cast<double>(n) / interval_s, p_.min_frequency_Hz, p_.max_frequency_Hz);
-    const double per_step = std::abs(d) / static_cast<double>(n);
-    const double A = std::max(map_.amplitude_for_step(per_step, f, dir), smallest_A);
-    st.start(A, f, d >= 0.0 ? 1 : -1, n, u_now);
-    last_periods_[i] = static_cast<int>(n);
-    last_amplitude_[i] = A;
+    else
+      st.start(run.amplitude_V, run.frequency_Hz, run.direction, run.periods, u_now);
   }
 }
 

@@ -15,6 +15,7 @@
 /// construction; command() and advance() never allocate.
 
 #include <array>
+#include <cstdint>
 #include <memory>
 
 #include <Eigen/Core>
@@ -34,6 +35,22 @@ struct EncoderlessDriveParams {
 
   void validate() const;
 };
+
+/// One axis' open-loop run: `periods` sawtooth periods (0: none, the axis holds at rest).
+struct OpenLoopRun {
+  double amplitude_V = 0.0;
+  double frequency_Hz = 0.0;
+  int direction = 1;  ///< +1 forward, -1 backward
+  std::int64_t periods = 0;
+};
+
+/// The run that moves an axis by `d_m` within `interval_s`: as many periods as the largest step
+/// needs at the nominal 1 kHz (at most max_frequency_Hz x T), spread over T (frequency n / T, at
+/// least min_frequency_Hz), at the amplitude whose step the map gives as d / n (at least the
+/// smallest that steps). None for a displacement under half the finest step, a non-finite one,
+/// or T <= 0. Never allocates or throws.
+OpenLoopRun plan_open_loop_run(const control::StepMap& map, const EncoderlessDriveParams& params, double d_m,
+                               double interval_s) noexcept;
 
 class EncoderlessStage {
  public:

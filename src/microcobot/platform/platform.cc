@@ -121,6 +121,9 @@ void Platform::build() {
     require(std::abs(period - model_->dt_s()) <= 1e-9 * model_->dt_s(), "devices.axes.sample_period_s",
             "must equal the stick-slip model's step (integrator.dt_s)", period);
   }
+  vision_xy_ = config_.stage.vision_xy();
+  require(!(vision_xy_ && position_controlled_), "stage.xy_sensor",
+          "vision needs voltage-driven axes (a position-controlled stage closes its own loop)", 1.0);
   map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
   stage_ = std::make_unique<StageController>(
       config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
@@ -255,7 +258,9 @@ void Platform::devices_task(double dt_s) noexcept {
     const bool was_running = st.running();
     if (was_running && open_loop_must_stop(i)) st.halt();
     if (!faulted_ && !position_controlled_) {
-      if (st.running()) {
+      if (vision_xy_ && i < 2) {
+        devices_.axes[i]->command_drive(st.drive());  // its run, or 0 V at rest: no loop on x, y
+      } else if (st.running()) {
         const DriveBlock open_loop = st.drive();
         stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m());  // keeps the controller's clock
         devices_.axes[i]->command_drive(open_loop);
@@ -300,9 +305,9 @@ void Platform::telemetry_task(double t_s) noexcept {
   for (std::size_t i = 0; i < 3; ++i)
     put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->position_m());
   for (std::size_t i = 0; i < 3; ++i)
-    put(faulted_                  ? 0.0
-        : steppers_[i]->running() ? steppers_[i]->output_V()
-                                  : stage_->last_voltage_V(static_cast<int>(i)));
+    put(faulted_                                           ? 0.0
+        : steppers_[i]->running() || (vision_xy_ && i < 2) ? steppers_[i]->output_V()
+                                                           : stage_->last_voltage_V(static_cast<int>(i)));
   put(o.haptic_force_N.x()), put(o.haptic_force_N.y());
   put(devices_.tweezers->opening_m()), put(o.finger_force_N);
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
@@ -405,8 +410,21 @@ bool Platform::start_open_loop_steps(int axis, double amplitude_V, double freque
   if (!(frequency_Hz > 0.0 && frequency_Hz <= 10e3) || periods < 1 || periods > 1'000'000'000) return false;
   if (!(console_.active && console_.fresh && console_.deadman)) return false;
   const auto i = static_cast<std::size_t>(axis);
-  steppers_[i]->start(amplitude_V, frequency_Hz, direction, periods, stage_->last_voltage_V(axis));
+  // From the voltage on the axis: the controller's, or (x, y without sensors) the last run's.
+  const double u_V = vision_xy_ && axis < 2 ? steppers_[i]->output_V() : stage_->last_voltage_V(axis);
+  steppers_[i]->start(amplitude_V, frequency_Hz, direction, periods, u_V);
   return true;
+}
+
+bool Platform::command_open_loop_velocity(int axis, double velocity_m_s, double interval_s) noexcept {
+  if (axis < 0 || axis > 2) return false;
+  const OpenLoopRun run =
+      plan_open_loop_run(*map_, EncoderlessDriveParams{}, velocity_m_s * interval_s, interval_s);
+  if (run.periods == 0) {
+    steppers_[static_cast<std::size_t>(axis)]->halt();
+    return !faulted_;
+  }
+  return start_open_loop_steps(axis, run.amplitude_V, run.frequency_Hz, run.direction, run.periods);
 }
 
 void Platform::stop_open_loop() noexcept {
@@ -422,6 +440,8 @@ bool Platform::open_loop_must_stop(std::size_t i) const noexcept {
   if (faulted_ || !(console_.active && console_.fresh && console_.deadman)) return true;
   const Vec3 f = devices_.gripper->contact_force_N();
   if (std::hypot(f.x, f.y, f.z) > world_.params().contact_force_limit_N) return true;
+  // Without its sensor (x, y positioned by vision) an axis knows only its end stop.
+  if (vision_xy_ && i < 2) return devices_.axes[i]->at_end_stop();
   // Leaving the workspace (or going below the floor) in the direction of travel.
   const double x = devices_.axes[i]->position_m();
   const int dir = steppers_[i]->drive_direction();

@@ -31,6 +31,7 @@
 #include "microcobot/core/recorder.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/camera_device.h"
+#include "microcobot/platform/encoderless_stage.h"
 #include "microcobot/platform/fixed_rate_loop.h"
 #include "microcobot/platform/open_loop_stepper.h"
 #include "microcobot/platform/platform_config.h"
@@ -180,6 +181,15 @@ class Platform {
   /// axis leaves the workspace (or, on Z, goes below the floor) in its direction of travel.
   bool start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
                              std::int64_t periods) noexcept;
+  /// Open-loop velocity (issue #28 point 5, `stage.xy_sensor: vision`): axis `axis` moves by
+  /// v x `interval_s` within `interval_s`, its run planned from the step map
+  /// (plan_open_loop_run(): a calibration of the drive, not a sensor), then holds at rest. A
+  /// displacement under half the finest step stops the axis' run instead. The rules of
+  /// start_open_loop_steps() apply (deadman, faults, force, workspace). Real-time safe.
+  bool command_open_loop_velocity(int axis, double velocity_m_s, double interval_s) noexcept;
+  /// True when x and y are positioned by vision (`stage.xy_sensor: vision`): their stage loop is
+  /// open, they move only by open-loop runs and rest at 0 V between them.
+  bool vision_xy() const noexcept { return vision_xy_; }
   /// Stops every open-loop run at once (0 V) and holds every axis. Real-time safe.
   void stop_open_loop() noexcept;
   bool open_loop_running(int axis) const noexcept {
@@ -273,6 +283,7 @@ class Platform {
   std::function<void(const TickInfo&)> operator_;
   control::ConsoleInput console_;
   bool faulted_ = false;
+  bool vision_xy_ = false;            ///< x and y open loop, positioned by vision (stage.xy_sensor)
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)
   /// The camera's scene (loop thread): tool and part positions of the last ticks, for velocities
   /// over the last kVelocityTicks ticks.

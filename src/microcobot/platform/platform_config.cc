@@ -89,6 +89,10 @@ void PlatformConfig::validate() const {
     stage.step_map.validate();
     require(std::isfinite(stage.home_x_m) && std::isfinite(stage.home_y_m) && std::isfinite(stage.home_z_m),
             "home_m", "must be finite");
+    if (stage.xy_sensor != "encoders" && stage.xy_sensor != "vision")
+      throw InvalidParams("xy_sensor", "'" + excerpt(stage.xy_sensor) + "' is not encoders or vision");
+    if (stage.vision_xy() && !camera.enabled)
+      throw InvalidParams("xy_sensor", "vision needs the camera (camera.enabled: true)");
   });
   in_section("stage.control", [&] {
     require(std::abs(stage.control.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),

@@ -66,11 +66,17 @@ struct StageParams {
   bool tracking_enabled = true;
   control::TrackingParams tracking = default_tracking();
   control::PositionSensorParams sensor;
+  /// What positions the stage in the plane (issue #28 point 5): "encoders", the axes' position
+  /// sensors closing the stage controller's loop, or "vision", the x and y sensors unused: the
+  /// axes step open loop (their drive planned from the step map) on velocity commands of the
+  /// visual servo watching the camera's frames (live/vision_positioner.h); z keeps its loop.
+  std::string xy_sensor = "encoders";
   control::StepMapParams step_map;
   /// Finger-tip position (world frame) when the three axes are at 0 (mid-stroke).
   double home_x_m = -0.2e-3;
   double home_y_m = 0.0;
   double home_z_m = 0.45e-3;
+  bool vision_xy() const { return xy_sensor == "vision"; }
 
   template <class V>
   void visit(V& v) {
@@ -78,6 +84,7 @@ struct StageParams {
     v("tracking_enabled", tracking_enabled);
     v("tracking", tracking);
     v("sensor", sensor);
+    v("xy_sensor", xy_sensor);
     v("step_map", step_map);
     v("home_x_m", home_x_m);
     v("home_y_m", home_y_m);

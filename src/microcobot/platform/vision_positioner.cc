@@ -1,0 +1,246 @@
+#include "microcobot/platform/vision_positioner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "microcobot/core/error.h"
+#include "microcobot/platform/grey_frame.h"
+
+namespace mc::platform {
+
+void VisionPositionerParams::validate() const {
+  servo.validate();
+  tracker.validate();
+  require(std::isfinite(template_m) && template_m > 0.0 && template_m <= 1e-3, "template_m",
+          "must be within (0, 1 mm]", template_m);
+  require(std::isfinite(margin_s) && margin_s >= 0.0 && margin_s < 0.1, "margin_s",
+          "must be within [0, 0.1) s", margin_s);
+  require(std::isfinite(min_run_s) && min_run_s > 0.0 && min_run_s < 1.0, "min_run_s",
+          "must be within (0, 1) s", min_run_s);
+}
+
+VisionPositioner::VisionPositioner(const PlatformConfig& config, const VisionPositionerParams& params)
+    : config_(config),
+      p_(params),
+      home_xy_m_(config.stage.home_x_m, config.stage.home_y_m),
+      trackers_{vision::TemplateTracker(params.tracker), vision::TemplateTracker(params.tracker)} {
+  p_.validate();
+  config_.camera.validate();
+}
+
+vision::AffineMap VisionPositioner::map_for(int objective, bool* calibrated) const {
+  if (const vision::StageCalibration* c = config_.camera.calibration(objective)) {
+    if (calibrated) *calibrated = true;
+    return c->map();
+  }
+  if (calibrated) *calibrated = false;
+  // The nominal map: the objective's pixel size, the image's columns along stage x and its rows
+  // down along -y, the home where the camera's view centre puts it (renderer.h's u_of_x, v_of_y).
+  const double px = config_.camera.m_per_px(objective);
+  const auto& s = config_.camera.sensor;
+  vision::AffineMap m;
+  m.A << 1.0 / px, 0.0, 0.0, -1.0 / px;
+  m.b = {(home_xy_m_.x() - config_.camera.view_center_x_m) / px + 0.5 * (s.width_px - 1),
+         0.5 * (s.height_px - 1) - (home_xy_m_.y() - config_.camera.view_center_y_m) / px};
+  return m;
+}
+
+void VisionPositioner::request_goal_world(double x_m, double y_m) noexcept {
+  if (goal_kind_.load(std::memory_order_relaxed) == 1 && goal_a_.load(std::memory_order_relaxed) == x_m &&
+      goal_b_.load(std::memory_order_relaxed) == y_m)
+    return;  // the same goal, asked again at every tick
+  goal_a_.store(x_m, std::memory_order_relaxed);
+  goal_b_.store(y_m, std::memory_order_relaxed);
+  goal_kind_.store(1, std::memory_order_relaxed);
+  goal_seq_.fetch_add(1, std::memory_order_release);
+}
+
+void VisionPositioner::request_goal_pixel(double u_px, double v_px) noexcept {
+  if (goal_kind_.load(std::memory_order_relaxed) == 2 && goal_a_.load(std::memory_order_relaxed) == u_px &&
+      goal_b_.load(std::memory_order_relaxed) == v_px)
+    return;
+  goal_a_.store(u_px, std::memory_order_relaxed);
+  goal_b_.store(v_px, std::memory_order_relaxed);
+  goal_kind_.store(2, std::memory_order_relaxed);
+  goal_seq_.fetch_add(1, std::memory_order_release);
+}
+
+void VisionPositioner::clear_goal() noexcept {
+  if (goal_kind_.load(std::memory_order_relaxed) == 0) return;
+  goal_kind_.store(0, std::memory_order_relaxed);
+  goal_seq_.fetch_add(1, std::memory_order_release);
+}
+
+void VisionPositioner::switch_objective(int objective, int width_px, int height_px) {
+  objective_ = objective;
+  width_ = width_px;
+  height_ = height_px;
+  map_ = map_for(objective, &calibrated_);
+  servo_.emplace(p_.servo, map_, width_px, height_px);
+  taught_ = false;  // the tips look different through another objective: taught again
+  moved_px_.setZero();
+  if (goal_kind_.load(std::memory_order_relaxed) == 2) clear_goal();  // a pixel means another point now
+  taken_goal_seq_ = ~std::uint64_t{0};                                // a world goal is mapped again
+}
+
+void VisionPositioner::take_goal(PositionerStatus& st) {
+  const std::uint64_t seq = goal_seq_.load(std::memory_order_acquire);
+  if (seq == taken_goal_seq_) return;
+  const int kind = goal_kind_.load(std::memory_order_relaxed);
+  const double a = goal_a_.load(std::memory_order_relaxed), b = goal_b_.load(std::memory_order_relaxed);
+  if (goal_seq_.load(std::memory_order_acquire) != seq) return;  // being written: the next frame takes it
+  taken_goal_seq_ = seq;
+  has_goal_ = false;
+  st.error.clear();
+  if (kind == 0) return;
+  const Eigen::Vector2d goal_px =
+      kind == 1 ? map_.pixel_of(Eigen::Vector2d(a, b) - home_xy_m_) : Eigen::Vector2d(a, b);
+  const Eigen::Vector2d target = goal_px;
+  try {
+    servo_->set_target(target.x(), target.y());
+  } catch (const Error&) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "goal (%.1f, %.1f) px is outside the %d x %d image: not moving",
+                  goal_px.x(), goal_px.y(), width_, height_);
+    st.error = buf;
+    return;
+  }
+  has_goal_ = true;
+  st.goal_u_px = goal_px.x();
+  st.goal_v_px = goal_px.y();
+}
+
+std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& frame, double t_mid_s,
+                                                            double t_now_s) {
+  if (!to_grey_frame(frame.image, frame.sequence, frame_)) return std::nullopt;
+  ++frames_;
+  if (reset_.exchange(false, std::memory_order_acquire)) {
+    objective_ = -1;  // taught again, from the home
+    stage_m_.setZero();
+    run_end_s_ = -1e9;
+  }
+  PositionerStatus st = status();
+  st.frames = frames_;
+  if (frame.objective != objective_ || frame_.width != width_ || frame_.height != height_)
+    switch_objective(frame.objective, frame_.width, frame_.height);
+  st.m_per_px = 1.0 / std::sqrt(std::abs(map_.A.determinant()));
+  st.calibrated = calibrated_;
+
+  // Where the tool is: taught where it is expected, then tracked near where the commands put it.
+  bool found = false;
+  double confidence = 0.0;
+  if (!taught_) {
+    if (!teach(map_.pixel_of(stage_m_), frame.gripper_opening_m, st)) {
+      publish(st);
+      return std::nullopt;
+    }
+    found = true;
+    confidence = 1.0;
+  } else {
+    const Eigen::Vector2d predicted_tool = tool_px_ + moved_px_;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    int agreeing = 0;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const Eigen::Vector2d tip_step =
+          map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * frame.gripper_opening_m, 0.0));
+      const Eigen::Vector2d predicted = predicted_tool + tip_step + tip_offset_px_[k];
+      const vision::TrackEstimate e = trackers_[k].track_near(frame_, predicted.x(), predicted.y());
+      const Eigen::Vector2d tool_k = Eigen::Vector2d(e.u_px, e.v_px) - tip_offset_px_[k] - tip_step;
+      if (!e.found || (tool_k - predicted_tool).norm() > p_.tracker.search_margin_px) continue;
+      sum += tool_k;
+      ++agreeing;
+      confidence = agreeing == 1 ? e.confidence : std::min(confidence, e.confidence);
+    }
+    found = agreeing > 0;
+    if (found) tool_px_ = sum / agreeing;
+    // Both lost for a second: taught again where the tool was last seen.
+    lost_frames_ = found ? 0 : lost_frames_ + 1;
+    if (lost_frames_ > config_.camera.frame_rate_Hz()) taught_ = false;
+  }
+  moved_px_.setZero();
+  if (found) stage_m_ = map_.stage_of(tool_px_);
+  st.taught = true;
+  st.found = found;
+  st.confidence = confidence;
+  st.tool_u_px = tool_px_.x();
+  st.tool_v_px = tool_px_.y();
+  st.stage_x_m = stage_m_.x();
+  st.stage_y_m = stage_m_.y();
+
+  take_goal(st);
+  st.has_goal = has_goal_;
+  std::optional<PositionerCommand> out;
+  const double frame_start_s = t_mid_s - 0.5 * frame.exposure_s;
+  if (!has_goal_) {
+    st.state = "no-goal";
+  } else if (!enabled_.load(std::memory_order_relaxed)) {
+    st.state = "no-deadman";
+    servo_->clear_history();  // nothing it asked is moving the stage
+  } else if (frame_start_s < run_end_s_) {
+    // Exposed while the last run may still play: the slider is anywhere within a period's stroke.
+  } else {
+    // The run ends before the first exposure that starts late enough to leave it min_run_s.
+    const double T = 1.0 / config_.camera.frame_rate_Hz();
+    double next_start = frame_start_s + T;
+    while (next_start - t_now_s - p_.margin_s < p_.min_run_s) next_start += T;
+    const double hold = next_start - t_now_s - p_.margin_s;
+    vision::ServoFeature f;
+    f.u_px = tool_px_.x();
+    f.v_px = tool_px_.y();
+    f.found = found;
+    f.t_mid_exposure_s = t_mid_s;
+    const vision::ServoCommand c = servo_->step(f, t_now_s, hold);
+    st.state = vision::to_string(c.status);
+    st.error_m = c.error_m.norm();
+    if (c.velocity_m_s.squaredNorm() > 0.0) {
+      out = PositionerCommand{c.velocity_m_s, hold, t_now_s};
+      run_end_s_ = t_now_s + hold + p_.margin_s;
+      moved_px_ = map_.pixel_step(c.velocity_m_s * hold);
+      ++commands_;
+    }
+  }
+  st.commands = commands_;
+  publish(st);
+  return out;
+}
+
+bool VisionPositioner::teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st) {
+  const double m_per_px = 1.0 / std::sqrt(std::abs(map_.A.determinant()));
+  const int side = std::max(16, static_cast<int>(std::lround(p_.template_m / m_per_px)));
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Eigen::Vector2d tip =
+        tool_px + map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * opening_m, 0.0));
+    const double cu = tip.x(), cv = tip.y() - 0.25 * side;
+    const vision::PixelRoi roi{static_cast<int>(std::lround(cu - 0.5 * (side - 1))),
+                               static_cast<int>(std::lround(cv - 0.5 * (side - 1))), side, side};
+    try {
+      trackers_[k].set_template(frame_, roi);
+    } catch (const Error& e) {
+      st.taught = st.found = false;
+      st.state = "error";
+      st.error = std::string("cannot see the gripper's ") + (k == 0 ? "left" : "right") +
+                 " tip where expected: " + e.what();
+      return false;
+    }
+    tip_offset_px_[k] = Eigen::Vector2d(trackers_[k].last().u_px, trackers_[k].last().v_px) - tip;
+  }
+  taught_ = true;
+  lost_frames_ = 0;
+  tool_px_ = tool_px;
+  taken_goal_seq_ = ~std::uint64_t{0};  // a goal asked before is taken again
+  st.error.clear();
+  return true;
+}
+
+PositionerStatus VisionPositioner::status() const {
+  std::lock_guard lock(status_mutex_);
+  return status_;
+}
+
+void VisionPositioner::publish(const PositionerStatus& st) {
+  std::lock_guard lock(status_mutex_);
+  status_ = st;
+}
+
+}  // namespace mc::platform
