@@ -189,5 +189,37 @@ mc.drawCameraImage = (g, c) => {
     $("scope-info").textContent = `${s.objective_name}, ${(s.m_per_px * um).toFixed(2)} µm/px, ` +
       `focus ${(s.focus_z_m * um).toFixed(0)} µm, ${(s.exposure_s * 1e3).toFixed(1)} ms × ${s.gain.toFixed(1)}, ` +
       `frame ${s.sequence}`;
+  const vi = visionInfo();
+  $("vision-info").hidden = !vi;
+  $("vision-info").textContent = vi;
+  drawVision(g, c);
   return true;
 };
+
+// The stage positioned by vision (stage.xy_sensor: vision, /console/status "vision"): where the
+// camera thread's tracker sees the tool point (a cross) and where the servo sends it (a ring),
+// in the full frame's pixels scaled to the canvas; its state in the panel's caption.
+function visionInfo() {
+  const v = mc.status && mc.status.vision;
+  if (!v) return "";
+  if (v.error) return `vision: ${v.error}`;
+  const left = v.has_goal ? `, ${(v.error_m * um).toFixed(2)} µm to go` : "";
+  return `vision: ${v.state}${left}${v.calibrated ? "" : " (nominal scale)"}`;
+}
+function drawVision(g, c) {
+  const v = mc.status && mc.status.vision, s = mc.camera.state;
+  if (!v || !v.taught || !s) return;
+  const kx = c.width / s.width, ky = c.height / s.height;
+  g.lineWidth = 1.5;
+  g.strokeStyle = v.found ? "#ffd23f" : "#ff6b6b";
+  const [tx, ty] = [v.tool_px[0] * kx, v.tool_px[1] * ky];
+  g.beginPath();
+  g.moveTo(tx - 8, ty); g.lineTo(tx + 8, ty); g.moveTo(tx, ty - 8); g.lineTo(tx, ty + 8);
+  g.stroke();
+  if (v.goal_px) {
+    g.strokeStyle = "#4fa3ff";
+    g.beginPath();
+    g.arc(v.goal_px[0] * kx, v.goal_px[1] * ky, 6, 0, 2 * Math.PI);
+    g.stroke();
+  }
+}
