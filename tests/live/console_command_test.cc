@@ -55,6 +55,33 @@ TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
   EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e308]})"), "accepted");  // finite: clamped to the workspace
 }
 
+TEST(ConsoleCommand, AGoalPixelMustLieInTheCamerasFrame) {
+  ConsoleLimits limits;
+  limits.max_goal_px = {639.0, 511.0};
+  const auto c = parse_console_command(R"({"deadman": true, "goal_px": [320.25, 511]})", limits);
+  EXPECT_TRUE(c.has_goal_px);
+  EXPECT_FALSE(c.has_goal);
+  EXPECT_DOUBLE_EQ(c.goal_px[0], 320.25);
+  EXPECT_DOUBLE_EQ(c.goal_px[1], 511.0);
+  auto refused = [&](const std::string& payload, const ConsoleLimits& l) {
+    try {
+      parse_console_command(payload, l);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"({"goal_px": [640, 0]})", limits),
+            "/console/command: goal_px[0]: must be within the frame [0, 639]");
+  EXPECT_EQ(refused(R"({"goal_px": [0, -1]})", limits),
+            "/console/command: goal_px[1]: must be within the frame [0, 511]");
+  EXPECT_EQ(refused(R"({"goal_px": [1, 2, 3]})", limits),
+            "/console/command: goal_px: must be an array of 2 numbers");
+  EXPECT_EQ(refused(R"({"goal_px": [1, "x"]})", limits), "/console/command: goal_px[1]: must be a number");
+  EXPECT_EQ(refused(R"({"goal_px": [1, 2]})", ConsoleLimits{}),
+            "/console/command: goal_px[0]: there is no camera");
+}
+
 TEST(ConsoleCommand, ParsesActionsAndRefusesUnknownOnes) {
   EXPECT_EQ(parse_console_action(R"({"action": "estop"})"), ConsoleAction::kEstop);
   EXPECT_EQ(parse_console_action(R"({"action": "reset"})"), ConsoleAction::kReset);
