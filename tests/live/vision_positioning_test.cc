@@ -99,7 +99,8 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   LiveParams p = vision_params();
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, 5.0))
+  ASSERT_TRUE(
+      rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, MC_UNDER_ASAN ? 30.0 : 10.0))
       << "the tips' template was not taught: "
       << (rig.live.status().vision ? rig.live.status().vision->error : "");
   const Eigen::Vector2d start = rig.truth();
@@ -139,11 +140,12 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
   LiveParams p = vision_params();
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, 5.0));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
   const Eigen::Vector2d far_goal = home + Eigen::Vector2d(-250e-6, 150e-6);
   rig.goal = {far_goal.x(), far_goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;  // a goal, no deadman
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "no-deadman"; }, 3.0));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "no-deadman"; }, 10.0));
   std::this_thread::sleep_for(500ms);
   EXPECT_LT((rig.truth() - home).norm(), 0.05e-6);
   EXPECT_EQ(rig.live.status().vision->commands, 0u);
@@ -180,13 +182,14 @@ TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneL
   p = vision_params();
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, 5.0));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
   EXPECT_NE(rig.live.demo_unavailable_reason().find("encoders"), std::string::npos);
   const Eigen::Vector2d outside = home + Eigen::Vector2d(1.5e-3, 0.0);  // 5x sees +-0.42 mm
   rig.goal = {outside.x(), outside.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
   rig.deadman = true;
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return !s.vision->error.empty(); }, 3.0));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return !s.vision->error.empty(); }, 10.0));
   EXPECT_NE(rig.live.status().vision->error.find("outside the 800 x 600 image"), std::string::npos)
       << rig.live.status().vision->error;
   std::this_thread::sleep_for(300ms);
