@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "support/counting_allocator.h"
+#include "support/sanitizers.h"
 #include "support/test_support.h"
 
 namespace mc::live {
@@ -81,7 +82,9 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   // Paced to the wall clock: never ahead of it; behind it only when the machine cannot keep up
   // (sanitizer builds, loaded CI machines), when the loop skips rather than bursts.
   EXPECT_LT(elapsed, 1.15) << "the loop ran ahead of the wall clock";
-  EXPECT_GT(elapsed, 0.4) << "the loop hardly ran";
+  // Under ASan beside another paced test a loop tick can take most of its period (CI-like run,
+  // 2026-11-27: 0.36 s of loop time in 1 s).
+  EXPECT_GT(elapsed, MC_UNDER_ASAN ? 0.2 : 0.4) << "the loop hardly ran";
   EXPECT_NEAR(moved, 100e-6 * elapsed, 15e-6);
   EXPECT_TRUE(rig.live.status().console_fresh);
 

@@ -123,7 +123,9 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
               static_cast<unsigned long long>(st.frames), 1e6 * (arrived - goal).norm());
   // Issue #28 asks 0.3 um; at 5x (1.06 um/px) the tips' tracking is biased by 0.1-0.5 px
   // (docs/benchmarks.md: the tool's tracking, an open item), which bounds this.
-  const double bound_m = 0.8e-6;
+  // Under ASan a loop tick takes about its period: a run plays longer than planned and may be
+  // seen mid-period by the next exposure; there only convergence and rest are asserted.
+  const double bound_m = MC_UNDER_ASAN ? 3e-6 : 0.8e-6;
   EXPECT_LT((arrived - goal).norm(), bound_m);
   EXPECT_GT(st.commands, 2u);
   EXPECT_TRUE(rig.live.status().vision->found);
