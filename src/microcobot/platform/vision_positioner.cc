@@ -18,6 +18,10 @@ void VisionPositionerParams::validate() const {
           "must be within [0, 0.1) s", margin_s);
   require(std::isfinite(min_run_s) && min_run_s > 0.0 && min_run_s < 1.0, "min_run_s",
           "must be within (0, 1) s", min_run_s);
+  require(settle_frames >= 0 && settle_frames <= 100, "settle_frames", "must be within [0, 100]",
+          settle_frames);
+  require(std::isfinite(in_position_m) && in_position_m > 0.0 && in_position_m <= servo.converged_m,
+          "in_position_m", "must be within (0, servo.converged_m]", in_position_m);
 }
 
 VisionPositioner::VisionPositioner(const PlatformConfig& config, const VisionPositionerParams& params)
@@ -107,6 +111,8 @@ void VisionPositioner::take_goal(PositionerStatus& st) {
     return;
   }
   has_goal_ = true;
+  converged_frames_ = 0;
+  in_position_ = false;
   st.goal_u_px = goal_px.x();
   st.goal_v_px = goal_px.y();
 }
@@ -177,6 +183,8 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   } else if (!enabled_.load(std::memory_order_relaxed)) {
     st.state = "no-deadman";
     servo_->clear_history();  // nothing it asked is moving the stage
+    converged_frames_ = 0;
+    in_position_ = false;
   } else if (frame_start_s < run_end_s_) {
     // Exposed while the last run may still play: the slider is anywhere within a period's stroke.
   } else {
@@ -193,7 +201,18 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     const vision::ServoCommand c = servo_->step(f, t_now_s, hold);
     st.state = vision::to_string(c.status);
     st.error_m = c.error_m.norm();
-    if (c.velocity_m_s.squaredNorm() > 0.0) {
+    // In position: after settle_frames frames in a row within in_position_m the stage is left at
+    // rest until the error leaves the converged window (hysteresis). A stick-slip axis' finest steps are its
+    // least reliable (near the break-away amplitude the step map's step may be off several times): chasing
+    // the last tens of nanometres made it jump by up to half a micrometre.
+    const bool within = c.status == vision::ServoStatus::kConverged;
+    const bool tight = within && st.error_m <= p_.in_position_m;
+    converged_frames_ = tight ? converged_frames_ + 1 : 0;
+    if (converged_frames_ > p_.settle_frames) in_position_ = true;
+    if (!within) in_position_ = false;
+    if (in_position_) {
+      servo_->clear_history();  // nothing of what it just asked is played
+    } else if (c.velocity_m_s.squaredNorm() > 0.0) {
       out = PositionerCommand{c.velocity_m_s, hold, t_now_s};
       run_end_s_ = t_now_s + hold + p_.margin_s;
       moved_px_ = map_.pixel_step(c.velocity_m_s * hold);
