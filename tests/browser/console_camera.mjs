@@ -74,20 +74,7 @@ await s.run(async () => {
   const blurred = await measure(await expected(), await partSide());
   log(`focus on the substrate: part edge steepness ${blurred.steepness.toFixed(2)}`);
 
-  // As an operator would, clicked again when nothing happened: with the camera streaming on a
-  // loaded machine a click has been lost (CI, 2026-11-26: never granted in 30 s, no command seen
-  // by the server); each retry is logged, and control must come within three clicks.
-  for (let attempt = 1; ; ++attempt) {
-    await page.click("#take-control");
-    try {
-      await until("control granted", () => window.mc.inControl, 15);
-      break;
-    } catch (e) {
-      const state = await page.evaluate(() => ({ connected: window.mc.connected, lastAction: window.mc.lastAction }));
-      log(`take control: not granted after click ${attempt} (${JSON.stringify(state)})`);
-      if (attempt === 3 || await page.evaluate(() => window.mc.inControl)) throw e;
-    }
-  }
+  await s.takeControl();
   // Focus on the part's top: the focus slider (as a hand sets it).
   const top = await page.evaluate(() => window.mc.scene.part_height_m);
   await page.evaluate((z) => window.mc.setFocus(z), top);

@@ -99,6 +99,22 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     }
   };
   s.setSlider = (id, value) => page.locator(id).fill(String(value));
+  // Takes control as an operator would, clicking again when nothing happened: with the camera
+  // streaming on a loaded machine a click has been lost (CI, 2026-11-26: never granted in 30 s, no
+  // command seen by the server); each retry is logged, and control must come within three clicks.
+  s.takeControl = async () => {
+    for (let attempt = 1; ; ++attempt) {
+      await page.click("#take-control");
+      try {
+        await s.until("control granted", () => window.mc.inControl, 15);
+        return;
+      } catch (e) {
+        const state = await page.evaluate(() => ({ connected: window.mc.connected, lastAction: window.mc.lastAction }));
+        s.log(`take control: not granted after click ${attempt} (${JSON.stringify(state)})`);
+        if (attempt === 3 || await page.evaluate(() => window.mc.inControl)) throw e;
+      }
+    }
+  };
   // The objective turret by name ("20x"): the options are the camera's objectives, by index.
   s.selectObjective = async (name) => {
     await s.until(`the ${name} objective offered`, (n) =>

@@ -36,16 +36,7 @@ await s.run(async () => {
   await until("connected, frames shown, the tips' templates taught", () =>
     window.mc.connected && window.mc.camera.frames >= 3 && window.mc.status && window.mc.status.vision &&
     window.mc.status.vision.taught, 30);
-  for (let attempt = 1; ; ++attempt) {
-    await page.click("#take-control");
-    try {
-      await until("control granted", () => window.mc.inControl, 15);
-      break;
-    } catch (e) {
-      log(`take control: not granted after click ${attempt}`);
-      if (attempt === 3) throw e;
-    }
-  }
+  await s.takeControl();
   await shot("vision-01-taught");
   const start = await page.evaluate(() => [window.mc.telemetry.slave_x_m, window.mc.telemetry.slave_y_m]);
   const goal = [start[0] + 60e-6, start[1] - 30e-6];
