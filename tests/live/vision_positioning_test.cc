@@ -1,7 +1,8 @@
 // Issue #28 point 5 live: with `stage.xy_sensor: vision` the console's click-to-go is reached by
 // the visual servo on the camera's frames, x and y stepping open loop (their sensors unused);
 // nothing moves without the deadman; releasing it stops the stage; the goal is judged against
-// the simulation's ground truth (the tips' true position), which the servo never reads.
+// the simulation's ground truth (the tips' true position), which the servo never reads; the loop
+// never allocates while it plays the positioner's runs.
 // Figures: docs/benchmarks.md ("Live, in serve").
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/live/live_platform.h"
+#include "support/counting_allocator.h"
 #include "support/sanitizers.h"
 
 namespace mc::live {
@@ -112,8 +114,16 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
 
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
-  rig.has_goal = true;
-  rig.deadman = true;
+  std::size_t loop_allocations = 0;
+  {
+    // The loop takes the goal, the positioner's commands and plays their runs without allocating.
+    test::AllocationGuard guard(rig.live.loop_thread_id());
+    rig.has_goal = true;
+    rig.deadman = true;
+    rig.wait([](const LiveStatus& s) { return s.vision->commands >= 3; }, MC_UNDER_ASAN ? 20.0 : 5.0);
+    loop_allocations = guard.allocations();
+  }
+  EXPECT_EQ(loop_allocations, 0u);
   const double budget_s = MC_UNDER_ASAN ? 30.0 : 8.0;
   const bool converged = rig.wait(
       [](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; }, budget_s);
