@@ -231,7 +231,9 @@ TEST(SerialLine, UnpluggingTheLineMidMovePutsThePlatformInItsSafeStateWithinOneT
   constexpr double kTimeout = 0.1;  // the default reply timeout
   auto p = platform::make_platform(serial_gcs2_config(fake.server.tty_path()));
   Console console(*p, {30e-6, 0, 0});
-  run_paced(*p, 0.3);
+  // At least 0.3 s, until engaged: the driver's bus thread, starved beside other paced tests
+  // under ASan, can leave the axes' readings stale for a while (CI-like run, 2026-11-27).
+  run_paced(*p, 3.0, [&] { return p->loop().time_s() >= 0.3 && p->teleop().engaged; });
   ASSERT_FALSE(p->faulted());
   ASSERT_TRUE(p->teleop().engaged);
   fake.mode = Mode::kDisconnect;  // the next POS? closes the master
