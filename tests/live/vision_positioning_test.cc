@@ -49,8 +49,9 @@ struct VisionRig {
   LivePlatform live;
   std::mutex m;
   double truth_x = 0.0, truth_y = 0.0, t_s = 0.0;
-  std::atomic<bool> deadman{false}, has_goal{false}, run{true};
+  std::atomic<bool> deadman{false}, has_goal{false}, has_goal_px{false}, run{true};
   std::array<double, 3> goal{};
+  std::array<double, 2> goal_px{};  // set before has_goal_px
   std::thread sender;
   std::size_t sx, sy;
 
@@ -69,6 +70,8 @@ struct VisionRig {
         ConsoleCommand c;
         c.deadman = deadman.load();
         c.has_goal = has_goal.load();
+        c.has_goal_px = has_goal_px.load();
+        c.goal_px = goal_px;
         c.goal_m = goal;
         live.push_command(c);
         std::this_thread::sleep_for(20ms);
@@ -149,6 +152,32 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   EXPECT_LT((resting - goal).norm(), bound_m);
   std::this_thread::sleep_for(500ms);
   EXPECT_LT((rig.truth() - resting).norm(), 0.02e-6);
+}
+
+TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
+  LiveParams p = vision_params();
+  const double m_per_px = p.platform.camera.m_per_px(p.platform.camera.objective);
+  VisionRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
+  const platform::PositionerStatus before = rig.live.status().vision.value();
+  const Eigen::Vector2d start = rig.truth();
+  // 30 px right, 20 px down: +x, -y on the stage (rows go down).
+  rig.goal_px = {before.tool_u_px + 30.0, before.tool_v_px + 20.0};
+  rig.has_goal_px = true;
+  rig.deadman = true;
+  ASSERT_TRUE(
+      rig.wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
+               MC_UNDER_ASAN ? 30.0 : 8.0))
+      << rig.live.status().vision->state << " " << rig.live.status().vision->error;
+  std::this_thread::sleep_for(300ms);
+  rig.deadman = false;
+  const Eigen::Vector2d moved = rig.truth() - start;
+  EXPECT_NEAR(moved.x(), 30.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  EXPECT_NEAR(moved.y(), -20.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  const platform::PositionerStatus after = rig.live.status().vision.value();
+  EXPECT_NEAR(after.goal_u_px, before.tool_u_px + 30.0, 1e-9);
+  EXPECT_NEAR(after.goal_v_px, before.tool_v_px + 20.0, 1e-9);
 }
 
 TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage) {
