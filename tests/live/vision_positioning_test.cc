@@ -215,6 +215,34 @@ TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneL
     EXPECT_NE(std::string(e.what()).find("xy_sensor: 'camera' is not encoders or vision"), std::string::npos)
         << e.what();
   }
+  // The positioner's parameters (stage.vision), each refused naming its key.
+  p = vision_params();
+  p.platform.stage.vision.template_m = -1.0;
+  try {
+    LivePlatform live(p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("stage.vision.template_m"), std::string::npos) << e.what();
+  }
+  p = vision_params();
+  p.platform.stage.vision.servo.gain_per_s = std::nan("");
+  try {
+    LivePlatform live(p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("stage.vision.servo.gain_per_s"), std::string::npos) << e.what();
+  }
+  p = vision_params();
+  p.platform.stage.vision.tracker.search_margin_px = -3;
+  try {
+    LivePlatform live(p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "stage.vision.tracker.search_margin_px: must be within [2, 4096] (got -3)"),
+              std::string::npos)
+        << e.what();
+  }
   p = vision_params();
   p.platform.camera.enabled = false;
   EXPECT_THROW(LivePlatform{p}, Error);

@@ -47,7 +47,8 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
              params_.platform.stage.home_z_m};
   if (params_.task) task_ = std::make_unique<LiveTask>(*params_.task);
   if (params_.platform.stage.vision_xy())
-    positioner_ = std::make_unique<platform::VisionPositioner>(params_.platform);
+    positioner_ =
+        std::make_unique<platform::VisionPositioner>(params_.platform, params_.platform.stage.vision);
   build(/*demo=*/false);
   const auto& tp = params_.platform.teleop;
   limits_.max_speed_m_s = tp.console_max_speed_m_s;

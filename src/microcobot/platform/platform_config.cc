@@ -94,6 +94,7 @@ void PlatformConfig::validate() const {
     if (stage.vision_xy() && !camera.enabled)
       throw InvalidParams("xy_sensor", "vision needs the camera (camera.enabled: true)");
   });
+  in_section("stage.vision", [&] { stage.vision.validate(); });
   in_section("stage.control", [&] {
     require(std::abs(stage.control.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),
             "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",

@@ -26,6 +26,7 @@
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/camera_device.h"
+#include "microcobot/platform/vision_positioner_params.h"
 #include "microcobot/stickslip/stickslip_params.h"
 #include "microcobot/tweezers/teletweez.h"
 
@@ -71,6 +72,8 @@ struct StageParams {
   /// axes step open loop (their drive planned from the step map) on velocity commands of the
   /// visual servo watching the camera's frames (live/vision_positioner.h); z keeps its loop.
   std::string xy_sensor = "encoders";
+  /// The positioner's tracker, servo and timing with `xy_sensor: vision` (docs/parameters.md).
+  VisionPositionerParams vision;
   control::StepMapParams step_map;
   /// Finger-tip position (world frame) when the three axes are at 0 (mid-stroke).
   double home_x_m = -0.2e-3;
@@ -85,6 +88,7 @@ struct StageParams {
     v("tracking", tracking);
     v("sensor", sensor);
     v("xy_sensor", xy_sensor);
+    v("vision", vision);
     v("step_map", step_map);
     v("home_x_m", home_x_m);
     v("home_y_m", home_y_m);

@@ -10,8 +10,14 @@
 namespace mc::platform {
 
 void VisionPositionerParams::validate() const {
-  servo.validate();
-  tracker.validate();
+  servo.validate();  // names its fields servo.*
+  try {
+    tracker.validate();
+  } catch (const InvalidParams& e) {
+    // The tracker's fields under their key here: tracker.* (the message after the field kept).
+    const std::string what = e.what(), rest = what.substr(what.find(e.field()) + e.field().size());
+    throw InvalidParams("tracker." + e.field(), rest.size() > 2 ? rest.substr(2) : rest);
+  }
   require(std::isfinite(template_m) && template_m > 0.0 && template_m <= 1e-3, "template_m",
           "must be within (0, 1 mm]", template_m);
   require(std::isfinite(margin_s) && margin_s >= 0.0 && margin_s < 0.1, "margin_s",

@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// The vision positioner's parameters (`stage.vision` of the platform's configuration; the
+/// positioner itself: vision_positioner.h).
+
+#include "microcobot/vision/template_tracker.h"
+#include "microcobot/vision/visual_servo.h"
+
+namespace mc::platform {
+
+struct VisionPositionerParams {
+  vision::VisualServoParams servo;
+  vision::TrackerParams tracker;
+  /// Each finger tip's template, square, its side in the object [m] (at least 16 px): the tip's
+  /// end and what lies below it, its centre a quarter of it above the tip. The two tips are
+  /// tracked apart and the tool point is their midpoint, whatever the gripper's opening.
+  double template_m = 50e-6;
+  /// A run ends this long before the next exposure it must not be seen in [s]: the loop applies
+  /// a command within one operator tick (1 ms) of its issue.
+  double margin_s = 3e-3;
+  /// A run shorter than this is not worth starting (a stick-slip period at 1 kHz is 1 ms) [s].
+  double min_run_s = 4e-3;
+  /// In position after this many servoed frames in a row with the servo's predicted error within
+  /// in_position_m: the stage then rests until the error leaves the servo's converged window
+  /// (0.3 um). Half the window: the tips' tracking agrees with the truth within ~0.06 um at 5x
+  /// away from other structures, so a rest within 0.15 um is within 0.3 um of the goal.
+  int settle_frames = 2;
+  double in_position_m = 0.15e-6;
+
+  template <class V>
+  void visit(V& v) {
+    v("servo", servo);
+    v("tracker", tracker);
+    v("template_m", template_m);
+    v("margin_s", margin_s);
+    v("min_run_s", min_run_s);
+    v("settle_frames", settle_frames);
+    v("in_position_m", in_position_m);
+  }
+  /// Throws mc::InvalidParams naming the field.
+  void validate() const;
+};
+
+}  // namespace mc::platform
