@@ -135,5 +135,6 @@ $("estop").addEventListener("click", () => action("estop"));
 $("reset").addEventListener("click", () => action("reset"));
 $("demo").addEventListener("click", () => action("demo"));
 $("restart").addEventListener("click", () => action("restart"));
+$("vision-tare").addEventListener("click", () => action("vision_tare"));
 $("record").addEventListener("click", () => action(mc.status && mc.status.recording ? "record_stop" : "record_start"));
 

@@ -95,8 +95,19 @@ function overrunRow(s) {
   const pct = (x) => (100 * x < 0.1 && x > 0 ? "< 0.1" : (100 * x).toFixed(1)) + " %";
   return [`${s.overruns} (${pct(s.overruns / s.ticks)} of ${s.ticks} ticks; last 5 s ${pct(recent)})`, recent < 0.01];
 }
+// The grip force seen by the camera (/platform/status "grip_vision"), beside the sensor's.
+function showGripVision(g) {
+  $("grip-vision-row").hidden = !g;
+  if (!g) return;
+  const f = g.grip_force_N;
+  $("grip-vision-gauge").value = isNum(f) ? Math.max(0, f * um) : 0;
+  $("grip-vision-out").textContent = isNum(f) ? (f * um).toFixed(1) + " µN" : g.state === "untared" ? "press Tare" : g.state;
+  $("grip-vision-out").title = g.error || `gap ${(g.gap_m * um).toFixed(1)} µm, drive ${(g.free_opening_m * um).toFixed(1)} µm, correlation ${g.confidence.toFixed(2)}`;
+  $("grip-vision-out").className = g.state === "measuring" ? "" : "bad";
+}
 listen("/platform/status", (s) => {
   mc.status = s;
+  showGripVision(s.grip_vision);
   const demo = watchDemo(s);
   watchLastError(s);
   const rows = [
@@ -184,8 +195,10 @@ listen("/platform/scene", (s) => {
   $("contact-gauge").max = contact * f.scale;
   $("contact-gauge").high = 0.8 * contact * f.scale;
   $("contact-limit").textContent = "/ " + fmtForce(f, contact) + (optical ? " escape" : " limit");
-  $("grip-gauge").max = grip * um;
-  $("grip-gauge").high = 0.8 * grip * um;
+  for (const id of ["grip-gauge", "grip-vision-gauge"]) {
+    $(id).max = grip * um;
+    $(id).high = 0.8 * grip * um;
+  }
   $("grip-limit").textContent = "/ " + fmtForce({scale: um, label: "µN"}, grip) + (isNum(s.grip_force_limit_N) ? " limit" : "");
   // The demo is the pick-and-place: a scene without it says why (absent field: available).
   const available = s.demo_available !== false;

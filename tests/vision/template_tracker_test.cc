@@ -197,6 +197,26 @@ TEST(TemplateTracker, APredictionFindsAJumpBeyondTheSearchWindow) {
   EXPECT_NEAR(e.v_px, v0, 0.05);
 }
 
+TEST(TemplateTracker, ATargetBetweenTwoPredictionsIsFoundInTheWindowAlongThem) {
+  // A finger closing on a part stops anywhere between where its drive puts it and where it was:
+  // the window spans both; the target 40 px from either end is found there, not by a whole-frame
+  // search.
+  Fixture f;
+  TrackerParams p;
+  p.search_margin_px = 8;
+  TemplateTracker tracker = f.start(p);
+  const double u0 = tracker.last().u_px, v0 = tracker.last().v_px;
+  f.render(kX0 + 40.0 * f.renderer.camera().pixel_size_m(), kY0, 1);
+  const TrackEstimate e = tracker.track_along(f.frame, u0, v0, u0 + 80.0, v0);
+  ASSERT_TRUE(e.found);
+  EXPECT_FALSE(e.reacquired) << "found in the window along the predictions";
+  // Within a tenth of a pixel: 40 px from where it was taken, the blurred substrate behind the
+  // corner pulls by ~0.06 px (as in the test above).
+  EXPECT_NEAR(e.u_px, u0 + 40.0, 0.1);
+  EXPECT_NEAR(e.v_px, v0, 0.1);
+  EXPECT_THROW(tracker.track_along(f.frame, u0, v0, std::nan(""), v0), InvalidInput);
+}
+
 TEST(TemplateTracker, RefusesBadTemplatesAndInputsInOneLine) {
   Fixture f;
   f.render(kX0, kY0, 0);

@@ -19,6 +19,12 @@ InvalidParams::InvalidParams(const std::string& field, const std::string& constr
             fmt::format("invalid parameter {}: {} (got {:g})", field, constraint, got)),
       field_(field) {}
 
+InvalidParams InvalidParams::nested_in(const std::string& prefix) const {
+  const std::string what = this->what(), head = fmt::format("invalid parameter {}: ", field_);
+  const std::string rest = what.rfind(head, 0) == 0 ? what.substr(head.size()) : what;
+  return InvalidParams(prefix + "." + field_, rest);
+}
+
 namespace {
 std::string located(const std::string& file, std::size_t line, const std::string& what) {
   if (file.empty()) return what;

@@ -41,6 +41,9 @@ class InvalidParams : public Error {
   InvalidParams(const std::string& field, const std::string& constraint);
   InvalidParams(const std::string& field, const std::string& constraint, double got);
   const std::string& field() const { return field_; }
+  /// The same error with its field under `prefix`: a section's own parameters validated inside
+  /// a larger one ("lost_below" under "tracker" reads "tracker.lost_below").
+  InvalidParams nested_in(const std::string& prefix) const;
 
  private:
   std::string field_;

@@ -146,17 +146,33 @@ std::string camera_state_schema() {
           {"properties",
            {{"px_per_m", {{"type", "array"}, {"items", pair}, {"minItems", 2}, {"maxItems", 2}}},
             {"offset_px", pair},
-            {"residual_rms_px", number}}}}}}}}
+            {"residual_rms_px", number}}}}},
+        {"grip_vision",
+         {{"type", {"object", "null"}},
+          {"properties",
+           {{"grip_force_N", {{"type", {"number", "null"}}}},
+            {"gap_m", {{"type", {"number", "null"}}}},
+            {"state", text}}}}}}}}
       .dump();
 }
 
 std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_Hz, std::uint64_t dropped,
-                              const vision::StageCalibration* calibration) {
+                              const vision::StageCalibration* calibration,
+                              const platform::VisionGripStatus* grip) {
   nlohmann::json cal = nullptr;
   if (calibration)
     cal = {{"px_per_m", calibration->px_per_m},
            {"offset_px", calibration->offset_px},
            {"residual_rms_px", calibration->residual_rms_px}};
+  nlohmann::json grip_json = nullptr;
+  if (grip) {
+    const auto number_or_null = [](double v) {
+      return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+    };
+    grip_json = {{"grip_force_N", number_or_null(grip->grip_force_N)},
+                 {"gap_m", number_or_null(grip->gap_m)},
+                 {"state", grip->state}};
+  }
   return nlohmann::json{{"t_s", f.t_mid_s},
                         {"sequence", f.sequence},
                         {"width", f.image.width},
@@ -175,7 +191,8 @@ std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_
                         {"encode_ms", 1e3 * f.encode_s},
                         {"latency_ms", 1e3 * f.latency_s},
                         {"dropped", dropped},
-                        {"calibration", cal}}
+                        {"calibration", cal},
+                        {"grip_vision", grip_json}}
       .dump();
 }
 

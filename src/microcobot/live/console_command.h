@@ -69,6 +69,7 @@ enum class ConsoleAction {
   kRestart,         ///< restart the scene, console in control
   kRecordStart,     ///< start an MCAP recording in --out
   kRecordStop,
+  kVisionTare,  ///< force by vision's tare: nothing is between the fingers (the controlling client)
   // The supervised task (`serve --cell`, live_task.h): its controls, in TaskAction's order.
   kTaskStart,
   kTaskPause,
@@ -94,7 +95,7 @@ inline bool is_task_action(ConsoleAction a) {
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
 
 /// Parses `{"action": "estop" | "reset" | "take_control" | "release_control" | "demo" |
-/// "restart" | "record_start" | "record_stop" | "task_start" | "task_pause" | "task_resume" |
+/// "restart" | "record_start" | "record_stop" | "vision_tare" | "task_start" | "task_pause" | "task_resume" |
 /// "task_confirm" | "task_take_over" | "task_hand_back" | "task_step_done" | "task_skip"}`.
 /// Throws mc::InvalidInput.
 ConsoleAction parse_console_action(std::string_view json);

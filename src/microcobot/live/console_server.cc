@@ -100,7 +100,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                             {"ticks", number},
                                             {"camera", {{"type", {"object", "null"}}}},
                                             {"demo_result", {{"type", {"object", "null"}}}},
-                                            {"task", {{"type", {"object", "null"}}}}})});
+                                            {"task", {{"type", {"object", "null"}}}},
+                                            {"grip_vision", {{"type", {"object", "null"}}}}})});
   const json vec3 = {{"type", "array"}, {"items", number}, {"minItems", 3}, {"maxItems", 3}};
   // The optical-trap scene adds its beads; the pick-and-place keys are always there.
   const std::vector<std::string> scene_keys = {"kind",
@@ -280,8 +281,11 @@ void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
   encode_compressed_image(f, stamp, image_cdr_);
   encode_camera_info(f, stamp, info_cdr_);
   const LiveStatus s = live_.status();
+  // The grip force seen in this frame (the gauge ran on it before it reached here).
+  const bool grip_of_frame = s.grip_vision && s.grip_vision->t_mid_s == f.t_mid_s;
   const std::string state = camera_state_json(f, live_.camera_params().frame_rate_Hz(), s.camera_dropped,
-                                              live_.camera_params().calibration(f.objective));
+                                              live_.camera_params().calibration(f.objective),
+                                              grip_of_frame ? &*s.grip_vision : nullptr);
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
   server_.publish(image_ch_, ns, image_cdr_);
   if (server_.subscriber_count(preview_ch_) > 0) {
@@ -378,6 +382,18 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
         note(EventLevel::kInfo, "record_stop", "recording stopped by a client", m.client);
         stop_recording();
         server_.broadcast_status(StatusLevel::kInfo, "recording stopped");
+        return;
+      case ConsoleAction::kVisionTare:
+        if (m.client != controller) {
+          tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
+               "control");
+        } else if (!live_.request_vision_tare()) {
+          tell(m.client, StatusLevel::kWarning,
+               "vision_tare: no force by vision here (vision_force.enabled, a camera)", "refused",
+               "vision_tare");
+        } else {
+          note(EventLevel::kInfo, "vision_tare", "force by vision tared at the next frame", m.client);
+        }
         return;
       case ConsoleAction::kReset:
       case ConsoleAction::kDemo:

@@ -158,6 +158,22 @@ std::string ConsoleServer::status_json() {
   } else {
     j["vision"] = nullptr;
   }
+  if (s.grip_vision) {
+    // The grip force measured by vision (null force: not measured in the last frame).
+    const platform::VisionGripStatus& g = *s.grip_vision;
+    const auto number_or_null = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    j["grip_vision"] = {{"state", g.state},
+                        {"error", g.error},
+                        {"tared", g.tared},
+                        {"grip_force_N", number_or_null(g.grip_force_N)},
+                        {"gap_m", number_or_null(g.gap_m)},
+                        {"free_opening_m", g.free_opening_m},
+                        {"confidence", g.confidence},
+                        {"frames", g.frames},
+                        {"tares", g.tares}};
+  } else {
+    j["grip_vision"] = nullptr;
+  }
   const DemoResult& d = s.demo_result;
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;

@@ -49,6 +49,10 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   if (params_.platform.stage.vision_xy())
     positioner_ =
         std::make_unique<platform::VisionPositioner>(params_.platform, params_.platform.stage.vision);
+  // Force by vision wherever a camera looks at the gripper (not the optical trap's beads).
+  const platform::PlatformConfig& pc = params_.platform;
+  if (pc.vision_force.enabled && !pc.optical_trap_scene())
+    grip_gauge_ = std::make_unique<platform::VisionGripForce>(pc);
   build(/*demo=*/false);
   const auto& tp = params_.platform.teleop;
   limits_.max_speed_m_s = tp.console_max_speed_m_s;
@@ -121,6 +125,7 @@ void LivePlatform::build(bool demo) {
   remote_estopped_ = false;
   if (task_) task_->reset();  // a new scene, a new cycle (not started)
   if (positioner_) positioner_->reset();
+  if (grip_gauge_) grip_gauge_->reset();
   platform::PositionerCommand stale;
   while (vision_.pop(stale)) {
   }
@@ -134,14 +139,21 @@ void LivePlatform::set_frame_sink(FrameSink sink) {
 
 void LivePlatform::attach_camera(Platform& p) {
   // Without a sink the camera forms no frame (camera_device.h); vision positioning needs them.
-  if (p.camera() == nullptr || (!frame_sink_ && !positioner_)) return;
+  if (p.camera() == nullptr || (!frame_sink_ && !positioner_ && !grip_gauge_)) return;
   p.camera()->set_sink([this, offset = t_offset_s_](const platform::CameraFrame& f) {
     camera_frames_.fetch_add(1, std::memory_order_relaxed);  // for the status
+    platform::VisionGripForce::ToolHint hint;
     if (positioner_) {
       // Measured before the frame is shown: the command's latency is the servo's, not the page's.
       const double now = t_s_.load(std::memory_order_relaxed);
       if (auto c = positioner_->on_frame(f, offset + f.t_mid_s, now)) vision_.push(*c);
+      // Without x, y sensors the tips are looked for where the positioner sees the tool.
+      const platform::PositionerStatus st = positioner_->status();
+      hint.stage_sensed = false;
+      if (st.found) hint.pixel = Eigen::Vector2d(st.tool_u_px, st.tool_v_px);
     }
+    // Before the frame is shown: its camera state carries the force seen in it.
+    if (grip_gauge_) grip_gauge_->on_frame(f, hint);
     if (frame_sink_) frame_sink_(f, offset + f.t_mid_s);
   });
 }
@@ -449,6 +461,7 @@ LiveStatus LivePlatform::status() const {
   }
   if (task_) s.task = task_->status();
   if (positioner_) s.vision = positioner_->status();
+  if (grip_gauge_ && has_camera_) s.grip_vision = grip_gauge_->status();
   std::lock_guard lock(request_mutex_);
   s.last_error = last_error_;
   return s;

@@ -37,6 +37,7 @@
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/spsc_ring.h"
 #include "microcobot/platform/timing_stats.h"
+#include "microcobot/platform/vision_grip_force.h"
 #include "microcobot/platform/vision_positioner.h"
 
 namespace mc::live {
@@ -100,6 +101,9 @@ struct LiveStatus {
   std::optional<LiveTaskStatus> task;  ///< the supervised task (none without one)
   /// The stage positioned by vision (`stage.xy_sensor: vision`; none otherwise).
   std::optional<platform::PositionerStatus> vision;
+  /// The grip force measured by vision (`vision_force.enabled`, a camera, the gripper's scene;
+  /// none otherwise).
+  std::optional<platform::VisionGripStatus> grip_vision;
 };
 
 class LivePlatform {
@@ -149,6 +153,13 @@ class LivePlatform {
   /// Reset, demo or restart, done by the control thread between two loop runs; other actions
   /// are the server's business and ignored here.
   void request(ConsoleAction action);
+  /// Force by vision's tare at the next frame: the operator says nothing is between the
+  /// fingers. Any thread; false when the platform measures no force by vision.
+  bool request_vision_tare() noexcept {
+    if (!grip_gauge_) return false;
+    grip_gauge_->request_tare();
+    return true;
+  }
 
   LiveStatus status() const;
   /// Moves the command-to-target latencies measured by the loop since the last call (from the
@@ -236,6 +247,7 @@ class LivePlatform {
   std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
   std::uint64_t popped_seq_ = 0;                                // loop thread only
   std::unique_ptr<platform::VisionPositioner> positioner_;      // stage.xy_sensor: vision
+  std::unique_ptr<platform::VisionGripForce> grip_gauge_;       // vision_force.enabled
   platform::SpscRing<platform::PositionerCommand> vision_{16};  // camera thread -> loop
   platform::SpscRing<double> latencies_{4096};                  // loop -> status thread [s]
   platform::SpscRing<double> link_costs_{4096};                 // loop -> status thread [s]

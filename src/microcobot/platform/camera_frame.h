@@ -25,8 +25,11 @@ struct SceneSnapshot {
   double tool_m[3] = {};             ///< the gripper's point (finger tips), measured stage position
   double tool_velocity_m_s[3] = {};  ///< its velocity (motion blur over the exposure)
   double gripper_opening_m = 0.0;    ///< distance between the finger tips
-  bool has_part = false;             ///< the pick-and-place's part
-  double part_m[3] = {};             ///< part centre
+  /// The opening the gripper's drive puts its fingers at without a load (Gripper::free_opening_m;
+  /// NaN: the drive has no model of it): force by vision's reference.
+  double gripper_free_opening_m = 0.0;
+  bool has_part = false;  ///< the pick-and-place's part
+  double part_m[3] = {};  ///< part centre
   double part_velocity_m_s[3] = {};
   int part_phase = 0;      ///< microworld::PartPhase
   bool has_beads = false;  ///< the optical-trap scene's beads
@@ -68,12 +71,13 @@ struct CameraFrame {
   int objective = 0;           ///< turret position
   std::string objective_name;  ///< e.g. "10x"
   double magnification = 1.0;
-  double working_distance_m = 0.0;  ///< the objective's
-  double m_per_px = 0.0;            ///< object-side pixel size: pixel pitch / magnification
-  double focus_z_m = 0.0;           ///< focal plane height
-  double view_center_m[2] = {};     ///< world x, y at the image's centre (the microscope's axis)
-  double tool_m[3] = {};            ///< where the gripper's point was
-  double gripper_opening_m = 0.0;   ///< the gripper's opening (its own sensor) at the frame
+  double working_distance_m = 0.0;      ///< the objective's
+  double m_per_px = 0.0;                ///< object-side pixel size: pixel pitch / magnification
+  double focus_z_m = 0.0;               ///< focal plane height
+  double view_center_m[2] = {};         ///< world x, y at the image's centre (the microscope's axis)
+  double tool_m[3] = {};                ///< where the gripper's point was
+  double gripper_opening_m = 0.0;       ///< the gripper's opening (its own sensor) at the frame
+  double gripper_free_opening_m = 0.0;  ///< ... and its drive's unloaded opening (SceneSnapshot's)
   Image image;
   std::vector<std::uint8_t> jpeg;
   double capture_s = 0.0;  ///< time to form or grab the image (wall)

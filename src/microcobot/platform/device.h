@@ -15,6 +15,7 @@
 /// called at every tick once configured, whatever the state (a simulated device keeps its
 /// physics running; a hardware driver keeps its bus alive).
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -163,6 +164,9 @@ class Gripper : public Device {
   virtual double grip_force_N() const = 0;
   /// Force on the gripper from its contacts (the mount's force sensor), world frame [N].
   virtual Vec3 contact_force_N() const = 0;
+  /// The opening the drive puts the fingers at with nothing between them: its open-loop model
+  /// of its own actuation (force by vision's reference, vision_grip_force.h). NaN: none.
+  virtual double free_opening_m() const { return std::nan(""); }
 };
 
 }  // namespace mc::platform

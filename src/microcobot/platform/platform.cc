@@ -364,6 +364,7 @@ void Platform::camera_task(const TickInfo& t) noexcept {
     s.tool_velocity_m_s[i] = history ? (tool[i] - tool_then[i]) / span_s : 0.0;
   }
   s.gripper_opening_m = devices_.gripper->opening_m();
+  s.gripper_free_opening_m = devices_.gripper->free_opening_m();
   if (sim_.gripper != nullptr) {
     s.has_part = true;
     s.part_phase = static_cast<int>(sim_.gripper->world_state().phase);

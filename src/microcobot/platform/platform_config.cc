@@ -81,6 +81,7 @@ void PlatformConfig::validate() const {
                                       "' is not a camera driver of this build (known: " + known + ")");
   });
   in_section("camera", [&] { camera.validate(); });
+  in_section("vision_force", [&] { vision_force.validate(); });
   in_section("loop", [&] { loop.validate(); });
   in_section("teleop", [&] { teleop.validate(); });
   in_section("stage", [&] {

@@ -26,6 +26,7 @@
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/camera_device.h"
+#include "microcobot/platform/vision_grip_force_params.h"
 #include "microcobot/platform/vision_positioner_params.h"
 #include "microcobot/stickslip/stickslip_params.h"
 #include "microcobot/tweezers/teletweez.h"
@@ -172,6 +173,8 @@ struct PlatformConfig {
   microworld::OpticalTrapSceneParams optical_trap;
   /// The microscope camera and its focus drive (issue #27); which camera: devices.camera.
   CameraDeviceParams camera;
+  /// The grip force measured by vision, live (issue #28 point 4, vision_grip_force.h).
+  VisionGripForceParams vision_force;
 
   template <class V>
   void visit(V& v) {
@@ -186,6 +189,7 @@ struct PlatformConfig {
     v("world", world);
     v("optical_trap", optical_trap);
     v("camera", camera);
+    v("vision_force", vision_force);
   }
   bool optical_trap_scene() const { return microworld == "optical-trap"; }
   /// Validates every section and their consistency (rates); errors name the key path.

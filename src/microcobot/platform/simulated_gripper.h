@@ -23,6 +23,9 @@ class SimulatedGripper final : public Gripper {
   void command_opening_m(double opening) noexcept override;
   double opening_m() const override { return out_.opening_m; }
   double grip_force_N() const override { return out_.grip_force_N; }
+  /// The bender's free opening: the simulated drive is ideal (first order and slew limited, no
+  /// hysteresis), so its open-loop model is exact (docs/errata.md).
+  double free_opening_m() const override { return state_.gripper.free_opening_m; }
   Vec3 contact_force_N() const override {
     return {out_.force_on_gripper_N.x(), out_.force_on_gripper_N.y(), out_.force_on_gripper_N.z()};
   }

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "microcobot/core/error.h"
+#include "microcobot/platform/camera_map.h"
 #include "microcobot/platform/grey_frame.h"
 
 namespace mc::platform {
@@ -14,9 +15,7 @@ void VisionPositionerParams::validate() const {
   try {
     tracker.validate();
   } catch (const InvalidParams& e) {
-    // The tracker's fields under their key here: tracker.* (the message after the field kept).
-    const std::string what = e.what(), rest = what.substr(what.find(e.field()) + e.field().size());
-    throw InvalidParams("tracker." + e.field(), rest.size() > 2 ? rest.substr(2) : rest);
+    throw e.nested_in("tracker");  // the tracker's fields under their key here
   }
   require(std::isfinite(template_m) && template_m > 0.0 && template_m <= 1e-3, "template_m",
           "must be within (0, 1 mm]", template_m);
@@ -40,20 +39,7 @@ VisionPositioner::VisionPositioner(const PlatformConfig& config, const VisionPos
 }
 
 vision::AffineMap VisionPositioner::map_for(int objective, bool* calibrated) const {
-  if (const vision::StageCalibration* c = config_.camera.calibration(objective)) {
-    if (calibrated) *calibrated = true;
-    return c->map();
-  }
-  if (calibrated) *calibrated = false;
-  // The nominal map: the objective's pixel size, the image's columns along stage x and its rows
-  // down along -y, the home where the camera's view centre puts it (renderer.h's u_of_x, v_of_y).
-  const double px = config_.camera.m_per_px(objective);
-  const auto& s = config_.camera.sensor;
-  vision::AffineMap m;
-  m.A << 1.0 / px, 0.0, 0.0, -1.0 / px;
-  m.b = {(home_xy_m_.x() - config_.camera.view_center_x_m) / px + 0.5 * (s.width_px - 1),
-         0.5 * (s.height_px - 1) - (home_xy_m_.y() - config_.camera.view_center_y_m) / px};
-  return m;
+  return camera_stage_map(config_, objective, calibrated);
 }
 
 void VisionPositioner::request_goal_world(double x_m, double y_m) noexcept {
@@ -136,7 +122,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   st.frames = frames_;
   if (frame.objective != objective_ || frame_.width != width_ || frame_.height != height_)
     switch_objective(frame.objective, frame_.width, frame_.height);
-  st.m_per_px = 1.0 / std::sqrt(std::abs(map_.A.determinant()));
+  st.m_per_px = map_m_per_px(map_);
   st.calibrated = calibrated_;
 
   // Where the tool is: taught where it is expected, then tracked near where the commands put it.
@@ -231,7 +217,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
 }
 
 bool VisionPositioner::teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st) {
-  const double m_per_px = 1.0 / std::sqrt(std::abs(map_.A.determinant()));
+  const double m_per_px = map_m_per_px(map_);
   const int side = std::max(16, static_cast<int>(std::lround(p_.template_m / m_per_px)));
   for (std::size_t k = 0; k < 2; ++k) {
     const Eigen::Vector2d tip =

@@ -105,17 +105,26 @@ void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
 }
 
 TrackEstimate TemplateTracker::track(const Frame& frame) {
-  return track_around(frame, last_.u_px + du_, last_.v_px + dv_, lost_);
+  const double u = last_.u_px + du_, v = last_.v_px + dv_;
+  return track_around(frame, u, v, u, v, lost_);
 }
 
 TrackEstimate TemplateTracker::track_near(const Frame& frame, double u_px, double v_px) {
   if (!std::isfinite(u_px) || !std::isfinite(v_px))
     throw InvalidInput("template tracker: the predicted position (" + std::to_string(u_px) + ", " +
                        std::to_string(v_px) + ") px is not finite");
-  return track_around(frame, u_px, v_px, false);
+  return track_around(frame, u_px, v_px, u_px, v_px, false);
 }
 
-TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, double pv, bool whole) {
+TrackEstimate TemplateTracker::track_along(const Frame& frame, double u0_px, double v0_px, double u1_px,
+                                           double v1_px) {
+  if (!std::isfinite(u0_px) || !std::isfinite(v0_px) || !std::isfinite(u1_px) || !std::isfinite(v1_px))
+    throw InvalidInput("template tracker: a predicted position is not finite");
+  return track_around(frame, u0_px, v0_px, u1_px, v1_px, false);
+}
+
+TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu0, double pv0, double pu1,
+                                            double pv1, bool whole) {
   if (!images_) throw InvalidInput("template tracker: no template (set_template first)");
   Images& im = *images_;
   if (frame.width != im.frame_width || frame.height != im.frame_height)
@@ -150,9 +159,12 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu, doubl
   };
   const int m = params_.search_margin_px;
   const double far = 1e6;  // a prediction outside any frame
-  const cv::Rect predicted(static_cast<int>(std::lround(std::clamp(pu - cx, -far, far))) - m,
-                           static_cast<int>(std::lround(std::clamp(pv - cy, -far, far))) - m, tw + 2 * m,
-                           th + 2 * m);
+  const auto around = [&](double pu, double pv) {
+    return cv::Rect(static_cast<int>(std::lround(std::clamp(pu - cx, -far, far))) - m,
+                    static_cast<int>(std::lround(std::clamp(pv - cy, -far, far))) - m, tw + 2 * m,
+                    th + 2 * m);
+  };
+  const cv::Rect predicted = around(pu0, pv0) | around(pu1, pv1);
   const cv::Rect window = predicted & bounds;
   if (!whole && window.width >= tw && window.height >= th) search(window);
   // Correlation is blind to contrast: a faint patch of texture shaped like the target correlates

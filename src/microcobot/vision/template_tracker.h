@@ -89,12 +89,16 @@ class TemplateTracker {
   /// The same, searched around a caller's prediction of the template centre (a commanded stage
   /// move seen through the calibration, a servo's expected motion). Non-finite: InvalidInput.
   TrackEstimate track_near(const Frame& frame, double u_px, double v_px);
+  /// The same, searched around the segment between two predictions (a finger closing on a part
+  /// that may stop it anywhere between where its drive puts it and where it was).
+  TrackEstimate track_along(const Frame& frame, double u0_px, double v0_px, double u1_px, double v1_px);
   /// The last estimate (the template's own position before the first track()).
   const TrackEstimate& last() const { return last_; }
 
  private:
   struct Images;  // OpenCV's matrices, kept out of this header
-  TrackEstimate track_around(const Frame& frame, double u_px, double v_px, bool whole);
+  TrackEstimate track_around(const Frame& frame, double u0_px, double v0_px, double u1_px, double v1_px,
+                             bool whole);
   TrackerParams params_;
   std::unique_ptr<Images> images_;
   TrackEstimate last_;

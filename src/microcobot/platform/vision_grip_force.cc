@@ -1,0 +1,218 @@
+#include "microcobot/platform/vision_grip_force.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "microcobot/core/error.h"
+#include "microcobot/platform/camera_map.h"
+#include "microcobot/platform/grey_frame.h"
+
+namespace mc::platform {
+
+void VisionGripForceParams::validate() const {
+  try {
+    tracker.validate();
+  } catch (const InvalidParams& e) {
+    throw e.nested_in("tracker");
+  }
+  require(std::isfinite(finger_width_m) && finger_width_m >= 5e-6 && finger_width_m <= 1e-3, "finger_width_m",
+          "must be within [5 um, 1 mm]", finger_width_m);
+}
+
+namespace {
+// The template around each tip: the finger's outer half and what lies beyond it, from a little
+// below its end to a little up its length (fill_camera_scene's finger: a bar along +y from its
+// end at the tool point's y - width / 2). The jaw side, where a part touches, is left out.
+constexpr double kBeyond = 12e-6;  // background beside and below the finger [m]
+constexpr double kAlong = 30e-6;   // up the finger from its end [m]
+// A part holds the fingers apart by more than this: the next gap is predicted from the last.
+constexpr double kLoadedGap = 1e-6;
+}  // namespace
+
+VisionGripForce::VisionGripForce(const PlatformConfig& config)
+    : config_(config),
+      stiffness_N_m_(config.world.gripper.finger_stiffness_N_m),
+      trackers_{vision::TemplateTracker(config.vision_force.tracker),
+                vision::TemplateTracker(config.vision_force.tracker)} {
+  config_.vision_force.validate();
+  config_.camera.validate();
+  require(std::isfinite(stiffness_N_m_) && stiffness_N_m_ > 0.0, "world.gripper.finger_stiffness_N_m",
+          "must be > 0", stiffness_N_m_);
+}
+
+Eigen::Vector2d VisionGripForce::tip_step_px(int side, double gap_m) const {
+  return map_.pixel_step(Eigen::Vector2d(side * 0.5 * gap_m, 0.0));
+}
+
+bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m) {
+  const double w = config_.vision_force.finger_width_m;
+  for (int k = 0; k < 2; ++k) {
+    const int side = k == 0 ? -1 : 1;
+    // The finger's outer half, in stage coordinates from the tool point: x from its centre line
+    // outward past its edge, y from below its end up along it. Its box in the image.
+    const double x0 = side * 0.5 * (gap_m + w), x1 = side * (0.5 * gap_m + w + kBeyond);
+    const double y0 = -0.5 * w - kBeyond, y1 = -0.5 * w + kAlong;
+    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (double x : {x0, x1})
+      for (double y : {y0, y1}) {
+        const Eigen::Vector2d c = tool_px + map_.pixel_step(Eigen::Vector2d(x, y));
+        lo = lo.cwiseMin(c);
+        hi = hi.cwiseMax(c);
+      }
+    const vision::PixelRoi roi{static_cast<int>(std::lround(lo.x())), static_cast<int>(std::lround(lo.y())),
+                               static_cast<int>(std::lround(hi.x() - lo.x())),
+                               static_cast<int>(std::lround(hi.y() - lo.y()))};
+    try {
+      trackers_[static_cast<std::size_t>(k)].set_template(frame_, roi);
+    } catch (const Error& e) {
+      st_.state = "error";
+      st_.error = std::string("cannot see the gripper's ") + (k == 0 ? "left" : "right") +
+                  " tip where expected: " + e.what();
+      taught_ = false;
+      return false;
+    }
+    const vision::TrackEstimate& t = trackers_[static_cast<std::size_t>(k)].last();
+    offset_px_[static_cast<std::size_t>(k)] =
+        Eigen::Vector2d(t.u_px, t.v_px) - tool_px - tip_step_px(side, gap_m);
+  }
+  const vision::TrackEstimate &l = trackers_[0].last(), &r = trackers_[1].last();
+  ref_d_px_ = (Eigen::Vector2d(r.u_px, r.v_px) - Eigen::Vector2d(l.u_px, l.v_px)).dot(e_x_);
+  ref_gap_m_ = last_gap_m_ = gap_m;
+  last_tool_px_ = tool_px;
+  loaded_ = gap_m - free_opening_m > kLoadedGap;
+  taught_ = true;
+  return true;
+}
+
+const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, const ToolHint& hint) {
+  if (!to_grey_frame(frame.image, frame.sequence, frame_)) return st_;
+  ++st_.frames;
+  st_.t_mid_s = frame.t_mid_s;
+  st_.grip_force_N = st_.gap_m = std::nan("");
+  st_.confidence = 0.0;
+  if (reset_.exchange(false, std::memory_order_acq_rel)) {
+    taught_ = st_.tared = false;
+    st_.state = "untared";
+    st_.error.clear();
+    auto_tare_ = config_.vision_force.tare_at_start;
+  }
+  const double o = frame.gripper_free_opening_m;
+  st_.free_opening_m = o;
+  if (!std::isfinite(o)) {
+    st_.state = "error";
+    st_.error = "the gripper's drive has no model of its free opening: no force by vision";
+    publish();
+    return st_;
+  }
+  const bool new_view = frame.objective != objective_ || frame_.width != width_ || frame_.height != height_;
+  if (new_view) {
+    objective_ = frame.objective;
+    width_ = frame_.width;
+    height_ = frame_.height;
+    map_ = camera_stage_map(config_, objective_);
+    const Eigen::Vector2d ex = map_.pixel_step(Eigen::Vector2d::UnitX());
+    scale_px_m_ = ex.norm();
+    e_x_ = ex / scale_px_m_;
+  }
+  if (!hint.pixel && !hint.stage_sensed && !taught_) {
+    st_.state = st_.tared ? "lost" : "untared";
+    st_.error = "waiting for the vision positioner to see the tool";
+    publish();
+    return st_;
+  }
+  const Eigen::Vector2d tool = hint.pixel ? *hint.pixel
+                               : hint.stage_sensed
+                                   ? map_.pixel_of(Eigen::Vector2d(frame.tool_m[0] - config_.stage.home_x_m,
+                                                                   frame.tool_m[1] - config_.stage.home_y_m))
+                                   : last_tool_px_;
+  if (tare_.exchange(false, std::memory_order_acq_rel) || auto_tare_) {
+    // Nothing between the fingers: the gap is the drive's free opening. The scene's own tare is
+    // tried at each frame until the tips are in view.
+    if (teach(tool, o, o)) {
+      auto_tare_ = false;
+      st_.tared = true;
+      ++st_.tares;
+      st_.state = "measuring";
+      st_.error.clear();
+    }
+    st_.gap_m = taught_ ? o : st_.gap_m;
+    st_.grip_force_N = taught_ ? 0.0 : st_.grip_force_N;
+    st_.confidence = taught_ ? 1.0 : 0.0;
+    publish();
+    return st_;
+  }
+  if (!st_.tared) {
+    publish();
+    return st_;
+  }
+  if (new_view || !taught_) {
+    // Another objective: the tips look different. Taught again where they are, the gap carried
+    // over from the last one measured (the reference chains; a part may be held).
+    if (teach(tool, last_gap_m_, o)) st_.state = "measuring";
+    publish();
+    return st_;
+  }
+
+  // The gap lies between the drive's opening and the last gap while they close (a part may stop
+  // the fingers anywhere between), at the drive's opening while they open, and no lower than it.
+  const double predicted_gap = loaded_ ? std::max(o, last_gap_m_) : o;
+  const double closing_from = std::max(predicted_gap, last_gap_m_);
+  std::array<Eigen::Vector2d, 2> p;
+  double confidence = 1.0;
+  for (int k = 0; k < 2; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const int side = k == 0 ? -1 : 1;
+    const Eigen::Vector2d at = tool + tip_step_px(side, predicted_gap) + offset_px_[i];
+    const Eigen::Vector2d from = tool + tip_step_px(side, closing_from) + offset_px_[i];
+    const vision::TrackEstimate e = trackers_[i].track_along(frame_, at.x(), at.y(), from.x(), from.y());
+    if (!e.found) {
+      st_.state = "lost";
+      st_.error = std::string("the ") + (k == 0 ? "left" : "right") + " tip is not found";
+      publish();
+      return st_;
+    }
+    p[i] = {e.u_px, e.v_px};
+    confidence = std::min(confidence, e.confidence);
+  }
+  // Two matches that are not the two tips: the right one on the left, or rows apart.
+  const Eigen::Vector2d d = p[1] - p[0] - (offset_px_[1] - offset_px_[0]);
+  const double along = d.dot(e_x_), across = std::abs(d.x() * e_x_.y() - d.y() * e_x_.x());
+  if (along <= 0.0 || across > config_.vision_force.tracker.search_margin_px) {
+    st_.state = "lost";
+    st_.error = "the two matches are not the gripper's two tips";
+    publish();
+    return st_;
+  }
+  const double gap = ref_gap_m_ + ((p[1] - p[0]).dot(e_x_) - ref_d_px_) / scale_px_m_;
+  if (gap < o - std::max(kLoadedGap, 3.0 / scale_px_m_)) {
+    // Closer than the drive puts them: nothing pushes fingers inward; these are not the tips.
+    st_.state = "lost";
+    st_.error = "the tips seen closer than the drive puts them";
+    publish();
+    return st_;
+  }
+  last_gap_m_ = gap;
+  last_tool_px_ =
+      0.5 * (p[0] - offset_px_[0] - tip_step_px(-1, gap) + p[1] - offset_px_[1] - tip_step_px(1, gap));
+  loaded_ = gap - o > kLoadedGap;
+  st_.state = "measuring";
+  st_.error.clear();
+  st_.gap_m = gap;
+  st_.confidence = confidence;
+  st_.grip_force_N = 0.5 * stiffness_N_m_ * (gap - o);  // F = k (w - o) / 2, piezo_gripper.h
+  publish();
+  return st_;
+}
+
+VisionGripStatus VisionGripForce::status() const {
+  std::lock_guard lock(status_mutex_);
+  return published_;
+}
+
+void VisionGripForce::publish() {
+  std::lock_guard lock(status_mutex_);
+  published_ = st_;
+}
+
+}  // namespace mc::platform

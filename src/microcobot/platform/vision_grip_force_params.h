@@ -1,0 +1,33 @@
+#pragma once
+/// @file
+/// The live force-by-vision gauge's parameters (`vision_force` of the platform's configuration;
+/// the gauge itself: vision_grip_force.h).
+
+#include "microcobot/vision/template_tracker.h"
+
+namespace mc::platform {
+
+struct VisionGripForceParams {
+  /// Measure the grip force from the camera's frames whenever the camera forms them (a
+  /// console watching, a recording, vision positioning).
+  bool enabled = true;
+  /// Tare on the first frame of a scene: the gripper starts open with nothing between its
+  /// fingers (false: the gauge waits for the operator's tare).
+  bool tare_at_start = true;
+  /// The fingers' width across their closing direction [m] (the console's and the renderer's
+  /// 40 um): each tip's template is the finger's outer half and its end, away from the jaw.
+  double finger_width_m = 40e-6;
+  vision::TrackerParams tracker;
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled);
+    v("tare_at_start", tare_at_start);
+    v("finger_width_m", finger_width_m);
+    v("tracker", tracker);
+  }
+  /// Throws mc::InvalidParams naming the field (the tracker's under tracker.*).
+  void validate() const;
+};
+
+}  // namespace mc::platform

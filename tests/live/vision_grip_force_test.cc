@@ -1,0 +1,252 @@
+// Issue #28 point 4 live: the grip force measured by vision on the camera's frames (the finger
+// tips' distance against the drive's free opening, times the fingers' stiffness) agrees with the
+// simulated gripper's sensor; it is tared at the scene's start and on request; it needs no stage
+// sensor; without frames there is none.
+// Figures: docs/benchmarks.md ("Force by vision, live").
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "microcobot/core/error.h"
+#include "microcobot/live/live_platform.h"
+#include "support/sanitizers.h"
+
+namespace mc::live {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::size_t channel(const char* name) {
+  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
+    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
+  throw std::runtime_error(name);
+}
+
+// The part between the open fingers from the start, the tips at its mid-height, the microscope
+// on them at 5x (1.06 um per pixel; the 600 um opening and both fingers inside 848 um).
+LiveParams grip_params() {
+  LiveParams p;
+  auto& st = p.platform.stage;
+  auto& w = p.platform.world;
+  st.home_z_m = 0.5 * w.height_m();
+  w.part_start_m.x() = st.home_x_m;
+  w.part_start_m.y() = st.home_y_m;
+  w.grip_force_limit_N = 20e-3;  // up to what the closed gripper squeezes (7.5 mN on 300 um)
+  auto& cam = p.platform.camera;
+  cam.sensor.width_px = 800;
+  cam.sensor.height_px = 600;
+  cam.objective = 1;  // 5x
+  cam.view_center_x_m = st.home_x_m;
+  cam.view_center_y_m = st.home_y_m;
+  cam.focus_start_m = st.home_z_m;
+  return p;
+}
+
+// The live platform with the console in control and the deadman held (the gripper moves only
+// with it), its gripper command set by the test; the sensor's grip force collected from the
+// telemetry, the vision's from the gauge's status, once per frame.
+struct GripRig {
+  LivePlatform live;
+  std::mutex m;
+  std::vector<double> sensor;
+  bool collecting = false;
+  std::atomic<bool> run{true};
+  std::atomic<double> opening{600e-6};
+  std::thread sender;
+  const std::size_t grip = channel("grip_force_N");
+
+  explicit GripRig(LiveParams p) : live(std::move(p)) {
+    live.set_camera_wanted(true);  // a console watching: the camera forms frames
+    live.start([this](const platform::TelemetrySample& s, std::size_t) {
+      std::lock_guard lock(m);
+      if (!collecting) return;
+      sensor.push_back(s[grip]);
+    });
+    live.set_console_in_control(true);
+    sender = std::thread([this] {
+      while (run.load()) {
+        ConsoleCommand c;
+        c.deadman = true;
+        c.has_gripper = true;
+        c.gripper_opening_m = opening.load();
+        live.push_command(c);
+        std::this_thread::sleep_for(20ms);
+      }
+    });
+  }
+  ~GripRig() {
+    run = false;
+    sender.join();
+    live.stop();
+  }
+  template <class Done>
+  bool wait(Done done, double timeout_s) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < until) {
+      if (done(live.status())) return true;
+      std::this_thread::sleep_for(10ms);
+    }
+    return false;
+  }
+  // The mean of each force over `window`: the sensor's; the vision's over the frames that
+  // measured one, and how many frames there were.
+  struct Means {
+    double sensor_N = 0.0, vision_N = 0.0;
+    std::size_t measured_frames = 0, frames = 0;
+  };
+  Means collect(std::chrono::milliseconds window) {
+    {
+      std::lock_guard lock(m);
+      sensor.clear();
+      collecting = true;
+    }
+    Means r;
+    std::uint64_t last_frame = 0;
+    const auto until = std::chrono::steady_clock::now() + window;
+    while (std::chrono::steady_clock::now() < until) {
+      const auto g = live.status().grip_vision;
+      if (g && g->frames != last_frame) {
+        if (last_frame != 0) {
+          ++r.frames;
+          if (std::isfinite(g->grip_force_N)) {
+            r.vision_N += g->grip_force_N;
+            ++r.measured_frames;
+          }
+        }
+        last_frame = g->frames;
+      }
+      std::this_thread::sleep_for(3ms);
+    }
+    if (r.measured_frames > 0) r.vision_N /= static_cast<double>(r.measured_frames);
+    std::lock_guard lock(m);
+    collecting = false;
+    for (double v : sensor) r.sensor_N += v / static_cast<double>(sensor.size());
+    return r;
+  }
+};
+
+TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt) {
+  LiveParams p = grip_params();
+  const double k = p.platform.world.gripper.finger_stiffness_N_m, w = p.platform.world.part_side_m;
+  GripRig rig(std::move(p));
+  const double boot_s = MC_UNDER_ASAN ? 30.0 : 10.0;
+  ASSERT_TRUE(rig.wait(
+      [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 3; },
+      boot_s))
+      << "not tared: " << (rig.live.status().grip_vision ? rig.live.status().grip_vision->error : "no gauge");
+  // Open, nothing touched: no force, seen as none.
+  const auto open = rig.collect(600ms);
+  std::printf("open: vision %.2f uN\n", 1e6 * open.vision_N);
+  EXPECT_EQ(open.sensor_N, 0.0);
+  ASSERT_GT(open.frames, 5u) << "the camera forms no frames";
+  EXPECT_EQ(open.measured_frames, open.frames) << "a frame without a force";
+  EXPECT_LT(std::abs(open.vision_N), 20e-6);
+
+  // Squeezed at 1, 4 and 7 mN (the free opening w - 2 F / k): the estimate within 5 % of the
+  // sensor (issue #28's bias goal) once the fingers have settled.
+  for (double force : {1e-3, 4e-3, 7e-3}) {
+    rig.opening = w - 2.0 * force / k;
+    std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
+    const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+    const auto st = rig.live.status().grip_vision.value();
+    std::printf(
+        "grip %.1f mN: sensor %.4f mN, vision %.4f mN (%+.2f %%), %zu of %zu frames measured, state %s\n",
+        1e3 * force, 1e3 * g.sensor_N, 1e3 * g.vision_N, 100.0 * (g.vision_N / g.sensor_N - 1.0),
+        g.measured_frames, g.frames, st.state.c_str());
+    EXPECT_NEAR(g.sensor_N, force, 0.02 * force) << "the gripper did not squeeze as commanded";
+    ASSERT_GT(g.measured_frames, g.frames / 2) << st.state << ": " << st.error;
+    EXPECT_NEAR(g.vision_N, g.sensor_N, 0.05 * g.sensor_N);
+    EXPECT_EQ(st.state, "measuring");
+    EXPECT_GT(st.confidence, 0.8);
+  }
+  // Let go: back to no force.
+  rig.opening = 600e-6;
+  std::this_thread::sleep_for(500ms);
+  const auto released = rig.collect(600ms);
+  std::printf("released: vision %.2f uN\n", 1e6 * released.vision_N);
+  EXPECT_EQ(released.sensor_N, 0.0);
+  EXPECT_LT(std::abs(released.vision_N), 20e-6);
+}
+
+TEST(VisionGripForce, WithoutTheStagesXYSensorsTheTipsAreLookedForWhereThePositionerSeesTheTool) {
+  LiveParams p = grip_params();
+  p.platform.stage.xy_sensor = "vision";
+  const double k = p.platform.world.gripper.finger_stiffness_N_m, w = p.platform.world.part_side_m;
+  GripRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait(
+      [](const LiveStatus& s) {
+        return s.vision && s.vision->found && s.grip_vision && s.grip_vision->tared &&
+               s.grip_vision->frames > 3;
+      },
+      MC_UNDER_ASAN ? 30.0 : 10.0));
+  const double force = 3e-3;
+  rig.opening = w - 2.0 * force / k;
+  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
+  const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+  const auto st = rig.live.status().grip_vision.value();
+  std::printf("grip %.1f mN, stage on vision: sensor %.4f mN, vision %.4f mN\n", 1e3 * force,
+              1e3 * g.sensor_N, 1e3 * g.vision_N);
+  ASSERT_GT(g.measured_frames, g.frames / 2) << st.state << ": " << st.error;
+  EXPECT_NEAR(g.vision_N, g.sensor_N, 0.05 * g.sensor_N);
+  // The positioner's own tip templates hold the part's edge once it is gripped and lose the
+  // tool (docs/benchmarks.md); the gauge then looks where its own tips put the tool.
+}
+
+TEST(VisionGripForce, ATareOnRequestAndNoneWithoutFrames) {
+  LiveParams p = grip_params();
+  p.platform.vision_force.tare_at_start = false;
+  GripRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision && s.grip_vision->frames > 3; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
+  // Untared: no force published.
+  auto st = rig.live.status().grip_vision.value();
+  EXPECT_EQ(st.state, "untared");
+  EXPECT_FALSE(st.tared);
+  const auto untared = rig.collect(300ms);
+  EXPECT_GT(untared.frames, 0u);
+  EXPECT_EQ(untared.measured_frames, 0u);
+  ASSERT_TRUE(rig.live.request_vision_tare());
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->tares == 1; }, 5.0));
+  st = rig.live.status().grip_vision.value();
+  EXPECT_EQ(st.state, "measuring");
+  EXPECT_GT(rig.collect(300ms).measured_frames, 0u);
+  // The camera unwanted: no frames, no new force.
+  rig.live.set_camera_wanted(false);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(rig.collect(300ms).frames, 0u);
+}
+
+TEST(VisionGripForce, ItsParametersAreRefusedNamingTheirKey) {
+  LiveParams p = grip_params();
+  p.platform.vision_force.finger_width_m = 0.0;
+  try {
+    LivePlatform live(p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("vision_force.finger_width_m"), std::string::npos) << e.what();
+  }
+  p = grip_params();
+  p.platform.vision_force.tracker.lost_below = std::nan("");
+  try {
+    LivePlatform live(p);
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("vision_force.tracker.lost_below"), std::string::npos) << e.what();
+  }
+  // Off: no gauge, no status, the channel null.
+  p = grip_params();
+  p.platform.vision_force.enabled = false;
+  LivePlatform live(p);
+  EXPECT_FALSE(live.status().grip_vision.has_value());
+  EXPECT_FALSE(live.request_vision_tare());
+}
+
+}  // namespace
+}  // namespace mc::live
