@@ -86,6 +86,7 @@ TEST(ConsoleCommand, ParsesActionsAndRefusesUnknownOnes) {
   EXPECT_EQ(parse_console_action(R"({"action": "estop"})"), ConsoleAction::kEstop);
   EXPECT_EQ(parse_console_action(R"({"action": "reset"})"), ConsoleAction::kReset);
   EXPECT_EQ(parse_console_action(R"({"action": "demo"})"), ConsoleAction::kDemo);
+  EXPECT_EQ(parse_console_action(R"({"action": "vision_tare"})"), ConsoleAction::kVisionTare);
   // The supervised task's controls (serve --cell), in the loop's TaskAction order.
   EXPECT_EQ(parse_console_action(R"({"action": "task_start"})"), ConsoleAction::kTaskStart);
   EXPECT_EQ(parse_console_action(R"({"action": "task_take_over"})"), ConsoleAction::kTaskTakeOver);
