@@ -16,18 +16,13 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/live/live_platform.h"
+#include "support/live_status_wait.h"
 #include "support/sanitizers.h"
 
 namespace mc::live {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-  throw std::runtime_error(name);
-}
 
 // The part between the open fingers from the start, the tips at its mid-height, the microscope
 // on them at 5x (1.06 um per pixel; the 600 um opening and both fingers inside 848 um).
@@ -60,7 +55,7 @@ struct GripRig {
   std::atomic<bool> run{true};
   std::atomic<double> opening{600e-6};
   std::thread sender;
-  const std::size_t grip = channel("grip_force_N");
+  const std::size_t grip = test::telemetry_channel("grip_force_N");
 
   explicit GripRig(LiveParams p) : live(std::move(p)) {
     live.set_camera_wanted(true);  // a console watching: the camera forms frames
@@ -88,12 +83,7 @@ struct GripRig {
   }
   template <class Done>
   bool wait(Done done, double timeout_s) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < until) {
-      if (done(live.status())) return true;
-      std::this_thread::sleep_for(10ms);
-    }
-    return false;
+    return test::wait_status(live, done, timeout_s);
   }
   // The mean of each force over `window`: the sensor's; the vision's over the frames that
   // measured one, and how many frames there were.

@@ -16,6 +16,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/live/live_platform.h"
 #include "support/counting_allocator.h"
+#include "support/live_status_wait.h"
 #include "support/sanitizers.h"
 
 namespace mc::live {
@@ -56,8 +57,8 @@ struct VisionRig {
   std::size_t sx, sy;
 
   explicit VisionRig(LiveParams p) : live(std::move(p)) {
-    sx = channel("slave_x_m");
-    sy = channel("slave_y_m");
+    sx = test::telemetry_channel("slave_x_m");
+    sy = test::telemetry_channel("slave_y_m");
     live.start([this](const platform::TelemetrySample& s, std::size_t) {
       std::lock_guard lock(m);
       truth_x = s[sx];
@@ -83,11 +84,6 @@ struct VisionRig {
     sender.join();
     live.stop();
   }
-  static std::size_t channel(const char* name) {
-    for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-      if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-    throw std::runtime_error(name);
-  }
   Eigen::Vector2d truth() {
     std::lock_guard lock(m);
     return {truth_x, truth_y};
@@ -95,12 +91,7 @@ struct VisionRig {
   // Waits until `done(status)` or `timeout_s` of wall time.
   template <class Done>
   bool wait(Done done, double timeout_s) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < until) {
-      if (done(live.status())) return true;
-      std::this_thread::sleep_for(10ms);
-    }
-    return false;
+    return test::wait_status(live, done, timeout_s);
   }
 };
 
