@@ -34,9 +34,7 @@ LiveParams vision_params() {
   p.platform.camera.view_center_x_m = p.platform.stage.home_x_m;
   p.platform.camera.view_center_y_m = p.platform.stage.home_y_m;
   p.platform.camera.focus_start_m = p.platform.stage.home_z_m;
-  // The part 0.6 mm aside, out of the field: a tip template over its edge or its defocused glow
-  // holds something that does not move with the tip and biases the tracking toward no motion
-  // (0.3-0.9 um at 5x with the part under the right tip: docs/benchmarks.md).
+  // The part 0.6 mm aside, out of the field (AClickWithAPartsEdgeUnder... puts it back).
   p.platform.world.part_start_m.x() = 0.4e-3;
   // The gripper starts fully open (600 um): both tips inside the 5x view (848 x 636 um), and
   // inside it still after the moves below (a tip that leaves the field is left out: the tool
@@ -52,7 +50,8 @@ struct VisionRig {
   double truth_x = 0.0, truth_y = 0.0, t_s = 0.0;
   std::atomic<bool> deadman{false}, has_goal{false}, has_goal_px{false}, run{true};
   std::array<double, 3> goal{};
-  std::array<double, 2> goal_px{};  // set before has_goal_px
+  std::array<double, 2> goal_px{};    // set before has_goal_px
+  std::atomic<double> opening{-1.0};  // the gripper's command (< 0: none sent)
   std::thread sender;
   std::size_t sx, sy;
 
@@ -74,6 +73,8 @@ struct VisionRig {
         c.has_goal_px = has_goal_px.load();
         c.goal_px = goal_px;
         c.goal_m = goal;
+        c.has_gripper = opening.load() >= 0.0;
+        c.gripper_opening_m = std::max(0.0, opening.load());
         live.push_command(c);
         std::this_thread::sleep_for(20ms);
       }
@@ -126,9 +127,11 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
                          << " commands, " << st.frames << " frames; " << st.error;
   std::this_thread::sleep_for(300ms);  // at rest, a few frames later
   const Eigen::Vector2d arrived = rig.truth();
-  std::printf("vision click-to-go: %.1f um in %llu commands over %llu frames, true error %.3f um\n",
-              1e6 * (goal - start).norm(), static_cast<unsigned long long>(st.commands),
-              static_cast<unsigned long long>(st.frames), 1e6 * (arrived - goal).norm());
+  std::printf(
+      "vision click-to-go: %.1f um in %llu commands over %llu frames, true error %.3f um (%+.3f, %+.3f)\n",
+      1e6 * (goal - start).norm(), static_cast<unsigned long long>(st.commands),
+      static_cast<unsigned long long>(st.frames), 1e6 * (arrived - goal).norm(), 1e6 * (arrived - goal).x(),
+      1e6 * (arrived - goal).y());
   // Issue #28: 0.3 um.
   // Under ASan a loop tick takes about its period: a run plays longer than planned and may be
   // seen mid-period by the next exposure; there only convergence and rest are asserted.
@@ -143,6 +146,72 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   EXPECT_LT((resting - goal).norm(), bound_m);
   std::this_thread::sleep_for(500ms);
   EXPECT_LT((rig.truth() - resting).norm(), 0.02e-6);
+}
+
+TEST(VisionPositioning, AClickWithAPartsEdgeUnderATipsTemplateIsReachedOnTheOtherTip) {
+  // The part at its start, 200 um right of the tool: its right edge lies under the right tip's
+  // template, static while the tip moves, and biases that tip (3.1-3.3 um when both tips were
+  // averaged); the tips then disagree and the better-matching one alone gives the tool point.
+  LiveParams p = vision_params();
+  p.platform.world.part_start_m.x() = microworld::PickPlaceParams{}.part_start_m.x();
+  const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
+  VisionRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
+  const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
+  rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
+  rig.has_goal = true;
+  rig.deadman = true;
+  const bool converged =
+      rig.wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
+               MC_UNDER_ASAN ? 30.0 : 8.0);
+  const auto st = rig.live.status().vision.value();
+  ASSERT_TRUE(converged) << "state " << st.state << ", error " << st.error_m << " m; " << st.error;
+  std::this_thread::sleep_for(300ms);
+  const Eigen::Vector2d arrived = rig.truth();
+  std::printf("vision click-to-go, a part's edge under a tip: true error %.3f um\n",
+              1e6 * (arrived - goal).norm());
+  EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+}
+
+TEST(VisionPositioning, AHeldPartIsLiftedAndCarriedToTheClickedPoint) {
+  // The part between the open fingers, the tips at its mid-height: the tips' templates (the
+  // fingers' outer halves) leave the jaw out, so the gripped part does not take the tool away.
+  LiveParams p = vision_params();
+  auto& w = p.platform.world;
+  p.platform.stage.home_z_m = p.platform.camera.focus_start_m = 0.5 * w.height_m();
+  w.part_start_m.x() = p.platform.stage.home_x_m;
+  w.part_start_m.y() = p.platform.stage.home_y_m;
+  const double k = w.gripper.finger_stiffness_N_m, side = w.part_side_m;
+  const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
+  const double home_z = p.platform.stage.home_z_m;
+  VisionRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
+  rig.goal = {home.x(), home.y(), home_z};
+  rig.opening = side - 2.0 * 0.5e-3 / k;  // 0.5 mN of grip
+  rig.deadman = true;
+  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 400ms);
+  ASSERT_TRUE(rig.live.status().vision->found) << "the gripped part took the tool away";
+  // Lifted 30 um and carried 40 um right, 25 um down the image.
+  const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
+  rig.goal = {goal.x(), goal.y(), home_z + 30e-6};
+  rig.has_goal = true;
+  const bool converged =
+      rig.wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
+               MC_UNDER_ASAN ? 30.0 : 8.0);
+  const auto st = rig.live.status().vision.value();
+  ASSERT_TRUE(converged) << "state " << st.state << ", error " << st.error_m << " m; " << st.error;
+  std::this_thread::sleep_for(300ms);
+  const Eigen::Vector2d arrived = rig.truth();
+  std::printf("vision click-to-go holding the part: true error %.3f um, %llu commands\n",
+              1e6 * (arrived - goal).norm(), static_cast<unsigned long long>(st.commands));
+  // 0.135-0.279 um over 16 runs (docs/benchmarks.md): the held part's defocused top between the
+  // fingers, static against them no more, still shades the templates' background. Bound 0.4 um.
+  EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.4e-6);
+  const auto g = rig.live.status().grip_vision;
+  ASSERT_TRUE(g.has_value());
+  EXPECT_NEAR(g->grip_force_N, 0.5e-3, 0.025e-3) << g->state << " " << g->error;
 }
 
 TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
@@ -208,12 +277,12 @@ TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneL
   }
   // The positioner's parameters (stage.vision), each refused naming its key.
   p = vision_params();
-  p.platform.stage.vision.template_m = -1.0;
+  p.platform.stage.vision.margin_s = -1.0;
   try {
     LivePlatform live(p);
     FAIL() << "accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("stage.vision.template_m"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("stage.vision.margin_s"), std::string::npos) << e.what();
   }
   p = vision_params();
   p.platform.stage.vision.servo.gain_per_s = std::nan("");

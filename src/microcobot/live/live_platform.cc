@@ -25,8 +25,6 @@ void LiveParams::validate() const {
           "on_target_tolerance_m", "must be within (0, 1 mm)", on_target_tolerance_m);
   require(std::isfinite(settle_window_s) && settle_window_s >= 0 && settle_window_s <= 10.0,
           "settle_window_s", "must be within [0, 10] s", settle_window_s);
-  require(finger_width_m > 0 && finger_width_m < 1e-3, "finger_width_m", "must be within (0, 1 mm)",
-          finger_width_m);
   if (platform.stage.vision_xy()) {
     require(!task, "platform.stage.xy_sensor",
             "vision positions the console's click-to-go; the supervised task needs encoders", 1.0);

@@ -47,9 +47,7 @@ struct LiveParams {
   platform::PickPlaceOperatorParams demo;
   double command_timeout_s = 0.2;       ///< the console's commands go stale after this long
   double placement_tolerance_m = 5e-6;  ///< shown around the target (the session's criterion)
-  /// Drawn width of a finger tip in the microscope view (the model's fingers are lines).
-  double finger_width_m = 40e-6;
-  bool paced = true;  ///< false: as fast as possible (tests that need no wall clock)
+  bool paced = true;                    ///< false: as fast as possible (tests that need no wall clock)
   /// A protocol client's axis is on target (GCS ONT?) once within this distance of its goal...
   double on_target_tolerance_m = 1e-6;
   /// ...for this long (the settle window).
@@ -192,7 +190,8 @@ class LivePlatform {
     const Eigen::Vector2d c = params_.platform.optical_trap.obstacle_m({st.home_x_m, st.home_y_m});
     return {c.x(), c.y()};
   }
-  double finger_width_m() const { return params_.finger_width_m; }
+  /// The fingers' width as the camera sees them (world.gripper.finger_width_m).
+  double finger_width_m() const { return params_.platform.world.gripper.finger_width_m; }
   /// Why the scripted demo cannot run here (empty: it can).
   std::string demo_unavailable_reason() const;
   /// The force limits the platform enforces (control/safety_limits.h).

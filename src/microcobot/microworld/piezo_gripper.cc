@@ -12,6 +12,8 @@ void PiezoGripperParams::validate() const {
   require_positive(max_speed_m_s, "gripper.max_speed_m_s");
   require_positive(finger_stiffness_N_m, "gripper.finger_stiffness_N_m");
   require_positive(finger_length_m, "gripper.finger_length_m");
+  require(std::isfinite(finger_width_m) && finger_width_m >= 5e-6 && finger_width_m <= 1e-3,
+          "gripper.finger_width_m", "must be within [5 um, 1 mm]", finger_width_m);
 }
 
 void step_gripper(const PiezoGripperParams& p, PiezoGripperState& s, double command_m, double dt_s) noexcept {

@@ -17,6 +17,9 @@ struct PiezoGripperParams {
   double max_speed_m_s = 5e-3;         ///< slew limit of the opening
   double finger_stiffness_N_m = 50.0;  ///< bender tip stiffness
   double finger_length_m = 2e-3;       ///< tips reach this far below the gripper reference
+  /// The fingers' width across their closing direction, as the microscope sees them (drawn by the
+  /// camera's scene, looked for by the vision positioner and the grip gauge).
+  double finger_width_m = 40e-6;
 
   template <class V>
   void visit(V& v) {
@@ -26,6 +29,7 @@ struct PiezoGripperParams {
     v("max_speed_m_s", max_speed_m_s);
     v("finger_stiffness_N_m", finger_stiffness_N_m);
     v("finger_length_m", finger_length_m);
+    v("finger_width_m", finger_width_m);
   }
   void validate() const;
 };

@@ -75,8 +75,7 @@ CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetryS
   return p;
 }
 
-void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vision::SceneSnapshot& s,
-                       double finger_width_m) {
+void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vision::SceneSnapshot& s) {
   s.clear_objects();
   if (c.optical_trap_scene()) {
     // A Petri dish seen in transmitted or reflected light: a glass bottom, faint texture.
@@ -112,6 +111,7 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   part.size_x_m = part.size_y_m = w.part_side_m;
   part.vx_m_s = pose.part_vx_m_s, part.vy_m_s = pose.part_vy_m_s;
   s.parts.push_back(part);
+  const double finger_width_m = w.gripper.finger_width_m;
   for (int side : {-1, 1}) {
     vision::Finger f;
     f.width_m = finger_width_m;

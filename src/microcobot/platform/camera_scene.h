@@ -35,8 +35,8 @@ CameraScenePose initial_pose(const PlatformConfig& config);
 CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetrySample* previous, double dt_s);
 
 /// Fills `snapshot` (object lists cleared, their capacity kept) with the scene of `config` at
-/// `pose`. `finger_width_m`: the gripper fingers' width along x (the console's 40 um).
+/// `pose`; the fingers as wide as `world.gripper.finger_width_m`.
 void fill_camera_scene(const PlatformConfig& config, const CameraScenePose& pose,
-                       vision::SceneSnapshot& snapshot, double finger_width_m = 40e-6);
+                       vision::SceneSnapshot& snapshot);
 
 }  // namespace mc::platform

@@ -13,8 +13,7 @@ namespace {
 
 class SimulatedCamera final : public FrameSource {
  public:
-  SimulatedCamera(PlatformConfig config, double finger_width_m)
-      : config_(std::move(config)), finger_width_m_(finger_width_m) {}
+  explicit SimulatedCamera(PlatformConfig config) : config_(std::move(config)) {}
 
   void open(const CameraDeviceParams& params) override {
     params_ = params;
@@ -41,7 +40,7 @@ class SimulatedCamera final : public FrameSource {
     pose.vy_m_s = scene.tool_velocity_m_s[1];
     pose.part_vx_m_s = scene.part_velocity_m_s[0];
     pose.part_vy_m_s = scene.part_velocity_m_s[1];
-    fill_camera_scene(config_, pose, snapshot_, finger_width_m_);
+    fill_camera_scene(config_, pose, snapshot_);
     snapshot_.t_s = scene.t_s;
 
     vision::Renderer& r = renderer(scene.objective);
@@ -79,7 +78,6 @@ class SimulatedCamera final : public FrameSource {
   }
 
   PlatformConfig config_;
-  double finger_width_m_;
   CameraDeviceParams params_;
   std::vector<std::unique_ptr<vision::Renderer>> renderers_;
   vision::SceneSnapshot snapshot_;
@@ -89,8 +87,8 @@ class SimulatedCamera final : public FrameSource {
 
 }  // namespace
 
-std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config, double finger_width_m) {
-  return std::make_unique<SimulatedCamera>(config, finger_width_m);
+std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config) {
+  return std::make_unique<SimulatedCamera>(config);
 }
 
 }  // namespace mc::platform

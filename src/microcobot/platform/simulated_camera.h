@@ -13,8 +13,7 @@
 namespace mc::platform {
 
 /// The frame source that renders `config`'s microworld (its scene geometry; the moving parts come
-/// with each snapshot). `finger_width_m`: the fingers' drawn width along x.
-std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config,
-                                                   double finger_width_m = 40e-6);
+/// with each snapshot).
+std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config);
 
 }  // namespace mc::platform

@@ -6,6 +6,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/platform/camera_map.h"
+#include "microcobot/platform/finger_templates.h"
 #include "microcobot/platform/grey_frame.h"
 
 namespace mc::platform {
@@ -16,16 +17,9 @@ void VisionGripForceParams::validate() const {
   } catch (const InvalidParams& e) {
     throw e.nested_in("tracker");
   }
-  require(std::isfinite(finger_width_m) && finger_width_m >= 5e-6 && finger_width_m <= 1e-3, "finger_width_m",
-          "must be within [5 um, 1 mm]", finger_width_m);
 }
 
 namespace {
-// The template around each tip: the finger's outer half and what lies beyond it, from a little
-// below its end to a little up its length (fill_camera_scene's finger: a bar along +y from its
-// end at the tool point's y - width / 2). The jaw side, where a part touches, is left out.
-constexpr double kBeyond = 12e-6;  // background beside and below the finger [m]
-constexpr double kAlong = 30e-6;   // up the finger from its end [m]
 // A part holds the fingers apart by more than this: the next gap is predicted from the last.
 constexpr double kLoadedGap = 1e-6;
 }  // namespace
@@ -46,23 +40,10 @@ Eigen::Vector2d VisionGripForce::tip_step_px(int side, double gap_m) const {
 }
 
 bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m) {
-  const double w = config_.vision_force.finger_width_m;
   for (int k = 0; k < 2; ++k) {
     const int side = k == 0 ? -1 : 1;
-    // The finger's outer half, in stage coordinates from the tool point: x from its centre line
-    // outward past its edge, y from below its end up along it. Its box in the image.
-    const double x0 = side * 0.5 * (gap_m + w), x1 = side * (0.5 * gap_m + w + kBeyond);
-    const double y0 = -0.5 * w - kBeyond, y1 = -0.5 * w + kAlong;
-    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (double x : {x0, x1})
-      for (double y : {y0, y1}) {
-        const Eigen::Vector2d c = tool_px + map_.pixel_step(Eigen::Vector2d(x, y));
-        lo = lo.cwiseMin(c);
-        hi = hi.cwiseMax(c);
-      }
-    const vision::PixelRoi roi{static_cast<int>(std::lround(lo.x())), static_cast<int>(std::lround(lo.y())),
-                               static_cast<int>(std::lround(hi.x() - lo.x())),
-                               static_cast<int>(std::lround(hi.y() - lo.y()))};
+    const vision::PixelRoi roi =
+        finger_tip_template(map_, tool_px, side, gap_m, config_.world.gripper.finger_width_m);
     try {
       trackers_[static_cast<std::size_t>(k)].set_template(frame_, roi);
     } catch (const Error& e) {

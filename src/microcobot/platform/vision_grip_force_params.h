@@ -14,16 +14,12 @@ struct VisionGripForceParams {
   /// Tare on the first frame of a scene: the gripper starts open with nothing between its
   /// fingers (false: the gauge waits for the operator's tare).
   bool tare_at_start = true;
-  /// The fingers' width across their closing direction [m] (the console's and the renderer's
-  /// 40 um): each tip's template is the finger's outer half and its end, away from the jaw.
-  double finger_width_m = 40e-6;
   vision::TrackerParams tracker;
 
   template <class V>
   void visit(V& v) {
     v("enabled", enabled);
     v("tare_at_start", tare_at_start);
-    v("finger_width_m", finger_width_m);
     v("tracker", tracker);
   }
   /// Throws mc::InvalidParams naming the field (the tracker's under tracker.*).

@@ -6,6 +6,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/platform/camera_map.h"
+#include "microcobot/platform/finger_templates.h"
 #include "microcobot/platform/grey_frame.h"
 
 namespace mc::platform {
@@ -17,8 +18,6 @@ void VisionPositionerParams::validate() const {
   } catch (const InvalidParams& e) {
     throw e.nested_in("tracker");  // the tracker's fields under their key here
   }
-  require(std::isfinite(template_m) && template_m > 0.0 && template_m <= 1e-3, "template_m",
-          "must be within (0, 1 mm]", template_m);
   require(std::isfinite(margin_s) && margin_s >= 0.0 && margin_s < 0.1, "margin_s",
           "must be within [0, 0.1) s", margin_s);
   require(std::isfinite(min_run_s) && min_run_s > 0.0 && min_run_s < 1.0, "min_run_s",
@@ -137,21 +136,29 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     confidence = 1.0;
   } else {
     const Eigen::Vector2d predicted_tool = tool_px_ + moved_px_;
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    int agreeing = 0;
+    std::array<Eigen::Vector2d, 2> tool_k;
+    std::array<double, 2> rho{-2.0, -2.0};  // the agreeing tips' correlations (-2: left out)
     for (std::size_t k = 0; k < 2; ++k) {
       const Eigen::Vector2d tip_step =
           map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * frame.gripper_opening_m, 0.0));
       const Eigen::Vector2d predicted = predicted_tool + tip_step + tip_offset_px_[k];
       const vision::TrackEstimate e = trackers_[k].track_near(frame_, predicted.x(), predicted.y());
-      const Eigen::Vector2d tool_k = Eigen::Vector2d(e.u_px, e.v_px) - tip_offset_px_[k] - tip_step;
-      if (!e.found || (tool_k - predicted_tool).norm() > p_.tracker.search_margin_px) continue;
-      sum += tool_k;
-      ++agreeing;
-      confidence = agreeing == 1 ? e.confidence : std::min(confidence, e.confidence);
+      tool_k[k] = Eigen::Vector2d(e.u_px, e.v_px) - tip_offset_px_[k] - tip_step;
+      if (e.found && (tool_k[k] - predicted_tool).norm() <= p_.tracker.search_margin_px)
+        rho[k] = e.confidence;
     }
-    found = agreeing > 0;
-    if (found) tool_px_ = sum / agreeing;
+    found = rho[0] > -2.0 || rho[1] > -2.0;
+    if (found) {
+      // Both seen: their mean, unless they disagree by more than kTipsDisagree_px; then one of
+      // them holds something that does not move with the tip (a part's edge under its template,
+      // which lowers its match): the better-matching tip alone.
+      constexpr double kTipsDisagree_px = 1.0;
+      const bool both = rho[0] > -2.0 && rho[1] > -2.0;
+      const std::size_t best = rho[0] >= rho[1] ? 0 : 1;
+      tool_px_ = both && (tool_k[0] - tool_k[1]).norm() <= kTipsDisagree_px ? 0.5 * (tool_k[0] + tool_k[1])
+                                                                            : tool_k[best];
+      confidence = both ? std::min(rho[0], rho[1]) : rho[best];
+    }
     // Both lost for a second: taught again where the tool was last seen.
     lost_frames_ = found ? 0 : lost_frames_ + 1;
     if (lost_frames_ > config_.camera.frame_rate_Hz()) taught_ = false;
@@ -217,14 +224,11 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
 }
 
 bool VisionPositioner::teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st) {
-  const double m_per_px = map_m_per_px(map_);
-  const int side = std::max(16, static_cast<int>(std::lround(p_.template_m / m_per_px)));
   for (std::size_t k = 0; k < 2; ++k) {
     const Eigen::Vector2d tip =
         tool_px + map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * opening_m, 0.0));
-    const double cu = tip.x(), cv = tip.y() - 0.25 * side;
-    const vision::PixelRoi roi{static_cast<int>(std::lround(cu - 0.5 * (side - 1))),
-                               static_cast<int>(std::lround(cv - 0.5 * (side - 1))), side, side};
+    const vision::PixelRoi roi =
+        finger_tip_template(map_, tool_px, k == 0 ? -1 : 1, opening_m, config_.world.gripper.finger_width_m);
     try {
       trackers_[k].set_template(frame_, roi);
     } catch (const Error& e) {

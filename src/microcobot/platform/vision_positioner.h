@@ -6,10 +6,13 @@
 /// commands) turns the distance to the operator's goal into a stage velocity for an interval;
 /// the loop plays it as open-loop runs on x and y (Platform::command_open_loop_velocity). The
 /// axes' position sensors are never read: where the tool is comes from the image alone. The two
-/// finger tips are tracked apart; each, with the gripper's opening (its own sensor), says where
-/// the tool point is, and the tool point is the mean of the tips that agree with where the
-/// commands put it (within the tracker's search margin): a tip leaving the view, or a tracker
-/// that lost its tip and found its twin, the other finger, by a whole-frame search, is left out.
+/// finger tips are tracked apart, each by the finger's outer half (finger_templates.h: a gripped
+/// part never enters it); each, with the gripper's opening (its own sensor), says where the tool
+/// point is, and the tool point is the mean of the tips that agree with where the commands put it
+/// (within the tracker's search margin): a tip leaving the view, or a tracker that lost its tip
+/// and found its twin, the other finger, by a whole-frame search, is left out. Two tips that
+/// disagree by more than a pixel: one holds something that does not move with it (a part's edge
+/// under its template, 3 um off at 5x), and the better-matching tip alone gives the tool point.
 ///
 ///   loop (1 kHz) --goal (world or pixel), deadman--> atomics --> camera thread: on_frame()
 ///   camera thread --PositionerCommand--> returned to the caller, who rings it to the loop

@@ -11,10 +11,6 @@ namespace mc::platform {
 struct VisionPositionerParams {
   vision::VisualServoParams servo;
   vision::TrackerParams tracker;
-  /// Each finger tip's template, square, its side in the object [m] (at least 16 px): the tip's
-  /// end and what lies below it, its centre a quarter of it above the tip. The two tips are
-  /// tracked apart and the tool point is their midpoint, whatever the gripper's opening.
-  double template_m = 50e-6;
   /// A run ends this long before the next exposure it must not be seen in [s]: the loop applies
   /// a command within one operator tick (1 ms) of its issue.
   double margin_s = 3e-3;
@@ -31,7 +27,6 @@ struct VisionPositionerParams {
   void visit(V& v) {
     v("servo", servo);
     v("tracker", tracker);
-    v("template_m", template_m);
     v("margin_s", margin_s);
     v("min_run_s", min_run_s);
     v("settle_frames", settle_frames);

@@ -1,0 +1,26 @@
+#pragma once
+/// @file
+/// Where the live vision takes a finger tip's template (the vision positioner, the grip gauge):
+/// the finger's outer half with 12 um of background beside it, from 7.5 um above the finger's
+/// end 42 um up the finger. The jaw side, where a gripped part touches, is left out, so a part
+/// between the fingers never enters a tip's template (a template over a part's edge or its
+/// defocused glow holds something that does not move with the tip). The end is left out too:
+/// with its edge in the template the positioner read the stage's y motion 1 % long at 5x (it
+/// rested 0.22-0.27 um short of a 25 um move in y, 6 runs; without it 0.07-0.15 um:
+/// docs/benchmarks.md). The finger: a bar along +y from its end at the tool point's
+/// y - width / 2, its inner face at the tool point's x -+ opening / 2 (platform/camera_scene.cc).
+
+#include <Eigen/Core>
+
+#include "microcobot/vision/affine_calibration.h"
+#include "microcobot/vision/pixel_roi.h"
+
+namespace mc::platform {
+
+/// The template of the left (`side` -1) or right (+1) finger's tip, in the image, with the tool
+/// point at `tool_px`, the fingers `opening_m` apart and `finger_width_m` wide: the box around the
+/// region's corners mapped through `map` (pixel = A stage + b).
+vision::PixelRoi finger_tip_template(const vision::AffineMap& map, const Eigen::Vector2d& tool_px, int side,
+                                     double opening_m, double finger_width_m);
+
+}  // namespace mc::platform
