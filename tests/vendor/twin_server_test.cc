@@ -222,7 +222,16 @@ TEST(TwinServer, HostileClientsAreSurvived) {
   }
   std::this_thread::sleep_for(100ms);
   EXPECT_EQ(good.gcs("CSV?"), "2.0\n");  // still served
-  const auto counts = rig.server->counters();
+  // The deaf client is closed once the server has answered enough of its flood to fill what it
+  // will hold: under ASan on a loaded machine that may take longer than the test's own pauses (a
+  // full sanitizer run failed this test once, not reproduced alone), so the counters are read
+  // until they are in or 10 s have passed.
+  auto counts = rig.server->counters();
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while ((counts.closed_hostile < 2 || counts.refused < 1) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+    counts = rig.server->counters();
+  }
   EXPECT_GE(counts.closed_hostile, 2u);  // the slowloris and the deaf client
   EXPECT_GE(counts.refused, 1u);         // beyond max_clients
 }
