@@ -19,8 +19,10 @@ namespace mc::platform {
 
 /// The template of the left (`side` -1) or right (+1) finger's tip, in the image, with the tool
 /// point at `tool_px`, the fingers `opening_m` apart and `finger_width_m` wide: the box around the
-/// region's corners mapped through `map` (pixel = A stage + b).
+/// region's corners mapped through `map` (pixel = A stage + b). `inner`: the finger's inner half
+/// and 12 um of the jaw instead (for a finger whose outer side is out of the image; a part held
+/// between the fingers then enters the template).
 vision::PixelRoi finger_tip_template(const vision::AffineMap& map, const Eigen::Vector2d& tool_px, int side,
-                                     double opening_m, double finger_width_m);
+                                     double opening_m, double finger_width_m, bool inner = false);
 
 }  // namespace mc::platform

@@ -139,6 +139,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     std::array<Eigen::Vector2d, 2> tool_k;
     std::array<double, 2> rho{-2.0, -2.0};  // the agreeing tips' correlations (-2: left out)
     for (std::size_t k = 0; k < 2; ++k) {
+      if (!tip_taught_[k]) continue;
       const Eigen::Vector2d tip_step =
           map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * frame.gripper_opening_m, 0.0));
       const Eigen::Vector2d predicted = predicted_tool + tip_step + tip_offset_px_[k];
@@ -158,6 +159,10 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
       tool_px_ = both && (tool_k[0] - tool_k[1]).norm() <= kTipsDisagree_px ? 0.5 * (tool_k[0] + tool_k[1])
                                                                             : tool_k[best];
       confidence = both ? std::min(rho[0], rho[1]) : rho[best];
+      // A tip not yet taught (out of the image when the others were): taught where the tool is.
+      std::string unused;
+      for (std::size_t k = 0; k < 2; ++k)
+        if (!tip_taught_[k]) teach_tip(k, tool_px_, frame.gripper_opening_m, unused);
     }
     // Both lost for a second: taught again where the tool was last seen.
     lost_frames_ = found ? 0 : lost_frames_ + 1;
@@ -223,22 +228,48 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   return out;
 }
 
+bool VisionPositioner::teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, double opening_m,
+                                 std::string& why) {
+  const auto inside = [&](const vision::PixelRoi& r) {
+    return r.x >= 0 && r.y >= 0 && r.x + r.width <= width_ && r.y + r.height <= height_;
+  };
+  const int side = k == 0 ? -1 : 1;
+  const double w = config_.world.gripper.finger_width_m;
+  vision::PixelRoi roi = finger_tip_template(map_, tool_px, side, opening_m, w);
+  // The finger's outer side out of the image (a wide-open gripper under a small field): its
+  // inner half, until the tips are taught again.
+  if (!inside(roi)) roi = finger_tip_template(map_, tool_px, side, opening_m, w, /*inner=*/true);
+  const char* name = k == 0 ? "left" : "right";
+  if (!inside(roi)) {
+    why = std::string("the ") + name + " tip's template is not inside the image";
+    return false;
+  }
+  try {
+    trackers_[k].set_template(frame_, roi);
+  } catch (const Error& e) {
+    why = std::string("cannot see the gripper's ") + name + " tip where expected: " + e.what();
+    return false;
+  }
+  const Eigen::Vector2d tip =
+      tool_px + map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * opening_m, 0.0));
+  tip_offset_px_[k] = Eigen::Vector2d(trackers_[k].last().u_px, trackers_[k].last().v_px) - tip;
+  tip_taught_[k] = true;
+  return true;
+}
+
 bool VisionPositioner::teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st) {
+  // Each tip whose template lies inside the image (a wide-open gripper under a small field may
+  // show one); the other is taught once it comes into view.
+  std::string why[2];
   for (std::size_t k = 0; k < 2; ++k) {
-    const Eigen::Vector2d tip =
-        tool_px + map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * opening_m, 0.0));
-    const vision::PixelRoi roi =
-        finger_tip_template(map_, tool_px, k == 0 ? -1 : 1, opening_m, config_.world.gripper.finger_width_m);
-    try {
-      trackers_[k].set_template(frame_, roi);
-    } catch (const Error& e) {
-      st.taught = st.found = false;
-      st.state = "error";
-      st.error = std::string("cannot see the gripper's ") + (k == 0 ? "left" : "right") +
-                 " tip where expected: " + e.what();
-      return false;
-    }
-    tip_offset_px_[k] = Eigen::Vector2d(trackers_[k].last().u_px, trackers_[k].last().v_px) - tip;
+    tip_taught_[k] = false;
+    teach_tip(k, tool_px, opening_m, why[k]);
+  }
+  if (!tip_taught_[0] && !tip_taught_[1]) {
+    st.taught = st.found = false;
+    st.state = "error";
+    st.error = why[0] + "; " + why[1];
+    return false;
   }
   taught_ = true;
   lost_frames_ = 0;

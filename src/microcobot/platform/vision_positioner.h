@@ -125,8 +125,12 @@ class VisionPositioner {
   vision::AffineMap map_;
   bool calibrated_ = false;
   std::optional<vision::VisualServo> servo_;
-  /// Teaches both tips' templates around the tool point `tool_px` (false: not possible here).
+  /// Teaches the tips' templates around the tool point `tool_px`: each whose template lies in the
+  /// image (false: neither).
   bool teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st);
+  /// Teaches tip `k` (0 left, 1 right) around `tool_px`; false with `why` when it cannot.
+  bool teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, double opening_m, std::string& why);
+  std::array<bool, 2> tip_taught_{false, false};
 
   std::array<vision::TemplateTracker, 2> trackers_;  ///< the left and the right tip
   vision::Frame frame_;
