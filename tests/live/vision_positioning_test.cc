@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <thread>
 
 #include "microcobot/core/error.h"
@@ -84,6 +86,20 @@ struct VisionRig {
     run = false;
     sender.join();
     live.stop();
+  }
+  // Waits (8 s, 30 s under ASan) for the servo to converge on the goal, then 300 ms at rest:
+  // where the tips really are; none, with `why`, when it did not converge.
+  std::optional<Eigen::Vector2d> converge_and_rest(std::string& why) {
+    const bool converged =
+        wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
+             MC_UNDER_ASAN ? 30.0 : 8.0);
+    const auto st = live.status().vision.value();
+    if (!converged) {
+      why = "state " + st.state + ", error " + std::to_string(st.error_m) + " m; " + st.error;
+      return std::nullopt;
+    }
+    std::this_thread::sleep_for(300ms);
+    return truth();
   }
   Eigen::Vector2d truth() {
     std::lock_guard lock(m);
@@ -162,13 +178,10 @@ TEST(VisionPositioning, AClickWithAPartsEdgeUnderATipsTemplateIsReachedOnTheOthe
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
   rig.deadman = true;
-  const bool converged =
-      rig.wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
-               MC_UNDER_ASAN ? 30.0 : 8.0);
-  const auto st = rig.live.status().vision.value();
-  ASSERT_TRUE(converged) << "state " << st.state << ", error " << st.error_m << " m; " << st.error;
-  std::this_thread::sleep_for(300ms);
-  const Eigen::Vector2d arrived = rig.truth();
+  std::string why;
+  const auto rest = rig.converge_and_rest(why);
+  ASSERT_TRUE(rest.has_value()) << why;
+  const Eigen::Vector2d arrived = *rest;
   std::printf("vision click-to-go, a part's edge under a tip: true error %.3f um\n",
               1e6 * (arrived - goal).norm());
   EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
@@ -197,15 +210,13 @@ TEST(VisionPositioning, AHeldPartIsLiftedAndCarriedToTheClickedPoint) {
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), home_z + 30e-6};
   rig.has_goal = true;
-  const bool converged =
-      rig.wait([](const LiveStatus& s) { return s.vision->state == "converged" && s.vision->has_goal; },
-               MC_UNDER_ASAN ? 30.0 : 8.0);
-  const auto st = rig.live.status().vision.value();
-  ASSERT_TRUE(converged) << "state " << st.state << ", error " << st.error_m << " m; " << st.error;
-  std::this_thread::sleep_for(300ms);
-  const Eigen::Vector2d arrived = rig.truth();
+  std::string why;
+  const auto rest = rig.converge_and_rest(why);
+  ASSERT_TRUE(rest.has_value()) << why;
+  const Eigen::Vector2d arrived = *rest;
   std::printf("vision click-to-go holding the part: true error %.3f um, %llu commands\n",
-              1e6 * (arrived - goal).norm(), static_cast<unsigned long long>(st.commands));
+              1e6 * (arrived - goal).norm(),
+              static_cast<unsigned long long>(rig.live.status().vision->commands));
   // 0.135-0.279 um over 16 runs (docs/benchmarks.md): the held part's defocused top between the
   // fingers, static against them no more, still shades the templates' background. Bound 0.4 um.
   EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.4e-6);
