@@ -283,6 +283,15 @@ TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
   const json status = json::parse(c.next_on(8));
   EXPECT_TRUE(status.at("demo_result").is_null());
   EXPECT_GT(status.at("ticks").get<double>(), 0.0);
+  // Force by vision's gauge is there (a camera, the gripper's scene), and its tare is the
+  // controlling client's: an observer's is refused.
+  ASSERT_TRUE(status.at("grip_vision").is_object()) << status.dump();
+  EXPECT_EQ(status.at("grip_vision").at("tares").get<int>(), 0);
+  Console observer(rig.server.port());
+  ASSERT_TRUE(observer.action("vision_tare"));
+  const json tare_refused = observer.ws.read_status("control");
+  ASSERT_FALSE(tare_refused.is_null());
+  EXPECT_NE(tare_refused.value("message", "").find("take control first"), std::string::npos) << tare_refused;
 }
 
 }  // namespace
