@@ -76,6 +76,9 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   rig.drive(jog(100e-6, /*deadman=*/false), 300ms);
   EXPECT_DOUBLE_EQ(rig.get("target_x_m"), x0) << "no deadman, no motion";
 
+  // The sample the start is read from is the loop's present, not one the drain thread still
+  // holds back (a stale start would count time the stage did not jog).
+  ASSERT_TRUE(rig.catch_up());
   const double t0 = rig.get("t_s");
   rig.drive(jog(100e-6), 1000ms);
   const double moved = rig.get("target_x_m") - x0, elapsed = rig.get("t_s") - t0;
@@ -85,7 +88,15 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   // Under ASan beside another paced test a loop tick can take most of its period (CI-like run,
   // 2026-11-27: 0.36 s of loop time in 1 s).
   EXPECT_GT(elapsed, MC_UNDER_ASAN ? 0.2 : 0.4) << "the loop hardly ran";
+#if MC_UNDER_ASAN
+  // Under ASan on a loaded machine this thread's 50 Hz heartbeat can starve past the 0.2 s
+  // timeout: the stage then holds, as it must (asan run, 2026-11-27: 43 um in 0.67 s of loop
+  // time). Never faster than asked, and jogging for most of the run.
+  EXPECT_LE(moved, 100e-6 * elapsed + 1e-6);
+  EXPECT_GT(moved, 0.3 * 100e-6 * elapsed);
+#else
   EXPECT_NEAR(moved, 100e-6 * elapsed, 15e-6);
+#endif
   EXPECT_TRUE(rig.live.status().console_fresh);
 
   // The client goes silent: after the command timeout the stage holds.

@@ -51,10 +51,10 @@ struct Frames {
 
 TEST(Camera, FramesCarryTheLoopTimeAtMidExposureAndTheObjectiveAndFocusState) {
   PlatformConfig config = camera_config();
+  Frames got;  // declared before the platform: the camera thread writes to it until it stops
   Platform platform(config);
   ASSERT_NE(platform.camera(), nullptr);
   ASSERT_NE(platform.focus(), nullptr);
-  Frames got;
   platform.camera()->set_sink([&](const CameraFrame& f) { got.add(f); });
   // Unpaced, the loop would outrun the camera: run it in steps shorter than a frame period and
   // let the camera form each frame due before going on.
@@ -91,6 +91,7 @@ TEST(Camera, FramesCarryTheLoopTimeAtMidExposureAndTheObjectiveAndFocusState) {
 
 TEST(Camera, TheFocusDriveMovesAtItsSpeedWithinItsLimitsAndTheTurretChangesTheScale) {
   PlatformConfig config = camera_config();
+  Frames got;
   Platform platform(config);
   FocusDrive& focus = *platform.focus();
   focus.command_z_m(1.0);  // far beyond the travel: clamped
@@ -100,7 +101,6 @@ TEST(Camera, TheFocusDriveMovesAtItsSpeedWithinItsLimitsAndTheTurretChangesTheSc
   focus.command_objective(3);
   focus.command_objective(7);  // no such objective: ignored
   EXPECT_EQ(focus.objective(), 3);
-  Frames got;
   platform.camera()->set_sink([&](const CameraFrame& f) { got.add(f); });
   platform.loop().run_for(334);
   ASSERT_TRUE(test::eventually([&] { return got.size() >= 1; }, 5s));
@@ -131,8 +131,8 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   };
 
   // Baseline: the same platform with its camera flowing.
-  Platform flowing(config);
   Frames got;
+  Platform flowing(config);
   flowing.camera()->set_sink([&](const CameraFrame& f) { got.add(f); });
   flowing.loop().run_for(100);
   const double flowing_s = run(flowing);
@@ -140,9 +140,9 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   EXPECT_GE(got.size(), MC_UNDER_ASAN ? 5u : 20u) << "about 30 frames in the second";
 
   // The camera thread stalls in its first frame (a slow consumer) and the loop runs on.
+  std::atomic<int> delivered{0};
   Platform stalled(config);
   test::TestCameraControl& control = test::test_camera();
-  std::atomic<int> delivered{0};
   stalled.camera()->set_sink([&](const CameraFrame&) {
     delivered.fetch_add(1);
     while (control.stall.load()) std::this_thread::sleep_for(1ms);
@@ -192,8 +192,8 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
 
 TEST(Camera, ACameraThatFailsPutsEveryDeviceInItsSafeState) {
   PlatformConfig config = camera_config();
-  Platform platform(config);
   std::atomic<int> frames{0};
+  Platform platform(config);
   platform.camera()->set_sink([&](const CameraFrame&) { frames.fetch_add(1); });
   platform.loop().run_for(334);
   ASSERT_TRUE(test::eventually([&] { return frames.load() >= 1; }, 5s));

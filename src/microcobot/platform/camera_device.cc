@@ -178,6 +178,7 @@ void Camera::thread_main() {
                            (params_.sensor.bit_depth > 8 ? 2u : 1u));
   SceneSnapshot scene, newer;
   bool have_scene = false;
+  double last_t_mid = -1.0;
   try {
     JpegEncoder encoder;
     while (running_.load(std::memory_order_acquire)) {
@@ -212,8 +213,13 @@ void Camera::thread_main() {
         source_->capture(scene, frame.image);
         const std::int64_t t1 = steady_ns();
         const double exposure = exposure_s_.load(std::memory_order_relaxed);
-        frame.t_mid_s =
+        // The newest snapshot maps the wall clock onto the loop's. A loop that fell behind the
+        // wall clock and catches up moves that map back by its lag; a frame grabbed after another
+        // is still never stamped before it.
+        const double mapped =
             have_scene ? scene.t_s + 1e-9 * static_cast<double>(t1 - scene.steady_ns) - 0.5 * exposure : 0.0;
+        frame.t_mid_s = std::max(mapped, last_t_mid + 1e-6);
+        last_t_mid = frame.t_mid_s;
         deliver(frame, scene, t0, encoder);
       }
     }
