@@ -232,17 +232,18 @@ void bind_vision(py::module_& m) {
       "2-D "
       "uint8/uint16 arrays; positions in continuous pixel coordinates (a pixel's centre at its column, row).")
       .def(py::init([](int search_margin_px, double lost_below, double min_contrast_ratio, int ecc_blur_px,
-                       bool rotation) {
+                       double ecc_highpass_px, bool rotation) {
              vision::TrackerParams p;
              p.search_margin_px = search_margin_px;
              p.lost_below = lost_below;
              p.min_contrast_ratio = min_contrast_ratio;
              p.ecc_blur_px = ecc_blur_px;
+             p.ecc_highpass_px = ecc_highpass_px;
              p.rotation = rotation;
              return vision::TemplateTracker(p);  // validates: ValueError naming the field
            }),
            "search_margin_px"_a = 24, "lost_below"_a = 0.5, "min_contrast_ratio"_a = 0.5, "ecc_blur_px"_a = 3,
-           "rotation"_a = false)
+           "ecc_highpass_px"_a = 0.0, "rotation"_a = false)
       .def(
           "set_template",
           [](vision::TemplateTracker& t, const py::array& frame, std::array<int, 4> roi) {

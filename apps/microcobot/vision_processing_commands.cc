@@ -228,6 +228,8 @@ struct TrackOptions {
   int frames = 60;
   double speed_um_s = 20.0;
   double direction_deg = 30.0;
+  std::optional<double> highpass_px;
+  double template_above_px = 0.0;
 };
 
 void run_track(const TrackOptions& o) {
@@ -260,16 +262,23 @@ void run_track(const TrackOptions& o) {
     controls.focus_z_m = scene.parts.front().z_top_m;
     frame_at(start, 0);
   }
-  // The part: its upper left corner (two edges; its face is uniform); the tool: its tips and the
-  // gap between them.
-  double u0 = renderer.u_of_x(start.x()), v0 = renderer.v_of_y(start.y()) - 0.25 * o.camera.template_px;
+  // The part: its upper left corner (two edges; its face is uniform); the tool: its tips, their
+  // ends and the gap between them, centred on the tool point. The ends' edges fix the rows: a
+  // template a quarter of its side higher held only the fingers' sides and the gap (worst 0.45 px
+  // over seeded cases, docs/benchmarks.md).
+  double u0 = renderer.u_of_x(start.x()), v0 = renderer.v_of_y(start.y()) - o.template_above_px;
   if (!tool) {
     if (scene.parts.empty())
       throw mc::InvalidInput("--target part: the scene " + o.camera.scene + " has no part");
     u0 = renderer.u_of_x(start.x() - 0.5 * scene.parts.front().size_x_m);
     v0 = renderer.v_of_y(start.y() + 0.5 * scene.parts.front().size_y_m);
   }
-  vs::TemplateTracker tracker;
+  vs::TrackerParams params;
+  // The tips stand 150 um over the part: its defocused glow, under the gap, changes as the tool
+  // moves. A high-pass of 1.5 px takes it out of the alignment (chosen on the tuning cases:
+  // docs/parameters.md "Tracking the tool's tips").
+  params.ecc_highpass_px = o.highpass_px.value_or(tool ? vs::kToolTipHighpass_px : 0.0);
+  vs::TemplateTracker tracker(params);
   tracker.set_template(frame, centred_roi(u0, v0, o.camera.template_px, cam));
   const double u_off = tracker.last().u_px - renderer.u_of_x(start.x());
   const double v_off = tracker.last().v_px - renderer.v_of_y(start.y());
@@ -305,6 +314,7 @@ void run_track(const TrackOptions& o) {
                       {"speed_m_s", o.speed_um_s * 1e-6},
                       {"direction_deg", o.direction_deg},
                       {"template_px", o.camera.template_px},
+                      {"highpass_px", params.ecc_highpass_px},
                       {"rms_error_px", rms},
                       {"max_error_px", worst},
                       {"bias_px", {bias_u / n, bias_v / n}},
@@ -452,6 +462,15 @@ void add_vision_processing(CLI::App& group) {
         ->check(mc::cli::Range(0.0, 1e4));
     cmd->add_option("--direction-deg", o->direction_deg, "Direction of motion, from stage x (default 30)")
         ->check(mc::cli::Range(-360.0, 360.0));
+    cmd->add_option(
+           "--highpass-px", o->highpass_px,
+           "The tracker's high-pass before ECC, a Gaussian's sigma [px], 0 none (default: 1.5 for the "
+           "tool, 0 for the part)")
+        ->check(mc::cli::Range(0.0, 64.0));
+    cmd->add_option(
+           "--template-above-px", o->template_above_px,
+           "The tool's template this far above the tool point [px] (default 0: the tips' ends in it)")
+        ->check(mc::cli::Range(-1000.0, 1000.0));
     add_output_options(*cmd, o->common);
     cmd->callback([o] { run_track(*o); });
   }

@@ -144,6 +144,8 @@ def test_vision_measures_refuse_bad_input():
         t.set_template(frame, (1250, 10, 64, 64))
     with pytest.raises(ValueError, match="ecc_blur_px"):
         microcobot.vision.TemplateTracker(ecc_blur_px=4)
+    with pytest.raises(ValueError, match="ecc_highpass_px"):
+        microcobot.vision.TemplateTracker(ecc_highpass_px=float("nan"))
     with pytest.raises(ValueError, match="line"):
         microcobot.vision.fit_affine(np.zeros((4, 2)), np.zeros((4, 2)))
     with pytest.raises(ValueError, match="start_um"):

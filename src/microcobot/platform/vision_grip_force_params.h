@@ -14,7 +14,8 @@ struct VisionGripForceParams {
   /// Tare on the first frame of a scene: the gripper starts open with nothing between its
   /// fingers (false: the gauge waits for the operator's tare).
   bool tare_at_start = true;
-  vision::TrackerParams tracker;
+  /// The tips' tracker, as the positioner's (vision_positioner_params.h).
+  vision::TrackerParams tracker = vision::tool_tip_tracker_params();
 
   template <class V>
   void visit(V& v) {

@@ -10,7 +10,10 @@ namespace mc::platform {
 
 struct VisionPositionerParams {
   vision::VisualServoParams servo;
-  vision::TrackerParams tracker;
+  /// The tips' tracker: high-passed (the glow and edges of a part 150 um below move under the
+  /// templates; live, a click with a part's edge under a tip rested 0.12-0.32 um off without,
+  /// 0.02-0.09 um with: docs/benchmarks.md).
+  vision::TrackerParams tracker = vision::tool_tip_tracker_params();
   /// A run ends this long before the next exposure it must not be seen in [s]: the loop applies
   /// a command within one operator tick (1 ms) of its issue.
   double margin_s = 3e-3;

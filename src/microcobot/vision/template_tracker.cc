@@ -25,13 +25,20 @@ cv::Mat view16(const Frame& f) {
 
 // `area` of the frame as float, low-passed by a Gaussian of `ksize` computed with the frame's own
 // pixels around it (not a replicated border: where a bar crosses the template's edge, a blur
-// padded differently in the template and in the window biased the alignment by 0.14 px).
-void blurred(const cv::Mat& full, const cv::Rect& area, int ksize, cv::Mat& scratch, cv::Mat& out) {
-  const int pad = ksize / 2 + 1;
+// padded differently in the template and in the window biased the alignment by 0.14 px), and
+// high-passed (minus its Gaussian of sigma `highpass_px`) when that is > 0.
+void blurred(const cv::Mat& full, const cv::Rect& area, int ksize, double highpass_px, cv::Mat& scratch,
+             cv::Mat& out) {
+  const int pad = ksize / 2 + 1 + static_cast<int>(std::ceil(3.0 * highpass_px));
   const cv::Rect grown = cv::Rect(area.x - pad, area.y - pad, area.width + 2 * pad, area.height + 2 * pad) &
                          cv::Rect(0, 0, full.cols, full.rows);
   full(grown).convertTo(scratch, CV_32F);
   if (ksize > 1) cv::GaussianBlur(scratch, scratch, cv::Size(ksize, ksize), 0.0, 0.0, cv::BORDER_REPLICATE);
+  if (highpass_px > 0.0) {
+    cv::Mat low;
+    cv::GaussianBlur(scratch, low, cv::Size(0, 0), highpass_px, highpass_px, cv::BORDER_REPLICATE);
+    scratch -= low;
+  }
   scratch(cv::Rect(area.tl() - grown.tl(), area.size())).copyTo(out);
 }
 
@@ -53,6 +60,8 @@ void TrackerParams::validate() const {
   require(ecc_epsilon > 0.0 && ecc_epsilon < 1.0, "ecc_epsilon", "must be within (0, 1)", ecc_epsilon);
   require(ecc_blur_px >= 1 && ecc_blur_px <= 31 && ecc_blur_px % 2 == 1, "ecc_blur_px",
           "must be odd, within [1, 31]", ecc_blur_px);
+  require(std::isfinite(ecc_highpass_px) && ecc_highpass_px >= 0.0 && ecc_highpass_px <= 64.0,
+          "ecc_highpass_px", "must be within [0, 64] px", ecc_highpass_px);
 }
 
 struct TemplateTracker::Images {
@@ -89,8 +98,8 @@ void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
   cv::pyrDown(images->templ, images->templ_half);
   {
     cv::Mat scratch;
-    blurred(view16(frame), cv::Rect(roi.x, roi.y, roi.width, roi.height), params_.ecc_blur_px, scratch,
-            images->templ_smooth);
+    blurred(view16(frame), cv::Rect(roi.x, roi.y, roi.width, roi.height), params_.ecc_blur_px,
+            params_.ecc_highpass_px, scratch, images->templ_smooth);
   }
   images->frame_width = frame.width;
   images->frame_height = frame.height;
@@ -211,7 +220,7 @@ TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu0, doub
   const cv::Rect fine_area =
       cv::Rect(corner.x - fine_margin, corner.y - fine_margin, tw + 2 * fine_margin, th + 2 * fine_margin) &
       bounds;
-  blurred(full, fine_area, params_.ecc_blur_px, im.response, im.window);
+  blurred(full, fine_area, params_.ecc_blur_px, params_.ecc_highpass_px, im.response, im.window);
   const double a0 = -turn;  // image axes: rows go down
   cv::Mat warp = (cv::Mat_<float>(2, 3) << std::cos(a0), -std::sin(a0), corner.x - fine_area.x, std::sin(a0),
                   std::cos(a0), corner.y - fine_area.y);
