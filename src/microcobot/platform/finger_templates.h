@@ -1,13 +1,14 @@
 #pragma once
 /// @file
 /// Where the live vision takes a finger tip's template (the vision positioner, the grip gauge):
-/// the finger's outer half with 12 um of background beside it, from 7.5 um above the finger's
-/// end 42 um up the finger. The jaw side, where a gripped part touches, is left out, so a part
+/// the finger's outer half with 12 um of background beside it, from 5 um beyond the finger's end
+/// 42 um up the finger. The jaw side, where a gripped part touches, is left out, so a part
 /// between the fingers never enters a tip's template (a template over a part's edge or its
-/// defocused glow holds something that does not move with the tip). The end is left out too:
-/// with its edge in the template the positioner read the stage's y motion 1 % long at 5x (it
-/// rested 0.22-0.27 um short of a 25 um move in y, 6 runs; without it 0.07-0.15 um:
-/// docs/benchmarks.md). The finger: a bar along +y from its end at the tool point's
+/// defocused glow holds something that does not move with the tip). The end's edge is in: it
+/// fixes the rows. (It was left out from 2026-11-26 to 2026-11-27: with it the positioner read
+/// the stage's y motion 1 % long at 5x, which was the renderer's seams between a finger's
+/// segments, since removed; with it again the live click-to-go rests within 0.05 um in y:
+/// docs/benchmarks.md.) The finger: a bar along +y from its end at the tool point's
 /// y - width / 2, its inner face at the tool point's x -+ opening / 2 (platform/camera_scene.cc).
 
 #include <Eigen/Core>
