@@ -18,6 +18,7 @@
 #include "microcobot/server/foxglove_protocol.h"
 #include "support/console_client.h"
 #include "support/counting_allocator.h"
+#include "support/sanitizers.h"
 #include "support/test_support.h"
 #include "support/ws_client.h"
 
@@ -148,9 +149,10 @@ TEST(ConsoleServer, TheStatusReportsTheCommandToTargetLatency) {
   }
   EXPECT_EQ(latency["count"].get<std::uint64_t>(), 50u) << latency.dump();
   // The loop takes the commands at 1 kHz: half of them reach their target within about a
-  // millisecond (a loaded or sanitized machine may take longer, never ~100 ms).
+  // millisecond (a loaded machine may take longer; a sanitized one beside another test's loop
+  // took 43 ms in a cold CI run, 2026-11-27: never ~100 ms).
   EXPECT_GT(latency["p50"].get<double>(), 0.0);
-  EXPECT_LT(latency["p50"].get<double>(), 20.0) << latency.dump();
+  EXPECT_LT(latency["p50"].get<double>(), MC_UNDER_ASAN ? 100.0 : 20.0) << latency.dump();
   EXPECT_LE(latency["p50"].get<double>(), latency["p99"].get<double>());
   // A single process has no network link on its loop (RemoteEnds.* time the slave's).
   EXPECT_EQ(link_cost["count"].get<std::uint64_t>(), 0u) << link_cost.dump();

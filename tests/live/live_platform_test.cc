@@ -80,11 +80,14 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   // holds back (a stale start would count time the stage did not jog).
   ASSERT_TRUE(rig.catch_up());
   const double t0 = rig.get("t_s");
+  const auto wall0 = std::chrono::steady_clock::now();
   rig.drive(jog(100e-6), 1000ms);
   const double moved = rig.get("target_x_m") - x0, elapsed = rig.get("t_s") - t0;
-  // Paced to the wall clock: never ahead of it; behind it only when the machine cannot keep up
-  // (sanitizer builds, loaded CI machines), when the loop skips rather than bursts.
-  EXPECT_LT(elapsed, 1.15) << "the loop ran ahead of the wall clock";
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // Paced to the wall clock: never ahead of it (the drive's own wall time: its 20 ms sleeps
+  // overshoot on a loaded machine, 1.175 s in a cold CI run); behind it only when the machine
+  // cannot keep up (sanitizer builds, loaded CI machines), when the loop skips rather than bursts.
+  EXPECT_LT(elapsed, wall + 0.05) << "the loop ran ahead of the wall clock (" << wall << " s)";
   // Under ASan beside another paced test a loop tick can take most of its period (CI-like run,
   // 2026-11-27: 0.36 s of loop time in 1 s).
   EXPECT_GT(elapsed, MC_UNDER_ASAN ? 0.2 : 0.4) << "the loop hardly ran";
@@ -96,8 +99,8 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   EXPECT_GT(moved, 0.3 * 100e-6 * elapsed);
 #else
   EXPECT_NEAR(moved, 100e-6 * elapsed, 15e-6);
+  EXPECT_TRUE(rig.live.status().console_fresh);  // (under ASan the heartbeat may have starved)
 #endif
-  EXPECT_TRUE(rig.live.status().console_fresh);
 
   // The client goes silent: after the command timeout the stage holds.
   std::this_thread::sleep_for(300ms);

@@ -308,22 +308,23 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
 
   for (std::size_t l = begin; l < end; ++l) {
     // A finger's segments in this group (consecutive: the group is a range of heights) are one
-    // face: drawn as one box at its first, skipped after. Drawn one over the other, two segments
-    // sharing a pixel cover a a + b - ab of it instead of a + b: a dark seam that depends on
-    // where the boundary falls in the pixel (it pulled a tip's tracking toward whole pixels,
-    // 0.2 px at 5x).
-    int last_segment = -1;
+    // face: drawn as one box at the first of them met, skipped after. Drawn one over the other,
+    // two segments sharing a pixel cover a + b - ab of it instead of a + b: a dark seam that
+    // depends on where the boundary falls in the pixel (it pulled a tip's tracking toward whole
+    // pixels, 0.2 px at 5x).
+    int first_segment = layers[l].segment, last_segment = -1;
     if (layers[l].kind == Kind::kFinger) {
       bool drawn = false;
       for (std::size_t m = begin; m < end; ++m) {
         if (layers[m].kind != Kind::kFinger || layers[m].index != layers[l].index) continue;
         if (m < l) drawn = true;
+        first_segment = std::min(first_segment, layers[m].segment);
         last_segment = std::max(last_segment, layers[m].segment);
       }
       if (drawn) continue;
     }
     const Shape s =
-        shape_of(scene, layers[l].kind, layers[l].index, layers[l].segment, transmitted, cap, last_segment);
+        shape_of(scene, layers[l].kind, layers[l].index, first_segment, transmitted, cap, last_segment);
     const double du = s.vx * exposure_s / pixel_m_, dv = -s.vy * exposure_s / pixel_m_;
     const int samples =
         std::clamp(static_cast<int>(std::ceil(std::hypot(du, dv) / f)) + 1, 1, kMaxMotionSamples);
