@@ -279,7 +279,14 @@ void run_track(const TrackOptions& o) {
   // docs/parameters.md "Tracking the tool's tips").
   params.ecc_highpass_px = o.highpass_px.value_or(tool ? vs::kToolTipHighpass_px : 0.0);
   vs::TemplateTracker tracker(params);
-  tracker.set_template(frame, centred_roi(u0, v0, o.camera.template_px, cam));
+  vs::PixelRoi roi;
+  try {
+    roi = centred_roi(u0, v0, o.camera.template_px, cam);
+  } catch (const mc::InvalidInput& e) {
+    if (!tool || o.template_above_px == 0.0) throw;
+    throw mc::InvalidInput(fmt::format("--template-above-px {:g}: {}", o.template_above_px, e.what()));
+  }
+  tracker.set_template(frame, roi);
   const double u_off = tracker.last().u_px - renderer.u_of_x(start.x());
   const double v_off = tracker.last().v_px - renderer.v_of_y(start.y());
 
