@@ -79,12 +79,16 @@ std::vector<cell::CycleResult> run_mode(const Inputs& in, const std::vector<cell
 }
 
 mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
-  mc::CsvTable t({"index", "success", "cycle_s", "placement_error_m", "peak_grip_N", "mean_grip_N",
-                  "peak_contact_N", "grip_violations", "contact_violations", "clutches", "search_tries",
-                  "confirmations", "submovements", "path_m", "side_m", "clearance_m", "ended_holding",
-                  "wall_s"});
+  std::vector<std::string> columns = {"index", "success", "cycle_s", "placement_error_m", "peak_grip_N",
+                                      "mean_grip_N", "peak_contact_N", "grip_violations", "contact_violations",
+                                      "clutches", "search_tries", "confirmations", "submovements", "path_m",
+                                      "side_m", "clearance_m", "ended_holding", "wall_s"};
+  // Where each cycle's time went, step by step (zero for the scripted watchmaker).
+  for (std::size_t i = 0; i + 1 < cell::AssemblyTask::kStepCount; ++i)
+    columns.push_back(std::string(cell::AssemblyTask::name(static_cast<cell::AssemblyTask::Step>(i))) + "_s");
+  mc::CsvTable t(columns);
   for (const auto& c : cycles) {
-    const double row[] = {static_cast<double>(c.index),
+    std::vector<double> row = {static_cast<double>(c.index),
                           c.success ? 1.0 : 0.0,
                           c.cycle_s,
                           c.placement_error_m,
@@ -102,6 +106,7 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                           c.clearance_m,
                           c.ended_holding ? 1.0 : 0.0,
                           c.wall_s};
+    row.insert(row.end(), c.step_s.begin(), c.step_s.end());
     t.add_row(row);
   }
   return t;

@@ -87,7 +87,9 @@ TEST(CellRun, ACycleResultComesBackFromItsJsonWholeOrIsRefusedNamingTheKey) {
   c.clearance_m = 6e-6;
   c.wall_s = 4.2;
   c.ended_holding = true;
+  c.step_s = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.5};
   EXPECT_EQ(CycleResult::from_json(c.to_json()).to_json(), c.to_json());
+  EXPECT_EQ(c.to_json()["step_s"]["transport"], 5.0);
   nlohmann::json j = c.to_json();
   j.erase("cycle_s");
   EXPECT_THROW(
@@ -103,6 +105,18 @@ TEST(CellRun, ACycleResultComesBackFromItsJsonWholeOrIsRefusedNamingTheKey) {
   j = c.to_json();
   j["success"] = "yes";
   EXPECT_THROW(CycleResult::from_json(j), InvalidInput);
+  j = c.to_json();
+  j["step_s"].erase("retract");
+  EXPECT_THROW(
+      {
+        try {
+          CycleResult::from_json(j);
+        } catch (const InvalidInput& e) {
+          EXPECT_STREQ(e.what(), "cycle result: 'step_s' has no number for 'retract'");
+          throw;
+        }
+      },
+      InvalidInput);
   EXPECT_THROW(CycleResult::from_json(nlohmann::json::array()), InvalidInput);
 }
 

@@ -36,13 +36,29 @@ TEST(PersonOperator, WithSharedControlThePersonIsFasterAndThePinNeverMeetsTheRim
   // The funnel is a forbidden region: whatever the trembling hand does, the commanded target
   // is never inside it (stage coordinates, where the fixtures live).
   long funnel_ticks = 0;
-  double deepest_inside = 0.0;
-  c.set_observer([&](double) {
+  double deepest_inside = 0.0, off_axis_in_bore = 0.0;
+  // The person plans moves for twice the stage's pace; the platform paces the target (the
+  // fixtures' max_speed_m_s) in the plane and along the height stops.
+  double fastest_m_s = 0.0, last_t = -1.0;
+  Eigen::Vector3d last_target = Eigen::Vector3d::Zero();
+  c.set_observer([&](double t) {
+    const Eigen::Vector3d& target = c.platform().teleop().slave_target_m;
+    if (last_t >= 0.0 && c.platform().teleop().engaged)
+      fastest_m_s = std::max(fastest_m_s, (target - last_target).head<2>().norm() / (t - last_t));
+    last_t = t;
+    last_target = target;
     const auto& f = c.platform().fixtures();
     if (!f.fixtures().funnel) return;
     ++funnel_ticks;
     const Eigen::Vector3d& x = c.platform().teleop().slave_target_m;
-    deepest_inside = std::max(deepest_inside, f.lowest_z(x.head<2>()) - x.z());
+    // Above the rim: above the cone. Below it (the pin in its bore): within the bore's radius of
+    // the axis, give or take what the contact limit moved it toward the measured tool.
+    if (x.z() >= f.fixtures().rim_z_m) {
+      deepest_inside = std::max(deepest_inside, f.lowest_z(x.head<2>()) - x.z());
+    } else {
+      off_axis_in_bore = std::max(off_axis_in_bore, (x.head<2>() - f.fixtures().guide_xy_m).norm() -
+                                                         f.fixtures().funnel_radius_m);
+    }
   });
   c.run_to_end();
   const CycleResult assisted = c.result();
@@ -54,9 +70,21 @@ TEST(PersonOperator, WithSharedControlThePersonIsFasterAndThePinNeverMeetsTheRim
   }
   EXPECT_GT(funnel_ticks, 1000);
   EXPECT_LE(deepest_inside, 1e-12);
+  EXPECT_LE(off_axis_in_bore, 1e-12);
   EXPECT_EQ(assisted.search_tries, 0);  // the pin never landed on the rim
   EXPECT_LT(assisted.cycle_s, manual.cycle_s);
   EXPECT_LE(assisted.clutches, manual.clutches);
+  EXPECT_LE(fastest_m_s, c.platform().config().teleop.fixtures.max_speed_m_s * 1.001);
+  EXPECT_GT(fastest_m_s, 0.9 * c.platform().config().teleop.fixtures.max_speed_m_s);  // paced, not slow
+  using Step = AssemblyTask::Step;
+  const auto in = [](const CycleResult& r, Step s) { return r.step_s[static_cast<std::size_t>(s)]; };
+  EXPECT_LT(in(assisted, Step::kTransport), in(manual, Step::kTransport));
+  // Where the time went adds up to the cycle.
+  for (const CycleResult* r : {&manual, &assisted}) {
+    double sum = 0.0;
+    for (const double s : r->step_s) sum += s;
+    EXPECT_NEAR(sum, r->cycle_s, 2e-3) << r->mode;
+  }
   std::printf("seed 53: manual %.1f s, %.2f um; assisted %.1f s, %.2f um\n", manual.cycle_s,
               1e6 * manual.placement_error_m, assisted.cycle_s, 1e6 * assisted.placement_error_m);
 }

@@ -203,6 +203,76 @@ TEST(VirtualFixtures, RaisingTheLevelAddsNoEnergyTheHandCanTakeOut) {
   EXPECT_GT(v.dissipated_J(), 0.0);
 }
 
+FixtureSet height_stop_at(double z, double level) {
+  FixtureSet f = axis_at(0, 0, level);
+  f.height = true;
+  f.height_z_m = z;
+  return f;
+}
+
+TEST(VirtualFixtures, AHeightStopHoldsWithinItsCaptureAndFadesWithoutAJump) {
+  const VirtualFixtures v = settled(height_stop_at(400e-6, 1.0));
+  const double h = VirtualFixtureParams{}.height_capture_m;
+  EXPECT_TRUE(v.height_active());
+  // Within H the slave sits at the height; beyond 2H it is the input's.
+  EXPECT_EQ(v.guided_z(400e-6 + 0.9 * h), 400e-6);
+  EXPECT_EQ(v.guided_z(400e-6 - 0.5 * h), 400e-6);
+  EXPECT_EQ(v.guided_z(400e-6 + 2.5 * h), 400e-6 + 2.5 * h);
+  // Continuous and monotonic through the stop, both sides: slope 0 within H, at most 3 in the band.
+  double last = v.guided_z(400e-6 - 3.0 * h);
+  for (double e = -3.0 * h; e <= 3.0 * h; e += h / 1000) {
+    const double g = v.guided_z(400e-6 + e);
+    EXPECT_GE(g, last - 1e-18);
+    EXPECT_LE(g - last, 3.0 * h / 1000 * 1.0001) << "jump at e = " << e;
+    last = g;
+  }
+  // A set without the stop guides no height, whatever its level.
+  EXPECT_EQ(settled(axis_at(0, 0, 1.0)).guided_z(400e-6 + 0.5 * h), 400e-6 + 0.5 * h);
+}
+
+TEST(TeleoperationWithFixtures, AHeightStopHoldsTheSlaveAndNeverJumpsIt) {
+  // The thumb wheel (haptic) and the joystick (console) rolled down toward a stop 40 um below and on
+  // past it by less than its capture: the slave stops at the height, moved at most at the
+  // fixtures' pace per tick, and stays there; a new stop, and removing it, never jump the target.
+  const VirtualFixtureParams p;
+  const double pace_step = p.max_speed_m_s * kDt * (1 + 1e-9);
+  for (const bool console : {true, false}) {
+    Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 500e-6}, 600e-6);
+    t.tick(hand_at({0, 0}));
+    t.set_fixtures(height_stop_at(460e-6, 1.0));
+    Eigen::Vector3d last = t.output().slave_target_m;
+    double largest = 0.0;
+    const auto tick = [&](double rate_m_s) {
+      TeleoperationInput in = hand_at({0, 0});
+      if (console) {
+        in.console.active = in.console.fresh = in.console.deadman = true;
+        in.console.velocity_m_s = {0, 0, rate_m_s};
+      } else {
+        in.z_jog_m_s = rate_m_s;
+      }
+      const Eigen::Vector3d now = t.tick(in).slave_target_m;
+      largest = std::max(largest, (now - last).norm());
+      last = now;
+    };
+    for (int i = 0; i < 3000; ++i) tick(-20e-6 / 0.3);  // 60 um down in 0.3 s: 20 um past the stop
+    for (int i = 0; i < 5000; ++i) tick(0.0);
+    EXPECT_NEAR(last.z(), 460e-6, 1e-12) << (console ? "console" : "haptic");
+    EXPECT_LE(largest, pace_step) << (console ? "console" : "haptic");
+    // A new stop 20 um up (within its capture): the slave rises onto it, never faster than the pace.
+    largest = 0.0;
+    t.set_fixtures(height_stop_at(480e-6, 1.0));
+    for (int i = 0; i < 10000; ++i) tick(0.0);
+    EXPECT_NEAR(last.z(), 480e-6, 1e-12) << (console ? "console" : "haptic");
+    EXPECT_LE(largest, pace_step) << (console ? "console" : "haptic");
+    // The stop removed: the slave stays where it was put, and the wheel moves it from there.
+    t.set_fixtures(axis_at(0, 0, 1.0));
+    for (int i = 0; i < 100; ++i) tick(0.0);
+    EXPECT_NEAR(last.z(), 480e-6, 1e-15) << (console ? "console" : "haptic");
+    for (int i = 0; i < 1000; ++i) tick(10e-6 / 0.1);
+    EXPECT_NEAR(last.z(), 490e-6, 1e-9) << (console ? "console" : "haptic");
+  }
+}
+
 TEST(TeleoperationWithFixtures, TheFunnelIsNeverEnteredWhateverTheInput) {
   // A console joystick and a haptic hand driving down onto the rim beside the axis, with noise:
   // the target never goes below the funnel, and reaches the bore's depth only on the axis.
@@ -226,13 +296,53 @@ TEST(TeleoperationWithFixtures, TheFunnelIsNeverEnteredWhateverTheInput) {
         in.handle_m = h;
         in.z_jog_m_s = -3e-4;
       }
+      const double last_z = t.output().slave_target_m.z();
       const auto& out = t.tick(in);
       const Eigen::Vector3d& x = out.slave_target_m;
       ASSERT_GE(x.z(), t.fixtures().lowest_z(x.head<2>()) - 1e-15) << (console ? "console" : "haptic") << i;
       if (x.z() < 0.0) {
+        // In the bore: held within r0 of the axis (its walls), and never lifted out by the cone.
         ASSERT_LE(x.head<2>().norm(), f.funnel_radius_m + 1e-12);
+        ASSERT_LE(x.z(), last_z + 1e-15) << (console ? "console" : "haptic") << i;
       }
     }
+  }
+}
+
+TEST(TeleoperationWithFixtures, APartInItsBoreIsHeldByItsWallsNotLiftedOut) {
+  // Guided onto the axis and down into the bore, then dragged sideways far beyond the capture:
+  // the target stays within the bore's radius, at its depth (the cone once pulled it up to the rim).
+  FixtureSet f = axis_at(0, 0, 1.0);
+  f.funnel = true;
+  f.rim_z_m = 0.0;
+  f.funnel_radius_m = 2e-6;
+  for (const bool console : {true, false}) {
+    Teleoperation t(TeleoperationParams{}, kDt, {10e-6, 5e-6, 100e-6}, 600e-6);
+    t.set_fixtures(f);
+    Eigen::Vector2d h(0, 0);
+    const auto drive = [&](const Eigen::Vector3d& v_m_s) -> const Eigen::Vector3d& {
+      TeleoperationInput in = hand_at(h);
+      if (console) {
+        in.console.active = in.console.fresh = in.console.deadman = true;
+        in.console.velocity_m_s = v_m_s;
+      } else {
+        h += v_m_s.head<2>() * kDt / TeleoperationParams{}.motion_scale;
+        in.handle_m = h;
+        in.z_jog_m_s = v_m_s.z();
+      }
+      return t.tick(in).slave_target_m;
+    };
+    for (int i = 0; i < 10000; ++i) drive({0, 0, 0});                // the guidance takes it onto the axis
+    for (int i = 0; i < 5000; ++i) drive({0, 0, -3e-4});             // 150 um down: 50 um into the bore
+    const double z_in = t.output().slave_target_m.z();
+    ASSERT_NEAR(z_in, -50e-6, 1e-9) << (console ? "console" : "haptic");
+    ASSERT_LE(t.output().slave_target_m.head<2>().norm(), 1e-12);
+    for (int i = 0; i < 10000; ++i) {
+      const Eigen::Vector3d& x = drive({5e-4, 2e-4, 0.0});  // 0.5 mm sideways
+      ASSERT_LE(x.head<2>().norm(), f.funnel_radius_m + 1e-12) << (console ? "console" : "haptic") << i;
+      ASSERT_EQ(x.z(), z_in) << (console ? "console" : "haptic") << i;
+    }
+    EXPECT_NEAR(t.output().slave_target_m.head<2>().norm(), f.funnel_radius_m, 1e-12);  // against the wall
   }
 }
 

@@ -35,6 +35,17 @@ void CellRunParams::validate() const {
   manual.validate();
 }
 
+namespace {
+
+nlohmann::json step_times_json(const std::array<double, AssemblyTask::kStepCount - 1>& step_s) {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t i = 0; i < step_s.size(); ++i)
+    j[std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i)))] = step_s[i];
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json CycleResult::to_json() const {
   return {{"index", index},
           {"mode", mode},
@@ -56,7 +67,8 @@ nlohmann::json CycleResult::to_json() const {
           {"side_m", side_m},
           {"clearance_m", clearance_m},
           {"wall_s", wall_s},
-          {"ended_holding", ended_holding}};
+          {"ended_holding", ended_holding},
+          {"step_s", step_times_json(step_s)}};
 }
 
 CycleResult CycleResult::from_json(const nlohmann::json& j) {
@@ -95,6 +107,15 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("clearance_m", r.clearance_m);
   get("wall_s", r.wall_s);
   get("ended_holding", r.ended_holding);
+  nlohmann::json steps;
+  get("step_s", steps);
+  for (std::size_t i = 0; i < r.step_s.size(); ++i) {
+    const std::string key(AssemblyTask::name(static_cast<AssemblyTask::Step>(i)));
+    const auto it = steps.find(key);
+    if (it == steps.end() || !it->is_number())
+      throw InvalidInput("cycle result: 'step_s' has no number for '" + key + "'");
+    r.step_s[i] = it->get<double>();
+  }
   return r;
 }
 
@@ -120,6 +141,11 @@ struct CellCycle::Meter {
   double peak_grip = 0.0, grip_sum = 0.0, peak_contact = 0.0, path = 0.0;
   long gripped_ticks = 0;
   int grip_over = 0, contact_over = 0;
+  std::array<double, AssemblyTask::kStepCount - 1> step_s{};
+  void time_step(AssemblyTask::Step s, double dt_s) {
+    const auto i = static_cast<std::size_t>(s);
+    if (i < step_s.size()) step_s[i] += dt_s;
+  }
   Eigen::Vector3d last_tip = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 
   void sample(const TaskSensors& s) {
@@ -181,6 +207,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       }
       // Holding (deadman off) whenever the task does not drive: paused, awaiting, finished.
       // Taken over, the operator's master drives: the console lets go.
+      meter_->time_step(task_->step(), t.dt_s);
       control::ConsoleInput in = task_->tick(s, t.dt_s);
       if (task_->status() == AssemblyTask::Status::kOperator) in.active = false;
       platform_->set_console_input(in);
@@ -199,6 +226,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
                                                params_.mode == "assisted", seed);
     p.set_operator([this](const platform::TickInfo& t) {
       meter_->sample(read_task_sensors(*platform_, home_m_));
+      meter_->time_step(person_->step(), t.dt_s);
       person_->act(t);
       if ((person_->done() || person_->gave_up()) && !finished_) {
         finished_ = true;
@@ -254,6 +282,7 @@ CycleResult CellCycle::result() const {
   r.grip_violations = meter.grip_over;
   r.contact_violations = meter.contact_over;
   r.path_m = meter.path;
+  r.step_s = meter.step_s;
   const auto& teleop = p.teleop();
   Eigen::Vector3d measured;
   for (int i = 0; i < 3; ++i) measured[i] = p.axis(i).position_m();

@@ -95,6 +95,10 @@ struct CycleResult {
   double side_m = 0.0, clearance_m = 0.0;
   double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
   bool ended_holding = false;  ///< every axis' target at its measured position, the coupling off
+  /// Simulated seconds spent in each step of the task (auto) or of the person (manual, assisted),
+  /// indexed by AssemblyTask::Step (kDone: none); all zero for the scripted watchmaker, whose
+  /// phases differ. Where a cycle's time goes, mode against mode.
+  std::array<double, AssemblyTask::kStepCount - 1> step_s{};
   nlohmann::json to_json() const;
   /// Back from to_json()'s object (results gathered from other processes, e.g. the Python
   /// module's Dask campaigns, then summarized). Throws mc::InvalidInput naming a missing or

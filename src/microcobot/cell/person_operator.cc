@@ -31,6 +31,7 @@ void PersonOperatorParams::validate() const {
   require_positive(grip_seen_N, "grip_seen_N");
   require_positive(joystick_travel_m, "joystick_travel_m");
   require_positive(stalled_s, "stalled_s");
+  require_positive(assisted_pace_m_s, "assisted_pace_m_s");
   require_positive(step_timeout_s, "step_timeout_s");
   require(max_jams >= 1, "max_jams", "must be at least 1", max_jams);
 }
@@ -135,7 +136,10 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
   // hand travels D ln(s0/s1) / (s0 - s1), the scale's log-mean.
   const double s0 = platform_.motion_scale(), s1 = platform_.motion_scale_at(tool_xy_ + e);
   const double scale = std::abs(s0 - s1) < 1e-9 * s0 ? s0 : (s0 - s1) / std::log(s0 / s1);
-  const double pace = p_.person.stage_pace_m_s;
+  // Alone, the person keeps the slave to the stage's pace (a target run ahead makes the stick-slip
+  // stage overshoot); with shared control the platform paces the target itself (the fixtures'
+  // max_speed_m_s), so the person moves faster and the stage runs at its pace the whole way.
+  const double pace = assisted_ ? p_.assisted_pace_m_s : p_.person.stage_pace_m_s;
   if (!haptic_) {
     const double gain = scale / base_scale_;
     return xy_.aim(e / gain, tolerance_m / gain, t, pace / gain, width_m / gain);
@@ -171,18 +175,23 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
   return xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
 }
 
-bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept {
+bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t, double width_m) noexcept {
   if (!z_.ready(t) || !tool_still()) return false;
   const double e = z_goal - tip_z + rng_.normal(0.0, p_.person.vision_sd_m);
   const double v_max =
       haptic_ ? platform_.config().teleop.max_jog_m_s : platform_.config().teleop.console_max_speed_m_s;
-  return z_.aim({e, 0.0}, tolerance_m, t, v_max);
+  return z_.aim({e, 0.0}, tolerance_m, t, v_max, width_m > 0.0 ? width_m : tolerance_m);
 }
 
 void PersonOperator::assist() noexcept {
   control::FixtureSet f;
   f.level = 1.0;
   f.guide = true;
+  // The working heights as stops (the same heights the automatic task uses): the person rolls the
+  // wheel (or pushes the joystick) into the stop's capture and the slave sits at the height.
+  // None while inserting and releasing: the descent is the person's, felt or seen.
+  f.height = step_ != Step::kInsert && step_ != Step::kRelease;
+  f.height_z_m = step_height_z();
   switch (step_) {
     case Step::kApproach:
     case Step::kDescend:
@@ -228,14 +237,14 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
   switch (step_) {
     case Step::kApproach:
       if (tip.z() < safe_z_ - p_.z_tolerance_m) {
-        climb(safe_z_, tip.z(), p_.z_tolerance_m, t);
+        climb(safe_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width());
       } else if (steer(part.head<2>() - tip.head<2>(), p_.pin_tolerance_m, t,
                        aim_width(p_.pin_tolerance_m))) {
         enter(Step::kDescend, t);
       }
       break;
     case Step::kDescend:
-      if (climb(grasp_z_, tip.z(), p_.z_tolerance_m, t)) enter(Step::kGrasp, t);
+      if (climb(grasp_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) enter(Step::kGrasp, t);
       break;
     case Step::kGrasp: {
       const bool held =
@@ -259,7 +268,7 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
       break;
     }
     case Step::kLift:
-      if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t)) {
+      if (climb(carry_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) {
         // The pin's place in the fingers once it is up, as vision sees it (assisted).
         pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);
         enter(Step::kTransport, t);
@@ -312,7 +321,7 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
       if (g.opening_m() > 0.9 * goal_.open_m) enter(Step::kRetract, t);
       break;
     case Step::kRetract:
-      if (climb(safe_z_, tip.z(), p_.z_tolerance_m, t)) {
+      if (climb(safe_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) {
         enter(Step::kDone, t);
         let_go();
         return;
@@ -323,6 +332,19 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
   }
   if (assisted_) assist();
   apply(t);
+}
+
+double PersonOperator::step_height_z() const noexcept {
+  switch (step_) {
+    case Step::kDescend:
+    case Step::kGrasp:
+      return grasp_z_;
+    case Step::kLift:
+    case Step::kTransport:
+      return carry_z_;
+    default:
+      return safe_z_;  // approach, retract (and the steps without a stop)
+  }
 }
 
 void PersonOperator::apply(double t) noexcept {

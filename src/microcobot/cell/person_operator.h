@@ -22,7 +22,8 @@
 /// then guides the slave to the pin, and the carried pin to its bore's axis, with the insertion
 /// funnel round the rim and the coarse-far/fine-near scaling (control/virtual_fixtures.h). The
 /// person trusts the guidance: they aim within the fixture's capture radius, not at the last
-/// micrometre. Everything else (the person, the seeds, the parts) is the manual run's.
+/// micrometre; the step's working height is a stop the person rolls into (grasping, carrying,
+/// clear of the pins). Everything else (the person, the seeds, the parts) is the manual run's.
 ///
 /// act() runs as the platform's operator task: real-time safe (no allocation, lock, exception,
 /// I/O). The person lets go of everything when done or when a step times out (gave up).
@@ -48,6 +49,11 @@ struct PersonOperatorParams {
   /// the tool tips' worst tracking rms 0.45 px at 5x (1.1 um pixels), rounded up.
   double assist_vision_sd_m = 0.5e-6;
   double assisted_tolerance_m = 15e-6;  ///< assisted: the target width planned for (in the capture)
+  /// Assisted: the slave speed the person plans moves in the plane for. The platform paces the
+  /// target to the stage's (control::VirtualFixtureParams::max_speed_m_s, 0.5 mm/s), so the
+  /// person no longer has to: twice that turns a minimum-jerk move (peak 1.875x its mean speed)
+  /// into the stage's pace most of the way; the console's joystick allows 1 mm/s.
+  double assisted_pace_m_s = 1.0e-3;
   double z_tolerance_m = 10e-6;         ///< heights judged by eye (the depth of field)
   double still_m = 5e-6;                ///< the tool seen still: it moved less than this ...
   double still_window_s = 0.1;          ///< ... over this (one tremor period: tremor averages out)
@@ -76,6 +82,7 @@ struct PersonOperatorParams {
     v("bore_tolerance_m", bore_tolerance_m);
     v("assist_vision_sd_m", assist_vision_sd_m);
     v("assisted_tolerance_m", assisted_tolerance_m);
+    v("assisted_pace_m_s", assisted_pace_m_s);
     v("z_tolerance_m", z_tolerance_m);
     v("still_m", still_m);
     v("still_window_s", still_window_s);
@@ -128,8 +135,14 @@ class PersonOperator {
   double aim_width(double tolerance_m) const noexcept {
     return assisted_ ? std::max(tolerance_m, p_.assisted_tolerance_m) : tolerance_m;
   }
-  /// Brings the tip to height `z_goal`; true once seen there.
-  bool climb(double z_goal, double tip_z, double tolerance_m, double t) noexcept;
+  /// Brings the tip to height `z_goal`, planning for a target `width_m` wide (0: the tolerance);
+  /// true once seen within `tolerance_m`.
+  bool climb(double z_goal, double tip_z, double tolerance_m, double t, double width_m = 0.0) noexcept;
+  /// The width a height is aimed at: the eye's tolerance, or with shared control the height
+  /// stop's capture (assisted_tolerance_m), which holds the slave at the height.
+  double aim_height_width() const noexcept { return aim_width(p_.z_tolerance_m); }
+  /// The working height of the current step (the assisted run's height stop).
+  double step_height_z() const noexcept;
   void apply(double t) noexcept;
   /// Shared control: the fixtures for the current step (assisted runs).
   void assist() noexcept;

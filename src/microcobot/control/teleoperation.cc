@@ -33,6 +33,7 @@ Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
   out_.gripper_opening_m = gripper_start_m;
   last_xy_m_ = slave_start_m.head<2>();
   raw_xy_m_ = last_xy_m_;
+  raw_z_m_ = slave_start_m.z();
   scale_ = p_.motion_scale;
   force_alpha_ = 1.0 - std::exp(-2.0 * M_PI * p_.force_filter_Hz * dt_s);
   velocity_alpha_ = 1.0 - std::exp(-dt_s / p_.velocity_filter_s);
@@ -51,7 +52,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
   force_filtered_N_.setZero();
   if (out_.engaged) {
     // The console moves the master's own target (before the fixtures), from where it is.
-    const Eigen::Vector3d base(raw_xy_m_.x(), raw_xy_m_.y(), out_.slave_target_m.z());
+    const Eigen::Vector3d base(raw_xy_m_.x(), raw_xy_m_.y(), raw_z_m_);
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
     if (c.has_goal && c.goal_m.allFinite()) {
       // Straight to the goal at the requested speed, landing on it exactly.
@@ -74,9 +75,10 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
     Eigen::Vector3d raw;
     for (int i = 0; i < 3; ++i) raw[i] = clamp_workspace(base[i] + v[i] * dt_);
     raw_xy_m_ = raw.head<2>();
+    raw_z_m_ = raw.z();
     const Eigen::Vector3d before = out_.slave_target_m;
-    out_.slave_target_m.head<2>() = follow_fixtures(before.head<2>());
-    out_.slave_target_m.z() = std::max(raw.z(), fixtures_.lowest_z(out_.slave_target_m.head<2>()));
+    out_.slave_target_m.head<2>() = fixtures_.confined_xy(follow_fixtures(before.head<2>()), before.z());
+    out_.slave_target_m.z() = follow_height(before.z(), out_.slave_target_m.head<2>());
     out_.slave_velocity_m_s = (out_.slave_target_m - before) / dt_;
   }
   // The gripper moves on the console's command only while the coupling is engaged (deadman
@@ -85,7 +87,11 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
                                ? std::max(0.0, c.gripper_opening_m)
                                : out_.gripper_opening_m;
   apply_limits(in, requested);
-  if (!out_.engaged) raw_xy_m_ = out_.slave_target_m.head<2>();
+  if (!out_.engaged) {
+    raw_xy_m_ = out_.slave_target_m.head<2>();
+    raw_z_m_ = out_.slave_target_m.z();
+  }
+  sync_raw_z();
   last_xy_m_ = out_.slave_target_m.head<2>();
   out_.finger_force_N = 0.0;
   console_had_control_ = true;
@@ -99,6 +105,7 @@ void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_
   // slave does not jump to where the hand went meanwhile.
   offset_m_ += (out_.slave_target_m - before).head<2>();
   raw_xy_m_ += (out_.slave_target_m - before).head<2>();
+  raw_z_m_ += out_.slave_target_m.z() - before.z();
   out_.gripper_opening_m = limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N,
                                                    out_.gripper_opening_m);
 }
@@ -111,6 +118,7 @@ void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
   force_filtered_N_.setZero();
   last_xy_m_ = out_.slave_target_m.head<2>();
   raw_xy_m_ = last_xy_m_;
+  raw_z_m_ = out_.slave_target_m.z();
 }
 
 void Teleoperation::set_fixtures(const FixtureSet& set) noexcept {
@@ -118,6 +126,29 @@ void Teleoperation::set_fixtures(const FixtureSet& set) noexcept {
   fixtures_.set(set);
   const FixtureSet& now = fixtures_.fixtures();
   if (now.guide != before.guide || now.guide_xy_m != before.guide_xy_m) reindex_ = true;
+  if (now.height != before.height || now.height_z_m != before.height_z_m) reindex_z_ = true;
+}
+
+double Teleoperation::follow_height(double from_z, const Eigen::Vector2d& xy) noexcept {
+  const double lowest = fixtures_.lowest_z(xy, from_z);
+  double z = raw_z_m_;
+  if (fixtures_.height_active() || slewing_z_) {
+    // As in the plane: toward the guided height no faster than the stage follows.
+    const double want = fixtures_.guided_z(raw_z_m_), step = p_.fixtures.max_speed_m_s * dt_;
+    slewing_z_ = std::abs(want - from_z) > step;
+    z = slewing_z_ ? from_z + std::copysign(step, want - from_z) : want;
+  }
+  // The funnel holds the target up, and the master's height with it (no wind-up below the cone:
+  // reaching the axis must not drop the target to where the input went meanwhile).
+  if (z < lowest) {
+    z = lowest;
+    raw_z_m_ = std::max(raw_z_m_, lowest);
+  }
+  return z;
+}
+
+void Teleoperation::sync_raw_z() noexcept {
+  if (!fixtures_.height_active() && !slewing_z_) raw_z_m_ = out_.slave_target_m.z();
 }
 
 Eigen::Vector2d Teleoperation::follow_fixtures(const Eigen::Vector2d& from) noexcept {
@@ -142,6 +173,10 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     offset_m_ += shift;
     reindex_ = false;
   }
+  if (reindex_z_) {
+    raw_z_m_ = out_.slave_target_m.z();  // the new stop's field starts from the target
+    reindex_z_ = false;
+  }
   if (!in.slave_fresh) {
     // A silent slave (a remote one whose link went quiet): nothing to couple to. No force on
     // either master; the target is re-taken from the slave once it reports again.
@@ -160,6 +195,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     out_.slave_target_m = in.slave_position_m;
     last_xy_m_ = out_.slave_target_m.head<2>();
     raw_xy_m_ = last_xy_m_;
+    raw_z_m_ = out_.slave_target_m.z();
     out_.engaged = false;
     slave_was_stale_ = false;
   }
@@ -191,7 +227,8 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   if (engage) {
     const Eigen::Vector2d raw = offset_m_ + scale_ * in.handle_m;
     for (int i = 0; i < 2; ++i) raw_xy_m_[i] = clamp_workspace(raw[i]);
-    out_.slave_target_m.head<2>() = follow_fixtures(last_xy_m_);
+    out_.slave_target_m.head<2>() =
+        fixtures_.confined_xy(follow_fixtures(last_xy_m_), out_.slave_target_m.z());
     // The target's velocity, low-passed: a master read slower than this loop moves the target
     // in steps, and a feedforward of one tick's step (ten times the hand's speed for one tick
     // in ten) threw the stick-slip tracking controller into a limit cycle of millimetres.
@@ -203,9 +240,12 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     out_.slave_velocity_m_s.head<2>() = velocity_ff_;
     const double jog =
         std::isfinite(in.z_jog_m_s) ? std::clamp(in.z_jog_m_s, -p_.max_jog_m_s, p_.max_jog_m_s) : 0.0;
-    const double z = clamp_workspace(out_.slave_target_m.z() + jog * dt_);
-    out_.slave_target_m.z() = std::max(z, fixtures_.lowest_z(out_.slave_target_m.head<2>()));
-    out_.slave_velocity_m_s.z() = jog;
+    const double before_z = out_.slave_target_m.z();
+    raw_z_m_ = clamp_workspace(raw_z_m_ + jog * dt_);
+    out_.slave_target_m.z() = follow_height(before_z, out_.slave_target_m.head<2>());
+    // The wheel's rate, or what a height stop makes of it.
+    out_.slave_velocity_m_s.z() =
+        fixtures_.height_active() || slewing_z_ ? (out_.slave_target_m.z() - before_z) / dt_ : jog;
     // Slave forces back to the hand, in the handle's plane (slave XY = handle xy).
     Eigen::Vector2d f = p_.force_scale * in.contact_force_N.head<2>();
     if (!f.allFinite()) f.setZero();
@@ -222,6 +262,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     force_filtered_N_.setZero();
     velocity_ff_.setZero();
     raw_xy_m_ = out_.slave_target_m.head<2>();
+    raw_z_m_ = out_.slave_target_m.z();
   }
   // The gripper follows the TéléTweez only while the deadman is held (and its readings are
   // fresh); otherwise it holds its opening.
@@ -229,6 +270,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
   const double requested =
       in.deadman && tweezers_ok ? p_.grip_position_scale * in.tweezers_opening_m : out_.gripper_opening_m;
   apply_limits(in, requested);
+  sync_raw_z();
   last_xy_m_ = out_.slave_target_m.head<2>();
   if (tweezers_ok) {
     const double f = p_.grip_force_scale * in.grip_force_N;

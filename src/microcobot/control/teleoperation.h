@@ -150,6 +150,11 @@ class Teleoperation {
   void console_tick(const TeleoperationInput& in) noexcept;
   /// The target in the plane under the fixtures, from `from` (slewed where they act).
   Eigen::Vector2d follow_fixtures(const Eigen::Vector2d& from) noexcept;
+  /// The target's height under a height stop, from `from_z` (slewed like the plane's), then kept
+  /// above the funnel at `xy`; the master's raw height never winds up below what the funnel allows.
+  double follow_height(double from_z, const Eigen::Vector2d& xy) noexcept;
+  /// End of a tick: without a height stop the master's raw height is the target's.
+  void sync_raw_z() noexcept;
   /// The safety limits on this tick's commands (every input path).
   void apply_limits(const TeleoperationInput& in, double requested_opening_m) noexcept;
 
@@ -166,6 +171,9 @@ class Teleoperation {
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
   VirtualFixtures fixtures_;
   Eigen::Vector2d raw_xy_m_ = Eigen::Vector2d::Zero();  // the master's target before the fixtures
+  double raw_z_m_ = 0.0;                                // ... and its height
+  bool slewing_z_ = false;                              // the height catching up with a stop
+  bool reindex_z_ = false;                              // a new height stop: raw height re-taken
   Eigen::Vector2d last_handle_m_ = Eigen::Vector2d::Zero();
   double scale_ = 0.0;                // motion scale in force
   bool slewing_ = false;              // the target catching up with the fixtures' output

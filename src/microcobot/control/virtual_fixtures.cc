@@ -18,6 +18,7 @@ void VirtualFixtureParams::validate() const {
           "must be within (0, 89) degrees", funnel_half_angle_deg);
   require_positive(funnel_height_m, "funnel_height_m");
   require_positive(level_rate_1_s, "level_rate_1_s");
+  require_positive(height_capture_m, "height_capture_m");
 }
 
 VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params) {
@@ -28,7 +29,8 @@ VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params
 void VirtualFixtures::set(const FixtureSet& set) noexcept {
   const bool valid = std::isfinite(set.level) && set.level >= 0.0 && set.level <= 1.0 &&
                      set.guide_xy_m.allFinite() && std::isfinite(set.rim_z_m) &&
-                     std::isfinite(set.funnel_radius_m) && set.funnel_radius_m >= 0.0;
+                     std::isfinite(set.funnel_radius_m) && set.funnel_radius_m >= 0.0 &&
+                     std::isfinite(set.height_z_m);
   const FixtureSet next = valid ? set : FixtureSet{};
   if (next == set_) return;
   // A new guide moves the field under the handle: its energy is booked afresh. A new level alone
@@ -37,12 +39,15 @@ void VirtualFixtures::set(const FixtureSet& set) noexcept {
     rebase_ = true;
     level_ = 0.0;  // from nothing again: the new field comes in at level_rate_1_s
   }
+  if (next.height != set_.height || next.height_z_m != set_.height_z_m) height_level_ = 0.0;
   set_ = next;
 }
 
 void VirtualFixtures::tick(double dt_s) noexcept {
   const double step = p_.level_rate_1_s * dt_s;
   level_ += std::clamp(set_.level - level_, -step, step);
+  const double height_goal = set_.height ? set_.level : 0.0;
+  height_level_ += std::clamp(height_goal - height_level_, -step, step);
 }
 
 double VirtualFixtures::weight(double d) const noexcept {
@@ -77,8 +82,22 @@ Eigen::Vector2d VirtualFixtures::guided(const Eigen::Vector2d& raw_xy) const noe
   return set_.guide_xy_m + (1.0 - level_ * weight(e.norm())) * e;
 }
 
-double VirtualFixtures::lowest_z(const Eigen::Vector2d& xy) const noexcept {
-  if (!set_.guide || !set_.funnel) return -std::numeric_limits<double>::infinity();
+double VirtualFixtures::guided_z(double raw_z) const noexcept {
+  if (!set_.height || height_level_ <= 0.0) return raw_z;
+  const double e = raw_z - set_.height_z_m, h = p_.height_capture_m;
+  const double w = std::clamp((2.0 * h - std::abs(e)) / h, 0.0, 1.0);
+  return set_.height_z_m + (1.0 - height_level_ * w) * e;
+}
+
+Eigen::Vector2d VirtualFixtures::confined_xy(const Eigen::Vector2d& xy, double z) const noexcept {
+  if (!set_.guide || !set_.funnel || z >= set_.rim_z_m) return xy;
+  const Eigen::Vector2d e = xy - set_.guide_xy_m;
+  const double d = e.norm();
+  return d <= set_.funnel_radius_m ? xy : Eigen::Vector2d(set_.guide_xy_m + e * (set_.funnel_radius_m / d));
+}
+
+double VirtualFixtures::lowest_z(const Eigen::Vector2d& xy, double from_z) const noexcept {
+  if (!set_.guide || !set_.funnel || from_z < set_.rim_z_m) return -std::numeric_limits<double>::infinity();
   const double d = (xy - set_.guide_xy_m).norm();
   if (d <= set_.funnel_radius_m) return -std::numeric_limits<double>::infinity();
   // Off the axis: no lower than the cone, and never below the rim.

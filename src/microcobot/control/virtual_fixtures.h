@@ -22,7 +22,18 @@
 ///   funnel     a forbidden region: the hole's edge. Below `rim_z + cone height` the target's
 ///              z is kept above the cone z >= rim_z + (d - r0) / tan(half angle) (d: distance to
 ///              the axis, r0: the allowed radius at the rim), so that a carried part reaches the
-///              rim only on the axis, whatever the input. Hard, like the safety limits.
+///              rim only on the axis, whatever the input. Hard, like the safety limits. Below the
+///              rim (the part in its bore) the region goes on as the bore's walls: the target is
+///              kept within r0 of the axis (confined_xy), never lifted out by the cone (a
+///              target moved off the axis in the bore, e.g. by the contact limit, once had the
+///              cone pull it 170 um up at once, the pin half in).
+///   height     a stop at a working height (a detent for the Z input, e.g. the grasping or the
+///              carrying height): with e_z = raw_z - stop, guided_z = stop + (1 - b w_z(|e_z|)) e_z,
+///              w_z as w with the capture height H; b is the stop's own level, slewed from 0
+///              whenever the stop moves, so that a new height never jumps the target. Within H
+///              the slave sits at the height whatever the wheel or the joystick does; beyond 2H
+///              the input moves it as without fixture. Z is a rate input on every master (the
+///              thumb wheel, the joystick): nothing is displayed.
 ///   display    on a haptic master the operator feels the guidance as a spring from the handle
 ///              to where the guided slave is: F = -k (raw - guided) / s (hand newtons, s the
 ///              motion scale). It is a radial field, F = -grad Phi with
@@ -57,6 +68,7 @@ struct VirtualFixtureParams {
   double funnel_half_angle_deg = 60.0;  ///< the funnel's cone, from the vertical
   double funnel_height_m = 60e-6;       ///< above the rim, where the funnel begins
   double level_rate_1_s = 2.0;          ///< the assistance level's largest rate of change
+  double height_capture_m = 25e-6;      ///< H: a height stop holds within it, lets go beyond 2H
 
   template <class V>
   void visit(V& v) {
@@ -69,6 +81,7 @@ struct VirtualFixtureParams {
     v("funnel_half_angle_deg", funnel_half_angle_deg);
     v("funnel_height_m", funnel_height_m);
     v("level_rate_1_s", level_rate_1_s);
+    v("height_capture_m", height_capture_m);
   }
   /// Throws mc::InvalidParams naming the field.
   void validate() const;
@@ -82,9 +95,12 @@ struct FixtureSet {
   bool funnel = false;           ///< the forbidden region round the axis' rim (needs `guide`)
   double rim_z_m = 0.0;          ///< tool-point height at which the part meets the rim
   double funnel_radius_m = 0.0;  ///< r0: the allowed distance to the axis at the rim
+  bool height = false;           ///< a height stop at height_z_m (at the set's level)
+  double height_z_m = 0.0;       ///< tool-point height of the stop
   bool operator==(const FixtureSet& o) const noexcept {
     return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && funnel == o.funnel &&
-           rim_z_m == o.rim_z_m && funnel_radius_m == o.funnel_radius_m;
+           rim_z_m == o.rim_z_m && funnel_radius_m == o.funnel_radius_m && height == o.height &&
+           height_z_m == o.height_z_m;
   }
 };
 
@@ -103,13 +119,22 @@ class VirtualFixtures {
   /// Slews the level for one tick of `dt_s`.
   void tick(double dt_s) noexcept;
   bool active() const noexcept { return set_.guide && (level_ > 0.0 || set_.funnel); }
+  /// The height stop acts (its level above zero).
+  bool height_active() const noexcept { return set_.height && height_level_ > 0.0; }
 
   /// The motion-scale gain g(d) at the target `xy` (1 without a guide).
   double scale_gain(const Eigen::Vector2d& xy) const noexcept;
   /// The guided target for the master's raw target.
   Eigen::Vector2d guided(const Eigen::Vector2d& raw_xy) const noexcept;
-  /// The lowest z allowed at `xy` (-inf without a funnel).
-  double lowest_z(const Eigen::Vector2d& xy) const noexcept;
+  /// The guided height for the master's raw height (raw_z without a height stop).
+  double guided_z(double raw_z) const noexcept;
+  /// `xy` kept within the funnel's radius r0 of the axis when `z` is below the rim (the part in
+  /// its bore); `xy` otherwise, or without a funnel.
+  Eigen::Vector2d confined_xy(const Eigen::Vector2d& xy, double z) const noexcept;
+  /// The lowest z allowed at `xy` (-inf without a funnel) for a target now at `from_z`: a target
+  /// already in the bore (below the rim) is held by confined_xy, never lifted out by the cone.
+  double lowest_z(const Eigen::Vector2d& xy,
+                  double from_z = std::numeric_limits<double>::infinity()) const noexcept;
   /// The guidance felt on a haptic handle moving at `handle_v` (hand frame), with the passivity
   /// controller; `scale` is the motion scale in force.
   Eigen::Vector2d display_force(const Eigen::Vector2d& raw_xy, const Eigen::Vector2d& guided_xy,
@@ -129,6 +154,7 @@ class VirtualFixtures {
   VirtualFixtureParams p_;
   FixtureSet set_;
   double level_ = 0.0;
+  double height_level_ = 0.0;  // the height stop's own level (from 0 when the stop moves)
   double tan_cone_ = 1.0;
   double observed_J_ = 0.0, dissipated_J_ = 0.0;
   bool rebase_ = true;
