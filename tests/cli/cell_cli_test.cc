@@ -29,6 +29,15 @@ TEST(CellCli, RunsABatchAndWritesItsCyclesAndSummary) {
   const CsvTable t = read_csv(dir / "cycles.csv");
   EXPECT_EQ(t.rows(), 2u);
   EXPECT_EQ(t.column("success"), (std::vector<double>{1.0, 1.0}));
+  // Where each cycle's time went: its steps add up to it.
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    double steps = 0.0;
+    for (const char* c : {"approach_s", "descend_s", "grasp_s", "lift_s", "transport_s", "insert_s", "release_s",
+                          "retract_s"})
+      steps += t.column(c).at(i);
+    EXPECT_NEAR(steps, t.column("cycle_s").at(i), 2e-3) << "part " << i;
+    EXPECT_GT(t.column("transport_s").at(i), 1.0);
+  }
   EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "summary.json"))["cycles"].get<int>(), 2);
   EXPECT_THAT(test::read_text(dir / "index.html"), HasSubstr("Placement against clearance"));
   EXPECT_EQ(read_csv(dir / "fig-01-cycle-time.csv").rows(), 2u);

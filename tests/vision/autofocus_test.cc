@@ -140,6 +140,31 @@ TEST(Autofocus, FindsAnExactLorentzianPeakAnywhereInTheRange) {
   }
 }
 
+// The tool's tips from 100 um above (before this test, `vision autofocus --target tool` at 10x): the
+// start sits in the trough between the peak's tail below and a broad rise above (the fingers' body,
+// higher along their length, coming into focus), and the first step up reads sharper than the
+// start. The search looks on both sides of the start before it climbs, so it goes down to the peak.
+TEST(Autofocus, ASlopeOnOneSideOfTheStartDoesNotLeadItAwayFromThePeakOnTheOther) {
+  const double z0 = 0.0;
+  const auto measure = [&](double z) {
+    const double u = (z - z0) / 10e-6;
+    const double rise = 0.3 + 1.0 / (1.0 + std::exp(-(z - 200e-6) / 40e-6));  // 0.38 at +100, 1.3 from +400
+    return rise + 280.0 / (1.0 + u * u * u * u);
+  };
+  AutofocusParams p;
+  p.range_min_m = -500e-6;
+  p.range_max_m = 2000e-6;
+  p.start_m = 100e-6;
+  p.fine_metric = "normalized-variance";
+  ASSERT_GT(measure(140e-6), 1.1 * measure(100e-6)) << "the case: one step up is sharper than the start";
+  ASSERT_GT(measure(60e-6), measure(140e-6)) << "the case: one step down is sharper still";
+  Autofocus af(p);
+  while (!af.done()) af.observe(measure(af.next_focus_m()));
+  EXPECT_TRUE(af.converged()) << af.status();
+  EXPECT_NEAR(af.best_focus_m(), z0, 1e-6) << af.frames_used() << " frames";
+  EXPECT_LE(af.frames_used(), 15);
+}
+
 void expect_invalid(const std::function<void(AutofocusParams&)>& edit, const std::string& field) {
   AutofocusParams p;
   edit(p);

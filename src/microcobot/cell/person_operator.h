@@ -45,9 +45,11 @@ struct PersonOperatorParams {
   PersonParams person;
   double pin_tolerance_m = 10e-6;  ///< over the pin before descending
   double bore_tolerance_m = 2e-6;  ///< manual: the pin over its bore before inserting
-  /// What the cell's camera tracker makes out of the pin and the tips (SD): docs/benchmarks.md,
-  /// the tool tips' worst tracking rms 0.45 px at 5x (1.1 um pixels), rounded up.
-  double assist_vision_sd_m = 0.5e-6;
+  /// What the cell's camera makes out of the pin and the tips (SD), at 5x (1.1 um pixels):
+  /// docs/benchmarks.md's worst tracking rms on the validation sets, a part's corner 0.033 px and
+  /// the tool's tips 0.026 px, with the calibration's worst residual 0.052 px: 0.067 px = 0.074 um,
+  /// rounded up. (0.5 um, from the tips' 0.45 px before their fix of 2026-11-27, until then.)
+  double assist_vision_sd_m = 0.1e-6;
   double assisted_tolerance_m = 15e-6;  ///< assisted: the target width planned for (in the capture)
   /// Assisted: the slave speed the person plans moves in the plane for. The platform paces the
   /// target to the stage's (control::VirtualFixtureParams::max_speed_m_s, 0.5 mm/s), so the

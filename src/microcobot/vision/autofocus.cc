@@ -116,7 +116,24 @@ void Autofocus::coarse_next(bool budget_used) {
   for (const FocusSample& s : samples_) lo = std::min(lo, s.sharpness), hi = std::max(hi, s.sharpness);
   const double h = p_.coarse_step_m;
   const double first = std::max(h / p_.refinement, p_.final_step_m);
-  if (hi > 0.0 && hi >= p_.min_contrast * lo) {
+  const bool contrast = hi > 0.0 && hi >= p_.min_contrast * lo;
+  if (contrast && ring_ == 1 && side_ < 0) {
+    // Both sides of the start before the first climb: a slope on one side may be the tail of
+    // something else while the peak is on the other (the tool's tips from 100 um above: the
+    // fingers' body, rising beyond them, sharpens upwards from a minimum near the start).
+    ++ring_;
+    side_ = 1;
+    const double down = p_.start_m - h;
+    if (down >= p_.range_min_m && !measured(down)) {
+      if (budget_used) {
+        finish("frame budget used");
+      } else {
+        next_z_ = down;
+      }
+      return;
+    }
+  }
+  if (contrast) {
     // Climb: the sharpest sample's nearest neighbours below and above.
     const FocusSample b = samples_[best_];
     const FocusSample* below = nullptr;
@@ -277,7 +294,13 @@ void Autofocus::finish(const char* why) {
   const double v =
       parabola_vertex(n2->z_m, y_of(n2->sharpness), n1->z_m, y_of(n1->sharpness), b->z_m, y_of(b->sharpness));
   const double slack = std::max(std::abs(n1->z_m - b->z_m), p_.final_step_m);
-  if (std::isfinite(v) && (at_max ? v <= b->z_m + slack : v >= b->z_m - slack)) {
+  // A vertex is a peak only where the parabola bends down (its second divided difference < 0): a
+  // measure rising ever faster into the end has its parabola's vertex, a minimum, inside.
+  const auto slope = [this](const FocusSample& a, const FocusSample& c) {
+    return (y_of(c.sharpness) - y_of(a.sharpness)) / (c.z_m - a.z_m);
+  };
+  const bool bends_down = (slope(*n1, *b) - slope(*n2, *n1)) / (b->z_m - n2->z_m) < 0.0;
+  if (std::isfinite(v) && bends_down && (at_max ? v <= b->z_m + slack : v >= b->z_m - slack)) {
     converged_ = true;
     best_z_ = clamp_z(v);
     status_ = "converged: the peak at the range's end";

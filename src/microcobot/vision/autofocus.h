@@ -8,7 +8,10 @@
 ///  1. Coarse scan on a grid of h = coarse_step_m from the start. While the measures are flat
 ///     (the largest under min_contrast times the smallest: far out of focus, where the image has
 ///     lost its texture) the scan spirals outwards, start + h, start - h, start + 2h, ...; once
-///     they are not, it climbs: a step from the sharpest sample towards the side it has no
+///     they are not, and both start + h and start - h are measured (a slope on one side of the
+///     start may be another surface's while the peak is on the other: the tool's tips from
+///     above, the fingers' body rising beyond them), it climbs: a step from the sharpest sample
+///     towards the side it has no
 ///     neighbour on, until the sharpest sample has a neighbour on either side (a bracket
 ///     b - h, b, b + h with F(b) the largest) or is the range's end.
 ///  2. Refinement, with the fine metric (fine_metric; the coarse one when empty), by successive
@@ -28,7 +31,8 @@
 /// or the frame budget, the search reports not converged and leaves the best focus at the start.
 /// A peak at the range's end: the stages close in on the end; the parabola through the end and
 /// its two nearest samples tells whether the peak is at the end (converged, the end) or beyond
-/// it (not converged).
+/// it (not converged): a parabola that bends up (the measure rising ever faster into the end)
+/// has no peak, whatever its vertex.
 ///
 /// Allocation: the samples' storage is reserved on construction (max_frames); observe() and
 /// next_focus_m() allocate nothing.
