@@ -79,33 +79,47 @@ std::vector<cell::CycleResult> run_mode(const Inputs& in, const std::vector<cell
 }
 
 mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
-  std::vector<std::string> columns = {"index", "success", "cycle_s", "placement_error_m", "peak_grip_N",
-                                      "mean_grip_N", "peak_contact_N", "grip_violations", "contact_violations",
-                                      "clutches", "search_tries", "confirmations", "submovements", "path_m",
-                                      "side_m", "clearance_m", "ended_holding", "wall_s"};
+  std::vector<std::string> columns = {"index",
+                                      "success",
+                                      "cycle_s",
+                                      "placement_error_m",
+                                      "peak_grip_N",
+                                      "mean_grip_N",
+                                      "peak_contact_N",
+                                      "grip_violations",
+                                      "contact_violations",
+                                      "clutches",
+                                      "search_tries",
+                                      "confirmations",
+                                      "submovements",
+                                      "path_m",
+                                      "side_m",
+                                      "clearance_m",
+                                      "ended_holding",
+                                      "wall_s"};
   // Where each cycle's time went, step by step (zero for the scripted watchmaker).
   for (std::size_t i = 0; i + 1 < cell::AssemblyTask::kStepCount; ++i)
     columns.push_back(std::string(cell::AssemblyTask::name(static_cast<cell::AssemblyTask::Step>(i))) + "_s");
   mc::CsvTable t(columns);
   for (const auto& c : cycles) {
     std::vector<double> row = {static_cast<double>(c.index),
-                          c.success ? 1.0 : 0.0,
-                          c.cycle_s,
-                          c.placement_error_m,
-                          c.peak_grip_N,
-                          c.mean_grip_N,
-                          c.peak_contact_N,
-                          static_cast<double>(c.grip_violations),
-                          static_cast<double>(c.contact_violations),
-                          static_cast<double>(c.clutches),
-                          static_cast<double>(c.search_tries),
-                          static_cast<double>(c.confirmations),
-                          static_cast<double>(c.submovements),
-                          c.path_m,
-                          c.side_m,
-                          c.clearance_m,
-                          c.ended_holding ? 1.0 : 0.0,
-                          c.wall_s};
+                               c.success ? 1.0 : 0.0,
+                               c.cycle_s,
+                               c.placement_error_m,
+                               c.peak_grip_N,
+                               c.mean_grip_N,
+                               c.peak_contact_N,
+                               static_cast<double>(c.grip_violations),
+                               static_cast<double>(c.contact_violations),
+                               static_cast<double>(c.clutches),
+                               static_cast<double>(c.search_tries),
+                               static_cast<double>(c.confirmations),
+                               static_cast<double>(c.submovements),
+                               c.path_m,
+                               c.side_m,
+                               c.clearance_m,
+                               c.ended_holding ? 1.0 : 0.0,
+                               c.wall_s};
     row.insert(row.end(), c.step_s.begin(), c.step_s.end());
     t.add_row(row);
   }

@@ -357,7 +357,7 @@ void run_autofocus(const AutofocusOptions& o) {
   // The truth: the part's top, or the tips' height. The measured region holds one surface, and the
   // view is centred on it: the middle of the part's near edge (its top face is uniform: the edge
   // carries the focus; the gripper's fingers reach in from the far side), or a strip across the
-  // left tip's end a quarter of the template high (the fingers rise along their length).
+  // left tip's end an eighth of the template high (the fingers rise along their length).
   const double truth_m = tool ? pose.tool_z_m : scene.parts.front().z_top_m;
   const vs::Finger& finger = scene.fingers.front();
   const Eigen::Vector2d target =
@@ -370,8 +370,12 @@ void run_autofocus(const AutofocusOptions& o) {
   vs::PixelRoi roi =
       centred_roi(renderer.u_of_x(target.x()), renderer.v_of_y(target.y()), o.camera.template_px, cam);
   if (tool) {
-    roi.y += 3 * o.camera.template_px / 8;
-    roi.height = o.camera.template_px / 4;
+    // A strip an eighth of the template high (12 px of 96) centred on the tips' end: half of it
+    // beyond the end, half on the finger, whose face rises along its length; a quarter (24 px) read
+    // the tips 1.3-1.5 um high at 10x from the finger's face (chosen on noise seed 1, strips of 6, 12
+    // and 24 px; docs/benchmarks.md, "tool's tips").
+    roi.y += 7 * o.camera.template_px / 16;
+    roi.height = o.camera.template_px / 8;
   }
   std::optional<vs::FocusMetric> metric;
   if (!o.metric.empty()) {

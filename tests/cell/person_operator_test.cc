@@ -56,8 +56,8 @@ TEST(PersonOperator, WithSharedControlThePersonIsFasterAndThePinNeverMeetsTheRim
     if (x.z() >= f.fixtures().rim_z_m) {
       deepest_inside = std::max(deepest_inside, f.lowest_z(x.head<2>()) - x.z());
     } else {
-      off_axis_in_bore = std::max(off_axis_in_bore, (x.head<2>() - f.fixtures().guide_xy_m).norm() -
-                                                         f.fixtures().funnel_radius_m);
+      off_axis_in_bore = std::max(
+          off_axis_in_bore, (x.head<2>() - f.fixtures().guide_xy_m).norm() - f.fixtures().funnel_radius_m);
     }
   });
   c.run_to_end();

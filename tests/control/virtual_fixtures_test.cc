@@ -332,8 +332,8 @@ TEST(TeleoperationWithFixtures, APartInItsBoreIsHeldByItsWallsNotLiftedOut) {
       }
       return t.tick(in).slave_target_m;
     };
-    for (int i = 0; i < 10000; ++i) drive({0, 0, 0});                // the guidance takes it onto the axis
-    for (int i = 0; i < 5000; ++i) drive({0, 0, -3e-4});             // 150 um down: 50 um into the bore
+    for (int i = 0; i < 10000; ++i) drive({0, 0, 0});     // the guidance takes it onto the axis
+    for (int i = 0; i < 5000; ++i) drive({0, 0, -3e-4});  // 150 um down: 50 um into the bore
     const double z_in = t.output().slave_target_m.z();
     ASSERT_NEAR(z_in, -50e-6, 1e-9) << (console ? "console" : "haptic");
     ASSERT_LE(t.output().slave_target_m.head<2>().norm(), 1e-12);

@@ -175,7 +175,8 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
   return xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
 }
 
-bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t, double width_m) noexcept {
+bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t,
+                           double width_m) noexcept {
   if (!z_.ready(t) || !tool_still()) return false;
   const double e = z_goal - tip_z + rng_.normal(0.0, p_.person.vision_sd_m);
   const double v_max =

@@ -56,19 +56,19 @@ struct PersonOperatorParams {
   /// person no longer has to: twice that turns a minimum-jerk move (peak 1.875x its mean speed)
   /// into the stage's pace most of the way; the console's joystick allows 1 mm/s.
   double assisted_pace_m_s = 1.0e-3;
-  double z_tolerance_m = 10e-6;         ///< heights judged by eye (the depth of field)
-  double still_m = 5e-6;                ///< the tool seen still: it moved less than this ...
-  double still_window_s = 0.1;          ///< ... over this (one tremor period: tremor averages out)
-  double jam_margin_m = 20e-6;          ///< a contact this far above the bore's depth: on the rim
-  double jam_retreat_m = 30e-6;         ///< up by this before looking again
-  double press_m = 10e-6;               ///< inserting: aimed this far below the bore's floor
-  double hand_limit_m = 35e-3;          ///< haptic: clutch before the hand passes this
-  double pinch_m_s = 10e-3;             ///< TéléTweez lever closing speed
-  double max_pinch_m = 10e-3;           ///< the levers' travel
-  double felt_grip_N = 0.03;            ///< TéléTweez finger force that tells the part is held
-  double slider_m_s = 600e-6;           ///< console gripper slider speed (opening units)
-  double grip_seen_N = 0.25e-3;         ///< console: a grip force read as held
-  double joystick_travel_m = 15e-3;     ///< console: the joystick's half travel (tremor scale)
+  double z_tolerance_m = 10e-6;      ///< heights judged by eye (the depth of field)
+  double still_m = 5e-6;             ///< the tool seen still: it moved less than this ...
+  double still_window_s = 0.1;       ///< ... over this (one tremor period: tremor averages out)
+  double jam_margin_m = 20e-6;       ///< a contact this far above the bore's depth: on the rim
+  double jam_retreat_m = 30e-6;      ///< up by this before looking again
+  double press_m = 10e-6;            ///< inserting: aimed this far below the bore's floor
+  double hand_limit_m = 35e-3;       ///< haptic: clutch before the hand passes this
+  double pinch_m_s = 10e-3;          ///< TéléTweez lever closing speed
+  double max_pinch_m = 10e-3;        ///< the levers' travel
+  double felt_grip_N = 0.03;         ///< TéléTweez finger force that tells the part is held
+  double slider_m_s = 600e-6;        ///< console gripper slider speed (opening units)
+  double grip_seen_N = 0.25e-3;      ///< console: a grip force read as held
+  double joystick_travel_m = 15e-3;  ///< console: the joystick's half travel (tremor scale)
   /// Inserting: the pin seen no lower for this long, well into its bore (half its depth): it is
   /// at the bottom, felt or not. The hand may arrive at its aimed height (within z_tolerance_m)
   /// with the pin a micrometre short of the floor, no contact to feel (seed 4111, part 9).

@@ -104,20 +104,23 @@ const std::vector<float>& Renderer::render_expected(const SceneSnapshot& scene, 
     const Bead& b = scene.beads[i];
     layers_.push_back({Kind::kBead, i, 0, b.z_m, sigma_px(b.z_m), b.radius_m < pixel_m_});
   }
-  for (std::size_t i = 0; i < scene.fingers.size(); ++i) {
-    const Finger& f = scene.fingers[i];
-    for (int k = 0; k < kFingerSegments; ++k) {
-      const FingerSpan span = finger_span(f, k);
-      const double z = f.z_tip_m + f.rise * (span.start_m + 0.5 * span.length_m);
-      layers_.push_back({Kind::kFinger, i, k, z, sigma_px(z), false});
-    }
-  }
+  // A finger is laid over the scene at its tip's height (what is under its body higher up is
+  // lower than the tip in this scene: the substrate, parts, beads on the substrate).
+  for (std::size_t i = 0; i < scene.fingers.size(); ++i)
+    layers_.push_back(
+        {Kind::kFinger, i, -1, scene.fingers[i].z_tip_m, sigma_px(scene.fingers[i].z_tip_m), false});
   std::stable_sort(layers_.begin(), layers_.end(),
                    [](const Layer& a, const Layer& b) { return a.z_m < b.z_m; });
+  const auto alone = [](const Layer& l) { return l.analytic || l.whole_finger(); };
   for (std::size_t b = 0; b < layers_.size();) {
+    if (layers_[b].whole_finger()) {
+      composite_finger(scene, layers_[b].index, c.focus_z_m, c.exposure_s);
+      ++b;
+      continue;
+    }
     std::size_t e = b + 1;
     double lo = layers_[b].sigma_px, hi = lo;
-    while (!layers_[b].analytic && e < layers_.size() && !layers_[e].analytic) {
+    while (!alone(layers_[b]) && e < layers_.size() && !alone(layers_[e])) {
       const double s = layers_[e].sigma_px;
       if (std::max(hi, s) > kGroupRatio * std::min(lo, s)) break;
       lo = std::min(lo, s);
@@ -175,10 +178,9 @@ Shape bead_shape(const Bead& b, bool transmitted, double cap) {
   return s;
 }
 
-// `segment`..`last_segment`: a finger's segments drawn as one box (consecutive segments of one
-// group share one blur; see composite_group).
+// The shape of object `i` of `kind`; for a finger, its segment `segment` (composite_finger).
 Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment, bool transmitted,
-               double cap, int last_segment = -1) {
+               double cap) {
   Shape s;
   switch (kind) {
     case Kind::kHole: {
@@ -202,15 +204,15 @@ Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment
     case Kind::kFinger: {
       const Finger& f = scene.fingers[i];
       const FingerSpan span = finger_span(f, segment);
-      const FingerSpan last = finger_span(f, std::max(segment, last_segment));
-      const double len = last.start_m + last.length_m - span.start_m;
+      const double len = span.length_m;
       s.type = Shape::kBox;
       s.x = f.tip_x_m, s.y = f.tip_y_m + span.start_m + 0.5 * len;
       s.hx = 0.5 * f.width_m, s.hy = 0.5 * len;
       s.radiance = transmitted ? 0.0 : f.reflectance;
       s.edge_radiance = transmitted ? 0.0 : kFingerOutline * f.reflectance;
       s.inset_x = std::min(f.outline_m, s.hx);
-      s.inset_low_y = segment == 0 ? std::min(f.outline_m, len) : 0.0;
+      // The end's outline spans outline_m from the tip, over as many of the short first segments.
+      s.inset_low_y = std::clamp(f.outline_m - span.start_m, 0.0, len);
       s.vx = f.vx_m_s, s.vy = f.vy_m_s;
       break;
     }
@@ -267,8 +269,46 @@ void Renderer::draw_point_bead(const Bead& bead, double sigma_px, double exposur
   }
 }
 
+void Renderer::composite_finger(const SceneSnapshot& scene, std::size_t index, double focus_z_m,
+                                double exposure_s) {
+  // Each segment at the blur of its own height, their coverages and radiances summed: the
+  // segments partition the finger, so where two meet in a pixel their coverages add up to the
+  // finger's, whatever their blurs (laid one over the other, a + b - ab, they drew a dark seam),
+  // and the blur along the finger changes with the focus continuously (grouped by blur, a
+  // segment joining its neighbour's group changed the tip's drawn blur in one step: the tips'
+  // sharpness against focus had steps, docs/benchmarks.md "Autofocus").
+  const Finger& f = scene.fingers[index];
+  finger_layers_.clear();
+  for (int k = 0; k < kFingerSegments; ++k) {
+    const FingerSpan span = finger_span(f, k);
+    const double z = f.z_tip_m + f.rise * (span.start_m + 0.5 * span.length_m);
+    finger_layers_.push_back({Kind::kFinger, index, k, z, psf_.sigma_m(z - focus_z_m) / pixel_m_, false});
+  }
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  if (finger_cover_.size() != n) {
+    finger_cover_.assign(n, 0.0f);
+    finger_premult_.assign(n, 0.0f);
+  }
+  canvas_i0_ = height_, canvas_i1_ = -1, canvas_j0_ = width_, canvas_j1_ = -1;
+  for (std::size_t k = 0; k < finger_layers_.size(); ++k)
+    composite_group(scene, finger_layers_, k, k + 1, exposure_s, true);
+  for (int i = canvas_i0_; i <= canvas_i1_; ++i) {
+    const std::size_t row = static_cast<std::size_t>(i) * width_;
+    for (int j = canvas_j0_; j <= canvas_j1_; ++j) {
+      float& a = finger_cover_[row + j];
+      float& p = finger_premult_[row + j];
+      if (a > 1.0f) {  // blurs of different widths can overlap a little beyond full cover
+        p /= a;
+        a = 1.0f;
+      }
+      image_[row + j] = image_[row + j] * (1.0f - a) + p;
+      a = p = 0.0f;  // the canvas clean for the next finger
+    }
+  }
+}
+
 void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Layer>& layers,
-                               std::size_t begin, std::size_t end, double exposure_s) {
+                               std::size_t begin, std::size_t end, double exposure_s, bool to_finger) {
   if (layers[begin].analytic) {
     draw_point_bead(scene.beads[layers[begin].index], layers[begin].sigma_px, exposure_s);
     return;
@@ -307,24 +347,7 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
   obj_premult_.resize(cover_.size());
 
   for (std::size_t l = begin; l < end; ++l) {
-    // A finger's segments in this group (consecutive: the group is a range of heights) are one
-    // face: drawn as one box at the first of them met, skipped after. Drawn one over the other,
-    // two segments sharing a pixel cover a + b - ab of it instead of a + b: a dark seam that
-    // depends on where the boundary falls in the pixel (it pulled a tip's tracking toward whole
-    // pixels, 0.2 px at 5x).
-    int first_segment = layers[l].segment, last_segment = -1;
-    if (layers[l].kind == Kind::kFinger) {
-      bool drawn = false;
-      for (std::size_t m = begin; m < end; ++m) {
-        if (layers[m].kind != Kind::kFinger || layers[m].index != layers[l].index) continue;
-        if (m < l) drawn = true;
-        first_segment = std::min(first_segment, layers[m].segment);
-        last_segment = std::max(last_segment, layers[m].segment);
-      }
-      if (drawn) continue;
-    }
-    const Shape s =
-        shape_of(scene, layers[l].kind, layers[l].index, first_segment, transmitted, cap, last_segment);
+    const Shape s = shape_of(scene, layers[l].kind, layers[l].index, layers[l].segment, transmitted, cap);
     const double du = s.vx * exposure_s / pixel_m_, dv = -s.vy * exposure_s / pixel_m_;
     const int samples =
         std::clamp(static_cast<int>(std::ceil(std::hypot(du, dv) / f)) + 1, 1, kMaxMotionSamples);
@@ -407,6 +430,20 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
 
   const int j0 = std::max(0, bx0), j1 = std::min(width_ - 1, bx1);
   const int i0 = std::max(0, by0), i1 = std::min(height_ - 1, by1);
+  if (to_finger) {
+    canvas_i0_ = std::min(canvas_i0_, i0), canvas_i1_ = std::max(canvas_i1_, i1);
+    canvas_j0_ = std::min(canvas_j0_, j0), canvas_j1_ = std::max(canvas_j1_, j1);
+  }
+  // Over the image, or added to the finger's canvas.
+  const auto lay = [&](int i, int j, float a, float p) {
+    const std::size_t q = static_cast<std::size_t>(i) * width_ + j;
+    if (to_finger) {
+      finger_cover_[q] += a;
+      finger_premult_[q] += p;
+    } else {
+      image_[q] = image_[q] * (1.0f - a) + p;
+    }
+  };
   if (f > 1) {
     // Column positions in the cell grid, once per group (x0 + 1 always valid: one spare cell).
     col_x0_.resize(static_cast<std::size_t>(j1 - j0 + 1));
@@ -421,11 +458,10 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
     }
   }
   for (int i = i0; i <= i1; ++i) {
-    float* row = &image_[static_cast<std::size_t>(i) * width_];
     if (f == 1) {
       const float* a = &cover_[static_cast<std::size_t>(i - by0) * nx];
       const float* p = &premult_[static_cast<std::size_t>(i - by0) * nx];
-      for (int j = j0; j <= j1; ++j) row[j] = row[j] * (1.0f - a[j - bx0]) + p[j - bx0];
+      for (int j = j0; j <= j1; ++j) lay(i, j, a[j - bx0], p[j - bx0]);
       continue;
     }
     const double cyf = std::clamp((i - by0 + 0.5) / f - 0.5, 0.0, ny - 1.0);
@@ -444,7 +480,7 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
       const float tx = col_tx_[j - j0];
       const float a = row_cover_[x0] + tx * (row_cover_[x0 + 1] - row_cover_[x0]);
       const float p = row_premult_[x0] + tx * (row_premult_[x0 + 1] - row_premult_[x0]);
-      row[j] = row[j] * (1.0f - a) + p;
+      lay(i, j, a, p);
     }
   }
 }

@@ -39,6 +39,8 @@ struct Layer {
   double z_m;
   double sigma_px;
   bool analytic;  ///< a bead smaller than a pixel: its blurred image is drawn exactly
+  /// A whole finger (segment -1): its segments blurred one by one, laid over the scene at once.
+  bool whole_finger() const noexcept { return kind == LayerKind::kFinger && segment < 0; }
 };
 }  // namespace detail
 
@@ -76,8 +78,12 @@ class Renderer {
   using Layer = detail::Layer;
   void render_substrate(const Substrate& s, double sigma_px);
   void draw_point_bead(const Bead& bead, double sigma_px, double exposure_s);
+  /// Lays layers [begin, end), one blur, over the image; or, `to_finger`, adds them to the
+  /// finger's canvas (coverage and premultiplied radiance summed: a finger's segments partition it).
   void composite_group(const SceneSnapshot& scene, const std::vector<Layer>& layers, std::size_t begin,
-                       std::size_t end, double exposure_s);
+                       std::size_t end, double exposure_s, bool to_finger = false);
+  /// Finger `index`: each segment at its own blur, summed on the canvas, then over the image.
+  void composite_finger(const SceneSnapshot& scene, std::size_t index, double focus_z_m, double exposure_s);
 
   CameraParams camera_;
   OpticsFigures figures_;
@@ -98,6 +104,10 @@ class Renderer {
   std::vector<int> col_x0_;                     ///< a coarse group's cell column left of each pixel
   std::vector<float> col_tx_;                   ///< and the weight of the one right of it
   std::vector<Layer> layers_;
+  std::vector<Layer> finger_layers_;                  ///< one finger's segments
+  std::vector<float> finger_cover_, finger_premult_;  ///< a finger's canvas (zero between fingers)
+  int canvas_i0_ = 0, canvas_i1_ = -1, canvas_j0_ = 0,
+      canvas_j1_ = -1;  ///< the canvas's touched rows, columns
   BlurScratch scratch_;
 };
 
