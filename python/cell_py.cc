@@ -7,12 +7,14 @@
 // then recompiles this file alone rather than the control/platform bindings beside it (pybind11
 // compiles slowly; one more TU costs one more parse of its headers, ~15 s, once).
 
+#include <cctype>
 #include <climits>
 #include <optional>
 
 #include "common.h"
 #include "microcobot/cell/assembly_batch.h"
 #include "microcobot/cell/cell_run.h"
+#include "microcobot/cell/task_file.h"
 #include "microcobot/platform/platform_config.h"
 
 namespace mc::py {
@@ -114,6 +116,65 @@ struct Batch {
     return jobs[static_cast<std::size_t>(*i)];
   }
 };
+
+/// A task (None, a dict or a YAML file, as `cell run --task`) over the run parameters: the steps'
+/// autonomy and the task's parameters over `p.task`.
+void apply_task(py::handle task, cl::CellRunParams& p) {
+  if (task.is_none()) return;
+  cl::AssemblyTaskFile f;
+  try {
+    if (py::isinstance<py::str>(task) || py::hasattr(task, "__fspath__")) {
+      const auto path = py::str(py::module_::import("os").attr("fspath")(task)).cast<std::string>();
+      f = cl::load_task_file(path, p.task);
+    } else if (py::isinstance<py::dict>(task)) {
+      YAML::Emitter out;
+      out << to_yaml(task, "task");
+      f = cl::task_file_from_yaml(out.c_str(), p.task);
+    } else {
+      throw py::type_error("task: expected a dict, a YAML file name or None (got " + given(task) + ")");
+    }
+  } catch (const InvalidInput& e) {
+    // "<yaml>:2: unknown key ..." names the text the dict was written to: name the argument, without
+    // a line number the caller never wrote.
+    std::string what = e.what();
+    if (what.rfind("<yaml>", 0) == 0) {
+      std::size_t rest = 6;
+      if (rest < what.size() && what[rest] == ':') {
+        std::size_t k = rest + 1;
+        while (k < what.size() && std::isdigit(static_cast<unsigned char>(what[k]))) ++k;
+        if (k > rest + 1 && k < what.size() && what[k] == ':') rest = k;
+      }
+      throw InvalidInput("task" + what.substr(rest));
+    }
+    throw;
+  }
+  p.task = f.params;
+  p.autonomy = f.steps.autonomy();
+}
+
+/// One part's cycle, stepped from Python: the operator's controls reach the automatic task between
+/// run_for() calls (issue #29 point 5, "tasks from Python").
+struct Cycle {
+  std::unique_ptr<cl::CellCycle> cycle;
+  std::string mode;
+
+  cl::AssemblyTask& task(const char* control) {
+    if (cycle->task() == nullptr)
+      throw InvalidInput(std::string(control) + ": the cycle runs in mode '" + mode +
+                         "'; only the automatic task (mode 'auto') takes the operator's controls");
+    return *cycle->task();
+  }
+};
+
+double seconds_arg(py::handle v, const char* name) {
+  if (py::isinstance<py::bool_>(v) || !(py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v)))
+    throw py::type_error(std::string(name) + ": expected a number of seconds (got " + given(v) + ")");
+  const double s = v.cast<double>();
+  if (!std::isfinite(s) || s < 0.0)
+    throw InvalidInput(std::string(name) + ": " + py::repr(v).cast<std::string>() +
+                       " is not a duration (finite, >= 0 s)");
+  return s;
+}
 
 py::dict job_dict(const cl::AssemblyJob& j) {
   return py::dict("index"_a = j.index, "side_m"_a = j.side_m, "clearance_m"_a = j.clearance_m,
@@ -219,6 +280,88 @@ void bind_cell(py::module_& m) {
           "the cycles of `microcobot cell run --json` ('cycles_detail'). The GIL is released.")
       .def(py::pickle([](const Batch& b) { return params_dict(b.scene); },
                       [](const py::dict& scene) { return Batch(scene, py::none(), py::none()); }));
+
+  py::class_<Cycle>(
+      m, "Cycle",
+      "One part's cycle on its own simulated platform, stepped from Python (a task from Python): run it\n"
+      "for a while, look at its step and status, pause, resume, confirm, take over, hand back, skip,\n"
+      "then run on. The same part, mode and parameters give the same cycle as Batch.run_cycle.")
+      .def(py::init([](const Batch& b, py::handle index, py::handle mode, py::handle params,
+                       py::handle config, py::handle task) {
+             const cl::AssemblyJob& job = b.job(index);
+             cl::CellRunParams p = run_params_from(params, mode);
+             apply_task(task, p);
+             p.validate();
+             platform::PlatformConfig c = config_from(config);
+             Cycle out;
+             out.mode = p.mode;
+             out.cycle = nogil([&] { return std::make_unique<cl::CellCycle>(job, p, std::move(c)); });
+             return out;
+           }),
+           "batch"_a, "index"_a, "mode"_a = py::none(), "params"_a = py::none(), "config"_a = py::none(),
+           "task"_a = py::none(),
+           "Part `index` of `batch` in `mode` with `params` on the platform `config`, as Batch.run_cycle;\n"
+           "`task`: None, a dict or a YAML file as `cell run --task` ({'steps': {'insert': 'confirm'},\n"
+           "'params': {...}}). ValueError names a bad key, value or step.")
+      .def(
+          "run_for",
+          [](Cycle& c, py::handle seconds) {
+            const double s = seconds_arg(seconds, "seconds");
+            nogil([&] { c.cycle->run_for(s); });
+          },
+          "seconds"_a,
+          "Simulates `seconds` more (or to the cycle's end, or to max_cycle_s). The GIL is released.")
+      .def(
+          "run_to_end", [](Cycle& c) { nogil([&] { c.cycle->run_to_end(); }); },
+          "Simulates to the cycle's end (or to max_cycle_s).")
+      .def_property_readonly(
+          "finished", [](const Cycle& c) { return c.cycle->finished(); }, "The task (or the person) is done.")
+      .def_property_readonly(
+          "time_s", [](Cycle& c) { return c.cycle->platform().loop().time_s(); }, "Simulated time [s].")
+      .def_property_readonly(
+          "step",
+          [](Cycle& c) {
+            if (c.cycle->task()) return std::string(cl::AssemblyTask::name(c.cycle->task()->step()));
+            if (c.cycle->person()) return std::string(cl::AssemblyTask::name(c.cycle->person()->step()));
+            return std::string();
+          },
+          "The current step ('approach' ... 'retract', 'done'); '' for the scripted watchmaker.")
+      .def_property_readonly(
+          "status",
+          [](Cycle& c) {
+            if (c.cycle->task()) return std::string(cl::AssemblyTask::name(c.cycle->task()->status()));
+            return std::string(c.cycle->finished() ? "finished" : "running");
+          },
+          "The task's status: 'running', 'paused', 'awaiting confirmation', 'operator', 'succeeded',\n"
+          "'failed' (other modes: 'running' or 'finished').")
+      .def_property_readonly(
+          "tip_m",
+          [](Cycle& c) {
+            platform::Platform& p = c.cycle->platform();
+            return py::make_tuple(p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m());
+          },
+          "The stage's measured position (x, y, z) [m], relative to its home.")
+      .def(
+          "pause", [](Cycle& c) { c.task("pause").pause(); },
+          "The task lets the deadman go: the stage holds from the next tick until resume().")
+      .def(
+          "resume", [](Cycle& c) { c.task("resume").resume(); }, "Goes on from where the stage is.")
+      .def(
+          "confirm", [](Cycle& c) { c.task("confirm").confirm(); },
+          "Starts a step that awaits confirmation (autonomy 'confirm'; headless, the supervisor confirms\n"
+          "it after params' confirm_delay_s otherwise).")
+      .def(
+          "take_over", [](Cycle& c) { c.task("take_over").take_over(); },
+          "The operator takes the stage: the task sends nothing (headless, nothing drives: it holds).")
+      .def(
+          "hand_back", [](Cycle& c, bool step_done) { c.task("hand_back").hand_back(step_done); },
+          "step_done"_a = false,
+          "The task goes on: the current step again from where the stage is, or with step_done the next.")
+      .def(
+          "skip", [](Cycle& c) { c.task("skip").skip(); }, "Leaves the current step for the next one.")
+      .def(
+          "result", [](Cycle& c) { return from_json(c.cycle->result().to_json()); },
+          "The cycle's result dict (CycleResult), as Batch.run_cycle returns it; complete once finished.");
 }
 
 }  // namespace mc::py

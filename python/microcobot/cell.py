@@ -5,6 +5,8 @@ The compiled calls are the library's, as ``microcobot cell run`` makes them:
     b = cell.Batch(scene="scene.yaml", parts=5, seed=3)   # --scene --batch --seed
     cycles = b.run(mode="auto")                           # [CycleResult dicts], GIL released
     cell.summarize(cycles)                                # as `cell run --json`
+    c = cell.Cycle(b, 0, mode="auto", task={"steps": {"insert": "confirm"}})   # a task from Python
+    c.run_for(5.0); c.pause(); c.resume(); c.confirm(); c.run_to_end(); c.result()
 
 ``batch(config, seeds, client=None)`` runs the same batch for every seed, one Dask task per part:
 on a local process pool by default, or on a ``dask.distributed.Client``'s cluster. The simulation
@@ -19,6 +21,7 @@ from . import platform as _platform
 from ._microcobot import cell as _cell
 
 Batch = _cell.Batch
+Cycle = _cell.Cycle
 modes = _cell.modes
 params = _cell.params
 run_params = _cell.run_params

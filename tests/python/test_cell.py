@@ -102,6 +102,57 @@ def test_the_gil_is_released_while_a_cycle_simulates():
     assert wakes > 100, wakes
 
 
+def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_controls(serial):
+    """A task from Python (issue #29 point 5): stepped, it is the batch's cycle; paused, the stage
+    holds; a step set to `confirm` waits for the caller's go; the controls are the automatic task's."""
+    b = cell.Batch(parts=CONFIG["parts"], seed=SEEDS[0])
+    c = cell.Cycle(b, 0, mode="auto")
+    while not c.finished:
+        c.run_for(0.5)
+    assert without_wall([c.result()]) == without_wall([serial[SEEDS[0]][0]])
+    assert c.step == "done" and c.status == "succeeded"
+
+    c = cell.Cycle(b, 1, mode="auto")
+    while c.step != "transport":  # mid-cycle, the stage moving
+        assert not c.finished
+        c.run_for(0.2)
+    c.run_for(0.5)
+    assert c.status == "running"
+    c.pause()
+    c.run_for(0.05)  # the coupling lets go: the target stops at the next tick, the stage settles
+    held = c.tip_m
+    c.run_for(1.0)
+    assert c.status == "paused"
+    assert max(abs(a - b) for a, b in zip(c.tip_m, held)) < 50e-9, (held, c.tip_m)
+    c.resume()
+    c.run_to_end()
+    assert c.result()["success"], c.result()["verdict"]
+
+    # "confirm before insert", from a dict; the supervisor would confirm after 60 s: the caller does.
+    c = cell.Cycle(b, 0, mode="auto", params={"confirm_delay_s": 60.0}, task={"steps": {"insert": "confirm"}})
+    while c.status != "awaiting confirmation":
+        assert not c.finished
+        c.run_for(0.2)
+    assert c.step == "insert"
+    waited_from = c.time_s
+    c.run_for(2.0)
+    assert c.status == "awaiting confirmation"
+    c.confirm()
+    c.run_to_end()
+    r = c.result()
+    assert r["success"] and r["confirmations"] == 0  # the caller's, not the supervisor's
+    assert r["cycle_s"] > waited_from + 2.0
+
+    msg = one_line_error(ValueError, cell.Cycle, b, 0, task={"steps": {"inserting": "confirm"}})
+    assert msg.startswith("task: unknown key 'steps.inserting'"), msg
+    assert "steps.insert" in one_line_error(ValueError, cell.Cycle, b, 0, task={"steps": {"insert": "maybe"}})
+    assert "int 3" in one_line_error(TypeError, cell.Cycle, b, 0, task=3)
+    person = cell.Cycle(b, 0, mode="manual")
+    assert "mode 'manual'" in one_line_error(ValueError, person.pause)
+    assert "seconds" in one_line_error(ValueError, person.run_for, -1.0)
+    assert "seconds" in one_line_error(TypeError, person.run_for, "1")
+
+
 def test_the_serial_run_is_the_clis(cli, serial):
     code, out, err = cli("cell", "run", "--batch", CONFIG["parts"], "--seed", SEEDS[0], "--json")
     assert code == 0, err
