@@ -45,8 +45,9 @@ TEST(CellRun, OnTheSamePartsSharedControlMakesThePersonFasterAndMorePrecise) {
   EXPECT_EQ(manual.successes, 3);
   EXPECT_EQ(assisted.successes, 3);
   EXPECT_EQ(assisted.force_violations + manual.force_violations, 0);
-  EXPECT_LT(assisted.cycle_median_s, manual.cycle_median_s);
-  EXPECT_LT(assisted.placement_median_m, manual.placement_median_m);
+  // Issue #29's goals on the medians (0.58 and 0.05 when written; 20-part figures in docs/benchmarks.md).
+  EXPECT_LE(assisted.cycle_median_s, 0.7 * manual.cycle_median_s);
+  EXPECT_LE(assisted.placement_median_m, 0.5 * manual.placement_median_m);
   std::printf("3 parts (seed 61): assisted %.1f s %.2f um, manual %.1f s %.2f um\n", assisted.cycle_median_s,
               1e6 * assisted.placement_median_m, manual.cycle_median_s, 1e6 * manual.placement_median_m);
 }
@@ -90,33 +91,24 @@ TEST(CellRun, ACycleResultComesBackFromItsJsonWholeOrIsRefusedNamingTheKey) {
   c.step_s = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.5};
   EXPECT_EQ(CycleResult::from_json(c.to_json()).to_json(), c.to_json());
   EXPECT_EQ(c.to_json()["step_s"]["transport"], 5.0);
+  // Refused with exactly `message`.
+  const auto refused = [](const nlohmann::json& j) -> std::string {
+    try {
+      CycleResult::from_json(j);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
   nlohmann::json j = c.to_json();
   j.erase("cycle_s");
-  EXPECT_THROW(
-      {
-        try {
-          CycleResult::from_json(j);
-        } catch (const InvalidInput& e) {
-          EXPECT_STREQ(e.what(), "cycle result: missing 'cycle_s'");
-          throw;
-        }
-      },
-      InvalidInput);
+  EXPECT_EQ(refused(j), "cycle result: missing 'cycle_s'");
   j = c.to_json();
   j["success"] = "yes";
-  EXPECT_THROW(CycleResult::from_json(j), InvalidInput);
+  EXPECT_NE(refused(j), "accepted");
   j = c.to_json();
   j["step_s"].erase("retract");
-  EXPECT_THROW(
-      {
-        try {
-          CycleResult::from_json(j);
-        } catch (const InvalidInput& e) {
-          EXPECT_STREQ(e.what(), "cycle result: 'step_s' has no number for 'retract'");
-          throw;
-        }
-      },
-      InvalidInput);
+  EXPECT_EQ(refused(j), "cycle result: 'step_s' has no number for 'retract'");
   EXPECT_THROW(CycleResult::from_json(nlohmann::json::array()), InvalidInput);
 }
 
