@@ -273,6 +273,36 @@ TEST(TeleoperationWithFixtures, AHeightStopHoldsTheSlaveAndNeverJumpsIt) {
   }
 }
 
+TEST(TeleoperationWithFixtures, NoFixtureMovesTheSlaveWithoutTheDeadman) {
+  // A guide and a height stop within their captures pull the slave onto them, but only while the
+  // operator holds the deadman: released, on either master, the target does not move at all.
+  FixtureSet f = height_stop_at(480e-6, 1.0);
+  f.guide_xy_m = {15e-6, -10e-6};
+  for (const bool console : {true, false}) {
+    Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 500e-6}, 600e-6);
+    t.tick(hand_at({0, 0}));
+    const Eigen::Vector3d start = t.output().slave_target_m;
+    t.set_fixtures(f);
+    for (int i = 0; i < 10000; ++i) {
+      TeleoperationInput in = hand_at({0, 0});
+      in.deadman = false;
+      if (console) {
+        in.console.active = in.console.fresh = true;
+        in.console.deadman = false;
+      }
+      ASSERT_EQ(t.tick(in).slave_target_m, start) << (console ? "console" : "haptic") << " tick " << i;
+    }
+    // Held again: now the fixtures take the slave onto the axis and the height, at the pace.
+    for (int i = 0; i < 10000; ++i) {
+      TeleoperationInput in = hand_at({0, 0});
+      if (console) in.console.active = in.console.fresh = in.console.deadman = true;
+      t.tick(in);
+    }
+    EXPECT_LT((t.output().slave_target_m - Eigen::Vector3d(15e-6, -10e-6, 480e-6)).norm(), 1e-12)
+        << (console ? "console" : "haptic");
+  }
+}
+
 TEST(TeleoperationWithFixtures, TheFunnelIsNeverEnteredWhateverTheInput) {
   // A console joystick and a haptic hand driving down onto the rim beside the axis, with noise:
   // the target never goes below the funnel, and reaches the bore's depth only on the axis.
