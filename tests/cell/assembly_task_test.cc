@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <string>
 
 namespace mc::cell {
 namespace {
@@ -115,11 +117,44 @@ TEST(AssemblyTask, SkippingIntoTheInsertionStartsAFreshSearchAndSkippingTheLastS
   task.skip();
   EXPECT_EQ(task.step(), Step::kRetract);
   task.skip();
+  EXPECT_EQ(task.step(), Step::kVerify);
+  task.skip();
   EXPECT_EQ(task.step(), Step::kDone);
   EXPECT_EQ(task.status(), Status::kSucceeded);
   task.skip();  // finished: nothing
   EXPECT_EQ(task.status(), Status::kSucceeded);
   EXPECT_EQ(stage.tick(task), 0.0) << "a finished task holds";
+}
+
+// The last step looks at the pin (the cell's vision, TaskSensors::part_m): down in its bore, the
+// task succeeds; still up (stuck to a finger, on the rim), it fails saying so; without vision the
+// insertion's own evidence stands.
+TEST(AssemblyTask, VerifyLooksAtThePinAndFailsATaskWhosePinIsNotDown) {
+  const AssemblyGoal goal = skip_goal();
+  const double inserted_z = 0.5 * goal.part_height_m - goal.hole_depth_m;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    double seen_z;
+    Status expected;
+  };
+  for (const Case c : {Case{inserted_z + 0.3e-6, Status::kSucceeded}, Case{inserted_z + 150e-6, Status::kFailed},
+                       Case{0.5 * goal.part_height_m, Status::kFailed}, Case{nan, Status::kSucceeded}}) {
+    AssemblyTask task({}, goal);
+    IdealStage stage;
+    ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+    task.skip();  // into the insertion, then past it: the ideal stage has no contact to end it
+    task.skip();
+    task.skip();
+    ASSERT_EQ(task.step(), Step::kRetract);
+    ASSERT_TRUE(stage.run_to(task, Step::kVerify));
+    stage.s.part_m = {goal.target_m.x() + 1e-6, goal.target_m.y(), c.seen_z};
+    for (int i = 0; i < 1000 && !task.finished(); ++i) EXPECT_EQ(stage.tick(task), 0.0) << "verify holds still";
+    EXPECT_EQ(task.status(), c.expected) << "pin seen at " << c.seen_z * 1e6 << " um";
+    if (c.expected == Status::kFailed) {
+      EXPECT_EQ(task.step(), Step::kVerify);
+      EXPECT_NE(std::string(task.failure()).find("not down in its bore"), std::string::npos) << task.failure();
+    }
+  }
 }
 
 }  // namespace

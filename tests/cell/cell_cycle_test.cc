@@ -48,6 +48,28 @@ TEST(CellCycle, TheRobotInsertsAPinUnderTheLimitsAndEndsHolding) {
   EXPECT_LT((target(c.platform()) - before).norm(), 1e-12);
 }
 
+// Fingers whose adhesion beats the substrate's (van der Waals 50 times the default's): the
+// released pin sticks to a finger and comes up with the retract. The task's own evidence (the
+// contact at the bore's depth) said inserted; its verify step looks, fails the task saying why,
+// and the cycle ends holding.
+TEST(CellCycle, APinThatCameUpWithAFingerFailsTheVerifyStepAndTheCycleEndsHolding) {
+  AssemblyJob sticky = job();
+  sticky.world.finger_pulloff_N = 100e-6;
+  CellCycle c(sticky, CellRunParams{}, default_platform());
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(c.task()->status(), Status::kFailed);
+  EXPECT_EQ(c.task()->step(), Step::kVerify);
+  EXPECT_NE(r.verdict.find("not down in its bore"), std::string::npos) << r.verdict;
+  EXPECT_TRUE(r.ended_holding);
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+  // The same pin with the default fingers passes the look.
+  const CycleResult plain = run_cycle(job(), CellRunParams{}, default_platform());
+  EXPECT_TRUE(plain.success) << plain.verdict;
+  EXPECT_GT(plain.step_s[static_cast<std::size_t>(Step::kVerify)], 0.0);
+}
+
 TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {
   CellCycle c(job(), CellRunParams{}, default_platform());
   // Mid-transport the operator pauses for a second, then resumes.

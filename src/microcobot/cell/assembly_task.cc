@@ -25,6 +25,7 @@ void AssemblyTaskParams::validate() const {
   require_positive(position_tolerance_m, "position_tolerance_m");
   require_non_negative(settle_s, "settle_s");
   require_positive(step_timeout_s, "step_timeout_s");
+  require_positive(verify_tolerance_m, "verify_tolerance_m");
 }
 
 AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal)
@@ -51,7 +52,7 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
 
 std::string_view AssemblyTask::name(Step s) noexcept {
   static constexpr std::array<std::string_view, kStepCount> names = {
-      "approach", "descend", "grasp", "lift", "transport", "insert", "release", "retract", "done"};
+      "approach", "descend", "grasp", "lift", "transport", "insert", "release", "retract", "verify", "done"};
   return names[index(s)];
 }
 
@@ -237,7 +238,24 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
       break;
     case Step::kRetract:
       if (move_to({goal_.target_m.x(), goal_.target_m.y() + offset_y_, safe_z_}, p_.z_speed_m_s, s, dt_s))
-        enter(Step::kDone);
+        enter(Step::kVerify);
+      break;
+    case Step::kVerify:
+      // Still where the retract ended (settle_s), then one look.
+      if (!move_to(s.tip_m, p_.z_speed_m_s, s, dt_s)) break;
+      if (s.part_m.allFinite()) {
+        const double inserted_z = 0.5 * goal_.part_height_m - goal_.hole_depth_m;
+        const double off_axis = (s.part_m.head<2>() - goal_.target_m).cwiseAbs().maxCoeff();
+        if (s.part_m.z() > inserted_z + p_.verify_tolerance_m) {
+          fail("the pin is not down in its bore (seen by the cell's vision)");
+          break;
+        }
+        if (off_axis > goal_.clearance_m + p_.verify_tolerance_m) {
+          fail("the pin is off its bore's axis (seen by the cell's vision)");
+          break;
+        }
+      }
+      enter(Step::kDone);
       break;
     case Step::kDone:
       break;

@@ -22,6 +22,11 @@
 ///              `search_range_m`: failed
 ///   release    open the fingers (the substrate's adhesion keeps the pin in its bore)
 ///   retract    up clear of the pin
+///   verify     the stage still, the cell's vision looks at the pin: down in its bore (its centre
+///              within verify_tolerance_m of the inserted height, and within the bore's clearance
+///              of its axis), or the task fails: a pin that stuck to a finger and came up with
+///              it is not a success the task reports. Without vision (TaskSensors::part_m not
+///              finite, e.g. the live console) the insertion's contact at the bore's depth stands
 ///
 /// Status: running; paused (pause(): the deadman is let go, so the coupling stops the stage's
 /// target at the next tick and the stage holds; resume() goes on from where the stage is);
@@ -59,6 +64,9 @@ struct AssemblyTaskParams {
   double position_tolerance_m = 0.5e-6;  ///< a goal is reached within this ...
   double settle_s = 0.05;                ///< ... for this long
   double step_timeout_s = 20.0;          ///< a step that takes longer fails the task
+  /// verify: the pin's centre seen within this of its inserted height (a pin on the rim sits
+  /// 300 um higher, one stuck to a finger higher still; the vision is within 0.1 um)
+  double verify_tolerance_m = 20e-6;
 
   template <class V>
   void visit(V& v) {
@@ -76,6 +84,7 @@ struct AssemblyTaskParams {
     v("position_tolerance_m", position_tolerance_m);
     v("settle_s", settle_s);
     v("step_timeout_s", step_timeout_s);
+    v("verify_tolerance_m", verify_tolerance_m);
   }
   void validate() const;
 };
@@ -96,12 +105,15 @@ struct TaskSensors {
   Eigen::Vector3d contact_N = Eigen::Vector3d::Zero();  ///< force on the gripper
   double grip_N = 0.0;
   double opening_m = 0.0;
+  /// The part's centre as the cell's vision sees it; not finite: no vision (the verify step then
+  /// takes the insertion's contact as its evidence).
+  Eigen::Vector3d part_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 class AssemblyTask {
  public:
-  enum class Step { kApproach, kDescend, kGrasp, kLift, kTransport, kInsert, kRelease, kRetract, kDone };
-  static constexpr int kStepCount = 9;
+  enum class Step { kApproach, kDescend, kGrasp, kLift, kTransport, kInsert, kRelease, kRetract, kVerify, kDone };
+  static constexpr int kStepCount = 10;
   enum class Status { kRunning, kPaused, kAwaitingConfirm, kOperator, kSucceeded, kFailed };
   enum class Autonomy { kAuto, kConfirm, kManual };
 

@@ -179,7 +179,9 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     : job_(job),
       params_(params),
       start_(std::chrono::steady_clock::now()),
-      meter_(std::make_unique<Meter>()) {
+      meter_(std::make_unique<Meter>()),
+      vision_rng_(static_cast<std::uint64_t>(params.person_seed) * 1000003ULL + static_cast<std::uint64_t>(job.index) +
+                  0x766973696f6eULL) {
   params_.validate();
   base = with_world(std::move(base), job);
   platform_ = std::make_unique<platform::Platform>(base);
@@ -193,8 +195,14 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
     p.set_operator([this](const platform::TickInfo& t) {
-      const TaskSensors s = read_task_sensors(*platform_, home_m_);
+      TaskSensors s = read_task_sensors(*platform_, home_m_);
       meter_->sample(s);
+      if (task_->step() == AssemblyTask::Step::kVerify) {
+        // The cell's camera on the pin, at the precision the assisted person's guidance has.
+        const double sd = params_.person.assist_vision_sd_m;
+        s.part_m = platform_->simulation().gripper->world_state().part_m;
+        for (int i = 0; i < 3; ++i) s.part_m[i] += vision_rng_.normal(0.0, sd);
+      }
       // The supervisor confirms a waiting step after confirm_delay_s (the task holds meanwhile).
       if (task_->status() == AssemblyTask::Status::kAwaitingConfirm) {
         waiting_s_ += t.dt_s;

@@ -23,6 +23,7 @@
 #include "microcobot/cell/assembly_batch.h"
 #include "microcobot/cell/assembly_task.h"
 #include "microcobot/cell/person_operator.h"
+#include "microcobot/core/rng.h"
 #include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
@@ -161,6 +162,7 @@ class CellCycle {
   bool finished_ = false, held_ = false, settled_ = false;
   double finished_at_s_ = 0.0;
   double waiting_s_ = 0.0;  // how long the task has awaited confirmation
+  Rng vision_rng_;          // the cell's vision of the part (the robot's verify step)
   int confirmations_ = 0;
 };
 

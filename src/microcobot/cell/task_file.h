@@ -31,6 +31,7 @@ struct TaskStepsParams {
   std::string insert = "auto";
   std::string release = "auto";
   std::string retract = "auto";
+  std::string verify = "auto";
 
   template <class V>
   void visit(V& v) {
@@ -42,6 +43,7 @@ struct TaskStepsParams {
     v("insert", insert);
     v("release", release);
     v("retract", retract);
+    v("verify", verify);
   }
   void validate() const;
   /// Indexed by AssemblyTask::Step (kDone: auto). Throws like validate().
