@@ -137,8 +137,9 @@ TEST(AssemblyTask, VerifyLooksAtThePinAndFailsATaskWhosePinIsNotDown) {
     double seen_z;
     Status expected;
   };
-  for (const Case c : {Case{inserted_z + 0.3e-6, Status::kSucceeded}, Case{inserted_z + 150e-6, Status::kFailed},
-                       Case{0.5 * goal.part_height_m, Status::kFailed}, Case{nan, Status::kSucceeded}}) {
+  for (const Case c :
+       {Case{inserted_z + 0.3e-6, Status::kSucceeded}, Case{inserted_z + 150e-6, Status::kFailed},
+        Case{0.5 * goal.part_height_m, Status::kFailed}, Case{nan, Status::kSucceeded}}) {
     AssemblyTask task({}, goal);
     IdealStage stage;
     ASSERT_TRUE(stage.run_to(task, Step::kTransport));
@@ -148,11 +149,13 @@ TEST(AssemblyTask, VerifyLooksAtThePinAndFailsATaskWhosePinIsNotDown) {
     ASSERT_EQ(task.step(), Step::kRetract);
     ASSERT_TRUE(stage.run_to(task, Step::kVerify));
     stage.s.part_m = {goal.target_m.x() + 1e-6, goal.target_m.y(), c.seen_z};
-    for (int i = 0; i < 1000 && !task.finished(); ++i) EXPECT_EQ(stage.tick(task), 0.0) << "verify holds still";
+    for (int i = 0; i < 1000 && !task.finished(); ++i)
+      EXPECT_EQ(stage.tick(task), 0.0) << "verify holds still";
     EXPECT_EQ(task.status(), c.expected) << "pin seen at " << c.seen_z * 1e6 << " um";
     if (c.expected == Status::kFailed) {
       EXPECT_EQ(task.step(), Step::kVerify);
-      EXPECT_NE(std::string(task.failure()).find("not down in its bore"), std::string::npos) << task.failure();
+      EXPECT_NE(std::string(task.failure()).find("not down in its bore"), std::string::npos)
+          << task.failure();
     }
   }
 }

@@ -112,7 +112,18 @@ struct TaskSensors {
 
 class AssemblyTask {
  public:
-  enum class Step { kApproach, kDescend, kGrasp, kLift, kTransport, kInsert, kRelease, kRetract, kVerify, kDone };
+  enum class Step {
+    kApproach,
+    kDescend,
+    kGrasp,
+    kLift,
+    kTransport,
+    kInsert,
+    kRelease,
+    kRetract,
+    kVerify,
+    kDone
+  };
   static constexpr int kStepCount = 10;
   enum class Status { kRunning, kPaused, kAwaitingConfirm, kOperator, kSucceeded, kFailed };
   enum class Autonomy { kAuto, kConfirm, kManual };

@@ -180,8 +180,8 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       params_(params),
       start_(std::chrono::steady_clock::now()),
       meter_(std::make_unique<Meter>()),
-      vision_rng_(static_cast<std::uint64_t>(params.person_seed) * 1000003ULL + static_cast<std::uint64_t>(job.index) +
-                  0x766973696f6eULL) {
+      vision_rng_(static_cast<std::uint64_t>(params.person_seed) * 1000003ULL +
+                  static_cast<std::uint64_t>(job.index) + 0x766973696f6eULL) {
   params_.validate();
   base = with_world(std::move(base), job);
   platform_ = std::make_unique<platform::Platform>(base);
