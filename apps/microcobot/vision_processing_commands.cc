@@ -1,9 +1,10 @@
-// `microcobot vision calibrate|track|autofocus` (issue #28): the camera's frames turned into
-// measurements. `calibrate` moves the tool through a grid and fits the pixel <-> stage affine map;
-// `track` follows a part or the tool along a path; `autofocus` finds the plane of best focus of a
-// part's top or the tool's tips. Each is judged against the simulation's truth.
+// `microcobot vision calibrate|track` (issue #28): the camera's frames turned into measurements.
+// `calibrate` moves the tool through a grid and fits the pixel <-> stage affine map; `track`
+// follows a part or the tool along a path (`autofocus`: vision_autofocus_command.cc). Each is
+// judged against the simulation's truth.
 
 #include "vision_processing_commands.h"
+#include "vision_camera_options.h"
 
 #include <cmath>
 #include <filesystem>
@@ -16,10 +17,8 @@
 #include "microcobot/core/error.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/affine_calibration.h"
-#include "microcobot/vision/autofocus.h"
 #include "microcobot/vision/png_file.h"
 #include "microcobot/vision/renderer.h"
-#include "microcobot/vision/sharpness.h"
 #include "microcobot/vision/template_tracker.h"
 
 namespace mc::cli {
@@ -40,44 +39,6 @@ struct StageGeometry {
     return g;
   }
 };
-
-struct CameraOptions {
-  std::string scene = "pick-place";
-  std::string objective = "10x";
-  std::uint64_t seed = 1;
-  int template_px = 96;
-};
-
-void add_camera_options(CLI::App& cmd, CameraOptions& o) {
-  cmd.add_option("--scene", o.scene,
-                 "pick-place (default), pin-in-hole, or a YAML file of the microworld's keys");
-  cmd.add_option("--objective", o.objective, "Objective: 2x, 5x, 10x (default), 20x, 50x");
-  cmd.add_option("--seed", o.seed, "Seed of the sensor noise (default 1)");
-  cmd.add_option("--template-px", o.template_px, "Side of the tracked template [px] (default 96)")
-      ->check(CLI::Range(8, 1024));
-}
-
-vs::CameraParams camera_for(const CameraOptions& o) {
-  vs::CameraParams cam;
-  try {
-    cam.objective = vs::objective_by_name(o.objective);
-  } catch (const mc::UsageError& e) {
-    throw mc::UsageError(std::string("--objective: ") + e.what());
-  }
-  return cam;
-}
-
-// The template: template_px square centred on `u, v`, inside the frame (exit 3 otherwise).
-vs::PixelRoi centred_roi(double u, double v, int side, const vs::CameraParams& cam) {
-  const vs::PixelRoi roi{static_cast<int>(std::lround(u - 0.5 * (side - 1))),
-                         static_cast<int>(std::lround(v - 0.5 * (side - 1))), side, side};
-  if (roi.x < 0 || roi.y < 0 || roi.x + side > cam.sensor.width_px || roi.y + side > cam.sensor.height_px)
-    throw mc::InvalidInput(
-        fmt::format("--template-px {}: the template around the target ({:.0f}, {:.0f}) px "
-                    "leaves the {}x{} frame",
-                    side, u, v, cam.sensor.width_px, cam.sensor.height_px));
-  return roi;
-}
 
 nlohmann::json map_json(const vs::AffineMap& m) {
   const vs::AffineFigures f = vs::affine_figures(m);
@@ -335,99 +296,6 @@ void run_track(const TrackOptions& o) {
                    rms * cam.pixel_size_m() * 1e9, worst, bias_u / n, bias_v / n));
 }
 
-// ---- autofocus ----------------------------------------------------------------------------
-struct AutofocusOptions {
-  CommonOptions common;
-  CameraOptions camera;
-  std::string target = "part";
-  double offset_um = 100.0;
-  std::string metric;
-};
-
-void run_autofocus(const AutofocusOptions& o) {
-  const pf::PlatformConfig config = pf::scene_config(o.camera.scene);
-  vs::CameraParams cam = camera_for(o.camera);
-  pf::CameraScenePose pose = pf::initial_pose(config);
-  const bool tool = o.target == "tool";
-  if (tool) pose.opening_m = 20e-6;  // both tips in the view
-  vs::SceneSnapshot scene;
-  pf::fill_camera_scene(config, pose, scene);
-  if (!tool && scene.parts.empty())
-    throw mc::InvalidInput("--target part: the scene " + o.camera.scene + " has no part");
-  // The truth: the part's top, or the tips' height. The measured region holds one surface, and the
-  // view is centred on it: the middle of the part's near edge (its top face is uniform: the edge
-  // carries the focus; the gripper's fingers reach in from the far side), or a strip across the
-  // left tip's end an eighth of the template high (the fingers rise along their length).
-  const double truth_m = tool ? pose.tool_z_m : scene.parts.front().z_top_m;
-  const vs::Finger& finger = scene.fingers.front();
-  const Eigen::Vector2d target =
-      tool ? Eigen::Vector2d(finger.tip_x_m, finger.tip_y_m)
-           : Eigen::Vector2d(pose.part_x_m, pose.part_y_m - 0.5 * scene.parts.front().size_y_m);
-  cam.view_center_x_m = target.x();
-  cam.view_center_y_m = target.y();
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
-  vs::PixelRoi roi =
-      centred_roi(renderer.u_of_x(target.x()), renderer.v_of_y(target.y()), o.camera.template_px, cam);
-  if (tool) {
-    // A strip an eighth of the template high (12 px of 96) centred on the tips' end: half of it
-    // beyond the end, half on the finger, whose face rises along its length; a quarter (24 px) read
-    // the tips 1.3-1.5 um high at 10x from the finger's face (chosen on noise seed 1, strips of 6, 12
-    // and 24 px; docs/benchmarks.md, "tool's tips").
-    roi.y += 7 * o.camera.template_px / 16;
-    roi.height = o.camera.template_px / 8;
-  }
-  std::optional<vs::FocusMetric> metric;
-  if (!o.metric.empty()) {
-    try {
-      metric = vs::parse_focus_metric(o.metric);
-    } catch (const mc::InvalidInput& e) {
-      throw mc::UsageError(std::string("--metric: ") + e.what());
-    }
-  }
-  vs::AutofocusParams params =
-      metric ? vs::autofocus_params_for(renderer.figures(), truth_m + o.offset_um * 1e-6, *metric)
-             : vs::autofocus_params_for(renderer.figures(), truth_m + o.offset_um * 1e-6);
-  // The search may go wherever the focus drive goes (platform/camera_device.h).
-  params.range_min_m = std::min(config.camera.focus_min_m, params.start_m);
-  params.range_max_m = std::max(config.camera.focus_max_m, params.start_m);
-  vs::Autofocus search(params);
-  vs::Frame frame;
-  CsvTable rows({"frame", "focus_z_m", "sharpness"});
-  std::uint64_t index = 0;
-  while (!search.done()) {
-    controls.focus_z_m = search.next_focus_m();
-    renderer.render(scene, controls, o.camera.seed, index, frame);
-    const double measure = vs::sharpness(frame, roi, search.next_metric());
-    const double row[] = {static_cast<double>(index), controls.focus_z_m, measure};
-    rows.add_row(row);
-    search.observe(measure);
-    ++index;
-  }
-  const double error_m = search.best_focus_m() - truth_m;
-  const double dof_m = renderer.figures().dof_m;
-  nlohmann::json j = {{"scene", o.camera.scene},
-                      {"objective", cam.objective.name},
-                      {"target", o.target},
-                      {"start_offset_m", o.offset_um * 1e-6},
-                      {"converged", search.converged()},
-                      {"status", search.status()},
-                      {"frames", search.frames_used()},
-                      {"best_focus_m", search.best_focus_m()},
-                      {"truth_m", truth_m},
-                      {"error_m", error_m},
-                      {"dof_m", dof_m},
-                      {"error_dof", error_m / dof_m},
-                      {"seed", o.camera.seed}};
-  write_result_table(o.common, "autofocus.csv", rows, j);
-  emit(o.common, j,
-       fmt::format("{} ({}), from {:+g} um: {} after {} frames ({}), best focus {:.3f} um, error {:+.3f} um "
-                   "({:+.3f} DOF)",
-                   o.target, cam.objective.name, o.offset_um,
-                   search.converged() ? "converged" : "not converged", search.frames_used(), search.status(),
-                   search.best_focus_m() * 1e6, error_m * 1e6, error_m / dof_m));
-}
-
 }  // namespace
 
 void add_vision_processing(CLI::App& group) {
@@ -485,22 +353,7 @@ void add_vision_processing(CLI::App& group) {
     add_output_options(*cmd, o->common);
     cmd->callback([o] { run_track(*o); });
   }
-  {
-    auto o = std::make_shared<AutofocusOptions>();
-    auto* cmd = group.add_subcommand(
-        "autofocus",
-        "The plane of best focus of a part's top or the tool's tips, searched frame by frame (issue #28)");
-    add_camera_options(*cmd, o->camera);
-    cmd->add_option("--target", o->target, "part (default: its top) or tool (its tips)")
-        ->check(CLI::IsMember({"part", "tool"}));
-    cmd->add_option("--offset-um", o->offset_um, "Start this far from the truth [um] (default 100)")
-        ->check(mc::cli::Range(-5000.0, 5000.0));
-    cmd->add_option(
-        "--metric", o->metric,
-        "Fine focus measure: normalized-variance, tenengrad, brenner (default: by the objective)");
-    add_output_options(*cmd, o->common);
-    cmd->callback([o] { run_autofocus(*o); });
-  }
+  add_vision_autofocus(group);
 }
 
 }  // namespace mc::cli

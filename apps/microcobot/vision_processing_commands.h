@@ -1,10 +1,12 @@
 #pragma once
-// `microcobot vision calibrate|track` (issue #28), added to the `vision` group.
+// `microcobot vision calibrate|track|autofocus` (issue #28), added to the `vision` group.
 
 #include <CLI/CLI.hpp>
 
 namespace mc::cli {
 void add_vision_processing(CLI::App& group);
+/// `vision autofocus` (vision_autofocus_command.cc; add_vision_processing adds it).
+void add_vision_autofocus(CLI::App& group);
 /// `vision force` and `vision servo` (vision_force_servo_commands.cc).
 void add_vision_force(CLI::App& group);
 void add_vision_servo(CLI::App& group);
