@@ -286,8 +286,11 @@ void bind_cell(py::module_& m) {
       "One part's cycle on its own simulated platform, stepped from Python (a task from Python): run it\n"
       "for a while, look at its step and status, pause, resume, confirm, take over, hand back, skip,\n"
       "then run on. The same part, mode and parameters give the same cycle as Batch.run_cycle.")
-      .def(py::init([](const Batch& b, py::handle index, py::handle mode, py::handle params,
+      .def(py::init([](py::handle batch, py::handle index, py::handle mode, py::handle params,
                        py::handle config, py::handle task) {
+             if (!py::isinstance<Batch>(batch))
+               throw py::type_error("batch: expected a cell.Batch (got " + given(batch) + ")");
+             const Batch& b = batch.cast<const Batch&>();
              const cl::AssemblyJob& job = b.job(index);
              cl::CellRunParams p = run_params_from(params, mode);
              apply_task(task, p);
@@ -354,7 +357,12 @@ void bind_cell(py::module_& m) {
           "take_over", [](Cycle& c) { c.task("take_over").take_over(); },
           "The operator takes the stage: the task sends nothing (headless, nothing drives: it holds).")
       .def(
-          "hand_back", [](Cycle& c, bool step_done) { c.task("hand_back").hand_back(step_done); },
+          "hand_back",
+          [](Cycle& c, py::handle step_done) {
+            if (!py::isinstance<py::bool_>(step_done))
+              throw py::type_error("step_done: expected a bool (got " + given(step_done) + ")");
+            c.task("hand_back").hand_back(step_done.cast<bool>());
+          },
           "step_done"_a = false,
           "The task goes on: the current step again from where the stage is, or with step_done the next.")
       .def(

@@ -118,22 +118,19 @@ void run_autofocus(const AutofocusOptions& o) {
 }  // namespace
 
 void add_vision_autofocus(CLI::App& group) {
-  {
-    auto o = std::make_shared<AutofocusOptions>();
-    auto* cmd = group.add_subcommand(
-        "autofocus",
-        "The plane of best focus of a part's top or the tool's tips, searched frame by frame (issue #28)");
-    add_camera_options(*cmd, o->camera);
-    cmd->add_option("--target", o->target, "part (default: its top) or tool (its tips)")
-        ->check(CLI::IsMember({"part", "tool"}));
-    cmd->add_option("--offset-um", o->offset_um, "Start this far from the truth [um] (default 100)")
-        ->check(mc::cli::Range(-5000.0, 5000.0));
-    cmd->add_option(
-        "--metric", o->metric,
-        "Fine focus measure: normalized-variance, tenengrad, brenner (default: by the objective)");
-    add_output_options(*cmd, o->common);
-    cmd->callback([o] { run_autofocus(*o); });
-  }
+  auto o = std::make_shared<AutofocusOptions>();
+  auto* cmd = group.add_subcommand(
+      "autofocus",
+      "The plane of best focus of a part's top or the tool's tips, searched frame by frame (issue #28)");
+  add_camera_options(*cmd, o->camera);
+  cmd->add_option("--target", o->target, "part (default: its top) or tool (its tips)")
+      ->check(CLI::IsMember({"part", "tool"}));
+  cmd->add_option("--offset-um", o->offset_um, "Start this far from the truth [um] (default 100)")
+      ->check(mc::cli::Range(-5000.0, 5000.0));
+  cmd->add_option("--metric", o->metric,
+                  "Fine focus measure: normalized-variance, tenengrad, brenner (default: by the objective)");
+  add_output_options(*cmd, o->common);
+  cmd->callback([o] { run_autofocus(*o); });
 }
 
 }  // namespace mc::cli

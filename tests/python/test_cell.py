@@ -151,6 +151,11 @@ def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_contr
     assert "mode 'manual'" in one_line_error(ValueError, person.pause)
     assert "seconds" in one_line_error(ValueError, person.run_for, -1.0)
     assert "seconds" in one_line_error(TypeError, person.run_for, "1")
+    assert "seconds" in one_line_error(ValueError, person.run_for, float("nan"))
+    assert "str 'b'" in one_line_error(TypeError, cell.Cycle, "b", 0)
+    robot = cell.Cycle(b, 0)
+    assert "step_done" in one_line_error(TypeError, robot.hand_back, "x")
+    assert "step_done" in one_line_error(TypeError, robot.hand_back, None)
 
 
 def test_the_serial_run_is_the_clis(cli, serial):
