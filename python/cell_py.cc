@@ -7,6 +7,7 @@
 // then recompiles this file alone rather than the control/platform bindings beside it (pybind11
 // compiles slowly; one more TU costs one more parse of its headers, ~15 s, once).
 
+#include <atomic>
 #include <cctype>
 #include <climits>
 #include <optional>
@@ -157,8 +158,33 @@ void apply_task(py::handle task, cl::CellRunParams& p) {
 struct Cycle {
   std::unique_ptr<cl::CellCycle> cycle;
   std::string mode;
+  /// Set while run_for() simulates without the GIL: another Python thread's call meanwhile would
+  /// race the loop on the task, so it is refused.
+  std::shared_ptr<std::atomic<bool>> running = std::make_shared<std::atomic<bool>>(false);
+
+  /// Throws while another thread runs this cycle.
+  cl::CellCycle& idle(const char* call) {
+    if (running->load())
+      throw py::value_error(std::string(call) +
+                            ": the cycle is running in another thread (wait for its run_for)");
+    return *cycle;
+  }
+  /// Runs `f` without the GIL, the cycle marked as running.
+  template <class F>
+  void run(const char* call, F&& f) {
+    idle(call);
+    running->store(true);
+    try {
+      nogil(std::forward<F>(f));
+    } catch (...) {
+      running->store(false);
+      throw;
+    }
+    running->store(false);
+  }
 
   cl::AssemblyTask& task(const char* control) {
+    idle(control);
     if (cycle->task() == nullptr)
       throw InvalidInput(std::string(control) + ": the cycle runs in mode '" + mode +
                          "'; only the automatic task (mode 'auto') takes the operator's controls");
@@ -310,20 +336,23 @@ void bind_cell(py::module_& m) {
           "run_for",
           [](Cycle& c, py::handle seconds) {
             const double s = seconds_arg(seconds, "seconds");
-            nogil([&] { c.cycle->run_for(s); });
+            c.run("run_for", [&] { c.cycle->run_for(s); });
           },
           "seconds"_a,
           "Simulates `seconds` more (or to the cycle's end, or to max_cycle_s). The GIL is released.")
       .def(
-          "run_to_end", [](Cycle& c) { nogil([&] { c.cycle->run_to_end(); }); },
+          "run_to_end", [](Cycle& c) { c.run("run_to_end", [&] { c.cycle->run_to_end(); }); },
           "Simulates to the cycle's end (or to max_cycle_s).")
       .def_property_readonly(
-          "finished", [](const Cycle& c) { return c.cycle->finished(); }, "The task (or the person) is done.")
+          "finished", [](Cycle& c) { return c.idle("finished").finished(); },
+          "The task (or the person) is done.")
       .def_property_readonly(
-          "time_s", [](Cycle& c) { return c.cycle->platform().loop().time_s(); }, "Simulated time [s].")
+          "time_s", [](Cycle& c) { return c.idle("time_s").platform().loop().time_s(); },
+          "Simulated time [s].")
       .def_property_readonly(
           "step",
           [](Cycle& c) {
+            c.idle("step");
             if (c.cycle->task()) return std::string(cl::AssemblyTask::name(c.cycle->task()->step()));
             if (c.cycle->person()) return std::string(cl::AssemblyTask::name(c.cycle->person()->step()));
             return std::string();
@@ -332,6 +361,7 @@ void bind_cell(py::module_& m) {
       .def_property_readonly(
           "status",
           [](Cycle& c) {
+            c.idle("status");
             if (c.cycle->task()) return std::string(cl::AssemblyTask::name(c.cycle->task()->status()));
             return std::string(c.cycle->finished() ? "finished" : "running");
           },
@@ -340,7 +370,7 @@ void bind_cell(py::module_& m) {
       .def_property_readonly(
           "tip_m",
           [](Cycle& c) {
-            platform::Platform& p = c.cycle->platform();
+            platform::Platform& p = c.idle("tip_m").platform();
             return py::make_tuple(p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m());
           },
           "The stage's measured position (x, y, z) [m], relative to its home.")
@@ -368,7 +398,7 @@ void bind_cell(py::module_& m) {
       .def(
           "skip", [](Cycle& c) { c.task("skip").skip(); }, "Leaves the current step for the next one.")
       .def(
-          "result", [](Cycle& c) { return from_json(c.cycle->result().to_json()); },
+          "result", [](Cycle& c) { return from_json(c.idle("result").result().to_json()); },
           "The cycle's result dict (CycleResult), as Batch.run_cycle returns it; complete once finished.");
 }
 

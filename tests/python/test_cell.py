@@ -157,6 +157,19 @@ def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_contr
     assert "step_done" in one_line_error(TypeError, robot.hand_back, "x")
     assert "step_done" in one_line_error(TypeError, robot.hand_back, None)
 
+    # One thread runs the cycle (the GIL released): another thread's call meanwhile is refused.
+    runner = threading.Thread(target=robot.run_for, args=(5.0,))
+    runner.start()
+    refused = None
+    while runner.is_alive() and refused is None:
+        try:
+            robot.time_s  # a read, so that a call before the run starts changes nothing
+        except ValueError as e:
+            refused = str(e)
+    runner.join()
+    assert refused is not None and "another thread" in refused, refused
+    assert robot.time_s >= 5.0 and robot.status == "running"
+
 
 def test_the_serial_run_is_the_clis(cli, serial):
     code, out, err = cli("cell", "run", "--batch", CONFIG["parts"], "--seed", SEEDS[0], "--json")
