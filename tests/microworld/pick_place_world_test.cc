@@ -8,15 +8,16 @@
 namespace mc::microworld {
 namespace {
 
-// Moves the gripper in a straight line from `from` to `to` in 1 um steps, opening command fixed.
+// Moves the gripper in a straight line from `from` to `to` in 1 um steps, opening command and
+// fingers' yaw fixed.
 PickPlaceOutput move(const PickPlaceWorld& w, PickPlaceState& s, Eigen::Vector3d& at,
-                     const Eigen::Vector3d& to, double opening) {
+                     const Eigen::Vector3d& to, double opening, double yaw = 0.0) {
   PickPlaceOutput out;
   const int n = std::max(1, static_cast<int>((to - at).norm() / 1e-6));
   const Eigen::Vector3d from = at;
   for (int i = 1; i <= n; ++i) {
     at = from + (to - from) * (static_cast<double>(i) / n);
-    out = w.step(s, at, opening, 1e-3);
+    out = w.step(s, at, opening, 1e-3, yaw);
   }
   return out;
 }
@@ -181,6 +182,87 @@ TEST(PinInHole, TheHoleMustLeaveClearanceAndHoldThePinAboveTheSubstrate) {
   p.hole_depth_m = p.part_height_m;
   EXPECT_THROW(PickPlaceWorld{p}, InvalidParams);
   EXPECT_NEAR(pin_in_hole_scene().part_weight_N(), 8500 * 200e-6 * 200e-6 * 600e-6 * 9.81, 1e-15);
+}
+
+// Orientation (issue #29 point 2): the fingers turned by `yaw` (the rotary axis), steps of 1 ms.
+PickPlaceOutput turn(const PickPlaceWorld& w, PickPlaceState& s, const Eigen::Vector3d& at, double opening,
+                     double from, double to) {
+  PickPlaceOutput out;
+  const int n = std::max(1, static_cast<int>(std::abs(to - from) / 1e-3));
+  for (int i = 1; i <= n; ++i) out = w.step(s, at, opening, 1e-3, from + (to - from) * i / n);
+  return out;
+}
+
+TEST(Orientation, ATurnedSquarePinFitsItsHoleOnlyWithinTheAngleTheClearanceLeaves) {
+  const PickPlaceWorld w{pin_in_hole_scene()};  // 200 um in 220 um
+  // s (cos d + sin d) <= 220 um: d <= 6.06 deg (and its images modulo 90 deg). In the hole the
+  // pin's centre rests at 0 (its 600 um half down the 300 um bore), on the rim at 300 um.
+  const double limit = std::asin(1.1 / std::sqrt(2.0)) - M_PI / 4, in = 0.0, rim = 300e-6;
+  EXPECT_NEAR(limit * 180 / M_PI, 6.06, 0.01);
+  EXPECT_NEAR(w.rest_z_m(2e-3, 0, limit - 1e-3), in, 1e-12);
+  EXPECT_NEAR(w.rest_z_m(2e-3, 0, limit + 1e-3), rim, 1e-12);
+  EXPECT_NEAR(w.rest_z_m(2e-3, 0, M_PI / 2 + 0.5 * limit), in, 1e-12) << "a square fits every quarter turn";
+  EXPECT_NEAR(w.rest_z_m(2e-3, 0, -M_PI / 4), rim, 1e-12);
+  // Turned by 3 deg it has 10 - 100 (cos + sin - 1) = 4.6 um of play left each side.
+  const double d = 3 * M_PI / 180;
+  EXPECT_NEAR(w.hole_play_m(d), 0.5 * (220e-6 - 200e-6 * (std::cos(d) + std::sin(d))), 1e-15);
+  EXPECT_NEAR(w.rest_z_m(2e-3 + 4.5e-6, 0, d), in, 1e-12);
+  EXPECT_NEAR(w.rest_z_m(2e-3 + 5.0e-6, 0, d), rim, 1e-12);
+  // A hole turned by 30 deg takes the pin at 30 deg, in the hole's own frame.
+  PickPlaceParams p = pin_in_hole_scene();
+  p.hole_yaw_rad = M_PI / 6;
+  const PickPlaceWorld turned{p};
+  EXPECT_NEAR(turned.rest_z_m(2e-3, 0, 0.0), rim, 1e-12);
+  EXPECT_NEAR(turned.rest_z_m(2e-3, 0, M_PI / 6), in, 1e-12);
+  const Eigen::Vector2d along_side = 8e-6 * Eigen::Vector2d(std::cos(M_PI / 6), std::sin(M_PI / 6));
+  EXPECT_NEAR(turned.rest_z_m(2e-3 + along_side.x(), along_side.y(), M_PI / 6), in, 1e-12);
+  EXPECT_NEAR(turned.rest_z_m(2e-3 + 1.4 * along_side.x(), 1.4 * along_side.y(), M_PI / 6), rim, 1e-12);
+}
+
+TEST(Orientation, TheClosingFingersSquareThePinAndTurnItWithThemToItsHole) {
+  PickPlaceParams p = pin_in_hole_scene();
+  p.part_yaw_rad = 20 * M_PI / 180;  // on its tray, 20 deg off the fingers
+  p.hole_yaw_rad = -35 * M_PI / 180;
+  const PickPlaceWorld w{p};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(0, 0, 1e-3);
+  const double open = 400e-6, closed = 160e-6, align = 18 * M_PI / 180;
+  turn(w, s, g, open, 0.0, align);
+  move(w, s, g, {0, 0, 350e-6}, open, align);
+  for (double t = 0; t < 0.1; t += 1e-3) w.step(s, g, closed, 1e-3, align);
+  EXPECT_NEAR(s.part_yaw_rad, align, 1e-12) << "squeezed flat against the fingers (2 deg)";
+  for (int i = 1; i <= 200; ++i) w.step(s, {0, 0, 350e-6 + i * 1e-6}, closed, 1e-3, align);
+  g = {0, 0, 550e-6};
+  ASSERT_EQ(s.phase, PartPhase::kGrasped);
+  // Turned to the hole's orientation less a quarter turn: the square's symmetry.
+  const double to = p.hole_yaw_rad;
+  turn(w, s, g, closed, align, to);
+  EXPECT_NEAR(s.part_yaw_rad, to, 1e-12);
+  EXPECT_NEAR(w.orientation_error_rad(s), 0.0, 1e-12);
+  EXPECT_NEAR(s.part_m.x(), 0.0, 1e-12) << "the tips' centre is the axis of rotation";
+  move(w, s, g, {2e-3, 0, 550e-6}, closed, to);
+  move(w, s, g, {2e-3, 0, 40e-6}, closed, to);
+  EXPECT_TRUE(w.inserted(s));
+  // Down in its hole, the walls keep its yaw: the fingers slip round it.
+  turn(w, s, g, closed, to, to + 0.2);
+  EXPECT_NEAR(s.part_yaw_rad, to, 1e-12);
+}
+
+TEST(Orientation, APinNotTurnedToItsHoleSitsOnTheRim) {
+  PickPlaceParams p = pin_in_hole_scene();
+  p.hole_yaw_rad = 10 * M_PI / 180;  // beyond the 6.1 deg the clearance allows
+  const PickPlaceWorld w{p};
+  auto s = w.initial_state();
+  Eigen::Vector3d g(0, 0, 1e-3);
+  move(w, s, g, {0, 0, 350e-6}, 400e-6);
+  hold(w, s, g, 160e-6, 0.1);
+  move(w, s, g, {0, 0, 550e-6}, 160e-6);
+  move(w, s, g, {2e-3, 0, 550e-6}, 160e-6);
+  const auto out = move(w, s, g, {2e-3, 0, 340e-6}, 160e-6);
+  EXPECT_FALSE(w.inserted(s));
+  EXPECT_NEAR(s.part_m.z(), 300e-6, 1e-12) << "on the rim";
+  EXPECT_GT(out.force_on_gripper_N.z(), 0.0);
+  EXPECT_NEAR(w.orientation_error_rad(s), -p.hole_yaw_rad, 1e-12);
 }
 
 }  // namespace

@@ -83,6 +83,13 @@ struct ConsoleInput {
   double goal_speed_m_s = 100e-6;  ///< speed of the straight move to the goal
   double gripper_opening_m = 0.0;
   bool has_gripper = false;  ///< false: the TéléTweez drives the gripper
+  /// The rotary axis (rotary_axis.h): to theta_goal_rad at theta_speed_rad_s (has_theta_goal),
+  /// else at the dial's rate theta_rate_rad_s; with this input's deadman, whether or not it holds
+  /// the XYZ coupling (the haptic master has no rotation: the console's dial turns the gripper).
+  bool has_theta_goal = false;
+  double theta_goal_rad = 0.0;
+  double theta_speed_rad_s = 0.1;
+  double theta_rate_rad_s = 0.0;
 };
 
 /// What the masters and the slave report at one haptic tick.

@@ -7,6 +7,20 @@
 #include <fmt/format.h>
 
 namespace mc::microworld {
+namespace {
+
+// A planar vector turned by `a` (counter-clockwise).
+Eigen::Vector2d turned(const Eigen::Vector2d& v, double a) noexcept {
+  const double c = std::cos(a), s = std::sin(a);
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+}
+
+}  // namespace
+
+double wrap_quarter_turn(double a) noexcept {
+  const double q = 0.5 * M_PI;
+  return a - q * std::floor(a / q + 0.5);
+}
 
 void PickPlaceParams::validate() const {
   require_positive(part_side_m, "part_side_m");
@@ -22,6 +36,10 @@ void PickPlaceParams::validate() const {
   require_non_negative(part_height_m, "part_height_m");
   require_non_negative(hole_side_m, "hole_side_m");
   require_non_negative(hole_depth_m, "hole_depth_m");
+  require(std::isfinite(part_yaw_rad) && std::abs(part_yaw_rad) <= 2 * M_PI, "part_yaw_rad",
+          "must be within [-2 pi, 2 pi] rad", part_yaw_rad);
+  require(std::isfinite(hole_yaw_rad) && std::abs(hole_yaw_rad) <= 2 * M_PI, "hole_yaw_rad",
+          "must be within [-2 pi, 2 pi] rad", hole_yaw_rad);
   if (hole_side_m > 0.0) {
     require(hole_side_m > part_side_m, "hole_side_m",
             "must exceed part_side_m (the clearance must be positive)", hole_side_m);
@@ -70,7 +88,9 @@ PickPlaceWorld::PickPlaceWorld(PickPlaceParams params) : p_(std::move(params)) {
 
 PickPlaceState PickPlaceWorld::initial_state() const {
   PickPlaceState s;
-  s.part_m = {p_.part_start_m.x(), p_.part_start_m.y(), rest_z_m(p_.part_start_m.x(), p_.part_start_m.y())};
+  s.part_yaw_rad = p_.part_yaw_rad;
+  s.part_m = {p_.part_start_m.x(), p_.part_start_m.y(),
+              rest_z_m(p_.part_start_m.x(), p_.part_start_m.y(), p_.part_yaw_rad)};
   s.gripper.free_opening_m = p_.gripper.max_opening_m;
   s.last_gripper_m = {p_.part_start_m.x(), p_.part_start_m.y(), 10 * p_.part_side_m};
   return s;
@@ -80,11 +100,22 @@ double PickPlaceWorld::placement_error_m(const PickPlaceState& s) const {
   return std::hypot(s.part_m.x() - p_.target_m.x(), s.part_m.y() - p_.target_m.y());
 }
 
-double PickPlaceWorld::rest_z_m(double x, double y) const noexcept {
+double PickPlaceWorld::orientation_error_rad(const PickPlaceState& s) const noexcept {
+  return wrap_quarter_turn(s.part_yaw_rad - p_.hole_yaw_rad);
+}
+
+double PickPlaceWorld::hole_play_m(double yaw_rad) const noexcept {
+  // The turned square's extent along the hole's sides: s (|cos d| + |sin d|) / 2.
+  const double d = wrap_quarter_turn(yaw_rad - p_.hole_yaw_rad);
+  return 0.5 * (p_.hole_side_m - p_.part_side_m * (std::abs(std::cos(d)) + std::abs(std::sin(d))));
+}
+
+double PickPlaceWorld::rest_z_m(double x, double y, double yaw_rad) const noexcept {
   const double half_height = 0.5 * p_.height_m();
   if (p_.hole_side_m <= 0.0) return half_height;
-  const double play = 0.5 * (p_.hole_side_m - p_.part_side_m) + 1e-12;
-  const bool fits = std::abs(x - p_.target_m.x()) <= play && std::abs(y - p_.target_m.y()) <= play;
+  const double play = hole_play_m(yaw_rad) + 1e-12;
+  const Eigen::Vector2d d = turned({x - p_.target_m.x(), y - p_.target_m.y()}, -p_.hole_yaw_rad);
+  const bool fits = play > 0.0 && std::abs(d.x()) <= play && std::abs(d.y()) <= play;
   return fits ? half_height - p_.hole_depth_m : half_height;
 }
 
@@ -92,18 +123,17 @@ bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
   return p_.hole_side_m > 0.0 && s.part_m.z() < 0.5 * p_.height_m() - 1e-9;
 }
 
-Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_hole,
+Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, double yaw, bool in_hole,
                                                 double capacity_N) const noexcept {
   if (!in_hole) return Eigen::Vector2d::Zero();
-  const double play = 0.5 * (p_.hole_side_m - p_.part_side_m);
-  Eigen::Vector2d reaction = Eigen::Vector2d::Zero();
-  for (int i = 0; i < 2; ++i) {
-    const double centre = p_.target_m[i], d = part[i] - centre;
-    const double inside = std::clamp(d, -play, play);
-    // The wall stops the part; the fingers, pressing it into the wall, feel its stiffness.
-    reaction[i] = p_.substrate_stiffness_N_m * (inside - d);
-    part[i] = centre + inside;
-  }
+  const double play = std::max(hole_play_m(yaw), 0.0);
+  // In the hole's frame (its sides along the axes).
+  const Eigen::Vector2d d = turned(part.head<2>() - p_.target_m.head<2>(), -p_.hole_yaw_rad);
+  Eigen::Vector2d inside = d;
+  for (int i = 0; i < 2; ++i) inside[i] = std::clamp(d[i], -play, play);
+  // The wall stops the part; the fingers, pressing it into the wall, feel its stiffness.
+  Eigen::Vector2d reaction = p_.substrate_stiffness_N_m * turned(inside - d, p_.hole_yaw_rad);
+  part.head<2>() = p_.target_m.head<2>() + turned(inside, p_.hole_yaw_rad);
   // The part slips in the fingers once the wall pushes it harder than they hold it: the
   // fingers feel at most what holds the part (friction of the grip, or the adhesion to a finger).
   const double n = reaction.norm();
@@ -111,11 +141,13 @@ Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, bool in_h
   return reaction;
 }
 
-bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept {
+bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g,
+                                     double yaw) const noexcept {
   const double half = 0.5 * p_.part_side_m, half_height = 0.5 * p_.height_m();
   const double opening = std::max(s.gripper.free_opening_m, p_.part_side_m);
-  const bool in_jaw_x = std::abs(s.part_m.x() - g.x()) <= 0.5 * opening;
-  const bool in_jaw_y = std::abs(s.part_m.y() - g.y()) < half;
+  const Eigen::Vector2d d = turned((s.part_m - g).head<2>(), -yaw);  // the fingers' frame
+  const bool in_jaw_x = std::abs(d.x()) <= 0.5 * opening;
+  const bool in_jaw_y = std::abs(d.y()) < half;
   const bool tips_below_top = g.z() < s.part_m.z() + half_height;
   const bool fingers_above_bottom = g.z() + p_.gripper.finger_length_m > s.part_m.z() - half_height;
   return in_jaw_x && in_jaw_y && tips_below_top && fingers_above_bottom;
@@ -133,12 +165,15 @@ Eigen::Vector2d PickPlaceWorld::rubbing_force(const Eigen::Vector2d& motion, dou
 }
 
 PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g, double opening_command_m,
-                                     double dt_s) const noexcept {
+                                     double dt_s, double yaw) const noexcept {
   PickPlaceOutput out;
   step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
   const double side = p_.part_side_m;
   const Eigen::Vector3d motion = g - s.last_gripper_m;
+  const Eigen::Vector3d last_g = s.last_gripper_m;
+  const double last_yaw = s.last_gripper_yaw_rad;
   s.last_gripper_m = g;
+  s.last_gripper_yaw_rad = yaw;
 
   // A finger tip below the substrate: a crash, reported as a stiff vertical reaction.
   if (g.z() < 0.0) {
@@ -148,7 +183,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
 
   const bool held = s.phase != PartPhase::kOnSubstrate;
   const bool in_hole = inserted(s);
-  const bool between = held || between_fingers(s, g);
+  const bool between = held || between_fingers(s, g, yaw);
   const double grip = between ? grip_force_N(p_.gripper, s.gripper, side) : 0.0;
   out.part_between_fingers = between;
   out.grip_force_N = grip;
@@ -160,20 +195,25 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
     case PartPhase::kOnSubstrate: {
       if (grip <= 0.0) break;
       // The closing fingers centre the part in the jaw (it slides: the fingers are far stronger
-      // than the substrate friction).
-      s.part_m.x() = g.x();
+      // than the substrate friction) and square it against their flats; in its hole the walls
+      // keep its yaw. Dragged, it keeps its place along the fingers (their frame's y).
       const Eigen::Vector2d lateral(motion.x(), motion.y());
       const double drag_resistance = p_.substrate_friction * substrate_hold;
-      if (lateral.norm() > 0.0 && hold_capacity >= drag_resistance) {
-        s.part_m.y() += motion.y();  // dragged along the substrate with the gripper
+      const bool dragged = (lateral.norm() > 0.0 || yaw != last_yaw) && hold_capacity >= drag_resistance;
+      const double along = dragged ? turned((s.part_m - last_g).head<2>(), -last_yaw).y()
+                                   : turned((s.part_m - g).head<2>(), -yaw).y();
+      s.part_m.head<2>() = g.head<2>() + turned({0.0, along}, yaw);
+      if (!in_hole) s.part_yaw_rad -= wrap_quarter_turn(s.part_yaw_rad - yaw);  // to yaw + k 90 deg
+      if (dragged && lateral.norm() > 0.0)
         out.force_on_gripper_N.head<2>() += rubbing_force(lateral, dt_s, drag_resistance);
-      }
-      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, in_hole, hold_capacity);
+      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, s.part_yaw_rad, in_hole, hold_capacity);
       if (motion.z() > 0.0 && g.z() > s.part_m.z() - 0.5 * p_.height_m() - 1e-12) {
         if (hold_capacity >= substrate_hold) {
           s.phase = PartPhase::kGrasped;  // lift-off: the grip beats adhesion + weight
           s.part_m.z() += motion.z();     // from now on the part moves with the fingers
-          s.offset_m = s.part_m - g;
+          s.offset_m.head<2>() = turned((s.part_m - g).head<2>(), -yaw);
+          s.offset_m.z() = s.part_m.z() - g.z();
+          s.yaw_offset_rad = s.part_yaw_rad - yaw;
         } else {
           out.force_on_gripper_N.z() -= hold_capacity;  // fingers slip upward along the part
         }
@@ -182,13 +222,21 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
     }
     case PartPhase::kGrasped:
     case PartPhase::kStuckToFinger: {
-      Eigen::Vector3d next = g + s.offset_m;
-      // In the hole, its walls hold the part: it slips in the fingers, which feel the wall.
+      Eigen::Vector3d next = g;
+      next.head<2>() += turned(s.offset_m.head<2>(), yaw);
+      next.z() += s.offset_m.z();
+      // In the hole, its walls hold the part: it slips in the fingers, which feel the wall, and
+      // keeps its yaw while they turn round it.
+      if (in_hole) {
+        s.yaw_offset_rad = s.part_yaw_rad - yaw;
+      } else {
+        s.part_yaw_rad = yaw + s.yaw_offset_rad;
+      }
       const Eigen::Vector3d unconfined = next;
       const double held_by = s.phase == PartPhase::kGrasped ? hold_capacity : p_.finger_pulloff_N;
-      out.force_on_gripper_N.head<2>() += confine_to_hole(next, in_hole, held_by);
-      s.offset_m.head<2>() += (next - unconfined).head<2>();
-      const double floor = rest_z_m(next.x(), next.y());
+      out.force_on_gripper_N.head<2>() += confine_to_hole(next, s.part_yaw_rad, in_hole, held_by);
+      s.offset_m.head<2>() += turned((next - unconfined).head<2>(), -yaw);
+      const double floor = rest_z_m(next.x(), next.y(), s.part_yaw_rad);
       if (next.z() < floor) {  // pressed onto the substrate: the part stops, the fingers slide down
         const double press = floor - next.z();
         s.offset_m.z() += press;
@@ -228,7 +276,8 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       break;
     }
   }
-  out.part_on_substrate = s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y()) + p_.meniscus_rupture_m;
+  out.part_on_substrate =
+      s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
   return out;
 }
 

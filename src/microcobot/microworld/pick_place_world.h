@@ -23,6 +23,17 @@
 /// it only when its footprint fits (|x - x_hole| and |y - y_hole| <= clearance / 2), else it
 /// lands on the rim; once in, the hole's walls stop it sideways (a stiff reaction on the fingers,
 /// up to what holds the part in them: beyond it the part slips between the fingers).
+///
+/// Orientation (issue #29 point 2): the part and the hole are squares turned by part_yaw_rad and
+/// hole_yaw_rad about the vertical, and the fingers by the gripper's yaw (the rotary axis under
+/// it, turning about the vertical through the tips). A square part turned by d against the
+/// hole has a footprint s (|cos d| + |sin d|) wide along the hole's sides (d taken modulo 90 deg,
+/// the square's symmetry), so it goes in only when |d| is small enough for the clearance:
+/// 200 um in 220 um fits up to |d| = 6.06 deg, in 210 um up to 2.86 deg. Closing fingers square the
+/// part against their flats (the parallel-jaw squeeze turns a polygon to a stable face pair:
+/// Goldberg, "Orienting polygonal parts without sensors", Algorithmica 10, 1993): a grasped part's
+/// yaw is the fingers' plus a multiple of 90 deg, and it turns with them. A part down in its hole
+/// is held by the walls: it keeps its yaw, the fingers slip round it.
 
 #include <cmath>
 
@@ -57,6 +68,8 @@ struct PickPlaceParams {
   double substrate_stiffness_N_m = 1e5;         ///< finger-tip crash into the substrate (penalty)
   Eigen::Vector3d part_start_m{0.0, 0.0, 0.0};  ///< part centre on the substrate (z ignored)
   Eigen::Vector3d target_m{2e-3, 0.0, 0.0};     ///< where the part must be placed (x, y)
+  double part_yaw_rad = 0.0;  ///< the part's start orientation about the vertical (counter-clockwise)
+  double hole_yaw_rad = 0.0;  ///< the hole's (the part must be turned to it, modulo 90 deg)
   PiezoGripperParams gripper;
   /// The platform's limits for this part (issue #26; control/safety_limits.h). 1 mN of grip
   /// holds a 300 um brass part with a 27x margin (2 mu F >= pull-off + weight needs 60 uN) and
@@ -89,6 +102,8 @@ struct PickPlaceParams {
     v("part_start_y_m", part_start_m.y());
     v("target_x_m", target_m.x());
     v("target_y_m", target_m.y());
+    v("part_yaw_rad", part_yaw_rad);
+    v("hole_yaw_rad", hole_yaw_rad);
     v("gripper", gripper);
     v("grip_force_limit_N", grip_force_limit_N);
     v("contact_force_limit_N", contact_force_limit_N);
@@ -104,6 +119,9 @@ struct PickPlaceParams {
 /// pin-in-hole`; scenes/pin-in-hole.yaml is the same scene as a file.
 PickPlaceParams pin_in_hole_scene();
 
+/// `a` modulo a square's symmetry (90 deg), in [-45, 45) deg.
+double wrap_quarter_turn(double a) noexcept;
+
 /// Where the part is held.
 enum class PartPhase {
   kOnSubstrate,    ///< resting on the substrate (possibly squeezed by the fingers)
@@ -114,8 +132,12 @@ enum class PartPhase {
 struct PickPlaceState {
   Eigen::Vector3d part_m = Eigen::Vector3d::Zero();  ///< part centre
   PartPhase phase = PartPhase::kOnSubstrate;
-  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();  ///< part centre - gripper point while held
+  double part_yaw_rad = 0.0;  ///< the part's orientation about the vertical
+  /// Part centre - gripper point while held, in the fingers' frame (turned by the gripper's yaw).
+  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();
+  double yaw_offset_rad = 0.0;  ///< part yaw - gripper yaw while held
   Eigen::Vector3d last_gripper_m = Eigen::Vector3d::Zero();
+  double last_gripper_yaw_rad = 0.0;
   PiezoGripperState gripper;
   bool crashed = false;  ///< a finger tip went into the substrate at some point
 };
@@ -136,25 +158,32 @@ class PickPlaceWorld {
   const PickPlaceParams& params() const { return p_; }
 
   PickPlaceState initial_state() const;
-  /// Advances by dt with the gripper point at `gripper_m` and its opening commanded to
-  /// `opening_command_m`. Never allocates.
+  /// Advances by dt with the gripper point at `gripper_m`, the fingers turned by `gripper_yaw_rad`
+  /// (closing along that direction) and their opening commanded to `opening_command_m`. Never
+  /// allocates.
   PickPlaceOutput step(PickPlaceState& s, const Eigen::Vector3d& gripper_m, double opening_command_m,
-                       double dt_s) const noexcept;
+                       double dt_s, double gripper_yaw_rad = 0.0) const noexcept;
   /// Horizontal distance from the part centre to the target.
   double placement_error_m(const PickPlaceState& s) const;
-  /// Height of the part's centre when it rests at (x, y): in the hole when its footprint fits
-  /// the hole's clearance, on the substrate (or the hole's rim) otherwise.
-  double rest_z_m(double x, double y) const noexcept;
+  /// The part's orientation against the hole's, modulo the square's 90 deg, in [-45, 45) deg.
+  double orientation_error_rad(const PickPlaceState& s) const noexcept;
+  /// Height of the part's centre when it rests at (x, y) turned by `yaw_rad`: in the hole when its
+  /// footprint fits the hole's clearance, on the substrate (or the hole's rim) otherwise.
+  double rest_z_m(double x, double y, double yaw_rad = 0.0) const noexcept;
+  /// Half the play the hole leaves a part turned by `yaw_rad` along each of its sides (negative:
+  /// it does not fit at that angle).
+  double hole_play_m(double yaw_rad) const noexcept;
   /// The part is down in the hole (its bottom below the substrate).
   bool inserted(const PickPlaceState& s) const noexcept;
 
  private:
-  bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g) const noexcept;
+  bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g, double yaw) const noexcept;
   Eigen::Vector2d rubbing_force(const Eigen::Vector2d& motion, double dt_s, double coulomb_N) const noexcept;
   /// Keeps a part that was in the hole (`in_hole`, before this step's motion) inside its walls;
   /// returns the wall's reaction on the fingers [N], at most `capacity_N` (what holds the part in
   /// them: beyond it the part slips).
-  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, bool in_hole, double capacity_N) const noexcept;
+  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, double yaw, bool in_hole,
+                                  double capacity_N) const noexcept;
   PickPlaceParams p_;
   double weight_;
 };

@@ -44,6 +44,13 @@ Platform::Platform(const PlatformConfig& config)
     sim_.axes[i] = axis.get();
     devices_.axes[i] = std::move(axis);
   }
+  if (config_.stage.rotary.enabled && !config_.optical_trap_scene()) {
+    control::PositionSensorParams sp = config_.stage.sensor;
+    sp.seed = config_.stage.sensor.seed + 3;
+    auto rotary = std::make_unique<SimulatedSlaveAxis>("axis_theta", *model_, sp, 0.0);
+    sim_.rotary = rotary.get();
+    devices_.rotary = std::move(rotary);
+  }
   const std::array<const SimulatedSlaveAxis*, 3> carriers{sim_.axes[0], sim_.axes[1], sim_.axes[2]};
   const Vec3 home{home_m_.x(), home_m_.y(), home_m_.z()};
   if (config_.optical_trap_scene()) {
@@ -54,6 +61,7 @@ Platform::Platform(const PlatformConfig& config)
   } else {
     auto gripper = std::make_unique<SimulatedGripper>(
         "gripper", world_, std::array<const SlaveAxis*, 3>{carriers[0], carriers[1], carriers[2]}, home);
+    if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
     sim_.gripper = gripper.get();
     devices_.gripper = std::move(gripper);
   }
@@ -88,6 +96,7 @@ Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
         std::array<const SlaveAxis*, 3>{devices_.axes[0].get(), devices_.axes[1].get(),
                                         devices_.axes[2].get()},
         Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
+    if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
     sim_.gripper = gripper.get();
     devices_.gripper = std::move(gripper);
   }
@@ -95,11 +104,11 @@ Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
   // scripted operator moves their hands as on the simulated platform.
   sim_.haptic = dynamic_cast<SimulatedHapticMaster*>(devices_.haptic.get());
   sim_.tweezers = dynamic_cast<SimulatedTweezersMaster*>(devices_.tweezers.get());
-  const char* names[8] = {"axes[0]", "axes[1]",  "axes[2]", "gripper",
-                          "haptic",  "tweezers", "camera",  "focus"};
+  const char* names[9] = {"axes[0]",  "axes[1]", "axes[2]", "gripper", "haptic",
+                          "tweezers", "camera",  "focus",   "rotary"};
   const auto d = devices();
   for (std::size_t i = 0; i < d.size(); ++i) {
-    if (i >= 6 && d[i] == nullptr) continue;  // optional
+    if (i >= 6 && d[i] == nullptr) continue;  // optional: the camera, its focus, the rotary axis
     if (d[i] == nullptr) throw InvalidParams(std::string("devices.") + names[i], "is missing");
     if (d[i]->state() != Lifecycle::kUnconfigured)
       throw InvalidParams(std::string("devices.") + names[i], "must be handed over unconfigured");
@@ -114,10 +123,12 @@ void Platform::build() {
   require(std::abs(ratio - std::round(ratio)) < 1e-6 * ratio && ratio >= 1.0, "loop.base_rate_Hz",
           "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
   position_controlled_ = devices_.axes[0]->position_controlled();
-  for (std::size_t i = 0; i < 3; ++i) {
-    require(devices_.axes[i]->position_controlled() == position_controlled_, "devices.axes",
+  for (std::size_t i = 0; i < 4; ++i) {
+    const SlaveAxis* a = i < 3 ? devices_.axes[i].get() : devices_.rotary.get();
+    if (a == nullptr) continue;
+    require(a->position_controlled() == position_controlled_, "devices.axes",
             "must all be position-controlled or all voltage-driven", static_cast<double>(i));
-    const double period = devices_.axes[i]->sample_period_s();
+    const double period = a->sample_period_s();
     require(std::abs(period - model_->dt_s()) <= 1e-9 * model_->dt_s(), "devices.axes.sample_period_s",
             "must equal the stick-slip model's step (integrator.dt_s)", period);
   }
@@ -127,7 +138,7 @@ void Platform::build() {
   map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
   stage_ = std::make_unique<StageController>(
       config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
-      config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr);
+      config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr, devices_.rotary ? 4 : 3);
   for (auto& st : steppers_)
     st = std::make_unique<OpenLoopStepper>(static_cast<int>(std::lround(ratio)), model_->dt_s(),
                                            model_->params().drive.slew_rate_V_s);
@@ -138,6 +149,7 @@ void Platform::build() {
   limits.floor_m = world_.params().min_tip_height_m - home_m_.z();  // the substrate is at world z = 0
   teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                      world_.params().gripper.max_opening_m, limits);
+  build_rotary();
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
   if (!devices_.camera && config_.camera.enabled) {
     if (auto source = make_camera_source(config_))
@@ -167,9 +179,10 @@ Platform::~Platform() {
     if (d != nullptr) d->deactivate();
 }
 
-std::array<Device*, 8> Platform::devices() {
-  return {devices_.axes[0].get(), devices_.axes[1].get(),  devices_.axes[2].get(), devices_.gripper.get(),
-          devices_.haptic.get(),  devices_.tweezers.get(), devices_.camera.get(),  devices_.focus.get()};
+std::array<Device*, 9> Platform::devices() {
+  return {devices_.axes[0].get(), devices_.axes[1].get(), devices_.axes[2].get(),
+          devices_.gripper.get(), devices_.haptic.get(),  devices_.tweezers.get(),
+          devices_.camera.get(),  devices_.focus.get(),   devices_.rotary.get()};
 }
 
 const SimulatedDevices& Platform::simulation() const {
@@ -213,6 +226,7 @@ void Platform::teleoperation_task() noexcept {
   in.console = console_;
   in.console.deadman = console_.deadman && !faulted_;
   const auto& out = teleop_->tick(in);
+  rotary_command();
 
   devices_.haptic->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
   devices_.tweezers->command_grip_force_N(out.finger_force_N);
@@ -232,23 +246,27 @@ void Platform::slave_control_task() noexcept {
     tracking_.max_m = std::max(tracking_.max_m, e);
     ++tracking_.samples;
   }
+  std::array<double, StageController::kMaxAxes> target{}, velocity{}, all_measured{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    target[i] = out.slave_target_m[k], velocity[i] = out.slave_velocity_m_s[k], all_measured[i] = measured[i];
+  }
+  rotary_control(target, velocity, all_measured);
   if (position_controlled_) {
     // The stage's own loop (the slave process) follows the target.
-    for (std::size_t i = 0; i < 3; ++i)
-      devices_.axes[i]->command_target_m(out.slave_target_m[static_cast<Eigen::Index>(i)],
-                                         out.slave_velocity_m_s[static_cast<Eigen::Index>(i)]);
+    for (std::size_t i = 0; i < 3; ++i) devices_.axes[i]->command_target_m(target[i], velocity[i]);
+    if (devices_.rotary) devices_.rotary->command_target_m(target[3], velocity[3]);
     return;
   }
   // An axis stepping open loop is not the controller's: it idles there (target = measured), so
   // that it takes over bumplessly when the run ends.
-  Eigen::Vector3d target = out.slave_target_m, velocity = out.slave_velocity_m_s;
   for (std::size_t i = 0; i < 3; ++i) {
     if (steppers_[i]->running()) {
-      target[static_cast<Eigen::Index>(i)] = measured[i];
-      velocity[static_cast<Eigen::Index>(i)] = 0.0;
+      target[i] = measured[i];
+      velocity[i] = 0.0;
     }
   }
-  stage_->update(target, velocity, measured);
+  stage_->update(target, velocity, all_measured);
 }
 
 void Platform::devices_task(double dt_s) noexcept {
@@ -271,6 +289,7 @@ void Platform::devices_task(double dt_s) noexcept {
     devices_.axes[i]->update(dt_s);
     stepping_ended |= was_running && !st.running();
   }
+  rotary_drive(dt_s);
   // Every automatic move ends holding (issue #26): the targets re-taken where the axes are.
   if (stepping_ended) hold();
   devices_.gripper->update(dt_s);
@@ -312,6 +331,8 @@ void Platform::telemetry_task(double t_s) noexcept {
   put(devices_.tweezers->opening_m()), put(o.finger_force_N);
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
   put(contact.x), put(contact.y), put(contact.z);
+  put(has_rotary() ? yaw_target_rad() : 0.0), put(has_rotary() ? yaw_rad() : 0.0);
+  put(has_rotary() && !faulted_ ? stage_->last_voltage_V(3) : 0.0);
   // The last tick where this task ran with the others (slave control, telemetry: the heaviest),
   // one sample late: this tick is not over yet.
   put(1e6 * loop_.sampled_tick_s());
@@ -327,9 +348,10 @@ void Platform::telemetry_task(double t_s) noexcept {
       const auto& w = sim_.gripper->world_state();
       put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
       put(static_cast<double>(static_cast<int>(w.phase)));
+      put(sim_.gripper->yaw_rad()), put(w.part_yaw_rad);
     } else {
       const Eigen::Vector3d bead = sim_.optical_tweezers->bead_m();
-      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0);
+      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0), put(0.0), put(0.0);
     }
   }
   ring_.push(s);
@@ -409,6 +431,7 @@ void Platform::hold() noexcept {
   const Eigen::Vector3d measured(devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
                                  devices_.axes[2]->position_m());
   teleop_->hold_at(measured);
+  if (rotary_target_) rotary_target_->hold_at(yaw_rad());
 }
 
 void Platform::arm_devices(bool fault_on_failure) {

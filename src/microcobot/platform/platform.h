@@ -26,6 +26,7 @@
 #include <memory>
 #include <thread>
 
+#include "microcobot/control/rotary_axis.h"
 #include "microcobot/control/step_map.h"
 #include "microcobot/control/teleoperation.h"
 #include "microcobot/core/recorder.h"
@@ -52,7 +53,7 @@ namespace mc::platform {
 /// controller's commands): recorded on any devices. The rest are the simulation's ground truth
 /// (the operator's hand, the true carriage positions, the haptic channels' forces, the part):
 /// recorded only when the platform runs its simulated devices.
-inline constexpr std::array<const char*, 39> kTelemetryChannels = {"t_s",  // loop channels
+inline constexpr std::array<const char*, 44> kTelemetryChannels = {"t_s",  // loop channels
                                                                    "handle_x_m",
                                                                    "handle_y_m",
                                                                    "deadman",
@@ -78,6 +79,9 @@ inline constexpr std::array<const char*, 39> kTelemetryChannels = {"t_s",  // lo
                                                                    "contact_x_N",
                                                                    "contact_y_N",
                                                                    "contact_z_N",
+                                                                   "target_theta_rad",
+                                                                   "measured_theta_rad",
+                                                                   "u_theta_V",
                                                                    "tick_us",
                                                                    "tick_cpu_us",
                                                                    "hand_x_m",  // simulation channels
@@ -90,15 +94,21 @@ inline constexpr std::array<const char*, 39> kTelemetryChannels = {"t_s",  // lo
                                                                    "part_x_m",
                                                                    "part_y_m",
                                                                    "part_z_m",
-                                                                   "part_phase"};
-// In the optical-trap scene the part channels are the probe bead's (part_phase 0).
-inline constexpr std::size_t kLoopChannelCount = 28;
+                                                                   "part_phase",
+                                                                   "slave_theta_rad",
+                                                                   "part_yaw_rad"};
+// In the optical-trap scene the part channels are the probe bead's (part_phase 0). The theta
+// channels are the rotary axis' (0 on a platform without one).
+inline constexpr std::size_t kLoopChannelCount = 31;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
 /// The devices the loop drives, by their interfaces (device.h). A hardware set-up fills it
 /// with its drivers (docs/hardware.md); the default platform builds the simulated ones.
 struct PlatformDevices {
   std::array<std::unique_ptr<SlaveAxis>, 3> axes;  ///< X, Y, Z of the slave stage
+  /// The rotary axis under the gripper (optional; control/rotary_axis.h): a stick-slip axis whose
+  /// position is the rotor's arc at stage.rotary.radius_m, driven like the others.
+  std::unique_ptr<SlaveAxis> rotary;
   std::unique_ptr<Gripper> gripper;
   std::unique_ptr<HapticMaster> haptic;
   std::unique_ptr<TweezersMaster> tweezers;
@@ -112,6 +122,7 @@ struct PlatformDevices {
 /// device): the scripted operator moves their hands, the session report reads their ground truth.
 struct SimulatedDevices {
   std::array<SimulatedSlaveAxis*, 3> axes{};
+  SimulatedSlaveAxis* rotary = nullptr;
   SimulatedGripper* gripper = nullptr;  ///< the pick-and-place's (null in the optical-trap scene)
   SimulatedOpticalTweezers* optical_tweezers = nullptr;  ///< the optical-trap scene's (else null)
   SimulatedHapticMaster* haptic = nullptr;
@@ -195,6 +206,15 @@ class Platform {
   bool open_loop_running(int axis) const noexcept {
     return steppers_[static_cast<std::size_t>(axis)] && steppers_[static_cast<std::size_t>(axis)]->running();
   }
+  /// The rotary axis (issue #29 point 2): present, its measured angle and its target [rad] (the
+  /// console's theta commands move the target, with the console's deadman; hold() holds it).
+  bool has_rotary() const noexcept { return devices_.rotary != nullptr; }
+  double yaw_rad() const noexcept;
+  double yaw_target_rad() const noexcept;
+  /// The target's travel (the axis' end stops less a margin) [rad]; 0, 0 without the axis.
+  double yaw_min_rad() const noexcept { return rotary_target_ ? rotary_target_->min_rad() : 0.0; }
+  double yaw_max_rad() const noexcept { return rotary_target_ ? rotary_target_->max_rad() : 0.0; }
+  const SlaveAxis* rotary_axis() const noexcept { return devices_.rotary.get(); }
   /// The force and floor limits the coupling enforces (control/safety_limits.h).
   const control::SafetyLimits& safety_limits() const { return teleop_->limits(); }
 
@@ -260,8 +280,15 @@ class Platform {
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
   void arm_devices(bool fault_on_failure);
-  /// Every device; the camera and focus drive last, null when absent.
-  std::array<Device*, 8> devices();
+  /// Every device; the camera, focus drive and rotary axis last, null when absent.
+  std::array<Device*, 9> devices();
+  /// The rotary axis' part of each task (platform_rotary.cc).
+  void build_rotary();
+  void rotary_command() noexcept;
+  void rotary_control(std::array<double, StageController::kMaxAxes>& target,
+                      std::array<double, StageController::kMaxAxes>& velocity,
+                      std::array<double, StageController::kMaxAxes>& measured) noexcept;
+  void rotary_drive(double dt_s) noexcept;
 
   PlatformConfig config_;
   std::unique_ptr<stickslip::ActuatorModel> model_;
@@ -273,6 +300,7 @@ class Platform {
   std::array<std::unique_ptr<OpenLoopStepper>, 3> steppers_;
   TrackingErrorStats tracking_;
   std::unique_ptr<control::Teleoperation> teleop_;
+  std::unique_ptr<control::RotaryTarget> rotary_target_;  ///< null without the rotary axis
   Watchdog haptic_watchdog_;
   Watchdog tweezers_watchdog_;
   std::uint64_t haptic_seen_ = 0, tweezers_seen_ = 0;

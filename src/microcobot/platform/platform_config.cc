@@ -96,6 +96,7 @@ void PlatformConfig::validate() const {
       throw InvalidParams("xy_sensor", "vision needs the camera (camera.enabled: true)");
   });
   in_section("stage.vision", [&] { stage.vision.validate(); });
+  in_section("stage.rotary", [&] { stage.rotary.validate(); });
   in_section("stage.control", [&] {
     require(std::abs(stage.control.control_rate_Hz - loop.slave_rate_Hz()) <= 1e-9 * loop.slave_rate_Hz(),
             "control_rate_Hz", "must equal loop.base_rate_Hz / loop.slave_divisor",

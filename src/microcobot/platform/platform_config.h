@@ -17,6 +17,7 @@
 
 #include "microcobot/control/position_controller.h"
 #include "microcobot/control/position_sensor.h"
+#include "microcobot/control/rotary_axis.h"
 #include "microcobot/control/step_map.h"
 #include "microcobot/control/teleoperation.h"
 #include "microcobot/control/tracking_controller.h"
@@ -80,6 +81,9 @@ struct StageParams {
   double home_x_m = -0.2e-3;
   double home_y_m = 0.0;
   double home_z_m = 0.45e-3;
+  /// The rotary axis under the gripper (issue #29 point 2; control/rotary_axis.h): on by default
+  /// on the simulated platform; a driver set has one when its drivers bring it.
+  control::RotaryAxisParams rotary;
   bool vision_xy() const { return xy_sensor == "vision"; }
 
   template <class V>
@@ -94,6 +98,7 @@ struct StageParams {
     v("home_x_m", home_x_m);
     v("home_y_m", home_y_m);
     v("home_z_m", home_z_m);
+    v("rotary", rotary);
   }
   static control::TrackingParams default_tracking() {
     control::TrackingParams p;  // 10 kHz: updated at every loop tick (LoopParams.base_rate_Hz)

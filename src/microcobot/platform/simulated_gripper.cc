@@ -22,7 +22,8 @@ void SimulatedGripper::on_configure() {
   state_ = world_.initial_state();
   command_m_ = world_.params().gripper.max_opening_m;
   state_.last_gripper_m = tip_position_m();
-  out_ = world_.step(state_, tip_position_m(), command_m_, 0.0);
+  state_.last_gripper_yaw_rad = yaw_rad();
+  out_ = world_.step(state_, tip_position_m(), command_m_, 0.0, yaw_rad());
 }
 
 Eigen::Vector3d SimulatedGripper::tip_position_m() const {
@@ -35,7 +36,7 @@ void SimulatedGripper::command_opening_m(double opening) noexcept {
 }
 
 void SimulatedGripper::update(double dt_s) noexcept {
-  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s);
+  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad());
 }
 
 }  // namespace mc::platform

@@ -5,10 +5,12 @@
 /// The gripper's position is where the stage carries it (SlaveAxis::carried_position_m: the
 /// simulated axes' truth, a driver's sensor) plus the mount offset `home_m` (where the finger
 /// tips are when every axis is at 0). The safe state keeps the last opening command: a gripper
-/// that let go of the part on a fault would drop it.
+/// that let go of the part on a fault would drop it. With a rotary axis (set_rotary) the fingers
+/// turn with it about the vertical through their tips.
 
 #include <array>
 
+#include "microcobot/control/rotary_axis.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/platform/device.h"
 
@@ -32,8 +34,17 @@ class SimulatedGripper final : public Gripper {
   void update(double dt_s) noexcept override;
   void enter_safe_state() noexcept override {}
 
-  /// Where the finger tips are (world frame).
+  /// The rotary axis that turns the fingers (`axis` must outlive the gripper); call before
+  /// configure().
+  void set_rotary(const SlaveAxis* axis, const control::RotaryAxisParams& params) {
+    rotary_ = axis;
+    rotary_params_ = params;
+  }
+  /// Where the finger tips are (world frame), and the fingers' yaw (0 without a rotary axis).
   Eigen::Vector3d tip_position_m() const;
+  double yaw_rad() const noexcept {
+    return rotary_ != nullptr ? rotary_params_.angle_rad(rotary_->carried_position_m()) : 0.0;
+  }
   const microworld::PickPlaceState& world_state() const { return state_; }
   const microworld::PickPlaceOutput& world_output() const { return out_; }
   const microworld::PickPlaceWorld& world() const { return world_; }
@@ -44,6 +55,8 @@ class SimulatedGripper final : public Gripper {
  private:
   const microworld::PickPlaceWorld& world_;
   std::array<const SlaveAxis*, 3> axes_;
+  const SlaveAxis* rotary_ = nullptr;
+  control::RotaryAxisParams rotary_params_;
   Eigen::Vector3d home_m_;
   microworld::PickPlaceState state_;
   microworld::PickPlaceOutput out_;

@@ -9,13 +9,14 @@ namespace mc::platform {
 StageController::StageController(const control::PositionControlParams& params,
                                  const stickslip::StickSlipParams& model, const control::StepMap& map,
                                  int samples_per_tick, double sample_period_s,
-                                 const control::TrackingParams* tracking)
-    : sample_period_s_(sample_period_s) {
+                                 const control::TrackingParams* tracking, int axes)
+    : axes_(axes), sample_period_s_(sample_period_s) {
+  require(axes == 3 || axes == kMaxAxes, "axes", "must be 3 (XYZ) or 4 (XYZ and the rotary axis)", axes);
   require(samples_per_tick >= 1, "samples_per_tick", "must be at least 1", samples_per_tick);
   require_positive(sample_period_s, "sample_period_s");
   tick_s_ = static_cast<double>(samples_per_tick) * sample_period_s;
   fast_ = tracking != nullptr && std::abs(tracking->control_rate_Hz * tick_s_ - 1.0) < 1e-9;
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
     if (tracking) {
       track_[i] = std::make_unique<control::TrackingController>(*tracking, model, map);
     } else {
@@ -27,8 +28,25 @@ StageController::StageController(const control::PositionControlParams& params,
 
 void StageController::update(const Eigen::Vector3d& target_m, const Eigen::Vector3d& velocity_m_s,
                              const std::array<double, 3>& measured_m) noexcept {
+  std::array<double, kMaxAxes> t{}, v{}, m{};
   for (std::size_t i = 0; i < 3; ++i) {
     const auto k = static_cast<Eigen::Index>(i);
+    t[i] = target_m[k], v[i] = velocity_m_s[k], m[i] = measured_m[i];
+  }
+  update_axes(t, v, m, 3);
+}
+
+void StageController::update(const std::array<double, kMaxAxes>& target_m,
+                             const std::array<double, kMaxAxes>& velocity_m_s,
+                             const std::array<double, kMaxAxes>& measured_m) noexcept {
+  update_axes(target_m, velocity_m_s, measured_m, axes_);
+}
+
+void StageController::update_axes(const std::array<double, kMaxAxes>& target_m,
+                                  const std::array<double, kMaxAxes>& velocity_m_s,
+                                  const std::array<double, kMaxAxes>& measured_m, int count) noexcept {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+    const auto k = i;
     if (track_[i]) {
       auto& t = *track_[i];
       // The first tick (and the first after an emergency stop) starts from where the axis is.

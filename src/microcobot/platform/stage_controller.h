@@ -22,16 +22,25 @@ namespace mc::platform {
 
 class StageController {
  public:
+  /// X, Y, Z and the rotary axis (issue #29 point 2: the same actuator driving a rotor, its
+  /// position the arc at the drive's contact radius, control/rotary_axis.h).
+  static constexpr int kMaxAxes = 4;
   /// `params.control_rate_Hz` is the slave rate; `samples_per_tick` drive samples of
   /// `sample_period_s` make one loop tick. `model` and `map` must outlive the controller.
-  /// With `tracking` (issue #15) each axis runs a control::TrackingController instead.
+  /// With `tracking` (issue #15) each axis runs a control::TrackingController instead. `axes`:
+  /// 3 (XYZ) or 4 (with the rotary axis, index 3).
   StageController(const control::PositionControlParams& params, const stickslip::StickSlipParams& model,
                   const control::StepMap& map, int samples_per_tick, double sample_period_s,
-                  const control::TrackingParams* tracking = nullptr);
+                  const control::TrackingParams* tracking = nullptr, int axes = 3);
 
-  /// One slave-rate tick: new targets (with their velocity feedforward) and measurements.
+  /// One slave-rate tick: new targets (with their velocity feedforward) and measurements, per
+  /// axis (the first axis_count() of each).
+  void update(const std::array<double, kMaxAxes>& target_m, const std::array<double, kMaxAxes>& velocity_m_s,
+              const std::array<double, kMaxAxes>& measured_m) noexcept;
+  /// The same for X, Y and Z alone (a rotary axis, if any, is left as it was: a 3-axis stage's way).
   void update(const Eigen::Vector3d& target_m, const Eigen::Vector3d& velocity_m_s,
               const std::array<double, 3>& measured_m) noexcept;
+  int axis_count() const noexcept { return axes_; }
   /// The drive samples of axis `i` for the next loop tick.
   DriveBlock drive(int i) noexcept;
   /// The same with the axis' position measured now: a tracking controller whose rate is the loop's
@@ -54,14 +63,18 @@ class StageController {
   }
 
  private:
-  std::array<std::unique_ptr<control::PositionController>, 3> ctrl_;
-  std::array<std::unique_ptr<control::TrackingController>, 3> track_;
-  std::array<control::ReferenceSample, 3> ref_{};  ///< slave-rate target and velocity
-  std::array<double, 3> since_update_s_{};         ///< time since that target (loop ticks)
-  double tick_s_ = 0.0;                            ///< the loop tick: samples x sample period
-  bool fast_ = false;                              ///< tracking at the loop's rate
+  void update_axes(const std::array<double, kMaxAxes>& target_m,
+                   const std::array<double, kMaxAxes>& velocity_m_s,
+                   const std::array<double, kMaxAxes>& measured_m, int count) noexcept;
+  int axes_ = 3;
+  std::array<std::unique_ptr<control::PositionController>, kMaxAxes> ctrl_;
+  std::array<std::unique_ptr<control::TrackingController>, kMaxAxes> track_;
+  std::array<control::ReferenceSample, kMaxAxes> ref_{};  ///< slave-rate target and velocity
+  std::array<double, kMaxAxes> since_update_s_{};         ///< time since that target (loop ticks)
+  double tick_s_ = 0.0;                                   ///< the loop tick: samples x sample period
+  bool fast_ = false;                                     ///< tracking at the loop's rate
   bool started_ = false;
-  std::array<std::vector<stickslip::DriveSegment>, 3> samples_;
+  std::array<std::vector<stickslip::DriveSegment>, kMaxAxes> samples_;
   double sample_period_s_;
   bool stopped_ = false;
 };

@@ -1,0 +1,50 @@
+#include "microcobot/control/rotary_axis.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::control {
+
+void RotaryAxisParams::validate() const {
+  require(std::isfinite(radius_m) && radius_m >= 0.5e-3 && radius_m <= 0.1, "radius_m",
+          "must be within [0.5 mm, 100 mm]", radius_m);
+  require(std::isfinite(max_speed_rad_s) && max_speed_rad_s > 0.0 && max_speed_rad_s <= 10.0,
+          "max_speed_rad_s", "must be within (0, 10] rad/s", max_speed_rad_s);
+  require(std::isfinite(home_rad) && std::abs(home_rad) <= M_PI, "home_rad", "must be within [-pi, pi] rad",
+          home_rad);
+}
+
+RotaryTarget::RotaryTarget(const RotaryAxisParams& params, double dt_s, double start_rad, double min_rad,
+                           double max_rad)
+    : p_(params), dt_s_(dt_s), target_(start_rad), min_(min_rad), max_(max_rad) {
+  p_.validate();
+  require_positive(dt_s, "dt_s");
+  require(min_rad < max_rad && start_rad >= min_rad && start_rad <= max_rad, "rotary.start_rad",
+          "must lie within the axis' travel", start_rad);
+}
+
+void RotaryTarget::tick(const ConsoleInput& c) noexcept {
+  velocity_ = 0.0;
+  if (!(c.deadman && c.fresh)) return;  // nothing moves without the deadman
+  const double limit = p_.max_speed_rad_s;
+  double next = target_;
+  if (c.has_theta_goal && std::isfinite(c.theta_goal_rad)) {
+    const double speed =
+        std::isfinite(c.theta_speed_rad_s) ? std::clamp(c.theta_speed_rad_s, 0.0, limit) : 0.0;
+    const double goal = std::clamp(c.theta_goal_rad, min_, max_);
+    next = target_ + std::clamp(goal - target_, -speed * dt_s_, speed * dt_s_);
+  } else if (std::isfinite(c.theta_rate_rad_s)) {
+    next = std::clamp(target_ + std::clamp(c.theta_rate_rad_s, -limit, limit) * dt_s_, min_, max_);
+  }
+  velocity_ = (next - target_) / dt_s_;
+  target_ = next;
+}
+
+void RotaryTarget::hold_at(double measured_rad) noexcept {
+  if (std::isfinite(measured_rad)) target_ = std::clamp(measured_rad, min_, max_);
+  velocity_ = 0.0;
+}
+
+}  // namespace mc::control
