@@ -34,6 +34,10 @@ struct IdealStage {
       const double step = in.goal_speed_m_s * 1e-3;
       s.tip_m = d.norm() <= step ? in.goal_m : Eigen::Vector3d(s.tip_m + d * (step / d.norm()));
     }
+    if (in.deadman && in.has_theta_goal) {  // the rotary axis, likewise
+      const double d = in.theta_goal_rad - s.yaw_rad, step = in.theta_speed_rad_s * 1e-3;
+      s.yaw_rad = std::abs(d) <= step ? in.theta_goal_rad : s.yaw_rad + std::copysign(step, d);
+    }
     if (in.has_gripper) s.opening_m = std::max(200e-6, in.gripper_opening_m);
     s.grip_N = in.gripper_opening_m < 200e-6 ? 0.5e-3 : 0.0;
     return (s.tip_m - before).norm();
@@ -63,12 +67,12 @@ TEST(AssemblyTask, SkipGoesOnToTheNextStepFromWhereTheStageIs) {
   const Eigen::Vector3d here = stage.s.tip_m;
   ASSERT_GT((here - stage.start_m).norm(), 50e-6) << "on its way";
   task.skip();
-  EXPECT_EQ(task.step(), Step::kDescend);
+  EXPECT_EQ(task.step(), Step::kAlign);
   EXPECT_EQ(task.status(), Status::kRunning);
-  // The descent to the grasp height starts from where the stage was left: one tick's travel at
-  // the vertical speed, no jump.
+  // The alignment holds over the pin, going on there from where the stage was left: one tick's
+  // travel at the travel speed, no jump.
   const double moved = stage.tick(task);
-  EXPECT_LE(moved, AssemblyTaskParams{}.z_speed_m_s * 1e-3 * 1.001);
+  EXPECT_LE(moved, AssemblyTaskParams{}.travel_speed_m_s * 1e-3 * 1.001);
   EXPECT_GT(moved, 0.0);
   // And it goes on to the grasp from there.
   EXPECT_TRUE(stage.run_to(task, Step::kGrasp));
@@ -91,25 +95,25 @@ TEST(AssemblyTask, APausedTaskSkipsIntoThePausedNextStepAndHolds) {
 TEST(AssemblyTask, SkipLeavesAWaitingOrManualStepAndTheNextStepsAutonomyApplies) {
   AssemblyTask task({}, skip_goal());
   task.set_autonomy(Step::kApproach, Autonomy::kConfirm);
-  task.set_autonomy(Step::kDescend, Autonomy::kManual);
-  task.set_autonomy(Step::kGrasp, Autonomy::kConfirm);
+  task.set_autonomy(Step::kAlign, Autonomy::kManual);
+  task.set_autonomy(Step::kDescend, Autonomy::kConfirm);
   IdealStage stage;
   stage.tick(task);
   ASSERT_EQ(task.status(), Status::kAwaitingConfirm);
   task.skip();  // not confirmed: skipped
-  EXPECT_EQ(task.step(), Step::kDescend);
-  EXPECT_EQ(task.status(), Status::kOperator) << "descend is manual";
+  EXPECT_EQ(task.step(), Step::kAlign);
+  EXPECT_EQ(task.status(), Status::kOperator) << "align is manual";
   EXPECT_FALSE(task.drives());
-  task.skip();  // the operator says: no descent needed
-  EXPECT_EQ(task.step(), Step::kGrasp);
-  EXPECT_EQ(task.status(), Status::kAwaitingConfirm) << "grasp waits for its confirmation";
+  task.skip();  // the operator says: the fingers are square already
+  EXPECT_EQ(task.step(), Step::kDescend);
+  EXPECT_EQ(task.status(), Status::kAwaitingConfirm) << "descend waits for its confirmation";
   EXPECT_EQ(stage.tick(task), 0.0);
 }
 
 TEST(AssemblyTask, SkippingIntoTheInsertionStartsAFreshSearchAndSkippingTheLastStepSucceeds) {
   AssemblyTask task({}, skip_goal());
   IdealStage stage;
-  ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+  ASSERT_TRUE(stage.run_to(task, Step::kRotate));
   task.skip();
   EXPECT_EQ(task.step(), Step::kInsert);
   EXPECT_EQ(task.search_tries(), 0);
@@ -142,7 +146,7 @@ TEST(AssemblyTask, VerifyLooksAtThePinAndFailsATaskWhosePinIsNotDown) {
         Case{0.5 * goal.part_height_m, Status::kFailed}, Case{nan, Status::kSucceeded}}) {
     AssemblyTask task({}, goal);
     IdealStage stage;
-    ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+    ASSERT_TRUE(stage.run_to(task, Step::kRotate));
     task.skip();  // into the insertion, then past it: the ideal stage has no contact to end it
     task.skip();
     task.skip();

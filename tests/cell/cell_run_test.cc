@@ -90,7 +90,9 @@ TEST(CellRun, ACycleResultComesBackFromItsJsonWholeOrIsRefusedNamingTheKey) {
   c.ended_holding = true;
   c.step_s = {1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.5};
   EXPECT_EQ(CycleResult::from_json(c.to_json()).to_json(), c.to_json());
-  EXPECT_EQ(c.to_json()["step_s"]["transport"], 5.0);
+  EXPECT_EQ(c.to_json()["step_s"]["align"], 2.0);
+  EXPECT_EQ(c.to_json()["step_s"]["transport"], 6.0);
+  EXPECT_EQ(c.to_json()["step_s"]["rotate"], 7.0);
   // Refused with exactly `message`.
   const auto refused = [](const nlohmann::json& j) -> std::string {
     try {

@@ -32,8 +32,8 @@ TEST(CellCli, RunsABatchAndWritesItsCyclesAndSummary) {
   // Where each cycle's time went: its steps add up to it.
   for (std::size_t i = 0; i < t.rows(); ++i) {
     double steps = 0.0;
-    for (const char* c : {"approach_s", "descend_s", "grasp_s", "lift_s", "transport_s", "insert_s",
-                          "release_s", "retract_s", "verify_s"})
+    for (const char* c : {"approach_s", "align_s", "descend_s", "grasp_s", "lift_s", "transport_s",
+                          "rotate_s", "insert_s", "release_s", "retract_s", "verify_s"})
       steps += t.column(c).at(i);
     EXPECT_NEAR(steps, t.column("cycle_s").at(i), 2e-3) << "part " << i;
     EXPECT_GT(t.column("transport_s").at(i), 1.0);

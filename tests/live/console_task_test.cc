@@ -73,11 +73,11 @@ TEST(ConsoleTask, TheTasksActionsAreAnsweredAndItsTreeIsInTheStatus) {
   json task = task_status_until(op, 5, [](const json& t) { return !t.is_null(); });
   ASSERT_FALSE(task.is_null());
   EXPECT_EQ(task.at("status"), "idle");
-  ASSERT_EQ(task.at("steps").size(), 9u);  // approach ... retract, verify
+  ASSERT_EQ(task.at("steps").size(), 11u);  // approach ... retract, verify
   EXPECT_EQ(task.at("steps")[0].at("name"), "approach");
-  EXPECT_EQ(task.at("steps")[5].at("name"), "insert");
-  EXPECT_EQ(task.at("steps")[5].at("autonomy"), "confirm");
-  EXPECT_EQ(task.at("steps")[8].at("name"), "verify");
+  EXPECT_EQ(task.at("steps")[7].at("name"), "insert");
+  EXPECT_EQ(task.at("steps")[7].at("autonomy"), "confirm");
+  EXPECT_EQ(task.at("steps")[10].at("name"), "verify");
 
   // Started, it runs, with the console's heartbeat.
   ASSERT_TRUE(op.command({{"deadman", false}}));

@@ -49,6 +49,20 @@ TEST(RotaryAxis, TheConsoleTurnsTheGripperToItsGoalAndItHoldsThere) {
   // The last telemetry sample (a few ticks before the end): holding, within the noise.
   EXPECT_NEAR(rig.channel("slave_theta_rad"), rig.true_yaw(), 2e-6);
   EXPECT_NEAR(rig.channel("measured_theta_rad"), rig.platform->yaw_rad(), 2e-6);
+  // Arrived, the axis is parked: its voltage held constant, friction holding the rotor.
+  EXPECT_TRUE(rig.platform->parked(3));
+  const auto u = rig.platform->recording().channel("u_theta_V");
+  for (std::size_t i = u.size() - 100; i < u.size(); ++i) EXPECT_EQ(u[i], u.back());
+  const double parked_at = rig.true_yaw();
+  rig.platform->run(1.0);
+  EXPECT_NEAR(rig.true_yaw(), parked_at, 1e-9) << "parked, it does not creep";
+  // A new goal takes it out of the park without a jump.
+  rig.in.theta_goal_rad = 0.4;
+  rig.platform->run(0.01);
+  EXPECT_FALSE(rig.platform->parked(3));
+  EXPECT_LT(std::abs(rig.true_yaw() - parked_at), 0.16 * 0.01 + 1e-5);
+  rig.platform->run(1.5);
+  EXPECT_NEAR(rig.true_yaw(), 0.4, 2e-6);
 }
 
 TEST(RotaryAxis, NothingTurnsWithoutTheConsolesDeadman) {

@@ -26,6 +26,10 @@ void AssemblyBatchParams::validate() const {
   // The open fingers must pass around the pin with its slot error on either side.
   require(max_side_m + 8.0 * slot_error_m < world.gripper.max_opening_m, "max_side_m",
           "must leave the open gripper (world.gripper.max_opening_m) 4 slot errors each side", max_side_m);
+  require(std::isfinite(max_yaw_rad) && max_yaw_rad >= 0.0 && max_yaw_rad <= M_PI / 4 + 1e-12, "max_yaw_rad",
+          "must be within [0, pi/4] rad (a square's orientations)", max_yaw_rad);
+  require(std::isfinite(slot_yaw_error_rad) && slot_yaw_error_rad >= 0.0 && slot_yaw_error_rad <= 0.1,
+          "slot_yaw_error_rad", "must be within [0, 0.1] rad", slot_yaw_error_rad);
   require_positive(half_size_m, "half_size_m");
   for (const auto& [key, v] : {std::pair{"tray_x_m", tray_x_m}, std::pair{"tray_y_m", tray_y_m},
                                std::pair{"plate_x_m", plate_x_m}, std::pair{"plate_y_m", plate_y_m}})
@@ -41,6 +45,10 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   std::uniform_real_distribution<double> clearance(params.min_clearance_m, params.max_clearance_m);
   std::uniform_real_distribution<double> area(-params.half_size_m, params.half_size_m);
   std::normal_distribution<double> slot(0.0, 1.0);
+  // The orientations from a stream of their own: the positions are those of the same seed without.
+  std::mt19937_64 yaw_rng(static_cast<std::uint64_t>(params.seed) * 0x9E3779B97F4A7C15ULL + 0x796177ULL);
+  std::uniform_real_distribution<double> yaw(-1.0, 1.0);
+  std::normal_distribution<double> slot_yaw(0.0, 1.0);
   std::vector<AssemblyJob> jobs;
   jobs.reserve(static_cast<std::size_t>(params.parts));
   for (int i = 0; i < params.parts; ++i) {
@@ -58,6 +66,10 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     j.world.hole_depth_m = params.hole_depth_m;
     j.world.part_start_m = {j.nominal_part_m.x() + error.x(), j.nominal_part_m.y() + error.y(), 0.0};
     j.world.target_m = {j.target_m.x(), j.target_m.y(), 0.0};
+    j.nominal_part_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
+    j.target_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
+    j.world.part_yaw_rad = j.nominal_part_yaw_rad + params.slot_yaw_error_rad * slot_yaw(yaw_rng);
+    j.world.hole_yaw_rad = j.target_yaw_rad;
     j.world.validate();
     jobs.push_back(j);
   }

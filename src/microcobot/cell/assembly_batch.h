@@ -6,13 +6,18 @@
 /// their tray slots with a position error (the slot's play) that the cell does not know: the
 /// robot is told each slot's nominal position and each bore's, as a fixtured tray and plate
 /// would give them, and must cope with the rest (the closing fingers centre the pin along x; y is
-/// found by a force-guarded search, assembly_task.h).
+/// found by a force-guarded search, assembly_task.h). Each slot and each bore has its own
+/// orientation (issue #29 point 1), uniform within +-max_yaw_rad (+-45 deg: any orientation of a
+/// square), told to the cell; a pin sits in its slot turned by a further error it is not told (the
+/// grasp's squeeze takes it out). The orientations come from their own stream of the seed: with
+/// max_yaw_rad 0 and slot_yaw_error_rad 0 a batch is the one of before the rotary axis.
 ///
 /// One job is one part: its microworld (microworld::PickPlaceParams: the pin, the bore, the
 /// adhesion of the default 300 um scene) and what the cell is told. The cycles of a batch run one
 /// after another on a fresh platform each (cell_run.h), so neighbouring parts do not interact yet.
 /// Positions are world coordinates (the substrate's top at z = 0); SI units.
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -27,12 +32,14 @@ struct AssemblyBatchParams {
   int seed = 1;                ///< the generator's seed: the same seed gives the same batch
   double min_side_m = 100e-6;  ///< pin side, uniform in [min, max] (issue #29: 100-300 um)
   double max_side_m = 300e-6;
-  double part_height_m = 600e-6;   ///< every pin's height
-  double min_clearance_m = 3e-6;   ///< radial clearance of the bores, uniform in [min, max]
-  double max_clearance_m = 20e-6;  ///< (issue #29: 3-20 um)
-  double hole_depth_m = 300e-6;    ///< the bores' depth
-  double slot_error_m = 5e-6;      ///< standard deviation of a pin in its slot (x and y)
-  double tray_x_m = -1.0e-3;       ///< the tray's centre (slots are drawn within its half-size)
+  double part_height_m = 600e-6;       ///< every pin's height
+  double min_clearance_m = 3e-6;       ///< radial clearance of the bores, uniform in [min, max]
+  double max_clearance_m = 20e-6;      ///< (issue #29: 3-20 um)
+  double hole_depth_m = 300e-6;        ///< the bores' depth
+  double slot_error_m = 5e-6;          ///< standard deviation of a pin in its slot (x and y)
+  double max_yaw_rad = M_PI / 4;       ///< slots' and bores' orientations, uniform in [-max, max]
+  double slot_yaw_error_rad = 0.0175;  ///< standard deviation of a pin's yaw in its slot (1 deg)
+  double tray_x_m = -1.0e-3;           ///< the tray's centre (slots are drawn within its half-size)
   double tray_y_m = 0.0;
   double plate_x_m = 1.5e-3;  ///< the plate's centre (bores likewise)
   double plate_y_m = 0.0;
@@ -52,6 +59,8 @@ struct AssemblyBatchParams {
     v("max_clearance_m", max_clearance_m);
     v("hole_depth_m", hole_depth_m);
     v("slot_error_m", slot_error_m);
+    v("max_yaw_rad", max_yaw_rad);
+    v("slot_yaw_error_rad", slot_yaw_error_rad);
     v("tray_x_m", tray_x_m);
     v("tray_y_m", tray_y_m);
     v("plate_x_m", plate_x_m);
@@ -71,6 +80,8 @@ struct AssemblyJob {
   microworld::PickPlaceParams world;     ///< the true scene: the pin where it really is
   Eigen::Vector2d nominal_part_m{0, 0};  ///< its slot's nominal position (what the cell is told)
   Eigen::Vector2d target_m{0, 0};        ///< its bore's position (told, and true)
+  double nominal_part_yaw_rad = 0.0;     ///< its slot's orientation (told)
+  double target_yaw_rad = 0.0;           ///< its bore's (told, and true)
   double side_m = 0.0, clearance_m = 0.0;
 };
 

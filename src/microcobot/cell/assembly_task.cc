@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "microcobot/core/error.h"
+#include "microcobot/microworld/pick_place_world.h"
 
 namespace mc::cell {
 
@@ -26,6 +27,25 @@ void AssemblyTaskParams::validate() const {
   require_non_negative(settle_s, "settle_s");
   require_positive(step_timeout_s, "step_timeout_s");
   require_positive(verify_tolerance_m, "verify_tolerance_m");
+  require(std::isfinite(rotate_speed_rad_s) && rotate_speed_rad_s > 0.0 && rotate_speed_rad_s <= 10.0,
+          "rotate_speed_rad_s", "must be within (0, 10] rad/s", rotate_speed_rad_s);
+  require(std::isfinite(yaw_tolerance_rad) && yaw_tolerance_rad > 0.0 && yaw_tolerance_rad <= 0.1,
+          "yaw_tolerance_rad", "must be within (0, 0.1] rad", yaw_tolerance_rad);
+}
+
+double square_yaw_goal(double square_yaw_rad, double from_rad, double min_rad, double max_rad) noexcept {
+  const double quarter = 0.5 * M_PI;
+  const double nearest = from_rad + microworld::wrap_quarter_turn(square_yaw_rad - from_rad);
+  double best = std::clamp(nearest, min_rad, max_rad);
+  double best_turn = std::numeric_limits<double>::infinity();
+  for (int k = -4; k <= 4; ++k) {
+    const double c = nearest + k * quarter;
+    if (c >= min_rad && c <= max_rad && std::abs(c - from_rad) < best_turn) {
+      best = c;
+      best_turn = std::abs(c - from_rad);
+    }
+  }
+  return best;
 }
 
 AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal)
@@ -36,6 +56,10 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   require_positive(goal.hole_depth_m, "goal.hole_depth_m");
   require_positive(goal.clearance_m, "goal.clearance_m");
   require_positive(goal.open_m, "goal.open_m");
+  require(std::isfinite(goal.part_yaw_rad) && std::isfinite(goal.target_yaw_rad), "goal",
+          "orientations must be finite");
+  require(goal.yaw_min_rad < goal.yaw_max_rad, "goal.yaw_min_rad", "must be below goal.yaw_max_rad",
+          goal.yaw_min_rad);
   grasp_z_ = goal.hole_depth_m + p_.grip_above_m;
   require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
           p_.grip_above_m);
@@ -52,7 +76,8 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
 
 std::string_view AssemblyTask::name(Step s) noexcept {
   static constexpr std::array<std::string_view, kStepCount> names = {
-      "approach", "descend", "grasp", "lift", "transport", "insert", "release", "retract", "verify", "done"};
+      "approach", "align",  "descend", "grasp",   "lift",   "transport",
+      "rotate",   "insert", "release", "retract", "verify", "done"};
   return names[index(s)];
 }
 
@@ -94,6 +119,7 @@ void AssemblyTask::enter(Step s) noexcept {
   if (s == Step::kInsert) {  // a fresh search, however the insertion was reached
     tries_ = 0;
     offset_y_ = 0.0;
+    search_yaw_ = last_yaw_;  // along the fingers as they are
   }
   if (s == Step::kDone) {
     status_ = Status::kSucceeded;
@@ -143,7 +169,8 @@ void AssemblyTask::hand_back(bool step_done) noexcept {
     enter(static_cast<Step>(index(step_) + 1));
   } else {
     // The step again, from where the operator left the stage: its goals are absolute, and a
-    // move starts from the coupling's current target.
+    // move starts from the coupling's current target; a turn, from where the operator left it.
+    yaw_goal_ = std::numeric_limits<double>::quiet_NaN();
     step_s_ = 0.0;
     settled_s_ = 0.0;
     if (step_ == Step::kInsert) {  // clear of the rim before searching on
@@ -165,6 +192,7 @@ void AssemblyTask::set_autonomy(Step step, Autonomy a) noexcept {
 void AssemblyTask::skip() noexcept {
   if (finished()) return;
   const bool paused = status_ == Status::kPaused;
+  yaw_goal_ = std::numeric_limits<double>::quiet_NaN();  // the fingers stay as they are
   enter(static_cast<Step>(index(step_) + 1));
   if (paused && status_ == Status::kRunning) status_ = Status::kPaused;
 }
@@ -178,9 +206,33 @@ bool AssemblyTask::move_to(const Eigen::Vector3d& goal, double speed, const Task
   return settled_s_ >= p_.settle_s;
 }
 
+void AssemblyTask::turn_to(double yaw) noexcept {
+  yaw_goal_ = yaw;
+  out_.has_theta_goal = true;
+  out_.theta_goal_rad = yaw;
+  out_.theta_speed_rad_s = p_.rotate_speed_rad_s;
+}
+
+double AssemblyTask::align_yaw(double from) const noexcept {
+  return square_yaw_goal(goal_.part_yaw_rad, from, goal_.yaw_min_rad, goal_.yaw_max_rad);
+}
+
+double AssemblyTask::rotate_yaw(double from) const noexcept {
+  return square_yaw_goal(goal_.target_yaw_rad, from, goal_.yaw_min_rad, goal_.yaw_max_rad);
+}
+
+Eigen::Vector2d AssemblyTask::search_xy() const noexcept {
+  return goal_.target_m + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
+}
+
 const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {
   out_.deadman = false;
   out_.has_goal = false;
+  last_yaw_ = s.yaw_rad;
+  // The rotary axis holds its last goal (none yet: it stays where it is).
+  out_.has_theta_goal = std::isfinite(yaw_goal_);
+  out_.theta_goal_rad = std::isfinite(yaw_goal_) ? yaw_goal_ : 0.0;
+  out_.theta_rate_rad_s = 0.0;
   out_.velocity_m_s.setZero();
   out_.gripper_opening_m = opening_command_;
   if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
@@ -198,9 +250,18 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
           (s.tip_m.head<2>() - goal_.part_m).norm() > 1e-6) {
         move_to({s.tip_m.x(), s.tip_m.y(), safe_z_}, p_.z_speed_m_s, s, dt_s);
         settled_s_ = 0.0;
-      } else if (move_to(over_part, p_.travel_speed_m_s, s, dt_s)) {
-        enter(Step::kDescend);
+      } else {
+        // Clear of the pins: the fingers turn on the way when align is the robot's.
+        if (autonomy_[index(Step::kAlign)] == Autonomy::kAuto)
+          turn_to(align_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
+        if (move_to(over_part, p_.travel_speed_m_s, s, dt_s)) enter(Step::kAlign);
       }
+      break;
+    case Step::kAlign:
+      turn_to(align_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
+      move_to(over_part, p_.travel_speed_m_s, s, dt_s);
+      if (std::abs(s.yaw_rad - yaw_goal_) > p_.yaw_tolerance_rad) settled_s_ = 0.0;
+      if (settled_s_ >= p_.settle_s) enter(Step::kDescend);
       break;
     case Step::kDescend:
       if (move_to({goal_.part_m.x(), goal_.part_m.y(), grasp_z_}, p_.z_speed_m_s, s, dt_s))
@@ -223,8 +284,16 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
         enter(Step::kTransport);
       break;
     case Step::kTransport:
+      if (autonomy_[index(Step::kRotate)] == Autonomy::kAuto)
+        turn_to(rotate_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
       if (move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s))
-        enter(Step::kInsert);
+        enter(Step::kRotate);
+      break;
+    case Step::kRotate:
+      turn_to(rotate_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
+      move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s);
+      if (std::abs(s.yaw_rad - yaw_goal_) > p_.yaw_tolerance_rad) settled_s_ = 0.0;
+      if (settled_s_ >= p_.settle_s) enter(Step::kInsert);
       break;
     case Step::kInsert:
       insert_tick(s, dt_s);
@@ -237,15 +306,17 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
       if (settled_s_ >= p_.settle_s) enter(Step::kRetract);
       break;
     case Step::kRetract:
-      if (move_to({goal_.target_m.x(), goal_.target_m.y() + offset_y_, safe_z_}, p_.z_speed_m_s, s, dt_s))
-        enter(Step::kVerify);
+      if (move_to({search_xy().x(), search_xy().y(), safe_z_}, p_.z_speed_m_s, s, dt_s)) enter(Step::kVerify);
       break;
     case Step::kVerify:
       // Still where the retract ended (settle_s), then one look.
       if (!move_to(s.tip_m, p_.z_speed_m_s, s, dt_s)) break;
       if (s.part_m.allFinite()) {
         const double inserted_z = 0.5 * goal_.part_height_m - goal_.hole_depth_m;
-        const double off_axis = (s.part_m.head<2>() - goal_.target_m).cwiseAbs().maxCoeff();
+        // Off the axis along the bore's own sides.
+        const Eigen::Vector2d d = s.part_m.head<2>() - goal_.target_m;
+        const double c = std::cos(goal_.target_yaw_rad), sn = std::sin(goal_.target_yaw_rad);
+        const double off_axis = std::max(std::abs(c * d.x() + sn * d.y()), std::abs(-sn * d.x() + c * d.y()));
         if (s.part_m.z() > inserted_z + p_.verify_tolerance_m) {
           fail("the pin is not down in its bore (seen by the cell's vision)");
           break;
@@ -264,7 +335,7 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
 }
 
 void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
-  const Eigen::Vector2d xy = goal_.target_m + Eigen::Vector2d(0.0, offset_y_);
+  const Eigen::Vector2d xy = search_xy();
   const double floor_z = grasp_z_ - goal_.hole_depth_m;  // tips when the pin's bottom is on the bore's floor
   switch (insert_) {
     case Insert::kDescend: {
@@ -282,7 +353,7 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
         enter(Step::kRelease);  // down in the bore
         break;
       }
-      // On the rim: the next point of the search along y (0, +s, -s, +2s, -2s, ...).
+      // On the rim: the next point of the search along the fingers' y (0, +s, -s, +2s, -2s, ...).
       ++tries_;
       const double step = p_.search_step_factor * goal_.clearance_m;
       const int k = (tries_ + 1) / 2;

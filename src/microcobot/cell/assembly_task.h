@@ -8,16 +8,24 @@
 /// a straight move to a goal at a speed, a gripper opening, the deadman), so that the platform's
 /// own limits (control/safety_limits.h: grip, contact, floor) apply to it as to any operator.
 ///
-///   approach   over the pin's nominal slot, the finger tips clear of its top
+///   approach   over the pin's nominal slot, the finger tips clear of its top (turning the fingers
+///              to the pin's nominal orientation on the way, at that height, when align is automatic)
+///   align      the fingers' flats square with the pin's faces: the rotary axis to the pin's nominal
+///              yaw, modulo 90 deg, nearest to where it is (control/rotary_axis.h); the squeeze of
+///              the grasp takes out the pin's error in its slot
 ///   descend    to the grasp height: the tips `grip_above_m` above a full bore's depth
 ///   grasp      close until the grip force reaches `grip_force_N` (the closing fingers centre
 ///              the pin along x; its slot error along y stays unknown)
 ///   lift       the pin's bottom `clearance_height_m` above the substrate
-///   transport  over the bore
+///   transport  over the bore (turning the pin towards its bore's orientation on the way, when
+///              rotate is automatic)
+///   rotate     the pin's faces square with the bore's: the rotary axis to the bore's yaw modulo
+///              90 deg (the pin turns with the fingers about the tips' centre, over the bore)
 ///   insert     force-guarded: down at `insert_speed_m_s` until the contact force exceeds
 ///              `contact_threshold_N`. Reached near the bore's depth: inserted. Reached at the
 ///              surface: jammed on the rim; up by `search_retreat_m`, over to the next point of
-///              the search along y (0, +s, -s, +2s, ... with s = search_step_factor x the bore's
+///              the search along the fingers' y, the pin's unknown direction in them (0, +s, -s,
+///              +2s, ... with s = search_step_factor x the bore's
 ///              radial clearance; a pin fits when |dy| <= clearance), down again; beyond
 ///              `search_range_m`: failed
 ///   release    open the fingers (the substrate's adhesion keeps the pin in its bore)
@@ -67,6 +75,10 @@ struct AssemblyTaskParams {
   /// verify: the pin's centre seen within this of its inserted height (a pin on the rim sits
   /// 300 um higher, one stuck to a finger higher still; the vision is within 0.1 um)
   double verify_tolerance_m = 20e-6;
+  /// align, rotate: the rotary axis' speed, and the yaw a turn ends within (0.5 mrad costs a
+  /// 300 um pin 0.08 um of its play, whose least is 3 um).
+  double rotate_speed_rad_s = 0.16;
+  double yaw_tolerance_rad = 0.5e-3;
 
   template <class V>
   void visit(V& v) {
@@ -85,6 +97,8 @@ struct AssemblyTaskParams {
     v("settle_s", settle_s);
     v("step_timeout_s", step_timeout_s);
     v("verify_tolerance_m", verify_tolerance_m);
+    v("rotate_speed_rad_s", rotate_speed_rad_s);
+    v("yaw_tolerance_rad", yaw_tolerance_rad);
   }
   void validate() const;
 };
@@ -95,13 +109,22 @@ struct AssemblyGoal {
   Eigen::Vector2d target_m{0, 0};  ///< the bore
   double part_height_m = 600e-6;
   double hole_depth_m = 300e-6;
-  double clearance_m = 10e-6;  ///< the bore's radial clearance
-  double open_m = 600e-6;      ///< the gripper fully open
+  double clearance_m = 10e-6;   ///< the bore's radial clearance
+  double open_m = 600e-6;       ///< the gripper fully open
+  double part_yaw_rad = 0.0;    ///< the pin's nominal orientation in its slot (a square: modulo 90 deg)
+  double target_yaw_rad = 0.0;  ///< the bore's orientation
+  /// The rotary axis' travel (platform::Platform::yaw_min_rad, yaw_max_rad).
+  double yaw_min_rad = -1.0, yaw_max_rad = 1.0;
 };
+
+/// The fingers' yaw that squares them with a square turned by `square_yaw_rad` (modulo 90 deg):
+/// the one nearest `from_rad` within [min_rad, max_rad] (the nearest to the travel when none is).
+double square_yaw_goal(double square_yaw_rad, double from_rad, double min_rad, double max_rad) noexcept;
 
 /// The slave's sensors at one tick, world frame.
 struct TaskSensors {
   Eigen::Vector3d tip_m = Eigen::Vector3d::Zero();      ///< measured finger-tip position
+  double yaw_rad = 0.0;                                 ///< measured fingers' yaw (the rotary axis)
   Eigen::Vector3d contact_N = Eigen::Vector3d::Zero();  ///< force on the gripper
   double grip_N = 0.0;
   double opening_m = 0.0;
@@ -114,17 +137,19 @@ class AssemblyTask {
  public:
   enum class Step {
     kApproach,
+    kAlign,
     kDescend,
     kGrasp,
     kLift,
     kTransport,
+    kRotate,
     kInsert,
     kRelease,
     kRetract,
     kVerify,
     kDone
   };
-  static constexpr int kStepCount = 10;
+  static constexpr int kStepCount = 12;
   enum class Status { kRunning, kPaused, kAwaitingConfirm, kOperator, kSucceeded, kFailed };
   enum class Autonomy { kAuto, kConfirm, kManual };
 
@@ -172,6 +197,13 @@ class AssemblyTask {
   void fail(const char* why) noexcept;
   /// Heads for `goal` at `speed`; true once the tip has been within tolerance for settle_s.
   bool move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s, double dt) noexcept;
+  /// Turns the fingers towards `yaw` (the rotary axis' goal from this tick on).
+  void turn_to(double yaw) noexcept;
+  /// The fingers' yaw squaring them with the pin (align) and the pin with its bore (rotate).
+  double align_yaw(double from) const noexcept;
+  double rotate_yaw(double from) const noexcept;
+  /// The search's point: the bore's axis plus offset_y_ along the fingers' y.
+  Eigen::Vector2d search_xy() const noexcept;
   void insert_tick(const TaskSensors& s, double dt) noexcept;
 
   AssemblyTaskParams p_;
@@ -187,6 +219,9 @@ class AssemblyTask {
   Insert insert_ = Insert::kDescend;
   int tries_ = 0;                                                // search points tried
   double offset_y_ = 0.0;                                        // the current search point
+  double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();   // the rotary axis' (NaN: none yet)
+  double last_yaw_ = 0.0;                                        // the fingers' yaw at the last tick
+  double search_yaw_ = 0.0;                                      // ... when the insertion began
   double contact_z_ = std::numeric_limits<double>::quiet_NaN();  // where the last descent stopped
   Eigen::Vector2d retreat_xy_{0, 0};                             // the search's way up: from here ...
   double retreat_z_ = 0.0;                                       // ... to here (NaN: from where the tip is)

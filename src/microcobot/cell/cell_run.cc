@@ -189,14 +189,18 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   meter_->grip_limit_N = job.world.grip_force_limit_N;
   meter_->contact_limit_N = job.world.contact_force_limit_N;
   platform::Platform& p = *platform_;
-  const AssemblyGoal goal = assembly_goal(job);
+  AssemblyGoal goal = assembly_goal(job);
+  if (p.has_rotary()) {
+    goal.yaw_min_rad = p.yaw_min_rad();
+    goal.yaw_max_rad = p.yaw_max_rad();
+  }
   if (params_.mode == "auto") {
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
     p.set_operator([this](const platform::TickInfo& t) {
       TaskSensors s = read_task_sensors(*platform_, home_m_);
-      meter_->sample(s);
+      if (!finished_) meter_->sample(s);  // the cycle's measures end with it
       if (task_->step() == AssemblyTask::Step::kVerify) {
         // The cell's camera on the pin, at the precision the assisted person's guidance has.
         const double sd = params_.person.assist_vision_sd_m;
@@ -233,7 +237,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal,
                                                params_.mode == "assisted", seed);
     p.set_operator([this](const platform::TickInfo& t) {
-      meter_->sample(read_task_sensors(*platform_, home_m_));
+      if (!finished_) meter_->sample(read_task_sensors(*platform_, home_m_));
       meter_->time_step(person_->step(), t.dt_s);
       person_->act(t);
       if ((person_->done() || person_->gave_up()) && !finished_) {
@@ -244,9 +248,22 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     });
   } else {
     manual_ = std::make_unique<platform::PickPlaceOperator>(p, params_.manual);
-    p.set_operator([this](const platform::TickInfo& t) {
-      meter_->sample(read_task_sensors(*platform_, home_m_));
+    p.set_operator([this, goal](const platform::TickInfo& t) {
+      if (!finished_) meter_->sample(read_task_sensors(*platform_, home_m_));
       manual_->act(t);
+      // The scripted watchmaker has no dial: the cell turns the fingers for them, square with the
+      // pin until it is grasped, then with its bore (console input inactive: the haptic master
+      // keeps the XYZ coupling; its deadman is the dial's).
+      const auto& w = platform_->simulation().gripper->world_state();
+      const bool on_tray = w.phase == microworld::PartPhase::kOnSubstrate &&
+                           !platform_->simulation().gripper->world().inserted(w);
+      control::ConsoleInput dial;
+      dial.fresh = dial.deadman = !finished_;
+      dial.has_theta_goal = true;
+      dial.theta_goal_rad = square_yaw_goal(on_tray ? w.part_yaw_rad : goal.target_yaw_rad,
+                                            platform_->yaw_target_rad(), goal.yaw_min_rad, goal.yaw_max_rad);
+      dial.theta_speed_rad_s = params_.task.rotate_speed_rad_s;
+      platform_->set_console_input(dial);
       if ((manual_->done() || manual_->gave_up()) && !finished_) {
         finished_ = true;
         finished_at_s_ = t.t_s;

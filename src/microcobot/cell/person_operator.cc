@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "microcobot/core/error.h"
+#include "microcobot/microworld/pick_place_world.h"
 
 namespace mc::cell {
 
@@ -17,6 +18,10 @@ void PersonOperatorParams::validate() const {
   require_positive(assisted_tolerance_m, "assisted_tolerance_m");
   require_non_negative(assist_vision_sd_m, "assist_vision_sd_m");
   require_positive(z_tolerance_m, "z_tolerance_m");
+  require_non_negative(yaw_vision_sd_rad, "yaw_vision_sd_rad");
+  require(yaw_tolerance_rad > 0.0 && yaw_tolerance_rad <= 0.2, "yaw_tolerance_rad",
+          "must be within (0, 0.2] rad", yaw_tolerance_rad);
+  require_non_negative(assist_yaw_sd_rad, "assist_yaw_sd_rad");
   require_positive(still_m, "still_m");
   require(still_window_s > 0.0 && still_window_s <= 0.2, "still_window_s", "must be within (0, 0.2] s",
           still_window_s);
@@ -56,6 +61,7 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
       rng_(seed),
       xy_(params.person, rng_),
       z_(params.person, rng_),
+      yaw_(params.person, rng_),
       tremor_(params.person, operator_rate_Hz(platform.config()), seed ^ 0x7472656d6f72ULL),
       base_scale_(platform.config().teleop.motion_scale) {
   p_.validate();
@@ -72,6 +78,8 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
               : Eigen::Vector2d(tip.head<2>()),
       0.0);
   z_.reset({tip.z(), 0.0}, 0.0);
+  yaw_.reset({platform.yaw_target_rad(), 0.0}, 0.0);
+  yaw_arrived_rad_ = task.yaw_tolerance_rad;
   slider_ = goal.open_m;
   window_ticks_ =
       std::clamp(static_cast<int>(std::lround(p_.still_window_s * operator_rate_Hz(platform.config()))), 1,
@@ -84,6 +92,7 @@ void PersonOperator::enter(Step s, double t) noexcept {
   step_ = s;
   step_t0_ = t;
   rising_ = false;
+  rotated_ = false;
   held_since_ = -1.0;
   lowest_z_ = std::numeric_limits<double>::infinity();
   lowest_t_ = t;
@@ -101,7 +110,7 @@ void PersonOperator::let_go() noexcept {
   hand_.jog_m_s = 0.0;
   sim_.haptic->set_operator(hand_);
   console_ = {};
-  if (!haptic_) platform_.set_console_input(console_);
+  platform_.set_console_input(console_);  // the dial's deadman too
   platform_.set_fixtures({});
 }
 
@@ -175,6 +184,33 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
   return xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
 }
 
+bool PersonOperator::turn(double misalignment, double t) noexcept {
+  const double fingers = platform_.yaw_rad();
+  const auto to_square = [&](double seen_misalignment) {
+    return square_yaw_goal(fingers + seen_misalignment, fingers, goal_.yaw_min_rad, goal_.yaw_max_rad);
+  };
+  if (assisted_) {
+    // The cell's vision measures the misalignment once; the platform turns there.
+    if (!turning_) {
+      yaw_goal_ = to_square(misalignment + rng_.normal(0.0, p_.assist_yaw_sd_rad));
+      turning_ = true;
+    }
+    if (std::abs(fingers - yaw_goal_) > yaw_arrived_rad_) return false;
+    turning_ = false;
+    yaw_.reset({yaw_goal_, 0.0}, t);  // the dial where the rotor now is
+    return true;
+  }
+  // The rotor still where the dial put it before the person judges again.
+  if (!yaw_.ready(t) || std::abs(fingers - platform_.yaw_target_rad()) > 2e-3) return false;
+  const double goal = to_square(misalignment + rng_.normal(0.0, p_.yaw_vision_sd_rad));
+  return yaw_.aim({goal - fingers, 0.0}, p_.yaw_tolerance_rad, t,
+                  platform_.config().stage.rotary.max_speed_rad_s);
+}
+
+double PersonOperator::bore_misalignment() const noexcept {
+  return microworld::wrap_quarter_turn(goal_.target_yaw_rad - sim_.gripper->world_state().part_yaw_rad);
+}
+
 bool PersonOperator::climb(double z_goal, double tip_z, double tolerance_m, double t,
                            double width_m) noexcept {
   if (!z_.ready(t) || !tool_still()) return false;
@@ -195,12 +231,14 @@ void PersonOperator::assist() noexcept {
   f.height_z_m = step_height_z();
   switch (step_) {
     case Step::kApproach:
+    case Step::kAlign:
     case Step::kDescend:
     case Step::kGrasp:
     case Step::kLift:
       f.guide_xy_m = pin_seen_;  // the tips onto the pin vision found
       break;
     case Step::kTransport:
+    case Step::kRotate:
     case Step::kInsert:
     case Step::kRelease:
     case Step::kRetract:
@@ -241,9 +279,15 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
         climb(safe_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width());
       } else if (steer(part.head<2>() - tip.head<2>(), p_.pin_tolerance_m, t,
                        aim_width(p_.pin_tolerance_m))) {
-        enter(Step::kDescend, t);
+        enter(Step::kAlign, t);
       }
       break;
+    case Step::kAlign: {
+      // The fingers' flats square with the pin's faces.
+      const double pin_yaw = g.world_state().part_yaw_rad;
+      if (turn(microworld::wrap_quarter_turn(pin_yaw - g.yaw_rad()), t)) enter(Step::kDescend, t);
+      break;
+    }
     case Step::kDescend:
       if (climb(grasp_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) enter(Step::kGrasp, t);
       break;
@@ -277,13 +321,26 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
       break;
     case Step::kTransport:
       if (steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)))
+        enter(Step::kRotate, t);
+      break;
+    case Step::kRotate:
+      // The pin's faces square with the bore's; it turns about the tips, so it is aimed again after.
+      if (!rotated_) {
+        if (turn(bore_misalignment(), t)) {
+          rotated_ = true;
+          pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);  // vision looks again
+        }
+      } else if (steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t,
+                       aim_width(p_.bore_tolerance_m))) {
         enter(Step::kInsert, t);
+      }
       break;
     case Step::kInsert: {
       if (rising_) {
         // Off the rim: up, then a fresh look and aim before going down again.
         if (climb(rim_z_ + p_.jam_retreat_m, tip.z(), p_.z_tolerance_m, t) &&
-            steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)))
+            steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)) &&
+            turn(bore_misalignment(), t))
           rising_ = false;
         break;
       }
@@ -342,6 +399,7 @@ double PersonOperator::step_height_z() const noexcept {
       return grasp_z_;
     case Step::kLift:
     case Step::kTransport:
+    case Step::kRotate:
       return carry_z_;
     default:
       return safe_z_;  // approach, retract (and the steps without a stop)
@@ -350,12 +408,20 @@ double PersonOperator::step_height_z() const noexcept {
 
 void PersonOperator::apply(double t) noexcept {
   const Eigen::Vector2d tremor = tremor_.next();
+  // The console's dial (both masters: the haptic handle has no rotation): the rotor follows the
+  // dial's angle; with shared control, the platform's own turn.
+  console_.fresh = console_.deadman = true;
+  console_.has_theta_goal = true;
+  console_.theta_goal_rad = assisted_ && turning_ ? yaw_goal_ : yaw_.position(t).x();
+  console_.theta_speed_rad_s = platform_.config().stage.rotary.max_speed_rad_s;
   if (haptic_) {
     const Eigen::Vector2d h = xy_.position(t) + tremor;
     hand_.hand_m = {h.x(), h.y()};
     hand_.jog_m_s = z_.velocity(t).x();
     sim_.haptic->set_operator(hand_);
     sim_.tweezers->set_operator_closing(pinch_);
+    console_.active = false;  // the handle holds the XYZ coupling
+    platform_.set_console_input(console_);
     return;
   }
   // The joystick: the person's intended motion as a rate, its deflection trembling too.

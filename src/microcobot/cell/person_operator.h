@@ -15,7 +15,11 @@
 /// (assembly_task.h) so that the modes compare step by step: approach over the pin, descend,
 /// grasp, lift, transport the pin over its bore, insert (down; a contact felt above the bore's
 /// depth means the pin sits on the rim: up a little, look again, re-aim, down again), release,
-/// retract.
+/// retract. Orientation (the rotary axis under the gripper): the person turns the console's dial
+/// (the rotor follows its angle) to square the open fingers with the pin on the tray (align) and the
+/// carried pin with its bore (rotate), judging the edges' directions by eye (yaw_vision_sd_rad),
+/// in aimed sub-movements of the dial like any other; a pin on the rim makes them look at its
+/// orientation again too.
 ///
 /// Assisted (shared control): the cell's vision gives the pin's position and, once it is held,
 /// its offset from the finger tips (within assist_vision_sd_m, measured once per step); the platform
@@ -23,12 +27,15 @@
 /// funnel round the rim and the coarse-far/fine-near scaling (control/virtual_fixtures.h). The
 /// person trusts the guidance: they aim within the fixture's capture radius, not at the last
 /// micrometre; the step's working height is a stop the person rolls into (grasping, carrying,
-/// clear of the pins). Everything else (the person, the seeds, the parts) is the manual run's.
+/// clear of the pins); the turns are the platform's, to the orientations the cell's vision
+/// measures (within assist_yaw_sd_rad), the person holding the deadman. Everything else (the
+/// person, the seeds, the parts) is the manual run's.
 ///
 /// act() runs as the platform's operator task: real-time safe (no allocation, lock, exception,
 /// I/O). The person lets go of everything when done or when a step times out (gave up).
 
 #include <array>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -56,7 +63,15 @@ struct PersonOperatorParams {
   /// person no longer has to: twice that turns a minimum-jerk move (peak 1.875x its mean speed)
   /// into the stage's pace most of the way; the console's joystick allows 1 mm/s.
   double assisted_pace_m_s = 1.0e-3;
-  double z_tolerance_m = 10e-6;      ///< heights judged by eye (the depth of field)
+  double z_tolerance_m = 10e-6;  ///< heights judged by eye (the depth of field)
+  /// Orientations judged by eye: two edges' directions compared through the microscope (SD), and
+  /// the misalignment the person accepts. A square pin in its bore tolerates 1.15 deg at the
+  /// least (300 um, 3 um of clearance; microworld/pick_place_world.h).
+  double yaw_vision_sd_rad = 5e-3;  ///< 0.3 deg
+  double yaw_tolerance_rad = 9e-3;  ///< 0.5 deg
+  /// Assisted: the cell's vision of an orientation (SD): a 100 um edge located to 0.1 um at both
+  /// ends (assist_vision_sd_m) gives 1.4 mrad; rounded up.
+  double assist_yaw_sd_rad = 2e-3;
   double still_m = 5e-6;             ///< the tool seen still: it moved less than this ...
   double still_window_s = 0.1;       ///< ... over this (one tremor period: tremor averages out)
   double jam_margin_m = 20e-6;       ///< a contact this far above the bore's depth: on the rim
@@ -86,6 +101,9 @@ struct PersonOperatorParams {
     v("assisted_tolerance_m", assisted_tolerance_m);
     v("assisted_pace_m_s", assisted_pace_m_s);
     v("z_tolerance_m", z_tolerance_m);
+    v("yaw_vision_sd_rad", yaw_vision_sd_rad);
+    v("yaw_tolerance_rad", yaw_tolerance_rad);
+    v("assist_yaw_sd_rad", assist_yaw_sd_rad);
     v("still_m", still_m);
     v("still_window_s", still_window_s);
     v("jam_margin_m", jam_margin_m);
@@ -123,7 +141,7 @@ class PersonOperator {
   std::string_view give_up_reason() const noexcept { return reason_; }
   int clutches() const noexcept { return clutches_; }
   int jams() const noexcept { return jams_; }
-  int submovements() const noexcept { return xy_.submovements() + z_.submovements(); }
+  int submovements() const noexcept { return xy_.submovements() + z_.submovements() + yaw_.submovements(); }
 
  private:
   void enter(Step s, double t) noexcept;
@@ -153,6 +171,13 @@ class PersonOperator {
   /// The tool seen still: moved less than still_m over the last still_window_s (a person waits
   /// for the stage to arrive before judging where it is).
   bool tool_still() const noexcept;
+  /// Turns the fingers by what the person sees of `misalignment` (true, modulo 90 deg: the fingers
+  /// against the pin on the tray when aligning, the carried pin against its bore when rotating);
+  /// true once it is seen within yaw_tolerance_rad. Assisted: the platform turns by what its
+  /// vision sees, true once it has arrived.
+  bool turn(double misalignment, double t) noexcept;
+  /// The carried pin's misalignment with its bore (true, modulo 90 deg).
+  double bore_misalignment() const noexcept;
 
   platform::Platform& platform_;
   const platform::SimulatedDevices& sim_;
@@ -162,6 +187,7 @@ class PersonOperator {
   bool haptic_;
   Rng rng_;
   Reach xy_, z_;  // the hand in the plane (haptic: hand metres; console: stage metres), the height
+  Reach yaw_;     // the console's dial (x: the rotor's angle it asks for) [rad]
   Tremor tremor_;
   double base_scale_;
   double grasp_z_, safe_z_, carry_z_, inserted_z_;
@@ -181,8 +207,12 @@ class PersonOperator {
   double held_since_ = -1.0;  // grip first felt (the person stops closing a reaction later)
   Eigen::Vector2d pin_offset_seen_ = Eigen::Vector2d::Zero();  // pin - tips, as vision saw it
   Eigen::Vector2d pin_seen_ = Eigen::Vector2d::Zero();         // the pin on the tray, seen
-  double rim_z_ = 0.0;                  // tip height at which the carried pin meets the plate
-  static constexpr int kHistory = 256;  // tip positions, one per operator tick (ring)
+  double rim_z_ = 0.0;  // tip height at which the carried pin meets the plate
+  double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();  // assisted: the platform's turn ...
+  bool turning_ = false;                                        // ... under way
+  bool rotated_ = false;                                        // rotate: the turn is done
+  double yaw_arrived_rad_ = 0.0;                                // assisted: a turn's end (the task's)
+  static constexpr int kHistory = 256;                          // tip positions, one per operator tick (ring)
   std::array<Eigen::Vector3d, kHistory> tips_{};
   int tip_count_ = 0, window_ticks_ = 1;
   Eigen::Vector2d tool_xy_ = Eigen::Vector2d::Zero();  // the finger tips, this tick

@@ -24,10 +24,12 @@ namespace mc::cell {
 /// The autonomy of each step of AssemblyTask, by the step's name.
 struct TaskStepsParams {
   std::string approach = "auto";
+  std::string align = "auto";
   std::string descend = "auto";
   std::string grasp = "auto";
   std::string lift = "auto";
   std::string transport = "auto";
+  std::string rotate = "auto";
   std::string insert = "auto";
   std::string release = "auto";
   std::string retract = "auto";
@@ -36,10 +38,12 @@ struct TaskStepsParams {
   template <class V>
   void visit(V& v) {
     v("approach", approach);
+    v("align", align);
     v("descend", descend);
     v("grasp", grasp);
     v("lift", lift);
     v("transport", transport);
+    v("rotate", rotate);
     v("insert", insert);
     v("release", release);
     v("retract", retract);

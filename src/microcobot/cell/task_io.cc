@@ -9,6 +9,7 @@ TaskSensors read_task_sensors(const platform::Platform& p, const Eigen::Vector3d
   s.contact_N = {f.x, f.y, f.z};
   s.grip_N = p.gripper().grip_force_N();
   s.opening_m = p.gripper().opening_m();
+  s.yaw_rad = p.yaw_rad();
   return s;
 }
 
@@ -20,6 +21,8 @@ AssemblyGoal assembly_goal(const AssemblyJob& job) {
   goal.hole_depth_m = job.world.hole_depth_m;
   goal.clearance_m = job.clearance_m;
   goal.open_m = job.world.gripper.max_opening_m;
+  goal.part_yaw_rad = job.nominal_part_yaw_rad;
+  goal.target_yaw_rad = job.target_yaw_rad;
   return goal;
 }
 

@@ -9,6 +9,9 @@
 /// stroke seen as an arc, +-stroke / (2 r) (the gripper's cables keep a real one within a turn
 /// anyway). Defaults and their sources: docs/parameters.md, "Rotary axis".
 ///
+/// Like the other axes, the platform parks it once it has arrived (platform_config.h,
+/// stage.park_after_s).
+///
 /// RotaryTarget is its command: the console's rotation goal (or rate) moved at a bounded slew,
 /// only while the console's deadman is held and its commands are fresh; otherwise the target
 /// stays where it is and the axis holds there. Never allocates; noexcept.

@@ -266,6 +266,7 @@ void Platform::slave_control_task() noexcept {
       velocity[i] = 0.0;
     }
   }
+  park_still_axes(target, all_measured);
   stage_->update(target, velocity, all_measured);
 }
 

@@ -209,6 +209,9 @@ class Platform {
   /// The rotary axis (issue #29 point 2): present, its measured angle and its target [rad] (the
   /// console's theta commands move the target, with the console's deadman; hold() holds it).
   bool has_rotary() const noexcept { return devices_.rotary != nullptr; }
+  /// Axis i (3: the rotary axis) parked on its target: its loop off, its voltage held
+  /// (stage.park_after_s).
+  bool parked(int i) const noexcept { return i < stage_->axis_count() && stage_->parked(i); }
   double yaw_rad() const noexcept;
   double yaw_target_rad() const noexcept;
   /// The target's travel (the axis' end stops less a margin) [rad]; 0, 0 without the axis.
@@ -289,6 +292,9 @@ class Platform {
                       std::array<double, StageController::kMaxAxes>& velocity,
                       std::array<double, StageController::kMaxAxes>& measured) noexcept;
   void rotary_drive(double dt_s) noexcept;
+  /// Parks the axes that have arrived on still targets, resumes those whose target moved.
+  void park_still_axes(const std::array<double, StageController::kMaxAxes>& target,
+                       const std::array<double, StageController::kMaxAxes>& measured) noexcept;
 
   PlatformConfig config_;
   std::unique_ptr<stickslip::ActuatorModel> model_;
@@ -301,6 +307,10 @@ class Platform {
   TrackingErrorStats tracking_;
   std::unique_ptr<control::Teleoperation> teleop_;
   std::unique_ptr<control::RotaryTarget> rotary_target_;  ///< null without the rotary axis
+  /// Parking (stage.park_after_s): slave ticks each axis has stood on its still target, and the
+  /// targets of the last slave tick (the rotary axis' as its arc).
+  std::array<int, StageController::kMaxAxes> still_ticks_{};
+  std::array<double, StageController::kMaxAxes> last_target_m_{};
   Watchdog haptic_watchdog_;
   Watchdog tweezers_watchdog_;
   std::uint64_t haptic_seen_ = 0, tweezers_seen_ = 0;

@@ -92,6 +92,11 @@ void PlatformConfig::validate() const {
             "home_m", "must be finite");
     if (stage.xy_sensor != "encoders" && stage.xy_sensor != "vision")
       throw InvalidParams("xy_sensor", "'" + excerpt(stage.xy_sensor) + "' is not encoders or vision");
+    require(std::isfinite(stage.park_after_s) && stage.park_after_s >= 0.0 && stage.park_after_s <= 60.0,
+            "park_after_s", "must be within [0, 60] s", stage.park_after_s);
+    require(std::isfinite(stage.park_tolerance_m) && stage.park_tolerance_m > 0.0 &&
+                stage.park_tolerance_m <= 1e-6,
+            "park_tolerance_m", "must be within (0, 1 um]", stage.park_tolerance_m);
     if (stage.vision_xy() && !camera.enabled)
       throw InvalidParams("xy_sensor", "vision needs the camera (camera.enabled: true)");
   });

@@ -84,6 +84,14 @@ struct StageParams {
   /// The rotary axis under the gripper (issue #29 point 2; control/rotary_axis.h): on by default
   /// on the simulated platform; a driver set has one when its drivers bring it.
   control::RotaryAxisParams rotary;
+  /// An axis whose target has stood still, and which has been within park_tolerance_m of it for
+  /// park_after_s, is parked: its loop off, its drive held at the last voltage. Friction holds a
+  /// stick-slip slider where it is (so a real controller ends its "hold time": SmarAct MCS2's
+  /// hold time, PI's servo-off on target); a parked simulated axis at rest costs no integration.
+  /// A target that moves resumes the loop from there. 0 s never parks. The rotary axis' tolerance
+  /// is its arc (10 nm: 2 urad at 5 mm).
+  double park_after_s = 0.1;
+  double park_tolerance_m = 10e-9;
   bool vision_xy() const { return xy_sensor == "vision"; }
 
   template <class V>
@@ -99,6 +107,8 @@ struct StageParams {
     v("home_y_m", home_y_m);
     v("home_z_m", home_z_m);
     v("rotary", rotary);
+    v("park_after_s", park_after_s);
+    v("park_tolerance_m", park_tolerance_m);
   }
   static control::TrackingParams default_tracking() {
     control::TrackingParams p;  // 10 kHz: updated at every loop tick (LoopParams.base_rate_Hz)

@@ -2,6 +2,7 @@
 // console's theta commands under the console's deadman, its controller on the stage controller's
 // fourth channel (the arc at the contact radius), its drive, its hold.
 #include <algorithm>
+#include <cmath>
 
 #include "microcobot/platform/platform.h"
 
@@ -40,6 +41,27 @@ void Platform::rotary_control(std::array<double, StageController::kMaxAxes>& tar
   measured[3] = devices_.rotary->position_m();
   target[3] = r.arc_m(rotary_target_->target_rad());
   velocity[3] = rotary_target_->velocity_rad_s() * r.radius_m;
+}
+
+void Platform::park_still_axes(const std::array<double, StageController::kMaxAxes>& target,
+                               const std::array<double, StageController::kMaxAxes>& measured) noexcept {
+  const auto& st = config_.stage;
+  const int after = static_cast<int>(std::lround(st.park_after_s * config_.loop.slave_rate_Hz()));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(stage_->axis_count()); ++i) {
+    const int axis = static_cast<int>(i);
+    // Open-loop runs and vision's x, y are not the controller's to park.
+    const bool parkable = after > 0 && !(i < 3 && (steppers_[i]->running() || (vision_xy_ && i < 2)));
+    const bool still = target[i] == last_target_m_[i];
+    last_target_m_[i] = target[i];
+    if (!parkable || !still) {
+      still_ticks_[i] = 0;
+      stage_->unpark(axis, measured[i]);
+      continue;
+    }
+    if (stage_->parked(axis)) continue;
+    still_ticks_[i] = std::abs(measured[i] - target[i]) <= st.park_tolerance_m ? still_ticks_[i] + 1 : 0;
+    if (still_ticks_[i] >= after) stage_->park(axis);
+  }
 }
 
 void Platform::rotary_drive(double dt_s) noexcept {

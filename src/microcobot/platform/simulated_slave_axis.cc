@@ -42,6 +42,17 @@ void SimulatedSlaveAxis::update(double dt_s) noexcept {
         block_.direction < 0 ? stickslip::Direction::kBackward : stickslip::Direction::kForward);
   }
   const double vmax = max_voltage_V();
+  // A drive held at the model's own voltage on a model at rest changes nothing: a parked axis
+  // (its loop off, the voltage held) costs no integration.
+  bool held = active() && model_.at_rest(state_);
+  for (int i = 0; i < block_.count && held; ++i)
+    held = block_.segments[i].corners == 0 && block_.segments[i].end_V == state_.u_V;
+  if (held) {
+    state_.t_s += n * model_.dt_s();
+    block_ = DriveBlock{};
+    measured_m_ = sensor_.measure(true_position_m());
+    return;
+  }
   for (int i = 0; i < n; ++i) {
     // Past the block's end the last voltage holds (a DAC keeps its output).
     stickslip::DriveSegment d =

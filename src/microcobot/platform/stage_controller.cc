@@ -47,6 +47,7 @@ void StageController::update_axes(const std::array<double, kMaxAxes>& target_m,
                                   const std::array<double, kMaxAxes>& measured_m, int count) noexcept {
   for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
     const auto k = i;
+    if (parked_[i]) continue;
     if (track_[i]) {
       auto& t = *track_[i];
       // The first tick (and the first after an emergency stop) starts from where the axis is.
@@ -71,7 +72,7 @@ void StageController::update_axes(const std::array<double, kMaxAxes>& target_m,
 
 DriveBlock StageController::drive(int i, double measured_m) noexcept {
   const auto iu = static_cast<std::size_t>(i);
-  if (fast_ && started_ && !stopped_ && track_[iu]) {
+  if (fast_ && started_ && !stopped_ && track_[iu] && !parked_[iu]) {
     const auto& r = ref_[iu];
     track_[iu]->set_reference(control::ReferenceSample{r.x_m + r.v_m_s * since_update_s_[iu], r.v_m_s, 0.0});
     track_[iu]->update(measured_m);
@@ -82,6 +83,13 @@ DriveBlock StageController::drive(int i, double measured_m) noexcept {
 
 DriveBlock StageController::drive(int i) noexcept {
   auto& buf = samples_[static_cast<std::size_t>(i)];
+  if (parked_[static_cast<std::size_t>(i)]) {
+    for (auto& d : buf) d = stickslip::DriveSegment::to(parked_V_[static_cast<std::size_t>(i)]);
+    DriveBlock b;
+    b.segments = buf.data();
+    b.count = static_cast<int>(buf.size());
+    return b;
+  }
   if (auto* t = track_[static_cast<std::size_t>(i)].get()) {
     for (auto& d : buf) d = t->next_drive(sample_period_s_);
     const auto& op = t->operating_point();
@@ -105,7 +113,22 @@ DriveBlock StageController::drive(int i) noexcept {
   return b;
 }
 
+void StageController::park(int i) noexcept {
+  const auto iu = static_cast<std::size_t>(i);
+  if (!track_[iu] || parked_[iu] || stopped_) return;
+  parked_V_[iu] = last_voltage_V(i);
+  parked_[iu] = true;
+}
+
+void StageController::unpark(int i, double measured_m) noexcept {
+  const auto iu = static_cast<std::size_t>(i);
+  if (!parked_[iu]) return;
+  parked_[iu] = false;
+  track_[iu]->reset(measured_m, parked_V_[iu]);
+}
+
 void StageController::emergency_stop() noexcept {
+  parked_.fill(false);
   for (auto& c : ctrl_)
     if (c) c->emergency_stop();
   for (auto& t : track_)

@@ -54,6 +54,13 @@ class StageController {
   }
   /// Every axis to 0 V; they stay stopped until the next update() with a target.
   void emergency_stop() noexcept;
+  /// Parks axis i (tracking controllers only): its loop off, its drive held at the last voltage,
+  /// which a stick-slip axis holds by friction alone (a controller's "hold time" ended, as in
+  /// SmarAct's MCS2); update() leaves it alone until unpark(), which resumes the loop from
+  /// `measured_m` at that voltage without a jump. Real-time safe.
+  void park(int i) noexcept;
+  void unpark(int i, double measured_m) noexcept;
+  bool parked(int i) const noexcept { return parked_[static_cast<std::size_t>(i)]; }
 
   /// The hybrid controller of axis i (null when tracking).
   const control::PositionController* axis(int i) const { return ctrl_[static_cast<std::size_t>(i)].get(); }
@@ -73,6 +80,8 @@ class StageController {
   std::array<double, kMaxAxes> since_update_s_{};         ///< time since that target (loop ticks)
   double tick_s_ = 0.0;                                   ///< the loop tick: samples x sample period
   bool fast_ = false;                                     ///< tracking at the loop's rate
+  std::array<bool, kMaxAxes> parked_{};
+  std::array<double, kMaxAxes> parked_V_{};
   bool started_ = false;
   std::array<std::vector<stickslip::DriveSegment>, kMaxAxes> samples_;
   double sample_period_s_;

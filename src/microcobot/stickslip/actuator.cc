@@ -171,6 +171,19 @@ void ActuatorModel::step(ActuatorState& s, const DriveSegment& drive) const noex
   }
 }
 
+bool ActuatorModel::at_rest(const ActuatorState& s) const noexcept {
+  constexpr double kRest_m = 1e-12, kRest_m_s = 1e-9;  // a picometre; a picometre per millisecond
+  const double ff = p_.slider.attached ? s.friction_N : 0.0;
+  const double ea = s.x1a_m - (ka_ * s.uh_m - ff) * inv_ka_;
+  const double eb = s.x1b_m - (kb_ * s.uh_m - ff) * inv_kb_;
+  const double va = s.v1a_m_s * inv_wa_, vb = s.v1b_m_s * inv_wb_;
+  const double rest_sq = kRest_m * kRest_m;
+  if (ea * ea + va * va > rest_sq || eb * eb + vb * vb > rest_sq) return false;
+  for (std::size_t i = 0; i < 2; ++i)
+    if (std::abs(s.v2_m_s[i]) > kRest_m_s || std::abs(s.a2_m_s2[i]) * dt_ > kRest_m_s) return false;
+  return !s.diverged;
+}
+
 void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k) const noexcept {
   // A sub-step is one chain of dependent operations (PE -> relative motion -> strain -> friction
   // -> velocity -> next sub-step), so it is latency-bound: no division by a constant (reciprocals

@@ -75,6 +75,11 @@ class ActuatorModel {
   /// Slider position x2 [m]: the mass-weighted mean of its two parts (docs/model.md).
   double slider_position(const ActuatorState& s) const noexcept;
   double slider_velocity(const ActuatorState& s) const noexcept;
+  /// True when a step at the state's own voltage would leave it as it is, to within a picometre:
+  /// the PE modes at their static equilibrium and still, the slider's parts still. A drive held
+  /// constant brings the model there within milliseconds (the PE's ringing and the contact's
+  /// oscillation are damped); a simulated axis then skips its integration (a parked axis).
+  bool at_rest(const ActuatorState& s) const noexcept;
   /// Mass fraction of slider part a and b.
   std::array<double, 2> mass_fractions() const { return c_; }
 
