@@ -46,7 +46,7 @@ py::dict camera_model(const std::string& objective) {
 py::array render(const std::string& scene, const std::string& objective, double focus_um,
                  std::optional<double> exposure_ms, std::optional<double> gain, int bit_depth,
                  const std::string& illumination, std::uint64_t seed, std::uint64_t frame,
-                 std::optional<std::array<double, 3>> tool_um) {
+                 std::optional<std::array<double, 3>> tool_um, double tool_yaw_deg, double part_yaw_deg) {
   const platform::PlatformConfig config = platform::scene_config(scene);
   vision::CameraParams cam;
   cam.objective = vision::objective_by_name(objective);
@@ -58,6 +58,12 @@ py::array render(const std::string& scene, const std::string& objective, double 
   if (tool_um)
     pose.tool_x_m = (*tool_um)[0] * 1e-6, pose.tool_y_m = (*tool_um)[1] * 1e-6,
     pose.tool_z_m = (*tool_um)[2] * 1e-6;
+  if (!std::isfinite(tool_yaw_deg) || std::abs(tool_yaw_deg) > 360.0)
+    throw InvalidInput("tool_yaw_deg: must be within [-360, 360], not " + std::to_string(tool_yaw_deg));
+  if (!std::isfinite(part_yaw_deg) || std::abs(part_yaw_deg) > 360.0)
+    throw InvalidInput("part_yaw_deg: must be within [-360, 360], not " + std::to_string(part_yaw_deg));
+  pose.tool_yaw_rad = tool_yaw_deg * M_PI / 180.0;
+  pose.part_yaw_rad = part_yaw_deg * M_PI / 180.0;
   cam.view_center_x_m = pose.part_x_m;
   cam.view_center_y_m = pose.part_y_m;
   if (!std::isfinite(focus_um)) throw InvalidInput("focus_um: must be finite");
@@ -208,10 +214,11 @@ void bind_vision(py::module_& m) {
   m.def(
       "render", &render, "scene"_a = "pick-place", "objective"_a = "20x", "focus_um"_a = 0.0,
       "exposure_ms"_a = py::none(), "gain"_a = py::none(), "bit_depth"_a = 12, "illumination"_a = "reflected",
-      "seed"_a = 1, "frame"_a = 0, "tool_um"_a = py::none(),
+      "seed"_a = 1, "frame"_a = 0, "tool_um"_a = py::none(), "tool_yaw_deg"_a = 0.0, "part_yaw_deg"_a = 0.0,
       "One camera frame of a scene (pick-place, pin-in-hole, optical-trap or a YAML file) seen from the top, "
       "centred on the part: an H x W array, uint8 for 8-bit frames, else uint16. Deterministic in (seed, "
-      "frame).");
+      "frame). tool_yaw_deg turns the fingers about the tool point (the rotary axis), part_yaw_deg the "
+      "part.");
   m.def(
       "sharpness",
       [](const py::array& frame, std::optional<std::array<int, 4>> roi, const std::string& metric) {

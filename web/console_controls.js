@@ -1,11 +1,13 @@
 // The operator's inputs: the deadman (button, Space, gamepad shoulder), the joystick (touch pad,
 // arrows/WASD, gamepad stick), Z (buttons, PageUp/PageDown, wheel, right stick), the gripper
-// (slider, gamepad trigger), and the command they make, sent at 30 Hz while in control. Goals
+// (slider, gamepad trigger), the rotary axis under it (buttons, ',' and '.', or a goal from the
+// readout's θ row), and the command they make, sent at 30 Hz while in control. Goals
 // (click-to-go, go-to, step jog, saved positions) ride on the same command: the server applies
 // them, like every motion, only while the deadman is held.
 "use strict";
 
 const keys = new Set();
+const kThetaRate = 0.05;  // rad/s (2.9 deg/s): the buttons' and keys' turn
 function holdDeadman(el) {
   const on = (e) => { e.preventDefault(); mc.input.deadmanButton = true; };
   const off = () => { mc.input.deadmanButton = false; };
@@ -40,6 +42,8 @@ function holdButton(el, field, value) {
 }
 holdButton($("z-up"), "zButton", 1);
 holdButton($("z-down"), "zButton", -1);
+holdButton($("theta-ccw"), "thetaButton", 1);
+holdButton($("theta-cw"), "thetaButton", -1);
 
 $("speed").addEventListener("input", () => { $("speed-out").textContent = $("speed").value + " µm/s"; });
 function speed() { return Number($("speed").value) * 1e-6; }
@@ -122,6 +126,16 @@ function currentCommand() {
     cmd.goal_speed_m_s = v;
   }
   if (mc.input.gripperTouched) cmd.gripper_opening_m = mc.input.gripper;
+  // The rotary axis (when the scene has one): a turn at the dial's rate, or a goal from the readout.
+  if (mc.scene && mc.scene.theta_max_rad > mc.scene.theta_min_rad) {
+    const turn = (mc.input.thetaButton || 0) + k(",", "<") - k(".", ">");
+    if (turn !== 0) {
+      mc.input.thetaGoal = null;
+      cmd.theta_rate_rad_s = Math.max(-1, Math.min(1, turn)) * kThetaRate;
+    } else if (mc.input.thetaGoal !== null && mc.input.thetaGoal !== undefined) {
+      cmd.theta_goal_rad = mc.input.thetaGoal;
+    }
+  }
   Object.assign(cmd, mc.microscopeCommand ? mc.microscopeCommand() : {});  // focus, objective, exposure, gain
   return cmd;
 }

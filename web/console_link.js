@@ -88,7 +88,8 @@ const mc = (window.mc = {
   scene: null,      // /platform/scene: geometry and limits
   feedback: null,   // /console/feedback: forces and the vibrotactile channel
   messages: [],     // every status message the server sent, as text
-  input: {deadman: false, joystick: [0, 0], zJog: 0, goal: null, gripper: 600e-6, gripperTouched: false},
+  input: {deadman: false, joystick: [0, 0], zJog: 0, goal: null, gripper: 600e-6, gripperTouched: false,
+          thetaGoal: null, thetaButton: 0},
 });
 const $ = (id) => document.getElementById(id);
 const clamp = (v, lo, hi) => Math.max(lo, Math.min(hi, v));

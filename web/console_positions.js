@@ -1,4 +1,5 @@
-// Where the stage is and where it should go: the measured X/Y/Z readout (µm), a go-to entry,
+// Where the stage is and where it should go: the measured X/Y/Z readout (µm) and the rotary axis'
+// θ (degrees, with 1 and 5 degree steps, when the scene has one), a go-to entry,
 // step jog buttons (1, 10, 100 µm per axis) and saved positions (kept in the browser's
 // localStorage, per scene kind). Each sets the command's goal, as click-to-go does; the server
 // moves toward it only while the deadman is held, and the hint under the readout says so.
@@ -50,6 +51,30 @@ function goalBase() {
     tr.append(th, value, jog);
     $("readout").append(tr);
   }
+  // The rotary axis: its yaw in degrees; a step sets a goal from the pending one, else the target.
+  const tr = document.createElement("tr"), th = document.createElement("th");
+  const value = document.createElement("td"), jog = document.createElement("td");
+  tr.id = "theta-row";
+  tr.hidden = true;
+  th.textContent = "θ";
+  value.id = "pos-theta";
+  value.className = "num";
+  value.textContent = "—";
+  jog.className = "jog";
+  for (const step of [-5, -1, 1, 5]) {
+    const b = document.createElement("button");
+    b.textContent = (step > 0 ? "+" : "−") + Math.abs(step) + "°";
+    b.title = `θ ${step > 0 ? "+" : "−"}${Math.abs(step)}° (hold the deadman to turn)`;
+    b.addEventListener("click", () => {
+      const t = mc.telemetry, sc = mc.scene;
+      if (!t || !sc) return;
+      const base = mc.input.thetaGoal ?? t.target_theta_rad;
+      mc.input.thetaGoal = clamp(base + step * Math.PI / 180, sc.theta_min_rad, sc.theta_max_rad);
+    });
+    jog.append(b);
+  }
+  tr.append(th, value, jog);
+  $("readout").append(tr);
 })();
 
 // Go to: X, Y, Z in µm; an empty field keeps that axis where the stage is told to be.
@@ -139,6 +164,14 @@ listen("/platform/telemetry", (t) => {
   for (const name of kAxes) {
     const v = t["measured_" + name + "_m"];
     $("pos-" + name).textContent = isNum(v) ? fmtUm(v) : "—";
+  }
+  const rotary = !!(mc.scene && mc.scene.theta_max_rad > mc.scene.theta_min_rad);
+  $("theta-row").hidden = $("theta-controls").hidden = !rotary;
+  if (rotary && isNum(t.measured_theta_rad)) {
+    $("pos-theta").textContent = (t.measured_theta_rad * 180 / Math.PI).toFixed(3) + "°";
+    // A goal reached is let go: the target stays there, and no stale goal outlives it.
+    const g = mc.input.thetaGoal;
+    if (g !== null && g !== undefined && Math.abs(t.target_theta_rad - g) < 1e-9) mc.input.thetaGoal = null;
   }
   const g = mc.input.goal, hint = $("goal-hint");
   let text, cls = "";

@@ -16,7 +16,9 @@ def render(scene: str = "pick-place",
            illumination: str = "reflected",
            seed: int = 1,
            frame: int = 0,
-           tool_um: Optional[Tuple[float, float, float]] = None) -> npt.NDArray[Any]: ...
+           tool_um: Optional[Tuple[float, float, float]] = None,
+           tool_yaw_deg: float = 0.0,
+           part_yaw_deg: float = 0.0) -> npt.NDArray[Any]: ...
 
 # ---- what the frames measure (issue #28) ----
 Roi = Tuple[int, int, int, int]  # x, y, width, height

@@ -203,3 +203,17 @@ def test_visual_servo_holds_when_the_feature_is_lost_and_refuses_bad_input():
         servo.set_target(1300.0, 10.0)
     with pytest.raises(ValueError, match="finite"):
         servo.step(600.0, 520.0, True, float("nan"), 0.0)
+
+
+def test_the_rotary_axis_turns_the_fingers_about_the_tool_point_and_the_part_with_them():
+    """Issue #29 point 2: the camera sees the fingers turned about the tool point (the rotary axis
+    under the gripper) and the part at its yaw; turning moves grey level around, it does not add or
+    remove any (the same objects, the same areas), and the turned fingers' tips end where the turn
+    puts them."""
+    kw = dict(scene="pin-in-hole", objective="5x", focus_um=300.0, bit_depth=8, tool_um=(0.0, 0.0, 320.0))
+    flat = microcobot.vision.render(**kw).astype(np.float64)
+    turned = microcobot.vision.render(**kw, tool_yaw_deg=30.0, part_yaw_deg=30.0).astype(np.float64)
+    assert abs(turned.mean() - flat.mean()) < 0.005 * flat.mean()
+    assert np.abs(turned - flat).mean() > 0.5  # something moved
+    with pytest.raises(ValueError, match="tool_yaw_deg"):
+        microcobot.vision.render(**kw, tool_yaw_deg=float("nan"))

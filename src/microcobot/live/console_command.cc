@@ -70,6 +70,15 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else if (key == "gripper_opening_m") {
       c.gripper_opening_m = finite(kChannel, value, key);
       c.has_gripper = true;
+    } else if (key == "theta_goal_rad" || key == "theta_rate_rad_s") {
+      if (limits.max_theta_speed_rad_s <= 0.0) refuse(kChannel, key, "there is no rotary axis");
+      const double v = finite(kChannel, value, key);
+      if (key == "theta_goal_rad") {
+        c.theta_goal_rad = std::clamp(v, limits.min_theta_rad, limits.max_theta_rad);
+        c.has_theta_goal = true;
+      } else {
+        c.theta_rate_rad_s = std::clamp(v, -limits.max_theta_speed_rad_s, limits.max_theta_speed_rad_s);
+      }
     } else if (key == "focus_z_m") {
       c.focus_z_m = std::clamp(finite(kChannel, value, key), limits.focus_min_m, limits.focus_max_m);
       c.has_focus = true;
@@ -90,7 +99,7 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else {
       refuse(kChannel, key,
              "is not a known key (deadman, velocity_m_s, goal_m, goal_px, goal_speed_m_s, gripper_opening_m, "
-             "focus_z_m, objective, exposure_s, gain)");
+             "theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain)");
     }
   }
   // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.

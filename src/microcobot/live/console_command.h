@@ -19,6 +19,10 @@ struct ConsoleLimits {
   std::array<double, 3> min_m = {-6e-3, -6e-3, -6e-3};
   std::array<double, 3> max_m = {6e-3, 6e-3, 6e-3};
   double max_opening_m = 600e-6;
+  /// The rotary axis' travel and speed (issue #29 point 2; both 0: there is none).
+  double min_theta_rad = 0.0;
+  double max_theta_rad = 0.0;
+  double max_theta_speed_rad_s = 0.0;
   /// The microscope's focus travel (focal plane height) and turret positions (0: no camera).
   double focus_min_m = -0.5e-3;
   double focus_max_m = 2e-3;
@@ -46,6 +50,10 @@ struct ConsoleCommand {
   std::array<double, 2> goal_px{};
   bool has_gripper = false;
   double gripper_opening_m = 0.0;
+  /// The rotary axis: to a yaw (the gripper's, world frame), or at the dial's rate; with the deadman.
+  bool has_theta_goal = false;
+  double theta_goal_rad = 0.0;
+  double theta_rate_rad_s = 0.0;
   /// The microscope (issue #27): focal plane height to go to, objective to turn in, the camera's
   /// exposure and gain. Each optional; they need control but not the deadman (nothing of the
   /// slave moves).
@@ -88,7 +96,8 @@ inline bool is_task_action(ConsoleAction a) {
 
 /// Parses `{"deadman": bool, "velocity_m_s": [vx, vy, vz], "goal_m": [x, y, z] (optional),
 /// "goal_px": [u, v] (optional: a camera pixel, within the frame), "goal_speed_m_s": v (optional),
-/// "gripper_opening_m": o (optional), "focus_z_m": z, "objective": i, "exposure_s": e, "gain": g (optional;
+/// "gripper_opening_m": o (optional), "theta_goal_rad": a, "theta_rate_rad_s": w (optional: the rotary
+/// axis; refused without one), "focus_z_m": z, "objective": i, "exposure_s": e, "gain": g (optional;
 /// the microscope)}`; unknown keys are refused. Values are checked finite and clamped to `limits`; an
 /// objective that is not on the turret is refused. Throws mc::InvalidInput
 /// ("/console/command: velocity_m_s[1]: must be a finite number").

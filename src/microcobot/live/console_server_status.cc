@@ -52,6 +52,11 @@ std::string ConsoleServer::scene_json() const {
          {"part_height_m", live_.part_height_m()},
          {"hole_side_m", live_.hole_side_m()},
          {"hole_depth_m", live_.hole_depth_m()},
+         // The orientations and the rotary axis' travel (both 0: no rotary axis).
+         {"part_yaw_rad", live_.part_yaw_rad()},
+         {"hole_yaw_rad", live_.hole_yaw_rad()},
+         {"theta_min_rad", c.min_theta_rad},
+         {"theta_max_rad", c.max_theta_rad},
          {"target_m", live_.target_m()},
          {"tolerance_m", live_.placement_tolerance_m()},
          {"max_opening_m", c.max_opening_m},

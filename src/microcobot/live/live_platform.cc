@@ -61,6 +61,11 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
     limits_.max_m[i] = home[i] + tp.workspace_max_m;
   }
   limits_.max_opening_m = params_.platform.world.gripper.max_opening_m;
+  if (platform_->has_rotary()) {
+    limits_.min_theta_rad = platform_->yaw_min_rad();
+    limits_.max_theta_rad = platform_->yaw_max_rad();
+    limits_.max_theta_speed_rad_s = params_.platform.stage.rotary.max_speed_rad_s;
+  }
   const platform::CameraDeviceParams& cam = params_.platform.camera;
   limits_.focus_min_m = cam.focus_min_m;
   limits_.focus_max_m = cam.focus_max_m;
@@ -218,6 +223,10 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.goal_speed_m_s = latest_.goal_speed_m_s;
     in.has_gripper = latest_.has_gripper;
     in.gripper_opening_m = latest_.gripper_opening_m;
+    in.has_theta_goal = latest_.has_theta_goal;
+    in.theta_goal_rad = latest_.theta_goal_rad;
+    in.theta_speed_rad_s = limits_.max_theta_speed_rad_s;
+    in.theta_rate_rad_s = latest_.theta_rate_rad_s;
     // The task, supervised by the console in control: it drives or holds in the console's place.
     if (task_) task_->tick(p, home_m_, t.dt_s, console_control && !p.faulted(), fresh, in);
   }

@@ -176,6 +176,8 @@ class LivePlatform {
   double part_side_m() const { return params_.platform.world.part_side_m; }
   double part_height_m() const { return params_.platform.world.height_m(); }
   double hole_side_m() const { return params_.platform.world.hole_side_m; }
+  double part_yaw_rad() const { return params_.platform.world.part_yaw_rad; }
+  double hole_yaw_rad() const { return params_.platform.world.hole_yaw_rad; }
   double hole_depth_m() const { return params_.platform.world.hole_depth_m; }
   std::array<double, 3> target_m() const {
     return {params_.platform.world.target_m.x(), params_.platform.world.target_m.y(), 0.0};

@@ -256,6 +256,7 @@ void Camera::deliver(CameraFrame& frame, const SceneSnapshot& scene, std::int64_
   for (int i = 0; i < 3; ++i) frame.tool_m[i] = scene.tool_m[i];
   frame.gripper_opening_m = scene.gripper_opening_m;
   frame.gripper_free_opening_m = scene.gripper_free_opening_m;
+  frame.tool_yaw_rad = scene.tool_yaw_rad;
   frame.capture_s = 1e-9 * static_cast<double>(t1 - t0_ns);
   frame.encode_s = 1e-9 * static_cast<double>(t2 - t1);
   frame.latency_s = source_->renders_scene() ? 1e-9 * static_cast<double>(t2 - scene.steady_ns) : 0.0;

@@ -25,14 +25,16 @@ struct SceneSnapshot {
   double tool_m[3] = {};             ///< the gripper's point (finger tips), measured stage position
   double tool_velocity_m_s[3] = {};  ///< its velocity (motion blur over the exposure)
   double gripper_opening_m = 0.0;    ///< distance between the finger tips
+  double tool_yaw_rad = 0.0;         ///< the fingers' yaw (the rotary axis under the gripper)
   /// The opening the gripper's drive puts its fingers at without a load (Gripper::free_opening_m;
   /// NaN: the drive has no model of it): force by vision's reference.
   double gripper_free_opening_m = 0.0;
   bool has_part = false;  ///< the pick-and-place's part
   double part_m[3] = {};  ///< part centre
   double part_velocity_m_s[3] = {};
-  int part_phase = 0;      ///< microworld::PartPhase
-  bool has_beads = false;  ///< the optical-trap scene's beads
+  int part_phase = 0;         ///< microworld::PartPhase
+  double part_yaw_rad = 0.0;  ///< the part's orientation (the rotary axis turns it)
+  bool has_beads = false;     ///< the optical-trap scene's beads
   double probe_bead_m[3] = {};
   double obstacle_bead_m[2] = {};
   double focus_z_m = 0.0;   ///< height of the focal plane above the substrate (focus drive)
@@ -78,6 +80,7 @@ struct CameraFrame {
   double tool_m[3] = {};                ///< where the gripper's point was
   double gripper_opening_m = 0.0;       ///< the gripper's opening (its own sensor) at the frame
   double gripper_free_opening_m = 0.0;  ///< ... and its drive's unloaded opening (SceneSnapshot's)
+  double tool_yaw_rad = 0.0;            ///< the fingers' yaw (the rotary axis) at the frame
   Image image;
   std::vector<std::uint8_t> jpeg;
   double capture_s = 0.0;  ///< time to form or grab the image (wall)

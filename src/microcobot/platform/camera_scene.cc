@@ -52,6 +52,7 @@ CameraScenePose initial_pose(const PlatformConfig& c) {
     p.part_x_m = c.world.part_start_m.x();
     p.part_y_m = c.world.part_start_m.y();
     p.part_z_m = 0.5 * c.world.height_m();
+    p.part_yaw_rad = c.world.part_yaw_rad;
   }
   return p;
 }
@@ -63,9 +64,11 @@ CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetryS
   p.tool_y_m = channel(now, "slave_y_m");
   p.tool_z_m = channel(now, "slave_z_m");
   p.opening_m = channel(now, "gripper_opening_m");
+  p.tool_yaw_rad = channel(now, "slave_theta_rad");
   p.part_x_m = channel(now, "part_x_m");
   p.part_y_m = channel(now, "part_y_m");
   p.part_z_m = channel(now, "part_z_m");
+  p.part_yaw_rad = channel(now, "part_yaw_rad");
   if (previous && dt_s > 0.0) {
     p.vx_m_s = (p.tool_x_m - channel(*previous, "slave_x_m")) / dt_s;
     p.vy_m_s = (p.tool_y_m - channel(*previous, "slave_y_m")) / dt_s;
@@ -103,6 +106,7 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
     h.x_m = w.target_m.x(), h.y_m = w.target_m.y();
     h.size_x_m = h.size_y_m = w.hole_side_m;
     h.depth_m = w.hole_depth_m;
+    h.angle_rad = w.hole_yaw_rad;
     s.holes.push_back(h);
   }
   vision::Part part;
@@ -110,6 +114,7 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   part.z_top_m = pose.part_z_m + 0.5 * w.height_m();
   part.size_x_m = part.size_y_m = w.part_side_m;
   part.vx_m_s = pose.part_vx_m_s, part.vy_m_s = pose.part_vy_m_s;
+  part.angle_rad = pose.part_yaw_rad;
   s.parts.push_back(part);
   const double finger_width_m = w.gripper.finger_width_m;
   for (int side : {-1, 1}) {
@@ -121,6 +126,8 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
     f.length_m = w.gripper.finger_length_m;
     f.rise = 0.5;  // the benders come down to the part at about 27 degrees from the substrate
     f.vx_m_s = pose.vx_m_s, f.vy_m_s = pose.vy_m_s;
+    f.angle_rad = pose.tool_yaw_rad;  // turned about the tool point by the rotary axis
+    f.pivot_x_m = pose.tool_x_m, f.pivot_y_m = pose.tool_y_m;
     s.fingers.push_back(f);
   }
 }

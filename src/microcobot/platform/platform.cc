@@ -387,10 +387,12 @@ void Platform::camera_task(const TickInfo& t) noexcept {
     s.tool_velocity_m_s[i] = history ? (tool[i] - tool_then[i]) / span_s : 0.0;
   }
   s.gripper_opening_m = devices_.gripper->opening_m();
+  s.tool_yaw_rad = sim_.gripper != nullptr ? sim_.gripper->yaw_rad() : yaw_rad();
   s.gripper_free_opening_m = devices_.gripper->free_opening_m();
   if (sim_.gripper != nullptr) {
     s.has_part = true;
     s.part_phase = static_cast<int>(sim_.gripper->world_state().phase);
+    s.part_yaw_rad = sim_.gripper->world_state().part_yaw_rad;
   }
   if (sim_.optical_tweezers != nullptr) {
     s.has_beads = true;

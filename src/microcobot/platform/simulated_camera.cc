@@ -30,9 +30,11 @@ class SimulatedCamera final : public FrameSource {
     pose.tool_y_m = scene.tool_m[1];
     pose.tool_z_m = scene.tool_m[2];
     pose.opening_m = scene.gripper_opening_m;
+    pose.tool_yaw_rad = scene.tool_yaw_rad;
     const double* part = scene.has_beads ? scene.probe_bead_m : scene.part_m;
     pose.part_x_m = part[0];
     pose.part_y_m = part[1];
+    pose.part_yaw_rad = scene.has_beads ? 0.0 : scene.part_yaw_rad;
     // The trap's model is planar: the probe bead stays in the dish plane (camera_scene's
     // initial_pose), whatever height the stage's z reports.
     pose.part_z_m = scene.has_beads ? config_.optical_trap.trap.bead_radius_m : part[2];

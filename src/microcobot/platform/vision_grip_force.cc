@@ -1,5 +1,7 @@
 #include "microcobot/platform/vision_grip_force.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +24,8 @@ void VisionGripForceParams::validate() const {
 namespace {
 // A part holds the fingers apart by more than this: the next gap is predicted from the last.
 constexpr double kLoadedGap = 1e-6;
+// The fingers' yaw up to which the gauge measures: 1 mrad moves a tip 0.1 um across a 100 um gap.
+constexpr double kMaxYaw_rad = 1e-3;
 }  // namespace
 
 VisionGripForce::VisionGripForce(const PlatformConfig& config)
@@ -85,6 +89,20 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     st_.error = "the gripper's drive has no model of its free opening: no force by vision";
     publish();
     return st_;
+  }
+  if (std::abs(frame.tool_yaw_rad) > kMaxYaw_rad) {
+    // The tips are taught and tracked with the fingers along the image's x (their closing
+    // direction at yaw 0): turned, the gap seen is not the fingers'.
+    st_.state = "error";
+    st_.error = fmt::format(
+        "the fingers are turned (rotary axis at {:.2f} deg): force by vision measures them at 0 deg",
+        frame.tool_yaw_rad * 180.0 / M_PI);
+    publish();
+    return st_;
+  }
+  if (st_.error.rfind("the fingers are turned", 0) == 0) {
+    st_.error.clear();
+    st_.state = st_.tared ? "measuring" : "untared";
   }
   const bool new_view = frame.objective != objective_ || frame_.width != width_ || frame_.height != height_;
   if (new_view) {

@@ -188,6 +188,7 @@ Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment
       s.type = h.disc ? Shape::kDisc : Shape::kBox;
       s.x = h.x_m, s.y = h.y_m, s.hx = 0.5 * h.size_x_m, s.hy = h.disc ? s.hx : 0.5 * h.size_y_m;
       s.radiance = s.edge_radiance = transmitted ? 1.0 : h.bottom_reflectance;
+      s.angle = h.disc ? 0.0 : h.angle_rad;
       break;
     }
     case Kind::kPart: {
@@ -207,6 +208,13 @@ Shape shape_of(const SceneSnapshot& scene, Kind kind, std::size_t i, int segment
       const double len = span.length_m;
       s.type = Shape::kBox;
       s.x = f.tip_x_m, s.y = f.tip_y_m + span.start_m + 0.5 * len;
+      if (f.angle_rad != 0.0) {  // turned about the pivot (the gripper's rotary axis)
+        const double c = std::cos(f.angle_rad), sn = std::sin(f.angle_rad);
+        const double dx = s.x - f.pivot_x_m, dy = s.y - f.pivot_y_m;
+        s.x = f.pivot_x_m + c * dx - sn * dy;
+        s.y = f.pivot_y_m + sn * dx + c * dy;
+        s.angle = f.angle_rad;
+      }
       s.hx = 0.5 * f.width_m, s.hy = 0.5 * len;
       s.radiance = transmitted ? 0.0 : f.reflectance;
       s.edge_radiance = transmitted ? 0.0 : kFingerOutline * f.reflectance;
@@ -377,10 +385,24 @@ void Renderer::composite_group(const SceneSnapshot& scene, const std::vector<Lay
           if (s.type == Shape::kBox && s.angle != 0.0) {
             // Turned: the exact area of the polygon in the cell. Rows go down, so the
             // counter-clockwise turn seen from the top is clockwise in the cells' frame.
-            const RotatedRect r{
-                cu, cv, s.hx / pixel_m_ / f, s.hy / pixel_m_ / f, std::cos(s.angle), -std::sin(s.angle)};
+            const double cs = std::cos(s.angle), sn = -std::sin(s.angle);
+            const RotatedRect r{cu, cv, s.hx / pixel_m_ / f, s.hy / pixel_m_ / f, cs, sn};
             a = cell_coverage(r, cx, cy);
             p = a * s.radiance;
+            if (a > 0.0 && (s.inset_x > 0.0 || s.inset_low_y > 0.0)) {
+              // The outline (a turned finger): the inner box leaves inset_x each side and
+              // inset_low_y at the low-y end, its centre moved up the box's own y by half that.
+              const double ix = s.inset_x / pixel_m_ / f, iy = s.inset_low_y / pixel_m_ / f;
+              // The box's own +y in the cells' frame (rows down): (-sin, -cos) of the turn.
+              const RotatedRect in{cu - 0.5 * iy * std::sin(s.angle),
+                                   cv - 0.5 * iy * std::cos(s.angle),
+                                   std::max(0.0, r.a - ix),
+                                   std::max(0.0, r.b - 0.5 * iy),
+                                   cs,
+                                   sn};
+              const double inner = cell_coverage(in, cx, cy);
+              p = s.edge_radiance * (a - inner) + s.radiance * inner;
+            }
           } else if (s.type == Shape::kBox) {
             const double ox = overlap(cx, cx + 1.0, cu - ax, cu + ax);
             const double oy = overlap(cy, cy + 1.0, cv - ay, cv + ay);

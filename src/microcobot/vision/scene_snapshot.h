@@ -38,6 +38,7 @@ struct Hole {
   bool disc = false;
   double depth_m = 0.0;
   double bottom_reflectance = 0.03;  ///< what comes back out of the bore
+  double angle_rad = 0.0;            ///< a box turned about its centre, counter-clockwise seen from the top
 };
 
 /// A sphere (a bead) resting or floating: in reflected light a specular highlight where its
@@ -60,6 +61,10 @@ struct Finger {
   double rise = 0.0;                                   ///< dz/dy along the bar
   double reflectance = 0.6;
   double outline_m = 4e-6;  ///< width of the dark edge
+  /// The finger turned counter-clockwise (seen from the top) by angle_rad about the pivot: the
+  /// gripper's rotary axis through the tool point.
+  double angle_rad = 0.0;
+  double pivot_x_m = 0.0, pivot_y_m = 0.0;
   double vx_m_s = 0.0, vy_m_s = 0.0;
 };
 
