@@ -86,6 +86,8 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     rp.passivity = o.passivity == "on";
     rp.sample_period_s = axis.integrator.dt_s;
     rp.max_voltage_V = axis.drive.max_V;
+    rp.rotary = lp.platform.stage.rotary;  // the slave's rotary axis (the same configuration)
+    rp.rotary.enabled = rp.rotary.enabled && !lp.platform.optical_trap_scene();
     ends.slave = std::make_unique<mc::net::RemoteSlave>(rp);
     // The masters are this machine's (simulated, the operator then uses the console, or the
     // drivers' masters: their stage and gripper, built but never configured, are not opened);
@@ -102,6 +104,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
       }
       pf::PlatformDevices stage = remote->make_devices();
       d.axes = std::move(stage.axes);
+      d.rotary = std::move(stage.rotary);
       d.gripper = std::move(stage.gripper);
       return d;
     };
@@ -113,6 +116,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     rp.passivity = o.passivity == "on";
     rp.home_m = {lp.platform.stage.home_x_m, lp.platform.stage.home_y_m, lp.platform.stage.home_z_m};
     rp.goal_speed_m_s = lp.platform.teleop.console_max_speed_m_s;
+    rp.rotary = lp.platform.stage.rotary.enabled && !lp.platform.optical_trap_scene();
     ends.master = std::make_unique<mc::net::RemoteMaster>(rp);
     lp.remote = ends.master.get();
   }

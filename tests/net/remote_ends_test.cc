@@ -68,7 +68,7 @@ struct Pair {
   std::unique_ptr<End> master, slave;
 
   explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true,
-                const microworld::PickPlaceParams& world = {}) {
+                const microworld::PickPlaceParams& world = {}, bool rotary = false) {
     config.world = world;
     const int domain = test::test_domain_id();
     RemoteMasterParams mp;
@@ -76,6 +76,7 @@ struct Pair {
     mp.emulate = emulate;
     mp.passivity = passivity;
     mp.interpolate_targets = interpolate;
+    mp.rotary = rotary;
     mp.home_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     master_link = std::make_unique<RemoteMaster>(mp);
     live::LiveParams sp;
@@ -89,6 +90,7 @@ struct Pair {
     rp.emulate = emulate;
     rp.passivity = passivity;
     rp.sample_period_s = axis.integrator.dt_s;
+    if (rotary) rp.rotary = config.stage.rotary;
     slave_link = std::make_unique<RemoteSlave>(rp);
     live::LiveParams lp;
     lp.platform.world = config.world;
@@ -159,6 +161,26 @@ void moves_the_slave_without_allocating(Pair& pair);
 TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
   Pair pair;
   moves_the_slave_without_allocating(pair);
+}
+
+// Issue #29 point 2: the rotary axis over the link. The master's console turns the slave's rotary
+// axis (the target pose's orientation, a rotation about z) only while the master is engaged, and
+// the master sees the slave's angle (the measured pose's orientation).
+TEST(RemoteEnds, TheMastersConsoleTurnsTheSlavesRotaryAxisOverDds) {
+  Pair pair({}, true, true, {}, /*rotary=*/true);
+  ASSERT_TRUE(pair.engage());
+  live::ConsoleCommand turn = jog(0);
+  turn.has_theta_goal = true;
+  turn.theta_goal_rad = 0.3;
+  turn.deadman = false;
+  pair.drive(turn, 1000ms);
+  EXPECT_NEAR(pair.slave->get("slave_theta_rad"), 0.0, 1e-5) << "no deadman: nothing turns";
+  turn.deadman = true;
+  pair.drive(turn, 3000ms);  // 0.3 rad at 0.16 rad/s: 1.9 s
+  const double slave_yaw = pair.slave->get("slave_theta_rad"), seen = pair.master->get("measured_theta_rad");
+  std::printf("rotary over DDS: slave %.6f rad, seen by the master %.6f rad (goal 0.3)\n", slave_yaw, seen);
+  EXPECT_NEAR(slave_yaw, 0.3, 1e-5);
+  EXPECT_NEAR(seen, slave_yaw, 1e-5);
 }
 
 TEST(RemoteEnds, SoOverAnEmulatedLinkOf100msRoundTripWithJitterAndLoss) {

@@ -58,6 +58,35 @@ TEST(RosMapping, PoseStampedRoundTripsInMetresWithTheStageFrameAndIdentityOrient
   EXPECT_EQ(back.xyz, pose_sample().xyz);
 }
 
+// The rotary axis' angle rides as the pose's orientation, a rotation about z (issue #29 point 2).
+TEST(RosMapping, APosesYawIsARotationAboutZAndAnyOtherRotationIsRefused) {
+  NetSample s = pose_sample();
+  s.yaw_rad = -0.75;
+  geometry_msgs_msg_dds__PoseStamped_ m;
+  to_ros(s, m);
+  EXPECT_NEAR(m.pose_.orientation_.z_, std::sin(-0.375), 1e-15);
+  EXPECT_NEAR(m.pose_.orientation_.w_, std::cos(-0.375), 1e-15);
+  NetSample back;
+  ASSERT_EQ(from_ros(m, Channel::kMeasuredPose, NetLimits{}, back), Rejection::kNone);
+  EXPECT_NEAR(back.yaw_rad, -0.75, 1e-12);
+  // The same rotation written with the opposite sign (q and -q): the same yaw.
+  m.pose_.orientation_.z_ = -m.pose_.orientation_.z_, m.pose_.orientation_.w_ = -m.pose_.orientation_.w_;
+  ASSERT_EQ(from_ros(m, Channel::kMeasuredPose, NetLimits{}, back), Rejection::kNone);
+  EXPECT_NEAR(back.yaw_rad, -0.75, 1e-12);
+  // A ROS tool's default (all zero) is the identity.
+  m.pose_.orientation_ = {};
+  ASSERT_EQ(from_ros(m, Channel::kTarget, NetLimits{}, back), Rejection::kNone);
+  EXPECT_EQ(back.yaw_rad, 0.0);
+  // A tilt, a quaternion that is not a rotation, a NaN: refused.
+  m.pose_.orientation_.x_ = std::sin(0.05), m.pose_.orientation_.w_ = std::cos(0.05);
+  EXPECT_EQ(from_ros(m, Channel::kTarget, NetLimits{}, back), Rejection::kOutOfRange);
+  m.pose_.orientation_ = {};
+  m.pose_.orientation_.w_ = 2.0;
+  EXPECT_EQ(from_ros(m, Channel::kTarget, NetLimits{}, back), Rejection::kOutOfRange);
+  m.pose_.orientation_.z_ = kNaN;
+  EXPECT_EQ(from_ros(m, Channel::kTarget, NetLimits{}, back), Rejection::kNonFinite);
+}
+
 TEST(RosMapping, RefusesNonFiniteOutOfRangeAndBadStampsInPoses) {
   geometry_msgs_msg_dds__PoseStamped_ m;
   NetSample out;

@@ -44,6 +44,9 @@ struct NetSample {
   std::int64_t received_ns = 0;  ///< steady clock when the link thread took it (0 when sending)
   std::array<double, 3> xyz{};   ///< m or N
   double scalar = 0.0;           ///< m, or 0/1
+  /// Poses (target, measured): the gripper's yaw, the rotary axis' angle [rad], carried as the
+  /// pose's orientation (a rotation about z); 0 on a stage without one.
+  double yaw_rad = 0.0;
 
   /// Its transit (s): arrival (this end's steady clock) minus stamp (the sender's ROS time), the
   /// network's delay plus the clocks' offset (transit_estimate.h compares them).

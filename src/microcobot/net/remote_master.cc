@@ -49,6 +49,7 @@ RemoteMaster::~RemoteMaster() = default;
 void RemoteMaster::apply(const NetSample& s, double t_s, live::RemoteRequest& r) noexcept {
   switch (s.channel) {
     case Channel::kTarget:
+      target_yaw_rad_ = s.yaw_rad;  // the rotary axis' goal (turned at its own speed limit)
       // The goal follows in poll(), through the jitter buffer and the ports.
       if (params_.interpolate_targets) {
         targets_.push(1e-9 * static_cast<double>(s.stamp_ns), s.xyz, now_s_);
@@ -135,6 +136,8 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
     for (std::size_t i = 0; i < 3; ++i) command.goal_m[i] = params_.home_m[i] + goal_m_[i];
     command.velocity_m_s = {};
     command.goal_speed_m_s = params_.goal_speed_m_s;
+    command.has_theta_goal = params_.rotary;
+    command.theta_goal_rad = target_yaw_rad_;
   }
   const PortsReport ports = ports_.report();
   min_observed_J_.store(ports.min_observed_J, std::memory_order_relaxed);
@@ -142,13 +145,14 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
   return r;
 }
 
-void RemoteMaster::send(Channel c, const std::array<double, 3>& xyz, double scalar,
-                        std::int64_t stamp_ns) noexcept {
+void RemoteMaster::send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns,
+                        double yaw_rad) noexcept {
   NetSample s;
   s.channel = c;
   s.stamp_ns = stamp_ns;
   s.xyz = xyz;
   s.scalar = scalar;
+  s.yaw_rad = yaw_rad;
   link_->send(s);  // a full ring is counted by the link
 }
 
@@ -159,7 +163,7 @@ void RemoteMaster::publish(const platform::Platform& p) noexcept {
   const auto& g = p.gripper();
   const platform::Vec3 f = g.contact_force_N();
   send(Channel::kMeasuredPose, {p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m()}, 0.0,
-       stamp);
+       stamp, p.yaw_rad());
   send(Channel::kContactForce, {f.x, f.y, f.z}, 0.0, stamp);
   send(Channel::kGripForce, {g.grip_force_N(), 0.0, 0.0}, 0.0, stamp);
   send(Channel::kGripperOpening, {}, g.opening_m(), stamp);

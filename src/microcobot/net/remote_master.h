@@ -54,6 +54,9 @@ struct RemoteMasterParams {
   /// false: each target followed as it arrives (no buffer; the behaviour before issue #15, for
   /// comparison).
   bool interpolate_targets = true;
+  /// The slave's platform has the rotary axis: the master's target yaw is its goal (turned at the
+  /// axis' own speed limit, with the master's engaged flag as the deadman).
+  bool rotary = false;
   /// Time-domain passivity control at this end's ports (passive_ports.h); false: observed only.
   bool passivity = true;
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
@@ -85,7 +88,8 @@ class RemoteMaster final : public live::CommandSource {
   double dissipated_energy_J() const noexcept { return dissipated_J_.load(std::memory_order_relaxed); }
 
  private:
-  void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns) noexcept;
+  void send(Channel c, const std::array<double, 3>& xyz, double scalar, std::int64_t stamp_ns,
+            double yaw_rad = 0.0) noexcept;
   void apply(const NetSample& s, double t_s, live::RemoteRequest& r) noexcept;
 
   RemoteMasterParams params_;
@@ -108,6 +112,7 @@ class RemoteMaster final : public live::CommandSource {
   // The gripper's port likewise: the opening asked, the one let through (from the gripper's
   // measured opening at the first publish), the grip force of the last publish.
   double asked_opening_m_ = 0.0, goal_opening_m_ = 0.0, grip_N_ = 0.0;
+  double target_yaw_rad_ = 0.0;  // the master's target for the rotary axis
   bool has_gripper_target_ = false, opening_known_ = false;
   bool was_fresh_ = false;
   double last_poll_t_ = -1.0;

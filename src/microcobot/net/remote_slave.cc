@@ -39,12 +39,16 @@ class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
       : RemoteDevice(std::move(name), slave),
         index_(index),
         period_s_(p.sample_period_s),
-        max_V_(p.max_voltage_V) {}
+        max_V_(p.max_voltage_V),
+        rotary_(p.rotary) {}
   double sample_period_s() const override { return period_s_; }
   double max_voltage_V() const override { return max_V_; }
   // Never called: the platform sends targets to position-controlled axes.
   void command_drive(const platform::DriveBlock&) noexcept override {}
-  double position_m() const override { return slave_.state().position_m[static_cast<std::size_t>(index_)]; }
+  double position_m() const override {
+    return index_ == 3 ? rotary_.arc_m(slave_.state().yaw_rad)
+                       : slave_.state().position_m[static_cast<std::size_t>(index_)];
+  }
   bool at_end_stop() const override { return false; }  // the slave's stage controller knows
   bool position_controlled() const override { return true; }
   void command_target_m(double target_m, double velocity_m_s) noexcept override {
@@ -54,8 +58,9 @@ class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
   void update(double) noexcept override {}
 
  private:
-  int index_;
+  int index_;  // 0-2: x, y, z; 3: the rotary axis (its position the arc of the slave's yaw)
   double period_s_, max_V_;
+  control::RotaryAxisParams rotary_;
 };
 
 /// The slave's gripper; its update() runs the link exchange once per tick.
@@ -101,21 +106,27 @@ platform::PlatformDevices RemoteSlave::make_devices() {
   const char* names[3] = {"remote_axis_x", "remote_axis_y", "remote_axis_z"};
   for (int i = 0; i < 3; ++i)
     d.axes[static_cast<std::size_t>(i)] = std::make_unique<RemoteSlaveAxis>(names[i], *this, i, params_);
+  if (params_.rotary.enabled)
+    d.rotary = std::make_unique<RemoteSlaveAxis>("remote_axis_theta", *this, 3, params_);
   d.gripper = std::make_unique<RemoteGripper>("remote_gripper", *this);
   return d;
 }
 
-void RemoteSlave::send(Channel c, const std::array<double, 3>& xyz, double scalar) noexcept {
+void RemoteSlave::send(Channel c, const std::array<double, 3>& xyz, double scalar, double yaw_rad) noexcept {
   NetSample s;
   s.channel = c;
   s.stamp_ns = ros_time_ns();
   s.xyz = xyz;
   s.scalar = scalar;
+  s.yaw_rad = yaw_rad;
   link_->send(s);  // a full ring is counted by the link
 }
 
 void RemoteSlave::set_target(int axis, double target_m, double /*velocity_m_s*/) noexcept {
-  target_m_[static_cast<std::size_t>(axis)] = target_m;
+  if (axis == 3)
+    target_yaw_rad_ = params_.rotary.angle_rad(target_m);
+  else
+    target_m_[static_cast<std::size_t>(axis)] = target_m;
   target_mask_ |= 1u << axis;
   // A target computed while the slave was silent is the coupling's frozen guess, not a command
   // for a slave that (re)appears: only targets computed on fresh measurements are sent.
@@ -133,6 +144,7 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
   switch (s.channel) {
     case Channel::kMeasuredPose:
       state_.position_m = s.xyz;
+      state_.yaw_rad = s.yaw_rad;
       // As old as it is: a backlog arriving after an outage does not refresh the slave.
       state_.age_s = std::min(state_.age_s, pose_transit_.observe(s.transit_s(), s.received_s()));
       break;
@@ -188,7 +200,7 @@ void RemoteSlave::exchange(double dt_s) noexcept {
   min_observed_J_.store(ports.min_observed_J, std::memory_order_relaxed);
   dissipated_J_.store(ports.dissipated_J, std::memory_order_relaxed);
   since_sent_s_ += dt_s;
-  if (target_mask_ != 0b111u) return;
+  if (target_mask_ != (params_.rotary.enabled ? 0b1111u : 0b111u)) return;
   target_mask_ = 0;
   if (!targets_fresh_) {
     target_rate_m_s_ = {};
@@ -203,7 +215,7 @@ void RemoteSlave::exchange(double dt_s) noexcept {
   sent_gripper_m_ = gripper_target_m_;
   target_sent_ = true;
   since_sent_s_ = 0.0;
-  send(Channel::kTarget, target_m_, 0.0);
+  send(Channel::kTarget, target_m_, 0.0, params_.rotary.enabled ? target_yaw_rad_ : 0.0);
   send(Channel::kGripperTarget, {}, gripper_target_m_);
   send(Channel::kMasterPortEnergy, ports.axes_input_energy_J(), 0.0);
   send(Channel::kMasterGripperPortEnergy, {ports.input_energy_J[kGripperPort], 0.0, 0.0}, 0.0);

@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "microcobot/control/rotary_axis.h"
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
 #include "microcobot/net/transit_estimate.h"
@@ -54,6 +55,14 @@ struct RemoteSlaveParams {
   bool passivity = true;
   double sample_period_s = 1e-5;  ///< reported as the axes' drive period (the model's step)
   double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
+  /// The slave's rotary axis under the gripper (the platform's stage.rotary: its position on the
+  /// master is the arc at its radius); disabled: the link carries no yaw and the master has none.
+  control::RotaryAxisParams rotary = without_rotary();
+  static control::RotaryAxisParams without_rotary() {
+    control::RotaryAxisParams r;
+    r.enabled = false;
+    return r;
+  }
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
   /// jitter the timeout grows by twice the jitter (keep-latest lines then leave gaps that long).
   control::LinkParams emulate;
@@ -63,6 +72,7 @@ struct RemoteSlaveParams {
 /// What the master knows of the slave (loop thread).
 struct RemoteSlaveState {
   std::array<double, 3> position_m{};  ///< measured, stage coordinates
+  double yaw_rad = 0.0;                ///< the rotary axis' measured angle
   /// On the gripper, world frame, as it comes out of the channel (after the passivity controller)
   std::array<double, 3> contact_force_N{};
   double grip_force_N = 0.0;
@@ -111,7 +121,7 @@ class RemoteSlave {
   void set_estop(bool on) noexcept;
 
  private:
-  void send(Channel c, const std::array<double, 3>& xyz, double scalar) noexcept;
+  void send(Channel c, const std::array<double, 3>& xyz, double scalar, double yaw_rad = 0.0) noexcept;
   void apply(const NetSample& s) noexcept;
 
   RemoteSlaveParams params_;
@@ -122,8 +132,9 @@ class RemoteSlave {
   TransitEstimate pose_transit_;  // the poses' route: how late each one arrives
   RemoteSlaveState state_;
   std::array<double, 3> target_m_{};
-  unsigned target_mask_ = 0;    // bit i: axis i's target of this slave tick is in
-  bool targets_fresh_ = false;  // they were computed on fresh measurements
+  double target_yaw_rad_ = 0.0;  // the rotary axis' (its arc's angle)
+  unsigned target_mask_ = 0;     // bit i: axis i's target of this slave tick is in (3: the rotary)
+  bool targets_fresh_ = false;   // they were computed on fresh measurements
   double gripper_target_m_ = 0.0;
   int estop_sent_ = -1;  // -1: never sent
   // The channel's master end: the force received, the rate of the targets sent, the sessions.

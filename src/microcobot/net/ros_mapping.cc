@@ -76,7 +76,9 @@ void to_ros(const NetSample& s, geometry_msgs_msg_dds__PoseStamped_& m) {
   m.pose_.position_.x_ = s.xyz[0];
   m.pose_.position_.y_ = s.xyz[1];
   m.pose_.position_.z_ = s.xyz[2];
-  m.pose_.orientation_.w_ = 1.0;  // the stage translates only: the identity rotation
+  // The gripper's yaw (the rotary axis under it) as a rotation about z; 0: the identity.
+  m.pose_.orientation_.z_ = std::sin(0.5 * s.yaw_rad);
+  m.pose_.orientation_.w_ = std::cos(0.5 * s.yaw_rad);
 }
 
 void to_ros(const NetSample& s, geometry_msgs_msg_dds__WrenchStamped_& m) {
@@ -161,7 +163,23 @@ Rejection from_ros(const diagnostic_msgs_msg_dds__DiagnosticArray_& m, Channel c
 Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
                    NetSample& out) {
   const auto& p = m.pose_.position_;
-  return check_vector(p.x_, p.y_, p.z_, lim.max_abs_position_m, m.header_, c, out);
+  const Rejection r = check_vector(p.x_, p.y_, p.z_, lim.max_abs_position_m, m.header_, c, out);
+  if (r != Rejection::kNone) return r;
+  // The orientation: the yaw of a rotation about z (a ROS tool's all-zero quaternion is the identity).
+  const auto& q = m.pose_.orientation_;
+  if (!std::isfinite(q.x_) || !std::isfinite(q.y_) || !std::isfinite(q.z_) || !std::isfinite(q.w_))
+    return Rejection::kNonFinite;
+  const double n2 = q.x_ * q.x_ + q.y_ * q.y_ + q.z_ * q.z_ + q.w_ * q.w_;
+  if (n2 == 0.0) {
+    out.yaw_rad = 0.0;
+    return r;
+  }
+  if (std::abs(n2 - 1.0) > 1e-3 || std::abs(q.x_) > 1e-6 || std::abs(q.y_) > 1e-6)
+    return Rejection::kOutOfRange;  // not a unit rotation about z: the stage turns about z only
+  out.yaw_rad = 2.0 * std::atan2(q.z_, q.w_);
+  if (out.yaw_rad > M_PI) out.yaw_rad -= 2.0 * M_PI;
+  if (out.yaw_rad <= -M_PI) out.yaw_rad += 2.0 * M_PI;
+  return r;
 }
 
 Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, const NetLimits& lim,

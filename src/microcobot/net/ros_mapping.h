@@ -53,7 +53,9 @@ struct DiagnosticsBuffer {
 void to_ros(const NetSample& s, DiagnosticsBuffer& buf, diagnostic_msgs_msg_dds__DiagnosticArray_& m);
 
 /// Each from_ros fills `out` (channel `c`) and returns kNone, or returns why it refused.
-/// A pose's orientation is ignored (the stage only translates); a wrench's torque likewise.
+/// A pose's orientation is the gripper's yaw (the rotary axis): a unit rotation about z (an
+/// all-zero quaternion reads as the identity); any other is refused (out of range). A wrench's
+/// torque is ignored.
 Rejection from_ros(const geometry_msgs_msg_dds__PoseStamped_& m, Channel c, const NetLimits& lim,
                    NetSample& out);
 Rejection from_ros(const geometry_msgs_msg_dds__WrenchStamped_& m, Channel c, const NetLimits& lim,
