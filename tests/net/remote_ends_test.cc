@@ -176,7 +176,13 @@ TEST(RemoteEnds, TheMastersConsoleTurnsTheSlavesRotaryAxisOverDds) {
   pair.drive(turn, 1000ms);
   EXPECT_NEAR(pair.slave->get("slave_theta_rad"), 0.0, 1e-5) << "no deadman: nothing turns";
   turn.deadman = true;
-  pair.drive(turn, 3000ms);  // 0.3 rad at 0.16 rad/s: 1.9 s
+  // 0.3 rad at 0.16 rad/s: 1.9 s of loop time (longer on a slow build, whose paced loop lags).
+  test::wait_until(
+      [&] {
+        return std::abs(pair.slave->get("slave_theta_rad") - 0.3) < 1e-6 || (pair.drive(turn, 200ms), false);
+      },
+      30.0);
+  pair.drive(turn, 200ms);
   const double slave_yaw = pair.slave->get("slave_theta_rad"), seen = pair.master->get("measured_theta_rad");
   std::printf("rotary over DDS: slave %.6f rad, seen by the master %.6f rad (goal 0.3)\n", slave_yaw, seen);
   EXPECT_NEAR(slave_yaw, 0.3, 1e-5);
