@@ -42,10 +42,19 @@ TEST(CellCycle, TheRobotInsertsAPinUnderTheLimitsAndEndsHolding) {
   EXPECT_TRUE(r.ended_holding);
   EXPECT_LE(r.placement_error_m, r.clearance_m * std::sqrt(2.0) + 1e-9) << "inside its bore";
   EXPECT_LT(r.cycle_s, 30.0);
-  // Holding: the stage stays where it ended.
+  // The pin was turned to its bore (their orientations differ by more than the fit allows) and
+  // sits square in it, to the task's tolerance.
+  const AssemblyJob j = job();
+  const double turn = microworld::wrap_quarter_turn(j.target_yaw_rad - j.world.part_yaw_rad);
+  EXPECT_GT(std::abs(turn), 0.03) << "a part that needed turning";
+  const auto& g = *c.platform().simulation().gripper;
+  EXPECT_LT(std::abs(g.world().orientation_error_rad(g.world_state())), 1e-3);
+  // Holding: the stage stays where it ended, the rotary axis too.
   const Eigen::Vector3d before = target(c.platform());
+  const double yaw = c.platform().yaw_rad();
   c.platform().run(0.5);
   EXPECT_LT((target(c.platform()) - before).norm(), 1e-12);
+  EXPECT_NEAR(c.platform().yaw_rad(), yaw, 1e-6);
 }
 
 // Fingers whose adhesion beats the substrate's (van der Waals 50 times the default's): the

@@ -311,7 +311,10 @@ CycleResult CellCycle::result() const {
   const auto& teleop = p.teleop();
   Eigen::Vector3d measured;
   for (int i = 0; i < 3; ++i) measured[i] = p.axis(i).position_m();
-  r.ended_holding = !teleop.engaged && (teleop.slave_target_m - measured).norm() < 1e-6;
+  // The rotary axis too: its target where it is (hold() takes it there; the person's dial let go
+  // leaves it on its last target), within 1 urad (5 nm of arc: the sensor's noise, not a motion).
+  const bool rotary_holds = !p.has_rotary() || std::abs(p.yaw_target_rad() - p.yaw_rad()) < 1e-6;
+  r.ended_holding = !teleop.engaged && (teleop.slave_target_m - measured).norm() < 1e-6 && rotary_holds;
   if (task_) {
     r.search_tries = task_->search_tries();
     r.confirmations = confirmations_;
