@@ -357,7 +357,8 @@ void bind_cell(py::module_& m) {
             if (c.cycle->person()) return std::string(cl::AssemblyTask::name(c.cycle->person()->step()));
             return std::string();
           },
-          "The current step ('approach' ... 'retract', 'done'); '' for the scripted watchmaker.")
+          "The current step ('approach', 'align', ... 'rotate', ... 'verify', 'done'); '' for the scripted\n"
+          "watchmaker.")
       .def_property_readonly(
           "status",
           [](Cycle& c) {
@@ -374,6 +375,9 @@ void bind_cell(py::module_& m) {
             return py::make_tuple(p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m());
           },
           "The stage's measured position (x, y, z) [m], relative to its home.")
+      .def_property_readonly(
+          "yaw_rad", [](Cycle& c) { return c.idle("yaw_rad").platform().yaw_rad(); },
+          "The rotary axis' measured angle, the fingers' yaw [rad] (align and rotate turn it).")
       .def(
           "pause", [](Cycle& c) { c.task("pause").pause(); },
           "The task lets the deadman go: the stage holds from the next tick until resume().")

@@ -113,9 +113,11 @@ def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_contr
     assert c.step == "done" and c.status == "succeeded"
 
     c = cell.Cycle(b, 1, mode="auto")
+    yaw0 = c.yaw_rad
     while c.step != "transport":  # mid-cycle, the stage moving
         assert not c.finished
         c.run_for(0.2)
+    assert abs(c.yaw_rad - yaw0) > 1e-3  # aligned with the pin on the way (a seeded slot orientation)
     c.run_for(0.5)
     assert c.status == "running"
     c.pause()
