@@ -55,6 +55,27 @@ TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
   EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e308]})"), "accepted");  // finite: clamped to the workspace
 }
 
+// The rotary axis under the gripper (issue #29 point 2): its goal clamped to its travel, its rate to
+// its speed; refused where there is none, and non-numbers refused naming the key.
+TEST(ConsoleCommand, TheRotaryAxisCommandsAreClampedAndRefusedWithoutTheAxis) {
+  ConsoleLimits limits;
+  limits.min_theta_rad = -1.0, limits.max_theta_rad = 1.0, limits.max_theta_speed_rad_s = 0.16;
+  const auto c =
+      parse_console_command(R"({"deadman": true, "theta_goal_rad": 7, "theta_rate_rad_s": -3})", limits);
+  EXPECT_TRUE(c.has_theta_goal);
+  EXPECT_DOUBLE_EQ(c.theta_goal_rad, 1.0);
+  EXPECT_DOUBLE_EQ(c.theta_rate_rad_s, -0.16);
+  EXPECT_FALSE(parse_console_command("{}", limits).has_theta_goal);
+  EXPECT_EQ(message_of(R"({"theta_goal_rad": 0.1})"),
+            "/console/command: theta_goal_rad: there is no rotary axis");
+  try {
+    parse_console_command(R"({"theta_rate_rad_s": "fast"})", limits);
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_STREQ(e.what(), "/console/command: theta_rate_rad_s: must be a number");
+  }
+}
+
 TEST(ConsoleCommand, AGoalPixelMustLieInTheCamerasFrame) {
   ConsoleLimits limits;
   limits.max_goal_px = {639.0, 511.0};
