@@ -94,8 +94,9 @@ struct CycleResult {
   int confirmations = 0;  ///< steps the supervisor confirmed (autonomy `confirm`)
   double path_m = 0.0;    ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
-  double wall_s = 0.0;         ///< the cycle's wall-clock time, the platform's construction included
-  bool ended_holding = false;  ///< every axis' target (the rotary's too) at its measured position, the coupling off
+  double wall_s = 0.0;  ///< the cycle's wall-clock time, the platform's construction included
+  bool ended_holding =
+      false;  ///< every axis' target (the rotary's too) at its measured position, the coupling off
   /// Simulated seconds spent in each step of the task (auto) or of the person (manual, assisted),
   /// indexed by AssemblyTask::Step (kDone: none); all zero for the scripted watchmaker, whose
   /// phases differ. Where a cycle's time goes, mode against mode.

@@ -111,6 +111,7 @@ std::string ConsoleServer::status_json() {
   json lifecycle = json::object();
   const char* names[6] = {"axis_x", "axis_y", "axis_z", "gripper", "haptic", "tweezers"};
   for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(platform::to_string(s.lifecycle[i]));
+  if (s.has_rotary) lifecycle["axis_theta"] = std::string(platform::to_string(s.rotary_lifecycle));
   const std::string recording = recording_ ? recording_->name() : std::string();
   json j = {{"t_s", s.t_s},
             {"estopped", s.estopped},

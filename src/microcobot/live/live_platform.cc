@@ -261,6 +261,8 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   lifecycle_[3].store(static_cast<int>(p.gripper().state()), std::memory_order_relaxed);
   lifecycle_[4].store(static_cast<int>(p.haptic().state()), std::memory_order_relaxed);
   lifecycle_[5].store(static_cast<int>(p.tweezers().state()), std::memory_order_relaxed);
+  rotary_lifecycle_.store(p.rotary_axis() ? static_cast<int>(p.rotary_axis()->state()) : -1,
+                          std::memory_order_relaxed);
   overruns_.store(p.loop().overruns(), std::memory_order_relaxed);
   if (const platform::FocusDrive* focus = p.focus()) {
     focus_z_m_.store(focus->z_m(), std::memory_order_relaxed);
@@ -428,6 +430,9 @@ LiveStatus LivePlatform::status() const {
     s.demo_phase = PickPlaceOperator::name(static_cast<PickPlaceOperator::Phase>(demo_phase_.load()));
   s.console_fresh = fresh_.load(std::memory_order_relaxed);
   for (std::size_t i = 0; i < 6; ++i) s.lifecycle[i] = static_cast<Lifecycle>(lifecycle_[i].load());
+  const int rotary = rotary_lifecycle_.load();
+  s.has_rotary = rotary >= 0;
+  if (s.has_rotary) s.rotary_lifecycle = static_cast<Lifecycle>(rotary);
   s.overruns = overruns_.load(std::memory_order_relaxed);
   s.restarts = restarts_.load(std::memory_order_relaxed);
   s.ticks = ticks_.load(std::memory_order_relaxed);

@@ -85,6 +85,8 @@ struct LiveStatus {
   std::string demo_phase;                          ///< its phase (empty unless demo)
   bool console_fresh = false;                      ///< the controlling client's commands are fresh
   std::array<platform::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
+  bool has_rotary = false;                         ///< the rotary axis under the gripper ...
+  platform::Lifecycle rotary_lifecycle{};          ///< ... and its state
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
   std::uint64_t restarts = 0;
@@ -276,6 +278,7 @@ class LivePlatform {
   bool demo_finished_ = false;  // loop thread only: the operator is done, the console has control
   std::atomic<std::uint64_t> ticks_{0};
   std::array<std::atomic<int>, 6> lifecycle_{};
+  std::atomic<int> rotary_lifecycle_{-1};  // -1: no rotary axis
   std::atomic<std::uint64_t> overruns_{0}, restarts_{0};
   std::atomic<std::uint64_t> camera_frames_{0}, camera_dropped_{0};
   std::atomic<double> focus_z_m_{0.0}, focus_target_m_{0.0};
