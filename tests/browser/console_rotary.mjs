@@ -3,7 +3,7 @@
 // with the deadman held; a +5° step turns it to its goal and the goal is then let go; the camera
 // sees the fingers turned, and force by vision says it cannot measure them turned. With the camera
 // streaming, a loaded machine can starve the page's heartbeat (console_session.mjs): the turn then
-// pauses while the commands are late, so the waits are generous. Screenshots go to MC_ARTIFACTS.
+// pauses while the commands are late, so the waits and the bounds are generous. Screenshots go to MC_ARTIFACTS.
 import { startConsole } from "./console_session.mjs";
 
 const s = await startConsole("console_rotary", [], 200);
@@ -25,15 +25,27 @@ await s.run(async () => {
   await page.keyboard.up(",");
   if (Math.abs((await t()).target_theta_rad - before.target_theta_rad) > 1e-12) fail("turned without the deadman");
 
-  // With the deadman: a second of ',' at 0.05 rad/s.
+  // With the deadman: a second of ',' at 0.05 rad/s, timed from the first movement the page sees
+  // (a starved page handles its keys late), then held still until the target rests.
+  const steady = async (what) => {
+    await until(what, async () => {
+      const a = window.mc.telemetry.target_theta_rad;
+      await new Promise((r) => setTimeout(r, 400));
+      return Math.abs(window.mc.telemetry.target_theta_rad - a) < 1e-9;
+    }, 20);
+    return t();
+  };
   await page.keyboard.down(" ");
   await page.keyboard.down(",");
+  await until("the turn starts", (b) => window.mc.telemetry.target_theta_rad > b + 1e-6, 10, before.target_theta_rad);
   await page.waitForTimeout(1000);
   await page.keyboard.up(",");
-  await page.waitForTimeout(300);
-  const turned = await t();
+  const turned = await steady("the turn stops after ',' is let go");
   log(`',' held 1 s with the deadman: ${deg(turned.measured_theta_rad)} deg`);
-  if (!(turned.target_theta_rad > 0.02 && turned.target_theta_rad < 0.08)) fail(`the turn: ${turned.target_theta_rad} rad`);
+  // 0.05 rad for the second. A starved page sees the telemetry late and handles the key-up late,
+  // both adding to the hold (0.13 rad seen with three CPU hogs on two cores), so the bound is loose;
+  // the rate itself is RotaryTarget's test. A turn that went on without the key would not stop.
+  if (!(turned.target_theta_rad > 0.03 && turned.target_theta_rad < 0.3)) fail(`the turn: ${turned.target_theta_rad} rad`);
 
   // A +5° step from the target: reached and let go.
   const base = turned.target_theta_rad;
