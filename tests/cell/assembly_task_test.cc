@@ -166,3 +166,62 @@ TEST(AssemblyTask, VerifyLooksAtThePinAndFailsATaskWhosePinIsNotDown) {
 
 }  // namespace
 }  // namespace mc::cell
+
+namespace mc::cell {
+namespace {
+
+// With the cell's camera (set_looks): the task holds for its look before the approach moves, then
+// heads for the pin where it was seen; at the insertion's start it holds for the look at the pin
+// in the fingers, then aims the pin, not the tool point, at the bore's axis.
+TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
+  AssemblyGoal g = skip_goal();
+  g.target_yaw_rad = 0.3;
+  AssemblyTask task({}, g);
+  task.set_looks(true);
+  IdealStage stage;
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(stage.tick(task), 0.0);  // 0.1 s: held, the deadman off
+  EXPECT_EQ(task.status(), Status::kAwaitingLook);
+  EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kSlot);
+  EXPECT_FALSE(task.tick(stage.s, 1e-3).deadman);
+
+  AssemblyTask::Sighting slot;
+  slot.found = true;
+  slot.part_m = {g.part_m.x() + 4e-6, g.part_m.y() - 3e-6, 300e-6};
+  slot.yaw_rad = 0.02;
+  task.see(slot);
+  EXPECT_EQ(task.status(), Status::kRunning);
+  EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kNone);
+  ASSERT_TRUE(stage.run_to(task, Step::kGrasp));
+  EXPECT_LT((stage.s.tip_m.head<2>() - slot.part_m.head<2>()).norm(), 1e-9) << "over the pin as seen";
+  EXPECT_NEAR(stage.s.yaw_rad, 0.02, 1e-3) << "square with the pin as seen";
+
+  ASSERT_TRUE(stage.run_to(task, Step::kInsert));
+  stage.tick(task);
+  EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kHeld);
+  const Eigen::Vector3d tip = stage.s.tip_m;
+  const Eigen::Vector2d ey(-std::sin(stage.s.yaw_rad), std::cos(stage.s.yaw_rad));
+  AssemblyTask::Sighting held;
+  held.found = true;
+  held.part_m << tip.head<2>() + 5e-6 * ey, tip.z();
+  task.see(held);
+  EXPECT_NEAR(task.held_offset_m(), 5e-6, 1e-12);
+  const control::ConsoleInput& in = task.tick(stage.s, 1e-3);
+  ASSERT_TRUE(in.deadman && in.has_goal);
+  EXPECT_LT((in.goal_m.head<2>() - (g.target_m - 5e-6 * ey)).norm(), 1e-12) << "the pin on the bore's axis";
+}
+
+// A look that finds nothing leaves the task as without a camera: the slot's nominal position.
+TEST(AssemblyTask, ALookThatFindsNothingLeavesTheNominalSlot) {
+  const AssemblyGoal g = skip_goal();
+  AssemblyTask task({}, g);
+  task.set_looks(true);
+  IdealStage stage;
+  stage.tick(task);
+  ASSERT_EQ(task.look_wanted(), AssemblyTask::Look::kSlot);
+  task.see({});
+  ASSERT_TRUE(stage.run_to(task, Step::kGrasp));
+  EXPECT_LT((stage.s.tip_m.head<2>() - g.part_m).norm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace mc::cell

@@ -89,12 +89,28 @@ std::string_view AssemblyTask::name(Status s) noexcept {
       return "paused";
     case Status::kAwaitingConfirm:
       return "awaiting confirmation";
+    case Status::kAwaitingLook:
+      return "awaiting look";
     case Status::kOperator:
       return "operator";
     case Status::kSucceeded:
       return "succeeded";
     case Status::kFailed:
       return "failed";
+  }
+  return "?";
+}
+
+std::string_view AssemblyTask::name(Look l) noexcept {
+  switch (l) {
+    case Look::kNone:
+      return "none";
+    case Look::kSlot:
+      return "slot";
+    case Look::kHeld:
+      return "held";
+    case Look::kPlaced:
+      return "placed";
   }
   return "?";
 }
@@ -118,7 +134,8 @@ void AssemblyTask::enter(Step s) noexcept {
   insert_ = Insert::kDescend;
   if (s == Step::kInsert) {  // a fresh search, however the insertion was reached
     tries_ = 0;
-    offset_y_ = 0.0;
+    offset_y_ = search_base_ = 0.0;
+    held_seen_ = false;
     search_yaw_ = last_yaw_;  // along the fingers as they are
   }
   if (s == Step::kDone) {
@@ -145,6 +162,35 @@ void AssemblyTask::begin_step() noexcept {
 void AssemblyTask::fail(const char* why) noexcept {
   failure_ = why;
   status_ = Status::kFailed;
+}
+
+void AssemblyTask::see(const Sighting& sighting) noexcept {
+  if (status_ != Status::kAwaitingLook) return;
+  switch (look_) {
+    case Look::kSlot:
+      slot_seen_ = true;
+      if (sighting.found && sighting.part_m.allFinite() && std::isfinite(sighting.yaw_rad)) {
+        goal_.part_m = sighting.part_m.head<2>();
+        goal_.part_yaw_rad = sighting.yaw_rad;
+      }
+      break;
+    case Look::kHeld:
+      held_seen_ = true;
+      if (sighting.found && sighting.part_m.allFinite()) {
+        // Along the fingers' y from the tool point (the stage held still while the camera looked).
+        const Eigen::Vector2d ey(-std::sin(search_yaw_), std::cos(search_yaw_));
+        held_offset_ = (sighting.part_m.head<2>() - last_tip_.head<2>()).dot(ey);
+        search_base_ = offset_y_ = -held_offset_;
+      }
+      break;
+    case Look::kPlaced:
+      placed_seen_ = true;
+      placed_ = sighting;
+      break;
+    case Look::kNone:
+      break;
+  }
+  status_ = Status::kRunning;
 }
 
 void AssemblyTask::pause() noexcept {
@@ -229,6 +275,7 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
   out_.deadman = false;
   out_.has_goal = false;
   last_yaw_ = s.yaw_rad;
+  last_tip_ = s.tip_m;
   // The rotary axis holds its last goal (none yet: it stays where it is).
   out_.has_theta_goal = std::isfinite(yaw_goal_);
   out_.theta_goal_rad = std::isfinite(yaw_goal_) ? yaw_goal_ : 0.0;
@@ -236,6 +283,13 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
   out_.velocity_m_s.setZero();
   out_.gripper_opening_m = opening_command_;
   if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
+  // The camera's looks before the approach and the insertion (verify's is its own): holding.
+  if (looks_ && ((step_ == Step::kApproach && !slot_seen_) ||
+                 (step_ == Step::kInsert && !held_seen_ && tries_ == 0 && insert_ == Insert::kDescend))) {
+    look_ = step_ == Step::kApproach ? Look::kSlot : Look::kHeld;
+    status_ = Status::kAwaitingLook;
+    return out_;
+  }
   step_s_ += dt_s;
   if (step_s_ > p_.step_timeout_s) {
     fail("a step took longer than step_timeout_s");
@@ -311,13 +365,23 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
     case Step::kVerify:
       // Still where the retract ended (settle_s), then one look.
       if (!move_to(s.tip_m, p_.z_speed_m_s, s, dt_s)) break;
-      if (s.part_m.allFinite()) {
+      if (looks_ && !placed_seen_) {  // the camera's look, holding
+        look_ = Look::kPlaced;
+        status_ = Status::kAwaitingLook;
+        out_.deadman = false;
+        break;
+      }
+      if (looks_ && !placed_.found) {
+        fail("the camera does not see the pin down in its bore");
+        break;
+      }
+      if (const Eigen::Vector3d part = looks_ ? placed_.part_m : s.part_m; part.allFinite()) {
         const double inserted_z = 0.5 * goal_.part_height_m - goal_.hole_depth_m;
         // Off the axis along the bore's own sides.
-        const Eigen::Vector2d d = s.part_m.head<2>() - goal_.target_m;
+        const Eigen::Vector2d d = part.head<2>() - goal_.target_m;
         const double c = std::cos(goal_.target_yaw_rad), sn = std::sin(goal_.target_yaw_rad);
         const double off_axis = std::max(std::abs(c * d.x() + sn * d.y()), std::abs(-sn * d.x() + c * d.y()));
-        if (s.part_m.z() > inserted_z + p_.verify_tolerance_m) {
+        if (part.z() > inserted_z + p_.verify_tolerance_m) {
           fail("the pin is not down in its bore (seen by the cell's vision)");
           break;
         }
@@ -357,8 +421,8 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
       ++tries_;
       const double step = p_.search_step_factor * goal_.clearance_m;
       const int k = (tries_ + 1) / 2;
-      offset_y_ = (tries_ % 2 == 1 ? 1.0 : -1.0) * k * step;
-      if (std::abs(offset_y_) > p_.search_range_m + 1e-12) {
+      offset_y_ = search_base_ + (tries_ % 2 == 1 ? 1.0 : -1.0) * k * step;
+      if (std::abs(offset_y_ - search_base_) > p_.search_range_m + 1e-12) {
         fail("jammed: no fit within search_range_m");
         break;
       }

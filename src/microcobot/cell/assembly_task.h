@@ -36,6 +36,18 @@
 ///              it is not a success the task reports. Without vision (TaskSensors::part_m not
 ///              finite, e.g. the live console) the insertion's contact at the bore's depth stands
 ///
+/// Looks (set_looks(true): the cell has a camera, cell_camera.h): the task holds while the camera
+/// looks (status awaiting look), and see() hands it what was seen:
+///   slot    before the approach moves: the pin's position and yaw in its slot replace the slot's
+///           nominal ones (the grasp then centres the pin along the fingers' y too);
+///   held    at the insertion's start: the pin's offset along the fingers' y, seen over the bore;
+///           the descent aims the pin, not the tool point, at the bore's axis (the search goes on
+///           around that point if it still jams);
+///   placed  in verify, the stage still: the camera's sighting is the verify's evidence (a pin not
+///           seen down in its bore fails the task).
+/// A look that finds nothing leaves the task as without a camera (nominal slot, search from the
+/// tool point); in verify it fails the task.
+///
 /// Status: running; paused (pause(): the deadman is let go, so the coupling stops the stage's
 /// target at the next tick and the stage holds; resume() goes on from where the stage is);
 /// awaiting confirmation (a step whose autonomy is kConfirm waits before it starts, holding);
@@ -150,7 +162,14 @@ class AssemblyTask {
     kDone
   };
   static constexpr int kStepCount = 12;
-  enum class Status { kRunning, kPaused, kAwaitingConfirm, kOperator, kSucceeded, kFailed };
+  enum class Status { kRunning, kPaused, kAwaitingConfirm, kAwaitingLook, kOperator, kSucceeded, kFailed };
+  enum class Look { kNone, kSlot, kHeld, kPlaced };
+  /// What a look saw (world frame): the pin's centre and yaw, or nothing.
+  struct Sighting {
+    bool found = false;
+    Eigen::Vector3d part_m = Eigen::Vector3d::Zero();
+    double yaw_rad = 0.0;
+  };
   enum class Autonomy { kAuto, kConfirm, kManual };
 
   /// Throws mc::InvalidParams (parameters, goal).
@@ -161,6 +180,16 @@ class AssemblyTask {
   /// False while the operator drives (taken over, a manual step) and once finished.
   bool drives() const noexcept { return status_ != Status::kOperator && !finished(); }
   bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
+
+  /// The cell has a camera: the task asks for its looks (header). Before the first tick.
+  void set_looks(bool on) noexcept { looks_ = on; }
+  /// The look the task awaits (kNone unless the status is kAwaitingLook).
+  Look look_wanted() const noexcept { return status_ == Status::kAwaitingLook ? look_ : Look::kNone; }
+  /// What the awaited look saw; the task runs on from the next tick (nothing awaited: ignored).
+  void see(const Sighting& sighting) noexcept;
+  /// The pin's offset along the fingers' y seen over the bore (NaN: none).
+  double held_offset_m() const noexcept { return held_offset_; }
+  static std::string_view name(Look l) noexcept;
 
   void pause() noexcept;
   void resume() noexcept;
@@ -221,10 +250,18 @@ class AssemblyTask {
   double offset_y_ = 0.0;                                        // the current search point
   double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();   // the rotary axis' (NaN: none yet)
   double last_yaw_ = 0.0;                                        // the fingers' yaw at the last tick
+  Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();           // ... and the tip's position
   double search_yaw_ = 0.0;                                      // ... when the insertion began
   double contact_z_ = std::numeric_limits<double>::quiet_NaN();  // where the last descent stopped
-  Eigen::Vector2d retreat_xy_{0, 0};                             // the search's way up: from here ...
-  double retreat_z_ = 0.0;                                       // ... to here (NaN: from where the tip is)
+  bool looks_ = false;
+  Look look_ = Look::kNone;                     // the look awaited, or the last one
+  bool slot_seen_ = false, held_seen_ = false;  // looks done (found or not)
+  Sighting placed_;                             // verify's look
+  bool placed_seen_ = false;
+  double held_offset_ = std::numeric_limits<double>::quiet_NaN();  // the pin along the fingers' y
+  double search_base_ = 0.0;                                       // the search's centre along y
+  Eigen::Vector2d retreat_xy_{0, 0};                               // the search's way up: from here ...
+  double retreat_z_ = 0.0;                                         // ... to here (NaN: from where the tip is)
 };
 
 }  // namespace mc::cell

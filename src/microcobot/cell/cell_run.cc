@@ -33,6 +33,8 @@ void CellRunParams::validate() const {
             "steps." + std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i))),
             "is manual: a headless run has no operator to do it (serve --cell runs it with one)");
   manual.validate();
+  camera.validate();
+  require(!camera.enabled || mode == "auto", "camera.enabled", "is the robot's (mode auto)");
 }
 
 namespace {
@@ -68,6 +70,10 @@ nlohmann::json CycleResult::to_json() const {
           {"clearance_m", clearance_m},
           {"wall_s", wall_s},
           {"ended_holding", ended_holding},
+          {"looks", looks},
+          {"looks_found", looks_found},
+          {"look_error_m", look_error_m},
+          {"look_wall_s", look_wall_s},
           {"step_s", step_times_json(step_s)}};
 }
 
@@ -107,6 +113,10 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("clearance_m", r.clearance_m);
   get("wall_s", r.wall_s);
   get("ended_holding", r.ended_holding);
+  get("looks", r.looks);
+  get("looks_found", r.looks_found);
+  get("look_error_m", r.look_error_m);
+  get("look_wall_s", r.look_wall_s);
   nlohmann::json steps;
   get("step_s", steps);
   for (std::size_t i = 0; i < r.step_s.size(); ++i) {
@@ -196,12 +206,16 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   }
   if (params_.mode == "auto") {
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
+    if (params_.camera.enabled) {
+      camera_ = std::make_unique<CellCamera>(params_.camera, base, static_cast<std::uint64_t>(job.index));
+      task_->set_looks(true);
+    }
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
     p.set_operator([this](const platform::TickInfo& t) {
       TaskSensors s = read_task_sensors(*platform_, home_m_);
       if (!finished_) meter_->sample(s);  // the cycle's measures end with it
-      if (task_->step() == AssemblyTask::Step::kVerify) {
+      if (task_->step() == AssemblyTask::Step::kVerify && !camera_) {
         // The cell's camera on the pin, at the precision the assisted person's guidance has.
         const double sd = params_.person.assist_vision_sd_m;
         s.part_m = platform_->simulation().gripper->world_state().part_m;
@@ -275,11 +289,58 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
 
 CellCycle::~CellCycle() = default;
 
+void CellCycle::look() {
+  const auto t0 = std::chrono::steady_clock::now();
+  const platform::Platform& p = *platform_;
+  const platform::CameraScenePose truth = truth_pose(p);
+  const PinModel pin{job_.side_m, job_.world.height_m()};
+  const TaskSensors s = read_task_sensors(p, home_m_);
+  PinSighting seen;
+  switch (task_->look_wanted()) {
+    case AssemblyTask::Look::kSlot:
+      seen = camera_->look_slot(truth, pin, job_.nominal_part_m, job_.nominal_part_yaw_rad);
+      break;
+    case AssemblyTask::Look::kHeld: {
+      // The pin's top where the grasp left it: the tips grasp_z above its bottom.
+      const double grasp_z = job_.world.hole_depth_m + params_.task.grip_above_m;
+      seen = camera_->look_held(truth, pin, s.tip_m, s.yaw_rad, s.tip_m.z() - grasp_z + pin.height_m);
+      break;
+    }
+    case AssemblyTask::Look::kPlaced:
+      seen = camera_->look_placed(truth, pin, job_.target_m, job_.target_yaw_rad,
+                                  pin.height_m - job_.world.hole_depth_m);
+      break;
+    case AssemblyTask::Look::kNone:
+      return;
+  }
+  ++looks_;
+  if (!seen.found) last_look_miss_ = seen.reason;
+  if (seen.found) {
+    ++looks_found_;
+    const Eigen::Vector2d truth_xy(truth.part_x_m, truth.part_y_m);
+    look_error_m_ = std::max(look_error_m_, (seen.part_m.head<2>() - truth_xy).norm());
+  }
+  AssemblyTask::Sighting sighting;
+  sighting.found = seen.found;
+  sighting.part_m = seen.part_m;
+  sighting.yaw_rad = seen.yaw_rad;
+  task_->see(sighting);
+  look_wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 void CellCycle::run_for(double duration_s) {
   platform::Platform& p = *platform_;
   const double end = std::min(p.loop().time_s() + duration_s, params_.max_cycle_s);
-  while (!finished_ && !p.faulted() && p.loop().time_s() < end - 1e-9)
-    p.run(std::min(1.0, end - p.loop().time_s()));
+  // With a camera the loop runs in short stretches: a look the task asks for is taken between
+  // them, off the loop, after the look's time has passed with the task holding.
+  const double stretch = camera_ ? 0.01 : 1.0;
+  while (!finished_ && !p.faulted() && p.loop().time_s() < end - 1e-9) {
+    p.run(std::min(stretch, end - p.loop().time_s()));
+    if (camera_ && task_->look_wanted() != AssemblyTask::Look::kNone) {
+      p.run(params_.camera.look_s);
+      look();
+    }
+  }
   if (finished_ && !settled_) {
     p.run(0.2);  // the stage settles where it was left, and is seen holding there
     settled_ = true;
@@ -327,6 +388,8 @@ CycleResult CellCycle::result() const {
     } else if (task_->status() == AssemblyTask::Status::kFailed) {
       r.verdict = "failed in step " + std::string(AssemblyTask::name(task_->step())) + ": " +
                   std::string(task_->failure());
+      if (task_->step() == AssemblyTask::Step::kVerify && *last_look_miss_ != '\0')
+        r.verdict += " (" + std::string(last_look_miss_) + ")";
     } else {
       r.verdict = inserted ? "inserted and released" : "the task ended but the pin is not down in its bore";
     }
@@ -364,6 +427,10 @@ CycleResult CellCycle::result() const {
           inserted ? "inserted and released" : "the operator finished but the pin is not down in its bore";
     }
   }
+  r.looks = looks_;
+  r.looks_found = looks_found_;
+  r.look_error_m = look_error_m_;
+  r.look_wall_s = look_wall_s_;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   return r;
 }

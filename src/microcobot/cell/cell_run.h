@@ -22,6 +22,7 @@
 
 #include "microcobot/cell/assembly_batch.h"
 #include "microcobot/cell/assembly_task.h"
+#include "microcobot/cell/cell_camera.h"
 #include "microcobot/cell/person_operator.h"
 #include "microcobot/core/rng.h"
 #include "microcobot/platform/pick_place_operator.h"
@@ -31,6 +32,9 @@
 namespace mc::cell {
 
 struct CellRunParams {
+  // Not an aggregate: GCC 12 at -O3 warns falsely of uninitialised strings in a CellRunParams{}
+  // temporary built member by member.
+  CellRunParams() = default;
   std::string mode = "auto";   ///< cell_modes()
   double max_cycle_s = 120.0;  ///< simulated; a cycle not finished by then fails
   AssemblyTaskParams task;
@@ -45,6 +49,8 @@ struct CellRunParams {
   /// Each step's autonomy (a task file's `steps`, task_file.h; not a --params key). Headless
   /// runs have no operator for a `manual` step: refused.
   std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> autonomy = all_auto();
+  /// The cell's camera (mode auto): its looks at the pin in its slot, in the fingers, placed.
+  CellCameraParams camera;
   /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up to ~5 mm at
   /// 100 um/s, where the main scenario's is 2 mm).
   platform::PickPlaceOperatorParams manual = manual_defaults();
@@ -58,6 +64,7 @@ struct CellRunParams {
     v("person_seed", person_seed);
     v("confirm_delay_s", confirm_delay_s);
     v("manual", manual);
+    v("camera", camera);
   }
   void validate() const;
   static std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> all_auto() {
@@ -94,7 +101,10 @@ struct CycleResult {
   int confirmations = 0;  ///< steps the supervisor confirmed (autonomy `confirm`)
   double path_m = 0.0;    ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
-  double wall_s = 0.0;  ///< the cycle's wall-clock time, the platform's construction included
+  double wall_s = 0.0;             ///< the cycle's wall-clock time, the platform's construction included
+  int looks = 0, looks_found = 0;  ///< the cell camera's looks (CellCameraParams::enabled)
+  double look_error_m = 0.0;       ///< the largest |seen - true| of the pin's centre in x-y, found looks
+  double look_wall_s = 0.0;        ///< wall-clock time spent rendering and measuring
   bool ended_holding =
       false;  ///< every axis' target (the rotary's too) at its measured position, the coupling off
   /// Simulated seconds spent in each step of the task (auto) or of the person (manual, assisted),
@@ -163,7 +173,13 @@ class CellCycle {
   bool finished_ = false, held_ = false, settled_ = false;
   double finished_at_s_ = 0.0;
   double waiting_s_ = 0.0;  // how long the task has awaited confirmation
-  Rng vision_rng_;          // the cell's vision of the part (the robot's verify step)
+  Rng vision_rng_;          // the cell's vision of the part without a camera (the verify step)
+  std::unique_ptr<CellCamera> camera_;
+  int looks_ = 0, looks_found_ = 0;
+  double look_error_m_ = 0.0, look_wall_s_ = 0.0;
+  const char* last_look_miss_ = "";  // why the last look that found nothing did not
+  /// The look the task awaits, off the loop: the frames rendered from the truth, measured, seen.
+  void look();
   int confirmations_ = 0;
 };
 

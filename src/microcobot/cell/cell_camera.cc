@@ -1,0 +1,301 @@
+#include "microcobot/cell/cell_camera.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "microcobot/core/error.h"
+#include "microcobot/platform/platform.h"
+#include "microcobot/vision/depth_from_focus.h"
+#include "microcobot/vision/renderer.h"
+#include "microcobot/vision/sensor_model.h"
+#include "microcobot/vision/sharpness.h"
+#include "microcobot/vision/template_tracker.h"
+
+namespace mc::cell {
+
+namespace vs = mc::vision;
+
+void CellCameraParams::validate() const {
+  try {
+    (void)vs::objective_by_name(objective);
+  } catch (const Error& e) {
+    throw InvalidParams("objective", e.what());
+  }
+  require(width_px >= 0 && width_px <= 8192 && height_px >= 0 && height_px <= 8192, "width_px/height_px",
+          "must be within [0, 8192] (0: the sensor's)");
+  require(std::isfinite(look_s) && look_s >= 0.0 && look_s <= 5.0, "look_s", "must be within [0, 5] s",
+          look_s);
+  require(seed >= 0, "seed", "must be >= 0", seed);
+  require(std::isfinite(min_confidence) && min_confidence > 0.0 && min_confidence < 1.0, "min_confidence",
+          "must be within (0, 1)", min_confidence);
+  require(std::isfinite(focus_step_dof) && focus_step_dof >= 0.5 && focus_step_dof <= 10.0, "focus_step_dof",
+          "must be within [0.5, 10]", focus_step_dof);
+  require(std::isfinite(band_inset_m) && band_inset_m >= 0.0 && band_inset_m <= 100e-6, "band_inset_m",
+          "must be within [0, 100 um]", band_inset_m);
+}
+
+platform::CameraScenePose truth_pose(const platform::Platform& p) {
+  const platform::PlatformConfig& c = p.config();
+  platform::CameraScenePose pose;
+  pose.tool_x_m = c.stage.home_x_m + p.axis(0).carried_position_m();
+  pose.tool_y_m = c.stage.home_y_m + p.axis(1).carried_position_m();
+  pose.tool_z_m = c.stage.home_z_m + p.axis(2).carried_position_m();
+  pose.opening_m = p.gripper().opening_m();
+  if (const auto* g = p.simulated_gripper()) {
+    const auto& w = g->world_state();
+    pose.tool_yaw_rad = g->yaw_rad();
+    pose.part_x_m = w.part_m.x(), pose.part_y_m = w.part_m.y(), pose.part_z_m = w.part_m.z();
+    pose.part_yaw_rad = w.part_yaw_rad;
+  }
+  return pose;  // the stage holds while the cell looks: no motion blur
+}
+
+struct CellCamera::Impl {
+  platform::PlatformConfig config;
+  vs::CameraParams camera;
+  vs::SensorModel sensor;
+  vs::SceneSnapshot scene;
+  vs::Frame frame, model;
+
+  Impl(const CellCameraParams& p, const platform::PlatformConfig& c)
+      : config(c), camera(make_camera(p)), sensor(camera.sensor) {}
+
+  static vs::CameraParams make_camera(const CellCameraParams& p) {
+    vs::CameraParams cam;
+    cam.objective = vs::objective_by_name(p.objective);
+    if (p.width_px > 0) cam.sensor.width_px = p.width_px;
+    if (p.height_px > 0) cam.sensor.height_px = p.height_px;
+    return cam;
+  }
+
+  /// A renderer looking at `centre`.
+  vs::Renderer renderer_at(const Eigen::Vector2d& centre) const {
+    vs::CameraParams cam = camera;
+    cam.view_center_x_m = centre.x();
+    cam.view_center_y_m = centre.y();
+    return vs::Renderer(cam);
+  }
+
+  /// The frame of `pose` (noise from seed and index), or without the fingers and without noise
+  /// (`expected`: what the cell expects, from what it is told).
+  void render(vs::Renderer& r, const platform::CameraScenePose& pose, double focus_z_m, bool expected,
+              std::uint64_t seed, std::uint64_t index, vs::Frame& out) {
+    platform::fill_camera_scene(config, pose, scene);
+    if (expected) scene.fingers.clear();
+    vs::CameraControls controls = r.default_controls();
+    controls.focus_z_m = focus_z_m;
+    const std::vector<float>& photo_e = r.render_expected(scene, controls);
+    sensor.read_out(photo_e, {controls.exposure_s, controls.gain}, seed, index, !expected, out);
+  }
+};
+
+CellCamera::CellCamera(const CellCameraParams& params, const platform::PlatformConfig& config,
+                       std::uint64_t stream)
+    : p_(params), seed_(static_cast<std::uint64_t>(params.seed) * 1000003ULL + stream) {
+  p_.validate();
+  impl_ = std::make_unique<Impl>(p_, config);
+}
+
+CellCamera::~CellCamera() = default;
+
+namespace {
+
+// The pin's pose with only the pin moved: what the model template is rendered from.
+platform::CameraScenePose pin_at(platform::CameraScenePose pose, const Eigen::Vector2d& xy, double z_centre,
+                                 double yaw) {
+  pose.part_x_m = xy.x(), pose.part_y_m = xy.y(), pose.part_z_m = z_centre;
+  pose.part_yaw_rad = yaw;
+  return pose;
+}
+
+// The square's bounding box in pixels, `margin_px` wider each side, inside the frame (empty when it leaves
+// it).
+vs::PixelRoi pin_roi(const vs::Renderer& r, const Eigen::Vector2d& xy, double side_m, double yaw,
+                     int margin_px) {
+  const int width = r.camera().sensor.width_px, height = r.camera().sensor.height_px;
+  const double half_m = 0.5 * side_m * (std::abs(std::cos(yaw)) + std::abs(std::sin(yaw)));
+  const double half_px = half_m / r.camera().pixel_size_m() + margin_px;
+  const int x0 = static_cast<int>(std::floor(r.u_of_x(xy.x()) - half_px));
+  const int y0 = static_cast<int>(std::floor(r.v_of_y(xy.y()) - half_px));
+  const int side = static_cast<int>(std::ceil(2.0 * half_px)) + 1;
+  if (x0 < 0 || y0 < 0 || x0 + side > width || y0 + side > height) return {};
+  return {x0, y0, side, side};
+}
+
+// The frame's value at continuous pixel (u, v), bilinear; NaN outside.
+double bilinear(const vs::Frame& f, double u, double v) {
+  const double fu = std::floor(u), fv = std::floor(v);
+  const int j = static_cast<int>(fu), i = static_cast<int>(fv);
+  if (j < 0 || i < 0 || j + 1 >= f.width || i + 1 >= f.height) return std::nan("");
+  const double a = u - fu, b = v - fv;
+  const auto at = [&f](int row, int col) {
+    return static_cast<double>(f.pixels[static_cast<std::size_t>(row) * static_cast<std::size_t>(f.width) +
+                                        static_cast<std::size_t>(col)]);
+  };
+  return (1 - b) * ((1 - a) * at(i, j) + a * at(i, j + 1)) +
+         b * ((1 - a) * at(i + 1, j) + a * at(i + 1, j + 1));
+}
+
+// The vertex of the parabola through (-1, ym), (0, y0), (1, yp): the sub-sample offset of an extremum.
+double vertex_offset(double ym, double y0, double yp) {
+  const double d = ym - 2.0 * y0 + yp;
+  return d != 0.0 ? std::clamp(0.5 * (ym - yp) / d, -0.5, 0.5) : 0.0;
+}
+
+}  // namespace
+
+PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const PinModel& pin,
+                                  const Eigen::Vector2d& nominal_xy, double nominal_yaw) {
+  Impl& m = *impl_;
+  vs::Renderer r = m.renderer_at(nominal_xy);
+  const double focus = pin.height_m;  // the pin's top, standing on the tray
+  m.render(r, truth, focus, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  m.render(r, pin_at(truth, nominal_xy, 0.5 * pin.height_m, nominal_yaw), focus, true, 0, 0, m.model);
+  PinSighting s;
+  s.yaw_rad = nominal_yaw;
+  const vs::PixelRoi roi = pin_roi(r, nominal_xy, pin.side_m, nominal_yaw, 12);
+  if (roi.width == 0) {
+    s.reason = "the pin's slot is not inside the camera's field";
+    return s;
+  }
+  vs::TrackerParams tp;
+  tp.rotation = true;
+  vs::TemplateTracker tracker(tp);
+  tracker.set_template(m.model, roi);
+  const double cu = roi.x + 0.5 * (roi.width - 1), cv = roi.y + 0.5 * (roi.height - 1);
+  const vs::TrackEstimate e = tracker.track_near(m.frame, cu, cv);
+  s.confidence = e.confidence;
+  if (!e.found || e.confidence < p_.min_confidence) {
+    s.reason = "the pin does not match its model in its slot";
+    return s;
+  }
+  // The template's centre moved by (du, dv) px; the pin's centre with it (the ROI is centred on
+  // it to within half a pixel, which the small turn moves by under 0.01 px).
+  const double px = r.camera().pixel_size_m();
+  s.part_m = {nominal_xy.x() + (e.u_px - cu) * px, nominal_xy.y() - (e.v_px - cv) * px, 0.5 * pin.height_m};
+  s.yaw_rad = nominal_yaw + e.angle_rad;
+  s.found = true;
+  return s;
+}
+
+PinSighting CellCamera::look_held(const platform::CameraScenePose& truth, const PinModel& pin,
+                                  const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
+  Impl& m = *impl_;
+  vs::Renderer r = m.renderer_at(tool_m.head<2>());
+  m.render(r, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  PinSighting s;
+  s.yaw_rad = tool_yaw;
+  // The profile along the fingers' y, sampled every half pixel over the pin and 30 um either side,
+  // each sample the mean across the band |x_f| <= side / 2 - inset.
+  const double px = r.camera().pixel_size_m(), h = 0.5 * px;
+  const double half_band = 0.5 * pin.side_m - p_.band_inset_m;
+  if (half_band < 2.0 * px) {
+    s.reason = "the pin is too narrow for a band between the fingers";
+    return s;
+  }
+  const double reach = 0.5 * pin.side_m + 30e-6;
+  const int n = static_cast<int>(std::ceil(reach / h));
+  const Eigen::Vector2d ex(std::cos(tool_yaw), std::sin(tool_yaw)),
+      ey(-std::sin(tool_yaw), std::cos(tool_yaw));
+  std::vector<double> profile(static_cast<std::size_t>(2 * n + 1));
+  for (int k = -n; k <= n; ++k) {
+    double sum = 0.0;
+    int count = 0;
+    for (double xf = -half_band; xf <= half_band + 1e-12; xf += h) {
+      const Eigen::Vector2d w = tool_m.head<2>() + xf * ex + k * h * ey;
+      const double value = bilinear(m.frame, r.u_of_x(w.x()), r.v_of_y(w.y()));
+      if (std::isnan(value)) {
+        s.reason = "the pin in the fingers leaves the camera's field";
+        return s;
+      }
+      sum += value;
+      ++count;
+    }
+    profile[static_cast<std::size_t>(k + n)] = sum / count;
+  }
+  // The two faces: the strongest gradient in each half, the near face rising into the bright top
+  // and the far one falling out of it (or the reverse: the larger magnitude either way).
+  std::vector<double> g(profile.size(), 0.0);
+  for (std::size_t i = 1; i + 1 < profile.size(); ++i) g[i] = 0.5 * (profile[i + 1] - profile[i - 1]);
+  const auto strongest = [&g](std::size_t from, std::size_t to) {
+    std::size_t best = from;
+    for (std::size_t i = from; i < to; ++i)
+      if (std::abs(g[i]) > std::abs(g[best])) best = i;
+    return best;
+  };
+  const std::size_t mid = static_cast<std::size_t>(n);
+  const std::size_t a = strongest(2, mid), b = strongest(mid + 1, g.size() - 2);
+  const auto edge_y = [&](std::size_t i) {
+    return (static_cast<double>(i) - n +
+            vertex_offset(std::abs(g[i - 1]), std::abs(g[i]), std::abs(g[i + 1]))) *
+           h;
+  };
+  const double ya = edge_y(a), yb = edge_y(b);
+  // Contrast: the weaker edge against the profile's noise (the gradient's median magnitude).
+  std::vector<double> mags(g.size());
+  std::transform(g.begin(), g.end(), mags.begin(), [](double x) { return std::abs(x); });
+  std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2), mags.end());
+  const double noise = std::max(mags[mags.size() / 2], 1e-9);
+  s.confidence = std::min(std::abs(g[a]), std::abs(g[b])) / noise;
+  // The faces a side apart (within 3 pixels), each a clear edge: else not the pin.
+  if (std::abs((yb - ya) - pin.side_m) > 3.0 * px || s.confidence < 5.0) {
+    s.reason = "the pin's faces are not where a pin in the fingers has them";
+    return s;
+  }
+  const double centre = 0.5 * (ya + yb);
+  const Eigen::Vector2d xy = tool_m.head<2>() + centre * ey;
+  s.part_m = {xy.x(), xy.y(), top_z_m - 0.5 * pin.height_m};
+  s.found = true;
+  return s;
+}
+
+PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, const PinModel& pin,
+                                    const Eigen::Vector2d& bore_xy, double bore_yaw, double top_z_m) {
+  Impl& m = *impl_;
+  vs::Renderer r = m.renderer_at(bore_xy);
+  PinSighting s;
+  s.yaw_rad = bore_yaw;
+  const vs::PixelRoi box = pin_roi(r, bore_xy, pin.side_m, bore_yaw, 12);
+  if (box.width == 0) {
+    s.reason = "the bore is not inside the camera's field";
+    return s;
+  }
+  // Three frames: at the expected top and one depth of field either side; the measure on the
+  // pin's box, the frame in focus kept for the position.
+  const double step = p_.focus_step_dof * r.figures().dof_m;
+  std::array<vs::FocusSample, 3> samples;
+  vs::Frame focused;
+  for (int k = 0; k < 3; ++k) {
+    const double z = top_z_m + (k - 1) * step;
+    m.render(r, truth, z, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+    samples[static_cast<std::size_t>(k)] = {z, vs::tenengrad(m.frame, box)};
+    if (k == 1) focused = m.frame;
+  }
+  const vs::FocusPeak peak = vs::focus_peak(samples);
+  if (!peak.found) {
+    s.reason = "no pin top in focus at the height of a pin down in its bore";
+    return s;
+  }
+  m.render(r, pin_at(truth, bore_xy, top_z_m - 0.5 * pin.height_m, bore_yaw), top_z_m, true, 0, 0, m.model);
+  vs::TrackerParams tp;
+  tp.rotation = true;
+  vs::TemplateTracker tracker(tp);
+  tracker.set_template(m.model, box);
+  const double cu = box.x + 0.5 * (box.width - 1), cv = box.y + 0.5 * (box.height - 1);
+  const vs::TrackEstimate e = tracker.track_near(focused, cu, cv);
+  s.confidence = e.confidence;
+  if (!e.found || e.confidence < p_.min_confidence) {
+    s.reason = "the pin does not match its model in its bore";
+    return s;
+  }
+  const double px = r.camera().pixel_size_m();
+  s.part_m = {bore_xy.x() + (e.u_px - cu) * px, bore_xy.y() - (e.v_px - cv) * px,
+              peak.z_m - 0.5 * pin.height_m};
+  s.yaw_rad = bore_yaw + e.angle_rad;
+  s.found = true;
+  return s;
+}
+
+}  // namespace mc::cell
