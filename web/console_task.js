@@ -54,6 +54,7 @@ function taskHint(t) {
     return t.supervisor_lost ? "Paused by the platform: control or the console's heartbeat was lost. Resume to go on."
                              : "Paused: the stage holds. Resume, take over or skip.";
   if (t.status === "awaiting confirmation") return `“${t.step}” waits for your Confirm (or Skip).`;
+  if (t.status === "awaiting look") return `“${t.step}”: the cell's camera looks at the pin; the stage holds.`;
   if (t.status === "operator") return `You drive (${t.step}): hold the deadman to move. Hand back when ready.`;
   const truth = t.inserted === true ? " — the pin is in its bore" : t.inserted === false ? " — the pin is not in its bore" : "";
   if (t.status === "succeeded") return `Succeeded in ${t.elapsed_s.toFixed(1)} s${truth}. Restart scene for another cycle.`;
@@ -68,8 +69,9 @@ listen("/platform/status", (s) => {
   const state = $("task-state");
   state.textContent = t.status;
   state.className = "pill " + ({running: "ok", succeeded: "ok", failed: "bad", paused: "warn",
-                                "awaiting confirmation": "warn", operator: "warn"}[t.status] || "");
-  $("task-info").textContent = t.started ? `${t.elapsed_s.toFixed(1)} s · search tries ${t.search_tries}` : "";
+                                "awaiting confirmation": "warn", "awaiting look": "ok", operator: "warn"}[t.status] || "");
+  const looks = t.looks > 0 ? ` · camera ${t.looks_found}/${t.looks}` : "";
+  $("task-info").textContent = t.started ? `${t.elapsed_s.toFixed(1)} s · search tries ${t.search_tries}${looks}` : "";
   const key = JSON.stringify([t.step_index, t.status, t.steps]);
   if (key !== lastTaskKey) {  // the tree redrawn only when it changes
     lastTaskKey = key;

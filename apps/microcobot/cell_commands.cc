@@ -27,6 +27,7 @@ struct CellOptions {
   std::optional<std::filesystem::path> scene;   // AssemblyBatchParams
   std::optional<std::filesystem::path> config;  // the platform
   std::optional<std::filesystem::path> task;    // a task file: autonomy per step, the task's parameters
+  bool camera = false;                          // the cell's camera for the robot (camera.enabled)
   std::optional<int> batch, seed;
   std::optional<std::string> mode, master;
   std::vector<std::string> modes{"auto", "manual"};  // compare
@@ -60,11 +61,16 @@ Inputs load_inputs(const CellOptions& o) {
     }
   }
   if (o.master) in.params.person.master = *o.master;
-  mc::cli::naming_flags(
-      {{"parts", "--batch"}, {"seed", "--seed"}, {"mode", "--mode"}, {"master", "--master"}}, [&] {
-        in.scene.validate();
-        in.params.validate();
-      });
+  if (o.camera) in.params.camera.enabled = true;
+  mc::cli::naming_flags({{"parts", "--batch"},
+                         {"seed", "--seed"},
+                         {"mode", "--mode"},
+                         {"master", "--master"},
+                         {"camera.enabled", "--camera"}},
+                        [&] {
+                          in.scene.validate();
+                          in.params.validate();
+                        });
   if (o.config) in.config = pf::load_platform_config(*o.config);
   return in;
 }
@@ -73,6 +79,7 @@ std::vector<cell::CycleResult> run_mode(const Inputs& in, const std::vector<cell
                                         const std::string& mode) {
   cell::CellRunParams params = in.params;
   params.mode = mode;
+  params.camera.enabled = params.camera.enabled && mode == "auto";  // the robot's camera
   return cell::run_batch(jobs, params, in.config, [&](const cell::CycleResult& c) {
     mc::cli::progress("cell " + mode, static_cast<std::size_t>(c.index + 1), jobs.size());
   });
@@ -96,7 +103,11 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                       "side_m",
                                       "clearance_m",
                                       "ended_holding",
-                                      "wall_s"};
+                                      "wall_s",
+                                      "looks",
+                                      "looks_found",
+                                      "look_error_m",
+                                      "look_wall_s"};
   // Where each cycle's time went, step by step (zero for the scripted watchmaker).
   for (std::size_t i = 0; i + 1 < cell::AssemblyTask::kStepCount; ++i)
     columns.push_back(std::string(cell::AssemblyTask::name(static_cast<cell::AssemblyTask::Step>(i))) + "_s");
@@ -119,7 +130,11 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                c.side_m,
                                c.clearance_m,
                                c.ended_holding ? 1.0 : 0.0,
-                               c.wall_s};
+                               c.wall_s,
+                               static_cast<double>(c.looks),
+                               static_cast<double>(c.looks_found),
+                               c.look_error_m,
+                               c.look_wall_s};
     row.insert(row.end(), c.step_s.begin(), c.step_s.end());
     t.add_row(row);
   }
@@ -152,6 +167,11 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
   rep.add_result("placement error, median", s.placement_median_m, "m");
   rep.add_result("peak grip force", s.peak_grip_max_N, "N");
   rep.add_result("ticks over a force limit", s.force_violations);
+  if (s.looks > 0) {
+    rep.add_result("camera looks", s.looks);
+    rep.add_result("camera looks that found the pin", s.looks_found);
+    rep.add_result("camera's largest error (x-y, against the truth)", s.look_error_max_m, "m");
+  }
   std::vector<double> part, time, clearance_um, placement_um, grip_mN, contact_mN, tries;
   // By clearance: the plots draw each series' points in the order of its x.
   std::vector<const cell::CycleResult*> by_clearance;
@@ -249,15 +269,20 @@ void run(const CellOptions& o) {
   std::string failures;
   for (const auto& c : cycles)
     if (!c.success) failures += fmt::format("\n  part {}: {}", c.index, c.verdict);
+  const std::string looks =
+      s.looks > 0
+          ? fmt::format("; camera: {}/{} looks found the pin, largest error {:.3f} um, {:.1f} s rendering",
+                        s.looks_found, s.looks, 1e6 * s.look_error_max_m, s.look_wall_s)
+          : std::string();
   mc::cli::emit(
       o.common, summary,
       fmt::format("cell run {} (seed {}): {}/{} inserted ({:.0f} %, 95 % CI {:.0f}-{:.0f} %), cycle median "
                   "{:.1f} s (IQR {:.1f}-{:.1f} s), placement median {:.2f} um, peak grip {:.3f} mN, "
-                  "{} ticks over a force limit; {:.0f} s simulated in {:.1f} s{}",
+                  "{} ticks over a force limit; {:.0f} s simulated in {:.1f} s{}{}",
                   s.mode, scene.seed, s.successes, s.cycles, 100 * s.success_rate, 100 * s.success_low,
                   100 * s.success_high, s.cycle_median_s, s.cycle_q1_s, s.cycle_q3_s,
                   1e6 * s.placement_median_m, 1e3 * s.peak_grip_max_N, s.force_violations, s.simulated_s,
-                  s.wall_s, failures));
+                  s.wall_s, looks, failures));
 }
 
 // Several modes on the same parts: each one's summary, and its ratios to the last mode's.
@@ -318,6 +343,9 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
                  "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
                  "confirmed after confirm_delay_s, manual ones refused headless) and the task's parameters "
                  "(`params: {insert_speed_m_s: 1e-5}`); docs/cell.md");
+  cmd.add_flag("--camera", o.camera,
+               "The robot's camera (mode auto): looks at the pin in its slot, in the fingers and placed, on "
+               "rendered frames (camera.* in --params; docs/cell.md)");
   mc::cli::add_params_option(cmd, o.common);
   mc::cli::add_output_options(cmd, o.common);
   mc::cli::add_format_option(cmd, o.common);

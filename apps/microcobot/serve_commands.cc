@@ -44,6 +44,7 @@ struct ServeOptions {
   bool cell = false;                 // the automatic insertion supervised from the console (issue #29)
   std::optional<int> seed, part;     // --cell: the batch's seed, the part of it
   std::optional<std::filesystem::path> task;  // --cell: a task file (cell/task_file.h)
+  bool cell_camera = false;                   // --cell: the cell camera's looks (cell/cell_camera.h)
   std::string listen = "127.0.0.1:8080";
   std::string token;
   std::filesystem::path out = "out/live";
@@ -172,6 +173,7 @@ void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
     tp.task = f.params;
     tp.autonomy = f.steps.autonomy();
   }
+  tp.camera.enabled = o.cell_camera;
   lp.platform.microworld = "pick-place";
   lp.platform.world = job.world;
   lp.platform.validate();
@@ -184,16 +186,21 @@ void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
                             mc::cell::AssemblyTask::name(tp.autonomy[static_cast<std::size_t>(i)]));
   std::cerr << fmt::format(
       "serve: cell part {} of the batch of seed {}: a {:.0f} um pin into a bore with {:.1f} um of radial "
-      "clearance; steps {}; the task waits for Start in the console\n",
+      "clearance; steps {}{}; the task waits for Start in the console\n",
       part, batch.seed, 1e6 * job.side_m, 1e6 * job.clearance_m,
-      levels.empty() ? "all auto" : levels + " (the rest auto)");
+      levels.empty() ? "all auto" : levels + " (the rest auto)",
+      o.cell_camera ? "; the cell's camera looks" : "");
 }
 
 void serve(const ServeOptions& o) {
   mc::live::LiveParams lp;
   if (o.config) lp.platform = pf::load_platform_config(*o.config);
-  if (!o.cell && (o.seed || o.part || o.task))
-    throw mc::UsageError(std::string(o.task ? "--task" : o.seed ? "--seed" : "--part") + ": needs --cell");
+  if (!o.cell && (o.seed || o.part || o.task || o.cell_camera))
+    throw mc::UsageError(std::string(o.task          ? "--task"
+                                     : o.seed        ? "--seed"
+                                     : o.cell_camera ? "--cell-camera"
+                                                     : "--part") +
+                         ": needs --cell");
   const std::string scene = o.scene.value_or("pick-place");
   if (o.cell) {
     use_cell(o, lp);
@@ -332,6 +339,9 @@ void add_serve(CLI::App& cmd) {
       "--task", o->task,
       "With --cell: a task file (YAML: `steps` autonomy auto|confirm|manual, `params` of the task; "
       "docs/cell.md)");
+  cmd.add_flag("--cell-camera", o->cell_camera,
+               "With --cell: the cell's camera looks at the pin in its slot, in the fingers and placed "
+               "(rendered frames; the task holds while it looks; docs/cell.md)");
   cmd.add_option("--listen", o->listen,
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");

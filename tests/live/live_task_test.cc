@@ -53,7 +53,8 @@ struct TaskRig {
 
   // `paced`: the loop on the wall clock, the console's 0.2 s heartbeat timeout (the test of the
   // heartbeat's gaps); else as fast as the machine goes, with a 10 s timeout.
-  explicit TaskRig(bool paced = false) {
+  // `camera`: the cell camera's looks (a LiveLooker answers them).
+  explicit TaskRig(bool paced = false, bool camera = false) {
     cell::AssemblyBatchParams batch;
     batch.parts = 1;
     batch.seed = 41;
@@ -66,6 +67,7 @@ struct TaskRig {
     params.platform.devices.camera.driver = "none";
     LiveTaskParams tp;
     tp.goal = cell::assembly_goal(job);
+    tp.camera.enabled = camera;
     params.task = tp;
     live = std::make_unique<LivePlatform>(params);
     samples.reserve(200000);
@@ -209,6 +211,30 @@ TEST(LiveTask, PauseHoldsAtTheTickTakeOverIsBumplessAndTheHandedBackTaskInserts)
   EXPECT_LT((s.back().measured - s.back().target).norm(), 1e-6);
 }
 
+// With the cell's camera (`serve --cell --cell-camera`): the task holds while the looker thread
+// renders and measures its looks (the target does not move meanwhile), takes each sighting and
+// inserts the pin, the camera's verify included, ending with every axis holding.
+TEST(LiveTask, WithTheCellCameraTheTaskHoldsForItsLooksAndInserts) {
+  TaskRig rig(/*paced=*/false, /*camera=*/true);
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kStart));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kAwaitingLook; }));
+  EXPECT_EQ(rig.task().step, Step::kApproach);
+  const Eigen::Vector3d before = rig.copy().back().target;
+  ASSERT_TRUE(rig.run_for(0.02));
+  EXPECT_EQ(rig.copy().back().target, before) << "the stage holds while the camera looks";
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 180s));
+  const LiveTaskStatus end = rig.task();
+  EXPECT_EQ(end.status, Status::kSucceeded) << end.failure;
+  EXPECT_EQ(end.inserted, 1);
+  EXPECT_EQ(end.looks, 3);
+  EXPECT_EQ(end.looks_found, 3);
+  EXPECT_EQ(end.search_tries, 0);
+  ASSERT_TRUE(rig.run_for(0.3));
+  const std::vector<TaskSample> s = rig.copy();
+  EXPECT_FALSE(s.back().engaged) << "ended holding";
+  EXPECT_LT((s.back().measured - s.back().target).norm(), 1e-6);
+}
+
 TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   TaskRig rig(/*paced=*/true);
   rig.live->push_task_action(TaskAction::kStart);
@@ -260,6 +286,22 @@ TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   ASSERT_TRUE(test::eventually([&] { return rig.live->status().restarts == 1; }));
   EXPECT_EQ(rig.task().status_name(), "idle") << "a new scene, a new cycle";
   EXPECT_EQ(rig.task().step, Step::kApproach);
+}
+
+// The camera's looks reach the loop through a ring: it allocates nothing taking them (the looker
+// thread renders, and allocates, beside it).
+TEST(LiveTask, TheLoopAllocatesNothingWhileTheCameraLooks) {
+  TaskRig rig(/*paced=*/false, /*camera=*/true);
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard(rig.live->loop_thread_id());
+    rig.live->push_task_action(TaskAction::kStart);
+    ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.step == Step::kDescend; }));
+    EXPECT_EQ(rig.task().looks, 1);
+    ASSERT_TRUE(rig.run_for(0.3));
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
 }
 
 TEST(LiveTask, TheLoopAllocatesNothingWhileTheTaskRunsPausesAndIsTakenOver) {

@@ -142,7 +142,11 @@ nlohmann::json BatchSummary::to_json() const {
           {"peak_contact_max_N", peak_contact_max_N},
           {"force_violations", force_violations},
           {"simulated_s", simulated_s},
-          {"wall_s", wall_s}};
+          {"wall_s", wall_s},
+          {"looks", looks},
+          {"looks_found", looks_found},
+          {"look_error_max_m", look_error_max_m},
+          {"look_wall_s", look_wall_s}};
 }
 
 /// What the cycle measures at every operator tick (on the loop: arithmetic only).
@@ -237,6 +241,11 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       control::ConsoleInput in = task_->tick(s, t.dt_s);
       if (task_->status() == AssemblyTask::Status::kOperator) in.active = false;
       platform_->set_console_input(in);
+      // A look wanted: the loop stops at the end of this tick, the camera looks between runs.
+      if (camera_ && !look_requested_ && task_->look_wanted() != AssemblyTask::Look::kNone) {
+        look_requested_ = true;
+        platform_->stop();
+      }
       if (task_->finished() && !finished_) {
         finished_ = true;
         finished_at_s_ = t.t_s;
@@ -331,14 +340,14 @@ void CellCycle::look() {
 void CellCycle::run_for(double duration_s) {
   platform::Platform& p = *platform_;
   const double end = std::min(p.loop().time_s() + duration_s, params_.max_cycle_s);
-  // With a camera the loop runs in short stretches: a look the task asks for is taken between
-  // them, off the loop, after the look's time has passed with the task holding.
-  const double stretch = camera_ ? 0.01 : 1.0;
   while (!finished_ && !p.faulted() && p.loop().time_s() < end - 1e-9) {
-    p.run(std::min(stretch, end - p.loop().time_s()));
-    if (camera_ && task_->look_wanted() != AssemblyTask::Look::kNone) {
-      p.run(params_.camera.look_s);
+    p.run(std::min(1.0, end - p.loop().time_s()));
+    if (look_requested_) {
+      // The look the task asks for (the operator stopped the run): its time passes with the task
+      // holding, then the camera looks, off the loop.
+      if (params_.camera.look_s > 0.0) p.run(params_.camera.look_s);
       look();
+      look_requested_ = false;
     }
   }
   if (finished_ && !settled_) {
@@ -482,6 +491,10 @@ BatchSummary summarize(const std::vector<CycleResult>& cycles) {
     s.force_violations += c.grip_violations + c.contact_violations;
     s.simulated_s += c.cycle_s;
     s.wall_s += c.wall_s;
+    s.looks += c.looks;
+    s.looks_found += c.looks_found;
+    s.look_error_max_m = std::max(s.look_error_max_m, c.look_error_m);
+    s.look_wall_s += c.look_wall_s;
   }
   std::sort(times.begin(), times.end());
   std::sort(placement.begin(), placement.end());

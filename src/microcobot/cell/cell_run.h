@@ -128,6 +128,9 @@ struct BatchSummary {
   double peak_grip_max_N = 0.0, peak_contact_max_N = 0.0;
   int force_violations = 0;
   double simulated_s = 0.0, wall_s = 0.0;
+  int looks = 0, looks_found = 0;  ///< the cell camera's, over the batch
+  double look_error_max_m = 0.0;   ///< the largest of the cycles' look_error_m
+  double look_wall_s = 0.0;
   nlohmann::json to_json() const;
 };
 
@@ -178,6 +181,7 @@ class CellCycle {
   int looks_ = 0, looks_found_ = 0;
   double look_error_m_ = 0.0, look_wall_s_ = 0.0;
   const char* last_look_miss_ = "";  // why the last look that found nothing did not
+  bool look_requested_ = false;      // the operator stopped the run for a look
   /// The look the task awaits, off the loop: the frames rendered from the truth, measured, seen.
   void look();
   int confirmations_ = 0;

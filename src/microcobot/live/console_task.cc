@@ -62,6 +62,8 @@ nlohmann::json task_status_json(const std::optional<LiveTaskStatus>& task) {
           {"failure", s.failure},
           {"supervisor_lost", s.supervisor_lost},
           {"heartbeat_gap", s.heartbeat_gap},
+          {"looks", s.looks},
+          {"looks_found", s.looks_found},
           {"inserted", s.inserted < 0 ? nlohmann::json(nullptr) : nlohmann::json(s.inserted == 1)}};
 }
 

@@ -35,6 +35,8 @@ void LiveParams::validate() const {
     require(remote == nullptr, "task",
             "the console supervises a task only where it drives (not a slave process)");
     task->validate();
+    require(!task->camera.enabled || (!make_devices && platform.devices.simulated()), "task.camera.enabled",
+            "the cell's camera renders the simulation: every device simulated");
   }
 }
 
@@ -44,6 +46,13 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   home_m_ = {params_.platform.stage.home_x_m, params_.platform.stage.home_y_m,
              params_.platform.stage.home_z_m};
   if (params_.task) task_ = std::make_unique<LiveTask>(*params_.task);
+  if (task_ && params_.task->camera.enabled)
+    looker_ = std::make_unique<LiveLooker>(params_.task->camera, params_.platform, *params_.task, *task_,
+                                           [this](platform::TelemetrySample& out) {
+                                             std::lock_guard lock(latest_mutex_);
+                                             out = latest_sample_;
+                                             return has_latest_;
+                                           });
   if (params_.platform.stage.vision_xy())
     positioner_ =
         std::make_unique<platform::VisionPositioner>(params_.platform, params_.platform.stage.vision);
@@ -355,6 +364,11 @@ void LivePlatform::control_thread() {
       platform::TelemetrySample shifted = s;
       shifted[0] += offset;
       sink_(shifted, channels);
+      if (looker_) {  // the drain thread, not the loop: a lock is fine here
+        std::lock_guard lock(latest_mutex_);
+        latest_sample_ = s;
+        has_latest_ = true;
+      }
     });
     if (quit_.load()) break;
     int action = -1;

@@ -31,6 +31,7 @@
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
+#include "microcobot/live/live_looker.h"
 #include "microcobot/live/live_task.h"
 #include "microcobot/live/protocol_command.h"
 #include "microcobot/platform/pick_place_operator.h"
@@ -235,6 +236,11 @@ class LivePlatform {
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<platform::PickPlaceOperator> demo_;
   std::unique_ptr<LiveTask> task_;  // kept across scene rebuilds (its ring is the server's)
+  // The cell camera's looks for the task: the drain thread keeps the latest sample for them.
+  std::mutex latest_mutex_;
+  platform::TelemetrySample latest_sample_{};
+  bool has_latest_ = false;
+  std::unique_ptr<LiveLooker> looker_;  // after what it uses: destroyed (joined) first
   Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
   platform::SpscRing<ConsoleCommand> commands_{256};
   platform::SpscRing<ProtocolCommand> protocol_{256};

@@ -17,6 +17,11 @@ void LiveTaskParams::validate() const {
           "gripper_pickup_m", "must be within (0, 100 um)", gripper_pickup_m);
   require(std::isfinite(heartbeat_gap_s) && heartbeat_gap_s >= 0.0 && heartbeat_gap_s <= 10.0,
           "heartbeat_gap_s", "must be within [0, 10] s", heartbeat_gap_s);
+  try {
+    camera.validate();
+  } catch (const InvalidParams& e) {
+    throw e.nested_in("camera");
+  }
 }
 
 std::string LiveTaskStatus::status_name() const {
@@ -32,11 +37,21 @@ LiveTask::~LiveTask() = default;
 
 void LiveTask::reset() {
   task_ = std::make_unique<AssemblyTask>(params_.task, params_.goal);
+  task_->set_looks(params_.camera.enabled);
   for (int i = 0; i + 1 < AssemblyTask::kStepCount; ++i)
     task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[static_cast<std::size_t>(i)]);
   TaskAction dropped;
   while (actions_.pop(dropped)) {
   }
+  Delivery stale;
+  while (sightings_.pop(stale)) {
+  }
+  look_pending_ = false;
+  looks_ = looks_found_ = 0;
+  ++look_seq_;  // a sighting still on its way for the old scene is dropped
+  look_word_.store(look_seq_ << 2);
+  looks_pub_.store(0);
+  looks_found_pub_.store(0);
   started_ = ended_ = operator_had_stage_ = false;
   rearm_deadman_ = pickup_gripper_ = gap_paused_ = false;
   gap_s_ = 0.0;
@@ -123,7 +138,23 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
         gap_paused_ = false;
       }
     }
+    // The camera's answer to the look awaited (an older request's is dropped).
+    Delivery d;
+    while (sightings_.pop(d)) {
+      if (look_pending_ && d.seq == look_seq_ && task.look_wanted() != AssemblyTask::Look::kNone) {
+        task.see(d.sighting);
+        look_pending_ = false;
+        ++looks_;
+        looks_found_ += d.sighting.found ? 1 : 0;
+      }
+    }
     const control::ConsoleInput& out = task.tick(cell::read_task_sensors(p, home_m), dt_s);
+    if (task.look_wanted() == AssemblyTask::Look::kNone) {
+      look_pending_ = false;  // answered, or abandoned (taken over, skipped)
+    } else if (!look_pending_) {
+      look_pending_ = true;
+      ++look_seq_;
+    }
     elapsed_s_ += dt_s;
     const bool operator_drives = task.status() == Status::kOperator;
     if (operator_drives && !operator_had_stage_) console_takes_the_stage();
@@ -164,7 +195,19 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
   elapsed_pub_.store(elapsed_s_, std::memory_order_relaxed);
   failure_.store(task.failure().data(), std::memory_order_relaxed);
   gap_pub_.store(gap_paused_, std::memory_order_relaxed);
+  looks_pub_.store(looks_, std::memory_order_relaxed);
+  looks_found_pub_.store(looks_found_, std::memory_order_relaxed);
+  look_word_.store(look_seq_ << 2 | (look_pending_ ? static_cast<std::uint64_t>(task.look_wanted()) : 0u),
+                   std::memory_order_relaxed);
   ended_pub_.store(ended_, std::memory_order_release);  // last: the rest is read after it
+}
+
+LiveTask::LookRequest LiveTask::look_request() const noexcept {
+  const std::uint64_t w = look_word_.load(std::memory_order_relaxed);
+  LookRequest r;
+  r.seq = w >> 2;
+  r.look = static_cast<AssemblyTask::Look>(w & 3u);
+  return r;
 }
 
 LiveTaskStatus LiveTask::status() const {
@@ -179,6 +222,8 @@ LiveTaskStatus LiveTask::status() const {
   s.supervisor_lost = supervisor_lost_.load(std::memory_order_relaxed);
   s.heartbeat_gap = gap_pub_.load(std::memory_order_relaxed);
   s.inserted = inserted_.load(std::memory_order_relaxed);
+  s.looks = looks_pub_.load(std::memory_order_relaxed);
+  s.looks_found = looks_found_pub_.load(std::memory_order_relaxed);
   s.autonomy = params_.autonomy;
   return s;
 }

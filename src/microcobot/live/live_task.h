@@ -23,7 +23,11 @@
 ///    count, so that nothing the page held before the hand-over moves the stage: the deadman
 ///    must be seen released once, and the gripper slider must come within `gripper_pickup_m` of
 ///    the opening the gripper holds, or cross it (a "soft take-over", as a MIDI fader's pick-up);
-///  - a started task outranks the vendor-protocol clients until it ends.
+///  - a started task outranks the vendor-protocol clients until it ends;
+///  - with the cell's camera (`camera.enabled`), the task holds while a look is awaited; the looker thread
+///    (live_looker.h) takes the request (look_request()), renders and measures off the loop, and
+///    hands the sighting back through a ring (deliver()); a sighting for an older request (a look
+///    abandoned by a take-over, a rebuilt scene) is dropped.
 /// The loop's part never allocates, locks or throws (the task object is allocation-free).
 
 #include <array>
@@ -35,6 +39,7 @@
 #include <Eigen/Dense>
 
 #include "microcobot/cell/assembly_task.h"
+#include "microcobot/cell/cell_camera.h"
 #include "microcobot/control/teleoperation.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/spsc_ring.h"
@@ -63,6 +68,9 @@ struct LiveTaskParams {
   /// A heartbeat gap of the client in control up to this long (after the commands went stale)
   /// pauses the task while it lasts; longer, the pause latches.
   double heartbeat_gap_s = 1.0;
+  /// The cell's camera (`enabled`: it looks for the task; cell_camera.h, `serve --cell
+  /// --cell-camera`): the live platform's LiveLooker answers the looks.
+  cell::CellCameraParams camera;
   /// Throws mc::InvalidParams (the task's parameters and goal).
   void validate() const;
   static std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> all_auto() {
@@ -84,6 +92,8 @@ struct LiveTaskStatus {
   bool supervisor_lost = false;  ///< paused by the platform, latched: control, heartbeat or a fault lost
   bool heartbeat_gap = false;    ///< paused by the platform while the console's commands are stale
   int inserted = -1;  ///< at its end, the simulation's truth: 1 the pin is in its bore, 0 not, -1 unknown
+  int looks = 0;      ///< the camera's sightings the task took
+  int looks_found = 0;
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy{};
   /// "idle" before the start, else the task's status name.
   std::string status_name() const;
@@ -100,6 +110,18 @@ class LiveTask {
   void reset();
   /// One producer thread (the server's). Wait-free; false when the ring is full.
   bool push(TaskAction a) noexcept { return actions_.push(a); }
+
+  /// The look the task awaits (kNone: none) and its request number. Any thread.
+  struct LookRequest {
+    std::uint64_t seq = 0;
+    cell::AssemblyTask::Look look = cell::AssemblyTask::Look::kNone;
+  };
+  LookRequest look_request() const noexcept;
+  /// The sighting for request `seq` (one producer thread: the looker's). Wait-free; false when the
+  /// ring is full.
+  bool deliver(std::uint64_t seq, const cell::AssemblyTask::Sighting& s) noexcept {
+    return sightings_.push({seq, s});
+  }
 
   /// The operator tick's part (loop thread): applies the pending actions, pauses an unsupervised
   /// task, ticks it on the sensors and, while it drives or holds, replaces the console's input
@@ -121,6 +143,16 @@ class LiveTask {
   LiveTaskParams params_;
   std::unique_ptr<cell::AssemblyTask> task_;
   platform::SpscRing<TaskAction> actions_{64};
+  struct Delivery {
+    std::uint64_t seq = 0;
+    cell::AssemblyTask::Sighting sighting;
+  };
+  platform::SpscRing<Delivery> sightings_{8};
+  bool look_pending_ = false;  // loop thread: a look requested and not answered
+  int looks_ = 0, looks_found_ = 0;
+  std::uint64_t look_seq_ = 0;               // loop thread: the current request's number
+  std::atomic<std::uint64_t> look_word_{0};  // published: look_seq_ << 2 | the look awaited
+  std::atomic<int> looks_pub_{0}, looks_found_pub_{0};
   // Loop thread only.
   bool started_ = false, ended_ = false, operator_had_stage_ = false;
   bool rearm_deadman_ = false, pickup_gripper_ = false;
