@@ -90,6 +90,23 @@ function drawCameraPanel(c, g, t, sc) {
   drawOffField(g, c);
 }
 
+// Runs `draw` with the canvas' origin at world point (x, y), turned by `yaw` (world,
+// counter-clockwise; the canvas' y points down): a turned part, bore or pair of fingers.
+function turned(g, x, y, yaw, draw) {
+  const [px, py] = worldToCanvas(x, y);
+  g.save();
+  g.translate(px, py);
+  g.rotate(-(isNum(yaw) ? yaw : 0));
+  draw();
+  g.restore();
+}
+
+// The gripper's two fingers about the tool point, in the canvas frame `turned` sets up.
+function fingerRects(sc, t, s, rect) {
+  const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
+  for (const sign of [-1, 1]) rect((sign * (half + w / 2) - w / 2) * s, -w * s, w * s, 2 * w * s);
+}
+
 // The simulation's ground truth as outlines (part or beads, fingers), labelled as such.
 function drawGroundTruth(g, c, t, sc, s) {
   g.save();
@@ -103,16 +120,10 @@ function drawGroundTruth(g, c, t, sc, s) {
     if (isNum(t.part_x_m)) ring(t.part_x_m, t.part_y_m, sc.bead_radius_m);
   } else {
     const side = sc.part_side_m;
-    if (isNum(t.part_x_m)) {
-      const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-      g.strokeRect(px, py, side * s, side * s);
-    }
-    const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
-    for (const sign of [-1, 1]) {
-      const cx = t.measured_x_m + sign * (half + w / 2);
-      const [fx, fy] = worldToCanvas(cx - w / 2, t.measured_y_m + w);
-      g.strokeRect(fx, fy, w * s, 2 * w * s);
-    }
+    if (isNum(t.part_x_m))
+      turned(g, t.part_x_m, t.part_y_m, t.part_yaw_rad, () => g.strokeRect(-side * s / 2, -side * s / 2, side * s, side * s));
+    turned(g, t.slave_x_m ?? t.measured_x_m, t.slave_y_m ?? t.measured_y_m, t.slave_theta_rad,
+           () => fingerRects(sc, t, s, (x, y, w, h) => g.strokeRect(x, y, w, h)));
   }
   g.setLineDash([]);
   g.font = "bold 12px system-ui";
@@ -156,16 +167,17 @@ function drawMicroscope() {
   }
   // The hole at the target (pin-in-hole): its rim at z = 0.
   if (sc.hole_side_m > 0) {
-    const hs = sc.hole_side_m, [hx, hy] = worldToCanvas(sc.target_m[0] - hs / 2, sc.target_m[1] + hs / 2);
-    drawBlurred(g, hx, hy, hs * s, hs * s, blurPx(focus, o, s), "#0c0b09");
+    const hs = sc.hole_side_m * s;
+    turned(g, sc.target_m[0], sc.target_m[1], sc.hole_yaw_rad,
+           () => drawBlurred(g, -hs / 2, -hs / 2, hs, hs, blurPx(focus, o, s), "#0c0b09"));
   }
   // The part: a brass cube or pin, its top face at part_z + height / 2, blurred by its defocus.
   // (A master of a distributed platform has no part in its telemetry: the microworld is the
   // slave's.)
   const side = sc.part_side_m, height = sc.part_height_m || side;
   if (t.part_x_m !== undefined) {
-    const [px, py] = worldToCanvas(t.part_x_m - side / 2, t.part_y_m + side / 2);
-    drawBlurred(g, px, py, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a");
+    turned(g, t.part_x_m, t.part_y_m, t.part_yaw_rad, () =>
+      drawBlurred(g, -side * s / 2, -side * s / 2, side * s, side * s, blurPx(focus - (t.part_z_m + height / 2), o, s), "#c9a04a"));
   }
   // The target: a reticle overlaid on the view (a graticule, always sharp), with the tolerance.
   const [tx, ty] = worldToCanvas(sc.target_m[0], sc.target_m[1]);
@@ -173,14 +185,11 @@ function drawMicroscope() {
   g.lineWidth = 2;
   g.beginPath(); g.arc(tx, ty, Math.max(3, sc.tolerance_m * s), 0, 2 * Math.PI);
   g.moveTo(tx - 20, ty); g.lineTo(tx + 20, ty); g.moveTo(tx, ty - 20); g.lineTo(tx, ty + 20); g.stroke();
-  // The gripper's two fingers (in focus: the microscope follows their tips), along x.
-  const w = sc.finger_width_m, half = t.gripper_opening_m / 2;
+  // The gripper's two fingers (in focus: the microscope follows their tips), closing along their
+  // x, turned with the rotary axis (its sensor) about the tool point.
   g.fillStyle = "#b8c4d6";
-  for (const sign of [-1, 1]) {
-    const cx = t.measured_x_m + sign * (half + w / 2);
-    const [fx, fy] = worldToCanvas(cx - w / 2, t.measured_y_m + w);
-    g.fillRect(fx, fy, w * s, 2 * w * s);
-  }
+  turned(g, t.measured_x_m, t.measured_y_m, t.measured_theta_rad,
+         () => fingerRects(sc, t, s, (x, y, w, h) => g.fillRect(x, y, w, h)));
   if (mc.input.goal) {
     const [gx, gy] = worldToCanvas(mc.input.goal[0], mc.input.goal[1]);
     g.strokeStyle = "#4fa3ff";
