@@ -18,6 +18,7 @@
 #include "microcobot/live/live_platform.h"
 #include "support/live_status_wait.h"
 #include "support/sanitizers.h"
+#include "support/test_support.h"
 
 namespace mc::live {
 namespace {
@@ -54,12 +55,16 @@ struct GripRig {
   bool collecting = false;
   std::atomic<bool> run{true};
   std::atomic<double> opening{600e-6};
+  std::atomic<double> theta_goal{std::nan("")};  // the rotary axis' goal (NaN: none)
+  std::atomic<double> theta{0.0};                // its sensor, from the telemetry
   std::thread sender;
   const std::size_t grip = test::telemetry_channel("grip_force_N");
+  const std::size_t yaw = test::telemetry_channel("measured_theta_rad");
 
   explicit GripRig(LiveParams p) : live(std::move(p)) {
     live.set_camera_wanted(true);  // a console watching: the camera forms frames
     live.start([this](const platform::TelemetrySample& s, std::size_t) {
+      theta.store(s[yaw]);
       std::lock_guard lock(m);
       if (!collecting) return;
       sensor.push_back(s[grip]);
@@ -71,6 +76,8 @@ struct GripRig {
         c.deadman = true;
         c.has_gripper = true;
         c.gripper_opening_m = opening.load();
+        c.has_theta_goal = std::isfinite(theta_goal.load());
+        c.theta_goal_rad = c.has_theta_goal ? theta_goal.load() : 0.0;
         live.push_command(c);
         std::this_thread::sleep_for(20ms);
       }
@@ -187,6 +194,60 @@ TEST(VisionGripForce, WithoutTheStagesXYSensorsTheTipsAreLookedForWhereThePositi
   EXPECT_NEAR(g.vision_N, g.sensor_N, 0.05 * g.sensor_N);
   // The positioner follows the tool while the part is held (its templates leave the jaw out).
   EXPECT_TRUE(rig.live.status().vision->found) << rig.live.status().vision->state;
+}
+
+// The fingers turned by the rotary axis (issue #29): while they turn the gauge says so and
+// measures nothing; still at the new yaw, it measures the held part's grip again (the tips taught
+// there, the gap chained from before the turn) within 5 % of the sensor. A gripper that moved
+// while the fingers turned leaves the gap unknown: the gauge asks for a tare.
+TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurningAsksForATare) {
+  LiveParams p = grip_params();
+  const double k = p.platform.world.gripper.finger_stiffness_N_m, w = p.platform.world.part_side_m;
+  GripRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait(
+      [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 3; },
+      MC_UNDER_ASAN ? 30.0 : 10.0));
+  const double force = 4e-3, turn = 20.0 * M_PI / 180.0;
+  rig.opening = w - 2.0 * force / k;
+  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
+  rig.theta_goal = turn;
+  bool saw_turning = false;
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        const auto g = rig.live.status().grip_vision;
+        saw_turning = saw_turning ||
+                      (g && g->error.find("turning") != std::string::npos && !std::isfinite(g->grip_force_N));
+        return std::abs(rig.theta.load() - turn) < 1e-5;
+      },
+      MC_UNDER_ASAN ? 30s : 10s));
+  EXPECT_TRUE(saw_turning) << "the gauge did not say the fingers were turning";
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 5.0))
+      << rig.live.status().grip_vision->error;
+  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1000ms : 300ms);
+  const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+  const auto st = rig.live.status().grip_vision.value();
+  std::printf(
+      "grip %.1f mN, fingers at %.1f deg: sensor %.4f mN, vision %.4f mN (%+.2f %%), %zu of %zu frames\n",
+      1e3 * force, rig.theta.load() * 180.0 / M_PI, 1e3 * g.sensor_N, 1e3 * g.vision_N,
+      100.0 * (g.vision_N / g.sensor_N - 1.0), g.measured_frames, g.frames);
+  EXPECT_NEAR(g.sensor_N, force, 0.02 * force);
+  ASSERT_GT(g.measured_frames, g.frames / 2) << st.state << ": " << st.error;
+  EXPECT_NEAR(g.vision_N, g.sensor_N, 0.05 * g.sensor_N);
+
+  // Back to 0 deg while the gripper opens: the gap after the turn is unknown.
+  rig.theta_goal = 0.0;
+  std::this_thread::sleep_for(300ms);
+  rig.opening = 600e-6;
+  ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load()) < 1e-5; }, MC_UNDER_ASAN ? 30s : 10s));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "untared"; }, 5.0))
+      << rig.live.status().grip_vision->state;
+  EXPECT_NE(rig.live.status().grip_vision->error.find("tare again"), std::string::npos)
+      << rig.live.status().grip_vision->error;
+  // The operator's tare (nothing between the open fingers): measuring again, no force.
+  ASSERT_TRUE(rig.live.request_vision_tare());
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 5.0));
+  const auto open = rig.collect(600ms);
+  EXPECT_LT(std::abs(open.vision_N), 20e-6);
 }
 
 TEST(VisionGripForce, ATareOnRequestAndNoneWithoutFrames) {

@@ -52,8 +52,9 @@ struct VisionRig {
   double truth_x = 0.0, truth_y = 0.0, t_s = 0.0;
   std::atomic<bool> deadman{false}, has_goal{false}, has_goal_px{false}, run{true};
   std::array<double, 3> goal{};
-  std::array<double, 2> goal_px{};    // set before has_goal_px
-  std::atomic<double> opening{-1.0};  // the gripper's command (< 0: none sent)
+  std::array<double, 2> goal_px{};               // set before has_goal_px
+  std::atomic<double> opening{-1.0};             // the gripper's command (< 0: none sent)
+  std::atomic<double> theta_goal{std::nan("")};  // the rotary axis' goal (NaN: none sent)
   std::thread sender;
   std::size_t sx, sy;
 
@@ -77,6 +78,8 @@ struct VisionRig {
         c.goal_m = goal;
         c.has_gripper = opening.load() >= 0.0;
         c.gripper_opening_m = std::max(0.0, opening.load());
+        c.has_theta_goal = std::isfinite(theta_goal.load());
+        c.theta_goal_rad = c.has_theta_goal ? theta_goal.load() : 0.0;
         live.push_command(c);
         std::this_thread::sleep_for(20ms);
       }
@@ -274,6 +277,34 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
   std::this_thread::sleep_for(500ms);
   EXPECT_LT((rig.truth() - stopped).norm(), 0.05e-6);
   EXPECT_GT((far_goal - stopped).norm(), 20e-6);  // it did not get there
+}
+
+// Turned by the rotary axis, the tips move about the tool point: the positioner, which sees them
+// at 0 deg only, holds the stage and says why; turned back, it goes to the goal.
+TEST(VisionPositioning, TurnedFingersHoldTheStageUntilTheyAreTurnedBack) {
+  LiveParams p = vision_params();
+  const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
+  VisionRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_ASAN ? 30.0 : 10.0));
+  rig.deadman = true;
+  rig.theta_goal = 3.0 * M_PI / 180.0;
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "hold (fingers turned)"; },
+                       MC_UNDER_ASAN ? 20.0 : 5.0));
+  const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
+  rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
+  rig.has_goal = true;
+  std::this_thread::sleep_for(MC_UNDER_ASAN ? 2000ms : 800ms);
+  const auto held = rig.live.status().vision.value();
+  EXPECT_EQ(held.state, "hold (fingers turned)");
+  EXPECT_NE(held.error.find("turned"), std::string::npos) << held.error;
+  EXPECT_EQ(held.commands, 0u);
+  EXPECT_LT((rig.truth() - home).norm(), 0.05e-6) << "the stage moved with the fingers turned";
+  rig.theta_goal = 0.0;  // back: the positioner takes the goal
+  std::string why;
+  const auto rest = rig.converge_and_rest(why);
+  ASSERT_TRUE(rest) << why;
+  EXPECT_LT((*rest - goal).norm(), 0.3e-6);
 }
 
 TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneLine) {

@@ -22,8 +22,10 @@ namespace mc::platform {
 /// point at `tool_px`, the fingers `opening_m` apart and `finger_width_m` wide: the box around the
 /// region's corners mapped through `map` (pixel = A stage + b). `inner`: the finger's inner half
 /// and 12 um of the jaw instead (for a finger whose outer side is out of the image; a part held
-/// between the fingers then enters the template).
+/// between the fingers then enters the template). `yaw_rad`: the fingers turned by the rotary axis
+/// about the tool point (the region turned with them; the box around its turned corners).
 vision::PixelRoi finger_tip_template(const vision::AffineMap& map, const Eigen::Vector2d& tool_px, int side,
-                                     double opening_m, double finger_width_m, bool inner = false);
+                                     double opening_m, double finger_width_m, bool inner = false,
+                                     double yaw_rad = 0.0);
 
 }  // namespace mc::platform

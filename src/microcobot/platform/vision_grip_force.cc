@@ -24,8 +24,18 @@ void VisionGripForceParams::validate() const {
 namespace {
 // A part holds the fingers apart by more than this: the next gap is predicted from the last.
 constexpr double kLoadedGap = 1e-6;
-// The fingers' yaw up to which the gauge measures: 1 mrad moves a tip 0.1 um across a 100 um gap.
+// The fingers' yaw the tips are taught at holds within this: 1 mrad moves a tip 0.1 um across a
+// 100 um gap (turned further, they are taught again).
 constexpr double kMaxYaw_rad = 1e-3;
+// The fingers turned less than this since the last frame are still (the rotary axis' sensor noise
+// is 1 urad; its slowest console turn, 0.05 rad/s, is 1.7 mrad a frame at 30 frames/s).
+constexpr double kStillYaw_rad = 0.1e-3;
+// Frames the fingers must stay still before they are taught at a new yaw: a turn the console's
+// commands pause for a moment (a busy page) is not taught halfway.
+constexpr int kStillFrames = 3;
+// A tare's reference is the mean tips' distance over this many frames (the drive still): the
+// teaching frame's noise is in the templates; averaging the frames after it takes it out.
+constexpr int kTareFrames = 8;
 }  // namespace
 
 VisionGripForce::VisionGripForce(const PlatformConfig& config)
@@ -40,14 +50,22 @@ VisionGripForce::VisionGripForce(const PlatformConfig& config)
 }
 
 Eigen::Vector2d VisionGripForce::tip_step_px(int side, double gap_m) const {
-  return map_.pixel_step(Eigen::Vector2d(side * 0.5 * gap_m, 0.0));
+  const double h = side * 0.5 * gap_m;
+  return map_.pixel_step(Eigen::Vector2d(h * std::cos(yaw_), h * std::sin(yaw_)));
+}
+
+void VisionGripForce::set_directions(double yaw_rad) {
+  yaw_ = yaw_rad;
+  const Eigen::Vector2d ex = map_.pixel_step(Eigen::Vector2d(std::cos(yaw_rad), std::sin(yaw_rad)));
+  scale_px_m_ = ex.norm();
+  e_x_ = ex / scale_px_m_;
 }
 
 bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m) {
   for (int k = 0; k < 2; ++k) {
     const int side = k == 0 ? -1 : 1;
     const vision::PixelRoi roi =
-        finger_tip_template(map_, tool_px, side, gap_m, config_.world.gripper.finger_width_m);
+        finger_tip_template(map_, tool_px, side, gap_m, config_.world.gripper.finger_width_m, false, yaw_);
     try {
       trackers_[static_cast<std::size_t>(k)].set_template(frame_, roi);
     } catch (const Error& e) {
@@ -64,6 +82,10 @@ bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double
   const vision::TrackEstimate &l = trackers_[0].last(), &r = trackers_[1].last();
   ref_d_px_ = (Eigen::Vector2d(r.u_px, r.v_px) - Eigen::Vector2d(l.u_px, l.v_px)).dot(e_x_);
   ref_gap_m_ = last_gap_m_ = gap_m;
+  measured_free_opening_m_ = free_opening_m;
+  // A tare (nothing held: the gap is the drive's opening) is refined over the next frames.
+  tare_frames_ = gap_m == free_opening_m ? 1 : 0;
+  tare_d_sum_px_ = ref_d_px_;
   last_tool_px_ = tool_px;
   loaded_ = gap_m - free_opening_m > kLoadedGap;
   taught_ = true;
@@ -90,19 +112,18 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     publish();
     return st_;
   }
-  if (std::abs(frame.tool_yaw_rad) > kMaxYaw_rad) {
-    // The tips are taught and tracked with the fingers along the image's x (their closing
-    // direction at yaw 0): turned, the gap seen is not the fingers'.
-    st_.state = "error";
-    st_.error = fmt::format(
-        "the fingers are turned (rotary axis at {:.2f} deg): force by vision measures them at 0 deg",
-        frame.tool_yaw_rad * 180.0 / M_PI);
+  // The fingers' yaw (the rotary axis): turning, the tips' templates no longer match and the
+  // gap's direction moves; still at a new yaw, they are taught again there.
+  const double yaw = std::isfinite(frame.tool_yaw_rad) ? frame.tool_yaw_rad : 0.0;
+  const bool moved = std::isfinite(last_frame_yaw_) && std::abs(yaw - last_frame_yaw_) > kStillYaw_rad;
+  last_frame_yaw_ = yaw;
+  still_frames_ = moved ? 0 : still_frames_ + 1;
+  const bool turned = std::abs(yaw - yaw_) > kMaxYaw_rad;
+  if (turned && still_frames_ < kStillFrames) {
+    st_.state = st_.tared ? "lost" : "untared";
+    st_.error = "the fingers are turning: measured again once they stop";
     publish();
     return st_;
-  }
-  if (st_.error.rfind("the fingers are turned", 0) == 0) {
-    st_.error.clear();
-    st_.state = st_.tared ? "measuring" : "untared";
   }
   const bool new_view = frame.objective != objective_ || frame_.width != width_ || frame_.height != height_;
   if (new_view) {
@@ -110,10 +131,8 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     width_ = frame_.width;
     height_ = frame_.height;
     map_ = camera_stage_map(config_, objective_);
-    const Eigen::Vector2d ex = map_.pixel_step(Eigen::Vector2d::UnitX());
-    scale_px_m_ = ex.norm();
-    e_x_ = ex / scale_px_m_;
   }
+  if (new_view || turned) set_directions(yaw);
   if (!hint.pixel && !hint.stage_sensed && !taught_) {
     st_.state = st_.tared ? "lost" : "untared";
     st_.error = "waiting for the vision positioner to see the tool";
@@ -145,10 +164,23 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     publish();
     return st_;
   }
-  if (new_view || !taught_) {
-    // Another objective: the tips look different. Taught again where they are, the gap carried
-    // over from the last one measured (the reference chains; a part may be held).
-    if (teach(tool, last_gap_m_, o)) st_.state = "measuring";
+  if (new_view || turned || !taught_) {
+    // Another objective or another yaw: the tips look different. Taught again where they are, the
+    // gap carried over from the last one measured (the reference chains; a part may be held) ...
+    if (turned && std::abs(o - measured_free_opening_m_) > kLoadedGap) {
+      // ... unless the drive moved while the fingers turned: the gap now is unknown.
+      taught_ = st_.tared = false;
+      st_.state = "untared";
+      st_.error = "the gripper moved while the fingers turned: tare again with nothing between them";
+      publish();
+      return st_;
+    }
+    // Nothing held before the turn (and the drive still): nothing is now, the gap is the drive's
+    // opening, a fresh tare rather than a chained one (whose error would add up turn after turn).
+    if (teach(tool, turned && !loaded_ ? o : last_gap_m_, o)) {
+      st_.state = "measuring";
+      st_.error.clear();
+    }
     publish();
     return st_;
   }
@@ -183,7 +215,15 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     publish();
     return st_;
   }
-  const double gap = ref_gap_m_ + ((p[1] - p[0]).dot(e_x_) - ref_d_px_) / scale_px_m_;
+  const double d_px = (p[1] - p[0]).dot(e_x_);
+  if (tare_frames_ > 0 && tare_frames_ < kTareFrames && o == measured_free_opening_m_ && !loaded_) {
+    tare_d_sum_px_ += d_px;  // still the tare's scene: its reference averaged
+    ++tare_frames_;
+    ref_d_px_ = tare_d_sum_px_ / tare_frames_;
+  } else {
+    tare_frames_ = 0;
+  }
+  const double gap = ref_gap_m_ + (d_px - ref_d_px_) / scale_px_m_;
   if (gap < o - std::max(kLoadedGap, 3.0 / scale_px_m_)) {
     // Closer than the drive puts them: nothing pushes fingers inward; these are not the tips.
     st_.state = "lost";
@@ -192,6 +232,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     return st_;
   }
   last_gap_m_ = gap;
+  measured_free_opening_m_ = o;
   last_tool_px_ =
       0.5 * (p[0] - offset_px_[0] - tip_step_px(-1, gap) + p[1] - offset_px_[1] - tip_step_px(1, gap));
   loaded_ = gap - o > kLoadedGap;

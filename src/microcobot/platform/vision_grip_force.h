@@ -13,7 +13,12 @@
 /// [px/m] (the objective's calibration, or its nominal map: camera_map.h), o_free the drive's
 /// free opening (Gripper::free_opening_m: its open-loop model), k the finger stiffness, and
 /// (g_ref, d_ref) a reference: the tare, taken with nothing between the fingers (g_ref = o_free
-/// then), or, after an objective change, the gap last measured through the other objective.
+/// then, d_ref the mean over the tare's first 8 frames), or, after an objective change or a turn of
+/// the fingers, the gap last measured before it.
+/// With the fingers turned by the rotary axis (`tool_yaw_rad`), e_x and the tips' half gaps turn with
+/// them: the tips are taught again at each new yaw, once still for 3 frames, the gap chained from
+/// before the turn while a part is held (the drive's opening when nothing was: a fresh tare), unless
+/// the drive moved meanwhile (then a tare is asked for); while they turn, no force.
 /// The gap is a difference of two tips, so the stage's motion cancels: the gauge needs no
 /// stage sensor, only where to look (the tips' predicted pixels) and the scale.
 ///
@@ -90,6 +95,8 @@ class VisionGripForce {
 
  private:
   bool teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m);
+  /// e_x and its scale for the fingers at `yaw_rad` (the map's and the yaw's).
+  void set_directions(double yaw_rad);
   Eigen::Vector2d tip_step_px(int side, double gap_m) const;
   void publish();
 
@@ -103,6 +110,12 @@ class VisionGripForce {
   int objective_ = -1, width_ = 0, height_ = 0;
   Eigen::Vector2d e_x_ = Eigen::Vector2d::UnitX();  ///< stage x in the image (unit)
   double scale_px_m_ = 1.0;                         ///< its px per metre
+  double yaw_ = 0.0;                                ///< the fingers' yaw e_x is turned by
+  double last_frame_yaw_ = std::nan("");            ///< the previous frame's (turning or still)
+  int still_frames_ = 0;                            ///< frames in a row the yaw stayed still
+  int tare_frames_ = 0;         ///< frames averaged into the tare's reference (0: not refining)
+  double tare_d_sum_px_ = 0.0;  ///< their tips' distances
+  double measured_free_opening_m_ = std::nan("");  ///< the drive's at the last measurement
   bool taught_ = false, loaded_ = false;
   bool auto_tare_ = false;  ///< the scene's tare (tare_at_start), tried until it is taken
   /// Template centre - (tool point + the tip's half gap), per tip, as taught.

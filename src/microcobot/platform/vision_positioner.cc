@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 #include "microcobot/platform/camera_map.h"
 #include "microcobot/platform/finger_templates.h"
@@ -123,6 +125,23 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     switch_objective(frame.objective, frame_.width, frame_.height);
   st.m_per_px = map_m_per_px(map_);
   st.calibrated = calibrated_;
+  // The tips are taught and tracked with the fingers at 0 deg (the rotary axis' home): turned,
+  // they move about the tool point and would read as the stage's motion. The stage holds.
+  constexpr double kMaxYaw_rad = 1e-3;
+  if (std::abs(frame.tool_yaw_rad) > kMaxYaw_rad) {
+    st.found = false;
+    st.state = "hold (fingers turned)";
+    st.error = fmt::format(
+        "the fingers are turned ({:.2f} deg): vision positioning sees them at 0 deg only; turn them back",
+        frame.tool_yaw_rad * 180.0 / M_PI);
+    servo_->clear_history();
+    converged_frames_ = 0;
+    in_position_ = false;
+    moved_px_.setZero();
+    publish(st);
+    return std::nullopt;
+  }
+  if (st.error.rfind("the fingers are turned", 0) == 0) st.error.clear();
 
   // Where the tool is: taught where it is expected, then tracked near where the commands put it.
   bool found = false;

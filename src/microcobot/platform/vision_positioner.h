@@ -61,9 +61,9 @@ struct PositionerStatus {
   bool taught = false;  ///< the tips' template is taken
   bool found = false;   ///< ...and found in the last frame
   bool has_goal = false;
-  std::string state =
-      "waiting";      ///< waiting, moving, converged, hold-lost, hold-stale, no-goal, no-deadman, error
-  std::string error;  ///< why the goal was refused or the template could not be taken
+  std::string state = "waiting";  ///< waiting, moving, converged, hold-lost, hold-stale, hold (fingers
+                                  ///< turned), no-goal, no-deadman, error
+  std::string error;              ///< why the goal was refused or the template could not be taken
   double tool_u_px = 0.0, tool_v_px = 0.0;  ///< where the tool point is seen
   double goal_u_px = 0.0, goal_v_px = 0.0;  ///< where it is sent (the tool point's pixel)
   double error_m = 0.0;                     ///< the servo's predicted distance to the goal
