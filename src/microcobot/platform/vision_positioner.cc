@@ -127,8 +127,8 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   st.calibrated = calibrated_;
   // The tips are taught and tracked with the fingers at 0 deg (the rotary axis' home): turned,
   // they move about the tool point and would read as the stage's motion. The stage holds.
-  constexpr double kMaxYaw_rad = 1e-3;
-  if (std::abs(frame.tool_yaw_rad) > kMaxYaw_rad) {
+  constexpr double kTurned_rad = 1e-3;
+  if (std::abs(frame.tool_yaw_rad) > kTurned_rad) {
     st.found = false;
     st.state = "hold (fingers turned)";
     st.error = fmt::format(
