@@ -144,6 +144,31 @@ double vertex_offset(double ym, double y0, double yp) {
   return d != 0.0 ? std::clamp(0.5 * (ym - yp) / d, -0.5, 0.5) : 0.0;
 }
 
+// The model template (`model` inside `roi`, centred on the expected pin at `expected_xy`, turned by
+// `expected_yaw`) found in `frame` with the Euclidean warp: the pin's centre and yaw into `s` (its
+// z left to the caller), or `miss` as the reason. The ROI is centred on the pin to within half a
+// pixel, which the small turn moves by under 0.01 px: the pin's centre moves with the template's.
+void match_model(const vs::Renderer& r, const vs::Frame& model, const vs::Frame& frame,
+                 const vs::PixelRoi& roi, const Eigen::Vector2d& expected_xy, double expected_yaw,
+                 double min_confidence, const char* miss, PinSighting& s) {
+  vs::TrackerParams tp;
+  tp.rotation = true;
+  vs::TemplateTracker tracker(tp);
+  tracker.set_template(model, roi);
+  const double cu = roi.x + 0.5 * (roi.width - 1), cv = roi.y + 0.5 * (roi.height - 1);
+  const vs::TrackEstimate e = tracker.track_near(frame, cu, cv);
+  s.confidence = e.confidence;
+  if (!e.found || e.confidence < min_confidence) {
+    s.reason = miss;
+    return;
+  }
+  const double px = r.camera().pixel_size_m();
+  s.part_m.x() = expected_xy.x() + (e.u_px - cu) * px;
+  s.part_m.y() = expected_xy.y() - (e.v_px - cv) * px;  // rows go down, y up
+  s.yaw_rad = expected_yaw + e.angle_rad;
+  s.found = true;
+}
+
 }  // namespace
 
 PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const PinModel& pin,
@@ -160,23 +185,9 @@ PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const 
     s.reason = "the pin's slot is not inside the camera's field";
     return s;
   }
-  vs::TrackerParams tp;
-  tp.rotation = true;
-  vs::TemplateTracker tracker(tp);
-  tracker.set_template(m.model, roi);
-  const double cu = roi.x + 0.5 * (roi.width - 1), cv = roi.y + 0.5 * (roi.height - 1);
-  const vs::TrackEstimate e = tracker.track_near(m.frame, cu, cv);
-  s.confidence = e.confidence;
-  if (!e.found || e.confidence < p_.min_confidence) {
-    s.reason = "the pin does not match its model in its slot";
-    return s;
-  }
-  // The template's centre moved by (du, dv) px; the pin's centre with it (the ROI is centred on
-  // it to within half a pixel, which the small turn moves by under 0.01 px).
-  const double px = r.camera().pixel_size_m();
-  s.part_m = {nominal_xy.x() + (e.u_px - cu) * px, nominal_xy.y() - (e.v_px - cv) * px, 0.5 * pin.height_m};
-  s.yaw_rad = nominal_yaw + e.angle_rad;
-  s.found = true;
+  s.part_m.z() = 0.5 * pin.height_m;  // standing on the tray
+  match_model(r, m.model, m.frame, roi, nominal_xy, nominal_yaw, p_.min_confidence,
+              "the pin does not match its model in its slot", s);
   return s;
 }
 
@@ -262,8 +273,8 @@ PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, cons
     s.reason = "the bore is not inside the camera's field";
     return s;
   }
-  // Three frames: at the expected top and one depth of field either side; the measure on the
-  // pin's box, the frame in focus kept for the position.
+  // Three frames: at the expected top and focus_step_dof depths of field either side; the
+  // Tenengrad measure on the pin's box, the middle frame kept for the position.
   const double step = p_.focus_step_dof * r.figures().dof_m;
   std::array<vs::FocusSample, 3> samples;
   vs::Frame focused;
@@ -279,22 +290,9 @@ PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, cons
     return s;
   }
   m.render(r, pin_at(truth, bore_xy, top_z_m - 0.5 * pin.height_m, bore_yaw), top_z_m, true, 0, 0, m.model);
-  vs::TrackerParams tp;
-  tp.rotation = true;
-  vs::TemplateTracker tracker(tp);
-  tracker.set_template(m.model, box);
-  const double cu = box.x + 0.5 * (box.width - 1), cv = box.y + 0.5 * (box.height - 1);
-  const vs::TrackEstimate e = tracker.track_near(focused, cu, cv);
-  s.confidence = e.confidence;
-  if (!e.found || e.confidence < p_.min_confidence) {
-    s.reason = "the pin does not match its model in its bore";
-    return s;
-  }
-  const double px = r.camera().pixel_size_m();
-  s.part_m = {bore_xy.x() + (e.u_px - cu) * px, bore_xy.y() - (e.v_px - cv) * px,
-              peak.z_m - 0.5 * pin.height_m};
-  s.yaw_rad = bore_yaw + e.angle_rad;
-  s.found = true;
+  s.part_m.z() = peak.z_m - 0.5 * pin.height_m;  // its centre below the top seen in focus
+  match_model(r, m.model, focused, box, bore_xy, bore_yaw, p_.min_confidence,
+              "the pin does not match its model in its bore", s);
   return s;
 }
 
