@@ -213,6 +213,23 @@ TEST(CellCycle, TheCamerasVerifySeesAPinThatCameUpWithAFinger) {
   EXPECT_TRUE(r.ended_holding);
 }
 
+// A camera whose field cannot hold the pin (a 64 x 64 sensor) finds nothing: the robot falls back
+// to the slot's nominal place and the search, and the verify fails saying why; holding at the end.
+TEST(CellCycle, ACameraThatSeesNothingFailsTheVerifySayingWhyAndHolds) {
+  CellRunParams params;
+  params.camera.enabled = true;
+  params.camera.width_px = params.camera.height_px = 64;
+  CellCycle c(job(), params, default_platform());
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(r.looks, 3);
+  EXPECT_EQ(r.looks_found, 0);
+  EXPECT_NE(r.verdict.find("the bore is not inside the camera's field"), std::string::npos) << r.verdict;
+  EXPECT_TRUE(r.ended_holding);
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+}
+
 // The task and the cycle's meter run on the loop (the operator task): they never allocate.
 TEST(CellCycle, TheTaskAndItsMeterDoNotAllocateOnTheLoop) {
   CellCycle c(job(), CellRunParams{}, default_platform());

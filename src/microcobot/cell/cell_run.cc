@@ -193,25 +193,31 @@ void CellCycle::look() {
   const PinModel pin{job_.side_m, job_.world.height_m()};
   const TaskSensors s = read_task_sensors(p, home_m_);
   PinSighting seen;
-  switch (task_->look_wanted()) {
-    case AssemblyTask::Look::kSlot:
-      seen = camera_->look_slot(truth, pin, job_.nominal_part_m, job_.nominal_part_yaw_rad);
-      break;
-    case AssemblyTask::Look::kHeld: {
-      // The pin's top where the grasp left it: the tips grasp_z above its bottom.
-      const double grasp_z = job_.world.hole_depth_m + params_.task.grip_above_m;
-      seen = camera_->look_held(truth, pin, s.tip_m, s.yaw_rad, s.tip_m.z() - grasp_z + pin.height_m);
-      break;
+  std::string failed;  // a measure that threw (an image the tracker refused): nothing seen
+  try {
+    switch (task_->look_wanted()) {
+      case AssemblyTask::Look::kSlot:
+        seen = camera_->look_slot(truth, pin, job_.nominal_part_m, job_.nominal_part_yaw_rad);
+        break;
+      case AssemblyTask::Look::kHeld: {
+        // The pin's top where the grasp left it: the tips grasp_z above its bottom.
+        const double grasp_z = job_.world.hole_depth_m + params_.task.grip_above_m;
+        seen = camera_->look_held(truth, pin, s.tip_m, s.yaw_rad, s.tip_m.z() - grasp_z + pin.height_m);
+        break;
+      }
+      case AssemblyTask::Look::kPlaced:
+        seen = camera_->look_placed(truth, pin, job_.target_m, job_.target_yaw_rad,
+                                    pin.height_m - job_.world.hole_depth_m);
+        break;
+      case AssemblyTask::Look::kNone:
+        return;
     }
-    case AssemblyTask::Look::kPlaced:
-      seen = camera_->look_placed(truth, pin, job_.target_m, job_.target_yaw_rad,
-                                  pin.height_m - job_.world.hole_depth_m);
-      break;
-    case AssemblyTask::Look::kNone:
-      return;
+  } catch (const std::exception& e) {
+    seen = PinSighting{};
+    failed = std::string("the camera's measure failed: ") + e.what();
   }
   ++looks_;
-  if (!seen.found) last_look_miss_ = seen.reason;
+  if (!seen.found) last_look_miss_ = failed.empty() ? std::string(seen.reason) : failed;
   if (seen.found) {
     ++looks_found_;
     const Eigen::Vector2d truth_xy(truth.part_x_m, truth.part_y_m);
@@ -285,7 +291,7 @@ CycleResult CellCycle::result() const {
     } else if (task_->status() == AssemblyTask::Status::kFailed) {
       r.verdict = "failed in step " + std::string(AssemblyTask::name(task_->step())) + ": " +
                   std::string(task_->failure());
-      if (task_->step() == AssemblyTask::Step::kVerify && *last_look_miss_ != '\0')
+      if (task_->step() == AssemblyTask::Step::kVerify && !last_look_miss_.empty())
         r.verdict += " (" + std::string(last_look_miss_) + ")";
     } else {
       r.verdict = inserted ? "inserted and released" : "the task ended but the pin is not down in its bore";

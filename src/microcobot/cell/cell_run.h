@@ -180,8 +180,8 @@ class CellCycle {
   std::unique_ptr<CellCamera> camera_;
   int looks_ = 0, looks_found_ = 0;
   double look_error_m_ = 0.0, look_wall_s_ = 0.0;
-  const char* last_look_miss_ = "";  // why the last look that found nothing did not
-  bool look_requested_ = false;      // the operator stopped the run for a look
+  std::string last_look_miss_;   // why the last look that found nothing did not
+  bool look_requested_ = false;  // the operator stopped the run for a look
   /// The look the task awaits, off the loop: the frames rendered from the truth, measured, seen.
   void look();
   int confirmations_ = 0;
