@@ -129,6 +129,14 @@ TEST(CellCli, ServeCellStartsAndItsFlagsAreCheckedLikeAnyOther) {
       {"serve", "--task", (dir / "task.yaml").string(), "--listen", "127.0.0.1:0", "--duration", "0.3"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_THAT(r.err, HasSubstr("--task: needs --cell"));
+  r = run_cli({"serve", "--cell-camera", "--listen", "127.0.0.1:0", "--duration", "0.3"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--cell-camera: needs --cell"));
+  // The robot's camera in a person's mode: refused naming the flag, nothing run.
+  r = run_cli({"cell", "run", "--mode", "manual", "--camera", "--batch", "1"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--camera"));
   r = run_cli({"serve", "--cell", "--part", "10", "--listen", "127.0.0.1:0", "--duration", "0.3"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_THAT(r.err, HasSubstr("--part 10"));
