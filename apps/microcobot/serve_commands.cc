@@ -24,6 +24,7 @@
 #include "microcobot/live/live_platform.h"
 #include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
+#include "microcobot/net/microscope_link.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/driver_registry.h"
@@ -122,6 +123,17 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     lp.remote = ends.master.get();
   }
   return ends;
+}
+
+// The live platform's focus drive as the microscope topics carry it: where the focal plane is,
+// or (`wanted`) where its operator sent it.
+mc::net::MicroscopeJoints microscope_joints(const mc::live::LivePlatform& live, bool wanted) {
+  const mc::live::LiveStatus st = live.status();
+  mc::net::MicroscopeJoints j;
+  j.has_focus = true;
+  j.focus_z_m = wanted ? st.focus_target_m : st.focus_z_m;
+  j.objective = st.objective;
+  return j;
 }
 
 // "HOST:PORT" or "[V6]:PORT".
@@ -260,6 +272,28 @@ void serve(const ServeOptions& o) {
   std::unique_ptr<mc::net::CameraImagePublisher> images;
   if (o.role == "slave" && live.has_camera())
     images = std::make_unique<mc::net::CameraImagePublisher>(o.domain, mc::cli::network_config(o.network));
+  // The microscope's focus and turret on DDS: the slave takes them from any peer, the master
+  // sends its operator's (net/microscope_link.h).
+  std::unique_ptr<mc::net::MicroscopeServer> microscope_server;
+  std::unique_ptr<mc::net::MicroscopeClient> microscope_client;
+  if (o.role == "slave" && live.has_camera()) {
+    microscope_server = std::make_unique<mc::net::MicroscopeServer>(
+        o.domain, mc::cli::network_config(o.network),
+        [&live](const mc::net::MicroscopeJoints& j) {
+          mc::live::ConsoleCommand c;
+          c.has_focus = j.has_focus;
+          c.focus_z_m = j.focus_z_m;
+          c.objective = j.objective;
+          live.push_microscope_command(c);  // a full ring (16 waiting) drops it: the next one counts
+        },
+        [&live] { return microscope_joints(live, false); });
+    std::cerr << "serve: the microscope's focus and objective on DDS, ROS 2 topics "
+              << mc::net::kMicroscopeCommandRosName << " and " << mc::net::kMicroscopeStateRosName
+              << " (sensor_msgs/msg/JointState)\n";
+  }
+  if (o.role == "master" && live.has_camera())
+    microscope_client = std::make_unique<mc::net::MicroscopeClient>(
+        o.domain, mc::cli::network_config(o.network), [&live] { return microscope_joints(live, true); });
   mc::live::ConsoleServer server(live, sp);
   if (images) {
     server.add_frame_consumer(

@@ -186,5 +186,38 @@ TEST(DistributedServe, TeleoperatedAcrossProcessesAndSafeWhenEitherEndDies) {
   test::terminate_cleanly({&master2, &slave2});
 }
 
+// The operator's microscope on the master's console reaches the slave's (issue #27 point 2, over
+// the network: net/microscope_link.h): focus and objective set on the master's console move the
+// slave process's focus drive and turn its turret; its state comes back on DDS.
+TEST(DistributedServe, TheMastersMicroscopeControlsMoveTheSlavesFocusAndTurret) {
+  test::TempDir dir;
+  Reaper reaper;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+  Server slave = start_serve("slave", domain, dir, "slave", reaper);
+  Server master = start_serve("master", domain, dir, "master", reaper);
+  ASSERT_NE(slave.port, 0);
+  ASSERT_NE(master.port, 0);
+  {
+    test::Console m(master.port), s(slave.port);
+    constexpr std::uint32_t kStatus = 5;
+    s.subscribe("/platform/status", kStatus);
+    ASSERT_TRUE(m.action("take_control"));
+    json camera;
+    const auto end = std::chrono::steady_clock::now() + 60s;
+    while (std::chrono::steady_clock::now() < end) {
+      m.command({{"focus_z_m", 250e-6}, {"objective", 2}});
+      const std::string payload = s.next_on(kStatus);
+      ASSERT_FALSE(payload.empty()) << "the slave's console went quiet";
+      camera = json::parse(payload)["camera"];
+      ASSERT_TRUE(camera.is_object()) << "the slave images: " << payload;
+      if (camera["objective"] == 2 && std::abs(camera["focus_z_m"].get<double>() - 250e-6) < 1e-12) break;
+    }
+    EXPECT_EQ(camera["objective"], 2) << camera;
+    EXPECT_NEAR(camera["focus_z_m"].get<double>(), 250e-6, 1e-12) << camera;
+  }
+  EXPECT_NE(test::read_text(dir / "slave.err").find("microscope/command"), std::string::npos);
+  test::terminate_cleanly({&master, &slave});
+}
+
 }  // namespace
 }  // namespace mc

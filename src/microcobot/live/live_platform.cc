@@ -200,6 +200,10 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
       p.stop();
     }
   }
+  {
+    ConsoleCommand m;
+    while (microscope_.pop(m)) apply_microscope(p, m);
+  }
   while (!params_.remote && commands_.pop(c)) {
     got = true;
     apply_microscope(p, c);

@@ -137,6 +137,11 @@ class LivePlatform {
 
   /// The controlling client's command (one producer thread: the server's). Wait-free.
   bool push_command(const ConsoleCommand& c) noexcept;
+  /// A microscope command from the network (net/microscope_link.h: the slave's microscope topic;
+  /// one producer thread): only its focus, objective, exposure and gain count. Wait-free; false
+  /// when the ring is full. Applied at the next operator tick in every role: the focus drive and
+  /// the turret move the objective, no part of the slave (as the console's microscope controls).
+  bool push_microscope_command(const ConsoleCommand& c) noexcept { return microscope_.push(c); }
   /// Whether a client holds control (its commands count; otherwise the stage holds).
   void set_console_in_control(bool in_control) noexcept { in_control_.store(in_control); }
   bool console_in_control() const noexcept { return in_control_.load(); }
@@ -243,6 +248,7 @@ class LivePlatform {
   std::unique_ptr<LiveLooker> looker_;  // after what it uses: destroyed (joined) first
   Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
   platform::SpscRing<ConsoleCommand> commands_{256};
+  platform::SpscRing<ConsoleCommand> microscope_{16};  // the network's microscope commands
   platform::SpscRing<ProtocolCommand> protocol_{256};
   // Protocol state (loop thread only).
   double protocol_last_t_ = -1e9, protocol_speed_m_s_ = 0.0, last_operator_t_ = 0.0;

@@ -317,6 +317,49 @@ TEST(WireCompat, ACProgramReadsTheSlavesCameraImagesAndDecodesTheirJpeg) {
   }
 }
 
+// The microscope as any ROS 2 node sets it (issue #27 point 2): a plain C program publishes a
+// latched JointState command (focus 150 um, objective 2) to a real `serve --role slave`; the C
+// listener then reads the slave's state topic: the drive went there and the turret turned.
+TEST(WireCompat, ACProgramSetsTheSlavesMicroscopeAndReadsItsState) {
+  TempDir dir;
+  Reaper reaper;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+  const pid_t slave =
+      test::spawn_process({MC_CLI_PATH, "serve", "--role", "slave", "--domain", domain, "--listen",
+                           "127.0.0.1:0", "--out", (dir / "slave").string(), "--duration", "60"},
+                          dir / "slave.out", dir / "slave.err");
+  reaper.pids.push_back(slave);
+  const pid_t talker = test::spawn_process(
+      {MC_ROS2_TALKER_PATH, "--domain", domain, "--topic", "/microcobot/slave/microscope/command", "--joint",
+       "focus_z=0.00015", "--joint", "objective_turret=2", "--timeout", "40"},
+      dir / "talker.out", dir / "talker.err");
+  reaper.pids.push_back(talker);
+  ASSERT_EQ(test::wait_process(talker, std::chrono::seconds(50)), 0)
+      << test::read_text(dir / "talker.err") << test::read_text(dir / "slave.err");
+  const pid_t listener = test::spawn_process(
+      {MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", "/microcobot/slave/microscope/state", "--type",
+       "joint", "--count", "20", "--timeout", "30"},
+      dir / "listener.out", dir / "listener.err");
+  reaper.pids.push_back(listener);
+  ASSERT_EQ(test::wait_process(listener, std::chrono::seconds(40)), 0)
+      << test::read_text(dir / "listener.err");
+  ::kill(slave, SIGTERM);
+  EXPECT_EQ(test::wait_process(slave, std::chrono::seconds(30)), 0) << test::read_text(dir / "slave.err");
+  EXPECT_NE(test::read_text(dir / "slave.err").find("/microcobot/slave/microscope/command"),
+            std::string::npos);
+
+  const std::vector<json> samples = json_lines(test::read_text(dir / "listener.out"));
+  ASSERT_EQ(samples.size(), 20u);
+  for (const json& s : samples) {
+    EXPECT_EQ(s["type"], kJointType) << s;
+    EXPECT_EQ(s["name"], json({"focus_z", "objective_turret"})) << s;
+  }
+  // The drive moves at 1 mm/s: 150 um in 0.15 s, long before the last of 2 s of states.
+  const json& last = samples.back();
+  EXPECT_NEAR(last["position"][0].get<double>(), 150e-6, 1e-12) << last;
+  EXPECT_EQ(last["position"][1].get<double>(), 2.0) << last;
+}
+
 TEST(WireCompat, TheListenerTimesOutWithOneLine) {
   // This test's own domain, nothing published on it.
   TempDir dir;
