@@ -25,6 +25,7 @@
 #include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/microscope_link.h"
+#include "microcobot/net/remote_camera.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/driver_registry.h"
@@ -94,7 +95,8 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     // The masters are this machine's (simulated, the operator then uses the console, or the
     // drivers' masters: their stage and gripper, built but never configured, are not opened);
     // the stage is the slave process's.
-    lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform] {
+    lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform, domain = o.domain,
+                       network = mc::cli::network_config(o.network)] {
       pf::PlatformDevices d;
       if (cfg.devices.simulated()) {
         d.haptic = std::make_unique<pf::SimulatedHapticMaster>(
@@ -108,6 +110,10 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
       d.axes = std::move(stage.axes);
       d.rotary = std::move(stage.rotary);
       d.gripper = std::move(stage.gripper);
+      // The microscope is the slave's: its frames, over DDS (the master has no microworld to image).
+      if (cfg.camera.enabled && cfg.devices.camera.driver != "none")
+        d.camera = std::make_unique<pf::Camera>(
+            "camera", cfg.camera, std::make_unique<mc::net::RemoteCameraSource>(domain, network));
       return d;
     };
   } else {

@@ -36,7 +36,7 @@ class TestPatternSource final : public platform::FrameSource {
  public:
   void open(const platform::CameraDeviceParams& params) override { params_ = params; }
   bool renders_scene() const override { return true; }
-  void capture(const platform::SceneSnapshot& scene, platform::Image& out) override {
+  bool capture(const platform::SceneSnapshot& scene, platform::Image& out) override {
     TestCameraControl& c = test_camera();
     while (c.stall.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (c.fail.load()) throw std::runtime_error("test camera: unplugged");
@@ -57,6 +57,7 @@ class TestPatternSource final : public platform::FrameSource {
            x < std::min(out.width, static_cast<int>(cx + half)); ++x)
         out.data[static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) +
                  static_cast<std::size_t>(x)] = level;
+    return true;
   }
 
  private:

@@ -177,18 +177,21 @@ void Camera::thread_main() {
                            static_cast<std::size_t>(params_.sensor.height_px) *
                            (params_.sensor.bit_depth > 8 ? 2u : 1u));
   SceneSnapshot scene, newer;
-  bool have_scene = false;
+  bool have_scene = false, idle = false;
   double last_t_mid = -1.0;
   try {
     JpegEncoder encoder;
     while (running_.load(std::memory_order_acquire)) {
       if (!has_sink_.load(std::memory_order_acquire) || !wanted()) {
         // Nobody looks: no frame is formed (a batch run, a server without viewers pay nothing).
+        if (!idle) source_->idle();
+        idle = true;
         while (ring_.pop(newer)) {
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
         continue;
       }
+      idle = false;
       if (source_->renders_scene()) {
         // One frame per snapshot; when several wait (the thread fell behind), the newest wins.
         if (!ring_.pop(scene)) {
@@ -200,7 +203,7 @@ void Camera::thread_main() {
           skipped_.fetch_add(1, std::memory_order_relaxed);
         }
         const std::int64_t t0 = steady_ns();
-        source_->capture(scene, frame.image);
+        if (!source_->capture(scene, frame.image)) continue;
         frame.t_mid_s = scene.t_s;
         deliver(frame, scene, t0, encoder);
       } else {
@@ -210,7 +213,7 @@ void Camera::thread_main() {
           have_scene = true;
         }
         const std::int64_t t0 = steady_ns();
-        source_->capture(scene, frame.image);
+        if (!source_->capture(scene, frame.image)) continue;
         const std::int64_t t1 = steady_ns();
         const double exposure = exposure_s_.load(std::memory_order_relaxed);
         // The newest snapshot maps the wall clock onto the loop's. A loop that fell behind the

@@ -117,9 +117,13 @@ class FrameSource {
   /// True when the frame is formed from the snapshot (one frame per snapshot, due at the
   /// camera's rate in loop time); false for a camera that grabs at its own pace.
   virtual bool renders_scene() const = 0;
-  /// Forms (or waits for and grabs) one image into `out`, reusing its buffer. Throws mc::Error
-  /// when the device fails.
-  virtual void capture(const SceneSnapshot& scene, Image& out) = 0;
+  /// Forms (or waits for and grabs) one image into `out`, reusing its buffer. False when a
+  /// grabbing camera got none within its own wait (a producer that is silent for now: the thread
+  /// asks again); a renderer always forms one. Throws mc::Error when the device fails.
+  virtual bool capture(const SceneSnapshot& scene, Image& out) = 0;
+  /// Nobody looks at the frames (called on the camera thread when it stops asking for them): a
+  /// source whose producer works only while read may tell it to rest.
+  virtual void idle() {}
 };
 
 /// Counters of the camera (any thread).

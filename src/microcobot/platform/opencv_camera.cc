@@ -65,7 +65,7 @@ class OpenCvCamera final : public FrameSource {
 
   bool renders_scene() const override { return false; }
 
-  void capture(const SceneSnapshot&, Image& out) override {
+  bool capture(const SceneSnapshot&, Image& out) override {
     if (file_) {
       // A file is played at the camera's rate (a device paces itself), looped at its end.
       next_ += period_;
@@ -93,6 +93,7 @@ class OpenCvCamera final : public FrameSource {
     const std::size_t row = static_cast<std::size_t>(converted_.cols) * converted_.elemSize();
     for (int y = 0; y < converted_.rows; ++y)
       std::memcpy(out.data.data() + static_cast<std::size_t>(y) * row, converted_.ptr(y), row);
+    return true;
   }
 
  private:

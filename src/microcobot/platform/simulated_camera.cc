@@ -24,7 +24,7 @@ class SimulatedCamera final : public FrameSource {
 
   bool renders_scene() const override { return true; }
 
-  void capture(const SceneSnapshot& scene, Image& out) override {
+  bool capture(const SceneSnapshot& scene, Image& out) override {
     CameraScenePose pose;
     pose.tool_x_m = scene.tool_m[0];
     pose.tool_y_m = scene.tool_m[1];
@@ -61,6 +61,7 @@ class SimulatedCamera final : public FrameSource {
       static_assert(std::endian::native == std::endian::little);
       std::memcpy(out.data.data(), frame_.pixels.data(), 2 * frame_.pixels.size());
     }
+    return true;
   }
 
  private:
