@@ -7,9 +7,12 @@
 // Also the frame rate the page decoded and the server's own snapshot-to-JPEG latency.
 //
 //   MC_CLI=build/release/apps/microcobot/microcobot node bench/console_camera_bench.mjs [--seconds 30]
-//     [--config FILE.yaml]
+//     [--config FILE.yaml] [--distributed]
 import { startConsole } from "../tests/browser/console_session.mjs";
 import { join } from "node:path";
+import { mkdtempSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { spawn } from "node:child_process";
 
 const i = process.argv.indexOf("--seconds");
 const seconds = i > 0 ? Number(process.argv[i + 1]) : 30;
@@ -20,7 +23,20 @@ if (!(seconds >= 5 && seconds <= 600)) {
 process.env.MC_CLI ||= "build/release/apps/microcobot/microcobot";
 const c = process.argv.indexOf("--config");  // e.g. another frame rate or sensor size
 const config = c > 0 ? ["--config", process.argv[c + 1]] : [];
-const s = await startConsole("console_camera_bench", (dir) => ["--out", join(dir, "rec"), ...config], seconds + 120);
+// --distributed: the console is a master's (`serve --role master`) whose camera is the slave's,
+// received over DDS (net/remote_camera.h), with the slave a second process on this machine.
+let slave = null, role = [];
+if (process.argv.includes("--distributed")) {
+  const domain = String(100 + (process.pid % 100));
+  const dir = mkdtempSync(join(tmpdir(), "mc-bench-slave-"));
+  slave = spawn(process.env.MC_CLI, ["serve", "--role", "slave", "--domain", domain, "--listen", "127.0.0.1:0",
+                                     "--out", join(dir, "rec"), "--duration", String(seconds + 200), ...config],
+                { stdio: "ignore" });
+  role = ["--role", "master", "--domain", domain];
+  process.on("exit", () => slave.kill("SIGTERM"));  // also when the run fails
+}
+const s = await startConsole("console_camera_bench", (dir) => ["--out", join(dir, "rec"), ...role, ...config],
+                             seconds + 120);
 const { page, until, log } = s;
 const quantile = (v, q) => {
   const a = [...v].sort((x, y) => x - y);

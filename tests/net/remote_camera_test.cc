@@ -1,7 +1,7 @@
 // The slave's camera as the master's (net/remote_camera.h): frames published on the camera's DDS
 // topic (camera_image_publisher.h) come out of the remote source decoded, at the configured
-// sensor's depth; a frame of another size faults with both sizes named; a source nobody reads
-// from lets the publisher rest.
+// sensor's depth, their JPEG kept as it came; a frame of another size faults with both sizes named; a source
+// nobody reads from lets the publisher rest.
 
 #include "microcobot/net/remote_camera.h"
 
@@ -55,7 +55,10 @@ TEST(RemoteCamera, TheSlavesFramesComeOutDecodedAtTheSensorsDepth) {
   source.open(sensor(64, 48, 12));
   EXPECT_FALSE(source.renders_scene());
   platform::Image img;
-  ASSERT_TRUE(capture_one(source, publisher, ramp_frame(64, 48), img));
+  const platform::CameraFrame sent = ramp_frame(64, 48);
+  ASSERT_TRUE(capture_one(source, publisher, sent, img));
+  ASSERT_NE(source.captured_jpeg(), nullptr);
+  EXPECT_EQ(*source.captured_jpeg(), sent.jpeg) << "the slave's JPEG goes on as it came";
   ASSERT_EQ(img.width, 64);
   ASSERT_EQ(img.height, 48);
   ASSERT_EQ(img.bit_depth, 12);

@@ -75,6 +75,7 @@ bool RemoteCameraSource::capture(const platform::SceneSnapshot&, platform::Image
     const auto& m = *static_cast<const sensor_msgs_msg_dds__CompressedImage_*>(samples[newest]);
     try {
       decoded = decode_jpeg(std::span<const std::uint8_t>(m.data_._buffer, m.data_._length), 1);
+      jpeg_.assign(m.data_._buffer, m.data_._buffer + m.data_._length);
     } catch (const Error& e) {
       error = e.what();
     }

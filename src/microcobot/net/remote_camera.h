@@ -9,7 +9,8 @@
 ///
 /// It grabs at the slave's pace (renders_scene() false): each capture waits up to 100 ms for the
 /// next image and decodes the newest one; frames are stamped in the master's loop time on their
-/// arrival (minus half the exposure), so the network's delay is part of their age. The reader
+/// arrival (minus half the exposure), so the network's delay is part of their age. Their JPEG is
+/// passed on as the slave encoded it (decoded once for the console's preview and vision). The reader
 /// exists only while somebody looks at the master's frames (idle() deletes it): the slave forms
 /// frames only while a reader is matched. The master's focus and objective reach the slave by the
 /// microscope's topics (microscope_link.h); its exposure and gain stay the slave's.
@@ -19,6 +20,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <dds/dds.h>
 
@@ -39,6 +41,8 @@ class RemoteCameraSource final : public platform::FrameSource {
   /// Throws mc::InvalidInput when a frame does not decode or is not the configured size.
   bool capture(const platform::SceneSnapshot& scene, platform::Image& out) override;
   void idle() override;
+  /// The slave's JPEG of the last frame captured, sent on unchanged.
+  const std::vector<std::uint8_t>* captured_jpeg() const override { return &jpeg_; }
 
  private:
   void start_reading();
@@ -49,6 +53,7 @@ class RemoteCameraSource final : public platform::FrameSource {
   platform::CameraDeviceParams params_;
   std::unique_ptr<Participant> participant_;
   dds_entity_t topic_ = 0, reader_ = 0, waitset_ = 0;
+  std::vector<std::uint8_t> jpeg_;  // the last frame's, as the slave encoded it
 };
 
 }  // namespace mc::net

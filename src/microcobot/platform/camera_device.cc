@@ -239,8 +239,11 @@ void Camera::deliver(CameraFrame& frame, const SceneSnapshot& scene, std::int64_
                      JpegEncoder& encoder) {
   const std::int64_t t1 = steady_ns();
   const Image& img = frame.image;
-  encoder.encode({img.width, img.height, img.channels, img.bit_depth, img.data}, params_.jpeg_quality,
-                 frame.jpeg);
+  if (const std::vector<std::uint8_t>* jpeg = source_->captured_jpeg())
+    frame.jpeg.assign(jpeg->begin(), jpeg->end());
+  else
+    encoder.encode({img.width, img.height, img.channels, img.bit_depth, img.data}, params_.jpeg_quality,
+                   frame.jpeg);
   const std::int64_t t2 = steady_ns();
   const int objective = std::clamp(scene.objective, 0, static_cast<int>(params_.objectives.size()) - 1);
   const ObjectiveParams& o = params_.objectives[static_cast<std::size_t>(objective)];

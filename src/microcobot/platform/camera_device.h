@@ -124,6 +124,10 @@ class FrameSource {
   /// Nobody looks at the frames (called on the camera thread when it stops asking for them): a
   /// source whose producer works only while read may tell it to rest.
   virtual void idle() {}
+  /// A source that receives its frames as JPEG (a remote camera) gives the last captured one's
+  /// bytes here, and the camera sends them on as they are: no second encoding, no generation loss.
+  /// Null (the default): the camera encodes the image.
+  virtual const std::vector<std::uint8_t>* captured_jpeg() const { return nullptr; }
 };
 
 /// Counters of the camera (any thread).
