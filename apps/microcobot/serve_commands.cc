@@ -136,6 +136,7 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
 mc::net::MicroscopeJoints microscope_joints(const mc::live::LivePlatform& live, bool wanted) {
   const mc::live::LiveStatus st = live.status();
   mc::net::MicroscopeJoints j;
+  if (st.ticks == 0) return j;  // the loop has not run: its drive's state is not known yet
   j.has_focus = true;
   j.focus_z_m = wanted ? st.focus_target_m : st.focus_z_m;
   j.objective = st.objective;

@@ -158,6 +158,30 @@ TEST(MicroscopeLink, TheMastersChangesReachTheSlaveAndItsStateComesBack) {
   EXPECT_GT(st.states, 1u);
 }
 
+// A master whose loop has not run yet knows no focus: the first one it knows is the start, not
+// a change, so a master that starts sends nothing even when its drive does not start at 0.
+TEST(MicroscopeLink, AMasterTakesTheFirstFocusItKnowsAsTheStart) {
+  const int domain = test::test_domain_id();
+  std::atomic<bool> known{false};
+  std::atomic<int> taken{0};
+  MicroscopeServer server(
+      domain, {}, [&](const MicroscopeJoints&) { taken.fetch_add(1); }, [] { return MicroscopeJoints{}; });
+  MicroscopeClient client(domain, {}, [&] {
+    MicroscopeJoints j;
+    if (!known.load()) return j;
+    j.has_focus = true;
+    j.focus_z_m = 120e-6;  // the configuration's focus_start_m
+    j.objective = 0;
+    return j;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  known = true;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(client.commands_sent(), 0u);
+  EXPECT_EQ(taken.load(), 0);
+  EXPECT_EQ(server.stats().states, 0u) << "a slave that knows no state publishes none";
+}
+
 // A slave that starts after the master's last change still takes it (transient local).
 TEST(MicroscopeLink, ASlaveThatStartsLaterTakesTheLastCommand) {
   const int domain = test::test_domain_id();

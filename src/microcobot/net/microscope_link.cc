@@ -134,6 +134,7 @@ void MicroscopeServer::run() {
     dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(20));
     take_commands();
     const MicroscopeJoints now_state = read_state_();
+    if (!now_state.has_focus && now_state.objective < 0) continue;  // not known yet
     const auto now = std::chrono::steady_clock::now();
     // At 10 Hz, and while the drive moves at most every 20 ms (a state is a few hundred bytes).
     if (!published || now - last_at >= kMicroscopeStatePeriod ||
@@ -188,6 +189,7 @@ void MicroscopeClient::run() {
     if (now < next_poll) continue;
     next_poll = now + kMicroscopePollPeriod;
     const MicroscopeJoints wanted = wanted_();
+    if (!wanted.has_focus && wanted.objective < 0) continue;  // this end does not know it yet
     if (!baseline) {
       baseline = wanted;  // the start: the operator has asked nothing yet
       continue;

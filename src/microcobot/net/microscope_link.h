@@ -38,7 +38,7 @@ struct MicroscopeServerStats {
 class MicroscopeServer {
  public:
   using OnCommand = std::function<void(const MicroscopeJoints&)>;
-  using ReadState = std::function<MicroscopeJoints()>;
+  using ReadState = std::function<MicroscopeJoints()>;  ///< neither joint: not known yet (nothing published)
   /// Both callbacks run on this object's thread. Throws InvalidParams / ComputationFailed as
   /// Participant does.
   MicroscopeServer(int domain_id, const NetworkConfig& network, OnCommand on_command, ReadState read_state);
@@ -66,6 +66,7 @@ class MicroscopeServer {
 class MicroscopeClient {
  public:
   /// What this end's operator wants (focus target and objective); polled on this object's thread.
+  /// Neither joint: not known yet (the loop has not run), and the first known value is the start.
   using ReadWanted = std::function<MicroscopeJoints()>;
   MicroscopeClient(int domain_id, const NetworkConfig& network, ReadWanted wanted);
   ~MicroscopeClient();
