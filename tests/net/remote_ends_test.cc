@@ -422,12 +422,15 @@ double undisturbed_roughness_m(bool interpolate) {
 }
 
 TEST(RemoteEnds, TheSlaveRetracesTheMastersMotionThroughAJitteryLossyLine) {
-  const double raw = undisturbed_roughness_m(false);
   // The jitter buffer's playout is paced by the slave's loop: a loop kept off the CPU by other
   // work on the machine (a compiler beside the test: 670 nm at 198 um/s) plays the targets out
-  // late. Such a run is repeated, up to three times; an undisturbed one retraces the line.
-  double buffered = 0.0;
+  // late. Such a run is repeated, up to three times; an undisturbed one retraces the line. The
+  // targets as they arrive are measured again with each try: their roughness depends on how the
+  // real threads met the emulated jitter (115-424 nm in five undisturbed runs on 2026-11-27), and a smooth
+  // draw of it made the bound tighter than the buffered runs' own spread (2-36 nm).
+  double raw = 0.0, buffered = 0.0;
   for (int attempt = 0; attempt < 3; ++attempt) {
+    raw = undisturbed_roughness_m(false);
     buffered = undisturbed_roughness_m(true);
     if (buffered < 0.3 * raw) break;
   }
