@@ -34,6 +34,23 @@ dds_entity_t make_joint_topic(dds_entity_t pp, std::string_view name, const char
                    what);
 }
 
+enum class MicroscopeTopic { kCommand, kState };
+enum class EndpointKind { kReader, kWriter };
+
+// A reader or a writer of one of the two topics, with its QoS (the command latched, the state not).
+dds_entity_t make_endpoint(dds_entity_t pp, MicroscopeTopic which, EndpointKind end) {
+  const bool command = which == MicroscopeTopic::kCommand;
+  const dds_entity_t topic =
+      make_joint_topic(pp, command ? kMicroscopeCommandDdsName : kMicroscopeStateDdsName,
+                       command ? "microscope: the command topic" : "microscope: the state topic");
+  dds_qos_t* qos = microscope_topic_qos(command);
+  const dds_entity_t e = end == EndpointKind::kReader ? dds_create_reader(pp, topic, qos, nullptr)
+                                             : dds_create_writer(pp, topic, qos, nullptr);
+  dds_delete_qos(qos);
+  return check_dds(e, command ? "microscope: cannot create the command's endpoint"
+                              : "microscope: cannot create the state's endpoint");
+}
+
 dds_entity_t make_reader_waitset(dds_entity_t pp, dds_entity_t reader, const char* what) {
   const dds_entity_t ws = check_dds(dds_create_waitset(pp), what);
   const dds_entity_t cond = check_dds(dds_create_readcondition(reader, DDS_ANY_STATE), what);
@@ -81,17 +98,8 @@ MicroscopeServer::MicroscopeServer(int domain_id, const NetworkConfig& network, 
       on_command_(std::move(on_command)),
       read_state_(std::move(read_state)) {
   const dds_entity_t pp = participant_.handle();
-  const dds_entity_t command =
-      make_joint_topic(pp, kMicroscopeCommandDdsName, "microscope: the command topic");
-  const dds_entity_t state = make_joint_topic(pp, kMicroscopeStateDdsName, "microscope: the state topic");
-  dds_qos_t* latched = microscope_topic_qos(true);
-  dds_qos_t* volatile_qos = microscope_topic_qos(false);
-  command_reader_ = dds_create_reader(pp, command, latched, nullptr);
-  state_writer_ = dds_create_writer(pp, state, volatile_qos, nullptr);
-  dds_delete_qos(latched);
-  dds_delete_qos(volatile_qos);
-  check_dds(command_reader_, "microscope: cannot create the command reader");
-  check_dds(state_writer_, "microscope: cannot create the state writer");
+  command_reader_ = make_endpoint(pp, MicroscopeTopic::kCommand, EndpointKind::kReader);
+  state_writer_ = make_endpoint(pp, MicroscopeTopic::kState, EndpointKind::kWriter);
   waitset_ = make_reader_waitset(pp, command_reader_, "microscope: the command waitset");
   thread_ = std::thread([this] { run(); });
 }
@@ -150,17 +158,8 @@ void MicroscopeServer::run() {
 MicroscopeClient::MicroscopeClient(int domain_id, const NetworkConfig& network, ReadWanted wanted)
     : participant_(domain_id, network), wanted_(std::move(wanted)) {
   const dds_entity_t pp = participant_.handle();
-  const dds_entity_t command =
-      make_joint_topic(pp, kMicroscopeCommandDdsName, "microscope: the command topic");
-  const dds_entity_t state = make_joint_topic(pp, kMicroscopeStateDdsName, "microscope: the state topic");
-  dds_qos_t* latched = microscope_topic_qos(true);
-  dds_qos_t* volatile_qos = microscope_topic_qos(false);
-  command_writer_ = dds_create_writer(pp, command, latched, nullptr);
-  state_reader_ = dds_create_reader(pp, state, volatile_qos, nullptr);
-  dds_delete_qos(latched);
-  dds_delete_qos(volatile_qos);
-  check_dds(command_writer_, "microscope: cannot create the command writer");
-  check_dds(state_reader_, "microscope: cannot create the state reader");
+  command_writer_ = make_endpoint(pp, MicroscopeTopic::kCommand, EndpointKind::kWriter);
+  state_reader_ = make_endpoint(pp, MicroscopeTopic::kState, EndpointKind::kReader);
   waitset_ = make_reader_waitset(pp, state_reader_, "microscope: the state waitset");
   thread_ = std::thread([this] { run(); });
 }

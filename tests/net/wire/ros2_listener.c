@@ -35,17 +35,7 @@
 #include "dds/dds.h"
 #include "ros2_wire.h"
 
-/* The platform's Cyclone configuration (docs/distributed.md, "Middleware configuration"). */
-static const char kLoopbackConfig[] =
-    "<General>"
-    "<Interfaces><NetworkInterface address=\"127.0.0.1\" multicast=\"true\"/></Interfaces>"
-    "<AllowMulticast>spdp</AllowMulticast>"
-    "</General>"
-    "<Discovery>"
-    "<ParticipantIndex>auto</ParticipantIndex>"
-    "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex>"
-    "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-    "</Discovery>";
+#include "loopback_config.h"
 
 enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag, kImage };
 

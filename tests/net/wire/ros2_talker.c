@@ -23,16 +23,7 @@
 #include "dds/dds.h"
 #include "ros2_wire.h"
 
-static const char kLoopbackConfig[] =
-    "<General>"
-    "<Interfaces><NetworkInterface address=\"127.0.0.1\" multicast=\"true\"/></Interfaces>"
-    "<AllowMulticast>spdp</AllowMulticast>"
-    "</General>"
-    "<Discovery>"
-    "<ParticipantIndex>auto</ParticipantIndex>"
-    "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex>"
-    "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-    "</Discovery>";
+#include "loopback_config.h"
 
 #define kMaxJoints 4
 
