@@ -279,32 +279,36 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
   EXPECT_GT((far_goal - stopped).norm(), 20e-6);  // it did not get there
 }
 
-// Turned by the rotary axis, the tips move about the tool point: the positioner, which sees them
-// at 0 deg only, holds the stage and says why; turned back, it goes to the goal.
-TEST(VisionPositioning, TurnedFingersHoldTheStageUntilTheyAreTurnedBack) {
+// The rotary axis turns the fingers about the tool point (issue #28 with #29 point 2): while
+// they turn, the tips move about the tool point and would read as the stage's motion, so the
+// stage holds; still at 20 deg, the tips are taught again there and the click is reached with
+// the fingers turned.
+TEST(VisionPositioning, TurnedFingersHoldTheStageWhileTurningThenAreFollowedTurned) {
   LiveParams p = vision_params();
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
                        MC_UNDER_ASAN ? 30.0 : 10.0));
   rig.deadman = true;
-  rig.theta_goal = 3.0 * M_PI / 180.0;
-  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "hold (fingers turned)"; },
+  rig.theta_goal = 20.0 * M_PI / 180.0;  // about 2 s at the axis' 0.16 rad/s
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "hold (fingers turning)"; },
                        MC_UNDER_ASAN ? 20.0 : 5.0));
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
-  std::this_thread::sleep_for(MC_UNDER_ASAN ? 2000ms : 800ms);
+  std::this_thread::sleep_for(300ms);
   const auto held = rig.live.status().vision.value();
-  EXPECT_EQ(held.state, "hold (fingers turned)");
-  EXPECT_NE(held.error.find("turned"), std::string::npos) << held.error;
+  EXPECT_EQ(held.state, "hold (fingers turning)");
   EXPECT_EQ(held.commands, 0u);
-  EXPECT_LT((rig.truth() - home).norm(), 0.05e-6) << "the stage moved with the fingers turned";
-  rig.theta_goal = 0.0;  // back: the positioner takes the goal
+  EXPECT_LT((rig.truth() - home).norm(), 0.05e-6) << "the stage moved while the fingers turned";
   std::string why;
   const auto rest = rig.converge_and_rest(why);
   ASSERT_TRUE(rest) << why;
-  EXPECT_LT((*rest - goal).norm(), 0.3e-6);
+  const LiveStatus st = rig.live.status();
+  std::printf("vision click-to-go with the fingers turned 20 deg: true error %.3f um\n",
+              1e6 * (*rest - goal).norm());
+  EXPECT_LT((*rest - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  EXPECT_TRUE(st.vision->found);
 }
 
 TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneLine) {

@@ -125,23 +125,32 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     switch_objective(frame.objective, frame_.width, frame_.height);
   st.m_per_px = map_m_per_px(map_);
   st.calibrated = calibrated_;
-  // The tips are taught and tracked with the fingers at 0 deg (the rotary axis' home): turned,
-  // they move about the tool point and would read as the stage's motion. The stage holds.
-  constexpr double kTurned_rad = 1e-3;
-  if (std::abs(frame.tool_yaw_rad) > kTurned_rad) {
-    st.found = false;
-    st.state = "hold (fingers turned)";
-    st.error = fmt::format(
-        "the fingers are turned ({:.2f} deg): vision positioning sees them at 0 deg only; turn them back",
-        frame.tool_yaw_rad * 180.0 / M_PI);
-    servo_->clear_history();
-    converged_frames_ = 0;
-    in_position_ = false;
-    moved_px_.setZero();
-    publish(st);
-    return std::nullopt;
+  // The fingers' yaw (the rotary axis turns them about the tool point): while they turn the tips
+  // move about the tool point and would read as the stage's motion, so the stage holds; still
+  // for kStillFrames frames at a new yaw, the tips are taught again there (the tool point, on the
+  // axis, has not moved) and tracked turned.
+  constexpr double kTurned_rad = 1e-3;    // 1 mrad moves a tip 0.1 um across a 200 um opening
+  constexpr double kStillYaw_rad = 1e-4;  // a frame's change of yaw that counts as turning
+  constexpr int kStillFrames = 3;
+  const double yaw = std::isfinite(frame.tool_yaw_rad) ? frame.tool_yaw_rad : 0.0;
+  still_frames_ = std::isfinite(last_frame_yaw_) && std::abs(yaw - last_frame_yaw_) <= kStillYaw_rad
+                      ? still_frames_ + 1
+                      : 0;
+  last_frame_yaw_ = yaw;
+  if (std::abs(yaw - taught_yaw_) > kTurned_rad) {
+    if (still_frames_ < kStillFrames) {
+      st.found = false;
+      st.state = "hold (fingers turning)";
+      servo_->clear_history();
+      converged_frames_ = 0;
+      in_position_ = false;
+      moved_px_.setZero();
+      publish(st);
+      return std::nullopt;
+    }
+    taught_yaw_ = yaw;
+    taught_ = false;  // taught again below, where the tool point is
   }
-  if (st.error.rfind("the fingers are turned", 0) == 0) st.error.clear();
 
   // Where the tool is: taught where it is expected, then tracked near where the commands put it.
   bool found = false;
@@ -159,8 +168,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
     std::array<double, 2> rho{-2.0, -2.0};  // the agreeing tips' correlations (-2: left out)
     for (std::size_t k = 0; k < 2; ++k) {
       if (!tip_taught_[k]) continue;
-      const Eigen::Vector2d tip_step =
-          map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * frame.gripper_opening_m, 0.0));
+      const Eigen::Vector2d tip_step = tip_step_px(k, frame.gripper_opening_m);
       const Eigen::Vector2d predicted = predicted_tool + tip_step + tip_offset_px_[k];
       const vision::TrackEstimate e = trackers_[k].track_near(frame_, predicted.x(), predicted.y());
       tool_k[k] = Eigen::Vector2d(e.u_px, e.v_px) - tip_offset_px_[k] - tip_step;
@@ -247,6 +255,12 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   return out;
 }
 
+Eigen::Vector2d VisionPositioner::tip_step_px(std::size_t k, double opening_m) const {
+  // Tip k lies -+ opening / 2 from the tool point along the fingers' x, turned by their yaw.
+  const double h = (k == 0 ? -0.5 : 0.5) * opening_m;
+  return map_.pixel_step(Eigen::Vector2d(h * std::cos(taught_yaw_), h * std::sin(taught_yaw_)));
+}
+
 bool VisionPositioner::teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, double opening_m,
                                  std::string& why) {
   const auto inside = [&](const vision::PixelRoi& r) {
@@ -254,10 +268,10 @@ bool VisionPositioner::teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, 
   };
   const int side = k == 0 ? -1 : 1;
   const double w = config_.world.gripper.finger_width_m;
-  vision::PixelRoi roi = finger_tip_template(map_, tool_px, side, opening_m, w);
+  vision::PixelRoi roi = finger_tip_template(map_, tool_px, side, opening_m, w, false, taught_yaw_);
   // The finger's outer side out of the image (a wide-open gripper under a small field): its
   // inner half, until the tips are taught again.
-  if (!inside(roi)) roi = finger_tip_template(map_, tool_px, side, opening_m, w, /*inner=*/true);
+  if (!inside(roi)) roi = finger_tip_template(map_, tool_px, side, opening_m, w, /*inner=*/true, taught_yaw_);
   const char* name = k == 0 ? "left" : "right";
   if (!inside(roi)) {
     why = std::string("the ") + name + " tip's template is not inside the image";
@@ -269,8 +283,7 @@ bool VisionPositioner::teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, 
     why = std::string("cannot see the gripper's ") + name + " tip where expected: " + e.what();
     return false;
   }
-  const Eigen::Vector2d tip =
-      tool_px + map_.pixel_step(Eigen::Vector2d((k == 0 ? -0.5 : 0.5) * opening_m, 0.0));
+  const Eigen::Vector2d tip = tool_px + tip_step_px(k, opening_m);
   tip_offset_px_[k] = Eigen::Vector2d(trackers_[k].last().u_px, trackers_[k].last().v_px) - tip;
   tip_taught_[k] = true;
   return true;

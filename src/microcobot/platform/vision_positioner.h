@@ -13,6 +13,8 @@
 /// and found its twin, the other finger, by a whole-frame search, is left out. Two tips that
 /// disagree by more than a pixel: one holds something that does not move with it (a part's edge
 /// under its template, 3 um off at 5x), and the better-matching tip alone gives the tool point.
+/// The rotary axis turns the fingers about the tool point: while they turn the stage holds; still
+/// for 3 frames at a new yaw, the tips are taught again there and tracked turned.
 ///
 ///   loop (1 kHz) --goal (world or pixel), deadman--> atomics --> camera thread: on_frame()
 ///   camera thread --PositionerCommand--> returned to the caller, who rings it to the loop
@@ -34,6 +36,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -62,7 +65,7 @@ struct PositionerStatus {
   bool found = false;   ///< ...and found in the last frame
   bool has_goal = false;
   std::string state = "waiting";  ///< waiting, moving, converged, hold-lost, hold-stale, hold (fingers
-                                  ///< turned), no-goal, no-deadman, error
+                                  ///< turning), no-goal, no-deadman, error
   std::string error;              ///< why the goal was refused or the template could not be taken
   double tool_u_px = 0.0, tool_v_px = 0.0;  ///< where the tool point is seen
   double goal_u_px = 0.0, goal_v_px = 0.0;  ///< where it is sent (the tool point's pixel)
@@ -130,14 +133,19 @@ class VisionPositioner {
   bool teach(const Eigen::Vector2d& tool_px, double opening_m, PositionerStatus& st);
   /// Teaches tip `k` (0 left, 1 right) around `tool_px`; false with `why` when it cannot.
   bool teach_tip(std::size_t k, const Eigen::Vector2d& tool_px, double opening_m, std::string& why);
+  /// From the tool point to tip `k` (pixels), the fingers `opening_m` apart at taught_yaw_.
+  Eigen::Vector2d tip_step_px(std::size_t k, double opening_m) const;
   std::array<bool, 2> tip_taught_{false, false};
+  double taught_yaw_ = 0.0;  ///< the fingers' yaw the tips are taught and tracked at (rad)
+  double last_frame_yaw_ = std::numeric_limits<double>::quiet_NaN();
+  int still_frames_ = 0;  ///< frames in a row the fingers have not turned
 
   std::array<vision::TemplateTracker, 2> trackers_;  ///< the left and the right tip
   vision::Frame frame_;
   bool taught_ = false, has_goal_ = false;
   int lost_frames_ = 0;
   /// Template centre - the tip's point, per tip (taught); the tips lie at the tool point
-  /// -+ opening / 2 along stage x.
+  /// -+ opening / 2 along the fingers' x (stage x turned by taught_yaw_).
   std::array<Eigen::Vector2d, 2> tip_offset_px_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   Eigen::Vector2d tool_px_ = Eigen::Vector2d::Zero();   ///< the tool point last seen
   Eigen::Vector2d stage_m_ = Eigen::Vector2d::Zero();   ///< ... as a stage position
