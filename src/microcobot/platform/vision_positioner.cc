@@ -127,18 +127,18 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const CameraFrame& f
   st.calibrated = calibrated_;
   // The fingers' yaw (the rotary axis turns them about the tool point): while they turn the tips
   // move about the tool point and would read as the stage's motion, so the stage holds; still
-  // for kStillFrames frames at a new yaw, the tips are taught again there (the tool point, on the
+  // for kPositionerStillFrames frames at a new yaw, the tips are taught again there (the tool point, on the
   // axis, has not moved) and tracked turned.
-  constexpr double kTurned_rad = 1e-3;    // 1 mrad moves a tip 0.1 um across a 200 um opening
-  constexpr double kStillYaw_rad = 1e-4;  // a frame's change of yaw that counts as turning
-  constexpr int kStillFrames = 3;
+  constexpr double kTurned_rad = 1e-3;              // 1 mrad moves a tip 0.1 um across a 200 um opening
+  constexpr double kPositionerStillYaw_rad = 1e-4;  // a frame's change of yaw that counts as turning
+  constexpr int kPositionerStillFrames = 3;
   const double yaw = std::isfinite(frame.tool_yaw_rad) ? frame.tool_yaw_rad : 0.0;
-  still_frames_ = std::isfinite(last_frame_yaw_) && std::abs(yaw - last_frame_yaw_) <= kStillYaw_rad
+  still_frames_ = std::isfinite(last_frame_yaw_) && std::abs(yaw - last_frame_yaw_) <= kPositionerStillYaw_rad
                       ? still_frames_ + 1
                       : 0;
   last_frame_yaw_ = yaw;
   if (std::abs(yaw - taught_yaw_) > kTurned_rad) {
-    if (still_frames_ < kStillFrames) {
+    if (still_frames_ < kPositionerStillFrames) {
       st.found = false;
       st.state = "hold (fingers turning)";
       servo_->clear_history();
