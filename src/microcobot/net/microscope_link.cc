@@ -45,7 +45,7 @@ dds_entity_t make_endpoint(dds_entity_t pp, MicroscopeTopic which, EndpointKind 
                        command ? "microscope: the command topic" : "microscope: the state topic");
   dds_qos_t* qos = microscope_topic_qos(command);
   const dds_entity_t e = end == EndpointKind::kReader ? dds_create_reader(pp, topic, qos, nullptr)
-                                             : dds_create_writer(pp, topic, qos, nullptr);
+                                                      : dds_create_writer(pp, topic, qos, nullptr);
   dds_delete_qos(qos);
   return check_dds(e, command ? "microscope: cannot create the command's endpoint"
                               : "microscope: cannot create the state's endpoint");

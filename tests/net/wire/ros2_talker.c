@@ -63,7 +63,8 @@ static int parse(int argc, char** argv, struct Options* o) {
       o->topic = value;
     } else if (strcmp(flag, "--joint") == 0) {
       char* eq = strchr(value, '=');
-      if (eq == NULL || eq == value || o->joints == kMaxJoints) return usage("--joint must be NAME=VALUE", value);
+      if (eq == NULL || eq == value || o->joints == kMaxJoints)
+        return usage("--joint must be NAME=VALUE", value);
       *eq = '\0';
       const double x = strtod(eq + 1, &end);
       if (end == eq + 1 || *end != '\0') return usage("--joint's value must be a number", eq + 1);
@@ -108,7 +109,8 @@ int main(int argc, char** argv) {
     rc = fail("cannot create a participant", pp);
     goto out;
   }
-  const dds_entity_t topic = dds_create_topic(pp, &sensor_msgs_msg_dds__JointState__desc, dds_topic, NULL, NULL);
+  const dds_entity_t topic =
+      dds_create_topic(pp, &sensor_msgs_msg_dds__JointState__desc, dds_topic, NULL, NULL);
   if (topic < 0) {
     rc = fail("cannot create the topic", topic);
     goto out;
