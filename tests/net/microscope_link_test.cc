@@ -182,6 +182,76 @@ TEST(MicroscopeLink, AMasterTakesTheFirstFocusItKnowsAsTheStart) {
   EXPECT_EQ(server.stats().states, 0u) << "a slave that knows no state publishes none";
 }
 
+// A peer floods the command topic with garbage and good commands mixed: the server refuses the
+// bad ones by reason, never hands them on, keeps publishing its state, and the last good command
+// is the one that stays applied.
+TEST(MicroscopeLink, AFloodOfGarbageIsRefusedAndTheLastGoodCommandStands) {
+  const int domain = test::test_domain_id();
+  std::mutex m;
+  std::vector<MicroscopeJoints> taken;
+  MicroscopeJoints state;
+  state.has_focus = true;
+  state.objective = 0;
+  MicroscopeServer server(
+      domain, {},
+      [&](const MicroscopeJoints& j) {
+        std::lock_guard lock(m);
+        taken.push_back(j);
+      },
+      [&] { return state; });
+  Participant peer(domain);
+  const dds_entity_t topic =
+      dds_create_topic(peer.handle(), &sensor_msgs_msg_dds__JointState__desc,
+                       std::string(kMicroscopeCommandDdsName).c_str(), nullptr, nullptr);
+  ASSERT_GT(topic, 0);
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t writer = dds_create_writer(peer.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  ASSERT_GT(writer, 0);
+  ASSERT_TRUE(test::wait_until([&] {
+    dds_publication_matched_status_t st{};
+    return dds_get_publication_matched_status(writer, &st) >= 0 && st.current_count > 0;
+  }));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<std::vector<const char*>, std::vector<double>>> kinds = {
+      {{"focus_z"}, {nan}},
+      {{"focus_z"}, {1e308}},
+      {{"objective_turret"}, {2.5}},
+      {{"gripper_opening"}, {1e-3}},
+      {{}, {}},
+      {{"focus_z", "focus_z"}, {0, 0}},
+      {{"focus_z"}, {50e-6}},
+      {{"objective_turret"}, {1.0}}};
+  for (int i = 0; i < 800; ++i) {
+    Message msg(kinds[static_cast<std::size_t>(i) % kinds.size()].first,
+                kinds[static_cast<std::size_t>(i) % kinds.size()].second);
+    dds_write(writer, &msg.build());
+  }
+  Message last({"focus_z", "objective_turret"}, {123e-6, 3.0});
+  dds_write(writer, &last.build());
+  ASSERT_TRUE(test::wait_until([&] {
+    std::lock_guard lock(m);
+    return !taken.empty() && taken.back().focus_z_m == 123e-6;
+  }));
+  {
+    std::lock_guard lock(m);
+    for (const MicroscopeJoints& j : taken) {
+      EXPECT_TRUE(!j.has_focus || (std::isfinite(j.focus_z_m) && std::abs(j.focus_z_m) <= 1.0));
+      EXPECT_TRUE(j.objective == -1 || j.objective == 1 || j.objective == 3) << j.objective;
+    }
+    EXPECT_EQ(taken.back().objective, 3);
+  }
+  const MicroscopeServerStats st = server.stats();
+  std::uint64_t refused = 0;
+  for (std::uint64_t r : st.refused) refused += r;
+  EXPECT_GT(refused, 0u) << "keep-last-1 may drop some, never all of 600 bad ones";
+  const std::uint64_t states = st.states;
+  EXPECT_TRUE(test::wait_until([&] { return server.stats().states > states; })) << "it still publishes";
+}
+
 // A slave that starts after the master's last change still takes it (transient local).
 TEST(MicroscopeLink, ASlaveThatStartsLaterTakesTheLastCommand) {
   const int domain = test::test_domain_id();
