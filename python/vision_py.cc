@@ -163,7 +163,7 @@ py::dict fit_affine_py(const py::array_t<double>& stage_m, const py::array_t<dou
 
 vision::Autofocus make_autofocus(const std::string& objective, double start_um,
                                  std::optional<std::array<double, 2>> range_um,
-                                 std::optional<std::string> metric) {
+                                 std::optional<std::string> metric, bool reuse_coarse_samples) {
   if (!std::isfinite(start_um)) throw InvalidInput("start_um: must be finite");
   const vision::OpticsFigures figures =
       vision::optics_figures(vision::objective_by_name(objective), vision::SensorParams{});
@@ -174,6 +174,7 @@ vision::Autofocus make_autofocus(const std::string& objective, double start_um,
     p.range_min_m = (*range_um)[0] * 1e-6;
     p.range_max_m = (*range_um)[1] * 1e-6;
   }
+  p.reuse_coarse_samples = reuse_coarse_samples;
   return vision::Autofocus(p);  // validates: ValueError naming the field
 }
 
@@ -284,9 +285,10 @@ void bind_vision(py::module_& m) {
   py::class_<vision::Autofocus>(m, "Autofocus",
                                 "Steppable coarse-to-fine autofocus (vision/autofocus.h): set the focus to "
                                 "next_focus_um, measure the frame with sharpness(frame, roi, next_metric), "
-                                "observe() it, until done.")
+                                "observe() it, until done. reuse_coarse_samples=False when the coarse scan "
+                                "(next_is_coarse) is measured on another region than the refinement.")
       .def(py::init(&make_autofocus), "objective"_a = "10x", "start_um"_a = 0.0, "range_um"_a = py::none(),
-           "metric"_a = py::none())
+           "metric"_a = py::none(), "reuse_coarse_samples"_a = true)
       .def_property_readonly("done", &vision::Autofocus::done)
       .def_property_readonly("converged", &vision::Autofocus::converged)
       .def_property_readonly("next_focus_um",
@@ -294,6 +296,7 @@ void bind_vision(py::module_& m) {
       .def_property_readonly(
           "next_metric",
           [](const vision::Autofocus& a) { return vision::focus_metric_name(a.next_metric()); })
+      .def_property_readonly("next_is_coarse", &vision::Autofocus::next_is_coarse)
       .def_property_readonly("best_focus_um",
                              [](const vision::Autofocus& a) { return a.best_focus_m() * 1e6; })
       .def_property_readonly("frames_used", &vision::Autofocus::frames_used)

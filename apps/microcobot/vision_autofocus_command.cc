@@ -2,6 +2,7 @@
 // (vision/autofocus.h) run frame by frame on rendered frames, from a start off the truth, and
 // judged against it: a part's top or the tool's tips.
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -29,7 +30,21 @@ struct AutofocusOptions {
   std::string target = "part";
   double offset_um = 100.0;
   std::string metric;
+  int coarse_px = -1;  // -1: by the target (kToolCoarsePx for the tool, the measured region for a part)
 };
+
+// The tool's coarse scan measures a square this many pixels wide around the tips (clipped to the
+// frame): the strip sees the tips only within +-16 um at 50x (+-40 um at 20x), the wider square sees
+// their silhouette from +-60-100 um. Chosen on noise seed 1 among 0 (the strip), 192 and 384 px
+// (docs/benchmarks.md, "tool's tips").
+constexpr int kToolCoarsePx = 192;
+
+vision::PixelRoi square_in_frame(double u, double v, int side, const vision::CameraParams& cam) {
+  const int w = std::min(side, cam.sensor.width_px), h = std::min(side, cam.sensor.height_px);
+  const int x = std::clamp(static_cast<int>(std::lround(u - 0.5 * (w - 1))), 0, cam.sensor.width_px - w);
+  const int y = std::clamp(static_cast<int>(std::lround(v - 0.5 * (h - 1))), 0, cam.sensor.height_px - h);
+  return {x, y, w, h};
+}
 
 void run_autofocus(const AutofocusOptions& o) {
   const pf::PlatformConfig config = pf::scene_config(o.camera.scene);
@@ -78,6 +93,11 @@ void run_autofocus(const AutofocusOptions& o) {
   // The search may go wherever the focus drive goes (platform/camera_device.h).
   params.range_min_m = std::min(config.camera.focus_min_m, params.start_m);
   params.range_max_m = std::max(config.camera.focus_max_m, params.start_m);
+  const int coarse_px = o.coarse_px >= 0 ? o.coarse_px : (tool ? kToolCoarsePx : 0);
+  const vs::PixelRoi coarse_roi = coarse_px > 0 ? square_in_frame(renderer.u_of_x(target.x()),
+                                                                  renderer.v_of_y(target.y()), coarse_px, cam)
+                                                : roi;
+  params.reuse_coarse_samples = coarse_px == 0;
   vs::Autofocus search(params);
   vs::Frame frame;
   CsvTable rows({"frame", "focus_z_m", "sharpness"});
@@ -85,7 +105,8 @@ void run_autofocus(const AutofocusOptions& o) {
   while (!search.done()) {
     controls.focus_z_m = search.next_focus_m();
     renderer.render(scene, controls, o.camera.seed, index, frame);
-    const double measure = vs::sharpness(frame, roi, search.next_metric());
+    const double measure =
+        vs::sharpness(frame, search.next_is_coarse() ? coarse_roi : roi, search.next_metric());
     const double row[] = {static_cast<double>(index), controls.focus_z_m, measure};
     rows.add_row(row);
     search.observe(measure);
@@ -105,6 +126,7 @@ void run_autofocus(const AutofocusOptions& o) {
                       {"error_m", error_m},
                       {"dof_m", dof_m},
                       {"error_dof", error_m / dof_m},
+                      {"coarse_px", coarse_px},
                       {"seed", o.camera.seed}};
   write_result_table(o.common, "autofocus.csv", rows, j);
   emit(o.common, j,
@@ -129,6 +151,10 @@ void add_vision_autofocus(CLI::App& group) {
       ->check(mc::cli::Range(-5000.0, 5000.0));
   cmd->add_option("--metric", o->metric,
                   "Fine focus measure: normalized-variance, tenengrad, brenner (default: by the objective)");
+  cmd->add_option("--coarse-px", o->coarse_px,
+                  "The coarse scan's square region around the target [px] (0: the measured region itself; "
+                  "default: 192 for the tool, 0 for a part)")
+      ->check(CLI::Range(0, 1 << 16));
   add_output_options(*cmd, o->common);
   cmd->callback([o] { run_autofocus(*o); });
 }

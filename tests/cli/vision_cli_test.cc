@@ -77,6 +77,23 @@ TEST(VisionCli, AutofocusFindsThePartsTopFrom100UmAway) {
   }
 }
 
+// The tool's tips from 100 um out at 20x and 50x: the strip across the tips sees them only within
+// +-40 um (20x) and +-16 um (50x); the coarse scan on a wider square sees their silhouette.
+TEST(VisionCli, AutofocusFindsTheToolsTipsFrom100UmAwayAt20xAnd50x) {
+  for (const char* objective : {"20x", "50x"}) {
+    for (const char* offset : {"100", "-100"}) {
+      const auto r = run_cli({"vision", "autofocus", "--target", "tool", "--objective", objective,
+                              "--offset-um", offset, "--seed", "3", "--json"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const auto j = nlohmann::json::parse(r.out);
+      EXPECT_EQ(j["coarse_px"].get<int>(), 192);
+      EXPECT_TRUE(j["converged"].get<bool>()) << objective << " " << offset;
+      EXPECT_LE(j["frames"].get<int>(), 15) << objective << " " << offset;
+      EXPECT_LT(std::abs(j["error_dof"].get<double>()), 0.2) << objective << " " << offset;
+    }
+  }
+}
+
 TEST(VisionCli, BadInputsGetOneLineAndTheirExitCode) {
   auto r = run_cli({"vision", "track", "--objective", "7x"});
   EXPECT_EQ(r.exit_code, 2);

@@ -123,6 +123,27 @@ def test_autofocus_steps_from_python_to_the_tips_height():
     assert abs(af.best_focus_um - 450.0) < dof_um / 5
 
 
+def test_autofocus_scans_a_wide_region_and_refines_on_the_tips_strip():
+    """The coarse scan measured on a square around the tips (next_is_coarse), the refinement on
+    the strip: the search must not take a sample of one region as the other's."""
+    strip, box = (784, 537, 96, 24), (736, 453, 192, 192)
+    dof_um = microcobot.vision.camera_model("10x")["dof_m"] * 1e6
+    for start in (350.0, 550.0):
+        af = microcobot.vision.Autofocus("10x", start_um=start, range_um=(-500, 2000),
+                                         reuse_coarse_samples=False)
+        assert af.next_is_coarse
+        coarse = 0
+        while not af.done:
+            frame = microcobot.vision.render("pick-place", "10x", focus_um=af.next_focus_um, seed=4,
+                                             frame=af.frames_used)
+            coarse += af.next_is_coarse
+            af.observe(microcobot.vision.sharpness(frame, box if af.next_is_coarse else strip,
+                                                   af.next_metric))
+        assert af.converged, af.status
+        assert 2 < coarse < af.frames_used <= 15
+        assert abs(af.best_focus_um - 450.0) < dof_um / 5
+
+
 def test_fit_affine_recovers_a_known_map():
     rng = np.random.default_rng(8)
     a = np.array([[1.9e6, -0.08e6], [-0.07e6, -1.88e6]])

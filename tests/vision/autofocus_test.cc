@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -163,6 +164,56 @@ TEST(Autofocus, ASlopeOnOneSideOfTheStartDoesNotLeadItAwayFromThePeakOnTheOther)
   EXPECT_TRUE(af.converged()) << af.status();
   EXPECT_NEAR(af.best_focus_m(), z0, 1e-6) << af.frames_used() << " frames";
   EXPECT_LE(af.frames_used(), 15);
+}
+
+// A small target found on a wide region (reuse_coarse_samples false): the coarse scan measures a
+// broad curve whose peak is 6 um off the target's (the tool's silhouette, its body above the tips),
+// the refinement the target's own narrow curve. The broad peak lies on the coarse grid, so the first
+// stage centres on a coarse sample's height: the refinement measures it again rather than take the
+// broad curve's value there as the narrow one's (which the default, a single region, does).
+TEST(Autofocus, ACoarseScanOnAnotherRegionIsNeverTakenAsTheRefinementsSample) {
+  const double z0 = 20e-6, broad_peak = z0 + 6e-6;
+  const auto wide = [&](double z) {
+    const double u = (z - broad_peak) / 30e-6;
+    return 0.5 + 50.0 / (1.0 + u * u);
+  };
+  const auto narrow = [&](double z) {
+    const double u = (z - z0) / 3e-6;
+    return 0.5 + 300.0 / (1.0 + u * u);
+  };
+  for (const bool reuse : {false, true}) {
+    AutofocusParams p;
+    p.start_m = broad_peak + 80e-6;         // two coarse steps above the broad peak
+    p.fine_metric = "normalized-variance";  // the coarse scan's metric too
+    p.final_step_m = 2e-6;
+    p.reuse_coarse_samples = reuse;
+    Autofocus af(p);
+    std::vector<double> coarse_z;
+    int measured_again = 0;
+    while (!af.done()) {
+      const double z = af.next_focus_m();
+      if (af.next_is_coarse()) {
+        EXPECT_TRUE(af.observations().size() == coarse_z.size()) << "the coarse scan comes first, once";
+        coarse_z.push_back(z);
+        af.observe(wide(z));
+      } else {
+        for (const double c : coarse_z) measured_again += std::abs(c - z) < 1e-12;
+        af.observe(narrow(z));
+      }
+    }
+    const double err = af.best_focus_m() - z0;
+    std::printf(
+        "reuse %d: best %+.3f um from the target, %d frames (%zu coarse, %d heights measured again), %s\n",
+        reuse, err * 1e6, af.frames_used(), coarse_z.size(), measured_again, af.status());
+    if (reuse) {
+      EXPECT_EQ(measured_again, 0) << "one region: a coarse sample is the refinement's too";
+    } else {
+      EXPECT_GE(measured_again, 1);
+      EXPECT_TRUE(af.converged()) << af.status();
+      EXPECT_NEAR(err, 0.0, 0.1e-6) << af.frames_used() << " frames";
+      EXPECT_LE(af.frames_used(), 15);
+    }
+  }
 }
 
 void expect_invalid(const std::function<void(AutofocusParams&)>& edit, const std::string& field) {

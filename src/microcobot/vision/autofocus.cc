@@ -70,6 +70,7 @@ Autofocus::Autofocus(const AutofocusParams& params) : p_(params) {
   gaussian_ = p_.peak_model == "gaussian";
   samples_.reserve(static_cast<std::size_t>(p_.max_frames));
   sample_metrics_.reserve(static_cast<std::size_t>(p_.max_frames));
+  sample_coarse_.reserve(static_cast<std::size_t>(p_.max_frames));
   next_z_ = p_.start_m;
   best_z_ = p_.start_m;
 }
@@ -80,6 +81,10 @@ bool Autofocus::measured(double z) const {
   for (const FocusSample& s : samples_)
     if (std::abs(s.z_m - z) <= 1e-3 * p_.final_step_m) return true;
   return false;
+}
+
+bool Autofocus::refinement_sample(std::size_t i) const {
+  return sample_metrics_[i] == fine_metric_ && (p_.reuse_coarse_samples || !sample_coarse_[i]);
 }
 
 double Autofocus::y_of(double f) const {
@@ -94,6 +99,7 @@ void Autofocus::observe(double sharpness) {
                        " (expected a finite value >= 0)");
   samples_.push_back({next_z_, sharpness});
   sample_metrics_.push_back(next_metric());
+  sample_coarse_.push_back(next_is_coarse() ? 1 : 0);
   const bool budget_used = static_cast<int>(samples_.size()) >= p_.max_frames;
   if (phase_ == Phase::kCoarse) {
     if (sharpness > samples_[best_].sharpness) best_ = samples_.size() - 1;
@@ -193,7 +199,7 @@ void Autofocus::start_stage(double centre, double spacing, bool budget_used) {
     previous = z;
     const FocusSample* seen = nullptr;  // a sample of the fine metric there
     for (std::size_t i = 0; i < samples_.size(); ++i)
-      if (sample_metrics_[i] == fine_metric_ && std::abs(samples_[i].z_m - z) <= 1e-3 * p_.final_step_m)
+      if (refinement_sample(i) && std::abs(samples_[i].z_m - z) <= 1e-3 * p_.final_step_m)
         seen = &samples_[i];
     if (seen)
       stage_[n_stage_++] = *seen;  // measured already: no frame
@@ -264,7 +270,7 @@ void Autofocus::finish(const char* why) {
   // The sharpest sample of the fine metric, and its two nearest.
   const FocusSample* b = nullptr;
   for (std::size_t i = 0; i < samples_.size(); ++i)
-    if (sample_metrics_[i] == fine_metric_ && (!b || samples_[i].sharpness > b->sharpness)) b = &samples_[i];
+    if (refinement_sample(i) && (!b || samples_[i].sharpness > b->sharpness)) b = &samples_[i];
   const bool at_max = b && b->z_m >= p_.range_max_m, at_min = b && b->z_m <= p_.range_min_m;
   if (!at_max && !at_min) {
     converged_ = true;
@@ -277,7 +283,7 @@ void Autofocus::finish(const char* why) {
   const FocusSample* n2 = nullptr;
   for (std::size_t i = 0; i < samples_.size(); ++i) {
     const FocusSample& s = samples_[i];
-    if (sample_metrics_[i] != fine_metric_ || &s == b) continue;
+    if (!refinement_sample(i) || &s == b) continue;
     const double d = std::abs(s.z_m - b->z_m);
     if (!n1 || d < std::abs(n1->z_m - b->z_m)) {
       n2 = n1;

@@ -37,6 +37,7 @@
 /// Allocation: the samples' storage is reserved on construction (max_frames); observe() and
 /// next_focus_m() allocate nothing.
 
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -66,6 +67,12 @@ struct AutofocusParams {
   std::string fine_metric = "tenengrad";
   double min_contrast = kDefaultMinFocusContrast;  ///< largest / smallest measure for a peak
   std::string peak_model = "lorentzian";           ///< "lorentzian" (1/F) or "gaussian" (ln F)
+  /// The refinement may take a coarse sample of its own metric as one of its samples (a frame
+  /// saved). False when the caller measures the coarse scan on another region than the
+  /// refinement (a wide region to find a small target far out of focus, the target's own to place
+  /// it: the tool's tips, docs/model.md "Autofocus and depth from focus"): next_is_coarse() tells
+  /// the caller which.
+  bool reuse_coarse_samples = true;
 
   template <class V>
   void visit(V& v) {
@@ -80,6 +87,7 @@ struct AutofocusParams {
     v("fine_metric", fine_metric);
     v("min_contrast", min_contrast);
     v("peak_model", peak_model);
+    v("reuse_coarse_samples", reuse_coarse_samples);
   }
   /// Throws InvalidParams naming the field (NaN, negative, an empty range, the start outside it...).
   void validate() const;
@@ -111,6 +119,8 @@ class Autofocus {
   const AutofocusParams& params() const { return p_; }
   /// The focus measure the next frame is to be measured with (observe()).
   FocusMetric next_metric() const { return phase_ == Phase::kCoarse ? metric_ : fine_metric_; }
+  /// The next frame is for the coarse scan (else for the refinement).
+  bool next_is_coarse() const { return phase_ == Phase::kCoarse; }
 
   /// The search has ended (converged or not): no more frames wanted.
   bool done() const { return phase_ == Phase::kDone; }
@@ -136,6 +146,8 @@ class Autofocus {
   enum class Phase { kCoarse, kRefine, kDone };
   double clamp_z(double z) const;
   bool measured(double z) const;
+  /// Sample i counts in the refinement: of the fine metric, and not the coarse scan's unless reused.
+  bool refinement_sample(std::size_t i) const;
   double y_of(double f) const;
   void coarse_next(bool budget_used);
   void start_stage(double centre, double spacing, bool budget_used);
@@ -147,6 +159,7 @@ class Autofocus {
   bool gaussian_ = false;
   std::vector<FocusSample> samples_;
   std::vector<FocusMetric> sample_metrics_;
+  std::vector<std::uint8_t> sample_coarse_;  // taken by the coarse scan
   Phase phase_ = Phase::kCoarse;
   double next_z_ = 0.0;
   // Coarse scan: the spiral's next ring and side; the sharpest sample.
