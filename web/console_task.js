@@ -13,8 +13,10 @@ const kTaskButtons = [
   ["task-confirm", "Confirm", "task_confirm", "Let the waiting step start", (t) => t.status === "awaiting confirmation"],
   ["task-take-over", "Take over", "task_take_over", "Drive the stage yourself (deadman, joystick, click-to-go); the task waits",
    (t) => t.started && !["succeeded", "failed", "operator"].includes(t.status)],
-  ["task-hand-back", "Hand back", "task_hand_back", "The task again: this step, re-planned from where the stage is", (t) => t.status === "operator"],
-  ["task-step-done", "Step done", "task_step_done", "The task again: the next step (you did this one)", (t) => t.status === "operator"],
+  ["task-hand-back", "Hand back", "task_hand_back", "The task again: this step, re-planned from where the stage is",
+   (t) => t.status === "operator" || t.status === "assisted"],
+  ["task-step-done", "Step done", "task_step_done", "The task again: the next step (you did this one)",
+   (t) => t.status === "operator" || t.status === "assisted"],
   ["task-skip", "Skip step", "task_skip", "Leave this step for the next one, from where the stage is",
    (t) => t.started && !["succeeded", "failed"].includes(t.status)],
 ];
@@ -56,6 +58,8 @@ function taskHint(t) {
   if (t.status === "awaiting confirmation") return `“${t.step}” waits for your Confirm (or Skip).`;
   if (t.status === "awaiting look") return `“${t.step}”: the cell's camera looks at the pin; the stage holds.`;
   if (t.status === "operator") return `You drive (${t.step}): hold the deadman to move. Hand back when ready.`;
+  if (t.status === "assisted")
+    return `You drive “${t.step}”, guided to its goal: hold the deadman and move towards it; the task goes on once you are there.`;
   const truth = t.inserted === true ? " — the pin is in its bore" : t.inserted === false ? " — the pin is not in its bore" : "";
   if (t.status === "succeeded") return `Succeeded in ${t.elapsed_s.toFixed(1)} s${truth}. Restart scene for another cycle.`;
   return `Failed in “${t.step}”: ${t.failure || "no reason given"}${truth}. Restart scene for another cycle.`;
@@ -69,7 +73,7 @@ listen("/platform/status", (s) => {
   const state = $("task-state");
   state.textContent = t.status;
   state.className = "pill " + ({running: "ok", succeeded: "ok", failed: "bad", paused: "warn",
-                                "awaiting confirmation": "warn", "awaiting look": "ok", operator: "warn"}[t.status] || "");
+                                "awaiting confirmation": "warn", "awaiting look": "ok", operator: "warn", assisted: "warn"}[t.status] || "");
   const looks = t.looks > 0 ? ` · camera ${t.looks_found}/${t.looks}` : "";
   $("task-info").textContent = t.started ? `${t.elapsed_s.toFixed(1)} s · search tries ${t.search_tries}${looks}` : "";
   const key = JSON.stringify([t.step_index, t.status, t.steps]);

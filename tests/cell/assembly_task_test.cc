@@ -223,5 +223,63 @@ TEST(AssemblyTask, ALookThatFindsNothingLeavesTheNominalSlot) {
   EXPECT_LT((stage.s.tip_m.head<2>() - g.part_m).norm(), 1e-9);
 }
 
+// An assisted move (issue #29 point 5: a step done by the operator under shared control): the task
+// hands the stage to the operator's master, holds a guide at the step's goal x, y and a height stop
+// at its z, and goes on by itself once the tool has been at the goal for settle_s; the next step is
+// the robot's again, from where the stage is.
+TEST(AssemblyTask, AnAssistedMoveGuidesTheOperatorToItsGoalAndGoesOnOnceThere) {
+  AssemblyTask task({}, skip_goal());
+  task.set_autonomy(Step::kTransport, Autonomy::kAssisted);
+  IdealStage stage;
+  ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+  EXPECT_EQ(task.status(), Status::kAssisted);
+  EXPECT_FALSE(task.drives());
+  EXPECT_TRUE(task.operator_drives());
+  const Eigen::Vector3d lifted = stage.s.tip_m;
+  // The operator's master drives: the task sends no move, and holds its fixtures.
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(stage.tick(task), 0.0);
+  const control::FixtureSet& f = task.fixtures();
+  EXPECT_EQ(f.level, 1.0);
+  EXPECT_TRUE(f.guide && f.height && !f.funnel);
+  EXPECT_EQ(f.guide_xy_m, skip_goal().target_m) << "the guide on the bore";
+  EXPECT_DOUBLE_EQ(f.height_z_m, lifted.z()) << "the stop at the carrying height";
+  // Near the goal is not there: the step waits.
+  stage.s.tip_m = Eigen::Vector3d(f.guide_xy_m.x() + 3e-6, f.guide_xy_m.y(), f.height_z_m);
+  for (int i = 0; i < 200; ++i) stage.tick(task);
+  EXPECT_EQ(task.step(), Step::kTransport);
+  // At the goal (what the guide makes of an operator within its capture) for settle_s: the rotation.
+  stage.s.tip_m = Eigen::Vector3d(f.guide_xy_m.x(), f.guide_xy_m.y(), task.fixtures().height_z_m);
+  for (int i = 0; i < 49 && task.step() == Step::kTransport; ++i) stage.tick(task);
+  EXPECT_EQ(task.step(), Step::kTransport) << "held 49 ms of the 50";
+  stage.tick(task);
+  stage.tick(task);
+  EXPECT_EQ(task.step(), Step::kRotate);
+  EXPECT_EQ(task.status(), Status::kRunning);
+  EXPECT_TRUE(task.drives());
+  EXPECT_EQ(task.fixtures().level, 0.0) << "no guidance once the robot drives";
+  EXPECT_TRUE(stage.run_to(task, Step::kInsert)) << "and the robot turns the pin and inserts from there";
+}
+
+TEST(AssemblyTask, AnAssistedStepCanBeTakenOverHandedBackOrIsTheOperatorsWhenNotAMove) {
+  AssemblyTask task({}, skip_goal());
+  task.set_autonomy(Step::kApproach, Autonomy::kAssisted);
+  task.set_autonomy(Step::kAlign, Autonomy::kAssisted);  // not a move: the operator's
+  IdealStage stage;
+  stage.tick(task);
+  ASSERT_EQ(task.status(), Status::kAssisted);
+  task.take_over();
+  stage.tick(task);
+  EXPECT_EQ(task.status(), Status::kOperator);
+  EXPECT_EQ(task.fixtures().level, 0.0) << "taken over: no guidance";
+  task.hand_back(false);
+  EXPECT_EQ(task.status(), Status::kRunning) << "handed back: the robot does the approach";
+  EXPECT_TRUE(stage.run_to(task, Step::kAlign));
+  EXPECT_EQ(task.status(), Status::kOperator);
+  EXPECT_TRUE(AssemblyTask::assistable(Step::kRetract));
+  EXPECT_FALSE(AssemblyTask::assistable(Step::kInsert));
+  EXPECT_EQ(AssemblyTask::name(Status::kAssisted), "assisted");
+  EXPECT_EQ(AssemblyTask::name(Autonomy::kAssisted), "assisted");
+}
+
 }  // namespace
 }  // namespace mc::cell

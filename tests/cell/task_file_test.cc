@@ -76,6 +76,14 @@ TEST(TaskFile, RefusesUnknownStepsKeysAndLevelsWithOneLineNamingThem) {
   EXPECT_NE(m.find("steps.insert"), std::string::npos) << m;
   EXPECT_NE(m.find("sometimes"), std::string::npos) << m;
 
+  m = task_file_error([] { task_file_from_yaml("steps: {grasp: assisted}\n"); });
+  EXPECT_TRUE(one_line(m)) << m;
+  EXPECT_NE(m.find("steps.grasp"), std::string::npos) << m;
+  EXPECT_NE(m.find("assisted is for the moves"), std::string::npos) << m;
+  EXPECT_EQ(task_file_from_yaml("steps: {transport: assisted}\n")
+                .steps.autonomy()[static_cast<std::size_t>(Step::kTransport)],
+            Autonomy::kAssisted);
+
   m = task_file_error([] { task_file_from_yaml("params: {insert_speed_m_s: -1}\n"); });
   EXPECT_TRUE(one_line(m)) << m;
   EXPECT_NE(m.find("params.insert_speed_m_s"), std::string::npos) << m;

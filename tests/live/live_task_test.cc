@@ -11,6 +11,7 @@
 #include <cmath>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -54,7 +55,8 @@ struct TaskRig {
   // `paced`: the loop on the wall clock, the console's 0.2 s heartbeat timeout (the test of the
   // heartbeat's gaps); else as fast as the machine goes, with a 10 s timeout.
   // `camera`: the cell camera's looks (a LiveLooker answers them).
-  explicit TaskRig(bool paced = false, bool camera = false) {
+  // `assisted`: the step the operator does under the platform's guidance (the rest automatic).
+  explicit TaskRig(bool paced = false, bool camera = false, std::optional<Step> assisted = std::nullopt) {
     cell::AssemblyBatchParams batch;
     batch.parts = 1;
     batch.seed = 41;
@@ -68,6 +70,7 @@ struct TaskRig {
     LiveTaskParams tp;
     tp.goal = cell::assembly_goal(job);
     tp.camera.enabled = camera;
+    if (assisted) tp.autonomy[static_cast<std::size_t>(*assisted)] = cell::AssemblyTask::Autonomy::kAssisted;
     params.task = tp;
     live = std::make_unique<LivePlatform>(params);
     samples.reserve(200000);
@@ -209,6 +212,43 @@ TEST(LiveTask, PauseHoldsAtTheTickTakeOverIsBumplessAndTheHandedBackTaskInserts)
       << "no step at the hand-back nor after";
   EXPECT_FALSE(s.back().engaged) << "ended holding";
   EXPECT_LT((s.back().measured - s.back().target).norm(), 1e-6);
+}
+
+// An assisted transport (a task file's `steps: {transport: assisted}`): the operator carries the pin
+// with the console's joystick and aims 12 um off the bore (within the guide's 25 um capture); the
+// platform's guide puts the stage on the bore's axis, the task goes on by itself once it is there,
+// and the robot turns and inserts the pin. Without the guide the tool would rest 12 um off, never
+// within the step's 0.5 um, and the step would not end.
+TEST(LiveTask, AnAssistedTransportGuidesTheOperatorOntoTheBoreAndTheRobotInsertsFromThere) {
+  TaskRig rig(false, false, Step::kTransport);
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kStart));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.status == Status::kAssisted; }));
+  EXPECT_EQ(rig.task().step, Step::kTransport);
+  const Eigen::Vector2d bore = rig.params.task->goal.target_m;
+  const Eigen::Vector2d aim = bore + Eigen::Vector2d(8e-6, -9e-6);  // 12 um off, by eye
+  // The person: deadman held, the joystick towards the aim at up to 300 um/s, let go within 1 um.
+  const auto done = [&] { return rig.task().step != Step::kTransport || rig.task().ended; };
+  for (int i = 0; i < 3000 && !done(); ++i) {
+    const Eigen::Vector3d at = rig.copy().back().target;
+    const Eigen::Vector2d e = aim - at.head<2>();
+    ConsoleCommand c;
+    c.deadman = true;
+    if (e.norm() > 1e-6) {
+      const Eigen::Vector2d v = e.normalized() * std::min(300e-6, 4.0 * e.norm() / 0.05);
+      c.velocity_m_s = {v.x(), v.y(), 0.0};
+    }
+    rig.set_command(c);
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_EQ(rig.task().step, Step::kRotate) << rig.task().status_name();
+  std::vector<TaskSample> s = rig.copy();
+  EXPECT_LT((s.back().measured.head<2>() - bore).norm(), 1e-6) << "on the bore's axis, not at the aim";
+  ConsoleCommand idle;
+  rig.set_command(idle);  // the person lets go: the robot drives
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 120s));
+  const LiveTaskStatus end = rig.task();
+  EXPECT_EQ(end.status, Status::kSucceeded) << end.failure;
+  EXPECT_EQ(end.inserted, 1) << "the pin is in its bore (the simulation's truth)";
 }
 
 // With the cell's camera (`serve --cell --cell-camera`): the task holds while the looker thread

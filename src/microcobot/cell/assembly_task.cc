@@ -97,6 +97,8 @@ std::string_view AssemblyTask::name(Status s) noexcept {
       return "succeeded";
     case Status::kFailed:
       return "failed";
+    case Status::kAssisted:
+      return "assisted";
   }
   return "?";
 }
@@ -123,8 +125,15 @@ std::string_view AssemblyTask::name(Autonomy a) noexcept {
       return "confirm";
     case Autonomy::kManual:
       return "manual";
+    case Autonomy::kAssisted:
+      return "assisted";
   }
   return "?";
+}
+
+bool AssemblyTask::assistable(Step s) noexcept {
+  return s == Step::kApproach || s == Step::kDescend || s == Step::kLift || s == Step::kTransport ||
+         s == Step::kRetract;
 }
 
 void AssemblyTask::enter(Step s) noexcept {
@@ -155,6 +164,9 @@ void AssemblyTask::begin_step() noexcept {
       break;
     case Autonomy::kManual:
       status_ = Status::kOperator;
+      break;
+    case Autonomy::kAssisted:
+      status_ = assistable(step_) ? Status::kAssisted : Status::kOperator;
       break;
   }
 }
@@ -190,7 +202,9 @@ void AssemblyTask::see(const Sighting& sighting) noexcept {
     case Look::kNone:
       break;
   }
-  status_ = Status::kRunning;
+  // Back to the step as its level has it (an assisted approach looks at the slot first).
+  status_ = autonomy_[index(step_)] == Autonomy::kAssisted && assistable(step_) ? Status::kAssisted
+                                                                                : Status::kRunning;
 }
 
 void AssemblyTask::pause() noexcept {
@@ -210,7 +224,7 @@ void AssemblyTask::take_over() noexcept {
 }
 
 void AssemblyTask::hand_back(bool step_done) noexcept {
-  if (status_ != Status::kOperator) return;
+  if (!operator_drives()) return;
   if (step_done) {
     enter(static_cast<Step>(index(step_) + 1));
   } else {
@@ -231,7 +245,7 @@ void AssemblyTask::set_autonomy(Step step, Autonomy a) noexcept {
   if (step == Step::kDone) return;
   autonomy_[index(step)] = a;
   const bool fresh = step_s_ == 0.0 && (status_ == Status::kRunning || status_ == Status::kAwaitingConfirm ||
-                                        status_ == Status::kOperator);
+                                        operator_drives());
   if (step == step_ && fresh) begin_step();
 }
 
@@ -267,6 +281,39 @@ double AssemblyTask::rotate_yaw(double from) const noexcept {
   return square_yaw_goal(goal_.target_yaw_rad, from, goal_.yaw_min_rad, goal_.yaw_max_rad);
 }
 
+Eigen::Vector3d AssemblyTask::move_goal(Step s, const Eigen::Vector3d& tip) const noexcept {
+  switch (s) {
+    case Step::kApproach:
+      return {goal_.part_m.x(), goal_.part_m.y(), safe_z_};
+    case Step::kDescend:
+      return {goal_.part_m.x(), goal_.part_m.y(), grasp_z_};
+    case Step::kLift:
+      return {goal_.part_m.x(), goal_.part_m.y(), carry_z_};
+    case Step::kTransport:
+      return {goal_.target_m.x(), goal_.target_m.y(), carry_z_};
+    case Step::kRetract:
+      return {search_xy().x(), search_xy().y(), safe_z_};
+    default:
+      return tip;
+  }
+}
+
+void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
+  // The operator's master drives (the deadman is theirs); the task holds the fixtures on the goal
+  // and watches. No step timeout: the person sets the pace.
+  const Eigen::Vector3d goal = move_goal(step_, s.tip_m);
+  fixtures_.level = 1.0;
+  fixtures_.guide = true;
+  fixtures_.guide_xy_m = goal.head<2>();
+  fixtures_.height = true;
+  fixtures_.height_z_m = goal.z();
+  step_s_ += dt;
+  settled_s_ = (s.tip_m - goal).norm() <= p_.position_tolerance_m ? settled_s_ + dt : 0.0;
+  if (settled_s_ < p_.settle_s) return;
+  fixtures_ = {};
+  enter(static_cast<Step>(index(step_) + 1));
+}
+
 Eigen::Vector2d AssemblyTask::search_xy() const noexcept {
   return goal_.target_m + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
 }
@@ -282,6 +329,16 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
   out_.theta_rate_rad_s = 0.0;
   out_.velocity_m_s.setZero();
   out_.gripper_opening_m = opening_command_;
+  fixtures_ = {};
+  if (status_ == Status::kAssisted) {
+    if (looks_ && step_ == Step::kApproach && !slot_seen_) {  // the slot seen before the guide is set
+      look_ = Look::kSlot;
+      status_ = Status::kAwaitingLook;
+      return out_;
+    }
+    assisted_tick(s, dt_s);
+    return out_;
+  }
   if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
   // The camera's looks before the approach and the insertion (verify's is its own): holding.
   if (looks_ && ((step_ == Step::kApproach && !slot_seen_) ||

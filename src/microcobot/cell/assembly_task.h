@@ -53,7 +53,12 @@
 /// awaiting confirmation (a step whose autonomy is kConfirm waits before it starts, holding);
 /// operator (take_over(), or a step whose autonomy is kManual: the task sends nothing and the
 /// operator's master drives; hand_back() resumes the current step, re-planned from where the
-/// stage is, or the next one when the operator says the step is done); succeeded; failed (a step's
+/// stage is, or the next one when the operator says the step is done); assisted (a move whose
+/// autonomy is kAssisted: the operator drives it under shared control, fixtures() guiding the
+/// tool to the step's goal, a guide at its x, y and a height stop at its z
+/// (control/virtual_fixtures.h), and the task goes on by itself once the tool has been within
+/// position_tolerance_m of the goal for settle_s; hand_back() and skip() as for the operator);
+/// succeeded; failed (a step's
 /// timeout, a jam beyond the search). skip() leaves the current step for the next one, from where
 /// the stage is (the operator judged it done or needless: e.g. a pin already in the fingers).
 /// Every goal is a move from the coupling's current target at a bounded speed, so resuming,
@@ -162,7 +167,16 @@ class AssemblyTask {
     kDone
   };
   static constexpr int kStepCount = 12;
-  enum class Status { kRunning, kPaused, kAwaitingConfirm, kAwaitingLook, kOperator, kSucceeded, kFailed };
+  enum class Status {
+    kRunning,
+    kPaused,
+    kAwaitingConfirm,
+    kAwaitingLook,
+    kOperator,
+    kSucceeded,
+    kFailed,
+    kAssisted
+  };
   enum class Look { kNone, kSlot, kHeld, kPlaced };
   /// What a look saw (world frame): the pin's centre and yaw, or nothing.
   struct Sighting {
@@ -170,15 +184,26 @@ class AssemblyTask {
     Eigen::Vector3d part_m = Eigen::Vector3d::Zero();
     double yaw_rad = 0.0;
   };
-  enum class Autonomy { kAuto, kConfirm, kManual };
+  /// kAssisted: the moves only (assistable()); another step given it is the operator's (kManual).
+  enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
+  /// The steps that may be assisted: the moves to a position (approach, descend, lift, transport,
+  /// retract), whose goal a guide and a height stop can hold.
+  static bool assistable(Step s) noexcept;
 
   /// Throws mc::InvalidParams (parameters, goal).
   AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal);
 
   /// One tick of `dt_s`: the console input to hand the platform (drives() says whether to).
   const control::ConsoleInput& tick(const TaskSensors& s, double dt_s) noexcept;
-  /// False while the operator drives (taken over, a manual step) and once finished.
-  bool drives() const noexcept { return status_ != Status::kOperator && !finished(); }
+  /// False while the operator drives (taken over, a manual or assisted step) and once finished.
+  bool drives() const noexcept { return !operator_drives() && !finished(); }
+  /// The operator's master drives the stage (taken over, a manual or an assisted step).
+  bool operator_drives() const noexcept {
+    return status_ == Status::kOperator || status_ == Status::kAssisted;
+  }
+  /// The shared control the current step wants on the coupling (world frame; level 0: none):
+  /// while assisted, a guide at the step's goal x, y and a height stop at its z, at level 1.
+  const control::FixtureSet& fixtures() const noexcept { return fixtures_; }
   bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
 
   /// The cell has a camera: the task asks for its looks (header). Before the first tick.
@@ -224,6 +249,10 @@ class AssemblyTask {
   void enter(Step s) noexcept;
   void begin_step() noexcept;
   void fail(const char* why) noexcept;
+  /// The goal of a move step (assistable()) from the tip at `tip`.
+  Eigen::Vector3d move_goal(Step s, const Eigen::Vector3d& tip) const noexcept;
+  /// An assisted step's tick: its fixtures; the next step once the goal has been held.
+  void assisted_tick(const TaskSensors& s, double dt) noexcept;
   /// Heads for `goal` at `speed`; true once the tip has been within tolerance for settle_s.
   bool move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s, double dt) noexcept;
   /// Turns the fingers towards `yaw` (the rotary axis' goal from this tick on).
@@ -239,6 +268,7 @@ class AssemblyTask {
   AssemblyGoal goal_;
   std::array<Autonomy, kStepCount> autonomy_{};
   control::ConsoleInput out_;
+  control::FixtureSet fixtures_;
   Step step_ = Step::kApproach;
   Status status_ = Status::kRunning;
   const char* failure_ = "";

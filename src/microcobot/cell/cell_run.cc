@@ -29,9 +29,11 @@ void CellRunParams::validate() const {
   require(std::isfinite(confirm_delay_s) && confirm_delay_s >= 0.0 && confirm_delay_s <= 60.0,
           "confirm_delay_s", "must be within [0, 60] s", confirm_delay_s);
   for (std::size_t i = 0; i < autonomy.size(); ++i)
-    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kManual,
+    require(mode != "auto" || (autonomy[i] != AssemblyTask::Autonomy::kManual &&
+                               autonomy[i] != AssemblyTask::Autonomy::kAssisted),
             "steps." + std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i))),
-            "is manual: a headless run has no operator to do it (serve --cell runs it with one)");
+            "is " + std::string(AssemblyTask::name(autonomy[i])) +
+                ": a headless run has no operator to do it (serve --cell runs it with one)");
   manual.validate();
   camera.validate();
   require(!camera.enabled || mode == "auto", "camera.enabled", "is the robot's (mode auto)");
@@ -127,7 +129,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       // Taken over, the operator's master drives: the console lets go.
       meter_->time_step(task_->step(), t.dt_s);
       control::ConsoleInput in = task_->tick(s, t.dt_s);
-      if (task_->status() == AssemblyTask::Status::kOperator) in.active = false;
+      if (task_->operator_drives()) in.active = false;
       platform_->set_console_input(in);
       // A look wanted: the loop stops at the end of this tick, the camera looks between runs.
       if (camera_ && !look_requested_ && task_->look_wanted() != AssemblyTask::Look::kNone) {

@@ -11,11 +11,16 @@ namespace {
 
 using Autonomy = AssemblyTask::Autonomy;
 
-Autonomy autonomy_of(const std::string& level, const char* step) {
-  for (Autonomy a : {Autonomy::kAuto, Autonomy::kConfirm, Autonomy::kManual})
-    if (AssemblyTask::name(a) == level) return a;
+Autonomy autonomy_of(const std::string& level, const char* step, AssemblyTask::Step s) {
+  for (Autonomy a : {Autonomy::kAuto, Autonomy::kConfirm, Autonomy::kManual, Autonomy::kAssisted})
+    if (AssemblyTask::name(a) == level) {
+      if (a == Autonomy::kAssisted && !AssemblyTask::assistable(s))
+        throw InvalidParams(std::string("steps.") + step,
+                            "assisted is for the moves (approach, descend, lift, transport, retract)");
+      return a;
+    }
   throw InvalidParams(std::string("steps.") + step,
-                      "must be auto, confirm or manual, not '" + excerpt(level) + "'");
+                      "must be auto, confirm, manual or assisted, not '" + excerpt(level) + "'");
 }
 
 // Each step's level, at its index in AssemblyTask::Step (found by its name).
@@ -24,7 +29,7 @@ struct StepIndexer {
   void operator()(const char* key, const std::string& level) {
     for (int i = 0; i < AssemblyTask::kStepCount; ++i)
       if (AssemblyTask::name(static_cast<AssemblyTask::Step>(i)) == key)
-        (*out)[static_cast<std::size_t>(i)] = autonomy_of(level, key);
+        (*out)[static_cast<std::size_t>(i)] = autonomy_of(level, key, static_cast<AssemblyTask::Step>(i));
   }
 };
 

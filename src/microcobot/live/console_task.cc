@@ -39,7 +39,9 @@ std::string task_action_refusal(ConsoleAction a, const std::optional<LiveTaskSta
       return s.status == Status::kAwaitingConfirm ? "" : "task: confirm: no step awaits confirmation";
     case ConsoleAction::kTaskHandBack:
     case ConsoleAction::kTaskStepDone:
-      return s.status == Status::kOperator ? "" : "task: hand back: the operator does not drive it";
+      return s.status == Status::kOperator || s.status == Status::kAssisted
+                 ? ""
+                 : "task: hand back: the operator does not drive it";
     default:
       return "";  // take over, skip: at any step
   }

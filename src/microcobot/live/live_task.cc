@@ -156,11 +156,18 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
       ++look_seq_;
     }
     elapsed_s_ += dt_s;
-    const bool operator_drives = task.status() == Status::kOperator;
+    const bool operator_drives = task.operator_drives();
+    // An assisted step's shared control on the coupling (installed on a change only: a set
+    // installed again would slew its level from 0 again).
+    if (!(task.fixtures() == fixtures_)) {
+      fixtures_ = task.fixtures();
+      p.set_fixtures(fixtures_);
+    }
     if (operator_drives && !operator_had_stage_) console_takes_the_stage();
     operator_had_stage_ = operator_drives;
     if (!operator_drives) in = out;  // the task drives, or holds (no deadman)
     if (task.finished()) {
+      if (!(fixtures_ == control::FixtureSet{})) p.set_fixtures(fixtures_ = {});
       p.hold();  // the sequence ends with every axis holding ...
       ended_ = true;
       console_takes_the_stage();  // ... and the console in control again

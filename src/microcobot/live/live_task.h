@@ -155,6 +155,7 @@ class LiveTask {
   std::atomic<int> looks_pub_{0}, looks_found_pub_{0};
   // Loop thread only.
   bool started_ = false, ended_ = false, operator_had_stage_ = false;
+  control::FixtureSet fixtures_;  // the task's shared control in force on the coupling
   bool rearm_deadman_ = false, pickup_gripper_ = false;
   bool gap_paused_ = false;  // paused for a heartbeat gap: resumes by itself when it ends soon
   double gap_s_ = 0.0;
