@@ -65,7 +65,7 @@ function taskHint(t) {
   return `Failed in “${t.step}”: ${t.failure || "no reason given"}${truth}. Restart scene for another cycle.`;
 }
 
-let lastTaskKey = "", lastTaskEnded = null;
+let lastTaskKey = "", lastTaskEnded = null, lastOperatorDrives = false;
 listen("/platform/status", (s) => {
   const t = s.task && typeof s.task === "object" ? s.task : null;
   $("task-group").hidden = !t;
@@ -96,6 +96,11 @@ listen("/platform/status", (s) => {
   const ended = ["succeeded", "failed"].includes(t.status);
   if (ended && lastTaskEnded === false) handOverToTheConsole();  // the console has the stage again
   lastTaskEnded = ended;
+  // The robot drives again (an assisted step reached, a hand-back): the operator's pending
+  // click-to-go was for their step; kept, it would pull the stage back there at the next take-over.
+  const operatorDrives = ["operator", "assisted"].includes(t.status);
+  if (lastOperatorDrives && !operatorDrives) mc.input.goal = null;
+  lastOperatorDrives = operatorDrives;
   $("task-hint").textContent = taskHint(t);
   for (const [id, , name, , enabled] of kTaskButtons) {
     // Pausing needs no control (it only stops); the rest does.
