@@ -276,9 +276,79 @@ TEST(AssemblyTask, AnAssistedStepCanBeTakenOverHandedBackOrIsTheOperatorsWhenNot
   EXPECT_TRUE(stage.run_to(task, Step::kAlign));
   EXPECT_EQ(task.status(), Status::kOperator);
   EXPECT_TRUE(AssemblyTask::assistable(Step::kRetract));
-  EXPECT_FALSE(AssemblyTask::assistable(Step::kInsert));
+  EXPECT_TRUE(AssemblyTask::assistable(Step::kInsert));
+  EXPECT_FALSE(AssemblyTask::assistable(Step::kRotate));
+  EXPECT_FALSE(AssemblyTask::assistable(Step::kVerify));
   EXPECT_EQ(AssemblyTask::name(Status::kAssisted), "assisted");
   EXPECT_EQ(AssemblyTask::name(Autonomy::kAssisted), "assisted");
+}
+
+// An assisted grasp: the operator closes the fingers (the console's slider), the guide and the
+// stop hold the tool over the pin; once the grip holds, the robot lifts with the operator's
+// gripper command, never its own open one (a hand-back that opened the fingers would drop the pin).
+TEST(AssemblyTask, AfterAnAssistedGraspTheRobotLiftsWithTheOperatorsGripNotItsOwnOpening) {
+  AssemblyTask task({}, skip_goal());
+  task.set_autonomy(Step::kGrasp, Autonomy::kAssisted);
+  IdealStage stage;
+  ASSERT_TRUE(stage.run_to(task, Step::kGrasp));
+  ASSERT_EQ(task.status(), Status::kAssisted);
+  const Eigen::Vector3d at = stage.s.tip_m;
+  stage.tick(task);  // the step's first tick sets its fixtures
+  EXPECT_EQ(task.fixtures().guide_xy_m, skip_goal().part_m);
+  EXPECT_TRUE(task.fixtures().height);
+  EXPECT_DOUBLE_EQ(task.fixtures().height_z_m, at.z()) << "the grasp height the descent reached";
+  // The operator's slider from wide open to 150 um at 1 mm/s.
+  stage.s.gripper_command_m = 600e-6;
+  for (int i = 0; i < 1000 && task.step() == Step::kGrasp; ++i) {
+    stage.s.gripper_command_m = std::max(150e-6, stage.s.gripper_command_m - 1e-6);
+    stage.tick(task);
+  }
+  ASSERT_EQ(task.step(), Step::kLift);
+  EXPECT_EQ(task.status(), Status::kRunning);
+  stage.s.gripper_command_m = std::numeric_limits<double>::quiet_NaN();  // the robot's command again
+  for (int i = 0; i < 3000 && task.step() != Step::kTransport; ++i) {
+    stage.tick(task);
+    ASSERT_GT(stage.s.grip_N, 0.0) << "the fingers opened at " << i << " ms of the lift";
+  }
+  EXPECT_EQ(task.step(), Step::kTransport);
+  EXPECT_GT(stage.s.tip_m.z(), at.z() + 100e-6) << "lifted";
+}
+
+// An assisted insertion: the guide on the bore's axis and the funnel round its rim; judged at the
+// first contact: half down in the bore, the release; on the rim, the robot's search takes over.
+TEST(AssemblyTask, AnAssistedInsertionHoldsTheFunnelAndIsJudgedAtItsFirstContact) {
+  for (const bool on_rim : {false, true}) {
+    AssemblyTask task({}, skip_goal());
+    task.set_autonomy(Step::kInsert, Autonomy::kAssisted);
+    IdealStage stage;
+    ASSERT_TRUE(stage.run_to(task, Step::kLift));
+    const double rim_z = stage.s.tip_m.z();  // where the grasp held the pin standing on the surface
+    ASSERT_TRUE(stage.run_to(task, Step::kInsert));
+    ASSERT_EQ(task.status(), Status::kAssisted);
+    stage.tick(task);
+    const control::FixtureSet& f = task.fixtures();
+    EXPECT_TRUE(f.guide && f.funnel && !f.height);
+    EXPECT_EQ(f.guide_xy_m, skip_goal().target_m);
+    EXPECT_DOUBLE_EQ(f.rim_z_m, rim_z);
+    EXPECT_DOUBLE_EQ(f.funnel_radius_m, 0.5 * skip_goal().clearance_m);
+    for (int i = 0; i < 100; ++i) stage.tick(task);
+    EXPECT_EQ(task.step(), Step::kInsert) << "no contact yet";
+    stage.s.contact_N = {0.0, 0.0, 0.2e-3};
+    stage.s.tip_m.z() = on_rim ? rim_z : rim_z - 0.9 * skip_goal().hole_depth_m;
+    stage.tick(task);
+    EXPECT_DOUBLE_EQ(task.insert_contact_z_m(), stage.s.tip_m.z());
+    if (on_rim) {
+      EXPECT_EQ(task.step(), Step::kInsert);
+      EXPECT_EQ(task.status(), Status::kRunning) << "the robot's search from the rim";
+      EXPECT_EQ(task.search_tries(), 1);
+      EXPECT_EQ(task.fixtures().level, 0.0);
+      stage.s.contact_N.setZero();
+      EXPECT_GT(stage.tick(task), 0.0) << "up from the rim, driven by the robot";
+    } else {
+      EXPECT_EQ(task.step(), Step::kRelease) << "at the first contact";
+      EXPECT_EQ(task.search_tries(), 0);
+    }
+  }
 }
 
 }  // namespace

@@ -76,10 +76,10 @@ TEST(TaskFile, RefusesUnknownStepsKeysAndLevelsWithOneLineNamingThem) {
   EXPECT_NE(m.find("steps.insert"), std::string::npos) << m;
   EXPECT_NE(m.find("sometimes"), std::string::npos) << m;
 
-  m = task_file_error([] { task_file_from_yaml("steps: {grasp: assisted}\n"); });
+  m = task_file_error([] { task_file_from_yaml("steps: {align: assisted}\n"); });
   EXPECT_TRUE(one_line(m)) << m;
-  EXPECT_NE(m.find("steps.grasp"), std::string::npos) << m;
-  EXPECT_NE(m.find("assisted is for the moves"), std::string::npos) << m;
+  EXPECT_NE(m.find("steps.align"), std::string::npos) << m;
+  EXPECT_NE(m.find("assisted is for approach"), std::string::npos) << m;
   EXPECT_EQ(task_file_from_yaml("steps: {transport: assisted}\n")
                 .steps.autonomy()[static_cast<std::size_t>(Step::kTransport)],
             Autonomy::kAssisted);

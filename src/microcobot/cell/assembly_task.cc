@@ -61,6 +61,7 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   require(goal.yaw_min_rad < goal.yaw_max_rad, "goal.yaw_min_rad", "must be below goal.yaw_max_rad",
           goal.yaw_min_rad);
   grasp_z_ = goal.hole_depth_m + p_.grip_above_m;
+  rim_z_ = grasp_z_;
   require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
           p_.grip_above_m);
   safe_z_ = goal.part_height_m + p_.clearance_height_m;
@@ -132,8 +133,8 @@ std::string_view AssemblyTask::name(Autonomy a) noexcept {
 }
 
 bool AssemblyTask::assistable(Step s) noexcept {
-  return s == Step::kApproach || s == Step::kDescend || s == Step::kLift || s == Step::kTransport ||
-         s == Step::kRetract;
+  return s == Step::kApproach || s == Step::kDescend || s == Step::kGrasp || s == Step::kLift ||
+         s == Step::kTransport || s == Step::kInsert || s == Step::kRelease || s == Step::kRetract;
 }
 
 void AssemblyTask::enter(Step s) noexcept {
@@ -299,17 +300,57 @@ Eigen::Vector3d AssemblyTask::move_goal(Step s, const Eigen::Vector3d& tip) cons
 }
 
 void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
-  // The operator's master drives (the deadman is theirs); the task holds the fixtures on the goal
-  // and watches. No step timeout: the person sets the pace.
-  const Eigen::Vector3d goal = move_goal(step_, s.tip_m);
+  // The operator's master drives (the deadman and the gripper are theirs); the task holds the
+  // fixtures on the step's goal and watches. No step timeout: the person sets the pace.
   fixtures_.level = 1.0;
   fixtures_.guide = true;
-  fixtures_.guide_xy_m = goal.head<2>();
-  fixtures_.height = true;
-  fixtures_.height_z_m = goal.z();
+  bool there = false;
+  switch (step_) {
+    case Step::kGrasp:  // held over the pin at the grasp height while the operator closes
+      fixtures_.guide_xy_m = goal_.part_m;
+      fixtures_.height = true;
+      fixtures_.height_z_m = grasp_z_;
+      there = s.grip_N >= p_.grip_force_N;
+      break;
+    case Step::kInsert:  // down the funnel, on the bore's axis; the platform's limits on the force
+      fixtures_.guide_xy_m = search_xy();
+      fixtures_.funnel = true;
+      fixtures_.rim_z_m = rim_z_;
+      fixtures_.funnel_radius_m = 0.5 * goal_.clearance_m;
+      // Judged at the first contact, as the robot's descent is (a pin pressed on goes on sliding
+      // in the fingers, so a later contact says nothing of its depth): down in the bore, the
+      // release; on the rim, the robot's search takes the insertion over from here.
+      if (s.contact_N.z() > p_.contact_threshold_N) {
+        contact_z_ = s.tip_m.z();
+        fixtures_ = {};
+        if (contact_z_ < rim_z_ - 0.5 * goal_.hole_depth_m) {
+          enter(Step::kRelease);
+        } else {
+          ++tries_;
+          insert_ = Insert::kRetreat;
+          retreat_z_ = std::numeric_limits<double>::quiet_NaN();
+          status_ = Status::kRunning;
+        }
+        return;
+      }
+      break;
+    case Step::kRelease:  // on the axis while the operator opens
+      fixtures_.guide_xy_m = search_xy();
+      there = s.opening_m >= 0.9 * goal_.open_m;
+      break;
+    default: {
+      const Eigen::Vector3d goal = move_goal(step_, s.tip_m);
+      fixtures_.guide_xy_m = goal.head<2>();
+      fixtures_.height = true;
+      fixtures_.height_z_m = goal.z();
+      there = (s.tip_m - goal).norm() <= p_.position_tolerance_m;
+      break;
+    }
+  }
   step_s_ += dt;
-  settled_s_ = (s.tip_m - goal).norm() <= p_.position_tolerance_m ? settled_s_ + dt : 0.0;
+  settled_s_ = there ? settled_s_ + dt : 0.0;
   if (settled_s_ < p_.settle_s) return;
+  if (step_ == Step::kGrasp) rim_z_ = s.tip_m.z();
   fixtures_ = {};
   enter(static_cast<Step>(index(step_) + 1));
 }
@@ -328,6 +369,9 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
   out_.theta_goal_rad = std::isfinite(yaw_goal_) ? yaw_goal_ : 0.0;
   out_.theta_rate_rad_s = 0.0;
   out_.velocity_m_s.setZero();
+  // While the operator drives, the gripper is theirs: the task follows its command, to take the
+  // stage back without opening or closing the fingers.
+  if (operator_drives() && std::isfinite(s.gripper_command_m)) opening_command_ = s.gripper_command_m;
   out_.gripper_opening_m = opening_command_;
   fixtures_ = {};
   if (status_ == Status::kAssisted) {
@@ -385,6 +429,7 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
         opening_command_ = std::max(0.0, opening_command_ - p_.close_rate_m_s * dt_s);
         if (opening_command_ <= 0.0 && s.grip_N <= 0.0) fail("the fingers closed on nothing");
       } else if (settled_s_ >= p_.settle_s) {
+        rim_z_ = s.tip_m.z();  // the pin stood on the surface: its bottom this far below the tips
         enter(Step::kLift);
       }
       out_.gripper_opening_m = opening_command_;

@@ -145,6 +145,10 @@ struct TaskSensors {
   Eigen::Vector3d contact_N = Eigen::Vector3d::Zero();  ///< force on the gripper
   double grip_N = 0.0;
   double opening_m = 0.0;
+  /// The gripper opening the coupling commands now (the operator's, while they drive); not finite:
+  /// unknown. The task takes it over when it drives again, so that a hand-back never opens or
+  /// closes the fingers by itself (a pin grasped by the operator stays grasped).
+  double gripper_command_m = std::numeric_limits<double>::quiet_NaN();
   /// The part's centre as the cell's vision sees it; not finite: no vision (the verify step then
   /// takes the insertion's contact as its evidence).
   Eigen::Vector3d part_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -187,7 +191,12 @@ class AssemblyTask {
   /// kAssisted: the moves only (assistable()); another step given it is the operator's (kManual).
   enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
   /// The steps that may be assisted: the moves to a position (approach, descend, lift, transport,
-  /// retract), whose goal a guide and a height stop can hold.
+  /// retract: a guide at the goal's x, y and a height stop at its z; done once the tool is there),
+  /// the grasp (the guide and stop hold the tool over the pin while the operator closes; done once
+  /// the grip reaches grip_force_N), the insertion (the guide on the bore's axis and the funnel round
+  /// its rim; judged at the first contact above contact_threshold_N: the pin half down in the
+  /// bore, the release; on the rim, the robot's search goes on from there, status running) and the release
+  /// (the guide holds; done once the fingers are open).
   static bool assistable(Step s) noexcept;
 
   /// Throws mc::InvalidParams (parameters, goal).
@@ -276,8 +285,9 @@ class AssemblyTask {
   double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
   double opening_command_ = 0.0;
   Insert insert_ = Insert::kDescend;
-  int tries_ = 0;                                                // search points tried
-  double offset_y_ = 0.0;                                        // the current search point
+  double rim_z_ = 0.0;     // tool-point height at which the held pin's bottom meets the surface
+  int tries_ = 0;          // search points tried
+  double offset_y_ = 0.0;  // the current search point
   double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();   // the rotary axis' (NaN: none yet)
   double last_yaw_ = 0.0;                                        // the fingers' yaw at the last tick
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();           // ... and the tip's position

@@ -15,8 +15,9 @@ Autonomy autonomy_of(const std::string& level, const char* step, AssemblyTask::S
   for (Autonomy a : {Autonomy::kAuto, Autonomy::kConfirm, Autonomy::kManual, Autonomy::kAssisted})
     if (AssemblyTask::name(a) == level) {
       if (a == Autonomy::kAssisted && !AssemblyTask::assistable(s))
-        throw InvalidParams(std::string("steps.") + step,
-                            "assisted is for the moves (approach, descend, lift, transport, retract)");
+        throw InvalidParams(
+            std::string("steps.") + step,
+            "assisted is for approach, descend, grasp, lift, transport, insert, release and retract");
       return a;
     }
   throw InvalidParams(std::string("steps.") + step,

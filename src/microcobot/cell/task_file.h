@@ -2,9 +2,9 @@
 /// @file
 /// A task in YAML (issue #29 point 5, "tasks in YAML"): the automatic insertion's autonomy per
 /// step (FlexBE-like levels: `auto` runs it, `confirm` waits for the operator's go before it
-/// starts, `manual` hands it to the operator, `assisted` hands a move to the operator under the
-/// platform's guidance to its goal and goes on once it is reached) and overrides of its parameters
-/// (AssemblyTaskParams), e.g.
+/// starts, `manual` hands it to the operator, `assisted` hands it to the operator under the
+/// platform's guidance (AssemblyTask::assistable()) and goes on once its goal is reached) and overrides of
+/// its parameters (AssemblyTaskParams), e.g.
 ///
 ///     steps: {insert: confirm, release: confirm}
 ///     params: {insert_speed_m_s: 1e-5}
@@ -13,7 +13,7 @@
 /// keys (a misspelt step or parameter) and levels other than the four are refused with one line
 /// naming them (mc::InvalidInput "file:line: unknown key 'steps.inserting' (known: ...)",
 /// mc::InvalidParams "steps.insert: must be auto, confirm, manual or assisted"; "steps.grasp:
-/// assisted is for the moves ...").
+/// assisted is for approach, ...").
 
 #include <array>
 #include <filesystem>

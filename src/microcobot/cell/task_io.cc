@@ -9,6 +9,7 @@ TaskSensors read_task_sensors(const platform::Platform& p, const Eigen::Vector3d
   s.contact_N = {f.x, f.y, f.z};
   s.grip_N = p.gripper().grip_force_N();
   s.opening_m = p.gripper().opening_m();
+  s.gripper_command_m = p.teleop().gripper_opening_m;
   s.yaw_rad = p.yaw_rad();
   return s;
 }
