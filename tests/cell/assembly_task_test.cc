@@ -242,6 +242,8 @@ TEST(AssemblyTask, AnAssistedMoveGuidesTheOperatorToItsGoalAndGoesOnOnceThere) {
   EXPECT_EQ(f.level, 1.0);
   EXPECT_TRUE(f.guide && f.height && !f.funnel);
   EXPECT_EQ(f.guide_xy_m, skip_goal().target_m) << "the guide on the bore";
+  EXPECT_TRUE(f.path);
+  EXPECT_EQ(f.path_from_xy_m, lifted.head<2>()) << "along the path from where the transport began";
   EXPECT_DOUBLE_EQ(f.height_z_m, lifted.z()) << "the stop at the carrying height";
   // Near the goal is not there: the step waits.
   stage.s.tip_m = Eigen::Vector3d(f.guide_xy_m.x() + 3e-6, f.guide_xy_m.y(), f.height_z_m);

@@ -66,6 +66,62 @@ TEST(VirtualFixtures, GuidanceHoldsTheAxisWithinTheCaptureRadiusAndFadesWithoutA
   }
 }
 
+FixtureSet path_to(const Eigen::Vector2d& from, const Eigen::Vector2d& to, double level) {
+  FixtureSet f = axis_at(to.x(), to.y(), level);
+  f.path = true;
+  f.path_from_xy_m = from;
+  return f;
+}
+
+// Guidance along a path (issue #29 point 4, "along a path"): within R of the segment the slave
+// sits on it at the hand's place along it (motion along is free, across is taken out); beyond its
+// end the end is the point guide; beyond 2R the hand's; no jump as the target crosses the field.
+TEST(VirtualFixtures, AlongAPathMotionAlongIsFreeAndMotionAcrossIsTakenOut) {
+  const Eigen::Vector2d a(0.0, 0.0), b(1e-3, 0.5e-3);
+  const VirtualFixtures v = settled(path_to(a, b, 1.0));
+  const double r = VirtualFixtureParams{}.capture_radius_m;
+  const Eigen::Vector2d along = (b - a).normalized(), across(-along.y(), along.x());
+  for (const double u : {0.1, 0.5, 0.93}) {
+    const Eigen::Vector2d on = a + u * (b - a);
+    EXPECT_LT((v.guided(on + 0.8 * r * across) - on).norm(), 1e-15) << "across taken out at u = " << u;
+    EXPECT_LT((v.guided(on - 0.5 * r * across) - on).norm(), 1e-15);
+    EXPECT_LT((v.guided(on + 2.2 * r * across) - (on + 2.2 * r * across)).norm(), 1e-15) << "beyond 2R: free";
+  }
+  EXPECT_LT((v.guided(b + 0.6 * r * along) - b).norm(), 1e-15) << "past the end: the point guide";
+  EXPECT_LT((v.guided(a - 0.6 * r * along) - a).norm(), 1e-15) << "before the start: its end";
+  // Continuous across the path: a ray from the middle outward, as for the axis.
+  const Eigen::Vector2d mid = 0.5 * (a + b);
+  double last = 0.0;
+  for (double d = 0.0; d <= 3.0 * r; d += r / 1000) {
+    const double g = (v.guided(mid + d * across) - mid).norm();
+    EXPECT_GE(g, last - 1e-18);
+    EXPECT_LE(g - last, 3.0 * r / 1000 * 1.0001) << "jump at d = " << d;
+    last = g;
+  }
+  EXPECT_LT((v.nearest_guide(mid + 10e-6 * across) - mid).norm(), 1e-15);
+}
+
+TEST(TeleoperationWithFixtures, APathsGuidanceDisplayIsPassiveUnderTremor) {
+  // As the axis' test, with the guide along a path the hand crosses back and forth.
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  std::mt19937 rng(12);
+  std::normal_distribution<double> noise(0, 1e-3);
+  t.tick(hand_at({0, 0}));
+  double lowest = 0.0, force = 0.0;
+  for (int i = 0; i < 60000; ++i) {
+    const double s = i * kDt;
+    if (i % 15000 == 0)
+      t.set_fixtures(path_to({-40e-6, 10e-6}, {60e-6, -5e-6}, (i / 15000) % 2 == 0 ? 1.0 : 0.3));
+    const Eigen::Vector2d h(6e-3 * std::sin(2 * M_PI * 0.5 * s) + noise(rng) * 0.1,
+                            2e-3 * std::sin(2 * M_PI * 7 * s) + noise(rng) * 0.1);
+    const auto& out = t.tick(hand_at(h));
+    lowest = std::min(lowest, t.fixtures().observed_J());
+    force = std::max(force, out.haptic_force_N.norm());
+  }
+  EXPECT_GT(force, 0.05);  // the guidance was felt
+  EXPECT_GE(lowest, -1e-12);
+}
+
 TEST(VirtualFixtures, TheLevelIsSlewedAndBadSetsRemoveTheFixtures) {
   VirtualFixtures v{VirtualFixtureParams{}};
   v.set(axis_at(0, 0, 1.0));

@@ -226,23 +226,45 @@ TEST(LiveTask, AnAssistedTransportGuidesTheOperatorOntoTheBoreAndTheRobotInserts
   EXPECT_EQ(rig.task().step, Step::kTransport);
   const Eigen::Vector2d bore = rig.params.task->goal.target_m;
   const Eigen::Vector2d aim = bore + Eigen::Vector2d(8e-6, -9e-6);  // 12 um off, by eye
-  // The person: deadman held, the joystick towards the aim at up to 300 um/s, let go within 1 um.
+  const std::vector<TaskSample> before = rig.copy();
+  const Eigen::Vector2d from = before.back().measured.head<2>();  // where the transport begins
+  const double t0 = before.back().t_s;
+  // The person: deadman held, clicking 30 um ahead along the way to the aim at a time (300 um/s),
+  // wobbling across it by 8 um at 2 Hz (loop time), then on the aim itself.
   const auto done = [&] { return rig.task().step != Step::kTransport || rig.task().ended; };
+  const Eigen::Vector2d along = (bore - from).normalized(), across(-along.y(), along.x());
+  const double aim_u = (aim - from).dot(along);
   for (int i = 0; i < 3000 && !done(); ++i) {
-    const Eigen::Vector3d at = rig.copy().back().target;
-    const Eigen::Vector2d e = aim - at.head<2>();
+    const TaskSample at = rig.copy().back();
+    const double u = (at.target.head<2>() - from).dot(along);
+    const Eigen::Vector2d goal = aim_u - u > 60e-6
+                                     ? Eigen::Vector2d(from + (u + 30e-6) * along +
+                                                       8e-6 * std::sin(2.0 * M_PI * 2.0 * at.t_s) * across)
+                                     : aim;
     ConsoleCommand c;
     c.deadman = true;
-    if (e.norm() > 1e-6) {
-      const Eigen::Vector2d v = e.normalized() * std::min(300e-6, 4.0 * e.norm() / 0.05);
-      c.velocity_m_s = {v.x(), v.y(), 0.0};
-    }
+    c.has_goal = true;
+    c.goal_m = {goal.x(), goal.y(), at.target.z()};
+    c.goal_speed_m_s = 300e-6;
     rig.set_command(c);
     std::this_thread::sleep_for(10ms);
   }
   ASSERT_GE(static_cast<int>(rig.task().step), static_cast<int>(Step::kRotate)) << rig.task().status_name();
   std::vector<TaskSample> s = rig.copy();
   EXPECT_LT((s.back().measured.head<2>() - bore).norm(), 1e-6) << "on the bore's axis, not at the aim";
+  // Along the way (the guide's level up, 0.6 s in; away from both ends) the commanded position
+  // stays on the path from where the transport began to the bore, whatever the wobble.
+  double off_path = 0.0;
+  int counted = 0;
+  for (const TaskSample& x : s) {
+    const Eigen::Vector2d p = x.target.head<2>() - from;
+    const double u = p.dot(along);
+    if (x.t_s < t0 + 0.6 || u < 100e-6 || u > (bore - from).norm() - 100e-6) continue;
+    off_path = std::max(off_path, std::abs(p.x() * along.y() - p.y() * along.x()));
+    ++counted;
+  }
+  EXPECT_GT(counted, 100);
+  EXPECT_LT(off_path, 1e-6) << "the guidance along the path takes the wobble out";
   ConsoleCommand idle;
   rig.set_command(idle);  // the person lets go: the robot drives
   ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 120s));

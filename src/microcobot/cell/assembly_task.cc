@@ -139,6 +139,7 @@ bool AssemblyTask::assistable(Step s) noexcept {
 
 void AssemblyTask::enter(Step s) noexcept {
   step_ = s;
+  assist_from_known_ = false;
   step_s_ = 0.0;
   settled_s_ = 0.0;
   insert_ = Insert::kDescend;
@@ -234,6 +235,7 @@ void AssemblyTask::hand_back(bool step_done) noexcept {
     yaw_goal_ = std::numeric_limits<double>::quiet_NaN();
     step_s_ = 0.0;
     settled_s_ = 0.0;
+    assist_from_known_ = false;
     if (step_ == Step::kInsert) {  // clear of the rim before searching on
       insert_ = Insert::kRetreat;
       retreat_z_ = std::numeric_limits<double>::quiet_NaN();
@@ -341,6 +343,13 @@ void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
     default: {
       const Eigen::Vector3d goal = move_goal(step_, s.tip_m);
       fixtures_.guide_xy_m = goal.head<2>();
+      if (step_ == Step::kApproach || step_ == Step::kTransport) {
+        // Across the plate: guidance along the path from where the step began to its goal.
+        if (!assist_from_known_) assist_from_ = s.tip_m.head<2>();
+        assist_from_known_ = true;
+        fixtures_.path = true;
+        fixtures_.path_from_xy_m = assist_from_;
+      }
       fixtures_.height = true;
       fixtures_.height_z_m = goal.z();
       there = (s.tip_m - goal).norm() <= p_.position_tolerance_m;

@@ -191,7 +191,8 @@ class AssemblyTask {
   /// kAssisted: the moves only (assistable()); another step given it is the operator's (kManual).
   enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
   /// The steps that may be assisted: the moves to a position (approach, descend, lift, transport,
-  /// retract: a guide at the goal's x, y and a height stop at its z; done once the tool is there),
+  /// retract: a guide at the goal's x, y, along the path from where the step began for approach and
+  /// transport, and a height stop at its z; done once the tool is there),
   /// the grasp (the guide and stop hold the tool over the pin while the operator closes; done once
   /// the grip reaches grip_force_N), the insertion (the guide on the bore's axis and the funnel round
   /// its rim; judged at the first contact above contact_threshold_N: the pin half down in the
@@ -285,9 +286,11 @@ class AssemblyTask {
   double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
   double opening_command_ = 0.0;
   Insert insert_ = Insert::kDescend;
-  double rim_z_ = 0.0;     // tool-point height at which the held pin's bottom meets the surface
-  int tries_ = 0;          // search points tried
-  double offset_y_ = 0.0;  // the current search point
+  double rim_z_ = 0.0;  // tool-point height at which the held pin's bottom meets the surface
+  Eigen::Vector2d assist_from_ = Eigen::Vector2d::Zero();  // where an assisted move's path starts
+  bool assist_from_known_ = false;
+  int tries_ = 0;                                                // search points tried
+  double offset_y_ = 0.0;                                        // the current search point
   double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();   // the rotary axis' (NaN: none yet)
   double last_yaw_ = 0.0;                                        // the fingers' yaw at the last tick
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();           // ... and the tip's position

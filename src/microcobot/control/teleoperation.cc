@@ -125,7 +125,9 @@ void Teleoperation::set_fixtures(const FixtureSet& set) noexcept {
   const FixtureSet before = fixtures_.fixtures();
   fixtures_.set(set);
   const FixtureSet& now = fixtures_.fixtures();
-  if (now.guide != before.guide || now.guide_xy_m != before.guide_xy_m) reindex_ = true;
+  if (now.guide != before.guide || now.guide_xy_m != before.guide_xy_m || now.path != before.path ||
+      now.path_from_xy_m != before.path_from_xy_m)
+    reindex_ = true;
   if (now.height != before.height || now.height_z_m != before.height_z_m) reindex_z_ = true;
 }
 

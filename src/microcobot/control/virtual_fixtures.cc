@@ -28,14 +28,15 @@ VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params
 
 void VirtualFixtures::set(const FixtureSet& set) noexcept {
   const bool valid = std::isfinite(set.level) && set.level >= 0.0 && set.level <= 1.0 &&
-                     set.guide_xy_m.allFinite() && std::isfinite(set.rim_z_m) &&
-                     std::isfinite(set.funnel_radius_m) && set.funnel_radius_m >= 0.0 &&
-                     std::isfinite(set.height_z_m);
+                     set.guide_xy_m.allFinite() && set.path_from_xy_m.allFinite() &&
+                     std::isfinite(set.rim_z_m) && std::isfinite(set.funnel_radius_m) &&
+                     set.funnel_radius_m >= 0.0 && std::isfinite(set.height_z_m);
   const FixtureSet next = valid ? set : FixtureSet{};
   if (next == set_) return;
   // A new guide moves the field under the handle: its energy is booked afresh. A new level alone
   // is slewed, and what it would add is the passivity controller's to dissipate.
-  if (next.guide != set_.guide || next.guide_xy_m != set_.guide_xy_m) {
+  if (next.guide != set_.guide || next.guide_xy_m != set_.guide_xy_m || next.path != set_.path ||
+      next.path_from_xy_m != set_.path_from_xy_m) {
     rebase_ = true;
     level_ = 0.0;  // from nothing again: the new field comes in at level_rate_1_s
   }
@@ -76,10 +77,19 @@ double VirtualFixtures::scale_gain(const Eigen::Vector2d& xy) const noexcept {
   return 1.0 + level_ * (p_.far_gain - 1.0) * x;
 }
 
+Eigen::Vector2d VirtualFixtures::nearest_guide(const Eigen::Vector2d& xy) const noexcept {
+  if (!set_.path) return set_.guide_xy_m;
+  const Eigen::Vector2d a = set_.path_from_xy_m, ab = set_.guide_xy_m - a;
+  const double l2 = ab.squaredNorm();
+  const double u = l2 > 0.0 ? std::clamp((xy - a).dot(ab) / l2, 0.0, 1.0) : 1.0;
+  return a + u * ab;
+}
+
 Eigen::Vector2d VirtualFixtures::guided(const Eigen::Vector2d& raw_xy) const noexcept {
   if (!set_.guide || level_ <= 0.0) return raw_xy;
-  const Eigen::Vector2d e = raw_xy - set_.guide_xy_m;
-  return set_.guide_xy_m + (1.0 - level_ * weight(e.norm())) * e;
+  const Eigen::Vector2d g = nearest_guide(raw_xy);
+  const Eigen::Vector2d e = raw_xy - g;
+  return g + (1.0 - level_ * weight(e.norm())) * e;
 }
 
 double VirtualFixtures::guided_z(double raw_z) const noexcept {
@@ -105,7 +115,7 @@ double VirtualFixtures::lowest_z(const Eigen::Vector2d& xy, double from_z) const
 }
 
 void VirtualFixtures::rebase_energy(const Eigen::Vector2d& raw_xy, double scale) noexcept {
-  observed_J_ = set_.guide ? potential_J((raw_xy - set_.guide_xy_m).norm(), level_, scale) : 0.0;
+  observed_J_ = set_.guide ? potential_J((raw_xy - nearest_guide(raw_xy)).norm(), level_, scale) : 0.0;
   rebase_ = false;
 }
 

@@ -13,6 +13,12 @@
 ///              falling linearly to 0 at 2R (continuous: no jump on entering), a = the
 ///              assistance level. At a = 1 the slave sits on the insertion axis however the
 ///              hand trembles within R; outside 2R the master moves it as without fixture.
+///              Along a path (`path`): the guide is the nearest point of the segment from
+///              path_from_xy_m to guide_xy_m, so that motion along it is free and motion across it
+///              is taken out within R (a guidance virtual fixture, Bettini, Marayong, Lang, Okamura
+///              and Hager, "Vision-assisted control for manipulation using virtual fixtures", IEEE
+///              T-RO 20(6), 2004); its end is the point guide. The field stays conservative: the
+///              distance to a segment (a convex set) has the gradient e / |e|.
 ///   scaling    the motion scale grows with the distance to the guide (coarse far, fine near):
 ///              g(d) = 1 + a (far_gain - 1) clamp((d - R) / (far_distance - R), 0, 1). The
 ///              coupling applies it to the master's increments, so changing it never moves the
@@ -92,15 +98,17 @@ struct FixtureSet {
   double level = 0.0;  ///< assistance level in [0, 1] (0: none)
   bool guide = false;  ///< a vertical insertion axis at guide_xy_m
   Eigen::Vector2d guide_xy_m = Eigen::Vector2d::Zero();
+  bool path = false;  ///< guidance along the segment from path_from_xy_m to guide_xy_m (needs `guide`)
+  Eigen::Vector2d path_from_xy_m = Eigen::Vector2d::Zero();
   bool funnel = false;           ///< the forbidden region round the axis' rim (needs `guide`)
   double rim_z_m = 0.0;          ///< tool-point height at which the part meets the rim
   double funnel_radius_m = 0.0;  ///< r0: the allowed distance to the axis at the rim
   bool height = false;           ///< a height stop at height_z_m (at the set's level)
   double height_z_m = 0.0;       ///< tool-point height of the stop
   bool operator==(const FixtureSet& o) const noexcept {
-    return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && funnel == o.funnel &&
-           rim_z_m == o.rim_z_m && funnel_radius_m == o.funnel_radius_m && height == o.height &&
-           height_z_m == o.height_z_m;
+    return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && path == o.path &&
+           path_from_xy_m == o.path_from_xy_m && funnel == o.funnel && rim_z_m == o.rim_z_m &&
+           funnel_radius_m == o.funnel_radius_m && height == o.height && height_z_m == o.height_z_m;
   }
 };
 
@@ -126,6 +134,8 @@ class VirtualFixtures {
   double scale_gain(const Eigen::Vector2d& xy) const noexcept;
   /// The guided target for the master's raw target.
   Eigen::Vector2d guided(const Eigen::Vector2d& raw_xy) const noexcept;
+  /// The guide's point nearest `xy`: guide_xy_m, or along a path the segment's nearest point.
+  Eigen::Vector2d nearest_guide(const Eigen::Vector2d& xy) const noexcept;
   /// The guided height for the master's raw height (raw_z without a height stop).
   double guided_z(double raw_z) const noexcept;
   /// `xy` kept within the funnel's radius r0 of the axis when `z` is below the rim (the part in

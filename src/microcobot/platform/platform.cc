@@ -425,6 +425,7 @@ void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
 void Platform::set_fixtures(const control::FixtureSet& set) noexcept {
   control::FixtureSet stage = set;
   stage.guide_xy_m = set.guide_xy_m - home_m_.head<2>();
+  stage.path_from_xy_m = set.path_from_xy_m - home_m_.head<2>();
   stage.rim_z_m = set.rim_z_m - home_m_.z();
   stage.height_z_m = set.height_z_m - home_m_.z();
   teleop_->set_fixtures(stage);
