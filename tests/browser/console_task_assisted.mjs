@@ -72,9 +72,10 @@ await s.run(async () => {
     await clickTop(far[0], far[1]);
     await page.keyboard.down(" ");
     try {
+      // (Within 10 um: the guide along the way holds the stage on the path, a few um off a click.)
       await until("the stage at the click", ([x, y]) => {
         const t = window.mc.telemetry;
-        return Math.hypot(t.measured_x_m - x, t.measured_y_m - y) < 3e-6;
+        return Math.hypot(t.measured_x_m - x, t.measured_y_m - y) < 10e-6;
       }, 30, far);
     } finally {
       await page.keyboard.up(" ");
