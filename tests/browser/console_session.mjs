@@ -72,6 +72,27 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     }
     throw new Error(`timed out after ${timeoutS} s: ${what}`);
   };
+  // The supervised task in the page's status (serve --cell).
+  s.task = () => page.evaluate(() => window.mc.status && window.mc.status.task);
+  // Waits for the task to satisfy `pred`. A pause the platform latched because the page's
+  // heartbeat stopped for longer than its gap (headless Chromium on a loaded 2-core machine stalls
+  // for seconds, screenshots most) is resumed, as the operator would, and counted in s.resumed.
+  s.resumed = 0;
+  s.untilTask = async (what, pred, timeoutS) => {
+    const end = Date.now() + timeoutS * 1000;
+    while (Date.now() < end) {
+      const t = await s.task();
+      if (pred(t)) return t;
+      if (t.status === "paused" && t.supervisor_lost) {
+        s.log("the platform paused the task (the page's heartbeat was away): resumed");
+        s.resumed++;
+        await page.evaluate(() => action("task_resume"));  // the Resume button's action
+        await page.waitForTimeout(500);
+      }
+      await page.waitForTimeout(100);
+    }
+    throw new Error(`timed out after ${timeoutS} s: ${what}; the task: ${JSON.stringify(await s.task())}`);
+  };
   s.shot = (file) => page.screenshot({ path: join(artifacts, file + ".png") });
   // Clicks the microscope (top view) at world (x, y) or the side view at (x, z), as an operator
   // clicks what they see: the page's own mapping from the world to its canvases.

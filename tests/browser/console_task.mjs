@@ -9,8 +9,7 @@ import { join } from "node:path";
 import { startConsole, withoutCamera } from "./console_session.mjs";
 
 const s = await startConsole("console_task", (dir) => ["--cell", "--out", join(dir, "rec"), ...withoutCamera(dir)], 240);
-const { page, until, shot, fail, log } = s;
-const task = () => page.evaluate(() => window.mc.status && window.mc.status.task);
+const { page, until, shot, fail, log, task, untilTask } = s;
 const samples = () => page.evaluate(() => window.taskSamples);
 const target = (x) => [x.target_x_m, x.target_y_m, x.target_z_m];
 const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
@@ -21,25 +20,6 @@ const largestStep = (xs, from, to) => {
   return m;
 };
 const um = (v) => (v * 1e6).toFixed(2);
-// Waits for the task to satisfy `pred`. A pause the platform latched because the page's
-// heartbeat stopped for longer than its gap (headless Chromium on a loaded 2-core machine stalls
-// for seconds, screenshots most) is resumed, as the operator would, and counted.
-let resumed = 0;
-const untilTask = async (what, pred, timeoutS) => {
-  const end = Date.now() + timeoutS * 1000;
-  while (Date.now() < end) {
-    const t = await task();
-    if (pred(t)) return t;
-    if (t.status === "paused" && t.supervisor_lost) {
-      log(`the platform paused the task (the page's heartbeat was away): resumed`);
-      resumed++;
-      await page.evaluate(() => action("task_resume"));  // the Resume button's action
-      await page.waitForTimeout(500);
-    }
-    await page.waitForTimeout(100);
-  }
-  throw new Error(`timed out after ${timeoutS} s: ${what}; the task: ${JSON.stringify(await task())}`);
-};
 
 await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
@@ -145,5 +125,5 @@ await s.run(async () => {
     Math.abs(window.mc.input.gripper - window.mc.telemetry.gripper_command_m) < 2e-6, 3);
   await shot("task-04-succeeded");
   const gaps = await page.evaluate(() => window.timerGaps);
-  log(`the page's timers: largest gap ${gaps.max.toFixed(0)} ms, ${gaps.over200} over 200 ms; ${resumed} latched pauses resumed`);
+  log(`the page's timers: largest gap ${gaps.max.toFixed(0)} ms, ${gaps.over200} over 200 ms; ${s.resumed} latched pauses resumed`);
 }, "started, paused, taken over, handed back and inserted from the page");

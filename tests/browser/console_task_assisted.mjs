@@ -13,25 +13,8 @@ const s = await startConsole("console_task_assisted", (dir) => {
   writeFileSync(file, "steps: {transport: assisted}\n");
   return ["--cell", "--task", file, ...withoutCamera(dir)];
 }, 240);
-const { page, until, shot, clickTop, fail, log } = s;
-const task = () => page.evaluate(() => window.mc.status && window.mc.status.task);
+const { page, until, shot, clickTop, fail, log, task, untilTask } = s;
 const um = (v) => (v * 1e6).toFixed(2);
-// Waits for the task to satisfy `pred`; a pause the platform latched while the page's heartbeat
-// was away (a stalled headless page) is resumed, as the operator would.
-const untilTask = async (what, pred, timeoutS) => {
-  const end = Date.now() + timeoutS * 1000;
-  while (Date.now() < end) {
-    const t = await task();
-    if (pred(t)) return t;
-    if (t.status === "paused" && t.supervisor_lost) {
-      log("the platform paused the task (the page's heartbeat was away): resumed");
-      await page.evaluate(() => action("task_resume"));
-      await page.waitForTimeout(500);
-    }
-    await page.waitForTimeout(100);
-  }
-  throw new Error(`timed out after ${timeoutS} s: ${what}; the task: ${JSON.stringify(await task())}`);
-};
 
 await s.run(async () => {
   await page.goto(s.url, { waitUntil: "domcontentloaded" });
