@@ -100,6 +100,8 @@ listen("/platform/status", (s) => {
   // click-to-go was for their step; kept, it would pull the stage back there at the next take-over.
   const operatorDrives = ["operator", "assisted"].includes(t.status);
   if (lastOperatorDrives && !operatorDrives) mc.input.goal = null;
+  // Handed a step (assisted, manual): the gripper slider where the gripper holds, as on Take over.
+  if (!lastOperatorDrives && operatorDrives) handOverToTheConsole();
   lastOperatorDrives = operatorDrives;
   $("task-hint").textContent = taskHint(t);
   for (const [id, , name, , enabled] of kTaskButtons) {

@@ -32,6 +32,8 @@ await s.run(async () => {
     document.getElementById("task-state").textContent === "assisted" &&
     /guided to its goal/.test(document.getElementById("task-hint").textContent) &&
     !document.getElementById("task-hand-back").disabled, 3);
+  await until("the gripper slider at the held opening", () =>
+    Math.abs(window.mc.input.gripper - window.mc.telemetry.gripper_command_m) < 2e-6, 3);
   await shot("assisted-01-handed");
 
   // The operator aims by eye, 12 um off the bore. The bore is out of the view (which follows the

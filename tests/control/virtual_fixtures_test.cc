@@ -330,32 +330,39 @@ TEST(TeleoperationWithFixtures, AHeightStopHoldsTheSlaveAndNeverJumpsIt) {
 }
 
 TEST(TeleoperationWithFixtures, NoFixtureMovesTheSlaveWithoutTheDeadman) {
-  // A guide and a height stop within their captures pull the slave onto them, but only while the
-  // operator holds the deadman: released, on either master, the target does not move at all.
-  FixtureSet f = height_stop_at(480e-6, 1.0);
-  f.guide_xy_m = {15e-6, -10e-6};
-  for (const bool console : {true, false}) {
-    Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 500e-6}, 600e-6);
-    t.tick(hand_at({0, 0}));
-    const Eigen::Vector3d start = t.output().slave_target_m;
-    t.set_fixtures(f);
-    for (int i = 0; i < 10000; ++i) {
-      TeleoperationInput in = hand_at({0, 0});
-      in.deadman = false;
-      if (console) {
-        in.console.active = in.console.fresh = true;
-        in.console.deadman = false;
+  // A guide (an axis, or a path) and a height stop within their captures pull the slave onto them,
+  // but only while the operator holds the deadman: released, on either master, the target does not
+  // move at all.
+  FixtureSet axis = height_stop_at(480e-6, 1.0);
+  axis.guide_xy_m = {15e-6, -10e-6};
+  FixtureSet path = axis;
+  path.path = true;
+  path.path_from_xy_m = {-85e-6, -10e-6};  // the slave's nearest point on it: (0, -10) um
+  for (const auto& [f, onto] : {std::pair{axis, Eigen::Vector3d(15e-6, -10e-6, 480e-6)},
+                                std::pair{path, Eigen::Vector3d(0.0, -10e-6, 480e-6)}}) {
+    for (const bool console : {true, false}) {
+      Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 500e-6}, 600e-6);
+      t.tick(hand_at({0, 0}));
+      const Eigen::Vector3d start = t.output().slave_target_m;
+      t.set_fixtures(f);
+      for (int i = 0; i < 10000; ++i) {
+        TeleoperationInput in = hand_at({0, 0});
+        in.deadman = false;
+        if (console) {
+          in.console.active = in.console.fresh = true;
+          in.console.deadman = false;
+        }
+        ASSERT_EQ(t.tick(in).slave_target_m, start) << (console ? "console" : "haptic") << " tick " << i;
       }
-      ASSERT_EQ(t.tick(in).slave_target_m, start) << (console ? "console" : "haptic") << " tick " << i;
+      // Held again: now the fixtures take the slave onto the guide and the height, at the pace.
+      for (int i = 0; i < 10000; ++i) {
+        TeleoperationInput in = hand_at({0, 0});
+        if (console) in.console.active = in.console.fresh = in.console.deadman = true;
+        t.tick(in);
+      }
+      EXPECT_LT((t.output().slave_target_m - onto).norm(), 1e-12)
+          << (console ? "console" : "haptic") << (f.path ? ", path" : ", axis");
     }
-    // Held again: now the fixtures take the slave onto the axis and the height, at the pace.
-    for (int i = 0; i < 10000; ++i) {
-      TeleoperationInput in = hand_at({0, 0});
-      if (console) in.console.active = in.console.fresh = in.console.deadman = true;
-      t.tick(in);
-    }
-    EXPECT_LT((t.output().slave_target_m - Eigen::Vector3d(15e-6, -10e-6, 480e-6)).norm(), 1e-12)
-        << (console ? "console" : "haptic");
   }
 }
 
