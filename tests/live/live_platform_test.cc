@@ -132,8 +132,16 @@ TEST(LivePlatform, TheEstopLatchesEveryDeviceInItsSafeStateUntilAnExplicitReset)
   s = rig.live.status();
   EXPECT_FALSE(s.estopped) << s.last_error;
   for (Lifecycle l : s.lifecycle) EXPECT_EQ(l, Lifecycle::kActive);
-  rig.drive(jog(200e-6), 300ms);
-  EXPECT_GT(rig.get("target_x_m"), held + 20e-6) << "driven again after the reset";
+  // The reset re-takes the target where the stage stands, which lags the held target by the
+  // jog's tracking error (20 um in a CI run): the jog is measured from there.
+  ASSERT_TRUE(rig.catch_up());
+  const double restart = rig.get("target_x_m");
+  rig.drive(jog(200e-6), 600ms);
+  ASSERT_TRUE(rig.catch_up());
+  // 120 um asked; under ASan on a loaded machine the loop runs a third of the wall time and the
+  // heartbeat may starve (see the jog test above).
+  EXPECT_GT(rig.get("target_x_m"), restart + (MC_UNDER_ASAN ? 10e-6 : 60e-6))
+      << "driven again after the reset";
 }
 
 TEST(LivePlatform, TheLoopThreadNeverAllocatesWhileCommandsAndTelemetryFlow) {
