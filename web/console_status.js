@@ -104,6 +104,16 @@ function showGripVision(g) {
   $("grip-vision-out").textContent = isNum(f) ? (f * um).toFixed(1) + " µN" : g.state === "untared" ? "press Tare" : g.state;
   $("grip-vision-out").title = g.error || `gap ${(g.gap_m * um).toFixed(1)} µm, drive ${(g.free_opening_m * um).toFixed(1)} µm, correlation ${g.confidence.toFixed(2)}`;
   $("grip-vision-out").className = g.state === "measuring" ? "" : "bad";
+  // The contact force along the closing axis (signed: + along the fingers' x); null without the
+  // stage's sensors (the tips are then the only tool point there is).
+  const c = g.contact_force_N;
+  $("contact-vision-row").hidden = false;
+  const f = forceUnit();
+  $("contact-vision-gauge").max = $("contact-gauge").max;
+  $("contact-vision-gauge").high = $("contact-gauge").high;
+  $("contact-vision-gauge").value = isNum(c) ? Math.abs(c) * f.scale : 0;
+  $("contact-vision-out").textContent = isNum(c) ? (c < 0 ? "−" : "") + fmtForce(f, Math.abs(c)) : g.state === "measuring" ? "no stage sensor" : "—";
+  $("contact-vision-out").title = isNum(g.bend_m) ? `tips bent ${(g.bend_m * um).toFixed(2)} µm` : "";
 }
 listen("/platform/status", (s) => {
   mc.status = s;

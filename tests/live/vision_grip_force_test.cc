@@ -16,6 +16,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/live/live_platform.h"
+#include "microcobot/microworld/pick_place_world.h"
 #include "support/live_status_wait.h"
 #include "support/sanitizers.h"
 #include "support/test_support.h"
@@ -51,15 +52,17 @@ LiveParams grip_params() {
 struct GripRig {
   LivePlatform live;
   std::mutex m;
-  std::vector<double> sensor;
+  std::vector<double> sensor, contact;
   bool collecting = false;
   std::atomic<bool> run{true};
   std::atomic<double> opening{600e-6};
-  std::atomic<double> theta_goal{std::nan("")};  // the rotary axis' goal (NaN: none)
-  std::atomic<double> theta{0.0};                // its sensor, from the telemetry
+  std::atomic<double> theta_goal{std::nan("")};                        // the rotary axis' goal (NaN: none)
+  std::atomic<double> theta{0.0};                                      // its sensor, from the telemetry
+  std::atomic<double> goal_x{std::nan("")}, goal_y{0.0}, goal_z{0.0};  // click-to-go (NaN: none)
   std::thread sender;
   const std::size_t grip = test::telemetry_channel("grip_force_N");
   const std::size_t yaw = test::telemetry_channel("measured_theta_rad");
+  const std::size_t contact_x = test::telemetry_channel("contact_x_N");
 
   explicit GripRig(LiveParams p) : live(std::move(p)) {
     live.set_camera_wanted(true);  // a console watching: the camera forms frames
@@ -68,6 +71,7 @@ struct GripRig {
       std::lock_guard lock(m);
       if (!collecting) return;
       sensor.push_back(s[grip]);
+      contact.push_back(s[contact_x]);
     });
     live.set_console_in_control(true);
     sender = std::thread([this] {
@@ -78,6 +82,8 @@ struct GripRig {
         c.gripper_opening_m = opening.load();
         c.has_theta_goal = std::isfinite(theta_goal.load());
         c.theta_goal_rad = c.has_theta_goal ? theta_goal.load() : 0.0;
+        c.has_goal = std::isfinite(goal_x.load());
+        if (c.has_goal) c.goal_m = {goal_x.load(), goal_y.load(), goal_z.load()};
         live.push_command(c);
         std::this_thread::sleep_for(20ms);
       }
@@ -96,12 +102,14 @@ struct GripRig {
   // measured one, and how many frames there were.
   struct Means {
     double sensor_N = 0.0, vision_N = 0.0;
+    double contact_sensor_N = 0.0, contact_vision_N = 0.0;  // along x (the fingers' closing axis)
     std::size_t measured_frames = 0, frames = 0;
   };
   Means collect(std::chrono::milliseconds window) {
     {
       std::lock_guard lock(m);
       sensor.clear();
+      contact.clear();
       collecting = true;
     }
     Means r;
@@ -114,6 +122,7 @@ struct GripRig {
           ++r.frames;
           if (std::isfinite(g->grip_force_N)) {
             r.vision_N += g->grip_force_N;
+            r.contact_vision_N += g->contact_force_N;
             ++r.measured_frames;
           }
         }
@@ -122,9 +131,11 @@ struct GripRig {
       std::this_thread::sleep_for(3ms);
     }
     if (r.measured_frames > 0) r.vision_N /= static_cast<double>(r.measured_frames);
+    if (r.measured_frames > 0) r.contact_vision_N /= static_cast<double>(r.measured_frames);
     std::lock_guard lock(m);
     collecting = false;
     for (double v : sensor) r.sensor_N += v / static_cast<double>(sensor.size());
+    for (double v : contact) r.contact_sensor_N += v / static_cast<double>(contact.size());
     return r;
   }
 };
@@ -170,6 +181,55 @@ TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt)
   std::printf("released: vision %.2f uN\n", 1e6 * released.vision_N);
   EXPECT_EQ(released.sensor_N, 0.0);
   EXPECT_LT(std::abs(released.vision_N), 20e-6);
+}
+
+// The contact force (issue #28 point 4): the pin gripped in its bore (10 um of play each side) and
+// the stage sent past the wall: the fingers bend (microworld/pick_place_world.h), the gripper's
+// sensor feels 2 k times the push, and the camera sees the tips' common bend against where the
+// stage's sensors put the fingers.
+TEST(VisionGripForce, ThePinPushedIntoItsBoresWallIsAContactForceSeenAsTheSensorFeelsIt) {
+  LiveParams p = grip_params();
+  auto& w = p.platform.world;
+  auto& st = p.platform.stage;
+  w = microworld::pin_in_hole_scene();
+  w.part_start_m.head<2>() = w.target_m.head<2>();  // down in its bore
+  w.gripper.max_opening_m = 300e-6;  // a pin gripper: both fingers open in the 10x field
+  st.home_x_m = w.target_m.x(), st.home_y_m = w.target_m.y();
+  st.home_z_m = 200e-6;  // the tips 100 um below the pin's top, 200 um above the substrate
+  auto& cam = p.platform.camera;
+  cam.objective = 2;  // 10x: 0.53 um per pixel, the 200 um pin and both fingers in 424 um
+  cam.view_center_x_m = st.home_x_m, cam.view_center_y_m = st.home_y_m;
+  cam.focus_start_m = st.home_z_m;
+  const double k2 = 2.0 * w.gripper.finger_stiffness_N_m, home_x = st.home_x_m;
+  GripRig rig(std::move(p));
+  ASSERT_TRUE(rig.wait(
+      [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 10; },
+      MC_UNDER_ASAN ? 30.0 : 10.0));
+  rig.goal_y = 0.0, rig.goal_z = 200e-6;
+  rig.opening = 160e-6;  // 1 mN on the 200 um pin: the grip holds 600 uN
+  const auto settle = MC_UNDER_ASAN ? 2500ms : 1200ms;
+  const auto window = MC_UNDER_ASAN ? 1500ms : 800ms;
+  std::this_thread::sleep_for(settle);
+  const auto centred = rig.collect(window);
+  std::printf("centred: contact sensor %.1f uN, vision %.1f uN\n", 1e6 * centred.contact_sensor_N,
+              1e6 * centred.contact_vision_N);
+  ASSERT_GT(centred.sensor_N, 0.9e-3) << "not gripped";
+  EXPECT_EQ(centred.contact_sensor_N, 0.0);
+  EXPECT_LT(std::abs(centred.contact_vision_N), 10e-6);
+  // 3 um past the right wall, then 4 um past the left one: 300 and 400 uN.
+  for (double past : {13e-6, -14e-6}) {
+    rig.goal_x = home_x + past;
+    std::this_thread::sleep_for(settle);
+    const auto c = rig.collect(window);
+    const auto g = rig.live.status().grip_vision.value();
+    std::printf("pushed %+.0f um: contact sensor %.1f uN, vision %.1f uN (%+.2f %%), %zu of %zu frames\n",
+                1e6 * past, 1e6 * c.contact_sensor_N, 1e6 * c.contact_vision_N,
+                100.0 * (c.contact_vision_N / c.contact_sensor_N - 1.0), c.measured_frames, c.frames);
+    const double want = -k2 * (past - std::copysign(10e-6, past));
+    EXPECT_NEAR(c.contact_sensor_N, want, 0.1 * std::abs(want)) << "the stage did not push as sent";
+    ASSERT_GT(c.measured_frames, c.frames / 2) << g.state << ": " << g.error;
+    EXPECT_NEAR(c.contact_vision_N, c.contact_sensor_N, 0.05 * std::abs(c.contact_sensor_N));
+  }
 }
 
 TEST(VisionGripForce, WithoutTheStagesXYSensorsTheTipsAreLookedForWhereThePositionerSeesTheTool) {

@@ -168,10 +168,49 @@ TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
   ASSERT_GT(out.grip_force_N, 0.0);
   EXPECT_NEAR(out.force_on_gripper_N.x(), -holds, 1e-12)
       << "pressed into the wall, the pin slips in the fingers";
-  // Pulled out, it is free again.
+  const double k2 = 2 * pin.w.params().gripper.finger_stiffness_N_m;
+  EXPECT_NEAR(pin.s.finger_deflection_m.x(), -holds / k2, 1e-12) << "bent as far as the grip holds";
+  // Pulled out, it is free again: the fingers spring back with it.
   move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 600e-6}, Pin::closed);
   EXPECT_FALSE(pin.w.inserted(pin.s));
-  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-12) << "it slipped in the fingers while held by the wall";
+  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6 + holds / k2, 1e-12)
+      << "it slipped in the fingers by what their bend did not take";
+  EXPECT_EQ(pin.s.finger_deflection_m.norm(), 0.0);
+}
+
+// Issue #28 (contact force by vision): along their closing axis the fingers are benders, so a pin
+// pushed into its hole's wall bends them (both together, 2 k_finger) before it slips in them.
+TEST(PinInHole, PushedIntoTheWallTheFingersBendBeforeThePinSlipsAndSpringBack) {
+  Pin pin;
+  pin.carry_over(2e-3, 0);
+  move(pin.w, pin.s, pin.g, {2e-3, 0, 100e-6}, Pin::closed);
+  ASSERT_TRUE(pin.w.inserted(pin.s));
+  const double offset = pin.s.offset_m.x(), k2 = 2 * pin.w.params().gripper.finger_stiffness_N_m;
+  // 3 um past the wall (10 um of play): 2 k x 3 um = 300 uN, under the 600 uN the grip holds.
+  auto out = move(pin.w, pin.s, pin.g, {2e-3 + 13e-6, 0, 100e-6}, Pin::closed);
+  const double holds = 2 * pin.w.params().finger_friction * out.grip_force_N;
+  ASSERT_GT(holds, k2 * 3e-6);
+  EXPECT_NEAR(out.force_on_gripper_N.x(), -k2 * 3e-6, 1e-12) << "the bend's spring, not the wall's";
+  EXPECT_NEAR(pin.s.finger_deflection_m.x(), -3e-6, 1e-15) << "the tips held at the wall";
+  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-15);
+  EXPECT_EQ(pin.s.offset_m.x(), offset) << "no slip";
+  // A steady press is a steady force (the stage still).
+  out = hold(pin.w, pin.s, pin.g, Pin::closed, 0.05);
+  EXPECT_NEAR(out.force_on_gripper_N.x(), -k2 * 3e-6, 1e-12);
+  // Back to the middle: the fingers spring back, the pin where it was in them.
+  out = move(pin.w, pin.s, pin.g, {2e-3, 0, 100e-6}, Pin::closed);
+  EXPECT_EQ(out.force_on_gripper_N.x(), 0.0);
+  EXPECT_EQ(pin.s.finger_deflection_m.norm(), 0.0);
+  EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + offset, 1e-15);
+  // Turned by 90 degrees the fingers close along y: pushed along x (across them), the pin slips at
+  // once (their width is stiff), and they do not bend.
+  move(pin.w, pin.s, pin.g, {2e-3, 0, 550e-6}, Pin::closed);
+  move(pin.w, pin.s, pin.g, {2e-3, 0, 550e-6}, Pin::closed, M_PI / 2);
+  move(pin.w, pin.s, pin.g, {2e-3, 0, 100e-6}, Pin::closed, M_PI / 2);
+  ASSERT_TRUE(pin.w.inserted(pin.s));
+  out = move(pin.w, pin.s, pin.g, {2e-3 + 13e-6, 0, 100e-6}, Pin::closed, M_PI / 2);
+  EXPECT_LT(std::abs(pin.s.finger_deflection_m.x()), 1e-9);
+  EXPECT_LT(std::abs(pin.s.finger_deflection_m.y()), 1e-12);
 }
 
 TEST(PinInHole, TheHoleMustLeaveClearanceAndHoldThePinAboveTheSubstrate) {

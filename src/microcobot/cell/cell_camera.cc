@@ -48,6 +48,7 @@ platform::CameraScenePose truth_pose(const platform::Platform& p) {
     pose.tool_yaw_rad = g->yaw_rad();
     pose.part_x_m = w.part_m.x(), pose.part_y_m = w.part_m.y(), pose.part_z_m = w.part_m.z();
     pose.part_yaw_rad = w.part_yaw_rad;
+    pose.deflection_x_m = w.finger_deflection_m.x(), pose.deflection_y_m = w.finger_deflection_m.y();
   }
   return pose;  // the stage holds while the cell looks: no motion blur
 }

@@ -171,6 +171,7 @@ std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_
     };
     grip_json = {{"grip_force_N", number_or_null(grip->grip_force_N)},
                  {"gap_m", number_or_null(grip->gap_m)},
+                 {"contact_force_N", number_or_null(grip->contact_force_N)},
                  {"state", grip->state}};
   }
   return nlohmann::json{{"t_s", f.t_mid_s},

@@ -173,6 +173,8 @@ std::string ConsoleServer::status_json() {
                         {"tared", g.tared},
                         {"grip_force_N", number_or_null(g.grip_force_N)},
                         {"gap_m", number_or_null(g.gap_m)},
+                        {"contact_force_N", number_or_null(g.contact_force_N)},
+                        {"bend_m", number_or_null(g.bend_m)},
                         {"free_opening_m", g.free_opening_m},
                         {"confidence", g.confidence},
                         {"frames", g.frames},

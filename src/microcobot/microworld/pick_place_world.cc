@@ -123,22 +123,29 @@ bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
   return p_.hole_side_m > 0.0 && s.part_m.z() < 0.5 * p_.height_m() - 1e-9;
 }
 
-Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, double yaw, bool in_hole,
-                                                double capacity_N) const noexcept {
+Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, double part_yaw, double yaw,
+                                                bool in_hole, double capacity_N,
+                                                Eigen::Vector2d& slip_m) const noexcept {
+  slip_m.setZero();
   if (!in_hole) return Eigen::Vector2d::Zero();
-  const double play = std::max(hole_play_m(yaw), 0.0);
+  const double play = std::max(hole_play_m(part_yaw), 0.0);
   // In the hole's frame (its sides along the axes).
   const Eigen::Vector2d d = turned(part.head<2>() - p_.target_m.head<2>(), -p_.hole_yaw_rad);
   Eigen::Vector2d inside = d;
   for (int i = 0; i < 2; ++i) inside[i] = std::clamp(d[i], -play, play);
-  // The wall stops the part; the fingers, pressing it into the wall, feel its stiffness.
-  Eigen::Vector2d reaction = p_.substrate_stiffness_N_m * turned(inside - d, p_.hole_yaw_rad);
   part.head<2>() = p_.target_m.head<2>() + turned(inside, p_.hole_yaw_rad);
-  // The part slips in the fingers once the wall pushes it harder than they hold it: the
-  // fingers feel at most what holds the part (friction of the grip, or the adhesion to a finger).
+  // What the wall moves the part by against the fingers, in their frame (x: their closing axis).
+  const Eigen::Vector2d push = turned(turned(inside - d, p_.hole_yaw_rad), -yaw);
+  // Along their closing axis both fingers bend together (2 k_finger) before the part slips in them;
+  // across it they are as stiff as their width (the wall's stiffness stands for it). The fingers
+  // feel at most what holds the part (friction of the grip, or the adhesion to a finger): beyond
+  // it the part slips between them, by what the bend does not take.
+  const double k2 = 2.0 * p_.gripper.finger_stiffness_N_m;
+  Eigen::Vector2d reaction(k2 * push.x(), p_.substrate_stiffness_N_m * push.y());
   const double n = reaction.norm();
   if (n > capacity_N) reaction *= capacity_N / n;
-  return reaction;
+  slip_m = {push.x() - reaction.x() / k2, push.y()};
+  return turned(reaction, yaw);
 }
 
 bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g,
@@ -206,7 +213,9 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       if (!in_hole) s.part_yaw_rad -= wrap_quarter_turn(s.part_yaw_rad - yaw);  // to yaw + k 90 deg
       if (dragged && lateral.norm() > 0.0)
         out.force_on_gripper_N.head<2>() += rubbing_force(lateral, dt_s, drag_resistance);
-      out.force_on_gripper_N.head<2>() += confine_to_hole(s.part_m, s.part_yaw_rad, in_hole, hold_capacity);
+      Eigen::Vector2d slid;  // the part is centred in the jaw again at every step: no slip kept
+      out.force_on_gripper_N.head<2>() +=
+          confine_to_hole(s.part_m, s.part_yaw_rad, yaw, in_hole, hold_capacity, slid);
       if (motion.z() > 0.0 && g.z() > s.part_m.z() - 0.5 * p_.height_m() - 1e-12) {
         if (hold_capacity >= substrate_hold) {
           s.phase = PartPhase::kGrasped;  // lift-off: the grip beats adhesion + weight
@@ -234,8 +243,9 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       }
       const Eigen::Vector3d unconfined = next;
       const double held_by = s.phase == PartPhase::kGrasped ? hold_capacity : p_.finger_pulloff_N;
-      out.force_on_gripper_N.head<2>() += confine_to_hole(next, s.part_yaw_rad, in_hole, held_by);
-      s.offset_m.head<2>() += turned((next - unconfined).head<2>(), -yaw);
+      Eigen::Vector2d slip;
+      out.force_on_gripper_N.head<2>() += confine_to_hole(next, s.part_yaw_rad, yaw, in_hole, held_by, slip);
+      s.offset_m.head<2>() += slip;
       const double floor = rest_z_m(next.x(), next.y(), s.part_yaw_rad);
       if (next.z() < floor) {  // pressed onto the substrate: the part stops, the fingers slide down
         const double press = floor - next.z();
@@ -276,6 +286,10 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       break;
     }
   }
+  // The lateral force on the fingers bends them along their closing axis (common mode, 2 k_finger);
+  // the walls' share is the bend confine_to_hole left unslipped.
+  const Eigen::Vector2d on_fingers = turned(out.force_on_gripper_N.head<2>(), -yaw);
+  s.finger_deflection_m = turned({on_fingers.x() / (2.0 * p_.gripper.finger_stiffness_N_m), 0.0}, yaw);
   out.part_on_substrate =
       s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
   return out;

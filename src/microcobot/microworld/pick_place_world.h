@@ -21,8 +21,16 @@
 /// taller). With hole_side_m > 0 the target is a square hole of that side and hole_depth_m deep
 /// (a pin-in-hole insertion with clearance hole_side_m - part_side_m): the part goes down into
 /// it only when its footprint fits (|x - x_hole| and |y - y_hole| <= clearance / 2), else it
-/// lands on the rim; once in, the hole's walls stop it sideways (a stiff reaction on the fingers,
-/// up to what holds the part in them: beyond it the part slips between the fingers).
+/// lands on the rim; once in, the hole's walls stop it sideways, up to what holds the part in the
+/// fingers (beyond it the part slips between them).
+///
+/// Finger compliance (issue #28, contact force by vision): the fingers are benders of stiffness
+/// k_finger along their closing axis, so a lateral force F on them along it (a wall, the
+/// substrate's drag) bends both tips together by F / (2 k_finger) (common mode; across that axis
+/// they are as stiff as their width). Against a wall they bend before the part slips: the wall's
+/// reaction along the closing axis is 2 k_finger times the push, not the wall's own stiffness. The
+/// bend carries the part at the wall (it stays in the jaws); the drag's (at most mu (F_pulloff +
+/// W) / (2 k) = 0.1 um) is drawn on the tips only.
 ///
 /// Orientation (issue #29 point 2): the part and the hole are squares turned by part_yaw_rad and
 /// hole_yaw_rad about the vertical, and the fingers by the gripper's yaw (the rotary axis under
@@ -139,6 +147,10 @@ struct PickPlaceState {
   Eigen::Vector3d last_gripper_m = Eigen::Vector3d::Zero();
   double last_gripper_yaw_rad = 0.0;
   PiezoGripperState gripper;
+  /// The fingers' common-mode deflection [m] (world x, y; along their closing axis): a lateral force
+  /// F on them (a wall, the substrate's drag) bends both tips by F / (2 k_finger). Where the
+  /// microscope sees the tips: the gripper point plus this.
+  Eigen::Vector2d finger_deflection_m = Eigen::Vector2d::Zero();
   bool crashed = false;  ///< a finger tip went into the substrate at some point
 };
 
@@ -180,10 +192,11 @@ class PickPlaceWorld {
   bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g, double yaw) const noexcept;
   Eigen::Vector2d rubbing_force(const Eigen::Vector2d& motion, double dt_s, double coulomb_N) const noexcept;
   /// Keeps a part that was in the hole (`in_hole`, before this step's motion) inside its walls;
-  /// returns the wall's reaction on the fingers [N], at most `capacity_N` (what holds the part in
-  /// them: beyond it the part slips).
-  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, double yaw, bool in_hole,
-                                  double capacity_N) const noexcept;
+  /// returns the wall's reaction on the fingers (turned by `yaw`) [N], at most `capacity_N` (what
+  /// holds the part in them). Along their closing axis the fingers bend by reaction / (2 k_finger)
+  /// first; `slip_m` (their frame) is how far the part slips in them.
+  Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, double part_yaw, double yaw, bool in_hole,
+                                  double capacity_N, Eigen::Vector2d& slip_m) const noexcept;
   PickPlaceParams p_;
   double weight_;
 };

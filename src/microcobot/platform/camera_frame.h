@@ -26,6 +26,9 @@ struct SceneSnapshot {
   double tool_velocity_m_s[3] = {};  ///< its velocity (motion blur over the exposure)
   double gripper_opening_m = 0.0;    ///< distance between the finger tips
   double tool_yaw_rad = 0.0;         ///< the fingers' yaw (the rotary axis under the gripper)
+  /// The fingers' common-mode bend (x, y): the tips are seen at tool_m plus this (a lateral
+  /// contact force on them: force by vision's contact force).
+  double finger_deflection_m[2] = {};
   /// The opening the gripper's drive puts its fingers at without a load (Gripper::free_opening_m;
   /// NaN: the drive has no model of it): force by vision's reference.
   double gripper_free_opening_m = 0.0;

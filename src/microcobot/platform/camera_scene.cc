@@ -117,17 +117,20 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   part.angle_rad = pose.part_yaw_rad;
   s.parts.push_back(part);
   const double finger_width_m = w.gripper.finger_width_m;
+  // A lateral force bends both benders: their tips move by the deflection, drawn as the bars
+  // shifted (a 2 mm bender bent by a few um: its end turns by 3 d / 2 L, under 0.01 rad).
+  const double tip_x = pose.tool_x_m + pose.deflection_x_m, tip_y = pose.tool_y_m + pose.deflection_y_m;
   for (int side : {-1, 1}) {
     vision::Finger f;
     f.width_m = finger_width_m;
-    f.tip_x_m = pose.tool_x_m + side * 0.5 * (std::max(pose.opening_m, 0.0) + finger_width_m);
-    f.tip_y_m = pose.tool_y_m - 0.5 * finger_width_m;  // the end of the bar covers the tool point
+    f.tip_x_m = tip_x + side * 0.5 * (std::max(pose.opening_m, 0.0) + finger_width_m);
+    f.tip_y_m = tip_y - 0.5 * finger_width_m;  // the end of the bar covers the tool point
     f.z_tip_m = pose.tool_z_m;
     f.length_m = w.gripper.finger_length_m;
     f.rise = 0.5;  // the benders come down to the part at about 27 degrees from the substrate
     f.vx_m_s = pose.vx_m_s, f.vy_m_s = pose.vy_m_s;
     f.angle_rad = pose.tool_yaw_rad;  // turned about the tool point by the rotary axis
-    f.pivot_x_m = pose.tool_x_m, f.pivot_y_m = pose.tool_y_m;
+    f.pivot_x_m = tip_x, f.pivot_y_m = tip_y;
     s.fingers.push_back(f);
   }
 }

@@ -23,6 +23,9 @@ struct CameraScenePose {
   double tool_x_m = 0.0, tool_y_m = 0.0, tool_z_m = 0.0;  ///< finger tips' centre (slave_*_m)
   double opening_m = 0.0;                                 ///< gripper opening
   double tool_yaw_rad = 0.0;                              ///< the fingers' yaw (slave_theta_rad)
+  /// The fingers' common-mode bend (a lateral contact force): their tips drawn this far from the
+  /// tool point (the telemetry has no channel for it: 0 from pose_from_telemetry).
+  double deflection_x_m = 0.0, deflection_y_m = 0.0;
   double part_x_m = 0.0, part_y_m = 0.0, part_z_m = 0.0;  ///< part centre, or the probe bead's
   double part_yaw_rad = 0.0;                              ///< the part's orientation
   double vx_m_s = 0.0, vy_m_s = 0.0;                      ///< the tool's velocity

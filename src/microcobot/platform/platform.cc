@@ -393,6 +393,8 @@ void Platform::camera_task(const TickInfo& t) noexcept {
     s.has_part = true;
     s.part_phase = static_cast<int>(sim_.gripper->world_state().phase);
     s.part_yaw_rad = sim_.gripper->world_state().part_yaw_rad;
+    const Eigen::Vector2d bend = sim_.gripper->finger_deflection_m();
+    s.finger_deflection_m[0] = bend.x(), s.finger_deflection_m[1] = bend.y();
   }
   if (sim_.optical_tweezers != nullptr) {
     s.has_beads = true;

@@ -31,6 +31,8 @@ class SimulatedCamera final : public FrameSource {
     pose.tool_z_m = scene.tool_m[2];
     pose.opening_m = scene.gripper_opening_m;
     pose.tool_yaw_rad = scene.tool_yaw_rad;
+    pose.deflection_x_m = scene.finger_deflection_m[0];
+    pose.deflection_y_m = scene.finger_deflection_m[1];
     const double* part = scene.has_beads ? scene.probe_bead_m : scene.part_m;
     pose.part_x_m = part[0];
     pose.part_y_m = part[1];

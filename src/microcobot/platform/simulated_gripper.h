@@ -45,6 +45,9 @@ class SimulatedGripper final : public Gripper {
   double yaw_rad() const noexcept {
     return rotary_ != nullptr ? rotary_params_.angle_rad(rotary_->carried_position_m()) : 0.0;
   }
+  /// The fingers' common-mode bend under a lateral force (world x, y): the tips are seen there,
+  /// away from tip_position_m() (microworld/pick_place_world.h).
+  Eigen::Vector2d finger_deflection_m() const { return state_.finger_deflection_m; }
   const microworld::PickPlaceState& world_state() const { return state_; }
   const microworld::PickPlaceOutput& world_output() const { return out_; }
   const microworld::PickPlaceWorld& world() const { return world_; }

@@ -61,7 +61,8 @@ void VisionGripForce::set_directions(double yaw_rad) {
   e_x_ = ex / scale_px_m_;
 }
 
-bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m) {
+bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m,
+                            double bend_m) {
   for (int k = 0; k < 2; ++k) {
     const int side = k == 0 ? -1 : 1;
     const vision::PixelRoi roi =
@@ -82,10 +83,14 @@ bool VisionGripForce::teach(const Eigen::Vector2d& tool_px, double gap_m, double
   const vision::TrackEstimate &l = trackers_[0].last(), &r = trackers_[1].last();
   ref_d_px_ = (Eigen::Vector2d(r.u_px, r.v_px) - Eigen::Vector2d(l.u_px, l.v_px)).dot(e_x_);
   ref_gap_m_ = last_gap_m_ = gap_m;
+  // The offsets hold this frame's bend: the midpoint's offset from the tool point is 0 now.
+  ref_bend_m_ = last_bend_m_ = bend_m;
+  ref_c_px_ = 0.0;
   measured_free_opening_m_ = free_opening_m;
   // A tare (nothing held: the gap is the drive's opening) is refined over the next frames.
   tare_frames_ = gap_m == free_opening_m ? 1 : 0;
   tare_d_sum_px_ = ref_d_px_;
+  tare_c_sum_px_ = 0.0;
   last_tool_px_ = tool_px;
   loaded_ = gap_m - free_opening_m > kLoadedGap;
   taught_ = true;
@@ -96,7 +101,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
   if (!to_grey_frame(frame.image, frame.sequence, frame_)) return st_;
   ++st_.frames;
   st_.t_mid_s = frame.t_mid_s;
-  st_.grip_force_N = st_.gap_m = std::nan("");
+  st_.grip_force_N = st_.gap_m = st_.contact_force_N = st_.bend_m = std::nan("");
   st_.confidence = 0.0;
   if (reset_.exchange(false, std::memory_order_acq_rel)) {
     taught_ = st_.tared = false;
@@ -147,7 +152,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
   if (tare_.exchange(false, std::memory_order_acq_rel) || auto_tare_) {
     // Nothing between the fingers: the gap is the drive's free opening. The scene's own tare is
     // tried at each frame until the tips are in view.
-    if (teach(tool, o, o)) {
+    if (teach(tool, o, o, 0.0)) {
       auto_tare_ = false;
       st_.tared = true;
       ++st_.tares;
@@ -156,6 +161,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     }
     st_.gap_m = taught_ ? o : st_.gap_m;
     st_.grip_force_N = taught_ ? 0.0 : st_.grip_force_N;
+    if (taught_ && hint.stage_sensed && !hint.pixel) st_.contact_force_N = st_.bend_m = 0.0;
     st_.confidence = taught_ ? 1.0 : 0.0;
     publish();
     return st_;
@@ -177,7 +183,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     }
     // Nothing held before the turn (and the drive still): nothing is now, the gap is the drive's
     // opening, a fresh tare rather than a chained one (whose error would add up turn after turn).
-    if (teach(tool, turned && !loaded_ ? o : last_gap_m_, o)) {
+    if (teach(tool, turned && !loaded_ ? o : last_gap_m_, o, last_bend_m_)) {
       st_.state = "measuring";
       st_.error.clear();
     }
@@ -189,13 +195,15 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
   // the fingers anywhere between), at the drive's opening while they open, and no lower than it.
   const double predicted_gap = loaded_ ? std::max(o, last_gap_m_) : o;
   const double closing_from = std::max(predicted_gap, last_gap_m_);
+  // The tips are looked for bent as much as last seen (their bend since the offsets were taught).
+  const Eigen::Vector2d bent = tool + (last_bend_m_ - ref_bend_m_) * scale_px_m_ * e_x_;
   std::array<Eigen::Vector2d, 2> p;
   double confidence = 1.0;
   for (int k = 0; k < 2; ++k) {
     const auto i = static_cast<std::size_t>(k);
     const int side = k == 0 ? -1 : 1;
-    const Eigen::Vector2d at = tool + tip_step_px(side, predicted_gap) + offset_px_[i];
-    const Eigen::Vector2d from = tool + tip_step_px(side, closing_from) + offset_px_[i];
+    const Eigen::Vector2d at = bent + tip_step_px(side, predicted_gap) + offset_px_[i];
+    const Eigen::Vector2d from = bent + tip_step_px(side, closing_from) + offset_px_[i];
     const vision::TrackEstimate e = trackers_[i].track_along(frame_, at.x(), at.y(), from.x(), from.y());
     if (!e.found) {
       st_.state = "lost";
@@ -216,10 +224,16 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     return st_;
   }
   const double d_px = (p[1] - p[0]).dot(e_x_);
+  // The common mode: the tips' midpoint against the tool point (where the stage puts the fingers),
+  // known only from the stage's sensors.
+  const bool stage_known = hint.stage_sensed && !hint.pixel;
+  const double c_px = (0.5 * (p[0] - offset_px_[0] + p[1] - offset_px_[1]) - tool).dot(e_x_);
   if (tare_frames_ > 0 && tare_frames_ < kTareFrames && o == measured_free_opening_m_ && !loaded_) {
-    tare_d_sum_px_ += d_px;  // still the tare's scene: its reference averaged
+    tare_d_sum_px_ += d_px;  // still the tare's scene: its references averaged
+    tare_c_sum_px_ += c_px;
     ++tare_frames_;
     ref_d_px_ = tare_d_sum_px_ / tare_frames_;
+    ref_c_px_ = tare_c_sum_px_ / tare_frames_;
   } else {
     tare_frames_ = 0;
   }
@@ -241,6 +255,11 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
   st_.gap_m = gap;
   st_.confidence = confidence;
   st_.grip_force_N = 0.5 * stiffness_N_m_ * (gap - o);  // F = k (w - o) / 2, piezo_gripper.h
+  if (stage_known) {
+    last_bend_m_ = ref_bend_m_ + (c_px - ref_c_px_) / scale_px_m_;
+    st_.bend_m = last_bend_m_;
+    st_.contact_force_N = 2.0 * stiffness_N_m_ * last_bend_m_;  // F_c = 2 k b, pick_place_world.h
+  }
   publish();
   return st_;
 }

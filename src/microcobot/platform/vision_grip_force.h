@@ -22,6 +22,20 @@
 /// The gap is a difference of two tips, so the stage's motion cancels: the gauge needs no
 /// stage sensor, only where to look (the tips' predicted pixels) and the scale.
 ///
+/// The contact force: a lateral force on the fingers along their closing axis bends both tips
+/// together (microworld/pick_place_world.h: common mode, 2 k), so their midpoint leaves the tool
+/// point the stage's x, y sensors give, through the map:
+///
+///     b    = b_ref + ((m - t) . e_x - c_ref) / s      [m]     m = (p_left + p_right) / 2 - offsets
+///     F_c  = 2 k b                                     [N]     (signed, along e_x)
+///
+/// with t the tool point's pixel and (b_ref, c_ref) the reference: the tare's (nothing touches the
+/// fingers: b_ref = 0, c_ref the mean over its first 8 frames) or, chained, the bend last measured.
+/// The midpoint is measured against the stage's motion since the tare, so the map's error e adds
+/// 2 k e |motion| (10 uN for 0.1 % over 100 um): a contact is read near where the gauge was
+/// tared. Without stage sensors (the vision positioner's tool point is the tips themselves) there
+/// is no contact force (NaN).
+///
 /// The offline estimator (vision/finger_force.h, `microcobot vision force`) fits the opening's
 /// scale on four unloaded openings with a fixed stage; live, the stage moves and the operator
 /// does not sweep the gripper, so the scale is the map's: its error e scales the deflection
@@ -62,8 +76,12 @@ struct VisionGripStatus {
   double grip_force_N = std::nan("");  ///< NaN when not measured in the last frame
   double gap_m = std::nan("");         ///< the tips' distance as seen
   double free_opening_m = 0.0;         ///< the drive's opening without a load, at the frame
-  double confidence = 0.0;             ///< the lower of the two tips' correlations
-  double t_mid_s = 0.0;                ///< the frame's mid-exposure (loop time)
+  /// The lateral contact force along the fingers' closing axis (their yaw: +x at 0), signed
+  /// [N]; NaN when not measured (no stage sensor, or the frame not measured).
+  double contact_force_N = std::nan("");
+  double bend_m = std::nan("");  ///< the tips' common-mode bend it comes from
+  double confidence = 0.0;       ///< the lower of the two tips' correlations
+  double t_mid_s = 0.0;          ///< the frame's mid-exposure (loop time)
   std::uint64_t frames = 0, tares = 0;
 };
 
@@ -94,7 +112,8 @@ class VisionGripForce {
   VisionGripStatus status() const;
 
  private:
-  bool teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m);
+  /// `bend_m`: the fingers' common-mode bend at this frame (0 at a tare).
+  bool teach(const Eigen::Vector2d& tool_px, double gap_m, double free_opening_m, double bend_m);
   /// e_x and its scale for the fingers at `yaw_rad` (the map's and the yaw's).
   void set_directions(double yaw_rad);
   Eigen::Vector2d tip_step_px(int side, double gap_m) const;
@@ -115,13 +134,15 @@ class VisionGripForce {
   int still_frames_ = 0;                            ///< frames in a row the yaw stayed still
   int tare_frames_ = 0;         ///< frames averaged into the tare's reference (0: not refining)
   double tare_d_sum_px_ = 0.0;  ///< their tips' distances
+  double tare_c_sum_px_ = 0.0;  ///< their midpoints' offsets from the tool point along e_x
   double measured_free_opening_m_ = std::nan("");  ///< the drive's at the last measurement
   bool taught_ = false, loaded_ = false;
   bool auto_tare_ = false;  ///< the scene's tare (tare_at_start), tried until it is taken
   /// Template centre - (tool point + the tip's half gap), per tip, as taught.
   std::array<Eigen::Vector2d, 2> offset_px_{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
-  double ref_gap_m_ = 0.0, ref_d_px_ = 0.0;  ///< (g_ref, d_ref)
-  double last_gap_m_ = 0.0;
+  double ref_gap_m_ = 0.0, ref_d_px_ = 0.0;   ///< (g_ref, d_ref)
+  double ref_bend_m_ = 0.0, ref_c_px_ = 0.0;  ///< (b_ref, c_ref)
+  double last_gap_m_ = 0.0, last_bend_m_ = 0.0;
   Eigen::Vector2d last_tool_px_ = Eigen::Vector2d::Zero();  ///< the tool point the tips say
   VisionGripStatus st_;
   mutable std::mutex status_mutex_;
