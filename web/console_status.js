@@ -108,11 +108,11 @@ function showGripVision(g) {
   // stage's sensors (the tips are then the only tool point there is).
   const c = g.contact_force_N;
   $("contact-vision-row").hidden = false;
-  const f = forceUnit();
+  const unit = forceUnit();
   $("contact-vision-gauge").max = $("contact-gauge").max;
   $("contact-vision-gauge").high = $("contact-gauge").high;
-  $("contact-vision-gauge").value = isNum(c) ? Math.abs(c) * f.scale : 0;
-  $("contact-vision-out").textContent = isNum(c) ? (c < 0 ? "−" : "") + fmtForce(f, Math.abs(c)) : g.state === "measuring" ? "no stage sensor" : "—";
+  $("contact-vision-gauge").value = isNum(c) ? Math.abs(c) * unit.scale : 0;
+  $("contact-vision-out").textContent = isNum(c) ? (c < 0 ? "−" : "") + fmtForce(unit, Math.abs(c)) : g.state === "measuring" ? "no stage sensor" : "—";
   $("contact-vision-out").title = isNum(g.bend_m) ? `tips bent ${(g.bend_m * um).toFixed(2)} µm` : "";
 }
 listen("/platform/status", (s) => {

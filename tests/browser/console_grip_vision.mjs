@@ -5,9 +5,7 @@
 // against the drive's free opening, times the fingers' stiffness) beside the sensor's "grip".
 // Then the gripper opens, the operator tares, and the force seen is back at zero. Run by CTest
 // (`console_browser_grip_vision`); screenshots to MC_ARTIFACTS.
-import { writeFileSync } from "node:fs";
-import { join } from "node:path";
-import { startConsole } from "./console_session.mjs";
+import { startConsole, withConfig } from "./console_session.mjs";
 
 // The stage's home at (-0.2 mm, 0), the tips 150 um above the substrate: the 300 um part's
 // mid-height, with the part centred between them.
@@ -25,23 +23,11 @@ camera:
     width_px: 800
     height_px: 600
 `;
-const s = await startConsole("console_grip_vision", (dir) => {
-  writeFileSync(join(dir, "grip.yaml"), config);
-  return ["--config", join(dir, "grip.yaml")];
-}, 200);
-const { page, until, shot, fail, log } = s;
-
-const setGripper = (um) => page.$eval("#gripper", (el, v) => {
-  el.value = String(v);
-  el.dispatchEvent(new Event("input"));
-}, um);
+const s = await startConsole("console_grip_vision", withConfig(config), 200);
+const { page, until, shot, fail, log, setGripper } = s;
 
 await s.run(async () => {
-  await page.goto(s.url, { waitUntil: "domcontentloaded", timeout: 90000 });
-  await until("connected, frames shown, the gauge tared at the start", () =>
-    window.mc.connected && window.mc.camera.frames >= 3 && window.mc.status && window.mc.status.grip_vision &&
-    window.mc.status.grip_vision.tared, 30);
-  if (await page.isHidden("#grip-vision-row")) fail("the 'grip, seen' gauge is hidden");
+  await s.openTared("#grip-vision-row");
   await s.takeControl();
   // 0.8 mN, under the default 1 mN limit: the free opening 300 - 2 * 0.8 mN / (50 N/m) = 268 um.
   await page.keyboard.down(" ");

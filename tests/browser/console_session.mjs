@@ -20,6 +20,15 @@ export function withoutCamera(dir) {
   return ["--config", file];
 }
 
+// serve's options for a configuration given as YAML text (written into the test's directory).
+export function withConfig(yaml) {
+  return (dir) => {
+    const file = join(dir, "config.yaml");
+    writeFileSync(file, yaml);
+    return ["--config", file];
+  };
+}
+
 export async function startConsole(name, serveArgs, timeoutS, options = {}) {
   const cli = process.env.MC_CLI;
   if (!cli || !existsSync(cli)) {
@@ -120,6 +129,20 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     }
   };
   s.setSlider = (id, value) => page.locator(id).fill(String(value));
+  // The gripper's slider as a drag leaves it (an input event with the new value, in um).
+  s.setGripper = (um) => page.$eval("#gripper", (el, v) => {
+    el.value = String(v);
+    el.dispatchEvent(new Event("input"));
+  }, um);
+  // The page loaded with the camera's frames shown and force by vision tared (at the scene's
+  // start), the gauge row `row` shown.
+  s.openTared = async (row) => {
+    await page.goto(s.url, { waitUntil: "domcontentloaded", timeout: 90000 });
+    await s.until("connected, frames shown, the gauge tared at the start", () =>
+      window.mc.connected && window.mc.camera.frames >= 3 && window.mc.status && window.mc.status.grip_vision &&
+      window.mc.status.grip_vision.tared, 30);
+    if (await page.isHidden(row)) s.fail(`the gauge ${row} is hidden`);
+  };
   // Takes control as an operator would, clicking again when nothing happened: with the camera
   // streaming on a loaded machine a click has been lost (CI, 2026-11-26: never granted in 30 s, no
   // command seen by the server); each retry is logged, and control must come within three clicks.

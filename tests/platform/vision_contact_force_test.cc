@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -41,13 +42,7 @@ struct ContactScene {
     cam.view_center_x_m = config.stage.home_x_m;
     cam.view_center_y_m = config.stage.home_y_m;
     k = config.world.gripper.finger_stiffness_N_m;
-    vision::CameraParams cp;
-    cp.sensor = cam.sensor;
-    cp.objective = cam.objectives[kObjective];
-    cp.illumination = cam.illumination;
-    cp.view_center_x_m = cam.view_center_x_m;
-    cp.view_center_y_m = cam.view_center_y_m;
-    renderer = std::make_unique<vision::Renderer>(cp);
+    renderer = std::make_unique<vision::Renderer>(renderer_params(cam, kObjective));
     pose.tool_x_m = pose.part_x_m = config.stage.home_x_m;
     pose.tool_y_m = pose.part_y_m = config.stage.home_y_m;
     pose.part_z_m = 0.5 * config.world.height_m();
@@ -161,7 +156,7 @@ TEST(VisionContactForce, TheTipsCommonBendReadsTheContactForceWithinFivePercent)
     const double tracking_m = w.sd / std::sqrt(2.0);
     EXPECT_LT(f.sd, 2.0 * k2 * tracking_m) << "noise " << f.sd * 1e6 << " uN, gap sd " << w.sd * 1e9 << " nm";
     std::printf(
-        "bend %+.0f um at (%+.0f, %+.0f) um: %.2f uN of %.2f (%+.2f %%), sd %.3f uN, tip noise %.2f nm\n",
+        "bend %+.2f um at (%+.1f, %+.1f) um: %.2f uN of %.2f (%+.2f %%), sd %.3f uN, tip noise %.2f nm\n",
         c.bend_m * 1e6, c.stage.x() * 1e6, c.stage.y() * 1e6, f.mean * 1e6, truth * 1e6,
         100 * (f.mean / truth - 1), f.sd * 1e6, tracking_m * 1e9);
     // The grip is not disturbed by the common mode.

@@ -38,6 +38,17 @@ PlatformConfig scene_config(const std::string& scene) {
   return c;
 }
 
+vision::CameraParams renderer_params(const CameraDeviceParams& camera, int objective) {
+  const int last = static_cast<int>(camera.objectives.size()) - 1;
+  vision::CameraParams cp;
+  cp.sensor = camera.sensor;
+  cp.objective = camera.objectives.at(static_cast<std::size_t>(std::clamp(objective, 0, last)));
+  cp.illumination = camera.illumination;
+  cp.view_center_x_m = camera.view_center_x_m;
+  cp.view_center_y_m = camera.view_center_y_m;
+  return cp;
+}
+
 CameraScenePose initial_pose(const PlatformConfig& c) {
   CameraScenePose p;
   p.tool_x_m = c.stage.home_x_m;

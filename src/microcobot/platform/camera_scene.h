@@ -18,6 +18,10 @@ namespace mc::platform {
 /// file of the microworld's keys (as `serve --scene`). Throws InvalidInput naming `scene`.
 PlatformConfig scene_config(const std::string& scene);
 
+/// What the renderer needs to form `camera`'s image through its objective `objective` (clamped to
+/// the turret).
+vision::CameraParams renderer_params(const CameraDeviceParams& camera, int objective);
+
 /// Where the moving things are (world frame, the telemetry's ground-truth channels).
 struct CameraScenePose {
   double tool_x_m = 0.0, tool_y_m = 0.0, tool_z_m = 0.0;  ///< finger tips' centre (slave_*_m)

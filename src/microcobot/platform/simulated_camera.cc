@@ -71,13 +71,7 @@ class SimulatedCamera final : public FrameSource {
     const auto i =
         static_cast<std::size_t>(std::clamp(objective, 0, static_cast<int>(renderers_.size()) - 1));
     if (!renderers_[i]) {
-      vision::CameraParams cp;
-      cp.sensor = params_.sensor;
-      cp.objective = params_.objectives[i];
-      cp.illumination = params_.illumination;
-      cp.view_center_x_m = params_.view_center_x_m;
-      cp.view_center_y_m = params_.view_center_y_m;
-      renderers_[i] = std::make_unique<vision::Renderer>(cp);
+      renderers_[i] = std::make_unique<vision::Renderer>(renderer_params(params_, static_cast<int>(i)));
     }
     return *renderers_[i];
   }
