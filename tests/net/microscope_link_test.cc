@@ -98,27 +98,40 @@ TEST(MicroscopeTopics, RefusesWhatIsNotAMicroscopeCommandSayingWhy) {
   EXPECT_NE(std::string(to_string(MicroscopeRejection::kOutOfRange)).find("whole number"), std::string::npos);
 }
 
+// A slave end that keeps the commands it takes and reports `state`, both under `m`.
+struct CollectingServer {
+  std::mutex m;
+  std::vector<MicroscopeJoints> taken;
+  MicroscopeJoints state;
+  MicroscopeServer server;
+  CollectingServer(int domain, const MicroscopeJoints& initial)
+      : state(initial),
+        server(
+            domain, {},
+            [this](const MicroscopeJoints& j) {
+              std::lock_guard lock(m);
+              taken.push_back(j);
+            },
+            [this] {
+              std::lock_guard lock(m);
+              return state;
+            }) {}
+};
+
 // The master's operator changes focus then objective: the slave end gets each change with both
 // joints, its state comes back to the master, and nothing is sent before the operator asks.
 TEST(MicroscopeLink, TheMastersChangesReachTheSlaveAndItsStateComesBack) {
   const int domain = test::test_domain_id();
-  std::mutex m;
-  std::vector<MicroscopeJoints> taken;
-  MicroscopeJoints slave_state;
-  slave_state.has_focus = true;
-  slave_state.focus_z_m = 10e-6;
-  slave_state.objective = 1;
-  MicroscopeServer server(
-      domain, {},
-      [&](const MicroscopeJoints& j) {
-        std::lock_guard lock(m);
-        taken.push_back(j);
-      },
-      [&] {
-        std::lock_guard lock(m);
-        return slave_state;
-      });
-  MicroscopeJoints wanted = slave_state;
+  MicroscopeJoints start;
+  start.has_focus = true;
+  start.focus_z_m = 10e-6;
+  start.objective = 1;
+  CollectingServer slave(domain, start);
+  std::mutex& m = slave.m;
+  std::vector<MicroscopeJoints>& taken = slave.taken;
+  MicroscopeJoints& slave_state = slave.state;
+  MicroscopeServer& server = slave.server;
+  MicroscopeJoints wanted = start;
   MicroscopeClient client(domain, {}, [&] {
     std::lock_guard lock(m);
     return wanted;
@@ -187,18 +200,13 @@ TEST(MicroscopeLink, AMasterTakesTheFirstFocusItKnowsAsTheStart) {
 // is the one that stays applied.
 TEST(MicroscopeLink, AFloodOfGarbageIsRefusedAndTheLastGoodCommandStands) {
   const int domain = test::test_domain_id();
-  std::mutex m;
-  std::vector<MicroscopeJoints> taken;
   MicroscopeJoints state;
   state.has_focus = true;
   state.objective = 0;
-  MicroscopeServer server(
-      domain, {},
-      [&](const MicroscopeJoints& j) {
-        std::lock_guard lock(m);
-        taken.push_back(j);
-      },
-      [&] { return state; });
+  CollectingServer slave(domain, state);
+  std::mutex& m = slave.m;
+  std::vector<MicroscopeJoints>& taken = slave.taken;
+  MicroscopeServer& server = slave.server;
   Participant peer(domain);
   const dds_entity_t topic =
       dds_create_topic(peer.handle(), &sensor_msgs_msg_dds__JointState__desc,
