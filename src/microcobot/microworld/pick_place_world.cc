@@ -241,7 +241,6 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       } else {
         s.part_yaw_rad = yaw + s.yaw_offset_rad;
       }
-      const Eigen::Vector3d unconfined = next;
       const double held_by = s.phase == PartPhase::kGrasped ? hold_capacity : p_.finger_pulloff_N;
       Eigen::Vector2d slip;
       out.force_on_gripper_N.head<2>() += confine_to_hole(next, s.part_yaw_rad, yaw, in_hole, held_by, slip);

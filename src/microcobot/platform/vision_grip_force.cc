@@ -183,7 +183,8 @@ const VisionGripStatus& VisionGripForce::on_frame(const CameraFrame& frame, cons
     }
     // Nothing held before the turn (and the drive still): nothing is now, the gap is the drive's
     // opening, a fresh tare rather than a chained one (whose error would add up turn after turn).
-    if (teach(tool, turned && !loaded_ ? o : last_gap_m_, o, last_bend_m_)) {
+    const bool fresh = turned && !loaded_;  // nothing held: nothing presses on the fingers either
+    if (teach(tool, fresh ? o : last_gap_m_, o, fresh ? 0.0 : last_bend_m_)) {
       st_.state = "measuring";
       st_.error.clear();
     }
