@@ -193,7 +193,7 @@ TEST(VisionGripForce, ThePinPushedIntoItsBoresWallIsAContactForceSeenAsTheSensor
   auto& st = p.platform.stage;
   w = microworld::pin_in_hole_scene();
   w.part_start_m.head<2>() = w.target_m.head<2>();  // down in its bore
-  w.gripper.max_opening_m = 300e-6;  // a pin gripper: both fingers open in the 10x field
+  w.gripper.max_opening_m = 300e-6;                 // a pin gripper: both fingers open in the 10x field
   st.home_x_m = w.target_m.x(), st.home_y_m = w.target_m.y();
   st.home_z_m = 200e-6;  // the tips 100 um below the pin's top, 200 um above the substrate
   auto& cam = p.platform.camera;
