@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "microcobot/microworld/release.h"
+
 namespace mc::microworld {
 namespace {
 
@@ -53,6 +55,12 @@ void PickPlaceParams::validate() const {
           "contact_force_limit_N", "must be within (0, 10] N", contact_force_limit_N);
   require(std::isfinite(min_tip_height_m) && min_tip_height_m >= -1e-3 && min_tip_height_m < 1e-3,
           "min_tip_height_m", "must be within [-1 mm, 1 mm)", min_tip_height_m);
+  require(std::isfinite(seat_tolerance_m) && seat_tolerance_m > 0.0 && seat_tolerance_m <= 1e-3,
+          "seat_tolerance_m", "must be within (0, 1 mm]", seat_tolerance_m);
+  require(std::isfinite(roll_edge_fraction) && roll_edge_fraction >= 0.0 && roll_edge_fraction <= 1.0,
+          "roll_edge_fraction", "must be within [0, 1]", roll_edge_fraction);
+  require(std::isfinite(roll_peel_angle_rad) && roll_peel_angle_rad > 0.0 && roll_peel_angle_rad <= 0.5,
+          "roll_peel_angle_rad", "must be within (0, 0.5] rad", roll_peel_angle_rad);
   gripper.validate();
   require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
           gripper.max_opening_m);
@@ -68,8 +76,10 @@ void PickPlaceParams::validate() const {
       gravity_m_s2);
 }
 
-double PickPlaceParams::part_weight_N() const {
-  return part_density_kg_m3 * part_side_m * part_side_m * height_m() * gravity_m_s2;
+double PickPlaceParams::part_weight_N() const { return part_mass_kg() * gravity_m_s2; }
+
+double PickPlaceParams::part_mass_kg() const {
+  return part_density_kg_m3 * part_side_m * part_side_m * height_m();
 }
 
 PickPlaceParams pin_in_hole_scene() {
@@ -78,6 +88,15 @@ PickPlaceParams pin_in_hole_scene() {
   p.part_height_m = 600e-6;
   p.hole_side_m = 220e-6;
   p.hole_depth_m = 300e-6;
+  return p;
+}
+
+PickPlaceParams flat_part_scene() {
+  PickPlaceParams p;
+  p.part_side_m = 300e-6;
+  p.part_height_m = 50e-6;
+  p.finger_pulloff_N = vdw_plane_plane_N(1e-19, 2e-13, 0.4e-9);       // 16.6 uN
+  p.substrate_pulloff_N = vdw_plane_plane_N(1e-19, 2.4e-13, 0.4e-9);  // 19.9 uN
   return p;
 }
 
@@ -121,6 +140,12 @@ double PickPlaceWorld::rest_z_m(double x, double y, double yaw_rad) const noexce
 
 bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
   return p_.hole_side_m > 0.0 && s.part_m.z() < 0.5 * p_.height_m() - 1e-9;
+}
+
+bool PickPlaceWorld::placed(const PickPlaceState& s) const noexcept {
+  if (s.phase != PartPhase::kOnSubstrate) return false;
+  if (p_.hole_side_m > 0.0) return inserted(s);
+  return std::abs(s.part_m.z() - 0.5 * p_.height_m()) < 1e-9 && placement_error_m(s) <= p_.seat_tolerance_m;
 }
 
 Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, double part_yaw, double yaw,
@@ -235,8 +260,21 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       next.head<2>() += turned(s.offset_m.head<2>(), yaw);
       next.z() += s.offset_m.z();
       // In the hole, its walls hold the part: it slips in the fingers, which feel the wall, and
-      // keeps its yaw while they turn round it.
-      if (in_hole) {
+      // keeps its yaw while they turn round it. Stuck to an opened finger on its seat, the seat's
+      // friction may hold it too (release.h, roll): the finger's contact peels as it turns.
+      const bool stuck_on_seat =
+          s.phase == PartPhase::kStuckToFinger &&
+          s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
+      const bool seat_holds_turn =
+          stuck_on_seat && (in_hole || seat_moment_Nm(p_) > finger_peel_moment_Nm(p_)) && yaw != last_yaw;
+      if (seat_holds_turn) {
+        s.stuck_turn_rad += std::abs(yaw - last_yaw);
+        if (s.stuck_turn_rad >= p_.roll_peel_angle_rad) s.finger_contact_rolled = true;
+        next = s.part_m;  // it stays where it is, as it is
+        s.offset_m.head<2>() = turned((s.part_m - g).head<2>(), -yaw);
+        s.offset_m.z() = s.part_m.z() - g.z();
+        s.yaw_offset_rad = s.part_yaw_rad - yaw;
+      } else if (in_hole) {
         s.yaw_offset_rad = s.part_yaw_rad - yaw;
       } else {
         s.part_yaw_rad = yaw + s.yaw_offset_rad;
@@ -255,12 +293,15 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       s.part_m = next;
       // The meniscus bridges a gap up to its rupture distance: a part that close still touches.
       const bool on_substrate = s.part_m.z() <= floor + p_.meniscus_rupture_m;
+      // Which adhesion keeps the part once the fingers are open (release.h: the shake's inertia,
+      // a contact rolled onto its edge).
+      const bool shaking = s.gripper.shaking;
+      const bool rolled = s.finger_contact_rolled;
       if (s.phase == PartPhase::kGrasped && grip <= 0.0) {
-        // Fingers opened: which adhesion keeps the part?
-        if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
+        if (on_substrate && seat_keeps(p_, shaking, rolled)) {
           s.phase = PartPhase::kOnSubstrate;
           s.part_m.z() = floor;
-        } else if (!on_substrate && 2.0 * p_.finger_pulloff_N < weight_) {
+        } else if (!on_substrate && drops_off(p_, shaking, rolled)) {
           s.phase = PartPhase::kOnSubstrate;  // falls
           s.part_m.z() = floor;
         } else {
@@ -269,10 +310,17 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       } else if (s.phase == PartPhase::kStuckToFinger) {
         if (grip > 0.0) {
           s.phase = PartPhase::kGrasped;  // grasped again
-        } else if (on_substrate && p_.substrate_pulloff_N > 2.0 * p_.finger_pulloff_N) {
-          s.phase = PartPhase::kOnSubstrate;  // touched down: the substrate wins
+        } else if (on_substrate && seat_keeps(p_, shaking, rolled)) {
+          s.phase = PartPhase::kOnSubstrate;  // on its seat: the seat wins
+          s.part_m.z() = floor;
+        } else if (!on_substrate && drops_off(p_, shaking, rolled)) {
+          s.phase = PartPhase::kOnSubstrate;  // shaken off in the air: it falls
           s.part_m.z() = floor;
         }
+      }
+      if (s.phase != PartPhase::kStuckToFinger) {  // a fresh contact the next time it sticks
+        s.stuck_turn_rad = 0.0;
+        s.finger_contact_rolled = false;
       }
       // A held part dragged on the substrate rubs on it.
       if (on_substrate && s.phase == PartPhase::kGrasped) {

@@ -90,6 +90,14 @@ struct PickPlaceParams {
   /// negative floor lets the tips into the substrate: only for tests of stiff contacts (the
   /// passivity tests), never on a platform with a customer's parts.
   double min_tip_height_m = 10e-6;
+  /// Without a hole the target is a flat seat: a part resting within this of it is placed.
+  double seat_tolerance_m = 10e-6;
+  /// Release by rolling (release.h): the share of a finger's pull-off left once its flat contact
+  /// has peeled onto its edge (line contact: a tenth of the face's), and the turn of the fingers
+  /// against the held part that peels it (it lifts the far edge of a 40 um contact by 0.4 um, far
+  /// beyond van der Waals' nanometre range, and far above the rotary axis' holding jitter).
+  double roll_edge_fraction = 0.1;
+  double roll_peel_angle_rad = 0.01;
 
   template <class V>
   void visit(V& v) {
@@ -116,9 +124,13 @@ struct PickPlaceParams {
     v("grip_force_limit_N", grip_force_limit_N);
     v("contact_force_limit_N", contact_force_limit_N);
     v("min_tip_height_m", min_tip_height_m);
+    v("seat_tolerance_m", seat_tolerance_m);
+    v("roll_edge_fraction", roll_edge_fraction);
+    v("roll_peel_angle_rad", roll_peel_angle_rad);
   }
   void validate() const;
   double part_weight_N() const;
+  double part_mass_kg() const;
   double height_m() const { return part_height_m > 0.0 ? part_height_m : part_side_m; }
 };
 
@@ -126,6 +138,13 @@ struct PickPlaceParams {
 /// deep at the target (20 um of clearance, 10 um each side). `microcobot serve --scene
 /// pin-in-hole`; scenes/pin-in-hole.yaml is the same scene as a file.
 PickPlaceParams pin_in_hole_scene();
+
+/// A flat part on a flat, dry seat (issue #29 point 1; release.h): a 300 x 300 x 50 um brass plate
+/// (a bridge's blank) whose edge faces cling to the fingers' flat tips by van der Waals over a true
+/// contact of 2e-13 m^2 (1e-4 of the 40 x 50 um face: 16.6 uN per finger), while the ground seat
+/// holds its face over 2.4e-13 m^2 (2.7e-6 of 300 x 300 um: 19.9 uN), no meniscus. Opened, the
+/// fingers keep it (19.9 < 2 x 16.6 uN); shaking (37.8 uN of inertia) or rolling releases it.
+PickPlaceParams flat_part_scene();
 
 /// `a` modulo a square's symmetry (90 deg), in [-45, 45) deg.
 double wrap_quarter_turn(double a) noexcept;
@@ -151,6 +170,10 @@ struct PickPlaceState {
   /// F on them (a wall, the substrate's drag) bends both tips by F / (2 k_finger). Where the
   /// microscope sees the tips: the gripper point plus this.
   Eigen::Vector2d finger_deflection_m = Eigen::Vector2d::Zero();
+  /// Stuck to a finger: how far the fingers have turned against the part held on its seat, and
+  /// whether that has peeled their flat contact onto its edge (release.h, roll).
+  double stuck_turn_rad = 0.0;
+  bool finger_contact_rolled = false;
   bool crashed = false;  ///< a finger tip went into the substrate at some point
 };
 
@@ -187,6 +210,9 @@ class PickPlaceWorld {
   double hole_play_m(double yaw_rad) const noexcept;
   /// The part is down in the hole (its bottom below the substrate).
   bool inserted(const PickPlaceState& s) const noexcept;
+  /// The part is where the target wants it and let go: down in the hole, or, on a flat seat,
+  /// resting on the substrate within seat_tolerance_m of the target.
+  bool placed(const PickPlaceState& s) const noexcept;
 
  private:
   bool between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g, double yaw) const noexcept;
