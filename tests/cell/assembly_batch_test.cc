@@ -56,6 +56,57 @@ TEST(AssemblyBatch, BadScenesAreRefusedWithTheKeyNamed) {
   refused("plate_x_m: 3.9e-3", "plate_x_m");            // beyond the stage's reach
   refused("bore_depth: 1", "bore_depth");               // an unknown key
   refused("world:\n  finger_friction: -1", "finger_friction");
+  refused("flat_fraction: 1.5", "flat_fraction");
+  refused("release: wiggle", "release");
+  refused("flat_thickness_m: 10.0e-6", "flat_thickness_m");  // the tips may not go below 10 um
+  refused("flat_seat_min_pulloff_N: 5.0e-5\nflat_seat_max_pulloff_N: 1.0e-5", "flat_seat_max_pulloff_N");
+  refused("min_release_margin: 0.5", "min_release_margin");
+}
+
+TEST(AssemblyBatch, FlatPartsComeFromTheirOwnStreamAndEachGetsTheReleaseItsAdhesionNeeds) {
+  AssemblyBatchParams pins;
+  pins.parts = 100;
+  pins.seed = 31;
+  AssemblyBatchParams mixed = pins;
+  mixed.flat_fraction = 0.5;
+  const auto a = assembly_jobs(pins), b = assembly_jobs(mixed);
+  int flats = 0;
+  int chosen[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_FALSE(a[i].flat);
+    EXPECT_EQ(a[i].release, microworld::ReleaseStrategy::kOpen) << "a pin in its bore lets go when opened";
+    EXPECT_EQ(a[i].world.part_start_m, b[i].world.part_start_m) << "the positions do not depend on the kinds";
+    if (!b[i].flat) {
+      EXPECT_EQ(a[i].side_m, b[i].side_m);
+      continue;
+    }
+    ++flats;
+    const auto& w = b[i].world;
+    EXPECT_EQ(w.hole_side_m, 0.0);
+    EXPECT_EQ(w.part_side_m, mixed.flat_side_m);
+    EXPECT_EQ(w.part_height_m, mixed.flat_thickness_m);
+    EXPECT_GE(w.substrate_pulloff_N, mixed.flat_seat_min_pulloff_N);
+    EXPECT_LE(w.substrate_pulloff_N, mixed.flat_seat_max_pulloff_N);
+    // auto: the first of open, roll, shake that reaches the margin; the ones before it do not.
+    const auto r = b[i].release;
+    ++chosen[static_cast<int>(r)];
+    EXPECT_GE(b[i].release_margin, mixed.min_release_margin);
+    EXPECT_DOUBLE_EQ(b[i].release_margin, microworld::release_margin(w, r, false));
+    if (r != microworld::ReleaseStrategy::kOpen) {
+      EXPECT_LT(microworld::release_margin(w, microworld::ReleaseStrategy::kOpen, false),
+                mixed.min_release_margin);
+    }
+    if (r == microworld::ReleaseStrategy::kShake) {
+      EXPECT_LT(microworld::release_margin(w, microworld::ReleaseStrategy::kRoll, false),
+                mixed.min_release_margin);
+    }
+  }
+  EXPECT_GT(flats, 35);
+  EXPECT_LT(flats, 65);
+  // Seats of 5-60 uN: every strategy has its parts (open above 40 uN, roll above ~11 uN).
+  for (int c : chosen) EXPECT_GT(c, 0);
+  mixed.release = "shake";
+  for (const auto& j : assembly_jobs(mixed)) EXPECT_EQ(j.release, microworld::ReleaseStrategy::kShake);
 }
 
 }  // namespace

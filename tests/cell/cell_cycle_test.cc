@@ -79,6 +79,55 @@ TEST(CellCycle, APinThatCameUpWithAFingerFailsTheVerifyStepAndTheCycleEndsHoldin
   EXPECT_GT(plain.step_s[static_cast<std::size_t>(Step::kVerify)], 0.0);
 }
 
+// A flat part on a dry seat of 20 uN (microworld/release.h): opened, the fingers (2 x 16.6 uN) keep
+// it and it comes up with the retract; rolled or shaken off, it stays on its seat. Each cycle
+// ends holding, the rotary axis too, the burst off.
+TEST(CellCycle, AFlatPartOnADrySeatIsLeftThereOnlyByTheReleaseStrategyItsAdhesionNeeds) {
+  AssemblyBatchParams p;
+  p.parts = 1;
+  p.seed = 43;
+  p.flat_fraction = 1.0;
+  p.flat_seat_min_pulloff_N = p.flat_seat_max_pulloff_N = 20e-6;
+  for (const char* release : {"open", "roll", "shake"}) {
+    p.release = release;
+    const AssemblyJob flat = assembly_jobs(p).front();
+    ASSERT_TRUE(flat.flat);
+    CellCycle c(flat, CellRunParams{}, default_platform());
+    c.run_to_end();
+    const CycleResult r = c.result();
+    EXPECT_EQ(r.part, "flat");
+    EXPECT_EQ(r.release, release);
+    EXPECT_TRUE(r.ended_holding) << release;
+    EXPECT_EQ(r.grip_violations + r.contact_violations, 0) << release;
+    EXPECT_FALSE(c.platform().simulation().gripper->world_state().gripper.shaking) << release;
+    const auto phase = c.platform().simulation().gripper->world_state().phase;
+    if (std::string(release) == "open") {
+      EXPECT_FALSE(r.success);
+      EXPECT_EQ(phase, microworld::PartPhase::kStuckToFinger);
+      EXPECT_NE(r.verdict.find("not down on its seat"), std::string::npos) << r.verdict;
+    } else {
+      EXPECT_TRUE(r.success) << release << ": " << r.verdict;
+      EXPECT_EQ(r.verdict, "placed and released");
+      EXPECT_LE(r.placement_error_m, p.seat_tolerance_m);
+      EXPECT_GT(r.step_s[static_cast<std::size_t>(Step::kRelease)], 0.05) << "the strategy takes its time";
+    }
+  }
+}
+
+TEST(CellCycle, FlatPartsAreTheRobotsOnlyAndSaySo) {
+  AssemblyBatchParams p;
+  p.parts = 1;
+  p.flat_fraction = 1.0;
+  CellRunParams manual;
+  manual.mode = "manual";
+  try {
+    CellCycle c(assembly_jobs(p).front(), manual, default_platform());
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("flat_fraction"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {
   CellCycle c(job(), CellRunParams{}, default_platform());
   // Mid-transport the operator pauses for a second, then resumes.

@@ -191,6 +191,27 @@ TEST(Teleoperation, TheConsoleJogsTheStageAtItsVelocityCappedAndOnlyWithTheDeadm
   EXPECT_DOUBLE_EQ(t.output().slave_target_m.x(), held);
 }
 
+TEST(Teleoperation, TheGrippersReleaseBurstPassesOnlyFromAnEngagedConsoleThatHasTheGripper) {
+  Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
+  auto in = console_at(0.0);
+  in.console.has_gripper = true;
+  in.console.gripper_opening_m = 600e-6;
+  in.console.gripper_shake = true;
+  EXPECT_TRUE(t.tick(in).gripper_shake);
+  in.console.deadman = false;  // nothing of the slave moves without the deadman, the fingers neither
+  EXPECT_FALSE(t.tick(in).gripper_shake);
+  in.console.deadman = true;
+  in.console.fresh = false;  // stale commands
+  EXPECT_FALSE(t.tick(in).gripper_shake);
+  in.console.fresh = true;
+  in.console.has_gripper = false;  // the TéléTweez has the gripper
+  EXPECT_FALSE(t.tick(in).gripper_shake);
+  in.console.has_gripper = true;
+  in.console.active = false;  // the haptic master holds control
+  in.deadman = true;
+  EXPECT_FALSE(t.tick(in).gripper_shake);
+}
+
 TEST(Teleoperation, ClickToGoMovesStraightToTheGoalAndLandsOnIt) {
   Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
   auto in = console_at(0.0);

@@ -35,7 +35,57 @@ void AssemblyBatchParams::validate() const {
                                std::pair{"plate_x_m", plate_x_m}, std::pair{"plate_y_m", plate_y_m}})
     require(std::isfinite(v) && std::abs(v) + half_size_m <= 4e-3, key,
             "must keep the area (half_size_m) within 4 mm of the stage's home", v);
+  require(std::isfinite(flat_fraction) && flat_fraction >= 0.0 && flat_fraction <= 1.0, "flat_fraction",
+          "must be within [0, 1]", flat_fraction);
+  require_positive(flat_side_m, "flat_side_m");
+  require(flat_side_m + 8.0 * slot_error_m < world.gripper.max_opening_m, "flat_side_m",
+          "must leave the open gripper (world.gripper.max_opening_m) 4 slot errors each side", flat_side_m);
+  require(4.0 * slot_error_m < 0.25 * flat_side_m, "slot_error_m", "must be below flat_side_m / 16",
+          slot_error_m);
+  require(
+      std::isfinite(flat_thickness_m) && 0.5 * flat_thickness_m >= world.min_tip_height_m &&
+          flat_thickness_m < flat_side_m,
+      "flat_thickness_m",
+      "must be below flat_side_m and at least twice world.min_tip_height_m (the tips grasp at half of it)",
+      flat_thickness_m);
+  require(std::isfinite(seat_tolerance_m) && seat_tolerance_m > 0.0 && seat_tolerance_m <= 1e-3,
+          "seat_tolerance_m", "must be within (0, 1 mm]", seat_tolerance_m);
+  require_non_negative(flat_finger_pulloff_N, "flat_finger_pulloff_N");
+  require_non_negative(flat_seat_min_pulloff_N, "flat_seat_min_pulloff_N");
+  require(std::isfinite(flat_seat_max_pulloff_N) && flat_seat_max_pulloff_N >= flat_seat_min_pulloff_N,
+          "flat_seat_max_pulloff_N", "must be at least flat_seat_min_pulloff_N", flat_seat_max_pulloff_N);
+  microworld::ReleaseStrategy r;
+  require(release == "auto" || microworld::parse_release(release, r), "release",
+          "must be auto, open, shake or roll (got '" + release + "')");
+  require(std::isfinite(min_release_margin) && min_release_margin >= 1.0 && min_release_margin <= 100.0,
+          "min_release_margin", "must be within [1, 100]", min_release_margin);
   world.validate();
+}
+
+microworld::ReleaseStrategy choose_release(const microworld::PickPlaceParams& world, bool in_bore,
+                                           const std::string& release, double min_margin, double& margin) {
+  using microworld::ReleaseStrategy;
+  ReleaseStrategy chosen = ReleaseStrategy::kOpen;
+  if (release != "auto") {
+    require(microworld::parse_release(release, chosen), "release",
+            "must be auto, open, shake or roll (got '" + release + "')");
+    margin = microworld::release_margin(world, chosen, in_bore);
+    return chosen;
+  }
+  // The least disturbing first: opening alone, then a turn of the fingers, then the burst.
+  margin = -1.0;
+  for (ReleaseStrategy r : {ReleaseStrategy::kOpen, ReleaseStrategy::kRoll, ReleaseStrategy::kShake}) {
+    const double m = microworld::release_margin(world, r, in_bore);
+    if (m >= min_margin) {
+      margin = m;
+      return r;
+    }
+    if (m > margin) {
+      margin = m;
+      chosen = r;
+    }
+  }
+  return chosen;
 }
 
 std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
@@ -49,6 +99,10 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   std::mt19937_64 yaw_rng(static_cast<std::uint64_t>(params.seed) * 0x9E3779B97F4A7C15ULL + 0x796177ULL);
   std::uniform_real_distribution<double> yaw(-1.0, 1.0);
   std::normal_distribution<double> slot_yaw(0.0, 1.0);
+  std::mt19937_64 flat_rng(static_cast<std::uint64_t>(params.seed) * 0xD1B54A32D192ED03ULL + 0x666c6174ULL);
+  std::uniform_real_distribution<double> flat_u(0.0, 1.0);
+  std::uniform_real_distribution<double> seat_pulloff(params.flat_seat_min_pulloff_N,
+                                                      params.flat_seat_max_pulloff_N);
   std::vector<AssemblyJob> jobs;
   jobs.reserve(static_cast<std::size_t>(params.parts));
   for (int i = 0; i < params.parts; ++i) {
@@ -70,6 +124,22 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     j.target_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
     j.world.part_yaw_rad = j.nominal_part_yaw_rad + params.slot_yaw_error_rad * slot_yaw(yaw_rng);
     j.world.hole_yaw_rad = j.target_yaw_rad;
+    // Flat parts from a stream of their own: without any, the batch is the one of before.
+    const bool flat = flat_u(flat_rng) < params.flat_fraction;
+    const double pulloff = seat_pulloff(flat_rng);  // drawn for every part: each seat's finish is its own
+    if (flat) {
+      j.flat = true;
+      j.side_m = params.flat_side_m;
+      j.clearance_m = params.seat_tolerance_m;
+      j.world.part_side_m = params.flat_side_m;
+      j.world.part_height_m = params.flat_thickness_m;
+      j.world.hole_side_m = 0.0;
+      j.world.hole_depth_m = 0.0;
+      j.world.seat_tolerance_m = params.seat_tolerance_m;
+      j.world.finger_pulloff_N = params.flat_finger_pulloff_N;
+      j.world.substrate_pulloff_N = pulloff;
+    }
+    j.release = choose_release(j.world, !j.flat, params.release, params.min_release_margin, j.release_margin);
     j.world.validate();
     jobs.push_back(j);
   }

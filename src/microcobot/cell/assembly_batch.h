@@ -12,18 +12,29 @@
 /// grasp's squeeze takes it out). The orientations come from their own stream of the seed: with
 /// max_yaw_rad 0 and slot_yaw_error_rad 0 a batch is the one of before the rotary axis.
 ///
+/// Flat parts (issue #29 point 1): a share flat_fraction of the parts, drawn from a stream of
+/// their own, are flat plates (flat_side_m x flat_side_m x flat_thickness_m, a bridge's blank) to
+/// be placed on flat, dry seats within seat_tolerance_m, where adhesion, not gravity, decides the
+/// release (microworld/release.h): the plate clings to each finger with flat_finger_pulloff_N, and
+/// each seat's finish holds it with a pull-off drawn uniform in [flat_seat_min_pulloff_N,
+/// flat_seat_max_pulloff_N] (told to the cell, as a plate's inspection sheet would). Each part's
+/// release strategy is `release`; `auto` chooses per part the first of open, roll, shake whose
+/// margin (release.h) reaches min_release_margin, else the one of largest margin.
+///
 /// One job is one part: its microworld (microworld::PickPlaceParams: the pin, the bore, the
-/// adhesion of the default 300 um scene) and what the cell is told. The cycles of a batch run one
-/// after another on a fresh platform each (cell_run.h), so neighbouring parts do not interact yet.
-/// Positions are world coordinates (the substrate's top at z = 0); SI units.
+/// adhesion of the default 300 um scene; or the plate, its seat) and what the cell is told. The cycles of a
+/// batch run one after another on a fresh platform each (cell_run.h), so neighbouring parts do not interact
+/// yet. Positions are world coordinates (the substrate's top at z = 0); SI units.
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/microworld/release.h"
 
 namespace mc::cell {
 
@@ -44,6 +55,16 @@ struct AssemblyBatchParams {
   double plate_x_m = 1.5e-3;  ///< the plate's centre (bores likewise)
   double plate_y_m = 0.0;
   double half_size_m = 0.75e-3;  ///< half the side of the tray's and the plate's areas
+  double flat_fraction = 0.0;    ///< the share of flat parts, [0, 1] (header)
+  double flat_side_m = 300e-6;   ///< a flat part's side (issue #29: 300 um)
+  double flat_thickness_m = 50e-6;
+  double seat_tolerance_m = 10e-6;  ///< a flat part rests within this of its seat's centre
+  /// A flat part's pull-off per finger: van der Waals over its edge face (microworld::flat_part_scene).
+  double flat_finger_pulloff_N = microworld::flat_part_scene().finger_pulloff_N;
+  double flat_seat_min_pulloff_N = 5e-6;  ///< the seats' pull-off, uniform in [min, max]
+  double flat_seat_max_pulloff_N = 60e-6;
+  std::string release = "auto";     ///< auto, open, shake or roll (header)
+  double min_release_margin = 1.2;  ///< auto: the margin a strategy must reach to be chosen
   /// The microworld every part is put in (adhesion, friction, gripper, force limits); its part,
   /// hole, start and target are the job's.
   microworld::PickPlaceParams world;
@@ -66,6 +87,15 @@ struct AssemblyBatchParams {
     v("plate_x_m", plate_x_m);
     v("plate_y_m", plate_y_m);
     v("half_size_m", half_size_m);
+    v("flat_fraction", flat_fraction);
+    v("flat_side_m", flat_side_m);
+    v("flat_thickness_m", flat_thickness_m);
+    v("seat_tolerance_m", seat_tolerance_m);
+    v("flat_finger_pulloff_N", flat_finger_pulloff_N);
+    v("flat_seat_min_pulloff_N", flat_seat_min_pulloff_N);
+    v("flat_seat_max_pulloff_N", flat_seat_max_pulloff_N);
+    v("release", release);
+    v("min_release_margin", min_release_margin);
     v("world", world);
   }
   /// Throws mc::InvalidParams naming the key: counts and ranges, a pin the open gripper cannot
@@ -77,13 +107,21 @@ struct AssemblyBatchParams {
 /// One part of the batch.
 struct AssemblyJob {
   int index = 0;
-  microworld::PickPlaceParams world;     ///< the true scene: the pin where it really is
-  Eigen::Vector2d nominal_part_m{0, 0};  ///< its slot's nominal position (what the cell is told)
-  Eigen::Vector2d target_m{0, 0};        ///< its bore's position (told, and true)
-  double nominal_part_yaw_rad = 0.0;     ///< its slot's orientation (told)
-  double target_yaw_rad = 0.0;           ///< its bore's (told, and true)
-  double side_m = 0.0, clearance_m = 0.0;
+  microworld::PickPlaceParams world;       ///< the true scene: the pin where it really is
+  Eigen::Vector2d nominal_part_m{0, 0};    ///< its slot's nominal position (what the cell is told)
+  Eigen::Vector2d target_m{0, 0};          ///< its bore's position (told, and true)
+  double nominal_part_yaw_rad = 0.0;       ///< its slot's orientation (told)
+  double target_yaw_rad = 0.0;             ///< its bore's (told, and true)
+  double side_m = 0.0, clearance_m = 0.0;  ///< a flat part's clearance: its seat's tolerance
+  bool flat = false;                       ///< a flat part on a flat seat
+  microworld::ReleaseStrategy release = microworld::ReleaseStrategy::kOpen;
+  double release_margin = 0.0;  ///< the chosen strategy's (release.h)
 };
+
+/// The release strategy `release` ("auto" or a strategy's name) gives a part in `world` (in a bore
+/// or not), and its margin.
+microworld::ReleaseStrategy choose_release(const microworld::PickPlaceParams& world, bool in_bore,
+                                           const std::string& release, double min_margin, double& margin);
 
 /// The batch's jobs, the same for the same parameters (validated here).
 std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params);

@@ -31,6 +31,14 @@ void AssemblyTaskParams::validate() const {
           "rotate_speed_rad_s", "must be within (0, 10] rad/s", rotate_speed_rad_s);
   require(std::isfinite(yaw_tolerance_rad) && yaw_tolerance_rad > 0.0 && yaw_tolerance_rad <= 0.1,
           "yaw_tolerance_rad", "must be within (0, 0.1] rad", yaw_tolerance_rad);
+  require(std::isfinite(shake_s) && shake_s > 0.0 && shake_s <= 5.0, "shake_s", "must be within (0, 5] s",
+          shake_s);
+  require(std::isfinite(roll_rad) && roll_rad > 0.0 && roll_rad <= 0.5, "roll_rad",
+          "must be within (0, 0.5] rad", roll_rad);
+}
+
+double AssemblyTask::grasp_height_m(const AssemblyTaskParams& p, const AssemblyGoal& goal) noexcept {
+  return goal.flat_seat ? 0.5 * goal.part_height_m : goal.hole_depth_m + p.grip_above_m;
 }
 
 double square_yaw_goal(double square_yaw_rad, double from_rad, double min_rad, double max_rad) noexcept {
@@ -53,14 +61,18 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   p_.validate();
   require(goal.part_m.allFinite() && goal.target_m.allFinite(), "goal", "positions must be finite");
   require_positive(goal.part_height_m, "goal.part_height_m");
-  require_positive(goal.hole_depth_m, "goal.hole_depth_m");
+  if (goal.flat_seat) {
+    require(goal.hole_depth_m == 0.0, "goal.hole_depth_m", "must be 0 on a flat seat", goal.hole_depth_m);
+  } else {
+    require_positive(goal.hole_depth_m, "goal.hole_depth_m");
+  }
   require_positive(goal.clearance_m, "goal.clearance_m");
   require_positive(goal.open_m, "goal.open_m");
   require(std::isfinite(goal.part_yaw_rad) && std::isfinite(goal.target_yaw_rad), "goal",
           "orientations must be finite");
   require(goal.yaw_min_rad < goal.yaw_max_rad, "goal.yaw_min_rad", "must be below goal.yaw_max_rad",
           goal.yaw_min_rad);
-  grasp_z_ = goal.hole_depth_m + p_.grip_above_m;
+  grasp_z_ = grasp_height_m(p_, goal);
   rim_z_ = grasp_z_;
   require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
           p_.grip_above_m);
@@ -143,6 +155,9 @@ void AssemblyTask::enter(Step s) noexcept {
   step_s_ = 0.0;
   settled_s_ = 0.0;
   insert_ = Insert::kDescend;
+  release_ = Release::kOpen;
+  release_s_ = 0.0;
+  out_.gripper_shake = false;
   if (s == Step::kInsert) {  // a fresh search, however the insertion was reached
     tries_ = 0;
     offset_y_ = search_base_ = 0.0;
@@ -464,11 +479,7 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
       insert_tick(s, dt_s);
       break;
     case Step::kRelease:
-      opening_command_ = goal_.open_m;
-      out_.gripper_opening_m = opening_command_;
-      move_to(s.tip_m, p_.z_speed_m_s, s, dt_s);  // stay
-      settled_s_ = s.opening_m >= 0.9 * goal_.open_m ? settled_s_ : 0.0;
-      if (settled_s_ >= p_.settle_s) enter(Step::kRetract);
+      release_tick(s, dt_s);
       break;
     case Step::kRetract:
       if (move_to({search_xy().x(), search_xy().y(), safe_z_}, p_.z_speed_m_s, s, dt_s)) enter(Step::kVerify);
@@ -493,11 +504,15 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
         const double c = std::cos(goal_.target_yaw_rad), sn = std::sin(goal_.target_yaw_rad);
         const double off_axis = std::max(std::abs(c * d.x() + sn * d.y()), std::abs(-sn * d.x() + c * d.y()));
         if (part.z() > inserted_z + p_.verify_tolerance_m) {
-          fail("the pin is not down in its bore (seen by the cell's vision)");
+          fail(goal_.flat_seat ? "the part is not down on its seat (seen by the cell's vision)"
+                               : "the pin is not down in its bore (seen by the cell's vision)");
           break;
         }
-        if (off_axis > goal_.clearance_m + p_.verify_tolerance_m) {
-          fail("the pin is off its bore's axis (seen by the cell's vision)");
+        // A flat seat's tolerance is told as its clearance; a pin is off its bore's axis.
+        const double allowed = goal_.clearance_m + (goal_.flat_seat ? 0.0 : p_.verify_tolerance_m);
+        if (off_axis > allowed) {
+          fail(goal_.flat_seat ? "the part is off its seat (seen by the cell's vision)"
+                               : "the pin is off its bore's axis (seen by the cell's vision)");
           break;
         }
       }
@@ -524,8 +539,8 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
         break;
       }
       contact_z_ = s.tip_m.z();
-      if (contact_z_ < grasp_z_ - 0.5 * goal_.hole_depth_m) {
-        enter(Step::kRelease);  // down in the bore
+      if (goal_.flat_seat || contact_z_ < grasp_z_ - 0.5 * goal_.hole_depth_m) {
+        enter(Step::kRelease);  // down in the bore, or on the flat seat
         break;
       }
       // On the rim: the next point of the search along the fingers' y (0, +s, -s, +2s, -2s, ...).
@@ -560,6 +575,39 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
         settled_s_ = 0.0;
       }
       break;
+  }
+}
+
+void AssemblyTask::release_tick(const TaskSensors& s, double dt) noexcept {
+  opening_command_ = goal_.open_m;
+  out_.gripper_opening_m = opening_command_;
+  move_to(s.tip_m, p_.z_speed_m_s, s, dt);  // stay
+  switch (release_) {
+    case Release::kOpen:
+      settled_s_ = s.opening_m >= 0.9 * goal_.open_m ? settled_s_ : 0.0;
+      if (settled_s_ < p_.settle_s) return;
+      if (goal_.release == microworld::ReleaseStrategy::kOpen) {
+        enter(Step::kRetract);
+        return;
+      }
+      release_ = Release::kStrategy;
+      release_s_ = 0.0;
+      if (goal_.release == microworld::ReleaseStrategy::kRoll) {
+        // The way that stays within the rotary axis' travel.
+        const double up = s.yaw_rad + p_.roll_rad;
+        turn_to(up <= goal_.yaw_max_rad ? up : s.yaw_rad - p_.roll_rad);
+      }
+      return;
+    case Release::kStrategy:
+      release_s_ += dt;
+      if (goal_.release == microworld::ReleaseStrategy::kShake) {
+        out_.gripper_shake = release_s_ < p_.shake_s;
+        if (out_.gripper_shake) return;
+      } else if (std::abs(s.yaw_rad - yaw_goal_) > p_.yaw_tolerance_rad) {
+        return;  // still turning
+      }
+      enter(Step::kRetract);
+      return;
   }
 }
 

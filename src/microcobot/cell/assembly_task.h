@@ -21,14 +21,18 @@
 ///              rotate is automatic)
 ///   rotate     the pin's faces square with the bore's: the rotary axis to the bore's yaw modulo
 ///              90 deg (the pin turns with the fingers about the tips' centre, over the bore)
-///   insert     force-guarded: down at `insert_speed_m_s` until the contact force exceeds
-///              `contact_threshold_N`. Reached near the bore's depth: inserted. Reached at the
+///   insert     a flat part onto a flat seat (AssemblyGoal::flat_seat): down at insert_speed_m_s
+///              until the contact force exceeds contact_threshold_N, which is the seat: placed.
+///              A pin into its bore: force-guarded: down at `insert_speed_m_s` until the contact force
+///              exceeds `contact_threshold_N`. Reached near the bore's depth: inserted. Reached at the
 ///              surface: jammed on the rim; up by `search_retreat_m`, over to the next point of
 ///              the search along the fingers' y, the pin's unknown direction in them (0, +s, -s,
 ///              +2s, ... with s = search_step_factor x the bore's
 ///              radial clearance; a pin fits when |dy| <= clearance), down again; beyond
 ///              `search_range_m`: failed
-///   release    open the fingers (the substrate's adhesion keeps the pin in its bore)
+///   release    open the fingers (the substrate's adhesion keeps the pin in its bore), then the
+///              goal's release strategy (microworld/release.h): shake, the gripper's burst for
+///              shake_s; roll, the fingers turned by roll_rad with the part on its seat
 ///   retract    up clear of the pin
 ///   verify     the stage still, the cell's vision looks at the pin: down in its bore (its centre
 ///              within verify_tolerance_m of the inserted height, and within the bore's clearance
@@ -71,6 +75,7 @@
 #include <Eigen/Dense>
 
 #include "microcobot/control/teleoperation.h"
+#include "microcobot/microworld/release.h"
 
 namespace mc::cell {
 
@@ -96,6 +101,11 @@ struct AssemblyTaskParams {
   /// 300 um pin 0.08 um of its play, whose least is 3 um).
   double rotate_speed_rad_s = 0.16;
   double yaw_tolerance_rad = 0.5e-3;
+  /// release: how long the gripper's burst shakes the opened fingers (release.h, shake), and how
+  /// far the fingers turn to roll their contact off the part (three times the world's 0.01 rad
+  /// peel angle).
+  double shake_s = 0.05;
+  double roll_rad = 0.03;
 
   template <class V>
   void visit(V& v) {
@@ -116,6 +126,8 @@ struct AssemblyTaskParams {
     v("verify_tolerance_m", verify_tolerance_m);
     v("rotate_speed_rad_s", rotate_speed_rad_s);
     v("yaw_tolerance_rad", yaw_tolerance_rad);
+    v("shake_s", shake_s);
+    v("roll_rad", roll_rad);
   }
   void validate() const;
 };
@@ -125,8 +137,12 @@ struct AssemblyGoal {
   Eigen::Vector2d part_m{0, 0};    ///< the pin's nominal position
   Eigen::Vector2d target_m{0, 0};  ///< the bore
   double part_height_m = 600e-6;
-  double hole_depth_m = 300e-6;
-  double clearance_m = 10e-6;   ///< the bore's radial clearance
+  double hole_depth_m = 300e-6;  ///< the bore's depth (0 on a flat seat)
+  /// The bore's radial clearance; on a flat seat, how far from its centre the part may rest.
+  double clearance_m = 10e-6;
+  bool flat_seat = false;  ///< the target is a flat seat, not a bore (a flat part is placed on it)
+  /// How the fingers let go of the part (microworld/release.h; assembly_batch.h chooses per part).
+  microworld::ReleaseStrategy release = microworld::ReleaseStrategy::kOpen;
   double open_m = 600e-6;       ///< the gripper fully open
   double part_yaw_rad = 0.0;    ///< the pin's nominal orientation in its slot (a square: modulo 90 deg)
   double target_yaw_rad = 0.0;  ///< the bore's orientation
@@ -200,6 +216,9 @@ class AssemblyTask {
   /// (the guide holds; done once the fingers are open).
   static bool assistable(Step s) noexcept;
 
+  /// The finger tips' height while grasping: grip_above_m over a full bore (the pin's bottom sits
+  /// at the bore's depth below them), half a flat part's thickness on a flat seat.
+  static double grasp_height_m(const AssemblyTaskParams& p, const AssemblyGoal& goal) noexcept;
   /// Throws mc::InvalidParams (parameters, goal).
   AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal);
 
@@ -255,6 +274,7 @@ class AssemblyTask {
 
  private:
   enum class Insert { kDescend, kRetreat, kShift };
+  enum class Release { kOpen, kStrategy };
   static std::size_t index(Step s) noexcept { return static_cast<std::size_t>(s); }
   void enter(Step s) noexcept;
   void begin_step() noexcept;
@@ -273,6 +293,7 @@ class AssemblyTask {
   /// The search's point: the bore's axis plus offset_y_ along the fingers' y.
   Eigen::Vector2d search_xy() const noexcept;
   void insert_tick(const TaskSensors& s, double dt) noexcept;
+  void release_tick(const TaskSensors& s, double dt) noexcept;
 
   AssemblyTaskParams p_;
   AssemblyGoal goal_;
@@ -286,7 +307,9 @@ class AssemblyTask {
   double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
   double opening_command_ = 0.0;
   Insert insert_ = Insert::kDescend;
-  double rim_z_ = 0.0;  // tool-point height at which the held pin's bottom meets the surface
+  Release release_ = Release::kOpen;
+  double release_s_ = 0.0;  // time in the release's strategy
+  double rim_z_ = 0.0;      // tool-point height at which the held pin's bottom meets the surface
   Eigen::Vector2d assist_from_ = Eigen::Vector2d::Zero();  // where an assisted move's path starts
   bool assist_from_known_ = false;
   int tries_ = 0;                                                // search points tried

@@ -40,6 +40,8 @@ nlohmann::json CycleResult::to_json() const {
           {"path_m", path_m},
           {"side_m", side_m},
           {"clearance_m", clearance_m},
+          {"part", part},
+          {"release", release},
           {"wall_s", wall_s},
           {"ended_holding", ended_holding},
           {"looks", looks},
@@ -78,6 +80,8 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("contact_violations", r.contact_violations);
   get("clutches", r.clutches);
   get("search_tries", r.search_tries);
+  get("part", r.part);
+  get("release", r.release);
   get("submovements", r.submovements);
   get("confirmations", r.confirmations);
   get("path_m", r.path_m);

@@ -87,6 +87,8 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       vision_rng_(static_cast<std::uint64_t>(params.person_seed) * 1000003ULL +
                   static_cast<std::uint64_t>(job.index) + 0x766973696f6eULL) {
   params_.validate();
+  require(!job.flat || params_.mode == "auto", "flat_fraction",
+          "gives flat parts, which only the robot places (mode auto; got mode '" + params_.mode + "')");
   base = with_world(std::move(base), job);
   platform_ = std::make_unique<platform::Platform>(base);
   home_m_ = {base.stage.home_x_m, base.stage.home_y_m, base.stage.home_z_m};
@@ -203,7 +205,7 @@ void CellCycle::look() {
         break;
       case AssemblyTask::Look::kHeld: {
         // The pin's top where the grasp left it: the tips grasp_z above its bottom.
-        const double grasp_z = job_.world.hole_depth_m + params_.task.grip_above_m;
+        const double grasp_z = AssemblyTask::grasp_height_m(params_.task, assembly_goal(job_));
         seen = camera_->look_held(truth, pin, s.tip_m, s.yaw_rad, s.tip_m.z() - grasp_z + pin.height_m);
         break;
       }
@@ -262,10 +264,15 @@ CycleResult CellCycle::result() const {
   r.mode = params_.mode;
   r.side_m = job_.side_m;
   r.clearance_m = job_.clearance_m;
+  r.part = job_.flat ? "flat" : "pin";
+  r.release = std::string(microworld::name(job_.release));
   r.cycle_s = finished_ ? finished_at_s_ : p.loop().time_s();
   const auto& gripper = *p.simulation().gripper;
   const auto& w = gripper.world_state();
-  const bool inserted = gripper.world().inserted(w) && w.phase == microworld::PartPhase::kOnSubstrate;
+  // Down in its bore, or resting on its flat seat within its tolerance, and let go.
+  const bool inserted = gripper.world().placed(w);
+  const std::string done = job_.flat ? "placed and released" : "inserted and released";
+  const std::string not_done = job_.flat ? "the part is not on its seat" : "the pin is not down in its bore";
   r.placement_error_m = gripper.world().placement_error_m(w);
   r.peak_grip_N = meter.peak_grip;
   r.mean_grip_N = meter.gripped_ticks > 0 ? meter.grip_sum / static_cast<double>(meter.gripped_ticks) : 0.0;
@@ -296,7 +303,7 @@ CycleResult CellCycle::result() const {
       if (task_->step() == AssemblyTask::Step::kVerify && !last_look_miss_.empty())
         r.verdict += " (" + std::string(last_look_miss_) + ")";
     } else {
-      r.verdict = inserted ? "inserted and released" : "the task ended but the pin is not down in its bore";
+      r.verdict = inserted ? done : "the task ended but " + not_done;
     }
     r.ended_holding = r.ended_holding && held_;
   } else if (person_) {

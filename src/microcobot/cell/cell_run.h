@@ -101,6 +101,8 @@ struct CycleResult {
   int confirmations = 0;  ///< steps the supervisor confirmed (autonomy `confirm`)
   double path_m = 0.0;    ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
+  std::string part = "pin";        ///< "pin" (into a bore) or "flat" (onto a flat seat)
+  std::string release;             ///< the release strategy the part was given (microworld/release.h)
   double wall_s = 0.0;             ///< the cycle's wall-clock time, the platform's construction included
   int looks = 0, looks_found = 0;  ///< the cell camera's looks (CellCameraParams::enabled)
   double look_error_m = 0.0;       ///< the largest |seen - true| of the pin's centre in x-y, found looks

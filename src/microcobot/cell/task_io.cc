@@ -24,6 +24,8 @@ AssemblyGoal assembly_goal(const AssemblyJob& job) {
   goal.open_m = job.world.gripper.max_opening_m;
   goal.part_yaw_rad = job.nominal_part_yaw_rad;
   goal.target_yaw_rad = job.target_yaw_rad;
+  goal.flat_seat = job.flat;
+  goal.release = job.release;
   return goal;
 }
 

@@ -87,6 +87,7 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
                                ? std::max(0.0, c.gripper_opening_m)
                                : out_.gripper_opening_m;
   apply_limits(in, requested);
+  out_.gripper_shake = out_.engaged && c.has_gripper && c.gripper_shake;
   if (!out_.engaged) {
     raw_xy_m_ = out_.slave_target_m.head<2>();
     raw_z_m_ = out_.slave_target_m.z();
@@ -167,6 +168,7 @@ Eigen::Vector2d Teleoperation::follow_fixtures(const Eigen::Vector2d& from) noex
 
 const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noexcept {
   fixtures_.tick(dt_);
+  out_.gripper_shake = false;  // the console's path below turns it on, engaged only
   if (reindex_) {
     // The master's own target becomes where the slave is sent now (like a clutch), so that the
     // new field starts from the slave's target, not from where the hand's mapping would put it.

@@ -83,6 +83,8 @@ struct ConsoleInput {
   double goal_speed_m_s = 100e-6;  ///< speed of the straight move to the goal
   double gripper_opening_m = 0.0;
   bool has_gripper = false;  ///< false: the TéléTweez drives the gripper
+  /// The gripper's release burst (microworld/release.h, shake), with the gripper and the deadman.
+  bool gripper_shake = false;
   /// The rotary axis (rotary_axis.h): to theta_goal_rad at theta_speed_rad_s (has_theta_goal),
   /// else at the dial's rate theta_rate_rad_s; with this input's deadman, whether or not it holds
   /// the XYZ coupling (the haptic master has no rotation: the console's dial turns the gripper).
@@ -117,6 +119,7 @@ struct TeleoperationOutput {
   Eigen::Vector3d slave_target_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d slave_velocity_m_s = Eigen::Vector3d::Zero();  ///< feedforward of the target
   double gripper_opening_m = 0.0;
+  bool gripper_shake = false;  ///< the release burst: only from an engaged console that has the gripper
   Eigen::Vector2d haptic_force_N = Eigen::Vector2d::Zero();
   double finger_force_N = 0.0;
   bool engaged = false;

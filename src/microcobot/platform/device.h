@@ -167,6 +167,10 @@ class Gripper : public Device {
   /// The opening the drive puts the fingers at with nothing between them: its open-loop model
   /// of its own actuation (force by vision's reference, vision_grip_force.h). NaN: none.
   virtual double free_opening_m() const { return std::nan(""); }
+  /// The drive's release burst on or off (microworld/release.h, shake); a gripper whose drive has
+  /// none ignores it (can_shake() false).
+  virtual void command_shake(bool /*on*/) noexcept {}
+  virtual bool can_shake() const { return false; }
 };
 
 }  // namespace mc::platform

@@ -231,6 +231,7 @@ void Platform::teleoperation_task() noexcept {
   devices_.haptic->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
   devices_.tweezers->command_grip_force_N(out.finger_force_N);
   devices_.gripper->command_opening_m(out.gripper_opening_m);
+  devices_.gripper->command_shake(out.gripper_shake);
 }
 
 void Platform::slave_control_task() noexcept {

@@ -21,6 +21,7 @@ SimulatedGripper::SimulatedGripper(std::string name, const microworld::PickPlace
 void SimulatedGripper::on_configure() {
   state_ = world_.initial_state();
   command_m_ = world_.params().gripper.max_opening_m;
+  shake_ = false;
   state_.last_gripper_m = tip_position_m();
   state_.last_gripper_yaw_rad = yaw_rad();
   out_ = world_.step(state_, tip_position_m(), command_m_, 0.0, yaw_rad());
@@ -36,6 +37,7 @@ void SimulatedGripper::command_opening_m(double opening) noexcept {
 }
 
 void SimulatedGripper::update(double dt_s) noexcept {
+  state_.gripper.shaking = shake_;
   out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad());
 }
 

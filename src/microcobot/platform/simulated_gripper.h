@@ -31,8 +31,12 @@ class SimulatedGripper final : public Gripper {
   Vec3 contact_force_N() const override {
     return {out_.force_on_gripper_N.x(), out_.force_on_gripper_N.y(), out_.force_on_gripper_N.z()};
   }
+  /// The burst shakes the fingers in the microworld while on (an inactive gripper ignores it).
+  void command_shake(bool on) noexcept override { shake_ = active() && on; }
+  bool can_shake() const override { return true; }
   void update(double dt_s) noexcept override;
-  void enter_safe_state() noexcept override {}
+  /// The safe state keeps the opening but stops the burst.
+  void enter_safe_state() noexcept override { shake_ = false; }
 
   /// The rotary axis that turns the fingers (`axis` must outlive the gripper); call before
   /// configure().
@@ -64,6 +68,7 @@ class SimulatedGripper final : public Gripper {
   microworld::PickPlaceState state_;
   microworld::PickPlaceOutput out_;
   double command_m_;
+  bool shake_ = false;
 };
 
 }  // namespace mc::platform
