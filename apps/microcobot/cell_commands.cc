@@ -102,6 +102,8 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                       "path_m",
                                       "side_m",
                                       "clearance_m",
+                                      "flat",
+                                      "release",
                                       "ended_holding",
                                       "wall_s",
                                       "looks",
@@ -113,6 +115,10 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
     columns.push_back(std::string(cell::AssemblyTask::name(static_cast<cell::AssemblyTask::Step>(i))) + "_s");
   mc::CsvTable t(columns);
   for (const auto& c : cycles) {
+    // The release strategy as its number (0 open, 1 shake, 2 roll: microworld::ReleaseStrategy).
+    mc::microworld::ReleaseStrategy release = mc::microworld::ReleaseStrategy::kOpen;
+    const double release_code =
+        mc::microworld::parse_release(c.release, release) ? static_cast<double>(release) : std::nan("");
     std::vector<double> row = {static_cast<double>(c.index),
                                c.success ? 1.0 : 0.0,
                                c.cycle_s,
@@ -129,6 +135,8 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                c.path_m,
                                c.side_m,
                                c.clearance_m,
+                               c.part == "flat" ? 1.0 : 0.0,
+                               release_code,
                                c.ended_holding ? 1.0 : 0.0,
                                c.wall_s,
                                static_cast<double>(c.looks),
@@ -157,7 +165,7 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
       fmt::format("{} parts (seed {}) inserted by {}; each on a fresh simulated platform. Success: the pin "
                   "down in its bore and released (the simulation's truth). docs/cell.md.",
                   s.cycles, seed, who(s.mode)));
-  rep.add_result("inserted", s.successes);
+  rep.add_result("placed (pins in their bores, flat parts on their seats)", s.successes);
   rep.add_result("success rate", 100.0 * s.success_rate, "%");
   rep.add_result("95 % Wilson interval, low", 100.0 * s.success_low, "%");
   rep.add_result("95 % Wilson interval, high", 100.0 * s.success_high, "%");
@@ -276,7 +284,7 @@ void run(const CellOptions& o) {
           : std::string();
   mc::cli::emit(
       o.common, summary,
-      fmt::format("cell run {} (seed {}): {}/{} inserted ({:.0f} %, 95 % CI {:.0f}-{:.0f} %), cycle median "
+      fmt::format("cell run {} (seed {}): {}/{} placed ({:.0f} %, 95 % CI {:.0f}-{:.0f} %), cycle median "
                   "{:.1f} s (IQR {:.1f}-{:.1f} s), placement median {:.2f} um, peak grip {:.3f} mN, "
                   "{} ticks over a force limit; {:.0f} s simulated in {:.1f} s{}{}",
                   s.mode, scene.seed, s.successes, s.cycles, 100 * s.success_rate, 100 * s.success_low,

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <random>
+
 #include "microcobot/core/error.h"
 
 namespace mc::control {
@@ -210,6 +213,58 @@ TEST(Teleoperation, TheGrippersReleaseBurstPassesOnlyFromAnEngagedConsoleThatHas
   in.console.active = false;  // the haptic master holds control
   in.deadman = true;
   EXPECT_FALSE(t.tick(in).gripper_shake);
+}
+
+// A neighbouring part's keep-out region (virtual_fixtures.h): a hand that sweeps the slave across
+// it low, trembling (8-12 Hz, 100 um RMS at the hand, issue #29) and rolling the wheel down, never
+// puts the target inside; above the part's top it passes over; nothing jumps on leaving.
+TEST(Teleoperation, UnderTremorTheTargetNeverEntersANeighboursKeepOutAndNeverJumps) {
+  TeleoperationParams p;
+  Teleoperation t(p, kDt, {-400e-6, 0, 200e-6}, 600e-6);
+  FixtureSet f;
+  f.keep_out_count = 2;
+  f.keep_outs[0] = {{0.0, 0.0}, 250e-6, 650e-6};
+  f.keep_outs[1] = {{600e-6, 100e-6}, 250e-6, 400e-6};
+  t.set_fixtures(f);
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Tremor: three sines in 8-12 Hz of random phases, 100 um RMS per axis at the hand.
+  std::array<double, 6> hz{}, phase{};
+  for (std::size_t i = 0; i < 6; ++i) {
+    hz[i] = 8.0 + 4.0 * u(rng);
+    phase[i] = 2 * M_PI * u(rng);
+  }
+  const double a = 100e-6 * std::sqrt(2.0 / 3.0);
+  auto in = engaged_at(0.0, 0.0);
+  int held = 0;
+  double largest_step = 0.0;
+  Eigen::Vector3d last = t.tick(in).slave_target_m;
+  for (int k = 1; k < 200000; ++k) {  // 20 s
+    const double s = k * kDt;
+    // The hand sweeps +-60 mm (+-600 um of slave) at 0.05 Hz, its y wandering; the wheel goes
+    // down for 15 s (towards 0), then up.
+    double x = 0.06 * std::sin(2 * M_PI * 0.05 * s), y = 0.02 * std::sin(2 * M_PI * 0.13 * s);
+    for (std::size_t i = 0; i < 3; ++i) x += a * std::sin(2 * M_PI * hz[i] * s + phase[i]);
+    for (std::size_t i = 3; i < 6; ++i) y += a * std::sin(2 * M_PI * hz[i] * s + phase[i]);
+    in.handle_m = {x, y};
+    in.z_jog_m_s = s < 15.0 ? -40e-6 : 100e-6;
+    const Eigen::Vector3d now = t.tick(in).slave_target_m;
+    for (int i = 0; i < f.keep_out_count; ++i) {
+      const auto& ko = f.keep_outs[static_cast<std::size_t>(i)];
+      ASSERT_FALSE(now.z() < ko.top_z_m && (now.head<2>() - ko.xy_m).norm() < ko.radius_m * (1 - 1e-12))
+          << "inside region " << i << " at " << s << " s";
+    }
+    for (int i = 0; i < f.keep_out_count; ++i) {
+      const auto& ko = f.keep_outs[static_cast<std::size_t>(i)];
+      if (now.z() < ko.top_z_m && std::abs((now.head<2>() - ko.xy_m).norm() - ko.radius_m) < 1e-9) ++held;
+    }
+    if (k > 1) largest_step = std::max(largest_step, (now - last).norm());  // the first: the tremor's start
+    last = now;
+  }
+  // The hand's fastest motion is 2 pi 0.05 x 60 mm x 0.01 = 190 um/s of slave plus the tremor's
+  // ~60 um/s: a tick moves at most ~30 nm; a jump out of a region would be hundreds of um.
+  EXPECT_LT(largest_step, 0.1e-6);
+  EXPECT_GT(held, 1000) << "ticks held on a region's edge: the sweep must reach the regions";
 }
 
 TEST(Teleoperation, ClickToGoMovesStraightToTheGoalAndLandsOnIt) {

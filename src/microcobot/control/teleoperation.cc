@@ -30,6 +30,7 @@ Teleoperation::Teleoperation(const TeleoperationParams& params, double dt_s,
   p_.validate();
   require_positive(dt_s, "dt_s");
   out_.slave_target_m = slave_start_m;
+  kept_from_m_ = slave_start_m;
   out_.gripper_opening_m = gripper_start_m;
   last_xy_m_ = slave_start_m.head<2>();
   raw_xy_m_ = last_xy_m_;
@@ -99,6 +100,18 @@ void Teleoperation::console_tick(const TeleoperationInput& in) noexcept {
 }
 
 void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_opening_m) noexcept {
+  // The neighbours' keep-out regions first (virtual_fixtures.h): from where the target was at the
+  // last tick; the master's own target goes with the correction (no wind-up).
+  Eigen::Vector3d kept = out_.slave_target_m;
+  if (fixtures_.keep_out(kept_from_m_, kept)) {
+    const Eigen::Vector3d d = kept - out_.slave_target_m;
+    offset_m_ += d.head<2>();
+    raw_xy_m_ += d.head<2>();
+    raw_z_m_ += d.z();
+    for (int i = 0; i < 3; ++i)
+      if (d[i] != 0.0) out_.slave_velocity_m_s[i] = 0.0;
+    out_.slave_target_m = kept;
+  }
   const Eigen::Vector3d before = out_.slave_target_m;
   limits_.limit_target(out_.slave_target_m, out_.slave_velocity_m_s, in.slave_position_m, in.contact_force_N);
   contact_limited_ = limits_.contact_over_limit(in.contact_force_N);
@@ -109,10 +122,12 @@ void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_
   raw_z_m_ += out_.slave_target_m.z() - before.z();
   out_.gripper_opening_m = limits_.limit_opening_m(requested_opening_m, in.gripper_opening_m, in.grip_force_N,
                                                    out_.gripper_opening_m);
+  kept_from_m_ = out_.slave_target_m;
 }
 
 void Teleoperation::hold_at(const Eigen::Vector3d& measured_m) noexcept {
   if (measured_m.allFinite()) out_.slave_target_m = measured_m;
+  kept_from_m_ = out_.slave_target_m;
   out_.slave_velocity_m_s.setZero();
   out_.engaged = false;
   out_.haptic_force_N.setZero();
@@ -197,6 +212,7 @@ const TeleoperationOutput& Teleoperation::tick(const TeleoperationInput& in) noe
     // Back from silence (possibly a restarted slave, elsewhere): hold where it is now, so that
     // re-engaging never moves it (the haptic path below re-indexes its offset on engagement).
     out_.slave_target_m = in.slave_position_m;
+    kept_from_m_ = out_.slave_target_m;
     last_xy_m_ = out_.slave_target_m.head<2>();
     raw_xy_m_ = last_xy_m_;
     raw_z_m_ = out_.slave_target_m.z();

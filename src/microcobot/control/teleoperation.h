@@ -179,6 +179,7 @@ class Teleoperation {
   Eigen::Vector2d force_filtered_N_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d offset_m_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d last_xy_m_ = Eigen::Vector2d::Zero();
+  Eigen::Vector3d kept_from_m_ = Eigen::Vector3d::Zero();  // the target the keep-outs judge a tick from
   VirtualFixtures fixtures_;
   Eigen::Vector2d raw_xy_m_ = Eigen::Vector2d::Zero();  // the master's target before the fixtures
   double raw_z_m_ = 0.0;                                // ... and its height

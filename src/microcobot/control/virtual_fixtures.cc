@@ -26,11 +26,25 @@ VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params
   tan_cone_ = std::tan(p_.funnel_half_angle_deg * M_PI / 180.0);
 }
 
+namespace {
+
+bool keep_outs_valid(const FixtureSet& set) noexcept {
+  if (set.keep_out_count < 0 || set.keep_out_count > FixtureSet::kMaxKeepOuts) return false;
+  for (int i = 0; i < set.keep_out_count; ++i) {
+    const auto& k = set.keep_outs[static_cast<std::size_t>(i)];
+    if (!k.xy_m.allFinite() || !std::isfinite(k.radius_m) || k.radius_m < 0.0 || !std::isfinite(k.top_z_m))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 void VirtualFixtures::set(const FixtureSet& set) noexcept {
   const bool valid = std::isfinite(set.level) && set.level >= 0.0 && set.level <= 1.0 &&
                      set.guide_xy_m.allFinite() && set.path_from_xy_m.allFinite() &&
                      std::isfinite(set.rim_z_m) && std::isfinite(set.funnel_radius_m) &&
-                     set.funnel_radius_m >= 0.0 && std::isfinite(set.height_z_m);
+                     set.funnel_radius_m >= 0.0 && std::isfinite(set.height_z_m) && keep_outs_valid(set);
   const FixtureSet next = valid ? set : FixtureSet{};
   if (next == set_) return;
   // A new guide moves the field under the handle: its energy is booked afresh. A new level alone
@@ -104,6 +118,35 @@ Eigen::Vector2d VirtualFixtures::confined_xy(const Eigen::Vector2d& xy, double z
   const Eigen::Vector2d e = xy - set_.guide_xy_m;
   const double d = e.norm();
   return d <= set_.funnel_radius_m ? xy : Eigen::Vector2d(set_.guide_xy_m + e * (set_.funnel_radius_m / d));
+}
+
+bool VirtualFixtures::in_keep_out(const Eigen::Vector3d& p) const noexcept {
+  for (int i = 0; i < set_.keep_out_count; ++i) {
+    const auto& k = set_.keep_outs[static_cast<std::size_t>(i)];
+    if (p.z() < k.top_z_m && (p.head<2>() - k.xy_m).norm() < k.radius_m) return true;
+  }
+  return false;
+}
+
+bool VirtualFixtures::keep_out(const Eigen::Vector3d& from, Eigen::Vector3d& to) const noexcept {
+  const Eigen::Vector3d asked = to;
+  for (int i = 0; i < set_.keep_out_count; ++i) {
+    const auto& k = set_.keep_outs[static_cast<std::size_t>(i)];
+    // On the edge (where this puts a target) counts as outside, whatever the rounding.
+    const bool was_inside_circle = (from.head<2>() - k.xy_m).norm() < k.radius_m * (1.0 - 1e-9);
+    if (was_inside_circle && from.z() < k.top_z_m) continue;  // installed round it: nothing to hold
+    if (was_inside_circle) {
+      to.z() = std::max(to.z(), k.top_z_m);  // above the part: no lower than its top
+      continue;
+    }
+    const Eigen::Vector2d e = to.head<2>() - k.xy_m;
+    const double d = e.norm();
+    if (to.z() < k.top_z_m && d < k.radius_m) {
+      // Below its top: on the circle's edge, radially (from its centre: the way out is outward).
+      to.head<2>() = d > 0.0 ? Eigen::Vector2d(k.xy_m + e * (k.radius_m / d)) : from.head<2>();
+    }
+  }
+  return to != asked;
 }
 
 double VirtualFixtures::lowest_z(const Eigen::Vector2d& xy, double from_z) const noexcept {

@@ -50,11 +50,20 @@
 ///              level rises or the coupling re-indexes, E would go negative and the passivity
 ///              controller adds the damping that dissipates exactly the excess (f' = f + b v,
 ///              control/passivity.h's rule).
+///   keep-out   forbidden regions round the neighbouring parts (issue #29 point 4): each a vertical
+///              cylinder (centre c, radius r: the neighbour's footprint grown by the gripper's) up to
+///              a height z_top (its top plus a clearance). The target never has both |xy - c| < r
+///              and z < z_top: a target inside the circle (above the part) is held at z_top at least,
+///              and a target below z_top is held on the circle's edge (projected radially). Hard and
+///              independent of the level, like the funnel; the master's own target goes with it (no
+///              wind-up: leaving the region never jumps). A region installed round a target already
+///              inside it and below its top holds nothing until the target has left it.
 ///
 /// The assistance level follows its set value at a bounded rate, from 0 whenever the guide moves
 /// (no jump in the target).
 /// Everything here is real-time safe: no allocation, lock, exception or I/O.
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -105,10 +114,23 @@ struct FixtureSet {
   double funnel_radius_m = 0.0;  ///< r0: the allowed distance to the axis at the rim
   bool height = false;           ///< a height stop at height_z_m (at the set's level)
   double height_z_m = 0.0;       ///< tool-point height of the stop
+  /// A forbidden cylinder round a neighbouring part (header, keep-out).
+  struct KeepOut {
+    Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();
+    double radius_m = 0.0;
+    double top_z_m = 0.0;  ///< tool-point height below which the circle is forbidden
+    bool operator==(const KeepOut& o) const noexcept {
+      return xy_m == o.xy_m && radius_m == o.radius_m && top_z_m == o.top_z_m;
+    }
+  };
+  static constexpr int kMaxKeepOuts = 8;
+  std::array<KeepOut, kMaxKeepOuts> keep_outs{};
+  int keep_out_count = 0;  ///< the first keep_out_count of keep_outs are in force
   bool operator==(const FixtureSet& o) const noexcept {
     return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && path == o.path &&
            path_from_xy_m == o.path_from_xy_m && funnel == o.funnel && rim_z_m == o.rim_z_m &&
-           funnel_radius_m == o.funnel_radius_m && height == o.height && height_z_m == o.height_z_m;
+           funnel_radius_m == o.funnel_radius_m && height == o.height && height_z_m == o.height_z_m &&
+           keep_out_count == o.keep_out_count && keep_outs == o.keep_outs;
   }
 };
 
@@ -141,6 +163,11 @@ class VirtualFixtures {
   /// `xy` kept within the funnel's radius r0 of the axis when `z` is below the rim (the part in
   /// its bore); `xy` otherwise, or without a funnel.
   Eigen::Vector2d confined_xy(const Eigen::Vector2d& xy, double z) const noexcept;
+  /// Keeps `to`, the target after a tick that started at `from`, out of the keep-out regions
+  /// (header); true if it moved it.
+  bool keep_out(const Eigen::Vector3d& from, Eigen::Vector3d& to) const noexcept;
+  /// `p` is inside a keep-out region (within its circle, below its top).
+  bool in_keep_out(const Eigen::Vector3d& p) const noexcept;
   /// The lowest z allowed at `xy` (-inf without a funnel) for a target now at `from_z`: a target
   /// already in the bore (below the rim) is held by confined_xy, never lifted out by the cone.
   double lowest_z(const Eigen::Vector2d& xy,

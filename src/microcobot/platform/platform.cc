@@ -431,6 +431,10 @@ void Platform::set_fixtures(const control::FixtureSet& set) noexcept {
   stage.path_from_xy_m = set.path_from_xy_m - home_m_.head<2>();
   stage.rim_z_m = set.rim_z_m - home_m_.z();
   stage.height_z_m = set.height_z_m - home_m_.z();
+  for (auto& k : stage.keep_outs) {
+    k.xy_m -= home_m_.head<2>();
+    k.top_z_m -= home_m_.z();
+  }
   teleop_->set_fixtures(stage);
 }
 
