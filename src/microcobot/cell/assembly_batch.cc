@@ -3,6 +3,8 @@
 #include <cmath>
 #include <random>
 
+#include <fmt/format.h>
+
 #include "microcobot/core/error.h"
 
 namespace mc::cell {
@@ -54,6 +56,26 @@ void AssemblyBatchParams::validate() const {
   require_non_negative(flat_seat_min_pulloff_N, "flat_seat_min_pulloff_N");
   require(std::isfinite(flat_seat_max_pulloff_N) && flat_seat_max_pulloff_N >= flat_seat_min_pulloff_N,
           "flat_seat_max_pulloff_N", "must be at least flat_seat_min_pulloff_N", flat_seat_max_pulloff_N);
+  require(layout == "random" || layout == "grid", "layout", "must be random or grid (got '" + layout + "')");
+  if (layout == "grid") {
+    // The open gripper round one part must clear the next: the fingers' reach (half the opening plus
+    // their thickness, to its corner) plus a neighbour's half-diagonal, plus 4 slot errors of each.
+    const auto& g = world.gripper;
+    const double reach = std::hypot(0.5 * g.max_opening_m + g.finger_thickness_m, 0.5 * g.finger_width_m);
+    const double widest = std::max(max_side_m, flat_fraction > 0.0 ? flat_side_m : 0.0);
+    const double need = reach + widest / std::sqrt(2.0) + 8.0 * slot_error_m;
+    require(std::isfinite(grid_pitch_m) && grid_pitch_m >= need, "grid_pitch_m",
+            fmt::format("must be at least {:.0f} um: the open fingers' reach round a part plus a neighbour's "
+                        "half-diagonal and 8 slot errors",
+                        need * 1e6),
+            grid_pitch_m);
+    const int n = grid_cells_per_side(half_size_m, grid_pitch_m);
+    require(
+        n * n - 1 <= microworld::PickPlaceParams::kMaxNeighbours, "grid_pitch_m",
+        fmt::format("makes a load of {} x {} parts within half_size_m: a scene holds at most {} neighbours",
+                    n, n, microworld::PickPlaceParams::kMaxNeighbours),
+        grid_pitch_m);
+  }
   microworld::ReleaseStrategy r;
   require(release == "auto" || microworld::parse_release(release, r), "release",
           "must be auto, open, shake or roll (got '" + release + "')");
@@ -88,6 +110,37 @@ microworld::ReleaseStrategy choose_release(const microworld::PickPlaceParams& wo
   return chosen;
 }
 
+int grid_cells_per_side(double half_size_m, double pitch_m) noexcept {
+  if (!(pitch_m > 0.0) || !(half_size_m >= 0.0)) return 0;
+  return 1 + static_cast<int>(std::floor(2.0 * half_size_m / pitch_m + 1e-9));
+}
+
+namespace {
+
+// A grid cell's offset from its area's centre (cells row by row, the grid centred).
+Eigen::Vector2d grid_offset(int cell, int n, double pitch_m) {
+  const double c = 0.5 * (n - 1);
+  return {(cell % n - c) * pitch_m, (cell / n - c) * pitch_m};
+}
+
+// A part as its neighbours see it: standing in its slot, or placed (on its seat, or in its bore).
+microworld::NeighbourPart standing(const AssemblyJob& j, bool placed) {
+  microworld::NeighbourPart n;
+  n.side_m = j.world.part_side_m;
+  if (placed) {
+    n.xy_m = j.target_m;
+    n.yaw_rad = j.target_yaw_rad;
+    n.top_z_m = j.world.height_m() - j.world.hole_depth_m;
+  } else {
+    n.xy_m = j.world.part_start_m.head<2>();
+    n.yaw_rad = j.world.part_yaw_rad;
+    n.top_z_m = j.world.height_m();
+  }
+  return n;
+}
+
+}  // namespace
+
 std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   params.validate();
   std::mt19937_64 rng(static_cast<std::uint64_t>(params.seed));
@@ -103,6 +156,9 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   std::uniform_real_distribution<double> flat_u(0.0, 1.0);
   std::uniform_real_distribution<double> seat_pulloff(params.flat_seat_min_pulloff_N,
                                                       params.flat_seat_max_pulloff_N);
+  const bool grid = params.layout == "grid";
+  const int per_side = grid ? grid_cells_per_side(params.half_size_m, params.grid_pitch_m) : 1;
+  const int per_load = per_side * per_side;
   std::vector<AssemblyJob> jobs;
   jobs.reserve(static_cast<std::size_t>(params.parts));
   for (int i = 0; i < params.parts; ++i) {
@@ -112,6 +168,11 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     j.clearance_m = clearance(rng);
     j.nominal_part_m = {params.tray_x_m + area(rng), params.tray_y_m + area(rng)};
     j.target_m = {params.plate_x_m + area(rng), params.plate_y_m + area(rng)};
+    if (grid) {  // the same draws, the places on the grids
+      const Eigen::Vector2d cell = grid_offset(i % per_load, per_side, params.grid_pitch_m);
+      j.nominal_part_m = Eigen::Vector2d(params.tray_x_m, params.tray_y_m) + cell;
+      j.target_m = Eigen::Vector2d(params.plate_x_m, params.plate_y_m) + cell;
+    }
     const Eigen::Vector2d error(params.slot_error_m * slot(rng), params.slot_error_m * slot(rng));
     j.world = params.world;
     j.world.part_side_m = j.side_m;
@@ -140,9 +201,24 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
       j.world.substrate_pulloff_N = pulloff;
     }
     j.release = choose_release(j.world, !j.flat, params.release, params.min_release_margin, j.release_margin);
-    j.world.validate();
     jobs.push_back(j);
   }
+  if (grid) {
+    // Each part's scene holds the rest of its load: the later parts in their slots, the earlier
+    // ones placed (a load's n^2 - 1 others; n^2 <= 9 keeps them within kMaxNeighbours).
+    for (AssemblyJob& j : jobs) {
+      const int load = j.index / per_load;
+      const int first = load * per_load, end = std::min(first + per_load, params.parts);
+      auto& w = j.world;
+      w.neighbour_count = 0;
+      for (int k = first; k < end; ++k) {
+        if (k == j.index || w.neighbour_count >= microworld::PickPlaceParams::kMaxNeighbours) continue;
+        w.neighbours[static_cast<std::size_t>(w.neighbour_count++)] =
+            standing(jobs[static_cast<std::size_t>(k)], k < j.index);
+      }
+    }
+  }
+  for (AssemblyJob& j : jobs) j.world.validate();
   return jobs;
 }
 

@@ -21,6 +21,14 @@
 /// release strategy is `release`; `auto` chooses per part the first of open, roll, shake whose
 /// margin (release.h) reaches min_release_margin, else the one of largest margin.
 ///
+/// Several parts in one scene (issue #29 point 1): with `layout: grid` the tray's slots and the
+/// plate's bores are grids of pitch grid_pitch_m (n x n within each area's half_size_m), filled in
+/// order, n^2 parts a load; each part's microworld holds the rest of its load as neighbours
+/// (microworld/neighbours.h): the parts after it still in their slots, the ones before it placed on
+/// their bores (pins standing part_height_m - hole_depth_m proud, plates their thickness). The
+/// orientations and slot errors are drawn as in the random layout. `layout: random` (the default)
+/// is the batch of before: each part alone in its scene.
+///
 /// One job is one part: its microworld (microworld::PickPlaceParams: the pin, the bore, the
 /// adhesion of the default 300 um scene; or the plate, its seat) and what the cell is told. The cycles of a
 /// batch run one after another on a fresh platform each (cell_run.h), so neighbouring parts do not interact
@@ -54,9 +62,11 @@ struct AssemblyBatchParams {
   double tray_y_m = 0.0;
   double plate_x_m = 1.5e-3;  ///< the plate's centre (bores likewise)
   double plate_y_m = 0.0;
-  double half_size_m = 0.75e-3;  ///< half the side of the tray's and the plate's areas
-  double flat_fraction = 0.0;    ///< the share of flat parts, [0, 1] (header)
-  double flat_side_m = 300e-6;   ///< a flat part's side (issue #29: 300 um)
+  double half_size_m = 0.75e-3;   ///< half the side of the tray's and the plate's areas
+  std::string layout = "random";  ///< random (each part alone) or grid (header)
+  double grid_pitch_m = 700e-6;   ///< the grids' pitch (layout grid)
+  double flat_fraction = 0.0;     ///< the share of flat parts, [0, 1] (header)
+  double flat_side_m = 300e-6;    ///< a flat part's side (issue #29: 300 um)
   double flat_thickness_m = 50e-6;
   double seat_tolerance_m = 10e-6;  ///< a flat part rests within this of its seat's centre
   /// A flat part's pull-off per finger: van der Waals over its edge face (microworld::flat_part_scene).
@@ -87,6 +97,8 @@ struct AssemblyBatchParams {
     v("plate_x_m", plate_x_m);
     v("plate_y_m", plate_y_m);
     v("half_size_m", half_size_m);
+    v("layout", layout);
+    v("grid_pitch_m", grid_pitch_m);
     v("flat_fraction", flat_fraction);
     v("flat_side_m", flat_side_m);
     v("flat_thickness_m", flat_thickness_m);
@@ -122,6 +134,9 @@ struct AssemblyJob {
 /// or not), and its margin.
 microworld::ReleaseStrategy choose_release(const microworld::PickPlaceParams& world, bool in_bore,
                                            const std::string& release, double min_margin, double& margin);
+
+/// The slots (or bores) of a grid layout within an area of half side `half_size_m` (n x n, row by row).
+int grid_cells_per_side(double half_size_m, double pitch_m) noexcept;
 
 /// The batch's jobs, the same for the same parameters (validated here).
 std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params);

@@ -70,14 +70,16 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   require_positive(goal.open_m, "goal.open_m");
   require(std::isfinite(goal.part_yaw_rad) && std::isfinite(goal.target_yaw_rad), "goal",
           "orientations must be finite");
+  require(std::isfinite(goal.tallest_neighbour_m) && goal.tallest_neighbour_m >= 0.0,
+          "goal.tallest_neighbour_m", "must be finite and non-negative", goal.tallest_neighbour_m);
   require(goal.yaw_min_rad < goal.yaw_max_rad, "goal.yaw_min_rad", "must be below goal.yaw_max_rad",
           goal.yaw_min_rad);
   grasp_z_ = grasp_height_m(p_, goal);
   rim_z_ = grasp_z_;
   require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
           p_.grip_above_m);
-  safe_z_ = goal.part_height_m + p_.clearance_height_m;
-  carry_z_ = grasp_z_ + p_.clearance_height_m;
+  safe_z_ = std::max(goal.part_height_m, goal.tallest_neighbour_m) + p_.clearance_height_m;
+  carry_z_ = grasp_z_ + goal.tallest_neighbour_m + p_.clearance_height_m;
   opening_command_ = goal.open_m;
   out_.active = true;
   out_.fresh = true;
@@ -318,8 +320,11 @@ Eigen::Vector3d AssemblyTask::move_goal(Step s, const Eigen::Vector3d& tip) cons
 
 void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
   // The operator's master drives (the deadman and the gripper are theirs); the task holds the
-  // fixtures on the step's goal and watches. No step timeout: the person sets the pace.
+  // fixtures on the step's goal and the neighbours' keep-outs, and watches. No step timeout: the
+  // person sets the pace.
   fixtures_.level = 1.0;
+  fixtures_.keep_outs = goal_.keep_outs;
+  fixtures_.keep_out_count = goal_.keep_out_count;
   fixtures_.guide = true;
   bool there = false;
   switch (step_) {

@@ -148,6 +148,13 @@ struct AssemblyGoal {
   double target_yaw_rad = 0.0;  ///< the bore's orientation
   /// The rotary axis' travel (platform::Platform::yaw_min_rad, yaw_max_rad).
   double yaw_min_rad = -1.0, yaw_max_rad = 1.0;
+  /// The forbidden regions round the scene's other parts (control/virtual_fixtures.h, keep-out;
+  /// task_io.h's assembly_goal), in force with the shared control of an assisted step.
+  std::array<control::FixtureSet::KeepOut, control::FixtureSet::kMaxKeepOuts> keep_outs{};
+  int keep_out_count = 0;
+  /// The tallest of the scene's other parts (0: none): the tips travel clear of its top and a
+  /// carried part's bottom above it (safe and carrying heights).
+  double tallest_neighbour_m = 0.0;
 };
 
 /// The fingers' yaw that squares them with a square turned by `square_yaw_rad` (modulo 90 deg):

@@ -33,6 +33,7 @@ nlohmann::json CycleResult::to_json() const {
           {"peak_contact_N", peak_contact_N},
           {"grip_violations", grip_violations},
           {"contact_violations", contact_violations},
+          {"neighbour_contacts", neighbour_contacts},
           {"clutches", clutches},
           {"search_tries", search_tries},
           {"submovements", submovements},
@@ -80,6 +81,7 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("contact_violations", r.contact_violations);
   get("clutches", r.clutches);
   get("search_tries", r.search_tries);
+  get("neighbour_contacts", r.neighbour_contacts);
   get("part", r.part);
   get("release", r.release);
   get("submovements", r.submovements);

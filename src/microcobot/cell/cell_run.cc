@@ -279,6 +279,7 @@ CycleResult CellCycle::result() const {
   r.peak_contact_N = meter.peak_contact;
   r.grip_violations = meter.grip_over;
   r.contact_violations = meter.contact_over;
+  r.neighbour_contacts = w.neighbour_contacts;
   r.path_m = meter.path;
   r.step_s = meter.step_s;
   const auto& teleop = p.teleop();

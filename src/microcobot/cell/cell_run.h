@@ -95,6 +95,8 @@ struct CycleResult {
   double peak_grip_N = 0.0, mean_grip_N = 0.0;  ///< mean over the ticks the pin was gripped
   double peak_contact_N = 0.0;
   int grip_violations = 0, contact_violations = 0;  ///< ticks over the platform's limits
+  /// The gripper's steps striking another part of the scene (layout grid; microworld/neighbours.h).
+  int neighbour_contacts = 0;
   int clutches = 0;
   int search_tries = 0;   ///< the task's search points, or the times the person's pin met the rim
   int submovements = 0;   ///< the person's aimed movements

@@ -69,8 +69,8 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
   require(sim_.gripper != nullptr && sim_.haptic != nullptr && sim_.tweezers != nullptr, "microworld",
           "the simulated person needs the pick-and-place scene's simulated devices");
   grasp_z_ = goal.hole_depth_m + task.grip_above_m;
-  safe_z_ = goal.part_height_m + task.clearance_height_m;
-  carry_z_ = grasp_z_ + task.clearance_height_m;
+  safe_z_ = std::max(goal.part_height_m, goal.tallest_neighbour_m) + task.clearance_height_m;
+  carry_z_ = grasp_z_ + goal.tallest_neighbour_m + task.clearance_height_m;
   inserted_z_ = grasp_z_ - goal.hole_depth_m;
   const Eigen::Vector3d tip = sim_.gripper->tip_position_m();
   xy_.reset(
@@ -254,6 +254,8 @@ void PersonOperator::assist() noexcept {
       f = {};
       break;
   }
+  f.keep_outs = goal_.keep_outs;  // the neighbours' forbidden regions, whatever the step
+  f.keep_out_count = goal_.keep_out_count;
   platform_.set_fixtures(f);
 }
 

@@ -1,5 +1,8 @@
 #include "microcobot/cell/task_io.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace mc::cell {
 
 TaskSensors read_task_sensors(const platform::Platform& p, const Eigen::Vector3d& home_m) noexcept {
@@ -26,6 +29,20 @@ AssemblyGoal assembly_goal(const AssemblyJob& job) {
   goal.target_yaw_rad = job.target_yaw_rad;
   goal.flat_seat = job.flat;
   goal.release = job.release;
+  const auto& g = job.world.gripper;
+  const double reach = std::hypot(0.5 * g.max_opening_m + g.finger_thickness_m, 0.5 * g.finger_width_m);
+  const int n = std::min(job.world.neighbour_count, control::FixtureSet::kMaxKeepOuts);
+  for (int i = 0; i < n; ++i) {
+    const auto& nb = job.world.neighbours[static_cast<std::size_t>(i)];
+    auto& k = goal.keep_outs[static_cast<std::size_t>(i)];
+    k.xy_m = nb.xy_m;
+    k.radius_m = reach + nb.side_m / std::sqrt(2.0) + kKeepOutMargin_m;
+    k.top_z_m = nb.top_z_m + kKeepOutClearance_m;
+  }
+  for (int i = 0; i < job.world.neighbour_count; ++i)
+    goal.tallest_neighbour_m =
+        std::max(goal.tallest_neighbour_m, job.world.neighbours[static_cast<std::size_t>(i)].top_z_m);
+  goal.keep_out_count = n;
   return goal;
 }
 

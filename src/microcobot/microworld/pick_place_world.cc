@@ -61,6 +61,14 @@ void PickPlaceParams::validate() const {
           "roll_edge_fraction", "must be within [0, 1]", roll_edge_fraction);
   require(std::isfinite(roll_peel_angle_rad) && roll_peel_angle_rad > 0.0 && roll_peel_angle_rad <= 0.5,
           "roll_peel_angle_rad", "must be within (0, 0.5] rad", roll_peel_angle_rad);
+  require(neighbour_count >= 0 && neighbour_count <= kMaxNeighbours, "neighbour_count",
+          fmt::format("must be within [0, {}]", kMaxNeighbours), neighbour_count);
+  for (int i = 0; i < neighbour_count; ++i) {
+    const NeighbourPart& n = neighbours[static_cast<std::size_t>(i)];
+    require(n.xy_m.allFinite() && std::isfinite(n.yaw_rad) && std::isfinite(n.side_m) && n.side_m > 0.0 &&
+                std::isfinite(n.top_z_m) && n.top_z_m > 0.0,
+            fmt::format("neighbours[{}]", i), "must have a finite place, a positive side and top", i);
+  }
   gripper.validate();
   require(gripper.max_opening_m > part_side_m, "gripper.max_opening_m", "must exceed part_side_m",
           gripper.max_opening_m);
@@ -171,6 +179,38 @@ Eigen::Vector2d PickPlaceWorld::confine_to_hole(Eigen::Vector3d& part, double pa
   if (n > capacity_N) reaction *= capacity_N / n;
   slip_m = {push.x() - reaction.x() / k2, push.y()};
   return turned(reaction, yaw);
+}
+
+Eigen::Vector2d PickPlaceWorld::neighbour_reaction(const PickPlaceState& s, const Eigen::Vector3d& g,
+                                                   double yaw, double opening,
+                                                   bool& touching) const noexcept {
+  Eigen::Vector2d f = Eigen::Vector2d::Zero();
+  touching = false;
+  const auto& gp = p_.gripper;
+  const double held_bottom = s.part_m.z() - 0.5 * p_.height_m();
+  const bool held = s.phase != PartPhase::kOnSubstrate;
+  for (int i = 0; i < p_.neighbour_count; ++i) {
+    const NeighbourPart& n = p_.neighbours[static_cast<std::size_t>(i)];
+    const Footprint square{n.xy_m, {0.5 * n.side_m, 0.5 * n.side_m}, n.yaw_rad};
+    Eigen::Vector2d out;
+    const auto strike = [&](const Footprint& body) {
+      const double depth = overlap(square, body, out);
+      if (depth <= 0.0) return;
+      f += p_.substrate_stiffness_N_m * depth * out;
+      touching = true;
+    };
+    if (g.z() < n.top_z_m) {
+      for (double side : {-1.0, 1.0}) {  // each finger, from its inner face outward
+        const double x = side * (0.5 * opening + 0.5 * gp.finger_thickness_m);
+        strike({g.head<2>() + turned({x, 0.0}, yaw),
+                {0.5 * gp.finger_thickness_m, 0.5 * gp.finger_width_m},
+                yaw});
+      }
+    }
+    if (held && held_bottom < n.top_z_m)
+      strike({s.part_m.head<2>(), {0.5 * p_.part_side_m, 0.5 * p_.part_side_m}, s.part_yaw_rad});
+  }
+  return f;
 }
 
 bool PickPlaceWorld::between_fingers(const PickPlaceState& s, const Eigen::Vector3d& g,
@@ -333,6 +373,11 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       break;
     }
   }
+  // The scene's other parts: struck, they push back on the fingers (and on the held part, hence on them).
+  bool touching = false;
+  out.force_on_gripper_N.head<2>() += neighbour_reaction(s, g, yaw, out.opening_m, touching);
+  out.touching_neighbour = touching;
+  if (touching) ++s.neighbour_contacts;
   // The lateral force on the fingers bends them along their closing axis (common mode, 2 k_finger);
   // the walls' share is the bend confine_to_hole left unslipped.
   const Eigen::Vector2d on_fingers = turned(out.force_on_gripper_N.head<2>(), -yaw);

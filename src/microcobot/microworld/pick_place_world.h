@@ -47,7 +47,10 @@
 
 #include <Eigen/Dense>
 
+#include <array>
+
 #include "microcobot/core/params.h"
+#include "microcobot/microworld/neighbours.h"
 #include "microcobot/microworld/piezo_gripper.h"
 #include "microcobot/microworld/surface_forces.h"
 
@@ -98,6 +101,11 @@ struct PickPlaceParams {
   /// beyond van der Waals' nanometre range, and far above the rotary axis' holding jitter).
   double roll_edge_fraction = 0.1;
   double roll_peel_angle_rad = 0.01;
+  /// The scene's other parts (neighbours.h): set by the cell from its batch (assembly_batch.h), not
+  /// a file's key; the first neighbour_count count.
+  static constexpr int kMaxNeighbours = 8;
+  std::array<NeighbourPart, kMaxNeighbours> neighbours{};
+  int neighbour_count = 0;
 
   template <class V>
   void visit(V& v) {
@@ -174,7 +182,8 @@ struct PickPlaceState {
   /// whether that has peeled their flat contact onto its edge (release.h, roll).
   double stuck_turn_rad = 0.0;
   bool finger_contact_rolled = false;
-  bool crashed = false;  ///< a finger tip went into the substrate at some point
+  int neighbour_contacts = 0;  ///< steps in which a finger or the held part struck a neighbour
+  bool crashed = false;        ///< a finger tip went into the substrate at some point
 };
 
 /// What the world returns each step: the forces the slave feels (to be fed back, scaled, to
@@ -185,6 +194,7 @@ struct PickPlaceOutput {
   double opening_m = 0.0;  ///< actual finger opening (blocked by the part when gripping)
   bool part_between_fingers = false;
   bool part_on_substrate = true;
+  bool touching_neighbour = false;  ///< a finger or the held part strikes another part of the scene
 };
 
 class PickPlaceWorld {
@@ -221,6 +231,9 @@ class PickPlaceWorld {
   /// returns the wall's reaction on the fingers (turned by `yaw`) [N], at most `capacity_N` (what
   /// holds the part in them). Along their closing axis the fingers bend by reaction / (2 k_finger)
   /// first; `slip_m` (their frame) is how far the part slips in them.
+  /// The neighbours' reaction on the fingers (at `opening`, turned by `yaw`) and on the held part.
+  Eigen::Vector2d neighbour_reaction(const PickPlaceState& s, const Eigen::Vector3d& g, double yaw,
+                                     double opening, bool& touching) const noexcept;
   Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, double part_yaw, double yaw, bool in_hole,
                                   double capacity_N, Eigen::Vector2d& slip_m) const noexcept;
   PickPlaceParams p_;

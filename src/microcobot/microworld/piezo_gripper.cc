@@ -14,6 +14,8 @@ void PiezoGripperParams::validate() const {
   require_positive(finger_length_m, "gripper.finger_length_m");
   require(std::isfinite(finger_width_m) && finger_width_m >= 5e-6 && finger_width_m <= 1e-3,
           "gripper.finger_width_m", "must be within [5 um, 1 mm]", finger_width_m);
+  require(std::isfinite(finger_thickness_m) && finger_thickness_m >= 5e-6 && finger_thickness_m <= 1e-3,
+          "gripper.finger_thickness_m", "must be within [5 um, 1 mm]", finger_thickness_m);
   require(std::isfinite(shake_amplitude_m) && shake_amplitude_m >= 0.0 && shake_amplitude_m <= 20e-6,
           "gripper.shake_amplitude_m", "must be within [0, 20 um]", shake_amplitude_m);
   require(std::isfinite(shake_frequency_Hz) && shake_frequency_Hz > 0.0 && shake_frequency_Hz <= 100e3,

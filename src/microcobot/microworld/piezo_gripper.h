@@ -20,6 +20,9 @@ struct PiezoGripperParams {
   /// The fingers' width across their closing direction, as the microscope sees them (drawn by the
   /// camera's scene, looked for by the vision positioner and the grip gauge).
   double finger_width_m = 40e-6;
+  /// The fingers' thickness along their closing axis, outward from their inner faces (where they
+  /// strike a neighbouring part, microworld/neighbours.h).
+  double finger_thickness_m = 50e-6;
   /// The drive's release burst (release.h, "shake"): the opened fingers vibrate along their
   /// closing axis at this amplitude and frequency at the tips. 1 um at 5 kHz, below the first
   /// bending mode of a 2 mm piezo bender (tens of kHz), accelerates the tips at 990 m/s^2.
@@ -35,6 +38,7 @@ struct PiezoGripperParams {
     v("finger_stiffness_N_m", finger_stiffness_N_m);
     v("finger_length_m", finger_length_m);
     v("finger_width_m", finger_width_m);
+    v("finger_thickness_m", finger_thickness_m);
     v("shake_amplitude_m", shake_amplitude_m);
     v("shake_frequency_Hz", shake_frequency_Hz);
   }
