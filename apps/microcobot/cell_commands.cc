@@ -177,6 +177,7 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
   rep.add_result("placement error, median", s.placement_median_m, "m");
   rep.add_result("peak grip force", s.peak_grip_max_N, "N");
   rep.add_result("ticks over a force limit", s.force_violations);
+  rep.add_result("steps striking a neighbouring part", s.neighbour_contacts);
   if (s.looks > 0) {
     rep.add_result("camera looks", s.looks);
     rep.add_result("camera looks that found the pin", s.looks_found);

@@ -61,6 +61,42 @@ TEST(AssemblyBatch, BadScenesAreRefusedWithTheKeyNamed) {
   refused("flat_thickness_m: 10.0e-6", "flat_thickness_m");  // the tips may not go below 10 um
   refused("flat_seat_min_pulloff_N: 5.0e-5\nflat_seat_max_pulloff_N: 1.0e-5", "flat_seat_max_pulloff_N");
   refused("min_release_margin: 0.5", "min_release_margin");
+  refused("layout: spiral", "layout");
+  refused("layout: grid\ngrid_pitch_m: 500.0e-6", "grid_pitch_m");  // the open fingers reach 350 um
+  refused("layout: grid\ngrid_pitch_m: 610.0e-6\nhalf_size_m: 1.0e-3", "grid_pitch_m");  // 4 x 4 a load
+}
+
+TEST(AssemblyBatch, OnAGridEachPartsSceneHoldsTheRestOfItsLoadInTheTrayOrPlaced) {
+  AssemblyBatchParams p;
+  p.parts = 10;
+  p.seed = 37;
+  p.layout = "grid";
+  const auto jobs = assembly_jobs(p);
+  ASSERT_EQ(grid_cells_per_side(p.half_size_m, p.grid_pitch_m), 3);
+  for (const auto& j : jobs) {
+    // On the grids: the slot's nominal place and the bore on grid points 700 um apart.
+    const Eigen::Vector2d cell = j.nominal_part_m - Eigen::Vector2d(p.tray_x_m, p.tray_y_m);
+    EXPECT_NEAR(std::remainder(cell.x(), p.grid_pitch_m), 0.0, 1e-12);
+    EXPECT_NEAR(std::remainder(cell.y(), p.grid_pitch_m), 0.0, 1e-12);
+    EXPECT_LT((j.target_m - Eigen::Vector2d(p.plate_x_m, p.plate_y_m) - cell).norm(), 1e-12);
+  }
+  // Part 4, the grid's middle: 4 placed before it, 4 still in the tray after it.
+  const auto& w = jobs[4].world;
+  ASSERT_EQ(w.neighbour_count, 8);
+  int placed = 0;
+  for (int i = 0; i < w.neighbour_count; ++i) {
+    const auto& n = w.neighbours[static_cast<std::size_t>(i)];
+    const bool on_plate = (n.xy_m - Eigen::Vector2d(p.plate_x_m, p.plate_y_m)).norm() < 1.2e-3;
+    placed += on_plate ? 1 : 0;
+    EXPECT_NEAR(n.top_z_m, on_plate ? p.part_height_m - p.hole_depth_m : p.part_height_m, 1e-15);
+    // Nothing of a neighbour within the open fingers' reach round this part's slot.
+    EXPECT_GT((n.xy_m - jobs[4].world.part_start_m.head<2>()).norm(), 350e-6 + n.side_m / std::sqrt(2.0));
+  }
+  EXPECT_EQ(placed, 4);
+  EXPECT_EQ(jobs[9].world.neighbour_count, 0) << "the tenth part begins a new load, alone";
+  // The random layout is the batch of before: nobody else in a scene.
+  p.layout = "random";
+  for (const auto& j : assembly_jobs(p)) EXPECT_EQ(j.world.neighbour_count, 0);
 }
 
 TEST(AssemblyBatch, FlatPartsComeFromTheirOwnStreamAndEachGetsTheReleaseItsAdhesionNeeds) {

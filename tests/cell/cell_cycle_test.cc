@@ -3,6 +3,7 @@
 // motion at the next tick; confirming, taking over and handing back never jump; a jam the
 // search cannot clear fails and holds.
 #include "microcobot/cell/cell_run.h"
+#include "microcobot/cell/task_io.h"
 
 #include <gtest/gtest.h>
 
@@ -112,6 +113,27 @@ TEST(CellCycle, AFlatPartOnADrySeatIsLeftThereOnlyByTheReleaseStrategyItsAdhesio
       EXPECT_GT(r.step_s[static_cast<std::size_t>(Step::kRelease)], 0.05) << "the strategy takes its time";
     }
   }
+}
+
+// A full tray (layout grid): the middle part of a 3 x 3 load, four placed parts and four standing
+// pins round it. The robot carries the pin above their tops and never strikes one.
+TEST(CellCycle, AmongItsNeighboursTheRobotCarriesThePinOverThemAndStrikesNone) {
+  AssemblyBatchParams p;
+  p.parts = 9;
+  p.seed = 45;
+  p.layout = "grid";
+  const AssemblyJob middle = assembly_jobs(p)[4];
+  ASSERT_EQ(middle.world.neighbour_count, 8);
+  const AssemblyGoal goal = assembly_goal(middle);
+  EXPECT_EQ(goal.keep_out_count, 8);
+  EXPECT_DOUBLE_EQ(goal.tallest_neighbour_m, p.part_height_m);
+  CellCycle c(middle, CellRunParams{}, default_platform());
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_EQ(r.neighbour_contacts, 0);
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+  EXPECT_TRUE(r.ended_holding);
 }
 
 TEST(CellCycle, FlatPartsAreTheRobotsOnlyAndSaySo) {

@@ -119,6 +119,7 @@ nlohmann::json BatchSummary::to_json() const {
           {"peak_grip_max_N", peak_grip_max_N},
           {"peak_contact_max_N", peak_contact_max_N},
           {"force_violations", force_violations},
+          {"neighbour_contacts", neighbour_contacts},
           {"simulated_s", simulated_s},
           {"wall_s", wall_s},
           {"looks", looks},
@@ -153,6 +154,7 @@ BatchSummary summarize(const std::vector<CycleResult>& cycles) {
     s.peak_grip_max_N = std::max(s.peak_grip_max_N, c.peak_grip_N);
     s.peak_contact_max_N = std::max(s.peak_contact_max_N, c.peak_contact_N);
     s.force_violations += c.grip_violations + c.contact_violations;
+    s.neighbour_contacts += c.neighbour_contacts;
     s.simulated_s += c.cycle_s;
     s.wall_s += c.wall_s;
     s.looks += c.looks;

@@ -131,6 +131,7 @@ struct BatchSummary {
   double placement_median_m = 0.0;
   double peak_grip_max_N = 0.0, peak_contact_max_N = 0.0;
   int force_violations = 0;
+  int neighbour_contacts = 0;  ///< the gripper's steps striking a neighbour, every cycle
   double simulated_s = 0.0, wall_s = 0.0;
   int looks = 0, looks_found = 0;  ///< the cell camera's, over the batch
   double look_error_max_m = 0.0;   ///< the largest of the cycles' look_error_m
