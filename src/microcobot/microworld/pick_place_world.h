@@ -6,7 +6,7 @@
 ///
 /// At this scale surface forces dominate (thesis §1.1.1): a 300 um brass cube weighs 2.3 uN
 /// while a capillary meniscus holds it to the substrate with ~70 uN and van der Waals
-/// forces hold it to a finger with a few uN. Inertia is negligible (a 0.23 ug part reaches
+/// forces hold it to a finger with a few uN. Inertia is negligible (a 0.23 mg part reaches
 /// force equilibrium in microseconds), so the world is quasi-static: at each step the part is
 /// where the force balance puts it, and contacts switch by comparing pull-off and friction
 /// capacities:
@@ -14,7 +14,8 @@
 ///  - drag:       2 mu_finger F_grip  >= mu_substrate (F_pulloff_substrate + W)
 ///  - release:    on the substrate, fingers open: the part stays on the substrate when
 ///                F_pulloff_substrate > 2 F_pulloff_finger, else it sticks to a finger;
-///                opened in the air it sticks to a finger when 2 F_pulloff_finger > W.
+///                opened in the air it sticks to a finger when 2 F_pulloff_finger > W
+///                (release.h: the strategies that shake or roll it off a finger).
 /// The gripper reference point is the middle of the finger tips; fingers close along x.
 ///
 /// The part is a block part_side_m x part_side_m x part_height_m (a cube by default, a pin when
