@@ -58,6 +58,8 @@ function taskHint(t) {
   if (t.status === "awaiting confirmation") return `“${t.step}” waits for your Confirm (or Skip).`;
   if (t.status === "awaiting look") return `“${t.step}”: the cell's camera looks at the pin; the stage holds.`;
   if (t.status === "operator") return `You drive (${t.step}): hold the deadman to move. Hand back when ready.`;
+  if (t.status === "assisted" && (t.step === "align" || t.step === "rotate"))
+    return `You turn “${t.step}” with the dial, guided: hold the deadman and turn; a stop holds the fingers square, and the task goes on once they are.`;
   if (t.status === "assisted")
     return `You drive “${t.step}”, guided to its goal: hold the deadman and move towards it; the task goes on once you are there.`;
   const truth = t.inserted === true ? " — the pin is in its bore" : t.inserted === false ? " — the pin is not in its bore" : "";

@@ -262,10 +262,36 @@ TEST(AssemblyTask, AnAssistedMoveGuidesTheOperatorToItsGoalAndGoesOnOnceThere) {
   EXPECT_TRUE(stage.run_to(task, Step::kInsert)) << "and the robot turns the pin and inserts from there";
 }
 
+// An assisted turn: the guide and the height stop hold the carried pin over its bore while the
+// operator turns the dial into the yaw stop, at the bore's square yaw nearest where the turn began;
+// the task goes on once the fingers have been there for settle_s.
+TEST(AssemblyTask, AnAssistedTurnHoldsAYawStopAtTheSquaresYawAndGoesOnOnceTurned) {
+  AssemblyGoal g = skip_goal();
+  g.target_yaw_rad = 0.3;
+  AssemblyTask task({}, g);
+  task.set_autonomy(Step::kRotate, Autonomy::kAssisted);
+  IdealStage stage;
+  ASSERT_TRUE(stage.run_to(task, Step::kRotate));
+  ASSERT_EQ(task.status(), Status::kAssisted);
+  stage.tick(task);
+  const control::FixtureSet& f = task.fixtures();
+  EXPECT_TRUE(f.yaw && f.guide && f.height);
+  EXPECT_NEAR(f.yaw_rad, 0.3, 1e-12) << "the bore's yaw, nearest where the turn began";
+  EXPECT_EQ(f.guide_xy_m, g.target_m);
+  // Turned near it, not within yaw_tolerance_rad: the step waits.
+  stage.s.yaw_rad = 0.3 + 2e-3;
+  for (int i = 0; i < 200; ++i) stage.tick(task);
+  EXPECT_EQ(task.step(), Step::kRotate);
+  stage.s.yaw_rad = 0.3;  // what the stop makes of a dial within its capture
+  for (int i = 0; i < 60; ++i) stage.tick(task);
+  EXPECT_EQ(task.step(), Step::kInsert);
+  EXPECT_FALSE(task.fixtures().yaw) << "no stop once the robot drives";
+}
+
 TEST(AssemblyTask, AnAssistedStepCanBeTakenOverHandedBackOrIsTheOperatorsWhenNotAMove) {
   AssemblyTask task({}, skip_goal());
   task.set_autonomy(Step::kApproach, Autonomy::kAssisted);
-  task.set_autonomy(Step::kAlign, Autonomy::kAssisted);  // not a move: the operator's
+  task.set_autonomy(Step::kVerify, Autonomy::kAssisted);  // not a move: the operator's
   IdealStage stage;
   stage.tick(task);
   ASSERT_EQ(task.status(), Status::kAssisted);
@@ -276,10 +302,12 @@ TEST(AssemblyTask, AnAssistedStepCanBeTakenOverHandedBackOrIsTheOperatorsWhenNot
   task.hand_back(false);
   EXPECT_EQ(task.status(), Status::kRunning) << "handed back: the robot does the approach";
   EXPECT_TRUE(stage.run_to(task, Step::kAlign));
+  while (task.step() != Step::kVerify) task.skip();
   EXPECT_EQ(task.status(), Status::kOperator);
   EXPECT_TRUE(AssemblyTask::assistable(Step::kRetract));
   EXPECT_TRUE(AssemblyTask::assistable(Step::kInsert));
-  EXPECT_FALSE(AssemblyTask::assistable(Step::kRotate));
+  EXPECT_TRUE(AssemblyTask::assistable(Step::kRotate));
+  EXPECT_TRUE(AssemblyTask::assistable(Step::kAlign));
   EXPECT_FALSE(AssemblyTask::assistable(Step::kVerify));
   EXPECT_EQ(AssemblyTask::name(Status::kAssisted), "assisted");
   EXPECT_EQ(AssemblyTask::name(Autonomy::kAssisted), "assisted");

@@ -76,12 +76,15 @@ TEST(TaskFile, RefusesUnknownStepsKeysAndLevelsWithOneLineNamingThem) {
   EXPECT_NE(m.find("steps.insert"), std::string::npos) << m;
   EXPECT_NE(m.find("sometimes"), std::string::npos) << m;
 
-  m = task_file_error([] { task_file_from_yaml("steps: {align: assisted}\n"); });
+  m = task_file_error([] { task_file_from_yaml("steps: {verify: assisted}\n"); });
   EXPECT_TRUE(one_line(m)) << m;
-  EXPECT_NE(m.find("steps.align"), std::string::npos) << m;
+  EXPECT_NE(m.find("steps.verify"), std::string::npos) << m;
   EXPECT_NE(m.find("assisted is for approach"), std::string::npos) << m;
   EXPECT_EQ(task_file_from_yaml("steps: {transport: assisted}\n")
                 .steps.autonomy()[static_cast<std::size_t>(Step::kTransport)],
+            Autonomy::kAssisted);
+  EXPECT_EQ(task_file_from_yaml("steps: {rotate: assisted}\n")
+                .steps.autonomy()[static_cast<std::size_t>(Step::kRotate)],
             Autonomy::kAssisted);
 
   m = task_file_error([] { task_file_from_yaml("params: {insert_speed_m_s: -1}\n"); });

@@ -71,6 +71,40 @@ TEST(RotaryTarget, StaysWithinTheTravelAndTakesTheAxisWhereItIs) {
   EXPECT_EQ(t.target_rad(), 0.5);
 }
 
+// A yaw stop (shared control of a turn): the dial turning steadily through the stop's yaw; within its
+// capture the target sits there, beyond twice it the dial has it back; it fades in without a jump.
+TEST(RotaryTarget, AYawStopHoldsTheDialWithinItsCaptureAndFadesInWithoutAJump) {
+  RotaryTarget t({}, kRotaryDt, 0.0, -1.0, 1.0);
+  ConsoleInput dial;
+  dial.deadman = dial.fresh = true;
+  dial.theta_rate_rad_s = 0.05;
+  for (int i = 0; i < 1000; ++i) t.tick(dial);  // 0.1 s: 5 mrad
+  const double before = t.target_rad();
+  t.set_stop(true, 0.1, 1.0, 0.02, 2.0);
+  t.tick(dial);
+  EXPECT_NEAR(t.target_rad(), before + 0.05 * kRotaryDt, 1e-9) << "installed: no jump";
+  double largest_step = 0.0, last = t.target_rad(), at_stop_s = 0.0;
+  for (int i = 0; i < 40000; ++i) {  // 4 s more: the dial to 205 mrad
+    t.tick(dial);
+    largest_step = std::max(largest_step, std::abs(t.target_rad() - last));
+    last = t.target_rad();
+    if (std::abs(t.target_rad() - 0.1) < 1e-6) at_stop_s += kRotaryDt;
+  }
+  // Held at the stop while the dial crossed its capture (0.08-0.12 rad at 50 mrad/s: 0.8 s, less
+  // the fades), then the dial's again: 41001 ticks at 5 urad, 0.205005 rad.
+  EXPECT_GT(at_stop_s, 0.5);
+  EXPECT_NEAR(t.target_rad(), 0.205005, 1e-9);
+  EXPECT_LE(largest_step, RotaryAxisParams{}.max_speed_rad_s * kRotaryDt * (1 + 1e-9))
+      << "within the slew limit";
+  // Let go (the deadman released), the dial starts again from where the target is.
+  dial.deadman = false;
+  t.tick(dial);
+  dial.deadman = true;
+  t.set_stop(false, 0.0, 0.0, 0.02, 2.0);
+  t.tick(dial);
+  EXPECT_NEAR(t.target_rad(), 0.205005 + 0.05 * kRotaryDt, 1e-9);
+}
+
 TEST(RotaryAxisParams, BadValuesAreRefusedNamingTheField) {
   RotaryAxisParams p;
   p.radius_m = 0.0;

@@ -147,12 +147,14 @@ std::string_view AssemblyTask::name(Autonomy a) noexcept {
 }
 
 bool AssemblyTask::assistable(Step s) noexcept {
-  return s == Step::kApproach || s == Step::kDescend || s == Step::kGrasp || s == Step::kLift ||
-         s == Step::kTransport || s == Step::kInsert || s == Step::kRelease || s == Step::kRetract;
+  return s == Step::kApproach || s == Step::kAlign || s == Step::kDescend || s == Step::kGrasp ||
+         s == Step::kLift || s == Step::kTransport || s == Step::kRotate || s == Step::kInsert ||
+         s == Step::kRelease || s == Step::kRetract;
 }
 
 void AssemblyTask::enter(Step s) noexcept {
   step_ = s;
+  assist_yaw_ = std::numeric_limits<double>::quiet_NaN();
   assist_from_known_ = false;
   step_s_ = 0.0;
   settled_s_ = 0.0;
@@ -360,6 +362,18 @@ void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
       fixtures_.guide_xy_m = search_xy();
       there = s.opening_m >= 0.9 * goal_.open_m;
       break;
+    case Step::kAlign:  // held over the pin (or the bore) while the operator turns into the yaw stop
+    case Step::kRotate: {
+      const bool align = step_ == Step::kAlign;
+      if (!std::isfinite(assist_yaw_)) assist_yaw_ = align ? align_yaw(s.yaw_rad) : rotate_yaw(s.yaw_rad);
+      fixtures_.guide_xy_m = align ? goal_.part_m : goal_.target_m;
+      fixtures_.height = true;
+      fixtures_.height_z_m = align ? safe_z_ : carry_z_;
+      fixtures_.yaw = true;
+      fixtures_.yaw_rad = assist_yaw_;
+      there = std::abs(s.yaw_rad - assist_yaw_) <= p_.yaw_tolerance_rad;
+      break;
+    }
     default: {
       const Eigen::Vector3d goal = move_goal(step_, s.tip_m);
       fixtures_.guide_xy_m = goal.head<2>();

@@ -215,7 +215,10 @@ class AssemblyTask {
   enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
   /// The steps that may be assisted: the moves to a position (approach, descend, lift, transport,
   /// retract: a guide at the goal's x, y, along the path from where the step began for approach and
-  /// transport, and a height stop at its z; done once the tool is there),
+  /// transport, and a height stop at its z; done once the tool is there), the turns (align, rotate:
+  /// the guide and the height stop hold the tool where it is to turn while the operator turns the
+  /// dial into a yaw stop at the square's yaw nearest where the turn began; done once the fingers
+  /// are within yaw_tolerance_rad of it),
   /// the grasp (the guide and stop hold the tool over the pin while the operator closes; done once
   /// the grip reaches grip_force_N), the insertion (the guide on the bore's axis and the funnel round
   /// its rim; judged at the first contact above contact_threshold_N: the pin half down in the
@@ -319,13 +322,14 @@ class AssemblyTask {
   double rim_z_ = 0.0;      // tool-point height at which the held pin's bottom meets the surface
   Eigen::Vector2d assist_from_ = Eigen::Vector2d::Zero();  // where an assisted move's path starts
   bool assist_from_known_ = false;
-  int tries_ = 0;                                                // search points tried
-  double offset_y_ = 0.0;                                        // the current search point
-  double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();   // the rotary axis' (NaN: none yet)
-  double last_yaw_ = 0.0;                                        // the fingers' yaw at the last tick
-  Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();           // ... and the tip's position
-  double search_yaw_ = 0.0;                                      // ... when the insertion began
-  double contact_z_ = std::numeric_limits<double>::quiet_NaN();  // where the last descent stopped
+  int tries_ = 0;                                                 // search points tried
+  double offset_y_ = 0.0;                                         // the current search point
+  double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();    // the rotary axis' (NaN: none yet)
+  double assist_yaw_ = std::numeric_limits<double>::quiet_NaN();  // an assisted turn's yaw stop
+  double last_yaw_ = 0.0;                                         // the fingers' yaw at the last tick
+  Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();            // ... and the tip's position
+  double search_yaw_ = 0.0;                                       // ... when the insertion began
+  double contact_z_ = std::numeric_limits<double>::quiet_NaN();   // where the last descent stopped
   bool looks_ = false;
   Look look_ = Look::kNone;                     // the look awaited, or the last one
   bool slot_seen_ = false, held_seen_ = false;  // looks done (found or not)

@@ -17,7 +17,8 @@ Autonomy autonomy_of(const std::string& level, const char* step, AssemblyTask::S
       if (a == Autonomy::kAssisted && !AssemblyTask::assistable(s))
         throw InvalidParams(
             std::string("steps.") + step,
-            "assisted is for approach, descend, grasp, lift, transport, insert, release and retract");
+            "assisted is for approach, align, descend, grasp, lift, transport, rotate, insert, release and "
+            "retract");
       return a;
     }
   throw InvalidParams(std::string("steps.") + step,

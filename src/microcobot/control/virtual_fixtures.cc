@@ -19,6 +19,8 @@ void VirtualFixtureParams::validate() const {
   require_positive(funnel_height_m, "funnel_height_m");
   require_positive(level_rate_1_s, "level_rate_1_s");
   require_positive(height_capture_m, "height_capture_m");
+  require(std::isfinite(yaw_capture_rad) && yaw_capture_rad > 0.0 && yaw_capture_rad <= 0.5,
+          "yaw_capture_rad", "must be within (0, 0.5] rad", yaw_capture_rad);
 }
 
 VirtualFixtures::VirtualFixtures(const VirtualFixtureParams& params) : p_(params) {
@@ -44,7 +46,8 @@ void VirtualFixtures::set(const FixtureSet& set) noexcept {
   const bool valid = std::isfinite(set.level) && set.level >= 0.0 && set.level <= 1.0 &&
                      set.guide_xy_m.allFinite() && set.path_from_xy_m.allFinite() &&
                      std::isfinite(set.rim_z_m) && std::isfinite(set.funnel_radius_m) &&
-                     set.funnel_radius_m >= 0.0 && std::isfinite(set.height_z_m) && keep_outs_valid(set);
+                     set.funnel_radius_m >= 0.0 && std::isfinite(set.height_z_m) &&
+                     std::isfinite(set.yaw_rad) && keep_outs_valid(set);
   const FixtureSet next = valid ? set : FixtureSet{};
   if (next == set_) return;
   // A new guide moves the field under the handle: its energy is booked afresh. A new level alone

@@ -84,6 +84,9 @@ struct VirtualFixtureParams {
   double funnel_height_m = 60e-6;       ///< above the rim, where the funnel begins
   double level_rate_1_s = 2.0;          ///< the assistance level's largest rate of change
   double height_capture_m = 25e-6;      ///< H: a height stop holds within it, lets go beyond 2H
+  /// A yaw stop (rotary_axis.h) holds within it, lets go beyond twice it: 20 mrad (1.15 deg), the
+  /// turn within which a 300 um pin still fits a bore of 3 um radial clearance (docs/cell.md).
+  double yaw_capture_rad = 0.02;
 
   template <class V>
   void visit(V& v) {
@@ -97,6 +100,7 @@ struct VirtualFixtureParams {
     v("funnel_height_m", funnel_height_m);
     v("level_rate_1_s", level_rate_1_s);
     v("height_capture_m", height_capture_m);
+    v("yaw_capture_rad", yaw_capture_rad);
   }
   /// Throws mc::InvalidParams naming the field.
   void validate() const;
@@ -114,6 +118,8 @@ struct FixtureSet {
   double funnel_radius_m = 0.0;  ///< r0: the allowed distance to the axis at the rim
   bool height = false;           ///< a height stop at height_z_m (at the set's level)
   double height_z_m = 0.0;       ///< tool-point height of the stop
+  bool yaw = false;  ///< a yaw stop at yaw_rad on the rotary axis (rotary_axis.h, at the set's level)
+  double yaw_rad = 0.0;
   /// A forbidden cylinder round a neighbouring part (header, keep-out).
   struct KeepOut {
     Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();
@@ -130,7 +136,8 @@ struct FixtureSet {
     return level == o.level && guide == o.guide && guide_xy_m == o.guide_xy_m && path == o.path &&
            path_from_xy_m == o.path_from_xy_m && funnel == o.funnel && rim_z_m == o.rim_z_m &&
            funnel_radius_m == o.funnel_radius_m && height == o.height && height_z_m == o.height_z_m &&
-           keep_out_count == o.keep_out_count && keep_outs == o.keep_outs;
+           yaw == o.yaw && yaw_rad == o.yaw_rad && keep_out_count == o.keep_out_count &&
+           keep_outs == o.keep_outs;
   }
 };
 

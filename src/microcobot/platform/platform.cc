@@ -436,6 +436,9 @@ void Platform::set_fixtures(const control::FixtureSet& set) noexcept {
     k.top_z_m -= home_m_.z();
   }
   teleop_->set_fixtures(stage);
+  const auto& fp = config_.teleop.fixtures;
+  if (rotary_target_)
+    rotary_target_->set_stop(set.yaw, set.yaw_rad, set.level, fp.yaw_capture_rad, fp.level_rate_1_s);
 }
 
 void Platform::hold() noexcept {
