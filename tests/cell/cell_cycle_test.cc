@@ -9,6 +9,7 @@
 
 #include "cell/cell_test_support.h"
 
+#include <chrono>
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -148,6 +149,12 @@ TEST(CellCycle, FlatPartsAreTheRobotsOnlyAndSaySo) {
   } catch (const InvalidParams& e) {
     EXPECT_NE(std::string(e.what()).find("flat_fraction"), std::string::npos) << e.what();
   }
+  // A batch is refused before its first cycle, not when its first flat part comes up.
+  const std::vector<AssemblyJob> pin_then_flat = {job(), assembly_jobs(p).front()};
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THROW(run_batch(pin_then_flat, manual, default_platform()), InvalidParams);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0)
+      << "no cycle ran (a person's cycle takes seconds of wall time)";
 }
 
 TEST(CellCycle, PauseStopsTheCommandedMotionAtTheNextTickAndResumeGoesOn) {

@@ -70,6 +70,12 @@ struct CellCycle::Meter {
 
 namespace {
 
+// Flat parts are the robot's only (the simulated person and the scripted watchmaker only open).
+void require_mode_places(const AssemblyJob& job, const std::string& mode) {
+  require(!job.flat || mode == "auto", "flat_fraction",
+          "gives flat parts, which only the robot places (mode auto; got mode '" + mode + "')");
+}
+
 platform::PlatformConfig with_world(platform::PlatformConfig c, const AssemblyJob& job) {
   c.microworld = "pick-place";
   c.world = job.world;
@@ -87,8 +93,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       vision_rng_(static_cast<std::uint64_t>(params.person_seed) * 1000003ULL +
                   static_cast<std::uint64_t>(job.index) + 0x766973696f6eULL) {
   params_.validate();
-  require(!job.flat || params_.mode == "auto", "flat_fraction",
-          "gives flat parts, which only the robot places (mode auto; got mode '" + params_.mode + "')");
+  require_mode_places(job, params_.mode);
   base = with_world(std::move(base), job);
   platform_ = std::make_unique<platform::Platform>(base);
   home_m_ = {base.stage.home_x_m, base.stage.home_y_m, base.stage.home_z_m};
@@ -358,6 +363,8 @@ std::vector<CycleResult> run_batch(const std::vector<AssemblyJob>& jobs, const C
                                    const platform::PlatformConfig& base,
                                    const std::function<void(const CycleResult&)>& progress) {
   params.validate();
+  // Refused before the first cycle, not when the first flat part comes up.
+  for (const AssemblyJob& j : jobs) require_mode_places(j, params.mode);
   std::vector<CycleResult> out;
   out.reserve(jobs.size());
   for (const AssemblyJob& j : jobs) {
