@@ -1,6 +1,6 @@
 // The operator's inputs: the deadman (button, Space, gamepad shoulder), the joystick (touch pad,
 // arrows/WASD, gamepad stick), Z (buttons, PageUp/PageDown, wheel, right stick), the gripper
-// (slider, gamepad trigger), the rotary axis under it (buttons, ',' and '.', or a goal from the
+// (slider, gamepad trigger; its release burst: the Shake button or B), the rotary axis under it (buttons, ',' and '.', or a goal from the
 // readout's θ row), and the command they make, sent at 30 Hz while in control. Goals
 // (click-to-go, go-to, step jog, saved positions) ride on the same command: the server applies
 // them, like every motion, only while the deadman is held.
@@ -44,6 +44,7 @@ holdButton($("z-up"), "zButton", 1);
 holdButton($("z-down"), "zButton", -1);
 holdButton($("theta-ccw"), "thetaButton", 1);
 holdButton($("theta-cw"), "thetaButton", -1);
+holdButton($("gripper-shake"), "shakeButton", 1);
 
 $("speed").addEventListener("input", () => { $("speed-out").textContent = $("speed").value + " µm/s"; });
 function speed() { return Number($("speed").value) * 1e-6; }
@@ -125,7 +126,13 @@ function currentCommand() {
     cmd.goal_m = mc.input.goal;
     cmd.goal_speed_m_s = v;
   }
+  // The release burst (held button or B): a gripper command, so it carries the opening; one the
+  // operator has not set yet is the measured one (the burst must not move the fingers).
+  const shake = !!(mc.input.shakeButton || keys.has("b") || keys.has("B"));
+  if (shake && !mc.input.gripperTouched && mc.telemetry) setGripper(mc.telemetry.gripper_opening_m);
+  $("gripper-shake").classList.toggle("held", shake);
   if (mc.input.gripperTouched) cmd.gripper_opening_m = mc.input.gripper;
+  if (shake) cmd.gripper_shake = true;
   // The rotary axis (when the scene has one): a turn at the dial's rate, or a goal from the readout.
   if (mc.scene && mc.scene.theta_max_rad > mc.scene.theta_min_rad) {
     const turn = (mc.input.thetaButton || 0) + k(",", "<") - k(".", ">");

@@ -3,6 +3,8 @@
 // deadman, the gripper slider, the arrow-key jog, the step jog and the go-to entry leave the
 // stage's target and position and the gripper's opening unchanged in the telemetry; holding the
 // deadman, the same gripper command then moves the fingers (the check is not vacuous). The
+// gripper's release burst (the Shake button, B) does not shake it without the deadman, and does
+// with it (the telemetry's simulation channel gripper_shaking). The
 // platform enforces it, not the page: the page sends these commands all the same. Run by CTest
 // (`console_browser_deadman`); screenshots to MC_ARTIFACTS.
 import { join } from "node:path";
@@ -43,6 +45,20 @@ await s.run(async () => {
     await page.fill("#goto-y", ((before.measured_y_m + 200e-6) * 1e6).toFixed(1));
     await page.click("#goto-go");
   });
+  // The gripper's release burst (Shake held, or B): never without the deadman.
+  const shakingMax = () => page.evaluate(async () => {
+    let m = 0;
+    for (let i = 0; i < 25; ++i) {
+      m = Math.max(m, window.mc.telemetry.gripper_shaking || 0);
+      await new Promise((r) => setTimeout(r, 30));
+    }
+    return m;
+  });
+  await page.hover("#gripper-shake");
+  await page.mouse.down();
+  const shookAlone = await shakingMax();
+  await page.mouse.up();
+  if (shookAlone !== 0) fail("the Shake button shook the gripper without the deadman");
   await shot("deadman-01-commands-without-deadman");
 
   // The same commands with the deadman held: now the fingers close (and the stage goes).
@@ -56,4 +72,16 @@ await s.run(async () => {
     await page.keyboard.up(" ");
   }
   log(`with the deadman: opening ${((await t()).gripper_opening_m * 1e6).toFixed(1)} um`);
+  // ... and the burst with it (B and Space held together), stopping with the deadman.
+  await page.keyboard.down(" ");
+  await page.keyboard.down("b");
+  try {
+    await until("the gripper shaking with the deadman and B held", () => window.mc.telemetry.gripper_shaking === 1, 10);
+    await shot("deadman-02-shake-with-deadman");
+  } finally {
+    await page.keyboard.up(" ");
+  }
+  await until("the burst stopping when the deadman is let go", () => window.mc.telemetry.gripper_shaking === 0, 5);
+  await page.keyboard.up("b");
+  log("the release burst: only with the deadman");
 }, "nothing moved without the deadman");

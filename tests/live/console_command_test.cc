@@ -53,6 +53,19 @@ TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
   EXPECT_EQ(message_of(R"({"goal_speed_m_s": -1})"), "/console/command: goal_speed_m_s: must be > 0");
   EXPECT_NE(message_of(R"({"fly": true})").find("fly: is not a known key"), std::string::npos);
   EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e308]})"), "accepted");  // finite: clamped to the workspace
+  EXPECT_EQ(message_of(R"({"gripper_shake": 1})"), "/console/command: gripper_shake: must be true or false");
+}
+
+// The gripper's release burst (issue #29 point 1): a flag riding on the command, off unless sent.
+TEST(ConsoleCommand, TheGrippersReleaseBurstIsAFlagThatIsOffUnlessSent) {
+  const ConsoleLimits limits;
+  const ConsoleCommand c =
+      parse_console_command(R"({"deadman": true, "gripper_opening_m": 4e-4, "gripper_shake": true})", limits);
+  EXPECT_TRUE(c.gripper_shake);
+  EXPECT_TRUE(c.has_gripper);
+  EXPECT_FALSE(
+      parse_console_command(R"({"deadman": true, "gripper_opening_m": 4e-4})", limits).gripper_shake);
+  EXPECT_FALSE(parse_console_command(R"({"gripper_shake": false})", limits).gripper_shake);
 }
 
 // The rotary axis under the gripper (issue #29 point 2): its goal clamped to its travel, its rate to

@@ -163,6 +163,34 @@ TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
   moves_the_slave_without_allocating(pair);
 }
 
+// Issue #29 point 1: the gripper's release burst over the link. The master's console holds Shake:
+// the slave's gripper shakes only while the master is engaged (the deadman), and stops when the
+// deadman is let go or the burst is.
+TEST(RemoteEnds, TheMastersShakeReachesTheSlavesGripperOnlyWithTheDeadman) {
+  Pair pair;
+  ASSERT_TRUE(pair.engage());
+  live::ConsoleCommand c = jog(0);
+  c.has_gripper = true;
+  c.gripper_opening_m = 400e-6;
+  pair.drive(c, 300ms);
+  EXPECT_EQ(pair.slave->get("gripper_shaking"), 0.0) << "nothing asked for the burst";
+  c.gripper_shake = true;
+  EXPECT_TRUE(test::wait_until(
+      [&] { return pair.slave->get("gripper_shaking") == 1.0 || (pair.drive(c, 20ms), false); }, 10.0))
+      << "the slave's gripper never shook";
+  c.deadman = false;
+  EXPECT_TRUE(test::wait_until(
+      [&] { return pair.slave->get("gripper_shaking") == 0.0 || (pair.drive(c, 20ms), false); }, 10.0))
+      << "the burst went on without the deadman";
+  pair.drive(c, 300ms);
+  EXPECT_EQ(pair.slave->get("gripper_shaking"), 0.0) << "Shake held without the deadman";
+  c.deadman = true;
+  c.gripper_shake = false;
+  ASSERT_TRUE(pair.engage());
+  pair.drive(c, 300ms);
+  EXPECT_EQ(pair.slave->get("gripper_shaking"), 0.0) << "the burst let go";
+}
+
 // Issue #29 point 2: the rotary axis over the link. The master's console turns the slave's rotary
 // axis (the target pose's orientation, a rotation about z) only while the master is engaged, and
 // the master sees the slave's angle (the measured pose's orientation).

@@ -70,6 +70,9 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else if (key == "gripper_opening_m") {
       c.gripper_opening_m = finite(kChannel, value, key);
       c.has_gripper = true;
+    } else if (key == "gripper_shake") {
+      if (!value.is_boolean()) refuse(kChannel, key, "must be true or false");
+      c.gripper_shake = value.get<bool>();
     } else if (key == "theta_goal_rad" || key == "theta_rate_rad_s") {
       if (limits.max_theta_speed_rad_s <= 0.0) refuse(kChannel, key, "there is no rotary axis");
       const double v = finite(kChannel, value, key);
@@ -99,7 +102,7 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else {
       refuse(kChannel, key,
              "is not a known key (deadman, velocity_m_s, goal_m, goal_px, goal_speed_m_s, gripper_opening_m, "
-             "theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain)");
+             "gripper_shake, theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain)");
     }
   }
   // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.

@@ -50,6 +50,9 @@ struct ConsoleCommand {
   std::array<double, 2> goal_px{};
   bool has_gripper = false;
   double gripper_opening_m = 0.0;
+  /// The gripper's release burst while true (microworld/release.h, shake): with the deadman and
+  /// an opening, like every gripper command.
+  bool gripper_shake = false;
   /// The rotary axis: to a yaw (the gripper's, world frame), or at the dial's rate; with the deadman.
   bool has_theta_goal = false;
   double theta_goal_rad = 0.0;

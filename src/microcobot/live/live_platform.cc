@@ -236,6 +236,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
     in.goal_speed_m_s = latest_.goal_speed_m_s;
     in.has_gripper = latest_.has_gripper;
     in.gripper_opening_m = latest_.gripper_opening_m;
+    in.gripper_shake = latest_.gripper_shake;
     in.has_theta_goal = latest_.has_theta_goal;
     in.theta_goal_rad = latest_.theta_goal_rad;
     in.theta_speed_rad_s = limits_.max_theta_speed_rad_s;

@@ -33,8 +33,11 @@ enum class Channel : std::uint8_t {
   kMasterGripperPortEnergy,
   /// slave -> master: the same of the slave's end (J, in `xyz[0]`)
   kSlaveGripperPortEnergy,
+  /// master -> slave: the gripper's release burst on or off (latched state, 0 or 1; the slave's
+  /// coupling passes it only while engaged and fresh: microworld/release.h, shake)
+  kGripperShake,
 };
-inline constexpr std::size_t kChannelCount = 13;
+inline constexpr std::size_t kChannelCount = 14;
 
 /// One message. `xyz` holds a position (m), a force (N) or the energies of the ports (J) in the
 /// stage frame; `scalar` the gripper opening (m) or a boolean (0/1). Unused fields are zero.

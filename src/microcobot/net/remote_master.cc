@@ -79,6 +79,9 @@ void RemoteMaster::apply(const NetSample& s, double t_s, live::RemoteRequest& r)
     case Channel::kEngaged:
       engaged_ = s.scalar != 0.0;
       break;
+    case Channel::kGripperShake:
+      shake_ = s.scalar != 0.0;
+      break;
     default:
       break;  // the slave's own channels never come back (the link ignores them)
   }
@@ -130,6 +133,7 @@ live::RemoteRequest RemoteMaster::poll(double t_s, live::ConsoleCommand& command
   if (has_gripper_target_ && opening_known_) {
     command.has_gripper = true;
     command.gripper_opening_m = goal_opening_m_;
+    command.gripper_shake = shake_;  // the coupling passes it only while engaged and fresh
   }
   if (has_target_) {
     command.has_goal = true;

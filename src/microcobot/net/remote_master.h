@@ -100,6 +100,7 @@ class RemoteMaster final : public live::CommandSource {
   TransitEstimate target_transit_;  // the targets' route: how late each one arrives
   bool engaged_ = false;
   bool estop_ = false;
+  bool shake_ = false;                                 // the master's gripper burst (latched)
   std::array<double, 4> states_sent_{-1, -1, -1, -1};  // lifecycles last put on /diagnostics
   int ticks_to_diagnostics_ = 0;
   // The channel's slave end: the master's latest target and the goal let through towards it

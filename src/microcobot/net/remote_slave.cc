@@ -70,6 +70,15 @@ class RemoteGripper final : public RemoteDevice<platform::Gripper> {
   void command_opening_m(double opening) noexcept override {
     if (active()) slave_.set_gripper_target(opening);
   }
+  /// The burst travels to the slave's gripper; its coupling decides whether it shakes.
+  void command_shake(bool on) noexcept override {
+    if (active()) slave_.set_gripper_shake(on);
+  }
+  bool can_shake() const override { return true; }
+  void enter_safe_state() noexcept override {
+    if (active()) slave_.set_gripper_shake(false);
+    RemoteDevice::enter_safe_state();
+  }
   double opening_m() const override { return slave_.state().opening_m; }
   double grip_force_N() const override { return slave_.state().grip_force_N; }
   platform::Vec3 contact_force_N() const override {
@@ -131,6 +140,12 @@ void RemoteSlave::set_target(int axis, double target_m, double /*velocity_m_s*/)
   // A target computed while the slave was silent is the coupling's frozen guess, not a command
   // for a slave that (re)appears: only targets computed on fresh measurements are sent.
   targets_fresh_ = fresh();
+}
+
+void RemoteSlave::set_gripper_shake(bool on) noexcept {
+  if (shake_sent_ == static_cast<int>(on)) return;
+  shake_sent_ = static_cast<int>(on);
+  send(Channel::kGripperShake, {}, on ? 1.0 : 0.0);
 }
 
 void RemoteSlave::set_estop(bool on) noexcept {

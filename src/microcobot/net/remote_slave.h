@@ -116,6 +116,8 @@ class RemoteSlave {
   // The devices' side (loop thread).
   void set_target(int axis, double target_m, double velocity_m_s) noexcept;
   void set_gripper_target(double opening_m) noexcept { gripper_target_m_ = opening_m; }
+  /// The gripper's release burst: sent on change (latched), as the e-stop.
+  void set_gripper_shake(bool on) noexcept;
   void exchange(double dt_s) noexcept;
   /// Latches the e-stop on the slave (a device entered its safe state) or releases it.
   void set_estop(bool on) noexcept;
@@ -137,6 +139,7 @@ class RemoteSlave {
   bool targets_fresh_ = false;   // they were computed on fresh measurements
   double gripper_target_m_ = 0.0;
   int estop_sent_ = -1;  // -1: never sent
+  int shake_sent_ = -1;  // the same for the gripper's burst
   // The channel's master end: the force received, the rate of the targets sent, the sessions.
   MasterPorts ports_;
   std::array<double, 3> received_contact_N_{};

@@ -80,6 +80,8 @@ constexpr std::array<TopicSpec, kChannelCount> kTable{{
     state(Channel::kSlaveGripperPortEnergy, "/microcobot/slave/gripper/port_energy",
           "rt/microcobot/slave/gripper/port_energy", RosType::kVector3Stamped, kVector3Stamped, Role::kSlave,
           "J (x: the gripper's opening port; y, z: 0)"),
+    latched(Channel::kGripperShake, "/microcobot/master/gripper/shake", "rt/microcobot/master/gripper/shake",
+            Role::kMaster),
 }};
 
 constexpr bool table_is_indexed_by_channel() {

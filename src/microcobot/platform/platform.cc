@@ -351,9 +351,10 @@ void Platform::telemetry_task(double t_s) noexcept {
       put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
       put(static_cast<double>(static_cast<int>(w.phase)));
       put(sim_.gripper->yaw_rad()), put(w.part_yaw_rad);
+      put(w.gripper.shaking ? 1.0 : 0.0);
     } else {
       const Eigen::Vector3d bead = sim_.optical_tweezers->bead_m();
-      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0), put(0.0), put(0.0);
+      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0), put(0.0), put(0.0), put(0.0);
     }
   }
   ring_.push(s);

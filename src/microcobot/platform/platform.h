@@ -53,7 +53,7 @@ namespace mc::platform {
 /// controller's commands): recorded on any devices. The rest are the simulation's ground truth
 /// (the operator's hand, the true carriage positions, the haptic channels' forces, the part):
 /// recorded only when the platform runs its simulated devices.
-inline constexpr std::array<const char*, 44> kTelemetryChannels = {"t_s",  // loop channels
+inline constexpr std::array<const char*, 45> kTelemetryChannels = {"t_s",  // loop channels
                                                                    "handle_x_m",
                                                                    "handle_y_m",
                                                                    "deadman",
@@ -96,9 +96,11 @@ inline constexpr std::array<const char*, 44> kTelemetryChannels = {"t_s",  // lo
                                                                    "part_z_m",
                                                                    "part_phase",
                                                                    "slave_theta_rad",
-                                                                   "part_yaw_rad"};
+                                                                   "part_yaw_rad",
+                                                                   "gripper_shaking"};
 // In the optical-trap scene the part channels are the probe bead's (part_phase 0). The theta
-// channels are the rotary axis' (0 on a platform without one).
+// channels are the rotary axis' (0 on a platform without one). gripper_shaking: 1 while the
+// simulated gripper's release burst shakes its fingers.
 inline constexpr std::size_t kLoopChannelCount = 31;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
