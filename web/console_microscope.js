@@ -171,6 +171,13 @@ function drawMicroscope() {
     turned(g, sc.target_m[0], sc.target_m[1], sc.hole_yaw_rad,
            () => drawBlurred(g, -hs / 2, -hs / 2, hs, hs, blurPx(focus, o, s), "#0c0b09"));
   }
+  // The scene's other parts (a grid load's, `serve --cell`): standing in their slots or placed,
+  // their tops at top_z_m, in a darker brass.
+  for (const n of sc.neighbours || []) {
+    const ns = n.side_m * s;
+    turned(g, n.xy_m[0], n.xy_m[1], n.yaw_rad,
+           () => drawBlurred(g, -ns / 2, -ns / 2, ns, ns, blurPx(focus - n.top_z_m, o, s), "#9c7d3c"));
+  }
   // The part: a brass cube or pin, its top face at part_z + height / 2, blurred by its defocus.
   // (A master of a distributed platform has no part in its telemetry: the microworld is the
   // slave's.)
@@ -264,6 +271,8 @@ function drawSide() {
     g.fillStyle = "#111";
     g.fillRect(X(sc.target_m[0] - sc.hole_side_m / 2), Z(0), sc.hole_side_m * s, sc.hole_depth_m * zs);
   }
+  g.fillStyle = "#9c7d3c";  // the other parts, in section along x (all of them: a side view)
+  for (const n of sc.neighbours || []) g.fillRect(X(n.xy_m[0] - n.side_m / 2), Z(n.top_z_m), n.side_m * s, Z(0) - Z(n.top_z_m));
   const side = sc.part_side_m, height = sc.part_height_m || side;
   g.fillStyle = "#c9a04a";
   if (t.part_x_m !== undefined) g.fillRect(X(t.part_x_m - side / 2), Z(t.part_z_m + height / 2), side * s, height * zs);

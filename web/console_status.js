@@ -39,7 +39,7 @@ function onServerStatus(m) {
   else if (m.level === 1) banner("warning", m.message);
 }
 
-// last_error: the control thread's (or the request's) refusal of demo, restart or reset. Shown
+// last_error: the control thread's (or the request's) refusal of demo, restart, reset or next_part. Shown
 // when it changes to a new text, and again when an action was just pressed and it is still set
 // (the same refusal twice is still an answer). Statuses sampled before the action reached the
 // server (5 Hz, under 300 ms after the press) do not count.
@@ -47,7 +47,7 @@ let lastError = "";
 function watchLastError(s) {
   const error = typeof s.last_error === "string" ? s.last_error : "";
   const a = mc.lastAction, since = a ? performance.now() - a.at : Infinity;
-  const answered = a && ["demo", "restart", "reset"].includes(a.name) && since > 300 && since < 3000;
+  const answered = a && ["demo", "restart", "reset", "next_part"].includes(a.name) && since > 300 && since < 3000;
   if (error && (error !== lastError || answered)) {
     banner("error", error);
     mc.lastAction = null;  // answered

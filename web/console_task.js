@@ -1,6 +1,7 @@
 // The supervised task (`serve --cell`, issue #29 point 5): its steps with their autonomy, the
 // current one highlighted, its status, and the operator's controls (start, pause, resume,
-// confirm, take over, hand back, step done, skip) sent as /console/action task_*. The rules
+// confirm, take over, hand back, step done, skip) sent as /console/action task_*, and the batch's
+// Next part (next_part) when serve has a batch. The rules
 // (who may, what stops the stage, what a take-over re-takes) are the platform's; this panel
 // presents the status's `task` and sends the actions. Hidden without a task.
 "use strict";
@@ -19,6 +20,8 @@ const kTaskButtons = [
    (t) => t.status === "operator" || t.status === "assisted"],
   ["task-skip", "Skip step", "task_skip", "Leave this step for the next one, from where the stage is",
    (t) => t.started && !["succeeded", "failed"].includes(t.status)],
+  ["task-next-part", "Next part", "next_part", "The batch's next part: the scene rebuilt on it, its task waiting for Start",
+   (t) => t.parts > 1 && (!t.started || ["succeeded", "failed"].includes(t.status))],
 ];
 
 (function taskPanel() {
@@ -63,8 +66,9 @@ function taskHint(t) {
   if (t.status === "assisted")
     return `You drive “${t.step}”, guided to its goal: hold the deadman and move towards it; the task goes on once you are there.`;
   const truth = t.inserted === true ? " — the pin is in its bore" : t.inserted === false ? " — the pin is not in its bore" : "";
-  if (t.status === "succeeded") return `Succeeded in ${t.elapsed_s.toFixed(1)} s${truth}. Restart scene for another cycle.`;
-  return `Failed in “${t.step}”: ${t.failure || "no reason given"}${truth}. Restart scene for another cycle.`;
+  const again = t.parts > 1 ? "Next part for the batch's next, Restart scene for this one again." : "Restart scene for another cycle.";
+  if (t.status === "succeeded") return `Succeeded in ${t.elapsed_s.toFixed(1)} s${truth}. ${again}`;
+  return `Failed in “${t.step}”: ${t.failure || "no reason given"}${truth}. ${again}`;
 }
 
 let lastTaskKey = "", lastTaskEnded = null, lastOperatorDrives = false;
@@ -77,7 +81,9 @@ listen("/platform/status", (s) => {
   state.className = "pill " + ({running: "ok", succeeded: "ok", failed: "bad", paused: "warn",
                                 "awaiting confirmation": "warn", "awaiting look": "ok", operator: "warn", assisted: "warn"}[t.status] || "");
   const looks = t.looks > 0 ? ` · camera ${t.looks_found}/${t.looks}` : "";
-  $("task-info").textContent = t.started ? `${t.elapsed_s.toFixed(1)} s · search tries ${t.search_tries}${looks}` : "";
+  const part = t.parts > 1 ? `part ${t.part + 1} of ${t.parts}` : "";
+  $("task-info").textContent = [part, t.started ? `${t.elapsed_s.toFixed(1)} s · search tries ${t.search_tries}${looks}` : ""]
+                                 .filter((x) => x).join(" · ");
   const key = JSON.stringify([t.step_index, t.status, t.steps]);
   if (key !== lastTaskKey) {  // the tree redrawn only when it changes
     lastTaskKey = key;

@@ -184,9 +184,14 @@ void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
     throw mc::UsageError("--part " + std::to_string(part) + ": the batch has " + std::to_string(batch.parts) +
                          " parts (0 to " + std::to_string(batch.parts - 1) + ")");
   mc::cli::naming_flags({{"seed", "--seed"}}, [&] { batch.validate(); });
-  const mc::cell::AssemblyJob job = mc::cell::assembly_jobs(batch)[static_cast<std::size_t>(part)];
+  const std::vector<mc::cell::AssemblyJob> jobs = mc::cell::assembly_jobs(batch);
+  const mc::cell::AssemblyJob& job = jobs[static_cast<std::size_t>(part)];
   mc::live::LiveTaskParams tp;
   tp.goal = mc::cell::assembly_goal(job);
+  // The whole batch, so that the console's Next part goes through it.
+  for (const mc::cell::AssemblyJob& j : jobs)
+    tp.parts.push_back({j.index, j.world, mc::cell::assembly_goal(j)});
+  tp.part = part;
   if (o.task) {
     const mc::cell::AssemblyTaskFile f = mc::cell::load_task_file(*o.task);
     tp.task = f.params;
@@ -204,9 +209,12 @@ void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
                             mc::cell::AssemblyTask::name(static_cast<mc::cell::AssemblyTask::Step>(i)),
                             mc::cell::AssemblyTask::name(tp.autonomy[static_cast<std::size_t>(i)]));
   std::cerr << fmt::format(
-      "serve: cell part {} of the batch of seed {}: a {:.0f} um pin into a bore with {:.1f} um of radial "
-      "clearance; steps {}{}; the task waits for Start in the console\n",
-      part, batch.seed, 1e6 * job.side_m, 1e6 * job.clearance_m,
+      "serve: cell part {} of the {} of the batch of seed {}: a {:.0f} um {} with {:.1f} um of {}{}; steps "
+      "{}{}; "
+      "the task waits for Start in the console (Next part: the batch's next)\n",
+      part, batch.parts, batch.seed, 1e6 * job.side_m, job.flat ? "plate onto its seat" : "pin into a bore",
+      1e6 * job.clearance_m, job.flat ? "seat tolerance" : "radial clearance",
+      job.world.neighbour_count > 0 ? fmt::format(", among {} other parts", job.world.neighbour_count) : "",
       levels.empty() ? "all auto" : levels + " (the rest auto)",
       o.cell_camera ? "; the cell's camera looks" : "");
 }

@@ -56,11 +56,15 @@ struct TaskRig {
   // heartbeat's gaps); else as fast as the machine goes, with a 10 s timeout.
   // `camera`: the cell camera's looks (a LiveLooker answers them).
   // `assisted`: the step the operator does under the platform's guidance (the rest automatic).
-  explicit TaskRig(bool paced = false, bool camera = false, std::optional<Step> assisted = std::nullopt) {
+  // `batch`: the console works through this batch's parts (Next part), from its first.
+  explicit TaskRig(bool paced = false, bool camera = false, std::optional<Step> assisted = std::nullopt,
+                   std::optional<cell::AssemblyBatchParams> batch_served = std::nullopt) {
     cell::AssemblyBatchParams batch;
     batch.parts = 1;
     batch.seed = 41;
-    const cell::AssemblyJob job = cell::assembly_jobs(batch).front();
+    if (batch_served) batch = *batch_served;
+    const std::vector<cell::AssemblyJob> jobs = cell::assembly_jobs(batch);
+    const cell::AssemblyJob& job = jobs.front();
     params.paced = paced;
     // Unpaced, loop time runs faster than the 50 Hz heartbeat's wall clock.
     if (!paced) params.command_timeout_s = 10.0;
@@ -71,6 +75,8 @@ struct TaskRig {
     tp.goal = cell::assembly_goal(job);
     tp.camera.enabled = camera;
     if (assisted) tp.autonomy[static_cast<std::size_t>(*assisted)] = cell::AssemblyTask::Autonomy::kAssisted;
+    if (batch_served)
+      for (const cell::AssemblyJob& j : jobs) tp.parts.push_back({j.index, j.world, cell::assembly_goal(j)});
     params.task = tp;
     live = std::make_unique<LivePlatform>(params);
     samples.reserve(200000);
@@ -388,6 +394,50 @@ TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   ASSERT_TRUE(test::eventually([&] { return rig.live->status().restarts == 1; }));
   EXPECT_EQ(rig.task().status_name(), "idle") << "a new scene, a new cycle";
   EXPECT_EQ(rig.task().step, Step::kApproach);
+}
+
+// Issue #29, a batch in the console: Next part rebuilds the scene on the batch's next part (its
+// world, its neighbours, its goal) with a fresh task, and the task inserts it among the others;
+// after the last part the first comes again. Without a batch the action is refused with one line.
+TEST(LiveTask, NextPartWorksThroughAGridLoadEachAmongItsNeighbours) {
+  cell::AssemblyBatchParams batch;
+  batch.parts = 3;
+  batch.seed = 43;
+  batch.layout = "grid";
+  const std::vector<cell::AssemblyJob> jobs = cell::assembly_jobs(batch);
+  TaskRig rig(/*paced=*/false, /*camera=*/false, std::nullopt, batch);
+  EXPECT_EQ(rig.task().part, 0);
+  EXPECT_EQ(rig.task().parts, 3);
+  for (int k = 0; k < 2; ++k) {
+    const cell::AssemblyJob& j = jobs[static_cast<std::size_t>(k)];
+    const microworld::PickPlaceParams& w = rig.live->scene_world();
+    EXPECT_EQ(w.part_side_m, j.world.part_side_m) << "part " << k;
+    EXPECT_EQ(w.target_m, j.world.target_m) << "part " << k;
+    ASSERT_EQ(w.neighbour_count, 2) << "the load's two others";
+    // Part 1's scene holds part 0 placed in its bore (its top a bore's depth lower than standing).
+    if (k == 1) {
+      EXPECT_EQ(w.neighbours[0].xy_m, jobs[0].target_m);
+      EXPECT_NEAR(w.neighbours[0].top_z_m, jobs[0].world.height_m() - jobs[0].world.hole_depth_m, 1e-12);
+    }
+    ASSERT_TRUE(rig.live->push_task_action(TaskAction::kStart));
+    ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 180s));
+    EXPECT_EQ(rig.task().status, Status::kSucceeded) << "part " << k << ": " << rig.task().failure;
+    EXPECT_EQ(rig.task().inserted, 1) << "part " << k;
+    rig.live->request(ConsoleAction::kNextPart);
+    ASSERT_TRUE(
+        test::eventually([&] { return rig.live->status().restarts == static_cast<std::uint64_t>(k + 1); }));
+    EXPECT_EQ(rig.task().part, k + 1);
+    EXPECT_EQ(rig.task().status_name(), "idle") << "a new part, a task not started";
+  }
+  rig.live->request(ConsoleAction::kNextPart);
+  ASSERT_TRUE(test::eventually([&] { return rig.live->status().restarts == 3; }));
+  EXPECT_EQ(rig.task().part, 0) << "after the last part, the first";
+  EXPECT_TRUE(rig.live->status().last_error.empty()) << rig.live->status().last_error;
+
+  TaskRig single;
+  single.live->request(ConsoleAction::kNextPart);
+  EXPECT_EQ(single.live->status().last_error, "next_part: there is no batch here (serve --cell serves one)");
+  EXPECT_EQ(single.task().part, -1);
 }
 
 // The camera's looks reach the loop through a ring: it allocates nothing taking them (the looker

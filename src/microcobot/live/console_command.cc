@@ -131,6 +131,7 @@ ConsoleAction parse_console_action(std::string_view text) {
       {"record_start", ConsoleAction::kRecordStart},
       {"record_stop", ConsoleAction::kRecordStop},
       {"vision_tare", ConsoleAction::kVisionTare},
+      {"next_part", ConsoleAction::kNextPart},
       {"task_start", ConsoleAction::kTaskStart},
       {"task_pause", ConsoleAction::kTaskPause},
       {"task_resume", ConsoleAction::kTaskResume},
@@ -145,7 +146,8 @@ ConsoleAction parse_console_action(std::string_view text) {
     if (n == name) return action;
   refuse(kChannel, "action",
          "must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
-         "record_stop, vision_tare, task_start, task_pause, task_resume, task_confirm, task_take_over, "
+         "record_stop, vision_tare, next_part, task_start, task_pause, task_resume, task_confirm, "
+         "task_take_over, "
          "task_hand_back, "
          "task_step_done, task_skip");
 }

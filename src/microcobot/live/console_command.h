@@ -81,6 +81,9 @@ enum class ConsoleAction {
   kRecordStart,     ///< start an MCAP recording in --out
   kRecordStop,
   kVisionTare,  ///< force by vision's tare: nothing is between the fingers (the controlling client)
+  /// The batch's next part (`serve --cell`): the scene rebuilt on it, its task not started (after
+  /// the last part, the first again). The controlling client, as Restart.
+  kNextPart,
   // The supervised task (`serve --cell`, live_task.h): its controls, in TaskAction's order.
   kTaskStart,
   kTaskPause,

@@ -124,34 +124,37 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                                "grip_force_limit_N",
                                                "contact_force_limit_N",
                                                "demo_available",
-                                               "demo_unavailable_reason"};
-  scene_ch_ = server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
-                                   schema({{"kind", text},
-                                           {"part_side_m", number},
-                                           {"part_height_m", number},
-                                           {"hole_side_m", number},
-                                           {"hole_depth_m", number},
-                                           {"part_yaw_rad", number},
-                                           {"hole_yaw_rad", number},
-                                           {"theta_min_rad", number},
-                                           {"theta_max_rad", number},
-                                           {"target_m", vec3},
-                                           {"tolerance_m", number},
-                                           {"max_opening_m", number},
-                                           {"finger_width_m", number},
-                                           {"workspace_min_m", vec3},
-                                           {"workspace_max_m", vec3},
-                                           {"max_speed_m_s", number},
-                                           {"force_full_scale_N", number},
-                                           {"grip_force_limit_N", number},
-                                           {"contact_force_limit_N", number},
-                                           {"demo_available", boolean},
-                                           {"demo_unavailable_reason", text},
-                                           {"bead_radius_m", number},
-                                           {"obstacle_m", {{"type", "array"}, {"items", number}}},
-                                           {"obstacle_radius_m", number},
-                                           {"camera", {{"type", {"object", "null"}}}}},
-                                          scene_keys)});
+                                               "demo_unavailable_reason",
+                                               "neighbours"};
+  scene_ch_ =
+      server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
+                           schema({{"kind", text},
+                                   {"part_side_m", number},
+                                   {"part_height_m", number},
+                                   {"hole_side_m", number},
+                                   {"hole_depth_m", number},
+                                   {"part_yaw_rad", number},
+                                   {"hole_yaw_rad", number},
+                                   {"theta_min_rad", number},
+                                   {"theta_max_rad", number},
+                                   {"target_m", vec3},
+                                   {"tolerance_m", number},
+                                   {"max_opening_m", number},
+                                   {"finger_width_m", number},
+                                   {"workspace_min_m", vec3},
+                                   {"workspace_max_m", vec3},
+                                   {"max_speed_m_s", number},
+                                   {"force_full_scale_N", number},
+                                   {"grip_force_limit_N", number},
+                                   {"contact_force_limit_N", number},
+                                   {"demo_available", boolean},
+                                   {"demo_unavailable_reason", text},
+                                   {"bead_radius_m", number},
+                                   {"obstacle_m", {{"type", "array"}, {"items", number}}},
+                                   {"obstacle_radius_m", number},
+                                   {"camera", {{"type", {"object", "null"}}}},
+                                   {"neighbours", {{"type", "array"}, {"items", {{"type", "object"}}}}}},
+                                  scene_keys)});
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
@@ -406,17 +409,20 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
       case ConsoleAction::kReset:
       case ConsoleAction::kDemo:
       case ConsoleAction::kRestart:
+      case ConsoleAction::kNextPart:
         if (m.client != controller) {
           tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
                "control");
           return;
         }
         note(EventLevel::kInfo,
-             a == ConsoleAction::kReset  ? "reset"
-             : a == ConsoleAction::kDemo ? "demo_requested"
-                                         : "restart_requested",
-             a == ConsoleAction::kReset ? "reset requested: the e-stop cleared, devices reactivated"
-                                        : "the scene restarts (the control thread rebuilds it)",
+             a == ConsoleAction::kReset      ? "reset"
+             : a == ConsoleAction::kDemo     ? "demo_requested"
+             : a == ConsoleAction::kNextPart ? "next_part_requested"
+                                             : "restart_requested",
+             a == ConsoleAction::kReset      ? "reset requested: the e-stop cleared, devices reactivated"
+             : a == ConsoleAction::kNextPart ? "the batch's next part (the control thread rebuilds the scene)"
+                                             : "the scene restarts (the control thread rebuilds it)",
              m.client);
         live_.request(a);
         return;

@@ -90,6 +90,17 @@ std::string ConsoleServer::scene_json() const {
   } else {
     j["camera"] = nullptr;
   }
+  // The scene's other parts (a grid load's: microworld/neighbours.h), where they stand.
+  json others = json::array();
+  const microworld::PickPlaceParams& w = live_.scene_world();
+  for (int i = 0; i < w.neighbour_count; ++i) {
+    const microworld::NeighbourPart& n = w.neighbours[static_cast<std::size_t>(i)];
+    others.push_back({{"xy_m", {n.xy_m.x(), n.xy_m.y()}},
+                      {"yaw_rad", n.yaw_rad},
+                      {"side_m", n.side_m},
+                      {"top_z_m", n.top_z_m}});
+  }
+  j["neighbours"] = std::move(others);
   const std::string no_demo = live_.demo_unavailable_reason();
   j["demo_available"] = no_demo.empty();
   j["demo_unavailable_reason"] = no_demo;

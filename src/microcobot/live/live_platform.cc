@@ -45,14 +45,11 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   params_.validate();
   home_m_ = {params_.platform.stage.home_x_m, params_.platform.stage.home_y_m,
              params_.platform.stage.home_z_m};
-  if (params_.task) task_ = std::make_unique<LiveTask>(*params_.task);
-  if (task_ && params_.task->camera.enabled)
-    looker_ = std::make_unique<LiveLooker>(params_.task->camera, params_.platform, *params_.task, *task_,
-                                           [this](platform::TelemetrySample& out) {
-                                             std::lock_guard lock(latest_mutex_);
-                                             out = latest_sample_;
-                                             return has_latest_;
-                                           });
+  if (params_.task) {
+    task_ = std::make_unique<LiveTask>(*params_.task);
+    if (!params_.task->parts.empty()) params_.platform.world = scene_world();
+  }
+  make_looker();
   if (params_.platform.stage.vision_xy())
     positioner_ =
         std::make_unique<platform::VisionPositioner>(params_.platform, params_.platform.stage.vision);
@@ -141,6 +138,17 @@ void LivePlatform::build(bool demo) {
   platform::PositionerCommand stale;
   while (vision_.pop(stale)) {
   }
+}
+
+void LivePlatform::make_looker() {
+  looker_.reset();  // joined before its successor starts
+  if (!task_ || !params_.task->camera.enabled) return;
+  looker_ = std::make_unique<LiveLooker>(params_.task->camera, params_.platform, task_->params(), *task_,
+                                         [this](platform::TelemetrySample& out) {
+                                           std::lock_guard lock(latest_mutex_);
+                                           out = latest_sample_;
+                                           return has_latest_;
+                                         });
 }
 
 void LivePlatform::set_frame_sink(FrameSink sink) {
@@ -393,6 +401,16 @@ void LivePlatform::control_thread() {
         t_offset_s_ += platform_->loop().time_s();
         build(action == static_cast<int>(ConsoleAction::kDemo));
         restarts_.fetch_add(1);
+      } else if (action == static_cast<int>(ConsoleAction::kNextPart)) {
+        // The batch's next part: its world for the platform, its goal for the task, the looker's
+        // scene; the readers of the scene go through scene_world() (the part's index).
+        const int n = static_cast<int>(params_.task->parts.size());
+        t_offset_s_ += platform_->loop().time_s();
+        task_->set_part((task_->part() + 1) % n);
+        params_.platform.world = scene_world();
+        make_looker();
+        build(false);
+        restarts_.fetch_add(1);
       }
     } catch (const std::exception& e) {
       std::lock_guard lock(request_mutex_);
@@ -403,9 +421,14 @@ void LivePlatform::control_thread() {
 }
 
 void LivePlatform::request(ConsoleAction action) {
-  if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo && action != ConsoleAction::kRestart)
+  if (action != ConsoleAction::kReset && action != ConsoleAction::kDemo &&
+      action != ConsoleAction::kRestart && action != ConsoleAction::kNextPart)
     return;
   std::lock_guard lock(request_mutex_);
+  if (action == ConsoleAction::kNextPart && (!task_ || params_.task->parts.empty())) {
+    last_error_ = "next_part: there is no batch here (serve --cell serves one)";
+    return;
+  }
   if (action == ConsoleAction::kDemo) {
     if (std::string why = demo_unavailable_reason(); !why.empty()) {
       last_error_ = std::move(why);
@@ -482,9 +505,8 @@ LiveStatus LivePlatform::status() const {
         r.reason = "the pin is down in its hole";
         break;
       case DemoResult::Outcome::kMissed:
-        r.reason = params_.platform.world.hole_side_m > 0.0
-                       ? "the pin is not in its hole"
-                       : "the part rests outside the placement tolerance";
+        r.reason = scene_world().hole_side_m > 0.0 ? "the pin is not in its hole"
+                                                   : "the part rests outside the placement tolerance";
         break;
       default:
         break;

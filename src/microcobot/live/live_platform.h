@@ -156,8 +156,9 @@ class LivePlatform {
   bool has_task() const noexcept { return task_ != nullptr; }
   /// Latches the e-stop at the next operator tick (at most 1 ms). Any thread, async-signal-safe.
   void estop() noexcept { estop_.store(true); }
-  /// Reset, demo or restart, done by the control thread between two loop runs; other actions
-  /// are the server's business and ignored here.
+  /// Reset, demo, restart or next part, done by the control thread between two loop runs; other
+  /// actions are the server's business and ignored here. One the platform cannot do here (a demo
+  /// without the simulation, a next part without a batch) is refused in the status' last_error.
   void request(ConsoleAction action);
   /// Force by vision's tare at the next frame: the operator says nothing is between the
   /// fingers. Any thread; false when the platform measures no force by vision.
@@ -180,15 +181,23 @@ class LivePlatform {
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
   const LiveParams& params() const { return params_; }
+  /// The scene's microworld: the batch part's the task works on (`serve --cell`; the parts never
+  /// change, the index is atomic), else the platform's. Any thread.
+  const microworld::PickPlaceParams& scene_world() const noexcept {
+    if (task_ && !params_.task->parts.empty())
+      return params_.task->parts[static_cast<std::size_t>(task_->part())].world;
+    return params_.platform.world;
+  }
   /// The scene's geometry, for the microscope view (world coordinates).
-  double part_side_m() const { return params_.platform.world.part_side_m; }
-  double part_height_m() const { return params_.platform.world.height_m(); }
-  double hole_side_m() const { return params_.platform.world.hole_side_m; }
-  double part_yaw_rad() const { return params_.platform.world.part_yaw_rad; }
-  double hole_yaw_rad() const { return params_.platform.world.hole_yaw_rad; }
-  double hole_depth_m() const { return params_.platform.world.hole_depth_m; }
+  double part_side_m() const { return scene_world().part_side_m; }
+  double part_height_m() const { return scene_world().height_m(); }
+  double hole_side_m() const { return scene_world().hole_side_m; }
+  double part_yaw_rad() const { return scene_world().part_yaw_rad; }
+  double hole_yaw_rad() const { return scene_world().hole_yaw_rad; }
+  double hole_depth_m() const { return scene_world().hole_depth_m; }
   std::array<double, 3> target_m() const {
-    return {params_.platform.world.target_m.x(), params_.platform.world.target_m.y(), 0.0};
+    const auto& w = scene_world();
+    return {w.target_m.x(), w.target_m.y(), 0.0};
   }
   double placement_tolerance_m() const { return params_.placement_tolerance_m; }
   /// The optical-trap scene (else the pick-and-place's part, hole and target above).
@@ -201,16 +210,18 @@ class LivePlatform {
     return {c.x(), c.y()};
   }
   /// The fingers' width as the camera sees them (world.gripper.finger_width_m).
-  double finger_width_m() const { return params_.platform.world.gripper.finger_width_m; }
+  double finger_width_m() const { return scene_world().gripper.finger_width_m; }
   /// Why the scripted demo cannot run here (empty: it can).
   std::string demo_unavailable_reason() const;
   /// The force limits the platform enforces (control/safety_limits.h).
-  double grip_force_limit_N() const { return params_.platform.world.grip_force_limit_N; }
-  double contact_force_limit_N() const { return params_.platform.world.contact_force_limit_N; }
+  double grip_force_limit_N() const { return scene_world().grip_force_limit_N; }
+  double contact_force_limit_N() const { return scene_world().contact_force_limit_N; }
   std::size_t channel_count() const { return channel_count_; }
 
  private:
   void build(bool demo);
+  /// The cell camera's looker for the task's current part (off the loop: it starts a thread).
+  void make_looker();
   /// Every device simulated here (the scripted demo needs their ground truth).
   bool whole_simulation() const {
     return !params_.make_devices && !params_.remote && params_.platform.devices.simulated();

@@ -22,6 +22,15 @@ void LiveTaskParams::validate() const {
   } catch (const InvalidParams& e) {
     throw e.nested_in("camera");
   }
+  if (!parts.empty()) {
+    require(part >= 0 && part < static_cast<int>(parts.size()), "part",
+            "must be one of the batch's parts (0 to " + std::to_string(parts.size() - 1) + ")",
+            static_cast<double>(part));
+    for (const LivePart& p : parts) {
+      p.world.validate();
+      AssemblyTask each(task, p.goal);
+    }
+  }
 }
 
 std::string LiveTaskStatus::status_name() const {
@@ -30,7 +39,17 @@ std::string LiveTaskStatus::status_name() const {
 
 LiveTask::LiveTask(LiveTaskParams params) : params_(std::move(params)) {
   params_.validate();
+  if (!params_.parts.empty()) set_part(params_.part);
   reset();
+}
+
+void LiveTask::set_part(int i) {
+  if (i < 0 || i >= static_cast<int>(params_.parts.size()))
+    throw InvalidInput("part " + std::to_string(i) + ": the batch served has " +
+                       std::to_string(params_.parts.size()) + " parts");
+  params_.part = i;
+  params_.goal = params_.parts[static_cast<std::size_t>(i)].goal;
+  part_.store(i, std::memory_order_relaxed);
 }
 
 LiveTask::~LiveTask() = default;
@@ -232,6 +251,10 @@ LiveTaskStatus LiveTask::status() const {
   s.looks = looks_pub_.load(std::memory_order_relaxed);
   s.looks_found = looks_found_pub_.load(std::memory_order_relaxed);
   s.autonomy = params_.autonomy;
+  if (!params_.parts.empty()) {  // the parts never change: only the index is the loop's
+    s.part = params_.parts[static_cast<std::size_t>(part_.load(std::memory_order_relaxed))].index;
+    s.parts = static_cast<int>(params_.parts.size());
+  }
   return s;
 }
 

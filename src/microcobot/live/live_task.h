@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -58,8 +59,20 @@ enum class TaskAction : std::uint8_t {
   kSkip,      ///< the next step, from where the stage is
 };
 
+/// One part of the batch the console works through (`serve --cell`, Next part): its microworld
+/// (a grid load's neighbours among it) and the task's goal on it.
+struct LivePart {
+  int index = 0;  ///< in its batch
+  microworld::PickPlaceParams world;
+  cell::AssemblyGoal goal;
+};
+
 struct LiveTaskParams {
   cell::AssemblyGoal goal;
+  /// The batch's parts in order (empty: the one `goal`, on the platform's world). The task starts
+  /// on parts[part] (whose goal `goal` must then be); the console's Next part takes the next one.
+  std::vector<LivePart> parts;
+  int part = 0;
   cell::AssemblyTaskParams task;
   /// Indexed by cell::AssemblyTask::Step (a task file's `steps`, cell/task_file.h).
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy = all_auto();
@@ -94,6 +107,8 @@ struct LiveTaskStatus {
   int inserted = -1;  ///< at its end, the simulation's truth: 1 the pin is in its bore, 0 not, -1 unknown
   int looks = 0;      ///< the camera's sightings the task took
   int looks_found = 0;
+  int part = -1;  ///< the batch's part it works on (LivePart::index; -1: no batch)
+  int parts = 0;  ///< the parts the console can go through (LiveTaskParams::parts)
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy{};
   /// "idle" before the start, else the task's status name.
   std::string status_name() const;
@@ -108,6 +123,12 @@ class LiveTask {
   /// A fresh task, not started; pending actions dropped. The loop's thread only, between loop
   /// runs (scene (re)builds): it allocates.
   void reset();
+  /// Works on the batch's part `i` (LiveTaskParams::parts) from the next reset(): the same thread
+  /// and time as reset(). Throws mc::InvalidInput when there is no such part.
+  void set_part(int i);
+  /// The part worked on, an index into LiveTaskParams::parts (0 without a batch). Any thread.
+  int part() const noexcept { return part_.load(std::memory_order_relaxed); }
+  const LiveTaskParams& params() const noexcept { return params_; }
   /// One producer thread (the server's). Wait-free; false when the ring is full.
   bool push(TaskAction a) noexcept { return actions_.push(a); }
 
@@ -166,6 +187,7 @@ class LiveTask {
   std::atomic<int> step_{0}, status_{0}, tries_{0}, inserted_{-1};
   std::atomic<double> elapsed_pub_{0.0};
   std::atomic<const char*> failure_{""};
+  std::atomic<int> part_{0};
 };
 
 }  // namespace mc::live

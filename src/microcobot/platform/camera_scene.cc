@@ -126,7 +126,17 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   part.size_x_m = part.size_y_m = w.part_side_m;
   part.vx_m_s = pose.part_vx_m_s, part.vy_m_s = pose.part_vy_m_s;
   part.angle_rad = pose.part_yaw_rad;
-  s.parts.push_back(part);
+  s.parts.push_back(part);  // first: the part the scene is about
+  // The other parts of the scene (a grid load's: microworld/neighbours.h), where they stand.
+  for (int i = 0; i < w.neighbour_count; ++i) {
+    const microworld::NeighbourPart& n = w.neighbours[static_cast<std::size_t>(i)];
+    vision::Part other;
+    other.x_m = n.xy_m.x(), other.y_m = n.xy_m.y();
+    other.z_top_m = n.top_z_m;
+    other.size_x_m = other.size_y_m = n.side_m;
+    other.angle_rad = n.yaw_rad;
+    s.parts.push_back(other);
+  }
   const double finger_width_m = w.gripper.finger_width_m;
   // A lateral force bends both benders: their tips move by the deflection, drawn as the bars
   // shifted (a 2 mm bender bent by a few um: its end turns by 3 d / 2 L, under 0.01 rad).
