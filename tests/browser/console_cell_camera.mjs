@@ -1,6 +1,6 @@
 // Browser test of the cell's camera in the supervised task (`serve --cell --cell-camera`;
 // docs/cell.md, "The cell's camera"): started from the task panel, the task holds while the
-// camera looks (the panel says so), takes the three looks (the pin in its slot, in the fingers,
+// camera looks (the panel says so), takes the four looks (the pin in its slot, its bore, the pin in the fingers,
 // placed) and inserts the pin; the panel counts the looks. Screenshots to MC_ARTIFACTS.
 import { join } from "node:path";
 import { startConsole, withoutCamera } from "./console_session.mjs";
@@ -35,7 +35,7 @@ await s.run(async () => {
   log(`the task ${t.status} in ${t.elapsed_s.toFixed(1)} s: camera ${t.looks_found}/${t.looks}, ${t.search_tries} search tries, inserted ${t.inserted}`);
   if (t.status !== "succeeded") fail(`the task ${t.status} in ${t.step}: ${t.failure}`);
   if (t.inserted !== true) fail("the pin is not in its bore");
-  if (t.looks !== 3 || t.looks_found !== 3) fail(`the camera's looks: ${t.looks_found} found of ${t.looks}`);
-  await until("the panel counts the looks", () => document.getElementById("task-info").textContent.includes("camera 3/3"), 5);
+  if (t.looks !== 4 || t.looks_found !== 4) fail(`the camera's looks: ${t.looks_found} found of ${t.looks}`);
+  await until("the panel counts the looks", () => document.getElementById("task-info").textContent.includes("camera 4/4"), 5);
   await shot("cell-camera-02-done");
 }, "the task holds for the cell camera's looks, takes them and inserts the pin");

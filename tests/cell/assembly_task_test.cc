@@ -171,8 +171,9 @@ namespace mc::cell {
 namespace {
 
 // With the cell's camera (set_looks): the task holds for its look before the approach moves, then
-// heads for the pin where it was seen; at the insertion's start it holds for the look at the pin
-// in the fingers, then aims the pin, not the tool point, at the bore's axis.
+// heads for the pin where it was seen; before the transport it holds for the look at the bore and
+// carries the pin where the bore was seen; at the insertion's start it holds for the look at the
+// pin in the fingers, then aims the pin, not the tool point, at the bore's axis.
 TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
   AssemblyGoal g = skip_goal();
   g.target_yaw_rad = 0.3;
@@ -195,6 +196,16 @@ TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
   EXPECT_LT((stage.s.tip_m.head<2>() - slot.part_m.head<2>()).norm(), 1e-9) << "over the pin as seen";
   EXPECT_NEAR(stage.s.yaw_rad, 0.02, 1e-3) << "square with the pin as seen";
 
+  // Before the transport moves: the bore, 9 um off its drawing.
+  ASSERT_TRUE(stage.run_to(task, Step::kTransport));
+  stage.tick(task);
+  EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kBore);
+  const Eigen::Vector2d drawn = g.target_m;
+  AssemblyTask::Sighting bore;
+  bore.found = true;
+  bore.part_m << drawn + Eigen::Vector2d(6e-6, -7e-6), 0.0;
+  task.see(bore);
+  EXPECT_EQ(task.goal().target_m, bore.part_m.head<2>());
   ASSERT_TRUE(stage.run_to(task, Step::kInsert));
   stage.tick(task);
   EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kHeld);
@@ -207,7 +218,8 @@ TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
   EXPECT_NEAR(task.held_offset_m(), 5e-6, 1e-12);
   const control::ConsoleInput& in = task.tick(stage.s, 1e-3);
   ASSERT_TRUE(in.deadman && in.has_goal);
-  EXPECT_LT((in.goal_m.head<2>() - (g.target_m - 5e-6 * ey)).norm(), 1e-12) << "the pin on the bore's axis";
+  EXPECT_LT((in.goal_m.head<2>() - (bore.part_m.head<2>() - 5e-6 * ey)).norm(), 1e-12)
+      << "the pin on the axis of the bore as seen";
 }
 
 // A look that finds nothing leaves the task as without a camera: the slot's nominal position.

@@ -61,6 +61,30 @@ TEST(CellCamera, FindsThePinInItsSlotWhereThePlayPutIt) {
   }
 }
 
+// The bore look (AssemblyBatchParams::bore_error_m): the bore found where the plate's errors put
+// it, tens of micrometres from its drawing, to a fraction of a micrometre; a flat seat has none.
+TEST(CellCamera, FindsTheBoreWhereThePlatesErrorsPutIt) {
+  AssemblyBatchParams b;
+  b.parts = 4;
+  b.seed = 67;
+  b.bore_error_m = 15e-6;
+  for (const AssemblyJob& j : assembly_jobs(b)) {
+    CellCamera camera(on(), config_of(j), static_cast<std::uint64_t>(j.index));
+    // The pin still in its slot, the fingers at the home: the bore's station is clear.
+    const PinSighting s = camera.look_bore(in_slot(j), j.target_m, j.target_yaw_rad);
+    ASSERT_TRUE(s.found) << s.reason;
+    const Eigen::Vector2d truth = j.world.target_m.head<2>();
+    EXPECT_GT((j.target_m - truth).norm(), 3e-6) << "part " << j.index << ": the drawing is off";
+    std::printf("bore look, part %d: the drawing %.1f um off, the look %.0f nm off\n", j.index,
+                1e6 * (j.target_m - truth).norm(), 1e9 * (s.part_m.head<2>() - truth).norm());
+    EXPECT_LT((s.part_m.head<2>() - truth).norm(), 0.3e-6) << "part " << j.index;
+  }
+  b.flat_fraction = 1.0;
+  const AssemblyJob flat = assembly_jobs(b).front();
+  CellCamera camera(on(), config_of(flat));
+  EXPECT_FALSE(camera.look_bore(in_slot(flat), flat.target_m, flat.target_yaw_rad).found);
+}
+
 TEST(CellCamera, MeasuresThePinsOffsetAlongTheFingersBetweenThem) {
   for (const AssemblyJob& j : jobs(3, 62)) {
     const platform::PlatformConfig c = config_of(j);

@@ -334,8 +334,8 @@ TEST(LiveTask, WithTheCellCameraTheTaskHoldsForItsLooksAndInserts) {
   const LiveTaskStatus end = rig.task();
   EXPECT_EQ(end.status, Status::kSucceeded) << end.failure;
   EXPECT_EQ(end.inserted, 1);
-  EXPECT_EQ(end.looks, 3);
-  EXPECT_EQ(end.looks_found, 3);
+  EXPECT_EQ(end.looks, 4);  // the slot, the bore, the pin held and placed
+  EXPECT_EQ(end.looks_found, 4);
   EXPECT_EQ(end.search_tries, 0);
   ASSERT_TRUE(rig.run_for(0.3));
   const std::vector<TaskSample> s = rig.copy();

@@ -56,6 +56,8 @@ void AssemblyBatchParams::validate() const {
   require_non_negative(flat_seat_min_pulloff_N, "flat_seat_min_pulloff_N");
   require(std::isfinite(flat_seat_max_pulloff_N) && flat_seat_max_pulloff_N >= flat_seat_min_pulloff_N,
           "flat_seat_max_pulloff_N", "must be at least flat_seat_min_pulloff_N", flat_seat_max_pulloff_N);
+  require(std::isfinite(bore_error_m) && bore_error_m >= 0.0 && bore_error_m <= 100e-6, "bore_error_m",
+          "must be within [0, 100 um]", bore_error_m);
   require(layout == "random" || layout == "grid", "layout", "must be random or grid (got '" + layout + "')");
   if (layout == "grid") {
     // The open gripper round one part must clear the next: the fingers' reach (half the opening plus
@@ -128,7 +130,7 @@ microworld::NeighbourPart standing(const AssemblyJob& j, bool placed) {
   microworld::NeighbourPart n;
   n.side_m = j.world.part_side_m;
   if (placed) {
-    n.xy_m = j.target_m;
+    n.xy_m = j.world.target_m.head<2>();  // where its bore really is
     n.yaw_rad = j.target_yaw_rad;
     n.top_z_m = j.world.height_m() - j.world.hole_depth_m;
   } else {
@@ -156,6 +158,9 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   std::uniform_real_distribution<double> flat_u(0.0, 1.0);
   std::uniform_real_distribution<double> seat_pulloff(params.flat_seat_min_pulloff_N,
                                                       params.flat_seat_max_pulloff_N);
+  // The bores' errors from a stream of their own: without them, the batch is the one of before.
+  std::mt19937_64 bore_rng(static_cast<std::uint64_t>(params.seed) * 0xA24BAED4963EE407ULL + 0x626f7265ULL);
+  std::normal_distribution<double> bore(0.0, 1.0);
   const bool grid = params.layout == "grid";
   const int per_side = grid ? grid_cells_per_side(params.half_size_m, params.grid_pitch_m) : 1;
   const int per_load = per_side * per_side;
@@ -180,7 +185,9 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     j.world.hole_side_m = j.side_m + 2.0 * j.clearance_m;
     j.world.hole_depth_m = params.hole_depth_m;
     j.world.part_start_m = {j.nominal_part_m.x() + error.x(), j.nominal_part_m.y() + error.y(), 0.0};
-    j.world.target_m = {j.target_m.x(), j.target_m.y(), 0.0};
+    const Eigen::Vector2d bore_error(params.bore_error_m * bore(bore_rng),
+                                     params.bore_error_m * bore(bore_rng));
+    j.world.target_m = {j.target_m.x() + bore_error.x(), j.target_m.y() + bore_error.y(), 0.0};
     j.nominal_part_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
     j.target_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
     j.world.part_yaw_rad = j.nominal_part_yaw_rad + params.slot_yaw_error_rad * slot_yaw(yaw_rng);

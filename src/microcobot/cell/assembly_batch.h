@@ -73,6 +73,10 @@ struct AssemblyBatchParams {
   double flat_finger_pulloff_N = microworld::flat_part_scene().finger_pulloff_N;
   double flat_seat_min_pulloff_N = 5e-6;  ///< the seats' pull-off, uniform in [min, max]
   double flat_seat_max_pulloff_N = 60e-6;
+  /// The standard deviation (x and y) of each bore's (or seat's) true position from its drawing:
+  /// the plate's fixture and machining. The cell is told the drawing; its camera sees the bore
+  /// (cell_camera.h, look_bore). 0: the bores are where the drawing says.
+  double bore_error_m = 0.0;
   std::string release = "auto";     ///< auto, open, shake or roll (header)
   double min_release_margin = 1.2;  ///< auto: the margin a strategy must reach to be chosen
   /// The microworld every part is put in (adhesion, friction, gripper, force limits); its part,
@@ -106,6 +110,7 @@ struct AssemblyBatchParams {
     v("flat_finger_pulloff_N", flat_finger_pulloff_N);
     v("flat_seat_min_pulloff_N", flat_seat_min_pulloff_N);
     v("flat_seat_max_pulloff_N", flat_seat_max_pulloff_N);
+    v("bore_error_m", bore_error_m);
     v("release", release);
     v("min_release_margin", min_release_margin);
     v("world", world);
@@ -119,11 +124,11 @@ struct AssemblyBatchParams {
 /// One part of the batch.
 struct AssemblyJob {
   int index = 0;
-  microworld::PickPlaceParams world;       ///< the true scene: the pin where it really is
-  Eigen::Vector2d nominal_part_m{0, 0};    ///< its slot's nominal position (what the cell is told)
-  Eigen::Vector2d target_m{0, 0};          ///< its bore's position (told, and true)
-  double nominal_part_yaw_rad = 0.0;       ///< its slot's orientation (told)
-  double target_yaw_rad = 0.0;             ///< its bore's (told, and true)
+  microworld::PickPlaceParams world;     ///< the true scene: the pin where it really is
+  Eigen::Vector2d nominal_part_m{0, 0};  ///< its slot's nominal position (what the cell is told)
+  Eigen::Vector2d target_m{0, 0};     ///< its bore's position as drawn (told; world.target_m is the true one)
+  double nominal_part_yaw_rad = 0.0;  ///< its slot's orientation (told)
+  double target_yaw_rad = 0.0;        ///< its bore's (told, and true)
   double side_m = 0.0, clearance_m = 0.0;  ///< a flat part's clearance: its seat's tolerance
   bool flat = false;                       ///< a flat part on a flat seat
   microworld::ReleaseStrategy release = microworld::ReleaseStrategy::kOpen;

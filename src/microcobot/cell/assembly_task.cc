@@ -124,6 +124,8 @@ std::string_view AssemblyTask::name(Look l) noexcept {
       return "none";
     case Look::kSlot:
       return "slot";
+    case Look::kBore:
+      return "bore";
     case Look::kHeld:
       return "held";
     case Look::kPlaced:
@@ -207,6 +209,10 @@ void AssemblyTask::see(const Sighting& sighting) noexcept {
         goal_.part_yaw_rad = sighting.yaw_rad;
       }
       break;
+    case Look::kBore:
+      bore_seen_ = true;
+      if (sighting.found && sighting.part_m.head<2>().allFinite()) goal_.target_m = sighting.part_m.head<2>();
+      break;
     case Look::kHeld:
       held_seen_ = true;
       if (sighting.found && sighting.part_m.allFinite()) {
@@ -226,6 +232,16 @@ void AssemblyTask::see(const Sighting& sighting) noexcept {
   // Back to the step as its level has it (an assisted approach looks at the slot first).
   status_ = autonomy_[index(step_)] == Autonomy::kAssisted && assistable(step_) ? Status::kAssisted
                                                                                 : Status::kRunning;
+}
+
+AssemblyTask::Look AssemblyTask::look_before_moving() const noexcept {
+  if (!looks_) return Look::kNone;
+  if (step_ == Step::kApproach && !slot_seen_) return Look::kSlot;
+  if (step_ == Step::kTransport && !bore_seen_ && !goal_.flat_seat) return Look::kBore;
+  if (step_ == Step::kInsert && !held_seen_ && tries_ == 0 && insert_ == Insert::kDescend &&
+      status_ == Status::kRunning)
+    return Look::kHeld;
+  return Look::kNone;
 }
 
 void AssemblyTask::pause() noexcept {
@@ -418,8 +434,9 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
   out_.gripper_opening_m = opening_command_;
   fixtures_ = {};
   if (status_ == Status::kAssisted) {
-    if (looks_ && step_ == Step::kApproach && !slot_seen_) {  // the slot seen before the guide is set
-      look_ = Look::kSlot;
+    // The slot or the bore seen before the guide is set.
+    if (const Look l = look_before_moving(); l != Look::kNone) {
+      look_ = l;
       status_ = Status::kAwaitingLook;
       return out_;
     }
@@ -427,10 +444,10 @@ const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_
     return out_;
   }
   if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
-  // The camera's looks before the approach and the insertion (verify's is its own): holding.
-  if (looks_ && ((step_ == Step::kApproach && !slot_seen_) ||
-                 (step_ == Step::kInsert && !held_seen_ && tries_ == 0 && insert_ == Insert::kDescend))) {
-    look_ = step_ == Step::kApproach ? Look::kSlot : Look::kHeld;
+  // The camera's looks before the approach, the transport and the insertion (verify's is its own):
+  // holding.
+  if (const Look l = look_before_moving(); l != Look::kNone) {
+    look_ = l;
     status_ = Status::kAwaitingLook;
     return out_;
   }

@@ -44,6 +44,8 @@
 /// looks (status awaiting look), and see() hands it what was seen:
 ///   slot    before the approach moves: the pin's position and yaw in its slot replace the slot's
 ///           nominal ones (the grasp then centres the pin along the fingers' y too);
+///   bore    before the transport moves (a pin's bore, not a flat seat): the bore's position seen
+///           replaces its drawing's (the plate's errors: AssemblyBatchParams::bore_error_m);
 ///   held    at the insertion's start: the pin's offset along the fingers' y, seen over the bore;
 ///           the descent aims the pin, not the tool point, at the bore's axis (the search goes on
 ///           around that point if it still jams);
@@ -204,7 +206,7 @@ class AssemblyTask {
     kFailed,
     kAssisted
   };
-  enum class Look { kNone, kSlot, kHeld, kPlaced };
+  enum class Look { kNone, kSlot, kBore, kHeld, kPlaced };
   /// What a look saw (world frame): the pin's centre and yaw, or nothing.
   struct Sighting {
     bool found = false;
@@ -231,6 +233,8 @@ class AssemblyTask {
   static double grasp_height_m(const AssemblyTaskParams& p, const AssemblyGoal& goal) noexcept;
   /// Throws mc::InvalidParams (parameters, goal).
   AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal& goal);
+  /// The goal as the task now knows it (its looks replace the slot's and the bore's drawn places).
+  const AssemblyGoal& goal() const noexcept { return goal_; }
 
   /// One tick of `dt_s`: the console input to hand the platform (drives() says whether to).
   const control::ConsoleInput& tick(const TaskSensors& s, double dt_s) noexcept;
@@ -330,10 +334,13 @@ class AssemblyTask {
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();            // ... and the tip's position
   double search_yaw_ = 0.0;                                       // ... when the insertion began
   double contact_z_ = std::numeric_limits<double>::quiet_NaN();   // where the last descent stopped
+  /// The look the current step needs before it moves (kNone: none, or no camera).
+  Look look_before_moving() const noexcept;
   bool looks_ = false;
   Look look_ = Look::kNone;                     // the look awaited, or the last one
   bool slot_seen_ = false, held_seen_ = false;  // looks done (found or not)
-  Sighting placed_;                             // verify's look
+  bool bore_seen_ = false;
+  Sighting placed_;  // verify's look
   bool placed_seen_ = false;
   double held_offset_ = std::numeric_limits<double>::quiet_NaN();  // the pin along the fingers' y
   double search_base_ = 0.0;                                       // the search's centre along y

@@ -34,6 +34,8 @@ void CellCameraParams::validate() const {
           "must be within [0.5, 10]", focus_step_dof);
   require(std::isfinite(band_inset_m) && band_inset_m >= 0.0 && band_inset_m <= 100e-6, "band_inset_m",
           "must be within [0, 100 um]", band_inset_m);
+  require(std::isfinite(bore_search_m) && bore_search_m >= 1e-6 && bore_search_m <= 200e-6, "bore_search_m",
+          "must be within [1, 200] um", bore_search_m);
 }
 
 platform::CameraScenePose truth_pose(const platform::Platform& p) {
@@ -82,9 +84,10 @@ struct CellCamera::Impl {
   /// The frame of `pose` (noise from seed and index), or without the fingers and without noise
   /// (`expected`: what the cell expects, from what it is told).
   void render(vs::Renderer& r, const platform::CameraScenePose& pose, double focus_z_m, bool expected,
-              std::uint64_t seed, std::uint64_t index, vs::Frame& out) {
+              std::uint64_t seed, std::uint64_t index, vs::Frame& out, bool plain_substrate = false) {
     platform::fill_camera_scene(config, pose, scene);
     if (expected) scene.fingers.clear();
+    if (plain_substrate) scene.substrate.texture_contrast = 0.0;
     vs::CameraControls controls = r.default_controls();
     controls.focus_z_m = focus_z_m;
     const std::vector<float>& photo_e = r.render_expected(scene, controls);
@@ -151,9 +154,10 @@ double vertex_offset(double ym, double y0, double yp) {
 // pixel, which the small turn moves by under 0.01 px: the pin's centre moves with the template's.
 void match_model(const vs::Renderer& r, const vs::Frame& model, const vs::Frame& frame,
                  const vs::PixelRoi& roi, const Eigen::Vector2d& expected_xy, double expected_yaw,
-                 double min_confidence, const char* miss, PinSighting& s) {
+                 double min_confidence, const char* miss, PinSighting& s, int search_margin_px = 0) {
   vs::TrackerParams tp;
   tp.rotation = true;
+  if (search_margin_px > 0) tp.search_margin_px = search_margin_px;
   vs::TemplateTracker tracker(tp);
   tracker.set_template(model, roi);
   const double cu = roi.x + 0.5 * (roi.width - 1), cv = roi.y + 0.5 * (roi.height - 1);
@@ -189,6 +193,39 @@ PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const 
   s.part_m.z() = 0.5 * pin.height_m;  // standing on the tray
   match_model(r, m.model, m.frame, roi, nominal_xy, nominal_yaw, p_.min_confidence,
               "the pin does not match its model in its slot", s);
+  return s;
+}
+
+PinSighting CellCamera::look_bore(const platform::CameraScenePose& truth, const Eigen::Vector2d& drawn_xy,
+                                  double yaw) {
+  Impl& m = *impl_;
+  vs::Renderer r = m.renderer_at(drawn_xy);
+  constexpr double kRim = 0.0;  // the focus: the substrate's surface, the bore's rim
+  m.render(r, truth, kRim, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  // The model: the bore where its drawing puts it, the pin and the fingers far from it.
+  auto& world = m.config.world;
+  const Eigen::Vector3d true_bore = world.target_m;
+  world.target_m = {drawn_xy.x(), drawn_xy.y(), 0.0};
+  // Its substrate plain: the texture is fixed to the plate, so round a bore that is not where it
+  // is drawn the model's texture would be another one, and pull the match.
+  m.render(r, pin_at(truth, drawn_xy + Eigen::Vector2d(10e-3, 10e-3), truth.part_z_m, truth.part_yaw_rad),
+           kRim, true, 0, 0, m.model, /*plain_substrate=*/true);
+  world.target_m = true_bore;
+  PinSighting s;
+  s.yaw_rad = yaw;
+  if (world.hole_side_m <= 0.0) {
+    s.reason = "a seat without a bore: nothing to see";
+    return s;
+  }
+  const vs::PixelRoi roi = pin_roi(r, drawn_xy, world.hole_side_m, yaw, 12);
+  if (roi.width == 0) {
+    s.reason = "the bore is not inside the camera's field";
+    return s;
+  }
+  const int margin = static_cast<int>(std::ceil(p_.bore_search_m / r.camera().pixel_size_m()));
+  match_model(r, m.model, m.frame, roi, drawn_xy, yaw, p_.min_confidence,
+              "the bore does not match its drawing", s, margin);
+  s.part_m.z() = 0.0;
   return s;
 }
 

@@ -9,6 +9,11 @@
 ///           its slot's nominal position and orientation, rendered without noise: the CAD-model
 ///           tracking of Tamadazte et al. 2010) found in the frame by vision::TemplateTracker with
 ///           its Euclidean warp: the pin's position and yaw, which the slot's play changed.
+///   bore    the pin's bore (or a flat part's seat) before the transport, the station clear: a model
+///           template (the bore alone where its drawing puts it, rendered without noise) found in
+///           the frame focused on the substrate: where the bore really is (the plate's fixture
+///           and machining: AssemblyBatchParams::bore_error_m), searched `bore_search_m` round
+///           its drawing. A seat without a bore shows nothing to find: not looked for.
 ///   held    the pin in the fingers, over its bore, before the insertion: the fingers cover its
 ///           faces along their x (they squeezed it there, so it is centred along x), so its
 ///           offset along their y is measured on the two faces the fingers leave free: the
@@ -53,6 +58,9 @@ struct CellCameraParams {
   double band_inset_m = 20e-6;
   /// The placed look's frames: at the expected top and this many depths of field either side.
   double focus_step_dof = 2.0;
+  /// How far from its drawing the bore look searches for the bore (3 of 10 um's standard deviations
+  /// and some).
+  double bore_search_m = 50e-6;
 
   template <class V>
   void visit(V& v) {
@@ -65,6 +73,7 @@ struct CellCameraParams {
     v("min_confidence", min_confidence);
     v("band_inset_m", band_inset_m);
     v("focus_step_dof", focus_step_dof);
+    v("bore_search_m", bore_search_m);
   }
   void validate() const;
 };
@@ -98,6 +107,8 @@ class CellCamera {
   /// The pin in its slot, expected at `nominal_xy` turned by `nominal_yaw` (its top in focus).
   PinSighting look_slot(const platform::CameraScenePose& truth, const PinModel& pin,
                         const Eigen::Vector2d& nominal_xy, double nominal_yaw);
+  /// The bore drawn at `drawn_xy`, turned by `yaw`: where it is (part_m's z 0: the rim).
+  PinSighting look_bore(const platform::CameraScenePose& truth, const Eigen::Vector2d& drawn_xy, double yaw);
   /// The pin in the fingers: the tool point at `tool_m` (the stage's sensors), the fingers turned
   /// by `tool_yaw`; `top_z_m` the pin's top as the grasp left it (focus).
   PinSighting look_held(const platform::CameraScenePose& truth, const PinModel& pin,

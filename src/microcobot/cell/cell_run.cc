@@ -208,6 +208,9 @@ void CellCycle::look() {
       case AssemblyTask::Look::kSlot:
         seen = camera_->look_slot(truth, pin, job_.nominal_part_m, job_.nominal_part_yaw_rad);
         break;
+      case AssemblyTask::Look::kBore:
+        seen = camera_->look_bore(truth, job_.target_m, job_.target_yaw_rad);  // where its drawing puts it
+        break;
       case AssemblyTask::Look::kHeld: {
         // The pin's top where the grasp left it: the tips grasp_z above its bottom.
         const double grasp_z = AssemblyTask::grasp_height_m(params_.task, assembly_goal(job_));
@@ -215,7 +218,7 @@ void CellCycle::look() {
         break;
       }
       case AssemblyTask::Look::kPlaced:
-        seen = camera_->look_placed(truth, pin, job_.target_m, job_.target_yaw_rad,
+        seen = camera_->look_placed(truth, pin, task_->goal().target_m, job_.target_yaw_rad,
                                     pin.height_m - job_.world.hole_depth_m);
         break;
       case AssemblyTask::Look::kNone:
@@ -229,7 +232,10 @@ void CellCycle::look() {
   if (!seen.found) last_look_miss_ = failed.empty() ? std::string(seen.reason) : failed;
   if (seen.found) {
     ++looks_found_;
-    const Eigen::Vector2d truth_xy(truth.part_x_m, truth.part_y_m);
+    // What the look measured: the bore, or the pin.
+    const Eigen::Vector2d truth_xy = task_->look_wanted() == AssemblyTask::Look::kBore
+                                         ? Eigen::Vector2d(job_.world.target_m.head<2>())
+                                         : Eigen::Vector2d(truth.part_x_m, truth.part_y_m);
     look_error_m_ = std::max(look_error_m_, (seen.part_m.head<2>() - truth_xy).norm());
   }
   AssemblyTask::Sighting sighting;

@@ -40,6 +40,8 @@ cell::PinSighting LiveLooker::look(AssemblyTask::Look kind, const platform::Tele
   switch (kind) {
     case AssemblyTask::Look::kSlot:
       return camera_->look_slot(truth, pin, goal.part_m, goal.part_yaw_rad);
+    case AssemblyTask::Look::kBore:
+      return camera_->look_bore(truth, goal.target_m, goal.target_yaw_rad);  // where its drawing puts it
     case AssemblyTask::Look::kHeld: {
       // The tool point as the stage's sensors give it; the pin's top where the grasp left it.
       const Eigen::Vector3d tool(channel(s, "measured_x_m"), channel(s, "measured_y_m"),
