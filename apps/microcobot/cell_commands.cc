@@ -346,10 +346,12 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
   cmd.add_option("--config", o.config, "Platform configuration (YAML; as `run --print-config`)");
   cmd.add_option("--batch", o.batch, "Parts in the batch (default 10)")->check(CLI::Range(1, 10000));
   cmd.add_option("--seed", o.seed, "The batch's seed (default 1)")->check(CLI::NonNegativeNumber);
-  cmd.add_option("--master", o.master,
-                 "The simulated person's master in manual and assisted modes: haptic (handle, thumb wheel, "
-                 "TéléTweez; default) or console (joystick, gripper slider)")
-      ->check(CLI::IsMember({"haptic", "console"}));
+  cmd.add_option(
+         "--master", o.master,
+         "The simulated person's master in manual and assisted modes: haptic (handle, thumb wheel, "
+         "TéléTweez; default), console (joystick, gripper slider) or click (the console's click-to-go; "
+         "manual only)")
+      ->check(CLI::IsMember({"haptic", "console", "click"}));
   cmd.add_option("--task", o.task,
                  "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
                  "confirmed after confirm_delay_s, manual ones refused headless) and the task's parameters "

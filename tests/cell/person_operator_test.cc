@@ -100,6 +100,38 @@ TEST(PersonOperator, TheConsoleJoystickDoesTheSameCycle) {
   EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
 }
 
+// The console's click-to-go (master click): the person moves in the plane only by clicks (the
+// console's input carries a goal and no x-y rate), the platform's closed loop takes the stage
+// there, and the cycle goes through under the limits, each click on a point the stage then
+// reaches. Shared control with clicks is refused naming the key.
+TEST(PersonOperator, TheConsolesClickToGoDoesTheSameCycleByClicks) {
+  CellRunParams params;
+  params.mode = "manual";
+  params.person.master = "click";
+  CellCycle c(person_job(), params, default_platform());
+  int goal_ticks = 0, rate_ticks = 0;
+  c.set_observer([&](double) {
+    const control::ConsoleInput& in = c.platform().console_input();
+    if (in.has_goal) ++goal_ticks;
+    if (in.velocity_m_s.head<2>().norm() > 0.0) ++rate_ticks;
+  });
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_EQ(r.master, "click");
+  EXPECT_GT(goal_ticks, 1000) << "the plane by clicks";
+  EXPECT_EQ(rate_ticks, 0) << "no x-y rate from a person who clicks";
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
+  EXPECT_TRUE(r.ended_holding);
+  params.mode = "assisted";
+  try {
+    params.validate();
+    ADD_FAILURE() << "assisted click-to-go accepted";
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("person.master"), std::string::npos) << e.what();
+  }
+}
+
 // The person aims the tips a press below the height where the pin would bottom, judged by eye
 // (z_tolerance_m: the depth of field). When the pin was taken a little high in the fingers, the
 // hand arrives within that tolerance with the pin a micrometre short of the bore's floor: no

@@ -36,6 +36,8 @@ void CellRunParams::validate() const {
                 ": a headless run has no operator to do it (serve --cell runs it with one)");
   manual.validate();
   camera.validate();
+  require(person.master != "click" || mode != "assisted", "person.master",
+          "click: the console's click-to-go is for manual runs (the click is the platform's move already)");
   require(!camera.enabled || mode == "auto", "camera.enabled", "is the robot's (mode auto)");
 }
 

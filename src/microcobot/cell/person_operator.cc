@@ -10,8 +10,12 @@
 namespace mc::cell {
 
 void PersonOperatorParams::validate() const {
-  require(master == "haptic" || master == "console", "master",
-          "must be haptic or console, got '" + master + "'");
+  require(master == "haptic" || master == "console" || master == "click", "master",
+          "must be haptic, console or click, got '" + master + "'");
+  require(std::isfinite(screen_px_per_m) && screen_px_per_m >= 1e3 && screen_px_per_m <= 1e9,
+          "screen_px_per_m", "must be within [1e3, 1e9] px/m", screen_px_per_m);
+  require(std::isfinite(min_click_px) && min_click_px >= 1.0 && min_click_px <= 100.0, "min_click_px",
+          "must be within [1, 100] px", min_click_px);
   person.validate();
   require_positive(pin_tolerance_m, "pin_tolerance_m");
   require_positive(bore_tolerance_m, "bore_tolerance_m");
@@ -58,9 +62,11 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
       goal_(goal),
       assisted_(assisted),
       haptic_(params.master == "haptic"),
+      click_(params.master == "click"),
       rng_(seed),
       xy_(params.person, rng_),
       z_(params.person, rng_),
+      cursor_(params.person, rng_),
       yaw_(params.person, rng_),
       tremor_(params.person, operator_rate_Hz(platform.config()), seed ^ 0x7472656d6f72ULL),
       base_scale_(platform.config().teleop.motion_scale) {
@@ -78,6 +84,10 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
               : Eigen::Vector2d(tip.head<2>()),
       0.0);
   z_.reset({tip.z(), 0.0}, 0.0);
+  cursor_scale_ = p_.screen_px_per_m;
+  cursor_.reset(tip.head<2>() * cursor_scale_, 0.0);  // on the tool, where the view is centred
+  require(!(click_ && assisted), "master",
+          "click: the console's click-to-go is for manual runs (the click is the platform's move already)");
   yaw_.reset({platform.yaw_target_rad(), 0.0}, 0.0);
   yaw_arrived_rad_ = task.yaw_tolerance_rad;
   slider_ = goal.open_m;
@@ -129,8 +139,38 @@ bool PersonOperator::tool_still() const noexcept {
   return (now - then).norm() < p_.still_m;
 }
 
+bool PersonOperator::click_steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept {
+  if (click_goal_) {
+    // The stage on its way to the click: the person watches it arrive, and reacts.
+    if (t - click_t_ < p_.still_window_s || !tool_still()) return false;
+    click_goal_ = false;
+    cursor_.reset(cursor_.end(), t);
+    return false;
+  }
+  if (!cursor_.ready(t) || !tool_still()) return false;
+  const Eigen::Vector2d e = seen(error_m);
+  if (e.norm() <= tolerance_m) return true;
+  // A target narrower than min_click_px on the screen is clicked zoomed in.
+  const double scale = std::max(p_.screen_px_per_m, p_.min_click_px / tolerance_m);
+  if (scale != cursor_scale_) {
+    cursor_.reset(cursor_.end() * (scale / cursor_scale_), t);  // the same point, another zoom: a look
+    cursor_scale_ = scale;
+    return false;
+  }
+  // The cursor onto the target as seen (tool + e), within the target's width on the screen.
+  const Eigen::Vector2d target_px = (tool_xy_ + e) * scale;
+  if (!cursor_.aim(target_px - cursor_.end(), std::max(tolerance_m * scale, p_.min_click_px), t))
+    return false;
+  const Eigen::Vector2d at = cursor_.end() / scale;
+  click_m_ = {at.x(), at.y(), tips_[static_cast<std::size_t>((tip_count_ - 1) % kHistory)].z()};
+  click_goal_ = true;
+  click_t_ = t;
+  return false;
+}
+
 bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, double t,
                            double width_m) noexcept {
+  if (click_) return click_steer(error_m, tolerance_m, t);
   if (clutching_) {
     if (xy_.moving(t)) return false;
     clutching_ = false;  // the hand back: clutch released, and a look before going on
@@ -434,6 +474,17 @@ void PersonOperator::apply(double t) noexcept {
   console_.has_goal = false;
   console_.velocity_m_s.head<2>() = xy_.velocity(t) + per_m * tremor;
   console_.velocity_m_s.z() = z_.velocity(t).x();
+  if (click_) {
+    // The plane is the clicks': the stage goes to the last one at the person's pace (a click and a
+    // jog at once: the page drops the click, so the person does one at a time).
+    console_.velocity_m_s.head<2>().setZero();
+    if (click_goal_) {
+      console_.has_goal = true;
+      console_.goal_m = click_m_;
+      console_.goal_speed_m_s = p_.person.stage_pace_m_s;
+      console_.velocity_m_s.z() = 0.0;
+    }
+  }
   console_.has_gripper = true;
   console_.gripper_opening_m = slider_;
   platform_.set_console_input(console_);

@@ -7,7 +7,15 @@
 ///                     scale, clutching near the workspace's edge), the Z thumb wheel and the
 ///                     TéléTweez, whose finger force tells the grip;
 ///   master "console"  the console's joystick (a rate control: stage velocity in x, y, z) and
-///                     its gripper slider, the grip force read off the console's display.
+///                     its gripper slider, the grip force read off the console's display;
+///   master "click"    the console's click-to-go (docs/console.md): a move in the plane is a click
+///                     on the microscope's image, the mouse cursor aimed at the target on the
+///                     screen in Fitts sub-movements (the display's scale: screen_px_per_m, zoomed
+///                     so that a target is at least min_click_px wide); the click sends the stage
+///                     straight there at stage_pace_m_s under its own closed loop, and the person
+///                     watches it arrive before judging again (a corrective click, or done). Z by
+///                     the joystick, the gripper slider, the dial: as "console". Manual only: the
+///                     click is the platform's move already, and shared control guides a rate.
 ///
 /// The person looks through the microscope (the true positions, made out within vision_sd_m),
 /// moves in minimum-jerk sub-movements timed by Fitts' law with the endpoint noise, reaction
@@ -48,7 +56,7 @@
 namespace mc::cell {
 
 struct PersonOperatorParams {
-  std::string master = "haptic";  ///< "haptic" or "console"
+  std::string master = "haptic";  ///< "haptic", "console" or "click" (header)
   PersonParams person;
   double pin_tolerance_m = 10e-6;  ///< over the pin before descending
   double bore_tolerance_m = 2e-6;  ///< manual: the pin over its bore before inserting
@@ -84,6 +92,12 @@ struct PersonOperatorParams {
   double slider_m_s = 600e-6;        ///< console gripper slider speed (opening units)
   double grip_seen_N = 0.25e-3;      ///< console: a grip force read as held
   double joystick_travel_m = 15e-3;  ///< console: the joystick's half travel (tremor scale)
+  /// click: the microscope's image on the screen, px per metre of the stage: the 5x camera's 1.41 mm
+  /// field on a 640 px panel (docs/console.md's layout).
+  double screen_px_per_m = 4.5e5;
+  /// click: the narrowest target the person clicks at; a finer one is clicked zoomed in (a higher
+  /// objective) so that it is this wide on the screen.
+  double min_click_px = 4.0;
   /// Inserting: the pin seen no lower for this long, well into its bore (half its depth): it is
   /// at the bottom, felt or not. The hand may arrive at its aimed height (within z_tolerance_m)
   /// with the pin a micrometre short of the floor, no contact to feel (seed 4111, part 9).
@@ -116,6 +130,8 @@ struct PersonOperatorParams {
     v("slider_m_s", slider_m_s);
     v("grip_seen_N", grip_seen_N);
     v("joystick_travel_m", joystick_travel_m);
+    v("screen_px_per_m", screen_px_per_m);
+    v("min_click_px", min_click_px);
     v("stalled_s", stalled_s);
     v("step_timeout_s", step_timeout_s);
     v("max_jams", max_jams);
@@ -141,7 +157,9 @@ class PersonOperator {
   std::string_view give_up_reason() const noexcept { return reason_; }
   int clutches() const noexcept { return clutches_; }
   int jams() const noexcept { return jams_; }
-  int submovements() const noexcept { return xy_.submovements() + z_.submovements() + yaw_.submovements(); }
+  int submovements() const noexcept {
+    return xy_.submovements() + z_.submovements() + yaw_.submovements() + cursor_.submovements();
+  }
 
  private:
   void enter(Step s, double t) noexcept;
@@ -150,6 +168,8 @@ class PersonOperator {
   /// Steers the tip (or the carried pin) by the seen error in the plane, planning for a target
   /// `width_m` wide; true once seen within `tolerance_m`.
   bool steer(const Eigen::Vector2d& error_m, double tolerance_m, double t, double width_m) noexcept;
+  /// steer() with the console's click-to-go (master click).
+  bool click_steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept;
   /// What the person aims at: the tolerance alone, or with shared control the guidance's
   /// capture (assisted_tolerance_m), which pulls the slave the rest of the way.
   double aim_width(double tolerance_m) const noexcept {
@@ -185,8 +205,10 @@ class PersonOperator {
   AssemblyGoal goal_;
   bool assisted_;
   bool haptic_;
+  bool click_;  // master click: the plane by click-to-go
   Rng rng_;
   Reach xy_, z_;  // the hand in the plane (haptic: hand metres; console: stage metres), the height
+  Reach cursor_;  // click: the mouse cursor on the screen [px of the current zoom]
   Reach yaw_;     // the console's dial (x: the rotor's angle it asks for) [rad]
   Tremor tremor_;
   double base_scale_;
@@ -199,11 +221,15 @@ class PersonOperator {
   control::ConsoleInput console_;
   bool clutching_ = false;
   int clutches_ = 0, jams_ = 0;
-  bool rising_ = false;       // insert: backing off the rim
-  double lowest_z_ = 0.0;     // insert: the lowest tip height seen ...
-  double lowest_t_ = 0.0;     // ... and since when
-  double pinch_ = 0.0;        // TéléTweez lever closing [m]
-  double slider_ = 0.0;       // console gripper opening [m]
+  bool click_goal_ = false;                            // click: the stage goes to the last click
+  Eigen::Vector3d click_m_ = Eigen::Vector3d::Zero();  // ... there (its z: the height at the click)
+  double click_t_ = 0.0;                               // ... since
+  double cursor_scale_ = 0.0;                          // the screen's px per metre (zoom)
+  bool rising_ = false;                                // insert: backing off the rim
+  double lowest_z_ = 0.0;                              // insert: the lowest tip height seen ...
+  double lowest_t_ = 0.0;                              // ... and since when
+  double pinch_ = 0.0;                                 // TéléTweez lever closing [m]
+  double slider_ = 0.0;                                // console gripper opening [m]
   double held_since_ = -1.0;  // grip first felt (the person stops closing a reaction later)
   Eigen::Vector2d pin_offset_seen_ = Eigen::Vector2d::Zero();  // pin - tips, as vision saw it
   Eigen::Vector2d pin_seen_ = Eigen::Vector2d::Zero();         // the pin on the tray, seen

@@ -162,6 +162,9 @@ class Platform {
   /// The operator console's command for the next ticks (issue #14), in world coordinates (the
   /// telemetry's): set from the operator task, on the loop. Real-time safe.
   void set_console_input(const control::ConsoleInput& in) noexcept;
+  /// The console input in force (the last set_console_input()'s; its goal relative to the stage's
+  /// home, as the coupling takes it).
+  const control::ConsoleInput& console_input() const noexcept { return console_; }
   /// Shared control (issue #29): the virtual fixtures on the coupling for the next ticks, in world
   /// coordinates (control/virtual_fixtures.h). On the loop (the operator task); real-time safe.
   void set_fixtures(const control::FixtureSet& set) noexcept;
