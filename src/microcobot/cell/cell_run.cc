@@ -72,10 +72,11 @@ struct CellCycle::Meter {
 
 namespace {
 
-// Flat parts are the robot's only (the simulated person and the scripted watchmaker only open).
+// Flat parts are placed by the robot and the simulated person (the scripted watchmaker only opens).
 void require_mode_places(const AssemblyJob& job, const std::string& mode) {
-  require(!job.flat || mode == "auto", "flat_fraction",
-          "gives flat parts, which only the robot places (mode auto; got mode '" + mode + "')");
+  require(!job.flat || mode != "scripted", "flat_fraction",
+          "gives flat parts, which the scripted watchmaker does not place (it only opens the fingers; "
+          "modes auto, manual, assisted do)");
 }
 
 platform::PlatformConfig with_world(platform::PlatformConfig c, const AssemblyJob& job) {

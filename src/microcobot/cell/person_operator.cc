@@ -42,6 +42,8 @@ void PersonOperatorParams::validate() const {
   require_positive(stalled_s, "stalled_s");
   require_positive(assisted_pace_m_s, "assisted_pace_m_s");
   require_positive(step_timeout_s, "step_timeout_s");
+  require(std::isfinite(shake_hold_s) && shake_hold_s > 0.0 && shake_hold_s <= 5.0, "shake_hold_s",
+          "must be within (0, 5] s", shake_hold_s);
   require(max_jams >= 1, "max_jams", "must be at least 1", max_jams);
 }
 
@@ -74,7 +76,8 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
   task.validate();
   require(sim_.gripper != nullptr && sim_.haptic != nullptr && sim_.tweezers != nullptr, "microworld",
           "the simulated person needs the pick-and-place scene's simulated devices");
-  grasp_z_ = goal.hole_depth_m + task.grip_above_m;
+  grasp_z_ = AssemblyTask::grasp_height_m(task, goal);  // a flat part at half its thickness
+  roll_rad_ = task.roll_rad;
   safe_z_ = std::max(goal.part_height_m, goal.tallest_neighbour_m) + task.clearance_height_m;
   carry_z_ = grasp_z_ + goal.tallest_neighbour_m + task.clearance_height_m;
   inserted_z_ = grasp_z_ - goal.hole_depth_m;
@@ -106,6 +109,8 @@ void PersonOperator::enter(Step s, double t) noexcept {
   held_since_ = -1.0;
   lowest_z_ = std::numeric_limits<double>::infinity();
   lowest_t_ = t;
+  release_stage_ = 0;
+  shaking_ = false;
 }
 
 void PersonOperator::give_up(const char* why) noexcept {
@@ -222,6 +227,14 @@ bool PersonOperator::steer(const Eigen::Vector2d& error_m, double tolerance_m, d
     return false;
   }
   return xy_.aim(move, tolerance_m / scale, t, hand_max, width_m / scale);
+}
+
+bool PersonOperator::turn_by(double delta_rad, double t) noexcept {
+  // The rotor still where the dial put it before the person judges again.
+  if (!yaw_.ready(t) || std::abs(platform_.yaw_rad() - platform_.yaw_target_rad()) > 2e-3) return false;
+  const double seen_delta = delta_rad + rng_.normal(0.0, p_.yaw_vision_sd_rad);
+  return yaw_.aim({seen_delta, 0.0}, p_.yaw_tolerance_rad, t,
+                  platform_.config().stage.rotary.max_speed_rad_s);
 }
 
 bool PersonOperator::turn(double misalignment, double t) noexcept {
@@ -418,7 +431,25 @@ void PersonOperator::act(const platform::TickInfo& tick) noexcept {
       } else {
         slider_ = std::min(goal_.open_m, slider_ + p_.slider_m_s * dt);
       }
-      if (g.opening_m() > 0.9 * goal_.open_m) enter(Step::kRetract, t);
+      if (release_stage_ == 0 && g.opening_m() > 0.9 * goal_.open_m) {
+        release_stage_ = goal_.flat_seat && goal_.release != microworld::ReleaseStrategy::kOpen ? 1 : 2;
+        release_t0_ = t;
+        // The haptic master has no burst: its person rolls.
+        const bool roll = goal_.release == microworld::ReleaseStrategy::kRoll || haptic_;
+        const double fingers = platform_.yaw_rad();
+        roll_goal_rad_ =
+            roll ? (fingers + roll_rad_ <= goal_.yaw_max_rad ? fingers + roll_rad_ : fingers - roll_rad_)
+                 : std::numeric_limits<double>::quiet_NaN();
+      }
+      if (release_stage_ == 1) {
+        if (std::isnan(roll_goal_rad_)) {
+          shaking_ = t - release_t0_ < p_.shake_hold_s;  // Shake held, then let go
+          if (!shaking_) release_stage_ = 2;
+        } else if (turn_by(roll_goal_rad_ - platform_.yaw_rad(), t)) {
+          release_stage_ = 2;
+        }
+      }
+      if (release_stage_ == 2) enter(Step::kRetract, t);
       break;
     case Step::kRetract:
       if (climb(safe_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) {
@@ -487,6 +518,7 @@ void PersonOperator::apply(double t) noexcept {
   }
   console_.has_gripper = true;
   console_.gripper_opening_m = slider_;
+  console_.gripper_shake = shaking_;
   platform_.set_console_input(console_);
 }
 

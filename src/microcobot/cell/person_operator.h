@@ -23,11 +23,13 @@
 /// (assembly_task.h) so that the modes compare step by step: approach over the pin, descend,
 /// grasp, lift, transport the pin over its bore, insert (down; a contact felt above the bore's
 /// depth means the pin sits on the rim: up a little, look again, re-aim, down again), release,
-/// retract. Orientation (the rotary axis under the gripper): the person turns the console's dial
-/// (the rotor follows its angle) to square the open fingers with the pin on the tray (align) and the
-/// carried pin with its bore (rotate), judging the edges' directions by eye (yaw_vision_sd_rad),
-/// in aimed sub-movements of the dial like any other; a pin on the rim makes them look at its
-/// orientation again too.
+/// retract. A flat part (AssemblyGoal::flat_seat) is grasped at half its thickness, set down until
+/// its seat is felt, and let go by its process sheet's strategy (open; shake: the console's Shake
+/// held; roll: the dial turned with the plate on its seat). Orientation (the rotary axis under the gripper):
+/// the person turns the console's dial (the rotor follows its angle) to square the open fingers with the pin
+/// on the tray (align) and the carried pin with its bore (rotate), judging the edges' directions by eye
+/// (yaw_vision_sd_rad), in aimed sub-movements of the dial like any other; a pin on the rim makes them look
+/// at its orientation again too.
 ///
 /// Assisted (shared control): the cell's vision gives the pin's position and, once it is held,
 /// its offset from the finger tips (within assist_vision_sd_m, measured once per step); the platform
@@ -98,6 +100,11 @@ struct PersonOperatorParams {
   /// click: the narrowest target the person clicks at; a finer one is clicked zoomed in (a higher
   /// objective) so that it is this wide on the screen.
   double min_click_px = 4.0;
+  /// A flat part's release (its process sheet's strategy, microworld/release.h): the console's
+  /// Shake held this long (a press, seen to take, let go: two reaction times' worth), or the dial
+  /// turned by the task's roll_rad with the plate on its seat. The haptic master has no burst: its
+  /// person rolls instead.
+  double shake_hold_s = 0.4;
   /// Inserting: the pin seen no lower for this long, well into its bore (half its depth): it is
   /// at the bottom, felt or not. The hand may arrive at its aimed height (within z_tolerance_m)
   /// with the pin a micrometre short of the floor, no contact to feel (seed 4111, part 9).
@@ -132,6 +139,7 @@ struct PersonOperatorParams {
     v("joystick_travel_m", joystick_travel_m);
     v("screen_px_per_m", screen_px_per_m);
     v("min_click_px", min_click_px);
+    v("shake_hold_s", shake_hold_s);
     v("stalled_s", stalled_s);
     v("step_timeout_s", step_timeout_s);
     v("max_jams", max_jams);
@@ -196,6 +204,9 @@ class PersonOperator {
   /// true once it is seen within yaw_tolerance_rad. Assisted: the platform turns by what its
   /// vision sees, true once it has arrived.
   bool turn(double misalignment, double t) noexcept;
+  /// Turns the fingers by `delta_rad` on the dial as the person sees it (a flat part's roll); true
+  /// once the turn is seen done within yaw_tolerance_rad.
+  bool turn_by(double delta_rad, double t) noexcept;
   /// The carried pin's misalignment with its bore (true, modulo 90 deg).
   double bore_misalignment() const noexcept;
 
@@ -221,6 +232,11 @@ class PersonOperator {
   control::ConsoleInput console_;
   bool clutching_ = false;
   int clutches_ = 0, jams_ = 0;
+  double roll_rad_ = 0.0;                              // a flat part's roll (the task's roll_rad)
+  int release_stage_ = 0;                              // release: 0 opening, 1 its strategy, 2 done
+  double release_t0_ = 0.0;                            // ... the strategy's start
+  double roll_goal_rad_ = 0.0;                         // ... a roll's dial angle
+  bool shaking_ = false;                               // the console's Shake held
   bool click_goal_ = false;                            // click: the stage goes to the last click
   Eigen::Vector3d click_m_ = Eigen::Vector3d::Zero();  // ... there (its z: the height at the click)
   double click_t_ = 0.0;                               // ... since
