@@ -209,10 +209,9 @@ void use_cell(const ServeOptions& o, mc::live::LiveParams& lp) {
                             mc::cell::AssemblyTask::name(static_cast<mc::cell::AssemblyTask::Step>(i)),
                             mc::cell::AssemblyTask::name(tp.autonomy[static_cast<std::size_t>(i)]));
   std::cerr << fmt::format(
-      "serve: cell part {} of the {} of the batch of seed {}: a {:.0f} um {} with {:.1f} um of {}{}; steps "
-      "{}{}; "
-      "the task waits for Start in the console (Next part: the batch's next)\n",
-      part, batch.parts, batch.seed, 1e6 * job.side_m, job.flat ? "plate onto its seat" : "pin into a bore",
+      "serve: cell part {} of the batch of seed {} ({} parts): a {:.0f} um {} with {:.1f} um of {}{}; steps "
+      "{}{}; the task waits for Start in the console (Next part: the batch's next)\n",
+      part, batch.seed, batch.parts, 1e6 * job.side_m, job.flat ? "plate onto its seat" : "pin into a bore",
       1e6 * job.clearance_m, job.flat ? "seat tolerance" : "radial clearance",
       job.world.neighbour_count > 0 ? fmt::format(", among {} other parts", job.world.neighbour_count) : "",
       levels.empty() ? "all auto" : levels + " (the rest auto)",

@@ -343,6 +343,28 @@ TEST(LiveTask, WithTheCellCameraTheTaskHoldsForItsLooksAndInserts) {
   EXPECT_LT((s.back().measured - s.back().target).norm(), 1e-6);
 }
 
+// The plate's errors live (`serve --cell --cell-camera` on a batch with bore_error_m): the looker
+// answers the bore look before the transport (the fourth kind of look: the request word holds it),
+// the pin goes in at its first descent, and the verify's look, taken where the task aimed (the bore
+// as seen, over 5 um from its drawing), finds it.
+TEST(LiveTask, WithTheCellCameraABoreOffItsDrawingIsSeenAndThePinGoesIn) {
+  cell::AssemblyBatchParams batch;
+  batch.parts = 1;
+  batch.seed = 41;
+  batch.bore_error_m = 10e-6;
+  const cell::AssemblyJob job = cell::assembly_jobs(batch).front();
+  ASSERT_GT((job.world.target_m.head<2>() - job.target_m).norm(), 5e-6) << "the case this test is about";
+  TaskRig rig(/*paced=*/false, /*camera=*/true, std::nullopt, batch);
+  ASSERT_TRUE(rig.live->push_task_action(TaskAction::kStart));
+  ASSERT_TRUE(rig.wait_for([](const LiveTaskStatus& st) { return st.ended; }, 180s));
+  const LiveTaskStatus end = rig.task();
+  EXPECT_EQ(end.status, Status::kSucceeded) << end.failure;
+  EXPECT_EQ(end.inserted, 1);
+  EXPECT_EQ(end.looks, 4);
+  EXPECT_EQ(end.looks_found, 4);
+  EXPECT_EQ(end.search_tries, 0);
+}
+
 TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   TaskRig rig(/*paced=*/true);
   rig.live->push_task_action(TaskAction::kStart);

@@ -50,8 +50,8 @@ cell::PinSighting LiveLooker::look(AssemblyTask::Look kind, const platform::Tele
       return camera_->look_held(truth, pin, tool, channel(s, "measured_theta_rad"),
                                 tool.z() - grasp_z + pin.height_m);
     }
-    case AssemblyTask::Look::kPlaced:
-      return camera_->look_placed(truth, pin, goal.target_m, goal.target_yaw_rad,
+    case AssemblyTask::Look::kPlaced:  // where the task aimed: the bore as the camera saw it
+      return camera_->look_placed(truth, pin, task_.target_m(), goal.target_yaw_rad,
                                   pin.height_m - goal.hole_depth_m);
     case AssemblyTask::Look::kNone:
       break;

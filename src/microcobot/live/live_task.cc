@@ -68,7 +68,9 @@ void LiveTask::reset() {
   look_pending_ = false;
   looks_ = looks_found_ = 0;
   ++look_seq_;  // a sighting still on its way for the old scene is dropped
-  look_word_.store(look_seq_ << 2);
+  look_word_.store(look_seq_ << kLookBits);
+  target_x_m_.store(params_.goal.target_m.x());
+  target_y_m_.store(params_.goal.target_m.y());
   looks_pub_.store(0);
   looks_found_pub_.store(0);
   started_ = ended_ = operator_had_stage_ = false;
@@ -223,16 +225,19 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
   gap_pub_.store(gap_paused_, std::memory_order_relaxed);
   looks_pub_.store(looks_, std::memory_order_relaxed);
   looks_found_pub_.store(looks_found_, std::memory_order_relaxed);
-  look_word_.store(look_seq_ << 2 | (look_pending_ ? static_cast<std::uint64_t>(task.look_wanted()) : 0u),
-                   std::memory_order_relaxed);
+  target_x_m_.store(task.goal().target_m.x(), std::memory_order_relaxed);
+  target_y_m_.store(task.goal().target_m.y(), std::memory_order_relaxed);
+  look_word_.store(
+      look_seq_ << kLookBits | (look_pending_ ? static_cast<std::uint64_t>(task.look_wanted()) : 0u),
+      std::memory_order_relaxed);
   ended_pub_.store(ended_, std::memory_order_release);  // last: the rest is read after it
 }
 
 LiveTask::LookRequest LiveTask::look_request() const noexcept {
   const std::uint64_t w = look_word_.load(std::memory_order_relaxed);
   LookRequest r;
-  r.seq = w >> 2;
-  r.look = static_cast<AssemblyTask::Look>(w & 3u);
+  r.seq = w >> kLookBits;
+  r.look = static_cast<AssemblyTask::Look>(w & ((1u << kLookBits) - 1u));
   return r;
 }
 

@@ -138,6 +138,10 @@ class LiveTask {
     cell::AssemblyTask::Look look = cell::AssemblyTask::Look::kNone;
   };
   LookRequest look_request() const noexcept;
+  /// The bore the task aims at now (world x, y): its drawing, or where the camera saw it. Any thread.
+  Eigen::Vector2d target_m() const noexcept {
+    return {target_x_m_.load(std::memory_order_relaxed), target_y_m_.load(std::memory_order_relaxed)};
+  }
   /// The sighting for request `seq` (one producer thread: the looker's). Wait-free; false when the
   /// ring is full.
   bool deliver(std::uint64_t seq, const cell::AssemblyTask::Sighting& s) noexcept {
@@ -171,8 +175,13 @@ class LiveTask {
   platform::SpscRing<Delivery> sightings_{8};
   bool look_pending_ = false;  // loop thread: a look requested and not answered
   int looks_ = 0, looks_found_ = 0;
-  std::uint64_t look_seq_ = 0;               // loop thread: the current request's number
-  std::atomic<std::uint64_t> look_word_{0};  // published: look_seq_ << 2 | the look awaited
+  std::uint64_t look_seq_ = 0;  // loop thread: the current request's number
+  // Published: look_seq_ << kLookBits | the look awaited (AssemblyTask::Look's values fit the bits).
+  static constexpr unsigned kLookBits = 3;
+  static_assert(static_cast<unsigned>(cell::AssemblyTask::Look::kPlaced) < (1u << kLookBits));
+  std::atomic<std::uint64_t> look_word_{0};
+  // The bore the task aims at (its drawing, or where the camera saw it): the looker's placed look.
+  std::atomic<double> target_x_m_{0.0}, target_y_m_{0.0};
   std::atomic<int> looks_pub_{0}, looks_found_pub_{0};
   // Loop thread only.
   bool started_ = false, ended_ = false, operator_had_stage_ = false;
