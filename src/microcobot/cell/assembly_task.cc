@@ -118,6 +118,22 @@ std::string_view AssemblyTask::name(Status s) noexcept {
   return "?";
 }
 
+std::string_view AssemblyTask::name(Look l) noexcept {
+  switch (l) {
+    case Look::kNone:
+      return "none";
+    case Look::kSlot:
+      return "slot";
+    case Look::kBore:
+      return "bore";
+    case Look::kHeld:
+      return "held";
+    case Look::kPlaced:
+      return "placed";
+  }
+  return "?";
+}
+
 std::string_view AssemblyTask::name(Autonomy a) noexcept {
   switch (a) {
     case Autonomy::kAuto:

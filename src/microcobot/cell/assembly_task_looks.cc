@@ -6,22 +6,6 @@
 
 namespace mc::cell {
 
-std::string_view AssemblyTask::name(Look l) noexcept {
-  switch (l) {
-    case Look::kNone:
-      return "none";
-    case Look::kSlot:
-      return "slot";
-    case Look::kBore:
-      return "bore";
-    case Look::kHeld:
-      return "held";
-    case Look::kPlaced:
-      return "placed";
-  }
-  return "?";
-}
-
 void AssemblyTask::see(const Sighting& sighting) noexcept {
   if (status_ != Status::kAwaitingLook) return;
   switch (look_) {
