@@ -158,20 +158,25 @@ TEST(PersonOperator, APinThatStopsShortOfTheFloorUnfeltIsReleased) {
   EXPECT_TRUE(r.ended_holding);
 }
 
-// The person, the fixtures and the coupling run on the loop: a whole assisted cycle, no allocation.
+// The person, the fixtures and the coupling run on the loop: a whole assisted cycle, and a manual
+// one by clicks, no allocation.
 TEST(PersonOperator, ThePersonAndTheFixturesDoNotAllocateOnTheLoop) {
-  CellRunParams params;
-  params.mode = "assisted";
-  CellCycle c(person_job(), params, default_platform());
-  c.platform().loop().run_for(1000);  // warm-up: 0.1 s of base ticks
-  std::size_t allocations = 0;
-  {
-    mc::test::AllocationGuard guard;
-    c.platform().loop().run_for(400000);  // 40 s: every step of the cycle
-    allocations = guard.allocations();
+  for (const auto& [mode, master] : {std::pair{"assisted", "haptic"}, std::pair{"manual", "click"}}) {
+    CellRunParams params;
+    params.mode = mode;
+    params.person.master = master;
+    CellCycle c(person_job(), params, default_platform());
+    c.platform().loop().run_for(1000);  // warm-up: 0.1 s of base ticks
+    std::size_t allocations = 0;
+    {
+      mc::test::AllocationGuard guard;
+      c.platform().loop().run_for(400000);  // 40 s: every step of the cycle
+      allocations = guard.allocations();
+    }
+    EXPECT_EQ(allocations, 0u) << mode << ", " << master;
+    EXPECT_TRUE(c.person()->done()) << mode << ", " << master << ": in step "
+                                    << AssemblyTask::name(c.person()->step());
   }
-  EXPECT_EQ(allocations, 0u);
-  EXPECT_TRUE(c.person()->done()) << "in step " << AssemblyTask::name(c.person()->step());
 }
 
 TEST(PersonOperator, BadParametersAreNamed) {
