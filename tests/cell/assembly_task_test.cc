@@ -222,6 +222,90 @@ TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
       << "the pin on the axis of the bore as seen";
 }
 
+// With the visual servo (set_looks(true, true)): at the insertion's start the task holds for the
+// align look (the pin against its bore, one camera pose), moves the tool by minus the error seen at
+// the carrying height, looks again, and descends once the servo says converged; the pin's offset
+// in the fingers is in that error, so no held look is taken.
+TEST(AssemblyTask, WithTheServoItMovesByTheErrorSeenAndLooksAgainUntilConverged) {
+  const AssemblyGoal g = skip_goal();
+  AssemblyTask task({}, g);
+  task.set_looks(true, true);
+  IdealStage stage;
+  const auto look = [&](AssemblyTask::Look want) {
+    for (int i = 0; i < 20000 && task.look_wanted() == AssemblyTask::Look::kNone; ++i) stage.tick(task);
+    return task.look_wanted() == want;
+  };
+  ASSERT_TRUE(look(AssemblyTask::Look::kSlot));
+  task.see({});
+  ASSERT_TRUE(look(AssemblyTask::Look::kBore));
+  AssemblyTask::Sighting bore;
+  bore.found = true;
+  bore.part_m << g.target_m + Eigen::Vector2d(6e-6, -7e-6), 0.0;
+  task.see(bore);
+  ASSERT_TRUE(look(AssemblyTask::Look::kAlign));
+  EXPECT_EQ(task.step(), Step::kInsert);
+  const Eigen::Vector3d over = stage.s.tip_m;
+  EXPECT_LT((over.head<2>() - bore.part_m.head<2>()).norm(), 1e-9) << "over the bore as seen";
+  AssemblyTask::Sighting off;
+  off.found = true;
+  off.error_m = {3e-6, -4e-6};  // the pin seen 5 um off the bore's axis
+  task.see(off);
+  ASSERT_TRUE(look(AssemblyTask::Look::kAlign)) << "looks again once the correction is made";
+  EXPECT_LT((stage.s.tip_m.head<2>() - (over.head<2>() - off.error_m)).norm(), 1e-9);
+  EXPECT_NEAR(stage.s.tip_m.z(), over.z(), 1e-9) << "at the carrying height";
+  EXPECT_EQ(task.align_looks(), 1);
+  AssemblyTask::Sighting there;
+  there.found = true;
+  there.error_m = {0.1e-6, 0.05e-6};
+  there.converged = true;
+  task.see(there);
+  const control::ConsoleInput& in = task.tick(stage.s, 1e-3);
+  EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kNone);
+  ASSERT_TRUE(in.deadman && in.has_goal);
+  EXPECT_LT((in.goal_m.head<2>() - (over.head<2>() - off.error_m)).norm(), 1e-12)
+      << "descends where it aimed";
+  EXPECT_LT(in.goal_m.z(), over.z()) << "down";
+  EXPECT_EQ(task.align_looks(), 2);
+  EXPECT_TRUE(std::isnan(task.held_offset_m())) << "no held look";
+}
+
+// The servo's looks are bounded (align_max_looks): an error that never converges (a stage whose
+// moves miss) is corrected for the last time and the descent goes on, the search round that point;
+// an align look that finds nothing descends over the bore as seen.
+TEST(AssemblyTask, TheServoGivesUpAfterItsLooksAndANothingSeenDescends) {
+  const AssemblyGoal g = skip_goal();
+  AssemblyTaskParams p;
+  p.align_max_looks = 3;
+  for (const bool seen : {true, false}) {
+    AssemblyTask task(p, g);
+    task.set_looks(true, true);
+    IdealStage stage;
+    int aligns = 0;
+    for (int i = 0; i < 60000 && task.step() != Step::kRelease; ++i) {
+      switch (task.look_wanted()) {
+        case AssemblyTask::Look::kNone:
+          stage.tick(task);
+          // Down in the bore (its rim at the grasp height, 400 um; its floor 300 um below).
+          if (task.step() == Step::kInsert && stage.s.tip_m.z() < 200e-6) stage.s.contact_N.z() = 1e-3;
+          break;
+        case AssemblyTask::Look::kAlign: {
+          ++aligns;
+          AssemblyTask::Sighting s;
+          s.found = seen;
+          s.error_m = {1e-6, 0.0};  // never converges
+          task.see(s);
+          break;
+        }
+        default:
+          task.see({});
+      }
+    }
+    ASSERT_EQ(task.step(), Step::kRelease) << (seen ? "seen: " : "not seen: ") << task.failure();
+    EXPECT_EQ(aligns, seen ? 3 : 1);
+    EXPECT_NEAR(task.align_aim_m().x(), seen ? -3e-6 : 0.0, 1e-12);
+  }
+}
+
 // A look that finds nothing leaves the task as without a camera: the slot's nominal position.
 TEST(AssemblyTask, ALookThatFindsNothingLeavesTheNominalSlot) {
   const AssemblyGoal g = skip_goal();

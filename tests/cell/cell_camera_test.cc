@@ -110,6 +110,60 @@ TEST(CellCamera, MeasuresThePinsOffsetAlongTheFingersBetweenThem) {
   }
 }
 
+// The visual servo's look (look_align): the pin in the fingers and its bore seen from one camera
+// pose. The view is off by micrometres (view_error_m), so each look alone is off by as much, but
+// the servo's error, pin minus bore, is not: the same error moved both.
+TEST(CellCamera, TheServoSeesThePinAgainstItsBoreWhereverTheViewIs) {
+  AssemblyBatchParams b;
+  b.parts = 3;
+  b.seed = 64;
+  b.bore_error_m = 10e-6;
+  CellCameraParams p = on();
+  p.view_error_m = 10e-6;
+  for (const AssemblyJob& j : assembly_jobs(b)) {
+    const platform::PlatformConfig c = config_of(j);
+    CellCamera camera(p, c, static_cast<std::uint64_t>(j.index));
+    const PinSighting bore = camera.look_bore(in_slot(j), j.target_m, j.target_yaw_rad);
+    ASSERT_TRUE(bore.found) << bore.reason;
+    const Eigen::Vector2d bore_truth = j.world.target_m.head<2>();
+    const double view_off = (bore.part_m.head<2>() - bore_truth).norm();
+    EXPECT_NEAR(view_off, camera.view_error().norm(), 0.3e-6) << "part " << j.index;
+    // Held 150 um over the bore, the pin off its axis by (4, -7) um, 6 um along the fingers' y.
+    const double yaw = j.target_yaw_rad, grasp_z = j.world.hole_depth_m + 100e-6, lift = 150e-6;
+    const Eigen::Vector2d ey(-std::sin(yaw), std::cos(yaw));
+    const Eigen::Vector2d part = bore_truth + Eigen::Vector2d(4e-6, -7e-6);
+    const Eigen::Vector2d tool = part - 6e-6 * ey;
+    platform::CameraScenePose pose;
+    pose.tool_x_m = tool.x(), pose.tool_y_m = tool.y(), pose.tool_z_m = grasp_z + lift;
+    pose.tool_yaw_rad = yaw;
+    pose.opening_m = j.side_m;
+    pose.part_x_m = part.x(), pose.part_y_m = part.y(), pose.part_z_m = lift + 0.5 * j.world.height_m();
+    pose.part_yaw_rad = yaw;
+    const PinModel pin{j.side_m, j.world.height_m()};
+    const Eigen::Vector3d tool_m(tool.x(), tool.y(), pose.tool_z_m);
+    const PinSighting s = camera.look_align(pose, pin, j.target_m, bore.part_m.head<2>(), tool_m, yaw,
+                                            lift + j.world.height_m());
+    ASSERT_TRUE(s.found) << s.reason;
+    std::printf(
+        "align look, part %d (%.0f um pin): view %.2f um off, pin %.2f um off, servo error %.0f nm off\n",
+        j.index, 1e6 * j.side_m, 1e6 * view_off, 1e6 * (s.part_m.head<2>() - part).norm(),
+        1e9 * (s.error_m - (part - bore_truth)).norm());
+    EXPECT_GT((s.part_m.head<2>() - part).norm(), 1e-6) << "part " << j.index << ": the view is off";
+    EXPECT_LT((s.error_m - (part - bore_truth)).norm(), 0.3e-6) << "part " << j.index;
+    EXPECT_FALSE(s.converged);
+    // The pin on the bore's axis: converged.
+    const Eigen::Vector2d shift = bore_truth - part;
+    pose.part_x_m += shift.x(), pose.part_y_m += shift.y();
+    pose.tool_x_m += shift.x(), pose.tool_y_m += shift.y();
+    const PinSighting on_axis = camera.look_align(pose, pin, j.target_m, bore.part_m.head<2>(),
+                                                  tool_m + Eigen::Vector3d(shift.x(), shift.y(), 0.0), yaw,
+                                                  lift + j.world.height_m());
+    ASSERT_TRUE(on_axis.found) << on_axis.reason;
+    EXPECT_LT(on_axis.error_m.norm(), 0.3e-6) << "part " << j.index;
+    EXPECT_TRUE(on_axis.converged) << "part " << j.index;
+  }
+}
+
 TEST(CellCamera, TellsAPinDownInItsBoreFromOneOnItsRimOrGone) {
   const AssemblyJob j = jobs(1, 63).front();
   const platform::PlatformConfig c = config_of(j);
@@ -126,7 +180,8 @@ TEST(CellCamera, TellsAPinDownInItsBoreFromOneOnItsRimOrGone) {
   // Down in its bore, 1.5 um off its axis.
   const Eigen::Vector2d in = j.target_m + Eigen::Vector2d(1.5e-6, -1.0e-6);
   pose.part_x_m = in.x(), pose.part_y_m = in.y(), pose.part_z_m = top_inserted - 0.5 * j.world.height_m();
-  const PinSighting down = camera.look_placed(pose, pin, j.target_m, j.target_yaw_rad, top_inserted);
+  const PinSighting down =
+      camera.look_placed(pose, pin, j.target_m, j.target_m, j.target_yaw_rad, top_inserted);
   ASSERT_TRUE(down.found) << down.reason;
   EXPECT_LT((down.part_m.head<2>() - in).norm(), 0.2e-6);
   EXPECT_NEAR(down.part_m.z(), pose.part_z_m, 10e-6);  // a bore's depth tells in from out
@@ -136,14 +191,15 @@ TEST(CellCamera, TellsAPinDownInItsBoreFromOneOnItsRimOrGone) {
   // On the rim: beside its bore, a bore's depth higher.
   const Eigen::Vector2d rim = j.target_m + Eigen::Vector2d(0.0, 0.4 * j.side_m);
   pose.part_x_m = rim.x(), pose.part_y_m = rim.y(), pose.part_z_m = 0.5 * j.world.height_m();
-  const PinSighting on_rim = camera.look_placed(pose, pin, j.target_m, j.target_yaw_rad, top_inserted);
+  const PinSighting on_rim =
+      camera.look_placed(pose, pin, j.target_m, j.target_m, j.target_yaw_rad, top_inserted);
   EXPECT_FALSE(on_rim.found);
   EXPECT_STREQ(on_rim.reason, "no pin top in focus at the height of a pin down in its bore");
 
   // Gone: stuck to a finger, up with the retract.
   pose.part_x_m = j.target_m.x(), pose.part_y_m = j.target_m.y();
   pose.part_z_m = pose.tool_z_m + 0.5 * j.world.height_m() - (j.world.hole_depth_m + 100e-6);
-  EXPECT_FALSE(camera.look_placed(pose, pin, j.target_m, j.target_yaw_rad, top_inserted).found);
+  EXPECT_FALSE(camera.look_placed(pose, pin, j.target_m, j.target_m, j.target_yaw_rad, top_inserted).found);
   EXPECT_EQ(camera.frames(), 9);
 }
 
@@ -164,6 +220,17 @@ TEST(CellCamera, RefusesBadParameters) {
   EXPECT_THROW(p.validate(), InvalidParams);
   p = on();
   p.focus_step_dof = 0.1;
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = on();
+  p.view_error_m = -1e-6;
+  try {
+    p.validate();
+    FAIL();
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("view_error_m"), std::string::npos) << e.what();
+  }
+  p = on();
+  p.servo_converged_m = 0.0;
   EXPECT_THROW(p.validate(), InvalidParams);
 }
 

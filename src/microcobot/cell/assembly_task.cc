@@ -35,6 +35,8 @@ void AssemblyTaskParams::validate() const {
           shake_s);
   require(std::isfinite(roll_rad) && roll_rad > 0.0 && roll_rad <= 0.5, "roll_rad",
           "must be within (0, 0.5] rad", roll_rad);
+  require(align_max_looks >= 1 && align_max_looks <= 20, "align_max_looks", "must be within [1, 20]",
+          align_max_looks);
 }
 
 double AssemblyTask::grasp_height_m(const AssemblyTaskParams& p, const AssemblyGoal& goal) noexcept {
@@ -89,65 +91,6 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   enter(Step::kApproach);
 }
 
-std::string_view AssemblyTask::name(Step s) noexcept {
-  static constexpr std::array<std::string_view, kStepCount> names = {
-      "approach", "align",  "descend", "grasp",   "lift",   "transport",
-      "rotate",   "insert", "release", "retract", "verify", "done"};
-  return names[index(s)];
-}
-
-std::string_view AssemblyTask::name(Status s) noexcept {
-  switch (s) {
-    case Status::kRunning:
-      return "running";
-    case Status::kPaused:
-      return "paused";
-    case Status::kAwaitingConfirm:
-      return "awaiting confirmation";
-    case Status::kAwaitingLook:
-      return "awaiting look";
-    case Status::kOperator:
-      return "operator";
-    case Status::kSucceeded:
-      return "succeeded";
-    case Status::kFailed:
-      return "failed";
-    case Status::kAssisted:
-      return "assisted";
-  }
-  return "?";
-}
-
-std::string_view AssemblyTask::name(Look l) noexcept {
-  switch (l) {
-    case Look::kNone:
-      return "none";
-    case Look::kSlot:
-      return "slot";
-    case Look::kBore:
-      return "bore";
-    case Look::kHeld:
-      return "held";
-    case Look::kPlaced:
-      return "placed";
-  }
-  return "?";
-}
-
-std::string_view AssemblyTask::name(Autonomy a) noexcept {
-  switch (a) {
-    case Autonomy::kAuto:
-      return "auto";
-    case Autonomy::kConfirm:
-      return "confirm";
-    case Autonomy::kManual:
-      return "manual";
-    case Autonomy::kAssisted:
-      return "assisted";
-  }
-  return "?";
-}
-
 bool AssemblyTask::assistable(Step s) noexcept {
   return s == Step::kApproach || s == Step::kAlign || s == Step::kDescend || s == Step::kGrasp ||
          s == Step::kLift || s == Step::kTransport || s == Step::kRotate || s == Step::kInsert ||
@@ -168,6 +111,9 @@ void AssemblyTask::enter(Step s) noexcept {
     tries_ = 0;
     offset_y_ = search_base_ = 0.0;
     held_seen_ = false;
+    aligned_ = align_move_ = false;
+    align_looks_ = 0;
+    aim_.setZero();
     search_yaw_ = last_yaw_;  // along the fingers as they are
   }
   if (s == Step::kDone) {
@@ -370,7 +316,7 @@ void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
 }
 
 Eigen::Vector2d AssemblyTask::search_xy() const noexcept {
-  return goal_.target_m + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
+  return goal_.target_m + aim_ + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
 }
 
 const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {

@@ -49,6 +49,12 @@
 ///   held    at the insertion's start: the pin's offset along the fingers' y, seen over the bore;
 ///           the descent aims the pin, not the tool point, at the bore's axis (the search goes on
 ///           around that point if it still jams);
+///   align   instead of held, with the visual servo (set_looks(true, true)): at the insertion's
+///           start the pin and its bore seen from one camera pose, the error between them; the tool
+///           moves by minus that error (at the carrying height) and the task looks again, until
+///           the servo says converged or align_max_looks looks were taken (the last error is
+///           still corrected); the descent then aims there (the search goes on around that point
+///           if it still jams);
 ///   placed  in verify, the stage still: the camera's sighting is the verify's evidence (a pin not
 ///           seen down in its bore fails the task).
 /// A look that finds nothing leaves the task as without a camera (nominal slot, search from the
@@ -108,6 +114,9 @@ struct AssemblyTaskParams {
   /// peel angle).
   double shake_s = 0.05;
   double roll_rad = 0.03;
+  /// The visual servo's looks before an insertion at most (set_looks(true, true)): one converges
+  /// unless the stage's moves are off (each look corrects what the last move missed).
+  int align_max_looks = 5;
 
   template <class V>
   void visit(V& v) {
@@ -130,6 +139,7 @@ struct AssemblyTaskParams {
     v("yaw_tolerance_rad", yaw_tolerance_rad);
     v("shake_s", shake_s);
     v("roll_rad", roll_rad);
+    v("align_max_looks", align_max_looks);
   }
   void validate() const;
 };
@@ -206,12 +216,15 @@ class AssemblyTask {
     kFailed,
     kAssisted
   };
-  enum class Look { kNone, kSlot, kBore, kHeld, kPlaced };
-  /// What a look saw (world frame): the pin's centre and yaw, or nothing.
+  enum class Look { kNone, kSlot, kBore, kHeld, kPlaced, kAlign };
+  /// What a look saw (world frame): the pin's centre and yaw, or nothing; an align look also the
+  /// servo's error (the pin's centre minus the bore's) and whether it converged.
   struct Sighting {
     bool found = false;
     Eigen::Vector3d part_m = Eigen::Vector3d::Zero();
     double yaw_rad = 0.0;
+    Eigen::Vector2d error_m = Eigen::Vector2d::Zero();
+    bool converged = false;
   };
   /// kAssisted: the moves only (assistable()); another step given it is the operator's (kManual).
   enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
@@ -249,8 +262,16 @@ class AssemblyTask {
   const control::FixtureSet& fixtures() const noexcept { return fixtures_; }
   bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
 
-  /// The cell has a camera: the task asks for its looks (header). Before the first tick.
-  void set_looks(bool on) noexcept { looks_ = on; }
+  /// The cell has a camera: the task asks for its looks (header), the insertion aligned by the
+  /// visual servo with `servo` (align looks) or by one held look. Before the first tick.
+  void set_looks(bool on, bool servo = false) noexcept {
+    looks_ = on;
+    servo_ = servo;
+  }
+  /// Align looks taken for the present insertion, and the aim they set (the tool's offset from the
+  /// bore as seen).
+  int align_looks() const noexcept { return align_looks_; }
+  Eigen::Vector2d align_aim_m() const noexcept { return aim_; }
   /// The look the task awaits (kNone unless the status is kAwaitingLook).
   Look look_wanted() const noexcept { return status_ == Status::kAwaitingLook ? look_ : Look::kNone; }
   /// What the awaited look saw; the task runs on from the next tick (nothing awaited: ignored).
@@ -344,8 +365,13 @@ class AssemblyTask {
   bool placed_seen_ = false;
   double held_offset_ = std::numeric_limits<double>::quiet_NaN();  // the pin along the fingers' y
   double search_base_ = 0.0;                                       // the search's centre along y
-  Eigen::Vector2d retreat_xy_{0, 0};                               // the search's way up: from here ...
-  double retreat_z_ = 0.0;                                         // ... to here (NaN: from where the tip is)
+  bool servo_ = false;                // the insertion aligned by the visual servo (align looks)
+  bool aligned_ = false;              // ... done: converged, out of looks, or nothing seen
+  bool align_move_ = false;           // ... the tool moving to the corrected aim before the next look
+  int align_looks_ = 0;               // ... looks taken for this insertion
+  Eigen::Vector2d aim_{0, 0};         // ... the tool's offset from the bore as seen
+  Eigen::Vector2d retreat_xy_{0, 0};  // the search's way up: from here ...
+  double retreat_z_ = 0.0;            // ... to here (NaN: from where the tip is)
 };
 
 }  // namespace mc::cell

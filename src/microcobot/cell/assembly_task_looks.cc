@@ -29,6 +29,19 @@ void AssemblyTask::see(const Sighting& sighting) noexcept {
         search_base_ = offset_y_ = -held_offset_;
       }
       break;
+    case Look::kAlign:
+      // The look-and-move servo: the tool moves by minus the error seen (the stage's loop makes
+      // the displacement), then looks again, until converged or out of looks. Nothing seen: the
+      // descent aims as without a camera, the search round the bore as seen.
+      ++align_looks_;
+      if (sighting.found && sighting.error_m.allFinite()) {
+        if (!sighting.converged) aim_ -= sighting.error_m;
+        aligned_ = sighting.converged || align_looks_ >= p_.align_max_looks;
+      } else {
+        aligned_ = true;
+      }
+      align_move_ = !aligned_;
+      break;
     case Look::kPlaced:
       placed_seen_ = true;
       placed_ = sighting;
@@ -45,9 +58,15 @@ AssemblyTask::Look AssemblyTask::look_before_moving() const noexcept {
   if (!looks_) return Look::kNone;
   if (step_ == Step::kApproach && !slot_seen_) return Look::kSlot;
   if (step_ == Step::kTransport && !bore_seen_ && !goal_.flat_seat) return Look::kBore;
-  if (step_ == Step::kInsert && !held_seen_ && tries_ == 0 && insert_ == Insert::kDescend &&
-      status_ == Status::kRunning)
-    return Look::kHeld;
+  // The servo aligns a pin on its bore as seen from the bore's station; a flat seat shows nothing
+  // to servo on (its place is its drawing's), so a flat part takes the held look.
+  if (step_ == Step::kInsert && tries_ == 0 && insert_ == Insert::kDescend && status_ == Status::kRunning) {
+    if (servo_ && !goal_.flat_seat) {
+      if (!aligned_ && !align_move_) return Look::kAlign;
+    } else if (!held_seen_) {
+      return Look::kHeld;
+    }
+  }
   return Look::kNone;
 }
 

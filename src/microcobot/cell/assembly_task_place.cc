@@ -13,6 +13,10 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
   const double floor_z = grasp_z_ - goal_.hole_depth_m;  // tips when the pin's bottom is on the bore's floor
   switch (insert_) {
     case Insert::kDescend: {
+      if (align_move_) {  // the servo's correction, at the carrying height, before its next look
+        if (move_to({xy.x(), xy.y(), carry_z_}, p_.insert_speed_m_s, s, dt)) align_move_ = false;
+        break;
+      }
       // Aim below the floor: the descent ends on a contact, on the rim or on the floor. Slowly
       // only where a contact may come: the last 20 um to the surface and to the floor.
       const double z = s.tip_m.z(), near = 20e-6;

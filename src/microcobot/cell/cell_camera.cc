@@ -12,6 +12,7 @@
 #include "microcobot/vision/sensor_model.h"
 #include "microcobot/vision/sharpness.h"
 #include "microcobot/vision/template_tracker.h"
+#include "microcobot/vision/visual_servo.h"
 
 namespace mc::cell {
 
@@ -36,6 +37,10 @@ void CellCameraParams::validate() const {
           "must be within [0, 100 um]", band_inset_m);
   require(std::isfinite(bore_search_m) && bore_search_m >= 1e-6 && bore_search_m <= 200e-6, "bore_search_m",
           "must be within [1, 200] um", bore_search_m);
+  require(std::isfinite(view_error_m) && view_error_m >= 0.0 && view_error_m <= 50e-6, "view_error_m",
+          "must be within [0, 50] um", view_error_m);
+  require(std::isfinite(servo_converged_m) && servo_converged_m > 0.0 && servo_converged_m <= 10e-6,
+          "servo_converged_m", "must be within (0, 10] um", servo_converged_m);
 }
 
 platform::CameraScenePose truth_pose(const platform::Platform& p) {
@@ -97,12 +102,23 @@ struct CellCamera::Impl {
 
 CellCamera::CellCamera(const CellCameraParams& params, const platform::PlatformConfig& config,
                        std::uint64_t stream)
-    : p_(params), seed_(static_cast<std::uint64_t>(params.seed) * 1000003ULL + stream) {
+    : p_(params),
+      seed_(static_cast<std::uint64_t>(params.seed) * 1000003ULL + stream),
+      view_rng_(seed_ ^ 0x7669657745727272ULL) {
   p_.validate();
   impl_ = std::make_unique<Impl>(p_, config);
 }
 
 CellCamera::~CellCamera() = default;
+
+Eigen::Vector2d CellCamera::move_to_station(const Eigen::Vector2d& centre) {
+  if (!at_station_ || (centre - station_).norm() > 1e-6) {
+    station_ = centre;
+    at_station_ = true;
+    view_error_ = {view_rng_.normal(0.0, p_.view_error_m), view_rng_.normal(0.0, p_.view_error_m)};
+  }
+  return centre + view_error_;
+}
 
 namespace {
 
@@ -180,8 +196,9 @@ PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const 
                                   const Eigen::Vector2d& nominal_xy, double nominal_yaw) {
   Impl& m = *impl_;
   vs::Renderer r = m.renderer_at(nominal_xy);
+  vs::Renderer view = m.renderer_at(move_to_station(nominal_xy));
   const double focus = pin.height_m;  // the pin's top, standing on the tray
-  m.render(r, truth, focus, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  m.render(view, truth, focus, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   m.render(r, pin_at(truth, nominal_xy, 0.5 * pin.height_m, nominal_yaw), focus, true, 0, 0, m.model);
   PinSighting s;
   s.yaw_rad = nominal_yaw;
@@ -200,8 +217,9 @@ PinSighting CellCamera::look_bore(const platform::CameraScenePose& truth, const 
                                   double yaw) {
   Impl& m = *impl_;
   vs::Renderer r = m.renderer_at(drawn_xy);
+  vs::Renderer view = m.renderer_at(move_to_station(drawn_xy));
   constexpr double kRim = 0.0;  // the focus: the substrate's surface, the bore's rim
-  m.render(r, truth, kRim, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  m.render(view, truth, kRim, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   // The model: the bore where its drawing puts it, the pin and the fingers far from it.
   auto& world = m.config.world;
   const Eigen::Vector3d true_bore = world.target_m;
@@ -229,43 +247,41 @@ PinSighting CellCamera::look_bore(const platform::CameraScenePose& truth, const 
   return s;
 }
 
-PinSighting CellCamera::look_held(const platform::CameraScenePose& truth, const PinModel& pin,
-                                  const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
-  Impl& m = *impl_;
-  vs::Renderer r = m.renderer_at(tool_m.head<2>());
-  m.render(r, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
-  PinSighting s;
-  s.yaw_rad = tool_yaw;
-  // The profile along the fingers' y, sampled every half pixel over the pin and 30 um either side,
-  // each sample the mean across the band |x_f| <= side / 2 - inset.
+namespace {
+
+// The pin's two faces across a profile: along `along` from `origin` (world, as the cell believes
+// it: `r` maps it to the frame), sampled every half pixel over `reach` either side, each sample the
+// mean across `across` from `across_from` to `across_to` (bilinear). The faces are the strongest
+// gradient in each half (the near face rising into the bright top and the far one falling out of
+// it, or the reverse), refined by a parabola; they must lie a side apart (within 3 pixels), each a
+// clear edge (contrast >= 5 against the gradient's median). `centre`: their midpoint along `along`.
+struct FacePair {
+  bool found = false;
+  double centre = 0.0, confidence = 0.0;
+  const char* reason = "";
+};
+FacePair face_pair(const vs::Frame& frame, const vs::Renderer& r, const Eigen::Vector2d& origin,
+                   const Eigen::Vector2d& along, const Eigen::Vector2d& across, double across_from,
+                   double across_to, double reach, double side_m) {
+  FacePair out;
   const double px = r.camera().pixel_size_m(), h = 0.5 * px;
-  const double half_band = 0.5 * pin.side_m - p_.band_inset_m;
-  if (half_band < 2.0 * px) {
-    s.reason = "the pin is too narrow for a band between the fingers";
-    return s;
-  }
-  const double reach = 0.5 * pin.side_m + 30e-6;
   const int n = static_cast<int>(std::ceil(reach / h));
-  const Eigen::Vector2d ex(std::cos(tool_yaw), std::sin(tool_yaw)),
-      ey(-std::sin(tool_yaw), std::cos(tool_yaw));
   std::vector<double> profile(static_cast<std::size_t>(2 * n + 1));
   for (int k = -n; k <= n; ++k) {
     double sum = 0.0;
     int count = 0;
-    for (double xf = -half_band; xf <= half_band + 1e-12; xf += h) {
-      const Eigen::Vector2d w = tool_m.head<2>() + xf * ex + k * h * ey;
-      const double value = bilinear(m.frame, r.u_of_x(w.x()), r.v_of_y(w.y()));
+    for (double c = across_from; c <= across_to + 1e-12; c += h) {
+      const Eigen::Vector2d w = origin + c * across + k * h * along;
+      const double value = bilinear(frame, r.u_of_x(w.x()), r.v_of_y(w.y()));
       if (std::isnan(value)) {
-        s.reason = "the pin in the fingers leaves the camera's field";
-        return s;
+        out.reason = "the pin in the fingers leaves the camera's field";
+        return out;
       }
       sum += value;
       ++count;
     }
     profile[static_cast<std::size_t>(k + n)] = sum / count;
   }
-  // The two faces: the strongest gradient in each half, the near face rising into the bright top
-  // and the far one falling out of it (or the reverse: the larger magnitude either way).
   std::vector<double> g(profile.size(), 0.0);
   for (std::size_t i = 1; i + 1 < profile.size(); ++i) g[i] = 0.5 * (profile[i + 1] - profile[i - 1]);
   const auto strongest = [&g](std::size_t from, std::size_t to) {
@@ -276,34 +292,128 @@ PinSighting CellCamera::look_held(const platform::CameraScenePose& truth, const 
   };
   const std::size_t mid = static_cast<std::size_t>(n);
   const std::size_t a = strongest(2, mid), b = strongest(mid + 1, g.size() - 2);
-  const auto edge_y = [&](std::size_t i) {
+  const auto edge = [&](std::size_t i) {
     return (static_cast<double>(i) - n +
             vertex_offset(std::abs(g[i - 1]), std::abs(g[i]), std::abs(g[i + 1]))) *
            h;
   };
-  const double ya = edge_y(a), yb = edge_y(b);
-  // Contrast: the weaker edge against the profile's noise (the gradient's median magnitude).
+  const double ea = edge(a), eb = edge(b);
   std::vector<double> mags(g.size());
   std::transform(g.begin(), g.end(), mags.begin(), [](double x) { return std::abs(x); });
   std::nth_element(mags.begin(), mags.begin() + static_cast<std::ptrdiff_t>(mags.size() / 2), mags.end());
   const double noise = std::max(mags[mags.size() / 2], 1e-9);
-  s.confidence = std::min(std::abs(g[a]), std::abs(g[b])) / noise;
-  // The faces a side apart (within 3 pixels), each a clear edge: else not the pin.
-  if (std::abs((yb - ya) - pin.side_m) > 3.0 * px || s.confidence < 5.0) {
-    s.reason = "the pin's faces are not where a pin in the fingers has them";
+  out.confidence = std::min(std::abs(g[a]), std::abs(g[b])) / noise;
+  if (std::abs((eb - ea) - side_m) > 3.0 * px || out.confidence < 5.0) {
+    out.reason = "the pin's faces are not where a pin in the fingers has them";
+    return out;
+  }
+  out.centre = 0.5 * (ea + eb);
+  out.found = true;
+  return out;
+}
+
+}  // namespace
+
+PinSighting CellCamera::look_held(const platform::CameraScenePose& truth, const PinModel& pin,
+                                  const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
+  Impl& m = *impl_;
+  const vs::Renderer r = m.renderer_at(tool_m.head<2>());
+  vs::Renderer view = m.renderer_at(move_to_station(tool_m.head<2>()));
+  m.render(view, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  PinSighting s;
+  s.yaw_rad = tool_yaw;
+  // The profile along the fingers' y over the pin and 30 um either side, across the band between
+  // the fingers, |x_f| <= side / 2 - inset.
+  const double half_band = 0.5 * pin.side_m - p_.band_inset_m;
+  if (half_band < 2.0 * r.camera().pixel_size_m()) {
+    s.reason = "the pin is too narrow for a band between the fingers";
     return s;
   }
-  const double centre = 0.5 * (ya + yb);
-  const Eigen::Vector2d xy = tool_m.head<2>() + centre * ey;
+  const Eigen::Vector2d ex(std::cos(tool_yaw), std::sin(tool_yaw)),
+      ey(-std::sin(tool_yaw), std::cos(tool_yaw));
+  const FacePair y = face_pair(m.frame, r, tool_m.head<2>(), ey, ex, -half_band, half_band,
+                               0.5 * pin.side_m + 30e-6, pin.side_m);
+  s.confidence = y.confidence;
+  if (!y.found) {
+    s.reason = y.reason;
+    return s;
+  }
+  const Eigen::Vector2d xy = tool_m.head<2>() + y.centre * ey;
   s.part_m = {xy.x(), xy.y(), top_z_m - 0.5 * pin.height_m};
   s.found = true;
   return s;
 }
 
-PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, const PinModel& pin,
-                                    const Eigen::Vector2d& bore_xy, double bore_yaw, double top_z_m) {
+PinSighting CellCamera::look_align(const platform::CameraScenePose& truth, const PinModel& pin,
+                                   const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_seen_xy,
+                                   const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
   Impl& m = *impl_;
-  vs::Renderer r = m.renderer_at(bore_xy);
+  const vs::Renderer r = m.renderer_at(station_xy);
+  vs::Renderer view = m.renderer_at(move_to_station(station_xy));
+  m.render(view, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+  PinSighting s;
+  s.yaw_rad = tool_yaw;
+  const double px = r.camera().pixel_size_m();
+  const double half_band = 0.5 * pin.side_m - p_.band_inset_m;
+  if (half_band < 2.0 * px) {
+    s.reason = "the pin is too narrow for a band between the fingers";
+    return s;
+  }
+  const Eigen::Vector2d ex(std::cos(tool_yaw), std::sin(tool_yaw)),
+      ey(-std::sin(tool_yaw), std::cos(tool_yaw));
+  // Searched wider than the held look: the view's error moves everything it sees.
+  const double reach = 0.5 * pin.side_m + 30e-6 + 3.0 * p_.view_error_m;
+  // Along the fingers' y between them, as the held look.
+  const FacePair y =
+      face_pair(m.frame, r, tool_m.head<2>(), ey, ex, -half_band, half_band, reach, pin.side_m);
+  if (!y.found) {
+    s.confidence = y.confidence;
+    s.reason = y.reason;
+    return s;
+  }
+  // Along their x across the part of the pin below the fingers' ends (their bars begin half a
+  // finger's width before the tool point and run along +y): both faces free there. 5 um clear of
+  // the pin's corners and of the bars' dark outline (4 um), so that a 100 um pin keeps a band.
+  constexpr double kClear = 5e-6;
+  const double finger_w = m.config.world.gripper.finger_width_m;
+  const double from = y.centre - 0.5 * pin.side_m + kClear;
+  const double to = std::min(y.centre + 0.5 * pin.side_m - kClear, -0.5 * finger_w - kClear);
+  if (to - from < 2.0 * px) {
+    s.confidence = y.confidence;
+    s.reason = "the fingers leave too little of the pin's faces along their x";
+    return s;
+  }
+  const FacePair x = face_pair(m.frame, r, tool_m.head<2>(), ex, ey, from, to, reach, pin.side_m);
+  s.confidence = std::min(x.confidence, y.confidence);
+  if (!x.found) {
+    s.reason = x.reason;
+    return s;
+  }
+  const Eigen::Vector2d xy = tool_m.head<2>() + x.centre * ex + y.centre * ey;
+  s.part_m = {xy.x(), xy.y(), top_z_m - 0.5 * pin.height_m};
+  s.found = true;
+  // The servo: the feature (the pin's pixel) against its target (the bore's, seen from this pose).
+  vs::AffineMap map;  // the objective's nominal map, pixel = A world + b (rows down)
+  map.A << 1.0 / px, 0.0, 0.0, -1.0 / px;
+  map.b = Eigen::Vector2d(r.u_of_x(0.0), r.v_of_y(0.0));
+  vs::VisualServoParams sp;
+  sp.converged_m = p_.servo_converged_m;
+  sp.deadband_m = std::min(sp.deadband_m, sp.converged_m);
+  vs::VisualServo servo(sp, map, r.camera().sensor.width_px, r.camera().sensor.height_px);
+  const Eigen::Vector2d target = map.pixel_of(bore_seen_xy), feature = map.pixel_of(xy);
+  servo.set_target(target.x(), target.y());
+  const vs::ServoCommand c = servo.step({feature.x(), feature.y(), true, 0.0}, 0.0);
+  s.error_m = c.error_m;
+  s.converged = c.status == vs::ServoStatus::kConverged;
+  return s;
+}
+
+PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, const PinModel& pin,
+                                    const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_xy,
+                                    double bore_yaw, double top_z_m) {
+  Impl& m = *impl_;
+  vs::Renderer r = m.renderer_at(station_xy);
+  vs::Renderer view = m.renderer_at(move_to_station(station_xy));
   PinSighting s;
   s.yaw_rad = bore_yaw;
   const vs::PixelRoi box = pin_roi(r, bore_xy, pin.side_m, bore_yaw, 12);
@@ -318,7 +428,7 @@ PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, cons
   vs::Frame focused;
   for (int k = 0; k < 3; ++k) {
     const double z = top_z_m + (k - 1) * step;
-    m.render(r, truth, z, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
+    m.render(view, truth, z, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
     samples[static_cast<std::size_t>(k)] = {z, vs::tenengrad(m.frame, box)};
     if (k == 1) focused = m.frame;
   }

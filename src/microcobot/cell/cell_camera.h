@@ -20,6 +20,15 @@
 ///           intensity profile along the fingers' y, averaged across a band between the fingers
 ///           (the frame sampled in the fingers' frame, bilinearly), its two edges located at the
 ///           gradient's extrema, refined by a parabola; the pin's centre is their midpoint.
+///   align   the pin in the fingers over its bore (the visual servo of issue #28 in its look-and-move
+///           form): the camera still where the bore look left it, one frame focused on the pin's
+///           top; its faces the fingers leave free give its centre (along the fingers' y between
+///           them, along their x below their ends), and vision::VisualServo's error e = s - s*
+///           between its pixel and the pixel where the bore was seen, in metres through the
+///           camera's map (L_e^+ = A^-1). Pin and bore are seen from the same camera pose, so an
+///           error in where that pose is (view_error_m) cancels in e; the stage's own loop then
+///           makes the displacement -e (look-and-move: Weiss, Sanderson & Neuman, IEEE J. Robotics
+///           and Automation 3(5), 1987), and the task looks again until the servo says converged.
 ///   placed  the pin after the release, the fingers retracted: three frames focused at the height
 ///           a pin down in its bore has its top, and `focus_step_dof` depths of field either side;
 ///           the Tenengrad focus
@@ -29,9 +38,12 @@
 ///
 /// The microscope is moved over each station (its view centred on the look's nominal point), as
 /// a camera on its own positioner or one camera per station would be; the pixel <-> world map is
-/// the objective's nominal one (the renderer's). The truth renders the frames and judges the
-/// estimates (CycleResult::look_error_m), never steers. Not real-time: CellCycle calls it
-/// between runs of the loop, the task holding meanwhile (AssemblyTask::Status::kAwaitingLook).
+/// the objective's nominal one (the renderer's). Where the view really is differs from where the
+/// cell believes it by `view_error_m` (per axis, drawn anew each time the microscope moves to
+/// another station: its positioner's repeatability, the hand-eye calibration's drift): every
+/// position a look reports is off by that much, the same for every look from one station. The truth renders
+/// the frames and judges the estimates (CycleResult::look_error_m), never steers. Not real-time: CellCycle
+/// calls it between runs of the loop, the task holding meanwhile (AssemblyTask::Status::kAwaitingLook).
 
 #include <cstdint>
 #include <memory>
@@ -39,6 +51,7 @@
 
 #include <Eigen/Core>
 
+#include "microcobot/core/rng.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/platform/platform_config.h"
 
@@ -61,6 +74,17 @@ struct CellCameraParams {
   /// How far from its drawing the bore look searches for the bore (3 of 10 um's standard deviations
   /// and some).
   double bore_search_m = 50e-6;
+  /// The standard deviation, per axis, of where the microscope's view is from where the cell
+  /// believes it, drawn each time it moves to another station (0: a calibrated, drift-free
+  /// camera) [m].
+  double view_error_m = 0.0;
+  /// The insertion aligned by the visual servo (align looks until it converges: the pin and its bore
+  /// in one camera pose) instead of one held look (the pin's offset in the fingers, the tool then
+  /// placed by the stage's sensors over the bore as seen).
+  bool servo = true;
+  /// The servo's convergence: the pin's centre seen within this of its bore's (vision::VisualServo's
+  /// converged_m; issue #28's 0.3 um) [m].
+  double servo_converged_m = 0.3e-6;
 
   template <class V>
   void visit(V& v) {
@@ -74,6 +98,9 @@ struct CellCameraParams {
     v("band_inset_m", band_inset_m);
     v("focus_step_dof", focus_step_dof);
     v("bore_search_m", bore_search_m);
+    v("view_error_m", view_error_m);
+    v("servo", servo);
+    v("servo_converged_m", servo_converged_m);
   }
   void validate() const;
 };
@@ -85,6 +112,10 @@ struct PinSighting {
   double yaw_rad = 0.0;                              ///< slot: measured; else the expected one
   double confidence = 0.0;                           ///< the template's correlation (held: edge contrast)
   const char* reason = "";                           ///< why not found ("" when found)
+  /// align: the servo's error, the pin's centre minus the bore's (world frame, from one camera
+  /// pose), and whether it is within servo_converged_m.
+  Eigen::Vector2d error_m = Eigen::Vector2d::Zero();
+  bool converged = false;
 };
 
 /// What the cell knows of the pin (told, or measured by the task), for the looks.
@@ -113,20 +144,36 @@ class CellCamera {
   /// by `tool_yaw`; `top_z_m` the pin's top as the grasp left it (focus).
   PinSighting look_held(const platform::CameraScenePose& truth, const PinModel& pin,
                         const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m);
+  /// The pin in the fingers over its bore: the camera over the bore's station `station_xy` (where
+  /// the bore look looked: its drawing), the bore seen at `bore_seen_xy` from there; the tool
+  /// point at `tool_m` (the stage's sensors), the fingers turned by `tool_yaw`, the pin's top at
+  /// `top_z_m`. part_m: the pin's centre; error_m, converged: the servo's.
+  PinSighting look_align(const platform::CameraScenePose& truth, const PinModel& pin,
+                         const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_seen_xy,
+                         const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m);
   /// The pin after its release, expected down in its bore at `bore_xy` (turned by `bore_yaw`), its
-  /// top at `top_z_m`.
+  /// top at `top_z_m`; the camera over `station_xy` (the bore's station: the bore look's pose).
   PinSighting look_placed(const platform::CameraScenePose& truth, const PinModel& pin,
-                          const Eigen::Vector2d& bore_xy, double bore_yaw, double top_z_m);
+                          const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_xy, double bore_yaw,
+                          double top_z_m);
 
   int frames() const noexcept { return frames_; }
   const CellCameraParams& params() const noexcept { return p_; }
+  /// Where the view is from where the cell believes it, at the present station.
+  Eigen::Vector2d view_error() const noexcept { return view_error_; }
 
  private:
   struct Impl;
+  /// The microscope over `centre` (believed): a new station draws a new view error. Returns where
+  /// the view really is centred.
+  Eigen::Vector2d move_to_station(const Eigen::Vector2d& centre);
   CellCameraParams p_;
   std::uint64_t seed_;
   std::unique_ptr<Impl> impl_;
   int frames_ = 0;
+  Rng view_rng_;
+  Eigen::Vector2d station_ = Eigen::Vector2d::Zero(), view_error_ = Eigen::Vector2d::Zero();
+  bool at_station_ = false;
 };
 
 /// The truth the camera renders: the slave's tips (the sliders, not the sensors), the gripper, the

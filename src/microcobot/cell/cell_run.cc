@@ -112,7 +112,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
     if (params_.camera.enabled) {
       camera_ = std::make_unique<CellCamera>(params_.camera, base, static_cast<std::uint64_t>(job.index));
-      task_->set_looks(true);
+      task_->set_looks(true, params_.camera.servo);
     }
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
@@ -220,8 +220,15 @@ void CellCycle::look() {
         seen = camera_->look_held(truth, pin, s.tip_m, s.yaw_rad, s.tip_m.z() - grasp_z + pin.height_m);
         break;
       }
-      case AssemblyTask::Look::kPlaced:
-        seen = camera_->look_placed(truth, pin, task_->goal().target_m, job_.target_yaw_rad,
+      case AssemblyTask::Look::kAlign: {
+        // Over the bore's station, where the bore look looked from.
+        const double grasp_z = AssemblyTask::grasp_height_m(params_.task, assembly_goal(job_));
+        seen = camera_->look_align(truth, pin, job_.target_m, task_->goal().target_m, s.tip_m, s.yaw_rad,
+                                   s.tip_m.z() - grasp_z + pin.height_m);
+        break;
+      }
+      case AssemblyTask::Look::kPlaced:  // from the bore's station too
+        seen = camera_->look_placed(truth, pin, job_.target_m, task_->goal().target_m, job_.target_yaw_rad,
                                     pin.height_m - job_.world.hole_depth_m);
         break;
       case AssemblyTask::Look::kNone:
@@ -245,6 +252,8 @@ void CellCycle::look() {
   sighting.found = seen.found;
   sighting.part_m = seen.part_m;
   sighting.yaw_rad = seen.yaw_rad;
+  sighting.error_m = seen.error_m;
+  sighting.converged = seen.converged;
   task_->see(sighting);
   look_wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -50,8 +50,15 @@ cell::PinSighting LiveLooker::look(AssemblyTask::Look kind, const platform::Tele
       return camera_->look_held(truth, pin, tool, channel(s, "measured_theta_rad"),
                                 tool.z() - grasp_z + pin.height_m);
     }
+    case AssemblyTask::Look::kAlign: {  // over the bore's station, where the bore look looked from
+      const Eigen::Vector3d tool(channel(s, "measured_x_m"), channel(s, "measured_y_m"),
+                                 channel(s, "measured_z_m"));
+      const double grasp_z = goal.hole_depth_m + task_params_.task.grip_above_m;
+      return camera_->look_align(truth, pin, goal.target_m, task_.target_m(), tool,
+                                 channel(s, "measured_theta_rad"), tool.z() - grasp_z + pin.height_m);
+    }
     case AssemblyTask::Look::kPlaced:  // where the task aimed: the bore as the camera saw it
-      return camera_->look_placed(truth, pin, task_.target_m(), goal.target_yaw_rad,
+      return camera_->look_placed(truth, pin, goal.target_m, task_.target_m(), goal.target_yaw_rad,
                                   pin.height_m - goal.hole_depth_m);
     case AssemblyTask::Look::kNone:
       break;
@@ -77,6 +84,8 @@ void LiveLooker::run() {
       sighting.found = seen.found;
       sighting.part_m = seen.part_m;
       sighting.yaw_rad = seen.yaw_rad;
+      sighting.error_m = seen.error_m;
+      sighting.converged = seen.converged;
     } catch (const std::exception&) {
       sighting.found = false;  // nothing seen: the task goes on as without a camera (verify: fails)
     }

@@ -56,7 +56,7 @@ LiveTask::~LiveTask() = default;
 
 void LiveTask::reset() {
   task_ = std::make_unique<AssemblyTask>(params_.task, params_.goal);
-  task_->set_looks(params_.camera.enabled);
+  task_->set_looks(params_.camera.enabled, params_.camera.servo);
   for (int i = 0; i + 1 < AssemblyTask::kStepCount; ++i)
     task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[static_cast<std::size_t>(i)]);
   TaskAction dropped;

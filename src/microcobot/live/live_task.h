@@ -178,7 +178,7 @@ class LiveTask {
   std::uint64_t look_seq_ = 0;  // loop thread: the current request's number
   // Published: look_seq_ << kLookBits | the look awaited (AssemblyTask::Look's values fit the bits).
   static constexpr unsigned kLookBits = 3;
-  static_assert(static_cast<unsigned>(cell::AssemblyTask::Look::kPlaced) < (1u << kLookBits));
+  static_assert(static_cast<unsigned>(cell::AssemblyTask::Look::kAlign) < (1u << kLookBits));
   std::atomic<std::uint64_t> look_word_{0};
   // The bore the task aims at (its drawing, or where the camera saw it): the looker's placed look.
   std::atomic<double> target_x_m_{0.0}, target_y_m_{0.0};
