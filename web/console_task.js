@@ -59,8 +59,11 @@ function taskHint(t) {
     return t.supervisor_lost ? "Paused by the platform: control or the console's heartbeat was lost. Resume to go on."
                              : "Paused: the stage holds. Resume, take over or skip.";
   if (t.status === "awaiting confirmation") return `“${t.step}” waits for your Confirm (or Skip).`;
-  if (t.status === "awaiting look")
-    return `“${t.step}”: the cell's camera looks at the ${t.step === "transport" ? "bore" : "pin"}; the stage holds.`;
+  if (t.status === "awaiting look") {
+    const what = {slot: "the pin in its slot", bore: "the bore", held: "the pin in the fingers",
+                  align: "the pin against its bore (the visual servo)", placed: "the pin placed"}[t.look] || "the pin";
+    return `“${t.step}”: the cell's camera looks at ${what}; the stage holds.`;
+  }
   if (t.status === "operator") return `You drive (${t.step}): hold the deadman to move. Hand back when ready.`;
   if (t.status === "assisted" && (t.step === "align" || t.step === "rotate"))
     return `You turn “${t.step}” with the dial, guided: hold the deadman and turn; a stop holds the fingers square, and the task goes on once they are.`;

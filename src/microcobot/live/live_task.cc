@@ -255,6 +255,7 @@ LiveTaskStatus LiveTask::status() const {
   s.inserted = inserted_.load(std::memory_order_relaxed);
   s.looks = looks_pub_.load(std::memory_order_relaxed);
   s.looks_found = looks_found_pub_.load(std::memory_order_relaxed);
+  s.look = look_request().look;
   s.autonomy = params_.autonomy;
   if (!params_.parts.empty()) {  // the parts never change: only the index is the loop's
     s.part = params_.parts[static_cast<std::size_t>(part_.load(std::memory_order_relaxed))].index;

@@ -107,6 +107,8 @@ struct LiveTaskStatus {
   int inserted = -1;  ///< at its end, the simulation's truth: 1 the pin is in its bore, 0 not, -1 unknown
   int looks = 0;      ///< the camera's sightings the task took
   int looks_found = 0;
+  /// The look the task awaits (kNone: none).
+  cell::AssemblyTask::Look look = cell::AssemblyTask::Look::kNone;
   int part = -1;  ///< the batch's part it works on (LivePart::index; -1: no batch)
   int parts = 0;  ///< the parts the console can go through (LiveTaskParams::parts)
   std::array<cell::AssemblyTask::Autonomy, cell::AssemblyTask::kStepCount> autonomy{};
