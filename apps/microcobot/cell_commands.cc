@@ -47,6 +47,7 @@ Inputs load_inputs(const CellOptions& o) {
   if (o.seed) in.scene.seed = *o.seed;
   if (o.common.params) in.params = mc::load_params<cell::CellRunParams>(*o.common.params);
   if (o.mode) in.params.mode = *o.mode;
+  if (o.master) in.params.person.master = *o.master;  // before the task file: its manual steps need one
   if (o.task) {
     // Over the run's `task` keys; a step no headless operator can do is refused naming the file.
     const cell::AssemblyTaskFile f = cell::load_task_file(*o.task, in.params.task);
@@ -60,7 +61,6 @@ Inputs load_inputs(const CellOptions& o) {
       throw mc::InvalidInput(o.task->string(), 0, e.what());
     }
   }
-  if (o.master) in.params.person.master = *o.master;
   if (o.camera) in.params.camera.enabled = true;
   mc::cli::naming_flags({{"parts", "--batch"},
                          {"seed", "--seed"},
@@ -99,6 +99,7 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                       "clutches",
                                       "search_tries",
                                       "confirmations",
+                                      "handovers",
                                       "submovements",
                                       "path_m",
                                       "side_m",
@@ -133,6 +134,7 @@ mc::CsvTable cycles_table(const std::vector<cell::CycleResult>& cycles) {
                                static_cast<double>(c.clutches),
                                static_cast<double>(c.search_tries),
                                static_cast<double>(c.confirmations),
+                               static_cast<double>(c.handovers),
                                static_cast<double>(c.submovements),
                                c.path_m,
                                c.side_m,
@@ -350,11 +352,12 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
          "--master", o.master,
          "The simulated person's master in manual and assisted modes: haptic (handle, thumb wheel, "
          "TéléTweez; default), console (joystick, gripper slider) or click (the console's click-to-go; "
-         "manual only)")
+         "manual only); console also for the task's manual steps, which the person takes over (mode auto)")
       ->check(CLI::IsMember({"haptic", "console", "click"}));
   cmd.add_option("--task", o.task,
                  "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
-                 "confirmed after confirm_delay_s, manual ones refused headless) and the task's parameters "
+                 "confirmed after confirm_delay_s, manual ones taken over by the simulated person with --master "
+                 "console, assisted ones refused headless) and the task's parameters "
                  "(`params: {insert_speed_m_s: 1e-5}`); docs/cell.md");
   cmd.add_flag("--camera", o.camera,
                "The robot's camera (mode auto): looks at the pin in its slot, in the fingers and placed, on "

@@ -439,14 +439,66 @@ TEST(CellCycle, AConfirmStepCostsTheSupervisorsDelayAndAManualStepIsRefusedHeadl
   EXPECT_EQ(plain.confirmations, 0);
   EXPECT_NEAR(r.cycle_s - plain.cycle_s, 2.0, 0.1);
 
+  // A manual step needs the person's console (the TéléTweez would command the held pin's grip from
+  // its own levers); an assisted one a person under shared control, which a headless run has not.
   CellRunParams manual;
   manual.autonomy[static_cast<std::size_t>(Step::kGrasp)] = AssemblyTask::Autonomy::kManual;
-  try {
-    CellCycle(job(), manual, default_platform());
-    ADD_FAILURE() << "a manual step headless";
-  } catch (const InvalidParams& e) {
-    EXPECT_NE(std::string(e.what()).find("steps.grasp"), std::string::npos) << e.what();
+  for (const auto level : {AssemblyTask::Autonomy::kManual, AssemblyTask::Autonomy::kAssisted}) {
+    manual.autonomy[static_cast<std::size_t>(Step::kGrasp)] = level;
+    try {
+      CellCycle(job(), manual, default_platform());
+      ADD_FAILURE() << "a headless " << AssemblyTask::name(level) << " step with the haptic master";
+    } catch (const InvalidParams& e) {
+      EXPECT_NE(std::string(e.what()).find("steps.grasp"), std::string::npos) << e.what();
+    }
   }
+}
+
+// A manual step headless (issue #29 point 5, the hand-over): the simulated person takes the task's
+// insertion over with the console (joystick, gripper slider), inserts, and hands back once the pin is
+// down; the task releases, retracts and verifies. Neither the take-over nor the hand-back jumps: the
+// commanded position moves at most the joystick's top speed a tick, the gripper's command while the
+// person has it at most the slider's, and the pin the robot grasped stays grasped until the task's
+// release.
+TEST(CellCycle, AManualStepIsTakenOverByThePersonAndHandedBackWithoutAJump) {
+  CellRunParams params;
+  params.person.master = "console";
+  params.autonomy[static_cast<std::size_t>(Step::kInsert)] = AssemblyTask::Autonomy::kManual;
+  CellCycle c(job(), params, default_platform());
+  Eigen::Vector3d last = target(c.platform());
+  double last_opening = c.platform().teleop().gripper_opening_m, largest = 0.0, largest_opening = 0.0;
+  double taken_at = -1.0, handed_at = -1.0, opened_at = -1.0;
+  c.set_observer([&](double t) {
+    const Eigen::Vector3d now = target(c.platform());
+    const double opening = c.platform().teleop().gripper_opening_m;
+    largest = std::max(largest, (now - last).norm());
+    const AssemblyTask& task = *c.task();
+    // The gripper's command while the person has the step (the task's release opens at once after).
+    if (task.status() == Status::kOperator)
+      largest_opening = std::max(largest_opening, std::abs(opening - last_opening));
+    last = now, last_opening = opening;
+    if (taken_at < 0.0 && task.status() == Status::kOperator) taken_at = t;
+    if (taken_at >= 0.0 && opened_at < 0.0 && c.platform().gripper().grip_force_N() <= 0.0) opened_at = t;
+    if (taken_at >= 0.0 && handed_at < 0.0 && task.status() != Status::kOperator) handed_at = t;
+  });
+  c.run_to_end();
+  const CycleResult r = c.result();
+  EXPECT_TRUE(r.success) << r.verdict;
+  EXPECT_EQ(r.handovers, 1);
+  EXPECT_EQ(r.master, "console");
+  EXPECT_GT(r.submovements, 0) << "the person moved";
+  ASSERT_GT(taken_at, 0.0);
+  ASSERT_GT(handed_at, taken_at);
+  EXPECT_GE(opened_at, handed_at) << "the grasped pin held through the person's step";
+  EXPECT_GT(r.step_s[static_cast<std::size_t>(Step::kRetract)], 0.0) << "the task went on after";
+  const double joystick = c.platform().config().teleop.console_max_speed_m_s;
+  std::printf("taken over at %.2f s, handed back at %.2f s; largest step %.3f um a tick (joystick %.3f um), "
+              "gripper %.3f um\n",
+              taken_at, handed_at, 1e6 * largest, 1e3 * joystick, 1e6 * largest_opening);
+  EXPECT_LE(largest, std::max(joystick, params.task.travel_speed_m_s) * 1e-3 * 1.001);
+  EXPECT_LE(largest_opening, params.person.slider_m_s * 1e-3 * 1.001 + 1e-12);
+  EXPECT_TRUE(r.ended_holding);
+  EXPECT_EQ(r.grip_violations + r.contact_violations, 0);
 }
 
 TEST(CellCycle, BadParametersAreRefusedWithTheKeyNamed) {

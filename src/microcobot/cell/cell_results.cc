@@ -38,6 +38,7 @@ nlohmann::json CycleResult::to_json() const {
           {"search_tries", search_tries},
           {"submovements", submovements},
           {"confirmations", confirmations},
+          {"handovers", handovers},
           {"path_m", path_m},
           {"side_m", side_m},
           {"clearance_m", clearance_m},
@@ -86,6 +87,7 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("release", r.release);
   get("submovements", r.submovements);
   get("confirmations", r.confirmations);
+  get("handovers", r.handovers);
   get("path_m", r.path_m);
   get("side_m", r.side_m);
   get("clearance_m", r.clearance_m);

@@ -28,12 +28,16 @@ void CellRunParams::validate() const {
   require(person_seed >= 0, "person_seed", "must be non-negative", person_seed);
   require(std::isfinite(confirm_delay_s) && confirm_delay_s >= 0.0 && confirm_delay_s <= 60.0,
           "confirm_delay_s", "must be within [0, 60] s", confirm_delay_s);
-  for (std::size_t i = 0; i < autonomy.size(); ++i)
-    require(mode != "auto" || (autonomy[i] != AssemblyTask::Autonomy::kManual &&
-                               autonomy[i] != AssemblyTask::Autonomy::kAssisted),
-            "steps." + std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i))),
-            "is " + std::string(AssemblyTask::name(autonomy[i])) +
-                ": a headless run has no operator to do it (serve --cell runs it with one)");
+  for (std::size_t i = 0; i < autonomy.size(); ++i) {
+    const std::string key = "steps." + std::string(AssemblyTask::name(static_cast<AssemblyTask::Step>(i)));
+    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kAssisted, key,
+            "is assisted: a headless run has no person under shared control for one step (serve --cell "
+            "runs it with one)");
+    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kManual || person.master == "console", key,
+            "is manual: the simulated person takes a step over with the console (person.master: console; "
+            "the TéléTweez' levers would command the held pin's grip from their own opening, a click "
+            "master has no gripper of its own)");
+  }
   manual.validate();
   camera.validate();
   require(person.master != "click" || mode != "assisted", "person.master",
@@ -110,6 +114,12 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
   }
   if (params_.mode == "auto") {
     task_ = std::make_unique<AssemblyTask>(params_.task, goal);
+    const bool manual_steps = std::find(params_.autonomy.begin(), params_.autonomy.end(),
+                                        AssemblyTask::Autonomy::kManual) != params_.autonomy.end();
+    if (manual_steps)  // the person who takes them over: the manual mode's, same seed
+      person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal, false,
+                                                 static_cast<std::uint64_t>(params_.person_seed) * 1000003ULL +
+                                                     static_cast<std::uint64_t>(job.index));
     if (params_.camera.enabled) {
       camera_ = std::make_unique<CellCamera>(params_.camera, base, static_cast<std::uint64_t>(job.index));
       task_->set_looks(true, params_.camera.servo);
@@ -141,6 +151,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       control::ConsoleInput in = task_->tick(s, t.dt_s);
       if (task_->operator_drives()) in.active = false;
       platform_->set_console_input(in);
+      if (person_) hand_over(t);
       // A look wanted: the loop stops at the end of this tick, the camera looks between runs.
       if (camera_ && !look_requested_ && task_->look_wanted() != AssemblyTask::Look::kNone) {
         look_requested_ = true;
@@ -197,6 +208,23 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
 }
 
 CellCycle::~CellCycle() = default;
+
+void CellCycle::hand_over(const platform::TickInfo& t) {
+  if (!person_has_step_ && task_->status() == AssemblyTask::Status::kOperator) {
+    person_step_ = task_->step();
+    person_->take_over(person_step_, t.t_s);
+    person_has_step_ = true;
+  }
+  if (!person_has_step_) return;
+  person_->act(t);  // after the task's tick: the person's console input is the one the coupling takes
+  const bool gave_up = person_->gave_up();
+  if (person_->step() != person_step_ || gave_up) {
+    person_->hand_back();
+    person_has_step_ = false;
+    ++handovers_;
+    task_->hand_back(/*step_done=*/!gave_up);  // given up: the robot does the step from where it is
+  }
+}
 
 void CellCycle::look() {
   const auto t0 = std::chrono::steady_clock::now();
@@ -315,6 +343,11 @@ CycleResult CellCycle::result() const {
   if (task_) {
     r.search_tries = task_->search_tries();
     r.confirmations = confirmations_;
+    r.handovers = handovers_;
+    if (person_) {
+      r.master = params_.person.master;
+      r.submovements = person_->submovements();
+    }
     r.success = task_->status() == AssemblyTask::Status::kSucceeded && inserted;
     if (p.faulted()) {
       r.verdict = "a device faulted";

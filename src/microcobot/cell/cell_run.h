@@ -46,8 +46,10 @@ struct CellRunParams {
   /// it started waiting (a stand-in for the operator's glance and click until the simulated
   /// person of issue #29 point 3): its cost shows in the cycle time.
   double confirm_delay_s = 1.0;
-  /// Each step's autonomy (a task file's `steps`, task_file.h; not a --params key). Headless
-  /// runs have no operator for a `manual` step: refused.
+  /// Each step's autonomy (a task file's `steps`, task_file.h; not a --params key). Headless, a
+  /// `manual` step is taken over by the simulated person with the console (person.master:
+  /// console), who hands back once it is done; an `assisted` step is refused (serve --cell runs it
+  /// with a person).
   std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> autonomy = all_auto();
   /// The cell's camera (mode auto): its looks at the pin in its slot, in the fingers, placed.
   CellCameraParams camera;
@@ -101,6 +103,7 @@ struct CycleResult {
   int search_tries = 0;   ///< the task's search points, or the times the person's pin met the rim
   int submovements = 0;   ///< the person's aimed movements
   int confirmations = 0;  ///< steps the supervisor confirmed (autonomy `confirm`)
+  int handovers = 0;      ///< manual steps the simulated person took over and handed back (auto)
   double path_m = 0.0;    ///< length of the measured tip's path
   double side_m = 0.0, clearance_m = 0.0;
   std::string part = "pin";        ///< "pin" (into a bore) or "flat" (onto a flat seat)
@@ -190,6 +193,12 @@ class CellCycle {
   /// The look the task awaits, off the loop: the frames rendered from the truth, measured, seen.
   void look();
   int confirmations_ = 0;
+  /// A manual step of the task: the person takes it over, acts, and hands back once their step
+  /// moved on (the task then goes on from the next step) or they gave up (the task does the step).
+  void hand_over(const platform::TickInfo& t);
+  bool person_has_step_ = false;
+  AssemblyTask::Step person_step_ = AssemblyTask::Step::kApproach;
+  int handovers_ = 0;
 };
 
 /// One part, run to its end.

@@ -113,6 +113,23 @@ void PersonOperator::enter(Step s, double t) noexcept {
   shaking_ = false;
 }
 
+void PersonOperator::take_over(Step s, double t) noexcept {
+  const platform::SimulatedGripper& g = *sim_.gripper;
+  const Eigen::Vector3d tip = g.tip_position_m(), part = g.world_state().part_m;
+  xy_.reset(tip.head<2>(), t);
+  z_.reset({tip.z(), 0.0}, t);
+  cursor_.reset(tip.head<2>() * cursor_scale_, t);
+  yaw_.reset({platform_.yaw_target_rad(), 0.0}, t);
+  slider_ = std::clamp(platform_.teleop().gripper_opening_m, 0.0, goal_.open_m);
+  if (g.grip_force_N() > 0.0) {  // held: where its bottom is below the tips, and its place in them
+    rim_z_ = tip.z() - (part.z() - 0.5 * goal_.part_height_m);
+    pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);
+  }
+  tip_count_ = 0;
+  gave_up_ = false;
+  enter(s, t);
+}
+
 void PersonOperator::give_up(const char* why) noexcept {
   gave_up_ = true;
   reason_ = why;

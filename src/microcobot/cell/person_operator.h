@@ -158,6 +158,14 @@ class PersonOperator {
 
   /// One operator tick (the platform's operator task). Real-time safe.
   void act(const platform::TickInfo& tick) noexcept;
+  /// The person takes the automatic task's step `s` over at `t_s` (a manual step of a headless
+  /// run, issue #29 point 5): their hands where the platform is (the joystick at rest, the
+  /// gripper slider at the opening the coupling commands, the dial at the rotor's target), what
+  /// they know of the pin from how it is held, and the step begun. Master console only: the
+  /// TéléTweez' levers would command the held pin's grip from their own opening.
+  void take_over(Step s, double t_s) noexcept;
+  /// Hands back: lets go of every input (the deadman too), so that the task drives again.
+  void hand_back() noexcept { let_go(); }
 
   Step step() const noexcept { return step_; }
   bool done() const noexcept { return step_ == Step::kDone; }
