@@ -354,11 +354,12 @@ void add_batch_options(CLI::App& cmd, CellOptions& o) {
          "TéléTweez; default), console (joystick, gripper slider) or click (the console's click-to-go; "
          "manual only); console also for the task's manual steps, which the person takes over (mode auto)")
       ->check(CLI::IsMember({"haptic", "console", "click"}));
-  cmd.add_option("--task", o.task,
-                 "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
-                 "confirmed after confirm_delay_s, manual ones taken over by the simulated person with --master "
-                 "console, assisted ones refused headless) and the task's parameters "
-                 "(`params: {insert_speed_m_s: 1e-5}`); docs/cell.md");
+  cmd.add_option(
+      "--task", o.task,
+      "A task file (YAML): each step's autonomy (`steps: {insert: confirm}`; confirm steps are "
+      "confirmed after confirm_delay_s, manual ones taken over by the simulated person with --master "
+      "console, assisted ones refused headless) and the task's parameters "
+      "(`params: {insert_speed_m_s: 1e-5}`); docs/cell.md");
   cmd.add_flag("--camera", o.camera,
                "The robot's camera (mode auto): looks at the pin in its slot, in the fingers and placed, on "
                "rendered frames (camera.* in --params; docs/cell.md)");

@@ -492,9 +492,10 @@ TEST(CellCycle, AManualStepIsTakenOverByThePersonAndHandedBackWithoutAJump) {
   EXPECT_GE(opened_at, handed_at) << "the grasped pin held through the person's step";
   EXPECT_GT(r.step_s[static_cast<std::size_t>(Step::kRetract)], 0.0) << "the task went on after";
   const double joystick = c.platform().config().teleop.console_max_speed_m_s;
-  std::printf("taken over at %.2f s, handed back at %.2f s; largest step %.3f um a tick (joystick %.3f um), "
-              "gripper %.3f um\n",
-              taken_at, handed_at, 1e6 * largest, 1e3 * joystick, 1e6 * largest_opening);
+  std::printf(
+      "taken over at %.2f s, handed back at %.2f s; largest step %.3f um a tick (joystick %.3f um), "
+      "gripper %.3f um\n",
+      taken_at, handed_at, 1e6 * largest, 1e3 * joystick, 1e6 * largest_opening);
   EXPECT_LE(largest, std::max(joystick, params.task.travel_speed_m_s) * 1e-3 * 1.001);
   EXPECT_LE(largest_opening, params.person.slider_m_s * 1e-3 * 1.001 + 1e-12);
   EXPECT_TRUE(r.ended_holding);

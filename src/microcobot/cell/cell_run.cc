@@ -33,7 +33,8 @@ void CellRunParams::validate() const {
     require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kAssisted, key,
             "is assisted: a headless run has no person under shared control for one step (serve --cell "
             "runs it with one)");
-    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kManual || person.master == "console", key,
+    require(mode != "auto" || autonomy[i] != AssemblyTask::Autonomy::kManual || person.master == "console",
+            key,
             "is manual: the simulated person takes a step over with the console (person.master: console; "
             "the TéléTweez' levers would command the held pin's grip from their own opening, a click "
             "master has no gripper of its own)");
@@ -117,9 +118,10 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     const bool manual_steps = std::find(params_.autonomy.begin(), params_.autonomy.end(),
                                         AssemblyTask::Autonomy::kManual) != params_.autonomy.end();
     if (manual_steps)  // the person who takes them over: the manual mode's, same seed
-      person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal, false,
-                                                 static_cast<std::uint64_t>(params_.person_seed) * 1000003ULL +
-                                                     static_cast<std::uint64_t>(job.index));
+      person_ =
+          std::make_unique<PersonOperator>(p, params_.person, params_.task, goal, false,
+                                           static_cast<std::uint64_t>(params_.person_seed) * 1000003ULL +
+                                               static_cast<std::uint64_t>(job.index));
     if (params_.camera.enabled) {
       camera_ = std::make_unique<CellCamera>(params_.camera, base, static_cast<std::uint64_t>(job.index));
       task_->set_looks(true, params_.camera.servo);
