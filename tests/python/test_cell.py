@@ -162,6 +162,13 @@ def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_contr
     assert r["success"] and r["confirmations"] == 0  # the caller's, not the supervisor's
     assert r["cycle_s"] > waited_from + 2.0
 
+    # A manual insertion, taken over by the simulated person at the console and handed back.
+    c = cell.Cycle(b, 0, mode="auto", params={"person": {"master": "console"}}, task={"steps": {"insert": "manual"}})
+    c.run_to_end()
+    r = c.result()
+    assert r["success"] and r["handovers"] == 1 and r["master"] == "console", r["verdict"]
+    assert "steps.insert" in one_line_error(ValueError, cell.Cycle, b, 0, task={"steps": {"insert": "manual"}})
+
     msg = one_line_error(ValueError, cell.Cycle, b, 0, task={"steps": {"inserting": "confirm"}})
     assert msg.startswith("task: unknown key 'steps.inserting'"), msg
     assert "steps.insert" in one_line_error(ValueError, cell.Cycle, b, 0, task={"steps": {"insert": "maybe"}})
