@@ -55,12 +55,15 @@ TEST(TwinRotary, AGcsClientTurnsThetaToItsGoalWithinTheStagesTolerance) {
   const double x0 = rig.x_mm(c);
   // 8 deg at 0.16 rad/s: 0.9 s (short: a loaded machine that starves the heartbeat for the loop's
   // 0.2 s timeout holds the stage, rightly, and the test would see it stop short).
+  const auto t0 = std::chrono::steady_clock::now();
   c.send("MOV 4 8\n");
   EXPECT_EQ(c.gcs("ONT? 4"), "4=0\n");
   ASSERT_TRUE(wait_theta_on_target(c, 10.0));
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double tol = tolerance_rad(rig);
-  std::cout << "[ gcs2 theta ] MOV 4 8: POS? " << theta_deg(c) << " deg, platform sensor "
-            << rig.theta_rad.load() / kDeg << " deg (tolerance " << tol / kDeg << " deg)\n";
+  std::cout << "[ gcs2 theta ] MOV 4 8: on target after " << took_s << " s, POS? " << theta_deg(c)
+            << " deg, platform sensor " << rig.theta_rad.load() / kDeg << " deg (tolerance " << tol / kDeg
+            << " deg)\n";
   EXPECT_NEAR(theta_deg(c) * kDeg, 8 * kDeg, tol);
   EXPECT_NEAR(rig.theta_rad.load(), 8 * kDeg, tol);  // the platform's own sensor, not the twin's
   EXPECT_NEAR(rig.x_mm(c), x0, 1e-3);                // X (servo off) held
