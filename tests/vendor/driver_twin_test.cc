@@ -322,5 +322,37 @@ TEST(DriverTwin, ThePiGcs2DriverTurnsTheTwinsRotationStage) {
   EXPECT_NEAR(x[0], 0.0, 1e-6);  // X, Y, Z held at the home
 }
 
+// The anc300 driver steps the twin's rotary positioner (option theta=4) on its sensor: the
+// console's theta goal, 1 mrad (5 um of arc), read back through the twin's GCS port (POS? 4).
+TEST(DriverTwin, TheAnc300DriverStepsTheTwinsRotaryPositioner) {
+  TwinProcess twin;
+  register_vendor_drivers();
+  PlatformConfig c;
+  c.devices.driver = "anc300";
+  // The dead band as for X, Y, Z (Anc300DrivesTheTwinInAnotherProcessByStepsOnItsSensor): 150 nm of arc.
+  c.devices.connection = fmt::format(
+      "127.0.0.1:{},timeout_s=1,stale_s=0.5,position=getpos,deadband_nm=150,theta=4", twin.anc300_port);
+  auto p = platform::make_platform(c);
+  ASSERT_TRUE(p->has_rotary());
+  control::ConsoleInput in;
+  in.active = in.fresh = in.deadman = true;
+  in.has_theta_goal = true;
+  in.theta_goal_rad = 1e-3;
+  in.theta_speed_rad_s = 0.16;
+  p->set_operator([&](const platform::TickInfo&) { p->set_console_input(in); });
+  constexpr double kTol = 170e-9 / 5e-3;  // the linear axes' 170 nm, as an arc at 5 mm
+  const auto start = Clock::now();
+  run_paced(*p, 20.0, [&] { return std::abs(twin_theta_rad(twin.gcs2_port) - 1e-3) < kTol; });
+  run_paced(*p, 0.3, [] { return false; });
+  const double s = std::chrono::duration<double>(Clock::now() - start).count();
+  const double twin_rad = twin_theta_rad(twin.gcs2_port);
+  std::cout << fmt::format(
+      "[ anc300 theta ] goal 1 mrad: twin {:.4f} mrad, platform {:.4f} mrad in {:.2f} s\n", 1e3 * twin_rad,
+      1e3 * p->yaw_rad(), s);
+  EXPECT_FALSE(p->faulted());
+  EXPECT_NEAR(twin_rad, 1e-3, kTol);
+  EXPECT_NEAR(p->yaw_rad(), twin_rad, kTol);  // the platform reads the twin's sensor
+}
+
 }  // namespace driver_twin_test
 }  // namespace mc::vendor

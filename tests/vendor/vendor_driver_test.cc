@@ -82,6 +82,9 @@ TEST(VendorDriverCodec, TheConnectionIsHostPortAndOptionsEachCheckedInOneLine) {
                InvalidParams);  // < poll
   EXPECT_THROW(anc300_driver_params(parse_connection("h:1,position=sensor", "anc300")), InvalidParams);
   EXPECT_THROW(anc300_driver_params(parse_connection("h:1,axes=1+2", "anc300")), InvalidParams);
+  EXPECT_EQ(anc300_driver_params(parse_connection("h:1,theta=4", "anc300")).theta, 4);
+  for (const char* bad : {"h:1,theta=8", "h:1,theta=4.5", "h:1,theta=x"})
+    EXPECT_THROW(anc300_driver_params(parse_connection(bad, "anc300")), InvalidParams) << bad;
   EXPECT_TRUE(anc300_driver_params(parse_connection("h:1,position=getpos", "anc300")).sensor);
   try {
     gcs2_driver_params(parse_connection("h:1,speed=3", "pi-gcs2"));
