@@ -1,6 +1,7 @@
 // Issue #30: open-loop stepping on the platform (the ANC300's stepu/stepd): n sawtooth periods
 // through the stick-slip model move the axis what the model alone moves for the same drive, end
-// holding, and obey the safety rules (deadman, fault, e-stop).
+// holding, and obey the safety rules (deadman, fault, e-stop); the rotary axis (issue #29 point 2)
+// too, on its rotor's arc, within its travel.
 
 #include <gtest/gtest.h>
 
@@ -55,15 +56,19 @@ constexpr int kPeriods = 100, kTransient = 10;
 // The steady stepping (periods 10 to 100) is what the model steps: the first periods differ by
 // construction (the model starts from rest with its power-up transient, the axis from its hold
 // voltage through the entry edge). 15%: the two runs' hysteresis and contact states differ.
+// Axis 3, the rotary axis (issue #29 point 2), steps the same arc on its rotor.
 void expect_steps_like_the_model(int axis, int direction) {
   SteppingRig rig;
-  const auto& sim = *rig.platform->simulation().axes[static_cast<std::size_t>(axis)];
+  const auto& sims = rig.platform->simulation();
+  const auto& sim = axis < 3 ? *sims.axes[static_cast<std::size_t>(axis)] : *sims.rotary;
   const double x0 = sim.true_position_m();
   ASSERT_TRUE(rig.platform->start_open_loop_steps(axis, kAmplitude_V, kFrequency_Hz, direction, kPeriods));
   EXPECT_TRUE(rig.platform->open_loop_running(axis));
   rig.platform->run(kTransient / kFrequency_Hz);
   const double x_transient = sim.true_position_m();
-  rig.platform->run((kPeriods - kTransient) / kFrequency_Hz + 0.005);
+  // To the run's end (within a tick of 1 ms), before the position loop takes the axis back.
+  rig.platform->run((kPeriods - kTransient) / kFrequency_Hz);
+  for (int k = 0; k < 10 && rig.platform->open_loop_running(axis); ++k) rig.platform->run(0.001);
   EXPECT_FALSE(rig.platform->open_loop_running(axis));
   const double x_end = sim.true_position_m();
   const auto model = model_positions(
@@ -87,10 +92,31 @@ void expect_steps_like_the_model(int axis, int direction) {
                   50e-9);
     }
   }
+  if (axis != 3) {
+    EXPECT_NEAR(sims.rotary->true_position_m(), 0.0, 50e-9);  // nor did the rotor turn
+  }
 }
 
 TEST(OpenLoop, PeriodsUpStepWhatTheModelStepsAndEndHolding) { expect_steps_like_the_model(0, +1); }
 TEST(OpenLoop, PeriodsDownStepWhatTheModelStepsAndEndHolding) { expect_steps_like_the_model(1, -1); }
+TEST(OpenLoop, TheRotaryAxisStepsTheModelsArcAndEndsHolding) {
+  expect_steps_like_the_model(3, +1);
+  expect_steps_like_the_model(3, -1);
+}
+
+TEST(OpenLoop, SteppingTheRotaryAxisStopsAtTheEndOfItsTravel) {
+  SteppingRig rig;
+  Platform& p = *rig.platform;
+  ASSERT_TRUE(p.start_open_loop_steps(3, 100.0, 4000.0, +1, 1'000'000));  // far past +62 deg
+  for (int i = 0; i < 1000 && p.open_loop_running(3); ++i) p.run(0.05);
+  EXPECT_FALSE(p.open_loop_running(3)) << "stopped at the travel's end, long before its periods";
+  const double stopped = p.yaw_rad();
+  std::printf("rotary stopped at %.6f rad (travel %.6f rad)\n", stopped, p.yaw_max_rad());
+  // At the travel's end: the run stops there, the loop then holds the target clamped to it.
+  EXPECT_NEAR(stopped, p.yaw_max_rad(), 1e-3);
+  p.run(0.3);
+  EXPECT_NEAR(p.yaw_rad(), stopped, 1e-5);  // holding
+}
 
 TEST(OpenLoop, NothingStepsWithoutTheDeadmanAndReleasingItStopsAtOnce) {
   SteppingRig rig;
@@ -134,12 +160,25 @@ TEST(OpenLoop, SteppingDownStopsAtTheFloorWhateverTheCountAsked) {
 
 TEST(OpenLoop, OutOfRangeDrivesAreRefused) {
   SteppingRig rig;
-  EXPECT_FALSE(rig.platform->start_open_loop_steps(3, 40.0, 500.0, +1, 10));
+  EXPECT_FALSE(rig.platform->start_open_loop_steps(4, 40.0, 500.0, +1, 10));
+  EXPECT_FALSE(rig.platform->start_open_loop_steps(-1, 40.0, 500.0, +1, 10));
+  EXPECT_FALSE(rig.platform->start_open_loop_steps(3, 150.0, 500.0, +1, 10));
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 150.0, 500.0, +1, 10));
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 40.0, 0.0, +1, 10));
   EXPECT_FALSE(rig.platform->start_open_loop_steps(0, 40.0, 500.0, +1, 0));
   EXPECT_FALSE(
       rig.platform->start_open_loop_steps(0, std::numeric_limits<double>::quiet_NaN(), 500.0, +1, 10));
+}
+
+TEST(OpenLoop, WithoutTheRotaryAxisAxis3IsRefused) {
+  PlatformConfig config;
+  config.stage.rotary.enabled = false;
+  Platform p(config);
+  control::ConsoleInput in;
+  in.active = in.fresh = in.deadman = true;
+  p.set_console_input(in);
+  EXPECT_FALSE(p.start_open_loop_steps(3, 40.0, 500.0, +1, 10));
+  EXPECT_TRUE(p.start_open_loop_steps(2, 40.0, 500.0, +1, 10));
 }
 
 }  // namespace

@@ -100,5 +100,35 @@ TEST(Anc300Twin, HaltedAndOutrankedStepsAnswerError) {
   EXPECT_EQ(rig.ask("stepu 2 10"), "Another operator controls the stage\r\nERROR\r\n");
 }
 
+// Issue #29 point 2: the rotary positioner (theta) on axis 4, stepped like the others.
+TEST(Anc300Twin, TheRotaryPositionerStepsOnAxis4) {
+  Anc300Rig rig;
+  EXPECT_EQ(rig.ask("getm 4"), "mode = gnd\r\nOK\r\n");
+  rig.ask("setm 4 stp");
+  rig.ask("setf 4 800");
+  rig.ask("setv 4 45");
+  EXPECT_EQ(rig.ask("stepd 4 250"), "OK\r\n");
+  EXPECT_EQ(rig.stage.log.back(), "step 3 45 800 -1 250");
+  EXPECT_EQ(rig.ask("stepw 4"), "<wait>");
+  EXPECT_EQ(rig.twin.waiting_axis(), 3);
+  rig.stage.axes[3].stepping = false;
+  EXPECT_EQ(rig.twin.poll_wait(rig.session, 3).value(), "OK\r\n");
+  rig.stage.axes[3].position = 0.5;  // rad
+  EXPECT_EQ(rig.ask("getpos 4"), "position = 2.864788976e+01 deg\r\nOK\r\n");
+  EXPECT_EQ(rig.ask("getser 4"), "serial number = TWIN-AXIS-4\r\nOK\r\n");
+  EXPECT_EQ(rig.ask("getf 5"), "Invalid axis '5' (axes 1 to 4)\r\nERROR\r\n");
+}
+
+TEST(Anc300Twin, WithoutTheRotaryAxisAxis4IsInvalid) {
+  FakeStage stage(/*rotary=*/false);
+  Anc300Twin twin(stage, {});
+  Anc300Session s;
+  twin.on_password(s, "123456", true);
+  s.echo = false;
+  EXPECT_EQ(twin.on_line(1, s, "getm 4").value(), "Invalid axis '4' (axes 1 to 3)\r\nERROR\r\n");
+  EXPECT_EQ(twin.on_line(1, s, "stepw 4").value(), "Invalid axis\r\nERROR\r\n");
+  EXPECT_TRUE(stage.log.empty());
+}
+
 }  // namespace
 }  // namespace mc::vendor

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <regex>
 #include <thread>
 
@@ -63,18 +64,18 @@ struct TwinProcess {
   }
 };
 
-// The twin's stage read through its GCS port, by a client of its own (queries take no control).
-std::array<double, 3> twin_position_m(std::uint16_t port) {
+// A query's `axis=value` replies from the twin, by a client of its own (queries take no control).
+std::vector<std::pair<std::string, double>> twin_query(std::uint16_t port, const std::string& query) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(port);
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  std::array<double, 3> out{};
+  std::vector<std::pair<std::string, double>> out;
   if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
     timeval tv{2, 0};
     ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    const std::string q = "POS? 1 2 3\n";
+    const std::string q = query + "\n";
     ::send(fd, q.data(), q.size(), MSG_NOSIGNAL);
     std::string text;
     char buf[1024];
@@ -83,11 +84,24 @@ std::array<double, 3> twin_position_m(std::uint16_t port) {
       if (n <= 0) break;
       text.append(buf, static_cast<std::size_t>(n));
     }
-    const auto v = gcs2::parse_axis_values(text);
-    for (std::size_t i = 0; i < 3 && i < v.size(); ++i) out[i] = v[i].second * 1e-3;
+    out = gcs2::parse_axis_values(text);
   }
   ::close(fd);
   return out;
+}
+
+// The twin's stage read through its GCS port.
+std::array<double, 3> twin_position_m(std::uint16_t port) {
+  const auto v = twin_query(port, "POS? 1 2 3");
+  std::array<double, 3> out{};
+  for (std::size_t i = 0; i < 3 && i < v.size(); ++i) out[i] = v[i].second * 1e-3;
+  return out;
+}
+
+// The twin's rotation stage (axis 4, deg) [rad].
+double twin_theta_rad(std::uint16_t port) {
+  const auto v = twin_query(port, "POS? 4");
+  return v.size() == 1 ? v[0].second / gcs2::kDegPerRad : std::nan("");
 }
 
 template <class Done>
@@ -272,6 +286,72 @@ TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableController
             std::string::npos)
       << r.err;
   EXPECT_EQ(r.err.find("microcobot: error:"), r.err.rfind("microcobot: error:"));
+}
+
+// Issue #29 point 2: the rotary axis on the controller's rotation stage (option theta=4): the
+// console's theta goal turns the twin's axis 4, read through the twin's own port (POS? 4, deg), and
+// the platform's rotary axis reads it back.
+TEST(DriverTwin, ThePiGcs2DriverTurnsTheTwinsRotationStage) {
+  TwinProcess twin;
+  register_vendor_drivers();
+  PlatformConfig c;
+  c.devices.driver = "pi-gcs2";
+  c.devices.connection = fmt::format("127.0.0.1:{},timeout_s=1,stale_s=0.5,theta=4", twin.gcs2_port);
+  auto p = platform::make_platform(c);
+  ASSERT_TRUE(p->has_rotary());
+  control::ConsoleInput in;
+  in.active = in.fresh = in.deadman = true;
+  in.has_theta_goal = true;
+  in.theta_goal_rad = 0.2;
+  in.theta_speed_rad_s = 0.16;
+  p->set_operator([&](const platform::TickInfo&) { p->set_console_input(in); });
+  // The twin's theta power-up VEL, 5 deg/s: 2.3 s for 0.2 rad. The tolerance: the twin's on-target
+  // tolerance on theta (1 um of arc at 5 mm).
+  constexpr double kTol = 2e-4;
+  const auto start = Clock::now();
+  run_paced(*p, 15.0, [&] { return std::abs(twin_theta_rad(twin.gcs2_port) - 0.2) < kTol; });
+  run_paced(*p, 0.3, [] { return false; });
+  const double s = std::chrono::duration<double>(Clock::now() - start).count();
+  const double twin_rad = twin_theta_rad(twin.gcs2_port);
+  std::cout << "[ pi-gcs2 theta ] 0.2 rad: twin " << twin_rad << " rad, platform " << p->yaw_rad()
+            << " rad in " << s << " s\n";
+  EXPECT_FALSE(p->faulted());
+  EXPECT_NEAR(twin_rad, 0.2, kTol);
+  EXPECT_NEAR(p->yaw_rad(), 0.2, kTol);
+  const auto x = twin_position_m(twin.gcs2_port);
+  EXPECT_NEAR(x[0], 0.0, 1e-6);  // X, Y, Z held at the home
+}
+
+// The anc300 driver steps the twin's rotary positioner (option theta=4) on its sensor: the
+// console's theta goal, 1 mrad (5 um of arc), read back through the twin's GCS port (POS? 4).
+TEST(DriverTwin, TheAnc300DriverStepsTheTwinsRotaryPositioner) {
+  TwinProcess twin;
+  register_vendor_drivers();
+  PlatformConfig c;
+  c.devices.driver = "anc300";
+  // The dead band as for X, Y, Z (Anc300DrivesTheTwinInAnotherProcessByStepsOnItsSensor): 150 nm of arc.
+  c.devices.connection = fmt::format(
+      "127.0.0.1:{},timeout_s=1,stale_s=0.5,position=getpos,deadband_nm=150,theta=4", twin.anc300_port);
+  auto p = platform::make_platform(c);
+  ASSERT_TRUE(p->has_rotary());
+  control::ConsoleInput in;
+  in.active = in.fresh = in.deadman = true;
+  in.has_theta_goal = true;
+  in.theta_goal_rad = 1e-3;
+  in.theta_speed_rad_s = 0.16;
+  p->set_operator([&](const platform::TickInfo&) { p->set_console_input(in); });
+  constexpr double kTol = 170e-9 / 5e-3;  // the linear axes' 170 nm, as an arc at 5 mm
+  const auto start = Clock::now();
+  run_paced(*p, 20.0, [&] { return std::abs(twin_theta_rad(twin.gcs2_port) - 1e-3) < kTol; });
+  run_paced(*p, 0.3, [] { return false; });
+  const double s = std::chrono::duration<double>(Clock::now() - start).count();
+  const double twin_rad = twin_theta_rad(twin.gcs2_port);
+  std::cout << fmt::format(
+      "[ anc300 theta ] goal 1 mrad: twin {:.4f} mrad, platform {:.4f} mrad in {:.2f} s\n", 1e3 * twin_rad,
+      1e3 * p->yaw_rad(), s);
+  EXPECT_FALSE(p->faulted());
+  EXPECT_NEAR(twin_rad, 1e-3, kTol);
+  EXPECT_NEAR(p->yaw_rad(), twin_rad, kTol);  // the platform reads the twin's sensor
 }
 
 }  // namespace driver_twin_test

@@ -9,17 +9,22 @@
 namespace mc::vendor::testing {
 
 struct FakeStage : TwinStage {
-  std::array<Axis, 3> axes{};
+  /// The rotary axis (theta) is there unless a test takes it away.
+  explicit FakeStage(bool rotary = true) : axes_present(rotary ? 4 : 3) {}
+  int axes_present;
+  std::array<Axis, kMaxAxes> axes{};
   bool is_halted = false, console = false;
   ClientId owner = 0;
   std::vector<std::string> log;
-  std::array<double, 3> last_goal{};
-  double last_speed = 0.0;
+  Goal last_goal{};
+  double last_speed = 0.0, last_theta_speed = 0.0;
 
+  int axis_count() const override { return axes_present; }
   Axis axis(int i) const override { return axes[static_cast<std::size_t>(i)]; }
-  double min_m(int) const override { return -5e-3; }
-  double max_m(int) const override { return 5e-3; }
-  double max_speed_m_s() const override { return 1e-3; }
+  // Linear: +-5 mm at 1 mm/s; theta: the platform's +-62 deg (1.08 rad) at 0.16 rad/s.
+  double min(int i) const override { return i == kTheta ? -1.08 : -5e-3; }
+  double max(int i) const override { return i == kTheta ? 1.08 : 5e-3; }
+  double max_speed(int i) const override { return i == kTheta ? 0.16 : 1e-3; }
   double max_voltage_V() const override { return 100.0; }
   bool halted() const override { return is_halted; }
   bool controls(ClientId c) const override { return owner == c && !console; }
@@ -29,11 +34,12 @@ struct FakeStage : TwinStage {
     owner = c;
     return Refusal::kNone;
   }
-  Refusal move_to(ClientId c, const std::array<double, 3>& goal, double speed) override {
+  Refusal move_to(ClientId c, const Goal& goal, double speed, double theta_speed) override {
     const Refusal r = claim(c);
     if (r == Refusal::kNone) {
       last_goal = goal;
       last_speed = speed;
+      last_theta_speed = theta_speed;
       log.push_back("move");
     }
     return r;

@@ -1,9 +1,11 @@
 """Issue #30: Debian's pymeasure ANC300 driver (ANC300Controller over its telnet adapter) drives the
 ANC300 twin of `microcobot serve --emulate anc300`: it logs in with the factory password, sets
 frequency and voltage, steps N up and N down (Axis.move: setm stp, stepu/stepd, stepw, setm gnd);
-the stage moves what the stick-slip model says for the same drive (`microcobot stickslip simulate`)."""
+the stage moves what the stick-slip model says for the same drive (`microcobot stickslip simulate`).
+Issue #29 point 2: the rotary positioner on axis 4 (theta) turns by the model's arc at its radius."""
 
 import json
+import math
 import os
 import socket
 import subprocess
@@ -24,6 +26,9 @@ TRANSIENT = 10  # periods
 # -0.53); the steady periods 10-100 within 15% of the model (-11.5% up, +5.1% down). Hence the
 # tolerance: |simulate over 10 periods| + 15% of simulate's periods 10 to N.
 STEADY_TOL = 0.15
+# The rotary axis' friction drive radius (stage.rotary.radius_m, docs/parameters.md): an arc of
+# s m at the contact turns the rotor s / RADIUS_M rad.
+RADIUS_M = 5e-3
 
 @pytest.fixture(scope="module")
 def serve():
@@ -32,8 +37,8 @@ def serve():
     s.stop()
 
 
-def position_m(port, axis):
-    """The twin's getpos (its sensor) over a second, raw console connection."""
+def getpos(port, axis):
+    """The twin's getpos (its sensor) over a second, raw console connection: (value, unit)."""
     with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
         f = s.makefile("rwb", buffering=0)
 
@@ -53,9 +58,39 @@ def position_m(port, axis):
         s.sendall(f"getpos {axis}\r\n".encode())
         reply = until(b"OK\r\n")
         f.close()
-    line = reply.split("\r\n")[0]
-    assert line.startswith("position = ") and line.endswith(" m"), reply
-    return float(line.split()[2])
+    words = reply.split("\r\n")[0].split()
+    assert len(words) == 4 and words[:2] == ["position", "="], reply
+    return float(words[2]), words[3]
+
+
+def position_m(port, axis):
+    value, unit = getpos(port, axis)
+    assert unit == "m", unit
+    return value
+
+
+def angle_rad(port):
+    """Theta (axis 4) from getpos, which reports it in degrees."""
+    value, unit = getpos(port, 4)
+    assert unit == "deg", unit
+    return math.radians(value)
+
+
+def connect(port, axes):
+    """pymeasure's ANC300Controller on the twin's port (it always dials 7230; the twin listens on a
+    free port)."""
+    adapter = anc300_module.AttocubeConsoleAdapter
+    anc300_module.AttocubeConsoleAdapter = lambda host, _port, passwd, **kw: adapter(host, port, passwd, **kw)
+    try:
+        return anc300_module.ANC300Controller("127.0.0.1", axes, "123456")
+    finally:
+        anc300_module.AttocubeConsoleAdapter = adapter
+
+
+def disconnect(ctrl):
+    """Closes the controller's console connection: the twin then frees control of the stage (a
+    second client's motion is refused while the first is connected, docs/hardware.md)."""
+    ctrl.adapter.connection.close()
 
 
 def simulated_displacement_m(direction, periods):
@@ -78,13 +113,14 @@ def expect_like_the_model(moved, direction):
 
 def test_pymeasure_steps_the_twin_as_the_model_moves(serve):
     port = serve.ports["anc300"]
-    adapter = anc300_module.AttocubeConsoleAdapter
-    # ANC300Controller always dials 7230; the twin listens on a free port (port 0).
-    anc300_module.AttocubeConsoleAdapter = lambda host, _port, passwd, **kw: adapter(host, port, passwd, **kw)
+    ctrl = connect(port, ["x", "y", "z"])
     try:
-        ctrl = anc300_module.ANC300Controller("127.0.0.1", ["x", "y", "z"], "123456")
+        step_x_and_y(ctrl, port)
     finally:
-        anc300_module.AttocubeConsoleAdapter = adapter
+        disconnect(ctrl)
+
+
+def step_x_and_y(ctrl, port):
     for axis in (ctrl.x, ctrl.y):
         axis.frequency = FREQUENCY_HZ  # setf N 500.000
         axis.voltage = VOLTAGE_V  # setv N 60.000
@@ -106,6 +142,38 @@ def test_pymeasure_steps_the_twin_as_the_model_moves(serve):
     x2 = position_m(port, 1)
     print(f"x down after up: {x2 - x1:.4e} m")
     assert x2 - x1 < 0
+
+
+def test_pymeasure_turns_the_rotary_positioner_by_the_models_arc(serve):
+    port = serve.ports["anc300"]
+    ctrl = connect(port, ["x", "y", "z", "theta"])  # theta: axis 4
+    try:
+        turn_theta(ctrl.theta, port)
+    finally:
+        disconnect(ctrl)
+
+
+def turn_theta(theta, port):
+    theta.frequency = FREQUENCY_HZ
+    theta.voltage = VOLTAGE_V
+    assert theta.frequency == FREQUENCY_HZ
+    assert float(theta.voltage) == VOLTAGE_V
+    assert theta.mode == "gnd"
+    a0 = angle_rad(port)
+    theta.move(N)  # setm 4 stp, stepu 4 N, stepw 4, setm 4 gnd
+    time.sleep(0.2)  # the position loop holds it again
+    a1 = angle_rad(port)
+    print(f"theta up: {a1 - a0:.4e} rad")
+    expect_like_the_model((a1 - a0) * RADIUS_M, "forward")
+    theta.move(-N)
+    time.sleep(0.2)
+    a2 = angle_rad(port)
+    print(f"theta down: {a2 - a1:.4e} rad")
+    assert a2 < a1
+    # Beyond the amplifier's 100 V: the controller answers ERROR, pymeasure raises, nothing changes.
+    with pytest.raises(ValueError, match="Value out of range"):
+        theta.voltage = 120
+    assert float(theta.voltage) == VOLTAGE_V
 
 
 def test_a_wrong_password_is_refused(serve):

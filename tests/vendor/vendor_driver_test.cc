@@ -75,10 +75,16 @@ TEST(VendorDriverCodec, TheConnectionIsHostPortAndOptionsEachCheckedInOneLine) {
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=-1", "pi-gcs2")), InvalidParams);
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,timeout_s=abc", "pi-gcs2")), InvalidParams);
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,axes=1+1+2", "pi-gcs2")), InvalidParams);
+  EXPECT_EQ(gcs2_driver_params(parse_connection("h:1,theta=U", "pi-gcs2")).theta, "U");
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,theta=3", "pi-gcs2")), InvalidParams);
+  EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,theta=a b", "pi-gcs2")), InvalidParams);
   EXPECT_THROW(gcs2_driver_params(parse_connection("h:1,stale_s=0.001", "pi-gcs2")),
                InvalidParams);  // < poll
   EXPECT_THROW(anc300_driver_params(parse_connection("h:1,position=sensor", "anc300")), InvalidParams);
   EXPECT_THROW(anc300_driver_params(parse_connection("h:1,axes=1+2", "anc300")), InvalidParams);
+  EXPECT_EQ(anc300_driver_params(parse_connection("h:1,theta=4", "anc300")).theta, 4);
+  for (const char* bad : {"h:1,theta=8", "h:1,theta=4.5", "h:1,theta=x"})
+    EXPECT_THROW(anc300_driver_params(parse_connection(bad, "anc300")), InvalidParams) << bad;
   EXPECT_TRUE(anc300_driver_params(parse_connection("h:1,position=getpos", "anc300")).sensor);
   try {
     gcs2_driver_params(parse_connection("h:1,speed=3", "pi-gcs2"));
@@ -137,8 +143,21 @@ TEST(Gcs2Driver, AControllerWithoutTheConfiguredAxesIsRefusedNamingWhatItHas) {
     EXPECT_NE(std::string(e.what()).find("SAI? ALL lists axes [A, B]: no axis '1'"), std::string::npos)
         << e.what();
   }
+  // The rotary axis (option theta) must be one of the controller's too.
+  fake.axes_reply = "1 \n2 \n3\n";
+  try {
+    platform::make_platform(gcs2_config(fake.server.port(), ",theta=4"));
+    FAIL() << "configured a rotary axis on a controller without axis 4";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("SAI? ALL lists axes [1, 2, 3]: no axis '4'"), std::string::npos)
+        << e.what();
+  }
   // Options are checked before anything is opened.
   EXPECT_THROW(platform::make_platform(gcs2_config(fake.server.port(), ",axes=1+2")), InvalidParams);
+  EXPECT_THROW(platform::make_platform(gcs2_config(fake.server.port(), ",theta=2")), InvalidParams);
+  PlatformConfig no_rotary = gcs2_config(fake.server.port(), ",theta=4");
+  no_rotary.stage.rotary.enabled = false;
+  EXPECT_THROW(platform::make_platform(no_rotary), InvalidParams);
   EXPECT_THROW(platform::make_platform(gcs2_config(fake.server.port(), ",poll=1")), InvalidParams);
 }
 

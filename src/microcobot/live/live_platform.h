@@ -263,12 +263,14 @@ class LivePlatform {
   platform::SpscRing<ProtocolCommand> protocol_{256};
   // Protocol state (loop thread only).
   double protocol_last_t_ = -1e9, protocol_speed_m_s_ = 0.0, last_operator_t_ = 0.0;
+  double protocol_theta_goal_rad_ = 0.0, protocol_theta_speed_rad_s_ = 0.0;
   bool protocol_fresh_ = false, protocol_has_goal_ = false, protocol_steps_pending_ = false;
-  std::array<double, 3> protocol_goal_m_{}, settled_s_{};
+  std::array<double, 3> protocol_goal_m_{};
+  std::array<double, 4> settled_s_{};  // X, Y, Z, theta
   ProtocolCommand pending_steps_;
-  // Published for the protocol thread.
-  std::array<std::atomic<double>, 3> axis_position_m_{};
-  std::array<std::atomic<bool>, 3> on_target_{}, stepping_{};
+  // Published for the protocol thread (ProtocolView's: X, Y, Z [m], theta [rad]).
+  std::array<std::atomic<double>, 4> axis_position_{};
+  std::array<std::atomic<bool>, 4> on_target_{}, stepping_{};
   std::atomic<bool> protocol_driving_{false};
   std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
   std::uint64_t popped_seq_ = 0;                                // loop thread only

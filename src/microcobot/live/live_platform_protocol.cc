@@ -1,7 +1,7 @@
-// The live platform's port for the vendor-protocol twins (issue #30, vendor/): what a GCS 2.0 or
-// ANC300 client asked, taken on the operator tick (a heartbeat-guarded goal or a run of open-loop
-// steps, outranked by a console user, the demo, a task or a remote master), and what it reads
-// back (positions, on-target after the settle window, stepping), published for its threads.
+// The live platform's port for the vendor-protocol twins (issue #30, vendor/; the rotary axis:
+// issue #29 point 2): what a GCS 2.0 or ANC300 client asked, taken on the operator tick (a heartbeat-guarded
+// goal or a run of open-loop steps, outranked by a console user, the demo, a task or a remote master), and
+// what it reads back (positions, on-target after the settle window, stepping), published for its threads.
 #include <algorithm>
 #include <cmath>
 
@@ -32,6 +32,8 @@ bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_contr
         p.stop_open_loop();
         protocol_goal_m_ = c.goal_m;
         protocol_speed_m_s_ = c.speed_m_s;
+        protocol_theta_goal_rad_ = c.theta_goal_rad;
+        protocol_theta_speed_rad_s_ = c.theta_speed_rad_s;
         protocol_has_goal_ = true;
         protocol_steps_pending_ = false;
         settled_s_ = {};
@@ -75,6 +77,10 @@ bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_contr
   in.has_goal = protocol_has_goal_;
   in.goal_m = {home[0] + protocol_goal_m_[0], home[1] + protocol_goal_m_[1], home[2] + protocol_goal_m_[2]};
   in.goal_speed_m_s = protocol_speed_m_s_;
+  // The rotary axis turns to the same command's goal (none without the axis: the target stays).
+  in.has_theta_goal = protocol_has_goal_ && p.has_rotary();
+  in.theta_goal_rad = protocol_theta_goal_rad_;
+  in.theta_speed_rad_s = protocol_theta_speed_rad_s_;
   return true;
 }
 
@@ -89,13 +95,20 @@ void LivePlatform::protocol_publish(const platform::TickInfo& t) noexcept {
   const double dt = std::max(0.0, t.t_s - last_operator_t_);
   last_operator_t_ = t.t_s;
   const auto& target = p.teleop().slave_target_m;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const double x = p.axis(static_cast<int>(i)).position_m();
+  // The rotary axis is on target within the linear axes' tolerance as an arc at its contact
+  // radius: the same actuator, the same sensor.
+  const double theta_tolerance_rad = params_.on_target_tolerance_m / params_.platform.stage.rotary.radius_m;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool theta = i == 3;
+    if (theta && !p.has_rotary()) break;
+    const double x = theta ? p.yaw_rad() : p.axis(static_cast<int>(i)).position_m();
     const bool running = p.open_loop_running(static_cast<int>(i));
-    const double goal = protocol_has_goal_ ? protocol_goal_m_[i] : target[static_cast<Eigen::Index>(i)];
-    settled_s_[i] =
-        !running && std::abs(x - goal) <= params_.on_target_tolerance_m ? settled_s_[i] + dt : 0.0;
-    axis_position_m_[i].store(x, std::memory_order_relaxed);
+    const double goal = theta ? (protocol_has_goal_ ? protocol_theta_goal_rad_ : p.yaw_target_rad())
+                        : protocol_has_goal_ ? protocol_goal_m_[i]
+                                             : target[static_cast<Eigen::Index>(i)];
+    const double tolerance = theta ? theta_tolerance_rad : params_.on_target_tolerance_m;
+    settled_s_[i] = !running && std::abs(x - goal) <= tolerance ? settled_s_[i] + dt : 0.0;
+    axis_position_[i].store(x, std::memory_order_relaxed);
     on_target_[i].store(settled_s_[i] >= params_.settle_window_s, std::memory_order_relaxed);
     stepping_[i].store(running, std::memory_order_relaxed);
   }
@@ -107,8 +120,8 @@ ProtocolView LivePlatform::protocol_view() const noexcept {
   ProtocolView v;
   v.applied_seq = applied_seq_.load(std::memory_order_acquire);
   v.protocol_fresh = protocol_driving_.load(std::memory_order_relaxed);
-  for (std::size_t i = 0; i < 3; ++i) {
-    v.position_m[i] = axis_position_m_[i].load(std::memory_order_relaxed);
+  for (std::size_t i = 0; i < 4; ++i) {
+    v.position[i] = axis_position_[i].load(std::memory_order_relaxed);
     v.on_target[i] = on_target_[i].load(std::memory_order_relaxed);
     v.stepping[i] = stepping_[i].load(std::memory_order_relaxed);
   }

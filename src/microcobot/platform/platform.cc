@@ -261,7 +261,7 @@ void Platform::slave_control_task() noexcept {
   }
   // An axis stepping open loop is not the controller's: it idles there (target = measured), so
   // that it takes over bumplessly when the run ends.
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < steppers_.size(); ++i) {
     if (steppers_[i]->running()) {
       target[i] = measured[i];
       velocity[i] = 0.0;
@@ -291,7 +291,7 @@ void Platform::devices_task(double dt_s) noexcept {
     devices_.axes[i]->update(dt_s);
     stepping_ended |= was_running && !st.running();
   }
-  rotary_drive(dt_s);
+  stepping_ended |= rotary_drive(dt_s);
   // Every automatic move ends holding (issue #26): the targets re-taken where the axes are.
   if (stepping_ended) hold();
   devices_.gripper->update(dt_s);
@@ -334,7 +334,9 @@ void Platform::telemetry_task(double t_s) noexcept {
   put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
   put(contact.x), put(contact.y), put(contact.z);
   put(has_rotary() ? yaw_target_rad() : 0.0), put(has_rotary() ? yaw_rad() : 0.0);
-  put(has_rotary() && !faulted_ ? stage_->last_voltage_V(3) : 0.0);
+  put(!has_rotary() || faulted_ ? 0.0
+      : steppers_[3]->running() ? steppers_[3]->output_V()
+                                : stage_->last_voltage_V(3));
   // The last tick where this task ran with the others (slave control, telemetry: the heaviest),
   // one sample late: this tick is not over yet.
   put(1e6 * loop_.sampled_tick_s());

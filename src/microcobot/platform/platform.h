@@ -186,7 +186,8 @@ class Platform {
   /// (issue #26). On the loop (the operator task); real-time safe.
   void hold() noexcept;
   /// Open-loop stepping (issue #30, the ANC300's `stepu`/`stepd`): `periods` sawtooth periods
-  /// of `amplitude_V` at `frequency_Hz` played straight to axis `axis` (0..2), forward
+  /// of `amplitude_V` at `frequency_Hz` played straight to axis `axis` (0..2; 3: the rotary
+  /// axis, turning its rotor by the arc the actuator steps, issue #29 point 2), forward
   /// (`direction` +1) or backward (-1), the stage controller set aside on that axis; the coupling's
   /// target follows nothing meanwhile and the axis holds where it ends (hold()). On the loop
   /// (the operator task); real-time safe. Refused (false, nothing moves) when faulted, on
@@ -194,7 +195,8 @@ class Platform {
   /// (0, 10 kHz] or period count (1..1e9) out of range. Safety: the run stops at once (0 V, every
   /// axis holding) as soon as the console input that drives the coupling is no longer active,
   /// fresh and with its deadman held, on a fault, on a contact force over the limit, or when the
-  /// axis leaves the workspace (or, on Z, goes below the floor) in its direction of travel.
+  /// axis leaves the workspace (or, on Z, goes below the floor; the rotary axis: its target's
+  /// travel, yaw_min_rad()..yaw_max_rad()) in its direction of travel.
   bool start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
                              std::int64_t periods) noexcept;
   /// Open-loop velocity (issue #28 point 5, `stage.xy_sensor: vision`): axis `axis` moves by
@@ -296,7 +298,8 @@ class Platform {
   void rotary_control(std::array<double, StageController::kMaxAxes>& target,
                       std::array<double, StageController::kMaxAxes>& velocity,
                       std::array<double, StageController::kMaxAxes>& measured) noexcept;
-  void rotary_drive(double dt_s) noexcept;
+  /// The rotary axis' drive for one tick; true when an open-loop run on it ended in this tick.
+  bool rotary_drive(double dt_s) noexcept;
   /// Parks the axes that have arrived on still targets, resumes those whose target moved.
   void park_still_axes(const std::array<double, StageController::kMaxAxes>& target,
                        const std::array<double, StageController::kMaxAxes>& measured) noexcept;
@@ -308,7 +311,7 @@ class Platform {
   PlatformDevices devices_;
   SimulatedDevices sim_;  ///< all null unless simulated
   std::unique_ptr<StageController> stage_;
-  std::array<std::unique_ptr<OpenLoopStepper>, 3> steppers_;
+  std::array<std::unique_ptr<OpenLoopStepper>, 4> steppers_;  ///< X, Y, Z, the rotary axis
   TrackingErrorStats tracking_;
   std::unique_ptr<control::Teleoperation> teleop_;
   std::unique_ptr<control::RotaryTarget> rotary_target_;  ///< null without the rotary axis

@@ -8,7 +8,7 @@ namespace mc::platform {
 
 bool Platform::start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
                                      std::int64_t periods) noexcept {
-  if (faulted_ || position_controlled_ || axis < 0 || axis > 2) return false;
+  if (faulted_ || position_controlled_ || axis < 0 || axis > (has_rotary() ? 3 : 2)) return false;
   if (!(amplitude_V > 0.0 && amplitude_V <= model_->params().drive.max_V)) return false;
   if (!(frequency_Hz > 0.0 && frequency_Hz <= 10e3) || periods < 1 || periods > 1'000'000'000) return false;
   if (!(console_.active && console_.fresh && console_.deadman)) return false;
@@ -43,6 +43,12 @@ bool Platform::open_loop_must_stop(std::size_t i) const noexcept {
   if (faulted_ || !(console_.active && console_.fresh && console_.deadman)) return true;
   const Vec3 f = devices_.gripper->contact_force_N();
   if (std::hypot(f.x, f.y, f.z) > world_.params().contact_force_limit_N) return true;
+  if (i == 3) {
+    // The rotary axis: leaving its target's travel (the end stops less a margin) as it turns.
+    const int dir = steppers_[i]->drive_direction();
+    const double yaw = yaw_rad();
+    return (dir > 0 && yaw >= yaw_max_rad()) || (dir < 0 && yaw <= yaw_min_rad());
+  }
   // Without its sensor (x, y positioned by vision) an axis knows only its end stop.
   if (vision_xy_ && i < 2) return devices_.axes[i]->at_end_stop();
   // Leaving the workspace (or going below the floor) in the direction of travel.

@@ -1,6 +1,6 @@
 // The platform's rotary axis (issue #29 point 2; control/rotary_axis.h): its target from the
 // console's theta commands under the console's deadman, its controller on the stage controller's
-// fourth channel (the arc at the contact radius), its drive, its hold.
+// fourth channel (the arc at the contact radius), its drive (or an open-loop run's), its hold.
 #include <algorithm>
 #include <cmath>
 
@@ -50,7 +50,7 @@ void Platform::park_still_axes(const std::array<double, StageController::kMaxAxe
   for (std::size_t i = 0; i < static_cast<std::size_t>(stage_->axis_count()); ++i) {
     const int axis = static_cast<int>(i);
     // Open-loop runs and vision's x, y are not the controller's to park.
-    const bool parkable = after > 0 && !(i < 3 && (steppers_[i]->running() || (vision_xy_ && i < 2)));
+    const bool parkable = after > 0 && !(steppers_[i]->running() || (vision_xy_ && i < 2));
     const bool still = target[i] == last_target_m_[i];
     last_target_m_[i] = target[i];
     if (!parkable || !still) {
@@ -64,11 +64,29 @@ void Platform::park_still_axes(const std::array<double, StageController::kMaxAxe
   }
 }
 
-void Platform::rotary_drive(double dt_s) noexcept {
-  if (!devices_.rotary) return;
-  if (!faulted_ && !position_controlled_)
-    devices_.rotary->command_drive(stage_->drive(3, devices_.rotary->position_m()));
+bool Platform::rotary_drive(double dt_s) noexcept {
+  if (!devices_.rotary) return false;
+  // An open-loop run (the ANC300's stepu/stepd on the rotary axis) plays straight to it, as on
+  // the linear axes (devices_task()).
+  OpenLoopStepper& st = *steppers_[3];
+  const bool was_running = st.running();
+  if (was_running && open_loop_must_stop(3)) st.halt();
+  if (!faulted_ && !position_controlled_) {
+    if (st.running()) {
+      const DriveBlock open_loop = st.drive();
+      stage_->drive(3, devices_.rotary->position_m());  // keeps the controller's clock
+      devices_.rotary->command_drive(open_loop);
+    } else {
+      devices_.rotary->command_drive(stage_->drive(3, devices_.rotary->position_m()));
+    }
+  }
   devices_.rotary->update(dt_s);
+  const bool ended = was_running && !st.running();
+  // The loop resumes from the run's end (0 V, halted or at a period boundary): the state it kept
+  // while set aside made it run away on the rotor (the linear axes' hand-back, measured for issue
+  // #30, is left as it was).
+  if (ended && !faulted_) stage_->resume(3, devices_.rotary->position_m(), 0.0);
+  return ended;
 }
 
 }  // namespace mc::platform

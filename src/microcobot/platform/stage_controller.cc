@@ -127,6 +127,15 @@ void StageController::unpark(int i, double measured_m) noexcept {
   track_[iu]->reset(measured_m, parked_V_[iu]);
 }
 
+void StageController::resume(int i, double measured_m, double u_V) noexcept {
+  const auto iu = static_cast<std::size_t>(i);
+  if (!track_[iu] || stopped_) return;
+  parked_[iu] = false;
+  track_[iu]->reset(measured_m, u_V);
+  ref_[iu] = control::ReferenceSample{measured_m, 0.0, 0.0};
+  since_update_s_[iu] = 0.0;
+}
+
 void StageController::emergency_stop() noexcept {
   parked_.fill(false);
   for (auto& c : ctrl_)

@@ -61,6 +61,10 @@ class StageController {
   void park(int i) noexcept;
   void unpark(int i, double measured_m) noexcept;
   bool parked(int i) const noexcept { return parked_[static_cast<std::size_t>(i)]; }
+  /// Restarts axis i's loop (tracking controllers only) from `measured_m` with the drive at `u_V`,
+  /// the voltage on the axis now: an open-loop run's hand-back, so that the loop resumes from where
+  /// the run left the axis, not from the state it kept while set aside. Real-time safe.
+  void resume(int i, double measured_m, double u_V) noexcept;
 
   /// The hybrid controller of axis i (null when tracking).
   const control::PositionController* axis(int i) const { return ctrl_[static_cast<std::size_t>(i)].get(); }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -29,6 +30,10 @@ void Anc300DriverParams::validate() const {
             static_cast<double>(a));
   require(axes[0] != axes[1] && axes[1] != axes[2] && axes[0] != axes[2], "devices.connection option axes",
           "must name three different axes");
+  require(
+      theta == 0 || (theta >= 1 && theta <= 7 && theta != axes[0] && theta != axes[1] && theta != axes[2]),
+      "devices.connection option theta", "must be an axis within 1..7 other than X's, Y's and Z's", theta);
+  require(std::isfinite(radius_m) && radius_m > 0, "stage.rotary.radius_m", "must be > 0", radius_m);
   require(std::isfinite(voltage_V) && voltage_V > 0 && voltage_V <= 150,
           "devices.connection option voltage_V", "must be within (0, 150] V (the ANC300's range)", voltage_V);
   require(std::isfinite(frequency_Hz) && frequency_Hz >= 1 && frequency_Hz <= 10e3,
@@ -46,7 +51,7 @@ void Anc300DriverParams::validate() const {
 
 Anc300DriverParams anc300_driver_params(const Connection& c) {
   check_connection_options(c,
-                           "timeout_s, connect_timeout_s, poll_s, stale_s, password, axes, voltage_V, "
+                           "timeout_s, connect_timeout_s, poll_s, stale_s, password, axes, theta, voltage_V, "
                            "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm, deadband_nm");
   Anc300DriverParams p;
   p.timing.reply_timeout_s = connection_number(c, "timeout_s", p.timing.reply_timeout_s, 0.001, 10.0);
@@ -75,6 +80,10 @@ Anc300DriverParams anc300_driver_params(const Connection& c) {
                           "'" + excerpt(v) + "' must be three axis numbers joined by '+' (e.g. 1+2+3)");
     p.axes = {v[0] - '0', v[2] - '0', v[4] - '0'};
   }
+  p.theta = static_cast<int>(connection_number(c, "theta", 0.0, 1.0, 7.0));
+  if (c.options.count("theta") && std::to_string(p.theta) != c.options.at("theta"))
+    throw InvalidParams("devices.connection option theta",
+                        "'" + excerpt(c.options.at("theta")) + "' must be an axis number within 1..7");
   return p;  // validated once the steps are known (make_anc300_devices)
 }
 
@@ -102,14 +111,18 @@ std::vector<std::string> Anc300Controller::request(LineClient& bus, const std::s
 }
 
 double Anc300Controller::read_position(LineClient& bus, int i) {
-  const std::string line = fmt::format("getpos {}", params_.axes[static_cast<std::size_t>(i)]);
+  const auto k = static_cast<std::size_t>(i);
+  const std::string line = fmt::format("getpos {}", axis_id(k));
   const auto lines = request(bus, line);
-  const auto value = lines.size() == 1 ? anc300::value_of(lines[0]) : std::nullopt;
-  const auto m = value ? anc300::parse_number(*value) : std::nullopt;
-  if (!m)
-    throw BusFault("'" + line + "': expected 'position = VALUE m', got '" +
-                   excerpt(lines.empty() ? "" : lines[0]) + "'");
-  return *m;
+  // The linear axes' in m; the rotary positioner's in deg, turned into the arc at the radius.
+  const std::string_view unit = k < 3 ? " m" : " deg";
+  const bool unit_ok = lines.size() == 1 && std::string_view(lines[0]).ends_with(unit);
+  const auto value = unit_ok ? anc300::value_of(lines[0]) : std::nullopt;
+  const auto v = value ? anc300::parse_number(*value) : std::nullopt;
+  if (!v)
+    throw BusFault(fmt::format("'{}': expected 'position = VALUE{}', got '{}'", line, unit,
+                               excerpt(lines.empty() ? "" : lines[0])));
+  return k < 3 ? *v : *v * std::numbers::pi / 180.0 * params_.radius_m;
 }
 
 void Anc300Controller::handshake(LineClient& bus) {
@@ -149,8 +162,9 @@ void Anc300Controller::handshake(LineClient& bus) {
   request(bus, "echo off", login_s);
   const auto ver = request(bus, "ver");
   set_identity(ver.empty() ? std::string("ANC300") : ver[0]);
-  for (std::size_t i = 0; i < 3; ++i) {
-    const int a = params_.axes[i];
+  const auto count = static_cast<std::size_t>(axis_count());
+  for (std::size_t i = 0; i < count; ++i) {
+    const int a = axis_id(i);
     try {
       request(bus, fmt::format("getser {}", a));
     } catch (const BusFault& e) {
@@ -168,17 +182,18 @@ void Anc300Controller::handshake(LineClient& bus) {
 
 void Anc300Controller::cycle(LineClient& bus) {
   const Targets t = targets();
+  const int count = axis_count();
   if (params_.sensor)
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < count; ++i) {
       est_m_[static_cast<std::size_t>(i)] = read_position(bus, i);
       publish_position(i, est_m_[static_cast<std::size_t>(i)]);
     }
   int best = -1;
   long long best_n = 0;
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
     if (!t.wanted[i]) continue;
     if (!stepping_mode_[i]) {
-      request(bus, fmt::format("setm {} stp", params_.axes[i]));  // armed again after a safe state
+      request(bus, fmt::format("setm {} stp", axis_id(i)));  // armed again after a safe state
       stepping_mode_[i] = true;
     }
     const double e = t.m[i] - est_m_[i];
@@ -195,9 +210,9 @@ void Anc300Controller::cycle(LineClient& bus) {
     const auto k = static_cast<std::size_t>(best);
     const long long cap = std::max(1LL, static_cast<long long>(params_.frequency_Hz * params_.max_run_s));
     const long long n = std::min(std::abs(best_n), cap);
-    request(bus, fmt::format("{} {} {}", best_n > 0 ? "stepu" : "stepd", params_.axes[k], n));
+    request(bus, fmt::format("{} {} {}", best_n > 0 ? "stepu" : "stepd", axis_id(k), n));
     // stepw answers once the run is over: n periods, then the reply's own time.
-    request(bus, fmt::format("stepw {}", params_.axes[k]),
+    request(bus, fmt::format("stepw {}", axis_id(k)),
             static_cast<double>(n) / params_.frequency_Hz + timing().reply_timeout_s);
     periods_[k].fetch_add(best_n > 0 ? n : -n);
     if (params_.sensor) {
@@ -212,9 +227,9 @@ void Anc300Controller::cycle(LineClient& bus) {
 }
 
 void Anc300Controller::safe_state(LineClient& bus) {
-  for (std::size_t i = 0; i < 3; ++i) {
-    request(bus, fmt::format("stop {}", params_.axes[i]));
-    request(bus, fmt::format("setm {} gnd", params_.axes[i]));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axis_count()); ++i) {
+    request(bus, fmt::format("stop {}", axis_id(i)));
+    request(bus, fmt::format("setm {} gnd", axis_id(i)));
     stepping_mode_[i] = false;
   }
 }
@@ -222,6 +237,10 @@ void Anc300Controller::safe_state(LineClient& bus) {
 platform::PlatformDevices make_anc300_devices(const platform::PlatformConfig& config) {
   const Connection c = parse_connection(config.devices.connection, "anc300", kAnc300DefaultBaud);
   Anc300DriverParams p = anc300_driver_params(c);
+  p.radius_m = config.stage.rotary.radius_m;
+  if (p.theta != 0 && !config.stage.rotary.enabled)
+    throw InvalidParams("devices.connection option theta",
+                        "needs the rotary axis (stage.rotary.enabled: true)");
   const stickslip::StickSlipParams axis = platform::axis_params(config);
   if (p.step_up_m == 0.0 || p.step_down_m == 0.0) {
     // The step of one period at the driver's amplitude and frequency, from the model identified for
@@ -243,6 +262,9 @@ platform::PlatformDevices make_anc300_devices(const platform::PlatformConfig& co
   for (std::size_t i = 0; i < 3; ++i)
     d.axes[i] = std::make_unique<BusAxis>(names[i], controller, static_cast<int>(i), axis.integrator.dt_s,
                                           axis.drive.max_V);
+  if (p.theta != 0)
+    d.rotary =
+        std::make_unique<BusAxis>("anc300_axis_theta", controller, 3, axis.integrator.dt_s, axis.drive.max_V);
   return d;
 }
 

@@ -26,6 +26,11 @@
 ///              fails naming the command and the controller's message)
 ///   each cycle [getpos N x3], setm N stp (an axis armed again), stepu|stepd N n, stepw N
 ///   safe state stop N, setm N gnd (every axis)
+///
+/// The rotary axis under the gripper (issue #29 point 2), with the option `theta=N`: the
+/// controller's rotary positioner on axis N, stepped like the three with the same step per period
+/// (the same actuator, on the rotor's arc at stage.rotary.radius_m; the platform's rotary axis
+/// position is that arc); its `getpos` is read in deg (the twin's), converted to the arc.
 
 #include <array>
 #include <memory>
@@ -45,6 +50,8 @@ struct Anc300DriverParams {
   BusTiming timing{2.0, 0.2, 0.005, 0.1};     ///< a step run blocks a cycle: slower than GCS's
   std::string password = "123456";            ///< the controller's factory password
   std::array<int, 3> axes = {1, 2, 3};        ///< the controller's axes for X, Y, Z
+  int theta = 0;                              ///< the controller's axis of the rotary axis; 0: none
+  double radius_m = 5e-3;                     ///< the rotary axis' contact radius: its arc per rad
   double voltage_V = 60.0;                    ///< setv: the sawtooth amplitude
   double frequency_Hz = 1000.0;               ///< setf
   double max_run_s = 0.02;                    ///< the longest run of one command
@@ -57,8 +64,8 @@ struct Anc300DriverParams {
 };
 
 /// `connection` options: timeout_s, connect_timeout_s, poll_s, stale_s, password, axes ("1+2+3"),
-/// voltage_V, frequency_Hz, max_run_s, position (counted|getpos), step_up_nm, step_down_nm,
-/// deadband_nm.
+/// theta (the rotary positioner's axis), voltage_V, frequency_Hz, max_run_s, position
+/// (counted|getpos), step_up_nm, step_down_nm, deadband_nm.
 Anc300DriverParams anc300_driver_params(const Connection& connection);
 
 class Anc300Controller final : public BusController {
@@ -66,6 +73,8 @@ class Anc300Controller final : public BusController {
   Anc300Controller(Connection connection, Anc300DriverParams params);
   ~Anc300Controller() override { shutdown(); }
   const Anc300DriverParams& params() const { return params_; }
+  /// X, Y, Z, and the rotary axis with the option theta.
+  int axis_count() const { return params_.theta == 0 ? 3 : 4; }
   /// Periods commanded since the start, per axis, signed (tests).
   long long periods_sent(int axis) const { return periods_[static_cast<std::size_t>(axis)].load(); }
 
@@ -79,15 +88,17 @@ class Anc300Controller final : public BusController {
   /// Throws BusFault on ERROR (with the controller's message), a timeout or a lost connection.
   std::vector<std::string> request(LineClient& bus, const std::string& line, double timeout_s = 0.0);
   double read_position(LineClient& bus, int i);
+  int axis_id(std::size_t i) const { return i < 3 ? params_.axes[i] : params_.theta; }
 
   Anc300DriverParams params_;
-  std::array<double, 3> est_m_{};  // counted, or the sensor's last
-  std::array<bool, 3> stepping_mode_{};
-  std::array<std::atomic<long long>, 3> periods_{};
+  std::array<double, kMaxAxes> est_m_{};  // counted, or the sensor's last
+  std::array<bool, kMaxAxes> stepping_mode_{};
+  std::array<std::atomic<long long>, kMaxAxes> periods_{};
 };
 
-/// The driver set `anc300`: the three axes on one Anc300Controller, the gripper and the masters
-/// simulated (vendor/sim_companions.h). Builds (the step from the model), opens nothing.
+/// The driver set `anc300`: the three axes (and the rotary axis, option theta, when the
+/// configuration has one) on one Anc300Controller, the gripper and the masters simulated
+/// (vendor/sim_companions.h). Builds (the step from the model), opens nothing.
 platform::PlatformDevices make_anc300_devices(const platform::PlatformConfig& config);
 
 }  // namespace mc::vendor

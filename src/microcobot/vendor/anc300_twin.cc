@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -14,6 +15,10 @@ using anc300::reply_error;
 using anc300::reply_ok;
 using anc300::value_line;
 
+namespace {
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+}  // namespace
+
 void Anc300TwinParams::validate() const {
   require(std::isfinite(frequency_Hz) && frequency_Hz >= 1 && frequency_Hz <= 10e3, "anc300.frequency_Hz",
           "must be within [1, 10000] Hz", frequency_Hz);
@@ -23,11 +28,17 @@ void Anc300TwinParams::validate() const {
           capacitance_nF);
 }
 
-Anc300Twin::Anc300Twin(TwinStage& stage, Anc300TwinParams params) : stage_(stage), params_(params) {
+Anc300Twin::Anc300Twin(TwinStage& stage, Anc300TwinParams params)
+    : stage_(stage), params_(params), axes_(std::clamp(stage.axis_count(), 3, TwinStage::kMaxAxes)) {
   params_.validate();
   mode_.fill(Mode::kGnd);  // a controller powers up with its axes grounded
   frequency_Hz_.fill(std::round(params_.frequency_Hz));
   voltage_V_.fill(std::min(params_.voltage_V, stage_.max_voltage_V()));
+}
+
+int Anc300Twin::axis_index(std::string_view id) const {
+  if (id.size() != 1 || id[0] < '1' || id[0] >= '1' + axes_) return -1;
+  return id[0] - '1';
 }
 
 std::string Anc300Twin::greeting() const {
@@ -90,11 +101,7 @@ std::optional<std::string> Anc300Twin::on_line(ClientId client, Anc300Session& s
     return out;
   }
   if (r->command == "stepw") {
-    const int axis = r->args.size() == 1 ? (r->args[0] == "1"   ? 0
-                                            : r->args[0] == "2" ? 1
-                                            : r->args[0] == "3" ? 2
-                                                                : -1)
-                                         : -1;
+    const int axis = r->args.size() == 1 ? axis_index(r->args[0]) : -1;
     if (axis < 0) return finish(s, line, reply_error("Invalid axis"));
     if (stage_.axis(axis).stepping) {
       waiting_axis_ = axis;
@@ -107,7 +114,7 @@ std::optional<std::string> Anc300Twin::on_line(ClientId client, Anc300Session& s
 }
 
 std::optional<std::string> Anc300Twin::poll_wait(Anc300Session& s, int axis) {
-  if (axis < 0 || axis > 2 || stage_.axis(axis).stepping) return std::nullopt;
+  if (axis < 0 || axis >= axes_ || stage_.axis(axis).stepping) return std::nullopt;
   return finish(s, pending_echo_, reply_ok());
 }
 
@@ -116,15 +123,17 @@ std::string Anc300Twin::execute(ClientId client, const anc300::Request& r) {
   if (c == "ver") return reply_ok({"attocube ANC300 controller, microcobot digital twin 1.0"});
   if (c == "getcser") return reply_ok({"ANC300-TWIN"});
   if (c == "help") {
-    return reply_ok({"echo on|off", "ver", "getcser", "getser N", "setm N gnd|stp|cap|off", "getm N",
-                     "setf N Hz", "getf N", "setv N V", "getv N", "stepu N [n]", "stepd N [n]", "stepw N",
-                     "stop N", "getc N", "capw N", "getpos N (twin only: the sensor)"});
+    return reply_ok(
+        {"echo on|off", "ver", "getcser", "getser N", "setm N gnd|stp|cap|off", "getm N", "setf N Hz",
+         "getf N", "setv N V", "getv N", "stepu N [n]", "stepd N [n]", "stepw N", "stop N", "getc N",
+         "capw N", "getpos N (twin only: the sensor)",
+         axes_ > TwinStage::kTheta ? "axes: 1 2 3 (X, Y, Z), 4 (theta, rotary)" : "axes: 1 2 3 (X, Y, Z)"});
   }
   // Every other command names an axis.
   if (r.args.empty()) return reply_error("Missing axis");
-  int axis = -1;
-  if (r.args[0] == "1" || r.args[0] == "2" || r.args[0] == "3") axis = r.args[0][0] - '1';
-  if (axis < 0) return reply_error("Invalid axis '" + r.args[0].substr(0, 16) + "' (axes 1, 2, 3)");
+  const int axis = axis_index(r.args[0]);
+  if (axis < 0)
+    return reply_error(fmt::format("Invalid axis '{}' (axes 1 to {})", r.args[0].substr(0, 16), axes_));
   const auto k = static_cast<std::size_t>(axis);
   const std::size_t nargs = r.args.size() - 1;
   auto one_value = [&]() -> std::optional<double> {
@@ -138,8 +147,13 @@ std::string Anc300Twin::execute(ClientId client, const anc300::Request& r) {
   if (c == "getc")
     return reply_ok({value_line("capacitance", fmt::format("{:.1f}", params_.capacitance_nF), "nF")});
   if (c == "capw") return reply_ok();
-  if (c == "getpos")
-    return reply_ok({value_line("position", fmt::format("{:.9e}", stage_.axis(axis).position_m), "m")});
+  if (c == "getpos") {
+    // The rotary positioner's angle in degrees, as attocube's rotators are read; the linear axes' in m.
+    if (axis == TwinStage::kTheta)
+      return reply_ok(
+          {value_line("position", fmt::format("{:.9e}", stage_.axis(axis).position * kDegPerRad), "deg")});
+    return reply_ok({value_line("position", fmt::format("{:.9e}", stage_.axis(axis).position), "m")});
+  }
   if (c == "setm") {
     const auto m = nargs == 1 ? anc300::parse_mode(r.args[1]) : std::nullopt;
     if (!m) return reply_error("Usage: setm N gnd|inp|cap|stp|off|stp+|stp-");

@@ -1,13 +1,15 @@
 #pragma once
 /// @file
 /// The stage answering the Attocube ANC300's console (issue #30): three open-loop stick-slip
-/// axes 1, 2, 3 (X, Y, Z) whose `stepu`/`stepd` run sawtooth periods of the set amplitude and
-/// frequency through the platform's stick-slip model (Platform::start_open_loop_steps). Lines are
+/// axes 1, 2, 3 (X, Y, Z) and, when the platform has the rotary axis under the gripper (issue #29
+/// point 2), a rotary positioner on axis 4 (theta), whose `stepu`/`stepd` run sawtooth periods of
+/// the set amplitude and frequency through the platform's stick-slip model
+/// (Platform::start_open_loop_steps; theta turns by the arc its actuator steps). Lines are
 /// parsed by anc300_codec.h; every value is checked before it reaches the stage. Commands
 /// (docs/hardware.md): echo, ver, getcser, getser, setm/getm, setf/getf, setv/getv, stepu, stepd,
-/// stepw, stop, getc, and `getpos` (the twin's sensor; no ANC300 has it). The axes' settings are
-/// the controller's (shared by every connection); echo and login are each connection's.
-/// Protocol thread only.
+/// stepw, stop, getc, and `getpos` (the twin's sensor, m or deg; no ANC300 has it). The axes'
+/// settings are the controller's (shared by every connection); echo and login are each
+/// connection's. Protocol thread only.
 
 #include <array>
 #include <optional>
@@ -57,11 +59,14 @@ class Anc300Twin {
   std::string finish(const Anc300Session& s, std::string_view echoed, const std::string& body) const;
   std::string execute(ClientId client, const anc300::Request& r);
   std::string refusal(TwinStage::Refusal r) const;
+  /// The axis (0-based) a console axis id names ("1".."4"), -1 for none of this controller's.
+  int axis_index(std::string_view id) const;
 
   TwinStage& stage_;
   Anc300TwinParams params_;
-  std::array<anc300::Mode, 3> mode_{};
-  std::array<double, 3> frequency_Hz_{}, voltage_V_{};
+  int axes_;  // 3, or 4 with the rotary positioner
+  std::array<anc300::Mode, TwinStage::kMaxAxes> mode_{};
+  std::array<double, TwinStage::kMaxAxes> frequency_Hz_{}, voltage_V_{};
   std::string pending_echo_;
   int waiting_axis_ = -1;
 };

@@ -98,7 +98,7 @@ std::string BusController::fault_reason() const {
 
 BusController::Targets BusController::targets() const noexcept {
   Targets t;
-  for (std::size_t i = 0; i < 3; ++i) {
+  for (std::size_t i = 0; i < kMaxAxes; ++i) {
     t.wanted[i] = armed_[i].load(std::memory_order_acquire) && given_[i].load(std::memory_order_acquire);
     t.m[i] = target_m_[i].load(std::memory_order_relaxed);
   }

@@ -53,6 +53,9 @@ class BusFault : public std::runtime_error {
 class BusController {
  public:
   using Clock = std::chrono::steady_clock;
+  /// X, Y, Z and, on a controller that drives it, the rotary axis under the gripper (index 3: its
+  /// position as the platform's rotary axis gives it, the arc at the rotor's contact radius).
+  static constexpr std::size_t kMaxAxes = 4;
   BusController(std::string driver, Connection connection, BusTiming timing);
   virtual ~BusController();
   BusController(const BusController&) = delete;
@@ -95,8 +98,8 @@ class BusController {
 
   // For the derived controllers (bus thread).
   struct Targets {
-    std::array<double, 3> m{};
-    std::array<bool, 3> wanted{};  ///< armed and given since armed
+    std::array<double, kMaxAxes> m{};
+    std::array<bool, kMaxAxes> wanted{};  ///< armed and given since armed
   };
   Targets targets() const noexcept;
   void publish_position(int axis, double m) noexcept;
@@ -120,8 +123,8 @@ class BusController {
   std::atomic<bool> stop_{false}, faulted_{false}, running_{false};
   std::atomic<std::uint64_t> safe_requests_{0}, safe_done_{0}, cycles_{0};
   std::uint64_t safe_seen_ = 0;  // bus thread
-  std::array<std::atomic<double>, 3> target_m_{}, position_m_{};
-  std::array<std::atomic<bool>, 3> armed_{}, given_{};
+  std::array<std::atomic<double>, kMaxAxes> target_m_{}, position_m_{};
+  std::array<std::atomic<bool>, kMaxAxes> armed_{}, given_{};
   std::atomic<std::int64_t> stamp_ns_{0};
   mutable std::mutex reason_mutex_;  // never taken on the loop
   std::string reason_;

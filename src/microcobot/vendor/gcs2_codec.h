@@ -13,6 +13,7 @@
 ///    reply parsing clients actually do (`int(answer, 16)` for #5, 0xB1/0xB0 for #7, the end of
 ///    a multi-line answer at a line not ending in space), and the error texts below.
 
+#include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -37,8 +38,12 @@ enum Error : int {
 /// The controller's text of an error code ("Unknown command"); "Unknown error" otherwise.
 std::string_view error_text(int code);
 
+/// GCS 2.0 positions and velocities are in the axis' physical unit (PUN?): mm (mm/s) for linear
+/// stages, deg (deg/s) for rotation stages.
+inline constexpr double kMmPerM = 1e3;
+inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
 /// The single-byte commands (sent without LF).
-inline constexpr double kMmPerM = 1e3;    ///< GCS 2.0 positions and velocities are in mm (mm/s)
 inline constexpr char kMotionStatus = 5;  ///< #5: hex mask of the moving axes
 inline constexpr char kReadyStatus = 7;   ///< #7: 0xB1 ready, 0xB0 busy
 inline constexpr char kStopAll = 24;      ///< #24: stop every axis (error 10)

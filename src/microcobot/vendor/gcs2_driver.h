@@ -16,6 +16,11 @@
 ///
 /// Positions are in mm on the wire (%.6f: 1 nm), m in the platform; the controller's zero is the
 /// platform's stage zero (its home).
+///
+/// The rotary axis under the gripper (issue #29 point 2), with the option `theta=ID`: the
+/// controller's rotation stage ID, checked at configure (listed by SAI?, PUN? `deg`, its TMN?..TMX?
+/// holding 0), referenced, moved and polled with the three: deg on the wire (%.6f: 1 udeg), the
+/// platform's rotary axis position (the arc at stage.rotary.radius_m from its home) in the platform.
 
 #include <array>
 #include <memory>
@@ -33,6 +38,8 @@ inline constexpr int kGcs2DefaultBaud = 115200;
 struct Gcs2DriverParams {
   BusTiming timing;
   std::array<std::string, 3> axes = {"1", "2", "3"};  ///< the controller's axis ids for X, Y, Z
+  std::string theta;                  ///< the controller's axis id of the rotary axis (deg); empty: none
+  double radius_m = 5e-3;             ///< the rotary axis' contact radius: its arc [m] per rad
   bool reference = true;              ///< FRF the axes that FRF? reports unreferenced (else refuse them)
   double reference_timeout_s = 60.0;  ///< FRF's longest wait (a switch search on a long stage)
   double velocity_mm_s = 0.0;         ///< VEL sent at configure; 0 keeps the controller's
@@ -43,7 +50,8 @@ struct Gcs2DriverParams {
 };
 
 /// `connection` options: timeout_s, connect_timeout_s, poll_s, stale_s, axes (three ids joined by
-/// '+', "1+2+3"), reference (0|1), reference_timeout_s, velocity_mm_s.
+/// '+', "1+2+3"), theta (the rotation stage's id), reference (0|1), reference_timeout_s,
+/// velocity_mm_s.
 Gcs2DriverParams gcs2_driver_params(const Connection& connection);
 
 class Gcs2Controller final : public BusController {
@@ -51,7 +59,9 @@ class Gcs2Controller final : public BusController {
   Gcs2Controller(Connection connection, Gcs2DriverParams params);
   ~Gcs2Controller() override { shutdown(); }
   const Gcs2DriverParams& params() const { return params_; }
-  /// TMN?/TMX? read at configure [m].
+  /// X, Y, Z, and the rotary axis with the option theta.
+  int axis_count() const { return params_.theta.empty() ? 3 : 4; }
+  /// TMN?/TMX? read at configure [m; the rotary axis: m of arc].
   double min_m(int axis) const { return min_m_[static_cast<std::size_t>(axis)]; }
   double max_m(int axis) const { return max_m_[static_cast<std::size_t>(axis)]; }
   /// MOV lines sent (tests, benchmarks).
@@ -67,16 +77,21 @@ class Gcs2Controller final : public BusController {
   std::string query(LineClient& bus, const std::string& line, double timeout_s = 0.0);
   /// Sends a set command, then ERR?: throws BusFault naming the code unless it is 0 (or `also_ok`).
   void command(LineClient& bus, const std::string& line, int also_ok = 0);
-  std::array<double, 3> read_axes(LineClient& bus, const std::string& mnemonic);
+  /// The reply of `mnemonic` on every axis, each in its unit on the wire (mm, deg).
+  std::array<double, kMaxAxes> read_axes(LineClient& bus, const std::string& mnemonic);
   std::string axis_list() const;
+  const std::string& axis_id(std::size_t i) const { return i < 3 ? params_.axes[i] : params_.theta; }
+  /// The platform's unit (m; the rotary axis: m of arc) per the wire's (mm; deg).
+  double si_per_wire(std::size_t i) const;
 
   Gcs2DriverParams params_;
-  std::array<double, 3> min_m_{}, max_m_{}, sent_m_{};
-  std::array<bool, 3> sent_{};
+  std::array<double, kMaxAxes> min_m_{}, max_m_{}, sent_m_{};
+  std::array<bool, kMaxAxes> sent_{};
   std::atomic<std::uint64_t> moves_{0};
 };
 
-/// The driver set `pi-gcs2`: the three axes on one Gcs2Controller (`config.devices.connection`),
+/// The driver set `pi-gcs2`: the three axes (and the rotary axis, option theta, when the
+/// configuration has one: stage.rotary.enabled) on one Gcs2Controller (`config.devices.connection`),
 /// the gripper and the masters simulated (vendor/sim_companions.h). Builds, opens nothing.
 platform::PlatformDevices make_gcs2_devices(const platform::PlatformConfig& config);
 

@@ -12,36 +12,52 @@ namespace mc::vendor {
 using gcs2::axis_value;
 
 namespace {
-constexpr const char* kAxisNames[3] = {"1", "2", "3"};
+constexpr const char* kAxisNames[TwinStage::kMaxAxes] = {"1", "2", "3", "4"};
+/// PUN?'s answers: PI's own spelling, as GCS clients compare it (docs/hardware.md).
+constexpr const char* kUnits[TwinStage::kMaxAxes] = {"mm", "mm", "mm", "deg"};
 }  // namespace
 
 void Gcs2TwinParams::validate() const {
   require(address >= 1 && address <= 254, "gcs2.address", "must be within [1, 254]", address);
   require(std::isfinite(velocity_mm_s) && velocity_mm_s > 0, "gcs2.velocity_mm_s", "must be > 0",
           velocity_mm_s);
+  require(std::isfinite(velocity_deg_s) && velocity_deg_s > 0, "gcs2.velocity_deg_s", "must be > 0",
+          velocity_deg_s);
   require(!idn.empty() && idn.size() < 200 && idn.find('\n') == std::string::npos, "gcs2.idn",
           "must be one line of fewer than 200 characters");
 }
 
-Gcs2Twin::Gcs2Twin(TwinStage& stage, Gcs2TwinParams params) : stage_(stage), params_(std::move(params)) {
+Gcs2Twin::Gcs2Twin(TwinStage& stage, Gcs2TwinParams params)
+    : stage_(stage),
+      params_(std::move(params)),
+      axes_(std::clamp(stage.axis_count(), 3, TwinStage::kMaxAxes)) {
   params_.validate();
-  for (int i = 0; i < 3; ++i) {
-    velocity_mm_s_[static_cast<std::size_t>(i)] =
-        std::min(params_.velocity_mm_s, stage_.max_speed_m_s() * gcs2::kMmPerM);
-    target_mm_[static_cast<std::size_t>(i)] = stage_.axis(i).position_m * gcs2::kMmPerM;
+  for (int i = 0; i < axes_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double v = i == TwinStage::kTheta ? params_.velocity_deg_s : params_.velocity_mm_s;
+    velocity_[k] = std::min(v, stage_.max_speed(i) * per_si(i));
+    target_[k] = position(i);
   }
 }
 
-int Gcs2Twin::axis_index(std::string_view word) {
-  for (int i = 0; i < 3; ++i)
+double Gcs2Twin::per_si(int i) { return i == TwinStage::kTheta ? gcs2::kDegPerRad : gcs2::kMmPerM; }
+
+int Gcs2Twin::axis_index(std::string_view word) const {
+  for (int i = 0; i < axes_; ++i)
     if (word == kAxisNames[i]) return i;
   return -1;
+}
+
+std::vector<int> Gcs2Twin::all_axes() const {
+  std::vector<int> axes;
+  for (int i = 0; i < axes_; ++i) axes.push_back(i);
+  return axes;
 }
 
 bool Gcs2Twin::query_axes(const std::vector<std::string>& args, std::vector<int>& axes) {
   axes.clear();
   if (args.empty() || (args.size() == 1 && (args[0] == "ALL" || args[0] == "all"))) {
-    axes = {0, 1, 2};
+    axes = all_axes();
     return true;
   }
   for (const auto& a : args) {
@@ -78,7 +94,7 @@ bool Gcs2Twin::pairs(const std::vector<std::string>& args, std::vector<std::pair
 }
 
 void Gcs2Twin::update_referencing() {
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < axes_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (referencing_[k] && stage_.axis(i).on_target) {
       referencing_[k] = false;
@@ -88,14 +104,21 @@ void Gcs2Twin::update_referencing() {
 }
 
 bool Gcs2Twin::send_goal(ClientId client, unsigned moved) {
-  std::array<double, 3> goal{};
-  double speed = 1e9;
-  for (std::size_t i = 0; i < 3; ++i) {
+  TwinStage::Goal goal{};
+  double speed = 1e9, slowest = 1e9;
+  for (int i = 0; i < axes_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
     // An axis with its servo off is not commanded: it holds where it is.
-    goal[i] = servo_[i] ? target_mm_[i] / gcs2::kMmPerM : stage_.axis(static_cast<int>(i)).position_m;
-    if (moved & (1u << i)) speed = std::min(speed, velocity_mm_s_[i] / gcs2::kMmPerM);
+    goal[k] = servo_[k] ? target_[k] / per_si(i) : stage_.axis(i).position;
+    if (i == TwinStage::kTheta) continue;
+    slowest = std::min(slowest, velocity_[k] / gcs2::kMmPerM);
+    if (moved & (1u << i)) speed = std::min(speed, velocity_[k] / gcs2::kMmPerM);
   }
-  switch (stage_.move_to(client, goal, speed)) {
+  // A move of the rotation stage alone leaves the linear axes at the slowest pace they may be
+  // travelling at.
+  if (speed == 1e9) speed = slowest;
+  const double theta_speed = velocity_[TwinStage::kTheta] / gcs2::kDegPerRad;
+  switch (stage_.move_to(client, goal, speed, theta_speed)) {
     case TwinStage::Refusal::kNone:
       return true;
     case TwinStage::Refusal::kHalted:
@@ -109,9 +132,9 @@ bool Gcs2Twin::send_goal(ClientId client, unsigned moved) {
 
 void Gcs2Twin::stop_all(ClientId client) {
   stage_.stop(client);
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < axes_; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    target_mm_[k] = stage_.axis(i).position_m * gcs2::kMmPerM;
+    target_[k] = position(i);
     referencing_[k] = false;
   }
   set_error(gcs2::kStopped);
@@ -121,7 +144,7 @@ std::string Gcs2Twin::on_byte(ClientId client, char byte) {
   update_referencing();
   if (byte == gcs2::kMotionStatus) {
     unsigned mask = 0;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < axes_; ++i) {
       const auto a = stage_.axis(i);
       if (a.stepping || (servo_[static_cast<std::size_t>(i)] && !a.on_target)) mask |= 1u << i;
     }
@@ -172,6 +195,7 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
                           "MVR {<AxisID> <Distance>} Set Target Relative To Current Target",
                           "ONT? [{<AxisID>}] Get On Target State",
                           "POS? [{<AxisID>}] Get Real Position",
+                          "PUN? [{<AxisID>}] Get Position Unit",
                           "SAI? [ALL] Get List Of Current Axis Identifiers",
                           "STP Stop All Axes",
                           "SVO {<AxisID> <ServoState>} Set Servo Mode",
@@ -190,16 +214,16 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
       set_error(gcs2::kParameterSyntax);
       return false;
     }
-    for (const char* a : kAxisNames) reply.emplace_back(a);
+    for (int i = 0; i < axes_; ++i) reply.emplace_back(kAxisNames[i]);
   } else if (m == "ERR?") {
     reply.push_back(std::to_string(error_));
     error_ = gcs2::kNoError;
   } else if (m == "POS?") {
-    return per_axis(
-        [&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).position_m * gcs2::kMmPerM); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], position(i)); });
+  } else if (m == "PUN?") {
+    return per_axis([&](int i) { return std::string(kAxisNames[i]) + "=" + kUnits[i]; });
   } else if (m == "MOV?") {
-    return per_axis(
-        [&](int i) { return axis_value(kAxisNames[i], target_mm_[static_cast<std::size_t>(i)]); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], target_[static_cast<std::size_t>(i)]); });
   } else if (m == "ONT?") {
     return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.axis(i).on_target ? 1 : 0); });
   } else if (m == "SVO?") {
@@ -209,12 +233,11 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
     return per_axis(
         [&](int i) { return axis_value(kAxisNames[i], referenced_[static_cast<std::size_t>(i)] ? 1 : 0); });
   } else if (m == "VEL?") {
-    return per_axis(
-        [&](int i) { return axis_value(kAxisNames[i], velocity_mm_s_[static_cast<std::size_t>(i)]); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], velocity_[static_cast<std::size_t>(i)]); });
   } else if (m == "TMN?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.min_m(i) * gcs2::kMmPerM); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.min(i) * per_si(i)); });
   } else if (m == "TMX?") {
-    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.max_m(i) * gcs2::kMmPerM); });
+    return per_axis([&](int i) { return axis_value(kAxisNames[i], stage_.max(i) * per_si(i)); });
   } else if (m == "SVO") {
     if (!pairs(r.args, values)) return false;
     for (auto [i, v] : values)
@@ -222,47 +245,47 @@ bool Gcs2Twin::execute(ClientId client, const gcs2::Request& r, Lines& reply) {
     for (auto [i, v] : values) {
       const auto k = static_cast<std::size_t>(i);
       // Servo on: the target becomes the present position (as the controller's does).
-      if (v == 1.0 && !servo_[k]) target_mm_[k] = stage_.axis(i).position_m * gcs2::kMmPerM;
+      if (v == 1.0 && !servo_[k]) target_[k] = position(i);
       servo_[k] = v == 1.0;
       if (!servo_[k]) referencing_[k] = false;
     }
   } else if (m == "VEL") {
     if (!pairs(r.args, values)) return false;
     for (auto [i, v] : values)
-      if (!(v > 0.0 && v <= stage_.max_speed_m_s() * gcs2::kMmPerM))
+      if (!(v > 0.0 && v <= stage_.max_speed(i) * per_si(i)))
         return set_error(gcs2::kParameterOutOfRange), false;
-    for (auto [i, v] : values) velocity_mm_s_[static_cast<std::size_t>(i)] = v;
+    for (auto [i, v] : values) velocity_[static_cast<std::size_t>(i)] = v;
   } else if (m == "MOV" || m == "MVR") {
     if (!pairs(r.args, values)) return false;
     if (stage_.halted()) return set_error(gcs2::kStopped), false;
-    std::array<double, 3> target = target_mm_;
+    auto target = target_;
     for (auto [i, v] : values) {
       const auto k = static_cast<std::size_t>(i);
       if (!servo_[k] || !referenced_[k]) return set_error(gcs2::kUnallowableMove), false;
-      target[k] = m == "MOV" ? v : target_mm_[k] + v;
-      if (target[k] < stage_.min_m(i) * gcs2::kMmPerM - 1e-9 ||
-          target[k] > stage_.max_m(i) * gcs2::kMmPerM + 1e-9)
+      target[k] = m == "MOV" ? v : target_[k] + v;
+      // Every named axis is checked before any is moved: nothing of a refused line is applied.
+      if (target[k] < stage_.min(i) * per_si(i) - 1e-9 || target[k] > stage_.max(i) * per_si(i) + 1e-9)
         return set_error(gcs2::kPositionOutOfLimits), false;
     }
     unsigned moved = 0;
     for (auto [i, v] : values) moved |= 1u << i;
-    const auto before = target_mm_;
-    target_mm_ = target;
-    if (!send_goal(client, moved)) target_mm_ = before;
+    const auto before = target_;
+    target_ = target;
+    if (!send_goal(client, moved)) target_ = before;
   } else if (m == "FRF") {
     if (!query_axes(r.args, axes)) return false;
     if (stage_.halted()) return set_error(gcs2::kStopped), false;
     for (int i : axes)
       if (!servo_[static_cast<std::size_t>(i)]) return set_error(gcs2::kUnallowableMove), false;
-    // The reference position is the stage's home (0 mm): a closed-loop move there.
-    const auto before = target_mm_;
+    // The reference position is the stage's home (0 mm, 0 deg): a closed-loop move there.
+    const auto before = target_;
     unsigned moved = 0;
     for (int i : axes) {
-      target_mm_[static_cast<std::size_t>(i)] = 0.0;
+      target_[static_cast<std::size_t>(i)] = 0.0;
       moved |= 1u << i;
     }
     if (!send_goal(client, moved)) {
-      target_mm_ = before;
+      target_ = before;
       return false;
     }
     for (int i : axes) {

@@ -12,10 +12,19 @@ LiveStage::LiveStage(live::LivePlatform& live) : live_(live) {
   const double home[3] = {live.params().platform.stage.home_x_m, live.params().platform.stage.home_y_m,
                           live.params().platform.stage.home_z_m};
   for (std::size_t i = 0; i < 3; ++i) {
-    min_m_[i] = l.min_m[i] - home[i];
-    max_m_[i] = l.max_m[i] - home[i];
+    min_[i] = l.min_m[i] - home[i];
+    max_[i] = l.max_m[i] - home[i];
   }
   max_speed_m_s_ = l.max_speed_m_s;
+  // The rotary axis: the console's travel and speed (both 0 without the axis), its angle from its
+  // home (the console's is the gripper's yaw: home_rad + that angle), as the stage's from its home.
+  if (l.max_theta_speed_rad_s > 0.0) {
+    axis_count_ = 4;
+    home_rad_ = live.params().platform.stage.rotary.home_rad;
+    min_[kTheta] = l.min_theta_rad - home_rad_;
+    max_[kTheta] = l.max_theta_rad - home_rad_;
+    max_theta_speed_rad_s_ = l.max_theta_speed_rad_s;
+  }
   max_voltage_V_ = platform::axis_params(live.params().platform).drive.max_V;
 }
 
@@ -23,7 +32,7 @@ TwinStage::Axis LiveStage::axis(int i) const {
   const live::ProtocolView v = live_.protocol_view();
   const auto k = static_cast<std::size_t>(i);
   Axis a;
-  a.position_m = v.position_m[k];
+  a.position = k == kTheta ? v.position[k] - home_rad_ : v.position[k];
   // Until the loop applied the last command, what it published is about the one before.
   a.on_target = v.on_target[k] && v.applied_seq >= move_seq_ && v.applied_seq >= step_seq_[k];
   a.stepping = v.stepping[k] || v.applied_seq < step_seq_[k];
@@ -56,16 +65,21 @@ bool LiveStage::push(live::ProtocolCommand c) {
   return live_.push_protocol_command(c);
 }
 
-TwinStage::Refusal LiveStage::move_to(ClientId client, const std::array<double, 3>& goal_m,
-                                      double speed_m_s) {
+TwinStage::Refusal LiveStage::move_to(ClientId client, const Goal& goal, double speed_m_s,
+                                      double theta_speed_rad_s) {
   if (const Refusal r = claim(client); r != Refusal::kNone) return r;
+  auto clamped = [&](std::size_t i) {
+    return std::clamp(std::isfinite(goal[i]) ? goal[i] : 0.0, min_[i], max_[i]);
+  };
+  auto speed = [](double v, double cap) { return std::isfinite(v) ? std::clamp(v, 0.0, cap) : 0.0; };
   live::ProtocolCommand c;
   c.kind = live::ProtocolCommand::Kind::kMoveTo;
-  for (std::size_t i = 0; i < 3; ++i) {
-    const double g = std::isfinite(goal_m[i]) ? goal_m[i] : 0.0;
-    c.goal_m[i] = std::clamp(g, min_m_[i], max_m_[i]);
+  for (std::size_t i = 0; i < 3; ++i) c.goal_m[i] = clamped(i);
+  c.speed_m_s = speed(speed_m_s, max_speed_m_s_);
+  if (axis_count_ > kTheta) {
+    c.theta_goal_rad = home_rad_ + clamped(kTheta);
+    c.theta_speed_rad_s = speed(theta_speed_rad_s, max_theta_speed_rad_s_);
   }
-  c.speed_m_s = std::isfinite(speed_m_s) ? std::clamp(speed_m_s, 0.0, max_speed_m_s_) : 0.0;
   if (!push(c)) return Refusal::kBusy;
   move_seq_ = seq_;
   return Refusal::kNone;
@@ -76,7 +90,7 @@ TwinStage::Refusal LiveStage::step(ClientId client, int i, double amplitude_V, d
   if (const Refusal r = claim(client); r != Refusal::kNone) return r;
   live::ProtocolCommand c;
   c.kind = live::ProtocolCommand::Kind::kSteps;
-  c.axis = std::clamp(i, 0, 2);
+  c.axis = std::clamp(i, 0, axis_count_ - 1);
   c.amplitude_V = amplitude_V;  // range-checked again by the platform
   c.frequency_Hz = frequency_Hz;
   c.direction = direction < 0 ? -1 : 1;

@@ -2,7 +2,8 @@
 /// @file
 /// The live platform as a protocol twin's stage (issue #30): reads the loop's protocol view
 /// (atomics), pushes checked and clamped commands into its protocol ring, and keeps who controls
-/// the stage (vendor/twin_stage.h). Protocol thread only: it is the ring's single producer.
+/// the stage (vendor/twin_stage.h), the rotary axis with the three when the platform has it.
+/// Protocol thread only: it is the ring's single producer.
 
 #include "microcobot/live/live_platform.h"
 #include "microcobot/vendor/twin_stage.h"
@@ -14,14 +15,15 @@ class LiveStage : public TwinStage {
   /// `live` must outlive this; its limits give the workspace and the speed cap.
   explicit LiveStage(live::LivePlatform& live);
 
+  int axis_count() const override { return axis_count_; }
   Axis axis(int i) const override;
-  double min_m(int i) const override { return min_m_[static_cast<std::size_t>(i)]; }
-  double max_m(int i) const override { return max_m_[static_cast<std::size_t>(i)]; }
-  double max_speed_m_s() const override { return max_speed_m_s_; }
+  double min(int i) const override { return min_[static_cast<std::size_t>(i)]; }
+  double max(int i) const override { return max_[static_cast<std::size_t>(i)]; }
+  double max_speed(int i) const override { return i == kTheta ? max_theta_speed_rad_s_ : max_speed_m_s_; }
   double max_voltage_V() const override { return max_voltage_V_; }
   bool halted() const override;
   bool controls(ClientId client) const override;
-  Refusal move_to(ClientId client, const std::array<double, 3>& goal_m, double speed_m_s) override;
+  Refusal move_to(ClientId client, const Goal& goal, double speed_m_s, double theta_speed_rad_s) override;
   Refusal step(ClientId client, int i, double amplitude_V, double frequency_Hz, int direction,
                std::int64_t periods) override;
   void stop(ClientId client) override;
@@ -33,12 +35,14 @@ class LiveStage : public TwinStage {
   bool push(live::ProtocolCommand c);
 
   live::LivePlatform& live_;
-  std::array<double, 3> min_m_{}, max_m_{};
-  double max_speed_m_s_ = 0.0, max_voltage_V_ = 0.0;
+  int axis_count_ = 3;
+  std::array<double, kMaxAxes> min_{}, max_{};
+  double max_speed_m_s_ = 0.0, max_theta_speed_rad_s_ = 0.0, max_voltage_V_ = 0.0;
+  double home_rad_ = 0.0;  // theta's home: the gripper's yaw at the axis' 0
   ClientId owner_ = 0;
   std::uint64_t seq_ = 0;
-  std::uint64_t move_seq_ = 0;               // the last goal's command
-  std::array<std::uint64_t, 3> step_seq_{};  // each axis' last open-loop run's command
+  std::uint64_t move_seq_ = 0;                      // the last goal's command
+  std::array<std::uint64_t, kMaxAxes> step_seq_{};  // each axis' last open-loop run's command
 };
 
 }  // namespace mc::vendor

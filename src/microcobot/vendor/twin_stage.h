@@ -19,6 +19,13 @@ using ClientId = std::uint64_t;
 
 class TwinStage {
  public:
+  /// Axes 0, 1, 2 are X, Y, Z (linear: m, stage coordinates, 0 at the home); axis 3, when the
+  /// platform has it, is the rotary axis theta under the gripper (issue #29 point 2: rad, 0 at its
+  /// home, stage.rotary.home_rad: the console's theta, the gripper's yaw, less home_rad).
+  static constexpr int kTheta = 3;
+  static constexpr int kMaxAxes = 4;
+  using Goal = std::array<double, kMaxAxes>;  ///< X, Y, Z [m], theta [rad]
+
   enum class Refusal {
     kNone,           ///< granted
     kHalted,         ///< the platform's e-stop latched (GCS error 10, ANC300 ERROR)
@@ -26,24 +33,29 @@ class TwinStage {
     kBusy,           ///< the command ring is full (try again)
   };
   struct Axis {
-    double position_m = 0.0;  ///< measured (sensor), stage coordinates
-    bool on_target = false;   ///< settled on the last goal (false until the loop applied it)
-    bool stepping = false;    ///< an open-loop run in progress (true from the ask on)
+    double position = 0.0;   ///< measured (sensor): m (X, Y, Z) or rad (theta)
+    bool on_target = false;  ///< settled on the last goal (false until the loop applied it)
+    bool stepping = false;   ///< an open-loop run in progress (true from the ask on)
   };
   virtual ~TwinStage() = default;
 
-  virtual Axis axis(int i) const = 0;  ///< i in 0..2
-  virtual double min_m(int i) const = 0;
-  virtual double max_m(int i) const = 0;
-  virtual double max_speed_m_s() const = 0;
+  /// 3, or 4 with the rotary axis.
+  virtual int axis_count() const = 0;
+  virtual Axis axis(int i) const = 0;  ///< i < axis_count()
+  /// Axis i's travel: the workspace [m], theta's [rad].
+  virtual double min(int i) const = 0;
+  virtual double max(int i) const = 0;
+  /// Axis i's speed cap: the linear axes' [m/s] (one for the three), theta's [rad/s].
+  virtual double max_speed(int i) const = 0;
   virtual double max_voltage_V() const = 0;
   virtual bool halted() const = 0;
   /// True while `client` holds control.
   virtual bool controls(ClientId client) const = 0;
 
-  /// Every axis to `goal_m` (stage coordinates, within the limits) at `speed_m_s`, closed loop.
-  virtual Refusal move_to(ClientId client, const std::array<double, 3>& goal_m, double speed_m_s) = 0;
-  /// `periods` sawtooth periods on axis `i` (direction +1 up, -1 down), open loop.
+  /// Every axis to `goal` (within the limits), closed loop: X, Y, Z together in a straight line
+  /// at `speed_m_s`, theta at `theta_speed_rad_s` (both ignored without the rotary axis).
+  virtual Refusal move_to(ClientId client, const Goal& goal, double speed_m_s, double theta_speed_rad_s) = 0;
+  /// `periods` sawtooth periods on axis `i` (theta too; direction +1 up, -1 down), open loop.
   virtual Refusal step(ClientId client, int i, double amplitude_V, double frequency_Hz, int direction,
                        std::int64_t periods) = 0;
   /// Stops the protocol's motion at once, every axis holding. Never refused (a stop from a client
