@@ -263,7 +263,7 @@ void Platform::slave_control_task() noexcept {
   // that it takes over bumplessly when the run ends.
   for (std::size_t i = 0; i < steppers_.size(); ++i) {
     if (steppers_[i]->running()) {
-      target[i] = measured[i];
+      target[i] = all_measured[i];  // the rotary axis' too (measured holds x, y, z only)
       velocity[i] = 0.0;
     }
   }
