@@ -67,7 +67,7 @@ nlohmann::json task_status_json(const std::optional<LiveTaskStatus>& task) {
           {"looks", s.looks},
           {"looks_found", s.looks_found},
           {"look", s.look == AssemblyTask::Look::kNone ? nlohmann::json(nullptr)
-                                                      : nlohmann::json(AssemblyTask::name(s.look))},
+                                                       : nlohmann::json(AssemblyTask::name(s.look))},
           {"part", s.part < 0 ? nlohmann::json(nullptr) : nlohmann::json(s.part)},
           {"parts", s.parts},
           {"inserted", s.inserted < 0 ? nlohmann::json(nullptr) : nlohmann::json(s.inserted == 1)}};
