@@ -12,7 +12,7 @@ else
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_WITH_OPENCV=ON
 endif
 
-.PHONY: run demo report test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
+.PHONY: graph run demo report test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state. It builds only
@@ -75,6 +75,13 @@ fuzz: deps
 bench: build
 	@for b in $(BUILD)/bench/*_bench; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
 	@echo "== bench/serve_bench.mjs"; MC_CLI=$(CLI) node --experimental-websocket --no-warnings bench/serve_bench.mjs
+
+# The module graph of docs/architecture.md, drawn from the layering declared in
+# src/microcobot/CMakeLists.txt (a test fails when the committed graph is stale).
+graph:
+	@scripts/check_layers.py --dot > docs/module-graph.dot
+	@dot -Tsvg docs/module-graph.dot -o docs/module-graph.svg
+	@echo "docs/module-graph.svg"
 
 format:
 	@git ls-files '*.h' '*.cc' | xargs clang-format -i

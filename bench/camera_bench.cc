@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "microcobot/live/live_platform.h"
-#include "microcobot/platform/timing_stats.h"
+#include "microcobot/runtime/timing_stats.h"
 #include "telemetry_channel.h"
 
 namespace {
@@ -37,11 +37,11 @@ void BM_CameraCostOnTheLoop(benchmark::State& state) {
     mc::live::LivePlatform live(lp);
     const std::size_t tick_channel = mc::bench::telemetry_channel("tick_us");
     std::atomic<int> phase{-1};  // -1 not counted; 0 camera idle; 1 camera forming frames
-    std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
-                                                   mc::platform::TimingStats(1e-7)};  // drain thread only
+    std::array<mc::runtime::TimingStats, 2> ticks{mc::runtime::TimingStats(1e-7),
+                                                  mc::runtime::TimingStats(1e-7)};  // drain thread only
     std::atomic<std::uint64_t> frames_counted{0}, bytes{0};
-    mc::platform::TimingStats latency(1e-4), capture(1e-4);  // camera thread only
-    live.set_frame_sink([&](const mc::platform::CameraFrame& f, double) {
+    mc::runtime::TimingStats latency(1e-4), capture(1e-4);  // camera thread only
+    live.set_frame_sink([&](const mc::devices::CameraFrame& f, double) {
       if (phase.load(std::memory_order_relaxed) != 1) return;
       frames_counted.fetch_add(1, std::memory_order_relaxed);
       bytes.fetch_add(f.jpeg.size(), std::memory_order_relaxed);

@@ -19,11 +19,11 @@
 #include <vector>
 
 #include "microcobot/cell/cell_run.h"
+#include "microcobot/devices/simulated_gripper.h"
+#include "microcobot/imaging/renderer.h"
+#include "microcobot/imaging/scene_snapshot.h"
+#include "microcobot/imaging/sensor_model.h"
 #include "microcobot/platform/camera_scene.h"
-#include "microcobot/platform/simulated_gripper.h"
-#include "microcobot/vision/renderer.h"
-#include "microcobot/vision/scene_snapshot.h"
-#include "microcobot/vision/sensor_model.h"
 
 namespace {
 
@@ -57,7 +57,7 @@ class CameraInTheLoop {
     c.set_observer([this, &c](double t_s) {
       if (t_s < next_s_) return;
       next_s_ += 1.0 / renderer_.camera().sensor.frame_rate_Hz;
-      const pf::SimulatedGripper& g = *c.platform().simulation().gripper;
+      const mc::devices::SimulatedGripper& g = *c.platform().simulation().gripper;
       pf::CameraScenePose pose;
       const Eigen::Vector3d tip = g.tip_position_m(), part = g.world_state().part_m;
       pose.tool_x_m = tip.x();
@@ -75,17 +75,17 @@ class CameraInTheLoop {
   std::uint64_t frames() const { return frames_; }
 
  private:
-  static vs::CameraParams camera(const cl::AssemblyJob& job) {
-    vs::CameraParams cam;
-    cam.objective = vs::objective_by_name("10x");
+  static mc::imaging::CameraParams camera(const cl::AssemblyJob& job) {
+    mc::imaging::CameraParams cam;
+    cam.objective = mc::imaging::objective_by_name("10x");
     cam.view_center_x_m = job.nominal_part_m.x();  // the tray's pin (fixed field of view)
     cam.view_center_y_m = job.nominal_part_m.y();
     return cam;
   }
-  vs::Renderer renderer_;
-  vs::CameraControls controls_;
-  vs::SceneSnapshot scene_;
-  vs::Frame frame_;
+  mc::imaging::Renderer renderer_;
+  mc::imaging::CameraControls controls_;
+  mc::imaging::SceneSnapshot scene_;
+  mc::imaging::Frame frame_;
   double next_s_ = 0.0;
   std::uint64_t frames_ = 0;
 };

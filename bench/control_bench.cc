@@ -3,32 +3,32 @@
 // plant is not included except in BM_XyzStageTick (three axes, model included).
 #include <benchmark/benchmark.h>
 
-#include "microcobot/control/contact_estimator.h"
-#include "microcobot/control/delayed_teleoperation.h"
-#include "microcobot/control/model_mediated_master.h"
-#include "microcobot/control/position_controller.h"
-#include "microcobot/control/setpoint_stream.h"
-#include "microcobot/control/tracking_controller.h"
-#include "microcobot/control/velocity_controller.h"
-#include "microcobot/control/xyz_stage.h"
+#include "microcobot/motion/position_controller.h"
+#include "microcobot/motion/setpoint_stream.h"
+#include "microcobot/motion/tracking_controller.h"
+#include "microcobot/motion/velocity_controller.h"
+#include "microcobot/motion/xyz_stage.h"
 #include "microcobot/stickslip/actuator.h"
+#include "microcobot/teleop/contact_estimator.h"
+#include "microcobot/teleop/delayed_teleoperation.h"
+#include "microcobot/teleop/model_mediated_master.h"
 
 namespace {
 
-namespace ct = mc::control;
 namespace ss = mc::stickslip;
 
 const ss::ActuatorModel& model() {
   static const ss::ActuatorModel m{ss::StickSlipParams{}};
   return m;
 }
-const ct::StepMap& step_map() {
-  static const ct::StepMap map{model()};
+const mc::motion::StepMap& step_map() {
+  static const mc::motion::StepMap map{model()};
   return map;
 }
 
 void BM_VelocityControllerTick(benchmark::State& st) {
-  ct::VelocityController c(ct::VelocityControlParams{}, ct::VelocityMode::kModelBased, &step_map());
+  mc::motion::VelocityController c(mc::motion::VelocityControlParams{}, mc::motion::VelocityMode::kModelBased,
+                                   &step_map());
   c.set_reference(100e-6);
   double x = 0.0;
   for (auto _ : st) {
@@ -41,7 +41,7 @@ BENCHMARK(BM_VelocityControllerTick);
 
 /// Position controller in a closed loop on the model, timed without the model's steps.
 void position_tick(benchmark::State& st, double target) {
-  ct::PositionController c(ct::PositionControlParams{}, model().params(), step_map());
+  mc::motion::PositionController c(mc::motion::PositionControlParams{}, model().params(), step_map());
   auto s = model().initial_state();
   c.set_target(target);
   mc::stickslip::DriveSegment u[10];
@@ -61,7 +61,7 @@ BENCHMARK(BM_PositionControllerTickScanning)->Iterations(20000);
 /// Tracking controller (issue #15) following a 200 um/s ramp on the model (edges every ~2.5 ms),
 /// timed without the model's steps.
 void BM_TrackingControllerTick(benchmark::State& st) {
-  ct::TrackingController c(ct::TrackingParams{}, model().params(), step_map());
+  mc::motion::TrackingController c(mc::motion::TrackingParams{}, model().params(), step_map());
   auto s = model().initial_state();
   c.reset(0.0, 0.0);
   double r = 0.0;
@@ -82,7 +82,7 @@ BENCHMARK(BM_TrackingControllerTick)->Iterations(20000);
 
 /// Setpoint stream: one setpoint per 10 ticks (1 kHz) and a sample per tick (10 kHz).
 void BM_SetpointStreamSample(benchmark::State& st) {
-  ct::SetpointStream s(ct::SetpointStreamParams{}, 0.0);
+  mc::motion::SetpointStream s(mc::motion::SetpointStreamParams{}, 0.0);
   long k = 0;
   for (auto _ : st) {
     const double t = static_cast<double>(k) * 1e-4;
@@ -94,10 +94,10 @@ void BM_SetpointStreamSample(benchmark::State& st) {
 BENCHMARK(BM_SetpointStreamSample);
 
 void BM_XyzStageTick(benchmark::State& st) {
-  ct::XyzStage stage(model(), step_map());
-  stage.set_target(ct::Axis::kX, 5e-3);
-  stage.set_target(ct::Axis::kY, -5e-3);
-  stage.set_target(ct::Axis::kZ, 0.3e-6);
+  mc::motion::XyzStage stage(model(), step_map());
+  stage.set_target(mc::motion::Axis::kX, 5e-3);
+  stage.set_target(mc::motion::Axis::kY, -5e-3);
+  stage.set_target(mc::motion::Axis::kZ, 0.3e-6);
   for (auto _ : st) stage.tick();
 }
 BENCHMARK(BM_XyzStageTick)->Iterations(20000);
@@ -105,7 +105,7 @@ BENCHMARK(BM_XyzStageTick)->Iterations(20000);
 /// Model-mediated teleoperation (issue #31): the master model's haptic step (eq. 1-3 of
 /// model_mediated_master.h, with its passivity controller) and the slave estimator's sample.
 void BM_ModelMediatedMasterStep(benchmark::State& st) {
-  ct::ModelMediatedMaster m({}, {0.0, 0.02, 1000.0});
+  mc::teleop::ModelMediatedMaster m({}, {0.0, 0.02, 1000.0});
   m.receive({0.0, 0.0201, 1200.0});
   double x = 0.021, v = 1e-3, acc = 0.0;
   for (auto _ : st) {
@@ -118,7 +118,7 @@ void BM_ModelMediatedMasterStep(benchmark::State& st) {
 BENCHMARK(BM_ModelMediatedMasterStep);
 
 void BM_ContactEstimatorUpdate(benchmark::State& st) {
-  ct::ContactEstimator e({}, {0.0, 0.02, 1000.0});
+  mc::teleop::ContactEstimator e({}, {0.0, 0.02, 1000.0});
   double x = 0.02, dx = 1e-6;
   for (auto _ : st) {
     e.update(x, 1500.0 * (x - 0.0199));
@@ -131,9 +131,10 @@ BENCHMARK(BM_ContactEstimatorUpdate);
 
 /// One delay-sweep case (6 s of the coupling at 1 kHz, mechanics at 10 kHz), per scheme.
 void BM_DelayCase(benchmark::State& st) {
-  const auto scheme = static_cast<ct::Scheme>(st.range(0));
+  const auto scheme = static_cast<mc::teleop::Scheme>(st.range(0));
   for (auto _ : st) {
-    const auto r = ct::run_delay_case(ct::DelayedTeleopParams{}, {0.2, 0.01, 0.2, scheme, 1, 0.0});
+    const auto r =
+        mc::teleop::run_delay_case(mc::teleop::DelayedTeleopParams{}, {0.2, 0.01, 0.2, scheme, 1, 0.0});
     benchmark::DoNotOptimize(r.max_handle_excursion_m);
   }
 }

@@ -28,7 +28,7 @@
 #include <thread>
 #include <vector>
 
-#include "microcobot/platform/cpu_affinity.h"
+#include "microcobot/runtime/cpu_affinity.h"
 
 namespace {
 
@@ -79,7 +79,7 @@ void BM_CoreInterference(benchmark::State& state) {
     std::atomic<int> kind{kIdle};
     std::atomic<bool> run{true};
     std::thread other([&] {
-      mc::platform::pin_calling_thread(0);
+      mc::runtime::pin_calling_thread(0);
       std::vector<float> a(2u << 20, 1.0f), b(2u << 20, 2.0f);  // 8 MB each
       double x = 1.0;
       while (run.load(std::memory_order_relaxed)) disturb(kind.load(std::memory_order_relaxed), a, b, x);
@@ -87,7 +87,7 @@ void BM_CoreInterference(benchmark::State& state) {
     });
     std::array<std::vector<double>, kKinds> ticks;
     std::thread loop([&] {
-      mc::platform::pin_calling_thread(cores - 1);
+      mc::runtime::pin_calling_thread(cores - 1);
       sched_param sp{};
       sp.sched_priority = sched_get_priority_max(SCHED_FIFO) - 10;
       pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);  // best effort (unprivileged: not)

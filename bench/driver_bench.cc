@@ -16,12 +16,12 @@
 
 #include <fmt/format.h>
 
+#include "microcobot/drivers/bus_controller.h"
+#include "microcobot/drivers/register_drivers.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/platform/driver_registry.h"
-#include "microcobot/vendor/bus_controller.h"
-#include "microcobot/vendor/live_stage.h"
-#include "microcobot/vendor/twin_server.h"
-#include "microcobot/vendor/vendor_drivers.h"
+#include "microcobot/twins/live_stage.h"
+#include "microcobot/twins/twin_server.h"
 
 namespace {
 
@@ -34,19 +34,19 @@ struct Phase {
 Phase run_phase(mc::platform::Platform& p, double seconds) {
   const auto& s = p.config().stage;
   const Eigen::Vector3d home(s.home_x_m, s.home_y_m, s.home_z_m);
-  mc::control::ConsoleInput in;
+  mc::teleop::ConsoleInput in;
   in.active = in.fresh = in.deadman = in.has_goal = true;
   in.goal_speed_m_s = 1e-3;
   std::uint64_t slave_ticks = 0, fresh_ticks = 0;
   const int divisor = p.config().loop.slave_divisor;
-  p.set_operator([&](const mc::platform::TickInfo& t) {
+  p.set_operator([&](const mc::runtime::TickInfo& t) {
     const bool right = static_cast<long long>(t.t_s / 0.5) % 2 == 0;
     in.goal_m = home + Eigen::Vector3d(right ? 10e-6 : -10e-6, 0, 0);
     p.set_console_input(in);
     ++slave_ticks;  // the operator task's rate (1 kHz, as the slave's)
     fresh_ticks += p.axis(0).measurement_fresh() ? 1 : 0;
   });
-  const auto* bus = dynamic_cast<const mc::vendor::BusAxis*>(&p.axis(0));
+  const auto* bus = dynamic_cast<const mc::drivers::BusAxis*>(&p.axis(0));
   const std::uint64_t cycles0 = bus != nullptr ? bus->controller().cycles() : 0;
   const std::uint64_t ticks0 = p.loop().ticks(), over0 = p.loop().overruns();
   const auto t0 = Clock::now();
@@ -63,15 +63,15 @@ Phase run_phase(mc::platform::Platform& p, double seconds) {
 }
 
 void BM_DriverBackedPlatformRate(benchmark::State& state) {
-  mc::vendor::register_vendor_drivers();
+  mc::drivers::register_vendor_drivers();
   for (auto _ : state) {
     mc::live::LiveParams lp;
     mc::live::LivePlatform live(lp);
     live.start([](const mc::platform::TelemetrySample&, std::size_t) {});
-    mc::vendor::LiveStage stage(live);
-    mc::vendor::TwinServerParams tp;
-    tp.endpoints = {{mc::vendor::Protocol::kGcs2, "127.0.0.1", 0}};
-    mc::vendor::TwinServer server(stage, tp);
+    mc::twins::LiveStage stage(live);
+    mc::twins::TwinServerParams tp;
+    tp.endpoints = {{mc::twins::Protocol::kGcs2, "127.0.0.1", 0}};
+    mc::twins::TwinServer server(stage, tp);
     server.start();
     mc::platform::PlatformConfig sim;
     sim.loop.realtime = true;

@@ -7,7 +7,7 @@
 #include <array>
 #include <memory>
 
-#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 
 namespace {
@@ -22,11 +22,11 @@ pf::PlatformConfig bench_config(bool tracking) {
 
 struct Rig {
   explicit Rig(bool tracking = true) : config(bench_config(tracking)) {
-    platform.set_operator([this](const pf::TickInfo& t) { op.act(t); });
+    platform.set_operator([this](const mc::runtime::TickInfo& t) { op.act(t); });
   }
   pf::PlatformConfig config;
   pf::Platform platform{config};
-  pf::PickPlaceOperator op{platform, pf::PickPlaceOperatorParams{}};
+  mc::cell::PickPlaceOperator op{platform, mc::cell::PickPlaceOperatorParams{}};
 };
 
 // Ticks of the scenario from `start_s` on: approach (0 s, one axis stepping) or transport
@@ -79,10 +79,11 @@ BENCHMARK(BM_ThreeAxesOneTick)->Unit(benchmark::kMicrosecond);
 
 // The masters' share: the dual-stage interface (pipeline + plant) and the TéléTweez.
 void BM_MastersOneTick(benchmark::State& state) {
-  pf::SimulatedHapticMaster h("h", mc::haptics::DualStagePlantParams{}, mc::haptics::RenderPipelineParams{},
-                              mc::haptics::PantographParams{}, 1e-4);
-  pf::SimulatedTweezersMaster t("t", mc::tweezers::TeleTweezParams{}, 1e-4);
-  for (mc::platform::Device* d : std::array<mc::platform::Device*, 2>{&h, &t}) {
+  mc::devices::SimulatedHapticMaster h("h", mc::haptics::DualStagePlantParams{},
+                                       mc::haptics::RenderPipelineParams{}, mc::haptics::PantographParams{},
+                                       1e-4);
+  mc::devices::SimulatedTweezersMaster t("t", mc::tweezers::TeleTweezParams{}, 1e-4);
+  for (mc::devices::Device* d : std::array<mc::devices::Device*, 2>{&h, &t}) {
     d->configure();
     d->activate();
   }

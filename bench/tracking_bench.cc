@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "microcobot/vision/renderer.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/vision/template_tracker.h"
 
 namespace {
@@ -20,18 +20,18 @@ constexpr int kTemplate = 128;
 constexpr int kFrames = 8;
 
 struct Frames {
-  std::vector<vs::Frame> frames;
-  vs::Frame first;
+  std::vector<mc::imaging::Frame> frames;
+  mc::imaging::Frame first;
   Frames() {
-    vs::CameraParams cam;
-    cam.objective = vs::objective_by_name("10x");
-    vs::Renderer renderer(cam);
-    vs::CameraControls c = renderer.default_controls();
+    mc::imaging::CameraParams cam;
+    cam.objective = mc::imaging::objective_by_name("10x");
+    mc::imaging::Renderer renderer(cam);
+    mc::imaging::CameraControls c = renderer.default_controls();
     c.focus_z_m = 100e-6;
     const double px = cam.pixel_size_m();
     const auto scene = [&](double shift_px) {
-      vs::SceneSnapshot s;
-      vs::Part p;
+      mc::imaging::SceneSnapshot s;
+      mc::imaging::Part p;
       p.x_m = 150e-6 + shift_px * px;
       p.y_m = -150e-6 - shift_px * px;
       p.size_x_m = p.size_y_m = 300e-6;
@@ -50,7 +50,7 @@ const Frames& frames() {
   return f;
 }
 
-vs::PixelRoi roi(const vs::Frame& f) {
+mc::imaging::PixelRoi roi(const mc::imaging::Frame& f) {
   return {f.width / 2 - kTemplate / 2, f.height / 2 - kTemplate / 2, kTemplate, kTemplate};
 }
 

@@ -27,9 +27,9 @@
 #include <vector>
 
 #include "microcobot/live/live_platform.h"
-#include "microcobot/platform/timing_stats.h"
-#include "microcobot/vendor/live_stage.h"
-#include "microcobot/vendor/twin_server.h"
+#include "microcobot/runtime/timing_stats.h"
+#include "microcobot/twins/live_stage.h"
+#include "microcobot/twins/twin_server.h"
 #include "telemetry_channel.h"
 
 namespace {
@@ -79,20 +79,20 @@ void BM_TwinPollingCost(benchmark::State& state) {
     mc::live::LivePlatform live(lp);
     const std::size_t tick_channel = mc::bench::telemetry_channel("tick_us");
     std::atomic<int> phase{-1};  // -1 not counted; 0 idle; 1 polled
-    std::array<mc::platform::TimingStats, 2> ticks{mc::platform::TimingStats(1e-7),
-                                                   mc::platform::TimingStats(1e-7)};  // drain thread only
+    std::array<mc::runtime::TimingStats, 2> ticks{mc::runtime::TimingStats(1e-7),
+                                                  mc::runtime::TimingStats(1e-7)};  // drain thread only
     live.start([&](const mc::platform::TelemetrySample& s, std::size_t) {
       const int p = phase.load(std::memory_order_relaxed);
       if (p >= 0) ticks[static_cast<std::size_t>(p)].add(1e-6 * s[tick_channel]);
     });
-    mc::vendor::LiveStage stage(live);
-    mc::vendor::TwinServerParams tp;
-    tp.endpoints = {{mc::vendor::Protocol::kGcs2, "127.0.0.1", 0}};
-    mc::vendor::TwinServer server(stage, tp);
+    mc::twins::LiveStage stage(live);
+    mc::twins::TwinServerParams tp;
+    tp.endpoints = {{mc::twins::Protocol::kGcs2, "127.0.0.1", 0}};
+    mc::twins::TwinServer server(stage, tp);
     server.start();
     const std::uint16_t port = server.ports()[0];
 
-    mc::platform::TimingStats latency(1e-6);  // 1 us bins
+    mc::runtime::TimingStats latency(1e-6);  // 1 us bins
     std::atomic<bool> polling{false}, quit{false};
     std::vector<std::vector<double>> samples(4);
     std::vector<std::thread> clients;

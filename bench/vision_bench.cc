@@ -30,9 +30,9 @@
 #include <benchmark/benchmark.h>
 
 #include "microcobot/core/rng.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/autofocus.h"
-#include "microcobot/vision/renderer.h"
 
 namespace {
 
@@ -48,15 +48,15 @@ void render_frames(benchmark::State& state, bool moving_focus) {
   pose.tool_x_m = pose.part_x_m, pose.tool_y_m = pose.part_y_m, pose.tool_z_m = 300e-6;
   pose.opening_m = 260e-6;
   pose.vx_m_s = 50e-6;  // the fingers moving: motion blur on
-  vs::SceneSnapshot scene;
+  mc::imaging::SceneSnapshot scene;
   pf::fill_camera_scene(config, pose, scene);
-  vs::CameraParams cam;
-  cam.objective = vs::objective_by_name(kObjectives[state.range(0)]);
+  mc::imaging::CameraParams cam;
+  cam.objective = mc::imaging::objective_by_name(kObjectives[state.range(0)]);
   cam.view_center_x_m = pose.part_x_m + 60e-6;
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
+  mc::imaging::Renderer renderer(cam);
+  mc::imaging::CameraControls controls = renderer.default_controls();
   controls.focus_z_m = 300e-6;
-  vs::Frame frame;
+  mc::imaging::Frame frame;
   renderer.render(scene, controls, 1, 0, frame);  // the substrate's texture: once per camera
   std::uint64_t index = 1;
   for (auto _ : state) {
@@ -82,7 +82,7 @@ namespace {
 // ---- Autofocus -------------------------------------------------------------------------------
 
 const char* kFocusObjectives[] = {"5x", "10x", "20x", "50x"};
-constexpr vs::PixelRoi kFocusRoi{64, 64, 256, 192};
+constexpr mc::imaging::PixelRoi kFocusRoi{64, 64, 256, 192};
 
 struct FocusCase {
   bool part = false;
@@ -114,21 +114,21 @@ struct FocusResult {
 };
 
 FocusResult run_focus_case(const char* objective, const FocusCase& c, const Variant& v) {
-  vs::CameraParams cam;
-  cam.objective = vs::objective_by_name(objective);
+  mc::imaging::CameraParams cam;
+  cam.objective = mc::imaging::objective_by_name(objective);
   cam.sensor.width_px = 384, cam.sensor.height_px = 320;
-  vs::SceneSnapshot s;
+  mc::imaging::SceneSnapshot s;
   s.substrate.texture_seed = c.texture_seed;
   if (c.part) {
-    vs::Part p;
+    mc::imaging::Part p;
     p.size_x_m = p.size_y_m = 300e-6;
     p.x_m = c.part_x_m;
     p.z_top_m = c.z_true_m;
     s.parts.push_back(p);
   }
-  vs::Renderer r(cam);
-  vs::CameraControls controls = r.default_controls();
-  vs::Frame frame;
+  mc::imaging::Renderer r(cam);
+  mc::imaging::CameraControls controls = r.default_controls();
+  mc::imaging::Frame frame;
   const vs::FocusMetric fine =
       *v.fine_metric ? vs::parse_focus_metric(v.fine_metric) : vs::default_fine_metric(r.figures());
   vs::AutofocusParams p = vs::autofocus_params_for(r.figures(), c.z_true_m + c.offset_m, fine);
@@ -167,7 +167,7 @@ std::vector<FocusCase> tuning_cases() {
 std::vector<FocusCase> validation_cases(int set, int objective) {
   mc::Rng rng(static_cast<std::uint64_t>(set == 0 ? 2028 : 5077) + static_cast<std::uint64_t>(objective));
   const double roi_w_m =
-      kFocusRoi.width * 5.3e-6 / vs::objective_by_name(kFocusObjectives[objective]).magnification;
+      kFocusRoi.width * 5.3e-6 / mc::imaging::objective_by_name(kFocusObjectives[objective]).magnification;
   std::vector<FocusCase> out;
   for (int i = 0; i < 30; ++i) {
     FocusCase c;
@@ -233,14 +233,14 @@ void BM_AutofocusValidation(benchmark::State& state) {
 
 // One focus measure over a whole 1280 x 1024 frame of the substrate in focus (10x).
 void BM_FocusMetric(benchmark::State& state) {
-  vs::CameraParams cam;
-  cam.objective = vs::objective_by_name("10x");
-  vs::Renderer r(cam);
-  vs::SceneSnapshot s;
-  vs::Frame frame;
+  mc::imaging::CameraParams cam;
+  cam.objective = mc::imaging::objective_by_name("10x");
+  mc::imaging::Renderer r(cam);
+  mc::imaging::SceneSnapshot s;
+  mc::imaging::Frame frame;
   r.render(s, r.default_controls(), 1, 0, frame);
   const auto metric = static_cast<vs::FocusMetric>(state.range(0));
-  const vs::PixelRoi roi = vs::full_roi(frame);
+  const mc::imaging::PixelRoi roi = mc::imaging::full_roi(frame);
   for (auto _ : state) benchmark::DoNotOptimize(vs::sharpness(frame, roi, metric));
   state.SetLabel(vs::focus_metric_name(metric));
   state.counters["Mpx_per_s"] =

@@ -1,5 +1,5 @@
 // microcobot.control and microcobot.platform: the stick-slip controllers steppable from a Python loop
-// and the closed-loop runs of `microcobot control` (control/closed_loop.h); the platform's scenario
+// and the closed-loop runs of `microcobot control` (motion/closed_loop.h); the platform's scenario
 // runs (`microcobot run`) and its recordings (CSV, MCAP, .mat) as dicts of numpy arrays.
 
 #include <map>
@@ -7,14 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
-#include "microcobot/control/closed_loop.h"
-#include "microcobot/control/control_params.h"
-#include "microcobot/control/position_controller.h"
-#include "microcobot/control/position_sensor.h"
-#include "microcobot/control/setpoint_stream.h"
-#include "microcobot/control/step_map.h"
-#include "microcobot/control/tracking_run.h"
-#include "microcobot/control/velocity_controller.h"
+#include "microcobot/cell/session.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mat_file.h"
 #include "microcobot/core/mcap_reader.h"
@@ -22,8 +15,15 @@
 #include "microcobot/haptics/evaluation.h"
 #include "microcobot/haptics/identification.h"
 #include "microcobot/haptics/render_pipeline.h"
+#include "microcobot/motion/closed_loop.h"
+#include "microcobot/motion/control_params.h"
+#include "microcobot/motion/position_controller.h"
+#include "microcobot/motion/position_sensor.h"
+#include "microcobot/motion/setpoint_stream.h"
+#include "microcobot/motion/step_map.h"
+#include "microcobot/motion/velocity_controller.h"
 #include "microcobot/platform/platform_config.h"
-#include "microcobot/platform/session.h"
+#include "microcobot/studies/tracking_run.h"
 #include "microcobot/tweezers/ballscrew.h"
 #include "microcobot/tweezers/bandwidth.h"
 #include "microcobot/tweezers/specs.h"
@@ -42,7 +42,6 @@ platform::PlatformConfig config_from(py::handle c) {
 
 namespace {
 
-namespace ct = mc::control;
 namespace pf = mc::platform;
 
 namespace ss = mc::stickslip;
@@ -51,24 +50,24 @@ using namespace pybind11::literals;
 /// One controlled axis: its parameters, the model and the model's step map (built once: the
 /// expensive part, ~0.3 s). Controllers keep a reference to it (kept alive by pybind11).
 struct Plant {
-  ct::ControlParams params;
+  motion::ControlParams params;
   ss::ActuatorModel model;
-  ct::StepMap map;
-  explicit Plant(const ct::ControlParams& p) : params(p), model(p.model), map(model, p.step_map) {}
+  motion::StepMap map;
+  explicit Plant(const motion::ControlParams& p) : params(p), model(p.model), map(model, p.step_map) {}
 };
 
-py::tuple operating_point(const ct::SawtoothGenerator& g) {
+py::tuple operating_point(const motion::SawtoothGenerator& g) {
   return py::make_tuple(g.amplitude_V(), g.frequency_Hz(), ss::to_string(g.direction()));
 }
 
-py::dict velocity_metrics_dict(const ct::VelocityMetrics& m) {
+py::dict velocity_metrics_dict(const motion::VelocityMetrics& m) {
   return py::dict(
       "mean_velocity_m_s"_a = m.mean_velocity_m_s, "steady_state_error_rel"_a = m.steady_state_error_rel,
       "settling_time_s"_a = m.settling_time_s, "settled"_a = m.settled, "ripple_m_s"_a = m.ripple_m_s,
       "excursions"_a = m.excursions, "max_excursion_rel"_a = m.max_excursion_rel);
 }
 
-py::dict position_run_dict(const ct::PositionRun& r) {
+py::dict position_run_dict(const motion::PositionRun& r) {
   const auto& m = r.metrics;
   return py::dict(
       "t_s"_a = to_array(r.t_s), "x_m"_a = to_array(r.x_m), "u_V"_a = to_array(r.u_V),
@@ -180,7 +179,7 @@ void write_mat_dict(const std::string& path, const py::dict& vars) {
 
 void bind_control(py::module_& m) {
   m.def(
-      "params", [](py::handle p) { return params_dict(params_from<ct::ControlParams>(p)); },
+      "params", [](py::handle p) { return params_dict(params_from<motion::ControlParams>(p)); },
       "params"_a = py::none(),
       "Every parameter of a controlled axis (model, step_map, sensor, velocity, position, baseline, limits): "
       "the keys "
@@ -189,13 +188,14 @@ void bind_control(py::module_& m) {
   py::class_<Plant>(m, "Plant",
                     "A controlled axis: its parameters, the stick-slip model and its step map (built once, "
                     "~0.3 s).")
-      .def(py::init([](py::handle p) { return std::make_unique<Plant>(params_from<ct::ControlParams>(p)); }),
+      .def(py::init(
+               [](py::handle p) { return std::make_unique<Plant>(params_from<motion::ControlParams>(p)); }),
            "params"_a = py::none())
       .def_property_readonly(
           "model", [](const Plant& p) { return p.model; }, "The stick-slip model (an Actuator copy)")
       .def_property_readonly("params", [](const Plant& p) { return params_dict(p.params); })
       .def(
-          "steps_per_tick", [](const Plant& p, double rate) { return ct::steps_per_tick(p.model, rate); },
+          "steps_per_tick", [](const Plant& p, double rate) { return motion::steps_per_tick(p.model, rate); },
           "control_rate_Hz"_a, "Model steps per control tick (the control period must be whole model steps).")
       .def(
           "step_length",
@@ -206,53 +206,55 @@ void bind_control(py::module_& m) {
           "|step| per sawtooth period [m] at (A, f, direction) from the step map (thesis §2.5.3, Fig. "
           "2.15).");
 
-  py::class_<ct::PositionSensor>(m, "PositionSensor",
-                                 "Position sensor (thesis §2.3): x + white noise, quantised.")
-      .def(
-          py::init([](py::handle p) { return ct::PositionSensor(params_from<ct::PositionSensorParams>(p)); }),
-          "params"_a = py::none())
-      .def("measure", &ct::PositionSensor::measure, "true_position_m"_a, "Measured position [m]");
+  py::class_<motion::PositionSensor>(m, "PositionSensor",
+                                     "Position sensor (thesis §2.3): x + white noise, quantised.")
+      .def(py::init([](py::handle p) {
+             return motion::PositionSensor(params_from<motion::PositionSensorParams>(p));
+           }),
+           "params"_a = py::none())
+      .def("measure", &motion::PositionSensor::measure, "true_position_m"_a, "Measured position [m]");
 
-  py::class_<ct::VelocityController>(
+  py::class_<motion::VelocityController>(
       m, "VelocityController",
       "Velocity control (thesis §2.7, Fig. 2.18): 1 kHz sawtooth whose amplitude a PID "
       "sets from the velocity error. Call update() at control_rate_Hz and next_drive() "
       "at every model step.")
       .def(py::init([](const Plant& p, const std::string& mode) {
-             return ct::VelocityController(p.params.velocity, ct::parse_velocity_mode(mode), &p.map,
-                                           p.model.params().drive.slew_rate_V_s);
+             return motion::VelocityController(p.params.velocity, motion::parse_velocity_mode(mode), &p.map,
+                                               p.model.params().drive.slew_rate_V_s);
            }),
            "plant"_a, "mode"_a = "model", py::keep_alive<1, 2>(), "mode: 'model' | 'pid' | 'open-loop'.")
-      .def("set_reference", &ct::VelocityController::set_reference, "v_m_s"_a, "Reference velocity [m/s]")
+      .def("set_reference", &motion::VelocityController::set_reference, "v_m_s"_a, "Reference velocity [m/s]")
       .def(
           "update",
-          [](ct::VelocityController& c, double x) {
+          [](motion::VelocityController& c, double x) {
             require(std::isfinite(x), "measured_position_m", "must be finite", x);
             c.update(x);
           },
           "measured_position_m"_a, "One control tick with the measured slider position [m].")
-      .def("next_drive", &ct::VelocityController::next_drive, "dt_s"_a,
+      .def("next_drive", &motion::VelocityController::next_drive, "dt_s"_a,
            "The drive over the next model step (pass it to Actuator.step).")
-      .def("emergency_stop", &ct::VelocityController::emergency_stop, "0 V at once, integrator cleared.")
-      .def_property_readonly("velocity_estimate_m_s", &ct::VelocityController::velocity_estimate_m_s)
-      .def_property_readonly("amplitude_V", &ct::VelocityController::amplitude_V)
-      .def_property_readonly("end_stop", &ct::VelocityController::end_stop)
+      .def("emergency_stop", &motion::VelocityController::emergency_stop, "0 V at once, integrator cleared.")
+      .def_property_readonly("velocity_estimate_m_s", &motion::VelocityController::velocity_estimate_m_s)
+      .def_property_readonly("amplitude_V", &motion::VelocityController::amplitude_V)
+      .def_property_readonly("end_stop", &motion::VelocityController::end_stop)
       .def_property_readonly(
-          "operating_point", [](const ct::VelocityController& c) { return operating_point(c.generator()); },
+          "operating_point",
+          [](const motion::VelocityController& c) { return operating_point(c.generator()); },
           "(amplitude_V, frequency_Hz, direction) of the sawtooth, for Actuator.set_operating_point (thesis "
           "§2.7).");
 
-  py::class_<ct::PositionController>(
+  py::class_<motion::PositionController>(
       m, "PositionController",
       "Hybrid positioning: stepping far from the target, scanning with the inverse PI "
       "hysteresis (eq. 2.5) near it, then hold.")
       .def(py::init([](const Plant& p) {
-             return std::make_unique<ct::PositionController>(p.params.position, p.params.model, p.map);
+             return std::make_unique<motion::PositionController>(p.params.position, p.params.model, p.map);
            }),
            "plant"_a, py::keep_alive<1, 2>())
       .def(
           "set_target",
-          [](ct::PositionController& c, double target, double v) {
+          [](motion::PositionController& c, double target, double v) {
             require(std::isfinite(target) && std::isfinite(v), "target_m", "must be finite", target);
             c.set_target(target, v);
           },
@@ -261,29 +263,30 @@ void bind_control(py::module_& m) {
           "stop.")
       .def(
           "update",
-          [](ct::PositionController& c, double x) {
+          [](motion::PositionController& c, double x) {
             require(std::isfinite(x), "measured_position_m", "must be finite", x);
             c.update(x);
           },
           "measured_position_m"_a, "One control tick with the measured slider position [m].")
-      .def("next_drive", &ct::PositionController::next_drive, "dt_s"_a,
+      .def("next_drive", &motion::PositionController::next_drive, "dt_s"_a,
            "The drive over the next model step (pass it to Actuator.step).")
-      .def("emergency_stop", &ct::PositionController::emergency_stop,
+      .def("emergency_stop", &motion::PositionController::emergency_stop,
            "0 V at once; the axis stays stopped until the next set_target().")
-      .def_property_readonly("mode", [](const ct::PositionController& c) { return ct::to_string(c.mode()); })
-      .def_property_readonly("in_position", &ct::PositionController::in_position)
-      .def_property_readonly("end_stop", &ct::PositionController::end_stop)
-      .def_property_readonly("voltage_V", &ct::PositionController::voltage_V)
-      .def_property_readonly("operating_point",
-                             [](const ct::PositionController& c) { return operating_point(c.generator()); });
+      .def_property_readonly("mode", [](const motion::PositionController& c) { return to_string(c.mode()); })
+      .def_property_readonly("in_position", &motion::PositionController::in_position)
+      .def_property_readonly("end_stop", &motion::PositionController::end_stop)
+      .def_property_readonly("voltage_V", &motion::PositionController::voltage_V)
+      .def_property_readonly("operating_point", [](const motion::PositionController& c) {
+        return operating_point(c.generator());
+      });
 
   m.def(
       "run_velocity",
       [](const Plant& p, double reference_m_s, const std::string& mode, double duration_s, double start_m) {
-        const auto mo = ct::parse_velocity_mode(mode);
+        const auto mo = motion::parse_velocity_mode(mode);
         const auto r = nogil([&] {
-          return ct::run_velocity(p.model, &p.map, p.params.velocity, mo, reference_m_s, duration_s,
-                                  p.params.sensor, start_m);
+          return motion::run_velocity(p.model, &p.map, p.params.velocity, mo, reference_m_s, duration_s,
+                                      p.params.sensor, start_m);
         });
         return py::dict("t_s"_a = to_array(r.t_s), "v_m_s"_a = to_array(r.v_true_m_s),
                         "v_est_m_s"_a = to_array(r.v_est_m_s), "amplitude_V"_a = to_array(r.amplitude_V),
@@ -297,8 +300,8 @@ void bind_control(py::module_& m) {
       "run_position",
       [](const Plant& p, double target_m, double start_m, double hold_s, double max_time_s) {
         const auto r = nogil([&] {
-          return ct::run_position(p.model, p.map, p.params.position, p.params.sensor, start_m, target_m,
-                                  hold_s, max_time_s);
+          return motion::run_position(p.model, p.map, p.params.position, p.params.sensor, start_m, target_m,
+                                      hold_s, max_time_s);
         });
         return position_run_dict(r);
       },
@@ -312,7 +315,7 @@ void bind_control(py::module_& m) {
         const auto sp = span_of(setpoints, "setpoints_m");
         if (!(setpoint_rate_Hz > 0.0 && setpoint_rate_Hz <= 1e5))
           throw InvalidParams("setpoint_rate_Hz", "in (0, 1e5] Hz", setpoint_rate_Hz);
-        const auto kind = ct::parse_tracker_kind(tracker);
+        const auto kind = studies::parse_tracker_kind(tracker);
         const double half = 0.5 * p.model.params().slider.stroke_m;
         for (std::size_t k = 0; k < sp.size(); ++k)
           if (std::abs(sp[k]) > half)
@@ -329,15 +332,15 @@ void bind_control(py::module_& m) {
           // The setpoints are stamped on the sender's clock, k / rate, and read through the
           // stream's bounded look-ahead by the 10 kHz controller (issue #15 item 4): past the
           // last one the stream holds.
-          ct::SetpointStream stream(p.params.stream, start_m);
+          motion::SetpointStream stream(p.params.stream, start_m);
           std::size_t next = 0;
           const auto reference = [&](double t, double dt) {
             for (; next < values.size() && static_cast<double>(next) / setpoint_rate_Hz <= t; ++next)
               stream.push(static_cast<double>(next) / setpoint_rate_Hz, values[next]);
             return stream.sample(t, dt);
           };
-          return ct::run_tracker(p.model, p.map, kind, ct::tracker_setup(p.params), start_m, reference,
-                                 duration_s);
+          return studies::run_tracker(p.model, p.map, kind, studies::tracker_setup(p.params), start_m,
+                                      reference, duration_s);
         });
         const auto& mt = r.metrics;
         return py::dict(
@@ -516,7 +519,7 @@ void bind_platform(py::module_& m) {
       "run",
       [](const std::string& scenario, double duration_s, py::handle config, py::handle out_dir) {
         const auto c = config_from(config);
-        pf::SessionParams sp;
+        cell::SessionParams sp;
         sp.scenario = scenario;
         sp.max_duration_s = duration_s;
         sp.validate();
@@ -524,7 +527,7 @@ void bind_platform(py::module_& m) {
             out_dir.is_none() ? std::nullopt : std::optional<std::string>(path_of(out_dir));
         CsvTable table;
         const auto result = nogil([&] {
-          pf::Session session(c, sp);
+          cell::Session session(c, sp);
           auto r = session.run();
           if (dir) session.write(*dir, r);
           table = session.platform().recording().to_table();

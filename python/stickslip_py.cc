@@ -12,13 +12,13 @@
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mat_file.h"
 #include "microcobot/stickslip/actuator.h"
-#include "microcobot/stickslip/experiments.h"
 #include "microcobot/stickslip/ident_all.h"
 #include "microcobot/stickslip/ident_breakaway.h"
 #include "microcobot/stickslip/ident_friction_modes.h"
 #include "microcobot/stickslip/ident_hysteresis.h"
 #include "microcobot/stickslip/ident_pe_modes.h"
 #include "microcobot/stickslip/ident_record.h"
+#include "microcobot/studies/experiments.h"
 
 namespace mc::py {
 namespace {
@@ -67,7 +67,7 @@ py::dict simulate(py::handle params, const std::string& wave, double amplitude_V
   return trajectory_dict(tr);
 }
 
-py::list cases_list(const std::vector<ss::SawtoothCase>& cases) {
+py::list cases_list(const std::vector<studies::SawtoothCase>& cases) {
   py::list out;
   for (const auto& c : cases) {
     py::dict d("amplitude_V"_a = c.amplitude_V, "frequency_Hz"_a = c.frequency_Hz,
@@ -81,31 +81,31 @@ py::list cases_list(const std::vector<ss::SawtoothCase>& cases) {
 
 py::dict experiment(const std::string& name, py::handle params) {
   const auto p = params_from<ss::StickSlipParams>(params);
-  auto step_result = [](const ss::StepSpectrumResult& r) {
+  auto step_result = [](const studies::StepSpectrumResult& r) {
     return py::dict("response"_a = trajectory_dict(r.response), "psd"_a = spectrum_dict(r.psd),
                     "peaks_Hz"_a = to_array(r.peaks_Hz));
   };
-  if (name == "pe-step") return step_result(ss::run_pe_step(p));
-  if (name == "actuator-step") return step_result(ss::run_actuator_step(p));
+  if (name == "pe-step") return step_result(studies::run_pe_step(p));
+  if (name == "actuator-step") return step_result(studies::run_actuator_step(p));
   if (name == "hysteresis") {
     py::list loops;
-    for (const auto& l : ss::run_hysteresis(p)) {
+    for (const auto& l : studies::run_hysteresis(p)) {
       loops.append(py::dict("frequency_Hz"_a = l.frequency_Hz, "amplitude_V"_a = l.amplitude_V,
                             "u_V"_a = to_array(l.u_V), "x2_m"_a = to_array(l.x2_m), "area_V_m"_a = l.area_V_m,
                             "range_m"_a = l.range_m));
     }
     return py::dict("loops"_a = loops);
   }
-  if (name == "scanning") return py::dict("cases"_a = cases_list(ss::run_scanning(p)));
-  if (name == "stepping") return py::dict("cases"_a = cases_list(ss::run_stepping(p)));
+  if (name == "scanning") return py::dict("cases"_a = cases_list(studies::run_scanning(p)));
+  if (name == "stepping") return py::dict("cases"_a = cases_list(studies::run_stepping(p)));
   if (name == "threshold") {
-    const auto t = ss::run_threshold(p);
+    const auto t = studies::run_threshold(p);
     return py::dict("frequency_Hz"_a = t.frequency_Hz, "forward_V"_a = t.forward_V,
                     "backward_V"_a = t.backward_V);
   }
   if (name == "psd") {
     py::list cases;
-    for (const auto& c : ss::run_psd(p)) {
+    for (const auto& c : studies::run_psd(p)) {
       cases.append(py::dict("amplitude_V"_a = c.amplitude_V, "frequency_Hz"_a = c.frequency_Hz,
                             "psd"_a = spectrum_dict(c.psd), "dominant_peak_Hz"_a = c.dominant_peak_Hz));
     }
@@ -502,7 +502,7 @@ void bind_stickslip(py::module_& m) {
       "experiment", &experiment, "name"_a, "params"_a = py::none(),
       "One chapter-2 experiment (thesis §2.5, Fig. 2.10-2.17): pe-step, actuator-step, hysteresis, scanning, "
       "stepping, threshold, psd. Returns its results as a dict.");
-  m.def("experiment_names", &ss::experiment_names, "Names experiment() accepts.");
+  m.def("experiment_names", &studies::experiment_names, "Names experiment() accepts.");
   m.def(
       "rollout", &rollout, "params"_a, "initial_states"_a, "voltages"_a, "threads"_a = 1,
       "operating_point"_a = py::none(), "out"_a = py::none(), "out_x1"_a = py::none(),

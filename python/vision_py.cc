@@ -9,10 +9,10 @@
 #include <optional>
 
 #include "common.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/affine_calibration.h"
 #include "microcobot/vision/autofocus.h"
-#include "microcobot/vision/renderer.h"
 #include "microcobot/vision/sharpness.h"
 #include "microcobot/vision/template_tracker.h"
 #include "microcobot/vision/visual_servo.h"
@@ -23,8 +23,8 @@ namespace {
 using namespace pybind11::literals;
 
 py::dict camera_model(const std::string& objective) {
-  const vision::ObjectiveParams o = vision::objective_by_name(objective);
-  const vision::OpticsFigures f = vision::optics_figures(o, vision::SensorParams{});
+  const imaging::ObjectiveParams o = imaging::objective_by_name(objective);
+  const imaging::OpticsFigures f = imaging::optics_figures(o, imaging::SensorParams{});
   py::dict d;
   d["objective"] = o.name;
   d["magnification"] = f.magnification;
@@ -48,8 +48,8 @@ py::array render(const std::string& scene, const std::string& objective, double 
                  const std::string& illumination, std::uint64_t seed, std::uint64_t frame,
                  std::optional<std::array<double, 3>> tool_um, double tool_yaw_deg, double part_yaw_deg) {
   const platform::PlatformConfig config = platform::scene_config(scene);
-  vision::CameraParams cam;
-  cam.objective = vision::objective_by_name(objective);
+  imaging::CameraParams cam;
+  cam.objective = imaging::objective_by_name(objective);
   cam.sensor.bit_depth = bit_depth;
   if (exposure_ms) cam.sensor.exposure_s = *exposure_ms * 1e-3;
   if (gain) cam.sensor.gain = *gain;
@@ -67,12 +67,12 @@ py::array render(const std::string& scene, const std::string& objective, double 
   cam.view_center_x_m = pose.part_x_m;
   cam.view_center_y_m = pose.part_y_m;
   if (!std::isfinite(focus_um)) throw InvalidInput("focus_um: must be finite");
-  vision::SceneSnapshot snapshot;
+  imaging::SceneSnapshot snapshot;
   platform::fill_camera_scene(config, pose, snapshot);
-  vision::Renderer renderer(cam);  // validates: ValueError naming the field
-  vision::CameraControls controls = renderer.default_controls();
+  imaging::Renderer renderer(cam);  // validates: ValueError naming the field
+  imaging::CameraControls controls = renderer.default_controls();
   controls.focus_z_m = focus_um * 1e-6;
-  vision::Frame f;
+  imaging::Frame f;
   {
     py::gil_scoped_release release;
     renderer.render(snapshot, controls, seed, frame, f);
@@ -90,13 +90,13 @@ py::array render(const std::string& scene, const std::string& objective, double 
 }
 
 // A frame from a caller's 2-D uint8 or uint16 array (copied: the tracker keeps no reference).
-vision::Frame frame_of(const py::array& a) {
+imaging::Frame frame_of(const py::array& a) {
   const bool u8 = py::isinstance<py::array_t<std::uint8_t>>(a),
              u16 = py::isinstance<py::array_t<std::uint16_t>>(a);
   if (a.ndim() != 2 || (!u8 && !u16))
     throw InvalidInput("frame: a 2-D uint8 or uint16 array is needed (got " + std::to_string(a.ndim()) +
                        "-D of dtype " + std::string(py::str(a.dtype())) + ")");
-  vision::Frame f;
+  imaging::Frame f;
   f.height = static_cast<int>(a.shape(0));
   f.width = static_cast<int>(a.shape(1));
   f.bit_depth = u8 ? 8 : 16;
@@ -111,8 +111,8 @@ vision::Frame frame_of(const py::array& a) {
   return f;
 }
 
-vision::PixelRoi roi_of(const std::optional<std::array<int, 4>>& roi, const vision::Frame& f) {
-  return roi ? vision::PixelRoi{(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]} : vision::full_roi(f);
+imaging::PixelRoi roi_of(const std::optional<std::array<int, 4>>& roi, const imaging::Frame& f) {
+  return roi ? imaging::PixelRoi{(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]} : imaging::full_roi(f);
 }
 
 py::dict estimate_dict(const vision::TrackEstimate& e) {
@@ -165,8 +165,8 @@ vision::Autofocus make_autofocus(const std::string& objective, double start_um,
                                  std::optional<std::array<double, 2>> range_um,
                                  std::optional<std::string> metric, bool reuse_coarse_samples) {
   if (!std::isfinite(start_um)) throw InvalidInput("start_um: must be finite");
-  const vision::OpticsFigures figures =
-      vision::optics_figures(vision::objective_by_name(objective), vision::SensorParams{});
+  const imaging::OpticsFigures figures =
+      imaging::optics_figures(imaging::objective_by_name(objective), imaging::SensorParams{});
   vision::AutofocusParams p =
       metric ? vision::autofocus_params_for(figures, start_um * 1e-6, vision::parse_focus_metric(*metric))
              : vision::autofocus_params_for(figures, start_um * 1e-6);
@@ -223,7 +223,7 @@ void bind_vision(py::module_& m) {
   m.def(
       "sharpness",
       [](const py::array& frame, std::optional<std::array<int, 4>> roi, const std::string& metric) {
-        const vision::Frame f = frame_of(frame);
+        const imaging::Frame f = frame_of(frame);
         return vision::sharpness(f, roi_of(roi, f), vision::parse_focus_metric(metric));
       },
       "frame"_a, "roi"_a = py::none(), "metric"_a = "normalized-variance",
@@ -255,14 +255,14 @@ void bind_vision(py::module_& m) {
       .def(
           "set_template",
           [](vision::TemplateTracker& t, const py::array& frame, std::array<int, 4> roi) {
-            t.set_template(frame_of(frame), vision::PixelRoi{roi[0], roi[1], roi[2], roi[3]});
+            t.set_template(frame_of(frame), imaging::PixelRoi{roi[0], roi[1], roi[2], roi[3]});
             return estimate_dict(t.last());
           },
           "frame"_a, "roi"_a, "Takes the template from roi = (x, y, width, height); returns its position.")
       .def(
           "track",
           [](vision::TemplateTracker& t, const py::array& frame) {
-            const vision::Frame f = frame_of(frame);
+            const imaging::Frame f = frame_of(frame);
             py::gil_scoped_release release;
             return t.track(f);
           },
@@ -270,7 +270,7 @@ void bind_vision(py::module_& m) {
       .def(
           "track_near",
           [](vision::TemplateTracker& t, const py::array& frame, double u_px, double v_px) {
-            const vision::Frame f = frame_of(frame);
+            const imaging::Frame f = frame_of(frame);
             py::gil_scoped_release release;
             return t.track_near(f, u_px, v_px);
           },

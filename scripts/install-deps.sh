@@ -20,7 +20,7 @@ RUN_PACKAGES=(
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
   libturbojpeg0-dev    # the camera's JPEG frames (core/jpeg)
-  libpng-dev           # the camera's PNG frames (vision/png_file; zlib comes with it)
+  libpng-dev           # the camera's PNG frames (imaging/png_file; zlib comes with it)
   libopencv-imgproc-dev libopencv-video-dev  # vision processing: template matching, ECC (vision/template_tracker)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
 )
@@ -28,6 +28,7 @@ RUN_PACKAGES=(
 # and its independent references.
 TEST_PACKAGES=(
   clang-format
+  graphviz             # dot: the module graph of docs/architecture.md (make graph, checked by a test)
   iproute2             # ip netns: the two-machine link test runs each end in its own network stack
   libgtest-dev libgmock-dev googletest  # unit tests
   libbenchmark-dev     # benchmarks
@@ -35,7 +36,7 @@ TEST_PACKAGES=(
   clang libclang-rt-14-dev  # libFuzzer harnesses of the parsers (scripts/fuzz.sh, make fuzz)
   pybind11-dev python3-dev python3-numpy  # the Python module (python/, `make python`)
   python3-scipy python3-pytest  # Python tests: scipy.signal / scipy.io as independent references
-  libopencv-videoio-dev  # the real-camera driver (platform/opencv_camera.cc; CMake MC_WITH_OPENCV), built and tested by `make test`
+  libopencv-videoio-dev  # the real-camera driver (devices/opencv_camera.cc; CMake MC_WITH_OPENCV), built and tested by `make test`
   gstreamer1.0-plugins-base  # videotestsrc: the OpenCV driver's synthetic source in its test
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
   python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins (issue #30)

@@ -58,7 +58,7 @@ SEARCHED = [
 ]
 GOALS = {"rms": 150e-9, "median": 100e-9, "max": 300e-9, "path": 200e-9, "powerup": 250e-9}
 # Hard constraints every trial must meet (else it is not kept): a move inside the PE's stroke only
-# scans (no step, max error <= 30 nm), as tests/control/tracking_controller_test.cc asserts.
+# scans (no step, max error <= 30 nm), as tests/motion/tracking_controller_test.cc asserts.
 AT_REST_SCAN = ["control", "trajectory", "--profile", "trapezoid", "--distance", "4e-7", "--velocity", "2e-4"]
 AT_REST_MAX_M = 30e-9
 

@@ -10,26 +10,25 @@
 
 #include "cli.h"
 #include "control_validate.h"
-#include "microcobot/control/closed_loop.h"
-#include "microcobot/control/control_params.h"
-#include "microcobot/control/setpoint_stream.h"
-#include "microcobot/control/tracking_run.h"
-#include "microcobot/control/xyz_stage.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
+#include "microcobot/motion/closed_loop.h"
+#include "microcobot/motion/control_params.h"
+#include "microcobot/motion/setpoint_stream.h"
+#include "microcobot/motion/xyz_stage.h"
+#include "microcobot/studies/tracking_run.h"
 
 namespace control_commands {
 namespace {
 
-namespace ct = mc::control;
 namespace ss = mc::stickslip;
 using mc::cli::CommonOptions;
 using mc::report::Figure;
 using mc::report::Report;
 using mc::report::Series;
 
-using ct::ControlParams;
+using mc::motion::ControlParams;
 
 ControlParams load(const CommonOptions& o) {
   return o.params ? mc::load_params<ControlParams>(*o.params) : ControlParams{};
@@ -38,7 +37,7 @@ ControlParams load(const CommonOptions& o) {
 /// The model and its step map (the step map is the expensive part: ~0.3 s).
 struct Plant {
   ss::ActuatorModel model;
-  ct::StepMap map;
+  mc::motion::StepMap map;
   explicit Plant(const ControlParams& p) : model(p.model), map(model, p.step_map) {}
 };
 
@@ -53,7 +52,7 @@ Series thin(const std::string& name, const std::vector<double>& x, const std::ve
   return s;
 }
 
-nlohmann::json velocity_json(const ct::VelocityMetrics& m) {
+nlohmann::json velocity_json(const mc::motion::VelocityMetrics& m) {
   return {{"mean_velocity_m_s", m.mean_velocity_m_s},
           {"steady_state_error_rel", m.steady_state_error_rel},
           {"settling_time_s", m.settling_time_s},
@@ -63,7 +62,7 @@ nlohmann::json velocity_json(const ct::VelocityMetrics& m) {
           {"ripple_m_s", m.ripple_m_s}};
 }
 
-nlohmann::json position_json(const ct::PositionMetrics& m) {
+nlohmann::json position_json(const mc::motion::PositionMetrics& m) {
   return {{"final_error_m", m.final_error_m}, {"overshoot_m", m.overshoot_m}, {"move_time_s", m.move_time_s}};
 }
 
@@ -82,11 +81,12 @@ nlohmann::json velocity_experiment(const ControlParams& p, const Plant& plant, d
   const double ref = dir == ss::Direction::kForward ? speed : -speed;
   nlohmann::json j;
   std::vector<Series> v_series, a_series;
-  for (auto mode :
-       {ct::VelocityMode::kModelBased, ct::VelocityMode::kThesisPid, ct::VelocityMode::kOpenLoop}) {
-    const auto run = ct::run_velocity(plant.model, &plant.map, p.velocity, mode, ref, duration, p.sensor);
-    const auto name = ct::to_string(mode);
-    if (mode == ct::VelocityMode::kModelBased) {
+  for (auto mode : {mc::motion::VelocityMode::kModelBased, mc::motion::VelocityMode::kThesisPid,
+                    mc::motion::VelocityMode::kOpenLoop}) {
+    const auto run =
+        mc::motion::run_velocity(plant.model, &plant.map, p.velocity, mode, ref, duration, p.sensor);
+    const auto name = to_string(mode);
+    if (mode == mc::motion::VelocityMode::kModelBased) {
       j = velocity_json(run.metrics);
     } else {
       j["baselines"][name] = velocity_json(run.metrics);
@@ -98,7 +98,7 @@ nlohmann::json velocity_experiment(const ControlParams& p, const Plant& plant, d
                  run.metrics.max_excursion_rel * 100.0, "%");
     v_series.push_back(thin(name + " (1-period velocity)", run.t_s, run.v_true_m_s));
     a_series.push_back(thin(name, run.t_s, run.amplitude_V));
-    if (table && mode == ct::VelocityMode::kModelBased) {
+    if (table && mode == mc::motion::VelocityMode::kModelBased) {
       table->add_column("t_s", run.t_s);
       table->add_column("v_m_s", run.v_true_m_s);
       table->add_column("v_est_m_s", run.v_est_m_s);
@@ -152,22 +152,23 @@ struct PositionOptions {
   std::string axis = "x";
 };
 
-nlohmann::json position_experiment(const ControlParams& p, const Plant& plant, ct::Axis axis, double start,
-                                   double target, Report& r, mc::CsvTable* table) {
+nlohmann::json position_experiment(const ControlParams& p, const Plant& plant, mc::motion::Axis axis,
+                                   double start, double target, Report& r, mc::CsvTable* table) {
   auto sensor = p.sensor;
   sensor.seed += static_cast<int>(axis);  // the XYZ stage's per-axis noise stream
-  const auto run = ct::run_position(plant.model, plant.map, p.position, sensor, start, target);
+  const auto run = mc::motion::run_position(plant.model, plant.map, p.position, sensor, start, target);
   auto j = position_json(run.metrics);
-  j["axis"] = ct::to_string(axis);
+  j["axis"] = to_string(axis);
   j["in_position"] = run.metrics.in_position;
   j["end_stop"] = run.metrics.end_stop;
   j["hold_peak_to_peak_m"] = run.metrics.hold_pp_m;
   j["switches"] = run.metrics.switches;
   const double duration = run.t_s.empty() ? 0.01 : run.t_s.back();
   std::vector<Series> xs{thin("hybrid", run.t_s, run.x_m)};
-  for (auto kind : {ct::BaselineKind::kOpenLoopCounting, ct::BaselineKind::kThesisPid}) {
-    const auto b = ct::run_baseline_position(plant.model, p.baseline, kind, sensor, start, target, duration);
-    const auto name = ct::to_string(kind);
+  for (auto kind : {mc::motion::BaselineKind::kOpenLoopCounting, mc::motion::BaselineKind::kThesisPid}) {
+    const auto b =
+        mc::motion::run_baseline_position(plant.model, p.baseline, kind, sensor, start, target, duration);
+    const auto name = to_string(kind);
     j["baselines"][name] = position_json(b.metrics);
     r.add_result(name + ": final error", b.metrics.final_error_m, "m");
     r.add_result(name + ": overshoot", b.metrics.overshoot_m, "m");
@@ -209,7 +210,7 @@ void run_position_cmd(const PositionOptions& o) {
             fmt::format("microcobot control position --target {:g} --start {:g} --axis {}", o.target, o.start,
                         o.axis));
   mc::CsvTable t;
-  auto j = position_experiment(p, plant, ct::parse_axis(o.axis), o.start, o.target, r, &t);
+  auto j = position_experiment(p, plant, mc::motion::parse_axis(o.axis), o.start, o.target, r, &t);
   mc::cli::write_result_table(o.common, "position.csv", t, j);
   mc::cli::write_report_if_requested(o.common, r);
   mc::cli::emit(o.common, j,
@@ -234,53 +235,55 @@ struct TrajectoryOptions {
   double angle = M_PI;
 };
 
-nlohmann::json tracking_json(const ct::TrackingMetrics& m) {
+nlohmann::json tracking_json(const mc::studies::TrackingMetrics& m) {
   return {{"rms_error_m", m.rms_error_m},     {"max_error_m", m.max_error_m},   {"lag_s", m.lag_s},
           {"final_error_m", m.final_error_m}, {"rms_error_all_m", m.rms_all_m}, {"steps", m.edges}};
 }
 
-nlohmann::json path_json(const ct::PathMetrics& m) {
+nlohmann::json path_json(const mc::studies::PathMetrics& m) {
   return {{"rms_error_m", m.rms_error_m},          {"max_error_m", m.max_error_m},
           {"path_deviation_m", m.max_deviation_m}, {"path_deviation_rms_m", m.rms_deviation_m},
           {"final_error_m", m.final_error_m},      {"steps", m.edges}};
 }
 
-constexpr std::array<ct::TrackerKind, 3> kTrackers{ct::TrackerKind::kTracking, ct::TrackerKind::kHybrid,
-                                                   ct::TrackerKind::kThesisPid};
+constexpr std::array<mc::studies::TrackerKind, 3> kTrackers{mc::studies::TrackerKind::kTracking,
+                                                            mc::studies::TrackerKind::kHybrid,
+                                                            mc::studies::TrackerKind::kThesisPid};
 
-std::string json_name(ct::TrackerKind k) {
-  return k == ct::TrackerKind::kThesisPid ? "thesis_pid" : ct::to_string(k);
+std::string json_name(mc::studies::TrackerKind k) {
+  return k == mc::studies::TrackerKind::kThesisPid ? "thesis_pid" : to_string(k);
 }
 
 /// 3-D line and arc: the three axes on the path, the tracker and both baselines.
 nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const TrajectoryOptions& o,
                                Report& r, mc::CsvTable* table) {
-  ct::PathLimits lim = p.path;
+  mc::motion::PathLimits lim = p.path;
   lim.max_velocity_m_s = p.limits.max_velocity_m_s;
   lim.max_acceleration_m_s2 = p.limits.max_acceleration_m_s2;
   if (o.jerk > 0.0) lim.max_jerk_m_s3 = o.jerk;
   const Eigen::Vector3d dir = Eigen::Vector3d(0.6, 0.64, 0.48).normalized();
-  const auto path = o.profile == "line"
-                        ? ct::PathGenerator::line(-0.5 * o.distance * dir, 0.5 * o.distance * dir, lim)
-                        : ct::PathGenerator::arc(Eigen::Vector3d(o.radius, 0.0, 0.0), Eigen::Vector3d::Zero(),
-                                                 Eigen::Vector3d(0.0, 0.3, 1.0), o.angle, lim);
+  const auto path =
+      o.profile == "line"
+          ? mc::motion::PathGenerator::line(-0.5 * o.distance * dir, 0.5 * o.distance * dir, lim)
+          : mc::motion::PathGenerator::arc(Eigen::Vector3d(o.radius, 0.0, 0.0), Eigen::Vector3d::Zero(),
+                                           Eigen::Vector3d(0.0, 0.3, 1.0), o.angle, lim);
   mc::require_budget(
       3.0 * (path.duration_s() + 0.03) / plant.model.dt_s(), mc::kMaxSimulatedSteps,
       "--distance/--velocity/--acceleration (path duration)",
       fmt::format("simulated steps (3 axes, {:.3g} s at {:g} s)", path.duration_s(), plant.model.dt_s()));
-  const auto su = ct::tracker_setup(p);
+  const auto su = mc::studies::tracker_setup(p);
   nlohmann::json j;
   std::vector<Series> dev;
   for (auto k : kTrackers) {
-    const auto run = ct::run_path(plant.model, plant.map, k, su, path);
-    const auto name = ct::to_string(k);
-    if (k == ct::TrackerKind::kTracking) {
+    const auto run = mc::studies::run_path(plant.model, plant.map, k, su, path);
+    const auto name = to_string(k);
+    if (k == mc::studies::TrackerKind::kTracking) {
       j = path_json(run.metrics);
       if (table) {
         table->add_column("t_s", run.t_s);
         table->add_column("deviation_m", run.deviation_m);
         for (std::size_t i = 0; i < 3; ++i) {
-          const std::string ax = ct::to_string(static_cast<ct::Axis>(i));
+          const std::string ax = to_string(static_cast<mc::motion::Axis>(i));
           table->add_column("ref_" + ax + "_m", run.ref_m[i]);
           table->add_column(ax + "_m", run.x_m[i]);
         }
@@ -318,22 +321,22 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
   const double sign = o.direction == "backward" ? -1.0 : 1.0;
   const double start = o.profile == "trapezoid" ? -0.5 * sign * o.distance : 0.0;
   // A fresh (stateful) reference per run: every tracker sees the same one.
-  std::function<ct::ReferenceFn()> make_ref;
+  std::function<mc::studies::ReferenceFn()> make_ref;
   double duration = 0.0;
   std::string what;
   if (o.profile == "trapezoid") {
     const double end = start + sign * o.distance;
     const auto lim = p.limits;
     make_ref = [lim, start, end] {
-      auto l = std::make_shared<ct::ReferenceLimiter>(lim, start);
-      return ct::ReferenceFn([l, end](double, double dt) { return l->step(end, dt); });
+      auto l = std::make_shared<mc::motion::ReferenceLimiter>(lim, start);
+      return mc::studies::ReferenceFn([l, end](double, double dt) { return l->step(end, dt); });
     };
-    duration = ct::trapezoid_duration_s(o.distance, p.limits) + 0.05;
+    duration = mc::motion::trapezoid_duration_s(o.distance, p.limits) + 0.05;
     what = fmt::format("trapezoidal move of {:g} m {} at <= {:g} m/s, <= {:g} m/s^2", o.distance, o.direction,
                        p.limits.max_velocity_m_s, p.limits.max_acceleration_m_s2);
   } else if (o.profile == "sine") {
-    auto sine = std::make_shared<ct::SineReference>(start, sign * o.amplitude, o.frequency, p.limits);
-    make_ref = [sine] { return ct::ReferenceFn([sine](double t, double) { return sine->at(t); }); };
+    auto sine = std::make_shared<mc::motion::SineReference>(start, sign * o.amplitude, o.frequency, p.limits);
+    make_ref = [sine] { return mc::studies::ReferenceFn([sine](double t, double) { return sine->at(t); }); };
     duration = 2.0 / o.frequency;
     what = fmt::format("sine of {:g} m amplitude at {:g} Hz", o.amplitude, o.frequency);
   } else {
@@ -345,9 +348,9 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
     make_ref = [sp, lim, start, sign] {
       auto sps = sp;
       sps.max_velocity_m_s = 1.5 * lim.max_velocity_m_s;  // rejoins after a dropout
-      auto stream = std::make_shared<ct::SetpointStream>(sps, start);
+      auto stream = std::make_shared<mc::motion::SetpointStream>(sps, start);
       auto next_ms = std::make_shared<double>(0.0);
-      return ct::ReferenceFn([stream, next_ms, start, sign](double t, double dt) {
+      return mc::studies::ReferenceFn([stream, next_ms, start, sign](double t, double dt) {
         while (t >= *next_ms) {  // a new setpoint every 1 ms (sender's clock)
           const double ts = *next_ms;
           const int stair = static_cast<int>(ts / 0.04);
@@ -372,13 +375,13 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
       duration / plant.model.dt_s(), mc::kMaxSimulatedSteps,
       o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
       fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
-  const auto su = ct::tracker_setup(p);
+  const auto su = mc::studies::tracker_setup(p);
   nlohmann::json j;
   std::vector<Series> xs, errs;
   for (auto k : kTrackers) {
-    const auto run = ct::run_tracker(plant.model, plant.map, k, su, start, make_ref(), duration);
-    const auto name = ct::to_string(k);
-    if (k == ct::TrackerKind::kTracking) {
+    const auto run = mc::studies::run_tracker(plant.model, plant.map, k, su, start, make_ref(), duration);
+    const auto name = to_string(k);
+    if (k == mc::studies::TrackerKind::kTracking) {
       j = tracking_json(run.metrics);
       xs.push_back(thin("reference", run.t_s, run.ref_m));
       if (table) {
@@ -517,8 +520,8 @@ void control_part(Report& r) {
             "microcobot control position --start -1e-4 --target 1e-4, and --start 1e-4 --target 9.99e-5 (10 "
             "nm back). "
             "Stepping (amplitude/frequency from the step map) -> scanning with the PI inverse -> hold.");
-  position_experiment(p, plant, ct::Axis::kX, -100e-6, 100e-6, r, nullptr);
-  position_experiment(p, plant, ct::Axis::kX, 100e-6, 100e-6 - 10e-9, r, nullptr);
+  position_experiment(p, plant, mc::motion::Axis::kX, -100e-6, 100e-6, r, nullptr);
+  position_experiment(p, plant, mc::motion::Axis::kX, 100e-6, 100e-6 - 10e-9, r, nullptr);
   r.section("Control: trajectory tracking (issue #15)",
             "microcobot control trajectory --profile trapezoid|sine|stream|arc: the tracking controller "
             "(reference-phased sawtooth) beside today's hybrid controller and the thesis's PID.");

@@ -1,4 +1,4 @@
-// `microcobot control validate`: a thin layer over control/validation_set (the library runs the
+// `microcobot control validate`: a thin layer over studies/validation_set (the library runs the
 // cases and judges them; this file parses flags and prints or writes the table).
 
 #include "control_validate.h"
@@ -9,16 +9,14 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "microcobot/control/control_params.h"
-#include "microcobot/control/validation_set.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
+#include "microcobot/motion/control_params.h"
+#include "microcobot/studies/validation_set.h"
 
 namespace mc::cli {
 namespace {
-
-namespace ct = mc::control;
 
 struct ValidateOptions {
   CommonOptions common;
@@ -36,33 +34,36 @@ std::string csv_field(const std::string& s) {
 }
 
 void run_validate(const ValidateOptions& o) {
-  const auto p = o.common.params ? mc::load_params<ct::ControlParams>(*o.common.params) : ct::ControlParams{};
-  const ct::CaseSet set = ct::parse_case_set(o.set, "--set");
-  const std::uint64_t seed = o.seed >= 0
-                                 ? static_cast<std::uint64_t>(o.seed)
-                                 : (set == ct::CaseSet::kTuning ? ct::kTuningSeed : ct::kValidationSeed);
-  const int n =
-      o.cases >= 0 ? o.cases : (set == ct::CaseSet::kTuning ? ct::kTuningRandomCases : ct::kValidationCases);
-  std::vector<ct::ValidationCase> cases;
-  naming_flags({{"seed", "--seed"}, {"cases", "--cases"}}, [&] { cases = ct::make_case_set(set, seed, n); });
+  const auto p =
+      o.common.params ? mc::load_params<motion::ControlParams>(*o.common.params) : motion::ControlParams{};
+  const studies::CaseSet set = studies::parse_case_set(o.set, "--set");
+  const std::uint64_t seed =
+      o.seed >= 0 ? static_cast<std::uint64_t>(o.seed)
+                  : (set == studies::CaseSet::kTuning ? studies::kTuningSeed : studies::kValidationSeed);
+  const int n = o.cases >= 0 ? o.cases
+                             : (set == studies::CaseSet::kTuning ? studies::kTuningRandomCases
+                                                                 : studies::kValidationCases);
+  std::vector<studies::ValidationCase> cases;
+  naming_flags({{"seed", "--seed"}, {"cases", "--cases"}},
+               [&] { cases = studies::make_case_set(set, seed, n); });
   if (cases.empty()) throw mc::UsageError("--cases must be >= 1 for the validation set");
   if (o.common.out) mc::ensure_writable_dir(*o.common.out);
   const mc::stickslip::ActuatorModel model(p.model);
-  const ct::StepMap map(model, p.step_map);
-  const ct::TrackerSetup su = ct::tracker_setup(p);
-  const ct::TrackingGoals goals;
-  std::vector<ct::CaseResult> results;
+  const motion::StepMap map(model, p.step_map);
+  const studies::TrackerSetup su = studies::tracker_setup(p);
+  const studies::TrackingGoals goals;
+  std::vector<studies::CaseResult> results;
   nlohmann::json rows = nlohmann::json::array();
   std::ostringstream csv, human;
   csv << "case,description,rms_error_m,max_error_m,path_deviation_m,final_error_m,steps,pass\n";
   human << fmt::format("{:<22} {:>7} {:>7} {:>8} {:>7}  {:<4} {}\n", "case", "RMS nm", "max nm", "path nm",
                        "final", "ok", "reference");
   for (const auto& c : cases) {
-    const ct::CaseResult r = ct::run_case(model, map, su, c, goals);
+    const studies::CaseResult r = studies::run_case(model, map, su, c, goals);
     results.push_back(r);
     nlohmann::json row = {{"case", c.name},
-                          {"description", ct::describe(c)},
-                          {"profile", ct::to_string(c.profile)},
+                          {"description", studies::describe(c)},
+                          {"profile", to_string(c.profile)},
                           {"power_up", c.power_up},
                           {"rms_error_m", r.rms_m},
                           {"max_error_m", r.max_m},
@@ -71,15 +72,15 @@ void run_validate(const ValidateOptions& o) {
                           {"pass", r.pass}};
     if (r.path_deviation_m >= 0.0) row["path_deviation_m"] = r.path_deviation_m;
     rows.push_back(row);
-    csv << fmt::format("{},{},{:.6g},{:.6g},{},{:.6g},{},{}\n", c.name, csv_field(ct::describe(c)), r.rms_m,
-                       r.max_m,
+    csv << fmt::format("{},{},{:.6g},{:.6g},{},{:.6g},{},{}\n", c.name, csv_field(studies::describe(c)),
+                       r.rms_m, r.max_m,
                        r.path_deviation_m >= 0.0 ? fmt::format("{:.6g}", r.path_deviation_m) : std::string(),
                        r.final_m, r.edges, r.pass ? 1 : 0);
     human << fmt::format("{:<22} {:>7} {:>7} {:>8} {:>7}  {:<4} {}\n", c.name, nm(r.rms_m), nm(r.max_m),
-                         nm(r.path_deviation_m), nm(r.final_m), r.pass ? "yes" : "NO", ct::describe(c));
+                         nm(r.path_deviation_m), nm(r.final_m), r.pass ? "yes" : "NO", studies::describe(c));
   }
-  const ct::ValidationSummary s = ct::summarise(cases, results, goals);
-  nlohmann::json j = {{"set", ct::to_string(set)},
+  const studies::ValidationSummary s = studies::summarise(cases, results, goals);
+  nlohmann::json j = {{"set", to_string(set)},
                       {"seed", seed},
                       {"cases", rows},
                       {"summary",
@@ -106,14 +107,14 @@ void run_validate(const ValidateOptions& o) {
     std::ostringstream head;
     head << fmt::format(
         "# microcobot control validate --set {} --seed {}: {} cases, {} pass; median RMS {} nm\n",
-        ct::to_string(set), seed, s.cases, s.passed, nm(s.median_rms_m));
-    mc::write_file_atomic(*o.common.out / (ct::to_string(set) + ".csv"), head.str() + csv.str());
+        to_string(set), seed, s.cases, s.passed, nm(s.median_rms_m));
+    mc::write_file_atomic(*o.common.out / (to_string(set) + ".csv"), head.str() + csv.str());
   }
   human << fmt::format(
       "{} set (seed {}): {}/{} cases pass; median RMS {} nm (goal {}), worst RMS {} nm ({}), worst max {} nm "
       "({}), worst path deviation {} nm ({}), power-up backward max {} nm ({})",
-      ct::to_string(set), seed, s.passed, s.cases, nm(s.median_rms_m), nm(goals.median_rms_m),
-      nm(s.worst_rms_m), nm(goals.rms_m), nm(s.worst_max_m), nm(goals.max_m), nm(s.worst_path_deviation_m),
+      to_string(set), seed, s.passed, s.cases, nm(s.median_rms_m), nm(goals.median_rms_m), nm(s.worst_rms_m),
+      nm(goals.rms_m), nm(s.worst_max_m), nm(goals.max_m), nm(s.worst_path_deviation_m),
       nm(goals.path_deviation_m), nm(s.worst_powerup_backward_m), nm(goals.powerup_backward_m));
   emit(o.common, j, human.str());
 }

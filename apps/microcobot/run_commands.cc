@@ -8,9 +8,9 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "microcobot/cell/session.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
-#include "microcobot/platform/session.h"
 #include "signals.h"
 
 namespace run_commands {
@@ -41,11 +41,11 @@ void run(const RunOptions& o) {
     return;
   }
   if (o.realtime) config.loop.realtime = true;
-  pf::SessionParams sp;
+  mc::cell::SessionParams sp;
   sp.scenario = o.scenario;
   sp.max_duration_s = o.duration_s;
   sp.validate();
-  pf::Session session(config, sp);
+  mc::cell::Session session(config, sp);
   const auto total = static_cast<std::size_t>(std::ceil(o.duration_s));
   // A signal during the run stops it cleanly: the recording and report are written, marked
   // as interrupted, and the command exits 128 + signal.
@@ -87,7 +87,8 @@ void add_run(CLI::App& cmd) {
   cmd.add_option("--scenario", o->scenario, "Scenario: pick-place (default) or stale-master")
       ->check(CLI::IsMember({"pick-place", "stale-master"}));
   cmd.add_option("--duration", o->duration_s, "Longest simulated time [s] (default 120)")
-      ->check(mc::cli::Range(pf::SessionParams::kMinDuration_s, pf::SessionParams::kMaxDuration_s));
+      ->check(
+          mc::cli::Range(mc::cell::SessionParams::kMinDuration_s, mc::cell::SessionParams::kMaxDuration_s));
   cmd.add_flag("--realtime", o->realtime, "Pace the loop to the wall clock (SCHED_FIFO when permitted)");
   cmd.add_flag("--print-config", o->print_config, "Print the configuration (default or --config) and exit");
   cmd.add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");

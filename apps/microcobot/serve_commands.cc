@@ -30,8 +30,8 @@
 #include "microcobot/net/remote_slave.h"
 #include "microcobot/platform/driver_registry.h"
 #include "microcobot/platform/platform_config.h"
-#include "microcobot/vendor/live_stage.h"
-#include "microcobot/vendor/twin_server.h"
+#include "microcobot/twins/live_stage.h"
+#include "microcobot/twins/twin_server.h"
 #include "network_options.h"
 #include "signals.h"
 
@@ -56,7 +56,7 @@ struct ServeOptions {
   std::string role = "single";  // single | master | slave (issue #17)
   int domain = 0;
   mc::cli::NetworkOptions network;   // where the DDS link goes (master and slave roles)
-  mc::control::LinkParams link;      // the emulated impairment of what this end receives
+  mc::teleop::LinkParams link;       // the emulated impairment of what this end receives
   std::string passivity = "on";      // time-domain passivity control at this end's ports
   std::vector<std::string> emulate;  // vendor-protocol twins (issue #30): gcs2[=ADDR:PORT], anc300[=...]
 };
@@ -97,22 +97,22 @@ RemoteEnds attach_role(const ServeOptions& o, mc::live::LiveParams& lp) {
     // the stage is the slave process's.
     lp.make_devices = [remote = ends.slave.get(), cfg = lp.platform, domain = o.domain,
                        network = mc::cli::network_config(o.network)] {
-      pf::PlatformDevices d;
+      mc::devices::DeviceSet d;
       if (cfg.devices.simulated()) {
-        d.haptic = std::make_unique<pf::SimulatedHapticMaster>(
+        d.haptic = std::make_unique<mc::devices::SimulatedHapticMaster>(
             "dual_stage", cfg.haptic.plant, cfg.haptic.render, cfg.haptic.pantograph, cfg.loop.period_s());
-        d.tweezers =
-            std::make_unique<pf::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+        d.tweezers = std::make_unique<mc::devices::SimulatedTweezersMaster>("teletweez", cfg.tweezers,
+                                                                            cfg.loop.period_s());
       } else {
         d = pf::make_driver_devices(cfg);
       }
-      pf::PlatformDevices stage = remote->make_devices();
+      mc::devices::DeviceSet stage = remote->make_devices();
       d.axes = std::move(stage.axes);
       d.rotary = std::move(stage.rotary);
       d.gripper = std::move(stage.gripper);
       // The microscope is the slave's: its frames, over DDS (the master has no microworld to image).
       if (cfg.camera.enabled && cfg.devices.camera.driver != "none")
-        d.camera = std::make_unique<pf::Camera>(
+        d.camera = std::make_unique<mc::devices::Camera>(
             "camera", cfg.camera, std::make_unique<mc::net::RemoteCameraSource>(domain, network));
       return d;
     };
@@ -265,8 +265,8 @@ void serve(const ServeOptions& o) {
   if (!std::filesystem::is_directory(o.out, ec))
     throw mc::InvalidInput("--out " + mc::excerpt(o.out.string()) + ": exists and is not a directory");
 
-  std::vector<mc::vendor::TwinEndpoint> twins;
-  for (const auto& e : o.emulate) twins.push_back(mc::vendor::parse_emulate(e));
+  std::vector<mc::twins::TwinEndpoint> twins;
+  for (const auto& e : o.emulate) twins.push_back(mc::twins::parse_emulate(e));
   std::string twin_token = sp.server.token;
   for (const auto& t : twins)
     if (twin_token.empty() && !is_loopback(t.address)) twin_token = random_token();
@@ -311,29 +311,29 @@ void serve(const ServeOptions& o) {
   mc::live::ConsoleServer server(live, sp);
   if (images) {
     server.add_frame_consumer(
-        {[p = images.get()](const pf::CameraFrame& f, double t_s) { p->publish(f, t_s); },
+        {[p = images.get()](const mc::devices::CameraFrame& f, double t_s) { p->publish(f, t_s); },
          [p = images.get()] { return p->wanted(); }});
     std::cerr << "serve: camera images on DDS, ROS 2 topic " << mc::net::kCameraImageRosName << " ("
               << mc::net::kCameraImageTypeName << ")\n";
   }
   server.start();
   // The vendor-protocol twins: their own thread, the live platform reached through its ring.
-  std::unique_ptr<mc::vendor::LiveStage> twin_stage;
-  std::unique_ptr<mc::vendor::TwinServer> twin_server;
+  std::unique_ptr<mc::twins::LiveStage> twin_stage;
+  std::unique_ptr<mc::twins::TwinServer> twin_server;
   if (!twins.empty()) {
-    mc::vendor::TwinServerParams tp;
+    mc::twins::TwinServerParams tp;
     tp.endpoints = twins;
     tp.token = twin_token;
     tp.gcs2.idn = std::string("microcobot, E-873 digital twin, 0, ") + MC_VERSION;
-    twin_stage = std::make_unique<mc::vendor::LiveStage>(live);
-    twin_server = std::make_unique<mc::vendor::TwinServer>(*twin_stage, tp);
+    twin_stage = std::make_unique<mc::twins::LiveStage>(live);
+    twin_server = std::make_unique<mc::twins::TwinServer>(*twin_stage, tp);
     twin_server->start();
   }
   if (o.record) server.start_recording();
   // The first line on stdout: what the operator opens; then one line per twin.
   std::cout << server.url() << std::endl;
   for (std::size_t k = 0; k < twins.size(); ++k) {
-    const char* name = twins[k].protocol == mc::vendor::Protocol::kGcs2 ? "gcs2" : "anc300";
+    const char* name = twins[k].protocol == mc::twins::Protocol::kGcs2 ? "gcs2" : "anc300";
     std::cout << "emulate " << name << " " << twins[k].address << ":" << twin_server->ports()[k] << std::endl;
     std::cerr << "serve: " << name << " twin on " << twins[k].address << ":" << twin_server->ports()[k]
               << (is_loopback(twins[k].address) ? "" : " (token " + twin_token + ")") << "\n";

@@ -13,8 +13,8 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 #include "microcobot/stickslip/actuator.h"
-#include "microcobot/stickslip/experiments.h"
-#include "microcobot/stickslip/integrator_accuracy.h"
+#include "microcobot/studies/experiments.h"
+#include "microcobot/studies/integrator_accuracy.h"
 
 namespace stickslip_commands {
 namespace {
@@ -42,7 +42,7 @@ Series log_series(const std::string& name, const mc::dsp::Spectrum& s, double f_
   return out;
 }
 
-nlohmann::json step_experiment(Report& r, const std::string& name, const ss::StepSpectrumResult& res,
+nlohmann::json step_experiment(Report& r, const std::string& name, const mc::studies::StepSpectrumResult& res,
                                const std::string& what, const std::string& expected) {
   r.section(name, what + " Peaks of the transient's PSD: " +
                       fmt::format("{:.1f}", fmt::join(res.peaks_Hz, " Hz, ")) + " Hz (thesis: " + expected +
@@ -65,7 +65,7 @@ nlohmann::json step_experiment(Report& r, const std::string& name, const ss::Ste
   return {{"peaks_Hz", res.peaks_Hz}};
 }
 
-Series periods_series(const ss::SawtoothCase& c) {
+Series periods_series(const mc::studies::SawtoothCase& c) {
   Series s{fmt::format("{:g} V {:g} Hz {}", c.amplitude_V, c.frequency_Hz, ss::to_string(c.direction)),
            {},
            {},
@@ -78,7 +78,7 @@ Series periods_series(const ss::SawtoothCase& c) {
   return s;
 }
 
-nlohmann::json case_json(const ss::SawtoothCase& c) {
+nlohmann::json case_json(const mc::studies::SawtoothCase& c) {
   return {{"amplitude_V", c.amplitude_V},
           {"frequency_Hz", c.frequency_Hz},
           {"direction", ss::to_string(c.direction)},
@@ -91,16 +91,16 @@ nlohmann::json case_json(const ss::SawtoothCase& c) {
 /// Runs experiment `name`, adds its section to `r`, returns the JSON summary.
 nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams& p, Report& r) {
   if (name == "pe-step") {
-    return step_experiment(r, name, ss::run_pe_step(p),
+    return step_experiment(r, name, mc::studies::run_pe_step(p),
                            "Slider removed, 90 V step, 1 MHz sampling (thesis §2.5.2.1, Fig. 2.10).",
                            "64 and 118 kHz");
   }
   if (name == "actuator-step") {
-    return step_experiment(r, name, ss::run_actuator_step(p),
+    return step_experiment(r, name, mc::studies::run_actuator_step(p),
                            "40 V step, 25 kHz sampling (thesis §2.5.2.1, Fig. 2.11).", "595 and 1633 Hz");
   }
   if (name == "hysteresis") {
-    const auto loops = ss::run_hysteresis(p);
+    const auto loops = mc::studies::run_hysteresis(p);
     r.section("hysteresis",
               "Sine 0..A V, last period, x2 against U (thesis §2.5.2.2, Fig. 2.12). The loops "
               "widen and tilt near the contact modes (595, 1633 Hz): the static PI hysteresis "
@@ -124,7 +124,7 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
     return {{"loops", arr}};
   }
   if (name == "scanning" || name == "stepping") {
-    const auto cases = name == "scanning" ? ss::run_scanning(p) : ss::run_stepping(p);
+    const auto cases = name == "scanning" ? mc::studies::run_scanning(p) : mc::studies::run_stepping(p);
     r.section(name,
               name == "scanning"
                   ? "Sawtooth 20 V at 50, 100, 500 Hz, both directions (thesis Fig. 2.14): scanning "
@@ -153,7 +153,7 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
     return {{"cases", arr}};
   }
   if (name == "threshold") {
-    const auto t = ss::run_threshold(p);
+    const auto t = mc::studies::run_threshold(p);
     r.section("threshold",
               "Smallest 50 Hz sawtooth amplitude that steps (|net| over 20 periods >= 2% of g*A "
               "in the commanded direction), bisection to 0.25 V (thesis §2.5.2: ~40 V).");
@@ -168,7 +168,7 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
       Series s{ss::to_string(d), {}, {}, true};
       for (double a = 20; a <= 80; a += 5) {
         s.x.push_back(a);
-        s.y.push_back(ss::run_sawtooth(p, a, t.frequency_Hz, d).velocity_m_s);
+        s.y.push_back(mc::studies::run_sawtooth(p, a, t.frequency_Hz, d).velocity_m_s);
       }
       f.series.push_back(std::move(s));
     }
@@ -176,7 +176,7 @@ nlohmann::json run_experiment(const std::string& name, const ss::StickSlipParams
     return {{"forward_V", t.forward_V}, {"backward_V", t.backward_V}, {"frequency_Hz", t.frequency_Hz}};
   }
   if (name == "psd") {
-    const auto cases = ss::run_psd(p);
+    const auto cases = mc::studies::run_psd(p);
     r.section("psd",
               "PSD of the slider position (25 kHz, Welch 4096, 0.5 s) for 20 V / 500 Hz (scanning) and "
               "40 V / 50 Hz (stepping), thesis Fig. 2.17.");
@@ -344,17 +344,17 @@ double quantile(std::vector<double> v, double q) {
 /// The integrator against the reference solver on drives drawn at random (issue #12).
 void run_accuracy(const AccuracyOptions& o) {
   const ss::ActuatorModel m(load(o.common));
-  const auto drives = ss::accuracy_drives(o.drives, o.seed, m.params().drive);
+  const auto drives = mc::studies::accuracy_drives(o.drives, o.seed, m.params().drive);
   nlohmann::json cases = nlohmann::json::array();
   std::vector<double> rms, mx, step;
-  ss::DriveAccuracy worst;
+  mc::studies::DriveAccuracy worst;
   std::size_t worst_i = 0;
   for (std::size_t i = 0; i < drives.size(); ++i) {
     const auto& d = drives[i];
     ss::ReferenceOptions ro;
     ro.rel_tol = o.rtol;
     ro.abs_tol_m = o.rtol * 1e-6;
-    ss::DriveAccuracy a = ss::check_drive(m, d, ro);
+    mc::studies::DriveAccuracy a = mc::studies::check_drive(m, d, ro);
     rms.push_back(a.rms_error);
     mx.push_back(a.max_error);
     step.push_back(a.step_error);
@@ -479,7 +479,7 @@ void add_stickslip(CLI::App& group) {
                                      "hysteresis, scanning, stepping, threshold, psd");
     cmd->add_option("name", *name, "Experiment name")
         ->required()
-        ->check(CLI::IsMember(ss::experiment_names()));
+        ->check(CLI::IsMember(mc::studies::experiment_names()));
     mc::cli::add_output_options(*cmd, *o);
     mc::cli::add_format_option(*cmd, *o);
     mc::cli::add_params_option(*cmd, *o);
@@ -495,7 +495,7 @@ void add_stickslip(CLI::App& group) {
 
 void stickslip_part(Report& r) {
   const ss::StickSlipParams p;
-  for (const auto& name : ss::experiment_names()) run_experiment(name, p, r);
+  for (const auto& name : mc::studies::experiment_names()) run_experiment(name, p, r);
 }
 
 const bool kRegistered = mc::cli::register_group(

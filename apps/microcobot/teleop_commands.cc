@@ -1,6 +1,6 @@
 // `microcobot teleop delay-sweep`: the coupling system over a delayed, lossy link pushed into a
 // stiff contact, unprotected, with time-domain passivity control or model-mediated (issues #17,
-// #31; control/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
+// #31; teleop/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
 // long delay"). `teleop delay-validate`: the tuning and validation sets of issue #31.
 
 #include <algorithm>
@@ -13,24 +13,23 @@
 #include <fmt/format.h>
 
 #include "cli.h"
-#include "microcobot/control/delay_case_sets.h"
-#include "microcobot/control/delayed_teleoperation.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
+#include "microcobot/studies/delay_case_sets.h"
+#include "microcobot/teleop/delayed_teleoperation.h"
 
 namespace teleop_commands {
 namespace {
 
-namespace ctl = mc::control;
 using mc::cli::CommonOptions;
 
 /// The coupling's settings every teleop command takes.
 struct CouplingOptions {
-  ctl::DelayedTeleopParams params;
+  mc::teleop::DelayedTeleopParams params;
   std::string mmt_passivity = "on";
   /// Applies what add() parsed into `params`; throws InvalidParams naming a bad value.
-  const ctl::DelayedTeleopParams& resolve() {
+  const mc::teleop::DelayedTeleopParams& resolve() {
     mc::require(mmt_passivity == "on" || mmt_passivity == "off", "--mmt-passivity",
                 "must be on or off, got '" + mmt_passivity + "'");
     params.mmt.passivity = mmt_passivity == "on";
@@ -72,11 +71,11 @@ nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
-nlohmann::json to_json(const ctl::DelayCaseResult& r) {
+nlohmann::json to_json(const mc::teleop::DelayCaseResult& r) {
   return {{"delay_s", r.c.delay_s},
           {"jitter_s", r.c.jitter_s},
           {"loss", r.c.loss},
-          {"scheme", ctl::to_string(r.c.scheme)},
+          {"scheme", to_string(r.c.scheme)},
           {"passivity", r.passivity},
           {"stable", r.stable},
           {"settled", r.settled},
@@ -90,9 +89,9 @@ nlohmann::json to_json(const ctl::DelayCaseResult& r) {
           {"max_handle_force_N", r.max_handle_force_N},
           {"max_contact_force_N", r.max_contact_force_N},
           {"dissipated_J", r.dissipated_J},
-          {"final_model_wall_m",
-           r.c.scheme == ctl::Scheme::kMmt ? nlohmann::json(r.final_model_wall_m) : nlohmann::json(nullptr)},
-          {"final_model_stiffness_N_m", r.c.scheme == ctl::Scheme::kMmt
+          {"final_model_wall_m", r.c.scheme == mc::teleop::Scheme::kMmt ? nlohmann::json(r.final_model_wall_m)
+                                                                        : nlohmann::json(nullptr)},
+          {"final_model_stiffness_N_m", r.c.scheme == mc::teleop::Scheme::kMmt
                                             ? nlohmann::json(r.final_model_stiffness_N_m)
                                             : nlohmann::json(nullptr)}};
 }
@@ -101,9 +100,9 @@ std::string fmt_or(double v, double scale, const char* never) {
   return std::isfinite(v) ? fmt::format("{:.3f}", scale * v) : std::string(never);
 }
 
-std::vector<ctl::Scheme> parse_schemes(const std::vector<std::string>& names) {
-  std::vector<ctl::Scheme> out;
-  for (const auto& n : names) out.push_back(ctl::scheme_from_string(n));
+std::vector<mc::teleop::Scheme> parse_schemes(const std::vector<std::string>& names) {
+  std::vector<mc::teleop::Scheme> out;
+  for (const auto& n : names) out.push_back(mc::teleop::scheme_from_string(n));
   mc::require(!out.empty(), "--schemes", "needs at least one of none, tdpa, mmt");
   return out;
 }
@@ -113,27 +112,27 @@ void run_sweep(SweepOptions& o) {
   for (double l : o.losses) mc::require(l >= 0.0 && l < 1.0, "--losses", "must be within [0, 1)", l);
   mc::require_in_range(o.jitter_fraction, 0.0, 1.0, "--jitter");
   mc::require_in_range(o.wall_prior_error_m, -0.01, 0.01, "--wall-prior-error");
-  const std::vector<ctl::Scheme> schemes = parse_schemes(o.schemes);
-  const ctl::DelayedTeleopParams& p = o.coupling.resolve();
+  const std::vector<mc::teleop::Scheme> schemes = parse_schemes(o.schemes);
+  const mc::teleop::DelayedTeleopParams& p = o.coupling.resolve();
   nlohmann::json cases = nlohmann::json::array();
   double unstable_delay = -1.0;
   nlohmann::json all_settled = nlohmann::json::object();
-  for (ctl::Scheme s : schemes) all_settled[ctl::to_string(s)] = true;
+  for (mc::teleop::Scheme s : schemes) all_settled[to_string(s)] = true;
   // For the report: the first unstable unprotected case and its protected twins.
-  std::vector<ctl::DelayCaseResult> shown;
+  std::vector<mc::teleop::DelayCaseResult> shown;
   double shown_delay = -1.0;
   const std::size_t total = o.delays_s.size() * o.losses.size() * schemes.size();
   std::size_t done = 0;
   for (double loss : o.losses) {
     for (double delay : o.delays_s) {
-      for (ctl::Scheme scheme : schemes) {
-        const ctl::DelayCase c{
+      for (mc::teleop::Scheme scheme : schemes) {
+        const mc::teleop::DelayCase c{
             delay, o.jitter_fraction * 0.5 * delay, loss, scheme, o.seed, o.wall_prior_error_m};
-        auto r = ctl::run_delay_case(p, c, /*keep_series=*/true);
-        if (scheme == ctl::Scheme::kNone && !r.stable && loss == 0.0 &&
+        auto r = mc::teleop::run_delay_case(p, c, /*keep_series=*/true);
+        if (scheme == mc::teleop::Scheme::kNone && !r.stable && loss == 0.0 &&
             (unstable_delay < 0 || delay < unstable_delay))
           unstable_delay = delay;
-        if (!r.settled) all_settled[ctl::to_string(scheme)] = false;
+        if (!r.settled) all_settled[to_string(scheme)] = false;
         cases.push_back(to_json(r));
         // The report shows the longest delay without loss, every scheme.
         if (loss == 0.0 && delay >= shown_delay) {
@@ -170,7 +169,7 @@ void run_sweep(SweepOptions& o) {
   }
   const bool lossless_unprotected =
       std::find(o.losses.begin(), o.losses.end(), 0.0) != o.losses.end() &&
-      std::find(schemes.begin(), schemes.end(), ctl::Scheme::kNone) != schemes.end();
+      std::find(schemes.begin(), schemes.end(), mc::teleop::Scheme::kNone) != schemes.end();
   // unstable_delay_s is about the unprotected loop without loss: said only when that was run.
   if (lossless_unprotected)
     human += unstable_delay < 0 ? "the unprotected loop stayed stable at every delay\n"
@@ -184,16 +183,16 @@ void run_sweep(SweepOptions& o) {
                 "force back), with time-domain passivity control at both ports (tdpa), or model-mediated "
                 "(mmt: the handle feels a local model of the wall that the slave estimates).");
     std::vector<mc::report::Series> pp;
-    for (ctl::Scheme s : schemes) {
+    for (mc::teleop::Scheme s : schemes) {
       std::vector<double> d, x;
       for (const auto& c : cases) {
-        if (c["loss"].get<double>() != 0.0 || c["scheme"] != ctl::to_string(s) ||
+        if (c["loss"].get<double>() != 0.0 || c["scheme"] != to_string(s) ||
             c["max_handle_excursion_m"].is_null())
           continue;
         d.push_back(c["delay_s"].get<double>());
         x.push_back(c["max_handle_excursion_m"].get<double>());
       }
-      pp.push_back({ctl::to_string(s), d, x});
+      pp.push_back({to_string(s), d, x});
     }
     rep.add_figure({"Handle motion in the contact",
                     "Peak-to-peak of the handle over the last second (no loss).",
@@ -201,7 +200,7 @@ void run_sweep(SweepOptions& o) {
                     {"Handle peak-to-peak", "m"},
                     pp});
     for (const auto& r : shown) {
-      const std::string name = fmt::format("{:g} ms, {}", 1e3 * r.c.delay_s, ctl::to_string(r.c.scheme));
+      const std::string name = fmt::format("{:g} ms, {}", 1e3 * r.c.delay_s, to_string(r.c.scheme));
       rep.add_figure({"Handle and slave, " + name,
                       "",
                       {"Time", "s"},
@@ -237,10 +236,11 @@ void run_validate(ValidateOptions& o) {
   mc::require(o.set == "tuning" || o.set == "validation", "--set",
               "must be tuning or validation, got '" + o.set + "'");
   mc::require(o.cases >= 1 && o.cases <= 1000, "--cases", "must be within [1, 1000]", o.cases);
-  const ctl::Scheme scheme = ctl::scheme_from_string(o.scheme);
+  const mc::teleop::Scheme scheme = mc::teleop::scheme_from_string(o.scheme);
   o.coupling.resolve();
-  const auto set = o.set == "tuning" ? ctl::tuning_set() : ctl::validation_set(o.cases, o.seed);
-  const ctl::SetSummary s = ctl::run_case_set(o.coupling.params, set, scheme);
+  const auto set =
+      o.set == "tuning" ? mc::studies::tuning_set() : mc::studies::validation_set(o.cases, o.seed);
+  const mc::studies::SetSummary s = mc::studies::run_case_set(o.coupling.params, set, scheme);
   nlohmann::json rows = nlohmann::json::array();
   std::string human =
       "round trip  jitter  loss  wall [N/m]    n  geometry err [mm]  noise [mN]  settled  settling [s]  "

@@ -1,10 +1,10 @@
 // The vendor driver sets (issue #30: pi-gcs2, anc300) registered before any command reads a
 // configuration (`devices: {driver: pi-gcs2, connection: ...}`; docs/hardware.md, "Drivers").
 
-#include "microcobot/vendor/vendor_drivers.h"
+#include "microcobot/drivers/register_drivers.h"
 
 namespace {
 
-[[maybe_unused]] const bool kVendorDrivers = (mc::vendor::register_vendor_drivers(), true);
+[[maybe_unused]] const bool kVendorDrivers = (mc::drivers::register_vendor_drivers(), true);
 
 }  // namespace

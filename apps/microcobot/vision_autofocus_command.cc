@@ -11,9 +11,9 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/autofocus.h"
-#include "microcobot/vision/renderer.h"
 #include "microcobot/vision/sharpness.h"
 #include "vision_camera_options.h"
 #include "vision_processing_commands.h"
@@ -39,7 +39,7 @@ struct AutofocusOptions {
 // (docs/benchmarks.md, "tool's tips").
 constexpr int kToolCoarsePx = 192;
 
-vision::PixelRoi square_in_frame(double u, double v, int side, const vision::CameraParams& cam) {
+imaging::PixelRoi square_in_frame(double u, double v, int side, const imaging::CameraParams& cam) {
   const int w = std::min(side, cam.sensor.width_px), h = std::min(side, cam.sensor.height_px);
   const int x = std::clamp(static_cast<int>(std::lround(u - 0.5 * (w - 1))), 0, cam.sensor.width_px - w);
   const int y = std::clamp(static_cast<int>(std::lround(v - 0.5 * (h - 1))), 0, cam.sensor.height_px - h);
@@ -48,11 +48,11 @@ vision::PixelRoi square_in_frame(double u, double v, int side, const vision::Cam
 
 void run_autofocus(const AutofocusOptions& o) {
   const pf::PlatformConfig config = pf::scene_config(o.camera.scene);
-  vs::CameraParams cam = camera_for(o.camera);
+  imaging::CameraParams cam = camera_for(o.camera);
   pf::CameraScenePose pose = pf::initial_pose(config);
   const bool tool = o.target == "tool";
   if (tool) pose.opening_m = 20e-6;  // both tips in the view
-  vs::SceneSnapshot scene;
+  imaging::SceneSnapshot scene;
   pf::fill_camera_scene(config, pose, scene);
   if (!tool && scene.parts.empty())
     throw mc::InvalidInput("--target part: the scene " + o.camera.scene + " has no part");
@@ -61,15 +61,15 @@ void run_autofocus(const AutofocusOptions& o) {
   // carries the focus; the gripper's fingers reach in from the far side), or a strip across the
   // left tip's end an eighth of the template high (the fingers rise along their length).
   const double truth_m = tool ? pose.tool_z_m : scene.parts.front().z_top_m;
-  const vs::Finger& finger = scene.fingers.front();
+  const imaging::Finger& finger = scene.fingers.front();
   const Eigen::Vector2d target =
       tool ? Eigen::Vector2d(finger.tip_x_m, finger.tip_y_m)
            : Eigen::Vector2d(pose.part_x_m, pose.part_y_m - 0.5 * scene.parts.front().size_y_m);
   cam.view_center_x_m = target.x();
   cam.view_center_y_m = target.y();
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
-  vs::PixelRoi roi =
+  imaging::Renderer renderer(cam);
+  imaging::CameraControls controls = renderer.default_controls();
+  imaging::PixelRoi roi =
       centred_roi(renderer.u_of_x(target.x()), renderer.v_of_y(target.y()), o.camera.template_px, cam);
   if (tool) {
     // A strip an eighth of the template high (12 px of 96) centred on the tips' end: half of it
@@ -90,16 +90,17 @@ void run_autofocus(const AutofocusOptions& o) {
   vs::AutofocusParams params =
       metric ? vs::autofocus_params_for(renderer.figures(), truth_m + o.offset_um * 1e-6, *metric)
              : vs::autofocus_params_for(renderer.figures(), truth_m + o.offset_um * 1e-6);
-  // The search may go wherever the focus drive goes (platform/camera_device.h).
+  // The search may go wherever the focus drive goes (devices/camera_device.h).
   params.range_min_m = std::min(config.camera.focus_min_m, params.start_m);
   params.range_max_m = std::max(config.camera.focus_max_m, params.start_m);
   const int coarse_px = o.coarse_px >= 0 ? o.coarse_px : (tool ? kToolCoarsePx : 0);
-  const vs::PixelRoi coarse_roi = coarse_px > 0 ? square_in_frame(renderer.u_of_x(target.x()),
-                                                                  renderer.v_of_y(target.y()), coarse_px, cam)
-                                                : roi;
+  const imaging::PixelRoi coarse_roi =
+      coarse_px > 0
+          ? square_in_frame(renderer.u_of_x(target.x()), renderer.v_of_y(target.y()), coarse_px, cam)
+          : roi;
   params.reuse_coarse_samples = coarse_px == 0;
   vs::Autofocus search(params);
-  vs::Frame frame;
+  imaging::Frame frame;
   CsvTable rows({"frame", "focus_z_m", "sharpness"});
   std::uint64_t index = 0;
   while (!search.done()) {

@@ -18,19 +18,19 @@ void add_camera_options(CLI::App& cmd, CameraOptions& o) {
       ->check(CLI::Range(8, 1024));
 }
 
-vision::CameraParams camera_for(const CameraOptions& o) {
-  vision::CameraParams cam;
+imaging::CameraParams camera_for(const CameraOptions& o) {
+  imaging::CameraParams cam;
   try {
-    cam.objective = vision::objective_by_name(o.objective);
+    cam.objective = imaging::objective_by_name(o.objective);
   } catch (const mc::UsageError& e) {
     throw mc::UsageError(std::string("--objective: ") + e.what());
   }
   return cam;
 }
 
-vision::PixelRoi centred_roi(double u, double v, int side, const vision::CameraParams& cam) {
-  const vision::PixelRoi roi{static_cast<int>(std::lround(u - 0.5 * (side - 1))),
-                             static_cast<int>(std::lround(v - 0.5 * (side - 1))), side, side};
+imaging::PixelRoi centred_roi(double u, double v, int side, const imaging::CameraParams& cam) {
+  const imaging::PixelRoi roi{static_cast<int>(std::lround(u - 0.5 * (side - 1))),
+                              static_cast<int>(std::lround(v - 0.5 * (side - 1))), side, side};
   if (roi.x < 0 || roi.y < 0 || roi.x + side > cam.sensor.width_px || roi.y + side > cam.sensor.height_px)
     throw mc::InvalidInput(
         fmt::format("--template-px {}: the template around the target ({:.0f}, {:.0f}) px "

@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "microcobot/vision/camera_params.h"
-#include "microcobot/vision/pixel_roi.h"
+#include "microcobot/imaging/camera_params.h"
+#include "microcobot/imaging/pixel_roi.h"
 
 namespace mc::cli {
 
@@ -22,10 +22,10 @@ struct CameraOptions {
 void add_camera_options(CLI::App& cmd, CameraOptions& o);
 
 /// The camera with the chosen objective (an unknown one: mc::UsageError naming --objective).
-vision::CameraParams camera_for(const CameraOptions& o);
+imaging::CameraParams camera_for(const CameraOptions& o);
 
 /// The template: `side` square centred on `u, v`, inside the frame (mc::InvalidInput naming
 /// --template-px otherwise: exit 3).
-vision::PixelRoi centred_roi(double u, double v, int side, const vision::CameraParams& cam);
+imaging::PixelRoi centred_roi(double u, double v, int side, const imaging::CameraParams& cam);
 
 }  // namespace mc::cli

@@ -12,10 +12,10 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
+#include "microcobot/imaging/png_file.h"
+#include "microcobot/imaging/renderer.h"
+#include "microcobot/imaging/tiff_file.h"
 #include "microcobot/platform/camera_scene.h"
-#include "microcobot/vision/png_file.h"
-#include "microcobot/vision/renderer.h"
-#include "microcobot/vision/tiff_file.h"
 #include "vision_processing_commands.h"
 
 namespace vision_commands {
@@ -25,7 +25,7 @@ namespace vs = mc::vision;
 namespace pf = mc::platform;
 using mc::cli::CommonOptions;
 
-nlohmann::json figures_json(const vs::ObjectiveParams& o, const vs::OpticsFigures& f) {
+nlohmann::json figures_json(const mc::imaging::ObjectiveParams& o, const mc::imaging::OpticsFigures& f) {
   return {{"objective", o.name},
           {"magnification", f.magnification},
           {"numerical_aperture", f.numerical_aperture},
@@ -45,9 +45,9 @@ nlohmann::json figures_json(const vs::ObjectiveParams& o, const vs::OpticsFigure
 }
 
 // The objective named by --objective (exit 2 naming the flag and the value).
-vs::ObjectiveParams objective_flag(const std::string& name) {
+mc::imaging::ObjectiveParams objective_flag(const std::string& name) {
   try {
-    return vs::objective_by_name(name);
+    return mc::imaging::objective_by_name(name);
   } catch (const mc::UsageError& e) {
     throw mc::UsageError(std::string("--objective: ") + e.what());
   }
@@ -60,9 +60,9 @@ struct ModelOptions {
 };
 
 void run_model(const ModelOptions& o) {
-  const vs::ObjectiveParams obj = objective_flag(o.objective);
-  const vs::SensorParams sensor;
-  const vs::OpticsFigures f = vs::optics_figures(obj, sensor);
+  const mc::imaging::ObjectiveParams obj = objective_flag(o.objective);
+  const mc::imaging::SensorParams sensor;
+  const mc::imaging::OpticsFigures f = mc::imaging::optics_figures(obj, sensor);
   mc::cli::emit(o.common, figures_json(obj, f),
                 fmt::format("objective {} (M {:g}, NA {:g}, WD {:g} mm, lambda {:g} nm)\n"
                             "resolution 0.61 lambda/NA   {:.3f} um\n"
@@ -94,7 +94,7 @@ void run_render(const RenderOptions& o) {
   if (!o.common.out)
     throw mc::UsageError("--out: required (the directory the frame and its camera state go to)");
   const pf::PlatformConfig config = pf::scene_config(o.scene);
-  vs::CameraParams cam;
+  mc::imaging::CameraParams cam;
   cam.objective = objective_flag(o.objective);
   cam.sensor.bit_depth = o.bit_depth;
   if (o.exposure_ms) cam.sensor.exposure_s = *o.exposure_ms * 1e-3;
@@ -109,15 +109,15 @@ void run_render(const RenderOptions& o) {
   cam.view_center_y_m = o.view_y_um ? *o.view_y_um * 1e-6 : pose.part_y_m;
   mc::cli::naming_flags({{"exposure_s", "--exposure-ms"}, {"gain", "--gain"}, {"bit_depth", "--bit-depth"}},
                         [&] { cam.validate(); });
-  vs::SceneSnapshot scene;
+  mc::imaging::SceneSnapshot scene;
   pf::fill_camera_scene(config, pose, scene);
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
+  mc::imaging::Renderer renderer(cam);
+  mc::imaging::CameraControls controls = renderer.default_controls();
   controls.focus_z_m = o.focus_um * 1e-6;
-  vs::Frame frame;
+  mc::imaging::Frame frame;
   renderer.render(scene, controls, o.seed, o.frame, frame);
 
-  const vs::OpticsFigures& f = renderer.figures();
+  const mc::imaging::OpticsFigures& f = renderer.figures();
   nlohmann::json j = figures_json(cam.objective, f);
   j["scene"] = o.scene;
   j["focus_z_m"] = controls.focus_z_m;
@@ -138,8 +138,8 @@ void run_render(const RenderOptions& o) {
   // Everything computed before anything is written; each file staged and renamed when complete.
   // A TIFF carries the scale (pixels per cm, object side) and this JSON (ImageJ/Fiji read both).
   const std::string image = o.format == "tiff"
-                                ? vs::encode_tiff(frame, f.um_per_px * 1e-6, j.dump(-1, ' ', true))
-                                : vs::encode_png(frame);
+                                ? mc::imaging::encode_tiff(frame, f.um_per_px * 1e-6, j.dump(-1, ' ', true))
+                                : mc::imaging::encode_png(frame);
   mc::ensure_writable_dir(*o.common.out);
   mc::write_file_atomic(*o.common.out / image_name, image);
   mc::write_file_atomic(*o.common.out / "camera.json", j.dump(2) + "\n");

@@ -12,19 +12,18 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
-#include "microcobot/platform/force_by_vision_run.h"
-#include "microcobot/platform/visual_servo_run.h"
+#include "microcobot/studies/force_by_vision_run.h"
+#include "microcobot/studies/visual_servo_run.h"
 #include "vision_processing_commands.h"
 
 namespace mc::cli {
 namespace {
 
-namespace pf = mc::platform;
 namespace vs = mc::vision;
 
 struct ServoOptions {
   CommonOptions common;
-  pf::ServoRunParams run;
+  studies::ServoRunParams run;
   double distance_um = 50.0;
   int starts = 1;
   std::uint64_t start_seed = 1;
@@ -49,16 +48,16 @@ void run_servo(const ServoOptions& o) {
   int worst_frames = -1, not_converged = 0;
   std::string first_png, last_png;
   for (int s = 0; s < o.starts; ++s) {
-    pf::ServoRunParams p = o.run;
+    studies::ServoRunParams p = o.run;
     const double a = angle(rng);
     p.start_offset_m = o.distance_um * 1e-6 * Eigen::Vector2d(std::cos(a), std::sin(a));
     p.seed = o.run.seed + 1000 * o.start_seed + static_cast<std::uint64_t>(s);
     p.servo.gain_per_s = o.gain;
     p.width_px = p.height_px = o.sensor_px;
     p.processing_latency_s = o.latency_ms * 1e-3;
-    const pf::ServoRunResult r = pf::run_visual_servo(p);
+    const studies::ServoRunResult r = studies::run_visual_servo(p);
     for (std::size_t k = 0; k < r.frames.size(); ++k) {
-      const pf::ServoFrame& f = r.frames[k];
+      const studies::ServoFrame& f = r.frames[k];
       const double row[] = {static_cast<double>(s),
                             static_cast<double>(k),
                             f.t_mid_s,
@@ -147,7 +146,7 @@ void run_force(const ForceOptions& o) {
   double worst_bias = 0.0, worst_noise = 0.0;
   std::string png;
   for (int s = 0; s < o.scenes; ++s) {
-    pf::ForceSceneParams p;
+    studies::ForceSceneParams p;
     p.objective = o.objective;
     p.force_N = 1e-3 * (o.min_mN + (o.max_mN - o.min_mN) * u01(rng));
     const double k_min = std::max(50.0, 2.0 * p.force_N / 470e-6);
@@ -160,7 +159,7 @@ void run_force(const ForceOptions& o) {
     p.seed = 100 * o.set_seed + static_cast<std::uint64_t>(s);
     p.loaded_frames = o.loaded_frames;
     p.width_px = p.height_px = o.sensor_px;
-    const pf::ForceSceneResult r = pf::run_force_scene(p);
+    const studies::ForceSceneResult r = studies::run_force_scene(p);
     const double bias = r.mean_force_N - r.true_force_N;
     const double k_sigma = p.finger_stiffness_N_m * r.tracking_noise_m;
     const double noise_ratio = r.force_noise_N / k_sigma;

@@ -1,6 +1,6 @@
 // `microcobot vision pick-place` (issue #28 point 5): a pick-and-place done by the visual servo
 // alone, the stage's encoders off, over a seeded random set of starts and targets judged against
-// the simulation's truth (platform/visual_pick_place_run.h).
+// the simulation's truth (studies/visual_pick_place_run.h).
 
 #include <algorithm>
 #include <cmath>
@@ -11,17 +11,15 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
-#include "microcobot/platform/visual_pick_place_run.h"
+#include "microcobot/studies/visual_pick_place_run.h"
 #include "vision_processing_commands.h"
 
 namespace mc::cli {
 namespace {
 
-namespace pf = mc::platform;
-
 struct PickPlaceOptions {
   CommonOptions common;
-  pf::VisualPickPlaceParams run;
+  studies::VisualPickPlaceParams run;
   int runs = 1;
   std::uint64_t set_seed = 1;
   int sensor_px = 0;
@@ -44,15 +42,15 @@ void run_pick_place(const PickPlaceOptions& o) {
   int failed = 0, not_holding = 0;
   std::string first_png, grasp_png, last_png;
   for (int s = 0; s < o.runs; ++s) {
-    pf::VisualPickPlaceParams p = o.run;
+    studies::VisualPickPlaceParams p = o.run;
     const double sx = u01(rng) < 0.5 ? -1.0 : 1.0;
     p.target_offset_m = {sx * (400e-6 + 150e-6 * u01(rng)), 200e-6 * (u01(rng) - 0.5)};
     p.start_offset_m = {300e-6 * (u01(rng) - 0.5), 250e-6 + 100e-6 * u01(rng)};
     p.seed = o.run.seed + 1000 * o.set_seed + static_cast<std::uint64_t>(s);
     p.width_px = p.height_px = o.sensor_px;
-    const pf::VisualPickPlaceResult r = pf::run_visual_pick_place(p);
+    const studies::VisualPickPlaceResult r = studies::run_visual_pick_place(p);
     for (std::size_t k = 0; k < r.frames.size(); ++k) {
-      const pf::PickPlaceFrame& f = r.frames[k];
+      const studies::PickPlaceFrame& f = r.frames[k];
       const double row[] = {static_cast<double>(s),
                             static_cast<double>(k),
                             static_cast<double>(f.phase),
@@ -94,7 +92,7 @@ void run_pick_place(const PickPlaceOptions& o) {
     runs.push_back({{"target_offset_m", {p.target_offset_m.x(), p.target_offset_m.y()}},
                     {"start_offset_m", {p.start_offset_m.x(), p.start_offset_m.y()}},
                     {"completed", r.completed},
-                    {"failed_phase", r.completed ? "" : pf::to_string(r.failed_phase)},
+                    {"failed_phase", r.completed ? "" : studies::to_string(r.failed_phase)},
                     {"part_on_substrate", r.part_on_substrate},
                     {"placement_error_m", err},
                     {"grasp_error_m", r.grasp_error_m.norm()},

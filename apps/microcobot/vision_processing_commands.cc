@@ -15,10 +15,10 @@
 #include "cli.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
+#include "microcobot/imaging/png_file.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/platform/camera_scene.h"
 #include "microcobot/vision/affine_calibration.h"
-#include "microcobot/vision/png_file.h"
-#include "microcobot/vision/renderer.h"
 #include "microcobot/vision/template_tracker.h"
 
 namespace mc::cli {
@@ -64,22 +64,22 @@ struct CalibrateOptions {
 
 void run_calibrate(const CalibrateOptions& o) {
   const pf::PlatformConfig config = pf::scene_config(o.camera.scene);
-  vs::CameraParams cam = camera_for(o.camera);
+  imaging::CameraParams cam = camera_for(o.camera);
   pf::CameraScenePose pose = pf::initial_pose(config);
   pose.opening_m = o.opening_um * 1e-6;
   const Eigen::Vector2d home(pose.tool_x_m, pose.tool_y_m);
   cam.view_center_x_m = home.x();
   cam.view_center_y_m = home.y();
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
+  imaging::Renderer renderer(cam);
+  imaging::CameraControls controls = renderer.default_controls();
   controls.focus_z_m = pose.tool_z_m;  // the finger tips in focus
   const double pixel_m = cam.pixel_size_m();
   // Default pitch: the grid spans half the field's short side.
   const double fov_m = std::min(cam.sensor.width_px, cam.sensor.height_px) * pixel_m;
   const double pitch_m = o.pitch_um ? *o.pitch_um * 1e-6 : 0.5 * fov_m / (o.grid - 1);
   const Eigen::Matrix2d g = o.geometry.matrix();
-  vs::SceneSnapshot scene;
-  vs::Frame frame;
+  imaging::SceneSnapshot scene;
+  imaging::Frame frame;
   const auto frame_at = [&](const Eigen::Vector2d& stage_m, std::uint64_t index) {
     const Eigen::Vector2d world = home + g * (stage_m - home);
     pose.tool_x_m = world.x();
@@ -98,7 +98,7 @@ void run_calibrate(const CalibrateOptions& o) {
   vs::TemplateTracker tracker;
   tracker.set_template(frame, centred_roi(renderer.u_of_x(home.x()), tip_v, o.camera.template_px, cam));
   const Eigen::Vector2d template_px(tracker.last().u_px, tracker.last().v_px);
-  const std::string first_png = vs::encode_png(frame);
+  const std::string first_png = imaging::encode_png(frame);
 
   const std::vector<Eigen::Vector2d> stage = vs::calibration_grid(home, o.grid, pitch_m);
   std::vector<Eigen::Vector2d> pixel;
@@ -195,7 +195,7 @@ struct TrackOptions {
 
 void run_track(const TrackOptions& o) {
   const pf::PlatformConfig config = pf::scene_config(o.camera.scene);
-  vs::CameraParams cam = camera_for(o.camera);
+  imaging::CameraParams cam = camera_for(o.camera);
   pf::CameraScenePose pose = pf::initial_pose(config);
   const bool tool = o.target == "tool";
   const Eigen::Vector2d start =
@@ -203,15 +203,15 @@ void run_track(const TrackOptions& o) {
   if (tool) pose.opening_m = 20e-6;
   cam.view_center_x_m = start.x();
   cam.view_center_y_m = start.y();
-  vs::Renderer renderer(cam);
-  vs::CameraControls controls = renderer.default_controls();
+  imaging::Renderer renderer(cam);
+  imaging::CameraControls controls = renderer.default_controls();
   controls.focus_z_m = pose.tool_z_m;
   const double dt = 1.0 / cam.sensor.frame_rate_Hz;
   const Eigen::Vector2d velocity =
       o.speed_um_s * 1e-6 *
       Eigen::Vector2d(std::cos(o.direction_deg * M_PI / 180.0), std::sin(o.direction_deg * M_PI / 180.0));
-  vs::SceneSnapshot scene;
-  vs::Frame frame;
+  imaging::SceneSnapshot scene;
+  imaging::Frame frame;
   const auto frame_at = [&](const Eigen::Vector2d& p, std::uint64_t index) {
     (tool ? pose.tool_x_m : pose.part_x_m) = p.x();
     (tool ? pose.tool_y_m : pose.part_y_m) = p.y();
@@ -240,7 +240,7 @@ void run_track(const TrackOptions& o) {
   // docs/parameters.md "Tracking the tool's tips").
   params.ecc_highpass_px = o.highpass_px.value_or(tool ? vs::kToolTipHighpass_px : 0.0);
   vs::TemplateTracker tracker(params);
-  vs::PixelRoi roi;
+  imaging::PixelRoi roi;
   try {
     roi = centred_roi(u0, v0, o.camera.template_px, cam);
   } catch (const mc::InvalidInput& e) {

@@ -8,8 +8,8 @@
 
 #include <algorithm>
 
+#include "microcobot/cell/session.h"
 #include "microcobot/core/csv.h"
-#include "microcobot/platform/session.h"
 #include "support/test_support.h"
 
 namespace mc {
@@ -47,10 +47,10 @@ TEST(MainJob, TheDefaultPickAndPlacePlacesThePartWithinFiveMicrometres) {
 }
 
 TEST(MainJob, AStaleMasterMidTransportIsHeldSafelyAndTheJobStillFinishes) {
-  platform::SessionParams sp;
+  cell::SessionParams sp;
   sp.scenario = "stale-master";
   platform::PlatformConfig config;
-  platform::Session s(config, sp);
+  cell::Session s(config, sp);
   const auto r = s.run();
   EXPECT_TRUE(r.success) << r.verdict;
   EXPECT_THAT(r.verdict, ::testing::HasSubstr("held with zero force"));

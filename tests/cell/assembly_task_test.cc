@@ -27,7 +27,7 @@ struct IdealStage {
   }
   // One 1 ms tick of `task`; returns the distance the tip moved.
   double tick(AssemblyTask& task) {
-    const control::ConsoleInput& in = task.tick(s, 1e-3);
+    const teleop::ConsoleInput& in = task.tick(s, 1e-3);
     const Eigen::Vector3d before = s.tip_m;
     if (in.deadman && in.has_goal) {
       const Eigen::Vector3d d = in.goal_m - s.tip_m;
@@ -216,7 +216,7 @@ TEST(AssemblyTask, WithACameraItHoldsForItsLooksAndGoesWhereThePinWasSeen) {
   held.part_m << tip.head<2>() + 5e-6 * ey, tip.z();
   task.see(held);
   EXPECT_NEAR(task.held_offset_m(), 5e-6, 1e-12);
-  const control::ConsoleInput& in = task.tick(stage.s, 1e-3);
+  const teleop::ConsoleInput& in = task.tick(stage.s, 1e-3);
   ASSERT_TRUE(in.deadman && in.has_goal);
   EXPECT_LT((in.goal_m.head<2>() - (bore.part_m.head<2>() - 5e-6 * ey)).norm(), 1e-12)
       << "the pin on the axis of the bore as seen";
@@ -259,7 +259,7 @@ TEST(AssemblyTask, WithTheServoItMovesByTheErrorSeenAndLooksAgainUntilConverged)
   there.error_m = {0.1e-6, 0.05e-6};
   there.converged = true;
   task.see(there);
-  const control::ConsoleInput& in = task.tick(stage.s, 1e-3);
+  const teleop::ConsoleInput& in = task.tick(stage.s, 1e-3);
   EXPECT_EQ(task.look_wanted(), AssemblyTask::Look::kNone);
   ASSERT_TRUE(in.deadman && in.has_goal);
   EXPECT_LT((in.goal_m.head<2>() - (over.head<2>() - off.error_m)).norm(), 1e-12)
@@ -334,7 +334,7 @@ TEST(AssemblyTask, AnAssistedMoveGuidesTheOperatorToItsGoalAndGoesOnOnceThere) {
   const Eigen::Vector3d lifted = stage.s.tip_m;
   // The operator's master drives: the task sends no move, and holds its fixtures.
   for (int i = 0; i < 100; ++i) EXPECT_EQ(stage.tick(task), 0.0);
-  const control::FixtureSet& f = task.fixtures();
+  const teleop::FixtureSet& f = task.fixtures();
   EXPECT_EQ(f.level, 1.0);
   EXPECT_TRUE(f.guide && f.height && !f.funnel);
   EXPECT_EQ(f.guide_xy_m, skip_goal().target_m) << "the guide on the bore";
@@ -370,7 +370,7 @@ TEST(AssemblyTask, AnAssistedTurnHoldsAYawStopAtTheSquaresYawAndGoesOnOnceTurned
   ASSERT_TRUE(stage.run_to(task, Step::kRotate));
   ASSERT_EQ(task.status(), Status::kAssisted);
   stage.tick(task);
-  const control::FixtureSet& f = task.fixtures();
+  const teleop::FixtureSet& f = task.fixtures();
   EXPECT_TRUE(f.yaw && f.guide && f.height);
   EXPECT_NEAR(f.yaw_rad, 0.3, 1e-12) << "the bore's yaw, nearest where the turn began";
   EXPECT_EQ(f.guide_xy_m, g.target_m);
@@ -452,7 +452,7 @@ TEST(AssemblyTask, AnAssistedInsertionHoldsTheFunnelAndIsJudgedAtItsFirstContact
     ASSERT_TRUE(stage.run_to(task, Step::kInsert));
     ASSERT_EQ(task.status(), Status::kAssisted);
     stage.tick(task);
-    const control::FixtureSet& f = task.fixtures();
+    const teleop::FixtureSet& f = task.fixtures();
     EXPECT_TRUE(f.guide && f.funnel && !f.height);
     EXPECT_EQ(f.guide_xy_m, skip_goal().target_m);
     EXPECT_DOUBLE_EQ(f.rim_z_m, rim_z);

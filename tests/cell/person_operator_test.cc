@@ -111,7 +111,7 @@ TEST(PersonOperator, TheConsolesClickToGoDoesTheSameCycleByClicks) {
   CellCycle c(person_job(), params, default_platform());
   int goal_ticks = 0, rate_ticks = 0;
   c.set_observer([&](double) {
-    const control::ConsoleInput& in = c.platform().console_input();
+    const teleop::ConsoleInput& in = c.platform().console_input();
     if (in.has_goal) ++goal_ticks;
     if (in.velocity_m_s.head<2>().norm() > 0.0) ++rate_ticks;
   });

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "microcobot/core/error.h"
-#include "microcobot/vendor/anc300_codec.h"
-#include "microcobot/vendor/gcs2_codec.h"
-#include "microcobot/vendor/line_client.h"
+#include "microcobot/drivers/anc300_codec.h"
+#include "microcobot/drivers/gcs2_codec.h"
+#include "microcobot/drivers/line_client.h"
 
 namespace {
 
@@ -22,8 +22,8 @@ void one_line(const mc::Error& e) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  namespace gcs2 = mc::vendor::gcs2;
-  namespace anc300 = mc::vendor::anc300;
+  namespace gcs2 = mc::drivers::gcs2;
+  namespace anc300 = mc::drivers::anc300;
   if (gcs2::reply_end(text) > text.size()) std::abort();
   (void)gcs2::reply_lines(text);
   (void)gcs2::parse_error_reply(text);
@@ -40,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (const auto v = anc300::value_of(line); v && v->empty()) std::abort();
   }
   try {
-    const auto c = mc::vendor::parse_connection(text, "pi-gcs2");
+    const auto c = mc::drivers::parse_connection(text, "pi-gcs2");
     if (c.is_serial() ? c.serial.path.front() != '/' || c.serial.baud == 0 : c.port == 0 || c.host.empty())
       std::abort();
   } catch (const mc::Error& e) {

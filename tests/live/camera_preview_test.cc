@@ -26,7 +26,7 @@ TEST(CameraPreview, TheBinningBringsAnyWidthToThePanel) {
 }
 
 TEST(CameraPreview, ATwelveBitFrameBecomesTheMeansOfItsBlocksAtEightBits) {
-  platform::Image full;
+  devices::Image full;
   full.resize(1279, 1025, 1, 12);  // remainders that fill no block are left out
   for (int y = 0; y < full.height; ++y)
     for (int x = 0; x < full.width; ++x) {
@@ -65,7 +65,7 @@ TEST(CameraPreview, ATwelveBitFrameBecomesTheMeansOfItsBlocksAtEightBits) {
 }
 
 TEST(CameraPreview, AnImageAlreadyThePanelsSizeIsKeptAsItIs) {
-  platform::Image rgb;
+  devices::Image rgb;
   rgb.resize(320, 240, 3, 8);
   for (std::size_t i = 0; i < rgb.data.size(); ++i) rgb.data[i] = static_cast<std::uint8_t>(i % 251);
   CameraPreview preview;
@@ -76,7 +76,7 @@ TEST(CameraPreview, AnImageAlreadyThePanelsSizeIsKeptAsItIs) {
 }
 
 TEST(CameraPreview, AMalformedImageIsRefusedInOneLine) {
-  platform::Image bad;
+  devices::Image bad;
   bad.resize(64, 64, 1, 8);
   bad.data.resize(10);
   CameraPreview preview;

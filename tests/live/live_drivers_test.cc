@@ -48,8 +48,7 @@ TEST(LiveDrivers, TheConsoleJogsTheStageThroughTheSelectedDriversAndTheDemoIsRef
     return measured_x;
   };
   ASSERT_TRUE(test::eventually([&] { return live.status().t_s > 0.1 && !std::isnan(x()); }));
-  for (std::size_t i = 0; i < 6; ++i)
-    EXPECT_EQ(live.status().lifecycle[i], platform::Lifecycle::kActive) << i;
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(live.status().lifecycle[i], devices::Lifecycle::kActive) << i;
   EXPECT_EQ(live.channel_count(), platform::kLoopChannelCount) << "no ground truth on drivers";
 
   // 0.5 s of +x at 100 um/s with the deadman: the skeleton axis's encoder counts it.

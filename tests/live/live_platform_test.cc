@@ -15,8 +15,8 @@ namespace mc::live {
 namespace {
 
 using namespace std::chrono_literals;
+using devices::Lifecycle;
 using platform::kTelemetryChannels;
-using platform::Lifecycle;
 
 std::size_t channel(const char* name) {
   for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)

@@ -234,7 +234,7 @@ TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
                        MC_UNDER_ASAN ? 30.0 : 10.0));
-  const platform::PositionerStatus before = rig.live.status().vision.value();
+  const perception::PositionerStatus before = rig.live.status().vision.value();
   const Eigen::Vector2d start = rig.truth();
   // 30 px right, 20 px down: +x, -y on the stage (rows go down).
   rig.goal_px = {before.tool_u_px + 30.0, before.tool_v_px + 20.0};
@@ -249,7 +249,7 @@ TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
   const Eigen::Vector2d moved = rig.truth() - start;
   EXPECT_NEAR(moved.x(), 30.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
   EXPECT_NEAR(moved.y(), -20.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
-  const platform::PositionerStatus after = rig.live.status().vision.value();
+  const perception::PositionerStatus after = rig.live.status().vision.value();
   EXPECT_NEAR(after.goal_u_px, before.tool_u_px + 30.0, 1e-9);
   EXPECT_NEAR(after.goal_v_px, before.tool_v_px + 20.0, 1e-9);
 }

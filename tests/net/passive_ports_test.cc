@@ -11,7 +11,7 @@
 #include <memory>
 #include <random>
 
-#include "microcobot/control/link_emulator.h"
+#include "microcobot/teleop/link_emulator.h"
 
 namespace mc::net {
 namespace {
@@ -105,15 +105,15 @@ TEST(PassivePorts, TheGrippersPortLetsTheJawsSqueezeOnlyWithTheEnergyTheMasterPu
 // Both ends joined by emulated lines (the energies travel with the loss and jitter of the state
 // they ride on), driven by random forces and velocities, with the master restarted half way;
 // through an axis' port or the gripper's.
-double lowest_channel_energy(bool passivity, const control::LinkParams& line, bool gripper) {
+double lowest_channel_energy(bool passivity, const teleop::LinkParams& line, bool gripper) {
   const std::size_t port = gripper ? kGripperPort : 0;
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto master = std::make_unique<MasterPorts>(passivity);
   SlavePorts slave(passivity);
-  control::LinkParams back = line;
+  teleop::LinkParams back = line;
   back.seed = line.seed + 1;
-  control::EmulatedLink forward(line, kDt), backward(back, kDt);
+  teleop::EmulatedLink forward(line, kDt), backward(back, kDt);
   double dead_master_balance = 0.0;  // the restarted master's predecessor: in - out
   double lowest = 0.0;
   for (int k = 0; k < 20000; ++k) {
@@ -134,7 +134,7 @@ double lowest_channel_energy(bool passivity, const control::LinkParams& line, bo
     }
     forward.send({t, 0.0, master->report().input_energy_J[port]});
     backward.send({t, 0.0, slave.report().input_energy_J[port]});
-    control::LinkSample got;
+    teleop::LinkSample got;
     const auto arrive = [&](auto& end, double e) {
       gripper ? end.arrived_gripper(e) : end.arrived({e, 0, 0});
     };
@@ -149,9 +149,9 @@ double lowest_channel_energy(bool passivity, const control::LinkParams& line, bo
 }
 
 TEST(PassivePorts, TheChannelNeverCreatesEnergyWhateverTheDelayJitterLossAndRestarts) {
-  for (const control::LinkParams& line :
-       {control::LinkParams{0.0, 0.0, 0.0, 3}, control::LinkParams{0.1, 0.0, 0.0, 5},
-        control::LinkParams{0.1, 0.02, 0.2, 7}}) {
+  for (const teleop::LinkParams& line :
+       {teleop::LinkParams{0.0, 0.0, 0.0, 3}, teleop::LinkParams{0.1, 0.0, 0.0, 5},
+        teleop::LinkParams{0.1, 0.02, 0.2, 7}}) {
     SCOPED_TRACE(testing::Message() << "delay " << line.delay_s << " s, jitter " << line.jitter_s
                                     << " s, loss " << line.loss);
     for (bool gripper : {false, true}) {

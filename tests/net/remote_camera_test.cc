@@ -19,8 +19,8 @@ namespace mc::net {
 namespace {
 
 // A frame whose JPEG is a horizontal ramp (x * 4 DN) of w x h pixels.
-platform::CameraFrame ramp_frame(int w, int h) {
-  platform::CameraFrame f;
+devices::CameraFrame ramp_frame(int w, int h) {
+  devices::CameraFrame f;
   std::vector<std::uint8_t> px(static_cast<std::size_t>(w * h));
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) px[static_cast<std::size_t>(y * w + x)] = static_cast<std::uint8_t>(4 * x);
@@ -29,8 +29,8 @@ platform::CameraFrame ramp_frame(int w, int h) {
   return f;
 }
 
-platform::CameraDeviceParams sensor(int w, int h, int bits) {
-  platform::CameraDeviceParams p;
+devices::CameraDeviceParams sensor(int w, int h, int bits) {
+  devices::CameraDeviceParams p;
   p.sensor.width_px = w;
   p.sensor.height_px = h;
   p.sensor.bit_depth = bits;
@@ -39,7 +39,7 @@ platform::CameraDeviceParams sensor(int w, int h, int bits) {
 
 // Captures until a frame comes (the publisher publishing meanwhile), or 10 s.
 bool capture_one(RemoteCameraSource& source, CameraImagePublisher& publisher,
-                 const platform::CameraFrame& frame, platform::Image& out) {
+                 const devices::CameraFrame& frame, devices::Image& out) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (std::chrono::steady_clock::now() < end) {
     publisher.publish(frame, 1.0);
@@ -54,8 +54,8 @@ TEST(RemoteCamera, TheSlavesFramesComeOutDecodedAtTheSensorsDepth) {
   RemoteCameraSource source(domain, {});
   source.open(sensor(64, 48, 12));
   EXPECT_FALSE(source.renders_scene());
-  platform::Image img;
-  const platform::CameraFrame sent = ramp_frame(64, 48);
+  devices::Image img;
+  const devices::CameraFrame sent = ramp_frame(64, 48);
   ASSERT_TRUE(capture_one(source, publisher, sent, img));
   ASSERT_NE(source.captured_jpeg(), nullptr);
   EXPECT_EQ(*source.captured_jpeg(), sent.jpeg) << "the slave's JPEG goes on as it came";
@@ -74,7 +74,7 @@ TEST(RemoteCamera, AFrameOfAnotherSizeFaultsNamingBothSizes) {
   CameraImagePublisher publisher(domain, {});
   RemoteCameraSource source(domain, {});
   source.open(sensor(1280, 1024, 8));
-  platform::Image img;
+  devices::Image img;
   try {
     capture_one(source, publisher, ramp_frame(64, 48), img);
     FAIL() << "a 64 x 48 frame for a 1280 x 1024 sensor was taken";
@@ -90,7 +90,7 @@ TEST(RemoteCamera, ASourceNobodyReadsFromLetsTheSlaveRest) {
   RemoteCameraSource source(domain, {});
   source.open(sensor(64, 48, 8));
   EXPECT_FALSE(publisher.wanted()) << "opened, not yet reading";
-  platform::Image img;
+  devices::Image img;
   ASSERT_TRUE(capture_one(source, publisher, ramp_frame(64, 48), img));
   EXPECT_TRUE(publisher.wanted());
   source.idle();

@@ -16,7 +16,7 @@
 #include "microcobot/live/live_platform.h"
 #include "microcobot/net/remote_master.h"
 #include "microcobot/net/remote_slave.h"
-#include "microcobot/platform/timing_stats.h"
+#include "microcobot/runtime/timing_stats.h"
 #include "net/net_test_support.h"
 #include "support/counting_allocator.h"
 #include "support/test_support.h"
@@ -67,7 +67,7 @@ struct Pair {
   std::unique_ptr<RemoteMaster> master_link;
   std::unique_ptr<End> master, slave;
 
-  explicit Pair(const control::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true,
+  explicit Pair(const teleop::LinkParams& emulate = {}, bool passivity = true, bool interpolate = true,
                 const microworld::PickPlaceParams& world = {}, bool rotary = false) {
     config.world = world;
     const int domain = test::test_domain_id();
@@ -95,12 +95,12 @@ struct Pair {
     live::LiveParams lp;
     lp.platform.world = config.world;
     lp.make_devices = [this] {
-      platform::PlatformDevices d = slave_link->make_devices();
-      d.haptic = std::make_unique<platform::SimulatedHapticMaster>(
+      devices::DeviceSet d = slave_link->make_devices();
+      d.haptic = std::make_unique<devices::SimulatedHapticMaster>(
           "dual_stage", config.haptic.plant, config.haptic.render, config.haptic.pantograph,
           config.loop.period_s());
-      d.tweezers = std::make_unique<platform::SimulatedTweezersMaster>("teletweez", config.tweezers,
-                                                                       config.loop.period_s());
+      d.tweezers = std::make_unique<devices::SimulatedTweezersMaster>("teletweez", config.tweezers,
+                                                                      config.loop.period_s());
       return d;
     };
     master = std::make_unique<End>(lp);
@@ -147,8 +147,8 @@ microworld::PickPlaceParams without_safety_limits() {
   return w;
 }
 
-control::LinkParams lossy_200ms_round_trip(std::uint64_t seed) {
-  control::LinkParams link;
+teleop::LinkParams lossy_200ms_round_trip(std::uint64_t seed) {
+  teleop::LinkParams link;
   link.delay_s = 0.1;
   link.jitter_s = 0.01;
   link.loss = 0.2;
@@ -218,7 +218,7 @@ TEST(RemoteEnds, TheMastersConsoleTurnsTheSlavesRotaryAxisOverDds) {
 }
 
 TEST(RemoteEnds, SoOverAnEmulatedLinkOf100msRoundTripWithJitterAndLoss) {
-  control::LinkParams link;
+  teleop::LinkParams link;
   link.delay_s = 0.05;  // each way
   link.jitter_s = 0.005;
   link.loss = 0.2;
@@ -260,7 +260,7 @@ void moves_the_slave_without_allocating(Pair& pair) {
   EXPECT_EQ(pair.slave_link->link().stats().rejected_total(), 0u);
   // The link's work on the slave's loop thread (its remote end's poll and publish) is timed
   // there at every operator tick; the master's loop has no remote end (its stage is a device).
-  platform::TimingStats slave_cost(1e-8), master_cost(1e-8);
+  runtime::TimingStats slave_cost(1e-8), master_cost(1e-8);
   pair.slave->live->drain_link_costs(slave_cost);
   pair.master->live->drain_link_costs(master_cost);
   EXPECT_GT(slave_cost.count(), 500u);  // one per ms over the drives above (the ring keeps 4096)
@@ -406,7 +406,7 @@ TEST(RemoteEnds, TheGrippersPortKeepsTheGraspPassiveOver200msRoundTripWith20Perc
 // jitter buffer the slave retraces the master's motion. Returns the RMS off the line and the
 // fitted speed.
 std::pair<double, double> slave_target_roughness(bool interpolate) {
-  control::LinkParams link;
+  teleop::LinkParams link;
   link.delay_s = 0.05;
   link.jitter_s = 0.005;
   link.loss = 0.2;
@@ -498,7 +498,7 @@ TEST(RemoteEnds, AMasterLetsGoOfASlaveSilentFor8msInLoopTime) {
   Link peer(peer_of(rp, Role::kSlave));
   auto devices = remote.make_devices();
   EXPECT_FALSE(devices.axes[0]->measurement_fresh()) << "no pose yet";
-  constexpr double kActive = static_cast<double>(platform::Lifecycle::kActive);
+  constexpr double kActive = static_cast<double>(devices::Lifecycle::kActive);
   deliver(peer, Channel::kSlaveDiagnostics, {kActive, kActive, kActive}, kActive, [&] {
     remote.exchange(0.0);
     return remote.state().slave_active();
@@ -592,7 +592,7 @@ TEST(RemoteEnds, AMasterDoesNotTakeBackASlaveOnPosesQueuedWhileItWasCutOff) {
   rp.watch_dds = false;  // the peer sends poses only: the age of the poses is under test
   RemoteSlave remote(rp);
   Link peer(peer_of(rp, Role::kSlave));
-  constexpr double kActive = static_cast<double>(platform::Lifecycle::kActive);
+  constexpr double kActive = static_cast<double>(devices::Lifecycle::kActive);
   deliver(peer, Channel::kSlaveDiagnostics, {kActive, kActive, kActive}, kActive, [&] {
     remote.exchange(0.0);
     return remote.state().slave_active();
@@ -698,7 +698,7 @@ TEST(RemoteEnds, TheMastersEstopLatchesTheSlaveAndItsResetReleasesIt) {
   ASSERT_TRUE(mc::test::eventually([&] { return pair.slave->live->status().estopped; }))
       << "the slave did not latch the master's e-stop";
   for (auto l : {pair.slave->live->status().lifecycle[0], pair.slave->live->status().lifecycle[3]})
-    EXPECT_EQ(l, platform::Lifecycle::kFault);
+    EXPECT_EQ(l, devices::Lifecycle::kFault);
   pair.master->live->request(live::ConsoleAction::kReset);
   ASSERT_TRUE(mc::test::eventually([&] {
     return !pair.master->live->status().estopped && !pair.slave->live->status().estopped;

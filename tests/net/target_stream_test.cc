@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <random>
 
-#include "microcobot/control/link_emulator.h"
+#include "microcobot/teleop/link_emulator.h"
 #include "support/counting_allocator.h"
 
 namespace mc::net {
@@ -30,13 +30,13 @@ struct Followed {
 
 // 3 s of a 200 um/s ramp, sent each ms stamped with a clock 3 s ahead of this end's, over
 // `line`; the receiver follows the stream (or the latest target) each ms; fitted over 1-3 s.
-Followed follow_ramp(const control::LinkParams& line, bool buffered) {
-  control::SetpointStreamParams sp;  // RemoteMaster's, with an emulated jitter: look-ahead 2 J + 1 ms
+Followed follow_ramp(const teleop::LinkParams& line, bool buffered) {
+  motion::SetpointStreamParams sp;  // RemoteMaster's, with an emulated jitter: look-ahead 2 J + 1 ms
   sp.delay_s = std::max(2e-3, 2.0 * line.jitter_s + 1e-3);
   sp.capacity = 64;
   sp.max_velocity_m_s = 1e-3;
   TargetStream stream(sp);
-  control::EmulatedLink wire(line, kDt);
+  teleop::EmulatedLink wire(line, kDt);
   const double offset_s = 3.0;
   std::array<double, 3> latest{};
   std::vector<double> t, x;
@@ -48,7 +48,7 @@ Followed follow_ramp(const control::LinkParams& line, bool buffered) {
     for (int k = 0; k < 3000; ++k) {
       const double now = k * kDt;
       wire.send({now, kSpeed * now, 0.0});  // sent at, position
-      control::LinkSample got;  // the newest arrived (the link keeps the latest, as a DDS reader may)
+      teleop::LinkSample got;  // the newest arrived (the link keeps the latest, as a DDS reader may)
       if (wire.receive(now, got) && got.sent_s > last_sent) {
         last_sent = got.sent_s;
         stream.push(got.sent_s + offset_s, {got.value, 0.0, 0.0}, now);
@@ -76,7 +76,7 @@ Followed follow_ramp(const control::LinkParams& line, bool buffered) {
 }
 
 TEST(TargetStream, AJitteryLossyLineDeliversTheMastersRampSmoothlyAndDelayedNotInJumps) {
-  control::LinkParams line;
+  teleop::LinkParams line;
   line.delay_s = 0.05;
   line.jitter_s = 0.005;
   line.loss = 0.2;
@@ -98,7 +98,7 @@ TEST(TargetStream, AJitteryLossyLineDeliversTheMastersRampSmoothlyAndDelayedNotI
 }
 
 TEST(TargetStream, LateTargetsHoldAndAreRejoinedAtTheSpeedLimitNeverByAJump) {
-  control::SetpointStreamParams sp;
+  motion::SetpointStreamParams sp;
   sp.delay_s = 2e-3;
   sp.max_velocity_m_s = 1e-3;
   TargetStream stream(sp);
@@ -121,7 +121,7 @@ TEST(TargetStream, LateTargetsHoldAndAreRejoinedAtTheSpeedLimitNeverByAJump) {
 }
 
 TEST(TargetStream, AStampFromTheFutureIsDroppedAndDoesNotFreezeTheGoal) {
-  TargetStream stream(control::SetpointStreamParams{});
+  TargetStream stream(motion::SetpointStreamParams{});
   double now = 0.0;
   for (int k = 0; k < 50; ++k, now += kDt) {
     ASSERT_TRUE(stream.push(now, {k * 1e-9, 0.0, 0.0}, now + 1e-3));

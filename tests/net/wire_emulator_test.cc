@@ -27,7 +27,7 @@ NetSample estop(bool on) {
 }
 
 TEST(WireEmulator, ASampleArrivesAfterTheDelayAndOnlyOnce) {
-  control::LinkParams p;
+  teleop::LinkParams p;
   p.delay_s = 0.02;
   WireEmulator w(p, 1000.0);
   w.arrive(0.0, pose(1e-6));
@@ -46,7 +46,7 @@ TEST(WireEmulator, ASampleArrivesAfterTheDelayAndOnlyOnce) {
 }
 
 TEST(WireEmulator, BestEffortSamplesAreLostAtTheRateAndTheEstopNever) {
-  control::LinkParams p;
+  teleop::LinkParams p;
   p.delay_s = 0.01;
   p.jitter_s = 0.005;
   p.loss = 0.2;
@@ -75,7 +75,7 @@ TEST(WireEmulator, BestEffortSamplesAreLostAtTheRateAndTheEstopNever) {
 }
 
 TEST(WireEmulator, TheNewestOfABurstInOneTickWins) {
-  WireEmulator w(control::LinkParams{.delay_s = 0.001}, 1000.0);
+  WireEmulator w(teleop::LinkParams{.delay_s = 0.001}, 1000.0);
   w.arrive(0.0, estop(true));
   w.arrive(0.0, estop(false));
   std::vector<double> got;
@@ -85,9 +85,9 @@ TEST(WireEmulator, TheNewestOfABurstInOneTickWins) {
 }
 
 TEST(WireEmulator, RefusesBadParameters) {
-  EXPECT_THROW(WireEmulator(control::LinkParams{.delay_s = 0.01, .jitter_s = 0.02}, 1000.0), InvalidParams);
-  EXPECT_THROW(WireEmulator(control::LinkParams{.loss = 1.0}, 1000.0), InvalidParams);
-  EXPECT_THROW(WireEmulator(control::LinkParams{}, 0.0), InvalidParams);
+  EXPECT_THROW(WireEmulator(teleop::LinkParams{.delay_s = 0.01, .jitter_s = 0.02}, 1000.0), InvalidParams);
+  EXPECT_THROW(WireEmulator(teleop::LinkParams{.loss = 1.0}, 1000.0), InvalidParams);
+  EXPECT_THROW(WireEmulator(teleop::LinkParams{}, 0.0), InvalidParams);
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ TEST(DriverRegistry, TheNamesAreTheSimulationThenTheRegisteredDrivers) {
 }
 
 TEST(DriverRegistry, RefusesBadTakenOrReservedNamesAndMissingFactories) {
-  const DeviceFactory f = [](const PlatformConfig&) { return PlatformDevices{}; };
+  const DeviceFactory f = [](const PlatformConfig&) { return devices::DeviceSet{}; };
   EXPECT_THROW(register_devices("", f), InvalidParams);
   EXPECT_THROW(register_devices("lab bench", f), InvalidParams);
   EXPECT_THROW(register_devices("simulated", f), InvalidParams);

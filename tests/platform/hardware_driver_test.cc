@@ -9,8 +9,8 @@
 #include <array>
 #include <thread>
 
-#include "microcobot/control/step_map.h"
 #include "microcobot/core/error.h"
+#include "microcobot/motion/step_map.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/stage_controller.h"
 #include "platform/skeleton_drivers.h"
@@ -25,8 +25,8 @@ using test::SkeletonBench;
 
 TEST(HardwareDriver, ASkeletonAxisDriverRunsTheStageControllerInClosedLoop) {
   const stickslip::ActuatorModel model{stickslip::StickSlipParams{}};
-  const control::StepMap map(model);
-  control::PositionControlParams cp;
+  const motion::StepMap map(model);
+  motion::PositionControlParams cp;
   cp.control_rate_Hz = 1000.0;
   StageController ctrl(cp, model.params(), map, 10, 1e-5);
   FakeBus bus;
@@ -51,7 +51,7 @@ TEST(HardwareDriver, ASkeletonAxisDriverRunsTheStageControllerInClosedLoop) {
   bus.fault = true;  // the board reports a fault: the driver goes to its safe state
   axis.command_drive(ctrl.drive(0));
   axis.update(1e-4);
-  EXPECT_EQ(axis.state(), Lifecycle::kFault);
+  EXPECT_EQ(axis.state(), devices::Lifecycle::kFault);
   EXPECT_FALSE(bus.powered);
   EXPECT_EQ(bus.fifo_size, 0);
 }
@@ -99,7 +99,7 @@ TEST(HardwareDriver, ThePlatformRunsOnDriversHandedToIt) {
   p.loop().run_for(1);
   EXPECT_TRUE(p.faulted());
   for (const auto& b : buses) EXPECT_FALSE(b.powered);
-  EXPECT_EQ(p.haptic().state(), Lifecycle::kFault);
+  EXPECT_EQ(p.haptic().state(), devices::Lifecycle::kFault);
   EXPECT_DOUBLE_EQ(hand.force_N.x, 0.0);
 }
 
@@ -145,7 +145,7 @@ TEST(HardwareDriver, ASimulatedGripperRidesTheDriversStageWhereItsSensorsSayItIs
 
 TEST(HardwareDriver, APlatformRefusesMissingOrAlreadyConfiguredDevices) {
   PlatformConfig config;
-  PlatformDevices none;
+  devices::DeviceSet none;
   try {
     Platform p(config, std::move(none));
     FAIL();

@@ -1,13 +1,13 @@
-#include "microcobot/platform/simulated_optical_tweezers.h"
+#include "microcobot/devices/simulated_optical_tweezers.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "microcobot/cell/pick_place_operator.h"
+#include "microcobot/cell/session.h"
 #include "microcobot/core/error.h"
-#include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
-#include "microcobot/platform/session.h"
 #include "support/counting_allocator.h"
 
 namespace mc::platform {
@@ -40,10 +40,11 @@ double stddev(const Recorder& r, const char* name, std::size_t from, std::size_t
 struct TrapRig {
   PlatformConfig config = trap_scene();
   Platform platform{config};
-  OperatorHand hand;
+  devices::OperatorHand hand;
   TrapRig() {
     hand.deadman = true;
-    platform.set_operator([this](const TickInfo&) { platform.simulation().haptic->set_operator(hand); });
+    platform.set_operator(
+        [this](const runtime::TickInfo&) { platform.simulation().haptic->set_operator(hand); });
   }
   double last(const char* name) const {
     const Recorder& r = platform.recording();
@@ -106,7 +107,7 @@ TEST(OpticalTweezersScene, PushingTheProbeIntoTheStuckBeadIsFeltAsAForceOpposing
   // The hand moves 10 mm to +x over 2 s: the trap 5 um, 1.5 um past where the beads touch
   // (less the handle's give under the force, F / k_f).
   const double hand_travel_m = 10e-3;
-  rig.platform.set_operator([&](const TickInfo& t) {
+  rig.platform.set_operator([&](const runtime::TickInfo& t) {
     const double s = std::clamp((t.t_s - 0.2) / 2.0, 0.0, 1.0);
     rig.hand.hand_m.x = hand_travel_m * s;
     sim.haptic->set_operator(rig.hand);
@@ -143,9 +144,9 @@ TEST(OpticalTweezersScene, TheLoopPathNeitherAllocatesNorThrows) {
 
 TEST(OpticalTweezersScene, TheScriptedPickAndPlaceRefusesIt) {
   const PlatformConfig c = trap_scene();
-  EXPECT_THROW(Session(c, SessionParams{}), InvalidParams);
+  EXPECT_THROW(cell::Session(c, cell::SessionParams{}), InvalidParams);
   Platform p(c);
-  EXPECT_THROW(PickPlaceOperator(p, PickPlaceOperatorParams{}), InvalidParams);
+  EXPECT_THROW(cell::PickPlaceOperator(p, cell::PickPlaceOperatorParams{}), InvalidParams);
 }
 
 // The error's text for a configuration that must be refused.

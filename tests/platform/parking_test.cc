@@ -13,7 +13,7 @@ namespace {
 struct ParkingRig {
   PlatformConfig config;
   std::unique_ptr<Platform> platform;
-  control::ConsoleInput in;
+  teleop::ConsoleInput in;
   explicit ParkingRig(double park_after_s = 0.1) {
     config.stage.park_after_s = park_after_s;
     platform = std::make_unique<Platform>(config);
@@ -21,7 +21,7 @@ struct ParkingRig {
     in.has_goal = true;
     in.goal_m = {config.stage.home_x_m, config.stage.home_y_m, config.stage.home_z_m};
     in.goal_speed_m_s = 200e-6;
-    platform->set_operator([this](const TickInfo&) { platform->set_console_input(in); });
+    platform->set_operator([this](const runtime::TickInfo&) { platform->set_console_input(in); });
     platform->set_console_input(in);
   }
   double true_x() const { return platform->simulation().axes[0]->true_position_m(); }

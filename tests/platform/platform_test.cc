@@ -4,10 +4,10 @@
 
 #include <fstream>
 
+#include "microcobot/cell/pick_place_operator.h"
+#include "microcobot/cell/session.h"
 #include "microcobot/core/error.h"
 #include "microcobot/core/mcap_reader.h"
-#include "microcobot/platform/pick_place_operator.h"
-#include "microcobot/platform/session.h"
 #include "support/counting_allocator.h"
 #include "support/test_support.h"
 
@@ -53,9 +53,9 @@ TEST(PlatformConfig, ANamedStickSlipFileIsReadRelativeToTheConfiguration) {
 struct Rig {
   PlatformConfig config;
   Platform platform{config};
-  PickPlaceOperator op{platform, PickPlaceOperatorParams{}};
+  cell::PickPlaceOperator op{platform, cell::PickPlaceOperatorParams{}};
   Rig() {
-    platform.set_operator([this](const TickInfo& t) { op.act(t); });
+    platform.set_operator([this](const runtime::TickInfo& t) { op.act(t); });
   }
 };
 
@@ -83,9 +83,9 @@ TEST(Platform, AFaultingDevicePutsEveryDeviceInItsSafeState) {
   p.tweezers().fault();  // e.g. the TéléTweez driver lost its encoder
   p.loop().run_for(1);
   EXPECT_TRUE(p.faulted());
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.axis(i).state(), Lifecycle::kFault);
-  EXPECT_EQ(p.haptic().state(), Lifecycle::kFault);
-  EXPECT_EQ(p.gripper().state(), Lifecycle::kFault);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.axis(i).state(), devices::Lifecycle::kFault);
+  EXPECT_EQ(p.haptic().state(), devices::Lifecycle::kFault);
+  EXPECT_EQ(p.gripper().state(), devices::Lifecycle::kFault);
   const double x = p.simulation().axes[0]->true_position_m();
   p.loop().run_for(1000);
   for (int i = 0; i < 3; ++i)
@@ -119,13 +119,13 @@ TEST(Platform, StaleHapticReadingsHoldTheSlaveAndZeroTheForceWithinTheWatchdogTi
 TEST(Session, AShortPickAndPlaceSucceedsAndWritesItsReport) {
   PlatformConfig c;
   c.world.target_m.x() = 0.3e-3;  // a 300 um transport keeps the test short
-  Session s(c, SessionParams{});
+  cell::Session s(c, cell::SessionParams{});
   const auto r = s.run();
   EXPECT_TRUE(r.success) << r.verdict;
   EXPECT_LT(r.placement_error_m, 5e-6);
   EXPECT_FALSE(r.crashed);
   EXPECT_EQ(r.telemetry_dropped, 0u);
-  EXPECT_EQ(s.op().phase(), PickPlaceOperator::Phase::kDone);
+  EXPECT_EQ(s.op().phase(), cell::PickPlaceOperator::Phase::kDone);
   test::TempDir dir;
   s.write(dir.path(), r);
   EXPECT_TRUE(std::filesystem::exists(dir / "index.html"));
@@ -139,7 +139,7 @@ TEST(Session, AShortPickAndPlaceSucceedsAndWritesItsReport) {
 }
 
 TEST(Session, UnknownScenarioIsAUsageError) {
-  SessionParams sp;
+  cell::SessionParams sp;
   sp.scenario = "juggle";
   EXPECT_THROW(sp.validate(), UsageError);
 }

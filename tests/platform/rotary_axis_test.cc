@@ -14,13 +14,13 @@ namespace {
 struct RotaryRig {
   PlatformConfig config;
   std::unique_ptr<Platform> platform;
-  control::ConsoleInput in;
+  teleop::ConsoleInput in;
   RotaryRig() {
     platform = std::make_unique<Platform>(config);
     in.active = in.fresh = in.deadman = true;
     in.has_theta_goal = true;
     in.theta_speed_rad_s = 0.16;
-    platform->set_operator([this](const TickInfo&) { platform->set_console_input(in); });
+    platform->set_operator([this](const runtime::TickInfo&) { platform->set_console_input(in); });
     platform->set_console_input(in);
     platform->run(0.05);
   }
@@ -99,7 +99,7 @@ TEST(RotaryAxis, HoldAndFaultsLeaveItHoldingAtZeroVolts) {
   rig.in.deadman = true;
   rig.platform->run(0.5);  // turning again
   rig.platform->fault_all();
-  EXPECT_EQ(rig.platform->rotary_axis()->state(), Lifecycle::kFault);
+  EXPECT_EQ(rig.platform->rotary_axis()->state(), devices::Lifecycle::kFault);
   const double at_fault = rig.true_yaw();
   rig.platform->run(0.5);
   EXPECT_EQ(rig.channel("u_theta_V"), 0.0);

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <functional>
 
-#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 
 namespace mc::platform {
@@ -49,13 +49,13 @@ double last(const Platform& p, const char* name) {
 struct ConsoleRig {
   PlatformConfig config;
   std::unique_ptr<Platform> platform;
-  control::ConsoleInput in;
+  teleop::ConsoleInput in;
   explicit ConsoleRig(const microworld::PickPlaceParams& world = {}) {
     config.world = world;
     platform = std::make_unique<Platform>(config);
     in.active = true;
     in.fresh = true;
-    platform->set_operator([this](const TickInfo&) { platform->set_console_input(in); });
+    platform->set_operator([this](const runtime::TickInfo&) { platform->set_console_input(in); });
   }
   Eigen::Vector3d tip() const { return platform->simulation().gripper->tip_position_m(); }
   void go_to(const Eigen::Vector3d& goal, double seconds) {
@@ -134,11 +134,11 @@ TEST(Safety, TheScriptedPinInHoleInsertsThePinUnderTheLimitsAndEndsHolding) {
   config.world = microworld::pin_in_hole_scene();
   config.world.target_m.x() = 0.3e-3;  // a short transport keeps the test short
   Platform p(config);
-  PickPlaceOperator op(p, PickPlaceOperatorParams{});
-  p.set_operator([&](const TickInfo& t) { op.act(t); });
+  cell::PickPlaceOperator op(p, cell::PickPlaceOperatorParams{});
+  p.set_operator([&](const runtime::TickInfo& t) { op.act(t); });
   for (int i = 0; i < 240 && !op.done() && !op.gave_up(); ++i) p.run(0.5);
-  ASSERT_TRUE(op.done()) << "gave up in " << PickPlaceOperator::name(op.failed_phase()) << ": "
-                         << PickPlaceOperator::give_up_reason(op.failed_phase());
+  ASSERT_TRUE(op.done()) << "gave up in " << cell::PickPlaceOperator::name(op.failed_phase()) << ": "
+                         << cell::PickPlaceOperator::give_up_reason(op.failed_phase());
   const auto* g = p.simulation().gripper;
   EXPECT_TRUE(g->world().inserted(g->world_state()));
   EXPECT_LT(g->world().placement_error_m(g->world_state()), 10e-6);

@@ -11,21 +11,21 @@
 #include <memory>
 #include <string>
 
-#include "microcobot/platform/device.h"
+#include "microcobot/devices/device.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/stickslip/actuator.h"
 
 namespace mc::test {
 
-using platform::DriveBlock;
-using platform::Gripper;
-using platform::HapticMaster;
+using devices::DeviceSet;
+using devices::DriveBlock;
+using devices::Gripper;
+using devices::HapticMaster;
+using devices::SlaveAxis;
+using devices::TweezersMaster;
+using devices::Vec2;
+using devices::Vec3;
 using platform::PlatformConfig;
-using platform::PlatformDevices;
-using platform::SlaveAxis;
-using platform::TweezersMaster;
-using platform::Vec2;
-using platform::Vec3;
 
 // What an amplifier + encoder board exposes: a DAC FIFO, an encoder counter, a fault flag.
 struct FakeBus {
@@ -156,8 +156,8 @@ struct SkeletonBench {
       b.state = model.initial_state();
     }
   }
-  PlatformDevices devices() {
-    PlatformDevices d;
+  devices::DeviceSet devices() {
+    devices::DeviceSet d;
     for (std::size_t i = 0; i < 3; ++i) d.axes[i] = std::make_unique<SkeletonAxisDriver>(buses[i]);
     auto h = std::make_unique<FakeHapticDriver>();
     hand = h.get();

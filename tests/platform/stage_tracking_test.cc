@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "microcobot/control/position_sensor.h"
+#include "microcobot/motion/position_sensor.h"
 #include "microcobot/platform/stage_controller.h"
 #include "support/counting_allocator.h"
 
@@ -14,14 +14,14 @@ namespace {
 
 TEST(StageTracking, FollowsAMovingTargetWithoutAllocating) {
   const stickslip::ActuatorModel model{stickslip::StickSlipParams{}};
-  const control::StepMap map(model);
-  control::TrackingParams tp;  // 10 kHz
-  StageController ctrl(control::PositionControlParams{}, model.params(), map, 10, 1e-5, &tp);
+  const motion::StepMap map(model);
+  motion::TrackingParams tp;  // 10 kHz
+  StageController ctrl(motion::PositionControlParams{}, model.params(), map, 10, 1e-5, &tp);
   ASSERT_NE(ctrl.tracker(0), nullptr);
   EXPECT_EQ(ctrl.axis(0), nullptr);
   std::array<stickslip::ActuatorState, 3> s{model.initial_state(), model.initial_state(),
                                             model.initial_state()};
-  control::PositionSensor sensor;
+  motion::PositionSensor sensor;
   double sq = 0.0, target = 0.0;
   int n = 0;
   std::size_t allocations = 0;
@@ -37,7 +37,7 @@ TEST(StageTracking, FollowsAMovingTargetWithoutAllocating) {
       }
       for (int i = 0; i < 3; ++i) {
         const auto& st0 = s[static_cast<std::size_t>(i)];
-        const DriveBlock b =
+        const devices::DriveBlock b =
             ctrl.drive(i, i == 0 ? sensor.measure(model.slider_position(st0)) : model.slider_position(st0));
         auto& st = s[static_cast<std::size_t>(i)];
         model.set_operating_point(

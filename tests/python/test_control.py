@@ -13,7 +13,7 @@ def plant():
 
 
 def test_velocity_controller_stepped_from_python_equals_run_velocity(plant):
-    # The loop of control/closed_loop.cc written in Python with the bound pieces: the same numbers.
+    # The loop of motion/closed_loop.cc written in Python with the bound pieces: the same numbers.
     ref, duration = 100e-6, 0.05
     p = plant.params
     model = plant.model

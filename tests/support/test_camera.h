@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "microcobot/platform/camera_device.h"
+#include "microcobot/devices/camera_device.h"
 #include "microcobot/platform/driver_registry.h"
 
 namespace mc::test {
@@ -32,11 +32,11 @@ inline TestCameraControl& test_camera() {
   return control;
 }
 
-class TestPatternSource final : public platform::FrameSource {
+class TestPatternSource final : public devices::FrameSource {
  public:
-  void open(const platform::CameraDeviceParams& params) override { params_ = params; }
+  void open(const devices::CameraDeviceParams& params) override { params_ = params; }
   bool renders_scene() const override { return true; }
-  bool capture(const platform::SceneSnapshot& scene, platform::Image& out) override {
+  bool capture(const devices::SceneSnapshot& scene, devices::Image& out) override {
     TestCameraControl& c = test_camera();
     while (c.stall.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     if (c.fail.load()) throw std::runtime_error("test camera: unplugged");
@@ -61,7 +61,7 @@ class TestPatternSource final : public platform::FrameSource {
   }
 
  private:
-  platform::CameraDeviceParams params_;
+  devices::CameraDeviceParams params_;
 };
 
 /// Registers "test-pattern" once (idempotent).

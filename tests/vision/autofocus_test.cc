@@ -25,13 +25,13 @@ using testing::FocusCamera;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Runs the search on `cam`, each frame measured with the metric the search asks for.
-Autofocus run(FocusCamera& cam, const AutofocusParams& p, const PixelRoi& roi = testing::kFocusRoi) {
+Autofocus run(FocusCamera& cam, const AutofocusParams& p, const imaging::PixelRoi& roi = testing::kFocusRoi) {
   Autofocus af(p);
   while (!af.done()) af.observe(cam.measure(af.next_focus_m(), af.next_metric(), roi));
   return af;
 }
 
-double goal_tolerance(const OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
+double goal_tolerance(const imaging::OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
 
 void expect_goal(FocusCamera& cam, double z_true, double offset, const char* what) {
   const AutofocusParams p = autofocus_params_for(cam.figures(), z_true + offset);
@@ -88,7 +88,7 @@ TEST(Autofocus, DimNoisyFramesStillWithinAFifthOfTheDepthOfField) {
 // No texture: the measures differ by the noise only. The search says so and leaves the focus
 // where it was, instead of returning the noisiest frame's height.
 TEST(Autofocus, AFlatTexturelessRegionIsNotConverged) {
-  SceneSnapshot s;
+  imaging::SceneSnapshot s;
   s.substrate.texture_contrast = 0.0;
   FocusCamera cam("10x", s, 45);
   AutofocusParams p = autofocus_params_for(cam.figures(), 37e-6);

@@ -87,7 +87,7 @@ TEST(DepthFromFocus, BadSamplesAreOneLineErrors) {
 
 // A sweep of `n` frames at `step` around `z_guess` (the height a part is expected at, off by
 // `guess_error`), measured with Tenengrad: the estimate against the true height.
-double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, const PixelRoi& roi) {
+double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, const imaging::PixelRoi& roi) {
   std::vector<FocusSample> sweep;
   for (int k = -n / 2; k <= n / 2; ++k) {
     const double z = z_guess + k * step;
@@ -99,7 +99,7 @@ double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, cons
 }
 
 // The goal's tolerance (issue #28): a fifth of the depth of field, and 0.3 um.
-double goal_tolerance(const OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
+double goal_tolerance(const imaging::OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
 
 TEST(DepthFromFocus, HeightOfAPartsTopFromASweep) {
   for (const double z_top : {180e-6, 262.5e-6}) {
@@ -132,9 +132,9 @@ TEST(DepthFromFocus, HeightOfAPartsTopFromAnAutofocusSearch) {
 
 TEST(DepthFromFocus, HeightOfTheGrippersTips) {
   const double z_tip = 150e-6;
-  SceneSnapshot s = testing::substrate_scene(8);
+  imaging::SceneSnapshot s = testing::substrate_scene(8);
   for (int side : {-1, 1}) {
-    Finger f;
+    imaging::Finger f;
     f.tip_x_m = side * 45e-6;  // two fingers 50 um apart, their tips in the view
     f.tip_y_m = -30e-6;
     f.z_tip_m = z_tip;

@@ -1,6 +1,6 @@
 // Force by vision (issue #28 point 4): two fingers rendered at a known deflection read back as
 // k x deflection; bad input (empty ROI, NaN stiffness, too few unloaded openings, no unloaded
-// pose) refused in one line. The benchmark over 1-20 mN is tests/platform/force_by_vision_test.cc.
+// pose) refused in one line. The benchmark over 1-20 mN is tests/studies/force_by_vision_test.cc.
 
 #include <cmath>
 #include <limits>
@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/vision/finger_force.h"
-#include "microcobot/vision/renderer.h"
 #include "tracking_scenes.h"
 
 namespace mc::vision {
@@ -18,14 +18,14 @@ namespace finger_force_test {
 
 // Two 40 um fingers whose tips' inner edges are `opening` apart, centred on the view.
 struct Fingers {
-  Renderer renderer{testing::small_camera()};
-  Frame frame;
+  imaging::Renderer renderer{testing::small_camera()};
+  imaging::Frame frame;
   std::uint64_t index = 0;
   void render(double opening_m) {
-    SceneSnapshot s;
+    imaging::SceneSnapshot s;
     s.substrate.texture_seed = 5;
     for (int side : {-1, 1}) {
-      Finger f;
+      imaging::Finger f;
       f.tip_x_m = side * 0.5 * (opening_m + f.width_m);
       f.tip_y_m = -20e-6;
       f.length_m = 1e-3;
@@ -33,11 +33,11 @@ struct Fingers {
     }
     renderer.render(s, renderer.default_controls(), 3, index++, frame);
   }
-  PixelRoi roi(double x0_m, double x1_m) const {
+  imaging::PixelRoi roi(double x0_m, double x1_m) const {
     const double u0 = renderer.u_of_x(x0_m), u1 = renderer.u_of_x(x1_m);
     const double v0 = renderer.v_of_y(-20e-6 + 30e-6), v1 = renderer.v_of_y(-20e-6 - 12e-6);
-    return PixelRoi{static_cast<int>(std::lround(u0)), static_cast<int>(std::lround(v0)),
-                    static_cast<int>(std::lround(u1 - u0)), static_cast<int>(std::lround(v1 - v0))};
+    return imaging::PixelRoi{static_cast<int>(std::lround(u0)), static_cast<int>(std::lround(v0)),
+                             static_cast<int>(std::lround(u1 - u0)), static_cast<int>(std::lround(v1 - v0))};
   }
 };
 
@@ -81,14 +81,15 @@ TEST(FingerForce, BadInputIsRefusedInOneLine) {
   f.render(60e-6);
   FingerForce force;
   try {
-    force.set_templates(f.frame, PixelRoi{10, 10, 0, 0}, f.roi(50e-6, 82e-6));
+    force.set_templates(f.frame, imaging::PixelRoi{10, 10, 0, 0}, f.roi(50e-6, 82e-6));
     FAIL() << "an empty ROI was accepted";
   } catch (const InvalidInput& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("left finger"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
-  EXPECT_THROW(force.set_templates(f.frame, f.roi(-82e-6, -50e-6), PixelRoi{300, 10, 64, 64}), InvalidInput);
+  EXPECT_THROW(force.set_templates(f.frame, f.roi(-82e-6, -50e-6), imaging::PixelRoi{300, 10, 64, 64}),
+               InvalidInput);
   force.set_templates(f.frame, f.roi(-82e-6, -50e-6), f.roi(50e-6, 82e-6));
   EXPECT_THROW(force.measure(f.frame, 50e-6), InvalidInput);  // no unloaded pose
   force.add_unloaded(f.frame, 60e-6);

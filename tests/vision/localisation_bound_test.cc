@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/vision/localisation_bound.h"
-#include "microcobot/vision/renderer.h"
 #include "microcobot/vision/template_tracker.h"
 #include "tracking_scenes.h"
 
@@ -23,10 +23,10 @@ using testing::kW;
 using testing::small_camera;
 
 // A 300 um part, 100 um thick, its upper left corner at the image's centre plus (du, dv) px.
-SceneSnapshot corner_at(double du_px, double dv_px, double pixel_m) {
-  SceneSnapshot s;
+imaging::SceneSnapshot corner_at(double du_px, double dv_px, double pixel_m) {
+  imaging::SceneSnapshot s;
   s.substrate.texture_seed = 7;
-  Part p;
+  imaging::Part p;
   p.x_m = 150e-6 + du_px * pixel_m;
   p.y_m = -150e-6 - dv_px * pixel_m;
   p.size_x_m = p.size_y_m = 300e-6;
@@ -36,9 +36,9 @@ SceneSnapshot corner_at(double du_px, double dv_px, double pixel_m) {
 }
 
 struct Bench {
-  Renderer renderer{small_camera()};
-  CameraControls controls;
-  PixelRoi roi{kW / 2 - 40, kH / 2 - 40, 80, 80};
+  imaging::Renderer renderer{small_camera()};
+  imaging::CameraControls controls;
+  imaging::PixelRoi roi{kW / 2 - 40, kH / 2 - 40, 80, 80};
   explicit Bench(double exposure_s) {
     controls = renderer.default_controls();
     controls.focus_z_m = kTop;
@@ -67,7 +67,7 @@ TEST(LocalisationBound, TheTrackerComesToAboutTwiceTheBound) {
   Bench s(10e-3);
   const LocalisationBound bound = s.bound();
   const double pixel_m = s.renderer.camera().pixel_size_m();
-  Frame frame;
+  imaging::Frame frame;
   s.renderer.render(corner_at(0.0, 0.0, pixel_m), s.controls, 1, 0, frame);
   TemplateTracker tracker;
   tracker.set_template(frame, s.roi);
@@ -104,8 +104,8 @@ TEST(LocalisationBound, RefusesAnRoiOutsideTheSensorOrWithoutAnEdge) {
   Bench s(10e-3);
   s.roi = {300, 10, 40, 40};
   EXPECT_THROW(s.bound(), InvalidInput);
-  Renderer r(small_camera());
-  SceneSnapshot flat;
+  imaging::Renderer r(small_camera());
+  imaging::SceneSnapshot flat;
   flat.substrate.texture_contrast = 0.0;
   EXPECT_THROW(
       translation_bound([&](double, double) { return r.render_expected(flat, r.default_controls()); },

@@ -17,8 +17,8 @@ namespace {
 
 using testing::FocusCamera;
 
-Frame make_frame(int w, int h, std::vector<std::uint16_t> pixels) {
-  Frame f;
+imaging::Frame make_frame(int w, int h, std::vector<std::uint16_t> pixels) {
+  imaging::Frame f;
   f.width = w, f.height = h, f.bit_depth = 12;
   f.pixels = std::move(pixels);
   return f;
@@ -27,19 +27,20 @@ Frame make_frame(int w, int h, std::vector<std::uint16_t> pixels) {
 // Values worked by hand from the definitions (sharpness.h).
 TEST(Sharpness, HandComputedValues) {
   // 2 x 2 checker 0, 2 / 2, 0: mean 1, variance 1, normalised variance var / mean = 1.
-  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {0, 2, 2, 0}), PixelRoi{0, 0, 2, 2}), 1.0);
+  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {0, 2, 2, 0}), imaging::PixelRoi{0, 0, 2, 2}), 1.0);
   // A uniform frame has none; a black one is 0, not NaN.
-  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {7, 7, 7, 7}), PixelRoi{0, 0, 2, 2}), 0.0);
-  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {0, 0, 0, 0}), PixelRoi{0, 0, 2, 2}), 0.0);
+  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {7, 7, 7, 7}), imaging::PixelRoi{0, 0, 2, 2}), 0.0);
+  EXPECT_DOUBLE_EQ(normalized_variance(make_frame(2, 2, {0, 0, 0, 0}), imaging::PixelRoi{0, 0, 2, 2}), 0.0);
   // 3 x 3, a vertical step 0 | 0 | 10: at the centre Gx = (10 + 2 * 10 + 10) - 0 = 40, Gy = 0.
-  const Frame step = make_frame(3, 3, {0, 0, 10, 0, 0, 10, 0, 0, 10});
-  EXPECT_DOUBLE_EQ(tenengrad(step, PixelRoi{0, 0, 3, 3}), 1600.0);
-  EXPECT_DOUBLE_EQ(tenengrad(step, PixelRoi{0, 0, 3, 3}, 1600.0), 0.0);  // at the threshold: left out
-  EXPECT_DOUBLE_EQ(tenengrad(step, PixelRoi{0, 0, 3, 3}, 1599.0), 1600.0);
+  const imaging::Frame step = make_frame(3, 3, {0, 0, 10, 0, 0, 10, 0, 0, 10});
+  EXPECT_DOUBLE_EQ(tenengrad(step, imaging::PixelRoi{0, 0, 3, 3}), 1600.0);
+  EXPECT_DOUBLE_EQ(tenengrad(step, imaging::PixelRoi{0, 0, 3, 3}, 1600.0),
+                   0.0);  // at the threshold: left out
+  EXPECT_DOUBLE_EQ(tenengrad(step, imaging::PixelRoi{0, 0, 3, 3}, 1599.0), 1600.0);
   // Brenner: one pair per row, (10 - 0)^2 each.
-  EXPECT_DOUBLE_EQ(brenner(step, PixelRoi{0, 0, 3, 3}), 100.0);
+  EXPECT_DOUBLE_EQ(brenner(step, imaging::PixelRoi{0, 0, 3, 3}), 100.0);
   // A ROI measures only its own pixels: the left two columns are flat.
-  EXPECT_DOUBLE_EQ(normalized_variance(step, PixelRoi{0, 0, 2, 3}), 0.0);
+  EXPECT_DOUBLE_EQ(normalized_variance(step, imaging::PixelRoi{0, 0, 2, 3}), 0.0);
 }
 
 TEST(Sharpness, MetricNamesRoundTrip) {
@@ -57,8 +58,8 @@ TEST(Sharpness, MetricNamesRoundTrip) {
   }
 }
 
-void expect_roi_error(const PixelRoi& roi, const std::string& words, FocusMetric metric) {
-  const Frame f = make_frame(8, 6, std::vector<std::uint16_t>(48, 100));
+void expect_roi_error(const imaging::PixelRoi& roi, const std::string& words, FocusMetric metric) {
+  const imaging::Frame f = make_frame(8, 6, std::vector<std::uint16_t>(48, 100));
   try {
     sharpness(f, roi, metric);
     FAIL() << "no error for ROI " << roi.x << " " << roi.y << " " << roi.width << " " << roi.height;
@@ -73,18 +74,18 @@ void expect_roi_error(const PixelRoi& roi, const std::string& words, FocusMetric
 
 TEST(Sharpness, BadRoisAreOneLineErrorsNamingTheRoi) {
   for (FocusMetric m : {FocusMetric::kNormalizedVariance, FocusMetric::kTenengrad, FocusMetric::kBrenner}) {
-    expect_roi_error(PixelRoi{0, 0, 0, 4}, "empty", m);
-    expect_roi_error(PixelRoi{2, 2, 3, -1}, "empty", m);
-    expect_roi_error(PixelRoi{6, 0, 3, 3}, "not inside the frame of the 8 x 6 image", m);
-    expect_roi_error(PixelRoi{-1, 0, 3, 3}, "not inside", m);
-    expect_roi_error(PixelRoi{0, 4, 3, 3}, "not inside", m);
-    expect_roi_error(PixelRoi{100, 100, 4, 4}, "not inside", m);
+    expect_roi_error(imaging::PixelRoi{0, 0, 0, 4}, "empty", m);
+    expect_roi_error(imaging::PixelRoi{2, 2, 3, -1}, "empty", m);
+    expect_roi_error(imaging::PixelRoi{6, 0, 3, 3}, "not inside the frame of the 8 x 6 image", m);
+    expect_roi_error(imaging::PixelRoi{-1, 0, 3, 3}, "not inside", m);
+    expect_roi_error(imaging::PixelRoi{0, 4, 3, 3}, "not inside", m);
+    expect_roi_error(imaging::PixelRoi{100, 100, 4, 4}, "not inside", m);
   }
-  expect_roi_error(PixelRoi{0, 0, 2, 2}, "too small", FocusMetric::kTenengrad);
-  expect_roi_error(PixelRoi{0, 0, 2, 6}, "too small", FocusMetric::kBrenner);
+  expect_roi_error(imaging::PixelRoi{0, 0, 2, 2}, "too small", FocusMetric::kTenengrad);
+  expect_roi_error(imaging::PixelRoi{0, 0, 2, 6}, "too small", FocusMetric::kBrenner);
   // The whole frame is fine.
-  const Frame f = make_frame(8, 6, std::vector<std::uint16_t>(48, 100));
-  EXPECT_DOUBLE_EQ(sharpness(f, full_roi(f), FocusMetric::kTenengrad), 0.0);
+  const imaging::Frame f = make_frame(8, 6, std::vector<std::uint16_t>(48, 100));
+  EXPECT_DOUBLE_EQ(sharpness(f, imaging::full_roi(f), FocusMetric::kTenengrad), 0.0);
 }
 
 // Through focus, each measure is largest at the surface's height and falls off on both sides.

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "microcobot/core/error.h"
-#include "microcobot/vision/renderer.h"
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/vision/template_tracker.h"
 #include "tracking_scenes.h"
 
@@ -26,10 +26,10 @@ using testing::small_camera;
 
 // A 300 um brass part 100 um thick, its top in focus, on the textured steel substrate (which is
 // then out of focus: a template that also holds a sharp static background is pulled toward it).
-SceneSnapshot part_at(double x_m, double y_m) {
-  SceneSnapshot s;
+imaging::SceneSnapshot part_at(double x_m, double y_m) {
+  imaging::SceneSnapshot s;
   s.substrate.texture_seed = 7;
-  Part p;
+  imaging::Part p;
   p.x_m = x_m;
   p.y_m = y_m;
   p.size_x_m = p.size_y_m = 300e-6;
@@ -42,17 +42,17 @@ SceneSnapshot part_at(double x_m, double y_m) {
 constexpr double kX0 = 150e-6, kY0 = -150e-6;
 
 struct Fixture {
-  Renderer renderer{small_camera()};
-  Frame frame;
+  imaging::Renderer renderer{small_camera()};
+  imaging::Frame frame;
   void render(double x_m, double y_m, std::uint64_t index) {
-    CameraControls c = renderer.default_controls();
+    imaging::CameraControls c = renderer.default_controls();
     c.focus_z_m = kTop;
     renderer.render(part_at(x_m, y_m), c, 11, index, frame);
   }
   TemplateTracker start(const TrackerParams& params = {}) {
     render(kX0, kY0, 0);
     TemplateTracker t(params);
-    t.set_template(frame, PixelRoi{kW / 2 - 40, kH / 2 - 40, 80, 80});
+    t.set_template(frame, imaging::PixelRoi{kW / 2 - 40, kH / 2 - 40, 80, 80});
     return t;
   }
 };
@@ -91,20 +91,20 @@ TEST(TemplateTracker, FollowsAPartWithSubPixelErrorAndNoPullTowardWholePixels) {
 // Without the high-pass the part's changing glow biased it (0.49 px rms in a seeded case); with
 // a finger drawn as segments laid one over the other, their seams did (0.2 px at 5x).
 TEST(TemplateTracker, FollowsTheToolsTipsOverAPartsGlowWithoutPixelLocking) {
-  CameraParams cam = small_camera();
-  cam.objective = objective_by_name("5x");
-  Renderer renderer(cam);
+  imaging::CameraParams cam = small_camera();
+  cam.objective = imaging::objective_by_name("5x");
+  imaging::Renderer renderer(cam);
   const double pixel_m = cam.pixel_size_m(), z_tips = 450e-6;
   const auto scene_at = [&](double x_m, double y_m) {
-    SceneSnapshot s;
+    imaging::SceneSnapshot s;
     s.substrate.texture_seed = 3;
-    Part p;
+    imaging::Part p;
     p.x_m = 120e-6;  // its left edge 30 um right of the tool at the start
     p.size_x_m = p.size_y_m = 300e-6;
     p.z_top_m = 300e-6;
     s.parts.push_back(p);
     for (const double side : {-1.0, 1.0}) {
-      Finger f;
+      imaging::Finger f;
       f.tip_x_m = x_m + side * 30e-6;  // 20 um apart
       f.tip_y_m = y_m - 20e-6;
       f.z_tip_m = z_tips;
@@ -113,9 +113,9 @@ TEST(TemplateTracker, FollowsTheToolsTipsOverAPartsGlowWithoutPixelLocking) {
     }
     return s;
   };
-  CameraControls c = renderer.default_controls();
+  imaging::CameraControls c = renderer.default_controls();
   c.focus_z_m = z_tips;
-  Frame frame;
+  imaging::Frame frame;
   renderer.render(scene_at(0.0, 0.0), c, 21, 0, frame);
   TrackerParams params;
   params.ecc_highpass_px = 1.5;
@@ -154,19 +154,19 @@ TEST(TemplateTracker, FollowsTheToolsTipsOverAPartsGlowWithoutPixelLocking) {
 // still: the estimate must stay on the template's own position. (A pre-filter padded at the
 // template's border but not in the frame's window put it 0.14 px off.)
 TEST(TemplateTracker, BarsCrossingTheTemplatesEdgeDoNotBiasAStillTarget) {
-  Renderer renderer(small_camera());
-  SceneSnapshot s;
+  imaging::Renderer renderer(small_camera());
+  imaging::SceneSnapshot s;
   s.substrate.texture_seed = 5;
   for (const double side : {-1.0, 1.0}) {
-    Finger f;
+    imaging::Finger f;
     f.tip_x_m = side * 30e-6;
     f.tip_y_m = -20e-6;
     f.rise = 0.5;
     s.fingers.push_back(f);
   }
-  CameraControls c = renderer.default_controls();
+  imaging::CameraControls c = renderer.default_controls();
   c.focus_z_m = 0.0;  // the tips in focus, the bars rising out of it
-  Frame frame;
+  imaging::Frame frame;
   renderer.render(s, c, 9, 0, frame);
   TemplateTracker tracker;
   // The template's lower edge cuts across the tips (sharp), its upper edge across the bars.
@@ -187,25 +187,25 @@ TEST(TemplateTracker, BarsCrossingTheTemplatesEdgeDoNotBiasAStillTarget) {
 // The part turned about its corner by 1.5 degrees a frame to 15 degrees, tracked with the Euclidean warp: the
 // angle within 0.2 degrees (issue #28) and the corner still within a twentieth of a pixel.
 TEST(TemplateTracker, FollowsAPartsTurnWithinAFifthOfADegree) {
-  Renderer renderer(small_camera());
-  CameraControls c = renderer.default_controls();
+  imaging::Renderer renderer(small_camera());
+  imaging::CameraControls c = renderer.default_controls();
   c.focus_z_m = kTop;
   // The part's centre placed so that its upper left corner stays at the image's centre.
-  const auto render = [&](double angle, std::uint64_t index, Frame& out) {
-    SceneSnapshot s = part_at(0.0, 0.0);
-    Part& p = s.parts.front();
+  const auto render = [&](double angle, std::uint64_t index, imaging::Frame& out) {
+    imaging::SceneSnapshot s = part_at(0.0, 0.0);
+    imaging::Part& p = s.parts.front();
     const double h = 150e-6;
     p.angle_rad = angle;
     p.x_m = h * std::cos(angle) + h * std::sin(angle);  // R(angle) (h, -h)
     p.y_m = h * std::sin(angle) - h * std::cos(angle);
     renderer.render(s, c, 11, index, out);
   };
-  Frame frame;
+  imaging::Frame frame;
   render(0.0, 0, frame);
   TrackerParams params;
   params.rotation = true;
   TemplateTracker tracker(params);
-  tracker.set_template(frame, PixelRoi{kW / 2 - 48, kH / 2 - 48, 96, 96});
+  tracker.set_template(frame, imaging::PixelRoi{kW / 2 - 48, kH / 2 - 48, 96, 96});
   const double u0 = tracker.last().u_px, v0 = tracker.last().v_px;
   const double corner_u = renderer.u_of_x(0.0), corner_v = renderer.v_of_y(0.0);
   double worst_deg = 0.0;
@@ -289,7 +289,7 @@ TEST(TemplateTracker, RefusesBadTemplatesAndInputsInOneLine) {
   Fixture f;
   f.render(kX0, kY0, 0);
   TemplateTracker tracker;
-  const auto message = [&](const PixelRoi& roi) {
+  const auto message = [&](const imaging::PixelRoi& roi) {
     try {
       tracker.set_template(f.frame, roi);
     } catch (const InvalidInput& e) {
@@ -301,7 +301,7 @@ TEST(TemplateTracker, RefusesBadTemplatesAndInputsInOneLine) {
   EXPECT_NE(message({300, 10, 40, 40}).find("not inside the 320x256 frame"), std::string::npos);
   EXPECT_NE(message({-1, 10, 40, 40}).find("ROI x -1, y 10, 40x40"), std::string::npos);
   // A flat patch: no contrast to follow.
-  Frame flat = f.frame;
+  imaging::Frame flat = f.frame;
   std::fill(flat.pixels.begin(), flat.pixels.end(), std::uint16_t{1000});
   EXPECT_THROW(tracker.set_template(flat, {10, 10, 40, 40}), InvalidInput);
   EXPECT_THROW(tracker.track(f.frame), InvalidInput) << "no template yet";

@@ -2,7 +2,7 @@
 // with a 5 % calibration error too; predicts the motion made during the latency; holds when the
 // target is lost or the frame stale; steps without allocating; refuses bad gains and targets in
 // one line. The closed loop on rendered frames and the stick-slip stage is
-// tests/platform/visual_servo_run_test.cc.
+// tests/studies/visual_servo_run_test.cc.
 
 #include <cmath>
 #include <limits>

@@ -319,7 +319,7 @@ Eigen::Vector2d AssemblyTask::search_xy() const noexcept {
   return goal_.target_m + aim_ + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
 }
 
-const control::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {
+const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {
   out_.deadman = false;
   out_.has_goal = false;
   last_yaw_ = s.yaw_rad;

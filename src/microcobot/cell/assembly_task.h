@@ -4,14 +4,14 @@
 /// steps with behaviour-tree semantics, run by the robot while the operator supervises, pauses,
 /// confirms, takes over and hands back. Like a ros2_control controller it is a pure object: each
 /// tick it reads the slave's sensors (TaskSensors: measured tip position, contact and grip
-/// forces, opening) and returns the console input the platform follows (control::ConsoleInput:
+/// forces, opening) and returns the console input the platform follows (teleop::ConsoleInput:
 /// a straight move to a goal at a speed, a gripper opening, the deadman), so that the platform's
-/// own limits (control/safety_limits.h: grip, contact, floor) apply to it as to any operator.
+/// own limits (teleop/safety_limits.h: grip, contact, floor) apply to it as to any operator.
 ///
 ///   approach   over the pin's nominal slot, the finger tips clear of its top (turning the fingers
 ///              to the pin's nominal orientation on the way, at that height, when align is automatic)
 ///   align      the fingers' flats square with the pin's faces: the rotary axis to the pin's nominal
-///              yaw, modulo 90 deg, nearest to where it is (control/rotary_axis.h); the squeeze of
+///              yaw, modulo 90 deg, nearest to where it is (motion/rotary_axis.h); the squeeze of
 ///              the grasp takes out the pin's error in its slot
 ///   descend    to the grasp height: the tips `grip_above_m` above a full bore's depth
 ///   grasp      close until the grip force reaches `grip_force_N` (the closing fingers centre
@@ -68,7 +68,7 @@
 /// stage is, or the next one when the operator says the step is done); assisted (a move whose
 /// autonomy is kAssisted: the operator drives it under shared control, fixtures() guiding the
 /// tool to the step's goal, a guide at its x, y and a height stop at its z
-/// (control/virtual_fixtures.h), and the task goes on by itself once the tool has been within
+/// (teleop/virtual_fixtures.h), and the task goes on by itself once the tool has been within
 /// position_tolerance_m of the goal for settle_s; hand_back() and skip() as for the operator);
 /// succeeded; failed (a step's
 /// timeout, a jam beyond the search). skip() leaves the current step for the next one, from where
@@ -82,8 +82,8 @@
 
 #include <Eigen/Dense>
 
-#include "microcobot/control/teleoperation.h"
 #include "microcobot/microworld/release.h"
+#include "microcobot/teleop/teleoperation.h"
 
 namespace mc::cell {
 
@@ -160,9 +160,9 @@ struct AssemblyGoal {
   double target_yaw_rad = 0.0;  ///< the bore's orientation
   /// The rotary axis' travel (platform::Platform::yaw_min_rad, yaw_max_rad).
   double yaw_min_rad = -1.0, yaw_max_rad = 1.0;
-  /// The forbidden regions round the scene's other parts (control/virtual_fixtures.h, keep-out;
+  /// The forbidden regions round the scene's other parts (teleop/virtual_fixtures.h, keep-out;
   /// task_io.h's assembly_goal), in force with the shared control of an assisted step.
-  std::array<control::FixtureSet::KeepOut, control::FixtureSet::kMaxKeepOuts> keep_outs{};
+  std::array<teleop::FixtureSet::KeepOut, teleop::FixtureSet::kMaxKeepOuts> keep_outs{};
   int keep_out_count = 0;
   /// The tallest of the scene's other parts (0: none): the tips travel clear of its top and a
   /// carried part's bottom above it (safe and carrying heights).
@@ -250,7 +250,7 @@ class AssemblyTask {
   const AssemblyGoal& goal() const noexcept { return goal_; }
 
   /// One tick of `dt_s`: the console input to hand the platform (drives() says whether to).
-  const control::ConsoleInput& tick(const TaskSensors& s, double dt_s) noexcept;
+  const teleop::ConsoleInput& tick(const TaskSensors& s, double dt_s) noexcept;
   /// False while the operator drives (taken over, a manual or assisted step) and once finished.
   bool drives() const noexcept { return !operator_drives() && !finished(); }
   /// The operator's master drives the stage (taken over, a manual or an assisted step).
@@ -259,7 +259,7 @@ class AssemblyTask {
   }
   /// The shared control the current step wants on the coupling (world frame; level 0: none):
   /// while assisted, a guide at the step's goal x, y and a height stop at its z, at level 1.
-  const control::FixtureSet& fixtures() const noexcept { return fixtures_; }
+  const teleop::FixtureSet& fixtures() const noexcept { return fixtures_; }
   bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
 
   /// The cell has a camera: the task asks for its looks (header), the insertion aligned by the
@@ -333,8 +333,8 @@ class AssemblyTask {
   AssemblyTaskParams p_;
   AssemblyGoal goal_;
   std::array<Autonomy, kStepCount> autonomy_{};
-  control::ConsoleInput out_;
-  control::FixtureSet fixtures_;
+  teleop::ConsoleInput out_;
+  teleop::FixtureSet fixtures_;
   Step step_ = Step::kApproach;
   Status status_ = Status::kRunning;
   const char* failure_ = "";

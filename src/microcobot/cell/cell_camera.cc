@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "microcobot/core/error.h"
+#include "microcobot/imaging/renderer.h"
+#include "microcobot/imaging/sensor_model.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/vision/depth_from_focus.h"
-#include "microcobot/vision/renderer.h"
-#include "microcobot/vision/sensor_model.h"
 #include "microcobot/vision/sharpness.h"
 #include "microcobot/vision/template_tracker.h"
 #include "microcobot/vision/visual_servo.h"
@@ -20,7 +20,7 @@ namespace vs = mc::vision;
 
 void CellCameraParams::validate() const {
   try {
-    (void)vs::objective_by_name(objective);
+    (void)imaging::objective_by_name(objective);
   } catch (const Error& e) {
     throw InvalidParams("objective", e.what());
   }
@@ -62,38 +62,38 @@ platform::CameraScenePose truth_pose(const platform::Platform& p) {
 
 struct CellCamera::Impl {
   platform::PlatformConfig config;
-  vs::CameraParams camera;
-  vs::SensorModel sensor;
-  vs::SceneSnapshot scene;
-  vs::Frame frame, model;
+  imaging::CameraParams camera;
+  imaging::SensorModel sensor;
+  imaging::SceneSnapshot scene;
+  imaging::Frame frame, model;
 
   Impl(const CellCameraParams& p, const platform::PlatformConfig& c)
       : config(c), camera(make_camera(p)), sensor(camera.sensor) {}
 
-  static vs::CameraParams make_camera(const CellCameraParams& p) {
-    vs::CameraParams cam;
-    cam.objective = vs::objective_by_name(p.objective);
+  static imaging::CameraParams make_camera(const CellCameraParams& p) {
+    imaging::CameraParams cam;
+    cam.objective = imaging::objective_by_name(p.objective);
     if (p.width_px > 0) cam.sensor.width_px = p.width_px;
     if (p.height_px > 0) cam.sensor.height_px = p.height_px;
     return cam;
   }
 
   /// A renderer looking at `centre`.
-  vs::Renderer renderer_at(const Eigen::Vector2d& centre) const {
-    vs::CameraParams cam = camera;
+  imaging::Renderer renderer_at(const Eigen::Vector2d& centre) const {
+    imaging::CameraParams cam = camera;
     cam.view_center_x_m = centre.x();
     cam.view_center_y_m = centre.y();
-    return vs::Renderer(cam);
+    return imaging::Renderer(cam);
   }
 
   /// The frame of `pose` (noise from seed and index), or without the fingers and without noise
   /// (`expected`: what the cell expects, from what it is told).
-  void render(vs::Renderer& r, const platform::CameraScenePose& pose, double focus_z_m, bool expected,
-              std::uint64_t seed, std::uint64_t index, vs::Frame& out, bool plain_substrate = false) {
+  void render(imaging::Renderer& r, const platform::CameraScenePose& pose, double focus_z_m, bool expected,
+              std::uint64_t seed, std::uint64_t index, imaging::Frame& out, bool plain_substrate = false) {
     platform::fill_camera_scene(config, pose, scene);
     if (expected) scene.fingers.clear();
     if (plain_substrate) scene.substrate.texture_contrast = 0.0;
-    vs::CameraControls controls = r.default_controls();
+    imaging::CameraControls controls = r.default_controls();
     controls.focus_z_m = focus_z_m;
     const std::vector<float>& photo_e = r.render_expected(scene, controls);
     sensor.read_out(photo_e, {controls.exposure_s, controls.gain}, seed, index, !expected, out);
@@ -132,8 +132,8 @@ platform::CameraScenePose pin_at(platform::CameraScenePose pose, const Eigen::Ve
 
 // The square's bounding box in pixels, `margin_px` wider each side, inside the frame (empty when it leaves
 // it).
-vs::PixelRoi pin_roi(const vs::Renderer& r, const Eigen::Vector2d& xy, double side_m, double yaw,
-                     int margin_px) {
+imaging::PixelRoi pin_roi(const imaging::Renderer& r, const Eigen::Vector2d& xy, double side_m, double yaw,
+                          int margin_px) {
   const int width = r.camera().sensor.width_px, height = r.camera().sensor.height_px;
   const double half_m = 0.5 * side_m * (std::abs(std::cos(yaw)) + std::abs(std::sin(yaw)));
   const double half_px = half_m / r.camera().pixel_size_m() + margin_px;
@@ -145,7 +145,7 @@ vs::PixelRoi pin_roi(const vs::Renderer& r, const Eigen::Vector2d& xy, double si
 }
 
 // The frame's value at continuous pixel (u, v), bilinear; NaN outside.
-double bilinear(const vs::Frame& f, double u, double v) {
+double bilinear(const imaging::Frame& f, double u, double v) {
   const double fu = std::floor(u), fv = std::floor(v);
   const int j = static_cast<int>(fu), i = static_cast<int>(fv);
   if (j < 0 || i < 0 || j + 1 >= f.width || i + 1 >= f.height) return std::nan("");
@@ -168,8 +168,8 @@ double vertex_offset(double ym, double y0, double yp) {
 // `expected_yaw`) found in `frame` with the Euclidean warp: the pin's centre and yaw into `s` (its
 // z left to the caller), or `miss` as the reason. The ROI is centred on the pin to within half a
 // pixel, which the small turn moves by under 0.01 px: the pin's centre moves with the template's.
-void match_model(const vs::Renderer& r, const vs::Frame& model, const vs::Frame& frame,
-                 const vs::PixelRoi& roi, const Eigen::Vector2d& expected_xy, double expected_yaw,
+void match_model(const imaging::Renderer& r, const imaging::Frame& model, const imaging::Frame& frame,
+                 const imaging::PixelRoi& roi, const Eigen::Vector2d& expected_xy, double expected_yaw,
                  double min_confidence, const char* miss, PinSighting& s, int search_margin_px = 0) {
   vs::TrackerParams tp;
   tp.rotation = true;
@@ -195,14 +195,14 @@ void match_model(const vs::Renderer& r, const vs::Frame& model, const vs::Frame&
 PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const PinModel& pin,
                                   const Eigen::Vector2d& nominal_xy, double nominal_yaw) {
   Impl& m = *impl_;
-  vs::Renderer r = m.renderer_at(nominal_xy);
-  vs::Renderer view = m.renderer_at(move_to_station(nominal_xy));
+  imaging::Renderer r = m.renderer_at(nominal_xy);
+  imaging::Renderer view = m.renderer_at(move_to_station(nominal_xy));
   const double focus = pin.height_m;  // the pin's top, standing on the tray
   m.render(view, truth, focus, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   m.render(r, pin_at(truth, nominal_xy, 0.5 * pin.height_m, nominal_yaw), focus, true, 0, 0, m.model);
   PinSighting s;
   s.yaw_rad = nominal_yaw;
-  const vs::PixelRoi roi = pin_roi(r, nominal_xy, pin.side_m, nominal_yaw, 12);
+  const imaging::PixelRoi roi = pin_roi(r, nominal_xy, pin.side_m, nominal_yaw, 12);
   if (roi.width == 0) {
     s.reason = "the pin's slot is not inside the camera's field";
     return s;
@@ -216,8 +216,8 @@ PinSighting CellCamera::look_slot(const platform::CameraScenePose& truth, const 
 PinSighting CellCamera::look_bore(const platform::CameraScenePose& truth, const Eigen::Vector2d& drawn_xy,
                                   double yaw) {
   Impl& m = *impl_;
-  vs::Renderer r = m.renderer_at(drawn_xy);
-  vs::Renderer view = m.renderer_at(move_to_station(drawn_xy));
+  imaging::Renderer r = m.renderer_at(drawn_xy);
+  imaging::Renderer view = m.renderer_at(move_to_station(drawn_xy));
   constexpr double kRim = 0.0;  // the focus: the substrate's surface, the bore's rim
   m.render(view, truth, kRim, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   // The model: the bore where its drawing puts it, the pin and the fingers far from it.
@@ -235,7 +235,7 @@ PinSighting CellCamera::look_bore(const platform::CameraScenePose& truth, const 
     s.reason = "a seat without a bore: nothing to see";
     return s;
   }
-  const vs::PixelRoi roi = pin_roi(r, drawn_xy, world.hole_side_m, yaw, 12);
+  const imaging::PixelRoi roi = pin_roi(r, drawn_xy, world.hole_side_m, yaw, 12);
   if (roi.width == 0) {
     s.reason = "the bore is not inside the camera's field";
     return s;
@@ -260,7 +260,7 @@ struct FacePair {
   double centre = 0.0, confidence = 0.0;
   const char* reason = "";
 };
-FacePair face_pair(const vs::Frame& frame, const vs::Renderer& r, const Eigen::Vector2d& origin,
+FacePair face_pair(const imaging::Frame& frame, const imaging::Renderer& r, const Eigen::Vector2d& origin,
                    const Eigen::Vector2d& along, const Eigen::Vector2d& across, double across_from,
                    double across_to, double reach, double side_m) {
   FacePair out;
@@ -317,8 +317,8 @@ FacePair face_pair(const vs::Frame& frame, const vs::Renderer& r, const Eigen::V
 PinSighting CellCamera::look_held(const platform::CameraScenePose& truth, const PinModel& pin,
                                   const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
   Impl& m = *impl_;
-  const vs::Renderer r = m.renderer_at(tool_m.head<2>());
-  vs::Renderer view = m.renderer_at(move_to_station(tool_m.head<2>()));
+  const imaging::Renderer r = m.renderer_at(tool_m.head<2>());
+  imaging::Renderer view = m.renderer_at(move_to_station(tool_m.head<2>()));
   m.render(view, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   PinSighting s;
   s.yaw_rad = tool_yaw;
@@ -348,8 +348,8 @@ PinSighting CellCamera::look_align(const platform::CameraScenePose& truth, const
                                    const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_seen_xy,
                                    const Eigen::Vector3d& tool_m, double tool_yaw, double top_z_m) {
   Impl& m = *impl_;
-  const vs::Renderer r = m.renderer_at(station_xy);
-  vs::Renderer view = m.renderer_at(move_to_station(station_xy));
+  const imaging::Renderer r = m.renderer_at(station_xy);
+  imaging::Renderer view = m.renderer_at(move_to_station(station_xy));
   m.render(view, truth, top_z_m, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);
   PinSighting s;
   s.yaw_rad = tool_yaw;
@@ -412,11 +412,11 @@ PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, cons
                                     const Eigen::Vector2d& station_xy, const Eigen::Vector2d& bore_xy,
                                     double bore_yaw, double top_z_m) {
   Impl& m = *impl_;
-  vs::Renderer r = m.renderer_at(station_xy);
-  vs::Renderer view = m.renderer_at(move_to_station(station_xy));
+  imaging::Renderer r = m.renderer_at(station_xy);
+  imaging::Renderer view = m.renderer_at(move_to_station(station_xy));
   PinSighting s;
   s.yaw_rad = bore_yaw;
-  const vs::PixelRoi box = pin_roi(r, bore_xy, pin.side_m, bore_yaw, 12);
+  const imaging::PixelRoi box = pin_roi(r, bore_xy, pin.side_m, bore_yaw, 12);
   if (box.width == 0) {
     s.reason = "the bore is not inside the camera's field";
     return s;
@@ -425,7 +425,7 @@ PinSighting CellCamera::look_placed(const platform::CameraScenePose& truth, cons
   // Tenengrad measure on the pin's box, the middle frame kept for the position.
   const double step = p_.focus_step_dof * r.figures().dof_m;
   std::array<vs::FocusSample, 3> samples;
-  vs::Frame focused;
+  imaging::Frame focused;
   for (int k = 0; k < 3; ++k) {
     const double z = top_z_m + (k - 1) * step;
     m.render(view, truth, z, false, seed_, static_cast<std::uint64_t>(frames_++), m.frame);

@@ -3,7 +3,7 @@
 /// The assembly cell's camera (issue #29 "vision steps on rendered images", issue #28 point 5's
 /// "used by the automated steps of the assembly cell"): a microscope pointed at the station the
 /// task looks at (the pin's slot, then its bore), whose frames are rendered from the simulation's
-/// truth (vision::Renderer, the sensor's noise included) and measured with what the cell is told:
+/// truth (imaging::Renderer, the sensor's noise included) and measured with what the cell is told:
 ///
 ///   slot    the pin in its tray slot, before the approach: a model template (the pin alone at
 ///           its slot's nominal position and orientation, rendered without noise: the CAD-model

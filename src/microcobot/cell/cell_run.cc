@@ -8,7 +8,7 @@
 
 #include "microcobot/cell/task_io.h"
 #include "microcobot/core/error.h"
-#include "microcobot/platform/simulated_gripper.h"
+#include "microcobot/devices/simulated_gripper.h"
 
 namespace mc::cell {
 
@@ -128,7 +128,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     }
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
-    p.set_operator([this](const platform::TickInfo& t) {
+    p.set_operator([this](const runtime::TickInfo& t) {
       TaskSensors s = read_task_sensors(*platform_, home_m_);
       if (!finished_) meter_->sample(s);  // the cycle's measures end with it
       if (task_->step() == AssemblyTask::Step::kVerify && !camera_) {
@@ -150,7 +150,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       // Holding (deadman off) whenever the task does not drive: paused, awaiting, finished.
       // Taken over, the operator's master drives: the console lets go.
       meter_->time_step(task_->step(), t.dt_s);
-      control::ConsoleInput in = task_->tick(s, t.dt_s);
+      teleop::ConsoleInput in = task_->tick(s, t.dt_s);
       if (task_->operator_drives()) in.active = false;
       platform_->set_console_input(in);
       if (person_) hand_over(t);
@@ -172,7 +172,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
         static_cast<std::uint64_t>(params_.person_seed) * 1000003ULL + static_cast<std::uint64_t>(job.index);
     person_ = std::make_unique<PersonOperator>(p, params_.person, params_.task, goal,
                                                params_.mode == "assisted", seed);
-    p.set_operator([this](const platform::TickInfo& t) {
+    p.set_operator([this](const runtime::TickInfo& t) {
       if (!finished_) meter_->sample(read_task_sensors(*platform_, home_m_));
       meter_->time_step(person_->step(), t.dt_s);
       person_->act(t);
@@ -183,8 +183,8 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       if (observer_) observer_(t.t_s);
     });
   } else {
-    manual_ = std::make_unique<platform::PickPlaceOperator>(p, params_.manual);
-    p.set_operator([this, goal](const platform::TickInfo& t) {
+    manual_ = std::make_unique<cell::PickPlaceOperator>(p, params_.manual);
+    p.set_operator([this, goal](const runtime::TickInfo& t) {
       if (!finished_) meter_->sample(read_task_sensors(*platform_, home_m_));
       manual_->act(t);
       // The scripted watchmaker has no dial: the cell turns the fingers for them, square with the
@@ -193,7 +193,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
       const auto& w = platform_->simulation().gripper->world_state();
       const bool on_tray = w.phase == microworld::PartPhase::kOnSubstrate &&
                            !platform_->simulation().gripper->world().inserted(w);
-      control::ConsoleInput dial;
+      teleop::ConsoleInput dial;
       dial.fresh = dial.deadman = !finished_;
       dial.has_theta_goal = true;
       dial.theta_goal_rad = square_yaw_goal(on_tray ? w.part_yaw_rad : goal.target_yaw_rad,
@@ -211,7 +211,7 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
 
 CellCycle::~CellCycle() = default;
 
-void CellCycle::hand_over(const platform::TickInfo& t) {
+void CellCycle::hand_over(const runtime::TickInfo& t) {
   if (!person_has_step_ && task_->status() == AssemblyTask::Status::kOperator) {
     person_step_ = task_->step();
     person_->take_over(person_step_, t.t_s);
@@ -390,7 +390,7 @@ CycleResult CellCycle::result() const {
       r.verdict = "a device faulted";
     } else if (manual_->gave_up()) {
       r.verdict = "the operator gave up in phase " +
-                  std::string(platform::PickPlaceOperator::name(manual_->failed_phase()));
+                  std::string(cell::PickPlaceOperator::name(manual_->failed_phase()));
     } else if (!finished_) {
       r.verdict = "not finished within max_cycle_s";
     } else {

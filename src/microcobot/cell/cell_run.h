@@ -3,7 +3,7 @@
 /// A batch of the assembly cell run headless (issue #29 point 6, a first step): each part of an
 /// AssemblyBatch picked from its slot and inserted into its bore on a fresh simulated platform,
 /// by the robot (mode "auto": AssemblyTask through the console input, the platform's limits in
-/// force) or by the scripted watchmaker (mode "manual": platform::PickPlaceOperator on the haptic
+/// force) or by the scripted watchmaker (mode "manual": cell::PickPlaceOperator on the haptic
 /// master and the TéléTweez, who sees the pin through the microscope to within 1 um and has none
 /// of a person's reaction time or tremor yet). Each cycle is measured from the platform's own
 /// sensors and the simulation's truth: time, success (the pin down in its bore, released),
@@ -24,8 +24,8 @@
 #include "microcobot/cell/assembly_task.h"
 #include "microcobot/cell/cell_camera.h"
 #include "microcobot/cell/person_operator.h"
+#include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/core/rng.h"
-#include "microcobot/platform/pick_place_operator.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
 
@@ -55,7 +55,7 @@ struct CellRunParams {
   CellCameraParams camera;
   /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up to ~5 mm at
   /// 100 um/s, where the main scenario's is 2 mm).
-  platform::PickPlaceOperatorParams manual = manual_defaults();
+  cell::PickPlaceOperatorParams manual = manual_defaults();
 
   template <class V>
   void visit(V& v) {
@@ -74,8 +74,8 @@ struct CellRunParams {
     a.fill(AssemblyTask::Autonomy::kAuto);
     return a;
   }
-  static platform::PickPlaceOperatorParams manual_defaults() {
-    platform::PickPlaceOperatorParams m;
+  static cell::PickPlaceOperatorParams manual_defaults() {
+    cell::PickPlaceOperatorParams m;
     m.phase_timeout_s = 90.0;
     return m;
   }
@@ -176,7 +176,7 @@ class CellCycle {
   std::chrono::steady_clock::time_point start_;
   std::unique_ptr<platform::Platform> platform_;
   std::unique_ptr<AssemblyTask> task_;
-  std::unique_ptr<platform::PickPlaceOperator> manual_;
+  std::unique_ptr<cell::PickPlaceOperator> manual_;
   std::unique_ptr<PersonOperator> person_;
   std::unique_ptr<Meter> meter_;
   std::function<void(double)> observer_;
@@ -195,7 +195,7 @@ class CellCycle {
   int confirmations_ = 0;
   /// A manual step of the task: the person takes it over, acts, and hands back once their step
   /// moved on (the task then goes on from the next step) or they gave up (the task does the step).
-  void hand_over(const platform::TickInfo& t);
+  void hand_over(const runtime::TickInfo& t);
   bool person_has_step_ = false;
   AssemblyTask::Step person_step_ = AssemblyTask::Step::kApproach;
   int handovers_ = 0;

@@ -114,7 +114,7 @@ void PersonOperator::enter(Step s, double t) noexcept {
 }
 
 void PersonOperator::take_over(Step s, double t) noexcept {
-  const platform::SimulatedGripper& g = *sim_.gripper;
+  const devices::SimulatedGripper& g = *sim_.gripper;
   const Eigen::Vector3d tip = g.tip_position_m(), part = g.world_state().part_m;
   xy_.reset(tip.head<2>(), t);
   z_.reset({tip.z(), 0.0}, t);
@@ -162,7 +162,7 @@ bool PersonOperator::tool_still() const noexcept {
 }
 
 void PersonOperator::assist() noexcept {
-  control::FixtureSet f;
+  teleop::FixtureSet f;
   f.level = 1.0;
   f.guide = true;
   // The working heights as stops (the same heights the automatic task uses): the person rolls the
@@ -200,17 +200,17 @@ void PersonOperator::assist() noexcept {
   platform_.set_fixtures(f);
 }
 
-void PersonOperator::act(const platform::TickInfo& tick) noexcept {
+void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
   const double t = tick.t_s, dt = tick.dt_s;
   if (step_ == Step::kDone || gave_up_) return;
   if (t - step_t0_ > p_.step_timeout_s) {
     give_up("a step took the person longer than step_timeout_s");
     return;
   }
-  const platform::SimulatedGripper& g = *sim_.gripper;
+  const devices::SimulatedGripper& g = *sim_.gripper;
   const Eigen::Vector3d tip = g.tip_position_m();
   const Eigen::Vector3d part = g.world_state().part_m;
-  const platform::Vec3 c = g.contact_force_N();
+  const devices::Vec3 c = g.contact_force_N();
   const Eigen::Vector3d contact(c.x, c.y, c.z);
   tool_xy_ = tip.head<2>();
   tips_[static_cast<std::size_t>(tip_count_ % kHistory)] = tip;

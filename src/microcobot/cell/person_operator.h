@@ -34,7 +34,7 @@
 /// Assisted (shared control): the cell's vision gives the pin's position and, once it is held,
 /// its offset from the finger tips (within assist_vision_sd_m, measured once per step); the platform
 /// then guides the slave to the pin, and the carried pin to its bore's axis, with the insertion
-/// funnel round the rim and the coarse-far/fine-near scaling (control/virtual_fixtures.h). The
+/// funnel round the rim and the coarse-far/fine-near scaling (teleop/virtual_fixtures.h). The
 /// person trusts the guidance: they aim within the fixture's capture radius, not at the last
 /// micrometre; the step's working height is a stop the person rolls into (grasping, carrying,
 /// clear of the pins); the turns are the platform's, to the orientations the cell's vision
@@ -69,7 +69,7 @@ struct PersonOperatorParams {
   double assist_vision_sd_m = 0.1e-6;
   double assisted_tolerance_m = 15e-6;  ///< assisted: the target width planned for (in the capture)
   /// Assisted: the slave speed the person plans moves in the plane for. The platform paces the
-  /// target to the stage's (control::VirtualFixtureParams::max_speed_m_s, 0.5 mm/s), so the
+  /// target to the stage's (teleop::VirtualFixtureParams::max_speed_m_s, 0.5 mm/s), so the
   /// person no longer has to: twice that turns a minimum-jerk move (peak 1.875x its mean speed)
   /// into the stage's pace most of the way; the console's joystick allows 1 mm/s.
   double assisted_pace_m_s = 1.0e-3;
@@ -157,7 +157,7 @@ class PersonOperator {
                  const AssemblyTaskParams& task, const AssemblyGoal& goal, bool assisted, std::uint64_t seed);
 
   /// One operator tick (the platform's operator task). Real-time safe.
-  void act(const platform::TickInfo& tick) noexcept;
+  void act(const runtime::TickInfo& tick) noexcept;
   /// The person takes the automatic task's step `s` over at `t_s` (a manual step of a headless
   /// run, issue #29 point 5): their hands where the platform is (the joystick at rest, the
   /// gripper slider at the opening the coupling commands, the dial at the rotor's target), what
@@ -219,7 +219,7 @@ class PersonOperator {
   double bore_misalignment() const noexcept;
 
   platform::Platform& platform_;
-  const platform::SimulatedDevices& sim_;
+  const devices::SimulatedDevices& sim_;
   PersonOperatorParams p_;
   AssemblyGoal goal_;
   bool assisted_;
@@ -236,8 +236,8 @@ class PersonOperator {
   double step_t0_ = 0.0;
   bool gave_up_ = false;
   const char* reason_ = "";
-  platform::OperatorHand hand_;
-  control::ConsoleInput console_;
+  devices::OperatorHand hand_;
+  teleop::ConsoleInput console_;
   bool clutching_ = false;
   int clutches_ = 0, jams_ = 0;
   double roll_rad_ = 0.0;                              // a flat part's roll (the task's roll_rad)

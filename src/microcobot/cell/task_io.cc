@@ -8,7 +8,7 @@ namespace mc::cell {
 TaskSensors read_task_sensors(const platform::Platform& p, const Eigen::Vector3d& home_m) noexcept {
   TaskSensors s;
   for (int i = 0; i < 3; ++i) s.tip_m[i] = home_m[i] + p.axis(i).position_m();
-  const platform::Vec3 f = p.gripper().contact_force_N();
+  const devices::Vec3 f = p.gripper().contact_force_N();
   s.contact_N = {f.x, f.y, f.z};
   s.grip_N = p.gripper().grip_force_N();
   s.opening_m = p.gripper().opening_m();
@@ -31,7 +31,7 @@ AssemblyGoal assembly_goal(const AssemblyJob& job) {
   goal.release = job.release;
   const auto& g = job.world.gripper;
   const double reach = std::hypot(0.5 * g.max_opening_m + g.finger_thickness_m, 0.5 * g.finger_width_m);
-  const int n = std::min(job.world.neighbour_count, control::FixtureSet::kMaxKeepOuts);
+  const int n = std::min(job.world.neighbour_count, teleop::FixtureSet::kMaxKeepOuts);
   for (int i = 0; i < n; ++i) {
     const auto& nb = job.world.neighbours[static_cast<std::size_t>(i)];
     auto& k = goal.keep_outs[static_cast<std::size_t>(i)];

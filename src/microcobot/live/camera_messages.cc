@@ -92,11 +92,11 @@ void encode_compressed_image(std::span<const std::uint8_t> jpeg, RosTime stamp, 
   w.bytes(jpeg.data(), jpeg.size());
 }
 
-void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out) {
+void encode_compressed_image(const devices::CameraFrame& frame, RosTime stamp, std::string& out) {
   encode_compressed_image(std::span<const std::uint8_t>(frame.jpeg), stamp, out);
 }
 
-void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::string& out) {
+void encode_camera_info(const devices::CameraFrame& frame, RosTime stamp, std::string& out) {
   CdrWriter w(out);
   w.header(stamp);
   const auto width = static_cast<std::uint32_t>(frame.image.width);
@@ -156,9 +156,9 @@ std::string camera_state_schema() {
       .dump();
 }
 
-std::string camera_state_json(const platform::CameraFrame& f, double frame_rate_Hz, std::uint64_t dropped,
+std::string camera_state_json(const devices::CameraFrame& f, double frame_rate_Hz, std::uint64_t dropped,
                               const vision::StageCalibration* calibration,
-                              const platform::VisionGripStatus* grip) {
+                              const perception::VisionGripStatus* grip) {
   nlohmann::json cal = nullptr;
   if (calibration)
     cal = {{"px_per_m", calibration->px_per_m},

@@ -25,8 +25,8 @@
 #include <string>
 #include <string_view>
 
-#include "microcobot/platform/camera_frame.h"
-#include "microcobot/platform/vision_grip_force.h"
+#include "microcobot/devices/camera_frame.h"
+#include "microcobot/perception/vision_grip_force.h"
 #include "microcobot/vision/affine_calibration.h"
 
 namespace mc::live {
@@ -54,15 +54,15 @@ RosTime ros_time(double t_s);
 /// sensor_msgs/msg/CompressedImage of `frame`'s JPEG, stamped `stamp`, into `out` (replaced).
 /// sensor_msgs/msg/CompressedImage of a JPEG (format "jpeg").
 void encode_compressed_image(std::span<const std::uint8_t> jpeg, RosTime stamp, std::string& out);
-void encode_compressed_image(const platform::CameraFrame& frame, RosTime stamp, std::string& out);
+void encode_compressed_image(const devices::CameraFrame& frame, RosTime stamp, std::string& out);
 /// sensor_msgs/msg/CameraInfo of `frame` (its objective's scale and working distance).
-void encode_camera_info(const platform::CameraFrame& frame, RosTime stamp, std::string& out);
+void encode_camera_info(const devices::CameraFrame& frame, RosTime stamp, std::string& out);
 /// /camera/state's JSON of `frame`, with the pixel <-> stage calibration of its objective when
 /// the configuration holds one ("calibration": px_per_m, offset_px, residual_rms_px; else null),
 /// and the grip force seen in it when the platform measures one ("grip_vision": grip_force_N
 /// (null: not measured in this frame), gap_m, state; else null).
-std::string camera_state_json(const platform::CameraFrame& frame, double frame_rate_Hz, std::uint64_t dropped,
+std::string camera_state_json(const devices::CameraFrame& frame, double frame_rate_Hz, std::uint64_t dropped,
                               const vision::StageCalibration* calibration,
-                              const platform::VisionGripStatus* grip = nullptr);
+                              const perception::VisionGripStatus* grip = nullptr);
 
 }  // namespace mc::live

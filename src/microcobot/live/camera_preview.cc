@@ -28,7 +28,7 @@ void add_row(const Sample* row, int w, int f, int c, std::uint32_t* sums) {
 
 }  // namespace
 
-const std::vector<std::uint8_t>& CameraPreview::encode(const platform::Image& image, int quality) {
+const std::vector<std::uint8_t>& CameraPreview::encode(const devices::Image& image, int quality) {
   if (image.data.size() != image.size_bytes() || image.width <= 0 || image.height <= 0)
     throw InvalidInput("camera preview: " + std::to_string(image.data.size()) + " bytes for a " +
                        std::to_string(image.width) + "x" + std::to_string(image.height) + " image");
@@ -49,7 +49,7 @@ const std::vector<std::uint8_t>& CameraPreview::encode(const platform::Image& im
       const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(i * f + r) * row_samples *
                                                         static_cast<std::size_t>(image.bytes_per_sample());
       if (deep) {
-        // Two-byte little-endian samples, as platform::Image keeps them (this host's order).
+        // Two-byte little-endian samples, as devices::Image keeps them (this host's order).
         static_assert(std::endian::native == std::endian::little);
         std::memcpy(deep_row_.data(), row, row_samples * 2);
         add_row(deep_row_.data(), w, f, c, row_sums_.data());

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "microcobot/core/jpeg.h"
-#include "microcobot/platform/camera_frame.h"
+#include "microcobot/devices/camera_frame.h"
 
 namespace mc::live {
 
@@ -28,15 +28,15 @@ class CameraPreview {
   /// Bins `image` by binning(image.width) in both directions (the mean of each f x f block; the
   /// right and bottom remainders that do not fill a block are left out), takes the top 8 bits of
   /// deeper samples as the full frame's JPEG does, and encodes it at `quality`. Returns the JPEG.
-  const std::vector<std::uint8_t>& encode(const platform::Image& image, int quality);
+  const std::vector<std::uint8_t>& encode(const devices::Image& image, int quality);
 
   int width() const { return binned_.width; }
   int height() const { return binned_.height; }
   /// The binned 8-bit image of the last encode().
-  const platform::Image& binned() const { return binned_; }
+  const devices::Image& binned() const { return binned_; }
 
  private:
-  platform::Image binned_;
+  devices::Image binned_;
   std::vector<std::uint32_t> row_sums_;
   std::vector<std::uint16_t> deep_row_;  // one row of 10-16 bit samples
   std::vector<std::uint8_t> jpeg_;

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "microcobot/platform/grey_frame.h"
-#include "microcobot/vision/png_file.h"
-#include "microcobot/vision/tiff_file.h"
+#include "microcobot/devices/grey_frame.h"
+#include "microcobot/imaging/png_file.h"
+#include "microcobot/imaging/tiff_file.h"
 
 namespace mc::live {
 namespace {
@@ -20,9 +20,9 @@ bool printable_ascii(const std::string& s) {
 
 }  // namespace
 
-void CameraSnapshot::offer(const platform::CameraFrame& frame, const std::string& state_json, double t_s) {
+void CameraSnapshot::offer(const devices::CameraFrame& frame, const std::string& state_json, double t_s) {
   std::lock_guard lock(mutex_);
-  if (!platform::to_grey_frame(frame.image, frame.sequence, kept_.frame)) return;
+  if (!devices::to_grey_frame(frame.image, frame.sequence, kept_.frame)) return;
   kept_.m_per_px = frame.m_per_px;
   kept_.objective = frame.objective_name;
   kept_.state = state_json;
@@ -47,10 +47,10 @@ std::optional<server::HttpReply> CameraSnapshot::reply(std::string_view path) co
   }
   if (ext == ".tiff") {
     r.content_type = "image/tiff";
-    r.body = vision::encode_tiff(copy.frame, copy.m_per_px, printable_ascii(copy.state) ? copy.state : "");
+    r.body = imaging::encode_tiff(copy.frame, copy.m_per_px, printable_ascii(copy.state) ? copy.state : "");
   } else {
     r.content_type = "image/png";
-    r.body = vision::encode_png(copy.frame);
+    r.body = imaging::encode_png(copy.frame);
   }
   std::string objective;
   for (char ch : copy.objective) objective += (std::isalnum(static_cast<unsigned char>(ch)) != 0) ? ch : '-';

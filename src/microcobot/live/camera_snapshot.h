@@ -16,9 +16,9 @@
 #include <string>
 #include <string_view>
 
-#include "microcobot/platform/camera_frame.h"
+#include "microcobot/devices/camera_frame.h"
+#include "microcobot/imaging/sensor_model.h"
 #include "microcobot/server/foxglove_server.h"
-#include "microcobot/vision/sensor_model.h"
 
 namespace mc::live {
 
@@ -27,7 +27,7 @@ inline constexpr std::string_view kSnapshotPath = "/camera/snapshot";
 class CameraSnapshot {
  public:
   /// Keeps `frame` (the latest), with its /camera/state JSON and live time. Camera thread.
-  void offer(const platform::CameraFrame& frame, const std::string& state_json, double t_s);
+  void offer(const devices::CameraFrame& frame, const std::string& state_json, double t_s);
 
   /// The answer to GET `path` when it is kSnapshotPath + ".tiff" or ".png" (nullopt: another
   /// path). 503 with a one-line reason before the first frame. Any thread.
@@ -35,7 +35,7 @@ class CameraSnapshot {
 
  private:
   struct Kept {
-    vision::Frame frame;  // grey samples (a colour frame: the mean of its channels)
+    imaging::Frame frame;  // grey samples (a colour frame: the mean of its channels)
     double m_per_px = 0.0;
     std::string objective, state;
     double t_s = 0.0;

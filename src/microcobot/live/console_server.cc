@@ -171,7 +171,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                     "ros2msg", std::string(camera_info_schema())});
     camera_state_ch_ = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",
                                             "jsonschema", camera_state_schema()});
-    live_.set_frame_sink([this](const platform::CameraFrame& f, double t_s) { on_frame(f, t_s); });
+    live_.set_frame_sink([this](const devices::CameraFrame& f, double t_s) { on_frame(f, t_s); });
   }
   server_.on_client_message([this](const server::ClientMessage& m) { on_message(m); });
   server_.on_disconnect([this](server::ClientId c) { on_disconnect(c); });
@@ -287,7 +287,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   publish(feedback_ch_, RecordedTopic::kFeedback, s[0], f.dump());
 }
 
-void ConsoleServer::on_frame(const platform::CameraFrame& f, double t_s) {
+void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
   const RosTime stamp = ros_time(t_s);
   encode_compressed_image(f, stamp, image_cdr_);
   encode_camera_info(f, stamp, info_cdr_);

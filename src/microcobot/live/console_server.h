@@ -50,7 +50,7 @@
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
 #include "microcobot/live/session_recording.h"
-#include "microcobot/platform/timing_stats.h"
+#include "microcobot/runtime/timing_stats.h"
 #include "microcobot/server/foxglove_server.h"
 
 namespace mc::live {
@@ -82,7 +82,7 @@ class ConsoleServer {
   /// `on_frame` runs on the camera thread after the console's channels; `wanted` (any thread)
   /// counts in the camera's demand. Before start().
   struct FrameConsumer {
-    std::function<void(const platform::CameraFrame&, double t_s)> on_frame;
+    std::function<void(const devices::CameraFrame&, double t_s)> on_frame;
     std::function<bool()> wanted;
   };
   void add_frame_consumer(FrameConsumer consumer);
@@ -105,7 +105,7 @@ class ConsoleServer {
  private:
   void on_sample(const platform::TelemetrySample& s, std::size_t count);
   /// A camera frame (camera thread): encoded, published and recorded.
-  void on_frame(const platform::CameraFrame& f, double t_s);
+  void on_frame(const devices::CameraFrame& f, double t_s);
   void on_message(const server::ClientMessage& m);
   void on_disconnect(server::ClientId client);
   void status_thread();
@@ -144,16 +144,16 @@ class ConsoleServer {
   double rumble_sum_ = 0.0;
   std::size_t rumble_n_ = 0;
   std::string json_;
-  platform::TimingStats ticks_;      // the telemetry's tick_us, per second
-  platform::TimingStats ticks_cpu_;  // its tick_cpu_us, per second
+  runtime::TimingStats ticks_;      // the telemetry's tick_us, per second
+  runtime::TimingStats ticks_cpu_;  // its tick_cpu_us, per second
 
   // The recording (fed by every thread, written by its own) and the recordings' folder.
   std::unique_ptr<SessionRecording> recording_;
   std::unique_ptr<RecordingFiles> files_;
   LiveStatus last_status_;  // status thread: what note_changes() compares with
   std::atomic<double> tick_p99_us_{0.0}, tick_cpu_p99_us_{0.0};
-  platform::TimingStats latency_{1e-5};    // status thread: command-to-target, 10 us bins
-  platform::TimingStats link_cost_{1e-8};  // status thread: the remote end's work per tick, 10 ns bins
+  runtime::TimingStats latency_{1e-5};    // status thread: command-to-target, 10 us bins
+  runtime::TimingStats link_cost_{1e-8};  // status thread: the remote end's work per tick, 10 ns bins
 };
 
 }  // namespace mc::live

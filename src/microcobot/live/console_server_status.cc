@@ -71,7 +71,7 @@ std::string ConsoleServer::scene_json() const {
   if (live_.has_camera()) {
     // What the microscope panel needs: the turret, the focus travel, the sensor, the settings'
     // ranges (the current state comes with each frame on /camera/state).
-    const platform::CameraDeviceParams& cam = live_.camera_params();
+    const devices::CameraDeviceParams& cam = live_.camera_params();
     json objectives = json::array();
     for (const auto& o : cam.objectives)
       objectives.push_back({{"name", o.name},
@@ -121,8 +121,8 @@ std::string ConsoleServer::status_json() {
   const LiveStatus s = live_.status();
   json lifecycle = json::object();
   const char* names[6] = {"axis_x", "axis_y", "axis_z", "gripper", "haptic", "tweezers"};
-  for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(platform::to_string(s.lifecycle[i]));
-  if (s.has_rotary) lifecycle["axis_theta"] = std::string(platform::to_string(s.rotary_lifecycle));
+  for (std::size_t i = 0; i < 6; ++i) lifecycle[names[i]] = std::string(devices::to_string(s.lifecycle[i]));
+  if (s.has_rotary) lifecycle["axis_theta"] = std::string(devices::to_string(s.rotary_lifecycle));
   const std::string recording = recording_ ? recording_->name() : std::string();
   json j = {{"t_s", s.t_s},
             {"estopped", s.estopped},
@@ -157,7 +157,7 @@ std::string ConsoleServer::status_json() {
   j["task"] = task_status_json(s.task);
   if (s.vision) {
     // The stage positioned by vision: what the camera thread's tracker and servo see and do.
-    const platform::PositionerStatus& v = *s.vision;
+    const perception::PositionerStatus& v = *s.vision;
     j["vision"] = {{"taught", v.taught},
                    {"found", v.found},
                    {"has_goal", v.has_goal},
@@ -177,7 +177,7 @@ std::string ConsoleServer::status_json() {
   }
   if (s.grip_vision) {
     // The grip force measured by vision (null force: not measured in the last frame).
-    const platform::VisionGripStatus& g = *s.grip_vision;
+    const perception::VisionGripStatus& g = *s.grip_vision;
     const auto number_or_null = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
     j["grip_vision"] = {{"state", g.state},
                         {"error", g.error},

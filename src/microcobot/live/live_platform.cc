@@ -10,8 +10,8 @@
 
 namespace mc::live {
 
-using platform::Lifecycle;
-using platform::PickPlaceOperator;
+using cell::PickPlaceOperator;
+using devices::Lifecycle;
 using platform::Platform;
 
 void LiveParams::validate() const {
@@ -51,12 +51,12 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   }
   make_looker();
   if (params_.platform.stage.vision_xy())
-    positioner_ =
-        std::make_unique<platform::VisionPositioner>(params_.platform, params_.platform.stage.vision);
+    positioner_ = std::make_unique<perception::VisionPositioner>(platform::camera_rig(params_.platform),
+                                                                 params_.platform.stage.vision);
   // Force by vision wherever a camera looks at the gripper (not the optical trap's beads).
   const platform::PlatformConfig& pc = params_.platform;
   if (pc.vision_force.enabled && !pc.optical_trap_scene())
-    grip_gauge_ = std::make_unique<platform::VisionGripForce>(pc);
+    grip_gauge_ = std::make_unique<perception::VisionGripForce>(platform::camera_rig(pc), pc.vision_force);
   build(/*demo=*/false);
   const auto& tp = params_.platform.teleop;
   limits_.max_speed_m_s = tp.console_max_speed_m_s;
@@ -72,7 +72,7 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
     limits_.max_theta_rad = platform_->yaw_max_rad();
     limits_.max_theta_speed_rad_s = params_.platform.stage.rotary.max_speed_rad_s;
   }
-  const platform::CameraDeviceParams& cam = params_.platform.camera;
+  const devices::CameraDeviceParams& cam = params_.platform.camera;
   limits_.focus_min_m = cam.focus_min_m;
   limits_.focus_max_m = cam.focus_max_m;
   limits_.objective_count = has_camera_ ? static_cast<int>(cam.objectives.size()) : 0;
@@ -82,14 +82,14 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
 
 LivePlatform::~LivePlatform() { stop(); }
 
-void LivePlatform::vision_tick(Platform& p, const platform::TickInfo& t, const control::ConsoleInput& in,
+void LivePlatform::vision_tick(Platform& p, const runtime::TickInfo& t, const teleop::ConsoleInput& in,
                                bool console_drives) noexcept {
   // A jog run: long enough for a few sawtooth periods, short enough to stop with the stick.
   constexpr double kJogRun_s = 0.02;
   const bool enabled = console_drives && in.active && in.fresh && in.deadman && !p.faulted();
   positioner_->set_enabled(enabled);
   const double now = t_offset_s_ + t.t_s;
-  platform::PositionerCommand c;
+  perception::PositionerCommand c;
   while (vision_.pop(c)) {
     const double interval = c.interval_s - (now - c.t_issue_s);  // what is left of it
     if (!enabled || interval <= 0.0) continue;
@@ -113,7 +113,7 @@ void LivePlatform::build(bool demo) {
                                 : platform::make_platform(params_.platform);
   std::unique_ptr<PickPlaceOperator> op;
   if (demo) op = std::make_unique<PickPlaceOperator>(*p, params_.demo);
-  p->set_operator([this](const platform::TickInfo& t) { operator_tick(t); });
+  p->set_operator([this](const runtime::TickInfo& t) { operator_tick(t); });
   channel_count_ = p->telemetry_channel_count();
   has_camera_ = p->camera() != nullptr;
   camera_frames_.store(0);
@@ -135,7 +135,7 @@ void LivePlatform::build(bool demo) {
   if (task_) task_->reset();  // a new scene, a new cycle (not started)
   if (positioner_) positioner_->reset();
   if (grip_gauge_) grip_gauge_->reset();
-  platform::PositionerCommand stale;
+  perception::PositionerCommand stale;
   while (vision_.pop(stale)) {
   }
 }
@@ -160,15 +160,15 @@ void LivePlatform::set_frame_sink(FrameSink sink) {
 void LivePlatform::attach_camera(Platform& p) {
   // Without a sink the camera forms no frame (camera_device.h); vision positioning needs them.
   if (p.camera() == nullptr || (!frame_sink_ && !positioner_ && !grip_gauge_)) return;
-  p.camera()->set_sink([this, offset = t_offset_s_](const platform::CameraFrame& f) {
+  p.camera()->set_sink([this, offset = t_offset_s_](const devices::CameraFrame& f) {
     camera_frames_.fetch_add(1, std::memory_order_relaxed);  // for the status
-    platform::VisionGripForce::ToolHint hint;
+    perception::VisionGripForce::ToolHint hint;
     if (positioner_) {
       // Measured before the frame is shown: the command's latency is the servo's, not the page's.
       const double now = t_s_.load(std::memory_order_relaxed);
       if (auto c = positioner_->on_frame(f, offset + f.t_mid_s, now)) vision_.push(*c);
       // Without x, y sensors the tips are looked for where the positioner sees the tool.
-      const platform::PositionerStatus st = positioner_->status();
+      const perception::PositionerStatus st = positioner_->status();
       hint.stage_sensed = false;
       if (st.found) hint.pixel = Eigen::Vector2d(st.tool_u_px, st.tool_v_px);
     }
@@ -180,7 +180,7 @@ void LivePlatform::attach_camera(Platform& p) {
 
 bool LivePlatform::push_command(const ConsoleCommand& c) noexcept { return commands_.push(c); }
 
-void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
+void LivePlatform::operator_tick(const runtime::TickInfo& t) noexcept {
   Platform& p = *platform_;
   if (estop_.exchange(false) && !p.faulted()) p.fault_all();
   if (p.camera() != nullptr)
@@ -230,7 +230,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   const bool fresh = params_.remote ? remote_fresh
                                     : in_control_.load(std::memory_order_relaxed) &&
                                           t.t_s - last_command_t_ <= params_.command_timeout_s;
-  control::ConsoleInput in;
+  teleop::ConsoleInput in;
   const bool console_control = in_control_.load(std::memory_order_relaxed);
   const bool protocol = protocol_tick(t, console_control, in);
   // A protocol client drives only while no demo runs (it is not fresh then).
@@ -286,7 +286,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
   rotary_lifecycle_.store(p.rotary_axis() ? static_cast<int>(p.rotary_axis()->state()) : -1,
                           std::memory_order_relaxed);
   overruns_.store(p.loop().overruns(), std::memory_order_relaxed);
-  if (const platform::FocusDrive* focus = p.focus()) {
+  if (const devices::FocusDrive* focus = p.focus()) {
     focus_z_m_.store(focus->z_m(), std::memory_order_relaxed);
     focus_target_m_.store(focus->target_z_m(), std::memory_order_relaxed);
     objective_.store(focus->objective(), std::memory_order_relaxed);
@@ -297,7 +297,7 @@ void LivePlatform::operator_tick(const platform::TickInfo& t) noexcept {
 
 void LivePlatform::apply_microscope(Platform& p, const ConsoleCommand& c) noexcept {
   // Every command's microscope part counts (a later command without it changes nothing).
-  platform::FocusDrive* focus = p.focus();
+  devices::FocusDrive* focus = p.focus();
   if (focus == nullptr) return;
   if (c.has_focus) focus->command_z_m(c.focus_z_m);
   if (c.objective >= 0) focus->command_objective(c.objective);
@@ -305,7 +305,7 @@ void LivePlatform::apply_microscope(Platform& p, const ConsoleCommand& c) noexce
   if (c.gain > 0.0) p.camera()->set_gain(c.gain);
 }
 
-bool LivePlatform::demo_tick(const platform::TickInfo& t) noexcept {
+bool LivePlatform::demo_tick(const runtime::TickInfo& t) noexcept {
   if (!demo_ || demo_finished_) return false;
   demo_->act(t);  // the scripted operator drives the simulated masters' hands
   demo_duration_s_.store(t.t_s, std::memory_order_relaxed);
@@ -453,12 +453,12 @@ void LivePlatform::stop() {
   estopped_.store(true);
 }
 
-void LivePlatform::drain_command_latencies(platform::TimingStats& stats) noexcept {
+void LivePlatform::drain_command_latencies(runtime::TimingStats& stats) noexcept {
   double latency_s = 0.0;
   while (latencies_.pop(latency_s)) stats.add(latency_s);
 }
 
-void LivePlatform::drain_link_costs(platform::TimingStats& stats) noexcept {
+void LivePlatform::drain_link_costs(runtime::TimingStats& stats) noexcept {
   double cost_s = 0.0;
   while (link_costs_.pop(cost_s)) stats.add(cost_s);
 }

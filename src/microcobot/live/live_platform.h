@@ -29,23 +29,23 @@
 #include <string>
 #include <thread>
 
+#include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
 #include "microcobot/live/live_looker.h"
 #include "microcobot/live/live_task.h"
 #include "microcobot/live/protocol_command.h"
-#include "microcobot/platform/pick_place_operator.h"
+#include "microcobot/perception/vision_grip_force.h"
+#include "microcobot/perception/vision_positioner.h"
 #include "microcobot/platform/platform.h"
-#include "microcobot/platform/spsc_ring.h"
-#include "microcobot/platform/timing_stats.h"
-#include "microcobot/platform/vision_grip_force.h"
-#include "microcobot/platform/vision_positioner.h"
+#include "microcobot/runtime/spsc_ring.h"
+#include "microcobot/runtime/timing_stats.h"
 
 namespace mc::live {
 
 struct LiveParams {
   platform::PlatformConfig platform;  ///< loop.realtime is forced on
-  platform::PickPlaceOperatorParams demo;
+  cell::PickPlaceOperatorParams demo;
   double command_timeout_s = 0.2;       ///< the console's commands go stale after this long
   double placement_tolerance_m = 5e-6;  ///< shown around the target (the session's criterion)
   bool paced = true;                    ///< false: as fast as possible (tests that need no wall clock)
@@ -56,7 +56,7 @@ struct LiveParams {
   /// The devices of each scene (re)build; empty: the simulated platform. A master process of a
   /// distributed platform gives the remote slave stage here (net/remote_slave.h); the scripted
   /// demo needs the simulation and is refused then.
-  std::function<platform::PlatformDevices()> make_devices;
+  std::function<devices::DeviceSet()> make_devices;
   /// Commands from the far end instead of the console (a slave process: net/remote_master.h);
   /// not owned, must outlive the live platform. The console then observes (and may e-stop).
   CommandSource* remote = nullptr;
@@ -82,12 +82,12 @@ struct DemoResult {
 struct LiveStatus {
   double t_s = 0.0;  ///< live time since serve started (continues across scene restarts)
   bool estopped = false;
-  bool demo = false;                               ///< the scripted operator is driving
-  std::string demo_phase;                          ///< its phase (empty unless demo)
-  bool console_fresh = false;                      ///< the controlling client's commands are fresh
-  std::array<platform::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
-  bool has_rotary = false;                         ///< the rotary axis under the gripper ...
-  platform::Lifecycle rotary_lifecycle{};          ///< ... and its state
+  bool demo = false;                              ///< the scripted operator is driving
+  std::string demo_phase;                         ///< its phase (empty unless demo)
+  bool console_fresh = false;                     ///< the controlling client's commands are fresh
+  std::array<devices::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
+  bool has_rotary = false;                        ///< the rotary axis under the gripper ...
+  devices::Lifecycle rotary_lifecycle{};          ///< ... and its state
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
   std::uint64_t restarts = 0;
@@ -101,10 +101,10 @@ struct LiveStatus {
   std::string last_error;              ///< the last failed request (reset refused, rebuild failed)
   std::optional<LiveTaskStatus> task;  ///< the supervised task (none without one)
   /// The stage positioned by vision (`stage.xy_sensor: vision`; none otherwise).
-  std::optional<platform::PositionerStatus> vision;
+  std::optional<perception::PositionerStatus> vision;
   /// The grip force measured by vision (`vision_force.enabled`, a camera, the gripper's scene;
   /// none otherwise).
-  std::optional<platform::VisionGripStatus> grip_vision;
+  std::optional<perception::VisionGripStatus> grip_vision;
 };
 
 class LivePlatform {
@@ -119,15 +119,15 @@ class LivePlatform {
   /// Where the camera's frames go, with their mid-exposure time in live time (the camera thread;
   /// keep it quick: a slow sink only costs frames, never the loop). Set before start(); kept
   /// across scene rebuilds.
-  using FrameSink = std::function<void(const platform::CameraFrame&, double t_live_s)>;
+  using FrameSink = std::function<void(const devices::CameraFrame&, double t_live_s)>;
   void set_frame_sink(FrameSink sink);
   /// Whether anyone looks at the frames (a subscribed client, a recording); while not, the
-  /// camera forms none (platform::Camera::set_wanted). Any thread; applied by the loop, kept
+  /// camera forms none (devices::Camera::set_wanted). Any thread; applied by the loop, kept
   /// across scene rebuilds.
   void set_camera_wanted(bool wanted) noexcept { camera_wanted_.store(wanted, std::memory_order_relaxed); }
   /// Whether the platform images (devices.camera.driver is not "none"), and its parameters.
   bool has_camera() const { return has_camera_; }
-  const platform::CameraDeviceParams& camera_params() const { return params_.platform.camera; }
+  const devices::CameraDeviceParams& camera_params() const { return params_.platform.camera; }
 
   /// Starts the control thread, which runs the loop; telemetry samples reach `sink` on the
   /// drain thread (keep it quick). Times are shifted to live time.
@@ -172,11 +172,11 @@ class LivePlatform {
   /// Moves the command-to-target latencies measured by the loop since the last call (from the
   /// server's receipt of a command to the tick that applies it) into `stats`. One consumer
   /// thread.
-  void drain_command_latencies(platform::TimingStats& stats) noexcept;
+  void drain_command_latencies(runtime::TimingStats& stats) noexcept;
   /// Moves the remote end's cost to the loop measured since the last call into `stats`: the
   /// duration of its poll() and publish() in each operator tick (the network link's whole work
   /// on the loop thread; none without a remote end). One consumer thread.
-  void drain_link_costs(platform::TimingStats& stats) noexcept;
+  void drain_link_costs(runtime::TimingStats& stats) noexcept;
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
@@ -213,7 +213,7 @@ class LivePlatform {
   double finger_width_m() const { return scene_world().gripper.finger_width_m; }
   /// Why the scripted demo cannot run here (empty: it can).
   std::string demo_unavailable_reason() const;
-  /// The force limits the platform enforces (control/safety_limits.h).
+  /// The force limits the platform enforces (teleop/safety_limits.h).
   double grip_force_limit_N() const { return scene_world().grip_force_limit_N; }
   double contact_force_limit_N() const { return scene_world().contact_force_limit_N; }
   std::size_t channel_count() const { return channel_count_; }
@@ -226,31 +226,31 @@ class LivePlatform {
   bool whole_simulation() const {
     return !params_.make_devices && !params_.remote && params_.platform.devices.simulated();
   }
-  void operator_tick(const platform::TickInfo& t) noexcept;
+  void operator_tick(const runtime::TickInfo& t) noexcept;
   /// The demo's part of the operator tick: the scripted operator acts until it is done or gives
   /// up, then every axis holds and the console has control again. Returns true while it drives.
-  bool demo_tick(const platform::TickInfo& t) noexcept;
+  bool demo_tick(const runtime::TickInfo& t) noexcept;
   /// The focus, objective, exposure and gain of a console command (loop thread).
   void apply_microscope(platform::Platform& p, const ConsoleCommand& c) noexcept;
   void control_thread();
   /// The protocol clients' part of the operator tick: their commands drained, their freshness (a
   /// client that went away or lost control leaves every axis holding). Returns true while a
   /// protocol client drives the coupling, and then fills `in`.
-  bool protocol_tick(const platform::TickInfo& t, bool console_control, control::ConsoleInput& in) noexcept;
+  bool protocol_tick(const runtime::TickInfo& t, bool console_control, teleop::ConsoleInput& in) noexcept;
   /// After the console input is set: a pending open-loop run started (or refused), the view published.
-  void protocol_publish(const platform::TickInfo& t) noexcept;
+  void protocol_publish(const runtime::TickInfo& t) noexcept;
   void attach_camera(platform::Platform& p);
   /// With x and y positioned by vision: the operator's goal handed to the positioner (the
   /// coupling does not chase it), its runs and the joystick's played open loop. After the
   /// console input is set (the runs check its deadman).
-  void vision_tick(platform::Platform& p, const platform::TickInfo& t, const control::ConsoleInput& in,
+  void vision_tick(platform::Platform& p, const runtime::TickInfo& t, const teleop::ConsoleInput& in,
                    bool console_drives) noexcept;
 
   LiveParams params_;
   ConsoleLimits limits_;
   std::size_t channel_count_ = 0;
   std::unique_ptr<platform::Platform> platform_;
-  std::unique_ptr<platform::PickPlaceOperator> demo_;
+  std::unique_ptr<cell::PickPlaceOperator> demo_;
   std::unique_ptr<LiveTask> task_;  // kept across scene rebuilds (its ring is the server's)
   // The cell camera's looks for the task: the drain thread keeps the latest sample for them.
   std::mutex latest_mutex_;
@@ -258,9 +258,9 @@ class LivePlatform {
   bool has_latest_ = false;
   std::unique_ptr<LiveLooker> looker_;  // after what it uses: destroyed (joined) first
   Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
-  platform::SpscRing<ConsoleCommand> commands_{256};
-  platform::SpscRing<ConsoleCommand> microscope_{16};  // the network's microscope commands
-  platform::SpscRing<ProtocolCommand> protocol_{256};
+  runtime::SpscRing<ConsoleCommand> commands_{256};
+  runtime::SpscRing<ConsoleCommand> microscope_{16};  // the network's microscope commands
+  runtime::SpscRing<ProtocolCommand> protocol_{256};
   // Protocol state (loop thread only).
   double protocol_last_t_ = -1e9, protocol_speed_m_s_ = 0.0, last_operator_t_ = 0.0;
   double protocol_theta_goal_rad_ = 0.0, protocol_theta_speed_rad_s_ = 0.0;
@@ -273,13 +273,13 @@ class LivePlatform {
   std::array<std::atomic<bool>, 4> on_target_{}, stepping_{};
   std::atomic<bool> protocol_driving_{false};
   std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
-  std::uint64_t popped_seq_ = 0;                                // loop thread only
-  std::unique_ptr<platform::VisionPositioner> positioner_;      // stage.xy_sensor: vision
-  std::unique_ptr<platform::VisionGripForce> grip_gauge_;       // vision_force.enabled
-  platform::SpscRing<platform::PositionerCommand> vision_{16};  // camera thread -> loop
-  platform::SpscRing<double> latencies_{4096};                  // loop -> status thread [s]
-  platform::SpscRing<double> link_costs_{4096};                 // loop -> status thread [s]
-  ConsoleCommand latest_;                                       // loop thread only
+  std::uint64_t popped_seq_ = 0;                                 // loop thread only
+  std::unique_ptr<perception::VisionPositioner> positioner_;     // stage.xy_sensor: vision
+  std::unique_ptr<perception::VisionGripForce> grip_gauge_;      // vision_force.enabled
+  runtime::SpscRing<perception::PositionerCommand> vision_{16};  // camera thread -> loop
+  runtime::SpscRing<double> latencies_{4096};                    // loop -> status thread [s]
+  runtime::SpscRing<double> link_costs_{4096};                   // loop -> status thread [s]
+  ConsoleCommand latest_;                                        // loop thread only
   double last_command_t_ = -1e9;
   double t_offset_s_ = 0.0;
 

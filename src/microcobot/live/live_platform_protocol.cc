@@ -11,8 +11,8 @@ namespace mc::live {
 
 using platform::Platform;
 
-bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_control,
-                                 control::ConsoleInput& in) noexcept {
+bool LivePlatform::protocol_tick(const runtime::TickInfo& t, bool console_control,
+                                 teleop::ConsoleInput& in) noexcept {
   Platform& p = *platform_;
   auto stop_and_hold = [&] {
     p.stop_open_loop();
@@ -84,7 +84,7 @@ bool LivePlatform::protocol_tick(const platform::TickInfo& t, bool console_contr
   return true;
 }
 
-void LivePlatform::protocol_publish(const platform::TickInfo& t) noexcept {
+void LivePlatform::protocol_publish(const runtime::TickInfo& t) noexcept {
   Platform& p = *platform_;
   if (protocol_steps_pending_) {
     const ProtocolCommand& s = pending_steps_;

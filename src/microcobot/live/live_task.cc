@@ -132,7 +132,7 @@ void LiveTask::console_takes_the_stage() noexcept {
 }
 
 void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool in_control,
-                    bool fresh, control::ConsoleInput& in) noexcept {
+                    bool fresh, teleop::ConsoleInput& in) noexcept {
   TaskAction a;
   while (actions_.pop(a)) apply(a);
   if (in_progress()) {
@@ -169,7 +169,7 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
         looks_found_ += d.sighting.found ? 1 : 0;
       }
     }
-    const control::ConsoleInput& out = task.tick(cell::read_task_sensors(p, home_m), dt_s);
+    const teleop::ConsoleInput& out = task.tick(cell::read_task_sensors(p, home_m), dt_s);
     if (task.look_wanted() == AssemblyTask::Look::kNone) {
       look_pending_ = false;  // answered, or abandoned (taken over, skipped)
     } else if (!look_pending_) {
@@ -188,7 +188,7 @@ void LiveTask::tick(platform::Platform& p, const Eigen::Vector3d& home_m, double
     operator_had_stage_ = operator_drives;
     if (!operator_drives) in = out;  // the task drives, or holds (no deadman)
     if (task.finished()) {
-      if (!(fixtures_ == control::FixtureSet{})) p.set_fixtures(fixtures_ = {});
+      if (!(fixtures_ == teleop::FixtureSet{})) p.set_fixtures(fixtures_ = {});
       p.hold();  // the sequence ends with every axis holding ...
       ended_ = true;
       console_takes_the_stage();  // ... and the console in control again

@@ -3,7 +3,7 @@
 /// The automatic insertion run live, supervised from the console (issue #29 point 5,
 /// `microcobot serve --cell`): the live platform's loop ticks a cell::AssemblyTask on the
 /// slave's sensors and hands its console input to the coupling, so that the platform's limits
-/// (grip, contact, floor: control/safety_limits.h) apply to it as to the operator. The
+/// (grip, contact, floor: teleop/safety_limits.h) apply to it as to the operator. The
 /// operator's controls (start, pause, resume, confirm, take over, hand back, step done, skip)
 /// reach the loop as console actions through a single-producer ring; the task's state leaves it
 /// through atomics for the status channel.
@@ -41,9 +41,9 @@
 
 #include "microcobot/cell/assembly_task.h"
 #include "microcobot/cell/cell_camera.h"
-#include "microcobot/control/teleoperation.h"
 #include "microcobot/platform/platform.h"
-#include "microcobot/platform/spsc_ring.h"
+#include "microcobot/runtime/spsc_ring.h"
+#include "microcobot/teleop/teleoperation.h"
 
 namespace mc::live {
 
@@ -156,7 +156,7 @@ class LiveTask {
   /// the re-take rules to `in`. `home_m`: the stage's home (world frame); `in_control`: a console
   /// client holds control and no device is faulted; `fresh`: its commands are fresh.
   void tick(platform::Platform& p, const Eigen::Vector3d& home_m, double dt_s, bool in_control, bool fresh,
-            control::ConsoleInput& in) noexcept;
+            teleop::ConsoleInput& in) noexcept;
   /// Started and not ended (loop thread).
   bool in_progress() const noexcept { return started_ && !ended_; }
 
@@ -169,12 +169,12 @@ class LiveTask {
 
   LiveTaskParams params_;
   std::unique_ptr<cell::AssemblyTask> task_;
-  platform::SpscRing<TaskAction> actions_{64};
+  runtime::SpscRing<TaskAction> actions_{64};
   struct Delivery {
     std::uint64_t seq = 0;
     cell::AssemblyTask::Sighting sighting;
   };
-  platform::SpscRing<Delivery> sightings_{8};
+  runtime::SpscRing<Delivery> sightings_{8};
   bool look_pending_ = false;  // loop thread: a look requested and not answered
   int looks_ = 0, looks_found_ = 0;
   std::uint64_t look_seq_ = 0;  // loop thread: the current request's number
@@ -187,7 +187,7 @@ class LiveTask {
   std::atomic<int> looks_pub_{0}, looks_found_pub_{0};
   // Loop thread only.
   bool started_ = false, ended_ = false, operator_had_stage_ = false;
-  control::FixtureSet fixtures_;  // the task's shared control in force on the coupling
+  teleop::FixtureSet fixtures_;  // the task's shared control in force on the coupling
   bool rearm_deadman_ = false, pickup_gripper_ = false;
   bool gap_paused_ = false;  // paused for a heartbeat gap: resumes by itself when it ends soon
   double gap_s_ = 0.0;

@@ -50,8 +50,8 @@ server::HttpReply file_reply(const std::filesystem::path& file, const std::strin
 
 }  // namespace
 
-platform::RecordingStory recording_story(const McapContents& mcap) {
-  platform::RecordingStory story;
+cell::RecordingStory recording_story(const McapContents& mcap) {
+  cell::RecordingStory story;
   if (const auto* m = mcap.find_metadata("microcobot"))
     if (const auto* v = m->find("version")) story.version = *v;
   if (const auto* m = mcap.find_metadata("scene"))
@@ -178,7 +178,7 @@ void RecordingFiles::make_report_now(const std::string& stem) const {
                            " MB: too long for a report (record shorter sessions)");
   const McapContents contents = read_mcap(mcap);
   const Recorder rec = platform::telemetry_from_mcap(contents, mcap.string(), kReportSamples);
-  const report::Report rep = platform::recording_report(rec, stem + ".mcap", recording_story(contents));
+  const report::Report rep = cell::recording_report(rec, stem + ".mcap", recording_story(contents));
   // The figures' CSVs first, the page last: a page that is there has its data beside it. Its
   // links are relative to /recordings/<stem>.html, so they reach the folder served above.
   const std::string figures = stem + std::string(kFigures);

@@ -22,14 +22,14 @@
 #include <string_view>
 #include <thread>
 
+#include "microcobot/cell/session.h"
 #include "microcobot/core/mcap_reader.h"
-#include "microcobot/platform/session.h"
 #include "microcobot/server/foxglove_server.h"
 
 namespace mc::live {
 
 /// What a live recording's /events and /platform/status say happened (the report's text).
-platform::RecordingStory recording_story(const McapContents& mcap);
+cell::RecordingStory recording_story(const McapContents& mcap);
 
 class RecordingFiles {
  public:

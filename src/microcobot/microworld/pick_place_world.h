@@ -83,7 +83,7 @@ struct PickPlaceParams {
   double part_yaw_rad = 0.0;  ///< the part's start orientation about the vertical (counter-clockwise)
   double hole_yaw_rad = 0.0;  ///< the hole's (the part must be turned to it, modulo 90 deg)
   PiezoGripperParams gripper;
-  /// The platform's limits for this part (issue #26; control/safety_limits.h). 1 mN of grip
+  /// The platform's limits for this part (issue #26; teleop/safety_limits.h). 1 mN of grip
   /// holds a 300 um brass part with a 27x margin (2 mu F >= pull-off + weight needs 60 uN) and
   /// stays well below what dents a watch part's finish.
   double grip_force_limit_N = 1e-3;

@@ -33,7 +33,7 @@ bool CameraImagePublisher::wanted() const {
   return status.current_count > 0;
 }
 
-bool CameraImagePublisher::publish(const platform::CameraFrame& frame, double t_s) {
+bool CameraImagePublisher::publish(const devices::CameraFrame& frame, double t_s) {
   if (frame.jpeg.empty()) return true;
   const live::RosTime stamp = live::ros_time(t_s);
   sensor_msgs_msg_dds__CompressedImage_ m{};

@@ -16,8 +16,8 @@
 
 #include <dds/dds.h>
 
+#include "microcobot/devices/camera_frame.h"
 #include "microcobot/net/participant.h"
-#include "microcobot/platform/camera_frame.h"
 
 namespace mc::net {
 
@@ -38,7 +38,7 @@ class CameraImagePublisher {
   bool wanted() const;
   /// Writes `frame`'s JPEG stamped `t_s` (live time). Frames without a JPEG are skipped.
   /// Returns false when DDS refused the write (counted in failures()).
-  bool publish(const platform::CameraFrame& frame, double t_s);
+  bool publish(const devices::CameraFrame& frame, double t_s);
 
   std::uint64_t published() const { return published_; }
   std::uint64_t failures() const { return failures_; }

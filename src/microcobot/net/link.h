@@ -22,7 +22,7 @@
 #include "microcobot/net/net_sample.h"
 #include "microcobot/net/participant.h"
 #include "microcobot/net/topics.h"
-#include "microcobot/platform/spsc_ring.h"
+#include "microcobot/runtime/spsc_ring.h"
 
 namespace mc::net {
 
@@ -98,7 +98,7 @@ class Link {
   std::array<dds_entity_t, kChannelCount> writers_{};  ///< 0 where the peer publishes
   std::array<dds_entity_t, kChannelCount> readers_{};  ///< 0 where this role publishes
   dds_entity_t waitset_ = 0;
-  platform::SpscRing<NetSample> outbound_, inbound_;
+  runtime::SpscRing<NetSample> outbound_, inbound_;
 
   std::atomic<bool> stop_{false};
   std::atomic<bool> peer_matched_{false}, peer_alive_{false};

@@ -21,7 +21,7 @@ enum class Channel : std::uint8_t {
   kEstop,           ///< master -> slave: emergency stop (latched state, 0 or 1)
   kEngaged,         ///< master -> slave: the coupling is engaged (clutch; 0 or 1)
   /// slave -> master: the slave's device states (/diagnostics): `xyz` the lifecycles of axes x,
-  /// y, z and `scalar` the gripper's, as platform::Lifecycle values (0 unconfigured, 1 inactive,
+  /// y, z and `scalar` the gripper's, as devices::Lifecycle values (0 unconfigured, 1 inactive,
   /// 2 active, 3 fault)
   kSlaveDiagnostics,
   /// master -> slave: the energy the master's end has put into the coupling's channel since it

@@ -6,7 +6,7 @@ namespace mc::net {
 
 namespace {
 
-// The port conventions of control/passivity.h take the force the far side opposes to the
+// The port conventions of teleop/passivity.h take the force the far side opposes to the
 // port's motion: the contact force on the gripper points against the motion that presses it.
 double opposing(double contact_N) { return -contact_N; }
 
@@ -52,8 +52,8 @@ PortsReport Ports<Controller>::report() const noexcept {
   return r;
 }
 
-template class Ports<control::MasterPassivityController>;
-template class Ports<control::SlavePassivityController>;
+template class Ports<teleop::MasterPassivityController>;
+template class Ports<teleop::SlavePassivityController>;
 
 Axes3 MasterPorts::contact_force(const Axes3& received_N, const Axes3& target_rate_m_s,
                                  double dt_s) noexcept {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Time-domain passivity across the two processes of a distributed platform (issue #17 point 4):
-/// the passivity observer and controller of control/passivity.h (Ryu, Artigas and Preusche's
+/// the passivity observer and controller of teleop/passivity.h (Ryu, Artigas and Preusche's
 /// time-delay form) at each end of the coupling's network channel, one port per stage axis and
 /// one for the gripper.
 ///
@@ -31,7 +31,7 @@
 #include <array>
 #include <cstddef>
 
-#include "microcobot/control/passivity.h"
+#include "microcobot/teleop/passivity.h"
 
 namespace mc::net {
 
@@ -104,7 +104,7 @@ class Ports {
 
 /// The master's end (net/remote_slave.h): the slave's contact force comes out of the channel
 /// through a variable damper on the target's rate.
-class MasterPorts final : public Ports<control::MasterPassivityController> {
+class MasterPorts final : public Ports<teleop::MasterPassivityController> {
  public:
   using Ports::Ports;
   /// The contact force (stage frame, N, on the gripper) to hand the coupling for one tick of
@@ -118,7 +118,7 @@ class MasterPorts final : public Ports<control::MasterPassivityController> {
 
 /// The slave's end (net/remote_master.h): the commanded velocity of the stage's target comes out
 /// of the channel against the contact force the environment opposes to it.
-class SlavePorts final : public Ports<control::SlavePassivityController> {
+class SlavePorts final : public Ports<teleop::SlavePassivityController> {
  public:
   using Ports::Ports;
   /// The velocity to command for one tick of `dt_s` (m/s), given the one the master's target

@@ -20,7 +20,7 @@ RemoteCameraSource::RemoteCameraSource(int domain_id, const NetworkConfig& netwo
 
 RemoteCameraSource::~RemoteCameraSource() { close(); }
 
-void RemoteCameraSource::open(const platform::CameraDeviceParams& params) {
+void RemoteCameraSource::open(const devices::CameraDeviceParams& params) {
   params_ = params;
   participant_ = std::make_unique<Participant>(domain_id_, network_);
   // The image publisher's QoS (ROS 2's sensor-data profile): best effort, volatile, keep last 1.
@@ -58,7 +58,7 @@ void RemoteCameraSource::stop_reading() {
 
 void RemoteCameraSource::idle() { stop_reading(); }
 
-bool RemoteCameraSource::capture(const platform::SceneSnapshot&, platform::Image& out) {
+bool RemoteCameraSource::capture(const devices::SceneSnapshot&, devices::Image& out) {
   start_reading();
   dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(100));
   void* samples[kImagesPerTake] = {};
@@ -83,7 +83,7 @@ bool RemoteCameraSource::capture(const platform::SceneSnapshot&, platform::Image
   dds_return_loan(reader_, samples, n);
   if (!error.empty()) throw InvalidInput("the slave's camera sent a frame that does not decode: " + error);
   if (newest < 0) return false;
-  const vision::SensorParams& sensor = params_.sensor;
+  const imaging::SensorParams& sensor = params_.sensor;
   if (decoded.width != sensor.width_px || decoded.height != sensor.height_px)
     throw InvalidInput("the slave's camera sends " + std::to_string(decoded.width) + " x " +
                        std::to_string(decoded.height) + " px frames; this configuration's camera.sensor is " +

@@ -24,22 +24,22 @@
 
 #include <dds/dds.h>
 
+#include "microcobot/devices/camera_device.h"
 #include "microcobot/net/participant.h"
-#include "microcobot/platform/camera_device.h"
 
 namespace mc::net {
 
-class RemoteCameraSource final : public platform::FrameSource {
+class RemoteCameraSource final : public devices::FrameSource {
  public:
   RemoteCameraSource(int domain_id, const NetworkConfig& network);
   ~RemoteCameraSource() override;
 
   /// Joins the domain (throws InvalidParams / ComputationFailed as Participant does).
-  void open(const platform::CameraDeviceParams& params) override;
+  void open(const devices::CameraDeviceParams& params) override;
   void close() override;
   bool renders_scene() const override { return false; }
   /// Throws mc::InvalidInput when a frame does not decode or is not the configured size.
-  bool capture(const platform::SceneSnapshot& scene, platform::Image& out) override;
+  bool capture(const devices::SceneSnapshot& scene, devices::Image& out) override;
   void idle() override;
   /// The slave's JPEG of the last frame captured, sent on unchanged.
   const std::vector<std::uint8_t>* captured_jpeg() const override { return &jpeg_; }
@@ -50,7 +50,7 @@ class RemoteCameraSource final : public platform::FrameSource {
 
   int domain_id_;
   NetworkConfig network_;
-  platform::CameraDeviceParams params_;
+  devices::CameraDeviceParams params_;
   std::unique_ptr<Participant> participant_;
   dds_entity_t topic_ = 0, reader_ = 0, waitset_ = 0;
   std::vector<std::uint8_t> jpeg_;  // the last frame's, as the slave encoded it

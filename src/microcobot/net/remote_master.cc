@@ -24,8 +24,8 @@ namespace {
 
 // An emulated jitter is known: the look-ahead covers it (the stamps spread by twice the jitter,
 // plus a period), and the ring holds the targets of that look-ahead.
-control::SetpointStreamParams covering_jitter(const RemoteMasterParams& p) {
-  control::SetpointStreamParams s = p.stream;
+motion::SetpointStreamParams covering_jitter(const RemoteMasterParams& p) {
+  motion::SetpointStreamParams s = p.stream;
   if (p.emulate.jitter_s > 0.0) {
     s.delay_s = std::max(s.delay_s, 2.0 * p.emulate.jitter_s + 1e-3);
     s.capacity = std::max(s.capacity, static_cast<int>(std::ceil(s.delay_s * 1e3)) + 8);
@@ -165,7 +165,7 @@ void RemoteMaster::publish(const platform::Platform& p) noexcept {
                                  std::chrono::system_clock::now().time_since_epoch())
                                  .count();
   const auto& g = p.gripper();
-  const platform::Vec3 f = g.contact_force_N();
+  const devices::Vec3 f = g.contact_force_N();
   send(Channel::kMeasuredPose, {p.axis(0).position_m(), p.axis(1).position_m(), p.axis(2).position_m()}, 0.0,
        stamp, p.yaw_rad());
   send(Channel::kContactForce, {f.x, f.y, f.z}, 0.0, stamp);

@@ -50,7 +50,7 @@ struct RemoteMasterParams {
   /// The targets' jitter buffer (target_stream.h): look-ahead 2 ms (twice the 1 kHz period:
   /// loopback's jitter is below it), rejoining after a hold at 1 mm/s (the console's speed).
   /// With an emulated jitter (`emulate`) the look-ahead is raised to cover it.
-  control::SetpointStreamParams stream = default_stream();
+  motion::SetpointStreamParams stream = default_stream();
   /// false: each target followed as it arrives (no buffer; the behaviour before issue #15, for
   /// comparison).
   bool interpolate_targets = true;
@@ -61,10 +61,10 @@ struct RemoteMasterParams {
   bool passivity = true;
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
   /// jitter the timeout grows by twice the jitter.
-  control::LinkParams emulate;
+  teleop::LinkParams emulate;
   void validate() const;
-  static control::SetpointStreamParams default_stream() {
-    control::SetpointStreamParams p;
+  static motion::SetpointStreamParams default_stream() {
+    motion::SetpointStreamParams p;
     p.delay_s = 2e-3;
     p.capacity = 64;
     p.max_velocity_m_s = 1e-3;

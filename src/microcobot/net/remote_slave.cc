@@ -33,7 +33,7 @@ class RemoteDevice : public Interface {
 };
 
 /// One axis of the remote stage: its measurements are the slave's latest pose.
-class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
+class RemoteSlaveAxis final : public RemoteDevice<devices::SlaveAxis> {
  public:
   RemoteSlaveAxis(std::string name, RemoteSlave& slave, int index, const RemoteSlaveParams& p)
       : RemoteDevice(std::move(name), slave),
@@ -44,7 +44,7 @@ class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
   double sample_period_s() const override { return period_s_; }
   double max_voltage_V() const override { return max_V_; }
   // Never called: the platform sends targets to position-controlled axes.
-  void command_drive(const platform::DriveBlock&) noexcept override {}
+  void command_drive(const devices::DriveBlock&) noexcept override {}
   double position_m() const override {
     return index_ == 3 ? rotary_.arc_m(slave_.state().yaw_rad)
                        : slave_.state().position_m[static_cast<std::size_t>(index_)];
@@ -60,11 +60,11 @@ class RemoteSlaveAxis final : public RemoteDevice<platform::SlaveAxis> {
  private:
   int index_;  // 0-2: x, y, z; 3: the rotary axis (its position the arc of the slave's yaw)
   double period_s_, max_V_;
-  control::RotaryAxisParams rotary_;
+  motion::RotaryAxisParams rotary_;
 };
 
 /// The slave's gripper; its update() runs the link exchange once per tick.
-class RemoteGripper final : public RemoteDevice<platform::Gripper> {
+class RemoteGripper final : public RemoteDevice<devices::Gripper> {
  public:
   using RemoteDevice::RemoteDevice;
   void command_opening_m(double opening) noexcept override {
@@ -81,7 +81,7 @@ class RemoteGripper final : public RemoteDevice<platform::Gripper> {
   }
   double opening_m() const override { return slave_.state().opening_m; }
   double grip_force_N() const override { return slave_.state().grip_force_N; }
-  platform::Vec3 contact_force_N() const override {
+  devices::Vec3 contact_force_N() const override {
     const auto& f = slave_.state().contact_force_N;
     return {f[0], f[1], f[2]};
   }
@@ -110,8 +110,8 @@ RemoteSlave::RemoteSlave(const RemoteSlaveParams& params) : params_(params), por
 
 RemoteSlave::~RemoteSlave() = default;
 
-platform::PlatformDevices RemoteSlave::make_devices() {
-  platform::PlatformDevices d;
+devices::DeviceSet RemoteSlave::make_devices() {
+  devices::DeviceSet d;
   const char* names[3] = {"remote_axis_x", "remote_axis_y", "remote_axis_z"};
   for (int i = 0; i < 3; ++i)
     d.axes[static_cast<std::size_t>(i)] = std::make_unique<RemoteSlaveAxis>(names[i], *this, i, params_);
@@ -179,8 +179,8 @@ void RemoteSlave::apply(const NetSample& s) noexcept {
       state_.opening_m = s.scalar;
       break;
     case Channel::kSlaveDiagnostics:  // checked by the link: each a Lifecycle value
-      for (std::size_t i = 0; i < 3; ++i) state_.lifecycle[i] = static_cast<platform::Lifecycle>(s.xyz[i]);
-      state_.lifecycle[3] = static_cast<platform::Lifecycle>(s.scalar);
+      for (std::size_t i = 0; i < 3; ++i) state_.lifecycle[i] = static_cast<devices::Lifecycle>(s.xyz[i]);
+      state_.lifecycle[3] = static_cast<devices::Lifecycle>(s.scalar);
       break;
     default:
       break;  // the master's own channels never come back (the link ignores them)

@@ -3,7 +3,7 @@
 /// The slave stage of a distributed platform as the master process sees it (issue #17,
 /// `microcobot serve --role master`): three position-controlled axes and a gripper whose far end
 /// is the slave process, over the DDS link. They are one more implementation of the platform's
-/// device interfaces (platform/device.h, docs/hardware.md): the master's platform runs its
+/// device interfaces (devices/device.h, docs/hardware.md): the master's platform runs its
 /// masters and the teleoperation coupling as always and hands the coupling's targets to these
 /// axes; the slave process's stage controller follows them.
 ///
@@ -32,7 +32,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "microcobot/control/rotary_axis.h"
+#include "microcobot/motion/rotary_axis.h"
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
 #include "microcobot/net/transit_estimate.h"
@@ -57,15 +57,15 @@ struct RemoteSlaveParams {
   double max_voltage_V = 100.0;   ///< reported; the slave's amplifier applies its own
   /// The slave's rotary axis under the gripper (the platform's stage.rotary: its position on the
   /// master is the arc at its radius); disabled: the link carries no yaw and the master has none.
-  control::RotaryAxisParams rotary = without_rotary();
-  static control::RotaryAxisParams without_rotary() {
-    control::RotaryAxisParams r;
+  motion::RotaryAxisParams rotary = without_rotary();
+  static motion::RotaryAxisParams without_rotary() {
+    motion::RotaryAxisParams r;
     r.enabled = false;
     return r;
   }
   /// The link emulator on what this end receives (wire_emulator.h); all zero: none. With
   /// jitter the timeout grows by twice the jitter (keep-latest lines then leave gaps that long).
-  control::LinkParams emulate;
+  teleop::LinkParams emulate;
   void validate() const;
 };
 
@@ -80,10 +80,10 @@ struct RemoteSlaveState {
   double age_s = 1e9;  ///< since the last pose (starts stale)
   /// The slave's devices (axes x, y, z, gripper) as its /diagnostics last reported them;
   /// unknown (Unconfigured) until the first report.
-  std::array<platform::Lifecycle, 4> lifecycle{};
+  std::array<devices::Lifecycle, 4> lifecycle{};
   bool slave_active() const {
     for (auto l : lifecycle)
-      if (l != platform::Lifecycle::kActive) return false;
+      if (l != devices::Lifecycle::kActive) return false;
     return true;
   }
 };
@@ -98,7 +98,7 @@ class RemoteSlave {
 
   /// New devices for one platform build: the three axes and the gripper (views of this link,
   /// which must outlive them). The masters are not filled in.
-  platform::PlatformDevices make_devices();
+  devices::DeviceSet make_devices();
 
   const Link& link() const { return *link_; }
   /// Poses flow and every slave device is active (a slave that faulted or e-stopped itself is

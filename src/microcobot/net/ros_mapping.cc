@@ -114,7 +114,7 @@ void to_ros(const NetSample& s, JointStateBuffer& buf, sensor_msgs_msg_dds__Join
 
 namespace {
 
-// platform::Lifecycle's order: unconfigured, inactive, active, fault.
+// devices::Lifecycle's order: unconfigured, inactive, active, fault.
 constexpr const char* kLifecycleNames[4] = {"unconfigured", "inactive", "active", "fault"};
 constexpr std::uint8_t kLifecycleLevels[4] = {3, 1, 0, 2};  // STALE, WARN, OK, ERROR
 

@@ -4,9 +4,8 @@
 
 namespace mc::net {
 
-TargetStream::TargetStream(const control::SetpointStreamParams& stream, double window_s)
-    : axes_{control::SetpointStream(stream), control::SetpointStream(stream),
-            control::SetpointStream(stream)},
+TargetStream::TargetStream(const motion::SetpointStreamParams& stream, double window_s)
+    : axes_{motion::SetpointStream(stream), motion::SetpointStream(stream), motion::SetpointStream(stream)},
       transit_(window_s) {}
 
 bool TargetStream::push(double stamp_s, const Axes3& target_m, double now_s) noexcept {

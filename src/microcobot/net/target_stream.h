@@ -4,7 +4,7 @@
 /// buffer. Targets leave the master at 1 kHz stamped with its clock and arrive late, bunched or
 /// not at all (delay, jitter, loss). Followed as they arrive, the slave's goal would stop at
 /// every gap and jump at every burst. Here each axis' targets go through a
-/// control::SetpointStream read at the sender's time minus the transit, so the goal retraces
+/// motion::SetpointStream read at the sender's time minus the transit, so the goal retraces
 /// the master's motion, interpolated between the targets that arrived, `delay_s` (the stream's
 /// look-ahead) behind; a target later than that holds the goal, which rejoins at the stream's
 /// speed limit, never by a jump.
@@ -18,7 +18,7 @@
 
 #include <array>
 
-#include "microcobot/control/setpoint_stream.h"
+#include "microcobot/motion/setpoint_stream.h"
 #include "microcobot/net/transit_estimate.h"
 
 namespace mc::net {
@@ -27,7 +27,7 @@ class TargetStream {
  public:
   using Axes3 = std::array<double, 3>;
   /// Allocates the three streams' rings here only.
-  explicit TargetStream(const control::SetpointStreamParams& stream, double window_s = 1.0);
+  explicit TargetStream(const motion::SetpointStreamParams& stream, double window_s = 1.0);
 
   /// A target stamped `stamp_s` by the sender, arriving at `now_s` (this end's clock, s). An
   /// out-of-order one is dropped, and so is one stamped more than `kMaxStampLead_s` ahead of the
@@ -45,7 +45,7 @@ class TargetStream {
   double transit_s() const noexcept { return transit_.estimate_s(); }
 
  private:
-  std::array<control::SetpointStream, 3> axes_;
+  std::array<motion::SetpointStream, 3> axes_;
   TransitEstimate transit_;
   bool holding_ = true;
 };

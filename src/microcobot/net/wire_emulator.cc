@@ -7,17 +7,17 @@
 
 namespace mc::net {
 
-bool impairs(const control::LinkParams& p) { return p.delay_s > 0 || p.jitter_s > 0 || p.loss > 0; }
+bool impairs(const teleop::LinkParams& p) { return p.delay_s > 0 || p.jitter_s > 0 || p.loss > 0; }
 
-WireEmulator::WireEmulator(const control::LinkParams& params, double rate_Hz) {
+WireEmulator::WireEmulator(const teleop::LinkParams& params, double rate_Hz) {
   params.validate();
   require_positive(rate_Hz, "rate_Hz");
   for (const TopicSpec& spec : topic_table()) {
     const auto c = static_cast<std::size_t>(spec.channel);
-    control::LinkParams p = params;
+    teleop::LinkParams p = params;
     p.seed = params.seed + c;  // independent losses and jitter per topic
     if (spec.reliability == Reliability::kReliable) p.loss = 0.0;
-    lines_[c] = std::make_unique<control::EmulatedLinkOf<Stamped>>(p, 1.0 / rate_Hz);
+    lines_[c] = std::make_unique<teleop::EmulatedLinkOf<Stamped>>(p, 1.0 / rate_Hz);
     delivered_s_[c] = -1.0;
   }
 }

@@ -4,7 +4,7 @@
 /// --link-jitter --link-loss`): what the DDS link delivers to the loop is held back by the
 /// emulated delay and jitter, and lost with the emulated probability, before the remote end
 /// (remote_slave.h, remote_master.h) applies it. One emulated line per channel
-/// (control::EmulatedLinkOf): each keeps the newest sample that has arrived, as a keep-last-1
+/// (teleop::EmulatedLinkOf): each keeps the newest sample that has arrived, as a keep-last-1
 /// reader does. Only best-effort topics lose samples: DDS retransmits the reliable ones (e-stop,
 /// engaged), which the emulator only delays. Each process emulates what it receives, so two
 /// processes with `--link-delay D` have a round trip of 2 D plus the network's own.
@@ -13,18 +13,18 @@
 #include <array>
 #include <memory>
 
-#include "microcobot/control/link_emulator.h"
 #include "microcobot/net/net_sample.h"
+#include "microcobot/teleop/link_emulator.h"
 
 namespace mc::net {
 
 /// True when `p` impairs a link at all (any delay, jitter or loss).
-bool impairs(const control::LinkParams& p);
+bool impairs(const teleop::LinkParams& p);
 
 class WireEmulator {
  public:
   /// `rate_Hz`: the fastest channel's rate (sizes the lines). Throws InvalidParams.
-  WireEmulator(const control::LinkParams& params, double rate_Hz);
+  WireEmulator(const teleop::LinkParams& params, double rate_Hz);
 
   /// A sample the link delivered at loop time `now_s`: into flight.
   void arrive(double now_s, const NetSample& s) noexcept;
@@ -47,7 +47,7 @@ class WireEmulator {
     double sent_s = 0.0;
     NetSample sample;
   };
-  std::array<std::unique_ptr<control::EmulatedLinkOf<Stamped>>, kChannelCount> lines_;
+  std::array<std::unique_ptr<teleop::EmulatedLinkOf<Stamped>>, kChannelCount> lines_;
   std::array<double, kChannelCount> delivered_s_{};
   double last_s_ = -1.0;
 };

@@ -38,9 +38,9 @@ PlatformConfig scene_config(const std::string& scene) {
   return c;
 }
 
-vision::CameraParams renderer_params(const CameraDeviceParams& camera, int objective) {
+imaging::CameraParams renderer_params(const devices::CameraDeviceParams& camera, int objective) {
   const int last = static_cast<int>(camera.objectives.size()) - 1;
-  vision::CameraParams cp;
+  imaging::CameraParams cp;
   cp.sensor = camera.sensor;
   cp.objective = camera.objectives.at(static_cast<std::size_t>(std::clamp(objective, 0, last)));
   cp.illumination = camera.illumination;
@@ -89,7 +89,7 @@ CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetryS
   return p;
 }
 
-void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vision::SceneSnapshot& s) {
+void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, imaging::SceneSnapshot& s) {
   s.clear_objects();
   if (c.optical_trap_scene()) {
     // A Petri dish seen in transmitted or reflected light: a glass bottom, faint texture.
@@ -97,13 +97,13 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
     s.substrate.reflectance = 0.35;
     s.substrate.texture_contrast = 0.03;
     s.substrate.texture_grain_m = 0.5e-6;
-    vision::Bead probe;
+    imaging::Bead probe;
     probe.x_m = pose.part_x_m, probe.y_m = pose.part_y_m, probe.z_m = pose.part_z_m;
     probe.radius_m = trap.bead_radius_m;
     probe.vx_m_s = pose.part_vx_m_s, probe.vy_m_s = pose.part_vy_m_s;
     s.beads.push_back(probe);
     const Eigen::Vector2d o = c.optical_trap.obstacle_m({c.stage.home_x_m, c.stage.home_y_m});
-    vision::Bead stuck;
+    imaging::Bead stuck;
     stuck.x_m = o.x(), stuck.y_m = o.y(), stuck.z_m = trap.obstacle_radius_m;
     stuck.radius_m = trap.obstacle_radius_m;
     s.beads.push_back(stuck);
@@ -113,14 +113,14 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   // target, the two fingers closing along x.
   const auto& w = c.world;
   if (w.hole_side_m > 0.0) {
-    vision::Hole h;
+    imaging::Hole h;
     h.x_m = w.target_m.x(), h.y_m = w.target_m.y();
     h.size_x_m = h.size_y_m = w.hole_side_m;
     h.depth_m = w.hole_depth_m;
     h.angle_rad = w.hole_yaw_rad;
     s.holes.push_back(h);
   }
-  vision::Part part;
+  imaging::Part part;
   part.x_m = pose.part_x_m, part.y_m = pose.part_y_m;
   part.z_top_m = pose.part_z_m + 0.5 * w.height_m();
   part.size_x_m = part.size_y_m = w.part_side_m;
@@ -130,7 +130,7 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   // The other parts of the scene (a grid load's: microworld/neighbours.h), where they stand.
   for (int i = 0; i < w.neighbour_count; ++i) {
     const microworld::NeighbourPart& n = w.neighbours[static_cast<std::size_t>(i)];
-    vision::Part other;
+    imaging::Part other;
     other.x_m = n.xy_m.x(), other.y_m = n.xy_m.y();
     other.z_top_m = n.top_z_m;
     other.size_x_m = other.size_y_m = n.side_m;
@@ -142,7 +142,7 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, vis
   // shifted (a 2 mm bender bent by a few um: its end turns by 3 d / 2 L, under 0.01 rad).
   const double tip_x = pose.tool_x_m + pose.deflection_x_m, tip_y = pose.tool_y_m + pose.deflection_y_m;
   for (int side : {-1, 1}) {
-    vision::Finger f;
+    imaging::Finger f;
     f.width_m = finger_width_m;
     f.tip_x_m = tip_x + side * 0.5 * (std::max(pose.opening_m, 0.0) + finger_width_m);
     f.tip_y_m = tip_y - 0.5 * finger_width_m;  // the end of the bar covers the tool point

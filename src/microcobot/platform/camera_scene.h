@@ -8,9 +8,9 @@
 
 #include <string>
 
+#include "microcobot/imaging/scene_snapshot.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
-#include "microcobot/vision/scene_snapshot.h"
 
 namespace mc::platform {
 
@@ -20,7 +20,7 @@ PlatformConfig scene_config(const std::string& scene);
 
 /// What the renderer needs to form `camera`'s image through its objective `objective` (clamped to
 /// the turret).
-vision::CameraParams renderer_params(const CameraDeviceParams& camera, int objective);
+imaging::CameraParams renderer_params(const devices::CameraDeviceParams& camera, int objective);
 
 /// Where the moving things are (world frame, the telemetry's ground-truth channels).
 struct CameraScenePose {
@@ -46,6 +46,6 @@ CameraScenePose pose_from_telemetry(const TelemetrySample& now, const TelemetryS
 /// Fills `snapshot` (object lists cleared, their capacity kept) with the scene of `config` at
 /// `pose`; the fingers as wide as `world.gripper.finger_width_m`.
 void fill_camera_scene(const PlatformConfig& config, const CameraScenePose& pose,
-                       vision::SceneSnapshot& snapshot);
+                       imaging::SceneSnapshot& snapshot);
 
 }  // namespace mc::platform

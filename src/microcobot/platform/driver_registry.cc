@@ -7,7 +7,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
-#include "microcobot/platform/opencv_camera.h"
+#include "microcobot/devices/opencv_camera.h"
 #include "microcobot/platform/simulated_camera.h"
 
 namespace mc::platform {
@@ -40,16 +40,6 @@ bool valid_name(const std::string& name) {
 
 }  // namespace
 
-#ifndef MC_HAVE_OPENCV
-// Built without OpenCV (MC_WITH_OPENCV off): the driver is not there, and says so.
-bool opencv_camera_available() { return false; }
-std::unique_ptr<FrameSource> make_opencv_camera(const std::string&) {
-  throw InvalidParams("devices.camera.driver",
-                      "'opencv': this build has no OpenCV (install libopencv-videoio-dev, then cmake "
-                      "-DMC_WITH_OPENCV=ON; make test does both)");
-}
-#endif
-
 void register_devices(const std::string& name, DeviceFactory factory) {
   if (!valid_name(name))
     throw InvalidParams("devices.driver",
@@ -74,7 +64,7 @@ bool is_device_driver(const std::string& name) {
   return entries().count(name) > 0;
 }
 
-PlatformDevices make_driver_devices(const PlatformConfig& config) {
+devices::DeviceSet make_driver_devices(const PlatformConfig& config) {
   DeviceFactory factory;
   {
     std::lock_guard lock(entries_mutex());
@@ -102,7 +92,7 @@ void register_camera(const std::string& name, CameraSourceFactory factory) {
 
 std::vector<std::string> camera_driver_names() {
   std::vector<std::string> names{kNoCamera, kSimulated};
-  if (opencv_camera_available()) names.emplace_back(kOpenCv);
+  if (devices::opencv_camera_available()) names.emplace_back(kOpenCv);
   std::lock_guard lock(entries_mutex());
   for (const auto& entry : cameras()) names.push_back(entry.first);
   return names;
@@ -113,11 +103,12 @@ bool is_camera_driver(const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-std::unique_ptr<FrameSource> make_camera_source(const PlatformConfig& config) {
+std::unique_ptr<devices::FrameSource> make_camera_source(const PlatformConfig& config) {
   const std::string& name = config.devices.camera.driver;
   if (name == kNoCamera) return nullptr;
   if (name == kSimulated) return make_simulated_camera(config);
-  if (name == kOpenCv && opencv_camera_available()) return make_opencv_camera(config.devices.camera.source);
+  if (name == kOpenCv && devices::opencv_camera_available())
+    return devices::make_opencv_camera(config.devices.camera.source);
   CameraSourceFactory factory;
   {
     std::lock_guard lock(entries_mutex());

@@ -25,7 +25,7 @@ namespace mc::platform {
 /// Builds a bench's devices, unconfigured, from the configuration (`config.devices.connection`
 /// says what to open; the loop's period, the axes' sample period and the limits are there too).
 /// Throws mc::Error when a device cannot be reached.
-using DeviceFactory = std::function<PlatformDevices(const PlatformConfig& config)>;
+using DeviceFactory = std::function<devices::DeviceSet(const PlatformConfig& config)>;
 
 /// Registers `factory` under `name` (letters, digits, '-', '_'; not "simulated"). Throws
 /// mc::InvalidParams on a bad or taken name. Thread-safe; meant for static initialisation
@@ -40,14 +40,15 @@ bool is_device_driver(const std::string& name);
 
 /// The registered factory's devices for `config.devices.driver` (not "simulated": those are the
 /// platform's own). Throws mc::InvalidParams naming `devices.driver` and the known names.
-PlatformDevices make_driver_devices(const PlatformConfig& config);
+devices::DeviceSet make_driver_devices(const PlatformConfig& config);
 
 /// The platform `config` asks for: simulated, or on the selected driver's devices.
 std::unique_ptr<Platform> make_platform(const PlatformConfig& config);
 
 /// Builds a camera's frame source (unopened) from the configuration (`devices.camera.source`
 /// says what to open). Throws mc::Error.
-using CameraSourceFactory = std::function<std::unique_ptr<FrameSource>(const PlatformConfig& config)>;
+using CameraSourceFactory =
+    std::function<std::unique_ptr<devices::FrameSource>(const PlatformConfig& config)>;
 
 /// Registers a camera driver under `name` (as register_devices; not "none" or "simulated").
 void register_camera(const std::string& name, CameraSourceFactory factory);
@@ -57,7 +58,7 @@ std::vector<std::string> camera_driver_names();
 bool is_camera_driver(const std::string& name);
 /// The frame source `config.devices.camera` selects; null for "none". Throws mc::InvalidParams
 /// naming `devices.camera.driver` for an unknown one, mc::Error when the driver cannot be built.
-std::unique_ptr<FrameSource> make_camera_source(const PlatformConfig& config);
+std::unique_ptr<devices::FrameSource> make_camera_source(const PlatformConfig& config);
 
 /// Registers a driver set at static initialisation, in a source file compiled into the program
 /// itself (a static library's object nobody references would be left out by the linker):

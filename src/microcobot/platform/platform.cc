@@ -38,36 +38,37 @@ Platform::Platform(const PlatformConfig& config)
   const double dt = config_.loop.period_s();
   const char* names[3] = {"axis_x", "axis_y", "axis_z"};
   for (std::size_t i = 0; i < 3; ++i) {
-    control::PositionSensorParams sp = config_.stage.sensor;
+    motion::PositionSensorParams sp = config_.stage.sensor;
     sp.seed = config_.stage.sensor.seed + static_cast<int>(i);  // independent noise per axis
-    auto axis = std::make_unique<SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
+    auto axis = std::make_unique<devices::SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
     sim_.axes[i] = axis.get();
     devices_.axes[i] = std::move(axis);
   }
   if (config_.stage.rotary.enabled && !config_.optical_trap_scene()) {
-    control::PositionSensorParams sp = config_.stage.sensor;
+    motion::PositionSensorParams sp = config_.stage.sensor;
     sp.seed = config_.stage.sensor.seed + 3;
-    auto rotary = std::make_unique<SimulatedSlaveAxis>("axis_theta", *model_, sp, 0.0);
+    auto rotary = std::make_unique<devices::SimulatedSlaveAxis>("axis_theta", *model_, sp, 0.0);
     sim_.rotary = rotary.get();
     devices_.rotary = std::move(rotary);
   }
-  const std::array<const SimulatedSlaveAxis*, 3> carriers{sim_.axes[0], sim_.axes[1], sim_.axes[2]};
-  const Vec3 home{home_m_.x(), home_m_.y(), home_m_.z()};
+  const std::array<const devices::SimulatedSlaveAxis*, 3> carriers{sim_.axes[0], sim_.axes[1], sim_.axes[2]};
+  const devices::Vec3 home{home_m_.x(), home_m_.y(), home_m_.z()};
   if (config_.optical_trap_scene()) {
-    auto trap = std::make_unique<SimulatedOpticalTweezers>("optical_tweezers", config_.optical_trap, carriers,
-                                                           home, dt);
+    auto trap = std::make_unique<devices::SimulatedOpticalTweezers>("optical_tweezers", config_.optical_trap,
+                                                                    carriers, home, dt);
     sim_.optical_tweezers = trap.get();
     devices_.gripper = std::move(trap);
   } else {
-    auto gripper = std::make_unique<SimulatedGripper>(
-        "gripper", world_, std::array<const SlaveAxis*, 3>{carriers[0], carriers[1], carriers[2]}, home);
+    auto gripper = std::make_unique<devices::SimulatedGripper>(
+        "gripper", world_, std::array<const devices::SlaveAxis*, 3>{carriers[0], carriers[1], carriers[2]},
+        home);
     if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
     sim_.gripper = gripper.get();
     devices_.gripper = std::move(gripper);
   }
-  auto haptic = std::make_unique<SimulatedHapticMaster>("dual_stage", config_.haptic.plant,
-                                                        config_.haptic.render, config_.haptic.pantograph, dt);
-  auto tweezers = std::make_unique<SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
+  auto haptic = std::make_unique<devices::SimulatedHapticMaster>(
+      "dual_stage", config_.haptic.plant, config_.haptic.render, config_.haptic.pantograph, dt);
+  auto tweezers = std::make_unique<devices::SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
   sim_.haptic = haptic.get();
   sim_.tweezers = tweezers.get();
   devices_.haptic = std::move(haptic);
@@ -75,7 +76,7 @@ Platform::Platform(const PlatformConfig& config)
   build();
 }
 
-Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
+Platform::Platform(const PlatformConfig& config, devices::DeviceSet drivers)
     : config_(config),
       world_((config_.validate(), config_.world)),
       devices_(std::move(drivers)),
@@ -91,26 +92,26 @@ Platform::Platform(const PlatformConfig& config, PlatformDevices drivers)
     for (std::size_t i = 0; i < 3; ++i)
       if (devices_.axes[i] == nullptr)
         throw InvalidParams("devices.axes[" + std::to_string(i) + "]", "is missing");
-    auto gripper = std::make_unique<SimulatedGripper>(
+    auto gripper = std::make_unique<devices::SimulatedGripper>(
         "gripper", world_,
-        std::array<const SlaveAxis*, 3>{devices_.axes[0].get(), devices_.axes[1].get(),
-                                        devices_.axes[2].get()},
-        Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
+        std::array<const devices::SlaveAxis*, 3>{devices_.axes[0].get(), devices_.axes[1].get(),
+                                                 devices_.axes[2].get()},
+        devices::Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
     if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
     sim_.gripper = gripper.get();
     devices_.gripper = std::move(gripper);
   }
-  // A driver set's companions may be the simulated masters (vendor/sim_companions.h): the
+  // A driver set's companions may be the simulated masters (drivers/sim_companions.h): the
   // scripted operator moves their hands as on the simulated platform.
-  sim_.haptic = dynamic_cast<SimulatedHapticMaster*>(devices_.haptic.get());
-  sim_.tweezers = dynamic_cast<SimulatedTweezersMaster*>(devices_.tweezers.get());
+  sim_.haptic = dynamic_cast<devices::SimulatedHapticMaster*>(devices_.haptic.get());
+  sim_.tweezers = dynamic_cast<devices::SimulatedTweezersMaster*>(devices_.tweezers.get());
   const char* names[9] = {"axes[0]",  "axes[1]", "axes[2]", "gripper", "haptic",
                           "tweezers", "camera",  "focus",   "rotary"};
   const auto d = devices();
   for (std::size_t i = 0; i < d.size(); ++i) {
     if (i >= 6 && d[i] == nullptr) continue;  // optional: the camera, its focus, the rotary axis
     if (d[i] == nullptr) throw InvalidParams(std::string("devices.") + names[i], "is missing");
-    if (d[i]->state() != Lifecycle::kUnconfigured)
+    if (d[i]->state() != devices::Lifecycle::kUnconfigured)
       throw InvalidParams(std::string("devices.") + names[i], "must be handed over unconfigured");
   }
   model_ = std::make_unique<stickslip::ActuatorModel>(axis_params(config_));
@@ -124,7 +125,7 @@ void Platform::build() {
           "the loop period must be a whole number of stick-slip model steps", config_.loop.base_rate_Hz);
   position_controlled_ = devices_.axes[0]->position_controlled();
   for (std::size_t i = 0; i < 4; ++i) {
-    const SlaveAxis* a = i < 3 ? devices_.axes[i].get() : devices_.rotary.get();
+    const devices::SlaveAxis* a = i < 3 ? devices_.axes[i].get() : devices_.rotary.get();
     if (a == nullptr) continue;
     require(a->position_controlled() == position_controlled_, "devices.axes",
             "must all be position-controlled or all voltage-driven", static_cast<double>(i));
@@ -135,64 +136,64 @@ void Platform::build() {
   vision_xy_ = config_.stage.vision_xy();
   require(!(vision_xy_ && position_controlled_), "stage.xy_sensor",
           "vision needs voltage-driven axes (a position-controlled stage closes its own loop)", 1.0);
-  map_ = std::make_unique<control::StepMap>(*model_, config_.stage.step_map);
+  map_ = std::make_unique<motion::StepMap>(*model_, config_.stage.step_map);
   stage_ = std::make_unique<StageController>(
       config_.stage.control, model_->params(), *map_, static_cast<int>(std::lround(ratio)), model_->dt_s(),
       config_.stage.tracking_enabled ? &config_.stage.tracking : nullptr, devices_.rotary ? 4 : 3);
   for (auto& st : steppers_)
-    st = std::make_unique<OpenLoopStepper>(static_cast<int>(std::lround(ratio)), model_->dt_s(),
-                                           model_->params().drive.slew_rate_V_s);
-  control::SafetyLimitParams limits;
+    st = std::make_unique<devices::OpenLoopStepper>(static_cast<int>(std::lround(ratio)), model_->dt_s(),
+                                                    model_->params().drive.slew_rate_V_s);
+  teleop::SafetyLimitParams limits;
   limits.grip_force_limit_N = world_.params().grip_force_limit_N;
   limits.contact_force_limit_N = world_.params().contact_force_limit_N;
   limits.finger_stiffness_N_m = world_.params().gripper.finger_stiffness_N_m;
   limits.floor_m = world_.params().min_tip_height_m - home_m_.z();  // the substrate is at world z = 0
-  teleop_ = std::make_unique<control::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
-                                                     world_.params().gripper.max_opening_m, limits);
+  teleop_ = std::make_unique<teleop::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
+                                                    world_.params().gripper.max_opening_m, limits);
   build_rotary();
   recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
   if (!devices_.camera && config_.camera.enabled) {
     if (auto source = make_camera_source(config_))
-      devices_.camera = std::make_unique<Camera>("camera", config_.camera, std::move(source));
+      devices_.camera = std::make_unique<devices::Camera>("camera", config_.camera, std::move(source));
   }
   if (devices_.camera && !devices_.focus)
-    devices_.focus = std::make_unique<FocusDrive>("focus", config_.camera);
+    devices_.focus = std::make_unique<devices::FocusDrive>("focus", config_.camera);
 
   arm_devices(/*fault_on_failure=*/false);
 
-  loop_.add_task("operator", config_.loop.operator_divisor, [this](const TickInfo& t) {
+  loop_.add_task("operator", config_.loop.operator_divisor, [this](const runtime::TickInfo& t) {
     if (operator_) operator_(t);
   });
-  loop_.add_task("teleoperation", 1, [this](const TickInfo&) { teleoperation_task(); });
+  loop_.add_task("teleoperation", 1, [this](const runtime::TickInfo&) { teleoperation_task(); });
   loop_.add_task("slave_control", config_.loop.slave_divisor,
-                 [this](const TickInfo&) { slave_control_task(); });
-  loop_.add_task("devices", 1, [this](const TickInfo& t) { devices_task(t.dt_s); });
+                 [this](const runtime::TickInfo&) { slave_control_task(); });
+  loop_.add_task("devices", 1, [this](const runtime::TickInfo& t) { devices_task(t.dt_s); });
   loop_.add_task("telemetry", config_.loop.telemetry_divisor,
-                 [this](const TickInfo& t) { telemetry_task(t.t_s); });
-  if (devices_.camera) loop_.add_task("camera", 1, [this](const TickInfo& t) { camera_task(t); });
+                 [this](const runtime::TickInfo& t) { telemetry_task(t.t_s); });
+  if (devices_.camera) loop_.add_task("camera", 1, [this](const runtime::TickInfo& t) { camera_task(t); });
   loop_.sample_ticks_every(config_.loop.telemetry_divisor);
   loop_.pin_to_core(config_.loop.cpu);
 }
 
 Platform::~Platform() {
-  for (Device* d : devices())
+  for (devices::Device* d : devices())
     if (d != nullptr) d->deactivate();
 }
 
-std::array<Device*, 9> Platform::devices() {
+std::array<devices::Device*, 9> Platform::devices() {
   return {devices_.axes[0].get(), devices_.axes[1].get(), devices_.axes[2].get(),
           devices_.gripper.get(), devices_.haptic.get(),  devices_.tweezers.get(),
           devices_.camera.get(),  devices_.focus.get(),   devices_.rotary.get()};
 }
 
-const SimulatedDevices& Platform::simulation() const {
+const devices::SimulatedDevices& Platform::simulation() const {
   if (sim_.haptic == nullptr && sim_.gripper == nullptr)
     throw InvalidParams("platform", "runs on hardware drivers, not on the simulation");
   return sim_;
 }
 
 void Platform::fault_all() noexcept {
-  for (Device* d : devices())
+  for (devices::Device* d : devices())
     if (d != nullptr) d->fault();
   stage_->emergency_stop();
   for (auto& st : steppers_) st->halt();
@@ -206,8 +207,8 @@ void Platform::teleoperation_task() noexcept {
   haptic_seen_ = devices_.haptic->reading_count();
   tweezers_seen_ = devices_.tweezers->reading_count();
 
-  control::TeleoperationInput in;
-  const Vec2 h = devices_.haptic->handle_position_m();
+  teleop::TeleoperationInput in;
+  const devices::Vec2 h = devices_.haptic->handle_position_m();
   in.handle_m = {h.x, h.y};
   in.deadman = devices_.haptic->enabled() && !faulted_;
   in.clutch = devices_.haptic->clutch();
@@ -217,7 +218,7 @@ void Platform::teleoperation_task() noexcept {
   in.tweezers_fresh = tweezers_watchdog_.tick();
   for (int i = 0; i < 3; ++i)
     in.slave_position_m[i] = devices_.axes[static_cast<std::size_t>(i)]->position_m();
-  const Vec3 f = devices_.gripper->contact_force_N();
+  const devices::Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
   in.grip_force_N = devices_.gripper->grip_force_N();
   in.gripper_opening_m = devices_.gripper->opening_m();
@@ -274,14 +275,14 @@ void Platform::slave_control_task() noexcept {
 void Platform::devices_task(double dt_s) noexcept {
   bool stepping_ended = false;
   for (std::size_t i = 0; i < 3; ++i) {
-    OpenLoopStepper& st = *steppers_[i];
+    devices::OpenLoopStepper& st = *steppers_[i];
     const bool was_running = st.running();
     if (was_running && open_loop_must_stop(i)) st.halt();
     if (!faulted_ && !position_controlled_) {
       if (vision_xy_ && i < 2) {
         devices_.axes[i]->command_drive(st.drive());  // its run, or 0 V at rest: no loop on x, y
       } else if (st.running()) {
-        const DriveBlock open_loop = st.drive();
+        const devices::DriveBlock open_loop = st.drive();
         stage_->drive(static_cast<int>(i), devices_.axes[i]->position_m());  // keeps the controller's clock
         devices_.axes[i]->command_drive(open_loop);
       } else {
@@ -302,8 +303,8 @@ void Platform::devices_task(double dt_s) noexcept {
     devices_.focus->update(dt_s);
   }
   if (!faulted_) {
-    for (Device* d : devices()) {
-      if (d != nullptr && d->state() == Lifecycle::kFault) {
+    for (devices::Device* d : devices()) {
+      if (d != nullptr && d->state() == devices::Lifecycle::kFault) {
         fault_all();
         break;
       }
@@ -314,8 +315,8 @@ void Platform::devices_task(double dt_s) noexcept {
 void Platform::telemetry_task(double t_s) noexcept {
   TelemetrySample s{};
   const auto& o = teleop_->output();
-  const Vec2 handle = devices_.haptic->handle_position_m();
-  const Vec3 contact = devices_.gripper->contact_force_N();
+  const devices::Vec2 handle = devices_.haptic->handle_position_m();
+  const devices::Vec3 contact = devices_.gripper->contact_force_N();
   std::size_t k = 0;
   auto put = [&](double v) { s[k++] = v; };
   // Loop channels (kTelemetryChannels' order).
@@ -343,7 +344,7 @@ void Platform::telemetry_task(double t_s) noexcept {
   put(1e6 * loop_.sampled_tick_cpu_s());
   // Simulation channels: the ground truth (on a driver's stage, the tips are where its sensors say).
   if (records_simulation()) {
-    const OperatorHand& hand = sim_.haptic->operator_hand();
+    const devices::OperatorHand& hand = sim_.haptic->operator_hand();
     put(hand.hand_m.x), put(hand.hand_m.y);
     for (std::size_t i = 0; i < 3; ++i)
       put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->carried_position_m());
@@ -362,7 +363,7 @@ void Platform::telemetry_task(double t_s) noexcept {
   ring_.push(s);
 }
 
-void Platform::camera_task(const TickInfo& t) noexcept {
+void Platform::camera_task(const runtime::TickInfo& t) noexcept {
   // The tool's and the part's positions over the last ticks give their mean velocities (the
   // motion blur of the exposure); the camera sees the true scene, not the sensors' readings.
   Eigen::Vector3d tool, part = Eigen::Vector3d::Zero();
@@ -379,7 +380,7 @@ void Platform::camera_task(const TickInfo& t) noexcept {
   history_index_ = (history_index_ + 1) % kVelocityTicks;
   if (!devices_.camera->frame_due(t.t_s) || !devices_.camera->wanted()) return;
 
-  SceneSnapshot s;
+  devices::SceneSnapshot s;
   s.t_s = t.t_s;
   s.steady_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                     std::chrono::steady_clock::now().time_since_epoch())
@@ -422,14 +423,14 @@ void Platform::drain() noexcept {
   while (ring_.pop(s)) recorder_->sample(std::span<const double>(s.data(), telemetry_channel_count()));
 }
 
-void Platform::set_console_input(const control::ConsoleInput& in) noexcept {
+void Platform::set_console_input(const teleop::ConsoleInput& in) noexcept {
   console_ = in;
   // World coordinates (the telemetry's) to the coupling's, which are relative to home.
   console_.goal_m = in.goal_m - home_m_;
 }
 
-void Platform::set_fixtures(const control::FixtureSet& set) noexcept {
-  control::FixtureSet stage = set;
+void Platform::set_fixtures(const teleop::FixtureSet& set) noexcept {
+  teleop::FixtureSet stage = set;
   stage.guide_xy_m = set.guide_xy_m - home_m_.head<2>();
   stage.path_from_xy_m = set.path_from_xy_m - home_m_.head<2>();
   stage.rim_z_m = set.rim_z_m - home_m_.z();
@@ -454,12 +455,12 @@ void Platform::hold() noexcept {
 void Platform::arm_devices(bool fault_on_failure) {
   // Configure, then activate; a device that throws leaves none of them armed.
   try {
-    for (Device* d : devices())
+    for (devices::Device* d : devices())
       if (d != nullptr) d->configure();
-    for (Device* d : devices())
+    for (devices::Device* d : devices())
       if (d != nullptr) d->activate();
   } catch (...) {
-    for (Device* d : devices())
+    for (devices::Device* d : devices())
       if (d != nullptr) fault_on_failure ? d->fault() : d->deactivate();
     throw;
   }

@@ -26,25 +26,27 @@
 #include <memory>
 #include <thread>
 
-#include "microcobot/control/rotary_axis.h"
-#include "microcobot/control/step_map.h"
-#include "microcobot/control/teleoperation.h"
 #include "microcobot/core/recorder.h"
+#include "microcobot/devices/camera_device.h"
+#include "microcobot/devices/device_set.h"
+#include "microcobot/devices/encoderless_stage.h"
+#include "microcobot/devices/open_loop_stepper.h"
+#include "microcobot/devices/simulated_gripper.h"
+#include "microcobot/devices/simulated_haptic_master.h"
+#include "microcobot/devices/simulated_optical_tweezers.h"
+#include "microcobot/devices/simulated_slave_axis.h"
+#include "microcobot/devices/simulated_tweezers_master.h"
 #include "microcobot/microworld/pick_place_world.h"
-#include "microcobot/platform/camera_device.h"
-#include "microcobot/platform/encoderless_stage.h"
-#include "microcobot/platform/fixed_rate_loop.h"
-#include "microcobot/platform/open_loop_stepper.h"
+#include "microcobot/motion/rotary_axis.h"
+#include "microcobot/motion/step_map.h"
 #include "microcobot/platform/platform_config.h"
-#include "microcobot/platform/simulated_gripper.h"
-#include "microcobot/platform/simulated_haptic_master.h"
-#include "microcobot/platform/simulated_optical_tweezers.h"
-#include "microcobot/platform/simulated_slave_axis.h"
-#include "microcobot/platform/simulated_tweezers_master.h"
-#include "microcobot/platform/spsc_ring.h"
 #include "microcobot/platform/stage_controller.h"
-#include "microcobot/platform/watchdog.h"
+#include "microcobot/runtime/fixed_rate_loop.h"
+#include "microcobot/runtime/spsc_ring.h"
+#include "microcobot/runtime/watchdog.h"
 #include "microcobot/stickslip/actuator.h"
+#include "microcobot/teleop/rotary_target.h"
+#include "microcobot/teleop/teleoperation.h"
 
 namespace mc::platform {
 
@@ -104,33 +106,6 @@ inline constexpr std::array<const char*, 45> kTelemetryChannels = {"t_s",  // lo
 inline constexpr std::size_t kLoopChannelCount = 31;
 using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
-/// The devices the loop drives, by their interfaces (device.h). A hardware set-up fills it
-/// with its drivers (docs/hardware.md); the default platform builds the simulated ones.
-struct PlatformDevices {
-  std::array<std::unique_ptr<SlaveAxis>, 3> axes;  ///< X, Y, Z of the slave stage
-  /// The rotary axis under the gripper (optional; control/rotary_axis.h): a stick-slip axis whose
-  /// position is the rotor's arc at stage.rotary.radius_m, driven like the others.
-  std::unique_ptr<SlaveAxis> rotary;
-  std::unique_ptr<Gripper> gripper;
-  std::unique_ptr<HapticMaster> haptic;
-  std::unique_ptr<TweezersMaster> tweezers;
-  /// The microscope camera and its focus drive (optional: absent, the platform builds the ones
-  /// `camera` and `devices.camera` ask for; none when devices.camera.driver is "none").
-  std::unique_ptr<Camera> camera;
-  std::unique_ptr<FocusDrive> focus;
-};
-
-/// The simulated devices of a platform, by their concrete types (non-owning; null for a driver's
-/// device): the scripted operator moves their hands, the session report reads their ground truth.
-struct SimulatedDevices {
-  std::array<SimulatedSlaveAxis*, 3> axes{};
-  SimulatedSlaveAxis* rotary = nullptr;
-  SimulatedGripper* gripper = nullptr;  ///< the pick-and-place's (null in the optical-trap scene)
-  SimulatedOpticalTweezers* optical_tweezers = nullptr;  ///< the optical-trap scene's (else null)
-  SimulatedHapticMaster* haptic = nullptr;
-  SimulatedTweezersMaster* tweezers = nullptr;
-};
-
 class Platform {
  public:
   /// The simulated platform: builds the models (the stick-slip step map is computed here: about
@@ -141,14 +116,14 @@ class Platform {
   /// stick-slip model of `config` (identified for these axes: stickslip_params_file). Every
   /// device must be present and unconfigured; they are configured and activated here (a driver
   /// that throws leaves the platform unbuilt, every device deactivated). Throws mc::Error.
-  Platform(const PlatformConfig& config, PlatformDevices drivers);
+  Platform(const PlatformConfig& config, devices::DeviceSet drivers);
   ~Platform();
   Platform(const Platform&) = delete;
   Platform& operator=(const Platform&) = delete;
 
   /// The operator's action, called at the operator rate at the start of a tick (the
   /// scripted operator of a scenario). Set before running; must be real-time safe.
-  void set_operator(std::function<void(const TickInfo&)> op) { operator_ = std::move(op); }
+  void set_operator(std::function<void(const runtime::TickInfo&)> op) { operator_ = std::move(op); }
 
   /// Runs for `duration_s` (as fast as possible, or paced when loop.realtime), recording the
   /// telemetry. May be called again to continue. Stops early when stop() is called.
@@ -161,17 +136,17 @@ class Platform {
 
   /// The operator console's command for the next ticks (issue #14), in world coordinates (the
   /// telemetry's): set from the operator task, on the loop. Real-time safe.
-  void set_console_input(const control::ConsoleInput& in) noexcept;
+  void set_console_input(const teleop::ConsoleInput& in) noexcept;
   /// The console input in force (the last set_console_input()'s; its goal relative to the stage's
   /// home, as the coupling takes it).
-  const control::ConsoleInput& console_input() const noexcept { return console_; }
+  const teleop::ConsoleInput& console_input() const noexcept { return console_; }
   /// Shared control (issue #29): the virtual fixtures on the coupling for the next ticks, in world
-  /// coordinates (control/virtual_fixtures.h). On the loop (the operator task); real-time safe.
-  void set_fixtures(const control::FixtureSet& set) noexcept;
+  /// coordinates (teleop/virtual_fixtures.h). On the loop (the operator task); real-time safe.
+  void set_fixtures(const teleop::FixtureSet& set) noexcept;
   /// The haptic master's motion scale in force (the configured one times the fixtures' gain).
   double motion_scale() const noexcept { return teleop_->motion_scale(); }
   /// The fixtures in force (stage coordinates: world minus the stage's home).
-  const control::VirtualFixtures& fixtures() const noexcept { return teleop_->fixtures(); }
+  const teleop::VirtualFixtures& fixtures() const noexcept { return teleop_->fixtures(); }
   /// The motion scale the fixtures would give with the tool at `world_xy`.
   double motion_scale_at(const Eigen::Vector2d& world_xy) const noexcept {
     return teleop_->motion_scale_at(world_xy - home_m_.head<2>());
@@ -224,33 +199,33 @@ class Platform {
   /// The target's travel (the axis' end stops less a margin) [rad]; 0, 0 without the axis.
   double yaw_min_rad() const noexcept { return rotary_target_ ? rotary_target_->min_rad() : 0.0; }
   double yaw_max_rad() const noexcept { return rotary_target_ ? rotary_target_->max_rad() : 0.0; }
-  const SlaveAxis* rotary_axis() const noexcept { return devices_.rotary.get(); }
-  /// The force and floor limits the coupling enforces (control/safety_limits.h).
-  const control::SafetyLimits& safety_limits() const { return teleop_->limits(); }
+  const devices::SlaveAxis* rotary_axis() const noexcept { return devices_.rotary.get(); }
+  /// The force and floor limits the coupling enforces (teleop/safety_limits.h).
+  const teleop::SafetyLimits& safety_limits() const { return teleop_->limits(); }
 
   /// Every device to its safe state and Fault (a fault injection or an operator's e-stop).
   void fault_all() noexcept;
   bool faulted() const noexcept { return faulted_; }
 
   const PlatformConfig& config() const { return config_; }
-  FixedRateLoop& loop() { return loop_; }
-  const FixedRateLoop& loop() const { return loop_; }
-  HapticMaster& haptic() { return *devices_.haptic; }
-  TweezersMaster& tweezers() { return *devices_.tweezers; }
-  const SlaveAxis& axis(int i) const { return *devices_.axes[static_cast<std::size_t>(i)]; }
-  const Gripper& gripper() const { return *devices_.gripper; }
+  runtime::FixedRateLoop& loop() { return loop_; }
+  const runtime::FixedRateLoop& loop() const { return loop_; }
+  devices::HapticMaster& haptic() { return *devices_.haptic; }
+  devices::TweezersMaster& tweezers() { return *devices_.tweezers; }
+  const devices::SlaveAxis& axis(int i) const { return *devices_.axes[static_cast<std::size_t>(i)]; }
+  const devices::Gripper& gripper() const { return *devices_.gripper; }
   /// The camera and its focus drive; null when the platform has none.
-  Camera* camera() { return devices_.camera.get(); }
-  FocusDrive* focus() { return devices_.focus.get(); }
-  const FocusDrive* focus() const { return devices_.focus.get(); }
+  devices::Camera* camera() { return devices_.camera.get(); }
+  devices::FocusDrive* focus() { return devices_.focus.get(); }
+  const devices::FocusDrive* focus() const { return devices_.focus.get(); }
   /// True when the platform runs its simulated devices (the whole digital twin).
   bool simulated() const { return sim_.axes[0] != nullptr; }
   /// The simulated devices, null where the platform runs a driver's (on a driver set: the
-  /// simulated masters of vendor/sim_companions.h, the gripper of `devices.gripper: simulated`).
+  /// simulated masters of drivers/sim_companions.h, the gripper of `devices.gripper: simulated`).
   /// Throws mc::InvalidParams when none is simulated.
-  const SimulatedDevices& simulation() const;
+  const devices::SimulatedDevices& simulation() const;
   /// The simulated gripper in its microworld, or null (a driver's gripper, the optical trap).
-  const SimulatedGripper* simulated_gripper() const { return sim_.gripper; }
+  const devices::SimulatedGripper* simulated_gripper() const { return sim_.gripper; }
   const StageController& stage_controller() const { return *stage_; }
   /// Operator-to-slave tracking error: |slave target - measured slave position| (3-D) at every
   /// slave tick while the teleoperation coupling is engaged (issue #15).
@@ -260,7 +235,7 @@ class Platform {
     double rms_m() const { return samples > 0 ? std::sqrt(sum_sq_m2 / static_cast<double>(samples)) : 0.0; }
   };
   const TrackingErrorStats& tracking_error() const { return tracking_; }
-  const control::TeleoperationOutput& teleop() const { return teleop_->output(); }
+  const teleop::TeleoperationOutput& teleop() const { return teleop_->output(); }
   const Recorder& recording() const { return *recorder_; }
   /// True when the telemetry carries the simulation's channels (the operator's hand, the finger
   /// tips, the part): a simulated haptic master and a simulated microworld (the whole twin, or a
@@ -285,13 +260,13 @@ class Platform {
   /// Whether axis i's open-loop run must stop now (the safety rules of start_open_loop_steps).
   bool open_loop_must_stop(std::size_t i) const noexcept;
   void telemetry_task(double t_s) noexcept;
-  void camera_task(const TickInfo& t) noexcept;
+  void camera_task(const runtime::TickInfo& t) noexcept;
   void drain() noexcept;
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
   void arm_devices(bool fault_on_failure);
   /// Every device; the camera, focus drive and rotary axis last, null when absent.
-  std::array<Device*, 9> devices();
+  std::array<devices::Device*, 9> devices();
   /// The rotary axis' part of each task (platform_rotary.cc).
   void build_rotary();
   void rotary_command() noexcept;
@@ -306,28 +281,28 @@ class Platform {
 
   PlatformConfig config_;
   std::unique_ptr<stickslip::ActuatorModel> model_;
-  std::unique_ptr<control::StepMap> map_;
+  std::unique_ptr<motion::StepMap> map_;
   microworld::PickPlaceWorld world_;
-  PlatformDevices devices_;
-  SimulatedDevices sim_;  ///< all null unless simulated
+  devices::DeviceSet devices_;
+  devices::SimulatedDevices sim_;  ///< all null unless simulated
   std::unique_ptr<StageController> stage_;
-  std::array<std::unique_ptr<OpenLoopStepper>, 4> steppers_;  ///< X, Y, Z, the rotary axis
+  std::array<std::unique_ptr<devices::OpenLoopStepper>, 4> steppers_;  ///< X, Y, Z, the rotary axis
   TrackingErrorStats tracking_;
-  std::unique_ptr<control::Teleoperation> teleop_;
-  std::unique_ptr<control::RotaryTarget> rotary_target_;  ///< null without the rotary axis
+  std::unique_ptr<teleop::Teleoperation> teleop_;
+  std::unique_ptr<teleop::RotaryTarget> rotary_target_;  ///< null without the rotary axis
   /// Parking (stage.park_after_s): slave ticks each axis has stood on its still target, and the
   /// targets of the last slave tick (the rotary axis' as its arc).
   std::array<int, StageController::kMaxAxes> still_ticks_{};
   std::array<double, StageController::kMaxAxes> last_target_m_{};
-  Watchdog haptic_watchdog_;
-  Watchdog tweezers_watchdog_;
+  runtime::Watchdog haptic_watchdog_;
+  runtime::Watchdog tweezers_watchdog_;
   std::uint64_t haptic_seen_ = 0, tweezers_seen_ = 0;
   Eigen::Vector3d home_m_;
-  FixedRateLoop loop_;
-  SpscRing<TelemetrySample> ring_;
+  runtime::FixedRateLoop loop_;
+  runtime::SpscRing<TelemetrySample> ring_;
   std::unique_ptr<Recorder> recorder_;
-  std::function<void(const TickInfo&)> operator_;
-  control::ConsoleInput console_;
+  std::function<void(const runtime::TickInfo&)> operator_;
+  teleop::ConsoleInput console_;
   bool faulted_ = false;
   bool vision_xy_ = false;            ///< x and y open loop, positioned by vision (stage.xy_sensor)
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)

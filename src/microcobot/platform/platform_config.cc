@@ -8,8 +8,8 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
-#include "microcobot/platform/cpu_affinity.h"
 #include "microcobot/platform/driver_registry.h"
+#include "microcobot/runtime/cpu_affinity.h"
 
 namespace mc::platform {
 namespace {
@@ -55,8 +55,8 @@ void LoopParams::validate() const {
   require(operator_divisor >= 1, "operator_divisor", "must be >= 1", operator_divisor);
   require(telemetry_divisor >= 1, "telemetry_divisor", "must be >= 1", telemetry_divisor);
   require(watchdog_ticks >= 1, "watchdog_ticks", "must be >= 1", watchdog_ticks);
-  require(cpu == -1 || core_allowed(cpu), "cpu",
-          "must be -1 (not pinned) or a core this process may use (" + allowed_cores() + ")", cpu);
+  require(cpu == -1 || runtime::core_allowed(cpu), "cpu",
+          "must be -1 (not pinned) or a core this process may use (" + runtime::allowed_cores() + ")", cpu);
 }
 
 void PlatformConfig::validate() const {
@@ -176,6 +176,15 @@ PlatformConfig load_platform_config(const std::filesystem::path& file) {
 stickslip::StickSlipParams axis_params(const PlatformConfig& config) {
   if (config.stickslip_params_file.empty()) return stickslip::StickSlipParams{};
   return load_params<stickslip::StickSlipParams>(config.stickslip_params_file);
+}
+
+perception::CameraRig camera_rig(const PlatformConfig& config) {
+  perception::CameraRig rig;
+  rig.camera = config.camera;
+  rig.stage_home_m = {config.stage.home_x_m, config.stage.home_y_m};
+  rig.finger_width_m = config.world.gripper.finger_width_m;
+  rig.finger_stiffness_N_m = config.world.gripper.finger_stiffness_N_m;
+  return rig;
 }
 
 }  // namespace mc::platform

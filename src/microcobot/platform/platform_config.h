@@ -15,21 +15,22 @@
 #include <filesystem>
 #include <string>
 
-#include "microcobot/control/position_controller.h"
-#include "microcobot/control/position_sensor.h"
-#include "microcobot/control/rotary_axis.h"
-#include "microcobot/control/step_map.h"
-#include "microcobot/control/teleoperation.h"
-#include "microcobot/control/tracking_controller.h"
+#include "microcobot/devices/camera_device.h"
 #include "microcobot/haptics/dual_stage_plant.h"
 #include "microcobot/haptics/pantograph.h"
 #include "microcobot/haptics/render_pipeline.h"
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
-#include "microcobot/platform/camera_device.h"
-#include "microcobot/platform/vision_grip_force_params.h"
-#include "microcobot/platform/vision_positioner_params.h"
+#include "microcobot/motion/position_controller.h"
+#include "microcobot/motion/position_sensor.h"
+#include "microcobot/motion/rotary_axis.h"
+#include "microcobot/motion/step_map.h"
+#include "microcobot/motion/tracking_controller.h"
+#include "microcobot/perception/camera_map.h"
+#include "microcobot/perception/vision_grip_force_params.h"
+#include "microcobot/perception/vision_positioner_params.h"
 #include "microcobot/stickslip/stickslip_params.h"
+#include "microcobot/teleop/teleoperation.h"
 #include "microcobot/tweezers/teletweez.h"
 
 namespace mc::platform {
@@ -62,28 +63,28 @@ struct LoopParams {
 };
 
 struct StageParams {
-  control::PositionControlParams control = default_control();
+  motion::PositionControlParams control = default_control();
   /// Issue #15: the axes follow the teleoperation target with the tracking controller
   /// (reference-phased sawtooth, updated at every loop tick on the axis positions; the 1 kHz target
   /// is extrapolated with its velocity) instead of the hybrid position controller (false).
   bool tracking_enabled = true;
-  control::TrackingParams tracking = default_tracking();
-  control::PositionSensorParams sensor;
+  motion::TrackingParams tracking = default_tracking();
+  motion::PositionSensorParams sensor;
   /// What positions the stage in the plane (issue #28 point 5): "encoders", the axes' position
   /// sensors closing the stage controller's loop, or "vision", the x and y sensors unused: the
   /// axes step open loop (their drive planned from the step map) on velocity commands of the
   /// visual servo watching the camera's frames (live/vision_positioner.h); z keeps its loop.
   std::string xy_sensor = "encoders";
   /// The positioner's tracker, servo and timing with `xy_sensor: vision` (docs/parameters.md).
-  VisionPositionerParams vision;
-  control::StepMapParams step_map;
+  perception::VisionPositionerParams vision;
+  motion::StepMapParams step_map;
   /// Finger-tip position (world frame) when the three axes are at 0 (mid-stroke).
   double home_x_m = -0.2e-3;
   double home_y_m = 0.0;
   double home_z_m = 0.45e-3;
-  /// The rotary axis under the gripper (issue #29 point 2; control/rotary_axis.h): on by default
+  /// The rotary axis under the gripper (issue #29 point 2; motion/rotary_axis.h): on by default
   /// on the simulated platform; a driver set has one when its drivers bring it.
-  control::RotaryAxisParams rotary;
+  motion::RotaryAxisParams rotary;
   /// An axis whose target has stood still, and which has been within park_tolerance_m of it for
   /// park_after_s, is parked: its loop off, its drive held at the last voltage. Friction holds a
   /// stick-slip slider where it is (so a real controller ends its "hold time": SmarAct MCS2's
@@ -110,12 +111,12 @@ struct StageParams {
     v("park_after_s", park_after_s);
     v("park_tolerance_m", park_tolerance_m);
   }
-  static control::TrackingParams default_tracking() {
-    control::TrackingParams p;  // 10 kHz: updated at every loop tick (LoopParams.base_rate_Hz)
+  static motion::TrackingParams default_tracking() {
+    motion::TrackingParams p;  // 10 kHz: updated at every loop tick (LoopParams.base_rate_Hz)
     return p;
   }
-  static control::PositionControlParams default_control() {
-    control::PositionControlParams p;
+  static motion::PositionControlParams default_control() {
+    motion::PositionControlParams p;
     p.control_rate_Hz = 1000.0;  // the slave rate of LoopParams
     return p;
   }
@@ -176,7 +177,7 @@ struct DeviceSelection {
 struct PlatformConfig {
   DeviceSelection devices;
   LoopParams loop;
-  control::TeleoperationParams teleop;
+  teleop::TeleoperationParams teleop;
   StageParams stage;
   std::string stickslip_params_file;  ///< empty: the built-in SLC-1720-like axis (#4)
   HapticMasterParams haptic;
@@ -187,9 +188,9 @@ struct PlatformConfig {
   microworld::PickPlaceParams world;
   microworld::OpticalTrapSceneParams optical_trap;
   /// The microscope camera and its focus drive (issue #27); which camera: devices.camera.
-  CameraDeviceParams camera;
+  devices::CameraDeviceParams camera;
   /// The grip force measured by vision, live (issue #28 point 4, vision_grip_force.h).
-  VisionGripForceParams vision_force;
+  perception::VisionGripForceParams vision_force;
 
   template <class V>
   void visit(V& v) {
@@ -232,5 +233,9 @@ PlatformConfig load_platform_config(const std::filesystem::path& file);
 
 /// The stick-slip parameters the configuration names (the built-in default when none).
 stickslip::StickSlipParams axis_params(const PlatformConfig& config);
+
+/// What the perception components need of the configuration: the camera, the stage's home and
+/// the gripper's fingers (world.gripper).
+perception::CameraRig camera_rig(const PlatformConfig& config);
 
 }  // namespace mc::platform

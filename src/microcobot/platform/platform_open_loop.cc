@@ -21,8 +21,8 @@ bool Platform::start_open_loop_steps(int axis, double amplitude_V, double freque
 
 bool Platform::command_open_loop_velocity(int axis, double velocity_m_s, double interval_s) noexcept {
   if (axis < 0 || axis > 2) return false;
-  const OpenLoopRun run =
-      plan_open_loop_run(*map_, EncoderlessDriveParams{}, velocity_m_s * interval_s, interval_s);
+  const devices::OpenLoopRun run = devices::plan_open_loop_run(*map_, devices::EncoderlessDriveParams{},
+                                                               velocity_m_s * interval_s, interval_s);
   if (run.periods == 0) {
     steppers_[static_cast<std::size_t>(axis)]->halt();
     return !faulted_;
@@ -41,7 +41,7 @@ void Platform::stop_open_loop() noexcept {
 
 bool Platform::open_loop_must_stop(std::size_t i) const noexcept {
   if (faulted_ || !(console_.active && console_.fresh && console_.deadman)) return true;
-  const Vec3 f = devices_.gripper->contact_force_N();
+  const devices::Vec3 f = devices_.gripper->contact_force_N();
   if (std::hypot(f.x, f.y, f.z) > world_.params().contact_force_limit_N) return true;
   if (i == 3) {
     // The rotary axis: leaving its target's travel (the end stops less a margin) as it turns.

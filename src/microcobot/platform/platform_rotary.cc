@@ -1,4 +1,4 @@
-// The platform's rotary axis (issue #29 point 2; control/rotary_axis.h): its target from the
+// The platform's rotary axis (issue #29 point 2; motion/rotary_axis.h): its target from the
 // console's theta commands under the console's deadman, its controller on the stage controller's
 // fourth channel (the arc at the contact radius), its drive (or an open-loop run's), its hold.
 #include <algorithm>
@@ -14,8 +14,8 @@ void Platform::build_rotary() {
   // The actuator's end stops lie half a stroke either side of its middle (the axis' 0); the
   // target keeps 5 % of that away from them.
   const double reach_m = 0.45 * model_->params().slider.stroke_m;
-  rotary_target_ = std::make_unique<control::RotaryTarget>(r, config_.loop.period_s(), r.home_rad,
-                                                           r.angle_rad(-reach_m), r.angle_rad(reach_m));
+  rotary_target_ = std::make_unique<teleop::RotaryTarget>(r, config_.loop.period_s(), r.home_rad,
+                                                          r.angle_rad(-reach_m), r.angle_rad(reach_m));
 }
 
 double Platform::yaw_rad() const noexcept {
@@ -28,7 +28,7 @@ double Platform::yaw_target_rad() const noexcept {
 
 void Platform::rotary_command() noexcept {
   if (!rotary_target_) return;
-  control::ConsoleInput c = console_;
+  teleop::ConsoleInput c = console_;
   c.deadman = console_.deadman && !faulted_;
   rotary_target_->tick(c);
 }
@@ -68,12 +68,12 @@ bool Platform::rotary_drive(double dt_s) noexcept {
   if (!devices_.rotary) return false;
   // An open-loop run (the ANC300's stepu/stepd on the rotary axis) plays straight to it, as on
   // the linear axes (devices_task()).
-  OpenLoopStepper& st = *steppers_[3];
+  devices::OpenLoopStepper& st = *steppers_[3];
   const bool was_running = st.running();
   if (was_running && open_loop_must_stop(3)) st.halt();
   if (!faulted_ && !position_controlled_) {
     if (st.running()) {
-      const DriveBlock open_loop = st.drive();
+      const devices::DriveBlock open_loop = st.drive();
       stage_->drive(3, devices_.rotary->position_m());  // keeps the controller's clock
       devices_.rotary->command_drive(open_loop);
     } else {

@@ -5,17 +5,17 @@
 #include <bit>
 #include <cstring>
 
+#include "microcobot/imaging/renderer.h"
 #include "microcobot/platform/camera_scene.h"
-#include "microcobot/vision/renderer.h"
 
 namespace mc::platform {
 namespace {
 
-class SimulatedCamera final : public FrameSource {
+class SimulatedCamera final : public devices::FrameSource {
  public:
   explicit SimulatedCamera(PlatformConfig config) : config_(std::move(config)) {}
 
-  void open(const CameraDeviceParams& params) override {
+  void open(const devices::CameraDeviceParams& params) override {
     params_ = params;
     // One renderer per objective, made when first turned in (each caches its blurred substrate).
     renderers_.clear();
@@ -24,7 +24,7 @@ class SimulatedCamera final : public FrameSource {
 
   bool renders_scene() const override { return true; }
 
-  bool capture(const SceneSnapshot& scene, Image& out) override {
+  bool capture(const devices::SceneSnapshot& scene, devices::Image& out) override {
     CameraScenePose pose;
     pose.tool_x_m = scene.tool_m[0];
     pose.tool_y_m = scene.tool_m[1];
@@ -47,8 +47,8 @@ class SimulatedCamera final : public FrameSource {
     fill_camera_scene(config_, pose, snapshot_);
     snapshot_.t_s = scene.t_s;
 
-    vision::Renderer& r = renderer(scene.objective);
-    vision::CameraControls controls;
+    imaging::Renderer& r = renderer(scene.objective);
+    imaging::CameraControls controls;
     controls.focus_z_m = scene.focus_z_m;
     controls.exposure_s = scene.exposure_s;
     controls.gain = scene.gain;
@@ -67,26 +67,26 @@ class SimulatedCamera final : public FrameSource {
   }
 
  private:
-  vision::Renderer& renderer(int objective) {
+  imaging::Renderer& renderer(int objective) {
     const auto i =
         static_cast<std::size_t>(std::clamp(objective, 0, static_cast<int>(renderers_.size()) - 1));
     if (!renderers_[i]) {
-      renderers_[i] = std::make_unique<vision::Renderer>(renderer_params(params_, static_cast<int>(i)));
+      renderers_[i] = std::make_unique<imaging::Renderer>(renderer_params(params_, static_cast<int>(i)));
     }
     return *renderers_[i];
   }
 
   PlatformConfig config_;
-  CameraDeviceParams params_;
-  std::vector<std::unique_ptr<vision::Renderer>> renderers_;
-  vision::SceneSnapshot snapshot_;
-  vision::Frame frame_;
+  devices::CameraDeviceParams params_;
+  std::vector<std::unique_ptr<imaging::Renderer>> renderers_;
+  imaging::SceneSnapshot snapshot_;
+  imaging::Frame frame_;
   std::uint64_t frame_index_ = 0;
 };
 
 }  // namespace
 
-std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config) {
+std::unique_ptr<devices::FrameSource> make_simulated_camera(const PlatformConfig& config) {
   return std::make_unique<SimulatedCamera>(config);
 }
 

@@ -7,13 +7,13 @@
 
 #include <memory>
 
-#include "microcobot/platform/camera_device.h"
+#include "microcobot/devices/camera_device.h"
 #include "microcobot/platform/platform_config.h"
 
 namespace mc::platform {
 
 /// The frame source that renders `config`'s microworld (its scene geometry; the moving parts come
 /// with each snapshot).
-std::unique_ptr<FrameSource> make_simulated_camera(const PlatformConfig& config);
+std::unique_ptr<devices::FrameSource> make_simulated_camera(const PlatformConfig& config);
 
 }  // namespace mc::platform

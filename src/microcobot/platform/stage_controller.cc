@@ -6,10 +6,10 @@
 
 namespace mc::platform {
 
-StageController::StageController(const control::PositionControlParams& params,
-                                 const stickslip::StickSlipParams& model, const control::StepMap& map,
+StageController::StageController(const motion::PositionControlParams& params,
+                                 const stickslip::StickSlipParams& model, const motion::StepMap& map,
                                  int samples_per_tick, double sample_period_s,
-                                 const control::TrackingParams* tracking, int axes)
+                                 const motion::TrackingParams* tracking, int axes)
     : axes_(axes), sample_period_s_(sample_period_s) {
   require(axes == 3 || axes == kMaxAxes, "axes", "must be 3 (XYZ) or 4 (XYZ and the rotary axis)", axes);
   require(samples_per_tick >= 1, "samples_per_tick", "must be at least 1", samples_per_tick);
@@ -18,9 +18,9 @@ StageController::StageController(const control::PositionControlParams& params,
   fast_ = tracking != nullptr && std::abs(tracking->control_rate_Hz * tick_s_ - 1.0) < 1e-9;
   for (std::size_t i = 0; i < static_cast<std::size_t>(axes_); ++i) {
     if (tracking) {
-      track_[i] = std::make_unique<control::TrackingController>(*tracking, model, map);
+      track_[i] = std::make_unique<motion::TrackingController>(*tracking, model, map);
     } else {
-      ctrl_[i] = std::make_unique<control::PositionController>(params, model, map);
+      ctrl_[i] = std::make_unique<motion::PositionController>(params, model, map);
     }
     samples_[i].assign(static_cast<std::size_t>(samples_per_tick), stickslip::DriveSegment{});
   }
@@ -52,7 +52,7 @@ void StageController::update_axes(const std::array<double, kMaxAxes>& target_m,
       auto& t = *track_[i];
       // The first tick (and the first after an emergency stop) starts from where the axis is.
       if (!started_ || stopped_) t.reset(measured_m[i], stopped_ ? 0.0 : t.voltage_V());
-      ref_[i] = control::ReferenceSample{target_m[k], velocity_m_s[k], 0.0};
+      ref_[i] = motion::ReferenceSample{target_m[k], velocity_m_s[k], 0.0};
       since_update_s_[i] = 0.0;
       if (fast_) continue;  // updated at every loop tick by drive(i, measured)
       t.set_reference(ref_[i]);
@@ -70,22 +70,22 @@ void StageController::update_axes(const std::array<double, kMaxAxes>& target_m,
   started_ = true;
 }
 
-DriveBlock StageController::drive(int i, double measured_m) noexcept {
+devices::DriveBlock StageController::drive(int i, double measured_m) noexcept {
   const auto iu = static_cast<std::size_t>(i);
   if (fast_ && started_ && !stopped_ && track_[iu] && !parked_[iu]) {
     const auto& r = ref_[iu];
-    track_[iu]->set_reference(control::ReferenceSample{r.x_m + r.v_m_s * since_update_s_[iu], r.v_m_s, 0.0});
+    track_[iu]->set_reference(motion::ReferenceSample{r.x_m + r.v_m_s * since_update_s_[iu], r.v_m_s, 0.0});
     track_[iu]->update(measured_m);
     since_update_s_[iu] += tick_s_;
   }
   return drive(i);
 }
 
-DriveBlock StageController::drive(int i) noexcept {
+devices::DriveBlock StageController::drive(int i) noexcept {
   auto& buf = samples_[static_cast<std::size_t>(i)];
   if (parked_[static_cast<std::size_t>(i)]) {
     for (auto& d : buf) d = stickslip::DriveSegment::to(parked_V_[static_cast<std::size_t>(i)]);
-    DriveBlock b;
+    devices::DriveBlock b;
     b.segments = buf.data();
     b.count = static_cast<int>(buf.size());
     return b;
@@ -93,7 +93,7 @@ DriveBlock StageController::drive(int i) noexcept {
   if (auto* t = track_[static_cast<std::size_t>(i)].get()) {
     for (auto& d : buf) d = t->next_drive(sample_period_s_);
     const auto& op = t->operating_point();
-    DriveBlock b;
+    devices::DriveBlock b;
     b.segments = buf.data();
     b.count = static_cast<int>(buf.size());
     b.amplitude_V = op.amplitude_V;
@@ -104,7 +104,7 @@ DriveBlock StageController::drive(int i) noexcept {
   auto& c = *ctrl_[static_cast<std::size_t>(i)];
   for (auto& d : buf) d = c.next_drive(sample_period_s_);
   const auto& g = c.generator();
-  DriveBlock b;
+  devices::DriveBlock b;
   b.segments = buf.data();
   b.count = static_cast<int>(buf.size());
   b.amplitude_V = g.amplitude_V();
@@ -132,7 +132,7 @@ void StageController::resume(int i, double measured_m, double u_V) noexcept {
   if (!track_[iu] || stopped_) return;
   parked_[iu] = false;
   track_[iu]->reset(measured_m, u_V);
-  ref_[iu] = control::ReferenceSample{measured_m, 0.0, 0.0};
+  ref_[iu] = motion::ReferenceSample{measured_m, 0.0, 0.0};
   since_update_s_[iu] = 0.0;
 }
 

@@ -43,16 +43,17 @@ void AutofocusParams::validate() const {
           "must be lorentzian or gaussian, not '" + excerpt(peak_model) + "'");
 }
 
-FocusMetric default_fine_metric(const OpticsFigures& figures) {
+FocusMetric default_fine_metric(const imaging::OpticsFigures& figures) {
   const double sigma_px = figures.psf_sigma_m / (figures.um_per_px * 1e-6);
   return sigma_px <= kGradientMaxPsfSigmaPx ? FocusMetric::kTenengrad : FocusMetric::kNormalizedVariance;
 }
 
-AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m) {
+AutofocusParams autofocus_params_for(const imaging::OpticsFigures& figures, double start_m) {
   return autofocus_params_for(figures, start_m, default_fine_metric(figures));
 }
 
-AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m, FocusMetric fine_metric) {
+AutofocusParams autofocus_params_for(const imaging::OpticsFigures& figures, double start_m,
+                                     FocusMetric fine_metric) {
   AutofocusParams p;
   p.fine_metric = focus_metric_name(fine_metric);
   p.start_m = start_m;

@@ -42,8 +42,8 @@
 #include <string>
 #include <vector>
 
+#include "microcobot/imaging/optics.h"
 #include "microcobot/vision/depth_from_focus.h"
-#include "microcobot/vision/optics.h"
 #include "microcobot/vision/sharpness.h"
 
 namespace mc::vision {
@@ -101,15 +101,16 @@ inline constexpr double kFinalStepDofGradient = 0.5;
 inline constexpr double kGradientMaxPsfSigmaPx = 1.5;
 /// The fine metric autofocus_params_for() picks: Tenengrad when the PSF's sigma is at most
 /// kGradientMaxPsfSigmaPx pixels, else the normalised variance (tuning set, docs/benchmarks.md).
-FocusMetric default_fine_metric(const OpticsFigures& figures);
+FocusMetric default_fine_metric(const imaging::OpticsFigures& figures);
 /// The defaults for an objective, starting at `start_m` (the range widened to hold it), refined
 /// with `fine_metric`: final_step_m = kFinalStepDof (normalised variance) or kFinalStepDofGradient
 /// (Tenengrad, Brenner: narrower peaks) x its depth of field. The coarse step is the same for every
 /// objective: far from focus the measure's slope comes from the texture's coarse octaves, not
 /// from the depth of field (docs/model.md, "Autofocus and depth from focus").
-AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m, FocusMetric fine_metric);
+AutofocusParams autofocus_params_for(const imaging::OpticsFigures& figures, double start_m,
+                                     FocusMetric fine_metric);
 /// The same with default_fine_metric(figures).
-AutofocusParams autofocus_params_for(const OpticsFigures& figures, double start_m);
+AutofocusParams autofocus_params_for(const imaging::OpticsFigures& figures, double start_m);
 
 class Autofocus {
  public:

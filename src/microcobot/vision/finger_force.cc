@@ -20,7 +20,8 @@ FingerForce::FingerForce(const FingerForceParams& params)
   p_.validate();
 }
 
-void FingerForce::set_templates(const Frame& frame, const PixelRoi& left, const PixelRoi& right) {
+void FingerForce::set_templates(const imaging::Frame& frame, const imaging::PixelRoi& left,
+                                const imaging::PixelRoi& right) {
   try {
     left_.set_template(frame, left);
   } catch (const InvalidInput& e) {
@@ -37,7 +38,7 @@ void FingerForce::set_templates(const Frame& frame, const PixelRoi& left, const 
   fitted_ = false;
 }
 
-void FingerForce::add_unloaded(const Frame& frame, double opening_m) {
+void FingerForce::add_unloaded(const imaging::Frame& frame, double opening_m) {
   if (!std::isfinite(opening_m))
     throw InvalidInput(fmt::format("finger force: opening {} m is not finite", opening_m));
   if (!left_.has_template() || !right_.has_template())
@@ -87,7 +88,7 @@ void FingerForce::fit_unloaded() {
   fitted_ = true;
 }
 
-FingerForceEstimate FingerForce::measure(const Frame& frame, double opening_m) {
+FingerForceEstimate FingerForce::measure(const imaging::Frame& frame, double opening_m) {
   if (!fitted_) throw InvalidInput("finger force: no unloaded pose (fit_unloaded first)");
   if (!std::isfinite(opening_m))
     throw InvalidInput(fmt::format("finger force: opening {} m is not finite", opening_m));

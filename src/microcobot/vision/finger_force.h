@@ -25,7 +25,7 @@
 
 #include <vector>
 
-#include "microcobot/vision/pixel_roi.h"
+#include "microcobot/imaging/pixel_roi.h"
 #include "microcobot/vision/template_tracker.h"
 
 namespace mc::vision {
@@ -58,10 +58,11 @@ class FingerForce {
 
   /// The tips' templates from `frame` (nothing between the fingers). Throws mc::InvalidInput
   /// naming an ROI that is empty, too small, outside the frame or without contrast.
-  void set_templates(const Frame& frame, const PixelRoi& left, const PixelRoi& right);
+  void set_templates(const imaging::Frame& frame, const imaging::PixelRoi& left,
+                     const imaging::PixelRoi& right);
   /// One unloaded observation: the tips tracked in `frame` taken at the opening command
   /// `opening_m`. Throws InvalidInput when a tip is lost or the command is not finite.
-  void add_unloaded(const Frame& frame, double opening_m);
+  void add_unloaded(const imaging::Frame& frame, double opening_m);
   /// Fits the unloaded lines. Throws InvalidInput with fewer than two distinct openings, or when a
   /// tip did not move with the opening.
   void fit_unloaded();
@@ -74,7 +75,7 @@ class FingerForce {
 
   /// The grip force in `frame` taken at the opening command `opening_m`. Throws InvalidInput
   /// before fit_unloaded() or for a non-finite command.
-  FingerForceEstimate measure(const Frame& frame, double opening_m);
+  FingerForceEstimate measure(const imaging::Frame& frame, double opening_m);
 
  private:
   FingerForceParams p_;

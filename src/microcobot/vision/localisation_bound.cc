@@ -8,8 +8,8 @@
 namespace mc::vision {
 
 LocalisationBound translation_bound(const std::function<std::vector<float>(double, double)>& expected_e,
-                                    const SensorParams& sensor, double exposure_s, double gain,
-                                    const PixelRoi& roi, double step_px) {
+                                    const imaging::SensorParams& sensor, double exposure_s, double gain,
+                                    const imaging::PixelRoi& roi, double step_px) {
   if (roi.width < 1 || roi.height < 1 || roi.x < 0 || roi.y < 0 || roi.x + roi.width > sensor.width_px ||
       roi.y + roi.height > sensor.height_px)
     throw InvalidInput("localisation bound: ROI x " + std::to_string(roi.x) + ", y " + std::to_string(roi.y) +

@@ -15,7 +15,7 @@
 #include <functional>
 #include <vector>
 
-#include "microcobot/vision/camera_params.h"
+#include "microcobot/imaging/camera_params.h"
 #include "microcobot/vision/template_tracker.h"
 
 namespace mc::vision {
@@ -31,6 +31,7 @@ struct LocalisationBound {
 /// target gives no information (the Fisher matrix is singular).
 LocalisationBound translation_bound(
     const std::function<std::vector<float>(double du_px, double dv_px)>& expected_e,
-    const SensorParams& sensor, double exposure_s, double gain, const PixelRoi& roi, double step_px = 0.05);
+    const imaging::SensorParams& sensor, double exposure_s, double gain, const imaging::PixelRoi& roi,
+    double step_px = 0.05);
 
 }  // namespace mc::vision

@@ -18,7 +18,7 @@ const struct {
               {FocusMetric::kTenengrad, "tenengrad"},
               {FocusMetric::kBrenner, "brenner"}};
 
-std::string roi_text(const PixelRoi& r) {
+std::string roi_text(const imaging::PixelRoi& r) {
   return "ROI x=" + std::to_string(r.x) + " y=" + std::to_string(r.y) + " width=" + std::to_string(r.width) +
          " height=" + std::to_string(r.height);
 }
@@ -40,7 +40,7 @@ FocusMetric parse_focus_metric(const std::string& name) {
   throw InvalidInput("focus metric '" + excerpt(name) + "' is not one of " + known);
 }
 
-void validate_roi(const PixelRoi& roi, int width, int height, int min_side) {
+void validate_roi(const imaging::PixelRoi& roi, int width, int height, int min_side) {
   const std::string image = " of the " + std::to_string(width) + " x " + std::to_string(height) + " image";
   if (roi.width <= 0 || roi.height <= 0)
     throw InvalidInput(roi_text(roi) + " is empty (width and height must be > 0)");
@@ -53,20 +53,20 @@ void validate_roi(const PixelRoi& roi, int width, int height, int min_side) {
 
 namespace {
 
-void validate_frame(const Frame& frame) {
+void validate_frame(const imaging::Frame& frame) {
   if (frame.width <= 0 || frame.height <= 0 ||
       frame.pixels.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height))
     throw InvalidInput("frame of " + std::to_string(frame.width) + " x " + std::to_string(frame.height) +
                        " pixels holds " + std::to_string(frame.pixels.size()) + " values");
 }
 
-const std::uint16_t* row(const Frame& f, int i) {
+const std::uint16_t* row(const imaging::Frame& f, int i) {
   return f.pixels.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(f.width);
 }
 
 }  // namespace
 
-double normalized_variance(const Frame& frame, const PixelRoi& roi) {
+double normalized_variance(const imaging::Frame& frame, const imaging::PixelRoi& roi) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height);
   // Integer sums are exact (16-bit values, < 2^32 pixels); the variance from the two-pass form.
@@ -93,7 +93,7 @@ double normalized_variance(const Frame& frame, const PixelRoi& roi) {
   return ss / (n * mean);
 }
 
-double tenengrad(const Frame& frame, const PixelRoi& roi, double threshold) {
+double tenengrad(const imaging::Frame& frame, const imaging::PixelRoi& roi, double threshold) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height, 3);
   double sum = 0.0;
@@ -112,7 +112,7 @@ double tenengrad(const Frame& frame, const PixelRoi& roi, double threshold) {
   return sum / (static_cast<double>(roi.width - 2) * (roi.height - 2));
 }
 
-double brenner(const Frame& frame, const PixelRoi& roi) {
+double brenner(const imaging::Frame& frame, const imaging::PixelRoi& roi) {
   validate_frame(frame);
   validate_roi(roi, frame.width, frame.height, 3);
   double sum = 0.0;
@@ -137,7 +137,8 @@ void SharpnessParams::validate() const {
           "must be finite and >= 0", tenengrad_threshold);
 }
 
-double sharpness(const Frame& frame, const PixelRoi& roi, FocusMetric metric, double tenengrad_threshold) {
+double sharpness(const imaging::Frame& frame, const imaging::PixelRoi& roi, FocusMetric metric,
+                 double tenengrad_threshold) {
   switch (metric) {
     case FocusMetric::kTenengrad:
       return tenengrad(frame, roi, tenengrad_threshold);

@@ -22,8 +22,8 @@
 
 #include <string>
 
-#include "microcobot/vision/pixel_roi.h"
-#include "microcobot/vision/sensor_model.h"
+#include "microcobot/imaging/pixel_roi.h"
+#include "microcobot/imaging/sensor_model.h"
 
 namespace mc::vision {
 
@@ -36,15 +36,15 @@ FocusMetric parse_focus_metric(const std::string& name);
 
 /// Throws InvalidInput (one line naming the ROI and the image's size) unless `roi` is non-empty,
 /// at least `min_side` pixels on each side and lies inside a `width` x `height` image.
-void validate_roi(const PixelRoi& roi, int width, int height, int min_side = 1);
+void validate_roi(const imaging::PixelRoi& roi, int width, int height, int min_side = 1);
 
 /// Normalised variance of the region (see above); 0 for a black region.
-double normalized_variance(const Frame& frame, const PixelRoi& roi);
+double normalized_variance(const imaging::Frame& frame, const imaging::PixelRoi& roi);
 /// Tenengrad with the threshold `threshold` on the squared Sobel magnitude [DN^2]; needs a region
 /// of at least 3 x 3 pixels.
-double tenengrad(const Frame& frame, const PixelRoi& roi, double threshold = 0.0);
+double tenengrad(const imaging::Frame& frame, const imaging::PixelRoi& roi, double threshold = 0.0);
 /// Brenner gradient; needs a region at least 3 pixels wide.
-double brenner(const Frame& frame, const PixelRoi& roi);
+double brenner(const imaging::Frame& frame, const imaging::PixelRoi& roi);
 
 /// The options of a focus measure evaluated by name.
 struct SharpnessParams {
@@ -60,7 +60,7 @@ struct SharpnessParams {
 };
 
 /// The measure `metric` of `roi` in `frame` (validates the region).
-double sharpness(const Frame& frame, const PixelRoi& roi, FocusMetric metric,
+double sharpness(const imaging::Frame& frame, const imaging::PixelRoi& roi, FocusMetric metric,
                  double tenengrad_threshold = 0.0);
 
 }  // namespace mc::vision

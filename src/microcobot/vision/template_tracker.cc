@@ -18,7 +18,7 @@ constexpr int kFineMargin = 4;
 // A refinement further than this from the coarse match is a divergence, not a correction [px].
 constexpr double kMaxRefinement = 2.0;
 
-cv::Mat view16(const Frame& f) {
+cv::Mat view16(const imaging::Frame& f) {
   // matchTemplate/ECC read; the frame's buffer is not written.
   return cv::Mat(f.height, f.width, CV_16U, const_cast<std::uint16_t*>(f.pixels.data()));
 }
@@ -42,7 +42,7 @@ void blurred(const cv::Mat& full, const cv::Rect& area, int ksize, double highpa
   scratch(cv::Rect(area.tl() - grown.tl(), area.size())).copyTo(out);
 }
 
-std::string roi_text(const PixelRoi& r) {
+std::string roi_text(const imaging::PixelRoi& r) {
   return "ROI x " + std::to_string(r.x) + ", y " + std::to_string(r.y) + ", " + std::to_string(r.width) +
          "x" + std::to_string(r.height);
 }
@@ -81,7 +81,7 @@ TemplateTracker& TemplateTracker::operator=(TemplateTracker&&) noexcept = defaul
 
 bool TemplateTracker::has_template() const { return images_ != nullptr; }
 
-void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
+void TemplateTracker::set_template(const imaging::Frame& frame, const imaging::PixelRoi& roi) {
   if (roi.width < 8 || roi.height < 8)
     throw InvalidInput(roi_text(roi) + ": a template needs at least 8x8 pixels");
   if (roi.x < 0 || roi.y < 0 || roi.x + roi.width > frame.width || roi.y + roi.height > frame.height)
@@ -113,26 +113,26 @@ void TemplateTracker::set_template(const Frame& frame, const PixelRoi& roi) {
   lost_ = false;
 }
 
-TrackEstimate TemplateTracker::track(const Frame& frame) {
+TrackEstimate TemplateTracker::track(const imaging::Frame& frame) {
   const double u = last_.u_px + du_, v = last_.v_px + dv_;
   return track_around(frame, u, v, u, v, lost_);
 }
 
-TrackEstimate TemplateTracker::track_near(const Frame& frame, double u_px, double v_px) {
+TrackEstimate TemplateTracker::track_near(const imaging::Frame& frame, double u_px, double v_px) {
   if (!std::isfinite(u_px) || !std::isfinite(v_px))
     throw InvalidInput("template tracker: the predicted position (" + std::to_string(u_px) + ", " +
                        std::to_string(v_px) + ") px is not finite");
   return track_around(frame, u_px, v_px, u_px, v_px, false);
 }
 
-TrackEstimate TemplateTracker::track_along(const Frame& frame, double u0_px, double v0_px, double u1_px,
-                                           double v1_px) {
+TrackEstimate TemplateTracker::track_along(const imaging::Frame& frame, double u0_px, double v0_px,
+                                           double u1_px, double v1_px) {
   if (!std::isfinite(u0_px) || !std::isfinite(v0_px) || !std::isfinite(u1_px) || !std::isfinite(v1_px))
     throw InvalidInput("template tracker: a predicted position is not finite");
   return track_around(frame, u0_px, v0_px, u1_px, v1_px, false);
 }
 
-TrackEstimate TemplateTracker::track_around(const Frame& frame, double pu0, double pv0, double pu1,
+TrackEstimate TemplateTracker::track_around(const imaging::Frame& frame, double pu0, double pv0, double pu1,
                                             double pv1, bool whole) {
   if (!images_) throw InvalidInput("template tracker: no template (set_template first)");
   Images& im = *images_;

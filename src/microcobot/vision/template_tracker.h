@@ -19,13 +19,13 @@
 ///
 /// The position reported is the template's centre in the frame's continuous pixel coordinates
 /// (pixel (row i, column j) spans [j - 1/2, j + 1/2] x [i - 1/2, i + 1/2]: its centre is (j, i)),
-/// as vision::Renderer's u_of_x/v_of_y. Not thread-safe: one tracker per camera thread. OpenCV
+/// as imaging::Renderer's u_of_x/v_of_y. Not thread-safe: one tracker per camera thread. OpenCV
 /// stays inside template_tracker.cc.
 
 #include <memory>
 
-#include "microcobot/vision/pixel_roi.h"
-#include "microcobot/vision/sensor_model.h"
+#include "microcobot/imaging/pixel_roi.h"
+#include "microcobot/imaging/sensor_model.h"
 
 namespace mc::vision {
 
@@ -99,24 +99,25 @@ class TemplateTracker {
   /// Takes the template from `frame` inside `roi` and tracks from there. Throws mc::InvalidInput
   /// naming the ROI when it is empty, smaller than 8x8 or not inside the frame, or when the patch
   /// has no contrast (nothing to track).
-  void set_template(const Frame& frame, const PixelRoi& roi);
+  void set_template(const imaging::Frame& frame, const imaging::PixelRoi& roi);
   bool has_template() const;
   /// Where the template is in `frame` (same size as the template's frame, else InvalidInput),
   /// searched around the last position plus the last frame-to-frame displacement.
-  TrackEstimate track(const Frame& frame);
+  TrackEstimate track(const imaging::Frame& frame);
   /// The same, searched around a caller's prediction of the template centre (a commanded stage
   /// move seen through the calibration, a servo's expected motion). Non-finite: InvalidInput.
-  TrackEstimate track_near(const Frame& frame, double u_px, double v_px);
+  TrackEstimate track_near(const imaging::Frame& frame, double u_px, double v_px);
   /// The same, searched around the segment between two predictions (a finger closing on a part
   /// that may stop it anywhere between where its drive puts it and where it was).
-  TrackEstimate track_along(const Frame& frame, double u0_px, double v0_px, double u1_px, double v1_px);
+  TrackEstimate track_along(const imaging::Frame& frame, double u0_px, double v0_px, double u1_px,
+                            double v1_px);
   /// The last estimate (the template's own position before the first track()).
   const TrackEstimate& last() const { return last_; }
 
  private:
   struct Images;  // OpenCV's matrices, kept out of this header
-  TrackEstimate track_around(const Frame& frame, double u0_px, double v0_px, double u1_px, double v1_px,
-                             bool whole);
+  TrackEstimate track_around(const imaging::Frame& frame, double u0_px, double v0_px, double u1_px,
+                             double v1_px, bool whole);
   TrackerParams params_;
   std::unique_ptr<Images> images_;
   TrackEstimate last_;

@@ -1,0 +1,44 @@
+#include "microcobot/devices/simulated_gripper.h"
+
+#include <cmath>
+
+#include "microcobot/core/error.h"
+
+namespace mc::devices {
+
+SimulatedGripper::SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
+                                   std::array<const SlaveAxis*, 3> axes, const Vec3& home_m)
+    : Gripper(std::move(name)),
+      world_(world),
+      axes_(axes),
+      home_m_(home_m.x, home_m.y, home_m.z),
+      state_(world.initial_state()),
+      command_m_(world.params().gripper.max_opening_m) {
+  for (const auto* a : axes_) require(a != nullptr, this->name() + ".axes", "must all be set");
+  require(home_m_.allFinite(), this->name() + ".home_m", "must be finite");
+}
+
+void SimulatedGripper::on_configure() {
+  state_ = world_.initial_state();
+  command_m_ = world_.params().gripper.max_opening_m;
+  shake_ = false;
+  state_.last_gripper_m = tip_position_m();
+  state_.last_gripper_yaw_rad = yaw_rad();
+  out_ = world_.step(state_, tip_position_m(), command_m_, 0.0, yaw_rad());
+}
+
+Eigen::Vector3d SimulatedGripper::tip_position_m() const {
+  return home_m_ + Eigen::Vector3d(axes_[0]->carried_position_m(), axes_[1]->carried_position_m(),
+                                   axes_[2]->carried_position_m());
+}
+
+void SimulatedGripper::command_opening_m(double opening) noexcept {
+  if (active() && std::isfinite(opening)) command_m_ = opening;
+}
+
+void SimulatedGripper::update(double dt_s) noexcept {
+  state_.gripper.shaking = shake_;
+  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad());
+}
+
+}  // namespace mc::devices

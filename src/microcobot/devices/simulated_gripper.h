@@ -1,0 +1,74 @@
+#pragma once
+/// @file
+/// The slave micro-gripper in its microworld: a PiezoGripper carried by the XYZ stage over a
+/// substrate with a micro-part (microworld::PickPlaceWorld, thesis §1.1.1 surface forces).
+/// The gripper's position is where the stage carries it (SlaveAxis::carried_position_m: the
+/// simulated axes' truth, a driver's sensor) plus the mount offset `home_m` (where the finger
+/// tips are when every axis is at 0). The safe state keeps the last opening command: a gripper
+/// that let go of the part on a fault would drop it. With a rotary axis (set_rotary) the fingers
+/// turn with it about the vertical through their tips.
+
+#include <array>
+
+#include "microcobot/devices/device.h"
+#include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/motion/rotary_axis.h"
+
+namespace mc::devices {
+
+class SimulatedGripper final : public Gripper {
+ public:
+  /// `world` and the axes must outlive the gripper.
+  SimulatedGripper(std::string name, const microworld::PickPlaceWorld& world,
+                   std::array<const SlaveAxis*, 3> axes, const Vec3& home_m);
+
+  void command_opening_m(double opening) noexcept override;
+  double opening_m() const override { return out_.opening_m; }
+  double grip_force_N() const override { return out_.grip_force_N; }
+  /// The bender's free opening: the simulated drive is ideal (first order and slew limited, no
+  /// hysteresis), so its open-loop model is exact (docs/errata.md).
+  double free_opening_m() const override { return state_.gripper.free_opening_m; }
+  Vec3 contact_force_N() const override {
+    return {out_.force_on_gripper_N.x(), out_.force_on_gripper_N.y(), out_.force_on_gripper_N.z()};
+  }
+  /// The burst shakes the fingers in the microworld while on (an inactive gripper ignores it).
+  void command_shake(bool on) noexcept override { shake_ = active() && on; }
+  bool can_shake() const override { return true; }
+  void update(double dt_s) noexcept override;
+  /// The safe state keeps the opening but stops the burst.
+  void enter_safe_state() noexcept override { shake_ = false; }
+
+  /// The rotary axis that turns the fingers (`axis` must outlive the gripper); call before
+  /// configure().
+  void set_rotary(const SlaveAxis* axis, const motion::RotaryAxisParams& params) {
+    rotary_ = axis;
+    rotary_params_ = params;
+  }
+  /// Where the finger tips are (world frame), and the fingers' yaw (0 without a rotary axis).
+  Eigen::Vector3d tip_position_m() const;
+  double yaw_rad() const noexcept {
+    return rotary_ != nullptr ? rotary_params_.angle_rad(rotary_->carried_position_m()) : 0.0;
+  }
+  /// The fingers' common-mode bend under a lateral force (world x, y): the tips are seen there,
+  /// away from tip_position_m() (microworld/pick_place_world.h).
+  Eigen::Vector2d finger_deflection_m() const { return state_.finger_deflection_m; }
+  const microworld::PickPlaceState& world_state() const { return state_; }
+  const microworld::PickPlaceOutput& world_output() const { return out_; }
+  const microworld::PickPlaceWorld& world() const { return world_; }
+
+ protected:
+  void on_configure() override;
+
+ private:
+  const microworld::PickPlaceWorld& world_;
+  std::array<const SlaveAxis*, 3> axes_;
+  const SlaveAxis* rotary_ = nullptr;
+  motion::RotaryAxisParams rotary_params_;
+  Eigen::Vector3d home_m_;
+  microworld::PickPlaceState state_;
+  microworld::PickPlaceOutput out_;
+  double command_m_;
+  bool shake_ = false;
+};
+
+}  // namespace mc::devices

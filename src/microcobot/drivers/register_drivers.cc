@@ -1,0 +1,19 @@
+#include "microcobot/drivers/register_drivers.h"
+
+#include <mutex>
+
+#include "microcobot/drivers/anc300_driver.h"
+#include "microcobot/drivers/gcs2_driver.h"
+#include "microcobot/platform/driver_registry.h"
+
+namespace mc::drivers {
+
+void register_vendor_drivers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    platform::register_devices("pi-gcs2", make_gcs2_devices);
+    platform::register_devices("anc300", make_anc300_devices);
+  });
+}
+
+}  // namespace mc::drivers

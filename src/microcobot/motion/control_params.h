@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// Every parameter of one controlled stick-slip axis: the model, its step map, the position
+/// sensor, the controllers and the motion limits. The keys of `microcobot control params --json`,
+/// which `--params FILE.yaml` and the Python module's control.params() accept.
+
+#include "microcobot/motion/baseline_position.h"
+#include "microcobot/motion/path_generator.h"
+#include "microcobot/motion/position_controller.h"
+#include "microcobot/motion/position_sensor.h"
+#include "microcobot/motion/reference.h"
+#include "microcobot/motion/setpoint_stream.h"
+#include "microcobot/motion/step_map.h"
+#include "microcobot/motion/tracking_controller.h"
+#include "microcobot/motion/velocity_controller.h"
+#include "microcobot/stickslip/stickslip_params.h"
+
+namespace mc::motion {
+
+struct ControlParams {
+  stickslip::StickSlipParams model;
+  StepMapParams step_map;
+  PositionSensorParams sensor;
+  VelocityControlParams velocity;
+  PositionControlParams position;
+  BaselinePositionParams baseline;
+  MotionLimits limits;
+  TrackingParams tracking;      ///< issue #15: the tracking controller
+  SetpointStreamParams stream;  ///< issue #15: setpoint streaming
+  PathLimits path;              ///< issue #15: 3-D paths (jerk; velocity/acceleration from limits)
+
+  template <class V>
+  void visit(V& v) {
+    v("model", model);
+    v("step_map", step_map);
+    v("sensor", sensor);
+    v("velocity", velocity);
+    v("position", position);
+    v("baseline", baseline);
+    v("limits", limits);
+    v("tracking", tracking);
+    v("stream", stream);
+    v("path", path);
+  }
+  void validate() const {
+    model.validate();
+    step_map.validate();
+    sensor.validate();
+    velocity.validate();
+    position.validate();
+    baseline.validate();
+    limits.validate();
+    tracking.validate();
+    stream.validate();
+    path.validate();
+  }
+};
+
+}  // namespace mc::motion
