@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What one stepping run moves on the ANC300 twin (issue #30, docs/hardware.md "anc300").
+"""What one stepping run moves on the ANC300 twin (docs/hardware.md "anc300").
 
 Against `microcobot serve --emulate anc300=127.0.0.1:PORT` (loopback): axis 1 at 60 V, 1 kHz,
 runs of n = 1, 1, 1, 2, 5, 10, 20, 20, 20 periods up then down (`stepu/stepd 1 n`, `stepw 1`),

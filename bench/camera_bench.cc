@@ -1,4 +1,4 @@
-// Issue #27's speed goals for the camera device while the live platform runs (the loop paced,
+// The speed goals for the camera device while the live platform runs (the loop paced,
 // SCHED_FIFO, as `microcobot serve` runs it), in one run:
 //  - the frame rate of 1280 x 1024 frames rendered and JPEG-encoded on the camera thread while
 //    the camera is wanted (goal >= 30 fps), and the snapshot-to-JPEG latency;

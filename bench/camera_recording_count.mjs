@@ -1,4 +1,4 @@
-// Counts the camera frames of a `serve` recording (issue #27's 10-minute benchmark,
+// Counts the camera frames of a `serve` recording (the 10-minute benchmark,
 // docs/benchmarks.md): frames, gaps in their sequence, the camera's own dropped count (frames
 // due the loop could not hand over), the span and rate, and the file's size per minute.
 //   node bench/camera_recording_count.mjs out/live/recording-*.mcap

@@ -1,4 +1,4 @@
-// The assembly cell's speed (issue #29 goal: the headless cell simulates >= 10x real time per
+// The assembly cell's speed (goal: the headless cell simulates >= 10x real time per
 // core without image rendering, and states its figure with vision in the loop). One automated
 // cycle (the robot's AssemblyTask on a fresh simulated platform, as `microcobot cell run --mode
 // auto` runs it) per iteration, on parts of a batch no parameter was chosen on (seed 7001).

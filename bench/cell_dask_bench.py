@@ -1,5 +1,5 @@
-"""microcobot.cell.batch on Dask: a LocalCluster of 2 worker processes against one (issue #29 point 7,
-goal >= 1.7x), the same campaign, in the same run.
+"""microcobot.cell.batch on Dask: a LocalCluster of 2 worker processes against one (goal
+>= 1.7x), the same campaign, in the same run.
 
 Workload: SEEDS x PARTS automatic cycles (one Dask task per part, ~2-3 s of wall time each). Each
 cluster (processes=True, threads_per_worker=1, loopback only, no dashboard) is started before its

@@ -1,4 +1,4 @@
-// Issue #27's goal "scene change to image in the browser p95 <= 3 frame periods": how old the
+// The camera's goal "scene change to image in the browser p95 <= 3 frame periods": how old the
 // scene of each frame is when the console page has decoded it and can show it, in Chromium
 // (Debian's, via playwright-core), against `microcobot serve` at its defaults (1280 x 1024 at
 // 30 fps, 2x). The page (web/console_camera.js) stamps each decoded frame with its age: its

@@ -58,7 +58,7 @@ void BM_PositionControllerTickScanning(benchmark::State& st) { position_tick(st,
 BENCHMARK(BM_PositionControllerTickStepping)->Iterations(20000);
 BENCHMARK(BM_PositionControllerTickScanning)->Iterations(20000);
 
-/// Tracking controller (issue #15) following a 200 um/s ramp on the model (edges every ~2.5 ms),
+/// Tracking controller following a 200 um/s ramp on the model (edges every ~2.5 ms),
 /// timed without the model's steps.
 void BM_TrackingControllerTick(benchmark::State& st) {
   mc::motion::TrackingController c(mc::motion::TrackingParams{}, model().params(), step_map());
@@ -102,7 +102,7 @@ void BM_XyzStageTick(benchmark::State& st) {
 }
 BENCHMARK(BM_XyzStageTick)->Iterations(20000);
 
-/// Model-mediated teleoperation (issue #31): the master model's haptic step (eq. 1-3 of
+/// Model-mediated teleoperation: the master model's haptic step (eq. 1-3 of
 /// model_mediated_master.h, with its passivity controller) and the slave estimator's sample.
 void BM_ModelMediatedMasterStep(benchmark::State& st) {
   mc::teleop::ModelMediatedMaster m({}, {0.0, 0.02, 1000.0});

@@ -1,4 +1,4 @@
-// What work on the other core does to a 10 kHz real-time loop on this one (issue #27: why the
+// What work on the other core does to a 10 kHz real-time loop on this one (why the
 // camera thread lengthens the loop's heaviest ticks). The loop (SCHED_FIFO when allowed, pinned
 // to the last core, spinning to each tick's start so that no wake-up cost enters the figure)
 // times a fixed piece of work over a 512 kB working set, like a platform tick that stays in its

@@ -1,4 +1,4 @@
-// Issue #30: does a driver-backed platform keep its 1 kHz slave control rate against the twin?
+// Does a driver-backed platform keep its 1 kHz slave control rate against the twin?
 // One run: the GCS 2.0 twin (the live platform, paced, with its TCP server) runs throughout; in
 // alternating 2 s phases (three of each) this process runs, paced to the wall clock, either the
 // simulated platform (no driver) or a platform whose axes are `pi-gcs2` on that twin, the console

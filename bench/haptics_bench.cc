@@ -1,5 +1,5 @@
 // Cost of one 10 kHz tick of the rendering pipeline and of one plant step (must be << 100 us;
-// the issue asks < 1 us for RenderPipeline::tick()).
+// the goal is < 1 us for RenderPipeline::tick()).
 #include <cmath>
 
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// Benchmark of the distributed platform (issue #17): what the DDS link costs the real-time loop,
+// Benchmark of the distributed platform: what the DDS link costs the real-time loop,
 // and the link's round trip, in one run.
 //
 //   node --experimental-websocket bench/link_bench.mjs [--phase-s 15] [--json]

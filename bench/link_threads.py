@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What the DDS link costs the machine, per thread (issue #17; docs/benchmarks.md).
+"""What the DDS link costs the machine, per thread (docs/benchmarks.md).
 
     /usr/bin/python3 bench/link_threads.py [MICROCOBOT [DOMAIN]]
 

@@ -1,4 +1,4 @@
-// Cost of the whole platform tick (issue #9 goal: <= 50 us mean per 10 kHz tick on one core):
+// Cost of the whole platform tick (goal: <= 50 us mean per 10 kHz tick on one core):
 // three simulated stick-slip axes, the dual-stage interface with its rendering pipeline, the
 // TéléTweez, the microworld, the teleoperation coupling, the slave controllers and the
 // telemetry, as `microcobot run` steps them; and, in the same run, its main parts alone.

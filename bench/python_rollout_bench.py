@@ -1,4 +1,4 @@
-"""microcobot.stickslip.rollout against the C++ single-axis loop, in the same run (issue #16).
+"""microcobot.stickslip.rollout against the C++ single-axis loop, in the same run.
 
 Workload: 64 axes x 0.1 s of fast stepping (60 V, 500 Hz sawtooth, one voltage sample per 10 us
 model step: the samples `stickslip.simulate` records, i.e. the waveform's values at the step ends).

@@ -1,4 +1,4 @@
-// Benchmark of `microcobot serve` (issue #14): the command-to-target latency on loopback and
+// Benchmark of `microcobot serve`: the command-to-target latency on loopback and
 // what eight telemetry clients cost the real-time loop, in one run.
 //
 //   node --experimental-websocket bench/serve_bench.mjs [--phase-s 15] [--clients 8] [--json]

@@ -26,7 +26,7 @@ const Scenario kScenarios[] = {
     {20, 50, ss::Direction::kForward, 0.1},    // scanning
     {40, 50, ss::Direction::kBackward, 0.1},   // stepping near the threshold
     {60, 500, ss::Direction::kForward, 0.02},  // fast stepping: the most sub-stepping
-    // Corners off the 10 us grid (issue #12): 300 Hz is 333.3 steps per period, 150 Hz 666.7.
+    // Corners off the 10 us grid: 300 Hz is 333.3 steps per period, 150 Hz 666.7.
     {70, 300, ss::Direction::kForward, 0.03},   // fast stepping, off the grid
     {45, 150, ss::Direction::kBackward, 0.04},  // backward stepping, off the grid
 };

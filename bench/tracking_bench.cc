@@ -1,4 +1,4 @@
-// Template tracks per second (issue #28: >= 200 tracks/s of a 128 x 128 template on one core at
+// Template tracks per second (goal: >= 200 tracks/s of a 128 x 128 template on one core at
 // 1280 x 1024): a part's corner under the 10x objective, moving 0.37 px per frame along a
 // diagonal, eight pre-rendered frames tracked in turn (the rendering is not timed).
 //   BM_Track:           track() around the last position (the steady case)

@@ -1,4 +1,4 @@
-// Issue #30: the GCS 2.0 twin's cost, on the live platform (paced loop) in one run:
+// The GCS 2.0 twin's cost, on the live platform (paced loop) in one run:
 //  - command-to-reply latency of `POS?` over loopback TCP (four clients polling at 100 Hz);
 //  - the loop's tick time p99 (the telemetry's tick_us) while those four clients poll, against
 //    the same loop with no client, in alternating 40 ms windows (240 of each, 9.6 s each in all):

@@ -1,10 +1,10 @@
-// Camera frames per second at 1280 x 1024 (issue #27: >= 30 fps on one core): the pin-in-hole
+// Camera frames per second at 1280 x 1024 (goal: >= 30 fps on one core): the pin-in-hole
 // scene with the gripper's fingers over the pin, each objective, sensor noise included.
 //   focus fixed:   the blurred substrate comes from the renderer's cache (a steady camera)
 //   focus moving:  a new focus every frame (the substrate re-blurred: a focus sweep)
 // build/release/bench/vision_bench --benchmark_counters_tabular=true
 //
-// Autofocus (issue #28, point 3; docs/benchmarks.md "Autofocus"): the search from a few tens of
+// Autofocus (docs/benchmarks.md "Autofocus"): the search from a few tens of
 // micrometres out of focus, on rendered 384 x 320 frames with the sensor's noise, a 256 x 192
 // ROI; one iteration each, the figures are counters:
 //   BM_AutofocusTuning/<variant>/<objective>   the TUNING set the parameters were chosen on
@@ -202,7 +202,7 @@ void report_focus(benchmark::State& state, const char* objective, const std::vec
       err_dof.push_back(std::abs(r.err_m) / r.dof_m);
       frames.push_back(r.frames);
       converged += r.converged;
-      // The goal (issue #28): <= DOF/5, and <= 0.3 um (stated for the 10x objective).
+      // The goal: <= DOF/5, and <= 0.3 um (stated for the 10x objective).
       const bool tight = std::string(objective) == "10x";
       goal += r.converged && std::abs(r.err_m) <= 0.2 * r.dof_m && (!tight || std::abs(r.err_m) <= 0.3e-6);
     }

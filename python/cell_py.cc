@@ -1,4 +1,4 @@
-// `microcobot.cell` (issue #29 points 6-7): the assembly cell's batches made from a scene and run
+// `microcobot.cell`: the assembly cell's batches made from a scene and run
 // by mode, each cycle's result as a dict (CycleResult::to_json) and the summary of a list of them
 // (summarize). The campaign over many seeds with Dask is pure Python over these calls
 // (microcobot/cell.py).
@@ -154,7 +154,7 @@ void apply_task(py::handle task, cl::CellRunParams& p) {
 }
 
 /// One part's cycle, stepped from Python: the operator's controls reach the automatic task between
-/// run_for() calls (issue #29 point 5, "tasks from Python").
+/// run_for() calls.
 struct Cycle {
   std::unique_ptr<cl::CellCycle> cycle;
   std::string mode;

@@ -330,7 +330,7 @@ void bind_control(py::module_& m) {
         const std::vector<double> values(sp.begin(), sp.end());  // the GIL is released below
         const auto r = nogil([&] {
           // The setpoints are stamped on the sender's clock, k / rate, and read through the
-          // stream's bounded look-ahead by the 10 kHz controller (issue #15 item 4): past the
+          // stream's bounded look-ahead by the 10 kHz controller: past the
           // last one the stream holds.
           motion::SetpointStream stream(p.params.stream, start_m);
           std::size_t next = 0;
@@ -352,7 +352,7 @@ void bind_control(py::module_& m) {
       },
       "plant"_a, "setpoints_m"_a, "setpoint_rate_Hz"_a = 1000.0, "tracker"_a = "tracking",
       "start_m"_a = py::none(), "duration_s"_a = 0.0,
-      "Follows position setpoints streamed from Python (issue #15): setpoints_m [m] at setpoint_rate_Hz "
+      "Follows position setpoints streamed from Python: setpoints_m [m] at setpoint_rate_Hz "
       "(the console's and the network link's 1 kHz by default) pass through the setpoint stream's "
       "bounded look-ahead (plant params 'stream') into the 10 kHz tracker ('tracking', or the "
       "baselines 'hybrid' and 'thesis-pid'), from start_m (default: the first setpoint) for duration_s "

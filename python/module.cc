@@ -126,11 +126,9 @@ PYBIND11_MODULE(_microcobot, m) {
   mc::py::bind_haptics(hp);
   auto tw = m.def_submodule("tweezers", "TéléTweez design calculators (thesis ch. 4, app. A-B)");
   mc::py::bind_tweezers(tw);
-  auto vs =
-      m.def_submodule("vision", "The microscope camera: rendered frames and optics figures (issue #27)");
+  auto vs = m.def_submodule("vision", "The microscope camera: rendered frames and optics figures");
   mc::py::bind_vision(vs);
   auto cl = m.def_submodule(
-      "cell",
-      "The assembly cell: batches of pin insertions by mode, their results and summaries (issue #29)");
+      "cell", "The assembly cell: batches of pin insertions by mode, their results and summaries");
   mc::py::bind_cell(cl);
 }

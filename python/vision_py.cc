@@ -1,6 +1,6 @@
-// microcobot.vision: the microscope camera (issue #27): render() a frame of a scene as an H x W
+// microcobot.vision: the microscope camera: render() a frame of a scene as an H x W
 // numpy array (uint8 for 8-bit frames, else uint16), camera_model() the optics figures; and what
-// the frames measure (issue #28): TemplateTracker, Autofocus and sharpness() steppable from a
+// the frames measure: TemplateTracker, Autofocus and sharpness() steppable from a
 // Python loop on those arrays, fit_affine() for the pixel <-> stage calibration, VisualServo
 // stepped frame by frame (a tracked feature in, the stage's velocity out). The same library
 // calls as `microcobot vision ...` (vision/, platform/camera_scene).

@@ -39,8 +39,8 @@ TEST_PACKAGES=(
   libopencv-videoio-dev  # the real-camera driver (devices/opencv_camera.cc; CMake MC_WITH_OPENCV), built and tested by `make test`
   gstreamer1.0-plugins-base  # videotestsrc: the OpenCV driver's synthetic source in its test
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
-  python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins (issue #30)
-  python3-dask python3-distributed  # microcobot.cell.batch: campaigns of many seeds on a process pool or a cluster (issue #29)
+  python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins
+  python3-dask python3-distributed  # microcobot.cell.batch: campaigns of many seeds on a process pool or a cluster
 )
 DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
 [[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")

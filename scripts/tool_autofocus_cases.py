@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seeded random cases of `microcobot vision autofocus --target tool` (issue #28 point 3): the
+"""Seeded random cases of `microcobot vision autofocus --target tool`: the
 height of the tool's tips from focus, started 20-100 um above or below them (sign and size
 uniform), an objective of the turret's 5x-50x, a random noise seed, judged against the simulation's
 truth. The goal: |error| <= DOF/5, and <= 0.3 um at 10x, within 15 frames. The measured strip's

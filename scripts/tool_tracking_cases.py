@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seeded random cases of `microcobot vision track --target tool` (issue #28): the tool's tips
+"""Seeded random cases of `microcobot vision track --target tool`: the tool's tips
 followed at 5x/10x, 0-60 um/s in any direction, 60 frames at 30 fps, the default sensor's noise,
 against the simulation's truth. The figures of docs/parameters.md ("Tracking the tool's tips",
 the tuning set: --seed 28 --cases 8) and docs/benchmarks.md (the validation set: --seed 4111

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Seeded (1+1) random search of the tracking controller's gains on the TUNING set only (issue #31).
+"""Seeded (1+1) random search of the tracking controller's gains on the TUNING set only.
 
 Every trial writes a parameter file (the present best with 1-4 of the searched values perturbed by
 log-normal steps, additive for kp), runs `microcobot control validate --set tuning --params FILE --json`

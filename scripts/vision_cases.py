@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Seeded random cases of `microcobot vision calibrate` and `vision track` (issue #28), the
+"""Seeded random cases of `microcobot vision calibrate` and `vision track`, the
 figures of docs/benchmarks.md ("Vision: calibration and tracking").
 
 Usage: scripts/vision_cases.py --cli build/release/apps/microcobot/microcobot [--cases 10] [--seed 28]

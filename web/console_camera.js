@@ -1,4 +1,4 @@
-// The microscope camera (issue #27): the image of /camera/preview/compressed (a ROS 2
+// The microscope camera: the image of /camera/preview/compressed (a ROS 2
 // sensor_msgs/msg/CompressedImage in CDR: the frame binned to the panel's 640 px by the server,
 // live/camera_preview.h; its JPEG decoded by the browser), scaled into the
 // microscope panel; the objective turret, the focus drive, exposure and gain, sent with the

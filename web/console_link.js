@@ -1,4 +1,4 @@
-// The Chronogrip console (issues #14, #26): the microscope, the operator's inputs and the
+// The Chronogrip console: the microscope, the operator's inputs and the
 // platform's feedback, over the Foxglove WebSocket protocol (docs/console.md). Everything the
 // loop receives is checked and clamped again by the server; this page only presents and collects.
 //

@@ -1,4 +1,4 @@
-// The supervised task (`serve --cell`, issue #29 point 5): its steps with their autonomy, the
+// The supervised task (`serve --cell`): its steps with their autonomy, the
 // current one highlighted, its status, and the operator's controls (start, pause, resume,
 // confirm, take over, hand back, step done, skip) sent as /console/action task_*, and the batch's
 // Next part (next_part) when serve has a batch. The rules

@@ -1,4 +1,4 @@
-// `microcobot cell run` (issue #29): a batch of pin insertions run headless by the robot (auto), a
+// `microcobot cell run`: a batch of pin insertions run headless by the robot (auto), a
 // simulated person (manual), the person with shared control (assisted) or the scripted watchmaker
 // (scripted), each cycle measured; cycles.csv and the summary under --out.
 
@@ -227,7 +227,7 @@ mc::report::Report batch_report(const std::vector<cell::CycleResult>& cycles, co
   return rep;
 }
 
-// The modes side by side (issue #29 point 6): box plots of each mode's cycles, one box per mode.
+// The modes side by side: box plots of each mode's cycles, one box per mode.
 mc::report::Report modes_report(const std::vector<std::vector<cell::CycleResult>>& by_mode) {
   using Groups = std::vector<std::pair<std::string, std::vector<double>>>;
   Groups time, placement, grip, contact;

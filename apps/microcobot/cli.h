@@ -8,7 +8,7 @@
 ///   const bool kRegistered = mc::cli::register_group({"dsp", "Signal and system toolkit", 20, &add_dsp});
 ///   }
 /// @endcode
-/// Conventions every command follows (DESIGN.md): `--json` prints one JSON object on stdout
+/// Conventions every command follows (docs/architecture.md): `--json` prints one JSON object on stdout
 /// and nothing else there; `--out DIR` writes CSV artifacts (and an index.html report);
 /// `--params FILE.yaml` takes the keys `<group> params --json` prints. Errors are thrown as
 /// mc::Error subclasses and turned into one line on stderr and the exit code by main.cc.

@@ -1,4 +1,4 @@
-// `microcobot control ...`: stick-slip motion control on the model (#6): velocity control of
+// `microcobot control ...`: stick-slip motion control on the model: velocity control of
 // thesis §2.7 (Fig. 2.18-2.19), hybrid closed-loop positioning, trajectory tracking, each with its
 // baselines (open-loop step counting, the thesis's PID) measured in the same run.
 
@@ -405,7 +405,7 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
   r.add_figure({"Tracking: " + o.profile, what, {"Time", "s"}, {"Position", "m"}, xs});
   r.add_figure({"Tracking error: " + o.profile,
                 "x - reference (true position): the tracking controller (reference-phased sawtooth) and the "
-                "baselines (today's hybrid controller fed the moving target, the thesis's PID).",
+                "baselines (the hybrid position controller fed the moving target, the thesis's PID).",
                 {"Time", "s"},
                 {"Error", "m"},
                 errs});
@@ -522,9 +522,9 @@ void control_part(Report& r) {
             "Stepping (amplitude/frequency from the step map) -> scanning with the PI inverse -> hold.");
   position_experiment(p, plant, mc::motion::Axis::kX, -100e-6, 100e-6, r, nullptr);
   position_experiment(p, plant, mc::motion::Axis::kX, 100e-6, 100e-6 - 10e-9, r, nullptr);
-  r.section("Control: trajectory tracking (issue #15)",
+  r.section("Control: trajectory tracking",
             "microcobot control trajectory --profile trapezoid|sine|stream|arc: the tracking controller "
-            "(reference-phased sawtooth) beside today's hybrid controller and the thesis's PID.");
+            "(reference-phased sawtooth) beside the hybrid position controller and the thesis's PID.");
   for (const char* prof : {"trapezoid", "sine", "stream", "arc"}) {
     TrajectoryOptions o;
     o.profile = prof;

@@ -124,8 +124,7 @@ void run_validate(const ValidateOptions& o) {
 void add_control_validate(CLI::App& group) {
   auto o = std::make_shared<ValidateOptions>();
   auto* cmd = group.add_subcommand(
-      "validate",
-      "Tracking controller on a seeded random tuning or validation set of references (issue #31)");
+      "validate", "Tracking controller on a seeded random tuning or validation set of references");
   cmd->add_option("--set", o->set, "tuning | validation")->check(CLI::IsMember({"tuning", "validation"}));
   cmd->add_option("--seed", o->seed, "Random draw's seed (default: tuning 15, validation 31)")
       ->check(CLI::Range(0LL, 1LL << 53));

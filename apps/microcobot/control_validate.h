@@ -1,5 +1,5 @@
 #pragma once
-// `microcobot control validate` (issue #31 point 1): the tracking controller on a seeded random
+// `microcobot control validate`: the tracking controller on a seeded random
 // tuning or validation set of references, one row per case, with the goals' verdicts.
 
 #include <CLI/CLI.hpp>

@@ -1,4 +1,4 @@
-// `microcobot dsp`: the signal and system toolkit on the command line (issue #3).
+// `microcobot dsp`: the signal and system toolkit on the command line.
 
 #include <algorithm>
 #include <cmath>

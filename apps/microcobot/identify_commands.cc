@@ -1,5 +1,5 @@
 // `microcobot identify ...`: identification of a stick-slip axis from measured data (thesis
-// §2.5.2, issue #5). Each command writes the identified parameter file (the keys of
+// §2.5.2). Each command writes the identified parameter file (the keys of
 // `stickslip params`), a report section with the fit plots (--out DIR) and --json.
 
 #include <chrono>

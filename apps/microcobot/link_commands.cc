@@ -1,5 +1,5 @@
-// `microcobot link`: the DDS link between a master and a slave process on its own (issue #17;
-// src/microcobot/net, docs/distributed.md). `link echo` is a slave that returns every target as
+// `microcobot link`: the DDS link between a master and a slave process on its own
+// (src/microcobot/net, docs/distributed.md). `link echo` is a slave that returns every target as
 // its measured position; `link ping` is a master that publishes targets at a fixed rate and
 // measures the round trips through the echo. Both use Cyclone DDS restricted to loopback.
 

@@ -1,4 +1,4 @@
-// `microcobot serve`: the platform live (issue #14). Builds the platform (simulated devices),
+// `microcobot serve`: the platform live. Builds the platform (simulated devices),
 // runs its loop paced to the wall clock and serves the operator's console over HTTP and the
 // Foxglove WebSocket protocol (docs/console.md). The first line on stdout is the console's URL.
 // Runs until SIGINT/SIGTERM, then puts every device in its safe state, closes the recording
@@ -43,7 +43,7 @@ namespace pf = mc::platform;
 struct ServeOptions {
   std::optional<std::filesystem::path> config;
   std::optional<std::string> scene;  // default pick-place; with --cell, the batch (AssemblyBatchParams)
-  bool cell = false;                 // the automatic insertion supervised from the console (issue #29)
+  bool cell = false;                 // the automatic insertion supervised from the console
   std::optional<int> seed, part;     // --cell: the batch's seed, the part of it
   std::optional<std::filesystem::path> task;  // --cell: a task file (cell/task_file.h)
   bool cell_camera = false;                   // --cell: the cell camera's looks (cell/cell_camera.h)
@@ -53,15 +53,15 @@ struct ServeOptions {
   bool record = false;
   bool record_csv = false;
   double duration_s = 0.0;
-  std::string role = "single";  // single | master | slave (issue #17)
+  std::string role = "single";  // single | master | slave
   int domain = 0;
   mc::cli::NetworkOptions network;   // where the DDS link goes (master and slave roles)
   mc::teleop::LinkParams link;       // the emulated impairment of what this end receives
   std::string passivity = "on";      // time-domain passivity control at this end's ports
-  std::vector<std::string> emulate;  // vendor-protocol twins (issue #30): gcs2[=ADDR:PORT], anc300[=...]
+  std::vector<std::string> emulate;  // vendor-protocol twins: gcs2[=ADDR:PORT], anc300[=...]
 };
 
-// The distributed platform's far end (issue #17): the master process sees the slave stage as
+// The distributed platform's far end: the master process sees the slave stage as
 // remote devices, the slave process takes its commands from the remote master.
 struct RemoteEnds {
   std::unique_ptr<mc::net::RemoteSlave> slave;

@@ -242,7 +242,7 @@ void run_simulate(const SimulateOptions& o) {
   };
   Instant first = instant(period), last = instant(whole_periods * period);
   // Only --out needs the whole trajectory (CSV, .mat, plots): without it the run is streamed and
-  // only what the summary needs is kept (issue #12: `simulate --duration 10` at >= 40x real time).
+  // only what the summary needs is kept (so that `simulate --duration 10` runs at >= 40x real time).
   ss::Trajectory tr;
   double x0 = 0.0, xf = 0.0, t0 = 0.0, tf = 0.0;
   std::size_t n = 0;
@@ -341,7 +341,7 @@ double quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
 }
 
-/// The integrator against the reference solver on drives drawn at random (issue #12).
+/// The integrator against the reference solver on drives drawn at random.
 void run_accuracy(const AccuracyOptions& o) {
   const ss::ActuatorModel m(load(o.common));
   const auto drives = mc::studies::accuracy_drives(o.drives, o.seed, m.params().drive);

@@ -1,7 +1,8 @@
 // `microcobot teleop delay-sweep`: the coupling system over a delayed, lossy link pushed into a
-// stiff contact, unprotected, with time-domain passivity control or model-mediated (issues #17,
-// #31; teleop/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
-// long delay"). `teleop delay-validate`: the tuning and validation sets of issue #31.
+// stiff contact, unprotected, with time-domain passivity control or model-mediated
+// (teleop/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
+// long delay"). `teleop delay-validate`: the tuning and validation sets of delay cases
+// (studies/delay_case_sets.h).
 
 #include <algorithm>
 #include <cmath>

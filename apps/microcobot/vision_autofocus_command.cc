@@ -1,4 +1,4 @@
-// `microcobot vision autofocus` (issue #28 point 3): the steppable coarse-to-fine search
+// `microcobot vision autofocus`: the steppable coarse-to-fine search
 // (vision/autofocus.h) run frame by frame on rendered frames, from a start off the truth, and
 // judged against it: a part's top or the tool's tips.
 
@@ -143,8 +143,7 @@ void run_autofocus(const AutofocusOptions& o) {
 void add_vision_autofocus(CLI::App& group) {
   auto o = std::make_shared<AutofocusOptions>();
   auto* cmd = group.add_subcommand(
-      "autofocus",
-      "The plane of best focus of a part's top or the tool's tips, searched frame by frame (issue #28)");
+      "autofocus", "The plane of best focus of a part's top or the tool's tips, searched frame by frame");
   add_camera_options(*cmd, o->camera);
   cmd->add_option("--target", o->target, "part (default: its top) or tool (its tips)")
       ->check(CLI::IsMember({"part", "tool"}));

@@ -1,4 +1,4 @@
-// `microcobot vision ...`: the microscope camera's image formation (issue #27): `model` prints an
+// `microcobot vision ...`: the microscope camera's image formation: `model` prints an
 // objective's optics figures, `render` makes one camera frame of a scene (PNG + the camera state).
 
 #include <cmath>
@@ -205,8 +205,7 @@ void add_vision(CLI::App& group) {
 }
 
 const bool kRegistered = mc::cli::register_group(
-    {"vision", "The microscope camera: optics, rendered frames, calibration and tracking (issues #27, #28)",
-     45, &add_vision});
+    {"vision", "The microscope camera: optics, rendered frames, calibration and tracking", 45, &add_vision});
 
 }  // namespace
 }  // namespace vision_commands

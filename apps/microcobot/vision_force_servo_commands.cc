@@ -1,4 +1,4 @@
-// `microcobot vision force|servo` (issue #28 points 4, 5): the grip force measured from the fingers'
+// `microcobot vision force|servo`: the grip force measured from the fingers'
 // deflection in the image, and the gripper's tips brought over the part by image-based visual
 // servoing with the stage's encoders off; each over a seeded random set judged against the
 // simulation's truth.
@@ -210,7 +210,7 @@ void run_force(const ForceOptions& o) {
 void add_vision_force(CLI::App& group) {
   auto o = std::make_shared<ForceOptions>();
   auto* cmd = group.add_subcommand(
-      "force", "Grip force from the fingers' deflection in the image, against the simulation (issue #28)");
+      "force", "Grip force from the fingers' deflection in the image, against the simulation");
   cmd->add_option("--objective", o->objective, "Objective: 2x, 5x, 10x (default), 20x, 50x");
   cmd->add_option("--scenes", o->scenes, "Scenes of the seeded random set (default 12)")
       ->check(CLI::Range(1, 1000));
@@ -229,8 +229,8 @@ void add_vision_force(CLI::App& group) {
 
 void add_vision_servo(CLI::App& group) {
   auto o = std::make_shared<ServoOptions>();
-  auto* cmd = group.add_subcommand(
-      "servo", "Visual servoing with the encoders off: the tips brought over the part (issue #28)");
+  auto* cmd =
+      group.add_subcommand("servo", "Visual servoing with the encoders off: the tips brought over the part");
   cmd->add_option("--scene", o->run.scene, "pick-place (default), pin-in-hole, or a YAML scene file");
   cmd->add_option("--objective", o->run.objective, "Objective: 2x, 5x, 10x (default), 20x, 50x");
   cmd->add_option("--seed", o->run.seed, "Seed of the sensor noise (default 1)");

@@ -1,4 +1,4 @@
-// `microcobot vision pick-place` (issue #28 point 5): a pick-and-place done by the visual servo
+// `microcobot vision pick-place`: a pick-and-place done by the visual servo
 // alone, the stage's encoders off, over a seeded random set of starts and targets judged against
 // the simulation's truth (studies/visual_pick_place_run.h).
 
@@ -141,8 +141,8 @@ void run_pick_place(const PickPlaceOptions& o) {
 
 void add_vision_pick_place(CLI::App& group) {
   auto o = std::make_shared<PickPlaceOptions>();
-  auto* cmd = group.add_subcommand(
-      "pick-place", "A pick-and-place by the visual servo alone, the encoders off (issue #28)");
+  auto* cmd =
+      group.add_subcommand("pick-place", "A pick-and-place by the visual servo alone, the encoders off");
   cmd->add_option("--scene", o->run.scene, "pick-place (default) or a YAML scene file (its part)");
   cmd->add_option("--objective", o->run.objective, "Objective: 2x, 5x (default), 10x, 20x, 50x");
   cmd->add_option("--seed", o->run.seed, "Seed of the sensor noise (default 1)");

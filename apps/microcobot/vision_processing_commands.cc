@@ -1,4 +1,4 @@
-// `microcobot vision calibrate|track` (issue #28): the camera's frames turned into measurements.
+// `microcobot vision calibrate|track`: the camera's frames turned into measurements.
 // `calibrate` moves the tool through a grid and fits the pixel <-> stage affine map; `track`
 // follows a part or the tool along a path (`autofocus`: vision_autofocus_command.cc). Each is
 // judged against the simulation's truth.
@@ -302,8 +302,7 @@ void add_vision_processing(CLI::App& group) {
   {
     auto o = std::make_shared<CalibrateOptions>();
     auto* cmd = group.add_subcommand(
-        "calibrate",
-        "Pixel <-> stage affine map: the tool moved through a grid, its tips tracked (issue #28)");
+        "calibrate", "Pixel <-> stage affine map: the tool moved through a grid, its tips tracked");
     add_camera_options(*cmd, o->camera);
     cmd->add_option("--grid", o->grid, "Grid points per side (default 5)")->check(CLI::Range(2, 21));
     cmd->add_option("--pitch-um", o->pitch_um, "Grid pitch [um] (default: the grid spans half the field)")
@@ -332,8 +331,7 @@ void add_vision_processing(CLI::App& group) {
   {
     auto o = std::make_shared<TrackOptions>();
     auto* cmd = group.add_subcommand(
-        "track",
-        "A part or the tool followed by the template tracker, against the simulation's truth (issue #28)");
+        "track", "A part or the tool followed by the template tracker, against the simulation's truth");
     add_camera_options(*cmd, o->camera);
     cmd->add_option("--target", o->target, "part (default) or tool")->check(CLI::IsMember({"part", "tool"}));
     cmd->add_option("--frames", o->frames, "Frames tracked (default 60)")->check(CLI::Range(1, 100000));

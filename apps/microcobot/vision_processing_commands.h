@@ -1,5 +1,5 @@
 #pragma once
-// `microcobot vision calibrate|track|autofocus` (issue #28), added to the `vision` group.
+// `microcobot vision calibrate|track|autofocus`, added to the `vision` group.
 
 #include <CLI/CLI.hpp>
 

@@ -1,4 +1,4 @@
-"""The assembly cell (issue #29): batches of pin insertions run by mode, and campaigns of many seeds.
+"""The assembly cell: batches of pin insertions run by mode, and campaigns of many seeds.
 
 The compiled calls are the library's, as ``microcobot cell run`` makes them:
 

@@ -1,5 +1,5 @@
-"""The microscope camera (issue #27): rendered frames and optics figures; what the frames measure
-(issue #28): tracking, autofocus, focus measures, the pixel <-> stage calibration, visual servoing."""
+"""The microscope camera: rendered frames and optics figures, and what the frames measure:
+tracking, autofocus, focus measures, the pixel <-> stage calibration, visual servoing."""
 
 from typing import Any, Dict, Optional, Tuple
 
@@ -20,7 +20,7 @@ def render(scene: str = "pick-place",
            tool_yaw_deg: float = 0.0,
            part_yaw_deg: float = 0.0) -> npt.NDArray[Any]: ...
 
-# ---- what the frames measure (issue #28) ----
+# ---- what the frames measure ----
 Roi = Tuple[int, int, int, int]  # x, y, width, height
 
 def sharpness(frame: npt.NDArray[Any], roi: Optional[Roi] = None, metric: str = "normalized-variance") -> float: ...

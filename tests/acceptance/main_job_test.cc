@@ -1,4 +1,4 @@
-// The main job end to end (issue #9): the default pick-and-place through `microcobot run`
+// The main job end to end: the default pick-and-place through `microcobot run`
 // and the stale-master scenario through the library. About 10 s each in release; labelled
 // slow (not run under the sanitizers).
 

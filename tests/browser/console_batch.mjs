@@ -1,4 +1,4 @@
-// Browser test of a batch in the console (issue #29, `serve --cell` with a grid load): the task
+// Browser test of a batch in the console (`serve --cell` with a grid load): the task
 // panel says which part of the batch the scene holds; the scene carries the load's other parts
 // (drawn in the microscope, rendered in the camera's image); Next part rebuilds the scene on the
 // batch's next part (its target and neighbours), its task waiting for Start; Next part is offered

@@ -1,4 +1,4 @@
-// Browser test of the camera in the console (issue #27): the microscope panel is the camera's
+// Browser test of the camera in the console: the microscope panel is the camera's
 // image (CDR CompressedImage decoded by the page); the part's centre found in the displayed
 // pixels lies within 2 px of where the calibration (view centre, objective scale) puts the
 // part's true position; focusing on the part's top sharpens it; the 5x objective shows it 2.5

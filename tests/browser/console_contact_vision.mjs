@@ -1,4 +1,4 @@
-// Browser test of the contact force seen by the camera (issue #28 point 4, live): `serve` with the
+// Browser test of the contact force seen by the camera (live): `serve` with the
 // pin-in-hole's 200 um pin down in its bore (10 um of play each side) between the open fingers,
 // the tips 200 um above the substrate under the 10x objective. The operator takes control, holds
 // the deadman (Space), closes the gripper on the pin with its slider and sends the stage 4 um past

@@ -1,4 +1,4 @@
-// Browser test of the deadman rule through the console (issue #26; DESIGN.md: no slave
+// Browser test of the deadman rule through the console (docs/architecture.md: no slave
 // actuator moves without the controlling operator's deadman): in control but without the
 // deadman, the gripper slider, the arrow-key jog, the step jog and the go-to entry leave the
 // stage's target and position and the gripper's opening unchanged in the telemetry; holding the

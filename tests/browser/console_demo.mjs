@@ -1,8 +1,8 @@
-// Browser test of the demo's end (issue #26): in a pin-in-hole scene (the repository's scene
+// Browser test of the demo's end: in a pin-in-hole scene (the repository's scene
 // file with a 300 um transport, to keep the test short), Demo from the page runs the scripted
 // operator live; when it is done the page shows how it ended ("inserted", a banner with the
 // server's result) and the platform has handed control back with every axis holding: the stage
-// does not move for three seconds (the issue saw z rise at 3.5 um/s after "demo: done"). Run by
+// does not move for three seconds (a stage left drifting would show z rising after "demo: done"). Run by
 // CTest (`console_browser_demo`); screenshots to MC_ARTIFACTS.
 import { writeFileSync } from "node:fs";
 import { join } from "node:path";
@@ -39,7 +39,7 @@ await s.run(async () => {
   await page.waitForTimeout(3000);
   const b = await t();
   for (const k of ["slave_x_m", "slave_y_m", "slave_z_m", "target_x_m", "target_y_m", "target_z_m"]) {
-    // 50 nm in 3 s: a held stick-slip axis; the issue's drift was 3.5 um/s.
+    // 50 nm in 3 s: a held stick-slip axis; an axis left drifting moves um/s.
     if (Math.abs(b[k] - a[k]) > 50e-9) fail(`after the demo ${k} moved ${((b[k] - a[k]) * 1e9).toFixed(0)} nm in 3 s`);
   }
   if (b.engaged !== 0) fail("after the demo the coupling is still engaged");

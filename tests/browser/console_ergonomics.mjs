@@ -1,4 +1,4 @@
-// Browser test of the console's ergonomics (issue #26): `microcobot serve` (pick-place) in
+// Browser test of the console's ergonomics: `microcobot serve` (pick-place) in
 // Debian's headless Chromium at a tablet's 1024x768. The microscope and the main controls are on
 // screen without scrolling; plots fill their panels (also after a resize to 1400x950) and their
 // legends show the latest sample; a server warning shows as a dismissable banner; with the

@@ -1,4 +1,4 @@
-// Browser test of the grip force seen by the camera (issue #28 point 4, live): `serve` with the
+// Browser test of the grip force seen by the camera (live): `serve` with the
 // part between the open fingers and the tips at its mid-height under the 5x objective; the
 // operator takes control, holds the deadman (Space) and closes the gripper with its slider onto
 // the part; the "grip, seen" gauge shows the force the camera measures (the tips' distance

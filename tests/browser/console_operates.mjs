@@ -1,4 +1,4 @@
-// Browser test of the live console (issue #14): starts `microcobot serve` on a free port, opens
+// Browser test of the live console: starts `microcobot serve` on a free port, opens
 // the console in Debian's headless Chromium through playwright-core, takes control and does a
 // pick-and-place through the page's own controls (objective, click-to-go on the microscope and
 // side views, the Space deadman, the gripper slider), then checks from the streamed telemetry

@@ -1,4 +1,4 @@
-// Browser test of the optical-tweezers scene (issue #14; thesis §3.5.2, Fig. 3.16): `microcobot
+// Browser test of the optical-tweezers scene (thesis §3.5.2, Fig. 3.16): `microcobot
 // serve --scene optical-trap` in Debian's headless Chromium. The page switches to the 100x oil
 // objective (behind a 2x tube lens) and piconewtons; the operator takes control and clicks the trap 1 um past where
 // the probe bead touches the stuck bead, holding the deadman: the streamed telemetry must show

@@ -1,4 +1,4 @@
-// Browser test of the rotary axis through the console (issue #29 point 2): the θ readout and
+// Browser test of the rotary axis through the console: the θ readout and
 // buttons show when the scene has the axis; the ',' key and the θ buttons turn the gripper only
 // with the deadman held; a +5° step turns it to its goal and the goal is then let go; the camera
 // sees the fingers turned, and force by vision measures them turned (no force, open). With the camera

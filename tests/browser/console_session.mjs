@@ -144,7 +144,7 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
     if (await page.isHidden(row)) s.fail(`the gauge ${row} is hidden`);
   };
   // Takes control as an operator would, clicking again when nothing happened: with the camera
-  // streaming on a loaded machine a click has been lost (CI, 2026-11-26: never granted in 30 s, no
+  // streaming on a loaded machine a click can be lost (seen in CI: never granted in 30 s, no
   // command seen by the server); each retry is logged, and control must come within three clicks.
   s.takeControl = async () => {
     for (let attempt = 1; ; ++attempt) {

@@ -1,4 +1,4 @@
-// Browser test of the supervised task (issue #29 point 5, `serve --cell`): from the page's task
+// Browser test of the supervised task (`serve --cell`): from the page's task
 // panel the operator starts the automatic insertion, pauses it while it carries the pin (the
 // commanded position stops at the first telemetry sample of the pause and stays; the stage
 // settles there), takes over (no jump in the commanded position; the operator jogs with the

@@ -1,4 +1,4 @@
-// Browser test of an assisted step (issue #29 point 5, `serve --cell --task FILE` with
+// Browser test of an assisted step (`serve --cell --task FILE` with
 // `steps: {transport: assisted}`): the robot grasps and lifts the pin, then hands the transport to
 // the operator under the platform's guidance. The panel says so; the operator clicks on the
 // microscope 12 um off the bore (by eye) and holds the deadman; the guide puts the stage on the

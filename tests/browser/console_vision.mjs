@@ -1,4 +1,4 @@
-// Browser test of click-to-go with the encoders off (issue #28 point 5): `serve` with
+// Browser test of click-to-go with the encoders off: `serve` with
 // `stage.xy_sensor: vision`; the operator takes control, clicks on the camera's image 60 um
 // beside the gripper's tips and holds the deadman (Space); the visual servo on the server's
 // camera thread brings the tool point there. Judged on the simulation's ground truth (the

@@ -20,7 +20,7 @@ let failures = 0;
 const fail = (msg) => { console.error("FAIL: " + msg); failures++; };
 
 // The reports a user opens: every module's figures, the main job's session report, and the cell's
-// modes side by side (issue #29 point 6: box plots of cycle time, placement error, peak forces).
+// modes side by side (box plots of cycle time, placement error, peak forces).
 const cellModes = ["auto", "manual"];
 const reports = [
   { name: "report", args: ["report", "--out", join(dir, "report")], index: join(dir, "report", "index.html") },

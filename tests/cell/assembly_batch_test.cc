@@ -1,4 +1,4 @@
-// The batch of insertions (issue #29 point 1): seeded, within its ranges, the pins off their
+// The batch of insertions: seeded, within its ranges, the pins off their
 // slots by what the robot is not told, and bad scenes refused with the key named.
 #include "microcobot/cell/assembly_batch.h"
 

@@ -1,4 +1,4 @@
-// The task object alone (issue #29 point 5): skip() leaves the current step for the next one
+// The task object alone: skip() leaves the current step for the next one
 // from where the stage is, whatever the task's status, on an ideal stage that follows the task's
 // goal moves exactly (the platform's part is cell_cycle_test.cc's).
 #include "microcobot/cell/assembly_task.h"
@@ -319,7 +319,7 @@ TEST(AssemblyTask, ALookThatFindsNothingLeavesTheNominalSlot) {
   EXPECT_LT((stage.s.tip_m.head<2>() - g.part_m).norm(), 1e-9);
 }
 
-// An assisted move (issue #29 point 5: a step done by the operator under shared control): the task
+// An assisted move (a step done by the operator under shared control): the task
 // hands the stage to the operator's master, holds a guide at the step's goal x, y and a height stop
 // at its z, and goes on by itself once the tool has been at the goal for settle_s; the next step is
 // the robot's again, from where the stage is.

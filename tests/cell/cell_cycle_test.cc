@@ -1,4 +1,4 @@
-// The automatic insertion on the simulated platform (issue #29 point 5): a cycle inserts its pin
+// The automatic insertion on the simulated platform: a cycle inserts its pin
 // under the platform's limits and ends with every axis holding; pausing stops the commanded
 // motion at the next tick; confirming, taking over and handing back never jump; a jam the
 // search cannot clear fails and holds.
@@ -138,7 +138,7 @@ TEST(CellCycle, AmongItsNeighboursTheRobotCarriesThePinOverThemAndStrikesNone) {
   EXPECT_TRUE(r.ended_holding);
 }
 
-// Flat parts with a person (issue #29): the person grasps a plate at half its thickness, sets it
+// Flat parts with a person: the person grasps a plate at half its thickness, sets it
 // down until the seat is felt and lets go by its process sheet's strategy: a plate whose seat holds
 // less than the fingers (it stays on a finger when they open) is placed once the console's Shake is
 // held, or once the dial rolls the fingers; the haptic master has no burst, so its person rolls.
@@ -454,7 +454,7 @@ TEST(CellCycle, AConfirmStepCostsTheSupervisorsDelayAndAManualStepIsRefusedHeadl
   }
 }
 
-// A manual step headless (issue #29 point 5, the hand-over): the simulated person takes the task's
+// A manual step headless (the hand-over): the simulated person takes the task's
 // insertion over with the console (joystick, gripper slider), inserts, and hands back once the pin is
 // down; the task releases, retracts and verifies. Neither the take-over nor the hand-back jumps: the
 // commanded position moves at most the joystick's top speed a tick, the gripper's command while the

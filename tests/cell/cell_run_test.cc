@@ -1,4 +1,4 @@
-// A small campaign (issue #29 tests): the robot and the scripted watchmaker on the same seeded
+// A small campaign: the robot and the scripted watchmaker on the same seeded
 // parts, the goals' directions asserted; the summary's statistics.
 #include "microcobot/cell/cell_run.h"
 
@@ -31,7 +31,7 @@ TEST(CellRun, OnTheSamePartsTheRobotIsFasterThanTheScriptedWatchmakerAndBothStay
 }
 
 TEST(CellRun, OnTheSamePartsSharedControlMakesThePersonFasterAndMorePrecise) {
-  // Issue #29's study in small: the same simulated person (same seeds) alone and with shared
+  // The assisted-against-manual study in small: the same simulated person (same seeds) alone and with shared
   // control, on parts none of the defaults were chosen on (tuned on seed 5).
   AssemblyBatchParams scene;
   scene.parts = 3;
@@ -45,7 +45,7 @@ TEST(CellRun, OnTheSamePartsSharedControlMakesThePersonFasterAndMorePrecise) {
   EXPECT_EQ(manual.successes, 3);
   EXPECT_EQ(assisted.successes, 3);
   EXPECT_EQ(assisted.force_violations + manual.force_violations, 0);
-  // Issue #29's goals on the medians (0.58 and 0.05 when written; 20-part figures in docs/benchmarks.md).
+  // The goals on the medians (20-part figures in docs/benchmarks.md).
   EXPECT_LE(assisted.cycle_median_s, 0.7 * manual.cycle_median_s);
   EXPECT_LE(assisted.placement_median_m, 0.5 * manual.placement_median_m);
   std::printf("3 parts (seed 61): assisted %.1f s %.2f um, manual %.1f s %.2f um\n", assisted.cycle_median_s,

@@ -1,4 +1,4 @@
-// The simulated person's motor model (issue #29 point 3): minimum-jerk sub-movements timed by
+// The simulated person's motor model: minimum-jerk sub-movements timed by
 // Fitts' law, endpoint noise proportional to the amplitude, the reaction time, tremor in its band.
 #include "microcobot/cell/person_model.h"
 

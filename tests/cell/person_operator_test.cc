@@ -1,5 +1,5 @@
-// The simulated person (issue #29 point 3) on the simulated platform, alone and with shared
-// control (point 4): a cycle goes through under the platform's limits, the funnel round the rim
+// The simulated person on the simulated platform, alone and with shared
+// control: a cycle goes through under the platform's limits, the funnel round the rim
 // is never entered under tremor, the person lets go at the end.
 #include "microcobot/cell/person_operator.h"
 
@@ -136,7 +136,7 @@ TEST(PersonOperator, TheConsolesClickToGoDoesTheSameCycleByClicks) {
 // (z_tolerance_m: the depth of field). When the pin was taken a little high in the fingers, the
 // hand arrives within that tolerance with the pin a micrometre short of the bore's floor: no
 // contact to feel, and nothing left to aim at. The person sees the pin go no lower, well into its
-// bore, and lets go (part 9 of seed 4111, where the person used to wait until the step's timeout).
+// bore, and lets go (part 9 of seed 4111; waiting there would last until the step's timeout).
 TEST(PersonOperator, APinThatStopsShortOfTheFloorUnfeltIsReleased) {
   AssemblyBatchParams batch;
   batch.parts = 10;

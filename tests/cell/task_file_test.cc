@@ -1,4 +1,4 @@
-// Tasks in YAML (issue #29 point 5): each step's autonomy and the task's parameters read from a
+// Tasks in YAML: each step's autonomy and the task's parameters read from a
 // file; misspelt steps and keys, unknown levels and bad values refused with one line naming them.
 #include "microcobot/cell/task_file.h"
 

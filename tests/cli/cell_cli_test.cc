@@ -1,4 +1,4 @@
-// `microcobot cell run|params` (issue #29) as a user runs them: the batch's summary and files, and
+// `microcobot cell run|params` as a user runs them: the batch's summary and files, and
 // one-line errors with their exit codes.
 
 #include <filesystem>
@@ -55,7 +55,7 @@ TEST(CellCli, CompareRunsTheModesOnTheSamePartsWithTheirRatios) {
   EXPECT_EQ(j["ratios"]["manual/manual"]["cycle_median"].get<double>(), 1.0);
   for (const char* f : {"cycles-auto.csv", "cycles-manual.csv", "summary.json", "index.html"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
-  // The page opens with the modes' box plots (issue #29 point 6), one box (series) per mode, the
+  // The page opens with the modes' box plots, one box (series) per mode, the
   // cycles' own values behind them.
   const CsvTable box = read_csv(dir / "fig-01-cycle-time-by-mode.csv");
   EXPECT_EQ(box.column("series"), (std::vector<double>{1.0, 2.0}));
@@ -88,7 +88,7 @@ TEST(CellCli, BadInputGetsOneLineAndItsExitCode) {
   EXPECT_EQ(nlohmann::json::parse(p.out)["scene"]["parts"].get<int>(), 10);
 }
 
-// Tasks in YAML (issue #29 point 5): a confirm step costs the supervisor's delay and is counted;
+// Tasks in YAML: a confirm step costs the supervisor's delay and is counted;
 // a manual step, a misspelt step or key is refused naming the file and the key (exit 3).
 TEST(CellCli, ATaskFileSetsTheStepsAutonomyAndBadOnesAreOneLineNamingTheKey) {
   test::TempDir dir;

@@ -1,7 +1,7 @@
-// Issue #13: every bad input, signal and resource limit meets the contract of docs/cli.md:
+// Every bad input, signal and resource limit meets the contract of docs/cli.md:
 // the documented exit code, exactly one line on stderr ("microcobot: error: ..."), no NaN on
 // stdout, nothing new left in --out on failure, and bounded time. Each case is a regression
-// test for a cause found by the hostile-user campaign of the issue.
+// test for a cause a hostile user can hit.
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -164,7 +164,7 @@ TEST(Hardening, WorkBudgetsAreCheckedBeforeTheRun) {
 }
 
 TEST(Hardening, ControlValidateNamesItsFlags) {
-  // Issue #31: the validation set cannot be drawn with the tuning set's seed (the sets are kept apart).
+  // The validation set cannot be drawn with the tuning set's seed (the sets are kept apart).
   expect_error({"control", "validate", "--seed", "15"}, 3, "--seed", kPromptly_s);
   expect_error({"control", "validate", "--set", "all"}, 2, "--set", kPromptly_s);
   expect_error({"control", "validate", "--cases", "0"}, 2, "--cases", kPromptly_s);

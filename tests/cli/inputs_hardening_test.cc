@@ -1,6 +1,5 @@
-// Issue #31, point 5 ("the last bad inputs"): the cases the second hostile-input audit found
-// outside the contract of docs/cli.md, each a regression test: stiffnesses beyond what their step
-// resolves, an overflowing FRF, --save onto the measurement, --out on a mount point, a signal
+// Bad inputs at the edge of the contract of docs/cli.md, each a regression test: stiffnesses beyond what
+// their step resolves, an overflowing FRF, --save onto the measurement, --out on a mount point, a signal
 // while outputs are written, messages that named internal quantities, absurd `run` scenes.
 
 #include <sys/mount.h>

@@ -59,7 +59,7 @@ TEST(RunCli, BadFlagsExitTwo) {
     EXPECT_EQ(r.exit_code, 2) << args[1];
     EXPECT_EQ(line_count(r.err), 1u) << r.err;
   }
-  // A missing configuration is invalid input, like a missing --params file (issue #13).
+  // A missing configuration is invalid input, like a missing --params file.
   const auto r = run_cli({"run", "--config", "/nonexistent.yaml"});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_EQ(line_count(r.err), 1u) << r.err;

@@ -1,5 +1,5 @@
 // `microcobot serve`'s scenes from the command line: a built-in name or a YAML file; a bad file
-// is refused before anything starts, with one line naming the key (issue #14).
+// is refused before anything starts, with one line naming the key.
 #include <gtest/gtest.h>
 
 #include "support/test_support.h"
@@ -64,7 +64,7 @@ TEST(ServeCli, ABadSceneIsRefusedWithOneLineNamingTheKey) {
   }
 }
 
-// Issue #26: a mistyped scene lists the built-in ones; an --out that cannot be created is one
+// A mistyped scene lists the built-in ones; an --out that cannot be created is one
 // line naming it (exit 3, not an internal error); on every interface the URL to open is loopback's.
 TEST(ServeCli, AMistypedSceneOrAnUncreatableOutIsOneHelpfulLine) {
   test::TempDir dir;
@@ -89,7 +89,7 @@ TEST(ServeCli, AMistypedSceneOrAnUncreatableOutIsOneHelpfulLine) {
 }
 
 TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
-  // The program registers the vendor drivers (issue #30) beside the simulation (docs/hardware.md).
+  // The program registers the vendor drivers beside the simulation (docs/hardware.md).
   test::TempDir dir;
   test::write_text(dir / "bench.yaml", "devices: {driver: smaract, connection: \"usb:0\"}\n");
   for (const std::string command : {"serve", "run"}) {

@@ -1,4 +1,4 @@
-// `microcobot vision calibrate|track|autofocus` (issue #28) as a user runs them: the goals on the
+// `microcobot vision calibrate|track|autofocus` as a user runs them: the goals on the
 // simulation's truth, the files under --out, and one-line errors with their exit codes.
 
 #include <filesystem>

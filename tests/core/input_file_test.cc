@@ -1,4 +1,4 @@
-// Reading input files (regular files only, size caps) and one-line message helpers (issue #13).
+// Reading input files (regular files only, size caps) and one-line message helpers.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

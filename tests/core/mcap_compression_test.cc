@@ -1,4 +1,4 @@
-// zstd-compressed MCAP chunks, Metadata and Attachment records (issue #26): written by
+// zstd-compressed MCAP chunks, Metadata and Attachment records: written by
 // McapWriter, read back and checked by the strict reader.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

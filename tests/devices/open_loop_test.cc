@@ -1,6 +1,6 @@
-// Issue #30: open-loop stepping on the platform (the ANC300's stepu/stepd): n sawtooth periods
+// Open-loop stepping on the platform (the ANC300's stepu/stepd): n sawtooth periods
 // through the stick-slip model move the axis what the model alone moves for the same drive, end
-// holding, and obey the safety rules (deadman, fault, e-stop); the rotary axis (issue #29 point 2)
+// holding, and obey the safety rules (deadman, fault, e-stop); the rotary axis
 // too, on its rotor's arc, within its travel.
 
 #include <gtest/gtest.h>
@@ -56,7 +56,7 @@ constexpr int kPeriods = 100, kTransient = 10;
 // The steady stepping (periods 10 to 100) is what the model steps: the first periods differ by
 // construction (the model starts from rest with its power-up transient, the axis from its hold
 // voltage through the entry edge). 15%: the two runs' hysteresis and contact states differ.
-// Axis 3, the rotary axis (issue #29 point 2), steps the same arc on its rotor.
+// Axis 3, the rotary axis, steps the same arc on its rotor.
 void expect_steps_like_the_model(int axis, int direction) {
   SteppingRig rig;
   const auto& sims = rig.platform->simulation();

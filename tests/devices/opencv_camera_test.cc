@@ -1,5 +1,5 @@
 // The real-camera driver (OpenCV's VideoCapture) on a synthetic source: GStreamer's videotestsrc
-// (a moving ball), selected by the configuration like a lab's camera (issue #27).
+// (a moving ball), selected by the configuration like a lab's camera.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A scriptable controller on loopback (port 0) for the vendor drivers' fault tests (issue #30):
+/// A scriptable controller on loopback (port 0) for the vendor drivers' fault tests:
 /// one connection at a time, every line handed to the test's `answer` (what to send back, or to
 /// close, or to say nothing), every line received kept. The thread polls, so that stop() returns
 /// at once whatever the client does.

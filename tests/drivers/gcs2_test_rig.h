@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The pi-gcs2 driver's test rig (issue #30), shared by vendor_driver_test.cc (TCP) and
+/// The pi-gcs2 driver's test rig, shared by vendor_driver_test.cc (TCP) and
 /// serial_line_test.cc (a pseudo-terminal): an E-873-like scriptable controller, the platform's
 /// configuration for it, a console holding control, and the loop run at wall-clock pace.
 

@@ -1,4 +1,4 @@
-// Issue #30, the vendor drivers' serial transport against a pseudo-terminal standing in for the
+// The vendor drivers' serial transport against a pseudo-terminal standing in for the
 // serial line (no USB adapter is involved): the line is opened raw, 8N1, at the configured baud,
 // without flow control unless asked; every read has its deadline; the pi-gcs2 driver configures
 // the platform and moves its axes over the line without allocating in the loop; a path that does
@@ -232,7 +232,7 @@ TEST(SerialLine, UnpluggingTheLineMidMovePutsThePlatformInItsSafeStateWithinOneT
   auto p = platform::make_platform(serial_gcs2_config(fake.server.tty_path()));
   Console console(*p, {30e-6, 0, 0});
   // At least 0.3 s, until engaged: the driver's bus thread, starved beside other paced tests
-  // under ASan, can leave the axes' readings stale for a while (CI-like run, 2026-11-27).
+  // under ASan, can leave the axes' readings stale for a while (seen in a CI-like run).
   run_paced(*p, 3.0, [&] { return p->loop().time_s() >= 0.3 && p->teleop().engaged; });
   ASSERT_FALSE(p->faulted());
   ASSERT_TRUE(p->teleop().engaged);

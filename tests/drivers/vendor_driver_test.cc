@@ -1,4 +1,4 @@
-// Issue #30, the drivers against a scriptable controller in this process (loopback, port 0): the
+// The drivers against a scriptable controller in this process (loopback, port 0): the
 // pi-gcs2 driver runs the whole platform (console goal -> coupling -> MOV; POS? -> measurements)
 // without allocating in the loop, checks the controller's axes at configure, and every bus fault
 // (a reply later than the timeout, a truncated line, garbage, a disconnect mid-move, a controller

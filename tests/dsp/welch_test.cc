@@ -105,7 +105,7 @@ TEST(Welch, RejectsBadOptions) {
   EXPECT_THROW(parse_detrend("linear"), UsageError);
 }
 
-// Issue #31: finite data near the largest double overflow the squared spectrum; the H1 estimate
+// Finite data near the largest double overflow the squared spectrum; the H1 estimate
 // read 0 there (Pxx = inf) instead of failing. Both estimates now fail naming the argument.
 TEST(Welch, AnOverflowingSpectrumFailsNamingTheSignal) {
   std::vector<double> x(512), y(512);

@@ -1,5 +1,5 @@
-// libFuzzer harness: the console's messages as the live server receives them from any client
-// (issue #14): a command or an action is either accepted and within the platform's limits, or
+// libFuzzer harness: the console's messages as the live server receives them from any client:
+// a command or an action is either accepted and within the platform's limits, or
 // refused with one line.
 
 #include <cmath>

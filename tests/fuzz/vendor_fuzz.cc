@@ -1,4 +1,4 @@
-// libFuzzer harness: what a controller sends the vendor drivers (issue #30), and the connection
+// libFuzzer harness: what a controller sends the vendor drivers, and the connection
 // text of the configuration. A reply is either parsed (finite values, whole lines) or refused with
 // one line (mc::Error); the reply framing never reads past its input; never a crash.
 

@@ -1,4 +1,4 @@
-// Image formation measured on rendered images (issue #27): the in-focus PSF's FWHM, the
+// Image formation measured on rendered images: the in-focus PSF's FWHM, the
 // through-focus sharpness curve's width against the depth-of-field formula, the scale, and
 // determinism. Small sensors (the physics does not depend on the pixel count) keep them fast.
 

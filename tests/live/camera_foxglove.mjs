@@ -1,4 +1,4 @@
-// The camera of `microcobot serve` as Foxglove and a ROS 2 tool see it (issue #27):
+// The camera of `microcobot serve` as Foxglove and a ROS 2 tool see it:
 //  - the Foxglove WebSocket client of npm @foxglove/ws-protocol receives /camera/image/compressed
 //    and /camera/camera_info (encoding cdr, ros2msg schemas) and decodes them with
 //    @foxglove/rosmsg2-serialization from the schemas the server advertises (@foxglove/rosmsg

@@ -1,4 +1,4 @@
-// The camera's frames through the live server (issue #27): every frame in the recording as a
+// The camera's frames through the live server: every frame in the recording as a
 // CDR sensor_msgs/msg/CompressedImage (with its CameraInfo and state), none dropped; focus and
 // objective commands through the console's command path.
 #include <gtest/gtest.h>

@@ -56,7 +56,7 @@ TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
   EXPECT_EQ(message_of(R"({"gripper_shake": 1})"), "/console/command: gripper_shake: must be true or false");
 }
 
-// The gripper's release burst (issue #29 point 1): a flag riding on the command, off unless sent.
+// The gripper's release burst: a flag riding on the command, off unless sent.
 TEST(ConsoleCommand, TheGrippersReleaseBurstIsAFlagThatIsOffUnlessSent) {
   const ConsoleLimits limits;
   const ConsoleCommand c =
@@ -68,7 +68,7 @@ TEST(ConsoleCommand, TheGrippersReleaseBurstIsAFlagThatIsOffUnlessSent) {
   EXPECT_FALSE(parse_console_command(R"({"gripper_shake": false})", limits).gripper_shake);
 }
 
-// The rotary axis under the gripper (issue #29 point 2): its goal clamped to its travel, its rate to
+// The rotary axis under the gripper: its goal clamped to its travel, its rate to
 // its speed; refused where there is none, and non-numbers refused naming the key.
 TEST(ConsoleCommand, TheRotaryAxisCommandsAreClampedAndRefusedWithoutTheAxis) {
   ConsoleLimits limits;

@@ -1,6 +1,6 @@
 // The console server with real clients over loopback: the loop's real-time contract while it
 // serves, the command-to-target latency it reports, and the recordings it lists, hands out and
-// reports on (issue #14).
+// reports on.
 #include "microcobot/live/console_server.h"
 
 #include <gtest/gtest.h>
@@ -150,7 +150,7 @@ TEST(ConsoleServer, TheStatusReportsTheCommandToTargetLatency) {
   EXPECT_EQ(latency["count"].get<std::uint64_t>(), 50u) << latency.dump();
   // The loop takes the commands at 1 kHz: half of them reach their target within about a
   // millisecond (a loaded machine may take longer; a sanitized one beside another test's loop
-  // took 43 ms in a cold CI run, 2026-11-27: never ~100 ms).
+  // took 43 ms in a cold CI run: never ~100 ms).
   EXPECT_GT(latency["p50"].get<double>(), 0.0);
   EXPECT_LT(latency["p50"].get<double>(), MC_UNDER_ASAN ? 100.0 : 20.0) << latency.dump();
   EXPECT_LE(latency["p50"].get<double>(), latency["p99"].get<double>());
@@ -264,7 +264,7 @@ TEST(ConsoleServer, ATokenGuardsTheRecordingsAsItGuardsTheWebSocket) {
   EXPECT_EQ(test::http_request(server.port(), "GET", "/").status, 200) << "the page itself is public";
 }
 
-// Issue #26: a refused message's status names it (its id is the message's topic), and the scene
+// A refused message's status names it (its id is the message's topic), and the scene
 // tells the page the force limits and whether the demo can run.
 TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
   Rig rig;

@@ -1,4 +1,4 @@
-// The supervised task through the console server (`serve --cell`, issue #29 point 5): the task_*
+// The supervised task through the console server (`serve --cell`): the task_*
 // actions on /console/action, their refusals (one line each: no task, no control, not started,
 // nothing to confirm), anyone's pause, and the task tree in /platform/status.
 #include "microcobot/live/console_server.h"

@@ -1,4 +1,4 @@
-// `serve` on hardware drivers (issue #14 point 1, docs/hardware.md): the live platform built on the
+// `serve` on hardware drivers (docs/hardware.md): the live platform built on the
 // driver set its configuration selects (platform/driver_registry.h), here the skeleton bench of
 // tests/platform/skeleton_drivers.h, operated from the console in wall-clock time.
 

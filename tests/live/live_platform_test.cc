@@ -88,12 +88,12 @@ TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFre
   // overshoot on a loaded machine, 1.175 s in a cold CI run); behind it only when the machine
   // cannot keep up (sanitizer builds, loaded CI machines), when the loop skips rather than bursts.
   EXPECT_LT(elapsed, wall + 0.05) << "the loop ran ahead of the wall clock (" << wall << " s)";
-  // Under ASan beside another paced test a loop tick can take most of its period (CI-like run,
-  // 2026-11-27: 0.36 s of loop time in 1 s).
+  // Under ASan beside another paced test a loop tick can take most of its period (CI-like run:
+  // 0.36 s of loop time in 1 s).
   EXPECT_GT(elapsed, MC_UNDER_ASAN ? 0.2 : 0.4) << "the loop hardly ran";
 #if MC_UNDER_ASAN
   // Under ASan on a loaded machine this thread's 50 Hz heartbeat can starve past the 0.2 s
-  // timeout: the stage then holds, as it must (asan run, 2026-11-27: 43 um in 0.67 s of loop
+  // timeout: the stage then holds, as it must (an ASan run: 43 um in 0.67 s of loop
   // time). Never faster than asked, and jogging for most of the run.
   EXPECT_LE(moved, 100e-6 * elapsed + 1e-6);
   EXPECT_GT(moved, 0.3 * 100e-6 * elapsed);
@@ -185,7 +185,7 @@ TEST(LivePlatform, TheDemoRestartsTheSceneWithTheScriptedOperatorAndTimeGoesOn) 
   EXPECT_TRUE(std::isfinite(rig.get("part_x_m")));
 }
 
-// Issue #26: a finished demo hands control back with every axis holding, and says how it ended.
+// A finished demo hands control back with every axis holding, and says how it ended.
 TEST(LivePlatform, AFinishedDemoHandsBackWithEveryAxisHoldingAndReportsItsOutcome) {
   LiveParams params;
   params.paced = false;  // as fast as the machine goes: the whole insertion in seconds
@@ -217,7 +217,7 @@ TEST(LivePlatform, AFinishedDemoHandsBackWithEveryAxisHoldingAndReportsItsOutcom
   EXPECT_LT(s.demo_result.placement_error_m, 10e-6);
   EXPECT_GT(s.demo_result.duration_s, 1.0);
   // Once the last motion has settled (half a second), nothing moves for three seconds: no axis
-  // drifts (the issue saw 3.5 um/s of z after the demo), the coupling is off.
+  // drifts (a held stick-slip axis stays within nanometres), the coupling is off.
   const double t_end = get("t_s");
   ASSERT_TRUE(test::eventually([&] { return get("t_s") > t_end + 0.5; }, std::chrono::seconds(60)));
   const double t0 = get("t_s");

@@ -1,4 +1,4 @@
-// The automatic insertion supervised live (issue #29 point 5, `serve --cell`): pausing stops the
+// The automatic insertion supervised live (`serve --cell`): pausing stops the
 // commanded motion at the tick that applies it; taking over is bumpless (the deadman and the
 // gripper the console held before are re-taken first) and the task goes on to insert the pin
 // after the hand-back, ending with every axis holding; a task that loses its supervisor pauses;
@@ -436,7 +436,7 @@ TEST(LiveTask, ATaskThatLosesItsSupervisorPausesAndARestartGivesAFreshOne) {
   EXPECT_EQ(rig.task().step, Step::kApproach);
 }
 
-// Issue #29, a batch in the console: Next part rebuilds the scene on the batch's next part (its
+// A batch in the console: Next part rebuilds the scene on the batch's next part (its
 // world, its neighbours, its goal) with a fresh task, and the task inserts it among the others;
 // after the last part the first comes again. Without a batch the action is refused with one line.
 TEST(LiveTask, NextPartWorksThroughAGridLoadEachAmongItsNeighbours) {

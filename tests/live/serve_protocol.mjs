@@ -1,4 +1,4 @@
-// Protocol test of `microcobot serve` (issue #14) with the Foxglove WebSocket client of npm
+// Protocol test of `microcobot serve` with the Foxglove WebSocket client of npm
 // @foxglove/ws-protocol (pinned): every advertised channel carries a JSON schema its messages
 // satisfy and arrives at its rate. Then hostile clients (malformed JSON, wrong types, 1e308,
 // binary garbage, a 1 MB frame, a burst of 10 000 messages, 200 connections) while the

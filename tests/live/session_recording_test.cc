@@ -1,4 +1,4 @@
-// The recording of a live session (issue #26): every channel with wall-clock log times that
+// The recording of a live session: every channel with wall-clock log times that
 // never go back, events, metadata, the optional CSV; and nothing left when writing fails.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue #28 point 4 live: the grip force measured by vision on the camera's frames (the finger
+// Live: the grip force measured by vision on the camera's frames (the finger
 // tips' distance against the drive's free opening, times the fingers' stiffness) agrees with the
 // simulated gripper's sensor; it is tared at the scene's start and on request; it needs no stage
 // sensor; without frames there is none.
@@ -158,7 +158,7 @@ TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt)
   EXPECT_LT(std::abs(open.vision_N), 20e-6);
 
   // Squeezed at 1, 4 and 7 mN (the free opening w - 2 F / k): the estimate within 5 % of the
-  // sensor (issue #28's bias goal) once the fingers have settled.
+  // sensor (the bias goal) once the fingers have settled.
   for (double force : {1e-3, 4e-3, 7e-3}) {
     rig.opening = w - 2.0 * force / k;
     std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
@@ -183,7 +183,7 @@ TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt)
   EXPECT_LT(std::abs(released.vision_N), 20e-6);
 }
 
-// The contact force (issue #28 point 4): the pin gripped in its bore (10 um of play each side) and
+// The contact force: the pin gripped in its bore (10 um of play each side) and
 // the stage sent past the wall: the fingers bend (microworld/pick_place_world.h), the gripper's
 // sensor feels 2 k times the push, and the camera sees the tips' common bend against where the
 // stage's sensors put the fingers.
@@ -256,7 +256,7 @@ TEST(VisionGripForce, WithoutTheStagesXYSensorsTheTipsAreLookedForWhereThePositi
   EXPECT_TRUE(rig.live.status().vision->found) << rig.live.status().vision->state;
 }
 
-// The fingers turned by the rotary axis (issue #29): while they turn the gauge says so and
+// The fingers turned by the rotary axis: while they turn the gauge says so and
 // measures nothing; still at the new yaw, it measures the held part's grip again (the tips taught
 // there, the gap chained from before the turn) within 5 % of the sensor. A gripper that moved
 // while the fingers turned leaves the gap unknown: the gauge asks for a tare.

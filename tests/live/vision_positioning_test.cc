@@ -1,4 +1,4 @@
-// Issue #28 point 5 live: with `stage.xy_sensor: vision` the console's click-to-go is reached by
+// Live: with `stage.xy_sensor: vision` the console's click-to-go is reached by
 // the visual servo on the camera's frames, x and y stepping open loop (their sensors unused);
 // nothing moves without the deadman; releasing it stops the stage; the goal is judged against
 // the simulation's ground truth (the tips' true position), which the servo never reads; the loop
@@ -151,7 +151,7 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
       1e6 * (goal - start).norm(), static_cast<unsigned long long>(st.commands),
       static_cast<unsigned long long>(st.frames), 1e6 * (arrived - goal).norm(), 1e6 * (arrived - goal).x(),
       1e6 * (arrived - goal).y());
-  // Issue #28: 0.3 um.
+  // 0.3 um.
   // Under ASan a loop tick takes about its period: a run plays longer than planned and may be
   // seen mid-period by the next exposure; there only convergence and rest are asserted.
   const double bound_m = MC_UNDER_ASAN ? 3e-6 : 0.3e-6;
@@ -279,7 +279,7 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
   EXPECT_GT((far_goal - stopped).norm(), 20e-6);  // it did not get there
 }
 
-// The rotary axis turns the fingers about the tool point (issue #28 with #29 point 2): while
+// The rotary axis turns the fingers about the tool point : while
 // they turn, the tips move about the tool point and would read as the stage's motion, so the
 // stage holds; still at 20 deg, the tips are taught again there and the click is reached with
 // the fingers turned.

@@ -12,7 +12,7 @@
 namespace mc::microworld {
 namespace {
 
-// Issue #31: the trap's stiffness is checked against the step like the contact's (a trap
+// The trap's stiffness is checked against the step like the contact's (a trap
 // stiffer than ~1e-2 N/m at 1e-5 s gave wrong corner frequencies with exit 0).
 TEST(OpticalTrap, ATrapThatRelaxesWithinAStepIsRefused) {
   OpticalTrapParams p;
@@ -93,7 +93,7 @@ TEST(OpticalTrap, StuckBeadPushesTheProbeAway) {
   EXPECT_LT(s.bead_m(1), 0.5e-6);
 }
 
-// Issue #26: a bead pushed into a stuck one is held up to the trap's escape force, k r within
+// A bead pushed into a stuck one is held up to the trap's escape force, k r within
 // 20 %, and escapes when pushed harder (it stays behind while the trap moves on).
 TEST(OpticalTrap, APushedBeadEscapesAtTheEscapeForce) {
   const OpticalTrapParams p;

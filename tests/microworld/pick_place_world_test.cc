@@ -163,7 +163,7 @@ TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
   const auto out = move(pin.w, pin.s, pin.g, {2e-3 + 50e-6, 0, 100e-6}, Pin::closed);
   EXPECT_NEAR(pin.s.part_m.x(), 2e-3 + 10e-6, 1e-12) << "against the wall";
   // The wall stops the pin with 1e5 N/m x 1 um = 0.1 N; the fingers feel at most what holds
-  // the pin in them, 2 mu F_grip: beyond it the pin slips between them (issue #26).
+  // the pin in them, 2 mu F_grip: beyond it the pin slips between them.
   const double holds = 2 * pin.w.params().finger_friction * out.grip_force_N;
   ASSERT_GT(out.grip_force_N, 0.0);
   EXPECT_NEAR(out.force_on_gripper_N.x(), -holds, 1e-12)
@@ -178,7 +178,7 @@ TEST(PinInHole, TheHolesWallsStopTheInsertedPinSideways) {
   EXPECT_EQ(pin.s.finger_deflection_m.norm(), 0.0);
 }
 
-// Issue #28 (contact force by vision): along their closing axis the fingers are benders, so a pin
+// Contact force by vision: along their closing axis the fingers are benders, so a pin
 // pushed into its hole's wall bends them (both together, 2 k_finger) before it slips in them.
 TEST(PinInHole, PushedIntoTheWallTheFingersBendBeforeThePinSlipsAndSpringBack) {
   Pin pin;
@@ -223,7 +223,7 @@ TEST(PinInHole, TheHoleMustLeaveClearanceAndHoldThePinAboveTheSubstrate) {
   EXPECT_NEAR(pin_in_hole_scene().part_weight_N(), 8500 * 200e-6 * 200e-6 * 600e-6 * 9.81, 1e-15);
 }
 
-// Orientation (issue #29 point 2): the fingers turned by `yaw` (the rotary axis), steps of 1 ms.
+// Orientation: the fingers turned by `yaw` (the rotary axis), steps of 1 ms.
 PickPlaceOutput turn(const PickPlaceWorld& w, PickPlaceState& s, const Eigen::Vector3d& at, double opening,
                      double from, double to) {
   PickPlaceOutput out;

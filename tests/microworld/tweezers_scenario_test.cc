@@ -42,7 +42,7 @@ TEST(TweezersScenario, RecordsAtTheLoopRateWithTheForceOfTheSpringModel) {
 
 TEST(TweezersScenario, TrapStiffnessFromTheBeadVarianceAndTheCornerFromItsPsd) {
   // Two trap stiffnesses: equipartition k = k_B T / var(y - y_trap) within 10 %, and the PSD
-  // corner within 5 % of k / (2 pi gamma) (the acceptance bound).
+  // corner within 5 % of k / (2 pi gamma) (the acceptance bound).
   for (double k : {1.0e-5, 4.0e-5}) {
     OpticalTrapParams p;
     p.trap_stiffness_N_per_m = k;

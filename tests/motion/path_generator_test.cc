@@ -1,4 +1,4 @@
-// Coordinated XYZ paths (issue #15): lines and arcs under velocity, acceleration and jerk limits,
+// Coordinated XYZ paths: lines and arcs under velocity, acceleration and jerk limits,
 // the path deviation of the three tracked axes.
 #include <cmath>
 #include <numbers>
@@ -68,7 +68,7 @@ TEST(PathGenerator, DistanceToPath) {
                InvalidParams);
 }
 
-// The issue's goal is a deviation <= 200 nm on a 1 mm line at 200 um/s: the RMS is close, the
+// The goal is a deviation <= 200 nm on a 1 mm line at 200 um/s: the RMS is close, the
 // maximum is not reached (the edges' transients, docs/errata.md). Measured figures + margin.
 TEST(PathGenerator, XyzLineOf1mmAt200umPerSecondIsTracked) {
   const Eigen::Vector3d dir = Eigen::Vector3d(0.6, 0.64, 0.48).normalized();

@@ -11,7 +11,7 @@
 namespace mc::motion {
 namespace {
 
-const PositionSensorParams kSensor{};  // 0.1 nm resolution, 1 nm RMS noise (issue #6)
+const PositionSensorParams kSensor{};  // 0.1 nm resolution, 1 nm RMS noise
 
 void expect_goals(double start, double target) {
   const auto run =
@@ -20,8 +20,8 @@ void expect_goals(double start, double target) {
   SCOPED_TRACE(::testing::Message() << "move " << start << " -> " << target);
   EXPECT_TRUE(m.in_position);
   EXPECT_FALSE(m.end_stop);
-  EXPECT_LE(m.final_error_m, 5e-9);  // issue goal
-  EXPECT_LE(m.overshoot_m, 20e-9);   // issue goal
+  EXPECT_LE(m.final_error_m, 5e-9);  // goal
+  EXPECT_LE(m.overshoot_m, 20e-9);   // goal
   // Hold: no stepping and no oscillation beyond the noise-driven jitter (no limit cycle).
   EXPECT_FALSE(m.stepped_in_hold);
   EXPECT_LT(m.hold_pp_m, 5e-9);

@@ -1,4 +1,4 @@
-// Setpoint streaming (issue #15): 1 kHz setpoints, bounded look-ahead, late/missing ones hold.
+// Setpoint streaming: 1 kHz setpoints, bounded look-ahead, late/missing ones hold.
 #include <cmath>
 #include <limits>
 

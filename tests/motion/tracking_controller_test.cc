@@ -1,5 +1,5 @@
-// Trajectory tracking within one step (issue #15): the reference-phased sawtooth against today's
-// hybrid controller and the thesis's PID on the same model, sensor noise and reference.
+// Trajectory tracking within one step: the reference-phased sawtooth against the
+// hybrid position controller and the thesis's PID on the same model, sensor noise and reference.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -31,11 +31,11 @@ studies::TrackingRecord trapezoid(studies::TrackerKind kind, double distance_m, 
       trapezoid_duration_s(std::abs(distance_m), lim) + 0.05);
 }
 
-// The issue's goals: RMS <= 100 nm at 200 um/s, <= 150 nm at 50 and 500 um/s, max <= 250 nm. With
-// the lead judged on the plan and the contact mode damped (issue #31, branch track3; `control
-// trajectory`): RMS 74 nm forward, 85 nm backward; max 227 nm forward (the goal holds; 274 nm
-// before) and 263 nm backward from power-up (272 nm before, 626 nm before the power-up ramp-in):
-// the backward max misses 250 nm (docs/benchmarks.md) and is bounded at its level + ~10 %.
+// The goals: RMS <= 100 nm at 200 um/s, <= 150 nm at 50 and 500 um/s, max <= 250 nm. With
+// the lead judged on the plan and the contact mode damped (`control trajectory`): RMS 74 nm
+// forward, 85 nm backward; max 227 nm forward (the goal holds) and 263 nm backward from power-up
+// (626 nm without the power-up ramp-in): the backward max misses 250 nm (docs/benchmarks.md) and is bounded
+// at its level + ~10 %.
 TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
   for (double d : {100e-6, -100e-6}) {
     SCOPED_TRACE(d);
@@ -43,9 +43,9 @@ TEST(TrackingController, TrapezoidAt200umPerSecondBothDirections) {
     const auto h = trapezoid(studies::TrackerKind::kHybrid, d, 200e-6).metrics;
     EXPECT_LE(t.rms_error_m, 100e-9);
     EXPECT_LE(t.max_error_m, d > 0 ? 250e-9 : 290e-9);
-    EXPECT_LE(t.final_error_m, 5e-9);  // issue goal: final error unchanged
+    EXPECT_LE(t.final_error_m, 5e-9);  // goal: final error <= 5 nm
     EXPECT_LE(t.lag_s, 0.5e-3);
-    EXPECT_LT(t.rms_error_m, 0.1 * h.rms_error_m);  // >= 10x better than today's controller
+    EXPECT_LT(t.rms_error_m, 0.1 * h.rms_error_m);  // >= 10x better than the hybrid controller
     EXPECT_GT(t.edges, 150);                        // it stepped (~0.3-0.4 um per edge)
   }
 }
@@ -135,7 +135,7 @@ TEST(TrackingController, WithoutTheRampInABackwardMoveFromPowerUpStepsWithTheUsu
 }
 
 TEST(TrackingController, AtPowerUpTheDriveIsLiftedToMidRangeWhileThePositionHolds) {
-  // Issue #31: from 0 V a backward move's first edge could not be led (626 nm). The ramp-in lifts
+  // From 0 V a backward move's first edge could not be led (626 nm). The ramp-in lifts
   // the drive into the range by one edge at rest; its drag (the fast rise pulls the slider forward)
   // is caught up by the hold before ready().
   const TrackingParams p;

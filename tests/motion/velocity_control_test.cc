@@ -123,8 +123,8 @@ TEST(VelocityControl, EndStopIsDetectedWithoutWindUpAndEmergencyStopZeroesTheDri
   }
   // stall_periods consecutive stalled periods end it; a slider part that still creeps into the
   // stop (the modal parts are microns apart, docs/errata.md) restarts the count once or twice:
-  // 19 periods at full amplitude in all with the model before issue #31, 26 after its friction
-  // impulse change (a part advanced 0.44 um after the first stalled periods).
+  // 26 periods at full amplitude in all with the default model (a part advanced 0.44 um after the
+  // first stalled periods).
   EXPECT_LE(at_max, VelocityControlParams{}.stall_periods + 8);
 
   VelocityController c(VelocityControlParams{}, VelocityMode::kModelBased, &test::step_map());

@@ -3,10 +3,10 @@
 // telemetry for over 5 s, its threads starved by the two processes' sanitized 10 kHz SCHED_FIFO
 // loops. Both ends in one process run under the sanitizers in tests/net/remote_ends_test.cc.)
 //
-// The distributed platform as a lab runs it (issue #17): `microcobot serve --role slave` and
+// The distributed platform as a lab runs it: `microcobot serve --role slave` and
 // `serve --role master` as real processes joined over DDS on loopback, on this test's own domain
 // id. The operator drives the master's console; the slave's console shows what the stage does.
-// Then the link faults of point 6: a killed master holds the slave, a silent slave disengages the
+// Then the link faults: a killed master holds the slave, a silent slave disengages the
 // master, and a restarted peer re-engages without a jump. (The 8 ms timeouts behind these
 // reactions are asserted in loop time by remote_ends_test.cc: here the link's delivery jitter
 // of a few ms would blur any timing read off the recordings.)
@@ -228,9 +228,9 @@ std::vector<double> column_profile(test::Console& c, std::uint32_t id, int frame
   return profile;
 }
 
-// The microscope of a distributed platform is the slave's (issue #27 over the network): the
-// master's console shows the slave's frames (net/remote_camera.h; before, the master rendered a
-// model of its own with no part in it), and focus and objective set on the master's console move
+// The microscope of a distributed platform is the slave's: the
+// master's console shows the slave's frames (net/remote_camera.h), not a model of its own with
+// no part in it, and focus and objective set on the master's console move
 // the slave process's focus drive and turn its turret (net/microscope_link.h).
 TEST(DistributedServe, TheMastersConsoleSeesAndFocusesTheSlavesMicroscope) {
   test::TempDir dir;

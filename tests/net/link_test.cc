@@ -173,7 +173,7 @@ TEST(Link, TheLoopSideNeverAllocates) {
   EXPECT_GT(slave.stats().received, 0u);
 }
 
-// The watchdogs' DDS verdict (issue #17 point 3: deadline and liveliness feed them).
+// The watchdogs' DDS verdict (deadline and liveliness feed them).
 TEST(Link, APeerIsAliveWhileItsStateFlowsAndNotOnceItFallsSilentOrLeaves) {
   Link master(config(Role::kMaster));
   auto slave = std::make_unique<Link>(config(Role::kSlave));

@@ -1,4 +1,4 @@
-// The microscope's focus drive and turret on DDS (issue #27 point 2, net/microscope_topics.h,
+// The microscope's focus drive and turret on DDS (net/microscope_topics.h,
 // net/microscope_link.h): the joint-state mapping and its refusals, and both ends over a real
 // Cyclone domain of this test process.
 

@@ -1,4 +1,4 @@
-// Time-domain passivity across the two processes (issue #17 point 4): each end outputs only the
+// Time-domain passivity across the two processes: each end outputs only the
 // energy the other has put in and that has arrived; a peer's restart opens a new session; the
 // channel between the two ends never creates energy, whatever the delay, jitter, loss and the
 // signals.

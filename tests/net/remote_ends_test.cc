@@ -1,4 +1,4 @@
-// The two ends of the distributed platform in one process (issue #17): a master live platform
+// The two ends of the distributed platform in one process: a master live platform
 // whose stage is the remote slave (net/remote_slave.h) and a slave live platform driven by the
 // remote master (net/remote_master.h), over DDS on loopback, on this test's domain. Neither loop
 // allocates while the link carries commands and measurements; the master's e-stop latches the
@@ -134,8 +134,8 @@ bool Pair::engage() {
                           30.0);
 }
 
-// 100 ms each way, 10 ms of jitter, 20 % loss: the 200 ms round trip of issue #17's goal.
-// The platform's safety limits (issue #26) keep the fingers 10 um above the substrate, the grip
+// 100 ms each way, 10 ms of jitter, 20 % loss: a 200 ms round trip, the link the platform must stand.
+// The platform's safety limits keep the fingers 10 um above the substrate, the grip
 // under 1 mN and the stage still above a 2 mN contact: the passivity tests below need the stiff
 // contact and the hard grip those limits forbid, so they lift them (a platform with a customer's
 // parts never would).
@@ -163,7 +163,7 @@ TEST(RemoteEnds, TheMastersConsoleMovesTheSlaveAndNeitherLoopAllocates) {
   moves_the_slave_without_allocating(pair);
 }
 
-// Issue #29 point 1: the gripper's release burst over the link. The master's console holds Shake:
+// The gripper's release burst over the link. The master's console holds Shake:
 // the slave's gripper shakes only while the master is engaged (the deadman), and stops when the
 // deadman is let go or the burst is.
 TEST(RemoteEnds, TheMastersShakeReachesTheSlavesGripperOnlyWithTheDeadman) {
@@ -191,7 +191,7 @@ TEST(RemoteEnds, TheMastersShakeReachesTheSlavesGripperOnlyWithTheDeadman) {
   EXPECT_EQ(pair.slave->get("gripper_shaking"), 0.0) << "the burst let go";
 }
 
-// Issue #29 point 2: the rotary axis over the link. The master's console turns the slave's rotary
+// The rotary axis over the link. The master's console turns the slave's rotary
 // axis (the target pose's orientation, a rotation about z) only while the master is engaged, and
 // the master sees the slave's angle (the measured pose's orientation).
 TEST(RemoteEnds, TheMastersConsoleTurnsTheSlavesRotaryAxisOverDds) {
@@ -269,7 +269,7 @@ void moves_the_slave_without_allocating(Pair& pair) {
   EXPECT_EQ(master_cost.count(), 0u);
 }
 
-// Time-domain passivity across the two ends (issue #17 point 4): over a 200 ms round trip with
+// Time-domain passivity across the two ends: over a 200 ms round trip with
 // jitter and 20 % loss, the master's console presses the slave's fingers 5 um into the substrate
 // (a 1e5 N/m contact). The slave reaches the contact 100 ms before the master hears of it, and
 // the master's target has stopped before the force has come back: the master has put in far less
@@ -341,7 +341,7 @@ TEST(RemoteEnds, PassivityControlKeepsTheChannelPassiveOver200msRoundTripWith20P
       protected_.min_observed_master_end_J, protected_.max_contact_N, protected_.dissipated_J);
 }
 
-// The gripper's port (issue #17 point 4): over the same 200 ms round trip with 20 % loss, the
+// The gripper's port: over the same 200 ms round trip with 20 % loss, the
 // master's console closes the slave's fingers on the 300 um part, the opening target ramped from
 // 400 to 150 um over 1 s. The slave's jaws squeeze while the master has not yet heard of the
 // grip force: unprotected, the slave's end outputs energy the master has not put in (with the
@@ -400,7 +400,7 @@ TEST(RemoteEnds, TheGrippersPortKeepsTheGraspPassiveOver200msRoundTripWith20Perc
   EXPECT_GT(protected_.max_grip_N, 0.0) << "protected, the fingers still close on the part";
 }
 
-// The target stream at the slave's end (issue #15 point 4): the master's console jogs at
+// The target stream at the slave's end: the master's console jogs at
 // 200 um/s over a line of 50 ms, 5 ms of jitter and 20 % loss. The slave's target is fitted with
 // a straight line over 1 s: followed as they arrive, the targets stop and jump; through the
 // jitter buffer the slave retraces the master's motion. Returns the RMS off the line and the
@@ -454,7 +454,7 @@ TEST(RemoteEnds, TheSlaveRetracesTheMastersMotionThroughAJitteryLossyLine) {
   // work on the machine (a compiler beside the test: 670 nm at 198 um/s) plays the targets out
   // late. Such a run is repeated, up to three times; an undisturbed one retraces the line. The
   // targets as they arrive are measured again with each try: their roughness depends on how the
-  // real threads met the emulated jitter (115-424 nm in five undisturbed runs on 2026-11-27), and a smooth
+  // real threads met the emulated jitter (115-424 nm in five undisturbed runs), and a smooth
   // draw of it made the bound tighter than the buffered runs' own spread (2-36 nm).
   double raw = 0.0, buffered = 0.0;
   for (int attempt = 0; attempt < 3; ++attempt) {
@@ -648,7 +648,7 @@ TEST(RemoteEnds, ASlaveDoesNotFollowTargetsQueuedWhileItsMasterWasCutOff) {
   EXPECT_TRUE(fresh_again);
 }
 
-// DDS's verdict feeds the watchdog (issue #17 point 3): with no loop time passing at all, a slave
+// DDS's verdict feeds the watchdog: with no loop time passing at all, a slave
 // that stops publishing is let go once its topics miss their deadline, and taken back when they
 // flow again; a slave whose process is gone is let go too.
 TEST(RemoteEnds, AMasterLetsGoOfASlaveWhoseTopicsMissTheirDdsDeadline) {

@@ -58,7 +58,7 @@ TEST(RosMapping, PoseStampedRoundTripsInMetresWithTheStageFrameAndIdentityOrient
   EXPECT_EQ(back.xyz, pose_sample().xyz);
 }
 
-// The rotary axis' angle rides as the pose's orientation, a rotation about z (issue #29 point 2).
+// The rotary axis' angle rides as the pose's orientation, a rotation about z.
 TEST(RosMapping, APosesYawIsARotationAboutZAndAnyOtherRotationIsRefused) {
   NetSample s = pose_sample();
   s.yaw_rad = -0.75;

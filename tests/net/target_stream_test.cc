@@ -1,4 +1,4 @@
-// The master's targets at the slave's end (issue #15 point 4 over the network link): through
+// The master's targets at the slave's end (over the network link): through
 // the jitter buffer, a ramp sent at 1 kHz over a line with delay, jitter, loss and a clock offset
 // comes out as the same ramp, delayed; followed as the targets arrive, it stops and jumps.
 #include "microcobot/net/target_stream.h"

@@ -1,5 +1,5 @@
-// The distributed platform on two hosts (issue #17: "the operator's desk and the microscope stage on
-// different computers"). One machine is all a test has, so the two hosts are two Linux network
+// The distributed platform on two hosts (the operator's desk and the microscope
+// stage on different computers). One machine is all a test has, so the two hosts are two Linux network
 // namespaces: each its own network stack (interfaces, addresses, routes, its own loopback), joined
 // only by a virtual cable (a veth pair) with the addresses 198.18.0.1 (desk) and 198.18.0.2
 // (bench), from RFC 2544's benchmarking range, which no real network routes. Each `serve` is told

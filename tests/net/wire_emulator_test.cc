@@ -1,4 +1,4 @@
-// The link emulator between two processes (issue #17 point 4): delay, jitter and loss applied to
+// The link emulator between two processes: delay, jitter and loss applied to
 // what the DDS link delivers, per topic, losing only best-effort samples.
 #include "microcobot/net/wire_emulator.h"
 

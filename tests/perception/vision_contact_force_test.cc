@@ -1,4 +1,4 @@
-// Issue #28 point 4, the contact force by vision: a lateral force on the fingers along their closing
+// The contact force by vision: a lateral force on the fingers along their closing
 // axis bends both tips together (microworld/pick_place_world.h), and the grip gauge reads the bend
 // as the tips' midpoint against the tool point the stage's sensors give, times 2 k_finger. Judged
 // here on rendered frames with a known bend (the camera's renderer, the live gauge): bias within 5 %
@@ -151,7 +151,7 @@ TEST(VisionContactForce, TheTipsCommonBendReadsTheContactForceWithinFivePercent)
                                     << ", " << c.stage.y() * 1e6 << ") um");
     EXPECT_LT(std::abs(f.mean - truth), 0.05 * std::abs(truth))
         << "read " << f.mean * 1e6 << " uN of " << truth * 1e6;
-    // Issue #28's noise goal, for the common mode's stiffness 2 k: within 2x of 2 k times a tip's
+    // The noise goal, for the common mode's stiffness 2 k: within 2x of 2 k times a tip's
     // tracking noise, sd_gap / sqrt(2) (the two tips' errors taken as independent).
     const double tracking_m = w.sd / std::sqrt(2.0);
     EXPECT_LT(f.sd, 2.0 * k2 * tracking_m) << "noise " << f.sd * 1e6 << " uN, gap sd " << w.sd * 1e9 << " nm";

@@ -1,4 +1,4 @@
-// Issue #29 point 2: the rotary axis under the gripper on the platform. The console turns it to a
+// The rotary axis under the gripper on the platform. The console turns it to a
 // goal through the stick-slip model and the stage controller's fourth channel; nothing turns
 // without the console's deadman; hold() and faults leave it holding at 0 V like the other axes.
 

@@ -1,4 +1,4 @@
-// Issue #26: the platform's safety invariants, on the whole simulated platform (the coupling,
+// The platform's safety invariants, on the whole simulated platform (the coupling,
 // the stage controller, the stick-slip axes, the gripper in its microworld), whatever the
 // console or the scripted operator asks: nothing moves without the deadman, grip and contact
 // forces stay under their limits, the finger tips never reach the substrate, an automatic

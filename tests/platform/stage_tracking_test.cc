@@ -1,4 +1,4 @@
-// The stage controller with the tracking controller on its axes (issue #15, stage.tracking_enabled):
+// The stage controller with the tracking controller on its axes (stage.tracking_enabled):
 // a teleoperation-like moving target at the 1 kHz slave rate, the tracking controllers updated at
 // every 10 kHz loop tick on the axis positions (drive(i, measured)), as the platform runs them.
 #include <cmath>

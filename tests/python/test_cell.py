@@ -1,4 +1,4 @@
-"""microcobot.cell (issue #29 points 6-7): the binding's contract, and a campaign on Dask giving the
+"""microcobot.cell: the binding's contract, and a campaign on Dask giving the
 serial run's results field for field (serial in this process, the local process pool, a
 LocalCluster of 2 worker processes on loopback), the serial run itself equal to the CLI's."""
 
@@ -120,7 +120,7 @@ def test_the_gil_is_released_while_a_cycle_simulates():
 
 
 def test_a_cycle_stepped_from_python_is_the_batchs_and_takes_the_operators_controls(serial):
-    """A task from Python (issue #29 point 5): stepped, it is the batch's cycle; paused, the stage
+    """A task from Python: stepped, it is the batch's cycle; paused, the stage
     holds; a step set to `confirm` waits for the caller's go; the controls are the automatic task's."""
     b = cell.Batch(parts=CONFIG["parts"], seed=SEEDS[0])
     c = cell.Cycle(b, 0, mode="auto")

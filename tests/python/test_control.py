@@ -63,7 +63,7 @@ def test_position_run_gets_in_position(plant):
 
 
 def test_streamed_setpoints_are_followed_closer_than_todays_controller_follows_them(plant):
-    # A 20 um ramp at 200 um/s streamed at 1 kHz from Python (issue #15 item 4), then held.
+    # A 20 um ramp at 200 um/s streamed at 1 kHz from Python, then held.
     t = np.arange(0, 0.15, 1e-3)
     setpoints = np.clip(200e-6 * t, 0.0, 20e-6)
     runs = {k: control.run_tracking(plant, setpoints, tracker=k) for k in ("tracking", "hybrid")}

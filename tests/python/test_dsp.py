@@ -123,7 +123,7 @@ def test_bad_inputs_raise_value_error():
 
 
 def test_an_overflowing_spectrum_raises_instead_of_reading_zero():
-    # Issue #31: finite data near 1e308 overflow the squared spectrum; H1 read 0 there.
+    # Finite data near 1e308 overflow the squared spectrum; H1 read 0 there.
     import microcobot
 
     n = np.arange(512)

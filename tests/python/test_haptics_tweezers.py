@@ -89,6 +89,6 @@ def test_teletweez_bandwidth_identification_reproduces_fig_4_25():
 
 
 def test_a_lead_whose_angle_rounds_to_90_degrees_is_named_as_the_lead():
-    # Issue #31: the error named the derived lead_angle_rad, not the lead the caller gave.
+    # The error named the derived lead_angle_rad, not the lead the caller gave.
     with pytest.raises(ValueError, match="lead_m: too large for diameter_m"):
         tweezers.ball_screw_efficiency(0.006, 1e20, 0.1)

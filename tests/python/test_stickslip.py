@@ -1,4 +1,4 @@
-"""microcobot.stickslip: parameters, simulate, rollout and the error contract (issue #16)."""
+"""microcobot.stickslip: parameters, simulate, rollout and the error contract."""
 
 import copy
 import csv

@@ -85,7 +85,7 @@ def test_bad_input_names_what_was_given(cli, tmp_path):
     assert not (tmp_path / "bad").exists()
 
 
-# ---- what the frames measure (issue #28) --------------------------------------------------------
+# ---- what the frames measure --------------------------------------------------------
 
 def _tool_frame(x_um, y_um, seed_frame):
     # 10x, the focus on the gripper's tips (450 um above the substrate), the tool at (x, y).
@@ -227,7 +227,7 @@ def test_visual_servo_holds_when_the_feature_is_lost_and_refuses_bad_input():
 
 
 def test_the_rotary_axis_turns_the_fingers_about_the_tool_point_and_the_part_with_them():
-    """Issue #29 point 2: the camera sees the fingers turned about the tool point (the rotary axis
+    """The camera sees the fingers turned about the tool point (the rotary axis
     under the gripper) and the part at its yaw; turning moves grey level around, it does not add or
     remove any (the same objects, the same areas), and the turned fingers' tips end where the turn
     puts them."""

@@ -22,7 +22,7 @@ namespace {
 TEST(Actuator, DefaultParamsMatchTable28) {
   const StickSlipParams p;
   EXPECT_NO_THROW(p.validate());
-  EXPECT_NEAR(p.pe.natural_frequency_a_Hz(), 64.4e3, 0.1e3);  // DESIGN errata 1
+  EXPECT_NEAR(p.pe.natural_frequency_a_Hz(), 64.4e3, 0.1e3);  // K_pa in N/m (docs/errata.md)
   EXPECT_NEAR(p.pe.natural_frequency_b_Hz(), 119.7e3, 0.1e3);
   EXPECT_NEAR(std::sqrt(p.friction.rho0_a_N_m / p.slider.mass_kg) / (2 * M_PI), 600.6, 0.5);
   EXPECT_NEAR(std::sqrt(p.friction.rho0_b_N_m / p.slider.mass_kg) / (2 * M_PI), 1639.0, 1.0);
@@ -131,9 +131,9 @@ TEST(Actuator, ExternalLoadPushesTheSlider) {
 
 TEST(Actuator, AStepThatCannotResolveTheContactIsRefused) {
   StickSlipParams p;
-  // A coupling spring far beyond the explicit update's stability limit (omega h >> 2): it used to
-  // diverge (NaN) during the run; validation now refuses it up front, naming the parameter and
-  // the largest value the step allows (issue #13).
+  // A coupling spring far beyond the explicit update's stability limit (omega h >> 2) would
+  // diverge (NaN) during the run; validation refuses it up front, naming the parameter and
+  // the largest value the step allows.
   p.friction.coupling_stiffness_N_m = 1e12;
   p.integrator.substeps = 1;
   try {
@@ -207,8 +207,8 @@ TEST(BreakawayTable, InterpolatesAndClamps) {
   EXPECT_NEAR(t.lookup(30, 100, Direction::kBackward), 5e-7, 1e-20);
   const BreakawayTable d = default_breakaway_table();
   EXPECT_NO_THROW(d.validate());
-  // The default surface is affine in A and in log f: reproduced exactly off the grid (issue #5's
-  // held-out frequencies), e.g. 70 V / 300 Hz between the 500 Hz column and the 100 Hz one.
+  // The default surface is affine in A and in log f: reproduced exactly off the grid (the
+  // identification's held-out frequencies), e.g. 70 V / 300 Hz between the 500 Hz column and the 100 Hz one.
   const double k300 = 1.0 - 0.03 * std::log10(300.0 / 50.0);
   EXPECT_NEAR(d.lookup(70, 300, Direction::kForward), (365e-9 + 2e-9 * 70) * k300, 1e-21);
   EXPECT_NEAR(d.lookup(75, 300, Direction::kBackward), (372e-9 + 2e-9 * 75) * k300, 1e-21);
@@ -240,7 +240,7 @@ TEST(Cli, ParamsSimulateAndErrors) {
   const auto s = nlohmann::json::parse(r.out);
   EXPECT_LT(s["final_position_m"].get<double>(), 0.0);
   EXPECT_LT(s["mean_velocity_m_s"].get<double>(), 0.0);
-  // Issue #31: a 20 V drive does not step. Its power-up slip (~0.26 um in the first period) is
+  // A 20 V drive does not step. Its power-up slip (~0.26 um in the first period) is
   // first_period_displacement_m; the mean velocity is over the whole periods after it (~0; it
   // was 9.1 um/s when the first period counted).
   r = test::run_cli({"stickslip", "simulate", "--wave", "sawtooth", "--amplitude", "20", "--frequency", "200",
@@ -271,7 +271,7 @@ TEST(Cli, ParamsSimulateAndErrors) {
   r = test::run_cli({"stickslip", "params", "--params", (dir / "bad.yaml").string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("pe.mass_kg"), std::string::npos);
-  // A contact the step cannot resolve: refused up front (exit 3), no NaN on stdout (issue #13).
+  // A contact the step cannot resolve: refused up front (exit 3), no NaN on stdout.
   test::write_text(dir / "stiff.yaml",
                    "friction:\n  coupling_stiffness_N_m: 1.0e12\nintegrator:\n  substeps: 1\n");
   r = test::run_cli(

@@ -1,4 +1,4 @@
-// The round trip of issue #5: a campaign simulated on an axis unlike the defaults, with the
+// The identification round trip: a campaign simulated on an axis unlike the defaults, with the
 // sensor effects of §2.5.1, identified by the three steps of §2.5.2; the identified axis
 // reproduces held-out sawtooth runs. Also the directory contracts (bad input, skipped runs).
 #include <atomic>
@@ -103,10 +103,10 @@ double steady_step(const ActuatorModel& m, double amplitude, double frequency, D
 }
 
 TEST(IdentAll, NearThresholdDrivesRelyOnExtrapolatedNotCopiedCells) {
-  // Issue #31: the default axis's full campaign (`identify synth --grid full`, realistic noise:
-  // 0.3 nm, 0.5 V). The backward runs below ~45 V never step at 50-100 Hz; their cells used to
-  // take the nearest stepping cell's z_ba (50 V: too high by the slope x 10 V), so the 45 V
-  // 150 Hz backward drive, just above the threshold, stepped 17 % short of the truth. Now those
+  // The default axis's full campaign (`identify synth --grid full`, realistic noise:
+  // 0.3 nm, 0.5 V). The backward runs below ~45 V never step at 50-100 Hz; were their cells to
+  // take the nearest stepping cell's z_ba (50 V: too high by the slope x 10 V), the 45 V
+  // 150 Hz backward drive, just above the threshold, would step 17 % short of the truth. So those
   // cells are extrapolated along the stepping cells' line in amplitude and reported as such.
   const StickSlipParams truth;
   CampaignPlan plan;

@@ -78,7 +78,7 @@ MeasuredRecord noisy_sine(const ActuatorModel& m, double voltage_noise_V, double
 }
 
 TEST(IdentHysteresis, FromRestIsDecidedFromTheWholeRecordUnderRealisticNoise) {
-  // Issue #31: with 0.4-0.5 V of voltage noise, deciding "from rest" from the first samples
+  // With 0.4-0.5 V of voltage noise, deciding "from rest" from the first samples
   // flipped in 34-49 % of noise draws, and 1 % of two-period records were refused as lacking a
   // full excursion. Over 40 draws at 0.5 V each way, >= 95 % are decided right and none fails;
   // the identified loop predicts the truth's sine (clean simulations, identified PI and g) within

@@ -1,6 +1,6 @@
-// The thesis's chapter-2 experiments on the default model (§2.5, Fig. 2.10-2.17), with the
-// numeric checks of issue #4, and the fixed-step integrator's error against the odeint reference.
-#include "microcobot/studies/experiments.h"
+// The thesis's chapter-2 experiments on the default model (§2.5, Fig. 2.10-2.17), with their
+// numeric checks, and the fixed-step integrator's error against the odeint reference.
+#include "microcobot/stickslip/experiments.h"
 
 #include <cmath>
 
@@ -95,7 +95,7 @@ TEST(Experiments, PsdDominatedByTheDriveFrequency) {
 }
 
 TEST(Integrator, FixedStepWithinOnePercentOfReference) {
-  // The acceptance of issue #4: slider RMS error < 1% of its range at the default step.
+  // Acceptance: slider RMS error < 1% of its range at the default step.
   const stickslip::StickSlipParams p;
   const stickslip::ActuatorModel m(p);
   struct Case {

@@ -1,4 +1,4 @@
-// Force by vision against the simulation's grip force (issue #28 point 4): over 1-20 mN on the
+// Force by vision against the simulation's grip force: over 1-20 mN on the
 // validation set (set seed 2 of `microcobot vision force`; the templates were shaped on set 1),
 // bias <= 5 % of the true force and noise <= 2 x k x the tips' tracking noise; a force the
 // gripper cannot squeeze refused.

@@ -1,4 +1,4 @@
-// The drive between grid points (issue #12): waveforms list their corners exactly, the mode
+// The drive between grid points: waveforms list their corners exactly, the mode
 // discretisation used for split steps equals the matrix exponential, the step no longer
 // depends on where the corners fall on the grid, and the default step's accuracy against the
 // reference solver over drives drawn at random.
@@ -147,7 +147,7 @@ TEST(Integrator, StepDoesNotDependOnWhereTheCornersFall) {
 }
 
 TEST(Integrator, DefaultStepMatchesTheReferenceOnRandomDrives) {
-  // Issue #12's acceptance: 40 drives (amplitude 10-100 V, 20-2000 Hz, both directions, sines,
+  // Acceptance: 40 drives (amplitude 10-100 V, 20-2000 Hz, both directions, sines,
   // steps) at the default step: slider RMS error <= 1 % of its range for every drive, and the
   // net step per period within 2 %. A drive that does not step (creep below the threshold, a
   // sine, a backward drive whose two slips nearly cancel) is judged against 10 % of its range:
@@ -176,7 +176,7 @@ TEST(Integrator, DefaultStepMatchesTheReferenceOnRandomDrives) {
 }
 
 TEST(Integrator, EveryDriveOfTheSeed7StudyStepsWithinTwoPercentAtTheSteadyState) {
-  // Issue #31: `stickslip accuracy --drives 200 --seed 7`, the net step per period over the
+  // `stickslip accuracy --drives 200 --seed 7`, the net step per period over the
   // periods after the power-up one (DriveAccuracy), within 2 % of the reference for every drive
   // (release build: ~2.5 s of CPU). Measured from the start, the first period's slip diluted a
   // fast backward drive's error (85 V 730 Hz: 1.06 % over 7 periods from rest, 2.7 % per steady
@@ -203,9 +203,9 @@ TEST(Integrator, EveryDriveOfTheSeed7StudyStepsWithinTwoPercentAtTheSteadyState)
               steady);
   EXPECT_LE(worst, 0.02) << worst_drive;
   EXPECT_GE(steady, 150);
-  // The issue's drive, judged raw as well (its 115 nm step is under a tenth of its range, so the
-  // study's normalisation judges it against the range): 2.7 % before the damping's impulse took
-  // this step's PE velocity (docs/benchmarks.md).
+  // A fast backward drive, judged raw as well (its 115 nm step is under a tenth of its range, so the
+  // study's normalisation judges it against the range): its step depends on the damping's impulse
+  // taking this step's PE velocity (stickslip/actuator.cc, docs/benchmarks.md).
   const AccuracyDrive fast{stickslip::make_waveform(stickslip::WaveKind::kSawtooth, 85, 730,
                                                     stickslip::Direction::kBackward, m.params().drive),
                            4.0 / 730};

@@ -1,4 +1,4 @@
-// Tracking that generalises (issue #31 point 1): the seeded tuning and validation sets, and the
+// Tracking that generalises: the seeded tuning and validation sets, and the
 // tracking controller judged on the validation set (never tuned on it).
 #include <algorithm>
 #include <cstdio>
@@ -112,7 +112,7 @@ TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
     results.push_back(run_case(motion::test::model(), motion::test::step_map(), su, all[i], goals));
     SCOPED_TRACE(all[i].name + ": " + describe(all[i]));
     if (all[i].profile != CaseProfile::kSine) {
-      EXPECT_LE(results.back().final_m, 5e-9);  // at rest: #15's goal
+      EXPECT_LE(results.back().final_m, 5e-9);  // at rest: the final-error goal
     }
   }
   const ValidationSummary s = summarise(cases, results, goals);
@@ -121,12 +121,12 @@ TEST(ValidationSet, AReducedRandomValidationSubsetMeetsTheTrackingGoals) {
       "nm\n",
       s.passed, s.cases, s.median_rms_m * 1e9, s.worst_rms_m * 1e9, s.worst_max_m * 1e9,
       s.worst_path_deviation_m * 1e9, s.worst_powerup_backward_m * 1e9);
-  // Hold on the full validation set (median 99 nm, power-up backward 208 nm; branch track3's
+  // Hold on the full validation set (median 99 nm, power-up backward 208 nm, with the
   // lead on the plan and resonant damping): the goals themselves.
   EXPECT_TRUE(s.median_ok) << s.median_rms_m;
   EXPECT_TRUE(s.powerup_ok) << s.worst_powerup_backward_m;
   // Do not hold on the full validation set (worst RMS 219 nm, max 642 nm, path deviation 382 nm:
-  // docs/benchmarks.md; before track3 403, 916 and 547 nm); bounded at the measured level with
+  // docs/benchmarks.md); bounded at the measured level with
   // ~10 % margin, so that a regression fails.
   EXPECT_LE(s.worst_rms_m, 240e-9);
   EXPECT_LE(s.worst_max_m, 700e-9);

@@ -1,4 +1,4 @@
-// A pick-and-place by the visual servo alone, the XY encoders off (issue #28 point 5): the part
+// A pick-and-place by the visual servo alone, the XY encoders off: the part
 // placed within 1 um of its target and every axis holding at the end, on starts and targets of the
 // validation draw (the sequence was set up on `vision pick-place --set-seed 1`) and on a scene it
 // was not set up on (scenes/small-part.yaml's 200 um cube); a sequence that cannot finish stops

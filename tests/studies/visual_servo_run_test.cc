@@ -1,4 +1,4 @@
-// Visual servoing with the stage's encoders off (issue #28 point 5), closed on rendered frames:
+// Visual servoing with the stage's encoders off, closed on rendered frames:
 // the tips brought over the part from 50 um away within 30 frames to <= 0.3 um, with a 5 %
 // calibration error too, holding still while the gripper is hidden. Starts from the validation
 // set (start seed 2; the gain was chosen on start seed 1).

@@ -1,4 +1,4 @@
-// Model-mediated teleoperation (issue #31): the slave's contact estimate, the master model's
+// Model-mediated teleoperation: the slave's contact estimate, the master model's
 // passivity, and the delay sweep's settling at 200 ms round trip with jitter and loss, where
 // TDPA alone limit-cycles and the unprotected loop is unstable.
 #include <gtest/gtest.h>
@@ -122,7 +122,7 @@ TEST(DelayedTeleoperation, ModelMediatedContactSettlesAt200msWithJitterAndLoss) 
       EXPECT_NEAR(r.final_model_wall_m, p.wall_m, 1e-6) << "the slave's estimate reached the master";
     }
   }
-  // TDPA alone does not settle there (issue #31's measurement), and the unprotected loop is
+  // TDPA alone does not settle there (measured), and the unprotected loop is
   // unstable, whatever the seed.
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     const auto tdpa = run(0.2, 0.2, Scheme::kTdpa, seed), none = run(0.2, 0.2, Scheme::kNone, seed);

@@ -1,4 +1,4 @@
-// The coupling over a delayed, lossy link (issue #17): the link emulator's contract, the
+// The coupling over a delayed, lossy link: the link emulator's contract, the
 // passivity controllers' energy bounds, and the delay sweep's physics: the unprotected loop goes
 // unstable in stiff contact as the delay grows, the protected one stays passive.
 #include "microcobot/teleop/delayed_teleoperation.h"

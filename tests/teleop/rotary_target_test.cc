@@ -1,4 +1,4 @@
-// Issue #29 point 2: the rotary axis' command. The target moves only with the console's deadman
+// The rotary axis' command. The target moves only with the console's deadman
 // held and fresh commands, at a bounded slew, within the axis' travel; hold_at() takes it where the
 // axis is.
 

@@ -82,7 +82,7 @@ TEST(SafetyLimits, RejectsBadLimits) {
   EXPECT_THROW(SafetyLimits{p}, InvalidParams);
 }
 
-// Issue #26: nothing of the slave moves without the deadman, the gripper included.
+// Nothing of the slave moves without the deadman, the gripper included.
 TEST(Teleoperation, TheGripperHoldsWithoutTheDeadmanWhateverTheConsoleOrTheTweezersSay) {
   Teleoperation t(TeleoperationParams{}, kDt, {0, 0, 0}, 600e-6);
   TeleoperationInput in;

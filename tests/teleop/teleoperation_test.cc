@@ -216,7 +216,7 @@ TEST(Teleoperation, TheGrippersReleaseBurstPassesOnlyFromAnEngagedConsoleThatHas
 }
 
 // A neighbouring part's keep-out region (virtual_fixtures.h): a hand that sweeps the slave across
-// it low, trembling (8-12 Hz, 100 um RMS at the hand, issue #29) and rolling the wheel down, never
+// it low, trembling (8-12 Hz, 100 um RMS at the hand) and rolling the wheel down, never
 // puts the target inside; above the part's top it passes over; nothing jumps on leaving.
 TEST(Teleoperation, UnderTremorTheTargetNeverEntersANeighboursKeepOutAndNeverJumps) {
   TeleoperationParams p;

@@ -75,7 +75,7 @@ FixtureSet path_to(const Eigen::Vector2d& from, const Eigen::Vector2d& to, doubl
   return f;
 }
 
-// Guidance along a path (issue #29 point 4, "along a path"): within R of the segment the slave
+// Guidance along a path: within R of the segment the slave
 // sits on it at the hand's place along it (motion along is free, across is taken out); beyond its
 // end the end is the point guide; beyond 2R the hand's; no jump as the target crosses the field.
 TEST(VirtualFixtures, AlongAPathMotionAlongIsFreeAndMotionAcrossIsTakenOut) {

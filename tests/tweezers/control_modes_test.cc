@@ -54,7 +54,7 @@ TEST(ManualMode, RejectsBadParams) {
   EXPECT_THROW(simulate_manual_mode(TeleTweezParams{}, p), InvalidParams);
 }
 
-// Issue #31: the object's spring acts on the tip explicitly; a stiffness the plant step cannot
+// The object's spring acts on the tip explicitly; a stiffness the plant step cannot
 // resolve diverged (exit 4) or held forces hundreds of newtons off (exit 0).
 TEST(ManualMode, AnObjectTooStiffForThePlantStepIsRefused) {
   const TeleTweezParams mp;

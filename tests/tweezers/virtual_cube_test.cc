@@ -77,7 +77,7 @@ TEST(VirtualCube, CompensatorAtLeastDoublesTheStiffness) {
   EXPECT_GT(max_chatter_free_stiffness(TeleTweezParams{}, c, 500, 1e6, 10), bare);
 }
 
-// Issue #31: a wall beyond the loop's Nyquist frequency is refused where the renderer is made
+// A wall beyond the loop's Nyquist frequency is refused where the renderer is made
 // (1e308 N/m reported no chatter with wall forces of 2e303 N), and the sweep stops below it.
 TEST(VirtualCube, AWallBeyondTheLoopsNyquistFrequencyIsRefused) {
   const TeleTweezParams p;

@@ -1,4 +1,4 @@
-// Issue #30: the ANC300 console codec and twin against a fake stage: login, echo, OK/ERROR
+// The ANC300 console codec and twin against a fake stage: login, echo, OK/ERROR
 // lines as pymeasure's adapter reads them, modes, stepping and stepw.
 
 #include <gtest/gtest.h>
@@ -102,7 +102,7 @@ TEST(Anc300Twin, HaltedAndOutrankedStepsAnswerError) {
   EXPECT_EQ(rig.ask("stepu 2 10"), "Another operator controls the stage\r\nERROR\r\n");
 }
 
-// Issue #29 point 2: the rotary positioner (theta) on axis 4, stepped like the others.
+// The rotary positioner (theta) on axis 4, stepped like the others.
 TEST(Anc300Twin, TheRotaryPositionerStepsOnAxis4) {
   Anc300Rig rig;
   EXPECT_EQ(rig.ask("getm 4"), "mode = gnd\r\nOK\r\n");

@@ -1,4 +1,4 @@
-// Issue #30: our drivers against our twins in separate processes. A `microcobot serve --emulate
+// Our drivers against our twins in separate processes. A `microcobot serve --emulate
 // gcs2=127.0.0.1:0 --emulate anc300=127.0.0.1:0` child is the controller (its port read from its
 // stdout line `emulate gcs2 127.0.0.1:PORT`); this process runs a platform whose axes are
 // `pi-gcs2` (or `anc300`) on it, the console holding a goal. The twin's stage, read independently
@@ -288,7 +288,7 @@ TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableController
   EXPECT_EQ(r.err.find("microcobot: error:"), r.err.rfind("microcobot: error:"));
 }
 
-// Issue #29 point 2: the rotary axis on the controller's rotation stage (option theta=4): the
+// The rotary axis on the controller's rotation stage (option theta=4): the
 // console's theta goal turns the twin's axis 4, read through the twin's own port (POS? 4, deg), and
 // the platform's rotary axis reads it back.
 TEST(DriverTwin, ThePiGcs2DriverTurnsTheTwinsRotationStage) {

@@ -1,4 +1,4 @@
-// Issue #30: the GCS 2.0 codec and twin, line by line against a fake stage: the syntax of PI's
+// The GCS 2.0 codec and twin, line by line against a fake stage: the syntax of PI's
 // manuals (multi-line replies, daisy-chain prefixes, single bytes) and the error register.
 
 #include <gtest/gtest.h>
@@ -139,7 +139,7 @@ TEST(Gcs2Twin, DaisyChainAddressesAreHonoured) {
   EXPECT_EQ(rig.ask("1 ERR?"), "0 1 0\n");
 }
 
-// Issue #29 point 2: the rotary axis under the gripper as the controller's fourth axis, a rotation
+// The rotary axis under the gripper as the controller's fourth axis, a rotation
 // stage in degrees (PUN?), its limits the platform's +-62 deg (1.08 rad) and 0.16 rad/s.
 struct Gcs2ThetaRig : Gcs2Rig {
   Gcs2ThetaRig() {

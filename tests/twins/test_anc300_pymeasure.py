@@ -1,8 +1,8 @@
-"""Issue #30: Debian's pymeasure ANC300 driver (ANC300Controller over its telnet adapter) drives the
+"""Debian's pymeasure ANC300 driver (ANC300Controller over its telnet adapter) drives the
 ANC300 twin of `microcobot serve --emulate anc300`: it logs in with the factory password, sets
 frequency and voltage, steps N up and N down (Axis.move: setm stp, stepu/stepd, stepw, setm gnd);
 the stage moves what the stick-slip model says for the same drive (`microcobot stickslip simulate`).
-Issue #29 point 2: the rotary positioner on axis 4 (theta) turns by the model's arc at its radius."""
+The rotary positioner on axis 4 (theta) turns by the model's arc at its radius."""
 
 import json
 import math

@@ -1,4 +1,4 @@
-"""Issue #30: the GCS 2.0 twin against independent clients: pyvisa-py (TCPIP SOCKET resource) and a
+"""The GCS 2.0 twin against independent clients: pyvisa-py (TCPIP SOCKET resource) and a
 raw-socket script replay the golden transcripts of tests/data/gcs2 (written from PI's public
 manuals; sources in each file) against `microcobot serve --emulate gcs2`."""
 

@@ -1,4 +1,4 @@
-"""Shared helpers of the twins' client tests (issue #30): a `microcobot serve --emulate` process on
+"""Shared helpers of the twins' client tests: a `microcobot serve --emulate` process on
 loopback port 0, and the golden-transcript player (tests/data/gcs2/*.txt, syntax in their headers)."""
 
 import os

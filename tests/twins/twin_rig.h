@@ -1,5 +1,5 @@
 #pragma once
-// The vendor twins' live rig (issue #30): a blocking loopback client and the live platform with
+// The vendor twins' live rig: a blocking loopback client and the live platform with
 // both twins served on loopback port 0.
 
 #include <arpa/inet.h>

@@ -1,4 +1,4 @@
-// Issue #29 point 2: the rotary axis under the gripper through the vendor twins on the live platform
+// The rotary axis under the gripper through the vendor twins on the live platform
 // (paced loop, loopback): a GCS 2.0 client turns theta (axis 4, deg) and the platform's own sensor,
 // read from its telemetry, ends within the stage's tolerance of the goal; a goal beyond the travel
 // is refused and nothing turns; a client that disconnects mid-turn leaves theta holding; an ANC300

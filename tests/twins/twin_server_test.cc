@@ -1,4 +1,4 @@
-// Issue #30: the twins served on the live platform (paced loop, loopback, port 0), through raw
+// The twins served on the live platform (paced loop, loopback, port 0), through raw
 // sockets: a GCS closed-loop move reaches its target and reports ONT; an ANC300 login; the safety
 // rules (e-stop, a console user in control, a client that disconnects mid-move); and hostile
 // clients (garbage, huge lines, slowloris, half-closed sockets, a client that never reads, too

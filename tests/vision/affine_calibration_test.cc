@@ -1,4 +1,4 @@
-// The pixel <-> stage affine fit (issue #28 point 1): a known map with a rotation, separate
+// The pixel <-> stage affine fit: a known map with a rotation, separate
 // scales and a shear recovered from noisy tracked points; its figures; bad point sets refused.
 
 #include <cmath>

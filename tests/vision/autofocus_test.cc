@@ -1,4 +1,4 @@
-// Autofocus (issue #28, point 3): the goal (from 100 um out of focus, within 15 frames, the focus
+// Autofocus: the goal (from 100 um out of focus, within 15 frames, the focus
 // error under a fifth of the depth of field and 0.3 um at 10x) on rendered frames with the
 // sensor's noise; a textureless region, the peak at the range's end or beyond it, dim (noisier)
 // frames; the parameters' and the inputs' validation.

@@ -1,4 +1,4 @@
-// Depth from focus (issue #28, point 3): the peak fit on exact curves, and the heights of a
+// Depth from focus: the peak fit on exact curves, and the heights of a
 // part's top and of the gripper's tips measured from rendered focus sweeps.
 
 #include "microcobot/vision/depth_from_focus.h"
@@ -98,7 +98,7 @@ double sweep_estimate(FocusCamera& cam, double z_guess, double step, int n, cons
   return peak.z_m;
 }
 
-// The goal's tolerance (issue #28): a fifth of the depth of field, and 0.3 um.
+// The goal's tolerance: a fifth of the depth of field, and 0.3 um.
 double goal_tolerance(const imaging::OpticsFigures& f) { return std::min(0.2 * f.dof_m, 0.3e-6); }
 
 TEST(DepthFromFocus, HeightOfAPartsTopFromASweep) {

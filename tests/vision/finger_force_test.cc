@@ -1,4 +1,4 @@
-// Force by vision (issue #28 point 4): two fingers rendered at a known deflection read back as
+// Force by vision: two fingers rendered at a known deflection read back as
 // k x deflection; bad input (empty ROI, NaN stiffness, too few unloaded openings, no unloaded
 // pose) refused in one line. The benchmark over 1-20 mN is tests/studies/force_by_vision_test.cc.
 

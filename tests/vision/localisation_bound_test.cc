@@ -1,5 +1,5 @@
-// The Cramér-Rao bound of a target's translation (issue #28: the tracker "within 2x of the
-// localisation bound for that SNR"), and the tracker measured against it on rendered frames.
+// The Cramér-Rao bound of a target's translation (the tracker's goal: within 2x of the
+// localisation bound for the frame's SNR), and the tracker measured against it on rendered frames.
 
 #include <cmath>
 #include <cstdio>
@@ -73,7 +73,7 @@ TEST(LocalisationBound, TheTrackerComesToAboutTwiceTheBound) {
   tracker.set_template(frame, s.roi);
   const double u0 = tracker.last().u_px, v0 = tracker.last().v_px;
   // Sub-pixel positions, each under 20 noise draws. Measured (this test's printout): 1.4-2.4x of
-  // the bound per phase and axis, 1.9-2.0x pooled; the issue's goal is 2x. Not closer: ECC is an
+  // the bound per phase and axis, 1.9-2.0x pooled; the goal is 2x. Not closer: ECC is an
   // unweighted least-squares fit (the bound weighs the brighter, noisier pixels less), the
   // template is itself a noisy frame, and the blurred substrate behind the corner, which does not
   // move with the part, pulls the estimate by ~0.005 px.

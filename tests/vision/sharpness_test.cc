@@ -1,4 +1,4 @@
-// Focus measures (issue #28, point 3): their values on hand-computed frames, their peaks at the
+// Focus measures: their values on hand-computed frames, their peaks at the
 // true focus on rendered frames (a textured substrate, a part's edge), and the ROI's validation.
 
 #include "microcobot/vision/sharpness.h"

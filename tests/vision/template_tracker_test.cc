@@ -1,4 +1,4 @@
-// The template tracker on rendered frames (issue #28 point 2): a part's corner followed with
+// The template tracker on rendered frames: a part's corner followed with
 // sub-pixel error at the default sensor's noise, no pull toward whole pixels, lost when the part
 // leaves the field and re-acquired when it returns; bad templates refused in one line.
 
@@ -78,7 +78,7 @@ TEST(TemplateTracker, FollowsAPartWithSubPixelErrorAndNoPullTowardWholePixels) {
     (phase < 0.5 ? mean_first_half : mean_second_half) += 0.5 * (eu + ev) / (kSteps / 2.0);
   }
   const double rms = std::sqrt(sum2 / kSteps);
-  EXPECT_LT(rms, 0.05) << "px (issue #28: <= 0.05 px at the default noise)";
+  EXPECT_LT(rms, 0.05) << "px (goal: <= 0.05 px at the default noise)";
   // Pixel locking biases phases below 1/2 backwards and above 1/2 forwards (toward the nearest
   // whole pixel): the halves' mean errors would differ by a sizeable fraction of a pixel.
   EXPECT_LT(std::abs(mean_first_half - mean_second_half), 0.02) << "px";
@@ -87,7 +87,7 @@ TEST(TemplateTracker, FollowsAPartWithSubPixelErrorAndNoPullTowardWholePixels) {
 // The gripper's tips at 5x, 150 um over a part whose edge passes under them, moved by 0.1 px
 // steps across a pixel in u and v and then 30 um over the part's edge: tracked with the tool's
 // template (both tips, their ends and the gap, centred on the tool point) and the 1.5 px
-// high-pass, the error stays under 0.05 px rms (issue #28) with no pull toward whole pixels.
+// high-pass, the error stays under 0.05 px rms with no pull toward whole pixels.
 // Without the high-pass the part's changing glow biased it (0.49 px rms in a seeded case); with
 // a finger drawn as segments laid one over the other, their seams did (0.2 px at 5x).
 TEST(TemplateTracker, FollowsTheToolsTipsOverAPartsGlowWithoutPixelLocking) {
@@ -146,7 +146,7 @@ TEST(TemplateTracker, FollowsTheToolsTipsOverAPartsGlowWithoutPixelLocking) {
   const double rms = std::sqrt(sum2 / n);
   std::printf("tool's tips at 5x: rms %.4f px, worst %.4f px, phase halves %+.4f / %+.4f px\n", rms, worst,
               first_half, second_half);
-  EXPECT_LT(rms, 0.05) << "px (issue #28: <= 0.05 px at the default noise)";
+  EXPECT_LT(rms, 0.05) << "px (goal: <= 0.05 px at the default noise)";
   EXPECT_LT(std::abs(first_half - second_half), 0.02) << "px";
 }
 
@@ -185,7 +185,7 @@ TEST(TemplateTracker, BarsCrossingTheTemplatesEdgeDoNotBiasAStillTarget) {
 }
 
 // The part turned about its corner by 1.5 degrees a frame to 15 degrees, tracked with the Euclidean warp: the
-// angle within 0.2 degrees (issue #28) and the corner still within a twentieth of a pixel.
+// angle within 0.2 degrees and the corner still within a twentieth of a pixel.
 TEST(TemplateTracker, FollowsAPartsTurnWithinAFifthOfADegree) {
   imaging::Renderer renderer(small_camera());
   imaging::CameraControls c = renderer.default_controls();

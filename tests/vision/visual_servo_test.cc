@@ -1,4 +1,4 @@
-// The visual servo's law (issue #28 point 5) on synthetic features: converges on an ideal plant,
+// The visual servo's law on synthetic features: converges on an ideal plant,
 // with a 5 % calibration error too; predicts the motion made during the latency; holds when the
 // target is lost or the frame stale; steps without allocating; refuses bad gains and targets in
 // one line. The closed loop on rendered frames and the stick-slip stage is

@@ -1,18 +1,18 @@
 #pragma once
 /// @file
-/// A small batch of watchmaking-like insertions (issue #29 point 1): N square pins taken from a
+/// A small batch of watchmaking-like insertions: N square pins taken from a
 /// tray and inserted into the bores of an assembly plate. Each pin has its own side (100-300 um),
 /// each bore its own radial clearance (3-20 um), drawn from a seeded generator; the pins sit in
 /// their tray slots with a position error (the slot's play) that the cell does not know: the
 /// robot is told each slot's nominal position and each bore's, as a fixtured tray and plate
 /// would give them, and must cope with the rest (the closing fingers centre the pin along x; y is
 /// found by a force-guarded search, assembly_task.h). Each slot and each bore has its own
-/// orientation (issue #29 point 1), uniform within +-max_yaw_rad (+-45 deg: any orientation of a
+/// orientation, uniform within +-max_yaw_rad (+-45 deg: any orientation of a
 /// square), told to the cell; a pin sits in its slot turned by a further error it is not told (the
 /// grasp's squeeze takes it out). The orientations come from their own stream of the seed: with
 /// max_yaw_rad 0 and slot_yaw_error_rad 0 a batch is the one of before the rotary axis.
 ///
-/// Flat parts (issue #29 point 1): a share flat_fraction of the parts, drawn from a stream of
+/// Flat parts: a share flat_fraction of the parts, drawn from a stream of
 /// their own, are flat plates (flat_side_m x flat_side_m x flat_thickness_m, a bridge's blank) to
 /// be placed on flat, dry seats within seat_tolerance_m, where adhesion, not gravity, decides the
 /// release (microworld/release.h): the plate clings to each finger with flat_finger_pulloff_N, and
@@ -21,7 +21,7 @@
 /// release strategy is `release`; `auto` chooses per part the first of open, roll, shake whose
 /// margin (release.h) reaches min_release_margin, else the one of largest margin.
 ///
-/// Several parts in one scene (issue #29 point 1): with `layout: grid` the tray's slots and the
+/// Several parts in one scene: with `layout: grid` the tray's slots and the
 /// plate's bores are grids of pitch grid_pitch_m (n x n within each area's half_size_m), filled in
 /// order, n^2 parts a load; each part's microworld holds the rest of its load as neighbours
 /// (microworld/neighbours.h): the parts after it still in their slots, the ones before it placed on
@@ -49,11 +49,11 @@ namespace mc::cell {
 struct AssemblyBatchParams {
   int parts = 10;              ///< pins in the batch, [1, 10000]
   int seed = 1;                ///< the generator's seed: the same seed gives the same batch
-  double min_side_m = 100e-6;  ///< pin side, uniform in [min, max] (issue #29: 100-300 um)
+  double min_side_m = 100e-6;  ///< pin side, uniform in [min, max] (100-300 um)
   double max_side_m = 300e-6;
   double part_height_m = 600e-6;       ///< every pin's height
   double min_clearance_m = 3e-6;       ///< radial clearance of the bores, uniform in [min, max]
-  double max_clearance_m = 20e-6;      ///< (issue #29: 3-20 um)
+  double max_clearance_m = 20e-6;      ///< (3-20 um)
   double hole_depth_m = 300e-6;        ///< the bores' depth
   double slot_error_m = 5e-6;          ///< standard deviation of a pin in its slot (x and y)
   double max_yaw_rad = M_PI / 4;       ///< slots' and bores' orientations, uniform in [-max, max]
@@ -66,7 +66,7 @@ struct AssemblyBatchParams {
   std::string layout = "random";  ///< random (each part alone) or grid (header)
   double grid_pitch_m = 700e-6;   ///< the grids' pitch (layout grid)
   double flat_fraction = 0.0;     ///< the share of flat parts, [0, 1] (header)
-  double flat_side_m = 300e-6;    ///< a flat part's side (issue #29: 300 um)
+  double flat_side_m = 300e-6;    ///< a flat part's side (300 um)
   double flat_thickness_m = 50e-6;
   double seat_tolerance_m = 10e-6;  ///< a flat part rests within this of its seat's centre
   /// A flat part's pull-off per finger: van der Waals over its edge face (microworld::flat_part_scene).

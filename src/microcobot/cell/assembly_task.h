@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The automatic pick-and-insert of one pin (issue #29 point 5, a first step): a sequence of
+/// The automatic pick-and-insert of one pin: a sequence of
 /// steps with behaviour-tree semantics, run by the robot while the operator supervises, pauses,
 /// confirms, takes over and hands back. Like a ros2_control controller it is a pure object: each
 /// tick it reads the slave's sensors (TaskSensors: measured tip position, contact and grip

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// The assembly cell's camera (issue #29 "vision steps on rendered images", issue #28 point 5's
-/// "used by the automated steps of the assembly cell"): a microscope pointed at the station the
-/// task looks at (the pin's slot, then its bore), whose frames are rendered from the simulation's
-/// truth (imaging::Renderer, the sensor's noise included) and measured with what the cell is told:
+/// The assembly cell's camera, the vision steps of the automatic task on rendered images: a microscope
+/// pointed at the station the task looks at (the pin's slot, then its bore), whose frames are rendered from
+/// the simulation's truth (imaging::Renderer, the sensor's noise included) and measured with what the cell is
+/// told:
 ///
 ///   slot    the pin in its tray slot, before the approach: a model template (the pin alone at
 ///           its slot's nominal position and orientation, rendered without noise: the CAD-model
@@ -20,7 +20,7 @@
 ///           intensity profile along the fingers' y, averaged across a band between the fingers
 ///           (the frame sampled in the fingers' frame, bilinearly), its two edges located at the
 ///           gradient's extrema, refined by a parabola; the pin's centre is their midpoint.
-///   align   the pin in the fingers over its bore (the visual servo of issue #28 in its look-and-move
+///   align   the pin in the fingers over its bore (the visual servo in its look-and-move
 ///           form): the camera still where the bore look left it, one frame focused on the pin's
 ///           top; its faces the fingers leave free give its centre (along the fingers' y between
 ///           them, along their x below their ends), and vision::VisualServo's error e = s - s*
@@ -83,7 +83,7 @@ struct CellCameraParams {
   /// placed by the stage's sensors over the bore as seen).
   bool servo = true;
   /// The servo's convergence: the pin's centre seen within this of its bore's (vision::VisualServo's
-  /// converged_m; issue #28's 0.3 um) [m].
+  /// converged_m: 0.3 um) [m].
   double servo_converged_m = 0.3e-6;
 
   template <class V>

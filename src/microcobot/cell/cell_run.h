@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A batch of the assembly cell run headless (issue #29 point 6, a first step): each part of an
+/// A batch of the assembly cell run headless: each part of an
 /// AssemblyBatch picked from its slot and inserted into its bore on a fresh simulated platform,
 /// by the robot (mode "auto": AssemblyTask through the console input, the platform's limits in
 /// force) or by the scripted watchmaker (mode "manual": cell::PickPlaceOperator on the haptic
@@ -43,8 +43,8 @@ struct CellRunParams {
   /// The person's seed: part i gets person_seed * 1000003 + i, the same in every mode.
   int person_seed = 1;
   /// Headless, a step whose autonomy is `confirm` is confirmed by the supervisor this long after
-  /// it started waiting (a stand-in for the operator's glance and click until the simulated
-  /// person of issue #29 point 3): its cost shows in the cycle time.
+  /// it started waiting (a stand-in for the operator's glance and click where no simulated
+  /// person takes the step, person_model.h): its cost shows in the cycle time.
   double confirm_delay_s = 1.0;
   /// Each step's autonomy (a task file's `steps`, task_file.h; not a --params key). Headless, a
   /// `manual` step is taken over by the simulated person with the console (person.master:

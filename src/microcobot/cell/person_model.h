@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A person's hand as a motor system (issue #29 point 3), for the simulated operator of the
+/// A person's hand as a motor system, for the simulated operator of the
 /// manual and assisted cycles: seeded, with the limits the human-factors literature measures.
 ///
 ///  - **Reaction time.** A correction starts `reaction_time_s` after the person has seen the

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// A simulated person doing one insertion of the assembly cell through the platform's own
-/// inputs (issue #29 point 3), manually or with shared control (point 4):
+/// inputs, manually or with shared control (control/virtual_fixtures.h):
 ///
 ///   master "haptic"   the dual-stage haptic handle (x, y; the slave follows at the motion
 ///                     scale, clutching near the workspace's edge), the Z thumb wheel and the
@@ -65,7 +65,7 @@ struct PersonOperatorParams {
   /// What the cell's camera makes out of the pin and the tips (SD), at 5x (1.1 um pixels):
   /// docs/benchmarks.md's worst tracking rms on the validation sets, a part's corner 0.033 px and
   /// the tool's tips 0.026 px, with the calibration's worst residual 0.052 px: 0.067 px = 0.074 um,
-  /// rounded up. (0.5 um, from the tips' 0.45 px before their fix of 2026-11-27, until then.)
+  /// rounded up.
   double assist_vision_sd_m = 0.1e-6;
   double assisted_tolerance_m = 15e-6;  ///< assisted: the target width planned for (in the capture)
   /// Assisted: the slave speed the person plans moves in the plane for. The platform paces the
@@ -159,7 +159,7 @@ class PersonOperator {
   /// One operator tick (the platform's operator task). Real-time safe.
   void act(const runtime::TickInfo& tick) noexcept;
   /// The person takes the automatic task's step `s` over at `t_s` (a manual step of a headless
-  /// run, issue #29 point 5): their hands where the platform is (the joystick at rest, the
+  /// run): their hands where the platform is (the joystick at rest, the
   /// gripper slider at the opening the coupling commands, the dial at the rotor's target), what
   /// they know of the pin from how it is held, and the step begun. Master console only: the
   /// TéléTweez' levers would command the held pin's grip from their own opening.

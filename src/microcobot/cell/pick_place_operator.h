@@ -29,7 +29,7 @@
 namespace mc::cell {
 
 struct PickPlaceOperatorParams {
-  double transport_speed_m_s = 100e-6;  ///< slave speed while transporting (issue #9)
+  double transport_speed_m_s = 100e-6;  ///< slave speed while transporting
   double approach_speed_m_s = 100e-6;   ///< slave speed of the other XY moves
   double fine_speed_m_s = 10e-6;        ///< slave speed within fine_distance_m of a goal
   double fine_distance_m = 20e-6;

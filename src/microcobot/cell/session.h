@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// A session of the platform: a scenario run from its configuration to its verdict, with
-/// the recording and the session report (issue #9, `microcobot run`).
+/// the recording and the session report (`microcobot run`).
 ///
 /// Scenarios:
 ///  - "pick-place" (default): the scripted watchmaker of PickPlaceOperator picks a 300 um

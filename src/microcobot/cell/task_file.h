@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A task in YAML (issue #29 point 5, "tasks in YAML"): the automatic insertion's autonomy per
+/// A task in YAML: the automatic insertion's autonomy per
 /// step (FlexBE-like levels: `auto` runs it, `confirm` waits for the operator's go before it
 /// starts, `manual` hands it to the operator, `assisted` hands it to the operator under the
 /// platform's guidance (AssemblyTask::assistable()) and goes on once its goal is reached) and overrides of

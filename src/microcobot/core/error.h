@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The error types of microcobot. Each carries the CLI exit code it maps to (DESIGN.md,
-/// "Errors"): 2 usage, 3 invalid input or parameters, 4 computation failed. Messages are one
+/// The error types of microcobot. Each carries the CLI exit code it maps to (docs/architecture.md,
+/// errors): 2 usage, 3 invalid input or parameters, 4 computation failed. Messages are one
 /// line and name where the problem is (file and line, or parameter field).
 
 #include <cstddef>

@@ -15,7 +15,7 @@
 /// data section's and the summary's CRCs are written too.
 ///
 /// The file is written under a temporary name beside the target and renamed at close(), so an
-/// interrupted run never leaves a partial file under the final name (DESIGN.md, "Errors").
+/// interrupted run never leaves a partial file under the final name (docs/architecture.md, errors).
 /// Not for the real-time path (it does I/O and compresses: a live recording writes it from a
 /// thread of its own, live/session_recording.h), but a message costs no allocation once the
 /// chunk buffers have grown to their size.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The microscope camera and its focus drive as devices of the platform (issue #27).
+/// The microscope camera and its focus drive as devices of the platform.
 ///
 /// The camera forms frames off the real-time loop, in a thread of its own at its frame rate:
 ///

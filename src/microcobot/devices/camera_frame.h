@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// What crosses from the real-time loop to the microscope camera, and what the camera produces
-/// (issue #27, DESIGN.md "Images never enter the loop"):
+/// (images never enter the loop: docs/architecture.md):
 ///
 ///   loop (every tick a frame is due) --SceneSnapshot (POD)--> SPSC ring --> camera thread
 ///   camera thread: FrameSource -> Image -> JPEG -> CameraFrame -> sinks (console, MCAP, DDS)

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The XY stage with its position sensors off (issue #28 point 5, `sensor: vision`): two
+/// The XY stage with its position sensors off (`sensor: vision`): two
 /// stick-slip axes (the platform's model, thesis ch. 2) driven open loop, as a controller without
 /// encoders drives them (Attocube ANC300 `stepu`/`stepd`, devices/open_loop_stepper.h). A velocity
 /// asked for an interval T becomes, per axis, a displacement d = v T played as n sawtooth periods

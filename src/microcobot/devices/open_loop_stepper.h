@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Open-loop stepping of one stick-slip axis (issue #30): `n` sawtooth periods of a given
+/// Open-loop stepping of one stick-slip axis: `n` sawtooth periods of a given
 /// amplitude, frequency and direction played straight to the axis, the stage controller set
 /// aside, as an open-loop controller (Attocube ANC300 `stepu`/`stepd`) drives its positioner.
 /// The waveform is the motion::SawtoothGenerator's (thesis §2.2.2, Fig. 2.3: slow ramp, edge at

@@ -5,7 +5,7 @@
 ///
 /// The operator's hand is a position source (the scripted operator moves it) coupled to the
 /// handle through the finger. Along y (the Haptuator's axis, Fig. 3.9) the rendered force goes
-/// through the crossover + compensation pipeline (eq. 3.5-3.8, #7) into the 4-mass plant of
+/// through the crossover + compensation pipeline (eq. 3.5-3.8) into the 4-mass plant of
 /// eq. 3.4, whose finger spring is anchored at the hand: the handle sits at hand + y_h. Along
 /// x the Pantograph alone renders and the handle sits at hand + F_x / k_f (the finger's
 /// compliance; the hand moves slowly next to the plant's dynamics). The handle stays inside the

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A slave axis backed by the stick-slip actuator model (#4, thesis ch. 2) and a position
+/// A slave axis backed by the stick-slip actuator model (thesis ch. 2) and a position
 /// sensor model: the digital twin behind the SlaveAxis interface. update() plays the drive
 /// samples of the tick through the model at its own step (10 us), so one 10 kHz tick is ten
 /// model steps. The safe state holds the drive at 0 V. A diverged model faults the axis.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The TéléTweez held by a (simulated) operator: the 7-DOF model of eq. 4.6 (#8) behind the
+/// The TéléTweez held by a (simulated) operator: the 7-DOF model of eq. 4.6 behind the
 /// TweezersMaster interface. The operator's fingers are position sources behind the finger
 /// stiffness k_f of the model (the finger force input is k_f x target, as in the thesis's
 /// robotic-mode experiment); the commanded grip force becomes the motor torque T = 2 F R_ss R_bs

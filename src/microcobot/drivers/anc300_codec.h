@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The Attocube ANC300's console protocol (issue #30), shared by the twin's server and the
+/// The Attocube ANC300's console protocol, shared by the twin's server and the
 /// real-controller driver. Documents followed (docs/hardware.md):
 ///  - attocube systems, "ANC300 Piezo Motion Controller, user manual", chapter "Command
 ///    reference" of the ASCII console (telnet TCP 7230 or serial): `setm/getm`, `setf/getf`,

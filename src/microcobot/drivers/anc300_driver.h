@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The `anc300` driver (issue #30): the platform's three stage axes on an Attocube ANC300 over its
+/// The `anc300` driver: the platform's three stage axes on an Attocube ANC300 over its
 /// telnet console (TCP 7230, or `microcobot serve --emulate anc300`). The ANC300 is open loop:
 /// it plays N sawtooth periods (`stepu/stepd AXIS N`) at the set amplitude (`setv`) and frequency
 /// (`setf`) and knows nothing of where the slider is. So the driver closes the platform's
@@ -27,7 +27,7 @@
 ///   each cycle [getpos N x3], setm N stp (an axis armed again), stepu|stepd N n, stepw N
 ///   safe state stop N, setm N gnd (every axis)
 ///
-/// The rotary axis under the gripper (issue #29 point 2), with the option `theta=N`: the
+/// The rotary axis under the gripper, with the option `theta=N`: the
 /// controller's rotary positioner on axis N, stepped like the three with the same step per period
 /// (the same actuator, on the rotor's arc at stage.rotary.radius_m; the platform's rotary axis
 /// position is that arc); its `getpos` is read in deg (the twin's), converted to the arc.

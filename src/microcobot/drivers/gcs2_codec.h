@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// PI's General Command Set, GCS 2.0 (issue #30): the line syntax both the twin's server and
+/// PI's General Command Set, GCS 2.0: the line syntax both the twin's server and
 /// the real-controller driver speak. Documents followed (docs/hardware.md):
 ///  - PI, "GCS 2.0 commands" chapters of the E-873 (Q-Motion) and C-867 user manuals (PZ..E,
 ///    MS196E): LF-terminated ASCII lines, case-insensitive three-letter mnemonics, `?` queries,

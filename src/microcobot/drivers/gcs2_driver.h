@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The `pi-gcs2` driver (issue #30): the platform's three stage axes on a PI controller speaking
+/// The `pi-gcs2` driver: the platform's three stage axes on a PI controller speaking
 /// GCS 2.0 over TCP (E-873 Q-Motion, E-871, C-867; or `microcobot serve --emulate gcs2`). The
 /// controller closes each axis' position loop: the axes are position-controlled
 /// (devices/device.h), the platform sends them the coupling's targets, the bus thread sends the
@@ -17,7 +17,7 @@
 /// Positions are in mm on the wire (%.6f: 1 nm), m in the platform; the controller's zero is the
 /// platform's stage zero (its home).
 ///
-/// The rotary axis under the gripper (issue #29 point 2), with the option `theta=ID`: the
+/// The rotary axis under the gripper, with the option `theta=ID`: the
 /// controller's rotation stage ID, checked at configure (listed by SAI?, PUN? `deg`, its TMN?..TMX?
 /// holding 0), referenced, moved and polled with the three: deg on the wire (%.6f: 1 udeg), the
 /// platform's rotary axis position (the arc at stage.rotary.radius_m from its home) in the platform.
@@ -33,7 +33,7 @@
 namespace mc::drivers {
 
 /// The serial rate of a PI GCS 2.0 controller out of the box (E-873/C-867: RS-232 and USB at
-/// 115200 baud, 8N1, as issue #30 quotes PI's manuals); `baud=` overrides it.
+/// 115200 baud, 8N1, per PI's manuals); `baud=` overrides it.
 inline constexpr int kGcs2DefaultBaud = 115200;
 
 struct Gcs2DriverParams {

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The controller end of a vendor driver (issue #30): `devices.connection` parsed, and a blocking
+/// The controller end of a vendor driver: `devices.connection` parsed, and a blocking
 /// line client with a deadline on every operation (poll()), owned by the driver's bus thread
 /// (never the loop), over TCP or a serial line (termios: raw, 8N1, no flow control unless asked).
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Registers the vendor driver sets (issue #30) in the driver registry (platform/driver_registry.h):
+/// Registers the vendor driver sets in the driver registry (platform/driver_registry.h):
 /// `pi-gcs2` (drivers/gcs2_driver.h) and `anc300` (drivers/anc300_driver.h), so that
 ///
 ///     devices: {driver: pi-gcs2, connection: "127.0.0.1:50000"}

@@ -1,5 +1,5 @@
 /// @file
-/// The serial transport of the vendor drivers' LineClient (issue #30): a termios line in raw mode,
+/// The serial transport of the vendor drivers' LineClient: a termios line in raw mode,
 /// 8 data bits, no parity, one stop bit (8N1, what PI's E-873/C-867 and Attocube's ANC300 speak),
 /// no flow control unless `flow=rtscts`, non-blocking so that every read and write waits in
 /// poll() against the same deadline as the TCP client (line_client.cc). termios(3) and

@@ -16,7 +16,7 @@
 
 namespace mc::haptics {
 
-/// Parameters of the dual-stage plant. The thesis gives no values (DESIGN.md erratum 7); the
+/// Parameters of the dual-stage plant. The thesis gives no values; the
 /// defaults are chosen (docs/parameters.md) so that the Pantograph channel is flat (+-1 dB)
 /// from 40 to 200 Hz, has a damped antiresonance just above 200 Hz, a damped resonance near
 /// 300 Hz and a sharp antiresonance/resonance pair near 800 Hz (Fig. 3.10), and the Haptuator

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The microscope camera's parameters (issue #27): the sensor, the objective and the
+/// The microscope camera's parameters: the sensor, the objective and the
 /// illumination. Plain Params structs (visit/validate) with the defaults of a real set-up: a
 /// 1.3 MP global-shutter CMOS camera (e2v EV76C560: 1280 x 1024, 5.3 um pixels) behind an
 /// infinity-corrected long-working-distance objective (Mitutoyo M Plan Apo series, 200 mm tube

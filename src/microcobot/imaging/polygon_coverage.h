@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Exact pixel coverage of a rotated rectangle (a part seen at an angle, issue #28): the area of
+/// Exact pixel coverage of a rotated rectangle (a part seen at an angle): the area of
 /// its intersection with a unit cell, by clipping the rectangle's polygon to the cell
 /// (Sutherland-Hodgman) and the shoelace formula. Pure functions, no allocation.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The camera's frames as ROS 2 messages (issue #27), for Foxglove / Lichtblick (channels with
+/// The camera's frames as ROS 2 messages, for Foxglove / Lichtblick (channels with
 /// encoding "cdr" and "ros2msg" schemas), the recordings (the same bytes in MCAP) and the
 /// console page (which reads the CompressedImage's JPEG out of the CDR):
 ///

@@ -1,6 +1,6 @@
 #pragma once
 
-/// The console's view of the camera (issue #27): each frame binned down to the microscope panel's
+/// The console's view of the camera: each frame binned down to the microscope panel's
 /// size and encoded as its own JPEG, published as /camera/preview/compressed beside the full
 /// frame. A 1280 x 1024 frame is four times the pixels of the 640 px panel: the browser decoded
 /// it, then threw three quarters away, and without a GPU that decode was what kept the page

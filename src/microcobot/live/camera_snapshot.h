@@ -1,6 +1,6 @@
 #pragma once
 
-/// The camera's latest full frame, kept for a lossless download (issue #27: a microscopy lab's
+/// The camera's latest full frame, kept for a lossless download (a microscopy lab's
 /// snapshot): GET /camera/snapshot.tiff (a baseline TIFF, 16-bit for deeper sensors, the
 /// object-side scale in its resolution tags for ImageJ/Fiji, the frame's /camera/state as its
 /// ImageDescription) or /camera/snapshot.png, named after the objective and the frame's live

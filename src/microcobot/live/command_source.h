@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// Where a live platform's operator commands come from when they do not come from its own
-/// console: the master process of a distributed platform, over the network (issue #17,
-/// net/remote_master.h). The live platform polls it on the loop at the operator rate, in place
+/// console: the master process of a distributed platform, over the network
+/// (net/remote_master.h). The live platform polls it on the loop at the operator rate, in place
 /// of the console's ring, and lets it publish what the slave measured. Real-time safe: no
 /// allocation, lock, exception or I/O in either call (a network implementation only pushes to
 /// and pops from its link's rings).

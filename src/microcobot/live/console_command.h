@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// What the operator console sends (docs/console.md, channels `/console/command` and
-/// `/console/action`), parsed, checked and clamped before it may reach the loop (issue #14):
+/// `/console/action`), parsed, checked and clamped before it may reach the loop:
 /// types, finite numbers, ranges; anything else is refused with a one-line message naming the
 /// field. The result is plain data, copied into the loop through a single-producer ring.
 
@@ -19,7 +19,7 @@ struct ConsoleLimits {
   std::array<double, 3> min_m = {-6e-3, -6e-3, -6e-3};
   std::array<double, 3> max_m = {6e-3, 6e-3, 6e-3};
   double max_opening_m = 600e-6;
-  /// The rotary axis' travel and speed (issue #29 point 2; both 0: there is none).
+  /// The rotary axis' travel and speed (both 0: there is none).
   double min_theta_rad = 0.0;
   double max_theta_rad = 0.0;
   double max_theta_speed_rad_s = 0.0;
@@ -44,7 +44,7 @@ struct ConsoleCommand {
   bool has_goal = false;                 ///< click-to-go
   std::array<double, 3> goal_m{};        ///< world coordinates (the telemetry's)
   double goal_speed_m_s = 100e-6;
-  /// Click-to-go on the camera's image (`stage.xy_sensor: vision`, issue #28): the pixel the
+  /// Click-to-go on the camera's image (`stage.xy_sensor: vision`): the pixel the
   /// tool point is to be brought to, in the full frame's pixels (a binned preview's scaled up).
   bool has_goal_px = false;
   std::array<double, 2> goal_px{};
@@ -57,7 +57,7 @@ struct ConsoleCommand {
   bool has_theta_goal = false;
   double theta_goal_rad = 0.0;
   double theta_rate_rad_s = 0.0;
-  /// The microscope (issue #27): focal plane height to go to, objective to turn in, the camera's
+  /// The microscope: focal plane height to go to, objective to turn in, the camera's
   /// exposure and gain. Each optional; they need control but not the deadman (nothing of the
   /// slave moves).
   bool has_focus = false;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The live platform served to its operators (issue #14, `microcobot serve`): the console page
+/// The live platform served to its operators (`microcobot serve`): the console page
 /// over HTTP and the platform over the Foxglove WebSocket protocol (docs/console.md).
 ///
 ///   /platform/telemetry  60 Hz   the loop's telemetry (kTelemetryChannels), JSON

@@ -21,7 +21,7 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
   if (s.demo && s.demo_phase != was.demo_phase && !s.demo_phase.empty())
     note(EventLevel::kInfo, "demo_phase", s.demo_phase);
   if (!s.demo && was.demo) {
-    // How it ended, in the words the console shows (issue #26).
+    // How it ended, in the words the console shows.
     const DemoResult& r = s.demo_result;
     std::string how = "the scripted demo ended: " + std::string(DemoResult::name(r.outcome));
     if (!r.phase.empty()) how += " (" + r.phase + ")";
@@ -64,7 +64,7 @@ std::string ConsoleServer::scene_json() const {
          {"workspace_min_m", c.min_m},
          {"workspace_max_m", c.max_m},
          {"max_speed_m_s", c.max_speed_m_s},
-         // The gauges' full scales are the limits the platform enforces (issue #26).
+         // The gauges' full scales are the limits the platform enforces.
          {"force_full_scale_N", live_.contact_force_limit_N()},
          {"grip_force_limit_N", live_.grip_force_limit_N()},
          {"contact_force_limit_N", live_.contact_force_limit_N()}};

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The cell camera's looks for the live task (`serve --cell --cell-camera`; issue #29, "the live
-/// verify by the camera"): a thread beside the loop that answers the looks the task asks for
+/// The cell camera's looks for the live task (`serve --cell --cell-camera`: the task
+/// verified live by the camera): a thread beside the loop that answers the looks the task asks for
 /// (LiveTask::look_request()). For each request it lets `look_s` pass (the exposure: the task
 /// holds meanwhile), takes the latest telemetry sample (the simulation's truth renders the frames;
 /// the stage's sensors give the tool point the held look measures from), renders and measures with

@@ -314,7 +314,7 @@ bool LivePlatform::demo_tick(const runtime::TickInfo& t) noexcept {
     demo_error_m_.store(gripper->world().placement_error_m(gripper->world_state()),
                         std::memory_order_relaxed);
   if (!demo_->done() && !demo_->gave_up()) return true;
-  // Finished: every axis holds where it is and the console has control again (issue #26).
+  // Finished: every axis holds where it is and the console has control again.
   platform_->hold();
   demo_finished_ = true;
   demo_running_.store(false, std::memory_order_relaxed);

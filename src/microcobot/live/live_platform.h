@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The platform run live (issue #14, `microcobot serve`): its loop paced to the wall clock in
+/// The platform run live (`microcobot serve`): its loop paced to the wall clock in
 /// its real-time thread, for as long as the server runs, operated by the console.
 ///
 ///   server thread  --ConsoleCommand--> SPSC ring --> operator task (loop, 1 kHz) --> coupling
@@ -66,7 +66,7 @@ struct LiveParams {
   void validate() const;
 };
 
-/// How the last scripted demo ended (issue #26: every outcome shown).
+/// How the last scripted demo ended (every outcome is shown to the operator).
 struct DemoResult {
   enum class Outcome { kNone, kRunning, kPlaced, kInserted, kMissed, kGaveUp };
   Outcome outcome = Outcome::kNone;
@@ -91,7 +91,7 @@ struct LiveStatus {
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
   std::uint64_t restarts = 0;
-  /// The camera (issue #27): frames delivered and dropped (the loop could not hand them over)
+  /// The camera: frames delivered and dropped (the loop could not hand them over)
   /// since the scene (re)started; the focal plane and the objective.
   bool camera = false;
   std::uint64_t camera_frames = 0, camera_dropped = 0;
@@ -145,7 +145,7 @@ class LivePlatform {
   /// Whether a client holds control (its commands count; otherwise the stage holds).
   void set_console_in_control(bool in_control) noexcept { in_control_.store(in_control); }
   bool console_in_control() const noexcept { return in_control_.load(); }
-  /// A vendor-protocol client's command (issue #30; one producer thread: the protocol thread).
+  /// A vendor-protocol client's command (one producer thread: the protocol thread).
   /// Wait-free; false when the ring is full. It counts only while no console client holds control.
   bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_.push(c); }
   /// What the loop last published for the protocol clients. Any thread.

@@ -1,5 +1,5 @@
-// The live platform's port for the vendor-protocol twins (issue #30, vendor/; the rotary axis:
-// issue #29 point 2): what a GCS 2.0 or ANC300 client asked, taken on the operator tick (a heartbeat-guarded
+// The live platform's port for the vendor-protocol twins (vendor/, the rotary axis
+// included): what a GCS 2.0 or ANC300 client asked, taken on the operator tick (a heartbeat-guarded
 // goal or a run of open-loop steps, outranked by a console user, the demo, a task or a remote master), and
 // what it reads back (positions, on-target after the settle window, stepping), published for its threads.
 #include <algorithm>

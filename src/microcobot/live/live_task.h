@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The automatic insertion run live, supervised from the console (issue #29 point 5,
-/// `microcobot serve --cell`): the live platform's loop ticks a cell::AssemblyTask on the
+/// The automatic insertion run live, supervised from the console
+/// (`microcobot serve --cell`): the live platform's loop ticks a cell::AssemblyTask on the
 /// slave's sensors and hands its console input to the coupling, so that the platform's limits
 /// (grip, contact, floor: teleop/safety_limits.h) apply to it as to the operator. The
 /// operator's controls (start, pause, resume, confirm, take over, hand back, step done, skip)

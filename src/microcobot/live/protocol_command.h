@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// What a vendor-protocol client (the GCS 2.0 and ANC300 twins, vendor/) asks of the live
-/// platform (issue #30), checked and clamped by the protocol thread before it is pushed: plain
+/// platform, checked and clamped by the protocol thread before it is pushed: plain
 /// data copied into the loop through the live platform's protocol ring (one producer: the
 /// protocol thread). The loop is the arbiter of who controls the stage: a protocol command counts
 /// only while no console client holds control, and the protocol's heartbeat is its deadman.
@@ -23,7 +23,7 @@ struct ProtocolCommand {
   Kind kind = Kind::kHeartbeat;
   std::array<double, 3> goal_m{};  ///< stage coordinates (relative to home) [m]
   double speed_m_s = 0.0;
-  /// The rotary axis (issue #29 point 2): its goal, the gripper's yaw as the console's
+  /// The rotary axis: its goal, the gripper's yaw as the console's
   /// theta_goal_rad (world frame), within the platform's travel [rad], and its speed [rad/s].
   double theta_goal_rad = 0.0;
   double theta_speed_rad_s = 0.0;

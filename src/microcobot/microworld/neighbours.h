@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The other parts of a scene (issue #29 point 1, several parts in one scene): the pins still in
+/// The other parts of a scene (several parts in one scene, `layout: grid`): the pins still in
 /// the tray and the parts already placed on the plate stand on the substrate as rigid square blocks
 /// the gripper must not strike. Each is a footprint (a square turned about the vertical) up to its
 /// top; the fingers (two rectangles finger_thickness_m x finger_width_m at their opening) and a held

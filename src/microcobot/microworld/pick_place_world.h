@@ -25,7 +25,7 @@
 /// lands on the rim; once in, the hole's walls stop it sideways, up to what holds the part in the
 /// fingers (beyond it the part slips between them).
 ///
-/// Finger compliance (issue #28, contact force by vision): the fingers are benders of stiffness
+/// Finger compliance (contact force by vision): the fingers are benders of stiffness
 /// k_finger along their closing axis, so a lateral force F on them along it (a wall, the
 /// substrate's drag) bends both tips together by F / (2 k_finger) (common mode; across that axis
 /// they are as stiff as their width). Against a wall they bend before the part slips: the wall's
@@ -33,7 +33,7 @@
 /// bend carries the part at the wall (it stays in the jaws); the drag's (at most mu (F_pulloff +
 /// W) / (2 k) = 0.1 um) is drawn on the tips only.
 ///
-/// Orientation (issue #29 point 2): the part and the hole are squares turned by part_yaw_rad and
+/// Orientation: the part and the hole are squares turned by part_yaw_rad and
 /// hole_yaw_rad about the vertical, and the fingers by the gripper's yaw (the rotary axis under
 /// it, turning about the vertical through the tips). A square part turned by d against the
 /// hole has a footprint s (|cos d| + |sin d|) wide along the hole's sides (d taken modulo 90 deg,
@@ -83,7 +83,7 @@ struct PickPlaceParams {
   double part_yaw_rad = 0.0;  ///< the part's start orientation about the vertical (counter-clockwise)
   double hole_yaw_rad = 0.0;  ///< the hole's (the part must be turned to it, modulo 90 deg)
   PiezoGripperParams gripper;
-  /// The platform's limits for this part (issue #26; teleop/safety_limits.h). 1 mN of grip
+  /// The platform's limits for this part (teleop/safety_limits.h). 1 mN of grip
   /// holds a 300 um brass part with a 27x margin (2 mu F >= pull-off + weight needs 60 uN) and
   /// stays well below what dents a watch part's finish.
   double grip_force_limit_N = 1e-3;
@@ -148,7 +148,7 @@ struct PickPlaceParams {
 /// pin-in-hole`; scenes/pin-in-hole.yaml is the same scene as a file.
 PickPlaceParams pin_in_hole_scene();
 
-/// A flat part on a flat, dry seat (issue #29 point 1; release.h): a 300 x 300 x 50 um brass plate
+/// A flat part on a flat, dry seat (release.h): a 300 x 300 x 50 um brass plate
 /// (a bridge's blank) whose edge faces cling to the fingers' flat tips by van der Waals over a true
 /// contact of 2e-13 m^2 (1e-4 of the 40 x 50 um face: 16.6 uN per finger), while the ground seat
 /// holds its face over 2.4e-13 m^2 (2.7e-6 of 300 x 300 um: 19.9 uN), no meniscus. Opened, the

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Letting go of a part against adhesion (issue #29 point 1): which of a finger and the seat keeps
+/// Letting go of a part against adhesion: which of a finger and the seat keeps
 /// a part when the fingers open, and the release strategies that tip the balance towards the seat
 /// (R. S. Fearing, "Survey of sticking effects for micro parts handling", IROS 1995; S. Haliyo,
 /// S. Régnier, Y. Rollot, "Manipulation of micro-objects using adhesion forces and dynamical

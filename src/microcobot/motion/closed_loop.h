@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Closed-loop simulations of one axis: the stick-slip model (#4) stepped at its own step, the
+/// Closed-loop simulations of one axis: the stick-slip model stepped at its own step, the
 /// position sensor and a controller updated at the controller rate, the sawtooth's operating
 /// point passed to the model's z_ba at every tick (thesis §2.7). These runners allocate only their
 /// records; the controllers inside never allocate. Divergence throws mc::ComputationFailed.

@@ -25,9 +25,9 @@ struct ControlParams {
   PositionControlParams position;
   BaselinePositionParams baseline;
   MotionLimits limits;
-  TrackingParams tracking;      ///< issue #15: the tracking controller
-  SetpointStreamParams stream;  ///< issue #15: setpoint streaming
-  PathLimits path;              ///< issue #15: 3-D paths (jerk; velocity/acceleration from limits)
+  TrackingParams tracking;      ///< the tracking controller
+  SetpointStreamParams stream;  ///< setpoint streaming
+  PathLimits path;              ///< 3-D paths (jerk; velocity/acceleration from limits)
 
   template <class V>
   void visit(V& v) {

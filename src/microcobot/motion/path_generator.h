@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Coordinated XYZ paths (issue #15): straight lines and circular arcs in 3-D, with the three axes
+/// Coordinated XYZ paths: straight lines and circular arcs in 3-D, with the three axes
 /// synchronised by one path parameter, the arc length s(t). s(t) is a trapezoidal profile under
 /// the path's velocity and acceleration limits smoothed by a moving average of length
 /// T_j = a_max / j_max, which bounds the jerk by j_max while keeping |v| <= v_max and

@@ -11,7 +11,7 @@ namespace mc::motion {
 
 struct PositionSensorParams {
   double resolution_m = 0.1e-9;  ///< quantisation step (thesis §2.3: 0.1 nm)
-  double noise_rms_m = 1.0e-9;   ///< white noise standard deviation (issue #6: 1 nm RMS)
+  double noise_rms_m = 1.0e-9;   ///< white noise standard deviation (1 nm RMS)
   int seed = 1;                  ///< noise stream (deterministic runs)
 
   template <class V>

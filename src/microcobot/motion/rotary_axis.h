@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The rotary axis under the gripper (issue #29 point 2): the stage's stick-slip actuator (thesis
+/// The rotary axis under the gripper: the stage's stick-slip actuator (thesis
 /// ch. 2) driving a rotor through its friction contact at radius r, so that a gripped part can be
 /// turned to its slot. The model is the linear one in angular units: with the rotor's arc
 /// s = r theta at the contact, the slider's equation m s'' = F(u, s) (eq. 2.1-2.9 of the thesis)

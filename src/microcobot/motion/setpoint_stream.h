@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Setpoint streaming (issue #15): position setpoints arrive at about 1 kHz (from the
+/// Setpoint streaming: position setpoints arrive at about 1 kHz (from the
 /// teleoperation coupling, the console, the network link or Python), each stamped with the
 /// sender's time. The controller reads the stream at its own rate, `delay_s` behind the newest
 /// stamp's clock (a bounded look-ahead: the interpolation sees at most `capacity` setpoints and

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The step length per sawtooth period, s(A, f, direction), of one stick-slip axis, computed from
-/// the model (#4) at configure time: for every grid point the model runs the sawtooth with the
+/// the model at configure time: for every grid point the model runs the sawtooth with the
 /// break-away strain z_ba(A, f, direction) of its table (thesis §2.5.2.3, Fig. 2.13; the
 /// "generator passes its configuration to the model" of §2.7), and the step is the mean slider
 /// displacement per period after a warm-up. This is the model knowledge that schedules the

@@ -262,8 +262,8 @@ void TrackingController::update(double x) noexcept {
   const double bottom = pe_displacement_m(floor_V_ + p_.guard_V);
   // Where the lead stands is judged on the plan (anchor, reference, catch-up) when lead_on_plan
   // is set, not on y_base with its feedback (integral): in the lead window the lead grows by
-  // (b + lead_m) / lead_window_m ~ 4 m per metre of y, which multiplied the feedback's own swing
-  // by ~5 there and rang the loop at ~400 Hz (+-280 nm at 23 um/s backward, issue #31).
+  // (b + lead_m) / lead_window_m ~ 4 m per metre of y, which multiplies the feedback's own swing
+  // by ~5 there and rings the loop at ~400 Hz (+-280 nm at 23 um/s backward).
   const double y_lead = p_.lead_on_plan ? y_anchor_ + (ref_.x_m - r_anchor_) + corr_ : y_base;
   double lead = 0.0;
   if (ref_.v_m_s > 0.0) {

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Trajectory tracking within one step (issue #15; the "trajectory tracking" that thesis §2.7 and
+/// Trajectory tracking within one step (the "trajectory tracking" that thesis §2.7 and
 /// §2.8 name as what the model makes possible): one continuous scanning loop whose sawtooth is
 /// phased by the reference itself.
 ///
@@ -39,9 +39,9 @@
 namespace mc::motion {
 
 /// The gains (sprint_*, unload_V, edge_ready_V, lead_*, catchup_s, settle_s, ki_1_s, kp, backslip_gain,
-/// damp_*; low_V and powerup_V earlier) were chosen by scripts/tune_tracking.py on the tuning set of
-/// `microcobot control validate --set tuning` only and are judged on its validation set (issue #31;
-/// docs/parameters.md, docs/benchmarks.md).
+/// damp_*, low_V, powerup_V) were chosen by scripts/tune_tracking.py on the tuning set of
+/// `microcobot control validate --set tuning` only and are judged on its validation set
+/// (docs/parameters.md, docs/benchmarks.md).
 struct TrackingParams {
   double control_rate_Hz = 10000.0;  ///< rate of update()
   /// Voltage range the ramp uses; the edge spans it (the sawtooth amplitude A = high - low). A
@@ -54,11 +54,11 @@ struct TrackingParams {
   /// axis behind it by more than sprint_lag_m (back to low_V once within half of it) [V].
   double sprint_low_V = 7.5;
   /// [m/s]: above the envelope's 800 um/s, so the sprint starts on the lag trigger: with the edge
-  /// transients damped (damp_gain) that trigger could come down to 0.42 um (from 0.72 um), and the
-  /// fast, strongly accelerating moves sprint earlier (docs/benchmarks.md).
+  /// transients damped (damp_gain) that trigger can be as low as 0.42 um, so that the
+  /// fast, strongly accelerating moves sprint early (docs/benchmarks.md).
   double sprint_velocity_m_s = 1191.0e-6;
   double sprint_lag_m = 422.8e-9;  ///< [m]
-  /// Anticipation (issue #31): the velocity trigger looks at the reference's speed this far ahead,
+  /// Anticipation: the velocity trigger looks at the reference's speed this far ahead,
   /// |v| + |a| h while the reference speeds up (a v > 0), so that a strongly accelerating move
   /// sprints before the narrow edges fall behind rather than once the lag says they have. 0: off [s].
   double sprint_horizon_s = 0.0;
@@ -83,7 +83,7 @@ struct TrackingParams {
   double lead_m = 923.8e-9;
   /// The lead builds up over this last part of the PE's range before the edge [m].
   /// ...judged on the plan (anchor + reference travel + catch-up), not on the wanted extension
-  /// with its feedback (false: the issue #15 design, for comparison; docs/benchmarks.md).
+  /// with its feedback (false: on the wanted extension, for comparison; docs/benchmarks.md).
   bool lead_on_plan = true;
   double lead_window_m = 238.8e-9;
   /// After an edge: the catch-up of the remaining error takes this long (raised cosine) [s].
@@ -95,14 +95,13 @@ struct TrackingParams {
   /// slider sticks, the edges leave it ringing on the contact at ~1.8 kHz (5-6 ticks a period),
   /// and the loop's delay (the sample, then the ramp's first-order hold: ~1.5 ticks) is close to
   /// a quarter of that period, so -|kp| e acts on the ringing as velocity feedback, i.e. damping;
-  /// a positive gain is anti-damping and rings it (docs/errata.md; tuned on the model: 200 um/s
-  /// trapezoid RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1 with the earlier 0-100 V edge; -0.4 with
-  /// the 7.5-100 V edge: 118 nm, with the 30-100 V edge and the issue #31 gains: 82 nm). Beyond
+  /// a positive gain is anti-damping and rings it (docs/errata.md; on the model, 200 um/s
+  /// trapezoid with a 0-100 V edge: RMS 159 nm at 0, 128 nm at -0.3, 220 nm at +0.1). Beyond
   /// |kp| ~ 0.45 the loop rings (100 um/s: max 262 nm at -0.4, 721 nm at -0.5); damp_gain adds
   /// damping at the contact mode only.
   double kp = -0.2794;
   double backslip_gain = 0.402;  ///< update rate of the backslip estimate per edge (0: model only)
-  /// Resonant damping of the contact's stiff mode (issue #31): the edges leave the slider ringing
+  /// Resonant damping of the contact's stiff mode: the edges leave the slider ringing
   /// on asperity b at sqrt(rho0_b / M_s) = 1.64 kHz (thesis Table 2.8, docs/model.md "two
   /// asperities"), with a damping ratio of rho1_b / (2 sqrt(rho0_b c_b M_s)) ~ 0.04 only. The
   /// measured position is band-passed around damp_Hz (RBJ biquad, peak gain 1, quality damp_q) and
@@ -110,13 +109,12 @@ struct TrackingParams {
   /// phase), is added to the wanted PE extension; with the loop's ~1.5-tick delay (about a quarter period) a
   /// positive gain moves the PE against the ringing's velocity, i.e. damps it, like kp's negative
   /// gain but without acting below or above the mode (200 um/s trapezoid, steady part: error
-  /// peak-to-peak 554 nm without, 401 nm at gain 0.4, phase 0, lead on the plan, issue #31's first gains). 0:
-  /// off.
+  /// peak-to-peak 554 nm without, 401 nm at gain 0.4, phase 0, lead on the plan). 0: off.
   double damp_gain = 0.4837;
   double damp_Hz = 1640.0;      ///< [Hz]
   double damp_q = 1.317;        ///< quality factor of the band-pass
   double damp_lag_ticks = 0.0;  ///< [ticks]
-  /// Power-up ramp-in (issue #31): the amplifier starts at 0 V, the bottom of the range, so a
+  /// Power-up ramp-in: the amplifier starts at 0 V, the bottom of the range, so a
   /// backward move's first edge would come at once, with no lead to split its dip (626 nm at
   /// 200 um/s). Instead the controller's first act after a reset below low_V is one edge that
   /// lifts the drive to powerup_V (mid-range: both directions then have ramp left to lead their

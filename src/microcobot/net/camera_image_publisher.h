@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The camera's frames on DDS (issue #27) as a ROS 2 image topic, so that a ROS 2 image viewer
+/// The camera's frames on DDS as a ROS 2 image topic, so that a ROS 2 image viewer
 /// (rqt_image_view, Foxglove over a ROS bridge) subscribes to the microscope:
 ///
 ///   /microcobot/slave/camera/image_raw/compressed   DDS rt/microcobot/slave/camera/image_raw/compressed

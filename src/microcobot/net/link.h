@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The DDS link between the real-time loop and the peer process (issue #17). The loop only
+/// The DDS link between the real-time loop and the peer process. The loop only
 /// pushes and pops NetSample through two SpscRing (send(), receive(): wait-free, no allocation,
 /// no DDS call); a link thread does every DDS write and take, maps between NetSample and the ROS 2
 /// types (ros_mapping.h), refuses and counts what the network sends out of bounds, and reads the

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The microscope's focus drive and objective turret on DDS (issue #27 point 2: they are commands
-/// "console, CLI, Python, network"), as ROS 2 joint states, so that the master process and any
+/// The microscope's focus drive and objective turret on DDS (commands from the
+/// console, the CLI, Python and the network alike), as ROS 2 joint states, so that the master process and any
 /// ROS 2 node set and read them by name:
 ///
 ///   /microcobot/slave/microscope/command   sensor_msgs/msg/JointState   to the slave    on change

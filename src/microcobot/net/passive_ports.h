@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Time-domain passivity across the two processes of a distributed platform (issue #17 point 4):
+/// Time-domain passivity across the two processes of a distributed platform:
 /// the passivity observer and controller of teleop/passivity.h (Ryu, Artigas and Preusche's
 /// time-delay form) at each end of the coupling's network channel, one port per stage axis and
 /// one for the gripper.

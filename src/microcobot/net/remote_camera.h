@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The slave's microscope as the master process's camera (issue #27 over the network, `serve
+/// The slave's microscope as the master process's camera over the network (`serve
 /// --role master`): a frame source that reads the slave's images on DDS
 /// (camera_image_publisher.h: /microcobot/slave/camera/image_raw/compressed, JPEG) and decodes
 /// them, so that the master's console, its recordings and its vision see what the slave's camera

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The master of a distributed platform as the slave process sees it (issue #17,
-/// `microcobot serve --role slave`): the source of the live platform's operator commands
+/// The master of a distributed platform as the slave process sees it
+/// (`microcobot serve --role slave`): the source of the live platform's operator commands
 /// (live/command_source.h) in place of the console, over the DDS link. Each operator tick it
 /// takes the master's latest target pose and gripper target into a console command (a
 /// straight move to the target, at most at the coupling's console speed), reads the master's
@@ -11,11 +11,11 @@
 /// The master is fresh while it is engaged, its last target is at most `stale_timeout_s` old
 /// (counted from when it was sent, beyond the fastest delivery seen (transit_estimate.h): targets
 /// queued while the cable was out do not look new when they arrive)
-/// and DDS sees it (Link::peer_alive(): matched, alive, within its deadlines) (issue #17 point 6:
-/// a dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
-/// target). Its e-stop latches the slave's; releasing it resets it.
+/// and DDS sees it (Link::peer_alive(): matched, alive, within its deadlines).
+/// A dead master holds the slave within 10 ms: the coupling disengages and the stage holds its
+/// target. Its e-stop latches the slave's; releasing it resets it.
 ///
-/// The targets go through a jitter buffer first (target_stream.h, issue #15 point 4): the master's
+/// The targets go through a jitter buffer first (target_stream.h): the master's
 /// motion interpolated `stream.delay_s` behind its stamps, late targets held, never jumped to.
 /// The target leaves the channel through this end's passivity controller (passive_ports.h): the
 /// stage's goal is the integral of the velocity the controller lets through towards the master's
@@ -38,7 +38,7 @@ namespace mc::net {
 struct RemoteMasterParams {
   LinkConfig link;  ///< its role is forced to slave
   /// A target older than this: the master is silent. 8 ms, so that the hold (at the next
-  /// operator tick) lands within the 10 ms of issue #17 point 6.
+  /// operator tick) lands within 10 ms of the master's death.
   double stale_timeout_s = 0.008;
   /// Also require DDS's verdict on the peer (Link::peer_alive(): every state topic matched, alive
   /// and within its deadline). Off only for a peer that is not a whole end of the platform: one
@@ -51,8 +51,7 @@ struct RemoteMasterParams {
   /// loopback's jitter is below it), rejoining after a hold at 1 mm/s (the console's speed).
   /// With an emulated jitter (`emulate`) the look-ahead is raised to cover it.
   motion::SetpointStreamParams stream = default_stream();
-  /// false: each target followed as it arrives (no buffer; the behaviour before issue #15, for
-  /// comparison).
+  /// false: each target followed as it arrives (no buffer, for comparison).
   bool interpolate_targets = true;
   /// The slave's platform has the rotary axis: the master's target yaw is its goal (turned at the
   /// axis' own speed limit, with the master's engaged flag as the deadman).

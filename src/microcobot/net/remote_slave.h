@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The slave stage of a distributed platform as the master process sees it (issue #17,
-/// `microcobot serve --role master`): three position-controlled axes and a gripper whose far end
+/// The slave stage of a distributed platform as the master process sees it
+/// (`microcobot serve --role master`): three position-controlled axes and a gripper whose far end
 /// is the slave process, over the DDS link. They are one more implementation of the platform's
 /// device interfaces (devices/device.h, docs/hardware.md): the master's platform runs its
 /// masters and the teleoperation coupling as always and hands the coupling's targets to these
@@ -44,7 +44,7 @@ namespace mc::net {
 struct RemoteSlaveParams {
   LinkConfig link;  ///< its role is forced to master
   /// No pose for this long and the slave counts as silent: 8 ms, so that the release (at the
-  /// next tick) lands within the 10 ms of issue #17 point 6.
+  /// next tick) lands within 10 ms of the slave's silence.
   double stale_timeout_s = 0.008;
   /// Also require DDS's verdict on the peer (Link::peer_alive(): every state topic matched, alive
   /// and within its deadline). Off only for a peer that is not a whole end of the platform: one

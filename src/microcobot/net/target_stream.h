@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The master's targets at the slave's end of the network link (issue #15 point 4): a jitter
+/// The master's targets at the slave's end of the network link: a jitter
 /// buffer. Targets leave the master at 1 kHz stamped with its clock and arrive late, bunched or
 /// not at all (delay, jitter, loss). Followed as they arrive, the slave's goal would stop at
 /// every gap and jump at every burst. Here each axis' targets go through a

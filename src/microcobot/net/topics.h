@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The coupling's topic table (issue #17, docs/distributed.md): every topic the DDS link carries,
+/// The coupling's topic table (docs/distributed.md): every topic the DDS link carries,
 /// with its ROS 2 name, DDS name (`rt/` + the ROS 2 name without its leading slash, as
 /// rmw_cyclonedds_cpp maps it), ROS 2 type as DDS names it, publisher, rate and QoS.
 /// The 1 kHz state is best effort keep-last 1 (a late sample is worth less than the next one);
@@ -49,7 +49,7 @@ struct TopicSpec {
 };
 
 /// Nominal rate of the state topics and the watchdog's bounds on them: a missing sample is
-/// noticed after the deadline (issue #17 point 6 asks for reactions within 10 ms), a peer whose
+/// noticed after the deadline (a fault must be acted on within 10 ms), a peer whose
 /// process died after the liveliness lease (longer: Cyclone asserts automatic liveliness with
 /// extra messages, a few per lease).
 inline constexpr double kStateRate_Hz = 1000.0;

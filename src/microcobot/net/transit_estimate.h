@@ -7,7 +7,7 @@
 /// fastest the network has carried a sample. A sample's lateness is its transit minus that
 /// estimate: how long ago, beyond the fastest delivery, it was measured.
 ///
-/// Why it matters (the cable pulled under load, issue #17 point 6): samples queued in a socket,
+/// Why it matters (the cable pulled under load): samples queued in a socket,
 /// the kernel or a starved receive thread while the link was down arrive in a burst afterwards,
 /// each looking new to a timeout counted from its arrival. A backlog 100 ms old would re-engage
 /// a coupling across a cable that is still out. Judged by its lateness, it is as stale as it is.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The link emulator of issue #17 point 4 between two processes (`serve --link-delay
+/// The link emulator between two processes (`serve --link-delay
 /// --link-jitter --link-loss`): what the DDS link delivers to the loop is held back by the
 /// emulated delay and jitter, and lost with the emulated probability, before the remote end
 /// (remote_slave.h, remote_master.h) applies it. One emulated line per channel

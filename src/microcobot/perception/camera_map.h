@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The pixel <-> stage map the live vision uses (issue #28 point 1): the objective's measured
+/// The pixel <-> stage map the live vision uses: the objective's measured
 /// calibration (`camera.calibrations`, written by `microcobot vision calibrate --save`), or
 /// without one the objective's nominal map: its pixel size, the image's columns along stage x
 /// and its rows down along -y, the stage's home where the camera's view centre puts it

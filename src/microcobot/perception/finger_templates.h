@@ -5,10 +5,8 @@
 /// 42 um up the finger. The jaw side, where a gripped part touches, is left out, so a part
 /// between the fingers never enters a tip's template (a template over a part's edge or its
 /// defocused glow holds something that does not move with the tip). The end's edge is in: it
-/// fixes the rows. (It was left out from 2026-11-26 to 2026-11-27: with it the positioner read
-/// the stage's y motion 1 % long at 5x, which was the renderer's seams between a finger's
-/// segments, since removed; with it again the live click-to-go rests within 0.05 um in y:
-/// docs/benchmarks.md.) The finger: a bar along +y from its end at the tool point's
+/// fixes the rows (with it the live click-to-go rests within 0.05 um in y: docs/benchmarks.md).
+/// The finger: a bar along +y from its end at the tool point's
 /// y - width / 2, its inner face at the tool point's x -+ opening / 2 (platform/camera_scene.cc).
 
 #include <Eigen/Core>

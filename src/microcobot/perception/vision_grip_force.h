@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The grip force measured by vision, live (issue #28 point 4; thesis Fig. 1.5, after Greminger
+/// The grip force measured by vision, live (thesis Fig. 1.5, after Greminger
 /// & Nelson, IEEE TPAMI 26(3), 2004): on the camera thread, each frame's two finger tips are
 /// tracked and the distance between them, against the opening the gripper's drive puts the
 /// fingers at without a load, is the fingers' deflection; times their stiffness it is the force

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The stage positioned by what the camera sees (issue #28 point 5, `stage.xy_sensor: vision`):
+/// The stage positioned by what the camera sees (`stage.xy_sensor: vision`):
 /// on the camera thread, each frame's gripper tips are tracked (vision/template_tracker.h) and
 /// the visual servo (vision/visual_servo.h, v = -lambda L+ e with the Smith predictor on its own
 /// commands) turns the distance to the operator's goal into a stage velocity for an interval;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// What the microscope camera sees of the platform's scene (issue #27): the configuration's
+/// What the microscope camera sees of the platform's scene: the configuration's
 /// microworld (the pick-and-place part, the pin-in-hole's pin and hole, the optical trap's
 /// beads) and the slave's gripper, as the vision module's SceneSnapshot. The camera thread fills
 /// one snapshot from each telemetry sample it receives (the tool and part channels, or the

@@ -240,7 +240,7 @@ void Platform::slave_control_task() noexcept {
   const auto& out = teleop_->output();
   const std::array<double, 3> measured = {devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
                                           devices_.axes[2]->position_m()};
-  // Operator-to-slave tracking error (issue #15): the target the operator commands now against
+  // Operator-to-slave tracking error: the target the operator commands now against
   // where the slave is, while the coupling is engaged.
   if (out.engaged) {
     const double e = (out.slave_target_m - Eigen::Vector3d(measured[0], measured[1], measured[2])).norm();
@@ -293,7 +293,7 @@ void Platform::devices_task(double dt_s) noexcept {
     stepping_ended |= was_running && !st.running();
   }
   stepping_ended |= rotary_drive(dt_s);
-  // Every automatic move ends holding (issue #26): the targets re-taken where the axes are.
+  // Every automatic move ends holding: the targets re-taken where the axes are.
   if (stepping_ended) hold();
   devices_.gripper->update(dt_s);
   devices_.haptic->update(dt_s);

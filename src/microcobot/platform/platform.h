@@ -129,18 +129,18 @@ class Platform {
   /// telemetry. May be called again to continue. Stops early when stop() is called.
   void run(double duration_s);
   /// Runs like run() but hands every telemetry sample to `sink` (on a thread beside the loop,
-  /// about every millisecond) instead of recording it: the live server's way (issue #14), whose
+  /// about every millisecond) instead of recording it: the live server's way, whose
   /// runs have no end known in advance. `duration_s` may be infinite.
   using TelemetrySink = std::function<void(const TelemetrySample&)>;
   void run_streaming(double duration_s, const TelemetrySink& sink);
 
-  /// The operator console's command for the next ticks (issue #14), in world coordinates (the
+  /// The operator console's command for the next ticks, in world coordinates (the
   /// telemetry's): set from the operator task, on the loop. Real-time safe.
   void set_console_input(const teleop::ConsoleInput& in) noexcept;
   /// The console input in force (the last set_console_input()'s; its goal relative to the stage's
   /// home, as the coupling takes it).
   const teleop::ConsoleInput& console_input() const noexcept { return console_; }
-  /// Shared control (issue #29): the virtual fixtures on the coupling for the next ticks, in world
+  /// Shared control: the virtual fixtures on the coupling for the next ticks, in world
   /// coordinates (teleop/virtual_fixtures.h). On the loop (the operator task); real-time safe.
   void set_fixtures(const teleop::FixtureSet& set) noexcept;
   /// The haptic master's motion scale in force (the configured one times the fixtures' gain).
@@ -157,12 +157,12 @@ class Platform {
   void recover();
   void stop() noexcept { loop_.request_stop(); }
   /// Every axis holds where it is measured (target = position, zero velocity), the coupling
-  /// disengaged until the next engagement: how an automatic sequence hands control back
-  /// (issue #26). On the loop (the operator task); real-time safe.
+  /// disengaged until the next engagement: how an automatic sequence hands control back.
+  /// On the loop (the operator task); real-time safe.
   void hold() noexcept;
-  /// Open-loop stepping (issue #30, the ANC300's `stepu`/`stepd`): `periods` sawtooth periods
+  /// Open-loop stepping (the ANC300's `stepu`/`stepd`): `periods` sawtooth periods
   /// of `amplitude_V` at `frequency_Hz` played straight to axis `axis` (0..2; 3: the rotary
-  /// axis, turning its rotor by the arc the actuator steps, issue #29 point 2), forward
+  /// axis, turning its rotor by the arc the actuator steps), forward
   /// (`direction` +1) or backward (-1), the stage controller set aside on that axis; the coupling's
   /// target follows nothing meanwhile and the axis holds where it ends (hold()). On the loop
   /// (the operator task); real-time safe. Refused (false, nothing moves) when faulted, on
@@ -174,7 +174,7 @@ class Platform {
   /// travel, yaw_min_rad()..yaw_max_rad()) in its direction of travel.
   bool start_open_loop_steps(int axis, double amplitude_V, double frequency_Hz, int direction,
                              std::int64_t periods) noexcept;
-  /// Open-loop velocity (issue #28 point 5, `stage.xy_sensor: vision`): axis `axis` moves by
+  /// Open-loop velocity (`stage.xy_sensor: vision`): axis `axis` moves by
   /// v x `interval_s` within `interval_s`, its run planned from the step map
   /// (plan_open_loop_run(): a calibration of the drive, not a sensor), then holds at rest. A
   /// displacement under half the finest step stops the axis' run instead. The rules of
@@ -188,7 +188,7 @@ class Platform {
   bool open_loop_running(int axis) const noexcept {
     return steppers_[static_cast<std::size_t>(axis)] && steppers_[static_cast<std::size_t>(axis)]->running();
   }
-  /// The rotary axis (issue #29 point 2): present, its measured angle and its target [rad] (the
+  /// The rotary axis: present, its measured angle and its target [rad] (the
   /// console's theta commands move the target, with the console's deadman; hold() holds it).
   bool has_rotary() const noexcept { return devices_.rotary != nullptr; }
   /// Axis i (3: the rotary axis) parked on its target: its loop off, its voltage held
@@ -228,7 +228,7 @@ class Platform {
   const devices::SimulatedGripper* simulated_gripper() const { return sim_.gripper; }
   const StageController& stage_controller() const { return *stage_; }
   /// Operator-to-slave tracking error: |slave target - measured slave position| (3-D) at every
-  /// slave tick while the teleoperation coupling is engaged (issue #15).
+  /// slave tick while the teleoperation coupling is engaged.
   struct TrackingErrorStats {
     double sum_sq_m2 = 0.0, max_m = 0.0;
     std::uint64_t samples = 0;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The one description of the platform (issue #9): loop rates, the teleoperation scales and
+/// The one description of the platform: loop rates, the teleoperation scales and
 /// limits, the slave stage's controller and sensors, the masters' models, the microworld, and
 /// optionally a stick-slip parameter file (as `microcobot stickslip params` prints it). The
 /// built-in default is the platform of the main scenario; a YAML file overrides any key:
@@ -64,13 +64,13 @@ struct LoopParams {
 
 struct StageParams {
   motion::PositionControlParams control = default_control();
-  /// Issue #15: the axes follow the teleoperation target with the tracking controller
+  /// The axes follow the teleoperation target with the tracking controller
   /// (reference-phased sawtooth, updated at every loop tick on the axis positions; the 1 kHz target
   /// is extrapolated with its velocity) instead of the hybrid position controller (false).
   bool tracking_enabled = true;
   motion::TrackingParams tracking = default_tracking();
   motion::PositionSensorParams sensor;
-  /// What positions the stage in the plane (issue #28 point 5): "encoders", the axes' position
+  /// What positions the stage in the plane: "encoders", the axes' position
   /// sensors closing the stage controller's loop, or "vision", the x and y sensors unused: the
   /// axes step open loop (their drive planned from the step map) on velocity commands of the
   /// visual servo watching the camera's frames (live/vision_positioner.h); z keeps its loop.
@@ -82,7 +82,7 @@ struct StageParams {
   double home_x_m = -0.2e-3;
   double home_y_m = 0.0;
   double home_z_m = 0.45e-3;
-  /// The rotary axis under the gripper (issue #29 point 2; motion/rotary_axis.h): on by default
+  /// The rotary axis under the gripper (motion/rotary_axis.h): on by default
   /// on the simulated platform; a driver set has one when its drivers bring it.
   motion::RotaryAxisParams rotary;
   /// An axis whose target has stood still, and which has been within park_tolerance_m of it for
@@ -179,7 +179,7 @@ struct PlatformConfig {
   LoopParams loop;
   teleop::TeleoperationParams teleop;
   StageParams stage;
-  std::string stickslip_params_file;  ///< empty: the built-in SLC-1720-like axis (#4)
+  std::string stickslip_params_file;  ///< empty: the built-in SLC-1720-like axis
   HapticMasterParams haptic;
   tweezers::TeleTweezParams tweezers;
   /// What the slave works in: "pick-place" (the gripper over a part, `world`) or
@@ -187,9 +187,9 @@ struct PlatformConfig {
   std::string microworld = "pick-place";
   microworld::PickPlaceParams world;
   microworld::OpticalTrapSceneParams optical_trap;
-  /// The microscope camera and its focus drive (issue #27); which camera: devices.camera.
+  /// The microscope camera and its focus drive; which camera: devices.camera.
   devices::CameraDeviceParams camera;
-  /// The grip force measured by vision, live (issue #28 point 4, vision_grip_force.h).
+  /// The grip force measured by vision, live (vision_grip_force.h).
   perception::VisionGripForceParams vision_force;
 
   template <class V>

@@ -1,5 +1,5 @@
-// The platform's open-loop stepping (issue #30, the ANC300's stepu/stepd) and open-loop velocity
-// (issue #28, x and y positioned by vision), with the safety rules every run obeys.
+// The platform's open-loop stepping (the ANC300's stepu/stepd) and open-loop velocity
+// (x and y positioned by vision), with the safety rules every run obeys.
 #include <cmath>
 
 #include "microcobot/platform/platform.h"

@@ -1,4 +1,4 @@
-// The platform's rotary axis (issue #29 point 2; motion/rotary_axis.h): its target from the
+// The platform's rotary axis (motion/rotary_axis.h): its target from the
 // console's theta commands under the console's deadman, its controller on the stage controller's
 // fourth channel (the arc at the contact radius), its drive (or an open-loop run's), its hold.
 #include <algorithm>
@@ -83,8 +83,7 @@ bool Platform::rotary_drive(double dt_s) noexcept {
   devices_.rotary->update(dt_s);
   const bool ended = was_running && !st.running();
   // The loop resumes from the run's end (0 V, halted or at a period boundary): the state it kept
-  // while set aside made it run away on the rotor (the linear axes' hand-back, measured for issue
-  // #30, is left as it was).
+  // while set aside made it run away on the rotor (the linear axes' hand-back does not need this).
   if (ended && !faulted_) stage_->resume(3, devices_.rotary->position_m(), 0.0);
   return ended;
 }

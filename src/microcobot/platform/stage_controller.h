@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The slave stage's controller on the platform: one hybrid position controller per axis
-/// (motion::PositionController, stepping + scanning, #6) updated at the slave rate (1 kHz by
+/// (motion::PositionController, stepping + scanning) updated at the slave rate (1 kHz by
 /// default) on the measured positions and the teleoperation targets, and, at every loop tick,
 /// the drive-voltage samples each axis plays until the next tick (one per model step, from
 /// the controller's sawtooth generator or scanning voltage). Buffers are allocated at
@@ -22,12 +22,12 @@ namespace mc::platform {
 
 class StageController {
  public:
-  /// X, Y, Z and the rotary axis (issue #29 point 2: the same actuator driving a rotor, its
+  /// X, Y, Z and the rotary axis (the same actuator driving a rotor, its
   /// position the arc at the drive's contact radius, motion/rotary_axis.h).
   static constexpr int kMaxAxes = 4;
   /// `params.control_rate_Hz` is the slave rate; `samples_per_tick` drive samples of
   /// `sample_period_s` make one loop tick. `model` and `map` must outlive the controller.
-  /// With `tracking` (issue #15) each axis runs a motion::TrackingController instead. `axes`:
+  /// With `tracking` each axis runs a motion::TrackingController instead. `axes`:
   /// 3 (XYZ) or 4 (with the rotary axis, index 3).
   StageController(const motion::PositionControlParams& params, const stickslip::StickSlipParams& model,
                   const motion::StepMap& map, int samples_per_tick, double sample_period_s,

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Box plots in reports (issue #29 point 6): a figure whose series are groups of samples (one box
+/// Box plots in reports: a figure whose series are groups of samples (one box
 /// each, e.g. one per mode of the cell), summarised here as Tukey's box plot so that the page only
 /// draws what the library computed (and tests check the numbers, not pixels).
 

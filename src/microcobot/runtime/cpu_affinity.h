@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Keeping a core for the real-time loop (issue #30's tick goal): the loop's thread is pinned to
+/// Keeping a core for the real-time loop (so that it keeps its tick): the loop's thread is pinned to
 /// one core and the process's other threads (servers, drivers' buses, the camera, clients in
 /// the same process) are moved off it, so that between two ticks nothing of this process runs
 /// there and evicts the loop's caches and TLB entries (on a kernel with page-table isolation a

@@ -20,7 +20,7 @@
 
 namespace mc::server {
 
-/// Where the server listens and the bounds it puts on every client (DESIGN.md, "Network").
+/// Where the server listens and the bounds it puts on every client (docs/architecture.md, network).
 struct ServerOptions {
   /// IPv4 or IPv6 address to bind; loopback unless told otherwise.
   std::string address = "127.0.0.1";

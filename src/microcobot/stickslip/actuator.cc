@@ -215,9 +215,9 @@ void ActuatorModel::substep(ActuatorState& s, double uh, const StepConstants& k)
   // by the trapezoid of its ends (Verlet), the velocity-dependent part with the PE's *mean*
   // velocity over this step (its 64/120 kHz ringing averaged, not sampled: aliased, at the step
   // rate) against the trapezoid of x2' (implicit, second order). The end-of-step force is what the
-  // PE feels and what the next position prediction uses. (Before issue #31 the velocity update took
-  // the trapezoid of end-of-step forces, each with its own step's mean PE velocity: the damping's
-  // drive lagged half a step, which cost up to 2.7 % of the step of fast backward drives.)
+  // PE feels and what the next position prediction uses. (The trapezoid of end-of-step forces, each
+  // with its own step's mean PE velocity, would make the damping's drive lag half a step, up to
+  // 2.7 % of the step of fast backward drives.)
   const double v1_mean = (x1_new - x1_old) * k.inv_h;
   const double load = p_.slider.load_force_N;
   const double rho2 = p_.friction.rho2_N_s_m;

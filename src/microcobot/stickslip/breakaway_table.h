@@ -2,7 +2,7 @@
 /// @file
 /// The break-away elastic strain z_ba as a function of the sawtooth's amplitude, frequency and
 /// direction (thesis §2.5.2.3, Fig. 2.13, §2.6): a table on an (amplitude x frequency) grid per
-/// direction, clamped at the edges, so that identification (#5) can replace it with measured
+/// direction, clamped at the edges, so that identification can replace it with measured
 /// values. In between it is bilinear in (amplitude, log frequency): z_ba is affine in the amplitude
 /// (Fig. 2.13) and varies with the frequency on a logarithmic scale (§2.8: "mainly depends on the
 /// voltage amplitude and less on the voltage frequency"; the grids span decades, 50 Hz..2 kHz),
@@ -36,7 +36,7 @@ struct BreakawayTable {
   double lookup(double amplitude_V, double frequency_Hz, Direction direction) const noexcept;
 };
 
-/// The default surface (DESIGN errata 7, docs/parameters.md): z_ba grows affinely with the
+/// The default surface (the thesis gives no values: chosen, docs/parameters.md): z_ba grows affinely with the
 /// amplitude (the shape of Fig. 2.13), a little less with frequency (§2.8: "mainly depends on the
 /// voltage amplitude and less on the voltage frequency"), and is larger backward than forward
 /// (the asymmetry of Fig. 2.15-2.16).

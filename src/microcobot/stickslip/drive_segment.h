@@ -7,8 +7,8 @@
 /// The sawtooth's corners (the start and end of its slew-limited edge, thesis Fig. 2.3) and the
 /// step's corner fall anywhere in time, not on the model's grid. Cutting them by sampling
 /// (a corner between two samples lost up to ~2 V at 1 V/us) changes the 64/120 kHz ringing
-/// the edge excites, and with it the slip: the step size then depended on where the corners fell
-/// (issue #12). A segment carries the corners exactly; the integrator splits its sub-steps at
+/// the edge excites, and with it the slip: the step size then depended on where the corners fell.
+/// A segment carries the corners exactly; the integrator splits its sub-steps at
 /// them and evaluates the PI hysteresis at each. A plain sample stream (a DAC played through
 /// its reconstruction filter) is a segment without corners: linear between samples.
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Single-state elasto-plastic friction (Dupont 2002) as modified by the thesis (eq. 2.9-2.13,
-/// 2.18), and the two-asperity contact of eq. 2.20-2.21 (DESIGN errata 2, docs/model.md).
+/// 2.18), and the two-asperity contact of eq. 2.20-2.21 (docs/errata.md, "Two asperities"; docs/model.md).
 ///
 ///   x = z + w                                           (2.9)  elastic z + plastic w
 ///   F_f = rho0 z + rho1 z' + rho2 x'                    (2.10)

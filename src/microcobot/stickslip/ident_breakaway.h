@@ -11,7 +11,7 @@
 /// branch bracketing the target (the largest z_ba with |v| >= |v_meas|), then a monotone bracketed
 /// search (Illinois regula falsi in log z_ba) solves |v(z_ba)| = |v_meas|.
 /// Runs are independent: they are spread over threads, one ActuatorModel shared read-only and one
-/// ActuatorState per simulation (DESIGN.md: one Params drives many States).
+/// ActuatorState per simulation (one Params drives many States: docs/architecture.md).
 
 #include <cstddef>
 #include <filesystem>

@@ -2,7 +2,7 @@
 /// @file
 /// The piezoelectric element (PE): two vibration modes sharing the mass M_p (thesis eq. 2.1-2.3),
 /// driven by the hysteretic "equivalent voltage" H(U) through a linear part of unit static gain
-/// (eq. 2.5-2.7, DESIGN errata 3) and loaded by the friction force -F_f.
+/// (eq. 2.5-2.7 as read in docs/errata.md, "Eq. 2.5") and loaded by the friction force -F_f.
 ///
 ///   M_p x1a'' + D_pa x1a' + K_pa x1a = K_act1 g H(U) F_h' - F_f      (2.1, normalised as 2.5/2.6)
 ///   M_p x1b'' + D_pb x1b' + K_pb x1b = K_act2 g H(U) F_h' - F_f      (2.2)
@@ -18,8 +18,8 @@ namespace mc::stickslip {
 
 struct PiezoParams {
   double mass_kg = 0.00075;         ///< M_p, Table 2.8
-  double damping_a_N_s_m = 25.86;   ///< D_pa, Table 2.8 (N s/m, DESIGN errata 1)
-  double stiffness_a_N_m = 1.23e8;  ///< K_pa, Table 2.8 (N/m, DESIGN errata 1): 64.4 kHz
+  double damping_a_N_s_m = 25.86;   ///< D_pa, Table 2.8 (N s/m: docs/errata.md, "Table 2.8 units")
+  double stiffness_a_N_m = 1.23e8;  ///< K_pa, Table 2.8 (N/m, the same erratum): 64.4 kHz
   double damping_b_N_s_m = 82.17;   ///< D_pb, Table 2.8
   double stiffness_b_N_m = 4.24e8;  ///< K_pb, Table 2.8: 119.7 kHz
   double static_gain_m_V = 15e-9;   ///< g: PE stroke per equivalent volt (errata 7: ~1.5 um at 100 V)

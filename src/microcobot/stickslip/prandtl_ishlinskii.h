@@ -27,7 +27,8 @@ struct PiParams {
 };
 
 /// Default PI model: n = 35 operators (thesis §2.5.2.2), thresholds on a non-uniform (quadratic)
-/// partition of 0..50 V, a linear weight w_0 and geometrically decaying others (DESIGN errata 7),
+/// partition of 0..50 V, a linear weight w_0 and geometrically decaying others (the thesis gives
+/// no values: chosen, docs/parameters.md),
 /// scaled so that the loading curve maps 100 V to 100 V.
 PiParams default_pi_params(int n = 35);
 

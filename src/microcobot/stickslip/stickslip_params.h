@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// The aggregate parameters of one stick-slip axis (thesis ch. 2, Table 2.8 + DESIGN errata 7).
+/// The aggregate parameters of one stick-slip axis (thesis ch. 2, Table 2.8, and the
+/// values the thesis leaves undetermined, chosen in docs/parameters.md).
 /// `microcobot stickslip params --json` prints them; `--params FILE.yaml` reads the same keys.
 
 #include <string>

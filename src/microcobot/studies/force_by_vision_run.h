@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The force-by-vision benchmark (issue #28 point 4; `microcobot vision force`): the gripper
+/// The force-by-vision benchmark (`microcobot vision force`): the gripper
 /// closes on a part, its fingers' tips are tracked, and vision::FingerForce's estimate is judged
 /// against the simulation's grip force (microworld/piezo_gripper.h: F = k (w - o) / 2 for a part
 /// of width w and a free opening o < w).

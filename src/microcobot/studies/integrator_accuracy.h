@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// The fixed-step integrator's accuracy against the reference solver (reference_solver.h), both
-/// driven by the exact waveform, over drives drawn at random across the operating range
-/// (issue #12): slider RMS and max error as fractions of the slider's range, and the net step
+/// driven by the exact waveform, over drives drawn at random across the operating range:
+/// slider RMS and max error as fractions of the slider's range, and the net step
 /// per period. The drives' corners fall anywhere in time, so the study measures what the
 /// model does between its grid points, not only on drives aligned with it.
 

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// Closed-loop trajectory-tracking runs of one axis (issue #15): the tracking controller and its
-/// baselines (today's hybrid position controller fed the moving target, the thesis's PID on the
-/// sawtooth amplitude, §2.7 Fig. 2.18) on the same model, sensor noise and reference, with the
-/// metrics of the issue: RMS and max error during motion, lag, final error. The runner allocates
+/// Closed-loop trajectory-tracking runs of one axis: the tracking controller and its
+/// baselines (the hybrid position controller, position_controller.h, fed the moving target, the thesis's PID
+/// on the sawtooth amplitude, §2.7 Fig. 2.18) on the same model, sensor noise and reference, with the
+/// tracking metrics: RMS and max error during motion, lag, final error. The runner allocates
 /// its records only; the controllers inside never allocate.
 
 #include <functional>

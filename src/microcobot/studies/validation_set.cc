@@ -72,7 +72,7 @@ double move_duration_s(const ValidationCase& c) {
   }
 }
 
-/// One random case of kind `profile` within the envelope of issue #31 (redrawn until its move
+/// One random case of kind `profile` within the operating envelope (validation_set.h; redrawn until its move
 /// lasts <= kMaxCaseDuration_s).
 ValidationCase draw_case(Rng& rng, CaseProfile profile, int index) {
   ValidationCase c;
@@ -167,7 +167,7 @@ std::vector<ValidationCase> make_case_set(CaseSet set, std::uint64_t seed, int r
           static_cast<double>(seed));
   std::vector<ValidationCase> cases;
   if (set == CaseSet::kTuning) {
-    // The cases issues #15 and #31 named (CLI defaults: power-up, 2e-3 m/s^2, sensor seed 1).
+    // The named cases (CLI defaults: power-up, 2e-3 m/s^2, sensor seed 1).
     const auto trap = [&](const char* name, double sign, double d, double v, double a) {
       ValidationCase c;
       c.name = name;

@@ -1,13 +1,14 @@
 #pragma once
 /// @file
-/// Tracking that generalises (issue #31 point 1): the tracking controller's gains are chosen on a
+/// Tracking that generalises: the tracking controller's gains are chosen on a
 /// tuning set and judged on a validation set drawn apart from it. Both are seeded random draws
 /// over the operating envelope (trapezoids 20-800 um/s, 10 um-2 mm, 2e-3-0.1 m/s^2, both
 /// directions; sines 0.1-5 Hz of 2-50 um; 3-D lines and arcs; each from power-up or from rest);
-/// the tuning set also holds the named cases of issues #15 and #31. A case from rest starts after
+/// the tuning set also holds named cases (trapezoids of 50-500 um/s, a sine, a 3-D
+/// line and an arc). A case from rest starts after
 /// a short lead-in move and a rest, so the drive sits where a previous move left it; a case from
 /// power-up starts with the drive at 0 V. run_validation() runs each case on the model (one axis,
-/// or the three axes of the XYZ stage) and checks the goals of issue #31.
+/// or the three axes of the XYZ stage) and checks the goals (TrackingGoals).
 
 #include <cstdint>
 #include <string>
@@ -32,7 +33,7 @@ CaseSet parse_case_set(const std::string& name, const std::string& field = "set"
 /// The default seeds. The validation seed must differ from the tuning seed (the sets are kept apart).
 inline constexpr std::uint64_t kTuningSeed = 15;
 inline constexpr std::uint64_t kValidationSeed = 31;
-/// The default sizes: the validation set >= 30 references (issue #31).
+/// The default sizes: the validation set >= 30 references.
 inline constexpr int kTuningRandomCases = 32;
 inline constexpr int kValidationCases = 32;
 /// Longest reference drawn [s]: a draw whose move would last longer is drawn again, so that a
@@ -57,11 +58,11 @@ struct ValidationCase {
   int sensor_seed = 1;  ///< sensor noise stream of the case (3-D: + axis)
 };
 
-/// The tuning set (the named cases of issues #15 and #31, then `random_cases` drawn with `seed`)
+/// The tuning set (the named cases, then `random_cases` drawn with `seed`)
 /// or the validation set (`random_cases` drawn with `seed`). Deterministic in the seed.
 std::vector<ValidationCase> make_case_set(CaseSet set, std::uint64_t seed, int random_cases);
 
-/// The goals of issue #31 [m].
+/// The tracking goals every run_validation() checks [m].
 struct TrackingGoals {
   double rms_m = 150e-9;               ///< every case's RMS error in motion
   double median_rms_m = 100e-9;        ///< the median of the cases' RMS

@@ -1,8 +1,7 @@
 #pragma once
 /// @file
-/// A pick-and-place done by the visual servo alone, the stage's encoders off (issue #28 point 5:
-/// "a pick-and-place done by the servo alone places the part within 1 um"; `microcobot vision
-/// pick-place`).
+/// A pick-and-place done by the visual servo alone, the stage's encoders off; the goal: the part
+/// placed within 1 um (`microcobot vision pick-place`).
 ///
 /// Sequence (one camera frame per step, as visual_servo_run.h's timeline):
 ///   1. approach: the tips (a template on a finger's tip) servoed by vision::VisualServo

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A visual servoing run with the stage's encoders off (issue #28 point 5; `microcobot vision
+/// A visual servoing run with the stage's encoders off (`microcobot vision
 /// servo`): the gripper's tips brought over the pick-and-place part by vision::VisualServo, the
 /// stage an EncoderlessStage (stick-slip axes driven open loop), the camera a imaging::Renderer
 /// of the scene at each frame's mid-exposure, the tips followed by a vision::TemplateTracker.

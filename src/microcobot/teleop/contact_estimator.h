@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The slave's estimate of the contact it touches, for model-mediated teleoperation (Mitra and
-/// Niemeyer, "Model-mediated telemanipulation", SPIE 6906, 2008; issue #31): a wall at x_w of
+/// Niemeyer, "Model-mediated telemanipulation", SPIE 6906, 2008): a wall at x_w of
 /// stiffness k,
 ///   f_e = k (x_s - x_w)  while f_e > contact threshold,                              (1)
 /// fitted by exponentially weighted least squares over the contact samples (recursive least

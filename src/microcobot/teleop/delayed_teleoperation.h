@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// The coupling system over a delayed, lossy link, 1 DOF, pushed into a stiff contact (issue
-/// #17's delay sweep, issue #31's settling), by one of three schemes (`Scheme`):
+/// The coupling system over a delayed, lossy link, 1 DOF, pushed into a stiff contact (the
+/// delay sweep: its stability and its settling), by one of three schemes (`Scheme`):
 ///  - none: position forward, force back, unprotected;
 ///  - tdpa: the same with time-domain passivity control (passivity.h) at both ports;
 ///  - mmt:  model-mediated teleoperation: position forward, the slave's estimate of the contact
@@ -33,7 +33,7 @@ const char* to_string(Scheme s);
 /// Throws InvalidParams naming `name` unless it is one of to_string's names.
 Scheme scheme_from_string(const std::string& name);
 
-/// The model-mediated scheme's settings (issue #31; docs/model.md "Settling under long delay").
+/// The model-mediated scheme's settings (docs/model.md "Settling under long delay").
 struct MmtSettings {
   ContactEstimatorParams estimator;
   double time_constant_s = 0.005;       ///< the master's model lag, eq. (1) of model_mediated_master.h

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// A network link as the coupling system sees it (issue #17): each sample sent at a fixed rate
+/// A network link as the coupling system sees it: each sample sent at a fixed rate
 /// arrives after a delay with jitter, or never (loss). Samples that arrive after a newer one are
 /// discarded (what a receiver keeping the latest sample does with reordered datagrams), and the
 /// receiver holds the latest sample until a newer one arrives. Deterministic for a seed.

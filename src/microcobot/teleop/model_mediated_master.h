@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The master of model-mediated teleoperation (Mitra and Niemeyer, "Model-mediated
-/// telemanipulation", SPIE 6906, 2008; issue #31): the handle feels a local model of the remote
+/// telemanipulation", SPIE 6906, 2008): the handle feels a local model of the remote
 /// contact, rendered without delay at the haptic rate, instead of the slave's delayed force. The
 /// slave estimates the model (contact_estimator.h) and sends it back; the master moves its model
 /// towards each new estimate with a first-order lag

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Time-domain passivity of a delayed bilateral channel (issue #17), after Ryu, Artigas and
+/// Time-domain passivity of a delayed bilateral channel, after Ryu, Artigas and
 /// Preusche, "A passive bilateral control scheme for a teleoperator with time-varying
 /// communication delay" (Mechatronics 20, 2010), the time-delay form of Ryu and Hannaford's
 /// passivity observer and controller. Why this and not wave variables: docs/model.md.

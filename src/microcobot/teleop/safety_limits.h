@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The force and workspace limits the teleoperation coupling enforces on the slave whatever its
-/// input (issue #26: a cobot puts a person's hands and a customer's parts next to the machine):
+/// input (a cobot puts a person's hands and a customer's parts next to the machine):
 ///
 ///  - **grip force**: a force-controlled close. A PiezoGripper finger is a spring of stiffness
 ///    k at its tip (microworld/piezo_gripper.h), so a part of width w squeezed by fingers

@@ -11,14 +11,14 @@
 ///  - gripper opening = grip_position_scale x TéléTweez tip opening (the robotic mode of §4.3.2);
 ///  - force: the haptic force = force_scale x slave contact force (XY), low-pass filtered, the
 ///    TéléTweez finger force = grip_force_scale x slave grip force, both capped;
-///  - console (issue #14): while the operator's console holds control, it replaces the haptic
+///  - console: while the operator's console holds control, it replaces the haptic
 ///    master: the stage target moves at the joystick's velocity or straight to a clicked goal
 ///    (rate-limited), and the gripper opening is the console's; the haptic force is zero;
 ///  - safety: the coupling is engaged only while the deadman is held, the clutch released and the
 ///    haptic master's (or the console's) commands fresh (the platform's watchdog). Disengaged, the slave
 ///    targets freeze (the stage holds where it is) and the haptic force is zero; the gripper follows the
 ///    TéléTweez (or the console) only while the deadman is held and its readings are fresh, and holds
-///    otherwise (issue #26: nothing of the slave moves without the deadman). Whatever the input, the
+///    otherwise (nothing of the slave moves without the deadman). Whatever the input, the
 ///    grip force, the contact force and the floor are limited (safety_limits.h).
 ///
 /// tick() runs on the real-time path at the haptic rate: no allocation, lock, exception or I/O.
@@ -48,7 +48,7 @@ struct TeleoperationParams {
   /// Time constant of the haptic target's velocity feedforward (the handle is read at the
   /// operator's rate, the coupling runs ten times faster).
   double velocity_filter_s = 0.005;
-  /// Shared control (issue #29): the virtual fixtures' shape; which fixtures act, and how
+  /// Shared control: the virtual fixtures' shape; which fixtures act, and how
   /// strongly, is set at run time (Teleoperation::set_fixtures).
   VirtualFixtureParams fixtures;
 
@@ -71,7 +71,7 @@ struct TeleoperationParams {
   void validate() const;
 };
 
-/// The operator console's command (joystick/tablet teleoperation, click-to-go; issue #14), in
+/// The operator console's command (joystick/tablet teleoperation, click-to-go), in
 /// the coupling's stage coordinates. The platform validates and clamps it before it gets here.
 struct ConsoleInput {
   bool active = false;   ///< the console holds control: the haptic master is ignored
@@ -140,7 +140,7 @@ class Teleoperation {
   /// True while the last tick held the stage against an over-limit contact.
   bool contact_limited() const noexcept { return contact_limited_; }
   /// Holds the slave where it is measured (target = position, zero velocity), disengaged: the
-  /// hand-back after an automatic sequence (issue #26). Real-time safe.
+  /// hand-back after an automatic sequence. Real-time safe.
   void hold_at(const Eigen::Vector3d& measured_m) noexcept;
   /// The virtual fixtures for the coming ticks (stage coordinates; virtual_fixtures.h), on every
   /// input path. Real-time safe.

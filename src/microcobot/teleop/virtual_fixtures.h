@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Shared control on the teleoperation coupling (issue #29 point 4): virtual fixtures that
+/// Shared control on the teleoperation coupling: virtual fixtures that
 /// guide the slave and keep it out of forbidden regions, whatever the master.
 ///
 /// The fixtures act on the slave target the operator commands (the coupling's stage
@@ -50,7 +50,7 @@
 ///              level rises or the coupling re-indexes, E would go negative and the passivity
 ///              controller adds the damping that dissipates exactly the excess (f' = f + b v,
 ///              teleop/passivity.h's rule).
-///   keep-out   forbidden regions round the neighbouring parts (issue #29 point 4): each a vertical
+///   keep-out   forbidden regions round the neighbouring parts: each a vertical
 ///              cylinder (centre c, radius r: the neighbour's footprint grown by the gripper's) up to
 ///              a height z_top (its top plus a clearance). The target never has both |xy - c| < r
 ///              and z < z_top: a target inside the circle (above the part) is held at z_top at least,

@@ -7,7 +7,7 @@
 /// half-angle phi = atan(mu). Forward transmission (torque drives translation, haptic display)
 /// has efficiency tan(theta)/tan(theta+phi) (eq. B.6); backward transmission (translation
 /// back-drives rotation, the operator moving the motor) has tan(theta-phi)/tan(theta)
-/// (eq. B.9 with the sign corrected, DESIGN.md errata 5). The screw is reversible only while
+/// (eq. B.9 with the sign corrected, docs/errata.md, "Eq. B.9"). The screw is reversible only while
 /// theta > phi.
 
 namespace mc::tweezers {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The 7-DOF linear dynamic model of the TéléTweez (thesis section 4.5.1, Fig. 4.23, eq. 4.6),
-/// derived from its kinetic, potential and dissipated energies (DESIGN.md errata 6) so that
+/// derived from its kinetic, potential and dissipated energies (docs/errata.md, "Eq. 4.6") so that
 /// M, C and K are symmetric positive (semi)definite and the model is passive.
 ///
 /// Generalized coordinates X = [theta_m, theta_cp, theta_bs, x_bs, x_ss, x_l, x_cl]: motor,

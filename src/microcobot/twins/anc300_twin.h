@@ -1,11 +1,10 @@
 #pragma once
 /// @file
-/// The stage answering the Attocube ANC300's console (issue #30): three open-loop stick-slip
-/// axes 1, 2, 3 (X, Y, Z) and, when the platform has the rotary axis under the gripper (issue #29
-/// point 2), a rotary positioner on axis 4 (theta), whose `stepu`/`stepd` run sawtooth periods of
-/// the set amplitude and frequency through the platform's stick-slip model
-/// (Platform::start_open_loop_steps; theta turns by the arc its actuator steps). Lines are
-/// parsed by anc300_codec.h; every value is checked before it reaches the stage. Commands
+/// The stage answering the Attocube ANC300's console: three open-loop stick-slip
+/// axes 1, 2, 3 (X, Y, Z) and, when the platform has the rotary axis under the gripper, a rotary positioner
+/// on axis 4 (theta), whose `stepu`/`stepd` run sawtooth periods of the set amplitude and frequency through
+/// the platform's stick-slip model (Platform::start_open_loop_steps; theta turns by the arc its actuator
+/// steps). Lines are parsed by anc300_codec.h; every value is checked before it reaches the stage. Commands
 /// (docs/hardware.md): echo, ver, getcser, getser, setm/getm, setf/getf, setv/getv, stepu, stepd,
 /// stepw, stop, getc, and `getpos` (the twin's sensor, m or deg; no ANC300 has it). The axes'
 /// settings are the controller's (shared by every connection); echo and login are each

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// The stage answering PI GCS 2.0 (issue #30): an E-873-like controller of three closed-loop
+/// The stage answering PI GCS 2.0: an E-873-like controller of three closed-loop
 /// linear axes "1", "2", "3" (X, Y, Z: positions in mm, velocities in mm/s) and, when the platform
-/// has the rotary axis under the gripper (issue #29 point 2), a rotation stage "4" (theta: deg,
+/// has the rotary axis under the gripper, a rotation stage "4" (theta: deg,
 /// deg/s, as PI's rotation stages report with PUN?), over the platform's own position control
 /// (twins/twin_stage.h). Every line is parsed by gcs2_codec.h; every value is checked (axis,
 /// number, limits) before it reaches the stage. Commands (docs/hardware.md): *IDN?, CSV?, HLP?,

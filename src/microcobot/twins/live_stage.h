@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The live platform as a protocol twin's stage (issue #30): reads the loop's protocol view
+/// The live platform as a protocol twin's stage: reads the loop's protocol view
 /// (atomics), pushes checked and clamped commands into its protocol ring, and keeps who controls
 /// the stage (twins/twin_stage.h), the rotary axis with the three when the platform has it.
 /// Protocol thread only: it is the ring's single producer.

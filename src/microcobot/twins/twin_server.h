@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The vendor-protocol twins served over TCP (issue #30, `microcobot serve --emulate gcs2
+/// The vendor-protocol twins served over TCP (`microcobot serve --emulate gcs2
 /// --emulate anc300`): one thread runs every listening socket and connection (Boost.Asio), the
 /// twins' controller state, and the stage's heartbeat; it is the only producer of the live
 /// platform's protocol ring (twins/live_stage.h) and never touches the loop otherwise.

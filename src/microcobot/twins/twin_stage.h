@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// What a protocol twin (GCS 2.0, ANC300) reads of the stage it emulates and asks of it
-/// (issue #30). Called from the protocol thread only. The live implementation (live_stage.h)
+/// What a protocol twin (GCS 2.0, ANC300) reads of the stage it emulates and asks of it.
+/// Called from the protocol thread only. The live implementation (live_stage.h)
 /// turns the asks into commands on the live platform's protocol ring; tests use a fake.
 ///
 /// Control (docs/hardware.md, "Who controls the stage"): a protocol client is an operator
@@ -20,7 +20,7 @@ using ClientId = std::uint64_t;
 class TwinStage {
  public:
   /// Axes 0, 1, 2 are X, Y, Z (linear: m, stage coordinates, 0 at the home); axis 3, when the
-  /// platform has it, is the rotary axis theta under the gripper (issue #29 point 2: rad, 0 at its
+  /// platform has it, is the rotary axis theta under the gripper (rad, 0 at its
   /// home, stage.rotary.home_rad: the console's theta, the gripper's yaw, less home_rad).
   static constexpr int kTheta = 3;
   static constexpr int kMaxAxes = 4;

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Pixel <-> stage calibration (issue #28 point 1): the full affine map from the stage's
+/// Pixel <-> stage calibration: the full affine map from the stage's
 /// commanded coordinates to the image, measured by moving the stage through a pattern and
 /// tracking a feature that moves with it (Micro-Manager's pixel-size calibration does the same).
 ///

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Autofocus (issue #28, point 3; docs/model.md, "Autofocus and depth from focus"): a search for the focus
+/// Autofocus (docs/model.md, "Autofocus and depth from focus"): a search for the focus
 /// height that maximises a focus measure F (sharpness.h), stepped by its caller one frame at a time, as a
 /// tracker or a servo task is: the search says where to set the focus (next_focus_m()), the
 /// caller takes a frame there, measures its sharpness and hands it back (observe()).

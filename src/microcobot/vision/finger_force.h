@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Force measured by vision (issue #28 point 4; thesis Fig. 1.5, after Greminger & Nelson,
+/// Force measured by vision (thesis Fig. 1.5, after Greminger & Nelson,
 /// "Vision-based force measurement", IEEE TPAMI 26(3), 2004): the gripper's fingers are springs
 /// of known stiffness k at their tips (microworld/piezo_gripper.h); the tips' deflection seen in
 /// the image, times k, is the force on them.
@@ -19,7 +19,7 @@
 ///     piezo_gripper.h); the stage's encoders are not used.
 ///
 /// Noise: F averages two tips, sigma_F = k sigma_tip / sqrt(2) for independent tip noise
-/// sigma_tip [m] (issue #28's goal: <= 2 k sigma_tip). Bias: whatever moves a tip's match other
+/// sigma_tip [m] (the goal: <= 2 k sigma_tip). Bias: whatever moves a tip's match other
 /// than the deflection (a part's defocused face beside it, the unloaded line's error).
 /// Not thread-safe: one per camera thread; the trackers allocate in OpenCV (not on the loop).
 

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// The best precision any unbiased estimator can reach for a target's translation in a noisy
-/// frame: the Cramér-Rao lower bound (issue #28: a tracker "within 2x of the localisation bound
-/// for that SNR"; the bound Thompson et al., Biophys. J. 82, 2002, and Mortensen et al., Nat.
+/// frame: the Cramér-Rao lower bound (the goal for a tracker: within 2x of it at the
+/// frame's SNR; the bound Thompson et al., Biophys. J. 82, 2002, and Mortensen et al., Nat.
 /// Methods 7, 2010, give in closed form for a point source, here for any rendered target).
 ///
 /// With the expected grey level mu_k(t) of pixel k when the target is translated by t = (du, dv)

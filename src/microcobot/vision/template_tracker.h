@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Sub-pixel template tracking (issue #28 point 2): a patch of a first frame (a part, a hole, a
+/// Sub-pixel template tracking: a patch of a first frame (a part, a hole, a
 /// pin, the gripper's tip) found again in each later frame.
 ///
 ///  1. Coarse: normalised cross-correlation (OpenCV matchTemplate, TM_CCOEFF_NORMED) over a

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Image-based visual servoing of the stage (issue #28 point 5): a feature seen in the camera's
+/// Image-based visual servoing of the stage: a feature seen in the camera's
 /// frames (the gripper's tips, a pin) driven onto a target pixel (a part, a hole) by stage
 /// velocity commands, with the stage's own position sensors unused.
 ///
@@ -48,7 +48,7 @@ struct VisualServoParams {
   /// No motion is commanded when the predicted error is under this [m]: the stage's smallest
   /// reliable open-loop step is ~30-60 nm; a smaller command only dithers it.
   double deadband_m = 0.05e-6;
-  /// The predicted error under which the servo reports itself converged [m] (issue #28: 0.3 um).
+  /// The predicted error under which the servo reports itself converged [m] (0.3 um).
   double converged_m = 0.3e-6;
   /// A feature older than this at step() is stale: hold [s].
   double max_feature_age_s = 0.2;

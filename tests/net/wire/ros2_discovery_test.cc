@@ -1,4 +1,4 @@
-// ROS 2 out of the box (issue #31 point 4): a ROS 2 node on the platform's machine finds the
+// ROS 2 out of the box: a ROS 2 node on the platform's machine finds the
 // platform's topics with the usual localhost settings and nothing else. No ROS 2 here, so the node
 // is ros2_node (ros2_node.c): a Cyclone participant whose domain is created from the configuration
 // string rmw_cyclonedds_cpp builds from ROS_LOCALHOST_ONLY and CYCLONEDDS_URI (Humble's and
@@ -239,7 +239,7 @@ void expect_found_the_slave(const NodeRun& r, const std::string& config) {
 #define MC_NEEDS_MACHINE(m) \
   if (!(m).ok()) GTEST_SKIP() << "needs a network namespace of its own: " << (m).why()
 
-// The case issue #31 measured: `lo` multicast-capable, Humble's ROS_LOCALHOST_ONLY=1. The node
+// A measured case: `lo` multicast-capable, Humble's ROS_LOCALHOST_ONLY=1. The node
 // announces itself only by multicast on loopback and has no predictable unicast port, so it finds
 // the platform only if the platform answers multicast discovery there.
 TEST(Ros2Discovery, AHumbleNodeWithRosLocalhostOnlyFindsThePlatformByMulticastOnLoopback) {

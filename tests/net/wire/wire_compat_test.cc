@@ -1,4 +1,4 @@
-// Wire compatibility of the DDS link (issue #17): a separate plain C program, compiled by idlc from
+// Wire compatibility of the DDS link: a separate plain C program, compiled by idlc from
 // the ROS 2 IDL in this directory (not the platform's), subscribes by the ROS 2 names to what a real
 // `microcobot link ping` (master) and `microcobot link echo` (slave) publish over loopback, and
 // reads the values ping sends: target i is (1 mm cos(2 pi i / 1000), 1 mm sin(2 pi i / 1000), 0),
@@ -269,7 +269,7 @@ TEST(WireCompat, TheListenerReadsTheSlavesForcesPoseAndDeviceStates) {
   }
 }
 
-// The slave's microscope camera as a ROS 2 image topic (issue #27): the C program subscribes to
+// The slave's microscope camera as a ROS 2 image topic: the C program subscribes to
 // /microcobot/slave/camera/image_raw/compressed by its ROS 2 name and type and decodes each
 // JPEG itself (libjpeg-turbo): the sensor's size, an image that is neither black nor saturated,
 // stamps at the camera's frame rate. The camera forms frames because this reader matched
@@ -317,7 +317,7 @@ TEST(WireCompat, ACProgramReadsTheSlavesCameraImagesAndDecodesTheirJpeg) {
   }
 }
 
-// The microscope as any ROS 2 node sets it (issue #27 point 2): a plain C program publishes a
+// The microscope as any ROS 2 node sets it: a plain C program publishes a
 // latched JointState command (focus 150 um, objective 2) to a real `serve --role slave`; the C
 // listener then reads the slave's state topic: the drive went there and the turret turned.
 TEST(WireCompat, ACProgramSetsTheSlavesMicroscopeAndReadsItsState) {
