@@ -483,7 +483,8 @@ void bind_tweezers(py::module_& m) {
                         "backward_efficiency"_a = e.backward_efficiency);
       },
       "diameter_m"_a, "lead_m"_a, "mu"_a,
-      "Forward (eq. B.6) and backward (eq. B.9, sign corrected: errata 5) efficiencies of a ball screw.");
+      "Forward (eq. B.6) and backward (eq. B.9, sign corrected, erratum 5 in docs/errata.md) efficiencies of "
+      "a ball screw.");
   m.def("axial_force", &tw::axial_force, "torque_Nm"_a, "lead_m"_a, "forward_efficiency"_a,
         "Axial force F_a = 2 pi eta_f C / p [N] (eq. 4.4).");
   m.def("finger_force", &tw::finger_force, "axial_force_N"_a, "alpha_rad"_a, "eta_t"_a,

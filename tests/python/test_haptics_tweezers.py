@@ -41,7 +41,7 @@ def test_tweezers_calculators_reproduce_the_thesis():
     # Eq. 4.1: 250 N/m over 7 mm -> 1.75 N; preload for 1.75 N at 63 deg -> 3.85 N (§4.4.2).
     assert tweezers.stiffness_force(250.0, 7e-3) == pytest.approx(1.75)
     assert tweezers.min_preload(1.75, math.radians(63.0)) == pytest.approx(3.85, abs=0.01)
-    # Eq. B.6 and B.9 (errata 5: tan(theta - phi) / tan(theta)), against the closed forms.
+    # Eq. B.6 and B.9 (erratum 5 in docs/errata.md: tan(theta - phi) / tan(theta)), against the closed forms.
     d, p, mu = 4e-3, 1e-3, 0.01
     e = tweezers.ball_screw_efficiency(d, p, mu)
     th, phi = math.atan(p / (math.pi * d)), math.atan(mu)

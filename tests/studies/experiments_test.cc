@@ -1,6 +1,6 @@
 // The thesis's chapter-2 experiments on the default model (§2.5, Fig. 2.10-2.17), with their
 // numeric checks, and the fixed-step integrator's error against the odeint reference.
-#include "microcobot/stickslip/experiments.h"
+#include "microcobot/studies/experiments.h"
 
 #include <cmath>
 

@@ -39,7 +39,8 @@ TEST(BallScrew, FrictionlessIsLosslessAndBackwardNeverExceedsForward) {
   EXPECT_DOUBLE_EQ(backward_efficiency(th, 0.0), 1.0);
   for (double mu : {0.005, 0.01, 0.05}) {
     EXPECT_LT(backward_efficiency(th, mu), forward_efficiency(th, mu));
-    EXPECT_GT(backward_efficiency(th, mu), 0.0);  // errata 5: the printed B.9 would be negative
+    EXPECT_GT(backward_efficiency(th, mu),
+              0.0);  // erratum 5 (docs/errata.md): the printed B.9 would be negative
   }
   // Self-locking when the friction angle exceeds the lead angle.
   EXPECT_EQ(backward_efficiency(th, 0.2), 0.0);

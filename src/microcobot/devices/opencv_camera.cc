@@ -1,6 +1,6 @@
 // The one translation unit that includes OpenCV (its headers are heavy, so they are kept in few places;
 // docs/architecture.md). Built only with MC_WITH_OPENCV (src/microcobot/CMakeLists.txt).
-#include "microcobot/platform/opencv_camera.h"
+#include "microcobot/devices/opencv_camera.h"
 
 #include <chrono>
 #include <cstring>

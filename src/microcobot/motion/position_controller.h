@@ -37,7 +37,7 @@ struct PositionControlParams {
   double step_fraction = 0.25;
   double max_velocity_m_s = 1.5e-3;  ///< velocity limit in stepping (frequency lowered)
   /// Velocity and acceleration limits of the scanning reference: the slider rides on the friction
-  /// contact's 600 Hz mode (errata 2), which a velocity step v rings by ~v / omega.
+  /// contact's 600 Hz mode (erratum 2, docs/errata.md), which a velocity step v rings by ~v / omega.
   double scan_velocity_m_s = 2.0e-4;
   double scan_acceleration_m_s2 = 0.03;
   double scan_ki_1_s = 300.0;         ///< integral gain of the scanning loop [1/s]

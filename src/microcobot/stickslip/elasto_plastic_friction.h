@@ -20,14 +20,15 @@ namespace mc::stickslip {
 
 /// Contact parameters of the two asperities (Table 2.8, eq. 2.20-2.21) and of the modal slider.
 struct FrictionParams {
-  double rho0_a_N_m = 3.517e5;            ///< rho_0a, Table 2.8: mode sqrt(rho0a/M_s) = 600 Hz
-  double rho1_a_N_s_m = 64.9651;          ///< rho_1a, Table 2.8
-  double rho0_b_N_m = 2.62e6;             ///< rho_0b, Table 2.8: mode sqrt(rho0b/M_s) = 1639 Hz
-  double rho1_b_N_s_m = 15.6125;          ///< rho_1b, Table 2.8
-  double rho2_N_s_m = 0.0;                ///< rho_2, viscous friction: negligible (thesis §2.4.3)
-  double zba_zss_ratio = 0.667;           ///< z_ba / |z_ss(z)|, Table 2.8
-  double mass_fraction_a = 0.5;           ///< c_a: share of the slider (mass and normal load) on asperity a
-  double coupling_stiffness_N_m = 2.0e3;  ///< k_c: slow coupling of the two slider parts (errata 2)
+  double rho0_a_N_m = 3.517e5;    ///< rho_0a, Table 2.8: mode sqrt(rho0a/M_s) = 600 Hz
+  double rho1_a_N_s_m = 64.9651;  ///< rho_1a, Table 2.8
+  double rho0_b_N_m = 2.62e6;     ///< rho_0b, Table 2.8: mode sqrt(rho0b/M_s) = 1639 Hz
+  double rho1_b_N_s_m = 15.6125;  ///< rho_1b, Table 2.8
+  double rho2_N_s_m = 0.0;        ///< rho_2, viscous friction: negligible (thesis §2.4.3)
+  double zba_zss_ratio = 0.667;   ///< z_ba / |z_ss(z)|, Table 2.8
+  double mass_fraction_a = 0.5;   ///< c_a: share of the slider (mass and normal load) on asperity a
+  double coupling_stiffness_N_m =
+      2.0e3;  ///< k_c: slow coupling of the two slider parts (erratum 2, docs/errata.md)
   /// z_ba,b / z_ba,a: the table gives z_ba of asperity a; default 1 (one break-away strain for the
   /// whole contact, as the thesis's single z_ba; docs/model.md).
   double breakaway_strain_ratio_b = 1.0;

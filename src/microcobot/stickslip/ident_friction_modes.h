@@ -13,7 +13,7 @@
 /// peaks of the free response seed separable nonlinear least squares on the time response over (f_a, zeta_a,
 /// f_b, zeta_b, c_a) with f_i = sqrt(rho0_i / M_s) / 2 pi and zeta_i = rho1_i / (2 sqrt(rho0_i M_s)); the
 /// input scale and the offset are linear. M_s, k_c and the PE come from the base parameters (Table 2.8;
-/// errata 2).
+/// erratum 2 (docs/errata.md)).
 
 #include <vector>
 

@@ -22,8 +22,10 @@ struct PiezoParams {
   double stiffness_a_N_m = 1.23e8;  ///< K_pa, Table 2.8 (N/m, the same erratum): 64.4 kHz
   double damping_b_N_s_m = 82.17;   ///< D_pb, Table 2.8
   double stiffness_b_N_m = 4.24e8;  ///< K_pb, Table 2.8: 119.7 kHz
-  double static_gain_m_V = 15e-9;   ///< g: PE stroke per equivalent volt (errata 7: ~1.5 um at 100 V)
-  double gain_fraction_a = 0.7;     ///< phi = (K_act1/K_pa) / (K_act1/K_pa + K_act2/K_pb), errata 7
+  double static_gain_m_V =
+      15e-9;  ///< g: PE stroke per equivalent volt (erratum 7 in docs/errata.md: ~1.5 um at 100 V)
+  double gain_fraction_a =
+      0.7;  ///< phi = (K_act1/K_pa) / (K_act1/K_pa + K_act2/K_pb), erratum 7 (docs/errata.md)
 
   template <class V>
   void visit(V& v) {

@@ -19,7 +19,7 @@ double lead_angle(double diameter_m, double lead_m);
 /// Forward efficiency eta_f = tan(theta) / tan(theta + atan(mu)) (eq. B.6), mu >= 0.
 double forward_efficiency(double lead_angle_rad, double mu);
 
-/// Backward efficiency eta_b = tan(theta - atan(mu)) / tan(theta) (eq. B.9, errata 5).
+/// Backward efficiency eta_b = tan(theta - atan(mu)) / tan(theta) (eq. B.9, erratum 5 in docs/errata.md).
 /// Returns 0 when the screw is self-locking (theta <= atan(mu)): nothing is transmitted back.
 double backward_efficiency(double lead_angle_rad, double mu);
 

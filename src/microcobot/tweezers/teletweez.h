@@ -13,7 +13,7 @@
 ///   T = 1/2 (J_m th_m'^2 + J_cp th_cp'^2 + J_bs th_bs'^2 + m_bs x_bs'^2 + m_ss x_ss'^2)
 ///       + m_l x_l'^2 + m_cl x_cl'^2
 ///   V = 1/2 k_cp (th_m - th_cp)^2 + 1/2 k_rot (th_cp - th_bs)^2
-///       + 1/2 k_ax (x_bs - R_bs th_bs)^2          (ball screw: x = R_bs theta, errata 6)
+///       + 1/2 k_ax (x_bs - R_bs th_bs)^2          (ball screw: x = R_bs theta, erratum 6 in docs/errata.md)
 ///       + 1/2 k_ss (x_ss - x_bs)^2 + k_l (x_l - R_ss x_ss)^2
 ///       + (k_clamp + k_f) x_l^2 + k_cl (x_cl - x_l)^2
 ///   D = the same with the dampings c_*, plus 1/2 c_m th_m'^2 (motor bearings).
