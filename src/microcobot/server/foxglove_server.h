@@ -3,8 +3,9 @@
 /// A generic Foxglove WebSocket (protocol v1) + HTTP server: publishes JSON telemetry on
 /// advertised channels to subscribed clients, hands client-published messages to a callback and
 /// serves a fixed map of HTTP resources (e.g. a browser console). It knows nothing of the
-/// platform. The transport (Boost.Beast) lives entirely in foxglove_server.cc, so this header is
-/// cheap to include. Limits and behaviour: docs/console.md, "Protocol".
+/// platform. The transport (Boost.Beast) lives in foxglove_server.cc, ws_session.cc and
+/// http_session.cc behind the private server_core.h, so this header is cheap to include. Limits
+/// and behaviour: docs/console.md, "Protocol".
 
 #include <cstddef>
 #include <cstdint>
