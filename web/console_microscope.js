@@ -8,16 +8,35 @@
 // 20x the field is 0.6 mm and the target is millimetres away.
 "use strict";
 
-// 200x: the same behind a 2x tube lens, which magnifies without resolving more)
-const objectives = {2: 0.06, 5: 0.14, 10: 0.28, 20: 0.42, 50: 0.55, 100: 1.3, 200: 1.3};
-const kFieldNumber = 12e-3;  // field of view = field number / magnification
-const kLambda = 550e-9;
+const kFieldNumber = 12e-3;  // the schematic's field of view = field number / magnification
 const view = {center: [0, 0], fov: 1.2e-3};
+// The objective the selector names: the server's turret (scene.optics, by index), whose
+// magnification, numerical aperture and wavelength set the schematic's field and resolution.
 function optics() {
-  const mag = Number($("objective").value);
-  const na = objectives[mag];
-  return {mag, na, fov: kFieldNumber / mag, resolution: (0.61 * kLambda) / na};
+  const list = mc.scene && mc.scene.optics ? mc.scene.optics.objectives : [];
+  const o = list[Number($("objective").value)];
+  if (!o) return null;
+  const na = o.numerical_aperture;
+  return {mag: o.magnification, na, fov: kFieldNumber / o.magnification, resolution: (0.61 * o.wavelength_m) / na};
 }
+// Without a camera the selector offers the turret's objectives with the schematic's field, and
+// starts at the one nearest 10x; with a camera, console_camera.js fills it from the camera's turret.
+let schematicTurretFor = null;
+listen("/platform/scene", (sc) => {
+  if (sc.camera || !sc.optics || schematicTurretFor === JSON.stringify(sc.optics)) return;
+  schematicTurretFor = JSON.stringify(sc.optics);
+  const sel = $("objective"), list = sc.optics.objectives;
+  sel.innerHTML = "";
+  list.forEach((o, i) => {
+    const opt = document.createElement("option"), field = kFieldNumber / o.magnification;
+    opt.value = String(i);
+    opt.textContent = `${o.name} (${field >= 1e-3 ? (field * 1e3).toFixed(1) + " mm" : Math.round(field * 1e6) + " µm"})`;
+    sel.appendChild(opt);
+  });
+  const near10 = list.reduce((b, o, i) => (Math.abs(Math.log(o.magnification / 10)) <
+                                          Math.abs(Math.log(list[b].magnification / 10)) ? i : b), 0);
+  sel.value = String(near10);
+});
 function worldToCanvas(x, y) {
   const c = $("microscope"), s = c.width / view.fov;
   return [c.width / 2 + (x - view.center[0]) * s, c.height / 2 - (y - view.center[1]) * s];
@@ -138,13 +157,13 @@ function drawMicroscope() {
     return;
   }
   const o = optics();
-  view.fov = o.fov;
+  if (o) view.fov = o.fov;
   if (t && $("follow").checked) view.center = [t.measured_x_m, t.measured_y_m];
   const s = c.width / view.fov;
   g.filter = "none";
   g.fillStyle = "#2a2722";
   g.fillRect(0, 0, c.width, c.height);
-  if (!t || !sc) return;
+  if (!t || !sc || !o) return;
   if (sc.kind === "optical-trap") {
     drawTrapScene(g, o, s);
     drawScaleBar(g, c, s);

@@ -190,8 +190,6 @@ listen("/platform/scene", (s) => {
   }
   const f = forceUnit(), optical = s.kind === "optical-trap";
   if (first) {
-    // A bead a hundred times smaller than a watch part: the tweezers' objective.
-    if (optical) $("objective").value = "200";
     setForceUnit(f, optical);
     $("forces-title").textContent = optical ? "Force on the probe bead" : "Forces on the gripper";
   }

@@ -15,6 +15,7 @@
 
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mcap_reader.h"
+#include "microcobot/imaging/camera_params.h"
 #include "microcobot/server/foxglove_protocol.h"
 #include "support/console_client.h"
 #include "support/counting_allocator.h"
@@ -281,6 +282,16 @@ TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
   EXPECT_DOUBLE_EQ(scene.at("grip_force_limit_N").get<double>(), 1e-3);
   EXPECT_DOUBLE_EQ(scene.at("contact_force_limit_N").get<double>(), 2e-3);
   EXPECT_TRUE(scene.at("demo_available").get<bool>());
+  // The microscope panel's optics are the camera's turret, from the library: the page has none.
+  const json& turret = scene.at("optics").at("objectives");
+  const std::vector<imaging::ObjectiveParams> expected = imaging::objective_table();
+  ASSERT_EQ(turret.size(), expected.size()) << scene.dump();
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(turret[i].at("name").get<std::string>(), expected[i].name);
+    EXPECT_DOUBLE_EQ(turret[i].at("magnification").get<double>(), expected[i].magnification);
+    EXPECT_DOUBLE_EQ(turret[i].at("numerical_aperture").get<double>(), expected[i].numerical_aperture);
+    EXPECT_DOUBLE_EQ(turret[i].at("wavelength_m").get<double>(), expected[i].wavelength_m);
+  }
   c.subscribe("/platform/status", 8);
   const json status = json::parse(c.next_on(8));
   EXPECT_TRUE(status.at("demo_result").is_null());

@@ -125,7 +125,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                                "contact_force_limit_N",
                                                "demo_available",
                                                "demo_unavailable_reason",
-                                               "neighbours"};
+                                               "neighbours",
+                                               "optics"};
   scene_ch_ =
       server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                            schema({{"kind", text},
@@ -153,7 +154,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                    {"obstacle_m", {{"type", "array"}, {"items", number}}},
                                    {"obstacle_radius_m", number},
                                    {"camera", {{"type", {"object", "null"}}}},
-                                   {"neighbours", {{"type", "array"}, {"items", {{"type", "object"}}}}}},
+                                   {"neighbours", {{"type", "array"}, {"items", {{"type", "object"}}}}},
+                                   {"optics", {{"type", "object"}}}},
                                   scene_keys)});
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",

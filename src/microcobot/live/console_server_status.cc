@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "microcobot/imaging/camera_params.h"
 #include "microcobot/live/console_task.h"
 
 namespace mc::live {
@@ -68,6 +69,16 @@ std::string ConsoleServer::scene_json() const {
          {"force_full_scale_N", live_.contact_force_limit_N()},
          {"grip_force_limit_N", live_.grip_force_limit_N()},
          {"contact_force_limit_N", live_.contact_force_limit_N()}};
+  // The objectives the microscope panel draws with, by the turret's index: the camera's, or without
+  // a camera the library's table (imaging/camera_params.h). The page keeps no optics of its own.
+  json turret = json::array();
+  for (const imaging::ObjectiveParams& o :
+       live_.has_camera() ? live_.camera_params().objectives : imaging::objective_table())
+    turret.push_back({{"name", o.name},
+                      {"magnification", o.magnification},
+                      {"numerical_aperture", o.numerical_aperture},
+                      {"wavelength_m", o.wavelength_m}});
+  j["optics"] = {{"objectives", turret}};
   if (live_.has_camera()) {
     // What the microscope panel needs: the turret, the focus travel, the sensor, the settings'
     // ranges (the current state comes with each frame on /camera/state).
