@@ -2,6 +2,7 @@
 // jog, the telemetry read back from a recording, quantiles.
 import { open } from "node:fs/promises";
 import { McapIndexedReader } from "@mcap/core";
+import zstd from "@foxglove/wasm-zstd";
 import foxglove from "@foxglove/ws-protocol";
 const { FoxgloveClient } = foxglove;
 
@@ -57,11 +58,14 @@ export async function openMcap(path, decompressHandlers = {}) {
   return { reader, file };
 }
 
-// Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader).
+// Every telemetry sample of an MCAP recording, parsed, in order (@mcap/core's indexed reader;
+// the live recordings' chunks are zstd-compressed, read with @foxglove/wasm-zstd).
 export async function readTelemetry(path) {
-  const { reader, file } = await openMcap(path);
+  await zstd.isLoaded;
+  const { reader, file } = await openMcap(path, { zstd: (data, size) => zstd.decompress(data, Number(size)) });
   const samples = [];
-  for await (const msg of reader.readMessages()) samples.push(JSON.parse(new TextDecoder().decode(msg.data)));
+  for await (const msg of reader.readMessages({ topics: ["/platform/telemetry"] }))
+    samples.push(JSON.parse(new TextDecoder().decode(msg.data)));
   await file.close();
   return samples;
 }
