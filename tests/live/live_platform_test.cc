@@ -126,6 +126,17 @@ TEST(LivePlatform, TheEstopLatchesEveryDeviceInItsSafeStateUntilAnExplicitReset)
   EXPECT_DOUBLE_EQ(rig.get("target_x_m"), held);
   EXPECT_EQ(rig.get("u_x_V"), 0.0);
   EXPECT_TRUE(rig.live.status().estopped) << "latched";
+  // A new scene is no way out of it: the demo and a restart are refused while it holds.
+  for (ConsoleAction a : {ConsoleAction::kDemo, ConsoleAction::kRestart}) {
+    rig.live.request(a);
+    EXPECT_NE(rig.live.status().last_error.find("reset first"), std::string::npos)
+        << rig.live.status().last_error;
+  }
+  std::this_thread::sleep_for(200ms);
+  s = rig.live.status();
+  EXPECT_TRUE(s.estopped) << "still latched";
+  EXPECT_FALSE(s.demo);
+  for (Lifecycle l : s.lifecycle) EXPECT_EQ(l, Lifecycle::kFault);
 
   rig.live.request(ConsoleAction::kReset);
   EXPECT_TRUE(test::eventually([&] { return !rig.live.status().estopped; }));

@@ -425,6 +425,15 @@ void LivePlatform::request(ConsoleAction action) {
       action != ConsoleAction::kRestart && action != ConsoleAction::kNextPart)
     return;
   std::lock_guard lock(request_mutex_);
+  // A new scene would bring the devices up again: while the e-stop (or a fault) holds them in
+  // their safe state, only an explicit reset releases them.
+  if (action != ConsoleAction::kReset && estopped_.load(std::memory_order_relaxed)) {
+    last_error_ = std::string(action == ConsoleAction::kDemo       ? "demo"
+                              : action == ConsoleAction::kNextPart ? "next_part"
+                                                                   : "restart") +
+                  ": the e-stop holds every device in its safe state; reset first";
+    return;
+  }
   if (action == ConsoleAction::kNextPart && (!task_ || params_.task->parts.empty())) {
     last_error_ = "next_part: there is no batch here (serve --cell serves one)";
     return;
