@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// A simulated person doing one insertion of the assembly cell through the platform's own
-/// inputs, manually or with shared control (control/virtual_fixtures.h):
+/// inputs, manually or with shared control (teleop/virtual_fixtures.h):
 ///
 ///   master "haptic"   the dual-stage haptic handle (x, y; the slave follows at the motion
 ///                     scale, clutching near the workspace's edge), the Z thumb wheel and the

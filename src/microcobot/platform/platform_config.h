@@ -73,7 +73,7 @@ struct StageParams {
   /// What positions the stage in the plane: "encoders", the axes' position
   /// sensors closing the stage controller's loop, or "vision", the x and y sensors unused: the
   /// axes step open loop (their drive planned from the step map) on velocity commands of the
-  /// visual servo watching the camera's frames (live/vision_positioner.h); z keeps its loop.
+  /// visual servo watching the camera's frames (perception/vision_positioner.h); z keeps its loop.
   std::string xy_sensor = "encoders";
   /// The positioner's tracker, servo and timing with `xy_sensor: vision` (docs/parameters.md).
   perception::VisionPositionerParams vision;
