@@ -7,10 +7,6 @@
 
 namespace mc::bench {
 
-inline std::size_t telemetry_channel(std::string_view name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-  return 0;
-}
+inline std::size_t telemetry_channel(std::string_view name) { return platform::telemetry_channel_index(name); }
 
 }  // namespace mc::bench

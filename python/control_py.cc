@@ -23,6 +23,7 @@
 #include "microcobot/motion/step_map.h"
 #include "microcobot/motion/velocity_controller.h"
 #include "microcobot/platform/platform_config.h"
+#include "microcobot/platform/telemetry_schema.h"
 #include "microcobot/studies/tracking_run.h"
 #include "microcobot/tweezers/ballscrew.h"
 #include "microcobot/tweezers/bandwidth.h"
@@ -89,8 +90,9 @@ std::string path_of(py::handle p) {
   return py::str(py::module_::import("os").attr("fspath")(p)).cast<std::string>();
 }
 
-/// MCAP file -> {topic: {'log_time_s': array, <numeric JSON field>: array, ...}}; messages whose
-/// encoding is not JSON keep their count only ('messages').
+/// MCAP file -> {topic: {'log_time_s': array, <numeric JSON field>: array, ..., 'units': {field:
+/// unit}}}; messages whose encoding is not JSON keep their count only ('messages'). 'units' holds
+/// the fields whose JSON Schema property declares a `unit` (the telemetry's: "" for flags).
 py::dict mcap_dict(const McapContents& c) {
   struct Topic {
     std::vector<double> t;
@@ -117,9 +119,23 @@ py::dict mcap_dict(const McapContents& c) {
       col.push_back(v.get<double>());
     }
   }
+  // The units the channels' JSON Schemas declare, by topic.
+  std::map<std::string, py::dict> units;
+  for (const auto& ch : c.channels) {
+    const McapSchema* schema = c.schema(ch.schema_id);
+    if (schema == nullptr || schema->encoding != "jsonschema") continue;
+    const auto j = nlohmann::json::parse(schema->data, nullptr, false);
+    if (!j.is_object() || !j.contains("properties") || !j["properties"].is_object()) continue;
+    py::dict u;
+    for (const auto& [key, prop] : j["properties"].items())
+      if (prop.is_object() && prop.contains("unit") && prop["unit"].is_string())
+        u[py::str(key)] = prop["unit"].get<std::string>();
+    if (!u.empty()) units[ch.topic] = u;
+  }
   py::dict out;
   for (auto& [name, tp] : topics) {
     py::dict d("messages"_a = tp.messages, "log_time_s"_a = to_array(tp.t));
+    if (const auto it = units.find(name); it != units.end()) d["units"] = it->second;
     for (auto& [key, col] : tp.fields) {
       if (col.size() != tp.t.size()) {
         throw InvalidInput("mcap: field '" + key + "' of " + name + " is missing from some messages");
@@ -512,6 +528,13 @@ void bind_tweezers(py::module_& m) {
         "Force holding tweezers of clamping stiffness k closed over opening d: F = k d [N] (eq. 4.1).");
 }
 
+py::list channels_list(const platform::TelemetrySchema& schema) {
+  py::list out;
+  for (const auto& ch : schema)
+    out.append(py::dict("name"_a = ch.name, "unit"_a = ch.unit, "description"_a = ch.description));
+  return out;
+}
+
 void bind_platform(py::module_& m) {
   m.def(
       "config", [](py::handle c) { return params_dict(config_from(c)); }, "config"_a = py::none(),
@@ -527,19 +550,27 @@ void bind_platform(py::module_& m) {
         const std::optional<std::string> dir =
             out_dir.is_none() ? std::nullopt : std::optional<std::string>(path_of(out_dir));
         CsvTable table;
+        platform::TelemetrySchema channels;
         const auto result = nogil([&] {
           cell::Session session(c, sp);
           auto r = session.run();
           if (dir) session.write(*dir, r);
           table = session.platform().recording().to_table();
+          channels = session.platform().telemetry_schema();
           return r;
         });
-        return py::dict("result"_a = from_json(result.to_json()), "recording"_a = table_dict(table));
+        return py::dict("result"_a = from_json(result.to_json()), "recording"_a = table_dict(table),
+                        "channels"_a = channels_list(channels));
       },
       "scenario"_a = "pick-place", "duration_s"_a = 120.0, "config"_a = py::none(), "out_dir"_a = py::none(),
       "Runs a scenario (pick-place | stale-master) as `microcobot run`: {'result': summary, 'recording': "
-      "{column: "
-      "array}} (columns with units, e.g. t_s); out_dir also writes recording.csv/.mcap and the report.");
+      "{column: array}, 'channels': [{'name', 'unit', 'description'}]} (the recording's columns, in order, "
+      "e.g. t_s in s); out_dir also writes recording.csv/.mcap and the report.");
+  m.def(
+      "telemetry_channels", [](bool simulation) { return channels_list(platform::builtin_telemetry(simulation)); },
+      "simulation"_a = true,
+      "The platform's built-in telemetry channels, in a sample's order: [{'name', 'unit', 'description'}] "
+      "(the loop's on any devices; with simulation, the simulation's ground truth after them).");
   m.def(
       "read_csv", [](py::handle path) { return table_dict(read_csv(path_of(path))); }, "path"_a,
       "A CSV recording (header row of unit-suffixed names) as {column: array}.");

@@ -38,7 +38,7 @@ TEST(LiveDrivers, TheConsoleJogsTheStageThroughTheSelectedDriversAndTheDemoIsRef
   double measured_x =
       std::numeric_limits<double>::quiet_NaN();  // the driver's encoder, as the telemetry carries it
   const std::size_t x_channel = 10;
-  ASSERT_STREQ(platform::kTelemetryChannels[x_channel], "measured_x_m");
+  ASSERT_EQ(platform::builtin_telemetry(false)[x_channel].name, "measured_x_m");
   live.start([&](const platform::TelemetrySample& s, std::size_t) {
     std::lock_guard lock(mutex);
     measured_x = s[x_channel];
@@ -49,7 +49,7 @@ TEST(LiveDrivers, TheConsoleJogsTheStageThroughTheSelectedDriversAndTheDemoIsRef
   };
   ASSERT_TRUE(test::eventually([&] { return live.status().t_s > 0.1 && !std::isnan(x()); }));
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(live.status().lifecycle[i], devices::Lifecycle::kActive) << i;
-  EXPECT_EQ(live.channel_count(), platform::kLoopChannelCount) << "no ground truth on drivers";
+  EXPECT_EQ(live.channel_count(), platform::loop_channel_count()) << "no ground truth on drivers";
 
   // 0.5 s of +x at 100 um/s with the deadman: the skeleton axis's encoder counts it.
   const double x0 = x();

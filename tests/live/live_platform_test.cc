@@ -16,13 +16,8 @@ namespace {
 
 using namespace std::chrono_literals;
 using devices::Lifecycle;
-using platform::kTelemetryChannels;
 
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
-    if (std::string_view(kTelemetryChannels[i]) == name) return i;
-  throw std::logic_error(name);
-}
+std::size_t channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 // The platform live, with the latest telemetry sample kept for the test to read.
 struct Live {

@@ -28,11 +28,7 @@ using cell::AssemblyTask;
 using Status = AssemblyTask::Status;
 using Step = AssemblyTask::Step;
 
-std::size_t task_channel(const char* name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-  throw std::logic_error(name);
-}
+std::size_t task_channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 struct TaskSample {
   double t_s = 0.0;

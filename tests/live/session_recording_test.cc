@@ -33,7 +33,7 @@ SessionRecordingParams params(const fs::path& dir, bool csv) {
   SessionRecordingParams p;
   p.out_dir = dir;
   p.csv = csv;
-  p.telemetry_channels = kChannels;
+  p.telemetry = platform::builtin_telemetry(true).first(kChannels);
   const std::string object = R"({"type":"object"})";
   p.status = {"/platform/status", "microcobot.Status", object};
   p.scene = {"/platform/scene", "microcobot.Scene", object};

@@ -25,13 +25,8 @@ namespace mc::net {
 namespace {
 
 using namespace std::chrono_literals;
-using platform::kTelemetryChannels;
 
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
-    if (std::string_view(kTelemetryChannels[i]) == name) return i;
-  throw std::logic_error(name);
-}
+std::size_t channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 // A live platform keeping its latest telemetry sample (and every one while `recording`).
 struct End {

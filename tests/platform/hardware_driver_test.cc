@@ -87,7 +87,7 @@ TEST(HardwareDriver, ThePlatformRunsOnDriversHandedToIt) {
 
   // The recording holds the loop's channels only (no ground truth on hardware).
   p.run(0.01);
-  EXPECT_EQ(p.recording().channels(), kLoopChannelCount);
+  EXPECT_EQ(p.recording().channels(), loop_channel_count());
   EXPECT_GT(p.recording().size(), 0u);
 
   // A stalled haptic bus: the watchdog holds the slave; a driver fault: every device safe.
@@ -128,7 +128,7 @@ TEST(HardwareDriver, ASimulatedGripperRidesTheDriversStageWhereItsSensorsSayItIs
   EXPECT_TRUE(bench.gripper_log.destroyed) << "the unused driver is released, not kept half-configured";
   // Without simulated masters there is no operator's hand to record: the loop's channels.
   p.run(0.01);
-  EXPECT_EQ(p.recording().channels(), kLoopChannelCount);
+  EXPECT_EQ(p.recording().channels(), loop_channel_count());
 
   config.devices.gripper = "claw";
   EXPECT_THROW(config.validate(), Error);

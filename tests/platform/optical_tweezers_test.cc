@@ -20,11 +20,7 @@ PlatformConfig trap_scene() {
   return c;
 }
 
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
-    if (std::string(kTelemetryChannels[i]) == name) return i;
-  throw std::logic_error(name);
-}
+std::size_t channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 // Standard deviation of a recorded channel over samples [from, to).
 double stddev(const Recorder& r, const char* name, std::size_t from, std::size_t to) {

@@ -19,11 +19,7 @@ namespace mc::platform {
 namespace safety_test {
 namespace {
 
-std::size_t channel(const char* name) {
-  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i)
-    if (std::string_view(kTelemetryChannels[i]) == name) return i;
-  throw std::logic_error(name);
-}
+std::size_t channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 // The largest value of a channel over the recording, from sample `from` on.
 double peak(const Platform& p, const char* name, std::size_t from = 0) {

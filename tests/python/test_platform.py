@@ -22,6 +22,11 @@ def test_run_returns_the_recording(session):
     assert np.all(np.diff(t) > 0) and t[-1] <= 1.0 + 1e-9
     assert all(np.all(np.isfinite(v)) for v in rec.values())
     assert r["result"]["duration_s"] == pytest.approx(1.0, abs=0.01)
+    # The columns are the telemetry's channels, in order, each with its unit.
+    assert [c["name"] for c in r["channels"]] == list(rec)
+    units = {c["name"]: c["unit"] for c in r["channels"]}
+    assert units["t_s"] == "s" and units["measured_x_m"] == "m" and units["deadman"] == ""
+    assert all(c["description"] for c in r["channels"])
     # One second of the scripted operator: the slave has not finished the pick-and-place yet.
     assert isinstance(r["result"]["verdict"], str) and r["result"]["verdict"]
 
@@ -41,6 +46,7 @@ def test_csv_and_mcap_recordings_equal_the_returned_arrays(session):
     for k in rec:
         np.testing.assert_allclose(tel[k], rec[k], rtol=5e-10, atol=0)
     np.testing.assert_allclose(tel["log_time_s"], rec["t_s"], atol=1e-9)
+    assert tel["units"] == {c["name"]: c["unit"] for c in r["channels"]}
 
 
 def test_platform_errors(tmp_path):

@@ -11,11 +11,7 @@
 
 namespace mc::test {
 
-inline std::size_t telemetry_channel(const char* name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-  throw std::runtime_error(name);
-}
+inline std::size_t telemetry_channel(const char* name) { return platform::telemetry_channel_index(name); }
 
 // Polls `live`'s status every 10 ms until `done(status)` or `timeout_s` of wall time.
 template <class Done>

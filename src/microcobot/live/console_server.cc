@@ -26,15 +26,10 @@ using server::StatusLevel;
 
 constexpr double kTelemetryRate_Hz = 1000.0;  // the platform's telemetry task (loop.telemetry_divisor)
 
-std::size_t channel_index(const char* name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (std::string_view(platform::kTelemetryChannels[i]) == name) return i;
-  return 0;
-}
-const std::size_t kContactX = channel_index("contact_x_N");
-const std::size_t kGrip = channel_index("grip_force_N");
-const std::size_t kTick = channel_index("tick_us");
-const std::size_t kTickCpu = channel_index("tick_cpu_us");
+const std::size_t kContactX = platform::telemetry_channel_index("contact_x_N");
+const std::size_t kGrip = platform::telemetry_channel_index("grip_force_N");
+const std::size_t kTick = platform::telemetry_channel_index("tick_us");
+const std::size_t kTickCpu = platform::telemetry_channel_index("tick_cpu_us");
 
 std::string schema(const json& properties) {
   return json{{"type", "object"}, {"properties", properties}}.dump();
@@ -79,13 +74,14 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
   telemetry_ch_ = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
                                        std::string(platform::kTelemetrySchemaName), "jsonschema",
-                                       platform::telemetry_json_schema(live_.channel_count())});
+                                       platform::telemetry_json_schema(live_.telemetry_schema())});
   const json number = {{"type", "number"}}, boolean = {{"type", "boolean"}}, text = {{"type", "string"}};
   status_ch_ = server_.add_channel({"/platform/status", "json", "microcobot.Status", "jsonschema",
                                     schema({{"t_s", number},
                                             {"estopped", boolean},
                                             {"controlled", boolean},
                                             {"console_fresh", boolean},
+                                            {"control", text},
                                             {"demo", boolean},
                                             {"demo_phase", text},
                                             {"lifecycle", {{"type", "object"}}},
@@ -186,7 +182,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     SessionRecordingParams rp;
     rp.out_dir = params_.out_dir;
     rp.csv = params_.record_csv;
-    rp.telemetry_channels = live_.channel_count();
+    rp.telemetry = live_.telemetry_schema();
     rp.status = recorded(status_ch_);
     rp.scene = recorded(scene_ch_);
     rp.feedback = recorded(feedback_ch_);
@@ -275,7 +271,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   countdown_ = decimation_ - 1;
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, s[0]) * 1e9));
   json_.clear();
-  platform::telemetry_to_json(sample, json_);
+  platform::telemetry_to_json(live_.telemetry_schema(), sample, json_);
   server_.publish(telemetry_ch_, ns, json_);  // recorded at full rate above
   const double rms = rumble_n_ ? std::sqrt(rumble_sum_ / static_cast<double>(rumble_n_)) : 0.0;
   rumble_sum_ = 0.0;

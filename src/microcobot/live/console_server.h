@@ -3,7 +3,7 @@
 /// The live platform served to its operators (`microcobot serve`): the console page
 /// over HTTP and the platform over the Foxglove WebSocket protocol (docs/console.md).
 ///
-///   /platform/telemetry  60 Hz   the loop's telemetry (kTelemetryChannels), JSON
+///   /platform/telemetry  60 Hz   the loop's telemetry (its TelemetrySchema), JSON
 ///   /platform/status      5 Hz   e-stop, control, watchdog, lifecycles, tick p99, recording
 ///   /platform/scene       1 Hz   geometry and limits the microscope view needs
 ///   /console/feedback    60 Hz   contact and grip forces, the vibrotactile channel

@@ -34,6 +34,8 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
              : EventLevel::kInfo,
          "demo_end", how);
   }
+  if (s.control != was.control && !s.control.empty())
+    note(EventLevel::kInfo, "control", "the " + s.control + " drives the coupling");
   if (s.estopped != was.estopped)
     note(s.estopped ? EventLevel::kWarning : EventLevel::kInfo, "estopped",
          s.estopped ? "e-stop latched: every device in its safe state" : "e-stop cleared");
@@ -139,6 +141,7 @@ std::string ConsoleServer::status_json() {
             {"estopped", s.estopped},
             {"controlled", controller_.load() != 0},
             {"console_fresh", s.console_fresh},
+            {"control", s.control},
             {"demo", s.demo},
             {"demo_phase", s.demo_phase},
             {"lifecycle", lifecycle},

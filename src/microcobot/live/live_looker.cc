@@ -12,10 +12,9 @@ using cell::AssemblyTask;
 
 namespace {
 
+// A built-in channel (0 where the platform does not record it: the samples are zero-filled).
 double channel(const platform::TelemetrySample& s, std::string_view name) {
-  for (std::size_t i = 0; i < platform::kTelemetryChannels.size(); ++i)
-    if (name == platform::kTelemetryChannels[i]) return s[i];
-  return 0.0;
+  return s[platform::telemetry_channel_index(name)];
 }
 
 }  // namespace

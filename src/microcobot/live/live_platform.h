@@ -3,12 +3,17 @@
 /// The platform run live (`microcobot serve`): its loop paced to the wall clock in
 /// its real-time thread, for as long as the server runs, operated by the console.
 ///
-///   server thread  --ConsoleCommand--> SPSC ring --> operator task (loop, 1 kHz) --> coupling
+///   server thread  --ConsoleCommand--> SPSC ring --> console source --+
+///   protocol thread --ProtocolCommand--> ring ---> protocol source ---+--> arbiter (operator
+///   DDS thread     --microscope, remote--> rings --> their sources ----+    task, 1 kHz) --> coupling
 ///   any thread     --estop()--> atomic flag ------> operator task: fault_all() at once
 ///   any thread     --request(reset|demo|restart)--> control thread, between two loop runs
 ///   loop           --telemetry--> ring --> drain thread --> sink (server, recording)
 ///
-/// The console's commands are its heartbeat: when the controlling client's last command is
+/// Every input is a CommandSource and one CommandArbiter (command_arbiter.h) gives the coupling
+/// to one of them at each tick, in this order: the microscope (never drives), the remote master
+/// (a slave process: then the only driver), the scripted demo, the console, the caller's
+/// sources (LiveParams::sources), the vendor protocols. The console's commands are its heartbeat: when the controlling client's last command is
 /// older than `command_timeout_s` (or nobody holds control) the coupling sees stale commands
 /// and the stage holds (the platform's watchdog). The e-stop latches until an explicit reset:
 /// devices reconfigured and re-activated off the loop (like ros2_control's lifecycle
@@ -28,11 +33,20 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "microcobot/cell/pick_place_operator.h"
+#include "microcobot/live/command_arbiter.h"
 #include "microcobot/live/command_source.h"
+#include "microcobot/live/console_source.h"
+#include "microcobot/live/demo_source.h"
+#include "microcobot/live/microscope_source.h"
+#include "microcobot/live/protocol_source.h"
+#include "microcobot/live/remote_link.h"
+#include "microcobot/live/remote_source.h"
 #include "microcobot/live/console_command.h"
 #include "microcobot/live/live_looker.h"
+#include "microcobot/live/live_status.h"
 #include "microcobot/live/live_task.h"
 #include "microcobot/live/protocol_command.h"
 #include "microcobot/perception/vision_grip_force.h"
@@ -59,52 +73,21 @@ struct LiveParams {
   std::function<devices::DeviceSet()> make_devices;
   /// Commands from the far end instead of the console (a slave process: net/remote_master.h);
   /// not owned, must outlive the live platform. The console then observes (and may e-stop).
-  CommandSource* remote = nullptr;
+  RemoteLink* remote = nullptr;
+  /// More inputs to the loop, ranked in this order below the console and above the vendor
+  /// protocols (command_arbiter.h); not owned, must outlive the live platform.
+  std::vector<CommandSource*> sources;
   /// The automatic insertion the console supervises (`serve --cell`; live_task.h), on the scene
   /// of `platform.world` (its job's). Not with a remote command source.
   std::optional<LiveTaskParams> task;
+  /// Channels added to the telemetry of every platform built here, after the built-in ones
+  /// (Platform::add_telemetry_channel): each source runs on the loop and must be real-time safe.
+  struct AddedChannel {
+    platform::TelemetryChannel channel;
+    platform::Platform::TelemetrySource source;
+  };
+  std::vector<AddedChannel> telemetry_channels;
   void validate() const;
-};
-
-/// How the last scripted demo ended (every outcome is shown to the operator).
-struct DemoResult {
-  enum class Outcome { kNone, kRunning, kPlaced, kInserted, kMissed, kGaveUp };
-  Outcome outcome = Outcome::kNone;
-  std::string phase;  ///< the phase it is in, or gave up in
-  double placement_error_m =
-      std::numeric_limits<double>::quiet_NaN();  ///< part centre to target, horizontal (NaN: no part)
-  double duration_s = 0.0;                       ///< since the demo started
-  std::string reason;                            ///< why it gave up, or what it achieved, in words
-  static std::string_view name(Outcome o);
-};
-
-/// What the loop reports, readable from any thread.
-struct LiveStatus {
-  double t_s = 0.0;  ///< live time since serve started (continues across scene restarts)
-  bool estopped = false;
-  bool demo = false;                              ///< the scripted operator is driving
-  std::string demo_phase;                         ///< its phase (empty unless demo)
-  bool console_fresh = false;                     ///< the controlling client's commands are fresh
-  std::array<devices::Lifecycle, 6> lifecycle{};  ///< axes x, y, z, gripper, haptic, tweezers
-  bool has_rotary = false;                        ///< the rotary axis under the gripper ...
-  devices::Lifecycle rotary_lifecycle{};          ///< ... and its state
-  std::uint64_t overruns = 0;
-  std::uint64_t ticks = 0;  ///< loop ticks since the scene (re)started (overruns are of these)
-  std::uint64_t restarts = 0;
-  /// The camera: frames delivered and dropped (the loop could not hand them over)
-  /// since the scene (re)started; the focal plane and the objective.
-  bool camera = false;
-  std::uint64_t camera_frames = 0, camera_dropped = 0;
-  double focus_z_m = 0.0, focus_target_m = 0.0;
-  int objective = 0;
-  DemoResult demo_result;
-  std::string last_error;              ///< the last failed request (reset refused, rebuild failed)
-  std::optional<LiveTaskStatus> task;  ///< the supervised task (none without one)
-  /// The stage positioned by vision (`stage.xy_sensor: vision`; none otherwise).
-  std::optional<perception::PositionerStatus> vision;
-  /// The grip force measured by vision (`vision_force.enabled`, a camera, the gripper's scene;
-  /// none otherwise).
-  std::optional<perception::VisionGripStatus> grip_vision;
 };
 
 class LivePlatform {
@@ -136,18 +119,18 @@ class LivePlatform {
   void stop();
 
   /// The controlling client's command (one producer thread: the server's). Wait-free.
-  bool push_command(const ConsoleCommand& c) noexcept;
+  bool push_command(const ConsoleCommand& c) noexcept { return console_->push(c); }
   /// A microscope command from the network (net/microscope_link.h: the slave's microscope topic;
   /// one producer thread): only its focus, objective, exposure and gain count. Wait-free; false
   /// when the ring is full. Applied at the next operator tick in every role: the focus drive and
   /// the turret move the objective, no part of the slave (as the console's microscope controls).
-  bool push_microscope_command(const ConsoleCommand& c) noexcept { return microscope_.push(c); }
+  bool push_microscope_command(const ConsoleCommand& c) noexcept { return microscope_->push(c); }
   /// Whether a client holds control (its commands count; otherwise the stage holds).
-  void set_console_in_control(bool in_control) noexcept { in_control_.store(in_control); }
-  bool console_in_control() const noexcept { return in_control_.load(); }
+  void set_console_in_control(bool in_control) noexcept { console_->set_in_control(in_control); }
+  bool console_in_control() const noexcept { return console_->in_control(); }
   /// A vendor-protocol client's command (one producer thread: the protocol thread).
   /// Wait-free; false when the ring is full. It counts only while no console client holds control.
-  bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_.push(c); }
+  bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_->push(c); }
   /// What the loop last published for the protocol clients. Any thread.
   ProtocolView protocol_view() const noexcept;
   /// The operator's control of the task (one producer thread: the server's). Wait-free; false
@@ -172,11 +155,13 @@ class LivePlatform {
   /// Moves the command-to-target latencies measured by the loop since the last call (from the
   /// server's receipt of a command to the tick that applies it) into `stats`. One consumer
   /// thread.
-  void drain_command_latencies(runtime::TimingStats& stats) noexcept;
+  void drain_command_latencies(runtime::TimingStats& stats) noexcept { console_->drain_latencies(stats); }
   /// Moves the remote end's cost to the loop measured since the last call into `stats`: the
   /// duration of its poll() and publish() in each operator tick (the network link's whole work
   /// on the loop thread; none without a remote end). One consumer thread.
-  void drain_link_costs(runtime::TimingStats& stats) noexcept;
+  void drain_link_costs(runtime::TimingStats& stats) noexcept {
+    if (remote_) remote_->drain_costs(stats);
+  }
   /// The loop's thread (tests prove it never allocates while the server runs). Started only.
   std::thread::id loop_thread_id() const { return platform_->loop().thread_id(); }
   const ConsoleLimits& limits() const { return limits_; }
@@ -216,7 +201,10 @@ class LivePlatform {
   /// The force limits the platform enforces (teleop/safety_limits.h).
   double grip_force_limit_N() const { return scene_world().grip_force_limit_N; }
   double contact_force_limit_N() const { return scene_world().contact_force_limit_N; }
-  std::size_t channel_count() const { return channel_count_; }
+  /// The telemetry's channels (the same across scene rebuilds); a sample's first
+  /// channel_count() values are these.
+  const platform::TelemetrySchema& telemetry_schema() const { return telemetry_; }
+  std::size_t channel_count() const { return telemetry_.size(); }
 
  private:
   void build(bool demo);
@@ -227,30 +215,15 @@ class LivePlatform {
     return !params_.make_devices && !params_.remote && params_.platform.devices.simulated();
   }
   void operator_tick(const runtime::TickInfo& t) noexcept;
-  /// The demo's part of the operator tick: the scripted operator acts until it is done or gives
-  /// up, then every axis holds and the console has control again. Returns true while it drives.
-  bool demo_tick(const runtime::TickInfo& t) noexcept;
-  /// The focus, objective, exposure and gain of a console command (loop thread).
-  void apply_microscope(platform::Platform& p, const ConsoleCommand& c) noexcept;
   void control_thread();
-  /// The protocol clients' part of the operator tick: their commands drained, their freshness (a
-  /// client that went away or lost control leaves every axis holding). Returns true while a
-  /// protocol client drives the coupling, and then fills `in`.
-  bool protocol_tick(const runtime::TickInfo& t, bool console_control, teleop::ConsoleInput& in) noexcept;
-  /// After the console input is set: a pending open-loop run started (or refused), the view published.
-  void protocol_publish(const runtime::TickInfo& t) noexcept;
   void attach_camera(platform::Platform& p);
-  /// With x and y positioned by vision: the operator's goal handed to the positioner (the
-  /// coupling does not chase it), its runs and the joystick's played open loop. After the
-  /// console input is set (the runs check its deadman).
-  void vision_tick(platform::Platform& p, const runtime::TickInfo& t, const teleop::ConsoleInput& in,
-                   bool console_drives) noexcept;
+  /// The sources in the arbiter's order (the constructor).
+  void add_sources();
 
   LiveParams params_;
   ConsoleLimits limits_;
-  std::size_t channel_count_ = 0;
+  platform::TelemetrySchema telemetry_;  ///< set by the first build, before any thread starts
   std::unique_ptr<platform::Platform> platform_;
-  std::unique_ptr<cell::PickPlaceOperator> demo_;
   std::unique_ptr<LiveTask> task_;  // kept across scene rebuilds (its ring is the server's)
   // The cell camera's looks for the task: the drain thread keeps the latest sample for them.
   std::mutex latest_mutex_;
@@ -258,34 +231,19 @@ class LivePlatform {
   bool has_latest_ = false;
   std::unique_ptr<LiveLooker> looker_;  // after what it uses: destroyed (joined) first
   Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
-  runtime::SpscRing<ConsoleCommand> commands_{256};
-  runtime::SpscRing<ConsoleCommand> microscope_{16};  // the network's microscope commands
-  runtime::SpscRing<ProtocolCommand> protocol_{256};
-  // Protocol state (loop thread only).
-  double protocol_last_t_ = -1e9, protocol_speed_m_s_ = 0.0, last_operator_t_ = 0.0;
-  double protocol_theta_goal_rad_ = 0.0, protocol_theta_speed_rad_s_ = 0.0;
-  bool protocol_fresh_ = false, protocol_has_goal_ = false, protocol_steps_pending_ = false;
-  std::array<double, 3> protocol_goal_m_{};
-  std::array<double, 4> settled_s_{};  // X, Y, Z, theta
-  ProtocolCommand pending_steps_;
-  // Published for the protocol thread (ProtocolView's: X, Y, Z [m], theta [rad]).
-  std::array<std::atomic<double>, 4> axis_position_{};
-  std::array<std::atomic<bool>, 4> on_target_{}, stepping_{};
-  std::atomic<bool> protocol_driving_{false};
-  std::atomic<std::uint64_t> refused_steps_{0}, applied_seq_{0};
-  std::uint64_t popped_seq_ = 0;                                 // loop thread only
   std::unique_ptr<perception::VisionPositioner> positioner_;     // stage.xy_sensor: vision
   std::unique_ptr<perception::VisionGripForce> grip_gauge_;      // vision_force.enabled
-  runtime::SpscRing<perception::PositionerCommand> vision_{16};  // camera thread -> loop
-  runtime::SpscRing<double> latencies_{4096};                    // loop -> status thread [s]
-  runtime::SpscRing<double> link_costs_{4096};                   // loop -> status thread [s]
-  ConsoleCommand latest_;                                        // loop thread only
-  double last_command_t_ = -1e9;
+  // The inputs (kept across scene rebuilds: their rings are other threads') and their arbiter.
+  std::unique_ptr<MicroscopeSource> microscope_;
+  std::unique_ptr<RemoteSource> remote_;  // a slave process only
+  std::unique_ptr<DemoSource> demo_;
+  std::unique_ptr<ConsoleSource> console_;
+  std::unique_ptr<ProtocolSource> protocol_;
+  CommandArbiter arbiter_;
   double t_offset_s_ = 0.0;
 
-  std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false}, in_control_{false};
+  std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false};
   std::atomic<bool> started_{false}, camera_wanted_{true};
-  bool remote_estopped_ = false;       // loop thread only: the far end latched our e-stop
   std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;
   FrameSink frame_sink_;
@@ -294,20 +252,8 @@ class LivePlatform {
 
   // Status written by the loop (atomics) and by the control thread (under status_mutex_, never
   // taken by the loop).
-  std::atomic<double> t_s_{0.0};
-  std::atomic<bool> estopped_{false}, fresh_{false}, demo_running_{false};
-  std::atomic<int> demo_phase_{0}, demo_failed_phase_{0};
-  // The demo's result, written by the loop (demo_outcome_ last, with release order).
-  std::atomic<int> demo_outcome_{0};  // DemoResult::Outcome
-  std::atomic<double> demo_error_m_{std::numeric_limits<double>::quiet_NaN()}, demo_duration_s_{0.0};
-  bool demo_finished_ = false;  // loop thread only: the operator is done, the console has control
-  std::atomic<std::uint64_t> ticks_{0};
-  std::array<std::atomic<int>, 6> lifecycle_{};
-  std::atomic<int> rotary_lifecycle_{-1};  // -1: no rotary axis
-  std::atomic<std::uint64_t> overruns_{0}, restarts_{0};
-  std::atomic<std::uint64_t> camera_frames_{0}, camera_dropped_{0};
-  std::atomic<double> focus_z_m_{0.0}, focus_target_m_{0.0};
-  std::atomic<int> objective_{0};
+  LoopReadings readings_;
+  std::atomic<std::uint64_t> restarts_{0}, camera_frames_{0};
   mutable std::mutex request_mutex_;  // control thread and requesters; never the loop
   int pending_ = -1;                  // a ConsoleAction, or -1
   std::string last_error_;

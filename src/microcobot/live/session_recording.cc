@@ -47,9 +47,7 @@ std::string utc_iso(std::int64_t ns) {
 }  // namespace
 
 void SessionRecordingParams::validate() const {
-  require(telemetry_channels >= 1 && telemetry_channels <= platform::kTelemetryChannels.size(),
-          "telemetry_channels", "must be within [1, kTelemetryChannels.size()]",
-          static_cast<double>(telemetry_channels));
+  require(!telemetry.empty(), "telemetry", "needs the telemetry's channels");
   for (const RecordedSchema* s : {&status, &scene, &feedback})
     require(!s->topic.empty() && !s->schema.empty(), "recorded channels", "need a topic and a schema");
 }
@@ -118,7 +116,7 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   };
   add(RecordedTopic::kTelemetry, std::string(platform::kTelemetryTopic),
       std::string(platform::kTelemetrySchemaName),
-      platform::telemetry_json_schema(params_.telemetry_channels));
+      platform::telemetry_json_schema(params_.telemetry));
   add(RecordedTopic::kStatus, params_.status.topic, params_.status.schema_name, params_.status.schema);
   add(RecordedTopic::kScene, params_.scene.topic, params_.scene.schema_name, params_.scene.schema);
   add(RecordedTopic::kFeedback, params_.feedback.topic, params_.feedback.schema_name,
@@ -167,9 +165,7 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   if (params_.csv) {
     csv = std::make_unique<CsvStreamWriter>(
         params_.out_dir / (stem + ".csv"),
-        std::vector<std::string>(
-            platform::kTelemetryChannels.begin(),
-            platform::kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(params_.telemetry_channels)));
+        params_.telemetry.names());
   }
   mcap_ = std::move(w);
   csv_ = std::move(csv);
@@ -246,7 +242,7 @@ void SessionRecording::push(std::span<Item> items) {
 }
 
 void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t count) {
-  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry_channels)};
+  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry.size())};
   push(std::move(item));
 }
 
@@ -295,7 +291,7 @@ void SessionRecording::writer_thread() {
         if (item.topic == RecordedTopic::kTelemetry) {
           const std::span<const double> sample(item.sample.data(), item.count);
           json_text.clear();
-          platform::telemetry_to_json(sample, json_text);
+          platform::telemetry_to_json(params_.telemetry, sample, json_text);
           mcap_->write(channel, item.log_ns, item.log_ns, json_text);
           if (csv_) csv_->append(sample);
         } else {

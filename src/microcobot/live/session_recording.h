@@ -77,7 +77,7 @@ enum class EventLevel : std::uint8_t { kInfo = 0, kWarning = 1, kError = 2 };
 struct SessionRecordingParams {
   std::filesystem::path out_dir;       ///< where recordings go
   bool csv = false;                    ///< also the telemetry as <stem>.csv (`serve --record-csv`)
-  std::size_t telemetry_channels = 0;  ///< the first N names of platform::kTelemetryChannels
+  platform::TelemetrySchema telemetry;  ///< the telemetry's channels (LivePlatform::telemetry_schema())
   /// /platform/status, /platform/scene, /console/feedback as the server advertises them.
   RecordedSchema status, scene, feedback;
   std::string version;      ///< the program's, e.g. "microcobot 0.1.0"

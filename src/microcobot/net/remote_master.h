@@ -2,7 +2,7 @@
 /// @file
 /// The master of a distributed platform as the slave process sees it
 /// (`microcobot serve --role slave`): the source of the live platform's operator commands
-/// (live/command_source.h) in place of the console, over the DDS link. Each operator tick it
+/// (live/remote_link.h) in place of the console, over the DDS link. Each operator tick it
 /// takes the master's latest target pose and gripper target into a console command (a
 /// straight move to the target, at most at the coupling's console speed), reads the master's
 /// e-stop and engaged flags, and publishes the slave's measured pose, contact and grip forces
@@ -26,7 +26,7 @@
 #include <atomic>
 #include <memory>
 
-#include "microcobot/live/command_source.h"
+#include "microcobot/live/remote_link.h"
 #include "microcobot/net/link.h"
 #include "microcobot/net/passive_ports.h"
 #include "microcobot/net/target_stream.h"
@@ -71,7 +71,7 @@ struct RemoteMasterParams {
   }
 };
 
-class RemoteMaster final : public live::CommandSource {
+class RemoteMaster final : public live::RemoteLink {
  public:
   /// Starts the link (throws mc::Error: parameters, DDS).
   explicit RemoteMaster(const RemoteMasterParams& params);

@@ -12,11 +12,9 @@ namespace mc::platform {
 
 namespace {
 
+// A built-in channel (0 where the platform does not record it: the samples are zero-filled).
 double channel(const TelemetrySample& s, std::string_view name) {
-  for (std::size_t i = 0; i < kTelemetryChannels.size(); ++i) {
-    if (name == kTelemetryChannels[i]) return s[i];
-  }
-  return 0.0;
+  return s[telemetry_channel_index(name)];
 }
 
 }  // namespace

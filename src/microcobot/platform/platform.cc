@@ -12,10 +12,6 @@
 namespace mc::platform {
 namespace {
 
-std::vector<std::string> telemetry_names(std::size_t count) {
-  return {kTelemetryChannels.begin(), kTelemetryChannels.begin() + static_cast<std::ptrdiff_t>(count)};
-}
-
 // Room for a few seconds of telemetry between drains; the drain thread empties it every ms.
 constexpr std::size_t kRingCapacity = 8192;
 
@@ -151,7 +147,7 @@ void Platform::build() {
   teleop_ = std::make_unique<teleop::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                     world_.params().gripper.max_opening_m, limits);
   build_rotary();
-  recorder_ = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()), 1);
+  build_telemetry();
   if (!devices_.camera && config_.camera.enabled) {
     if (auto source = make_camera_source(config_))
       devices_.camera = std::make_unique<devices::Camera>("camera", config_.camera, std::move(source));
@@ -169,7 +165,7 @@ void Platform::build() {
                  [this](const runtime::TickInfo&) { slave_control_task(); });
   loop_.add_task("devices", 1, [this](const runtime::TickInfo& t) { devices_task(t.dt_s); });
   loop_.add_task("telemetry", config_.loop.telemetry_divisor,
-                 [this](const runtime::TickInfo& t) { telemetry_task(t.t_s); });
+                 [this](const runtime::TickInfo&) { telemetry_task(); });
   if (devices_.camera) loop_.add_task("camera", 1, [this](const runtime::TickInfo& t) { camera_task(t); });
   loop_.sample_ticks_every(config_.loop.telemetry_divisor);
   loop_.pin_to_core(config_.loop.cpu);
@@ -310,57 +306,6 @@ void Platform::devices_task(double dt_s) noexcept {
       }
     }
   }
-}
-
-void Platform::telemetry_task(double t_s) noexcept {
-  TelemetrySample s{};
-  const auto& o = teleop_->output();
-  const devices::Vec2 handle = devices_.haptic->handle_position_m();
-  const devices::Vec3 contact = devices_.gripper->contact_force_N();
-  std::size_t k = 0;
-  auto put = [&](double v) { s[k++] = v; };
-  // Loop channels (kTelemetryChannels' order).
-  put(t_s);
-  put(handle.x), put(handle.y);
-  put(devices_.haptic->enabled()), put(devices_.haptic->clutch()), put(o.engaged), put(o.stale);
-  for (int i = 0; i < 3; ++i) put(home_m_[i] + o.slave_target_m[i]);
-  for (std::size_t i = 0; i < 3; ++i)
-    put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->position_m());
-  for (std::size_t i = 0; i < 3; ++i)
-    put(faulted_                                           ? 0.0
-        : steppers_[i]->running() || (vision_xy_ && i < 2) ? steppers_[i]->output_V()
-                                                           : stage_->last_voltage_V(static_cast<int>(i)));
-  put(o.haptic_force_N.x()), put(o.haptic_force_N.y());
-  put(devices_.tweezers->opening_m()), put(o.finger_force_N);
-  put(o.gripper_opening_m), put(devices_.gripper->opening_m()), put(devices_.gripper->grip_force_N());
-  put(contact.x), put(contact.y), put(contact.z);
-  put(has_rotary() ? yaw_target_rad() : 0.0), put(has_rotary() ? yaw_rad() : 0.0);
-  put(!has_rotary() || faulted_ ? 0.0
-      : steppers_[3]->running() ? steppers_[3]->output_V()
-                                : stage_->last_voltage_V(3));
-  // The last tick where this task ran with the others (slave control, telemetry: the heaviest),
-  // one sample late: this tick is not over yet.
-  put(1e6 * loop_.sampled_tick_s());
-  put(1e6 * loop_.sampled_tick_cpu_s());
-  // Simulation channels: the ground truth (on a driver's stage, the tips are where its sensors say).
-  if (records_simulation()) {
-    const devices::OperatorHand& hand = sim_.haptic->operator_hand();
-    put(hand.hand_m.x), put(hand.hand_m.y);
-    for (std::size_t i = 0; i < 3; ++i)
-      put(home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->carried_position_m());
-    put(sim_.haptic->channels().f_m_N), put(sim_.haptic->channels().u_V);
-    if (sim_.gripper != nullptr) {
-      const auto& w = sim_.gripper->world_state();
-      put(w.part_m.x()), put(w.part_m.y()), put(w.part_m.z());
-      put(static_cast<double>(static_cast<int>(w.phase)));
-      put(sim_.gripper->yaw_rad()), put(w.part_yaw_rad);
-      put(w.gripper.shaking ? 1.0 : 0.0);
-    } else {
-      const Eigen::Vector3d bead = sim_.optical_tweezers->bead_m();
-      put(bead.x()), put(bead.y()), put(bead.z()), put(0.0), put(0.0), put(0.0), put(0.0);
-    }
-  }
-  ring_.push(s);
 }
 
 void Platform::camera_task(const runtime::TickInfo& t) noexcept {
@@ -510,7 +455,7 @@ void Platform::run(double duration_s) {
   if (need > recorder_->capacity()) {
     // Grown geometrically: a caller stepping the platform by short runs (the cell's cycles, one
     // second at a time) would otherwise copy the whole recording at every run.
-    auto bigger = std::make_unique<Recorder>(telemetry_names(telemetry_channel_count()),
+    auto bigger = std::make_unique<Recorder>(telemetry_.names(),
                                              std::max(need, 2 * recorder_->capacity()));
     TelemetrySample s;
     for (std::size_t i = 0; i < recorder_->size(); ++i) {

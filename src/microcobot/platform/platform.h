@@ -24,6 +24,8 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <span>
+#include <vector>
 #include <thread>
 
 #include "microcobot/core/recorder.h"
@@ -41,6 +43,7 @@
 #include "microcobot/motion/step_map.h"
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/platform/stage_controller.h"
+#include "microcobot/platform/telemetry_schema.h"
 #include "microcobot/runtime/fixed_rate_loop.h"
 #include "microcobot/runtime/spsc_ring.h"
 #include "microcobot/runtime/watchdog.h"
@@ -49,62 +52,6 @@
 #include "microcobot/teleop/teleoperation.h"
 
 namespace mc::platform {
-
-/// The channels of a telemetry sample, unit-suffixed (the CSV recording's columns). The first
-/// kLoopChannelCount are what the loop itself sees (the devices' interfaces, the coupling, the
-/// controller's commands): recorded on any devices. The rest are the simulation's ground truth
-/// (the operator's hand, the true carriage positions, the haptic channels' forces, the part):
-/// recorded only when the platform runs its simulated devices.
-inline constexpr std::array<const char*, 45> kTelemetryChannels = {"t_s",  // loop channels
-                                                                   "handle_x_m",
-                                                                   "handle_y_m",
-                                                                   "deadman",
-                                                                   "clutch",
-                                                                   "engaged",
-                                                                   "stale",
-                                                                   "target_x_m",
-                                                                   "target_y_m",
-                                                                   "target_z_m",
-                                                                   "measured_x_m",
-                                                                   "measured_y_m",
-                                                                   "measured_z_m",
-                                                                   "u_x_V",
-                                                                   "u_y_V",
-                                                                   "u_z_V",
-                                                                   "haptic_force_x_N",
-                                                                   "haptic_force_y_N",
-                                                                   "tweezers_opening_m",
-                                                                   "finger_force_N",
-                                                                   "gripper_command_m",
-                                                                   "gripper_opening_m",
-                                                                   "grip_force_N",
-                                                                   "contact_x_N",
-                                                                   "contact_y_N",
-                                                                   "contact_z_N",
-                                                                   "target_theta_rad",
-                                                                   "measured_theta_rad",
-                                                                   "u_theta_V",
-                                                                   "tick_us",
-                                                                   "tick_cpu_us",
-                                                                   "hand_x_m",  // simulation channels
-                                                                   "hand_y_m",
-                                                                   "slave_x_m",
-                                                                   "slave_y_m",
-                                                                   "slave_z_m",
-                                                                   "pantograph_y_N",
-                                                                   "haptuator_V",
-                                                                   "part_x_m",
-                                                                   "part_y_m",
-                                                                   "part_z_m",
-                                                                   "part_phase",
-                                                                   "slave_theta_rad",
-                                                                   "part_yaw_rad",
-                                                                   "gripper_shaking"};
-// In the optical-trap scene the part channels are the probe bead's (part_phase 0). The theta
-// channels are the rotary axis' (0 on a platform without one). gripper_shaking: 1 while the
-// simulated gripper's release burst shakes its fingers.
-inline constexpr std::size_t kLoopChannelCount = 31;
-using TelemetrySample = std::array<double, kTelemetryChannels.size()>;
 
 class Platform {
  public:
@@ -243,10 +190,19 @@ class Platform {
   bool records_simulation() const {
     return sim_.haptic != nullptr && (sim_.gripper != nullptr || sim_.optical_tweezers != nullptr);
   }
-  /// Channels recorded: all of kTelemetryChannels with the simulation's, the loop channels otherwise.
-  std::size_t telemetry_channel_count() const {
-    return records_simulation() ? kTelemetryChannels.size() : kLoopChannelCount;
-  }
+  /// The channels of this platform's telemetry: the built-in loop channels, the simulation's
+  /// when records_simulation(), then those added (telemetry_schema.h).
+  const TelemetrySchema& telemetry_schema() const { return telemetry_; }
+  std::size_t telemetry_channel_count() const { return telemetry_.size(); }
+  /// Reads one added channel's value off the platform, on the loop at every telemetry tick:
+  /// must be real-time safe (no allocation, lock, exception or I/O).
+  using TelemetrySource = std::function<double(const Platform&)>;
+  /// Adds a channel to the telemetry (after the built-in ones): it is sampled with the others
+  /// and reaches every output (the recording's CSV and MCAP, the live server's schema, Python)
+  /// with its name and unit. Before the first run only. Returns its index in a sample. Throws
+  /// mc::InvalidParams for a channel the schema refuses (TelemetrySchema::add), without a
+  /// source, or after the platform ran.
+  std::size_t add_telemetry_channel(TelemetryChannel channel, TelemetrySource source);
   /// Telemetry samples lost because the ring was full (0 when the drain keeps up).
   std::size_t telemetry_dropped() const { return ring_.dropped() + recorder_->dropped(); }
 
@@ -259,7 +215,17 @@ class Platform {
   void devices_task(double dt_s) noexcept;
   /// Whether axis i's open-loop run must stop now (the safety rules of start_open_loop_steps).
   bool open_loop_must_stop(std::size_t i) const noexcept;
-  void telemetry_task(double t_s) noexcept;
+  void telemetry_task() noexcept;
+  /// The built-in channels, each with the function that reads it (platform_telemetry.cc).
+  struct BuiltinChannel;
+  static std::span<const BuiltinChannel> loop_channels();
+  static std::span<const BuiltinChannel> simulation_channels();
+  friend const TelemetrySchema& builtin_telemetry(bool simulation);
+  void build_telemetry();
+  /// Axis i's drive voltage as the telemetry reports it (0 when faulted).
+  double axis_voltage_V(std::size_t i) const noexcept;
+  /// The simulated part's (or probe bead's) position, zero without a simulated microworld.
+  Eigen::Vector3d simulated_part_m() const noexcept;
   void camera_task(const runtime::TickInfo& t) noexcept;
   void drain() noexcept;
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
@@ -300,6 +266,8 @@ class Platform {
   Eigen::Vector3d home_m_;
   runtime::FixedRateLoop loop_;
   runtime::SpscRing<TelemetrySample> ring_;
+  TelemetrySchema telemetry_;
+  std::vector<TelemetrySource> telemetry_sources_;  ///< one per channel of telemetry_
   std::unique_ptr<Recorder> recorder_;
   std::function<void(const runtime::TickInfo&)> operator_;
   teleop::ConsoleInput console_;

@@ -1,0 +1,95 @@
+#include "microcobot/live/console_source.h"
+
+#include "microcobot/live/microscope_source.h"
+
+namespace mc::live {
+
+using platform::Platform;
+
+SourceRequest ConsoleSource::poll(const SourceTick& t) noexcept {
+  driving_ = false;
+  ConsoleCommand c;
+  bool got = false;
+  while (commands_.pop(c)) {
+    got = true;
+    apply_microscope(t.platform, c);
+    if (c.received_ns > 0) {
+      // Applied in this tick: the command-to-target latency (a full ring drops the sample).
+      const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count();
+      latencies_.push(1e-9 * static_cast<double>(now - c.received_ns));
+    }
+  }
+  if (got) {
+    latest_ = c;
+    last_command_t_ = t.tick.t_s;
+  }
+  const bool in_control = in_control_.load(std::memory_order_relaxed);
+  fresh_.store(in_control && t.tick.t_s - last_command_t_ <= params_.command_timeout_s,
+               std::memory_order_relaxed);
+  SourceRequest r;
+  r.claim = in_control || (task_ && task_->in_progress()) ? Claim::kActive : Claim::kStandby;
+  return r;
+}
+
+void ConsoleSource::drive(const SourceTick& t, teleop::ConsoleInput& in) noexcept {
+  driving_ = true;
+  Platform& p = t.platform;
+  const bool fresh = fresh_.load(std::memory_order_relaxed);
+  in = coupling_input(latest_, fresh, params_.max_theta_speed_rad_s);
+  // The task, supervised by the console in control: it drives or holds in the console's place.
+  const bool in_control = in_control_.load(std::memory_order_relaxed);
+  if (task_) task_->tick(p, params_.home_m, t.tick.dt_s, in_control && !p.faulted(), fresh, in);
+  if (positioner_) {
+    // The goal is the positioner's: the coupling's x and y loops are open.
+    if (in.has_goal)
+      positioner_->request_goal_world(in.goal_m.x(), in.goal_m.y());
+    else if (latest_.has_goal_px)
+      positioner_->request_goal_pixel(latest_.goal_px[0], latest_.goal_px[1]);
+    else
+      positioner_->clear_goal();
+    in.has_goal = false;
+  }
+}
+
+void ConsoleSource::publish(const SourceTick& t) noexcept {
+  if (positioner_) vision_tick(t.platform, t.tick);
+}
+
+void ConsoleSource::vision_tick(Platform& p, const runtime::TickInfo& t) noexcept {
+  // A jog run: long enough for a few sawtooth periods, short enough to stop with the stick.
+  constexpr double kJogRun_s = 0.02;
+  const teleop::ConsoleInput& in = p.console_input();
+  const bool enabled = driving_ && in.active && in.fresh && in.deadman && !p.faulted();
+  positioner_->set_enabled(enabled);
+  const double now = params_.t_offset_s + t.t_s;
+  perception::PositionerCommand c;
+  while (vision_.pop(c)) {
+    const double interval = c.interval_s - (now - c.t_issue_s);  // what is left of it
+    if (!enabled || interval <= 0.0) continue;
+    for (int i = 0; i < 2; ++i) p.command_open_loop_velocity(i, c.velocity_m_s[i], interval);
+  }
+  // The joystick in the plane (no goal pending): open-loop runs while it asks.
+  if (!enabled || latest_.has_goal || latest_.has_goal_px) return;
+  for (int i = 0; i < 2; ++i) {
+    const double v = in.velocity_m_s[i];
+    if (v != 0.0 && !p.open_loop_running(i)) p.command_open_loop_velocity(i, v, kJogRun_s);
+  }
+}
+
+void ConsoleSource::reset() noexcept {
+  latest_ = ConsoleCommand{};
+  last_command_t_ = -1e9;
+  driving_ = false;
+  perception::PositionerCommand stale;
+  while (vision_.pop(stale)) {
+  }
+}
+
+void ConsoleSource::drain_latencies(runtime::TimingStats& stats) noexcept {
+  double latency_s = 0.0;
+  while (latencies_.pop(latency_s)) stats.add(latency_s);
+}
+
+}  // namespace mc::live

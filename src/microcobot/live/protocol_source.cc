@@ -1,0 +1,135 @@
+#include "microcobot/live/protocol_source.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mc::live {
+
+using platform::Platform;
+
+void ProtocolSource::stop_and_hold(Platform& p) noexcept {
+  p.stop_open_loop();
+  p.hold();
+  has_goal_ = false;
+  steps_pending_ = false;
+}
+
+SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
+  Platform& p = t.platform;
+  const double now = t.tick.t_s;
+  ProtocolCommand c;
+  while (ring_.pop(c)) {
+    popped_seq_ = std::max(popped_seq_, c.seq);
+    switch (c.kind) {
+      case ProtocolCommand::Kind::kHeartbeat:
+        last_t_ = now;
+        break;
+      case ProtocolCommand::Kind::kMoveTo:
+        last_t_ = now;
+        p.stop_open_loop();
+        goal_m_ = c.goal_m;
+        speed_m_s_ = c.speed_m_s;
+        theta_goal_rad_ = c.theta_goal_rad;
+        theta_speed_rad_s_ = c.theta_speed_rad_s;
+        has_goal_ = true;
+        steps_pending_ = false;
+        settled_s_ = {};
+        break;
+      case ProtocolCommand::Kind::kSteps:
+        last_t_ = now;
+        has_goal_ = false;
+        pending_steps_ = c;
+        steps_pending_ = true;
+        break;
+      case ProtocolCommand::Kind::kStop:
+        if (holding_) stop_and_hold(p);  // a protocol stop never interrupts another source
+        break;
+      case ProtocolCommand::Kind::kRelease:
+        stop_and_hold(p);
+        last_t_ = -1e9;
+        break;
+    }
+  }
+  // A halted platform forgets the protocol's goal: nothing resumes by itself after the reset.
+  if (p.faulted()) {
+    has_goal_ = false;
+    steps_pending_ = false;
+  }
+  SourceRequest r;
+  if (now - last_t_ <= params_.command_timeout_s) r.claim = Claim::kActive;
+  return r;
+}
+
+void ProtocolSource::drive(const SourceTick& t, teleop::ConsoleInput& in) noexcept {
+  holding_ = true;
+  const Eigen::Vector3d& home = params_.home_m;
+  in.active = true;
+  in.fresh = true;
+  in.deadman = true;
+  in.has_goal = has_goal_;
+  in.goal_m = {home.x() + goal_m_[0], home.y() + goal_m_[1], home.z() + goal_m_[2]};
+  in.goal_speed_m_s = speed_m_s_;
+  // The rotary axis turns to the same command's goal (none without the axis: the target stays).
+  in.has_theta_goal = has_goal_ && t.platform.has_rotary();
+  in.theta_goal_rad = theta_goal_rad_;
+  in.theta_speed_rad_s = theta_speed_rad_s_;
+}
+
+void ProtocolSource::released(const SourceTick& t) noexcept {
+  holding_ = false;
+  stop_and_hold(t.platform);  // gone, stale or outranked: every axis holds
+}
+
+void ProtocolSource::publish(const SourceTick& t) noexcept {
+  Platform& p = t.platform;
+  // Steps start only while the protocol drives (the console input they check is its).
+  if (steps_pending_ && holding_) {
+    const ProtocolCommand& s = pending_steps_;
+    if (!p.start_open_loop_steps(s.axis, s.amplitude_V, s.frequency_Hz, s.direction, s.periods))
+      refused_steps_.fetch_add(1, std::memory_order_relaxed);
+  }
+  steps_pending_ = false;
+  const double dt = std::max(0.0, t.tick.t_s - last_publish_t_);
+  last_publish_t_ = t.tick.t_s;
+  const auto& target = p.teleop().slave_target_m;
+  // The rotary axis is on target within the linear axes' tolerance as an arc at its contact
+  // radius: the same actuator, the same sensor.
+  const double theta_tolerance_rad = params_.on_target_tolerance_m / params_.rotary_radius_m;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool theta = i == 3;
+    if (theta && !p.has_rotary()) break;
+    const double x = theta ? p.yaw_rad() : p.axis(static_cast<int>(i)).position_m();
+    const bool running = p.open_loop_running(static_cast<int>(i));
+    const double goal = theta ? (has_goal_ ? theta_goal_rad_ : p.yaw_target_rad())
+                        : has_goal_ ? goal_m_[i]
+                                    : target[static_cast<Eigen::Index>(i)];
+    const double tolerance = theta ? theta_tolerance_rad : params_.on_target_tolerance_m;
+    settled_s_[i] = !running && std::abs(x - goal) <= tolerance ? settled_s_[i] + dt : 0.0;
+    position_[i].store(x, std::memory_order_relaxed);
+    on_target_[i].store(settled_s_[i] >= params_.settle_window_s, std::memory_order_relaxed);
+    stepping_[i].store(running, std::memory_order_relaxed);
+  }
+  driving_.store(holding_, std::memory_order_relaxed);
+  applied_seq_.store(popped_seq_, std::memory_order_release);
+}
+
+void ProtocolSource::reset() noexcept {
+  last_t_ = -1e9;
+  holding_ = has_goal_ = steps_pending_ = false;
+  settled_s_ = {};
+}
+
+ProtocolView ProtocolSource::view() const noexcept {
+  ProtocolView v;
+  v.applied_seq = applied_seq_.load(std::memory_order_acquire);
+  v.protocol_fresh = driving_.load(std::memory_order_relaxed);
+  for (std::size_t i = 0; i < 4; ++i) {
+    v.position[i] = position_[i].load(std::memory_order_relaxed);
+    v.on_target[i] = on_target_[i].load(std::memory_order_relaxed);
+    v.stepping[i] = stepping_[i].load(std::memory_order_relaxed);
+  }
+  v.refused_steps = refused_steps_.load(std::memory_order_relaxed);
+  return v;
+}
+
+}  // namespace mc::live
