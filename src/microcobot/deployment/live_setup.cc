@@ -91,7 +91,12 @@ void use_cell(const ServeConfig& o, live::LiveParams& lp, const Log& log) {
 
 live::LiveParams live_params(const ServeConfig& o, const Log& log) {
   live::LiveParams lp;
-  lp.platform = o.config_file ? pf::load_platform_config(*o.config_file) : o.platform;
+  if (o.config_file) {
+    lp.platform = pf::load_platform_config(*o.config_file);
+  } else {
+    lp.platform = o.platform;
+    lp.platform.validate();
+  }
   if (!o.cell && (o.seed || o.part || o.task || o.cell_camera))
     throw UsageError(std::string(o.task          ? "--task"
                                  : o.seed        ? "--seed"
