@@ -102,7 +102,6 @@ struct TrajectoryOptions : mc::studies::TrajectoryCase {
   CommonOptions common;
 };
 
-
 void run_trajectory_cmd(const TrajectoryOptions& o) {
   const auto p = load(o.common);
   const double half = 0.5 * p.model.slider.stroke_m;

@@ -102,7 +102,8 @@ void serve(const ServeOptions& o) {
 
 void add_serve(CLI::App& cmd) {
   auto o = std::make_shared<ServeOptions>();
-  cmd.add_option("--config", o->config.config_file, "Platform configuration (YAML; keys as `run --print-config` shows)");
+  cmd.add_option("--config", o->config.config_file,
+                 "Platform configuration (YAML; keys as `run --print-config` shows)");
   cmd.add_option(
       "--scene", o->config.scene,
       "Scene: pick-place (default: the 300 um part), pin-in-hole (a 200 um pin into a hole with "
@@ -126,7 +127,8 @@ void add_serve(CLI::App& cmd) {
   cmd.add_option("--listen", o->listen,
                  "Address and port (default 127.0.0.1:8080; port 0 picks a free one; any non-loopback "
                  "address requires a token)");
-  cmd.add_option("--token", o->config.token, "Token the WebSocket clients must give (generated off loopback)");
+  cmd.add_option("--token", o->config.token,
+                 "Token the WebSocket clients must give (generated off loopback)");
   cmd.add_option(
       "--emulate", o->emulate,
       "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "

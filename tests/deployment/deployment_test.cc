@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -31,10 +32,11 @@ namespace {
 
 std::unique_ptr<test::SkeletonBench> g_deployment_bench;
 
-const platform::DriverRegistration kDeploymentBench{"deployment-bench", [](const platform::PlatformConfig& config) {
-                                                      g_deployment_bench = std::make_unique<test::SkeletonBench>(config);
-                                                      return g_deployment_bench->devices();
-                                                    }};
+const platform::DriverRegistration kDeploymentBench{
+    "deployment-bench", [](const platform::PlatformConfig& config) {
+      g_deployment_bench = std::make_unique<test::SkeletonBench>(config);
+      return g_deployment_bench->devices();
+    }};
 
 // One line asked of a TCP server on loopback, its reply read up to the first newline (3 s at most).
 std::string ask_line(std::uint16_t port, const std::string& line) {
@@ -147,35 +149,39 @@ TEST(Deployment, ASlaveRoleJoinsItsDomainAndReportsItsPorts) {
 TEST(Deployment, ABadConfigurationFailsWithOneClearErrorBeforeAnythingIsServed) {
   test::TempDir dir;
   test::write_text(dir / "a-file", "x");
-  const auto base = [&] {
-    ServeConfig c;
-    c.listen_port = 0;
-    c.out = dir / "live";
-    return c;
-  };
+  using Change = std::function<void(ServeConfig&)>;
   const struct {
     std::string name;
-    ServeConfig config;
+    Change change;
     int exit_code;
     std::string message;
   } cases[] = {
-      {"unknown scene", [&] { auto c = base(); c.scene = "pin-in-hol"; return c; }(), 3,
-       "--scene 'pin-in-hol': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a scene file"},
-      {"cell field without cell", [&] { auto c = base(); c.seed = 3; return c; }(), 2, "--seed: needs --cell"},
-      {"link without role", [&] { auto c = base(); c.link.delay_s = 0.05; return c; }(), 2,
+      {"unknown scene", [](ServeConfig& c) { c.scene = "pin-in-hol"; }, 3,
+       "--scene 'pin-in-hol': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a scene "
+       "file"},
+      {"cell field without cell", [](ServeConfig& c) { c.seed = 3; }, 2, "--seed: needs --cell"},
+      {"link without role", [](ServeConfig& c) { c.link.delay_s = 0.05; }, 2,
        "--link-delay, --link-jitter, --link-loss: need --role master or slave"},
-      {"short token", [&] { auto c = base(); c.token = "short"; return c; }(), 2, "--token: must be 8 to 256"},
-      {"out is a file", [&] { auto c = base(); c.out = dir / "a-file"; return c; }(), 3,
+      {"short token", [](ServeConfig& c) { c.token = "short"; }, 2, "--token: must be 8 to 256"},
+      {"out is a file", [&](ServeConfig& c) { c.out = dir / "a-file"; }, 3,
        "cannot create --out " + (dir / "a-file").string()},
-      {"unknown driver", [&] { auto c = base(); c.platform.devices.driver = "smaract"; return c; }(), 3,
+      {"unknown driver", [](ServeConfig& c) { c.platform.devices.driver = "smaract"; }, 3,
        "devices.driver: 'smaract' is not a registered driver"},
-      {"domain out of range", [&] { auto c = base(); c.role = Role::kMaster; c.domain = 231; return c; }(), 2,
-       "--domain: 231 is out of range"},
+      {"domain out of range",
+       [](ServeConfig& c) {
+         c.role = Role::kMaster;
+         c.domain = 231;
+       },
+       2, "--domain: 231 is out of range"},
   };
   for (const auto& c : cases) {
+    ServeConfig config;
+    config.listen_port = 0;
+    config.out = dir / "live";
+    c.change(config);
     LogLines log;
     try {
-      Deployment d(c.config, log.sink());
+      Deployment d(config, log.sink());
       ADD_FAILURE() << c.name << ": built";
     } catch (const Error& e) {
       EXPECT_EQ(static_cast<int>(e.exit_code()), c.exit_code) << c.name << ": " << e.what();

@@ -91,9 +91,10 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
             : "the drivers '" + lp.platform.devices.driver + "' (" + lp.platform.devices.connection + ")"));
   const net::NetworkConfig network = o.network.value_or(net::NetworkConfig{});
   if (o.role != Role::kSingle)
-    log_(fmt::format("{} of a distributed platform on DDS domain {} ({}; the peer: serve --role {} --domain {})",
-                     role_name(o.role), o.domain, net::describe(network),
-                     o.role == Role::kMaster ? "slave" : "master", o.domain));
+    log_(fmt::format(
+        "{} of a distributed platform on DDS domain {} ({}; the peer: serve --role {} --domain {})",
+        role_name(o.role), o.domain, net::describe(network), o.role == Role::kMaster ? "slave" : "master",
+        o.domain));
   live_ = std::make_unique<live::LivePlatform>(lp);
   live::LivePlatform& live = *live_;
   // The slave's camera on DDS as a ROS 2 image topic (built before the server that calls it).
@@ -112,13 +113,14 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
           live.push_microscope_command(c);  // a full ring (16 waiting) drops it: the next one counts
         },
         [&live] { return microscope_joints(live, false); });
-    log_(fmt::format("the microscope's focus and objective on DDS, ROS 2 topics {} and {} "
-                     "(sensor_msgs/msg/JointState)",
-                     net::kMicroscopeCommandRosName, net::kMicroscopeStateRosName));
+    log_(
+        fmt::format("the microscope's focus and objective on DDS, ROS 2 topics {} and {} "
+                    "(sensor_msgs/msg/JointState)",
+                    net::kMicroscopeCommandRosName, net::kMicroscopeStateRosName));
   }
   if (o.role == Role::kMaster && live.has_camera())
-    microscope_client_ =
-        std::make_unique<net::MicroscopeClient>(o.domain, network, [&live] { return microscope_joints(live, true); });
+    microscope_client_ = std::make_unique<net::MicroscopeClient>(
+        o.domain, network, [&live] { return microscope_joints(live, true); });
   server_ = std::make_unique<live::ConsoleServer>(live, sp);
   if (images_) {
     server_->add_frame_consumer(
@@ -170,7 +172,8 @@ std::vector<ServedTwin> Deployment::twins() const {
 }
 
 std::optional<PortEnergy> Deployment::port_energy() const {
-  if (remote_slave_) return PortEnergy{remote_slave_->min_observed_energy_J(), remote_slave_->dissipated_energy_J()};
+  if (remote_slave_)
+    return PortEnergy{remote_slave_->min_observed_energy_J(), remote_slave_->dissipated_energy_J()};
   if (remote_master_)
     return PortEnergy{remote_master_->min_observed_energy_J(), remote_master_->dissipated_energy_J()};
   return std::nullopt;

@@ -28,7 +28,9 @@ void naming_flag(const std::string& field, const std::string& flag, Work&& work)
     work();
   } catch (const InvalidParams& e) {
     std::string text = e.what();
-    const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+    const auto word = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.';
+    };
     for (std::size_t pos = 0; (pos = text.find(field, pos)) != std::string::npos;) {
       const std::size_t end = pos + field.size();
       if ((pos > 0 && word(text[pos - 1])) || (end < text.size() && word(text[end]) && text[end] != '.')) {
@@ -84,7 +86,8 @@ void use_cell(const ServeConfig& o, live::LiveParams& lp, const Log& log) {
       part, batch.seed, batch.parts, 1e6 * job.side_m, job.flat ? "plate onto its seat" : "pin into a bore",
       1e6 * job.clearance_m, job.flat ? "seat tolerance" : "radial clearance",
       job.world.neighbour_count > 0 ? fmt::format(", among {} other parts", job.world.neighbour_count) : "",
-      levels.empty() ? "all auto" : levels + " (the rest auto)", o.cell_camera ? "; the cell's camera looks" : ""));
+      levels.empty() ? "all auto" : levels + " (the rest auto)",
+      o.cell_camera ? "; the cell's camera looks" : ""));
 }
 
 }  // namespace

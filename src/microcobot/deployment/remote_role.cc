@@ -28,7 +28,8 @@ RemoteEnds attach_role(const ServeConfig& o, live::LiveParams& lp) {
     throw UsageError("--domain: " + std::to_string(o.domain) + " is out of range: expected 0 to " +
                      std::to_string(net::kMaxDomainId));
   if (o.link.jitter_s > o.link.delay_s)
-    throw UsageError("--link-jitter: must not exceed --link-delay (delays are delay +- jitter, never negative)");
+    throw UsageError(
+        "--link-jitter: must not exceed --link-delay (delays are delay +- jitter, never negative)");
   const net::NetworkConfig network = o.network.value_or(net::NetworkConfig{});
   const stickslip::StickSlipParams axis = pf::axis_params(lp.platform);
   if (o.role == Role::kMaster) {
@@ -50,8 +51,8 @@ RemoteEnds attach_role(const ServeConfig& o, live::LiveParams& lp) {
       if (cfg.devices.simulated()) {
         d.haptic = std::make_unique<devices::SimulatedHapticMaster>(
             "dual_stage", cfg.haptic.plant, cfg.haptic.render, cfg.haptic.pantograph, cfg.loop.period_s());
-        d.tweezers =
-            std::make_unique<devices::SimulatedTweezersMaster>("teletweez", cfg.tweezers, cfg.loop.period_s());
+        d.tweezers = std::make_unique<devices::SimulatedTweezersMaster>("teletweez", cfg.tweezers,
+                                                                        cfg.loop.period_s());
       } else {
         d = pf::make_driver_devices(cfg);
       }
@@ -61,8 +62,8 @@ RemoteEnds attach_role(const ServeConfig& o, live::LiveParams& lp) {
       d.gripper = std::move(stage.gripper);
       // The microscope is the slave's: its frames, over DDS (the master has no microworld to image).
       if (cfg.camera.enabled && cfg.devices.camera.driver != "none")
-        d.camera = std::make_unique<devices::Camera>("camera", cfg.camera,
-                                                     std::make_unique<net::RemoteCameraSource>(domain, network));
+        d.camera = std::make_unique<devices::Camera>(
+            "camera", cfg.camera, std::make_unique<net::RemoteCameraSource>(domain, network));
       return d;
     };
   } else {

@@ -62,17 +62,14 @@ nlohmann::json path_json(const PathMetrics& m) {
           {"final_error_m", m.final_error_m},      {"steps", m.edges}};
 }
 
-constexpr std::array<TrackerKind, 3> kTrackers{TrackerKind::kTracking,
-                                                            TrackerKind::kHybrid,
-                                                            TrackerKind::kThesisPid};
+constexpr std::array<TrackerKind, 3> kTrackers{TrackerKind::kTracking, TrackerKind::kHybrid,
+                                               TrackerKind::kThesisPid};
 
-std::string json_name(TrackerKind k) {
-  return k == TrackerKind::kThesisPid ? "thesis_pid" : to_string(k);
-}
+std::string json_name(TrackerKind k) { return k == TrackerKind::kThesisPid ? "thesis_pid" : to_string(k); }
 
 /// 3-D line and arc: the three axes on the path, the tracker and both baselines.
-nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const TrajectoryCase& o,
-                               Report& r, CsvTable* table) {
+nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const TrajectoryCase& o, Report& r,
+                               CsvTable* table) {
   motion::PathLimits lim = p.path;
   lim.max_velocity_m_s = p.limits.max_velocity_m_s;
   lim.max_acceleration_m_s2 = p.limits.max_acceleration_m_s2;
@@ -82,7 +79,7 @@ nlohmann::json path_experiment(const ControlParams& p, const Plant& plant, const
       o.profile == "line"
           ? motion::PathGenerator::line(-0.5 * o.distance * dir, 0.5 * o.distance * dir, lim)
           : motion::PathGenerator::arc(Eigen::Vector3d(o.radius, 0.0, 0.0), Eigen::Vector3d::Zero(),
-                                           Eigen::Vector3d(0.0, 0.3, 1.0), o.angle, lim);
+                                       Eigen::Vector3d(0.0, 0.3, 1.0), o.angle, lim);
   require_budget(
       3.0 * (path.duration_s() + 0.03) / plant.model.dt_s(), kMaxSimulatedSteps,
       "--distance/--velocity/--acceleration (path duration)",
@@ -136,8 +133,7 @@ nlohmann::json velocity_experiment(const ControlParams& p, const Plant& plant, d
   std::vector<Series> v_series, a_series;
   for (auto mode : {motion::VelocityMode::kModelBased, motion::VelocityMode::kThesisPid,
                     motion::VelocityMode::kOpenLoop}) {
-    const auto run =
-        motion::run_velocity(plant.model, &plant.map, p.velocity, mode, ref, duration, p.sensor);
+    const auto run = motion::run_velocity(plant.model, &plant.map, p.velocity, mode, ref, duration, p.sensor);
     const auto name = to_string(mode);
     if (mode == motion::VelocityMode::kModelBased) {
       j = velocity_json(run.metrics);
@@ -286,10 +282,9 @@ nlohmann::json trajectory_experiment(const ControlParams& p0, const Plant& plant
   }
   // The work budget, before the runs: a slow trapezoid (tiny velocity or acceleration limit)
   // would otherwise simulate for days.
-  require_budget(
-      duration / plant.model.dt_s(), kMaxSimulatedSteps,
-      o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
-      fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
+  require_budget(duration / plant.model.dt_s(), kMaxSimulatedSteps,
+                 o.profile == "trapezoid" ? "--velocity/--acceleration (trapezoid duration)" : "--frequency",
+                 fmt::format("simulated steps ({:.3g} s at {:g} s)", duration, plant.model.dt_s()));
   const auto su = tracker_setup(p);
   nlohmann::json j;
   std::vector<Series> xs, errs;

@@ -45,10 +45,12 @@ struct TrajectoryCase {
 /// Velocity control at `speed` in direction `dir` for `duration` s (Fig. 2.18-2.19): the
 /// model-based PID, the thesis's PID and open-loop step counting.
 nlohmann::json velocity_experiment(const motion::ControlParams& p, const ControlPlant& plant, double speed,
-                                   stickslip::Direction dir, double duration, report::Report& r, CsvTable* table);
+                                   stickslip::Direction dir, double duration, report::Report& r,
+                                   CsvTable* table);
 /// A hybrid move of `axis` from `start` to `target` beside the open-loop and thesis-PID baselines.
-nlohmann::json position_experiment(const motion::ControlParams& p, const ControlPlant& plant, motion::Axis axis,
-                                   double start, double target, report::Report& r, CsvTable* table);
+nlohmann::json position_experiment(const motion::ControlParams& p, const ControlPlant& plant,
+                                   motion::Axis axis, double start, double target, report::Report& r,
+                                   CsvTable* table);
 /// The tracking controller on trajectory `o` beside the hybrid controller and the thesis's PID.
 /// Throws InvalidParams (limits) or naming the flags of a trajectory over the work budget.
 nlohmann::json trajectory_experiment(const motion::ControlParams& p0, const ControlPlant& plant,

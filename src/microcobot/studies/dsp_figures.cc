@@ -19,10 +19,10 @@ void dsp_figures(report::Report& r) {
             "|LP + HP| = 1), the Welch PSD of a 10 kHz PRBS and the first values of an MLS.");
   const double fs = 50000.0;
   report::Figure fig{"LR4 crossover magnitudes",
-                         "Low- and high-pass outputs and |LP + HP|.",
-                         {"Frequency", "Hz", true},
-                         {"Magnitude", "dB", false},
-                         {}};
+                     "Low- and high-pass outputs and |LP + HP|.",
+                     {"Frequency", "Hz", true},
+                     {"Magnitude", "dB", false},
+                     {}};
   double worst = 0.0;
   for (double fc : {200.0, 10000.0}) {
     const auto x = dsp::linkwitz_riley_crossover(4, fc, fs);
@@ -51,10 +51,10 @@ void dsp_figures(report::Report& r) {
   o.nperseg = 1024;
   const auto p = dsp::welch(u, o);
   report::Figure psd{"Welch PSD of a PRBS",
-                         "+-1 PRBS (15 bits) at 10 kHz: flat at 2/fs = 2e-4 V^2/Hz.",
-                         {"Frequency", "Hz", true},
-                         {"PSD", "V^2/Hz", true},
-                         {}};
+                     "+-1 PRBS (15 bits) at 10 kHz: flat at 2/fs = 2e-4 V^2/Hz.",
+                     {"Frequency", "Hz", true},
+                     {"PSD", "V^2/Hz", true},
+                     {}};
   report::Series s{"PRBS", {}, {}};
   for (std::size_t k = 1; k < p.f_Hz.size(); ++k) {
     s.x.push_back(p.f_Hz[k]);
@@ -64,10 +64,10 @@ void dsp_figures(report::Report& r) {
   r.add_figure(psd);
   const auto m = dsp::max_len_seq(6);
   report::Figure mf{"MLS (6 bits)",
-                        "One period (63 values) of scipy's 6-bit MLS.",
-                        {"Index", "", false},
-                        {"Bit", "", false},
-                        {}};
+                    "One period (63 values) of scipy's 6-bit MLS.",
+                    {"Index", "", false},
+                    {"Bit", "", false},
+                    {}};
   report::Series ms{"MLS", {}, {}, true};
   for (std::size_t k = 0; k < m.size(); ++k) {
     ms.x.push_back(static_cast<double>(k));

@@ -77,7 +77,8 @@ nlohmann::json case_json(const SawtoothCase& c) {
 
 }  // namespace
 
-nlohmann::json experiment_figures(const std::string& name, const stickslip::StickSlipParams& p, report::Report& r) {
+nlohmann::json experiment_figures(const std::string& name, const stickslip::StickSlipParams& p,
+                                  report::Report& r) {
   if (name == "pe-step") {
     return step_experiment(r, name, run_pe_step(p),
                            "Slider removed, 90 V step, 1 MHz sampling (thesis §2.5.2.1, Fig. 2.10).",
@@ -182,8 +183,8 @@ nlohmann::json experiment_figures(const std::string& name, const stickslip::Stic
     return {{"cases", arr}};
   }
   throw UsageError("unknown experiment '" + name +
-                       "' (pe-step, actuator-step, hysteresis, scanning, stepping, "
-                       "threshold, psd)");
+                   "' (pe-step, actuator-step, hysteresis, scanning, stepping, "
+                   "threshold, psd)");
 }
 
 void stickslip_figures(report::Report& r) {

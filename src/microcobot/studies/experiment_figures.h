@@ -14,7 +14,8 @@ namespace mc::studies {
 
 /// Runs the experiment `name` (experiment_names()) on `p`, adds its section to `r` and returns its
 /// summary. Throws mc::UsageError naming the known experiments when `name` is none of them.
-nlohmann::json experiment_figures(const std::string& name, const stickslip::StickSlipParams& p, report::Report& r);
+nlohmann::json experiment_figures(const std::string& name, const stickslip::StickSlipParams& p,
+                                  report::Report& r);
 
 /// The stick-slip part of the full report: every experiment on the default axis.
 void stickslip_figures(report::Report& r);

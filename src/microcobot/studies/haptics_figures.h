@@ -43,7 +43,8 @@ struct HapticsParams {
       // The message is "invalid parameter <field>: <constraint>"; keep the constraint.
       const std::string what = e.what();
       const std::string head = "invalid parameter " + e.field() + ": ";
-      throw InvalidParams(section + "." + e.field(), what.rfind(head, 0) == 0 ? what.substr(head.size()) : what);
+      throw InvalidParams(section + "." + e.field(),
+                          what.rfind(head, 0) == 0 ? what.substr(head.size()) : what);
     }
   }
 };
@@ -66,7 +67,8 @@ TweezersOut run_tweezers_core(const HapticsParams& p, microworld::TweezersScenar
 /// The two channels' FRFs and their models (section 3.4.2, Fig. 3.10-3.11).
 void identify_report(report::Report& r, const haptics::IdentificationResult& id);
 /// The LR4 crossover and the 1/3-octave evaluation (Fig. 3.8, 3.13).
-void evaluate_report(report::Report& r, const haptics::EvaluationResult& ev, const haptics::RenderPipelineParams& rp);
+void evaluate_report(report::Report& r, const haptics::EvaluationResult& ev,
+                     const haptics::RenderPipelineParams& rp);
 /// The Brownian histogram (Fig. 3.15) or the contact trace (`contact`, Fig. 3.16).
 void tweezers_report(report::Report& r, const TweezersOut& t, bool contact);
 

@@ -19,7 +19,7 @@ namespace ss = mc::stickslip;
 
 /// At most `max` points of a curve (plots stay light).
 report::Series series(std::string name, const std::vector<double>& x, const std::vector<double>& y,
-                          double yscale = 1.0, std::size_t max = 4000, bool points = false) {
+                      double yscale = 1.0, std::size_t max = 4000, bool points = false) {
   report::Series s;
   s.name = std::move(name);
   s.points = points;
@@ -64,8 +64,7 @@ void pe_section(report::Report& rep, const ss::MeasuredRecord& rec, const ss::Pe
                   {series("measured", rec.t_s, rec.x_m), series("model", rec.t_s, r.fitted_m)}});
 }
 
-void friction_section(report::Report& rep, const ss::MeasuredRecord& rec,
-                      const ss::FrictionModesResult& r) {
+void friction_section(report::Report& rep, const ss::MeasuredRecord& rec, const ss::FrictionModesResult& r) {
   rep.section(
       "identification: asperity modes (thesis 2.5.2.1, Fig. 2.11)",
       "Step response of the actuator in scanning mode (no slip). Each asperity's contact stiffness and "
@@ -99,8 +98,7 @@ void friction_section(report::Report& rep, const ss::MeasuredRecord& rec,
                   {series("measured", rec.t_s, rec.x_m), series("model", rec.t_s, r.fitted_m)}});
 }
 
-void hysteresis_section(report::Report& rep, const ss::MeasuredRecord& rec,
-                        const ss::HysteresisResult& r) {
+void hysteresis_section(report::Report& rep, const ss::MeasuredRecord& rec, const ss::HysteresisResult& r) {
   rep.section(
       "identification: PI hysteresis (thesis 2.5.2.2, Fig. 2.12)",
       "Play-operator thresholds on a non-uniform partition of the input range; weights by non-negative "
