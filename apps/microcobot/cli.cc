@@ -21,10 +21,6 @@ std::vector<Group>& group_registry() {
   static std::vector<Group> registry;
   return registry;
 }
-std::vector<ReportPart>& part_registry() {
-  static std::vector<ReportPart> registry;
-  return registry;
-}
 
 void check_finite(const nlohmann::json& v, const std::string& path) {
   if (v.is_number_float() && !std::isfinite(v.get<double>())) {
@@ -47,18 +43,6 @@ bool register_group(Group group) {
 std::vector<Group> groups() {
   auto out = group_registry();
   std::stable_sort(out.begin(), out.end(), [](const Group& a, const Group& b) { return a.order < b.order; });
-  return out;
-}
-
-bool register_report_part(ReportPart part) {
-  part_registry().push_back(std::move(part));
-  return true;
-}
-
-std::vector<ReportPart> report_parts() {
-  auto out = part_registry();
-  std::stable_sort(out.begin(), out.end(),
-                   [](const ReportPart& a, const ReportPart& b) { return a.order < b.order; });
   return out;
 }
 

@@ -39,15 +39,6 @@ bool register_group(Group group);
 /// All registered groups, sorted by order.
 std::vector<Group> groups();
 
-/// A section of the full report (`microcobot report`), computed by its module.
-struct ReportPart {
-  std::string name;
-  int order;
-  std::function<void(report::Report&)> build;
-};
-bool register_report_part(ReportPart part);
-std::vector<ReportPart> report_parts();
-
 /// CLI11's Range with the bounds in `%g` style ("1e-09 to 0.0001", not "0.000000 to
 /// 0.000100") and NaN refused; the message names the flag (CLI11 prefixes it).
 CLI::Validator Range(double lo, double hi);

@@ -68,7 +68,7 @@ void run_echo(const EchoOptions& o) {
   mc::cli::set_cooperative_interrupts(true);
   net::Link link(config);
   std::cerr << fmt::format("link echo: slave on DDS domain {} ({}); SIGINT/SIGTERM stops\n", o.domain,
-                           mc::cli::describe(config.network));
+                           mc::net::describe(config.network));
   std::uint64_t echoed = 0, estops = 0;
   bool estop = false;
   const auto start = Clock::now();

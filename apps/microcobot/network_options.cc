@@ -1,8 +1,5 @@
 #include "network_options.h"
 
-#include <fmt/format.h>
-#include <fmt/ranges.h>
-
 #include "microcobot/core/error.h"
 
 namespace mc::cli {
@@ -30,11 +27,6 @@ net::NetworkConfig network_config(const NetworkOptions& opts) {
     throw UsageError((e.field().rfind("network.peers", 0) == 0 ? "--peer: " : "--interface: ") + reason);
   }
   return n;
-}
-
-std::string describe(const net::NetworkConfig& network) {
-  if (network == net::NetworkConfig{}) return "loopback";
-  return fmt::format("interface {}, peers {}", network.interface, fmt::join(network.peers, ", "));
 }
 
 }  // namespace mc::cli

@@ -26,7 +26,4 @@ void add_network_options(CLI::App& cmd, NetworkOptions& opts);
 /// address, host or interface name (exit 2).
 net::NetworkConfig network_config(const NetworkOptions& opts);
 
-/// "loopback" or "interface ADDR, peers A, B" for the startup banners.
-std::string describe(const net::NetworkConfig& network);
-
 }  // namespace mc::cli

@@ -7,6 +7,7 @@
 #include "cli.h"
 #include "microcobot/core/error.h"
 #include "microcobot/report/report.h"
+#include "microcobot/studies/report_parts.h"
 #include "signals.h"
 
 namespace report_commands {
@@ -20,7 +21,7 @@ struct ReportOptions {
 void run_report(const ReportOptions& opts) {
   mc::report::Report full("microcobot report");
   std::size_t done = 0;
-  const auto parts = mc::cli::report_parts();
+  const auto parts = mc::studies::report_parts();
   for (const auto& name : opts.only) {
     if (std::none_of(parts.begin(), parts.end(), [&](const auto& p) { return p.name == name; })) {
       std::string known;
@@ -56,48 +57,5 @@ void add_report(CLI::App& cmd) {
 const bool kRegistered = mc::cli::register_group(
     {"report", "Build the full HTML report (every module's figures) into --out DIR", 100, &add_report});
 
-}  // namespace
-}  // namespace report_commands
-
-// The generator every simulation draws its noise from, checked against the density it
-// promises: a histogram of 200 000 draws over the standard normal density.
-#include <cmath>
-#include "microcobot/core/rng.h"
-namespace report_commands {
-namespace {
-void rng_part(mc::report::Report& r) {
-  r.section("Random number generator",
-            "Sensor noise, PRBS seeds and Brownian motion all come from mc::Rng "
-            "(xoshiro256**, identical streams on every platform). Histogram of 200000 normal "
-            "draws (seed 1) against the standard normal density.");
-  mc::Rng rng(1);
-  constexpr int kBins = 81;
-  constexpr double kLo = -4.05, kWidth = 0.1;
-  constexpr int kDraws = 200000;
-  std::vector<double> count(kBins, 0.0), centre(kBins), density(kBins);
-  double sum = 0, sum2 = 0;
-  for (int i = 0; i < kDraws; ++i) {
-    const double v = rng.normal();
-    sum += v;
-    sum2 += v * v;
-    const int b = static_cast<int>(std::floor((v - kLo) / kWidth));
-    if (b >= 0 && b < kBins) count[static_cast<std::size_t>(b)] += 1.0;
-  }
-  for (int b = 0; b < kBins; ++b) {
-    const auto i = static_cast<std::size_t>(b);
-    centre[i] = kLo + (b + 0.5) * kWidth;
-    count[i] /= kDraws * kWidth;
-    density[i] = std::exp(-0.5 * centre[i] * centre[i]) / std::sqrt(2 * M_PI);
-  }
-  const double mean = sum / kDraws;
-  r.add_result("mean of draws", mean);
-  r.add_result("variance of draws", sum2 / kDraws - mean * mean);
-  r.add_figure({"Normal draws",
-                "Histogram (points) against the N(0,1) density (line).",
-                {"Value", "", false},
-                {"Probability density", "", false},
-                {{"histogram", centre, count, true}, {"N(0,1) density", centre, density, false}}});
-}
-const bool kRngPart = mc::cli::register_report_part({"rng", 5, &rng_part});
 }  // namespace
 }  // namespace report_commands

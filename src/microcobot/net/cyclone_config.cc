@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cctype>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 
@@ -72,6 +75,11 @@ std::string cyclone_config(const NetworkConfig& network) {
   for (const auto& p : network.peers) xml += "<Peer address=\"" + p + "\"/>";
   xml += "</Peers></Discovery>";
   return xml;
+}
+
+std::string describe(const NetworkConfig& network) {
+  if (network == NetworkConfig{}) return "loopback";
+  return fmt::format("interface {}, peers {}", network.interface, fmt::join(network.peers, ", "));
 }
 
 }  // namespace mc::net

@@ -35,6 +35,9 @@ struct NetworkConfig {
 /// 127.0.0.0/8 (the peers then can only be reached through loopback too).
 bool on_loopback(const NetworkConfig& network);
 
+/// "loopback" or "interface ADDR, peers A, B": where the traffic goes, for startup banners.
+std::string describe(const NetworkConfig& network);
+
 /// The XML fragment given to dds_create_domain (Cyclone DDS 0.10 configuration elements:
 /// General/Interfaces/NetworkInterface (address= for an address, name= for a name; on loopback
 /// multicast="true"), General/AllowMulticast (spdp on loopback, false elsewhere),
