@@ -90,10 +90,12 @@ def main():
         sys.exit(1)
 
     shutil.rmtree(site, ignore_errors=True)
-    r = subprocess.run(["/usr/bin/python3", "-m", "mkdocs", "build", "--strict", "--quiet", "-f", str(ROOT / "mkdocs.yml")],
-                       cwd=ROOT, capture_output=True, text=True)
-    sys.stderr.write(r.stderr)
-    if r.returncode != 0 or re.search(r"^(WARNING|ERROR)", r.stderr, flags=re.M):
+    r = subprocess.run(["/usr/bin/python3", "-m", "mkdocs", "build", "--strict", "-f", str(ROOT / "mkdocs.yml")],
+                       cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       env=dict(os.environ, NO_COLOR="1"))
+    problems = [l for l in r.stdout.splitlines() if not l.startswith("INFO") and l.strip()]
+    sys.stderr.write("".join(l + "\n" for l in problems))
+    if r.returncode != 0 or any(re.search(r"WARNING|ERROR", l) for l in problems):
         sys.exit("docs: mkdocs build --strict failed")
     t0 = step("mkdocs build --strict", t0)
     print(f"docs: {site}/index.html ({len(pages)} pages) in {time.monotonic() - t_start:.1f} s")

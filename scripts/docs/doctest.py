@@ -13,7 +13,7 @@ A block is tested when the line before its fence is an HTML comment (invisible o
 `sh` blocks run in bash (`set -euo pipefail`), `python` blocks in /usr/bin/python3. The blocks of a
 page run in order in one fresh directory (they share its files), with `microcobot` (the --cli
 binary) and `python3` (Debian's) first on PATH, PYTHONPATH at the built module, and `examples/`
-and `scenes/` linked from the source tree. A block that exits non-zero fails the page; what a
+, `scenes/` and `scripts/` linked from the source tree. A block that exits non-zero fails the page; what a
 block left running in the background (`microcobot serve ... &`) is stopped at the page's end.
 Default pages: docs/getting-started/*.md and docs/tutorials/*.md.
 """
@@ -66,7 +66,7 @@ def run_page(page, cli, python_dir, keep):
     bindir.mkdir()
     (bindir / "microcobot").symlink_to(Path(cli).resolve())
     (bindir / "python3").symlink_to("/usr/bin/python3")
-    for d in ("examples", "scenes"):
+    for d in ("examples", "scenes", "scripts"):
         (work / d).symlink_to(ROOT / d)
     env = dict(os.environ, PATH=f"{bindir}:/usr/local/bin:/usr/bin:/bin",
                PYTHONPATH=str(Path(python_dir).resolve()), MC_DOCTEST="1", MPLBACKEND="Agg")
