@@ -1,7 +1,7 @@
 """The assembly cell from Python: the same parts by the robot and by the simulated person, with
 and without shared control, their cycles as a pandas DataFrame (as `microcobot cell compare`).
 
-    PYTHONPATH=build/release/python /usr/bin/python3 examples/cell_compare.py [PARTS] [SEED]
+    PYTHONPATH=build/release/python /usr/bin/python3 examples/cell_compare.py [PARTS (default 1)] [SEED]
 
 Tutorial: docs/tutorials/cell-batch.md.
 """
@@ -12,7 +12,7 @@ import pandas as pd
 
 from microcobot import cell
 
-parts = int(sys.argv[1]) if len(sys.argv) > 1 else 2
+parts = int(sys.argv[1]) if len(sys.argv) > 1 else 1
 seed = int(sys.argv[2]) if len(sys.argv) > 2 else 7
 batch = cell.Batch(scene=None, parts=parts, seed=seed)  # the default scene; the seed draws the parts
 rows = []

@@ -2,7 +2,7 @@
 twins of `microcobot serve --emulate gcs2 --emulate anc300`, then unchanged to the real controllers.
 
     microcobot serve --emulate gcs2 --emulate anc300 --out twin &
-    /usr/bin/python3 examples/vendor_twin_clients.py [GCS_HOST:PORT]
+    /usr/bin/python3 examples/clients/vendor_twin_clients.py [GCS_HOST:PORT]
 
 GCS 2.0 over a plain TCP socket (what PI's manuals describe: one ASCII command per line, replies
 ending with a line without a trailing space); the ANC300 through pymeasure's own driver (Debian's

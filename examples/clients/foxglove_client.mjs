@@ -4,7 +4,7 @@
 // telemetry messages.
 //
 //   microcobot serve &                       # ws://127.0.0.1:8080/
-//   node --experimental-websocket --no-warnings examples/foxglove_client.mjs [ws://127.0.0.1:8080/]
+//   node --experimental-websocket --no-warnings examples/clients/foxglove_client.mjs [ws://127.0.0.1:8080/]
 //
 // Tutorial: docs/tutorials/foxglove-ros2.md.
 import foxglove from "@foxglove/ws-protocol";
