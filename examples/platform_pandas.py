@@ -33,7 +33,7 @@ per_s = pd.DataFrame({"speed_um_s": speed * 1e6, "grip_uN": df["grip_force_N"] *
 per_s = per_s.groupby(per_s.index.astype(int)).mean()
 print(per_s.round(1).iloc[::5].to_string())
 
-# The part's phases (part_phase: 0 resting, then grasped, carried, placed): when each began.
+# The part's state (part_phase, a whole number per state): when it changed.
 phase_starts = df["part_phase"].ne(df["part_phase"].shift()).loc[lambda s: s].index
 print("part phase changes at t =", ", ".join(f"{t:.2f} s" for t in phase_starts))
 

@@ -84,12 +84,18 @@ def parse_help(text):
     return desc, usage, sections
 
 
-def cli_tree(cli, path=()):
+def cli_tree(cli, path=(), pool=None):
+    """The command tree from `--help` at every level (the groups' subtrees asked side by side)."""
     text = run([cli, *path, "--help"])
     desc, usage, sections = parse_help(text)
     node = {"path": path, "description": desc, "usage": usage, "sections": sections, "children": []}
-    for name, _ in sections.get("Subcommands", []):
-        node["children"].append(cli_tree(cli, path + (name,)))
+    subs = [path + (name,) for name, _ in sections.get("Subcommands", [])]
+    if pool is None:
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=os.cpu_count() or 2) as p:
+            node["children"] = list(p.map(lambda sub: cli_tree(cli, sub, "serial"), subs))
+    else:
+        node["children"] = [cli_tree(cli, sub, pool) for sub in subs]
     return node
 
 

@@ -40,6 +40,7 @@ const pages = [
 ];
 const viewports = [{ width: 1400, height: 950 }, { width: 1024, height: 768 }];
 
+const t0 = Date.now();
 const browser = await chromium.launch({
   executablePath: chromiumPath,
   args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
@@ -65,7 +66,7 @@ try {
       if (nav < 20) fail(`${p.path} at ${vp.width}: the navigation has ${nav} links`);
       const file = join(artifacts, `${vp.width}x${vp.height}-${p.path.replace(/[/.]/g, "_")}.png`);
       await page.screenshot({ path: file });
-      console.log(`ok ${p.path} at ${vp.width}x${vp.height}: ${file}`);
+      console.log(`ok ${p.path} at ${vp.width}x${vp.height} (${((Date.now() - t0) / 1000).toFixed(1)} s): ${file}`);
     }
     // The search: typed into the header's field (behind its button on narrow screens), answered
     // by the worker from the site's own index.
