@@ -2,7 +2,7 @@
 """Runs the documentation's tested blocks, so that a page cannot show a command that no longer works.
 
     scripts/docs/doctest.py --cli build/release/apps/microcobot/microcobot --python build/release/python \
-        [PAGE.md ...] [--list] [--keep]
+        [PAGE.md ...] [--list] [--keep] [--show]
 
 A block is tested when the line before its fence is an HTML comment (invisible on the site):
 
@@ -60,7 +60,7 @@ def blocks(page):
         yield line, m.group("lang"), body, opts
 
 
-def run_page(page, cli, python_dir, keep):
+def run_page(page, cli, python_dir, keep, show=False):
     work = Path(tempfile.mkdtemp(prefix="mc-doctest-"))
     bindir = work / ".bin"
     bindir.mkdir()
@@ -101,6 +101,8 @@ def run_page(page, cli, python_dir, keep):
                 print(f"FAIL {rel}:{line} ({lang}, {dt:.1f} s): exit {rc}\n{out}", flush=True)
             else:
                 print(f"ok   {rel}:{line} ({lang}, {dt:.1f} s)", flush=True)
+                if show:
+                    print(out, flush=True)
     finally:
         for pgid in groups:  # what the blocks left running in the background
             try:
@@ -126,6 +128,7 @@ def main():
     ap.add_argument("--python", required=True, help="the directory of the built Python package")
     ap.add_argument("--keep", action="store_true", help="keep each page's working directory")
     ap.add_argument("--list", action="store_true", help="list the tested blocks and exit")
+    ap.add_argument("--show", action="store_true", help="print each block's output (to update a page's)")
     ap.add_argument("pages", nargs="*", type=Path)
     args = ap.parse_args()
     pages = [p.resolve() for p in args.pages] or sorted((ROOT / "docs" / "getting-started").glob("*.md")) + \
@@ -137,7 +140,7 @@ def main():
         return 0
     total_blocks, total_fail, t0 = 0, 0, time.monotonic()
     for p in pages:
-        n, f, dt = run_page(p, args.cli, args.python, args.keep)
+        n, f, dt = run_page(p, args.cli, args.python, args.keep, args.show)
         total_blocks += n
         total_fail += f
     print(f"doctest: {total_blocks} blocks in {len(pages)} pages, {total_fail} failed, {time.monotonic() - t0:.1f} s")
