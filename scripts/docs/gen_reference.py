@@ -160,7 +160,9 @@ class Field:
 
 def scan_headers():
     """{struct name: {key: Field}} from every `v("key", member)` in a struct's visit() and the
-    member's declaration with its `///`, `///<` or trailing `//` comment."""
+    member's declaration with its `///`, `///<` or trailing `//` comment. A `///` comment above a
+    run of declarations (no blank line between them) describes each of the run that has none of its
+    own: "The focus drive: ..." above focus_start_m, focus_min_m, focus_max_m."""
     structs = {}
     decl = re.compile(r"^\s*(?:(?:static|inline|constexpr|mutable)\s+)*([\w:<>, ]+?[\w>])\s+(\w+)\s*(?:=[^;]*|\{[^;]*\})?;\s*(//.*)?$")
     for header in sorted(SRC.rglob("*.h")):
@@ -168,6 +170,7 @@ def scan_headers():
         stack = []  # [name, depth at open, members{}, keys[], pending doc]
         depth = 0
         pending = []
+        group = ""  # the `///` block above the current run of declarations
         for i, line in enumerate(lines):
             stripped = line.strip()
             m = re.match(r"^(?:struct|class)\s+(\w+)(?:\s+final)?(?:\s*:\s*[^{]*)?\s*\{", stripped)
@@ -180,16 +183,23 @@ def scan_headers():
                 if dm and depth == stack[-1]["depth"] + 1:
                     ftype, member, trailing = dm.group(1), dm.group(2), dm.group(3) or ""
                     doc = " ".join(pending)
+                    if pending:
+                        group = doc
                     t = re.sub(r"^///<\s*|^//\s*", "", trailing.strip()).strip()
                     if t and not doc:
                         doc = t
                     elif t and trailing.startswith("///<"):
                         doc = (doc + " " + t).strip()
+                    if not doc:
+                        doc = group
                     stack[-1]["members"][member] = (ftype.strip(), doc, f"{header.relative_to(ROOT)}:{i + 1}")
+                if not dm:
+                    group = ""
                 pending = [] if not stripped.startswith("///") else pending
             else:
                 if not stripped.startswith("///"):
                     pending = []
+                    group = ""
             for km in re.finditer(r'\bv\("([\w]+)",\s*(\w+)\)', line):
                 if stack:
                     stack[-1]["keys"].append((km.group(1), km.group(2)))
@@ -272,9 +282,9 @@ def best_root(structs, keys):
     return best
 
 
-def describe(structs, root, dotted):
-    """The Field of a dotted key, following the member types from the root struct; None when the
-    chain breaks (then any struct declaring the leaf key is tried)."""
+def describe(structs, root, dotted, siblings=()):
+    """The Field of a dotted key, following the member types from the root struct; when the chain
+    breaks, the struct that declares the leaf key and most of its siblings (the keys beside it)."""
     parts = dotted.replace("[]", "").split(".")
     fields = structs.get(root)
     field = None
@@ -285,10 +295,11 @@ def describe(structs, root, dotted):
         field = fields[p]
         fields = structs.get(element_type(field.type))
     if field is None:
-        candidates = [f[parts[-1]] for f in structs.values() if parts[-1] in f and f[parts[-1]].doc]
-        docs = {c.doc for c in candidates}
-        if len(docs) == 1:
-            field = candidates[0]
+        siblings = set(siblings)
+        scored = sorted(((len(siblings & set(f)) / len(siblings | set(f)), name) for name, f in structs.items()
+                         if parts[-1] in f), reverse=True)
+        if scored and (len(scored) == 1 or scored[0][0] > scored[1][0]):
+            field = structs[scored[0][1]][parts[-1]]
     return field
 
 
@@ -331,13 +342,17 @@ def gen_configuration(cli):
     for sid, title, used_by, data, command in sources:
         root = best_root(structs, data.keys())
         rows = flatten(data)
+        siblings = {}
+        for key, _ in rows:
+            parent, _, leaf = key.replace("[]", "").rpartition(".")
+            siblings.setdefault(parent, set()).add(leaf)
         toc.append(f"- [{title}](#{sid}) ({len(rows)} keys): {used_by}; `{command}` prints them")
         body.append(f"## {title} {{#{sid}}}\n")
         body.append(f"Printed by `{command}`; read by {used_by}. Declared in `{root}` and the structs it nests.\n")
         body.append("| key | default | unit | meaning |\n|---|---|---|---|")
         for key, default in rows:
             stats["keys"] += 1
-            f = describe(structs, root, key)
+            f = describe(structs, root, key, siblings.get(key.replace("[]", "").rpartition(".")[0], ()))
             doc = (f.doc if f else "").strip()
             full = f"{sid}:{key}"
             if doc:
