@@ -12,7 +12,7 @@ else
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_WITH_OPENCV=ON
 endif
 
-.PHONY: graph run demo report test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
+.PHONY: graph run demo report docs docs-serve results test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state. It builds only
@@ -33,6 +33,21 @@ report: cli-only
 
 test: build
 	ctest --preset $(PRESET) -j $(JOBS)
+
+# The documentation site, offline, into build/docs/ (open build/docs/index.html): docs/ with the
+# reference pages generated from this build's program and Python module and Doxygen's C++ pages,
+# built strict (scripts/docs/build.py; `make test` builds it too, ctest docs_build).
+docs: cli python
+	/usr/bin/python3 scripts/docs/build.py --cli $(CLI) --python $(BUILD)/python
+
+# The site on http://127.0.0.1:8000/ (its search runs in a web worker, which file:// refuses).
+docs-serve:
+	@test -f build/docs/index.html || $(MAKE) docs
+	/usr/bin/python3 -m http.server --bind 127.0.0.1 --directory build/docs 8000
+
+# Every C++ benchmark, briefly, its JSON into bench/results/: the tables of docs/benchmarks.md.
+results: build
+	/usr/bin/python3 scripts/docs/gen_results.py --run $(BUILD)/bench --min-time 0.05
 
 deps:
 	@scripts/install-deps.sh

@@ -41,6 +41,9 @@ TEST_PACKAGES=(
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
   python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins
   python3-dask python3-distributed  # microcobot.cell.batch: campaigns of many seeds on a process pool or a cluster
+  python3-pandas       # the tutorials' DataFrames (examples/platform_pandas.py, examples/cell_compare.py)
+  mkdocs mkdocs-material  # the documentation site (make docs; docs/dependencies.md says why MkDocs)
+  doxygen              # the C++ headers' reference in the site
 )
 DEBIAN_PACKAGES=("${RUN_PACKAGES[@]}")
 [[ "${1:-test}" == run ]] || DEBIAN_PACKAGES+=("${TEST_PACKAGES[@]}")

@@ -21,6 +21,8 @@ message; a computation that fails (divergence, no convergence) raises
 ``microcobot.ComputationFailed``. No call returns NaN.
 """
 
+__license__ = "Apache-2.0"  # SPDX identifier (LICENSE)
+
 import sys as _sys
 
 from ._microcobot import (ComputationFailed, __version__, control, dsp, haptics, identify, platform, stickslip,
