@@ -12,8 +12,7 @@ Sources, one per page:
                     that the key's `visit()` declaration names (src/microcobot/**/*.h)
   python.md         every public class and function of the Python module: signatures from the
                     `.pyi` stubs, descriptions from the module's docstrings
-  telemetry.md      the telemetry channels a recording holds (the Python module's recording);
-                    see telemetry_schema() for the hook of a schema with units and descriptions
+  telemetry.md      the telemetry channels, with unit and description (the library's schema)
   vendor.md         the commands the vendor-protocol twins answer (`serve --emulate`: HLP?, help)
   exit-codes.md     the exit codes (mc::ExitCode in src/microcobot/core/error.h, and the signals)
 
@@ -465,39 +464,35 @@ def doc_block(doc, name):
 # Telemetry channels
 # ---------------------------------------------------------------------------------------------
 
-def telemetry_schema(python_dir, cli):
-    """[(channel, unit, description, recorded on)] of the platform's telemetry.
-
-    The hook for the schema the platform is getting (each channel's unit and description declared
-    beside it in C++): when the Python module offers `platform.telemetry_schema()` (a list of dicts
-    with name, unit, description), it is used as it is. Until then the channels are those of a
-    recording (`platform.run(...)`), their unit from the name's SI suffix, their description empty.
-    """
+def telemetry_schema(python_dir):
+    """[(channel, unit, description, recorded on)] of the platform's built-in telemetry, from the
+    schema the C++ library declares (`microcobot.platform.telemetry_channels()`)."""
     sys.path.insert(0, str(python_dir))
     from microcobot import platform
-    if hasattr(platform, "telemetry_schema"):
-        return [(c["name"], c.get("unit", ""), c.get("description", ""), c.get("recorded", "")) for c in platform.telemetry_schema()], "schema"
-    import tempfile
-    with tempfile.TemporaryDirectory() as tmp:
-        rec = platform.run("pick-place", duration_s=0.05, out_dir=tmp)["recording"]
-    return [(name, unit_of(name), "", "") for name in rec.keys()], "recording"
+    loop = {c["name"] for c in platform.telemetry_channels(simulation=False)}
+    return [(c["name"], c["unit"], c["description"], "any devices" if c["name"] in loop else "simulation")
+            for c in platform.telemetry_channels(simulation=True)]
 
 
 def gen_telemetry(python_dir, cli):
-    rows, source = telemetry_schema(python_dir, cli)
+    rows = telemetry_schema(python_dir)
     out = ["# Telemetry channels\n", GENERATED,
-           f"The {len(rows)} channels of the platform's telemetry: the columns of `recording.csv`, the fields of the "
-           "`/platform/telemetry` messages in `recording.mcap` and on the Foxglove WebSocket, the keys of "
-           "`platform.run(...)[\"recording\"]` in Python. Units are SI, from each name's suffix; flags are 0 or 1. "
-           "The live server's other channels (camera, events, the console's) are in [the console](../console.md#channels).\n"]
-    if source == "recording":
-        out.append("These names are read from a recording made by the Python module. The channels' descriptions "
-                   "come with the telemetry schema being declared beside them in the C++ library "
-                   "(`platform.telemetry_schema()`); this page takes them from there as soon as it exists.\n")
-    out.append("| channel | unit | description |\n|---|---|---|")
-    for name, unit, desc, _ in rows:
-        out.append(f"| `{name}` | {unit} | {md_escape(desc)} |")
-    return "\n".join(out) + "\n", {"channels": len(rows), "source": source}
+           f"The {len(rows)} built-in channels of the platform's telemetry, in a sample's order: the columns of "
+           "`recording.csv`, the fields of the `/platform/telemetry` messages in `recording.mcap` and on the "
+           "Foxglove WebSocket (each with its `unit` in the JSON Schema), the keys of "
+           "`platform.run(...)[\"recording\"]` in Python. Units are SI and end each name; flags are 0 or 1. "
+           "The loop's channels are recorded on any devices; the simulation's ground truth only when the "
+           "platform simulates the microworld. A program adds its own channels after these "
+           "(`Platform::add_telemetry_channel`, [the architecture](../architecture.md)). "
+           "The live server's other channels (camera, events, the console's) are in "
+           "[the console](../console.md#channels).\n"]
+    out.append("| channel | unit | description | recorded on |\n|---|---|---|---|")
+    for name, unit, desc, recorded in rows:
+        out.append(f"| `{name}` | {unit} | {md_escape(desc)} | {recorded} |")
+    missing = [name for name, _, desc, _ in rows if not desc]
+    if missing:
+        raise SystemExit("telemetry channels without a description: " + ", ".join(missing))
+    return "\n".join(out) + "\n", {"channels": len(rows), "source": "schema"}
 
 
 # ---------------------------------------------------------------------------------------------
