@@ -38,7 +38,8 @@ class FakeSource final : public CommandSource {
 };
 
 struct ArbiterRig {
-  platform::Platform platform{platform::PlatformConfig{}};
+  platform::PlatformConfig config;
+  platform::Platform platform{config};
   runtime::TickInfo info{0, 0.0, 1e-3};
   FakeSource high{"high", 1.0}, middle{"middle", 2.0}, low{"low", 3.0};
   CommandArbiter arbiter;
