@@ -171,13 +171,18 @@ def scan_headers():
         pending = []
         group = ""  # the `///` block above the current run of declarations
         for i, line in enumerate(lines):
+            # A declaration clang-format wrapped after its `=` (the value and comment on the next
+            # line) is read as one line.
+            if re.match(r"^\s*[\w:<>, ]+\s+\w+\s*=\s*$", line) and i + 1 < len(lines):
+                line = line.rstrip() + " " + lines[i + 1].strip()
+                lines[i + 1] = ""
             stripped = line.strip()
             m = re.match(r"^(?:struct|class)\s+(\w+)(?:\s+final)?(?:\s*:\s*[^{]*)?\s*\{", stripped)
             if m:
                 stack.append({"name": m.group(1), "depth": depth, "members": {}, "keys": []})
             if stripped.startswith("///") and not stripped.startswith("///<"):
                 pending.append(stripped[3:].strip())
-            elif stack and "(" not in stripped.split("=")[0]:
+            elif stack and "(" not in stripped.split("//")[0].split("=")[0]:
                 dm = decl.match(line)
                 if dm and depth == stack[-1]["depth"] + 1:
                     ftype, member, trailing = dm.group(1), dm.group(2), dm.group(3) or ""
@@ -199,7 +204,7 @@ def scan_headers():
                 if not stripped.startswith("///"):
                     pending = []
                     group = ""
-            for km in re.finditer(r'\bv\("([\w]+)",\s*(\w+)\)', line):
+            for km in re.finditer(r'\bv\("([\w]+)",\s*(\w+)(?:\.\w+\(\))?\)', line):
                 if stack:
                     stack[-1]["keys"].append((km.group(1), km.group(2)))
             depth += line.count("{") - line.count("}")

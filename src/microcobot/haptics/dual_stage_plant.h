@@ -35,9 +35,9 @@ struct DualStagePlantParams {
   double k_v_N_per_m = 537.5;   ///< Haptuator membrane (suspension) stiffness
   double b_v_Ns_per_m = 1.52;   ///< Haptuator membrane damping
   double k_1_N_per_m = 2.83e3;  ///< distal links and the terminal assembly's mount (viscous above ~22 Hz)
-  double b_1_Ns_per_m = 20.2;
+  double b_1_Ns_per_m = 20.2;   ///< their damping
   double k_2_N_per_m = 1.20e5;  ///< proximal links
-  double b_2_Ns_per_m = 0.149;
+  double b_2_Ns_per_m = 0.149;  ///< their damping
   // Linkage modes off the force path (extension of eq. 3.4, docs/model.md): each a modal mass on
   // a spring-damper hung from a node of the chain; it blocks that node at its own frequency
   // (antiresonance of f_m -> y_h'') and adds a resonance above it. 0 kg removes the branch.

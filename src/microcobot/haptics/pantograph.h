@@ -18,7 +18,7 @@ struct PantographParams {
   double proximal_m = 0.090;         ///< proximal link length (motor to elbow)
   double distal_m = 0.120;           ///< distal link length (elbow to handle)
   double theta_min_rad = -0.35;      ///< joint limits of both motors (from the +x axis)
-  double theta_max_rad = 3.49;
+  double theta_max_rad = 3.49;      ///< (the upper joint limit)
   double min_transmission_rad = 0.35;  ///< minimum angle between distal links (singularity margin)
 
   template <class V>

@@ -15,11 +15,11 @@ namespace mc::imaging {
 
 /// The image sensor and its read-out (EMVA 1288's photon-transfer quantities).
 struct SensorParams {
-  int width_px = 1280;
-  int height_px = 1024;
-  double pixel_pitch_m = 5.3e-6;
+  int width_px = 1280;            ///< active pixels per row
+  int height_px = 1024;           ///< active rows
+  double pixel_pitch_m = 5.3e-6;  ///< the pixels' pitch (square pixels)
   int bit_depth = 12;  ///< 8 to 16 bits per pixel
-  double exposure_s = 10e-3;
+  double exposure_s = 10e-3;  ///< exposure time (at most the frame period)
   /// Analog gain: 1 maps the full well to the full digital scale (the system gain
   /// K = gain (2^bits - 1) / full_well DN per electron).
   double gain = 1.0;
@@ -50,10 +50,10 @@ struct SensorParams {
 
 /// An infinity-corrected objective (with its tube lens: the magnification on the sensor).
 struct ObjectiveParams {
-  std::string name = "20x";
-  double magnification = 20.0;
-  double numerical_aperture = 0.42;
-  double working_distance_m = 20.0e-3;
+  std::string name = "20x";             ///< its label in the console and the recordings
+  double magnification = 20.0;          ///< lateral magnification on the sensor
+  double numerical_aperture = 0.42;     ///< NA: resolution and depth of field
+  double working_distance_m = 20.0e-3;  ///< front lens to focal plane
   double wavelength_m = 550e-9;  ///< centre of the illumination's band (green)
   double immersion_index = 1.0;  ///< refractive index between the objective and the object (air)
 

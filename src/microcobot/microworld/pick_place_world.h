@@ -63,7 +63,7 @@ struct PickPlaceParams {
   double hole_side_m = 0.0;            ///< side of the square hole at the target; 0: no hole
   double hole_depth_m = 0.0;           ///< its depth
   double part_density_kg_m3 = 8500.0;  ///< brass (watch parts)
-  double gravity_m_s2 = 9.81;
+  double gravity_m_s2 = 9.81;          ///< the part's weight per mass
   /// Substrate-part pull-off: capillary meniscus in ambient humidity, 4 pi gamma R cos(theta)
   /// with water (gamma 0.072 N/m, theta 60 deg) and an effective radius of a quarter of the side.
   double substrate_pulloff_N = capillary_sphere_plane_N(0.072, 75e-6, M_PI / 3.0);  // 33.9 uN

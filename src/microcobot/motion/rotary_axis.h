@@ -17,7 +17,7 @@
 namespace mc::motion {
 
 struct RotaryAxisParams {
-  bool enabled = true;
+  bool enabled = true;  ///< the platform has the rotary axis under its gripper
   /// The friction drive's contact radius on the rotor: 1 nm of the actuator's slider is
   /// 1 / radius_m rad of the rotor (5 mm: 0.2 urad per nm; the stage's 12 mm stroke is +-69 deg).
   double radius_m = 5e-3;

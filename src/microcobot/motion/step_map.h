@@ -14,7 +14,9 @@
 namespace mc::motion {
 
 struct StepMapParams {
+  /// The sawtooth amplitudes the map steps the model at ...
   std::vector<double> amplitudes_V = {40, 45, 50, 55, 60, 65, 70, 75, 80, 85, 90, 95, 100};
+  /// ... and the frequencies (every pair is one entry of the map).
   std::vector<double> frequencies_Hz = {500, 1000, 2000};
   int warmup_periods = 3;   ///< periods run before measuring (start transient)
   int measure_periods = 6;  ///< periods averaged

@@ -139,7 +139,7 @@ struct HapticMasterParams {
 /// formation of vision/ rendering the microworld) or a registered camera driver ("opencv": a
 /// camera OpenCV's VideoCapture opens, a V4L2 device, a GStreamer pipeline or a video file).
 struct CameraSelection {
-  std::string driver = "simulated";
+  std::string driver = "simulated";  ///< "none", "simulated" or a registered camera driver
   /// What the driver opens: for "opencv" a device index ("0"), a device file, a file name or a
   /// GStreamer pipeline ending in "appsink".
   std::string source;
@@ -154,7 +154,7 @@ struct CameraSelection {
 /// Which devices the platform runs on (docs/hardware.md): "simulated", the digital twin, or a
 /// driver set registered under that name (platform/driver_registry.h).
 struct DeviceSelection {
-  std::string driver = "simulated";
+  std::string driver = "simulated";  ///< "simulated" or a registered driver set
   /// What the driver opens, in the driver's own syntax (a device file, HOST:PORT, a bus id);
   /// unused by the simulation.
   std::string connection;

@@ -18,7 +18,7 @@ enum class WaveKind { kSawtooth, kSine, kStep };
 struct DriveParams {
   double slew_rate_V_s = 1.0e6;  ///< slew limit of the HV amplifier: 1 V/us (erratum 7, docs/errata.md)
   double min_V = 0.0;            ///< amplifier output range (thesis §2.3: 100 V maximum)
-  double max_V = 100.0;
+  double max_V = 100.0;          ///< (its upper end)
 
   template <class V>
   void visit(V& v) {

@@ -18,7 +18,7 @@ struct BandwidthIdentParams {
   double settle_s = 0.5;                 ///< discarded start (transient from rest)
   double torque_amplitude_N_m = 0.5e-3;  ///< +- PRBS level, within the 2.2 mN m continuous torque
   double accel_noise_m_s2 = 0.05;        ///< accelerometer noise rms (choice)
-  int seed = 7;
+  int seed = 7;                          ///< the PRBS's and the noise's seed
   int nperseg = 8192;                     ///< Welch segment: 1.2 Hz resolution at 10 kHz
   double band_low_Hz = 20.0;              ///< flat band starts above the hand-held rigid mode (~12 Hz)
   double flatness_dB = 3.0;               ///< flat: within +- this of the band's mid level

@@ -13,8 +13,8 @@
 namespace mc::tweezers {
 
 struct RoboticModeParams {
-  double control_rate_Hz = 1000.0;
-  double plant_rate_Hz = 10000.0;
+  double control_rate_Hz = 1000.0;  ///< the controller's rate
+  double plant_rate_Hz = 10000.0;   ///< the simulated plant's rate (a multiple of it)
   double position_scale = 0.01;           ///< slave opening change per tweezers tip opening change
   double force_scale = 2e4;               ///< finger force per slave contact force (uN -> tens of mN)
   double slave_opening_m = 100e-6;        ///< slave gripper static opening (choice)
@@ -22,8 +22,8 @@ struct RoboticModeParams {
   double object_width_m = 80e-6;          ///< micro-object between the slave jaws (choice)
   double object_stiffness_N_per_m = 5.0;  ///< per jaw (choice): 10 um squeeze -> 50 uN
   double operator_target_m = 3e-3;        ///< finger aim per lever
-  double ramp_s = 1.0;
-  double duration_s = 2.0;
+  double ramp_s = 1.0;                    ///< the operator reaches the aim over this time
+  double duration_s = 2.0;                ///< the run's length
   template <class V>
   void visit(V& v) {
     v("control_rate_Hz", control_rate_Hz);
@@ -42,8 +42,8 @@ struct RoboticModeParams {
 };
 
 struct ManualModeParams {
-  double control_rate_Hz = 1000.0;
-  double plant_rate_Hz = 10000.0;
+  double control_rate_Hz = 1000.0;        ///< the force loop's rate
+  double plant_rate_Hz = 10000.0;         ///< the simulated plant's rate (a multiple of it)
   double object_width_m = 8e-3;           ///< real object between the tips (10 mm opening)
   double object_stiffness_N_per_m = 5e3;  ///< per tip (choice: a watch part between Delrin tips)
   double object_damping_N_s_per_m = 5.0;  ///< per tip contact damping (choice)
@@ -53,7 +53,7 @@ struct ManualModeParams {
   double operator_target_m = 3e-3;        ///< the operator pinches to grasp ...
   double grasp_s = 0.5;                   ///< ... during this time, then
   double release_s = 1.0;                 ///< relaxes the fingers from this time on
-  double duration_s = 2.5;
+  double duration_s = 2.5;                ///< the run's length
   bool hold = true;  ///< the force loop runs (false: plain tweezers)
   template <class V>
   void visit(V& v) {
