@@ -7,6 +7,8 @@
 
 namespace mc::bench {
 
-inline std::size_t telemetry_channel(std::string_view name) { return platform::telemetry_channel_index(name); }
+inline std::size_t telemetry_channel(std::string_view name) {
+  return platform::telemetry_channel_index(name);
+}
 
 }  // namespace mc::bench

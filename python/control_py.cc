@@ -567,7 +567,8 @@ void bind_platform(py::module_& m) {
       "{column: array}, 'channels': [{'name', 'unit', 'description'}]} (the recording's columns, in order, "
       "e.g. t_s in s); out_dir also writes recording.csv/.mcap and the report.");
   m.def(
-      "telemetry_channels", [](bool simulation) { return channels_list(platform::builtin_telemetry(simulation)); },
+      "telemetry_channels",
+      [](bool simulation) { return channels_list(platform::builtin_telemetry(simulation)); },
       "simulation"_a = true,
       "The platform's built-in telemetry channels, in a sample's order: [{'name', 'unit', 'description'}] "
       "(the loop's on any devices; with simulation, the simulation's ground truth after them).");

@@ -69,10 +69,12 @@ TEST(AddedSource, DrivesWhenGivenControlYieldsToTheConsoleAndMovesNothingUnderTh
   // Waits for `n` more telemetry samples (1 kHz of loop time): the loop ran that long.
   auto run_for = [&](std::uint64_t n) {
     const std::uint64_t until = samples.load() + n;
-    return test::wait_status(live, [&](const LiveStatus&) { return samples.load() >= until; }, 60.0);
+    return test::wait_status(
+        live, [&](const LiveStatus&) { return samples.load() >= until; }, 60.0);
   };
   auto control_is = [&](const std::string& who) {
-    return test::wait_status(live, [&](const LiveStatus& s) { return s.control == who; }, 60.0);
+    return test::wait_status(
+        live, [&](const LiveStatus& s) { return s.control == who; }, 60.0);
   };
   // Polled on the loop from the start; not asking, so the console (on standby) holds the stage.
   ASSERT_TRUE(control_is("console"));
@@ -81,7 +83,8 @@ TEST(AddedSource, DrivesWhenGivenControlYieldsToTheConsoleAndMovesNothingUnderTh
 
   jog.active = true;
   ASSERT_TRUE(control_is("jog"));
-  ASSERT_TRUE(test::wait_status(live, [&](const LiveStatus&) { return x_m.load() - x0 > 10e-6; }, 60.0))
+  ASSERT_TRUE(test::wait_status(
+      live, [&](const LiveStatus&) { return x_m.load() - x0 > 10e-6; }, 60.0))
       << "the source's jog moved x by " << 1e6 * (x_m.load() - x0) << " um";
 
   // A console user takes control: the console outranks the source, the stage holds.
@@ -95,11 +98,13 @@ TEST(AddedSource, DrivesWhenGivenControlYieldsToTheConsoleAndMovesNothingUnderTh
   // Released: the source drives again.
   live.set_console_in_control(false);
   ASSERT_TRUE(control_is("jog"));
-  ASSERT_TRUE(test::wait_status(live, [&](const LiveStatus&) { return x_m.load() - held > 10e-6; }, 60.0));
+  ASSERT_TRUE(test::wait_status(
+      live, [&](const LiveStatus&) { return x_m.load() - held > 10e-6; }, 60.0));
 
   // The e-stop: every device to its safe state while the source still asks; nothing moves.
   live.estop();
-  ASSERT_TRUE(test::wait_status(live, [](const LiveStatus& s) { return s.estopped; }, 60.0));
+  ASSERT_TRUE(test::wait_status(
+      live, [](const LiveStatus& s) { return s.estopped; }, 60.0));
   ASSERT_TRUE(run_for(50));
   const double stopped = x_m.load();
   ASSERT_TRUE(run_for(300));
@@ -149,7 +154,8 @@ TEST(AddedChannel, ReachesTheLiveSchemaTheMessagesTheMcapAndTheCsvWithItsUnit) {
 
   // The live messages carry it, and the recording runs meanwhile.
   const std::string name = server.start_recording();
-  ASSERT_TRUE(ws.send_json({{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", telemetry["id"]}}}}}));
+  ASSERT_TRUE(
+      ws.send_json({{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", telemetry["id"]}}}}}));
   double first_t = -1.0, t = -1.0;
   for (int i = 0; i < 100000 && (first_t < 0.0 || t - first_t < 0.3); ++i) {
     const auto m = ws.read();
@@ -190,15 +196,18 @@ TEST(AddedChannel, ReachesTheLiveSchemaTheMessagesTheMcapAndTheCsvWithItsUnit) {
   if (const char* out = std::getenv("MC_ADDED_CHANNEL_OUT")) {
     fs::create_directories(out);
     fs::copy_file(dir / name, fs::path(out) / "recording.mcap", fs::copy_options::overwrite_existing);
-    fs::copy_file(dir / (stem + ".csv"), fs::path(out) / "recording.csv", fs::copy_options::overwrite_existing);
+    fs::copy_file(dir / (stem + ".csv"), fs::path(out) / "recording.csv",
+                  fs::copy_options::overwrite_existing);
   }
 }
 
 TEST(AddedChannel, ARefusedChannelLeavesNothingBuilt) {
   LiveParams lp;
-  lp.telemetry_channels.push_back({{"probe_x", "m", "no unit suffix"}, [](const platform::Platform&) { return 0.0; }});
+  lp.telemetry_channels.push_back(
+      {{"probe_x", "m", "no unit suffix"}, [](const platform::Platform&) { return 0.0; }});
   EXPECT_THROW(LivePlatform{lp}, InvalidParams);
-  lp.telemetry_channels = {{{"measured_x_m", "m", "a built-in name"}, [](const platform::Platform&) { return 0.0; }}};
+  lp.telemetry_channels = {
+      {{"measured_x_m", "m", "a built-in name"}, [](const platform::Platform&) { return 0.0; }}};
   EXPECT_THROW(LivePlatform{lp}, InvalidParams);
   lp.telemetry_channels = {{{"probe_x_m", "m", "no source"}, nullptr}};
   EXPECT_THROW(LivePlatform{lp}, InvalidParams);

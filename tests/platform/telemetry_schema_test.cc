@@ -56,7 +56,8 @@ TEST(TelemetrySchema, AddRefusesWhatAColumnCannotBe) {
   } catch (const InvalidParams& e) {
     EXPECT_NE(std::string(e.what()).find("probe_x"), std::string::npos) << e.what();
   }
-  for (std::size_t i = s.size(); i < kMaxTelemetryChannels; ++i) s.add({"c" + std::to_string(i) + "_V", "V", "fill"});
+  for (std::size_t i = s.size(); i < kMaxTelemetryChannels; ++i)
+    s.add({"c" + std::to_string(i) + "_V", "V", "fill"});
   EXPECT_THROW(s.add({"one_more_V", "V", "over"}), InvalidParams);
 }
 

@@ -47,10 +47,10 @@
 namespace mc::cell {
 
 struct AssemblyBatchParams {
-  int parts = 10;              ///< pins in the batch, [1, 10000]
-  int seed = 1;                ///< the generator's seed: the same seed gives the same batch
-  double min_side_m = 100e-6;  ///< pin side, uniform in [min, max] (100-300 um)
-  double max_side_m = 300e-6;  ///< the largest pin side (min_side_m is the smallest)
+  int parts = 10;                      ///< pins in the batch, [1, 10000]
+  int seed = 1;                        ///< the generator's seed: the same seed gives the same batch
+  double min_side_m = 100e-6;          ///< pin side, uniform in [min, max] (100-300 um)
+  double max_side_m = 300e-6;          ///< the largest pin side (min_side_m is the smallest)
   double part_height_m = 600e-6;       ///< every pin's height
   double min_clearance_m = 3e-6;       ///< radial clearance of the bores, uniform in [min, max]
   double max_clearance_m = 20e-6;      ///< (3-20 um)
@@ -59,16 +59,16 @@ struct AssemblyBatchParams {
   double max_yaw_rad = M_PI / 4;       ///< slots' and bores' orientations, uniform in [-max, max]
   double slot_yaw_error_rad = 0.0175;  ///< standard deviation of a pin's yaw in its slot (1 deg)
   double tray_x_m = -1.0e-3;           ///< the tray's centre (slots are drawn within its half-size)
-  double tray_y_m = 0.0;  ///< the tray centre's y
-  double plate_x_m = 1.5e-3;  ///< the plate's centre (bores likewise)
-  double plate_y_m = 0.0;  ///< the plate centre's y
-  double half_size_m = 0.75e-3;   ///< half the side of the tray's and the plate's areas
-  std::string layout = "random";  ///< random (each part alone) or grid (header)
-  double grid_pitch_m = 700e-6;   ///< the grids' pitch (layout grid)
-  double flat_fraction = 0.0;     ///< the share of flat parts, [0, 1] (header)
-  double flat_side_m = 300e-6;    ///< a flat part's side (300 um)
-  double flat_thickness_m = 50e-6;  ///< a flat part's thickness (50 um)
-  double seat_tolerance_m = 10e-6;  ///< a flat part rests within this of its seat's centre
+  double tray_y_m = 0.0;               ///< the tray centre's y
+  double plate_x_m = 1.5e-3;           ///< the plate's centre (bores likewise)
+  double plate_y_m = 0.0;              ///< the plate centre's y
+  double half_size_m = 0.75e-3;        ///< half the side of the tray's and the plate's areas
+  std::string layout = "random";       ///< random (each part alone) or grid (header)
+  double grid_pitch_m = 700e-6;        ///< the grids' pitch (layout grid)
+  double flat_fraction = 0.0;          ///< the share of flat parts, [0, 1] (header)
+  double flat_side_m = 300e-6;         ///< a flat part's side (300 um)
+  double flat_thickness_m = 50e-6;     ///< a flat part's thickness (50 um)
+  double seat_tolerance_m = 10e-6;     ///< a flat part rests within this of its seat's centre
   /// A flat part's pull-off per finger: van der Waals over its edge face (microworld::flat_part_scene).
   double flat_finger_pulloff_N = microworld::flat_part_scene().finger_pulloff_N;
   double flat_seat_min_pulloff_N = 5e-6;  ///< the seats' pull-off, uniform in [min, max]

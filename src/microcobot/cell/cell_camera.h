@@ -58,10 +58,10 @@
 namespace mc::cell {
 
 struct CellCameraParams {
-  bool enabled = false;             ///< off: the nominal slot, the force-guarded search, a truth-based verify
-  std::string objective = "5x";     ///< 1.1 um pixels: a 300 um pin and its 3-20 um play in one view
-  int width_px = 0;   ///< the image's width; 0: the default sensor's (1280)
-  int height_px = 0;  ///< its height; 0: the default sensor's (1024)
+  bool enabled = false;          ///< off: the nominal slot, the force-guarded search, a truth-based verify
+  std::string objective = "5x";  ///< 1.1 um pixels: a 300 um pin and its 3-20 um play in one view
+  int width_px = 0;              ///< the image's width; 0: the default sensor's (1280)
+  int height_px = 0;             ///< its height; 0: the default sensor's (1024)
   /// Simulated time a look takes, the task holding: the exposure, the read-out and the measure
   /// (two frames at 30 frames/s).
   double look_s = 0.066;

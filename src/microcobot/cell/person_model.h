@@ -42,11 +42,11 @@ struct PersonParams {
   double fitts_b_s_per_bit = 0.12;     ///< Fitts' slope (pointing with a stylus or handle)
   double endpoint_sd_fraction = 0.05;  ///< endpoint error SD / amplitude, per axis
   double tremor_rms_m = 100e-6;        ///< hand tremor, per axis
-  double tremor_low_Hz = 8.0;    ///< the tremor's band: physiological tremor, 8 to 12 Hz
-  double tremor_high_Hz = 12.0;  ///< (its upper edge)
-  double vision_sd_m = 1.0e-6;     ///< what the person makes out through the microscope (SD)
-  double feel_contact_N = 60e-6;   ///< a contact force the person notices (seen or felt)
-  double stage_pace_m_s = 0.5e-3;  ///< the stage speed the person has learned not to outrun
+  double tremor_low_Hz = 8.0;          ///< the tremor's band: physiological tremor, 8 to 12 Hz
+  double tremor_high_Hz = 12.0;        ///< (its upper edge)
+  double vision_sd_m = 1.0e-6;         ///< what the person makes out through the microscope (SD)
+  double feel_contact_N = 60e-6;       ///< a contact force the person notices (seen or felt)
+  double stage_pace_m_s = 0.5e-3;      ///< the stage speed the person has learned not to outrun
 
   template <class V>
   void visit(V& v) {

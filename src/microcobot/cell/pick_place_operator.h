@@ -32,21 +32,21 @@ struct PickPlaceOperatorParams {
   double transport_speed_m_s = 100e-6;  ///< slave speed while transporting
   double approach_speed_m_s = 100e-6;   ///< slave speed of the other XY moves
   double fine_speed_m_s = 10e-6;        ///< slave speed within fine_distance_m of a goal
-  double fine_distance_m = 20e-6;  ///< within this of a goal the operator slows to fine_speed_m_s
-  double visual_gain_1_s = 4.0;    ///< how fast the operator corrects a seen error
-  double resolution_m = 1e-6;      ///< what the operator can see through the microscope
-  double jog_speed_m_s = 200e-6;   ///< Z thumb wheel speed
-  double grasp_z_m = 100e-6;       ///< finger-tip height for grasping (part is 300 um tall)
-  double carry_z_m = 400e-6;       ///< finger-tip height while transporting
-  double set_down_press_m = 5e-6;  ///< how far below the grasp height to set down
-  double retract_z_m = 600e-6;     ///< finger-tip height after the release (clear of the part)
-  double pinch_m = 5e-3;               ///< the fingers close the TéléTweez levers by this much ...
-  double pinch_s = 0.5;                ///< ... in this time (and open them as fast)
-  double max_pinch_m = 10e-3;          ///< and never further (the levers' travel)
-  double felt_grip_N = 0.05;           ///< finger force that tells the part is held
-  double hand_limit_m = 35e-3;         ///< clutch when the hand gets this far from the centre
-  double hand_return_speed_m_s = 0.2;  ///< hand speed while clutched
-  double phase_timeout_s = 30.0;       ///< give up a phase after this long
+  double fine_distance_m = 20e-6;       ///< within this of a goal the operator slows to fine_speed_m_s
+  double visual_gain_1_s = 4.0;         ///< how fast the operator corrects a seen error
+  double resolution_m = 1e-6;           ///< what the operator can see through the microscope
+  double jog_speed_m_s = 200e-6;        ///< Z thumb wheel speed
+  double grasp_z_m = 100e-6;            ///< finger-tip height for grasping (part is 300 um tall)
+  double carry_z_m = 400e-6;            ///< finger-tip height while transporting
+  double set_down_press_m = 5e-6;       ///< how far below the grasp height to set down
+  double retract_z_m = 600e-6;          ///< finger-tip height after the release (clear of the part)
+  double pinch_m = 5e-3;                ///< the fingers close the TéléTweez levers by this much ...
+  double pinch_s = 0.5;                 ///< ... in this time (and open them as fast)
+  double max_pinch_m = 10e-3;           ///< and never further (the levers' travel)
+  double felt_grip_N = 0.05;            ///< finger force that tells the part is held
+  double hand_limit_m = 35e-3;          ///< clutch when the hand gets this far from the centre
+  double hand_return_speed_m_s = 0.2;   ///< hand speed while clutched
+  double phase_timeout_s = 30.0;        ///< give up a phase after this long
 
   template <class V>
   void visit(V& v) {

@@ -365,7 +365,8 @@ void Session::write(const std::filesystem::path& dir, const SessionResult& resul
   std::vector<std::string> comment;
   if (result.interrupted) comment.push_back(result.verdict);
   write_csv(dir / "recording.csv", platform_->recording().to_table(), comment);
-  platform::write_telemetry_mcap(platform_->recording(), platform_->telemetry_schema(), dir / "recording.mcap");
+  platform::write_telemetry_mcap(platform_->recording(), platform_->telemetry_schema(),
+                                 dir / "recording.mcap");
   report(result).write(dir);
 }
 

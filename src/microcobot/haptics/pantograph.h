@@ -14,11 +14,11 @@ namespace mc::haptics {
 /// Geometry of the five-bar. Defaults: a desktop Pantograph with a ~100 x 160 mm workspace
 /// (Table 3.2); the thesis gives no link lengths, so these are a documented choice.
 struct PantographParams {
-  double base_separation_m = 0.040;  ///< distance between the two motor axes
-  double proximal_m = 0.090;         ///< proximal link length (motor to elbow)
-  double distal_m = 0.120;           ///< distal link length (elbow to handle)
-  double theta_min_rad = -0.35;      ///< joint limits of both motors (from the +x axis)
-  double theta_max_rad = 3.49;      ///< (the upper joint limit)
+  double base_separation_m = 0.040;    ///< distance between the two motor axes
+  double proximal_m = 0.090;           ///< proximal link length (motor to elbow)
+  double distal_m = 0.120;             ///< distal link length (elbow to handle)
+  double theta_min_rad = -0.35;        ///< joint limits of both motors (from the +x axis)
+  double theta_max_rad = 3.49;         ///< (the upper joint limit)
   double min_transmission_rad = 0.35;  ///< minimum angle between distal links (singularity margin)
 
   template <class V>

@@ -18,8 +18,8 @@ struct SensorParams {
   int width_px = 1280;            ///< active pixels per row
   int height_px = 1024;           ///< active rows
   double pixel_pitch_m = 5.3e-6;  ///< the pixels' pitch (square pixels)
-  int bit_depth = 12;  ///< 8 to 16 bits per pixel
-  double exposure_s = 10e-3;  ///< exposure time (at most the frame period)
+  int bit_depth = 12;             ///< 8 to 16 bits per pixel
+  double exposure_s = 10e-3;      ///< exposure time (at most the frame period)
   /// Analog gain: 1 maps the full well to the full digital scale (the system gain
   /// K = gain (2^bits - 1) / full_well DN per electron).
   double gain = 1.0;
@@ -54,8 +54,8 @@ struct ObjectiveParams {
   double magnification = 20.0;          ///< lateral magnification on the sensor
   double numerical_aperture = 0.42;     ///< NA: resolution and depth of field
   double working_distance_m = 20.0e-3;  ///< front lens to focal plane
-  double wavelength_m = 550e-9;  ///< centre of the illumination's band (green)
-  double immersion_index = 1.0;  ///< refractive index between the objective and the object (air)
+  double wavelength_m = 550e-9;         ///< centre of the illumination's band (green)
+  double immersion_index = 1.0;         ///< refractive index between the objective and the object (air)
 
   template <class V>
   void visit(V& v) {

@@ -25,8 +25,8 @@ namespace mc::live {
 
 struct ConsoleSourceParams {
   Eigen::Vector3d home_m = Eigen::Vector3d::Zero();  ///< the stage's home (the task's frame)
-  double command_timeout_s = 0.2;                     ///< the commands go stale after this long
-  double max_theta_speed_rad_s = 0.0;                 ///< the rotary axis' goal speed
+  double command_timeout_s = 0.2;                    ///< the commands go stale after this long
+  double max_theta_speed_rad_s = 0.0;                ///< the rotary axis' goal speed
   double t_offset_s = 0.0;  ///< live time at the scene's start (the positioner's clock)
 };
 

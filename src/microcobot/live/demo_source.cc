@@ -92,7 +92,8 @@ DemoResult DemoSource::result(bool scene_has_hole) const {
       r.reason = "the pin is down in its hole";
       break;
     case DemoResult::Outcome::kMissed:
-      r.reason = scene_has_hole ? "the pin is not in its hole" : "the part rests outside the placement tolerance";
+      r.reason =
+          scene_has_hole ? "the pin is not in its hole" : "the part rests outside the placement tolerance";
       break;
     default:
       break;

@@ -13,14 +13,14 @@
 /// Every input is a CommandSource and one CommandArbiter (command_arbiter.h) gives the coupling
 /// to one of them at each tick, in this order: the microscope (never drives), the remote master
 /// (a slave process: then the only driver), the scripted demo, the console, the caller's
-/// sources (LiveParams::sources), the vendor protocols. The console's commands are its heartbeat: when the controlling client's last command is
-/// older than `command_timeout_s` (or nobody holds control) the coupling sees stale commands
-/// and the stage holds (the platform's watchdog). The e-stop latches until an explicit reset:
-/// devices reconfigured and re-activated off the loop (like ros2_control's lifecycle
-/// transitions, which never run inside update()). "demo" and "restart" rebuild the scene
-/// (about a second: the step map) with the scripted pick-and-place operator or the console in
-/// control. With a task (`serve --cell`, live_task.h) the loop also runs the automatic insertion,
-/// supervised from the console. Nothing on the loop path allocates, locks, throws or does I/O.
+/// sources (LiveParams::sources), the vendor protocols. The console's commands are its heartbeat: when the
+/// controlling client's last command is older than `command_timeout_s` (or nobody holds control) the coupling
+/// sees stale commands and the stage holds (the platform's watchdog). The e-stop latches until an explicit
+/// reset: devices reconfigured and re-activated off the loop (like ros2_control's lifecycle transitions,
+/// which never run inside update()). "demo" and "restart" rebuild the scene (about a second: the step map)
+/// with the scripted pick-and-place operator or the console in control. With a task (`serve --cell`,
+/// live_task.h) the loop also runs the automatic insertion, supervised from the console. Nothing on the loop
+/// path allocates, locks, throws or does I/O.
 
 #include <array>
 #include <atomic>
@@ -38,17 +38,17 @@
 #include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/live/command_arbiter.h"
 #include "microcobot/live/command_source.h"
+#include "microcobot/live/console_command.h"
 #include "microcobot/live/console_source.h"
 #include "microcobot/live/demo_source.h"
-#include "microcobot/live/microscope_source.h"
-#include "microcobot/live/protocol_source.h"
-#include "microcobot/live/remote_link.h"
-#include "microcobot/live/remote_source.h"
-#include "microcobot/live/console_command.h"
 #include "microcobot/live/live_looker.h"
 #include "microcobot/live/live_status.h"
 #include "microcobot/live/live_task.h"
+#include "microcobot/live/microscope_source.h"
 #include "microcobot/live/protocol_command.h"
+#include "microcobot/live/protocol_source.h"
+#include "microcobot/live/remote_link.h"
+#include "microcobot/live/remote_source.h"
 #include "microcobot/perception/vision_grip_force.h"
 #include "microcobot/perception/vision_positioner.h"
 #include "microcobot/platform/platform.h"
@@ -231,8 +231,8 @@ class LivePlatform {
   bool has_latest_ = false;
   std::unique_ptr<LiveLooker> looker_;  // after what it uses: destroyed (joined) first
   Eigen::Vector3d home_m_ = Eigen::Vector3d::Zero();
-  std::unique_ptr<perception::VisionPositioner> positioner_;     // stage.xy_sensor: vision
-  std::unique_ptr<perception::VisionGripForce> grip_gauge_;      // vision_force.enabled
+  std::unique_ptr<perception::VisionPositioner> positioner_;  // stage.xy_sensor: vision
+  std::unique_ptr<perception::VisionGripForce> grip_gauge_;   // vision_force.enabled
   // The inputs (kept across scene rebuilds: their rings are other threads') and their arbiter.
   std::unique_ptr<MicroscopeSource> microscope_;
   std::unique_ptr<RemoteSource> remote_;  // a slave process only

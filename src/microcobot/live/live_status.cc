@@ -6,7 +6,8 @@ void LoopReadings::publish(platform::Platform& p, double t_live_s) noexcept {
   constexpr auto relaxed = std::memory_order_relaxed;
   t_s_.store(t_live_s, relaxed);
   estopped_.store(p.faulted(), relaxed);
-  for (int i = 0; i < 3; ++i) lifecycle_[static_cast<std::size_t>(i)].store(static_cast<int>(p.axis(i).state()), relaxed);
+  for (int i = 0; i < 3; ++i)
+    lifecycle_[static_cast<std::size_t>(i)].store(static_cast<int>(p.axis(i).state()), relaxed);
   lifecycle_[3].store(static_cast<int>(p.gripper().state()), relaxed);
   lifecycle_[4].store(static_cast<int>(p.haptic().state()), relaxed);
   lifecycle_[5].store(static_cast<int>(p.tweezers().state()), relaxed);
@@ -25,7 +26,8 @@ void LoopReadings::fill(LiveStatus& s) const noexcept {
   constexpr auto relaxed = std::memory_order_relaxed;
   s.t_s = t_s_.load(relaxed);
   s.estopped = estopped_.load(relaxed);
-  for (std::size_t i = 0; i < 6; ++i) s.lifecycle[i] = static_cast<devices::Lifecycle>(lifecycle_[i].load(relaxed));
+  for (std::size_t i = 0; i < 6; ++i)
+    s.lifecycle[i] = static_cast<devices::Lifecycle>(lifecycle_[i].load(relaxed));
   const int rotary = rotary_lifecycle_.load(relaxed);
   s.has_rotary = rotary >= 0;
   if (s.has_rotary) s.rotary_lifecycle = static_cast<devices::Lifecycle>(rotary);

@@ -100,7 +100,7 @@ void ProtocolSource::publish(const SourceTick& t) noexcept {
     if (theta && !p.has_rotary()) break;
     const double x = theta ? p.yaw_rad() : p.axis(static_cast<int>(i)).position_m();
     const bool running = p.open_loop_running(static_cast<int>(i));
-    const double goal = theta ? (has_goal_ ? theta_goal_rad_ : p.yaw_target_rad())
+    const double goal = theta       ? (has_goal_ ? theta_goal_rad_ : p.yaw_target_rad())
                         : has_goal_ ? goal_m_[i]
                                     : target[static_cast<Eigen::Index>(i)];
     const double tolerance = theta ? theta_tolerance_rad : params_.on_target_tolerance_m;

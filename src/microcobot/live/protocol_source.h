@@ -19,9 +19,9 @@ namespace mc::live {
 
 struct ProtocolSourceParams {
   Eigen::Vector3d home_m = Eigen::Vector3d::Zero();  ///< the stage's home (the goals are relative to it)
-  double command_timeout_s = 0.2;                     ///< the heartbeat's timeout
-  double on_target_tolerance_m = 1e-6;                ///< an axis is on target within this...
-  double settle_window_s = 0.02;                      ///< ...for this long
+  double command_timeout_s = 0.2;                    ///< the heartbeat's timeout
+  double on_target_tolerance_m = 1e-6;               ///< an axis is on target within this...
+  double settle_window_s = 0.02;                     ///< ...for this long
   double rotary_radius_m = 1.0;  ///< the rotary axis' contact radius (its tolerance as an arc)
 };
 

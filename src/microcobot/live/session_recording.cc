@@ -115,8 +115,7 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
     channel_[index(t)] = w->add_channel(w->add_schema(schema_name, "jsonschema", schema), topic, "json");
   };
   add(RecordedTopic::kTelemetry, std::string(platform::kTelemetryTopic),
-      std::string(platform::kTelemetrySchemaName),
-      platform::telemetry_json_schema(params_.telemetry));
+      std::string(platform::kTelemetrySchemaName), platform::telemetry_json_schema(params_.telemetry));
   add(RecordedTopic::kStatus, params_.status.topic, params_.status.schema_name, params_.status.schema);
   add(RecordedTopic::kScene, params_.scene.topic, params_.scene.schema_name, params_.scene.schema);
   add(RecordedTopic::kFeedback, params_.feedback.topic, params_.feedback.schema_name,
@@ -163,9 +162,7 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
 
   std::unique_ptr<CsvStreamWriter> csv;
   if (params_.csv) {
-    csv = std::make_unique<CsvStreamWriter>(
-        params_.out_dir / (stem + ".csv"),
-        params_.telemetry.names());
+    csv = std::make_unique<CsvStreamWriter>(params_.out_dir / (stem + ".csv"), params_.telemetry.names());
   }
   mcap_ = std::move(w);
   csv_ = std::move(csv);

@@ -75,8 +75,8 @@ struct RecordedSchema {
 enum class EventLevel : std::uint8_t { kInfo = 0, kWarning = 1, kError = 2 };
 
 struct SessionRecordingParams {
-  std::filesystem::path out_dir;       ///< where recordings go
-  bool csv = false;                    ///< also the telemetry as <stem>.csv (`serve --record-csv`)
+  std::filesystem::path out_dir;        ///< where recordings go
+  bool csv = false;                     ///< also the telemetry as <stem>.csv (`serve --record-csv`)
   platform::TelemetrySchema telemetry;  ///< the telemetry's channels (LivePlatform::telemetry_schema())
   /// /platform/status, /platform/scene, /console/feedback as the server advertises them.
   RecordedSchema status, scene, feedback;

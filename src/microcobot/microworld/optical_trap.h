@@ -26,9 +26,9 @@ namespace mc::microworld {
 /// Optical trap and scene. Defaults: a 3 um bead (radius 1.5 um, Fig. 3.14b) in water at
 /// 300 K; trap stiffness 10 pN/um, typical of [Ni 2013b] setups (a documented choice).
 struct OpticalTrapParams {
-  double bead_radius_m = 1.5e-6;    ///< trapped probe bead radius (Fig. 3.14b: 3 um bead)
-  double viscosity_Pa_s = 0.85e-3;  ///< water at 300 K
-  double temperature_K = 300.0;     ///< the bath's temperature: the bead's Brownian motion
+  double bead_radius_m = 1.5e-6;              ///< trapped probe bead radius (Fig. 3.14b: 3 um bead)
+  double viscosity_Pa_s = 0.85e-3;            ///< water at 300 K
+  double temperature_K = 300.0;               ///< the bath's temperature: the bead's Brownian motion
   double trap_stiffness_N_per_m = 1.0e-5;     ///< k (10 pN/um)
   double obstacle_radius_m = 5.0e-6;          ///< large bead stuck on the dish
   double contact_stiffness_N_per_m = 4.0e-4;  ///< linear repulsion once the beads overlap

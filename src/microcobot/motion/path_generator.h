@@ -20,9 +20,9 @@
 namespace mc::motion {
 
 struct PathLimits {
-  double max_velocity_m_s = 200e-6;    ///< the path's speed limit
+  double max_velocity_m_s = 200e-6;     ///< the path's speed limit
   double max_acceleration_m_s2 = 2e-3;  ///< its acceleration limit
-  double max_jerk_m_s3 = 0.2;  ///< jerk limit: T_j = a_max / j_max = 10 ms by default
+  double max_jerk_m_s3 = 0.2;           ///< jerk limit: T_j = a_max / j_max = 10 ms by default
 
   template <class V>
   void visit(V& v) {

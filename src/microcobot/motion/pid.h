@@ -7,12 +7,12 @@
 namespace mc::motion {
 
 struct PidParams {
-  double kp = 0.0;  ///< proportional gain (output per unit of error)
-  double ki = 0.0;  ///< integral gain (per second)
-  double kd = 0.0;  ///< derivative gain (seconds)
+  double kp = 0.0;                   ///< proportional gain (output per unit of error)
+  double ki = 0.0;                   ///< integral gain (per second)
+  double kd = 0.0;                   ///< derivative gain (seconds)
   double derivative_filter_s = 0.0;  ///< time constant of the derivative filter (0 = none)
-  double out_min = 0.0;    ///< the output's lower bound (the integrator stops there: anti-windup)
-  double out_max = 100.0;  ///< its upper bound
+  double out_min = 0.0;              ///< the output's lower bound (the integrator stops there: anti-windup)
+  double out_max = 100.0;            ///< its upper bound
 
   template <class V>
   void visit(V& v) {

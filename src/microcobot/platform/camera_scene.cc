@@ -13,9 +13,7 @@ namespace mc::platform {
 namespace {
 
 // A built-in channel (0 where the platform does not record it: the samples are zero-filled).
-double channel(const TelemetrySample& s, std::string_view name) {
-  return s[telemetry_channel_index(name)];
-}
+double channel(const TelemetrySample& s, std::string_view name) { return s[telemetry_channel_index(name)]; }
 
 }  // namespace
 

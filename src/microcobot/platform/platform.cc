@@ -455,8 +455,7 @@ void Platform::run(double duration_s) {
   if (need > recorder_->capacity()) {
     // Grown geometrically: a caller stepping the platform by short runs (the cell's cycles, one
     // second at a time) would otherwise copy the whole recording at every run.
-    auto bigger = std::make_unique<Recorder>(telemetry_.names(),
-                                             std::max(need, 2 * recorder_->capacity()));
+    auto bigger = std::make_unique<Recorder>(telemetry_.names(), std::max(need, 2 * recorder_->capacity()));
     TelemetrySample s;
     for (std::size_t i = 0; i < recorder_->size(); ++i) {
       for (std::size_t c = 0; c < telemetry_channel_count(); ++c) s[c] = recorder_->at(i, c);

@@ -25,8 +25,8 @@
 #include <functional>
 #include <memory>
 #include <span>
-#include <vector>
 #include <thread>
+#include <vector>
 
 #include "microcobot/core/recorder.h"
 #include "microcobot/devices/camera_device.h"

@@ -122,14 +122,17 @@ std::span<const Platform::BuiltinChannel> Platform::simulation_channels() {
        [](P p) noexcept { return p.simulated_part_m().z(); }},
       {"part_phase", "", "the part's phase index (microworld::PartPhase; 0 in the optical trap)",
        [](P p) noexcept {
-         return p.sim_.gripper ? static_cast<double>(static_cast<int>(p.sim_.gripper->world_state().phase)) : 0.0;
+         return p.sim_.gripper ? static_cast<double>(static_cast<int>(p.sim_.gripper->world_state().phase))
+                               : 0.0;
        }},
       {"slave_theta_rad", "rad", "the gripper's true yaw (0 in the optical trap)",
        [](P p) noexcept { return p.sim_.gripper ? p.sim_.gripper->yaw_rad() : 0.0; }},
       {"part_yaw_rad", "rad", "the part's yaw (0 in the optical trap)",
        [](P p) noexcept { return p.sim_.gripper ? p.sim_.gripper->world_state().part_yaw_rad : 0.0; }},
       {"gripper_shaking", "", "1 while the gripper's release burst shakes its fingers",
-       [](P p) noexcept { return p.sim_.gripper && p.sim_.gripper->world_state().gripper.shaking ? 1.0 : 0.0; }},
+       [](P p) noexcept {
+         return p.sim_.gripper && p.sim_.gripper->world_state().gripper.shaking ? 1.0 : 0.0;
+       }},
   };
   return kChannels;
 }

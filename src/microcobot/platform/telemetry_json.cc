@@ -23,7 +23,8 @@ std::string telemetry_json_schema(const TelemetrySchema& schema) {
       {"$schema", "https://json-schema.org/draft/2020-12/schema"},
       {"title", std::string(kTelemetrySchemaName)},
       {"description",
-       "One telemetry sample of the microcobot platform: SI units, each property's `unit` (\"\" for flags and "
+       "One telemetry sample of the microcobot platform: SI units, each property's `unit` (\"\" for flags "
+       "and "
        "indices) ending its name; null for a value that is not finite"},
       {"type", "object"},
       {"properties", std::move(props)},
@@ -54,7 +55,8 @@ void telemetry_to_json(const TelemetrySchema& schema, std::span<const double> sa
   out.push_back('}');
 }
 
-void write_telemetry_mcap(const Recorder& rec, const TelemetrySchema& schema, const std::filesystem::path& file) {
+void write_telemetry_mcap(const Recorder& rec, const TelemetrySchema& schema,
+                          const std::filesystem::path& file) {
   const std::size_t n = rec.channels();
   require(n == schema.size(), "telemetry recording", "must have the schema's channels",
           static_cast<double>(n));
@@ -132,7 +134,8 @@ Recorder telemetry_from_mcap(const McapContents& m, const std::string& name, std
       fail("has " + std::to_string(j.size()) + " members, the first had " + std::to_string(names.size()));
     std::size_t c = 0;
     for (const auto& item : j.items()) {
-      if (item.key() != names[c]) fail("member " + std::to_string(c) + " is " + item.key() + ", not " + names[c]);
+      if (item.key() != names[c])
+        fail("member " + std::to_string(c) + " is " + item.key() + ", not " + names[c]);
       const auto& v = item.value();
       if (v.is_null()) {
         values[c] = std::numeric_limits<double>::quiet_NaN();

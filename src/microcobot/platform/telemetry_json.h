@@ -37,7 +37,8 @@ void telemetry_to_json(const TelemetrySchema& schema, std::span<const double> sa
 /// schema (kTelemetrySchemaName, jsonschema), one channel (kTelemetryTopic, json), one message
 /// per kept sample whose log and publish times are its `t_s` in nanoseconds. The recording's
 /// channels must be `schema`'s names, in order. Throws mc::Error.
-void write_telemetry_mcap(const Recorder& rec, const TelemetrySchema& schema, const std::filesystem::path& file);
+void write_telemetry_mcap(const Recorder& rec, const TelemetrySchema& schema,
+                          const std::filesystem::path& file);
 
 /// Reads a telemetry recording back (what write_telemetry_mcap and `serve` write): the messages
 /// of kTelemetryTopic, each with the same numeric members, whose names become the recording's

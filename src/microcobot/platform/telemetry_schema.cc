@@ -18,16 +18,19 @@ std::size_t TelemetrySchema::add(TelemetryChannel channel) {
   const std::string field = "telemetry channel '" + excerpt(channel.name) + "'";
   require(!channel.name.empty(), "telemetry channel", "needs a name");
   const std::string suffix = telemetry_unit_suffix(channel.unit);
-  const std::string_view stem = std::string_view(channel.name).substr(
-      0, channel.name.size() >= suffix.size() ? channel.name.size() - suffix.size() : 0);
-  require(channel.name.size() > suffix.size() && channel.name.ends_with(suffix), field,
-          channel.unit.empty() ? std::string("has no unit") : "must end with its unit's suffix '" + suffix + "'");
+  const std::string_view stem =
+      std::string_view(channel.name)
+          .substr(0, channel.name.size() >= suffix.size() ? channel.name.size() - suffix.size() : 0);
+  require(
+      channel.name.size() > suffix.size() && channel.name.ends_with(suffix), field,
+      channel.unit.empty() ? std::string("has no unit") : "must end with its unit's suffix '" + suffix + "'");
   require(std::all_of(stem.begin(), stem.end(),
                       [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'; }),
           field, "must be lower-case letters, digits and '_' (then its unit)");
-  require(suffix.empty() || std::all_of(suffix.begin(), suffix.end(), [](char c) {
-            return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
-          }),
+  require(suffix.empty() || std::all_of(suffix.begin(), suffix.end(),
+                                        [](char c) {
+                                          return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+                                        }),
           field, "has a unit that is not letters and '/'");
   require(!find(channel.name), field, "is declared twice");
   require(channels_.size() < kMaxTelemetryChannels, field,
@@ -44,7 +47,8 @@ std::optional<std::size_t> TelemetrySchema::find(std::string_view name) const {
 
 std::size_t TelemetrySchema::index(std::string_view name) const {
   const auto i = find(name);
-  if (!i) throw InvalidParams("telemetry channel '" + excerpt(std::string(name)) + "'", "is not in the telemetry");
+  if (!i)
+    throw InvalidParams("telemetry channel '" + excerpt(std::string(name)) + "'", "is not in the telemetry");
   return *i;
 }
 

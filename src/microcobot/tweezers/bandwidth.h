@@ -12,13 +12,13 @@
 namespace mc::tweezers {
 
 struct BandwidthIdentParams {
-  double fs_Hz = 10e3;                   ///< sampling rate of the PRBS and the DAQ (section 4.5.2)
-  int prbs_bits = 15;                    ///< MLS register length: period 2^15 - 1 samples (3.3 s)
-  double duration_s = 8.0;               ///< recorded length
-  double settle_s = 0.5;                 ///< discarded start (transient from rest)
-  double torque_amplitude_N_m = 0.5e-3;  ///< +- PRBS level, within the 2.2 mN m continuous torque
-  double accel_noise_m_s2 = 0.05;        ///< accelerometer noise rms (choice)
-  int seed = 7;                          ///< the PRBS's and the noise's seed
+  double fs_Hz = 10e3;                    ///< sampling rate of the PRBS and the DAQ (section 4.5.2)
+  int prbs_bits = 15;                     ///< MLS register length: period 2^15 - 1 samples (3.3 s)
+  double duration_s = 8.0;                ///< recorded length
+  double settle_s = 0.5;                  ///< discarded start (transient from rest)
+  double torque_amplitude_N_m = 0.5e-3;   ///< +- PRBS level, within the 2.2 mN m continuous torque
+  double accel_noise_m_s2 = 0.05;         ///< accelerometer noise rms (choice)
+  int seed = 7;                           ///< the PRBS's and the noise's seed
   int nperseg = 8192;                     ///< Welch segment: 1.2 Hz resolution at 10 kHz
   double band_low_Hz = 20.0;              ///< flat band starts above the hand-held rigid mode (~12 Hz)
   double flatness_dB = 3.0;               ///< flat: within +- this of the band's mid level

@@ -13,8 +13,8 @@
 namespace mc::tweezers {
 
 struct RoboticModeParams {
-  double control_rate_Hz = 1000.0;  ///< the controller's rate
-  double plant_rate_Hz = 10000.0;   ///< the simulated plant's rate (a multiple of it)
+  double control_rate_Hz = 1000.0;        ///< the controller's rate
+  double plant_rate_Hz = 10000.0;         ///< the simulated plant's rate (a multiple of it)
   double position_scale = 0.01;           ///< slave opening change per tweezers tip opening change
   double force_scale = 2e4;               ///< finger force per slave contact force (uN -> tens of mN)
   double slave_opening_m = 100e-6;        ///< slave gripper static opening (choice)
@@ -54,7 +54,7 @@ struct ManualModeParams {
   double grasp_s = 0.5;                   ///< ... during this time, then
   double release_s = 1.0;                 ///< relaxes the fingers from this time on
   double duration_s = 2.5;                ///< the run's length
-  bool hold = true;  ///< the force loop runs (false: plain tweezers)
+  bool hold = true;                       ///< the force loop runs (false: plain tweezers)
   template <class V>
   void visit(V& v) {
     v("control_rate_Hz", control_rate_Hz);

@@ -48,7 +48,8 @@ double brenner(const imaging::Frame& frame, const imaging::PixelRoi& roi);
 
 /// The options of a focus measure evaluated by name.
 struct SharpnessParams {
-  std::string metric = "normalized-variance";  ///< the focus measure: normalized-variance, tenengrad or brenner
+  std::string metric =
+      "normalized-variance";         ///< the focus measure: normalized-variance, tenengrad or brenner
   double tenengrad_threshold = 0.0;  ///< T [DN^2]: gradients at or under it are left out (noise)
 
   template <class V>
