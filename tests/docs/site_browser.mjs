@@ -1,5 +1,6 @@
-// The documentation site in Debian's headless Chromium (playwright-core): three pages and the
-// search, at 1400x950 and 1024x768, served from build/docs by a local HTTP server on 127.0.0.1
+// The documentation site in Debian's headless Chromium (playwright-core): three pages at 1400x950,
+// the home page at 1024x768 (the navigation folded behind its button), and the search at both,
+// served from build/docs by a local HTTP server on 127.0.0.1
 // (the search's web worker needs one) and opened as files (the pages alone). Fails on a request
 // that leaves the machine, a console error, a page without its navigation or content, a search
 // that finds nothing; writes a screenshot of each view to MC_ARTIFACTS.
@@ -38,7 +39,9 @@ const pages = [
   { path: "tutorials/identify-axis.html", text: "identify all" },
   { path: "reference/configuration.html", text: "stickslip_params_file" },
 ];
-const viewports = [{ width: 1400, height: 950 }, { width: 1024, height: 768 }];
+// The narrow view checks the layout and the search behind the header's button on the home page:
+// the other pages share its template.
+const viewports = [{ width: 1400, height: 950, pages }, { width: 1024, height: 768, pages: pages.slice(0, 1) }];
 
 const t0 = Date.now();
 const browser = await chromium.launch({
@@ -48,7 +51,7 @@ const browser = await chromium.launch({
 });
 try {
   for (const vp of viewports) {
-    const context = await browser.newContext({ viewport: vp });
+    const context = await browser.newContext({ viewport: { width: vp.width, height: vp.height } });
     const offMachine = [];
     context.on("request", (r) => {
       const u = r.url();
@@ -58,7 +61,7 @@ try {
     const errors = [];
     page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
     page.on("pageerror", (e) => errors.push(String(e)));
-    for (const p of pages) {
+    for (const p of vp.pages) {
       await page.goto(base + p.path, { waitUntil: "load" });
       const body = (await page.textContent("article")) || "";
       if (!body.toLowerCase().includes(p.text.toLowerCase())) fail(`${p.path} at ${vp.width}: "${p.text}" not in the page`);
@@ -71,7 +74,10 @@ try {
     // The search: typed into the header's field (behind its button on narrow screens), answered
     // by the worker from the site's own index.
     await page.goto(base + "index.html", { waitUntil: "networkidle" });
-    await page.click("label.md-header__button[for='__search']").catch(() => {});
+    // On narrow screens the field is behind the header's button (hidden on wide ones, where a
+    // click would wait for it to show).
+    const button = page.locator("label.md-header__button[for='__search']");
+    if (await button.isVisible()) await button.click();
     // The worker answers once it has built its index from search_index.json: type again until then.
     let results = 0;
     for (let t0 = Date.now(); results === 0 && Date.now() - t0 < 30000;) {
@@ -84,13 +90,13 @@ try {
     const meta = (await page.textContent(".md-search-result__meta").catch(() => "")) || "";
     const file = join(artifacts, `${vp.width}x${vp.height}-search.png`);
     await page.screenshot({ path: file });
-    console.log(`ok search at ${vp.width}x${vp.height}: ${results} results (${meta.trim()}): ${file}`);
+    console.log(`ok search at ${vp.width}x${vp.height} (${((Date.now() - t0) / 1000).toFixed(1)} s): ${results} results (${meta.trim()}): ${file}`);
     if (offMachine.length) fail(`requests off the machine: ${[...new Set(offMachine)].join(", ")}`);
     if (errors.length) fail(`console errors at ${vp.width}: ${errors.join(" | ")}`);
     await context.close();
   }
   // Opened as files, without a server: the pages read (the search needs the server).
-  const context = await browser.newContext({ viewport: viewports[0] });
+  const context = await browser.newContext({ viewport: { width: viewports[0].width, height: viewports[0].height } });
   const offMachine = [];
   context.on("request", (r) => { if (!r.url().startsWith("file://") && !r.url().startsWith("data:")) offMachine.push(r.url()); });
   const page = await context.newPage();

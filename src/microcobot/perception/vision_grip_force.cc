@@ -35,7 +35,7 @@ constexpr double kStillYaw_rad = 0.1e-3;
 constexpr int kStillFrames = 3;
 // A tare's reference is the mean tips' distance over this many frames (the drive still): the
 // teaching frame's noise is in the templates; averaging the frames after it takes it out.
-constexpr int kTareFrames = 8;
+constexpr int kTareFrames = 15;
 }  // namespace
 
 VisionGripForce::VisionGripForce(const CameraRig& rig, const VisionGripForceParams& params)
@@ -45,6 +45,7 @@ VisionGripForce::VisionGripForce(const CameraRig& rig, const VisionGripForcePara
       trackers_{vision::TemplateTracker(params.tracker), vision::TemplateTracker(params.tracker)} {
   p_.validate();
   rig_.camera.validate();
+  still_frames_ = kStillFrames;  // nothing has turned yet
   require(std::isfinite(stiffness_N_m_) && stiffness_N_m_ > 0.0, "world.gripper.finger_stiffness_N_m",
           "must be > 0", stiffness_N_m_);
 }
@@ -122,9 +123,12 @@ const VisionGripStatus& VisionGripForce::on_frame(const devices::CameraFrame& fr
   const double yaw = std::isfinite(frame.tool_yaw_rad) ? frame.tool_yaw_rad : 0.0;
   const bool moved = std::isfinite(last_frame_yaw_) && std::abs(yaw - last_frame_yaw_) > kStillYaw_rad;
   last_frame_yaw_ = yaw;
-  still_frames_ = moved ? 0 : still_frames_ + 1;
+  still_frames_ = moved ? 0 : std::min(still_frames_ + 1, kStillFrames);
   const bool turned = std::abs(yaw - yaw_) > kMaxYaw_rad;
-  if (turned && still_frames_ < kStillFrames) {
+  // A frame taken while the fingers turn, even within kMaxYaw_rad of their taught yaw, measures
+  // nothing: its blurred tips would enter a tare's average or mark the fingers loaded, and the
+  // next teaching would then chain from that wrong gap.
+  if (still_frames_ < kStillFrames) {
     st_.state = st_.tared ? "lost" : "untared";
     st_.error = "the fingers are turning: measured again once they stop";
     publish();

@@ -13,7 +13,7 @@
 /// [px/m] (the objective's calibration, or its nominal map: camera_map.h), o_free the drive's
 /// free opening (Gripper::free_opening_m: its open-loop model), k the finger stiffness, and
 /// (g_ref, d_ref) a reference: the tare, taken with nothing between the fingers (g_ref = o_free
-/// then, d_ref the mean over the tare's first 8 frames), or, after an objective change or a turn of
+/// then, d_ref the mean over the tare's first 15 frames), or, after an objective change or a turn of
 /// the fingers, the gap last measured before it.
 /// With the fingers turned by the rotary axis (`tool_yaw_rad`), e_x and the tips' half gaps turn with
 /// them: the tips are taught again at each new yaw, once still for 3 frames, the gap chained from
@@ -30,7 +30,7 @@
 ///     F_c  = 2 k b                                     [N]     (signed, along e_x)
 ///
 /// with t the tool point's pixel and (b_ref, c_ref) the reference: the tare's (nothing touches the
-/// fingers: b_ref = 0, c_ref the mean over its first 8 frames) or, chained, the bend last measured.
+/// fingers: b_ref = 0, c_ref the mean over its first 15 frames) or, chained, the bend last measured.
 /// The midpoint is measured against the stage's motion since the tare, so the map's error e adds
 /// 2 k e |motion| (10 uN for 0.1 % over 100 um): a contact is read near where the gauge was
 /// tared. Without stage sensors (the vision positioner's tool point is the tips themselves) there
