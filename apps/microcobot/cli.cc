@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/field_names.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/mat_file.h"
 #include "signals.h"
@@ -81,26 +82,7 @@ const CLI::Validator NonNegativeNumber = lower_bound(false);
 
 void naming_flags(const std::vector<std::pair<std::string, std::string>>& field_to_flag,
                   const std::function<void()>& work) {
-  try {
-    work();
-  } catch (const InvalidParams& e) {
-    std::string text = e.what();
-    const auto word = [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.';
-    };
-    for (const auto& [field, flag] : field_to_flag) {
-      for (std::size_t pos = 0; (pos = text.find(field, pos)) != std::string::npos;) {
-        const std::size_t end = pos + field.size();
-        if ((pos > 0 && word(text[pos - 1])) || (end < text.size() && word(text[end]) && text[end] != '.')) {
-          pos = end;
-          continue;
-        }
-        text.replace(pos, field.size(), flag);
-        pos += flag.size();
-      }
-    }
-    throw Error(e.exit_code(), text);
-  }
+  naming_fields(field_to_flag, work);
 }
 
 void add_output_options(CLI::App& cmd, CommonOptions& opts) {

@@ -239,7 +239,7 @@ TEST(LiveTask, AnAssistedTransportGuidesTheOperatorOntoTheBoreAndTheRobotInserts
   const auto done = [&] { return rig.task().step != Step::kTransport || rig.task().ended; };
   const Eigen::Vector2d along = (bore - from).normalized(), across(-along.y(), along.x());
   const double aim_u = (aim - from).dot(along);
-  for (int i = 0; i < 3000 && !done(); ++i) {
+  for (int i = 0; i < 6000 && !done(); ++i) {  // up to a minute on a loaded machine
     const TaskSample at = rig.copy().back();
     const double u = (at.target.head<2>() - from).dot(along);
     const Eigen::Vector2d goal = aim_u - u > 60e-6

@@ -87,14 +87,7 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   out_.fresh = true;
   out_.has_gripper = true;
   out_.gripper_opening_m = opening_command_;
-  autonomy_.fill(Autonomy::kAuto);
   enter(Step::kApproach);
-}
-
-bool AssemblyTask::assistable(Step s) noexcept {
-  return s == Step::kApproach || s == Step::kAlign || s == Step::kDescend || s == Step::kGrasp ||
-         s == Step::kLift || s == Step::kTransport || s == Step::kRotate || s == Step::kInsert ||
-         s == Step::kRelease || s == Step::kRetract;
 }
 
 void AssemblyTask::enter(Step s) noexcept {
@@ -103,97 +96,48 @@ void AssemblyTask::enter(Step s) noexcept {
   assist_from_known_ = false;
   step_s_ = 0.0;
   settled_s_ = 0.0;
-  insert_ = Insert::kDescend;
+  search_.set_phase(InsertionSearch::Phase::kDescend);
   release_ = Release::kOpen;
   release_s_ = 0.0;
   out_.gripper_shake = false;
-  if (s == Step::kInsert) {  // a fresh search, however the insertion was reached
-    tries_ = 0;
-    offset_y_ = search_base_ = 0.0;
-    held_seen_ = false;
-    aligned_ = align_move_ = false;
-    align_looks_ = 0;
-    aim_.setZero();
-    search_yaw_ = last_yaw_;  // along the fingers as they are
+  if (s == Step::kInsert) {      // a fresh search, however the insertion was reached
+    search_.restart(last_yaw_);  // along the fingers as they are
+    looks_.new_insertion();
   }
-  if (s == Step::kDone) {
-    status_ = Status::kSucceeded;
-    return;
-  }
-  begin_step();
-}
-
-void AssemblyTask::begin_step() noexcept {
-  switch (autonomy_[index(step_)]) {
-    case Autonomy::kAuto:
-      status_ = Status::kRunning;
-      break;
-    case Autonomy::kConfirm:
-      status_ = Status::kAwaitingConfirm;
-      break;
-    case Autonomy::kManual:
-      status_ = Status::kOperator;
-      break;
-    case Autonomy::kAssisted:
-      status_ = assistable(step_) ? Status::kAssisted : Status::kOperator;
-      break;
-  }
-}
-
-void AssemblyTask::fail(const char* why) noexcept {
-  failure_ = why;
-  status_ = Status::kFailed;
-}
-
-void AssemblyTask::pause() noexcept {
-  if (status_ == Status::kRunning) status_ = Status::kPaused;
-}
-
-void AssemblyTask::resume() noexcept {
-  if (status_ == Status::kPaused) status_ = Status::kRunning;
-}
-
-void AssemblyTask::confirm() noexcept {
-  if (status_ == Status::kAwaitingConfirm) status_ = Status::kRunning;
-}
-
-void AssemblyTask::take_over() noexcept {
-  if (!finished()) status_ = Status::kOperator;
+  supervisor_.begin(s);
 }
 
 void AssemblyTask::hand_back(bool step_done) noexcept {
   if (!operator_drives()) return;
   if (step_done) {
-    enter(static_cast<Step>(index(step_) + 1));
-  } else {
-    // The step again, from where the operator left the stage: its goals are absolute, and a
-    // move starts from the coupling's current target; a turn, from where the operator left it.
-    yaw_goal_ = std::numeric_limits<double>::quiet_NaN();
-    step_s_ = 0.0;
-    settled_s_ = 0.0;
-    assist_from_known_ = false;
-    if (step_ == Step::kInsert) {  // clear of the rim before searching on
-      insert_ = Insert::kRetreat;
-      retreat_z_ = std::numeric_limits<double>::quiet_NaN();
-    }
-    status_ = Status::kRunning;
+    enter(next_step(step_));
+    return;
   }
+  // The step again, from where the operator left the stage: its goals are absolute, and a move
+  // starts from the coupling's current target; a turn, from where the operator left it.
+  yaw_goal_ = std::numeric_limits<double>::quiet_NaN();
+  step_s_ = 0.0;
+  settled_s_ = 0.0;
+  assist_from_known_ = false;
+  if (step_ == Step::kInsert) search_.retreat_from_tip();  // clear of the rim before searching on
+  supervisor_.run();
 }
 
 void AssemblyTask::set_autonomy(Step step, Autonomy a) noexcept {
   if (step == Step::kDone) return;
-  autonomy_[index(step)] = a;
-  const bool fresh = step_s_ == 0.0 && (status_ == Status::kRunning || status_ == Status::kAwaitingConfirm ||
-                                        operator_drives());
-  if (step == step_ && fresh) begin_step();
+  supervisor_.set_autonomy(step, a);
+  const Status st = status();
+  const bool fresh =
+      step_s_ == 0.0 && (st == Status::kRunning || st == Status::kAwaitingConfirm || operator_drives());
+  if (step == step_ && fresh) supervisor_.begin(step_);
 }
 
 void AssemblyTask::skip() noexcept {
   if (finished()) return;
-  const bool paused = status_ == Status::kPaused;
+  const bool paused = status() == Status::kPaused;
   yaw_goal_ = std::numeric_limits<double>::quiet_NaN();  // the fingers stay as they are
-  enter(static_cast<Step>(index(step_) + 1));
-  if (paused && status_ == Status::kRunning) status_ = Status::kPaused;
+  enter(next_step(step_));
+  if (paused) supervisor_.pause();  // a running next step stays paused; another level holds anyway
 }
 
 bool AssemblyTask::move_to(const Eigen::Vector3d& goal, double speed, const TaskSensors& s,
@@ -262,15 +206,14 @@ void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
       // in the fingers, so a later contact says nothing of its depth): down in the bore, the
       // release; on the rim, the robot's search takes the insertion over from here.
       if (s.contact_N.z() > p_.contact_threshold_N) {
-        contact_z_ = s.tip_m.z();
+        search_.record_contact(s.tip_m.z());
         fixtures_ = {};
-        if (contact_z_ < rim_z_ - 0.5 * goal_.hole_depth_m) {
+        if (s.tip_m.z() < rim_z_ - 0.5 * goal_.hole_depth_m) {
           enter(Step::kRelease);
         } else {
-          ++tries_;
-          insert_ = Insert::kRetreat;
-          retreat_z_ = std::numeric_limits<double>::quiet_NaN();
-          status_ = Status::kRunning;
+          search_.count_try();
+          search_.retreat_from_tip();
+          supervisor_.run();
         }
         return;
       }
@@ -312,11 +255,7 @@ void AssemblyTask::assisted_tick(const TaskSensors& s, double dt) noexcept {
   if (settled_s_ < p_.settle_s) return;
   if (step_ == Step::kGrasp) rim_z_ = s.tip_m.z();
   fixtures_ = {};
-  enter(static_cast<Step>(index(step_) + 1));
-}
-
-Eigen::Vector2d AssemblyTask::search_xy() const noexcept {
-  return goal_.target_m + aim_ + offset_y_ * Eigen::Vector2d(-std::sin(search_yaw_), std::cos(search_yaw_));
+  enter(next_step(step_));
 }
 
 const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s) noexcept {
@@ -334,22 +273,22 @@ const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s
   if (operator_drives() && std::isfinite(s.gripper_command_m)) opening_command_ = s.gripper_command_m;
   out_.gripper_opening_m = opening_command_;
   fixtures_ = {};
-  if (status_ == Status::kAssisted) {
+  if (status() == Status::kAssisted) {
     // The slot or the bore seen before the guide is set.
     if (const Look l = look_before_moving(); l != Look::kNone) {
-      look_ = l;
-      status_ = Status::kAwaitingLook;
+      looks_.await(l);
+      supervisor_.await_look();
       return out_;
     }
     assisted_tick(s, dt_s);
     return out_;
   }
-  if (status_ != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
+  if (status() != Status::kRunning) return out_;  // holding: paused, awaiting, operator, finished
   // The camera's looks before the approach, the transport and the insertion (verify's is its own):
   // holding.
   if (const Look l = look_before_moving(); l != Look::kNone) {
-    look_ = l;
-    status_ = Status::kAwaitingLook;
+    looks_.await(l);
+    supervisor_.await_look();
     return out_;
   }
   step_s_ += dt_s;
@@ -368,7 +307,7 @@ const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s
         settled_s_ = 0.0;
       } else {
         // Clear of the pins: the fingers turn on the way when align is the robot's.
-        if (autonomy_[index(Step::kAlign)] == Autonomy::kAuto)
+        if (autonomy(Step::kAlign) == Autonomy::kAuto)
           turn_to(align_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
         if (move_to(over_part, p_.travel_speed_m_s, s, dt_s)) enter(Step::kAlign);
       }
@@ -401,7 +340,7 @@ const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s
         enter(Step::kTransport);
       break;
     case Step::kTransport:
-      if (autonomy_[index(Step::kRotate)] == Autonomy::kAuto)
+      if (autonomy(Step::kRotate) == Autonomy::kAuto)
         turn_to(rotate_yaw(std::isfinite(yaw_goal_) ? yaw_goal_ : s.yaw_rad));
       if (move_to({goal_.target_m.x(), goal_.target_m.y(), carry_z_}, p_.travel_speed_m_s, s, dt_s))
         enter(Step::kRotate);
@@ -422,38 +361,7 @@ const teleop::ConsoleInput& AssemblyTask::tick(const TaskSensors& s, double dt_s
       if (move_to({search_xy().x(), search_xy().y(), safe_z_}, p_.z_speed_m_s, s, dt_s)) enter(Step::kVerify);
       break;
     case Step::kVerify:
-      // Still where the retract ended (settle_s), then one look.
-      if (!move_to(s.tip_m, p_.z_speed_m_s, s, dt_s)) break;
-      if (looks_ && !placed_seen_) {  // the camera's look, holding
-        look_ = Look::kPlaced;
-        status_ = Status::kAwaitingLook;
-        out_.deadman = false;
-        break;
-      }
-      if (looks_ && !placed_.found) {
-        fail("the camera does not see the pin down in its bore");
-        break;
-      }
-      if (const Eigen::Vector3d part = looks_ ? placed_.part_m : s.part_m; part.allFinite()) {
-        const double inserted_z = 0.5 * goal_.part_height_m - goal_.hole_depth_m;
-        // Off the axis along the bore's own sides.
-        const Eigen::Vector2d d = part.head<2>() - goal_.target_m;
-        const double c = std::cos(goal_.target_yaw_rad), sn = std::sin(goal_.target_yaw_rad);
-        const double off_axis = std::max(std::abs(c * d.x() + sn * d.y()), std::abs(-sn * d.x() + c * d.y()));
-        if (part.z() > inserted_z + p_.verify_tolerance_m) {
-          fail(goal_.flat_seat ? "the part is not down on its seat (seen by the cell's vision)"
-                               : "the pin is not down in its bore (seen by the cell's vision)");
-          break;
-        }
-        // A flat seat's tolerance is told as its clearance; a pin is off its bore's axis.
-        const double allowed = goal_.clearance_m + (goal_.flat_seat ? 0.0 : p_.verify_tolerance_m);
-        if (off_axis > allowed) {
-          fail(goal_.flat_seat ? "the part is off its seat (seen by the cell's vision)"
-                               : "the pin is off its bore's axis (seen by the cell's vision)");
-          break;
-        }
-      }
-      enter(Step::kDone);
+      verify_tick(s, dt_s);
       break;
     case Step::kDone:
       break;

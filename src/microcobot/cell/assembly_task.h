@@ -2,8 +2,9 @@
 /// @file
 /// The automatic pick-and-insert of one pin: a sequence of
 /// steps with behaviour-tree semantics, run by the robot while the operator supervises, pauses,
-/// confirms, takes over and hands back. Like a ros2_control controller it is a pure object: each
-/// tick it reads the slave's sensors (TaskSensors: measured tip position, contact and grip
+/// confirms, takes over and hands back (the supervisor: task_supervisor.h; the camera's looks:
+/// task_looks.h; the insertion's search: insertion_search.h). Like a ros2_control controller it is a pure
+/// object: each tick it reads the slave's sensors (TaskSensors: measured tip position, contact and grip
 /// forces, opening) and returns the console input the platform follows (teleop::ConsoleInput:
 /// a straight move to a goal at a speed, a gripper opening, the deadman), so that the platform's
 /// own limits (teleop/safety_limits.h: grip, contact, floor) apply to it as to any operator.
@@ -82,6 +83,10 @@
 
 #include <Eigen/Dense>
 
+#include "microcobot/cell/insertion_search.h"
+#include "microcobot/cell/task_looks.h"
+#include "microcobot/cell/task_steps.h"
+#include "microcobot/cell/task_supervisor.h"
 #include "microcobot/microworld/release.h"
 #include "microcobot/teleop/teleoperation.h"
 
@@ -191,43 +196,12 @@ struct TaskSensors {
 
 class AssemblyTask {
  public:
-  enum class Step {
-    kApproach,
-    kAlign,
-    kDescend,
-    kGrasp,
-    kLift,
-    kTransport,
-    kRotate,
-    kInsert,
-    kRelease,
-    kRetract,
-    kVerify,
-    kDone
-  };
-  static constexpr int kStepCount = 12;
-  enum class Status {
-    kRunning,
-    kPaused,
-    kAwaitingConfirm,
-    kAwaitingLook,
-    kOperator,
-    kSucceeded,
-    kFailed,
-    kAssisted
-  };
-  enum class Look { kNone, kSlot, kBore, kHeld, kPlaced, kAlign };
-  /// What a look saw (world frame): the pin's centre and yaw, or nothing; an align look also the
-  /// servo's error (the pin's centre minus the bore's) and whether it converged.
-  struct Sighting {
-    bool found = false;
-    Eigen::Vector3d part_m = Eigen::Vector3d::Zero();
-    double yaw_rad = 0.0;
-    Eigen::Vector2d error_m = Eigen::Vector2d::Zero();
-    bool converged = false;
-  };
-  /// kAssisted: the moves only (assistable()); another step given it is the operator's (kManual).
-  enum class Autonomy { kAuto, kConfirm, kManual, kAssisted };
+  using Step = TaskStep;
+  static constexpr int kStepCount = kTaskStepCount;
+  using Status = TaskStatus;
+  using Look = TaskLook;
+  using Sighting = TaskSighting;
+  using Autonomy = StepAutonomy;
   /// The steps that may be assisted: the moves to a position (approach, descend, lift, transport,
   /// retract: a guide at the goal's x, y, along the path from where the step began for approach and
   /// transport, and a height stop at its z; done once the tool is there), the turns (align, rotate:
@@ -239,7 +213,7 @@ class AssemblyTask {
   /// its rim; judged at the first contact above contact_threshold_N: the pin half down in the
   /// bore, the release; on the rim, the robot's search goes on from there, status running) and the release
   /// (the guide holds; done once the fingers are open).
-  static bool assistable(Step s) noexcept;
+  static bool assistable(Step s) noexcept { return step_assistable(s); }
 
   /// The finger tips' height while grasping: grip_above_m over a full bore (the pin's bottom sits
   /// at the bore's depth below them), half a flat part's thickness on a flat seat.
@@ -254,36 +228,33 @@ class AssemblyTask {
   /// False while the operator drives (taken over, a manual or assisted step) and once finished.
   bool drives() const noexcept { return !operator_drives() && !finished(); }
   /// The operator's master drives the stage (taken over, a manual or an assisted step).
-  bool operator_drives() const noexcept {
-    return status_ == Status::kOperator || status_ == Status::kAssisted;
-  }
+  bool operator_drives() const noexcept { return supervisor_.operator_drives(); }
   /// The shared control the current step wants on the coupling (world frame; level 0: none):
   /// while assisted, a guide at the step's goal x, y and a height stop at its z, at level 1.
   const teleop::FixtureSet& fixtures() const noexcept { return fixtures_; }
-  bool finished() const noexcept { return status_ == Status::kSucceeded || status_ == Status::kFailed; }
+  bool finished() const noexcept { return supervisor_.finished(); }
 
   /// The cell has a camera: the task asks for its looks (header), the insertion aligned by the
   /// visual servo with `servo` (align looks) or by one held look. Before the first tick.
-  void set_looks(bool on, bool servo = false) noexcept {
-    looks_ = on;
-    servo_ = servo;
-  }
+  void set_looks(bool on, bool servo = false) noexcept { looks_.enable(on, servo); }
   /// Align looks taken for the present insertion, and the aim they set (the tool's offset from the
   /// bore as seen).
-  int align_looks() const noexcept { return align_looks_; }
-  Eigen::Vector2d align_aim_m() const noexcept { return aim_; }
+  int align_looks() const noexcept { return looks_.align_looks(); }
+  Eigen::Vector2d align_aim_m() const noexcept { return search_.aim_m(); }
   /// The look the task awaits (kNone unless the status is kAwaitingLook).
-  Look look_wanted() const noexcept { return status_ == Status::kAwaitingLook ? look_ : Look::kNone; }
+  Look look_wanted() const noexcept {
+    return status() == Status::kAwaitingLook ? looks_.awaited() : Look::kNone;
+  }
   /// What the awaited look saw; the task runs on from the next tick (nothing awaited: ignored).
   void see(const Sighting& sighting) noexcept;
   /// The pin's offset along the fingers' y seen over the bore (NaN: none).
-  double held_offset_m() const noexcept { return held_offset_; }
+  double held_offset_m() const noexcept { return search_.held_offset_m(); }
   static std::string_view name(Look l) noexcept;
 
-  void pause() noexcept;
-  void resume() noexcept;
-  void confirm() noexcept;
-  void take_over() noexcept;
+  void pause() noexcept { supervisor_.pause(); }
+  void resume() noexcept { supervisor_.resume(); }
+  void confirm() noexcept { supervisor_.confirm(); }
+  void take_over() noexcept { supervisor_.take_over(); }
   /// The operator hands back: the current step again from where the stage is, or, with
   /// `step_done`, the next one.
   void hand_back(bool step_done = false) noexcept;
@@ -296,24 +267,21 @@ class AssemblyTask {
   void set_autonomy(Step step, Autonomy a) noexcept;
 
   Step step() const noexcept { return step_; }
-  Status status() const noexcept { return status_; }
+  Status status() const noexcept { return supervisor_.status(); }
   /// Why the task failed ("" otherwise); a static string.
-  std::string_view failure() const noexcept { return failure_; }
-  int search_tries() const noexcept { return tries_; }
+  std::string_view failure() const noexcept { return supervisor_.failure(); }
+  int search_tries() const noexcept { return search_.tries(); }
   /// Tip height at which the inserting descent met its stop (NaN before).
-  double insert_contact_z_m() const noexcept { return contact_z_; }
+  double insert_contact_z_m() const noexcept { return search_.contact_z_m(); }
   static std::string_view name(Step s) noexcept;
   static std::string_view name(Status s) noexcept;
   static std::string_view name(Autonomy a) noexcept;
-  Autonomy autonomy(Step step) const noexcept { return autonomy_[index(step)]; }
+  Autonomy autonomy(Step step) const noexcept { return supervisor_.autonomy(step); }
 
  private:
-  enum class Insert { kDescend, kRetreat, kShift };
   enum class Release { kOpen, kStrategy };
-  static std::size_t index(Step s) noexcept { return static_cast<std::size_t>(s); }
   void enter(Step s) noexcept;
-  void begin_step() noexcept;
-  void fail(const char* why) noexcept;
+  void fail(const char* why) noexcept { supervisor_.fail(why); }
   /// The goal of a move step (assistable()) from the tip at `tip`.
   Eigen::Vector3d move_goal(Step s, const Eigen::Vector3d& tip) const noexcept;
   /// An assisted step's tick: its fixtures; the next step once the goal has been held.
@@ -325,53 +293,34 @@ class AssemblyTask {
   /// The fingers' yaw squaring them with the pin (align) and the pin with its bore (rotate).
   double align_yaw(double from) const noexcept;
   double rotate_yaw(double from) const noexcept;
-  /// The search's point: the bore's axis plus offset_y_ along the fingers' y.
-  Eigen::Vector2d search_xy() const noexcept;
+  /// The insertion's point: the bore's axis, the servo's aim and the search's offset.
+  Eigen::Vector2d search_xy() const noexcept { return search_.point(goal_.target_m); }
+  /// The look the current step needs before it moves (kNone: none, or no camera).
+  Look look_before_moving() const noexcept;
   void insert_tick(const TaskSensors& s, double dt) noexcept;
   void release_tick(const TaskSensors& s, double dt) noexcept;
+  void verify_tick(const TaskSensors& s, double dt) noexcept;
 
   AssemblyTaskParams p_;
   AssemblyGoal goal_;
-  std::array<Autonomy, kStepCount> autonomy_{};
+  TaskSupervisor supervisor_;
+  TaskLooks looks_;
+  InsertionSearch search_;
   teleop::ConsoleInput out_;
   teleop::FixtureSet fixtures_;
   Step step_ = Step::kApproach;
-  Status status_ = Status::kRunning;
-  const char* failure_ = "";
   double step_s_ = 0.0, settled_s_ = 0.0;
   double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
+  double rim_z_ = 0.0;  // tool-point height at which the held pin's bottom meets the surface
   double opening_command_ = 0.0;
-  Insert insert_ = Insert::kDescend;
   Release release_ = Release::kOpen;
-  double release_s_ = 0.0;  // time in the release's strategy
-  double rim_z_ = 0.0;      // tool-point height at which the held pin's bottom meets the surface
+  double release_s_ = 0.0;                                 // time in the release's strategy
   Eigen::Vector2d assist_from_ = Eigen::Vector2d::Zero();  // where an assisted move's path starts
   bool assist_from_known_ = false;
-  int tries_ = 0;                                                 // search points tried
-  double offset_y_ = 0.0;                                         // the current search point
   double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();    // the rotary axis' (NaN: none yet)
   double assist_yaw_ = std::numeric_limits<double>::quiet_NaN();  // an assisted turn's yaw stop
   double last_yaw_ = 0.0;                                         // the fingers' yaw at the last tick
   Eigen::Vector3d last_tip_ = Eigen::Vector3d::Zero();            // ... and the tip's position
-  double search_yaw_ = 0.0;                                       // ... when the insertion began
-  double contact_z_ = std::numeric_limits<double>::quiet_NaN();   // where the last descent stopped
-  /// The look the current step needs before it moves (kNone: none, or no camera).
-  Look look_before_moving() const noexcept;
-  bool looks_ = false;
-  Look look_ = Look::kNone;                     // the look awaited, or the last one
-  bool slot_seen_ = false, held_seen_ = false;  // looks done (found or not)
-  bool bore_seen_ = false;
-  Sighting placed_;  // verify's look
-  bool placed_seen_ = false;
-  double held_offset_ = std::numeric_limits<double>::quiet_NaN();  // the pin along the fingers' y
-  double search_base_ = 0.0;                                       // the search's centre along y
-  bool servo_ = false;                // the insertion aligned by the visual servo (align looks)
-  bool aligned_ = false;              // ... done: converged, out of looks, or nothing seen
-  bool align_move_ = false;           // ... the tool moving to the corrected aim before the next look
-  int align_looks_ = 0;               // ... looks taken for this insertion
-  Eigen::Vector2d aim_{0, 0};         // ... the tool's offset from the bore as seen
-  Eigen::Vector2d retreat_xy_{0, 0};  // the search's way up: from here ...
-  double retreat_z_ = 0.0;            // ... to here (NaN: from where the tip is)
 };
 
 }  // namespace mc::cell

@@ -1,5 +1,5 @@
-// The assembly task's looks (assembly_task.h, "Looks"): which look a step needs before it moves,
-// and what each sighting changes in what the task knows of its part and bore.
+// The assembly task's looks (assembly_task.h, "Looks"): what each sighting changes in what the
+// task knows of its part, its bore and its insertion (what was seen is task_looks.h's).
 #include <cmath>
 
 #include "microcobot/cell/assembly_task.h"
@@ -7,67 +7,44 @@
 namespace mc::cell {
 
 void AssemblyTask::see(const Sighting& sighting) noexcept {
-  if (status_ != Status::kAwaitingLook) return;
-  switch (look_) {
+  if (status() != Status::kAwaitingLook) return;
+  const Look look = looks_.awaited();
+  looks_.took(look);
+  switch (look) {
     case Look::kSlot:
-      slot_seen_ = true;
       if (sighting.found && sighting.part_m.allFinite() && std::isfinite(sighting.yaw_rad)) {
         goal_.part_m = sighting.part_m.head<2>();
         goal_.part_yaw_rad = sighting.yaw_rad;
       }
       break;
     case Look::kBore:
-      bore_seen_ = true;
       if (sighting.found && sighting.part_m.head<2>().allFinite()) goal_.target_m = sighting.part_m.head<2>();
       break;
     case Look::kHeld:
-      held_seen_ = true;
       if (sighting.found && sighting.part_m.allFinite()) {
         // Along the fingers' y from the tool point (the stage held still while the camera looked).
-        const Eigen::Vector2d ey(-std::sin(search_yaw_), std::cos(search_yaw_));
-        held_offset_ = (sighting.part_m.head<2>() - last_tip_.head<2>()).dot(ey);
-        search_base_ = offset_y_ = -held_offset_;
+        search_.centre_on_held(
+            (sighting.part_m.head<2>() - last_tip_.head<2>()).dot(search_.along_fingers()));
       }
       break;
     case Look::kAlign:
-      // The look-and-move servo: the tool moves by minus the error seen (the stage's loop makes
-      // the displacement), then looks again, until converged or out of looks. Nothing seen: the
-      // descent aims as without a camera, the search round the bore as seen.
-      ++align_looks_;
-      if (sighting.found && sighting.error_m.allFinite()) {
-        if (!sighting.converged) aim_ -= sighting.error_m;
-        aligned_ = sighting.converged || align_looks_ >= p_.align_max_looks;
-      } else {
-        aligned_ = true;
-      }
-      align_move_ = !aligned_;
+      // Nothing seen: the descent aims as without a camera, the search round the bore as seen.
+      search_.shift_aim(looks_.saw_align(sighting, p_.align_max_looks));
       break;
     case Look::kPlaced:
-      placed_seen_ = true;
-      placed_ = sighting;
+      looks_.saw_placed(sighting);
       break;
     case Look::kNone:
       break;
   }
   // Back to the step as its level has it (an assisted approach looks at the slot first).
-  status_ = autonomy_[index(step_)] == Autonomy::kAssisted && assistable(step_) ? Status::kAssisted
-                                                                                : Status::kRunning;
+  supervisor_.after_look(step_);
 }
 
 AssemblyTask::Look AssemblyTask::look_before_moving() const noexcept {
-  if (!looks_) return Look::kNone;
-  if (step_ == Step::kApproach && !slot_seen_) return Look::kSlot;
-  if (step_ == Step::kTransport && !bore_seen_ && !goal_.flat_seat) return Look::kBore;
-  // The servo aligns a pin on its bore as seen from the bore's station; a flat seat shows nothing
-  // to servo on (its place is its drawing's), so a flat part takes the held look.
-  if (step_ == Step::kInsert && tries_ == 0 && insert_ == Insert::kDescend && status_ == Status::kRunning) {
-    if (servo_ && !goal_.flat_seat) {
-      if (!aligned_ && !align_move_) return Look::kAlign;
-    } else if (!held_seen_) {
-      return Look::kHeld;
-    }
-  }
-  return Look::kNone;
+  const bool insertion_start = search_.tries() == 0 && search_.phase() == InsertionSearch::Phase::kDescend &&
+                               status() == Status::kRunning;
+  return looks_.before_moving(step_, goal_.flat_seat, insertion_start);
 }
 
 }  // namespace mc::cell

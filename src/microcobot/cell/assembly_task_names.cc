@@ -10,7 +10,7 @@ std::string_view AssemblyTask::name(Step s) noexcept {
   static constexpr std::array<std::string_view, kStepCount> names = {
       "approach", "align",  "descend", "grasp",   "lift",   "transport",
       "rotate",   "insert", "release", "retract", "verify", "done"};
-  return names[index(s)];
+  return names[step_index(s)];
 }
 
 std::string_view AssemblyTask::name(Status s) noexcept {

@@ -10,10 +10,10 @@
 namespace mc::cell {
 
 bool PersonOperator::click_steer(const Eigen::Vector2d& error_m, double tolerance_m, double t) noexcept {
-  if (click_goal_) {
+  if (click_goal_.active) {
     // The stage on its way to the click: the person watches it arrive, and reacts.
-    if (t - click_t_ < p_.still_window_s || !tool_still()) return false;
-    click_goal_ = false;
+    if (t - click_goal_.since_s < p_.still_window_s || !tool_still()) return false;
+    click_goal_.active = false;
     cursor_.reset(cursor_.end(), t);
     return false;
   }
@@ -32,9 +32,9 @@ bool PersonOperator::click_steer(const Eigen::Vector2d& error_m, double toleranc
   if (!cursor_.aim(target_px - cursor_.end(), std::max(tolerance_m * scale, p_.min_click_px), t))
     return false;
   const Eigen::Vector2d at = cursor_.end() / scale;
-  click_m_ = {at.x(), at.y(), tips_[static_cast<std::size_t>((tip_count_ - 1) % kHistory)].z()};
-  click_goal_ = true;
-  click_t_ = t;
+  click_goal_.at_m = {at.x(), at.y(), tips_.back(0).z()};
+  click_goal_.active = true;
+  click_goal_.since_s = t;
   return false;
 }
 
@@ -109,13 +109,13 @@ bool PersonOperator::turn(double misalignment, double t) noexcept {
   };
   if (assisted_) {
     // The cell's vision measures the misalignment once; the platform turns there.
-    if (!turning_) {
-      yaw_goal_ = to_square(misalignment + rng_.normal(0.0, p_.assist_yaw_sd_rad));
-      turning_ = true;
+    if (!turn_.under_way) {
+      turn_.goal_rad = to_square(misalignment + rng_.normal(0.0, p_.assist_yaw_sd_rad));
+      turn_.under_way = true;
     }
-    if (std::abs(fingers - yaw_goal_) > yaw_arrived_rad_) return false;
-    turning_ = false;
-    yaw_.reset({yaw_goal_, 0.0}, t);  // the dial where the rotor now is
+    if (std::abs(fingers - turn_.goal_rad) > turn_.arrived_rad) return false;
+    turn_.under_way = false;
+    yaw_.reset({turn_.goal_rad, 0.0}, t);  // the dial where the rotor now is
     return true;
   }
   // The rotor still where the dial put it before the person judges again.

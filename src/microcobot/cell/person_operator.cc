@@ -92,9 +92,9 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
   require(!(click_ && assisted), "master",
           "click: the console's click-to-go is for manual runs (the click is the platform's move already)");
   yaw_.reset({platform.yaw_target_rad(), 0.0}, 0.0);
-  yaw_arrived_rad_ = task.yaw_tolerance_rad;
+  turn_.arrived_rad = task.yaw_tolerance_rad;
   slider_ = goal.open_m;
-  window_ticks_ =
+  tips_.window_ticks =
       std::clamp(static_cast<int>(std::lround(p_.still_window_s * operator_rate_Hz(platform.config()))), 1,
                  kHistory - 1);
   // The cell's vision finds the pin on the tray (assisted): where the guidance takes the tips.
@@ -104,13 +104,13 @@ PersonOperator::PersonOperator(platform::Platform& platform, const PersonOperato
 void PersonOperator::enter(Step s, double t) noexcept {
   step_ = s;
   step_t0_ = t;
-  rising_ = false;
-  rotated_ = false;
+  insertion_.rising = false;
+  turn_.rotated = false;
   held_since_ = -1.0;
-  lowest_z_ = std::numeric_limits<double>::infinity();
-  lowest_t_ = t;
-  release_stage_ = 0;
-  shaking_ = false;
+  insertion_.lowest_z_m = std::numeric_limits<double>::infinity();
+  insertion_.lowest_t_s = t;
+  release_.stage = 0;
+  release_.shaking = false;
 }
 
 void PersonOperator::take_over(Step s, double t) noexcept {
@@ -125,7 +125,7 @@ void PersonOperator::take_over(Step s, double t) noexcept {
     rim_z_ = tip.z() - (part.z() - 0.5 * goal_.part_height_m);
     pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);
   }
-  tip_count_ = 0;
+  tips_.count = 0;
   gave_up_ = false;
   enter(s, t);
 }
@@ -155,9 +155,9 @@ Eigen::Vector2d PersonOperator::seen(const Eigen::Vector2d& p, double sd_m) noex
 }
 
 bool PersonOperator::tool_still() const noexcept {
-  if (tip_count_ <= window_ticks_) return false;
-  const Eigen::Vector3d& now = tips_[static_cast<std::size_t>((tip_count_ - 1) % kHistory)];
-  const Eigen::Vector3d& then = tips_[static_cast<std::size_t>((tip_count_ - 1 - window_ticks_) % kHistory)];
+  if (tips_.count <= tips_.window_ticks) return false;
+  const Eigen::Vector3d& now = tips_.back(0);
+  const Eigen::Vector3d& then = tips_.back(tips_.window_ticks);
   return (now - then).norm() < p_.still_m;
 }
 
@@ -213,8 +213,7 @@ void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
   const devices::Vec3 c = g.contact_force_N();
   const Eigen::Vector3d contact(c.x, c.y, c.z);
   tool_xy_ = tip.head<2>();
-  tips_[static_cast<std::size_t>(tip_count_ % kHistory)] = tip;
-  ++tip_count_;
+  tips_.push(tip);
   hand_.deadman = true;
   switch (step_) {
     case Step::kApproach:
@@ -268,9 +267,9 @@ void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
       break;
     case Step::kRotate:
       // The pin's faces square with the bore's; it turns about the tips, so it is aimed again after.
-      if (!rotated_) {
+      if (!turn_.rotated) {
         if (turn(bore_misalignment(), t)) {
-          rotated_ = true;
+          turn_.rotated = true;
           pin_offset_seen_ = seen((part - tip).head<2>(), p_.assist_vision_sd_m);  // vision looks again
         }
       } else if (steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t,
@@ -279,12 +278,12 @@ void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
       }
       break;
     case Step::kInsert: {
-      if (rising_) {
+      if (insertion_.rising) {
         // Off the rim: up, then a fresh look and aim before going down again.
         if (climb(rim_z_ + p_.jam_retreat_m, tip.z(), p_.z_tolerance_m, t) &&
             steer(goal_.target_m - part.head<2>(), p_.bore_tolerance_m, t, aim_width(p_.bore_tolerance_m)) &&
             turn(bore_misalignment(), t))
-          rising_ = false;
+          insertion_.rising = false;
         break;
       }
       // The plate pushing the pin up, felt (haptic: through the handle's force; console: on the
@@ -297,19 +296,20 @@ void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
           return;
         }
         z_.reset({tip.z(), 0.0}, t);
-        rising_ = true;
-        lowest_z_ = std::numeric_limits<double>::infinity();
+        insertion_.rising = true;
+        insertion_.lowest_z_m = std::numeric_limits<double>::infinity();
         break;
       }
       // Down onto the bore's floor: aimed a press below it, done when the floor is felt there,
       // or when the pin, well into its bore, is seen going no lower.
       climb(inserted_z_ - p_.press_m, tip.z(), p_.z_tolerance_m, t);
-      if (tip.z() < lowest_z_ - p_.still_m) {
-        lowest_z_ = tip.z();
-        lowest_t_ = t;
+      if (tip.z() < insertion_.lowest_z_m - p_.still_m) {
+        insertion_.lowest_z_m = tip.z();
+        insertion_.lowest_t_s = t;
       }
       const bool in_bore = tip.z() < rim_z_ - 0.5 * goal_.hole_depth_m;
-      if ((touching && tip.z() <= inserted_z_ + p_.jam_margin_m) || (in_bore && t - lowest_t_ > p_.stalled_s))
+      if ((touching && tip.z() <= inserted_z_ + p_.jam_margin_m) ||
+          (in_bore && t - insertion_.lowest_t_s > p_.stalled_s))
         enter(Step::kRelease, t);
       break;
     }
@@ -319,25 +319,25 @@ void PersonOperator::act(const runtime::TickInfo& tick) noexcept {
       } else {
         slider_ = std::min(goal_.open_m, slider_ + p_.slider_m_s * dt);
       }
-      if (release_stage_ == 0 && g.opening_m() > 0.9 * goal_.open_m) {
-        release_stage_ = goal_.flat_seat && goal_.release != microworld::ReleaseStrategy::kOpen ? 1 : 2;
-        release_t0_ = t;
+      if (release_.stage == 0 && g.opening_m() > 0.9 * goal_.open_m) {
+        release_.stage = goal_.flat_seat && goal_.release != microworld::ReleaseStrategy::kOpen ? 1 : 2;
+        release_.t0_s = t;
         // The haptic master has no burst: its person rolls.
         const bool roll = goal_.release == microworld::ReleaseStrategy::kRoll || haptic_;
         const double fingers = platform_.yaw_rad();
-        roll_goal_rad_ =
+        release_.roll_goal_rad =
             roll ? (fingers + roll_rad_ <= goal_.yaw_max_rad ? fingers + roll_rad_ : fingers - roll_rad_)
                  : std::numeric_limits<double>::quiet_NaN();
       }
-      if (release_stage_ == 1) {
-        if (std::isnan(roll_goal_rad_)) {
-          shaking_ = t - release_t0_ < p_.shake_hold_s;  // Shake held, then let go
-          if (!shaking_) release_stage_ = 2;
-        } else if (turn_by(roll_goal_rad_ - platform_.yaw_rad(), t)) {
-          release_stage_ = 2;
+      if (release_.stage == 1) {
+        if (std::isnan(release_.roll_goal_rad)) {
+          release_.shaking = t - release_.t0_s < p_.shake_hold_s;  // Shake held, then let go
+          if (!release_.shaking) release_.stage = 2;
+        } else if (turn_by(release_.roll_goal_rad - platform_.yaw_rad(), t)) {
+          release_.stage = 2;
         }
       }
-      if (release_stage_ == 2) enter(Step::kRetract, t);
+      if (release_.stage == 2) enter(Step::kRetract, t);
       break;
     case Step::kRetract:
       if (climb(safe_z_, tip.z(), p_.z_tolerance_m, t, aim_height_width())) {
@@ -373,7 +373,7 @@ void PersonOperator::apply(double t) noexcept {
   // dial's angle; with shared control, the platform's own turn.
   console_.fresh = console_.deadman = true;
   console_.has_theta_goal = true;
-  console_.theta_goal_rad = assisted_ && turning_ ? yaw_goal_ : yaw_.position(t).x();
+  console_.theta_goal_rad = assisted_ && turn_.under_way ? turn_.goal_rad : yaw_.position(t).x();
   console_.theta_speed_rad_s = platform_.config().stage.rotary.max_speed_rad_s;
   if (haptic_) {
     const Eigen::Vector2d h = xy_.position(t) + tremor;
@@ -397,16 +397,16 @@ void PersonOperator::apply(double t) noexcept {
     // The plane is the clicks': the stage goes to the last one at the person's pace (a click and a
     // jog at once: the page drops the click, so the person does one at a time).
     console_.velocity_m_s.head<2>().setZero();
-    if (click_goal_) {
+    if (click_goal_.active) {
       console_.has_goal = true;
-      console_.goal_m = click_m_;
+      console_.goal_m = click_goal_.at_m;
       console_.goal_speed_m_s = p_.person.stage_pace_m_s;
       console_.velocity_m_s.z() = 0.0;
     }
   }
   console_.has_gripper = true;
   console_.gripper_opening_m = slider_;
-  console_.gripper_shake = shaking_;
+  console_.gripper_shake = release_.shaking;
   platform_.set_console_input(console_);
 }
 

@@ -240,31 +240,57 @@ class PersonOperator {
   teleop::ConsoleInput console_;
   bool clutching_ = false;
   int clutches_ = 0, jams_ = 0;
-  double roll_rad_ = 0.0;                              // a flat part's roll (the task's roll_rad)
-  int release_stage_ = 0;                              // release: 0 opening, 1 its strategy, 2 done
-  double release_t0_ = 0.0;                            // ... the strategy's start
-  double roll_goal_rad_ = 0.0;                         // ... a roll's dial angle
-  bool shaking_ = false;                               // the console's Shake held
-  bool click_goal_ = false;                            // click: the stage goes to the last click
-  Eigen::Vector3d click_m_ = Eigen::Vector3d::Zero();  // ... there (its z: the height at the click)
-  double click_t_ = 0.0;                               // ... since
-  double cursor_scale_ = 0.0;                          // the screen's px per metre (zoom)
-  bool rising_ = false;                                // insert: backing off the rim
-  double lowest_z_ = 0.0;                              // insert: the lowest tip height seen ...
-  double lowest_t_ = 0.0;                              // ... and since when
-  double pinch_ = 0.0;                                 // TéléTweez lever closing [m]
-  double slider_ = 0.0;                                // console gripper opening [m]
+  double roll_rad_ = 0.0;  // a flat part's roll (the task's roll_rad)
+  /// The release: 0 opening, 1 its strategy, 2 done; the strategy's start; a roll's dial angle;
+  /// the console's Shake held.
+  struct Release {
+    int stage = 0;
+    double t0_s = 0.0;
+    double roll_goal_rad = 0.0;
+    bool shaking = false;
+  } release_;
+  /// Click-to-go: the stage goes to the last click (`active`), there (its z: the height at the
+  /// click), since.
+  struct ClickGoal {
+    bool active = false;
+    Eigen::Vector3d at_m = Eigen::Vector3d::Zero();
+    double since_s = 0.0;
+  } click_goal_;
+  double cursor_scale_ = 0.0;  // the screen's px per metre (zoom)
+  /// The insertion: backing off the rim; the lowest tip height seen, and since when.
+  struct Insertion {
+    bool rising = false;
+    double lowest_z_m = 0.0;
+    double lowest_t_s = 0.0;
+  } insertion_;
+  double pinch_ = 0.0;        // TéléTweez lever closing [m]
+  double slider_ = 0.0;       // console gripper opening [m]
   double held_since_ = -1.0;  // grip first felt (the person stops closing a reaction later)
   Eigen::Vector2d pin_offset_seen_ = Eigen::Vector2d::Zero();  // pin - tips, as vision saw it
   Eigen::Vector2d pin_seen_ = Eigen::Vector2d::Zero();         // the pin on the tray, seen
   double rim_z_ = 0.0;  // tip height at which the carried pin meets the plate
-  double yaw_goal_ = std::numeric_limits<double>::quiet_NaN();  // assisted: the platform's turn ...
-  bool turning_ = false;                                        // ... under way
-  bool rotated_ = false;                                        // rotate: the turn is done
-  double yaw_arrived_rad_ = 0.0;                                // assisted: a turn's end (the task's)
-  static constexpr int kHistory = 256;                          // tip positions, one per operator tick (ring)
-  std::array<Eigen::Vector3d, kHistory> tips_{};
-  int tip_count_ = 0, window_ticks_ = 1;
+  /// Turns: assisted, the platform's turn's goal, under way, and the tolerance it ends within
+  /// (the task's); rotate's turn done.
+  struct Turn {
+    double goal_rad = std::numeric_limits<double>::quiet_NaN();
+    bool under_way = false;
+    double arrived_rad = 0.0;
+    bool rotated = false;
+  } turn_;
+  /// The finger tips' positions, one per operator tick (a ring), and the window over which the
+  /// person judges the tool still.
+  static constexpr int kHistory = 256;
+  struct TipHistory {
+    std::array<Eigen::Vector3d, kHistory> ring{};
+    int count = 0, window_ticks = 1;
+    const Eigen::Vector3d& back(int ago) const noexcept {
+      return ring[static_cast<std::size_t>((count - 1 - ago) % kHistory)];
+    }
+    void push(const Eigen::Vector3d& tip) noexcept {
+      ring[static_cast<std::size_t>(count % kHistory)] = tip;
+      ++count;
+    }
+  } tips_;
   Eigen::Vector2d tool_xy_ = Eigen::Vector2d::Zero();  // the finger tips, this tick
 };
 

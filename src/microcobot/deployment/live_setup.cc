@@ -1,8 +1,6 @@
 #include "microcobot/deployment/live_setup.h"
 
-#include <cctype>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include <fmt/format.h>
@@ -11,38 +9,16 @@
 #include "microcobot/cell/task_file.h"
 #include "microcobot/cell/task_io.h"
 #include "microcobot/core/error.h"
+#include "microcobot/core/field_names.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/core/params.h"
+#include "microcobot/platform/camera_scene.h"
 #include "microcobot/platform/platform_config.h"
 
 namespace mc::deployment {
 namespace {
 
 namespace pf = mc::platform;
-
-// Runs `work`; an InvalidParams naming `field` is re-thrown with the field replaced by `flag`
-// (the batch's seed is the --seed flag's value: the message blames what the user typed).
-template <class Work>
-void naming_flag(const std::string& field, const std::string& flag, Work&& work) {
-  try {
-    work();
-  } catch (const InvalidParams& e) {
-    std::string text = e.what();
-    const auto word = [](char c) {
-      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.';
-    };
-    for (std::size_t pos = 0; (pos = text.find(field, pos)) != std::string::npos;) {
-      const std::size_t end = pos + field.size();
-      if ((pos > 0 && word(text[pos - 1])) || (end < text.size() && word(text[end]) && text[end] != '.')) {
-        pos = end;
-        continue;
-      }
-      text.replace(pos, field.size(), flag);
-      pos += flag.size();
-    }
-    throw Error(e.exit_code(), text);
-  }
-}
 
 // `cell`: one part of a batch (its microworld becomes the scene) and the task the console
 // supervises on it, with the task file's autonomy and parameters.
@@ -55,7 +31,8 @@ void use_cell(const ServeConfig& o, live::LiveParams& lp, const Log& log) {
   if (part < 0 || part >= batch.parts)
     throw UsageError("--part " + std::to_string(part) + ": the batch has " + std::to_string(batch.parts) +
                      " parts (0 to " + std::to_string(batch.parts - 1) + ")");
-  naming_flag("seed", "--seed", [&] { batch.validate(); });
+  // The batch's seed is the --seed flag's value: the message blames what the user typed.
+  naming_fields({{"seed", "--seed"}}, [&] { batch.validate(); });
   const std::vector<cell::AssemblyJob> jobs = cell::assembly_jobs(batch);
   const cell::AssemblyJob& job = jobs[static_cast<std::size_t>(part)];
   live::LiveTaskParams tp;
@@ -109,18 +86,8 @@ live::LiveParams live_params(const ServeConfig& o, const Log& log) {
   const std::string scene = o.scene.value_or("pick-place");
   if (o.cell) {
     use_cell(o, lp, log);
-  } else if (scene == "pin-in-hole") {
-    lp.platform.world = microworld::pin_in_hole_scene();
-  } else if (scene == "optical-trap") {
-    pf::use_optical_trap_scene(lp.platform);
-  } else if (scene != "pick-place") {
-    // A scene file: the microworld's keys (part, hole, start, target, adhesion, gripper).
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(scene, ec))
-      throw InvalidInput("--scene '" + excerpt(scene) +
-                         "': neither a built-in scene (pick-place, pin-in-hole, optical-trap) nor a "
-                         "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
-    lp.platform.world = load_params<microworld::PickPlaceParams>(scene, lp.platform.world);
+  } else {
+    pf::use_scene(lp.platform, scene);
   }
   return lp;
 }

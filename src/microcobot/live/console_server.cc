@@ -12,7 +12,6 @@
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
-#include "microcobot/dsp/butterworth.h"
 #include "microcobot/live/camera_messages.h"
 #include "microcobot/live/console_page.h"
 #include "microcobot/live/console_task.h"
@@ -42,10 +41,6 @@ std::string schema(const json& properties, const std::vector<std::string>& requi
 
 EventLevel event_level(StatusLevel level) { return static_cast<EventLevel>(static_cast<int>(level)); }
 
-dsp::SosFilter rumble_filter(double fc_Hz) {
-  return dsp::SosFilter(dsp::linkwitz_riley(4, fc_Hz, kTelemetryRate_Hz, dsp::FilterType::kHighPass));
-}
-
 }  // namespace
 
 void ConsoleServerParams::validate() const {
@@ -67,9 +62,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       server_(params_.server, "microcobot",
               {{"/", {"text/html; charset=utf-8", console_page()}},
                {"/index.html", {"text/html; charset=utf-8", console_page()}}}),
-      rumble_x_(rumble_filter(params_.rumble_crossover_Hz)),
-      rumble_y_(rumble_filter(params_.rumble_crossover_Hz)),
-      rumble_z_(rumble_filter(params_.rumble_crossover_Hz)) {
+      rumble_(params_.rumble_crossover_Hz, kTelemetryRate_Hz, params_.rumble_full_scale_N) {
   decimation_ =
       static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
   telemetry_ch_ = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
@@ -260,10 +253,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
     ticks_.reset();
     ticks_cpu_.reset();
   }
-  const double hx = rumble_x_.process(s[kContactX]), hy = rumble_y_.process(s[kContactX + 1]),
-               hz = rumble_z_.process(s[kContactX + 2]);
-  rumble_sum_ += hx * hx + hy * hy + hz * hz;
-  ++rumble_n_;
+  rumble_.add(s[kContactX], s[kContactX + 1], s[kContactX + 2]);
   if (countdown_ > 0) {
     --countdown_;
     return;
@@ -273,10 +263,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   json_.clear();
   platform::telemetry_to_json(live_.telemetry_schema(), sample, json_);
   server_.publish(telemetry_ch_, ns, json_);  // recorded at full rate above
-  const double rms = rumble_n_ ? std::sqrt(rumble_sum_ / static_cast<double>(rumble_n_)) : 0.0;
-  rumble_sum_ = 0.0;
-  rumble_n_ = 0;
-  const double rumble = std::isfinite(rms) ? std::min(1.0, rms / params_.rumble_full_scale_N) : 0.0;
+  const double rumble = rumble_.take();
   auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
   const json f = {{"t_s", s[0]},
                   {"contact_N", {finite(s[kContactX]), finite(s[kContactX + 1]), finite(s[kContactX + 2])}},

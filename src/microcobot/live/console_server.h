@@ -28,9 +28,9 @@
 /// encoded and published on the drain thread (never on the loop), which hands it to the
 /// recording's own writer thread (encoding the 1 kHz stream, compressing, writing).
 ///
-/// The vibrotactile channel is the high band of the contact force, as the dual-stage
-/// interface's crossover splits it (ch. 3): an LR4 high-pass at `rumble_crossover_Hz` on the
-/// 1 kHz telemetry, its RMS over each 60 Hz frame, scaled so that `rumble_full_scale_N` is 1.
+/// The feedback topic's vibrotactile channel is the high band of the contact force
+/// (contact_rumble.h): an LR4 high-pass at `rumble_crossover_Hz` on the 1 kHz telemetry, its RMS
+/// over each 60 Hz frame, scaled so that `rumble_full_scale_N` is 1.
 
 #include <atomic>
 #include <cstdint>
@@ -44,9 +44,9 @@
 #include <thread>
 #include <vector>
 
-#include "microcobot/dsp/sos.h"
 #include "microcobot/live/camera_preview.h"
 #include "microcobot/live/camera_snapshot.h"
+#include "microcobot/live/contact_rumble.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
 #include "microcobot/live/session_recording.h"
@@ -140,9 +140,7 @@ class ConsoleServer {
 
   // Drain thread only.
   std::size_t decimation_ = 17, countdown_ = 0;
-  dsp::SosFilter rumble_x_, rumble_y_, rumble_z_;
-  double rumble_sum_ = 0.0;
-  std::size_t rumble_n_ = 0;
+  ContactRumble rumble_;  // the feedback's vibrotactile channel
   std::string json_;
   runtime::TimingStats ticks_;      // the telemetry's tick_us, per second
   runtime::TimingStats ticks_cpu_;  // its tick_cpu_us, per second

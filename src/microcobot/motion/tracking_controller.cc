@@ -48,15 +48,6 @@ void TrackingParams::validate() const {
   require_positive(powerup_ready_m, "tracking.powerup_ready_m");
 }
 
-namespace {
-/// Raised cosine from 0 (s <= 0) to 1 (s >= 1): zero slope at both ends (no velocity step).
-double blend(double s) noexcept {
-  if (s <= 0.0) return 0.0;
-  if (s >= 1.0) return 1.0;
-  return 0.5 - 0.5 * std::cos(std::numbers::pi * s);
-}
-}  // namespace
-
 TrackingController::TrackingController(const TrackingParams& p, const stickslip::StickSlipParams& model,
                                        const StepMap& map)
     : p_((p.validate(), p)),
@@ -66,17 +57,12 @@ TrackingController::TrackingController(const TrackingParams& p, const stickslip:
       slew_(model.drive.slew_rate_V_s),
       min_V_(model.drive.min_V),
       dt_c_(1.0 / p.control_rate_Hz),
-      obs_(stickslip::make_pi_state(model.hysteresis, 0.0)) {
-  // The damping's band-pass (RBJ cookbook, constant 0 dB peak gain), normalised by a0.
-  const double w0 = 2.0 * std::numbers::pi * p_.damp_Hz / p_.control_rate_Hz;
-  const double alpha = std::sin(w0) / (2.0 * p_.damp_q);
-  bp_b0_ = alpha / (1.0 + alpha);
-  bp_a1_ = -2.0 * std::cos(w0) / (1.0 + alpha);
-  bp_a2_ = (1.0 - alpha) / (1.0 + alpha);
+      obs_(stickslip::make_pi_state(model.hysteresis, 0.0)),
+      band_pass_(p_.damp_Hz, p_.damp_q, p_.control_rate_Hz) {
   require(p.sprint_low_V >= model.drive.min_V && p.high_V <= model.drive.max_V,
           "tracking.sprint_low_V/high_V", "must lie within the amplifier's range (drive.min_V..max_V)");
-  b_fwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward);
-  b_bwd_ = p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kBackward);
+  backslip_.set(p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kForward),
+                p_.unload_V > 0.0 ? p_.backslip_m : predicted_backslip_m(1000.0, Direction::kBackward));
   op_.amplitude_V = p_.high_V - p_.low_V;
   reset(0.0, 0.0);  // the amplifier at power-up
 }
@@ -118,17 +104,18 @@ void TrackingController::reset(double x_m, double u_V) noexcept {
   ref_ = ReferenceSample{x_m, 0.0, 0.0};
   y_anchor_ = pe_displacement_m(u_V);
   r_anchor_ = x_m;
-  corr_from_ = corr_ = corr_to_ = 0.0;
+  catch_up_.reset();
   since_edge_s_ = 1.0;
   integ_ = 0.0;
   x_filt_ = x_m;
   have_x_ = true;
-  edge_ = pending_anchor_ = check_backslip_ = sprint_ = false;
+  edge_ = pending_anchor_ = sprint_ = false;
+  backslip_.forget_outcome();
   stopped_ = false;
-  ramp_in_ = ramp_in_started_ = false;
-  powering_up_ = p_.powerup_V > 0.0 && u_V < p_.low_V;
-  powerup_t_ = 0.0;
-  bp_init_ = false;
+  powerup_.ramp_in = powerup_.ramp_in_started = false;
+  powerup_.under_way = p_.powerup_V > 0.0 && u_V < p_.low_V;
+  powerup_.settled_s = 0.0;
+  band_pass_.reset();
 }
 
 void TrackingController::emergency_stop() noexcept {
@@ -154,8 +141,7 @@ void TrackingController::start_edge(double x, bool forward) noexcept {
   if (forward) floor_V_ = low;
   unload_V_ = p_.unload_V * op_.amplitude_V / (p_.high_V - p_.low_V);
   unloading_ = false;
-  x_edge_ = x;
-  b_used_ = forward ? b_fwd_ : b_bwd_;
+  backslip_.edge_at(x, forward);
   ++edges_;
 }
 
@@ -172,23 +158,21 @@ void TrackingController::start_ramp_in(double x) noexcept {
   edge_target_V_ = p_.powerup_V + p_.powerup_unload_V;
   unload_V_ = p_.powerup_unload_V;
   unloading_ = false;
-  x_edge_ = x;
-  b_used_ = 0.0;
-  ramp_in_ = ramp_in_started_ = true;
+  backslip_.edge_at(x, false, 0.0);
+  powerup_.ramp_in = powerup_.ramp_in_started = true;
 }
 
 void TrackingController::anchor_after_edge() noexcept {
   // The slider kept its place but for the backslip: anchor the ramp there. The error the plan
   // now has (the reference moved on, the lead, the backslip) is caught up smoothly.
-  const double x_after = x_edge_ + (edge_forward_ ? -b_used_ : b_used_);
+  const double x_after = backslip_.landing_m();
   y_anchor_ = pe_displacement_m(u_);
   r_anchor_ = ref_.x_m;
-  corr_from_ = corr_ = 0.0;
-  corr_to_ = ref_.x_m - x_after;
+  catch_up_.restart(ref_.x_m - x_after);
   integ_ = 0.0;  // the anchor restarts the plan: the ramp's correction starts again from zero
   since_edge_s_ = 0.0;
   pending_anchor_ = false;
-  check_backslip_ = true;
+  backslip_.await_outcome();
 }
 
 void TrackingController::update(double x) noexcept {
@@ -199,48 +183,36 @@ void TrackingController::update(double x) noexcept {
   }
   x_filt_ += dt_c_ / (p_.filter_s + dt_c_) * (x - x_filt_);
   // The damping's band-pass runs on every sample (also during edges: it sees the slip).
-  if (!bp_init_) {
-    bp_x1_ = bp_x2_ = x;
-    bp_y1_ = bp_y2_ = 0.0;
-    bp_init_ = true;
-  }
-  const double bp = bp_b0_ * (x - bp_x2_) - bp_a1_ * bp_y1_ - bp_a2_ * bp_y2_;
-  bp_x2_ = bp_x1_;
-  bp_x1_ = x;
-  bp_y2_ = bp_y1_;
-  bp_y1_ = bp;
+  const double bp = band_pass_.step(x);
   in_position_ = ref_.v_m_s == 0.0 && std::abs(ref_.x_m - x_filt_) < p_.in_position_m;
-  if (powering_up_) {
-    if (!ramp_in_started_) {
+  if (powerup_.under_way) {
+    if (!powerup_.ramp_in_started) {
       start_ramp_in(x);
       return;
     }
     // Ready once the ramp-in and any edge the hold took after it to catch the drag up are
     // powerup_settle_s past, and the filtered error is small.
-    powerup_t_ = edge_ || pending_anchor_ ? 0.0 : powerup_t_ + dt_c_;
-    if (powerup_t_ >= p_.powerup_settle_s && std::abs(ref_.x_m - x_filt_) < p_.powerup_ready_m) {
-      powering_up_ = false;
+    powerup_.settled_s = edge_ || pending_anchor_ ? 0.0 : powerup_.settled_s + dt_c_;
+    if (powerup_.settled_s >= p_.powerup_settle_s && std::abs(ref_.x_m - x_filt_) < p_.powerup_ready_m) {
+      powerup_.under_way = false;
     }
   }
   if (edge_) return;  // the edge runs in next_drive()
   if (pending_anchor_) {
     anchor_after_edge();
-    if (ramp_in_) floor_V_ = p_.low_V;  // the drive is in range now
+    if (powerup_.ramp_in) floor_V_ = p_.low_V;  // the drive is in range now
   }
   since_edge_s_ += dt_c_;
-  corr_ = corr_from_ + (corr_to_ - corr_from_) * blend(since_edge_s_ / p_.catchup_s);
+  catch_up_.update(since_edge_s_ / p_.catchup_s);
   const double e = ref_.x_m - x;
-  const double e_plan = corr_to_ - corr_;  // the error the catch-up still expects
-  if (check_backslip_ && since_edge_s_ >= p_.settle_s) {
+  const double e_plan = catch_up_.remaining();  // the error the catch-up still expects
+  if (backslip_.awaiting_outcome() && since_edge_s_ >= p_.settle_s) {
     // The edge's outcome: the anchor was off by `miss` (measured). Refine the backslip estimate
     // and catch the miss up too (a second raised cosine from here).
-    check_backslip_ = false;
     const double miss = e - e_plan;
-    double& b = edge_forward_ ? b_fwd_ : b_bwd_;
-    if (!ramp_in_) b = std::max(0.0, b + p_.backslip_gain * (edge_forward_ ? miss : -miss));
-    ramp_in_ = false;
-    corr_from_ = corr_;
-    corr_to_ += miss;
+    backslip_.settle(miss, p_.backslip_gain, !powerup_.ramp_in);
+    powerup_.ramp_in = false;
+    catch_up_.add(miss);
     since_edge_s_ = 0.0;
   }
   // Sprint (the wider range) while the reference is fast or the axis has fallen behind it (at
@@ -257,26 +229,27 @@ void TrackingController::update(double x) noexcept {
   }
   // Lead before an edge: the ramp runs ahead of (forward) or behind (backward) the reference by a
   // growing fraction of the backslip, so the edge's jump is split around zero.
-  const double y_base = y_anchor_ + (ref_.x_m - r_anchor_) + corr_ + integ_;
+  const double y_base = y_anchor_ + (ref_.x_m - r_anchor_) + catch_up_.now() + integ_;
   const double top = pe_displacement_m(p_.high_V - p_.guard_V);
   const double bottom = pe_displacement_m(floor_V_ + p_.guard_V);
   // Where the lead stands is judged on the plan (anchor, reference, catch-up) when lead_on_plan
   // is set, not on y_base with its feedback (integral): in the lead window the lead grows by
   // (b + lead_m) / lead_window_m ~ 4 m per metre of y, which multiplies the feedback's own swing
   // by ~5 there and rings the loop at ~400 Hz (+-280 nm at 23 um/s backward).
-  const double y_lead = p_.lead_on_plan ? y_anchor_ + (ref_.x_m - r_anchor_) + corr_ : y_base;
+  const double y_lead = p_.lead_on_plan ? y_anchor_ + (ref_.x_m - r_anchor_) + catch_up_.now() : y_base;
   double lead = 0.0;
   if (ref_.v_m_s > 0.0) {
-    lead = (p_.lead_fraction * b_fwd_ + p_.lead_m) *
+    lead = (p_.lead_fraction * backslip_.of(true) + p_.lead_m) *
            std::clamp(1.0 - (top - y_lead) / p_.lead_window_m, 0.0, 1.0);
   } else if (ref_.v_m_s < 0.0) {
-    lead = -(p_.lead_fraction * b_bwd_ + p_.lead_m) *
+    lead = -(p_.lead_fraction * backslip_.of(false) + p_.lead_m) *
            std::clamp(1.0 - (y_lead - bottom) / p_.lead_window_m, 0.0, 1.0);
   }
   // Resonant damping of the contact's 1.64 kHz mode (see TrackingParams::damp_gain).
-  const double damp = p_.damp_gain * ((1.0 - p_.damp_lag_ticks) * bp + p_.damp_lag_ticks * bp_y2_);
+  const double damp =
+      p_.damp_gain * ((1.0 - p_.damp_lag_ticks) * bp + p_.damp_lag_ticks * band_pass_.previous());
   // The residual: the measured error minus the error the plan expects (catch-up still to go, lead).
-  const double e_res = e - (corr_to_ - corr_) + lead;
+  const double e_res = e - catch_up_.remaining() + lead;
   const double y_des = y_base + lead + p_.kp * e_res + damp;
   // An edge when the ramp runs out of range in the direction the reference moves, or, at rest,
   // when the wanted position lies beyond the range by more than the edge margin; never against
@@ -298,7 +271,7 @@ void TrackingController::update(double x) noexcept {
   // the residual pushes (anti-windup).
   const bool sat_hi = y_des >= pe_displacement_m(p_.high_V) && e_res > 0.0;
   const bool sat_lo = y_des <= pe_displacement_m(floor_V_) && e_res < 0.0;
-  if (!check_backslip_ && !sat_hi && !sat_lo) integ_ += p_.ki_1_s * dt_c_ * e_res;
+  if (!backslip_.awaiting_outcome() && !sat_hi && !sat_lo) integ_ += p_.ki_1_s * dt_c_ * e_res;
   u_prev_cmd_ = u_cmd_;
   u_cmd_ = inverse_V(y_des);
 }

@@ -31,6 +31,9 @@
 
 #include <cstdint>
 
+#include "microcobot/motion/backslip_estimate.h"
+#include "microcobot/motion/catch_up.h"
+#include "microcobot/motion/damping_band_pass.h"
 #include "microcobot/motion/reference.h"
 #include "microcobot/motion/step_map.h"
 #include "microcobot/stickslip/drive_segment.h"
@@ -204,12 +207,12 @@ class TrackingController {
   bool stopped() const noexcept { return stopped_; }
   /// False from a reset below low_V until the power-up ramp-in has settled (see powerup_V): a
   /// reference should rest until then. Always true with powerup_V = 0.
-  bool ready() const noexcept { return !powering_up_; }
+  bool ready() const noexcept { return !powerup_.under_way; }
   /// |filtered error| < in_position_m with the reference at rest.
   bool in_position() const noexcept { return in_position_; }
   /// Present backslip estimate [m] per direction (model prediction refined by the edges).
   double backslip_m(stickslip::Direction d) const noexcept {
-    return d == stickslip::Direction::kForward ? b_fwd_ : b_bwd_;
+    return backslip_.of(d == stickslip::Direction::kForward);
   }
   /// Model prediction of the backslip of an edge of the full range at `frequency_Hz`:
   /// g H(A) - s(A, f, direction) from the step map [m].
@@ -238,27 +241,25 @@ class TrackingController {
   ReferenceSample ref_;
   double u_ = 0.0, u_cmd_ = 0.0, u_prev_cmd_ = 0.0;
   double y_anchor_ = 0.0, r_anchor_ = 0.0, integ_ = 0.0;
-  double corr_from_ = 0.0, corr_ = 0.0, corr_to_ = 0.0;  ///< catch-up offset (raised cosine)
+  CatchUp catch_up_;  ///< the plan's offset after an edge
   double since_edge_s_ = 1.0;
-  double b_fwd_ = 0.0, b_bwd_ = 0.0;
-  double x_edge_ = 0.0, b_used_ = 0.0;
+  BackslipEstimate backslip_;  ///< per direction, refined by each edge's outcome
   double x_filt_ = 0.0;
   double edge_target_V_ = 0.0;
   double unload_V_ = 0.0;  ///< the present edge's unloading (unload_V scaled to its amplitude)
   /// The ramp's lowest voltage: low_V, or below it after power-up until the ramp rises through low_V
   /// or a forward edge lands there.
   double floor_V_ = 0.0;
-  bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false,
-       check_backslip_ = false;
+  bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false;
   bool stopped_ = false, in_position_ = false, have_x_ = false, sprint_ = false;
-  /// Power-up: ramp_in_ while its edge and catch-up run, powering_up_ until ready().
-  bool powering_up_ = false, ramp_in_ = false, ramp_in_started_ = false;
-  double powerup_t_ = 0.0;
+  /// The power-up (see powerup_V): under way until ready(); its ramp-in edge started, and running
+  /// with its catch-up; the time settled since.
+  struct PowerUp {
+    bool under_way = false, ramp_in = false, ramp_in_started = false;
+    double settled_s = 0.0;
+  } powerup_;
   std::int64_t edges_ = 0;
-  /// Resonant damping: the band-pass's coefficients and state (direct form I), last two outputs.
-  double bp_b0_ = 0.0, bp_a1_ = 0.0, bp_a2_ = 0.0;
-  double bp_x1_ = 0.0, bp_x2_ = 0.0, bp_y1_ = 0.0, bp_y2_ = 0.0;
-  bool bp_init_ = false;
+  DampingBandPass band_pass_;  ///< resonant damping: the measured position's band-pass
 };
 
 }  // namespace mc::motion

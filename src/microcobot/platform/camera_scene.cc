@@ -17,8 +17,7 @@ double channel(const TelemetrySample& s, std::string_view name) { return s[telem
 
 }  // namespace
 
-PlatformConfig scene_config(const std::string& scene) {
-  PlatformConfig c;
+void use_scene(PlatformConfig& c, const std::string& scene) {
   if (scene == "pin-in-hole") {
     c.world = microworld::pin_in_hole_scene();
   } else if (scene == "optical-trap") {
@@ -31,6 +30,11 @@ PlatformConfig scene_config(const std::string& scene) {
                          "scene file (a YAML file of the microworld's keys, e.g. scenes/pin-in-hole.yaml)");
     c.world = load_params<microworld::PickPlaceParams>(scene, c.world);
   }
+}
+
+PlatformConfig scene_config(const std::string& scene) {
+  PlatformConfig c;
+  use_scene(c, scene);
   return c;
 }
 

@@ -14,8 +14,11 @@
 
 namespace mc::platform {
 
-/// The configuration of a scene by name: "pick-place", "pin-in-hole", "optical-trap", or a YAML
-/// file of the microworld's keys (as `serve --scene`). Throws InvalidInput naming `scene`.
+/// Sets `config`'s scene by name: "pick-place" (the default world, left as it is), "pin-in-hole",
+/// "optical-trap", or a YAML file of the microworld's keys over `config.world` (as `serve
+/// --scene`). Throws InvalidInput naming `scene`.
+void use_scene(PlatformConfig& config, const std::string& scene);
+/// The default configuration with the scene `scene` (use_scene).
 PlatformConfig scene_config(const std::string& scene);
 
 /// What the renderer needs to form `camera`'s image through its objective `objective` (clamped to

@@ -31,6 +31,18 @@ report::Series series(std::string name, const std::vector<double>& x, const std:
   return s;
 }
 
+/// A PSD on log axes: its positive bins above DC.
+report::Series psd_series(std::string name, const dsp::Spectrum& psd) {
+  std::vector<double> f, p;
+  for (std::size_t i = 1; i < psd.f_Hz.size(); ++i) {
+    if (psd.value[i] > 0) {
+      f.push_back(psd.f_Hz[i]);
+      p.push_back(psd.value[i]);
+    }
+  }
+  return series(std::move(name), f, p);
+}
+
 }  // namespace
 
 void pe_section(report::Report& rep, const ss::MeasuredRecord& rec, const ss::PeModesResult& r) {
@@ -45,18 +57,11 @@ void pe_section(report::Report& rep, const ss::MeasuredRecord& rec, const ss::Pe
   rep.add_result("mode b damping ratio", r.b.damping_ratio);
   rep.add_result("gain fraction phi (mode a)", r.gain_fraction_a);
   rep.add_result("fit RMS residual", r.rms_m, "m");
-  std::vector<double> f, p;
-  for (std::size_t i = 1; i < r.psd.f_Hz.size(); ++i) {
-    if (r.psd.value[i] > 0) {
-      f.push_back(r.psd.f_Hz[i]);
-      p.push_back(r.psd.value[i]);
-    }
-  }
   rep.add_figure({"PSD of the PE free response",
                   "Resonance peaks seed the time-domain fit.",
                   {"Frequency", "Hz", true},
                   {"PSD", "m^2/Hz", true},
-                  {series("measured", f, p)}});
+                  {psd_series("measured", r.psd)}});
   rep.add_figure({"PE step response",
                   "Measured (with sensor effects) and identified model.",
                   {"Time", "s"},
@@ -79,18 +84,11 @@ void friction_section(report::Report& rep, const ss::MeasuredRecord& rec, const 
   rep.add_result("rho1_b", r.params.rho1_b_N_s_m, "N s/m");
   rep.add_result("mass fraction c_a", r.mass_fraction_a);
   rep.add_result("fit RMS residual", r.rms_m, "m");
-  std::vector<double> f, p;
-  for (std::size_t i = 1; i < r.psd.f_Hz.size(); ++i) {
-    if (r.psd.value[i] > 0) {
-      f.push_back(r.psd.f_Hz[i]);
-      p.push_back(r.psd.value[i]);
-    }
-  }
   rep.add_figure({"PSD of the actuator's free response",
                   "The two asperity modes.",
                   {"Frequency", "Hz", true},
                   {"PSD", "m^2/Hz", true},
-                  {series("measured", f, p)}});
+                  {psd_series("measured", r.psd)}});
   rep.add_figure({"Actuator step response (scanning mode)",
                   "Measured and identified elastic-phase model.",
                   {"Time", "s"},
