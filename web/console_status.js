@@ -264,6 +264,13 @@ function listRecordings() {
         const tr = document.createElement("tr");
         const name = document.createElement("td"), size = document.createElement("td"), links = document.createElement("td");
         name.textContent = rec.name;
+        if (rec.recovered) {  // left unfinished by a crash, recovered when serve started
+          const tag = document.createElement("span");
+          tag.className = "recovered";
+          tag.title = "left unfinished by an earlier run (a crash); recovered up to its last whole second";
+          tag.textContent = " recovered";
+          name.append(tag);
+        }
         size.textContent = rec.recording ? "" : (rec.bytes / 1e6).toFixed(1) + " MB";
         if (rec.recording) {
           links.textContent = "recording…";

@@ -250,6 +250,20 @@ TEST(TemplateTracker, LosesAPartThatLeavesTheFieldAndReacquiresItWhenItReturns) 
   EXPECT_NEAR(next.u_px, u0 - back_px - 0.5, 0.25);
 }
 
+TEST(TemplateTracker, SaysWhetherATemplatePredictedAtAPointFitsInTheFrame) {
+  Fixture f;
+  EXPECT_FALSE(TemplateTracker().fits(kW / 2.0, kH / 2.0, kW, kH)) << "no template: nothing fits";
+  TemplateTracker tracker = f.start();  // an 80 x 80 template: its centre 39.5 px from its left column
+  EXPECT_TRUE(tracker.fits(tracker.last().u_px, tracker.last().v_px, kW, kH)) << "where it was taken";
+  const double v = kH / 2.0;
+  EXPECT_TRUE(tracker.fits(39.5, v, kW, kH)) << "its left column on the frame's first";
+  EXPECT_FALSE(tracker.fits(38.5, v, kW, kH)) << "a pixel further left";
+  EXPECT_TRUE(tracker.fits(kW - 40.5, v, kW, kH)) << "its right column on the frame's last";
+  EXPECT_FALSE(tracker.fits(kW - 39.5, v, kW, kH));
+  EXPECT_FALSE(tracker.fits(kW / 2.0, -20.0, kW, kH)) << "above the top";
+  EXPECT_FALSE(tracker.fits(std::nan(""), v, kW, kH));
+}
+
 TEST(TemplateTracker, APredictionFindsAJumpBeyondTheSearchWindow) {
   Fixture f;
   TrackerParams p;

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/mcap_reader.h"
+#include "microcobot/core/mcap_recover.h"
 #include "microcobot/core/mcap_writer.h"
 
 namespace mc::mcap_detail {
@@ -99,6 +100,8 @@ class Parser {
 
   /// Parses and checks the whole file (throws InvalidInput).
   McapContents run();
+  /// Reads the data section up to its first cut or inconsistent record (mcap_salvage.cc).
+  McapSalvage salvage();
 
  private:
   // The record at `at`, which must end by `limit`.

@@ -206,6 +206,11 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std:
         fmt::format("message on unknown channel id {} ({} channels)", channel_id, channels_.size()));
   }
   ChannelState& ch = channels_[channel_id - 1u];
+  // A message a span or more after the open chunk's first: that chunk holds its span, and goes.
+  if (chunk_span_ns_ != 0 && !chunk_.empty() && log_time_ns >= chunk_start_ns_ + chunk_span_ns_) {
+    close_chunk();
+    flush_buffer();
+  }
   if (chunk_.empty()) {
     chunk_start_ns_ = chunk_end_ns_ = log_time_ns;
   } else {
@@ -228,7 +233,10 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std:
   chunk_.append(payload);
   ++ch.count;
   ++message_count_;
-  if (chunk_.size() >= chunk_target_) close_chunk();
+  if (chunk_.size() >= chunk_target_) {
+    close_chunk();
+    if (chunk_span_ns_ != 0) flush_buffer();
+  }
 }
 
 void McapWriter::close_chunk() {

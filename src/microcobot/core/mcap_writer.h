@@ -81,6 +81,12 @@ class McapWriter {
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
 
+  /// Also closes a chunk when a message comes `span_ns` or more of log time after its first, and
+  /// then writes the file through to the operating system, so that a writer that dies (a crash,
+  /// kill -9) leaves every chunk but the open one readable (core/mcap_recover.h). 0 (the
+  /// default): by size alone.
+  void set_chunk_max_span_ns(std::uint64_t span_ns) noexcept { chunk_span_ns_ = span_ns; }
+
   /// Adds a Schema record (e.g. encoding "jsonschema", data the JSON Schema text). Returns its
   /// id: 1, 2, ... (0 means "no schema" in MCAP).
   std::uint16_t add_schema(std::string_view name, std::string_view encoding, std::string_view data);
@@ -143,6 +149,7 @@ class McapWriter {
   std::filesystem::path path_;
   StagedFile file_;
   std::size_t chunk_target_;
+  std::uint64_t chunk_span_ns_ = 0;
   McapCompression compression_;
   std::string compressed_;     // the chunk's records, compressed
   std::string out_;            // bytes not yet written to file_

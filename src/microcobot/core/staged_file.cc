@@ -1,5 +1,7 @@
 #include "microcobot/core/staged_file.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -37,6 +39,17 @@ StagedFile::StagedFile(std::filesystem::path path) : path_(std::move(path)) {
     tmp_path_.clear();
     throw InvalidInput(path_.string(), 0, "cannot write: " + why_not_created(path_, err));
   }
+  // Held until the file is closed, released by the kernel when the process dies: a temporary
+  // found unlocked was left by a writer that crashed (staged_file_in_use).
+  ::flock(fd_, LOCK_EX | LOCK_NB);
+}
+
+bool staged_file_in_use(const std::filesystem::path& tmp) {
+  const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool locked = ::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // releases the lock this call may have taken
+  return locked;
 }
 
 StagedFile::~StagedFile() { discard(); }

@@ -16,6 +16,11 @@ namespace mc {
 /// "directory not writable", else strerror. For one-line errors that name what the user gave.
 std::string why_not_created(const std::filesystem::path& path, int err);
 
+/// Whether the temporary file `tmp` is held by a StagedFile still open in some process: each
+/// holds an advisory lock (flock) on its temporary, which the kernel releases when the process
+/// dies. A temporary that is not held was left by a writer that crashed.
+bool staged_file_in_use(const std::filesystem::path& tmp);
+
 class StagedFile {
  public:
   /// Creates the temporary file. Throws InvalidInput naming `path` when the directory is

@@ -10,6 +10,7 @@
 #include "microcobot/core/params.h"
 #include "microcobot/deployment/live_setup.h"
 #include "microcobot/deployment/remote_role.h"
+#include "microcobot/live/recording_recovery.h"
 #include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/microscope_link.h"
@@ -78,6 +79,17 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
   if (ec) throw InvalidInput("cannot create --out " + excerpt(o.out.string()) + ": " + ec.message());
   if (!std::filesystem::is_directory(o.out, ec))
     throw InvalidInput("--out " + excerpt(o.out.string()) + ": exists and is not a directory");
+  for (const live::RecoveredRecording& r : live::recover_unfinished_recordings(o.out)) {
+    if (!r.error.empty()) {
+      log_("could not recover " + r.from.string() + ", left by an earlier run: " + r.error);
+      continue;
+    }
+    log_(fmt::format("recovered {} from {}, left unfinished by an earlier run: {} messages over {:.1f} s{}",
+                     r.to.string(), r.from.filename().string(), r.messages, r.duration_s,
+                     r.lost_bytes == 0 ? std::string()
+                                       : fmt::format(" (its last {} bytes, a cut record, dropped)", r.lost_bytes)));
+    sp.recovered.push_back(r.to.stem().string());
+  }
 
   twin_token_ = sp.server.token;
   for (const auto& t : o.twins)

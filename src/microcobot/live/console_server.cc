@@ -190,7 +190,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
         params_.out_dir, [this] { return recording_->name(); },
         [this](StatusLevel level, const std::string& message) {
           server_.broadcast_status(level, message, "report");
-        });
+        },
+        params_.recovered);
   }
   server_.on_http_get([this](std::string_view path) -> std::optional<server::HttpReply> {
     if (snapshot_)

@@ -169,8 +169,8 @@ void LivePlatform::attach_camera(Platform& p) {
     camera_frames_.fetch_add(1, std::memory_order_relaxed);  // for the status
     perception::VisionGripForce::ToolHint hint;
     if (positioner_) {
-      // Measured before the frame is shown: the command's latency is the servo's, not the page's.
-      const double now = readings_.t_s();
+      // Before the frame is shown: the command's latency is the servo's, not the page's.
+      const auto now = [this] { return readings_.t_s(); };
       if (auto c = positioner_->on_frame(f, offset + f.t_mid_s, now)) console_->push_vision(*c);
       // Without x, y sensors the tips are looked for where the positioner sees the tool.
       const perception::PositionerStatus st = positioner_->status();

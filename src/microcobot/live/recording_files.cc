@@ -99,8 +99,12 @@ cell::RecordingStory recording_story(const McapContents& mcap) {
 }
 
 RecordingFiles::RecordingFiles(std::filesystem::path dir, std::function<std::string()> active,
-                               std::function<void(server::StatusLevel, const std::string&)> notify)
-    : dir_(std::move(dir)), active_(std::move(active)), notify_(std::move(notify)) {}
+                               std::function<void(server::StatusLevel, const std::string&)> notify,
+                               std::vector<std::string> recovered)
+    : dir_(std::move(dir)),
+      active_(std::move(active)),
+      notify_(std::move(notify)),
+      recovered_(std::move(recovered)) {}
 
 RecordingFiles::~RecordingFiles() { join(); }
 
@@ -219,7 +223,8 @@ std::string RecordingFiles::list_json() const {
                     {"url", "/recordings/" + name},
                     {"csv_url", has_csv ? json("/recordings/" + stem + ".csv") : json(nullptr)},
                     {"report_url", "/recordings/" + stem + ".html"},
-                    {"report_ready", has_report}});
+                    {"report_ready", has_report},
+                    {"recovered", std::find(recovered_.begin(), recovered_.end(), stem) != recovered_.end()}});
   }
   if (!active.empty()) {  // written under a temporary name until it is closed
     list.push_back({{"name", active},
@@ -228,7 +233,8 @@ std::string RecordingFiles::list_json() const {
                     {"url", nullptr},
                     {"csv_url", nullptr},
                     {"report_url", nullptr},
-                    {"report_ready", false}});
+                    {"report_ready", false},
+                    {"recovered", false}});
   }
   std::sort(list.begin(), list.end(), [](const json& a, const json& b) { return a["name"] > b["name"]; });
   return json{{"recordings", list}}.dump();

@@ -21,6 +21,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "microcobot/cell/session.h"
 #include "microcobot/core/mcap_reader.h"
@@ -39,9 +40,12 @@ class RecordingFiles {
   static constexpr std::size_t kReportSamples = 20000;
 
   /// `active()` names the MCAP file being written ("" when none): it is neither served nor
-  /// reported. `notify(level, message)` tells the clients (a report ready or failed).
+  /// reported. `notify(level, message)` tells the clients (a report ready or failed). The stems
+  /// in `recovered` (recordings this `serve` recovered at start, live/recording_recovery.h) are
+  /// listed with "recovered": true.
   RecordingFiles(std::filesystem::path dir, std::function<std::string()> active,
-                 std::function<void(server::StatusLevel, const std::string&)> notify);
+                 std::function<void(server::StatusLevel, const std::string&)> notify,
+                 std::vector<std::string> recovered = {});
   /// Waits for a report being made.
   ~RecordingFiles();
   RecordingFiles(const RecordingFiles&) = delete;
@@ -65,6 +69,7 @@ class RecordingFiles {
   std::filesystem::path dir_;
   std::function<std::string()> active_;
   std::function<void(server::StatusLevel, const std::string&)> notify_;
+  std::vector<std::string> recovered_;
   std::mutex mutex_;
   std::thread thread_;
   std::string reporting_;                      // the stem being made, empty when idle

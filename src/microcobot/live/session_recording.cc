@@ -110,6 +110,7 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"),
                                         params_.camera ? kCameraChunkBytes : McapWriter::kDefaultChunkBytes,
                                         McapCompression{true, kZstdLevel});
+  w->set_chunk_max_span_ns(kChunkSpan_ns);
   const auto add = [&](RecordedTopic t, const std::string& topic, const std::string& schema_name,
                        const std::string& schema) {
     channel_[index(t)] = w->add_channel(w->add_schema(schema_name, "jsonschema", schema), topic, "json");

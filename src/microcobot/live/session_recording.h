@@ -100,6 +100,11 @@ class SessionRecording {
   /// Chunks of a recording with images: several JPEG frames each (a 1280x1024 frame is a few
   /// hundred kB), so that a chunk is never a single frame.
   static constexpr std::size_t kCameraChunkBytes = std::size_t{8} << 20;
+  /// A chunk is closed and written through to the operating system every half second of
+  /// messages: a crash (kill -9) loses the open chunk and what waits in the writer's queue, under
+  /// a second (`serve` recovers the rest at start). Not synced to the disk: a power cut may also
+  /// lose what the system had not written yet.
+  static constexpr std::uint64_t kChunkSpan_ns = 500'000'000;
 
   explicit SessionRecording(SessionRecordingParams params);
   /// An unstopped recording is abandoned (its temporary files removed).

@@ -111,7 +111,7 @@ void VisionPositioner::take_goal(PositionerStatus& st) {
 }
 
 std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::CameraFrame& frame, double t_mid_s,
-                                                            double t_now_s) {
+                                                            const std::function<double()>& now) {
   if (!devices::to_grey_frame(frame.image, frame.sequence, frame_)) return std::nullopt;
   ++frames_;
   if (reset_.exchange(false, std::memory_order_acquire)) {
@@ -170,6 +170,9 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
       if (!tip_taught_[k]) continue;
       const Eigen::Vector2d tip_step = tip_step_px(k, frame.gripper_opening_m);
       const Eigen::Vector2d predicted = predicted_tool + tip_step + tip_offset_px_[k];
+      // A tip the commands took out of the image is left out, not searched for over the whole
+      // frame (tens of milliseconds on the camera thread, every frame, for nothing).
+      if (!trackers_[k].fits(predicted.x(), predicted.y(), width_, height_)) continue;
       const vision::TrackEstimate e = trackers_[k].track_near(frame_, predicted.x(), predicted.y());
       tool_k[k] = Eigen::Vector2d(e.u_px, e.v_px) - tip_offset_px_[k] - tip_step;
       if (e.found && (tool_k[k] - predicted_tool).norm() <= p_.tracker.search_margin_px)
@@ -220,6 +223,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
     // Exposed while the last run may still play: the slider is anywhere within a period's stroke.
   } else {
     // The run ends before the first exposure that starts late enough to leave it min_run_s.
+    const double t_now_s = now();
     const double T = 1.0 / rig_.camera.frame_rate_Hz();
     double next_start = frame_start_s + T;
     while (next_start - t_now_s - p_.margin_s < p_.min_run_s) next_start += T;

@@ -37,6 +37,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -93,11 +94,13 @@ class VisionPositioner {
   /// commands, no fault). Any thread; lock-free.
   void set_enabled(bool enabled) noexcept { enabled_.store(enabled, std::memory_order_relaxed); }
 
-  /// One frame (camera thread): `t_mid_s` its mid-exposure, `t_now_s` now, on one clock. The
-  /// command to ring to the loop, if any. Never throws: a goal outside the image or a template
-  /// that cannot be taken is reported in the status.
+  /// One frame (camera thread): `t_mid_s` its mid-exposure and `now()` the time, on one clock.
+  /// The clock is read once the tips are tracked: tracking takes milliseconds (tens when the
+  /// camera thread shares its core), and a run timed from before it would reach the loop after
+  /// its end. The command to ring to the loop, if any. Never throws: a goal outside the image or
+  /// a template that cannot be taken is reported in the status.
   std::optional<PositionerCommand> on_frame(const devices::CameraFrame& frame, double t_mid_s,
-                                            double t_now_s);
+                                            const std::function<double()>& now);
 
   /// A new scene: the stage back at its home, the template to be taught again, no goal. Any
   /// thread; taken at the next frame.

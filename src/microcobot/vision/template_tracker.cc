@@ -104,6 +104,8 @@ void TemplateTracker::set_template(const imaging::Frame& frame, const imaging::P
   images->frame_width = frame.width;
   images->frame_height = frame.height;
   images_ = std::move(images);
+  templ_width_ = roi.width;
+  templ_height_ = roi.height;
   last_ = {};
   last_.u_px = roi.x + 0.5 * (roi.width - 1);
   last_.v_px = roi.y + 0.5 * (roi.height - 1);
@@ -116,6 +118,14 @@ void TemplateTracker::set_template(const imaging::Frame& frame, const imaging::P
 TrackEstimate TemplateTracker::track(const imaging::Frame& frame) {
   const double u = last_.u_px + du_, v = last_.v_px + dv_;
   return track_around(frame, u, v, u, v, lost_);
+}
+
+bool TemplateTracker::fits(double u_px, double v_px, int width_px, int height_px) const noexcept {
+  if (!images_ || !std::isfinite(u_px) || !std::isfinite(v_px)) return false;
+  // Continuous pixel coordinates: the template's centre is (width - 1) / 2 from its left column.
+  const double left = u_px - 0.5 * (templ_width_ - 1), top = v_px - 0.5 * (templ_height_ - 1);
+  return left >= -0.5 && top >= -0.5 && left + templ_width_ <= width_px + 0.5 &&
+         top + templ_height_ <= height_px + 0.5;
 }
 
 TrackEstimate TemplateTracker::track_near(const imaging::Frame& frame, double u_px, double v_px) {

@@ -111,6 +111,10 @@ class TemplateTracker {
   /// that may stop it anywhere between where its drive puts it and where it was).
   TrackEstimate track_along(const imaging::Frame& frame, double u0_px, double v0_px, double u1_px,
                             double v1_px);
+  /// Whether the template centred at (u_px, v_px) lies wholly inside a `width_px` x `height_px`
+  /// frame (false without a template). Searching for a target predicted out of the frame is
+  /// a whole-frame search that cannot find it.
+  bool fits(double u_px, double v_px, int width_px, int height_px) const noexcept;
   /// The last estimate (the template's own position before the first track()).
   const TrackEstimate& last() const { return last_; }
 
@@ -121,6 +125,7 @@ class TemplateTracker {
   TrackerParams params_;
   std::unique_ptr<Images> images_;
   TrackEstimate last_;
+  int templ_width_ = 0, templ_height_ = 0;
   double du_ = 0.0, dv_ = 0.0;  // the last frame-to-frame displacement (prediction)
   bool lost_ = false;
 };
