@@ -5,12 +5,14 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <map>
 #include <thread>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -131,31 +133,48 @@ TEST(SessionRecording, TheCsvIsWrittenOnlyWhenAsked) {
   EXPECT_EQ(table.names().size(), kChannels);
 }
 
-TEST(SessionRecording, AFailedWriteLeavesNothingAndIsReported) {
+TEST(SessionRecording, AFullDiskEndsTheRecordingReadableUpToItsLastChunkAndIsReported) {
   test::TempDir dir;
   std::atomic<int> errors{0};
+  std::string why;
   auto p = params(dir.path(), true);
-  p.on_error = [&](const std::string&) { errors.fetch_add(1); };
+  p.on_error = [&](const std::string& w) {
+    why = w;
+    errors.fetch_add(1);
+  };
   SessionRecording rec(std::move(p));
-  // The disk "full" at 64 KiB per file: writes fail with EFBIG (the signal that would kill the
+  // The disk "full" at 256 KiB per file (a few half-second chunks): writes fail with EFBIG (the signal that would kill the
   // process instead is ignored), even for root, whom permissions would not stop.
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   rlimit old{};
   ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
   rlimit small = old;
-  small.rlim_cur = 64 * 1024;
+  small.rlim_cur = 256 * 1024;
   ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
   rec.start(0.0, "{}");
-  // Enough telemetry for the writer to flush its first MiB: it fails there, abandons the files.
+  // Telemetry until a half-second chunk no longer fits: the writer fails there, cuts the file
+  // back to its last whole chunk and closes it; the CSV file is removed.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   for (int i = 0; errors.load() == 0 && std::chrono::steady_clock::now() < deadline; ++i) {
     rec.telemetry(sample(0.001 * i), kChannels);
     if (i % 1000 == 999) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   EXPECT_EQ(errors.load(), 1);
+  EXPECT_THAT(why, HasSubstr("disk full"));
+  EXPECT_THAT(why, HasSubstr("kept up to its last half second"));
   EXPECT_EQ(rec.name(), "");
   EXPECT_NO_THROW(rec.stop());  // already reported
-  EXPECT_TRUE(fs::is_empty(dir.path()));
+  std::vector<fs::path> left;
+  for (const auto& e : fs::directory_iterator(dir.path())) left.push_back(e.path());
+  ASSERT_EQ(left.size(), 1u) << "the MCAP file alone, under its name";
+  EXPECT_EQ(left[0].extension(), ".mcap");
+  const McapContents kept = read_mcap(left[0]);  // whole, indexed
+  const auto telemetry = std::count_if(kept.messages.begin(), kept.messages.end(), [&](const McapMessage& m) {
+    return kept.channel(m.channel_id)->topic == "/platform/telemetry";
+  });
+  EXPECT_GE(telemetry, 500) << "at least one half-second chunk of 1 kHz telemetry";
+  EXPECT_EQ(telemetry % 500, 0) << "whole half-second chunks";
+  fs::remove(left[0]);
   // No room at all: the files cannot be written when the recording starts or closes; either
   // throws and nothing remains.
   small.rlim_cur = 1;

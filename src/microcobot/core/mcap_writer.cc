@@ -210,6 +210,7 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std:
   if (chunk_span_ns_ != 0 && !chunk_.empty() && log_time_ns >= chunk_start_ns_ + chunk_span_ns_) {
     close_chunk();
     flush_buffer();
+    take_checkpoint();
   }
   if (chunk_.empty()) {
     chunk_start_ns_ = chunk_end_ns_ = log_time_ns;
@@ -235,8 +236,68 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std:
   ++message_count_;
   if (chunk_.size() >= chunk_target_) {
     close_chunk();
-    if (chunk_span_ns_ != 0) flush_buffer();
+    if (chunk_span_ns_ != 0) {
+      flush_buffer();
+      take_checkpoint();
+    }
   }
+}
+
+void McapWriter::set_chunk_max_span_ns(std::uint64_t span_ns) {
+  chunk_span_ns_ = span_ns;
+  if (span_ns == 0) return;
+  close_chunk();
+  flush_buffer();  // a file that cannot take its header is discarded, as any
+  file_.keep_on_failure();
+  take_checkpoint();
+}
+
+void McapWriter::take_checkpoint() {
+  Checkpoint& c = checkpoint_;
+  c.position = flushed_;
+  c.data_crc = data_crc_;
+  c.schemas = schemas_.size();
+  c.channels = channels_.size();
+  c.chunks = chunk_indexes_.size();
+  c.indexes = indexes_.size();
+  c.attachments = attachment_count_;
+  c.metadata = metadata_count_;
+  c.messages = message_count_;
+  c.start_ns = start_ns_;
+  c.end_ns = end_ns_;
+  c.records_bytes = records_bytes_;
+  c.stored_bytes = stored_bytes_;
+  c.channel_counts.resize(channels_.size());
+  for (std::size_t i = 0; i < channels_.size(); ++i) c.channel_counts[i] = channels_[i].count;
+}
+
+std::uint64_t McapWriter::close_at_last_chunk() {
+  if (chunk_span_ns_ == 0) throw InvalidInput(path_.string(), 0, "close_at_last_chunk needs a chunk span");
+  const Checkpoint& c = checkpoint_;
+  file_.truncate(c.position);
+  flushed_ = c.position;
+  out_.clear();
+  chunk_.clear();
+  data_crc_ = c.data_crc;
+  schemas_.resize(c.schemas);
+  channels_.resize(c.channels);
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    channels_[i].count = c.channel_counts[i];
+    channels_[i].index.clear();
+  }
+  chunk_indexes_.resize(c.chunks);
+  indexes_.resize(c.indexes);
+  attachment_count_ = c.attachments;
+  metadata_count_ = c.metadata;
+  message_count_ = c.messages;
+  start_ns_ = c.start_ns;
+  end_ns_ = c.end_ns;
+  records_bytes_ = c.records_bytes;
+  stored_bytes_ = c.stored_bytes;
+  in_data_ = true;
+  closed_ = false;
+  close();
+  return message_count_;
 }
 
 void McapWriter::close_chunk() {

@@ -85,7 +85,14 @@ class McapWriter {
   /// then writes the file through to the operating system, so that a writer that dies (a crash,
   /// kill -9) leaves every chunk but the open one readable (core/mcap_recover.h). 0 (the
   /// default): by size alone.
-  void set_chunk_max_span_ns(std::uint64_t span_ns) noexcept { chunk_span_ns_ = span_ns; }
+  /// With a span, a failed write keeps the file for close_at_last_chunk() (StagedFile::keep_on_failure).
+  void set_chunk_max_span_ns(std::uint64_t span_ns);
+  /// After a failed write (a full disk) of a writer with a chunk span: cuts the file back to the
+  /// last chunk written through and closes it there (DataEnd, summary, renamed to its name), so
+  /// it is a readable recording of everything up to that chunk. Returns the messages kept. When
+  /// even that cannot be written, throws InvalidInput and leaves the temporary, whose whole
+  /// chunks a recovery reads (core/mcap_recover.h).
+  std::uint64_t close_at_last_chunk();
 
   /// Adds a Schema record (e.g. encoding "jsonschema", data the JSON Schema text). Returns its
   /// id: 1, 2, ... (0 means "no schema" in MCAP).
@@ -136,6 +143,7 @@ class McapWriter {
   };
 
   std::uint64_t position() const { return flushed_ + out_.size(); }
+  void take_checkpoint();  // the state after the last chunk written through
   void put(std::string_view bytes);  // to the file (buffered); CRC'd while in the data section
   void put_record(McapOpcode op, std::string_view content);
   void flush_buffer();
@@ -169,6 +177,18 @@ class McapWriter {
   std::uint64_t message_count_ = 0;
   std::uint64_t start_ns_ = 0, end_ns_ = 0;
   bool closed_ = false;
+
+  // What close_at_last_chunk() goes back to: the file and the summary's state after the last
+  // chunk written through.
+  struct Checkpoint {
+    std::uint64_t position = 0;
+    std::uint32_t data_crc = 0;
+    std::size_t schemas = 0, channels = 0, chunks = 0, indexes = 0;
+    std::uint32_t attachments = 0, metadata = 0;
+    std::uint64_t messages = 0, start_ns = 0, end_ns = 0, records_bytes = 0, stored_bytes = 0;
+    std::vector<std::uint64_t> channel_counts;
+  };
+  Checkpoint checkpoint_;
 };
 
 }  // namespace mc

@@ -26,6 +26,14 @@ std::string why_not_created(const std::filesystem::path& path, int err) {
   return std::strerror(err);
 }
 
+namespace {
+// "disk full" for ENOSPC and EDQUOT (and EFBIG: the file size limit), else strerror.
+std::string why_write_failed(int err) {
+  if (err == ENOSPC || err == EDQUOT || err == EFBIG) return "write failed: disk full (" + std::string(std::strerror(err)) + ")";
+  return "write failed: " + std::string(std::strerror(err));
+}
+}  // namespace
+
 StagedFile::StagedFile(std::filesystem::path path) : path_(std::move(path)) {
   if (path_.filename().string().size() > NAME_MAX)
     throw InvalidInput(path_.string(), 0, "cannot write: " + why_not_created(path_, ENAMETOOLONG));
@@ -52,7 +60,13 @@ bool staged_file_in_use(const std::filesystem::path& tmp) {
   return locked;
 }
 
-StagedFile::~StagedFile() { discard(); }
+StagedFile::~StagedFile() {
+  if (keep_on_failure_ && failed_) {
+    if (fd_ >= 0) ::close(fd_);  // the temporary stays, for a recovery
+    return;
+  }
+  discard();
+}
 
 void StagedFile::discard() noexcept {
   if (fd_ >= 0) ::close(fd_);
@@ -62,8 +76,23 @@ void StagedFile::discard() noexcept {
 }
 
 void StagedFile::fail(const std::string& what) {
+  if (keep_on_failure_ && !tmp_path_.empty()) {
+    failed_ = true;
+    // What the failed call wrote in part goes: the file ends where the last whole call did.
+    if (fd_ >= 0 && ::ftruncate(fd_, static_cast<off_t>(size_)) == 0)
+      ::lseek(fd_, static_cast<off_t>(size_), SEEK_SET);
+    throw InvalidInput(path_.string(), 0, what);
+  }
   discard();
   throw InvalidInput(path_.string(), 0, what);
+}
+
+void StagedFile::truncate(std::uint64_t size) {
+  if (fd_ < 0) throw InvalidInput(path_.string(), 0, committed_ ? "truncated after it was closed" : "abandoned");
+  if (::ftruncate(fd_, static_cast<off_t>(size)) != 0 ||
+      ::lseek(fd_, static_cast<off_t>(size), SEEK_SET) != static_cast<off_t>(size))
+    fail(std::string("cannot cut the file: ") + std::strerror(errno));
+  size_ = size;
 }
 
 void StagedFile::write(std::string_view bytes) {
@@ -73,16 +102,17 @@ void StagedFile::write(std::string_view bytes) {
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail("write failed (disk full or not writable)");
+    if (n <= 0) fail(why_write_failed(n < 0 ? errno : ENOSPC));
     done += static_cast<std::size_t>(n);
   }
+  size_ += bytes.size();
 }
 
 void StagedFile::commit() {
   if (committed_) return;
   if (fd_ < 0) throw InvalidInput(path_.string(), 0, "abandoned");
-  bool ok = ::fsync(fd_) == 0;
-  ok = (::close(fd_) == 0) && ok;
+  if (::fsync(fd_) != 0) fail(why_write_failed(errno));  // a full disk may show only here
+  bool ok = ::close(fd_) == 0;
   fd_ = -1;
   // mkstemp creates 0600; output files are meant to be shared like any other.
   ok = ok && ::chmod(tmp_path_.c_str(), 0644) == 0;

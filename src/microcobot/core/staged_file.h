@@ -5,6 +5,7 @@
 /// failed write, an exception unwinding, a cut run) leaves nothing. The streaming writers (MCAP,
 /// CSV) and write_file_atomic are built on it.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -34,6 +35,15 @@ class StagedFile {
   /// Writes all of `bytes`. On failure (disk full) the file is discarded and InvalidInput
   /// naming `path` is thrown; so is writing to a file committed or discarded.
   void write(std::string_view bytes);
+  /// From now on a failed write or commit keeps the temporary instead: cut back to what was
+  /// written before the failed call, still open (the owner may truncate() it and write again),
+  /// and left in place when destroyed after a failure (a writer of whole records leaves a file
+  /// whose records can be recovered: core/mcap_recover.h).
+  void keep_on_failure() noexcept { keep_on_failure_ = true; }
+  /// Cuts the file to its first `size` bytes and writes on from there. Throws InvalidInput.
+  void truncate(std::uint64_t size);
+  /// Bytes written so far.
+  std::uint64_t size() const { return size_; }
   /// Syncs, makes the file readable by all (0644, as any output) and renames it to `path`.
   /// Throws InvalidInput (the file discarded) when any of that fails. Idempotent.
   void commit();
@@ -49,7 +59,10 @@ class StagedFile {
   std::filesystem::path path_;
   std::string tmp_path_;
   int fd_ = -1;
+  std::uint64_t size_ = 0;
   bool committed_ = false;
+  bool keep_on_failure_ = false;
+  bool failed_ = false;
 };
 
 }  // namespace mc

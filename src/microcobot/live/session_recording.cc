@@ -305,18 +305,30 @@ void SessionRecording::writer_thread() {
 }
 
 void SessionRecording::abandon(const std::string& why) {
-  // Destroyed unclosed, the staged files remove their temporaries: nothing half-written stays.
+  // A failed write (a full disk): the MCAP file cut back to its last chunk written through and
+  // closed there, a readable recording up to that half second; when even that cannot be written
+  // its temporary stays, and the next serve recovers its whole chunks. The CSV file is removed.
+  std::string kept;
+  if (mcap_) {
+    const std::string file = mcap_->path().filename().string();
+    try {
+      const std::uint64_t n = mcap_->close_at_last_chunk();
+      kept = fmt::format("; {} kept up to its last half second ({} messages)", file, n);
+    } catch (const std::exception&) {
+      kept = "; " + file + " left unfinished: serve recovers it at its next start";
+    }
+  }
   mcap_.reset();
   csv_.reset();
   {
     std::lock_guard lock(mutex_);
     active_ = false;
-    error_ = why;
+    error_ = why + kept;
     queue_.clear();
     queued_bytes_ = 0;
     name_.clear();
   }
-  if (params_.on_error) params_.on_error(why);
+  if (params_.on_error) params_.on_error(why + kept);
 }
 
 }  // namespace mc::live
