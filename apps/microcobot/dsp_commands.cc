@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <cstdio>
 #include <utility>
@@ -55,12 +56,26 @@ mc::dsp::WelchOptions to_options(const WelchFlags& w) {
   return o;
 }
 
-/// Runs a Welch estimate of the columns `x` (and `y`) of `file`: an overflowing spectrum is named by
-/// the file and column the user gave, not by the library's argument (x, y).
+/// Runs a Welch estimate of the columns `x` (and `y`) of `file`: an overflowing spectrum or a
+/// signal too short is named by the file and column the user gave, a bad option by its flag, not
+/// by the library's names (x, y, fs_Hz).
 template <class F>
 auto naming_columns(const std::string& file, const std::string& x, const std::string& y, F&& estimate) {
   try {
-    return estimate();
+    std::optional<decltype(estimate())> result;
+    mc::cli::naming_flags({{"fs_Hz", "--fs"}, {"nperseg", "--nperseg"}, {"noverlap", "--noverlap"}, {"nfft", "--nfft"}},
+                          [&] {
+                            try {
+                              result.emplace(estimate());
+                            } catch (const mc::InvalidParams& e) {
+                              if (e.field() != "x" && e.field() != "y") throw;
+                              const std::string what = e.what(), head = "invalid parameter " + e.field() + ": ";
+                              throw mc::InvalidInput(fmt::format(
+                                  "{}: column '{}': {}", file, mc::excerpt(e.field() == "x" ? x : y),
+                                  what.rfind(head, 0) == 0 ? what.substr(head.size()) : what));
+                            }
+                          });
+    return std::move(*result);
   } catch (const mc::dsp::SpectrumOverflow& e) {
     throw mc::ComputationFailed(fmt::format(
         "{}: column '{}': the power spectrum overflows (values up to {:g}; their squares exceed the largest "
@@ -242,7 +257,10 @@ void add_dsp(CLI::App& group) {
       fo.np = o->np;
       fo.fmin_Hz = o->fmin;
       fo.fmax_Hz = o->fmax;
-      const auto fit = mc::ident::fit_tf(table.column("f_Hz"), read_frf(table), fo);
+      std::optional<mc::ident::TfFitResult> fitted;
+      mc::cli::naming_flags({{"fmin_Hz", "--fmin"}, {"fmax_Hz", "--fmax"}, {"h", o->in + ": columns re, im"}},
+                            [&] { fitted = mc::ident::fit_tf(table.column("f_Hz"), read_frf(table), fo); });
+      const mc::ident::TfFitResult& fit = *fitted;
       const nlohmann::json j{{"num", fit.tf.num()},
                              {"den", fit.tf.den()},
                              {"relative_rms_error", fit.relative_rms_error},
@@ -290,6 +308,9 @@ void add_dsp(CLI::App& group) {
       if (hi <= 0) {
         for (double v : f) hi = std::max(hi, v);
       }
+      // Data at DC alone (or no positive frequency) have no band to average.
+      if (o->fmin <= 0 && !std::isfinite(lo))
+        throw mc::InvalidInput(o->in, 0, "column 'f_Hz': no positive frequency (an octave band needs one above 0 Hz)");
       if (!(hi > lo)) {
         // Name what was given: a flag, or the data's end it defaulted to.
         const std::string lo_what = o->fmin > 0 ? "--fmin" : "the data's lowest frequency";

@@ -48,6 +48,8 @@ void refuse_save_onto_input(const Opts& o) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path save(o.save), in(o.in);
+  if (fs::is_directory(save, ec))
+    throw mc::UsageError("--save '" + mc::excerpt(o.save) + "' is a directory: name the YAML file to write");
   if (fs::equivalent(save, in, ec)) {
     throw mc::UsageError("--save '" + o.save +
                          "' is the --in file: writing the parameters there would replace the measurement");

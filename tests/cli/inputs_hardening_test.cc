@@ -10,6 +10,7 @@
 #include <csignal>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -117,6 +118,46 @@ TEST(InputsHardening, OverflowingSpectraFailNamingTheFileAndColumn) {
     const auto err = expect_error({"identify", verb, "--in", big}, 3, "big.csv: column 'x_m'");
     EXPECT_THAT(err, Not(HasSubstr("find_peaks")));
   }
+}
+
+TEST(InputsHardening, ErrorsBlameTheFlagOrColumnAtFault) {
+  TempDir d;
+  std::string sig = "t_s,y\n", one = "t_s,y\n0,1\n", zero = "f_Hz,re,im\n", dc = "f_Hz,re,im\n0,1,0\n";
+  for (int i = 0; i < 2000; ++i) sig += std::to_string(i * 1e-3) + "," + std::to_string(std::sin(0.3 * i)) + "\n";
+  for (int i = 1; i <= 50; ++i) zero += std::to_string(2.0 * i) + ",0,0\n";
+  // A step response whose position is fine and whose drive holds 1e308 V once.
+  std::string step = "t_s,u_V,x_m\n";
+  for (int i = 0; i < 7500; ++i) {
+    const double t = i * 4e-5, on = t > 0.002 ? 1.0 : 0.0;
+    const double x = on * 1e-7 * (1 - std::exp(-(t - 0.002) * 30) * std::cos(2 * M_PI * 55 * (t - 0.002)));
+    step += fmt::format("{},{},{}\n", t, i == 1000 ? 1e308 : 50.0 * on, x);
+  }
+  write_text(d / "sig.csv", sig);
+  write_text(d / "one.csv", one);
+  write_text(d / "zero.csv", zero);
+  write_text(d / "dc.csv", dc);
+  write_text(d / "step.csv", step);
+  // A rate near the smallest double overflows the density: --fs, not the spectrum's values.
+  auto err = expect_error({"dsp", "welch", "--in", (d / "sig.csv").string(), "--column", "y", "--fs", "1e-310"}, 3,
+                          "--fs: too small");
+  EXPECT_THAT(err, Not(HasSubstr("overflows (values")));
+  // One sample: the file and column, not the library's argument "x".
+  err = expect_error({"dsp", "welch", "--in", (d / "one.csv").string(), "--column", "y", "--fs", "1000"}, 3,
+                     "one.csv: column 'y': signal must have at least 2 samples");
+  EXPECT_THAT(err, Not(HasSubstr("parameter x")));
+  // A response zero everywhere: the data, not --fmin.
+  err = expect_error({"dsp", "tffit", "--in", (d / "zero.csv").string()}, 3, "the response is zero at 50");
+  EXPECT_THAT(err, Not(HasSubstr("fmin")));
+  // Data at DC alone: no band, not an infinite lowest frequency.
+  err = expect_error({"dsp", "octave", "--in", (d / "dc.csv").string()}, 3, "no positive frequency");
+  EXPECT_THAT(err, Not(HasSubstr("inf")));
+  // The drive's column holds the absurd value: u_V is blamed, not x_m.
+  expect_error({"identify", "friction-modes", "--in", (d / "step.csv").string()}, 3, "column 'u_V'");
+  // --save naming a directory: said so, not "disk full".
+  fs::create_directory(d / "dir");
+  err = expect_error({"identify", "friction-modes", "--in", (d / "step.csv").string(), "--save", (d / "dir").string()},
+                     2, "is a directory");
+  EXPECT_THAT(err, Not(HasSubstr("disk full")));
 }
 
 TEST(InputsHardening, SaveOntoTheMeasurementIsRefused) {

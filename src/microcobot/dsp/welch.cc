@@ -42,6 +42,16 @@ void require_finite_spectrum(const std::vector<T>& p, const char* signal, std::s
   }
 }
 
+// A spectrum that overflows although the data's periodogram cannot (|X|^2 <= (n max|x|)^2, finite)
+// was made so by the density's scale 1 / (fs S2): a sampling rate near the smallest double.
+template <class T>
+void require_finite_scaling(const std::vector<T>& p, std::span<const double> data, std::size_t n, double fs_Hz) {
+  if (std::all_of(p.begin(), p.end(), [](const T& v) { return std::isfinite(std::abs(v)); })) return;
+  const double bound = max_abs(data) * static_cast<double>(n);
+  if (std::isfinite(bound * bound))
+    throw InvalidParams("fs_Hz", "too small: the spectral density |X|^2 / (fs_Hz sum(w^2)) overflows", fs_Hz);
+}
+
 }  // namespace
 
 Detrend parse_detrend(const std::string& text) {
@@ -127,6 +137,10 @@ WelchEstimator::WelchEstimator(const WelchOptions& options, std::size_t signal_l
     sum2 += w * w;
   }
   m.scale = m.opt.scaling == Scaling::kDensity ? 1.0 / (m.opt.fs_Hz * sum2) : 1.0 / (sum * sum);
+  // The density's scale 1 / (fs S2) overflows for a sampling rate near the smallest double: the
+  // rate is wrong, not the data.
+  require(std::isfinite(m.scale), "fs_Hz", "too small: the density's scale 1 / (fs_Hz sum(w^2)) overflows",
+          options.fs_Hz);
   const std::size_t nfft = m.opt.nfft;
   m.nout = m.opt.onesided ? nfft / 2 + 1 : nfft;
   m.f.resize(m.nout);
@@ -162,6 +176,7 @@ std::vector<double> WelchEstimator::psd(std::span<const double> x) {
   }
   const double inv = 1.0 / static_cast<double>(m.nseg);
   for (std::size_t k = 0; k < m.nout; ++k) p[k] *= m.factor(k) * inv;
+  require_finite_scaling(p, x, m.opt.nperseg, m.opt.fs_Hz);
   require_finite_spectrum(p, "x", x);
   return p;
 }
@@ -197,6 +212,8 @@ void WelchEstimator::all(std::span<const double> x, std::span<const double> y, s
     pyy[k] *= g;
     pxy[k] *= g;
   }
+  require_finite_scaling(pxx, x, m.opt.nperseg, m.opt.fs_Hz);
+  require_finite_scaling(pyy, y, m.opt.nperseg, m.opt.fs_Hz);
   require_finite_spectrum(pxx, "x", x);
   require_finite_spectrum(pyy, "y", y);
   // Both finite, their cross spectrum is bounded by sqrt(Pxx Pyy) up to rounding; checked all the same.

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 
 #include "microcobot/core/error.h"
@@ -219,8 +221,18 @@ TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<do
       wmax = std::max(wmax, 2 * std::numbers::pi * f_Hz[k]);
     }
   }
-  require(2 * used.size() >= static_cast<std::size_t>(o.nz + 1 + o.np) + 1, "fmin_Hz",
-          "too few frequency points in the band for the model order", static_cast<double>(used.size()));
+  // Points left out for a zero response are the data's fault, not the band's.
+  std::size_t in_band = 0;
+  for (std::size_t k = 0; k < f_Hz.size(); ++k) in_band += f_Hz[k] >= o.fmin_Hz && f_Hz[k] <= o.fmax_Hz && f_Hz[k] > 0;
+  const auto needed = static_cast<std::size_t>(o.nz + 1 + o.np) + 1;
+  if (2 * in_band >= needed)
+    require(2 * used.size() >= needed, "h",
+            fmt::format("the response is zero at {} of the band's {} frequencies: too few left for the model "
+                        "order",
+                        in_band - used.size(), in_band),
+            static_cast<double>(used.size()));
+  require(2 * used.size() >= needed, "fmin_Hz", "too few frequency points in the band for the model order",
+          static_cast<double>(used.size()));
   const double w0 = discrete ? 1.0 : wmax;  // continuous: x = j w / w0
   for (std::size_t k : used) {
     const double w = 2 * std::numbers::pi * f_Hz[k];

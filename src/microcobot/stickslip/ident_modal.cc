@@ -111,8 +111,15 @@ ModePeaks dynamic_response_peaks(const MeasuredRecord& rec, const std::vector<do
   // static fit or the spectrum: named by the record's column, not by the peak finder that
   // would meet the infinities.
   const auto overflow = [&] {
-    double top = 0.0;
+    double top = 0.0, top_u = 0.0;
     for (double x : rec.x_m) top = std::max(top, std::abs(x));
+    for (double u : rec.u_V) top_u = std::max(top_u, std::abs(u));
+    // Positions within a metre (any positioner's) and a voltage beyond any amplifier's: the input.
+    if (top <= 1.0 && top_u > 1e150)
+      return InvalidInput(rec.source, 0,
+                          fmt::format("column 'u_V': the static fit overflows (values up to {:g} V): not a "
+                                      "measured voltage",
+                                      top_u));
     return InvalidInput(
         rec.source, 0,
         fmt::format("column 'x_m': the response's power spectrum overflows (values up to {:g} m): "
