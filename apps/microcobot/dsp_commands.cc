@@ -63,18 +63,18 @@ template <class F>
 auto naming_columns(const std::string& file, const std::string& x, const std::string& y, F&& estimate) {
   try {
     std::optional<decltype(estimate())> result;
-    mc::cli::naming_flags({{"fs_Hz", "--fs"}, {"nperseg", "--nperseg"}, {"noverlap", "--noverlap"}, {"nfft", "--nfft"}},
-                          [&] {
-                            try {
-                              result.emplace(estimate());
-                            } catch (const mc::InvalidParams& e) {
-                              if (e.field() != "x" && e.field() != "y") throw;
-                              const std::string what = e.what(), head = "invalid parameter " + e.field() + ": ";
-                              throw mc::InvalidInput(fmt::format(
-                                  "{}: column '{}': {}", file, mc::excerpt(e.field() == "x" ? x : y),
-                                  what.rfind(head, 0) == 0 ? what.substr(head.size()) : what));
-                            }
-                          });
+    mc::cli::naming_flags(
+        {{"fs_Hz", "--fs"}, {"nperseg", "--nperseg"}, {"noverlap", "--noverlap"}, {"nfft", "--nfft"}}, [&] {
+          try {
+            result.emplace(estimate());
+          } catch (const mc::InvalidParams& e) {
+            if (e.field() != "x" && e.field() != "y") throw;
+            const std::string what = e.what(), head = "invalid parameter " + e.field() + ": ";
+            throw mc::InvalidInput(fmt::format("{}: column '{}': {}", file,
+                                               mc::excerpt(e.field() == "x" ? x : y),
+                                               what.rfind(head, 0) == 0 ? what.substr(head.size()) : what));
+          }
+        });
     return std::move(*result);
   } catch (const mc::dsp::SpectrumOverflow& e) {
     throw mc::ComputationFailed(fmt::format(
@@ -310,7 +310,8 @@ void add_dsp(CLI::App& group) {
       }
       // Data at DC alone (or no positive frequency) have no band to average.
       if (o->fmin <= 0 && !std::isfinite(lo))
-        throw mc::InvalidInput(o->in, 0, "column 'f_Hz': no positive frequency (an octave band needs one above 0 Hz)");
+        throw mc::InvalidInput(o->in, 0,
+                               "column 'f_Hz': no positive frequency (an octave band needs one above 0 Hz)");
       if (!(hi > lo)) {
         // Name what was given: a flag, or the data's end it defaulted to.
         const std::string lo_what = o->fmin > 0 ? "--fmin" : "the data's lowest frequency";

@@ -29,7 +29,8 @@ struct RecoverOptions {
 
 void run_info(const InfoOptions& o) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.file, ec)) throw mc::InvalidInput(o.file.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(o.file, ec))
+    throw mc::InvalidInput(o.file.string() + ": no such file");
   mc::McapContents c;
   try {
     c = mc::read_mcap(o.file);
@@ -54,11 +55,14 @@ void run_info(const InfoOptions& o) {
   }
   const double duration = c.messages.empty() ? 0.0 : 1e-9 * static_cast<double>(last - first);
   nlohmann::json channels = nlohmann::json::array();
-  std::string text = fmt::format("{}: {} messages over {:.3f} s, {} bytes in {} chunks ({})\n", o.file.string(),
-                                 c.messages.size(), duration, std::filesystem::file_size(o.file),
-                                 c.chunk_count,
-                                 c.chunks.empty() ? "no chunks" : "compression: " + (c.chunks[0].compression.empty() ? std::string("none") : c.chunks[0].compression));
-  text += fmt::format("  {:<32} {:>9} {:>12} {:>10}  {}\n", "topic", "messages", "bytes", "rate (Hz)", "schema");
+  std::string text = fmt::format(
+      "{}: {} messages over {:.3f} s, {} bytes in {} chunks ({})\n", o.file.string(), c.messages.size(),
+      duration, std::filesystem::file_size(o.file), c.chunk_count,
+      c.chunks.empty() ? "no chunks"
+                       : "compression: " + (c.chunks[0].compression.empty() ? std::string("none")
+                                                                            : c.chunks[0].compression));
+  text +=
+      fmt::format("  {:<32} {:>9} {:>12} {:>10}  {}\n", "topic", "messages", "bytes", "rate (Hz)", "schema");
   for (const mc::McapChannel& ch : c.channels) {
     const PerChannel p = per.count(ch.id) ? per.at(ch.id) : PerChannel{};
     const double span = 1e-9 * static_cast<double>(p.last - p.first);
@@ -73,12 +77,9 @@ void run_info(const InfoOptions& o) {
                         {"rate_Hz", rate}});
     text += fmt::format("  {:<32} {:>9} {:>12} {:>10.1f}  {}\n", ch.topic, p.messages, p.bytes, rate, schema);
   }
-  nlohmann::json summary{{"file", o.file.string()},
-                         {"bytes", std::filesystem::file_size(o.file)},
-                         {"messages", c.messages.size()},
-                         {"duration_s", duration},
-                         {"chunks", c.chunk_count},
-                         {"channels", channels}};
+  nlohmann::json summary{{"file", o.file.string()},       {"bytes", std::filesystem::file_size(o.file)},
+                         {"messages", c.messages.size()}, {"duration_s", duration},
+                         {"chunks", c.chunk_count},       {"channels", channels}};
   if (const mc::McapMetadata* r = c.find_metadata("recovery")) {
     nlohmann::json rec = nlohmann::json::object();
     for (const auto& [k, v] : r->entries) rec[k] = v;
@@ -91,7 +92,8 @@ void run_info(const InfoOptions& o) {
 
 void run_recover(const RecoverOptions& o) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.file, ec)) throw mc::InvalidInput(o.file.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(o.file, ec))
+    throw mc::InvalidInput(o.file.string() + ": no such file");
   std::filesystem::path to;
   if (o.to) {
     to = *o.to;
@@ -123,7 +125,8 @@ void add_recording(CLI::App& group) {
   group.require_subcommand(1);
   {
     auto o = std::make_shared<InfoOptions>();
-    auto* cmd = group.add_subcommand("info", "Channels, message counts, rates, sizes and duration of an MCAP file");
+    auto* cmd =
+        group.add_subcommand("info", "Channels, message counts, rates, sizes and duration of an MCAP file");
     cmd->add_option("FILE", o->file, "The MCAP file (read and checked whole)")->required();
     cmd->add_flag("--json", o->common.json, "Print a machine-readable JSON summary on stdout");
     cmd->callback([o] { run_info(*o); });
@@ -131,8 +134,10 @@ void add_recording(CLI::App& group) {
   {
     auto o = std::make_shared<RecoverOptions>();
     auto* cmd = group.add_subcommand(
-        "recover", "Recover an MCAP file its writer never closed (a crash): every whole chunk, indexed again");
-    cmd->add_option("FILE", o->file, "The unfinished file (serve's .recording-<stamp>.mcap.<random>, or any MCAP)")
+        "recover",
+        "Recover an MCAP file its writer never closed (a crash): every whole chunk, indexed again");
+    cmd->add_option("FILE", o->file,
+                    "The unfinished file (serve's .recording-<stamp>.mcap.<random>, or any MCAP)")
         ->required();
     cmd->add_option("--to", o->to,
                     "The recovered file (default: recording-<stamp>.mcap for serve's, else FILE's stem "
@@ -143,7 +148,8 @@ void add_recording(CLI::App& group) {
 }
 
 const bool kRegistered = mc::cli::register_group(
-    {"recording", "What an MCAP recording holds; recovering one a crash left unfinished", 95, &add_recording});
+    {"recording", "What an MCAP recording holds; recovering one a crash left unfinished", 95,
+     &add_recording});
 
 }  // namespace
 }  // namespace recording_commands

@@ -123,7 +123,8 @@ TEST(InputsHardening, OverflowingSpectraFailNamingTheFileAndColumn) {
 TEST(InputsHardening, ErrorsBlameTheFlagOrColumnAtFault) {
   TempDir d;
   std::string sig = "t_s,y\n", one = "t_s,y\n0,1\n", zero = "f_Hz,re,im\n", dc = "f_Hz,re,im\n0,1,0\n";
-  for (int i = 0; i < 2000; ++i) sig += std::to_string(i * 1e-3) + "," + std::to_string(std::sin(0.3 * i)) + "\n";
+  for (int i = 0; i < 2000; ++i)
+    sig += std::to_string(i * 1e-3) + "," + std::to_string(std::sin(0.3 * i)) + "\n";
   for (int i = 1; i <= 50; ++i) zero += std::to_string(2.0 * i) + ",0,0\n";
   // A step response whose position is fine and whose drive holds 1e308 V once.
   std::string step = "t_s,u_V,x_m\n";
@@ -138,8 +139,9 @@ TEST(InputsHardening, ErrorsBlameTheFlagOrColumnAtFault) {
   write_text(d / "dc.csv", dc);
   write_text(d / "step.csv", step);
   // A rate near the smallest double overflows the density: --fs, not the spectrum's values.
-  auto err = expect_error({"dsp", "welch", "--in", (d / "sig.csv").string(), "--column", "y", "--fs", "1e-310"}, 3,
-                          "--fs: too small");
+  auto err =
+      expect_error({"dsp", "welch", "--in", (d / "sig.csv").string(), "--column", "y", "--fs", "1e-310"}, 3,
+                   "--fs: too small");
   EXPECT_THAT(err, Not(HasSubstr("overflows (values")));
   // One sample: the file and column, not the library's argument "x".
   err = expect_error({"dsp", "welch", "--in", (d / "one.csv").string(), "--column", "y", "--fs", "1000"}, 3,
@@ -155,8 +157,9 @@ TEST(InputsHardening, ErrorsBlameTheFlagOrColumnAtFault) {
   expect_error({"identify", "friction-modes", "--in", (d / "step.csv").string()}, 3, "column 'u_V'");
   // --save naming a directory: said so, not "disk full".
   fs::create_directory(d / "dir");
-  err = expect_error({"identify", "friction-modes", "--in", (d / "step.csv").string(), "--save", (d / "dir").string()},
-                     2, "is a directory");
+  err = expect_error(
+      {"identify", "friction-modes", "--in", (d / "step.csv").string(), "--save", (d / "dir").string()}, 2,
+      "is a directory");
   EXPECT_THAT(err, Not(HasSubstr("disk full")));
 }
 

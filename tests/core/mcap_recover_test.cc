@@ -86,7 +86,8 @@ TEST(McapRecover, ACutAnywhereKeepsEveryWholeChunkBeforeIt) {
       // What is kept is a prefix of the original, in whole chunks of 100 messages.
       ASSERT_LE(c.messages.size(), original.messages.size());
       EXPECT_EQ(c.messages.size() % 100, 0u) << "cut at byte " << cut;
-      for (std::size_t i = 0; i < c.messages.size(); i += 37) EXPECT_EQ(c.messages[i].data, original.messages[i].data);
+      for (std::size_t i = 0; i < c.messages.size(); i += 37)
+        EXPECT_EQ(c.messages[i].data, original.messages[i].data);
       EXPECT_GE(c.messages.size(), last_kept) << "a later cut never keeps less";
       last_kept = c.messages.size();
       if (!r.salvage.complete) {

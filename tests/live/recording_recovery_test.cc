@@ -27,9 +27,9 @@ TEST(RecordingRecovery, KnowsServesTemporariesByName) {
             "recording-20261205-101010");
   EXPECT_EQ(unfinished_recording_stem("/x/.recording-20261205-101010-2.mcap.zzzzzz").value_or(""),
             "recording-20261205-101010-2");
-  EXPECT_FALSE(unfinished_recording_stem("recording-20261205-101010.mcap"));   // finished
+  EXPECT_FALSE(unfinished_recording_stem("recording-20261205-101010.mcap"));  // finished
   EXPECT_FALSE(unfinished_recording_stem(".recording-20261205-101010.csv.Ab12Cd"));
-  EXPECT_FALSE(unfinished_recording_stem(".notes.mcap.Ab12Cd"));              // not serve's
+  EXPECT_FALSE(unfinished_recording_stem(".notes.mcap.Ab12Cd"));  // not serve's
   EXPECT_FALSE(unfinished_recording_stem(".recording-20261205-101010.mcap.Ab1"));
 }
 

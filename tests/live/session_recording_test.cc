@@ -143,8 +143,8 @@ TEST(SessionRecording, AFullDiskEndsTheRecordingReadableUpToItsLastChunkAndIsRep
     errors.fetch_add(1);
   };
   SessionRecording rec(std::move(p));
-  // The disk "full" at 256 KiB per file (a few half-second chunks): writes fail with EFBIG (the signal that would kill the
-  // process instead is ignored), even for root, whom permissions would not stop.
+  // The disk "full" at 256 KiB per file (a few half-second chunks): writes fail with EFBIG (the signal that
+  // would kill the process instead is ignored), even for root, whom permissions would not stop.
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   rlimit old{};
   ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);

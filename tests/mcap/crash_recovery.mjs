@@ -11,20 +11,12 @@
 // Run by CTest (`mcap_crash_recovery`); exits 77 (skipped) when node_modules lacks the readers.
 import { execFileSync, spawn } from "node:child_process";
 import { copyFileSync, existsSync, mkdtempSync, readdirSync, rmSync, statSync } from "node:fs";
-import { open } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
+import { loadReaders, openIndexed } from "./indexed_reader.mjs";
 
-let McapIndexedReader, zstd;
-try {
-  ({ McapIndexedReader } = await import("@mcap/core"));
-  zstd = (await import("@foxglove/wasm-zstd")).default;
-  await zstd.isLoaded;
-} catch {
-  console.error("crash_recovery: @mcap/core or @foxglove/wasm-zstd is not installed (scripts/install-deps.sh): skipped");
-  process.exit(77);
-}
+const readers = await loadReaders("crash_recovery");
 const cli = process.env.MC_CLI;
 if (!cli || !existsSync(cli)) {
   console.error("crash_recovery: set MC_CLI to the microcobot binary");
@@ -53,18 +45,7 @@ const serve = async (extra) => {
 const temporaries = () => readdirSync(dir).filter((f) => /^\.recording-[0-9-]+\.mcap\.[A-Za-z0-9]{6}$/.test(f));
 
 const readMcap = async (path) => {
-  const file = await open(path, "r");
-  const readable = {
-    size: async () => BigInt((await file.stat()).size),
-    read: async (offset, size) => {
-      const buf = Buffer.alloc(Number(size));
-      const { bytesRead } = await file.read(buf, 0, buf.length, Number(offset));
-      if (bytesRead !== buf.length) throw new Error(`short read at ${offset}`);
-      return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
-    },
-  };
-  const reader = await McapIndexedReader.Initialize({
-    readable, decompressHandlers: { zstd: (data, size) => zstd.decompress(data, Number(size)) } });
+  const { reader, close } = await openIndexed(readers, path);
   const topics = new Map([...reader.channelsById.values()].map((c) => [c.id, c.topic]));
   let telemetry = 0, messages = 0, lastTelemetryNs = 0n;
   const times = new Set();  // the telemetry's t_s, in microseconds
@@ -78,7 +59,7 @@ const readMcap = async (path) => {
   }
   const meta = [];
   for await (const m of reader.readMetadata({ name: "recovery" })) meta.push(m);
-  await file.close();
+  await close();
   return { reader, messages, telemetry, lastTelemetryNs, times, recovery: meta[0] };
 };
 

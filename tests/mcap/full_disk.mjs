@@ -10,20 +10,12 @@
 // to mount a tmpfs (root).
 import { execFileSync, spawn } from "node:child_process";
 import { existsSync, mkdtempSync, readdirSync, rmSync } from "node:fs";
-import { open } from "node:fs/promises";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { createInterface } from "node:readline";
+import { loadReaders, openIndexed } from "./indexed_reader.mjs";
 
-let McapIndexedReader, zstd;
-try {
-  ({ McapIndexedReader } = await import("@mcap/core"));
-  zstd = (await import("@foxglove/wasm-zstd")).default;
-  await zstd.isLoaded;
-} catch {
-  console.error("full_disk: @mcap/core or @foxglove/wasm-zstd is not installed (scripts/install-deps.sh): skipped");
-  process.exit(77);
-}
+const readers = await loadReaders("full_disk");
 const cli = process.env.MC_CLI;
 if (!cli || !existsSync(cli)) {
   console.error("full_disk: set MC_CLI to the microcobot binary");
@@ -95,24 +87,14 @@ try {
   if (mcaps.length !== 1) fail(`expected one recording, found: ${files.join(", ")}`);
   if (!list.recordings.some((r) => r.name === mcaps[0] && !r.recording)) fail(`/recordings: ${JSON.stringify(list)}`);
   // Read whole by the indexed reader.
-  const file = await open(join(dir, mcaps[0]), "r");
-  const reader = await McapIndexedReader.Initialize({
-    readable: {
-      size: async () => BigInt((await file.stat()).size),
-      read: async (offset, size) => {
-        const buf = Buffer.alloc(Number(size));
-        await file.read(buf, 0, buf.length, Number(offset));
-        return new Uint8Array(buf.buffer, buf.byteOffset, buf.byteLength);
-      },
-    },
-    decompressHandlers: { zstd: (data, size) => zstd.decompress(data, Number(size)) } });
+  const { reader, close } = await openIndexed(readers, join(dir, mcaps[0]));
   const topics = new Map([...reader.channelsById.values()].map((c) => [c.id, c.topic]));
   let n = 0, images = 0;
   for await (const m of reader.readMessages()) {
     ++n;
     if (topics.get(m.channelId) === "/camera/image/compressed") ++images;
   }
-  await file.close();
+  await close();
   console.error(`full_disk: ${mcaps[0]}: ${n} messages, ${images} camera images, ${reader.chunkIndexes.length} chunks`);
   if (!(n > 0 && images > 0)) fail("the recording kept nothing");
   ws.close();

@@ -113,6 +113,13 @@ class Parser {
   const McapMessage& message(const Record& r);
   void chunk(const Record& r);
   void message_index(const Record& r, ChunkInfo& ci);
+  // A data-section record with content (Schema, Channel, Message, Chunk, Attachment, Metadata):
+  // read, and true; else false.
+  bool content_record(const Record& r);
+  // Fails on a record that belongs to the summary (Header, Footer, the indexes, Statistics).
+  void summary_only(const Record& r);
+  // The Header record after the opening magic. Returns the offset just past it.
+  std::uint64_t read_header();
   // The data section, from the Header to DataEnd. Returns the offset just past DataEnd.
   std::uint64_t read_data();
   void read_summary(std::uint64_t data_end);

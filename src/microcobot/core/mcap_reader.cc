@@ -291,48 +291,33 @@ void Parser::message_index(const Record& r, ChunkInfo& ci) {
 }
 
 // The data section, from the Header to DataEnd. Returns the offset just past DataEnd.
-std::uint64_t Parser::read_data() {
-  std::uint64_t at = 8;
-  const Record h = frame(at, footer_, "data section");
+std::uint64_t Parser::read_header() {
+  const Record h = frame(8, footer_, "data section");
   if (h.op != static_cast<std::uint8_t>(Op::kHeader)) {
-    fail(name_, at, fmt::format("expected the Header record after the magic, found {}", op_name(h.op)));
+    fail(name_, 8, fmt::format("expected the Header record after the magic, found {}", op_name(h.op)));
   }
-  {
-    Fields fl(f_, name_, h.content, h.end, "Header");
-    out_.profile = fl.prefixed("profile");
-    out_.library = fl.prefixed("library");
-  }
-  at = h.end;
+  Fields fl(f_, name_, h.content, h.end, "Header");
+  out_.profile = fl.prefixed("profile");
+  out_.library = fl.prefixed("library");
+  return h.end;
+}
+
+std::uint64_t Parser::read_data() {
+  std::uint64_t at = read_header();
   bool after_chunk = false;  // MessageIndex records may follow a chunk only
   while (true) {
     const Record r = frame(at, footer_, "data section");
     const auto op = static_cast<Op>(r.op);
     if (op != Op::kMessageIndex) after_chunk = false;
+    if (content_record(r)) {
+      after_chunk = op == Op::kChunk;
+      at = r.end;
+      continue;
+    }
     switch (op) {
-      case Op::kSchema:
-        define_schema(r);
-        break;
-      case Op::kChannel:
-        define_channel(r);
-        break;
-      case Op::kMessage:
-        message(r);
-        break;
-      case Op::kChunk:
-        chunk(r);
-        after_chunk = true;
-        break;
       case Op::kMessageIndex:
         if (!after_chunk) fail(name_, at, "MessageIndex record that does not follow a chunk");
         message_index(r, chunks_.back());
-        break;
-      case Op::kAttachment:
-        attachment(r);
-        ++attachments_;
-        break;
-      case Op::kMetadata:
-        metadata(r);
-        ++metadata_;
         break;
       case Op::kDataEnd: {
         Fields fl(f_, name_, r.content, r.end, "DataEnd");
@@ -351,18 +336,53 @@ std::uint64_t Parser::read_data() {
         }
         return r.end;
       }
-      case Op::kHeader:
-      case Op::kFooter:
-      case Op::kChunkIndex:
-      case Op::kAttachmentIndex:
-      case Op::kStatistics:
-      case Op::kMetadataIndex:
-      case Op::kSummaryOffset:
-        fail(name_, at, fmt::format("{} record in the data section (no DataEnd before it)", op_name(r.op)));
       default:
-        break;  // unknown opcodes are skipped, as the spec asks
+        summary_only(r);  // fails on a summary record; unknown opcodes are skipped, as the spec asks
     }
     at = r.end;
+  }
+}
+
+bool Parser::content_record(const Record& r) {
+  switch (static_cast<Op>(r.op)) {
+    case Op::kSchema:
+      define_schema(r);
+      return true;
+    case Op::kChannel:
+      define_channel(r);
+      return true;
+    case Op::kMessage:
+      message(r);
+      return true;
+    case Op::kChunk:
+      chunk(r);
+      return true;
+    case Op::kAttachment:
+      attachment(r);
+      ++attachments_;
+      return true;
+    case Op::kMetadata:
+      metadata(r);
+      ++metadata_;
+      return true;
+    default:
+      return false;
+  }
+}
+
+void Parser::summary_only(const Record& r) {
+  switch (static_cast<Op>(r.op)) {
+    case Op::kHeader:
+    case Op::kFooter:
+    case Op::kChunkIndex:
+    case Op::kAttachmentIndex:
+    case Op::kStatistics:
+    case Op::kMetadataIndex:
+    case Op::kSummaryOffset:
+      fail(name_, r.offset,
+           fmt::format("{} record in the data section (no DataEnd before it)", op_name(r.op)));
+    default:
+      break;
   }
 }
 

@@ -12,15 +12,7 @@ McapSalvage Parser::salvage() {
   s.file_bytes = f_.size();
   if (f_.size() < 8 || f_.substr(0, 8) != kMcapMagic) fail(name_, 0, "not an MCAP file (bad opening magic)");
   footer_ = f_.size();  // no summary to stop at: records may run to the end of the file
-  const Record h = frame(8, footer_, "data section");
-  if (h.op != static_cast<std::uint8_t>(Op::kHeader))
-    fail(name_, 8, fmt::format("expected the Header record after the magic, found {}", op_name(h.op)));
-  {
-    Fields fl(f_, name_, h.content, h.end, "Header");
-    out_.profile = fl.prefixed("profile");
-    out_.library = fl.prefixed("library");
-  }
-  std::uint64_t at = h.end;
+  std::uint64_t at = read_header();
   s.whole_bytes = at;
   while (true) {
     // A record that fails leaves nothing of itself behind.
@@ -36,38 +28,10 @@ McapSalvage Parser::salvage() {
         break;
       }
       const Record r = frame(at, footer_, "data section");
-      switch (static_cast<Op>(r.op)) {
-        case Op::kSchema:
-          define_schema(r);
-          break;
-        case Op::kChannel:
-          define_channel(r);
-          break;
-        case Op::kMessage:
-          message(r);
-          break;
-        case Op::kChunk:
-          chunk(r);
-          break;
-        case Op::kAttachment:
-          attachment(r);
-          break;
-        case Op::kMetadata:
-          metadata(r);
-          break;
-        case Op::kDataEnd:
-          s.complete = true;
-          break;
-        case Op::kHeader:
-        case Op::kFooter:
-        case Op::kChunkIndex:
-        case Op::kAttachmentIndex:
-        case Op::kStatistics:
-        case Op::kMetadataIndex:
-        case Op::kSummaryOffset:
-          fail(name_, at, fmt::format("{} record in the data section", op_name(r.op)));
-        default:
-          break;  // MessageIndex records (rebuilt on writing) and unknown opcodes
+      if (!content_record(r)) {
+        // MessageIndex records are rebuilt on writing; unknown opcodes skipped.
+        if (r.op == static_cast<std::uint8_t>(Op::kDataEnd)) s.complete = true;
+        summary_only(r);
       }
       at = r.end;
       s.whole_bytes = at;

@@ -143,7 +143,7 @@ class McapWriter {
   };
 
   std::uint64_t position() const { return flushed_ + out_.size(); }
-  void take_checkpoint();  // the state after the last chunk written through
+  void take_checkpoint();            // the state after the last chunk written through
   void put(std::string_view bytes);  // to the file (buffered); CRC'd while in the data section
   void put_record(McapOpcode op, std::string_view content);
   void flush_buffer();

@@ -29,7 +29,8 @@ std::string why_not_created(const std::filesystem::path& path, int err) {
 namespace {
 // "disk full" for ENOSPC and EDQUOT (and EFBIG: the file size limit), else strerror.
 std::string why_write_failed(int err) {
-  if (err == ENOSPC || err == EDQUOT || err == EFBIG) return "write failed: disk full (" + std::string(std::strerror(err)) + ")";
+  if (err == ENOSPC || err == EDQUOT || err == EFBIG)
+    return "write failed: disk full (" + std::string(std::strerror(err)) + ")";
   return "write failed: " + std::string(std::strerror(err));
 }
 }  // namespace
@@ -88,7 +89,8 @@ void StagedFile::fail(const std::string& what) {
 }
 
 void StagedFile::truncate(std::uint64_t size) {
-  if (fd_ < 0) throw InvalidInput(path_.string(), 0, committed_ ? "truncated after it was closed" : "abandoned");
+  if (fd_ < 0)
+    throw InvalidInput(path_.string(), 0, committed_ ? "truncated after it was closed" : "abandoned");
   if (::ftruncate(fd_, static_cast<off_t>(size)) != 0 ||
       ::lseek(fd_, static_cast<off_t>(size), SEEK_SET) != static_cast<off_t>(size))
     fail(std::string("cannot cut the file: ") + std::strerror(errno));

@@ -86,8 +86,9 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
     }
     log_(fmt::format("recovered {} from {}, left unfinished by an earlier run: {} messages over {:.1f} s{}",
                      r.to.string(), r.from.filename().string(), r.messages, r.duration_s,
-                     r.lost_bytes == 0 ? std::string()
-                                       : fmt::format(" (its last {} bytes, a cut record, dropped)", r.lost_bytes)));
+                     r.lost_bytes == 0
+                         ? std::string()
+                         : fmt::format(" (its last {} bytes, a cut record, dropped)", r.lost_bytes)));
     sp.recovered.push_back(r.to.stem().string());
   }
 

@@ -45,7 +45,8 @@ void require_finite_spectrum(const std::vector<T>& p, const char* signal, std::s
 // A spectrum that overflows although the data's periodogram cannot (|X|^2 <= (n max|x|)^2, finite)
 // was made so by the density's scale 1 / (fs S2): a sampling rate near the smallest double.
 template <class T>
-void require_finite_scaling(const std::vector<T>& p, std::span<const double> data, std::size_t n, double fs_Hz) {
+void require_finite_scaling(const std::vector<T>& p, std::span<const double> data, std::size_t n,
+                            double fs_Hz) {
   if (std::all_of(p.begin(), p.end(), [](const T& v) { return std::isfinite(std::abs(v)); })) return;
   const double bound = max_abs(data) * static_cast<double>(n);
   if (std::isfinite(bound * bound))

@@ -223,7 +223,8 @@ TfFitResult fit_tf(std::span<const double> f_Hz, std::span<const std::complex<do
   }
   // Points left out for a zero response are the data's fault, not the band's.
   std::size_t in_band = 0;
-  for (std::size_t k = 0; k < f_Hz.size(); ++k) in_band += f_Hz[k] >= o.fmin_Hz && f_Hz[k] <= o.fmax_Hz && f_Hz[k] > 0;
+  for (std::size_t k = 0; k < f_Hz.size(); ++k)
+    in_band += f_Hz[k] >= o.fmin_Hz && f_Hz[k] <= o.fmax_Hz && f_Hz[k] > 0;
   const auto needed = static_cast<std::size_t>(o.nz + 1 + o.np) + 1;
   if (2 * in_band >= needed)
     require(2 * used.size() >= needed, "h",

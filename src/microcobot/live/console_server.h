@@ -56,8 +56,8 @@
 namespace mc::live {
 
 struct ConsoleServerParams {
-  server::ServerOptions server;     ///< listen address, port, token, limits
-  std::filesystem::path out_dir;    ///< where recordings go (empty: recording disabled)
+  server::ServerOptions server;   ///< listen address, port, token, limits
+  std::filesystem::path out_dir;  ///< where recordings go (empty: recording disabled)
   /// Recordings recovered in out_dir at start (their stems): listed as recovered.
   std::vector<std::string> recovered;
   double telemetry_rate_Hz = 60.0;  ///< to clients (the recording keeps every sample)

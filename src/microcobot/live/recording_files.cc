@@ -217,14 +217,15 @@ std::string RecordingFiles::list_json() const {
     const auto size = it->file_size(size_error);
     const bool has_report = std::filesystem::is_regular_file(dir_ / (stem + ".html"), other);
     const bool has_csv = std::filesystem::is_regular_file(dir_ / (stem + ".csv"), other);
-    list.push_back({{"name", name},
-                    {"bytes", size_error ? 0 : size},
-                    {"recording", false},
-                    {"url", "/recordings/" + name},
-                    {"csv_url", has_csv ? json("/recordings/" + stem + ".csv") : json(nullptr)},
-                    {"report_url", "/recordings/" + stem + ".html"},
-                    {"report_ready", has_report},
-                    {"recovered", std::find(recovered_.begin(), recovered_.end(), stem) != recovered_.end()}});
+    list.push_back(
+        {{"name", name},
+         {"bytes", size_error ? 0 : size},
+         {"recording", false},
+         {"url", "/recordings/" + name},
+         {"csv_url", has_csv ? json("/recordings/" + stem + ".csv") : json(nullptr)},
+         {"report_url", "/recordings/" + stem + ".html"},
+         {"report_ready", has_report},
+         {"recovered", std::find(recovered_.begin(), recovered_.end(), stem) != recovered_.end()}});
   }
   if (!active.empty()) {  // written under a temporary name until it is closed
     list.push_back({{"name", active},

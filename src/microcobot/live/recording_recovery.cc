@@ -25,8 +25,8 @@ std::vector<RecoveredRecording> recover_unfinished_recordings(const std::filesys
   std::vector<RecoveredRecording> out;
   std::error_code ec;
   std::vector<std::filesystem::path> found;
-  for (auto it = std::filesystem::directory_iterator(dir, ec); !ec && it != std::filesystem::directory_iterator();
-       it.increment(ec)) {
+  for (auto it = std::filesystem::directory_iterator(dir, ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
     std::error_code type_error;
     if (unfinished_recording_stem(it->path()) && it->is_regular_file(type_error) &&
         !staged_file_in_use(it->path()))
@@ -39,7 +39,8 @@ std::vector<RecoveredRecording> recover_unfinished_recordings(const std::filesys
     std::string name = stem;
     const auto taken = [&](const std::string& s) {
       std::error_code e;
-      return std::filesystem::exists(dir / (s + ".mcap"), e) || std::filesystem::exists(dir / (s + ".csv"), e);
+      return std::filesystem::exists(dir / (s + ".mcap"), e) ||
+             std::filesystem::exists(dir / (s + ".csv"), e);
     };
     for (int i = 2; taken(name) && i < 1000; ++i) name = stem + "-" + std::to_string(i);
     try {

@@ -36,8 +36,8 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <string>
