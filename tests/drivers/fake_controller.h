@@ -105,9 +105,10 @@ class FakeController {
   void run_pty() {
     while (!stop_ && master_fd_ >= 0) {
       if (serve(master_fd_)) {
+        // Said before the close: the client sees the hang-up as soon as the master closes.
+        unplugged_ = true;
         ::close(master_fd_);
         master_fd_ = -1;
-        unplugged_ = true;
         return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
