@@ -1,6 +1,7 @@
 """The documentation's own checks (ctest docs_pages): the README's first screen, the user pages free
-of history, every tutorial tested and every example used, and the reference generator failing on
-what has no description (a planted CLI option, Python function and configuration key).
+of history, every tutorial tested and every example used, the reference generator failing on
+what has no description (a planted CLI option, Python function and configuration key), and the
+results page failing on a benchmark script's missing JSON.
 
 Needs MC_CLI (the microcobot binary) and PYTHONPATH at the built module for the generator's tests.
 """
@@ -140,3 +141,15 @@ def test_the_list_of_undescribed_keys_only_shrinks(tmp_path):
     stale = sorted(listed - set(stats["undescribed"]))
     assert not stale, f"described now (or gone): remove them from scripts/docs/undescribed_keys.txt: {stale}"
     assert not gen.problems, gen.problems
+
+
+def test_a_benchmark_script_without_its_json_fails_the_results_page(tmp_path, monkeypatch):
+    spec = importlib.util.spec_from_file_location("gen_results", ROOT / "scripts" / "docs" / "gen_results.py")
+    results = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(results)
+    monkeypatch.setattr(results, "RESULTS", tmp_path)  # no JSON there
+    with pytest.raises(SystemExit) as failed:
+        results.script_tables()
+    message = str(failed.value)
+    assert "serve_bench.json is missing" in message, message
+    assert "gen_results.py --run build/release/bench serve_bench" in message, message
