@@ -5,7 +5,7 @@ Usage: python3 scripts/dsp_vs_scipy.py path/to/microcobot
 
 Needs no numpy or scipy: the references were made by tests/data/gen_reference.py (scipy
 1.10.1). Prints, per function, how many cases were compared and the largest deviation; the
-figures of docs/model.md's signal-toolkit section come from this script.
+figures of docs/concepts/stick-slip.md's signal-toolkit section come from this script.
 """
 import csv
 import json

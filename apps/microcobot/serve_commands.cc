@@ -167,8 +167,8 @@ void add_serve(CLI::App& cmd) {
       ->check(mc::cli::Range(0.0, 0.999));
   cmd.add_option("--passivity", o->passivity,
                  "Time-domain passivity control at this end's ports of the master-slave channel: on "
-                 "(default; keeps the coupling passive under delay and loss, docs/model.md) or off "
-                 "(observed only). Needs --role")
+                 "(default; keeps the coupling passive under delay and loss, docs/concepts/teleoperation.md) "
+                 "or off (observed only). Needs --role")
       ->check(CLI::IsMember({"on", "off"}));
   cmd.callback([o] { serve(*o); });
 }

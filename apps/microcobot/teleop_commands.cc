@@ -1,6 +1,6 @@
 // `microcobot teleop delay-sweep`: the coupling system over a delayed, lossy link pushed into a
 // stiff contact, unprotected, with time-domain passivity control or model-mediated
-// (teleop/delayed_teleoperation.h, docs/model.md "Passivity under delay" and "Settling under
+// (teleop/delayed_teleoperation.h, docs/concepts/teleoperation.md "Passivity under delay" and "Settling under
 // long delay"). `teleop delay-validate`: the tuning and validation sets of delay cases
 // (studies/delay_case_sets.h).
 

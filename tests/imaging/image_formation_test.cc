@@ -113,7 +113,7 @@ double normalised_variance(const std::vector<float>& img, int w, int h) {
 
 // The through-focus sharpness curve of a white texture (grain far below the pixel: one
 // independent value per pixel) is as wide as the depth-of-field formula says, at the level the
-// formula's two criteria set (docs/model.md, "Depth of field": the quarter-wave criterion's
+// formula's two criteria set (docs/concepts/vision.md, "Depth of field": the quarter-wave criterion's
 // level on a diffraction-limited curve and the blur-circle-equals-pixel level on a
 // pixel-limited one, averaged).
 TEST(ImageFormation, ThroughFocusSharpnessWidthMatchesTheDepthOfField) {
@@ -145,7 +145,7 @@ TEST(ImageFormation, ThroughFocusSharpnessWidthMatchesTheDepthOfField) {
     const double width = edges[0] - edges[1];
     std::printf("dof %s: level %.3f, width %.3f um, formula %.3f um, ratio %.4f\n", o.name.c_str(), level,
                 width * 1e6, dof * 1e6, width / dof);
-    // At 2x the model's curve is 10.1 % narrower than the formula (docs/model.md: the formula adds
+    // At 2x the model's curve is 10.1 % narrower than the formula (docs/concepts/vision.md: the formula adds
     // its two criteria linearly, the blurs add in quadrature; largest where both are comparable
     // in pixels): the one objective held to 11 %.
     EXPECT_NEAR(width / dof, 1.0, o.name == "2x" ? 0.11 : 0.10)
@@ -245,7 +245,7 @@ TEST(ImageFormation, AnInclinedFingersFaceHasNoSeamBetweenItsSegments) {
       // From 6 um up the finger (past the end's 4 um dark outline) to 17 um (segment boundaries
       // at 7.3 and 15.1 um from the tip), within the depth of field: one blur group. (Where two groups
       // meet, farther up, their layers still darken the face a little: the layered-defocus
-      // approximation, docs/model.md.)
+      // approximation, docs/concepts/vision.md.)
       const int i_lo = static_cast<int>(std::ceil(r.v_of_y(f.tip_y_m + 17e-6)));
       const int i_hi = static_cast<int>(std::floor(r.v_of_y(f.tip_y_m + 6e-6)));
       double worst = 0.0;

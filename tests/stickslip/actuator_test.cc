@@ -61,7 +61,7 @@ TEST(Actuator, OneModelDrivesIndependentStates) {
 }
 
 TEST(Actuator, ModalSliderPartsSeparateButStayBounded) {
-  // docs/model.md, limitation of the modal slider: in fast stepping the two parts slip by
+  // docs/concepts/stick-slip.md, limitation of the modal slider: in fast stepping the two parts slip by
   // different amounts and drift apart until the coupling spring balances their friction; the
   // drift is a property of the model (the same at a 4x smaller step), bounded, and converges.
   const StickSlipParams p;
@@ -82,7 +82,8 @@ TEST(Actuator, ModalSliderPartsSeparateButStayBounded) {
         "um\n",
         dt, 1e6 * sep_at_044, 1e6 * max_sep, 1e6 * m.slider_position(s));
     EXPECT_LT(max_sep, 30e-6);  // kc * 30 um = 60 mN, above the parts' friction difference
-    EXPECT_GT(max_sep, 1e-6);   // the limitation is still there: update docs/model.md if this fails
+    // The limitation is still there: update docs/concepts/stick-slip.md if this fails.
+    EXPECT_GT(max_sep, 1e-6);
   }
 }
 

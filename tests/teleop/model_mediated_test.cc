@@ -179,7 +179,7 @@ TEST(DelayedTeleoperation, ModelMediatedSettlesAtEveryDelayUpTo200ms) {
 }
 
 TEST(DelayedTeleoperation, ModelMediatedSettlesOnTheValidationSet) {
-  // The seeded random set docs/model.md reports (`teleop delay-validate`): delays to 200 ms,
+  // The seeded random set docs/concepts/teleoperation.md reports (`teleop delay-validate`): delays to 200 ms,
   // jitter to half each way's delay, loss to 20 %, walls 300-3000 N/m, half of them Hertzian,
   // geometry errors to 1.5 mm, sensor noise to 5 mN.
   const studies::SetSummary s =

@@ -4,7 +4,7 @@
 /// 4-mass model in the handle's y axis driven by the Pantograph motors (f_m on the motor
 /// windings m_2) and by the Haptuator (a force pair f_v between its moving magnet m_v and
 /// the handle m_h), extended by two modes of the Pantograph's linkage that hang off the force
-/// path (side branches on m_2 and m_1, which give Fig. 3.10 its antiresonances; docs/model.md),
+/// path (side branches on m_2 and m_1, which give Fig. 3.10 its antiresonances; docs/concepts/dual-stage.md),
 /// with the Haptuator's coil dynamics and the end stops of its magnet (stroke saturation).
 /// Output: the handle's acceleration, what the accelerometer measures.
 
@@ -38,9 +38,9 @@ struct DualStagePlantParams {
   double b_1_Ns_per_m = 20.2;   ///< their damping
   double k_2_N_per_m = 1.20e5;  ///< proximal links
   double b_2_Ns_per_m = 0.149;  ///< their damping
-  // Linkage modes off the force path (extension of eq. 3.4, docs/model.md): each a modal mass on
-  // a spring-damper hung from a node of the chain; it blocks that node at its own frequency
-  // (antiresonance of f_m -> y_h'') and adds a resonance above it. 0 kg removes the branch.
+  // Linkage modes off the force path (extension of eq. 3.4, docs/concepts/dual-stage.md): each a modal mass
+  // on a spring-damper hung from a node of the chain; it blocks that node at its own frequency (antiresonance
+  // of f_m -> y_h'') and adds a resonance above it. 0 kg removes the branch.
   double m_p_kg = 3.26e-4;       ///< proximal links' mode, hung from the motor node m_2 (~233 Hz)
   double k_p_N_per_m = 699.0;    ///< its stiffness
   double b_p_Ns_per_m = 0.0503;  ///< its damping

@@ -7,7 +7,7 @@
 ///   depth of field                  DOF = lambda n / NA^2 + n e / (M NA)   (e: pixel pitch)
 ///   field of view                   W e / M  x  H e / M
 ///
-/// PSF model (docs/model.md, "Image formation"): a Gaussian whose width is calibrated on the
+/// PSF model (docs/concepts/vision.md, "Image formation"): a Gaussian whose width is calibrated on the
 /// scalar diffraction integral of an aberration-free circular pupil with defocus (Born & Wolf,
 /// "Principles of Optics", 7th ed., §8.8): at each defocus dz the Gaussian has the same
 /// sharpness integral  S(dz) = ∫ I^2 d^2x = ∫ |OTF|^2 d^2k  as the diffraction PSF, i.e.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Image formation (docs/model.md, "Image formation"): a scene snapshot seen from the
+/// Image formation (docs/concepts/vision.md, "Image formation"): a scene snapshot seen from the
 /// top through the objective onto the sensor.
 ///
 ///  1. Radiance: each object's top face (reflectance, or transmittance in transmitted light)

@@ -9,7 +9,7 @@
 /// restoring force of a focused beam peaks near the bead's radius and falls off within about
 /// another radius (Neuman & Block 2004, "Optical trapping", Rev. Sci. Instrum. 75, Fig. 5;
 /// Ashkin 1992). A phenomenological profile with those features (a documented choice,
-/// docs/model.md):
+/// docs/concepts/dual-stage.md):
 ///     F_trap(d) = -k d g(d),   g(d) = exp(-(|d| / w)^4 / 4),   d = x - x_trap,
 /// whose slope at the centre is k and whose peak, at |d| = w, is k w e^(-1/4): with the default
 /// w = r e^(1/4) the escape force is k r (15 pN for the 3 um bead at 10 pN/um); at 2 w the

@@ -105,7 +105,7 @@ struct TrackingParams {
   double kp = -0.2794;
   double backslip_gain = 0.402;  ///< update rate of the backslip estimate per edge (0: model only)
   /// Resonant damping of the contact's stiff mode: the edges leave the slider ringing
-  /// on asperity b at sqrt(rho0_b / M_s) = 1.64 kHz (thesis Table 2.8, docs/model.md "two
+  /// on asperity b at sqrt(rho0_b / M_s) = 1.64 kHz (thesis Table 2.8, docs/concepts/stick-slip.md "two
   /// asperities"), with a damping ratio of rho1_b / (2 sqrt(rho0_b c_b M_s)) ~ 0.04 only. The
   /// measured position is band-passed around damp_Hz (RBJ biquad, peak gain 1, quality damp_q) and
   /// damp_gain times it, delayed by damp_lag_ticks (-1..1, linear between ticks, < 0 extrapolates: the

@@ -3,7 +3,7 @@
 /// One stick-slip positioning axis: PE (eq. 2.1-2.7) + PI hysteresis (Fig. 2.6) + two-asperity
 /// elasto-plastic friction (eq. 2.9-2.21) + slider (eq. 2.8), and its fixed-step integrator.
 ///
-/// Integrator (docs/model.md): each step of length h (split into integrator.substeps sub-steps
+/// Integrator (docs/concepts/stick-slip.md): each step of length h (split into integrator.substeps sub-steps
 /// while the contact is active: abrupt drive edge or a strain near z_ba; and cut at the drive's
 /// corners, DriveSegment)
 ///  1. H(U) by the PI operators (rate independent, exact) at each corner and at the step's end,
@@ -72,7 +72,7 @@ class ActuatorModel {
   /// A step whose drive is linear from s.u_V to `u_V` (a sample stream played by a DAC through
   /// its reconstruction filter).
   void step(ActuatorState& s, double u_V) const noexcept;
-  /// Slider position x2 [m]: the mass-weighted mean of its two parts (docs/model.md).
+  /// Slider position x2 [m]: the mass-weighted mean of its two parts (docs/concepts/stick-slip.md).
   double slider_position(const ActuatorState& s) const noexcept;
   double slider_velocity(const ActuatorState& s) const noexcept;
   /// True when a step at the state's own voltage would leave it as it is, to within a picometre:
@@ -91,7 +91,7 @@ class ActuatorModel {
     double h = 0.0;
     double inv_h = 0.0;
     ModeDiscretization ma, mb;     ///< exact PE mode matrices for h
-    std::array<double, 2> rho0{};  ///< rho0 pre-warped for Verlet at h (docs/model.md)
+    std::array<double, 2> rho0{};  ///< rho0 pre-warped for Verlet at h (docs/concepts/stick-slip.md)
   };
   /// The constants of a step of length h (the grid's, and a sub-step split at a corner).
   StepConstants constants(double h) const noexcept;

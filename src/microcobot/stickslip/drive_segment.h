@@ -2,7 +2,7 @@
 /// @file
 /// The drive voltage over one model step, as the amplifier outputs it: a piecewise-linear path
 /// from the voltage at the start of the step (the model's state) through `corners` interior
-/// corners to `end_V` at the end of the step (docs/model.md, "Drive between samples").
+/// corners to `end_V` at the end of the step (docs/concepts/stick-slip.md, "Drive between samples").
 ///
 /// The sawtooth's corners (the start and end of its slew-limited edge, thesis Fig. 2.3) and the
 /// step's corner fall anywhere in time, not on the model's grid. Cutting them by sampling

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Single-state elasto-plastic friction (Dupont 2002) as modified by the thesis (eq. 2.9-2.13,
-/// 2.18), and the two-asperity contact of eq. 2.20-2.21 (docs/errata.md, "Two asperities"; docs/model.md).
+/// Single-state elasto-plastic friction (Dupont 2002) as modified by the thesis (eq. 2.9-2.13, 2.18), and
+/// the two-asperity contact of eq. 2.20-2.21 (docs/errata.md, "Two asperities"; docs/concepts/stick-slip.md).
 ///
 ///   x = z + w                                           (2.9)  elastic z + plastic w
 ///   F_f = rho0 z + rho1 z' + rho2 x'                    (2.10)
@@ -30,7 +30,7 @@ struct FrictionParams {
   double coupling_stiffness_N_m =
       2.0e3;  ///< k_c: slow coupling of the two slider parts (erratum 2, docs/errata.md)
   /// z_ba,b / z_ba,a: the table gives z_ba of asperity a; default 1 (one break-away strain for the
-  /// whole contact, as the thesis's single z_ba; docs/model.md).
+  /// whole contact, as the thesis's single z_ba; docs/concepts/stick-slip.md).
   double breakaway_strain_ratio_b = 1.0;
 
   template <class V>

@@ -22,8 +22,9 @@ IdentificationRecords read_identification_records(const std::filesystem::path& d
   auto need = [&](const char* name) {
     const auto f = dir / name;
     if (!std::filesystem::exists(f)) {
-      throw InvalidInput(f.string(), 0,
-                         fmt::format("missing: identify all needs {} (see docs/model.md)", name));
+      throw InvalidInput(
+          f.string(), 0,
+          fmt::format("missing: identify all needs {} (see docs/concepts/stick-slip.md)", name));
     }
     return f;
   };

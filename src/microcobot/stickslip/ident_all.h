@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The whole identification of one stick-slip axis (thesis §2.5.2, steps 1-3 in order) from a
-/// directory of measurements (layout in ident_synthetic.h / docs/model.md):
+/// directory of measurements (layout in ident_synthetic.h / docs/concepts/stick-slip.md):
 ///  1. pe_step.csv (optional: PE without slider) -> PE modes, gain split;
 ///     step.csv -> the two asperities (rho0, rho1 each) and the slider mass split;
 ///  2. sine.csv -> PI thresholds and weights (NNLS) and the PE's static gain g;

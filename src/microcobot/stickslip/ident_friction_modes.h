@@ -5,7 +5,7 @@
 /// scanning mode (slider attached, a step small enough not to slip, ~25 kHz sampling).
 ///
 /// In the elastic phase (|z| < z_ba, eq. 2.13: alpha = 0, z' = x') each slider part i (mass share
-/// c_i M_s, docs/model.md) is a spring-damper on the PE:
+/// c_i M_s, docs/concepts/stick-slip.md) is a spring-damper on the PE:
 ///   c_i M_s x2i'' = c_i [rho0_i (x1 - x2i) + rho1_i (x1' - x2i')] + k_c (x2j - x2i),
 ///   x2 = c_a x2a + c_b x2b,
 /// and the PE's two modes (eq. 2.1-2.2, parameters from step 1a or the base) carry the contact's

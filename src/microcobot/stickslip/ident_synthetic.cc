@@ -45,7 +45,7 @@ std::size_t write_campaign(const std::filesystem::path& dir, const StickSlipPara
   const ActuatorModel model(truth);
   {
     // 1 us steps: the scanning-mode transient is the physics being measured; the default step
-    // would shift the heavily damped asperity mode by ~1% (docs/model.md).
+    // would shift the heavily damped asperity mode by ~1% (docs/concepts/stick-slip.md).
     const ActuatorModel fine(truth, std::min(truth.integrator.dt_s, 1e-6));
     const Waveform w = make_waveform(WaveKind::kStep, plan.step_V, 1.0, Direction::kForward, truth.drive);
     SensorEffects s = sensor;

@@ -42,7 +42,7 @@ struct IntegratorParams {
   double substep_edge_V = 4.0;           ///< drive change per step that counts as an abrupt edge
   double substep_strain_fraction = 0.9;  ///< |z| / z_ba beyond which the contact is sub-stepped
   /// PE ringing amplitude (its modes' distance from their static equilibrium) beyond which the
-  /// step is sub-stepped: the ringing an edge excites decides the slip (docs/model.md).
+  /// step is sub-stepped: the ringing an edge excites decides the slip (docs/concepts/stick-slip.md).
   double substep_ringing_m = 3e-9;
 
   template <class V>

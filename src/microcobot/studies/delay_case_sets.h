@@ -3,7 +3,7 @@
 /// Named sets of delay cases for "tune on one set, judge on another": the tuning
 /// set, a fixed grid on which the model-mediated scheme's lag was chosen, and the validation
 /// set, cases drawn at random from a seed over the delays, jitters, losses, wall stiffnesses,
-/// geometry errors and force-sensor noises the scheme must handle. docs/model.md names both.
+/// geometry errors and force-sensor noises the scheme must handle. docs/concepts/teleoperation.md names both.
 
 #include <cstdint>
 #include <vector>

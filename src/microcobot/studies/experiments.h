@@ -19,7 +19,7 @@ struct StepSpectrumResult {
 };
 
 /// §2.5.2.1, Fig. 2.10: slider removed, 90 V step, 1 MHz sampling; peaks near 64 and 118 kHz.
-/// The step's edge is 0.9 us (a laboratory source, faster than a PE period), see docs/model.md.
+/// The step's edge is 0.9 us (a laboratory source, faster than a PE period), see docs/concepts/stick-slip.md.
 StepSpectrumResult run_pe_step(const stickslip::StickSlipParams& params);
 
 /// §2.5.2.1, Fig. 2.11: 40 V step, 25 kHz sampling; peaks near 595 and 1633 Hz.

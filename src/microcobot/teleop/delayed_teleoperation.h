@@ -33,7 +33,7 @@ const char* to_string(Scheme s);
 /// Throws InvalidParams naming `name` unless it is one of to_string's names.
 Scheme scheme_from_string(const std::string& name);
 
-/// The model-mediated scheme's settings (docs/model.md "Settling under long delay").
+/// The model-mediated scheme's settings (docs/concepts/teleoperation.md "Settling under long delay").
 struct MmtSettings {
   ContactEstimatorParams estimator;
   double time_constant_s = 0.005;       ///< the master's model lag, eq. (1) of model_mediated_master.h
@@ -41,7 +41,7 @@ struct MmtSettings {
   /// The geometry's uncertainty on the wall's position: the prior wall is placed this much nearer
   /// than the geometry says, so that the slave's corrections move the model's wall away from the
   /// handle (releasing stored energy) and never towards it (which the passivity controller would
-  /// have to absorb by holding the handle deeper: docs/model.md).
+  /// have to absorb by holding the handle deeper: docs/concepts/teleoperation.md).
   double prior_margin_m = 1.5e-3;
   double force_noise_N = 0.0;  ///< std of the slave's force sensor noise
   bool passivity = true;       ///< the model port's passivity controller

@@ -29,7 +29,7 @@
 namespace mc::teleop {
 
 struct ModelMediatedMasterParams {
-  double time_constant_s = 0.005;     ///< tau of (1); chosen on the tuning set (docs/model.md)
+  double time_constant_s = 0.005;  ///< tau of (1); chosen on the tuning set (docs/concepts/teleoperation.md)
   double servo_stiffness_N_m = 5000;  ///< the slave's position servo k_p, for (2)
   double max_force_N = 20.0;          ///< the master's actuator saturates here
   bool passivity = true;              ///< false: observe (3) only

@@ -3,7 +3,7 @@
 /// Time-domain passivity of a delayed bilateral channel, after Ryu, Artigas and
 /// Preusche, "A passive bilateral control scheme for a teleoperator with time-varying
 /// communication delay" (Mechatronics 20, 2010), the time-delay form of Ryu and Hannaford's
-/// passivity observer and controller. Why this and not wave variables: docs/model.md.
+/// passivity observer and controller. Why this and not wave variables: docs/concepts/teleoperation.md.
 ///
 /// Each port of the channel books the power flowing into the channel, P = f v, as input energy
 /// (P > 0) or output energy (P < 0), and sends its input energy to the other side with every

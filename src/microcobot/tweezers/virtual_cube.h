@@ -5,7 +5,7 @@
 /// penetration by a sampled controller (zero-order hold), optionally through the lag compensator;
 /// the operator's fingers pinch as spring-dampers; the motor torque saturates.
 ///
-/// Chatter criterion (docs/model.md): during the hold window at the end of the pinch, the
+/// Chatter criterion (docs/concepts/teletweez.md): during the hold window at the end of the pinch, the
 /// rendered wall force oscillates with an rms above `chatter_rel_rms` of its mean, or the tips
 /// leave the cube (penetration <= 0 at a control sample) although the operator keeps pinching.
 
@@ -23,7 +23,7 @@ struct VirtualCubeParams {
   double control_rate_Hz = 1000.0;  ///< PIC32 loop rate: not given in the thesis (choice, docs)
   double plant_rate_Hz = 20000.0;   ///< simulation rate of the mechanics (continuous stand-in)
   bool compensator = true;          ///< the lag compensator of Fig. 4.27
-  double lag_pole_Hz = 1.0;         ///< w_p (choice, < 100 Hz; swept in docs/model.md)
+  double lag_pole_Hz = 1.0;         ///< w_p (choice, < 100 Hz; swept in docs/concepts/teletweez.md)
   double lag_zero_Hz = 10.0;        ///< w_z (choice, < 100 Hz): high-frequency gain 0.1
   double operator_target_m = 6e-3;  ///< where the fingers aim (per lever, at the finger contact)
   double ramp_s = 0.4;              ///< the pinch ramps to the target in this time

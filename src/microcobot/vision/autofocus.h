@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Autofocus (docs/model.md, "Autofocus and depth from focus"): a search for the focus
+/// Autofocus (docs/concepts/vision.md, "Autofocus and depth from focus"): a search for the focus
 /// height that maximises a focus measure F (sharpness.h), stepped by its caller one frame at a time, as a
 /// tracker or a servo task is: the search says where to set the focus (next_focus_m()), the
 /// caller takes a frame there, measures its sharpness and hands it back (observe()).
@@ -59,8 +59,8 @@ struct AutofocusParams {
   double final_step_m = 4.5e-6;  ///< the last stage's spacing (half the 10x objective's depth of field)
   int max_frames = 15;           ///< frame budget (the search ends when it is used)
   /// The coarse scan's focus measure: the normalised variance keeps a slope far from focus (its
-  /// coarse texture octaves), where gradient measures are flat (docs/model.md, "Autofocus and depth from
-  /// focus").
+  /// coarse texture octaves), where gradient measures are flat (docs/concepts/vision.md, "Autofocus and depth
+  /// from focus").
   std::string metric = "normalized-variance";
   /// The refinement's ("" = metric): a gradient measure's peak is narrower and, on edges, the
   /// one at the surface's height (the variance of a step hardly changes with focus).
@@ -70,7 +70,7 @@ struct AutofocusParams {
   /// The refinement may take a coarse sample of its own metric as one of its samples (a frame
   /// saved). False when the caller measures the coarse scan on another region than the
   /// refinement (a wide region to find a small target far out of focus, the target's own to place
-  /// it: the tool's tips, docs/model.md "Autofocus and depth from focus"): next_is_coarse() tells
+  /// it: the tool's tips, docs/concepts/vision.md "Autofocus and depth from focus"): next_is_coarse() tells
   /// the caller which.
   bool reuse_coarse_samples = true;
 
@@ -106,7 +106,7 @@ FocusMetric default_fine_metric(const imaging::OpticsFigures& figures);
 /// with `fine_metric`: final_step_m = kFinalStepDof (normalised variance) or kFinalStepDofGradient
 /// (Tenengrad, Brenner: narrower peaks) x its depth of field. The coarse step is the same for every
 /// objective: far from focus the measure's slope comes from the texture's coarse octaves, not
-/// from the depth of field (docs/model.md, "Autofocus and depth from focus").
+/// from the depth of field (docs/concepts/vision.md, "Autofocus and depth from focus").
 AutofocusParams autofocus_params_for(const imaging::OpticsFigures& figures, double start_m,
                                      FocusMetric fine_metric);
 /// The same with default_fine_metric(figures).

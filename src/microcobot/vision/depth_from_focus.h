@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Depth from focus (docs/model.md, "Autofocus and depth from focus"): the height of the
+/// Depth from focus (docs/concepts/vision.md, "Autofocus and depth from focus"): the height of the
 /// plane of best focus of a region, from the focus measures of frames taken at known focus heights (a sweep,
 /// or an Autofocus search's observations). With the focus set on it, a surface's image is sharpest, so the
 /// height of the sharpness peak is the surface's height: the top of a part, the tips of the gripper (Nayar &

@@ -1,11 +1,11 @@
 #pragma once
 /// @file
 /// Focus measures (sharpness) of a camera frame or of a rectangle of it
-/// (docs/model.md, "Autofocus and depth from focus"). Each is largest when the imaged surface is in focus:
-/// defocus is a low-pass filter (optics.h, DefocusPsf), so it removes image variance and gradient energy. The
-/// three are the ones Sun, Duthaler & Nelson compare ("Autofocusing in computer microscopy: selecting the
-/// optimal focus algorithm", Microsc. Res. Tech. 65:139, 2004), over the N pixels I(x, y) of the region with
-/// mean mu:
+/// (docs/concepts/vision.md, "Autofocus and depth from focus"). Each is largest when the imaged surface is in
+/// focus: defocus is a low-pass filter (optics.h, DefocusPsf), so it removes image variance and gradient
+/// energy. The three are the ones Sun, Duthaler & Nelson compare ("Autofocusing in computer microscopy:
+/// selecting the optimal focus algorithm", Microsc. Res. Tech. 65:139, 2004), over the N pixels I(x, y) of
+/// the region with mean mu:
 ///
 ///   normalised variance (Groen, Young & Ligthart, Cytometry 6:81, 1985; Sun et al. eq. 14):
 ///       F = 1 / (N mu) sum (I - mu)^2
