@@ -5,14 +5,14 @@ PRESET ?= release
 BUILD := build/$(PRESET)
 CLI := $(BUILD)/apps/microcobot/microcobot
 JOBS ?= $(shell nproc)
-# Everything `make test` builds; the sanitizer preset leaves out what it leaves out.
-ifeq ($(filter $(PRESET),asan),)
+# Everything `make test` builds; the sanitizer presets leave out what they leave out.
+ifeq ($(filter $(PRESET),asan tsan),)
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_BUILD_BENCH=ON -DMC_BUILD_PYTHON=ON -DMC_WITH_OPENCV=ON
 else
 FULL_OPTS := -DMC_BUILD_TESTS=ON -DMC_WITH_OPENCV=ON
 endif
 
-.PHONY: graph run demo report docs docs-serve results test deps deps-run configure configure-run build cli cli-only python asan fuzz bench format clean
+.PHONY: graph run demo report docs docs-serve results test deps deps-run configure configure-run build cli cli-only python asan tsan fuzz bench format clean
 
 # The main job: the platform live, operated from the browser console whose URL it prints first
 # (http://127.0.0.1:8080/); Ctrl-C stops it with every device in its safe state. It builds only
@@ -78,9 +78,14 @@ cli: configure
 python: configure
 	cmake --build --preset $(PRESET) -j $(JOBS) --target _microcobot
 
-# Sanitizer build and its tests (CI runs this after `make test`).
+# The sanitizer builds and their tests (CI runs both after `make test`; docs/ci.md): AddressSanitizer
+# over the code that handles buffers and outside input, with the parsers' fuzzers;
+# ThreadSanitizer over the threaded modules (tests/tsan.supp: third-party code only).
 asan:
 	$(MAKE) test PRESET=asan
+
+tsan:
+	$(MAKE) test PRESET=tsan
 
 # The parsers under libFuzzer (clang preset `fuzz`), 10 minutes each; ctest (label fuzz) runs
 # 100 000 inputs each from a fixed seed.

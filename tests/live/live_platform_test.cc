@@ -37,6 +37,10 @@ struct Live {
     std::lock_guard lock(mutex);
     return last[channel(name)];
   }
+  std::size_t sample_count() {
+    std::lock_guard lock(mutex);
+    return samples;
+  }
   // Waits until the telemetry (which reaches the sink through the drain thread, behind the
   // loop) shows the loop's state of now: a sample 20 ms of live time newer than the status.
   bool catch_up() {
@@ -62,10 +66,8 @@ ConsoleCommand jog(double vx, bool deadman = true) {
 
 TEST(LivePlatform, TheConsoleJogsTheStageInWallClockTimeOnlyWithTheDeadmanAndFreshCommands) {
   Live rig;
-  ASSERT_TRUE(test::eventually([&] {
-    std::lock_guard lock(rig.mutex);
-    return rig.samples > 50;
-  })) << "the loop runs paced and streams telemetry";
+  ASSERT_TRUE(test::eventually([&] { return rig.sample_count() > 50; }))
+      << "the loop runs paced and streams telemetry";
   const double x0 = rig.get("target_x_m");
   rig.live.set_console_in_control(true);
   rig.drive(jog(100e-6, /*deadman=*/false), 300ms);
@@ -172,7 +174,7 @@ TEST(LivePlatform, TheLoopThreadNeverAllocatesWhileCommandsAndTelemetryFlow) {
     allocations = guard.allocations();
   }
   EXPECT_EQ(allocations, 0u);
-  EXPECT_GT(rig.samples, 500u) << "telemetry kept flowing";
+  EXPECT_GT(rig.sample_count(), 500u) << "telemetry kept flowing";
 }
 
 TEST(LivePlatform, TheDemoRestartsTheSceneWithTheScriptedOperatorAndTimeGoesOn) {

@@ -119,7 +119,9 @@ TEST(FixedRateLoop, TheTicksCpuTimeCountsComputeNotTimeOffTheCpu) {
         EXPECT_LT(cpu[i], 5e-3);
       } else {
         EXPECT_GE(wall[i], 3e-3);
-        EXPECT_LT(cpu[i], 1e-3) << "a tick off the CPU for 3 ms";
+        // Half the tick's wall time: the sleep's own CPU (its call, under a sanitizer its
+        // interception) is not the 3 ms off the CPU.
+        EXPECT_LT(cpu[i], 0.5 * wall[i]) << "a tick off the CPU for 3 ms";
       }
     }
   }

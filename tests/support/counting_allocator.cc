@@ -4,6 +4,12 @@
 #include <cstdlib>
 #include <new>
 
+#include "support/sanitizers.h"
+
+#if MC_UNDER_TSAN
+#include <sanitizer/allocator_interface.h>
+#endif
+
 namespace {
 std::atomic<std::size_t> g_allocations{0};
 std::atomic<int> g_active{0};
@@ -14,9 +20,24 @@ bool counted_thread() {
   return only == std::thread::id{} || only == std::this_thread::get_id();
 }
 
-void* counted_alloc(std::size_t size, std::size_t align) {
+void count_allocation() {
   if (g_active.load(std::memory_order_relaxed) > 0 && counted_thread())
     g_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+#if MC_UNDER_TSAN
+// ThreadSanitizer's runtime owns operator new/delete (a second definition does not link); it calls
+// this hook on every allocation, new's and malloc's alike.
+namespace {
+void on_malloc(const volatile void*, std::size_t) { count_allocation(); }
+void on_free(const volatile void*) {}
+[[maybe_unused]] const int g_hooks = __sanitizer_install_malloc_and_free_hooks(on_malloc, on_free);
+}  // namespace
+#else
+namespace {
+void* counted_alloc(std::size_t size, std::size_t align) {
+  count_allocation();
   if (size == 0) size = 1;
   void* p = nullptr;
   if (align > alignof(std::max_align_t)) {
@@ -69,6 +90,7 @@ void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+#endif
 
 namespace mc::test {
 

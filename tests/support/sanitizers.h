@@ -12,3 +12,16 @@
 #ifndef MC_UNDER_ASAN
 #define MC_UNDER_ASAN 0
 #endif
+
+/// MC_UNDER_TSAN: 1 when the test is built with ThreadSanitizer, whose runtime defines the global
+/// operator new/delete itself (the allocation counter then counts through its malloc hook).
+#if defined(__SANITIZE_THREAD__)
+#define MC_UNDER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define MC_UNDER_TSAN 1
+#endif
+#endif
+#ifndef MC_UNDER_TSAN
+#define MC_UNDER_TSAN 0
+#endif

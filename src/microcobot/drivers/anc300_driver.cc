@@ -188,8 +188,10 @@ void Anc300Controller::cycle(LineClient& bus) {
       est_m_[static_cast<std::size_t>(i)] = read_position(bus, i);
       publish_position(i, est_m_[static_cast<std::size_t>(i)]);
     }
-  int best = -1;
-  long long best_n = 0;
+  // Every axis off its target starts its run, then each is waited for: the ANC300 plays its
+  // axes' runs at once, so a diagonal move goes at each axis's own speed.
+  std::array<long long, kMaxAxes> run{};  // periods started this cycle, signed
+  const long long cap = std::max(1LL, static_cast<long long>(params_.frequency_Hz * params_.max_run_s));
   for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
     if (!t.wanted[i]) continue;
     if (!stepping_mode_[i]) {
@@ -200,28 +202,24 @@ void Anc300Controller::cycle(LineClient& bus) {
     const double s = e >= 0.0 ? params_.step_up_m : params_.step_down_m;
     const double band = params_.deadband_m > 0.0 ? params_.deadband_m : 0.5 * s;
     if (std::abs(e) <= band) continue;
-    const long long n = std::max(1LL, std::llround(std::abs(e) / s));
-    if (n > std::abs(best_n)) {
-      best = static_cast<int>(i);
-      best_n = e >= 0.0 ? n : -n;
-    }
+    const long long n = std::min(std::max(1LL, std::llround(std::abs(e) / s)), cap);
+    request(bus, fmt::format("{} {} {}", e >= 0.0 ? "stepu" : "stepd", axis_id(i), n));
+    run[i] = e >= 0.0 ? n : -n;
   }
-  if (best >= 0) {
-    const auto k = static_cast<std::size_t>(best);
-    const long long cap = std::max(1LL, static_cast<long long>(params_.frequency_Hz * params_.max_run_s));
-    const long long n = std::min(std::abs(best_n), cap);
-    request(bus, fmt::format("{} {} {}", best_n > 0 ? "stepu" : "stepd", axis_id(k), n));
+  for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
+    const long long n = run[i];
+    if (n == 0) continue;
     // stepw answers once the run is over: n periods, then the reply's own time.
-    request(bus, fmt::format("stepw {}", axis_id(k)),
-            static_cast<double>(n) / params_.frequency_Hz + timing().reply_timeout_s);
-    periods_[k].fetch_add(best_n > 0 ? n : -n);
+    request(bus, fmt::format("stepw {}", axis_id(i)),
+            static_cast<double>(std::abs(n)) / params_.frequency_Hz + timing().reply_timeout_s);
+    periods_[i].fetch_add(n);
     if (params_.sensor) {
-      est_m_[k] = read_position(bus, best);
+      est_m_[i] = read_position(bus, static_cast<int>(i));
     } else {
-      est_m_[k] += best_n > 0 ? static_cast<double>(n) * params_.step_up_m
-                              : -static_cast<double>(n) * params_.step_down_m;
+      est_m_[i] +=
+          n > 0 ? static_cast<double>(n) * params_.step_up_m : static_cast<double>(n) * params_.step_down_m;
     }
-    publish_position(best, est_m_[k]);
+    publish_position(static_cast<int>(i), est_m_[i]);
   }
   publish_stamp();
 }

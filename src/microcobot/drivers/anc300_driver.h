@@ -9,9 +9,9 @@
 ///   error e = target - position; n = max(1, round(|e| / s)) periods (s: the step of one period at
 ///   the set amplitude and frequency, up or down), none while |e| is within the dead band (half a
 ///   step unless given: option deadband_nm),
-///   at most frequency * max_run_s per command so that a moving target is followed; one axis per
-///   cycle, the one furthest from its target (in steps): `stepu|stepd AXIS n`, then `stepw AXIS`
-///   (answers once the run is over)
+///   at most frequency * max_run_s per command so that a moving target is followed; every axis
+///   off its target is started (`stepu|stepd AXIS n`, the controller plays the runs at once), then
+///   each is waited for (`stepw AXIS` answers once its run is over)
 ///
 /// The position is either counted (the default, all a real ANC300 without a sensor gives: the
 /// sum of the periods sent times s, from 0 at the first configure; it drifts by the step's error,
@@ -24,7 +24,8 @@
 ///              setf N f, setv N v; getpos N (position=getpos). Every reply must end in OK: the
 ///              ANC300 has no error register, an ERROR line is its error (the configuration
 ///              fails naming the command and the controller's message)
-///   each cycle [getpos N x3], setm N stp (an axis armed again), stepu|stepd N n, stepw N
+///   each cycle [getpos N x3], setm N stp (an axis armed again), stepu|stepd N n for each axis
+///              off its target, then stepw N for each
 ///   safe state stop N, setm N gnd (every axis)
 ///
 /// The rotary axis under the gripper, with the option `theta=N`: the

@@ -247,7 +247,7 @@ class LivePlatform {
   std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;
   FrameSink frame_sink_;
-  bool has_camera_ = false;
+  std::atomic<bool> has_camera_{false};  // written by each build (the control thread), read by status()
   std::thread thread_;
 
   // Status written by the loop (atomics) and by the control thread (under status_mutex_, never

@@ -11,7 +11,7 @@ void ProtocolSource::stop_and_hold(Platform& p) noexcept {
   p.stop_open_loop();
   p.hold();
   has_goal_ = false;
-  steps_pending_ = false;
+  pending_steps_ = {};
 }
 
 SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
@@ -32,14 +32,13 @@ SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
         theta_goal_rad_ = c.theta_goal_rad;
         theta_speed_rad_s_ = c.theta_speed_rad_s;
         has_goal_ = true;
-        steps_pending_ = false;
+        pending_steps_ = {};
         settled_s_ = {};
         break;
       case ProtocolCommand::Kind::kSteps:
         last_t_ = now;
         has_goal_ = false;
-        pending_steps_ = c;
-        steps_pending_ = true;
+        pending_steps_[static_cast<std::size_t>(std::clamp(c.axis, 0, 3))] = c;
         break;
       case ProtocolCommand::Kind::kStop:
         if (holding_) stop_and_hold(p);  // a protocol stop never interrupts another source
@@ -53,7 +52,7 @@ SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
   // A halted platform forgets the protocol's goal: nothing resumes by itself after the reset.
   if (p.faulted()) {
     has_goal_ = false;
-    steps_pending_ = false;
+    pending_steps_ = {};
   }
   SourceRequest r;
   if (now - last_t_ <= params_.command_timeout_s) r.claim = Claim::kActive;
@@ -83,12 +82,14 @@ void ProtocolSource::released(const SourceTick& t) noexcept {
 void ProtocolSource::publish(const SourceTick& t) noexcept {
   Platform& p = t.platform;
   // Steps start only while the protocol drives (the console input they check is its).
-  if (steps_pending_ && holding_) {
-    const ProtocolCommand& s = pending_steps_;
-    if (!p.start_open_loop_steps(s.axis, s.amplitude_V, s.frequency_Hz, s.direction, s.periods))
-      refused_steps_.fetch_add(1, std::memory_order_relaxed);
+  for (auto& pending : pending_steps_) {
+    if (pending && holding_) {
+      const ProtocolCommand& s = *pending;
+      if (!p.start_open_loop_steps(s.axis, s.amplitude_V, s.frequency_Hz, s.direction, s.periods))
+        refused_steps_.fetch_add(1, std::memory_order_relaxed);
+    }
+    pending.reset();
   }
-  steps_pending_ = false;
   const double dt = std::max(0.0, t.tick.t_s - last_publish_t_);
   last_publish_t_ = t.tick.t_s;
   const auto& target = p.teleop().slave_target_m;
@@ -115,7 +116,8 @@ void ProtocolSource::publish(const SourceTick& t) noexcept {
 
 void ProtocolSource::reset() noexcept {
   last_t_ = -1e9;
-  holding_ = has_goal_ = steps_pending_ = false;
+  holding_ = has_goal_ = false;
+  pending_steps_ = {};
   settled_s_ = {};
 }
 

@@ -10,6 +10,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/protocol_command.h"
@@ -50,10 +51,11 @@ class ProtocolSource final : public CommandSource {
   // Loop thread only.
   double last_t_ = -1e9, speed_m_s_ = 0.0, last_publish_t_ = 0.0;
   double theta_goal_rad_ = 0.0, theta_speed_rad_s_ = 0.0;
-  bool holding_ = false, has_goal_ = false, steps_pending_ = false;
+  bool holding_ = false, has_goal_ = false;
   std::array<double, 3> goal_m_{};
   std::array<double, 4> settled_s_{};  // X, Y, Z, theta
-  ProtocolCommand pending_steps_;
+  // The step runs asked since the last tick, one per axis: runs on several axes play at once.
+  std::array<std::optional<ProtocolCommand>, 4> pending_steps_{};
   std::uint64_t popped_seq_ = 0;
   // Published for the protocol thread (X, Y, Z [m], theta [rad]).
   std::array<std::atomic<double>, 4> position_{};
