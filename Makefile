@@ -78,9 +78,9 @@ cli: configure
 python: configure
 	cmake --build --preset $(PRESET) -j $(JOBS) --target _microcobot
 
-# The sanitizer builds and their tests (CI runs both after `make test`; docs/ci.md): AddressSanitizer
-# over the code that handles buffers and outside input, with the parsers' fuzzers;
-# ThreadSanitizer over the threaded modules (tests/tsan.supp: third-party code only).
+# The sanitizer builds and their tests (docs/ci.md): AddressSanitizer and UBSan with the parsers'
+# fuzzers (CI runs it after `make test`); ThreadSanitizer over the threaded modules
+# (tests/tsan.supp: third-party code only).
 asan:
 	$(MAKE) test PRESET=asan
 
