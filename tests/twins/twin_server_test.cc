@@ -93,6 +93,38 @@ TEST(TwinServer, AWrongAnc300PasswordIsRefusedAndClosed) {
   EXPECT_TRUE(a.closed_by_server());  // the third failure closes
 }
 
+// Step runs asked of two axes in one breath (one segment: within one tick of the loop) both play,
+// as a controller plays its axes' runs at once: the protocol keeps a pending run per axis.
+TEST(TwinServer, Anc300StepRunsAskedOfTwoAxesAtOnceBothPlay) {
+  TwinRig rig;
+  Client a(rig.anc_port());
+  a.read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
+  a.send("123456\r\n");
+  a.read_until([](const std::string& t) { return t.find("success") != std::string::npos; });
+  const auto oks = [&](int n) {
+    const std::string t = a.read_until([n](const std::string& text) {
+      int count = 0;
+      for (auto at = text.find("OK\r\n"); at != std::string::npos; at = text.find("OK\r\n", at + 1)) ++count;
+      return count >= n;
+    });
+    EXPECT_EQ(t.find("ERROR"), std::string::npos) << t;
+  };
+  a.send("setm 1 stp\r\nsetm 2 stp\r\nsetf 1 1000\r\nsetf 2 1000\r\nsetv 1 60\r\nsetv 2 60\r\n");
+  oks(6);
+  Client g(rig.gcs_port());
+  const auto before = drivers::gcs2::parse_axis_values(g.gcs("POS? 1 2"));
+  a.send("stepu 1 200\r\nstepu 2 200\r\n");
+  oks(2);
+  a.send("stepw 1\r\n");
+  oks(1);
+  a.send("stepw 2\r\n");
+  oks(1);
+  const auto after = drivers::gcs2::parse_axis_values(g.gcs("POS? 1 2"));
+  // 200 periods of about 50 nm each (the model's step at 60 V, 1 kHz): micrometres, on both axes.
+  for (std::size_t i = 0; i < 2; ++i)
+    EXPECT_GT(after.at(i).second - before.at(i).second, 2e-3) << "axis " << i + 1 << " [mm]";
+}
+
 TEST(TwinServer, HostileClientsAreSurvived) {
   TwinRig rig(/*line_timeout_s=*/0.3);
   Client good(rig.gcs_port());
