@@ -68,6 +68,12 @@ struct Client {
     send(line + "\n");
     return read_until([](const std::string& t) { return drivers::gcs2::reply_complete(t); });
   }
+  /// Logs in to the ANC300 twin's console with its default password, up to its prompt.
+  void anc300_login() const {
+    read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
+    send("123456\r\n");
+    read_until([](const std::string& t) { return t.find("> ") != std::string::npos; });
+  }
   /// True once the server closed the connection (EOF) within the timeout.
   bool closed_by_server() const {
     char buf[4096];

@@ -126,9 +126,7 @@ TEST(TwinRotary, ADisconnectMidTurnLeavesThetaHolding) {
 TEST(TwinRotary, AnAnc300ClientStepsTheRotaryPositionerUpAndBack) {
   TwinRig rig;
   Client a(rig.anc_port());
-  a.read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
-  a.send("123456\r\n");
-  a.read_until([](const std::string& t) { return t.find("> ") != std::string::npos; });
+  a.anc300_login();
   auto ask = [&](const std::string& line) {
     a.send(line + "\r\n");
     return a.read_until([](const std::string& t) {

@@ -98,9 +98,7 @@ TEST(TwinServer, AWrongAnc300PasswordIsRefusedAndClosed) {
 TEST(TwinServer, Anc300StepRunsAskedOfTwoAxesAtOnceBothPlay) {
   TwinRig rig;
   Client a(rig.anc_port());
-  a.read_until([](const std::string& t) { return t.find("code: ") != std::string::npos; });
-  a.send("123456\r\n");
-  a.read_until([](const std::string& t) { return t.find("success") != std::string::npos; });
+  a.anc300_login();
   const auto oks = [&](int n) {
     const std::string t = a.read_until([n](const std::string& text) {
       int count = 0;
