@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -313,6 +314,34 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 5.0));
   const auto open = rig.collect(600ms);
   EXPECT_LT(std::abs(open.vision_N), 20e-6);
+}
+
+// The console's default view (2x, the tips out of focus: a frame's tips' distance is good to about
+// a pixel, +-50 uN of grip): open fingers turned to yaws drawn at random read no force once still.
+// Each turn tares afresh over frames; a noisy frame must neither cut that average short nor pass
+// for a held part, or the tare keeps one frame's error (up to 50 uN).
+TEST(VisionGripForce, OpenFingersTurnedAnywhereReadNoForceAtTheConsolesDefaultView) {
+  GripRig rig{LiveParams{}};
+  ASSERT_TRUE(
+      rig.wait([](const LiveStatus& s) { return s.grip_vision && s.grip_vision->state == "measuring"; },
+               MC_UNDER_ASAN ? 60.0 : 20.0));
+  std::mt19937 draw(20261206);
+  std::uniform_real_distribution<double> yaw_deg(-20.0, 20.0);
+  for (int turn = 0; turn < 12; ++turn) {
+    const double goal = yaw_deg(draw) * M_PI / 180.0;
+    rig.theta_goal = goal;
+    ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load() - goal) < 1e-5; },
+                                 MC_UNDER_ASAN ? 60s : 20s));
+    rig.theta_goal = std::nan("");  // let go, as the console does once there
+    ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 10.0))
+        << rig.live.status().grip_vision->error;
+    // The mean over the first 20 frames measured (their noise: 50 uN / sqrt(20) = 11 uN): no grip.
+    const auto open = rig.collect(0ms, 20);
+    std::printf("open fingers at %+6.2f deg: %+6.1f uN over %zu of %zu frames\n", goal * 180.0 / M_PI,
+                open.vision_N * 1e6, open.measured_frames, open.frames);
+    ASSERT_GE(open.measured_frames, 10u);
+    EXPECT_LT(std::abs(open.vision_N), 30e-6) << "at " << goal * 180.0 / M_PI << " deg";
+  }
 }
 
 TEST(VisionGripForce, ATareOnRequestAndNoneWithoutFrames) {

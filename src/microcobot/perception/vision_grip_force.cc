@@ -22,8 +22,12 @@ void VisionGripForceParams::validate() const {
 }
 
 namespace {
-// A part holds the fingers apart by more than this: the next gap is predicted from the last.
+// A part holds the fingers apart by more than this (and by more than kNoise_px): the next gap is
+// predicted from the last, and a turn chains the gap rather than taring afresh.
 constexpr double kLoadedGap = 1e-6;
+// A frame's tips' distance is good to about a pixel (at 2x with the tips out of focus, 0.8 px rms):
+// a gap this many pixels off the drive's opening is beyond a frame's noise.
+constexpr double kNoise_px = 3.0;
 // The fingers' yaw the tips are taught at holds within this: 1 mrad moves a tip 0.1 um across a
 // 100 um gap (turned further, they are taught again).
 constexpr double kMaxYaw_rad = 1e-3;
@@ -233,8 +237,11 @@ const VisionGripStatus& VisionGripForce::on_frame(const devices::CameraFrame& fr
   // known only from the stage's sensors.
   const bool stage_known = hint.stage_sensed && !hint.pixel;
   const double c_px = (0.5 * (p[0] - offset_px_[0] + p[1] - offset_px_[1]) - tool).dot(e_x_);
-  if (tare_frames_ > 0 && tare_frames_ < kTareFrames && o == measured_free_opening_m_ && !loaded_) {
-    tare_d_sum_px_ += d_px;  // still the tare's scene: its references averaged
+  // Still the tare's scene (the drive unmoved; nothing between the fingers, by the tare's
+  // definition, whatever a noisy frame says): its references averaged.
+  const bool taring = tare_frames_ > 0 && tare_frames_ < kTareFrames && o == measured_free_opening_m_;
+  if (taring) {
+    tare_d_sum_px_ += d_px;
     tare_c_sum_px_ += c_px;
     ++tare_frames_;
     ref_d_px_ = tare_d_sum_px_ / tare_frames_;
@@ -243,7 +250,8 @@ const VisionGripStatus& VisionGripForce::on_frame(const devices::CameraFrame& fr
     tare_frames_ = 0;
   }
   const double gap = ref_gap_m_ + (d_px - ref_d_px_) / scale_px_m_;
-  if (gap < o - std::max(kLoadedGap, 3.0 / scale_px_m_)) {
+  const double beyond_noise_m = std::max(kLoadedGap, kNoise_px / scale_px_m_);
+  if (gap < o - beyond_noise_m) {
     // Closer than the drive puts them: nothing pushes fingers inward; these are not the tips.
     st_.state = "lost";
     st_.error = "the tips seen closer than the drive puts them";
@@ -254,7 +262,7 @@ const VisionGripStatus& VisionGripForce::on_frame(const devices::CameraFrame& fr
   measured_free_opening_m_ = o;
   last_tool_px_ =
       0.5 * (p[0] - offset_px_[0] - tip_step_px(-1, gap) + p[1] - offset_px_[1] - tip_step_px(1, gap));
-  loaded_ = gap - o > kLoadedGap;
+  loaded_ = !taring && gap - o > beyond_noise_m;
   st_.state = "measuring";
   st_.error.clear();
   st_.gap_m = gap;
