@@ -13,6 +13,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/params.h"
 #include "microcobot/stickslip/actuator.h"
+#include "microcobot/studies/edge_dip.h"
 #include "microcobot/studies/experiment_figures.h"
 #include "microcobot/studies/experiments.h"
 #include "microcobot/studies/integrator_accuracy.h"
@@ -262,6 +263,110 @@ void run_accuracy(const AccuracyOptions& o) {
                   100 * quantile(step, 0.5), 100 * *std::max_element(step.begin(), step.end())));
 }
 
+/// One sweep's rows: the case, what it did.
+void add_rows(mc::CsvTable& t, int sweep_id, const std::vector<mc::studies::EdgeDip>& dips) {
+  for (const auto& d : dips) {
+    const std::array<double, 11> row{static_cast<double>(sweep_id),
+                                     d.edge.top_V,
+                                     d.edge.drop_V,
+                                     d.edge.slew_V_s,
+                                     d.edge.ramp_m_s,
+                                     d.edge.unload_V,
+                                     d.edge_s,
+                                     d.dip_m,
+                                     d.dip_at_s,
+                                     d.net_m,
+                                     d.z_ba_m};
+    t.add_row(row);
+  }
+}
+
+nlohmann::json fit_json(const mc::studies::PowerFit& f) {
+  return {{"exponent", f.exponent}, {"factor", f.factor}, {"points", f.points}};
+}
+
+Series dip_series(const std::string& name, const std::vector<mc::studies::EdgeDip>& dips, bool by_drop) {
+  Series s{name, {}, {}, true};
+  for (const auto& d : dips) {
+    s.x.push_back(by_drop ? d.edge.drop_V : d.edge_s);
+    s.y.push_back(d.dip_m);
+  }
+  return s;
+}
+
+/// The edge's dip against its drop, slew and operating point (studies/edge_dip.h).
+void run_edge_dip(const CommonOptions& o) {
+  const ss::ActuatorModel m(load(o));
+  const auto st = mc::studies::run_edge_study(
+      m, [](std::size_t done, std::size_t total) { mc::cli::progress("edge-dip", done, total); });
+  mc::studies::EdgeCase tracking_edge;  // the tracking controller's: 31.62..100 V, unloaded by 49.16 V
+  tracking_edge.unload_V = 49.16;
+  const auto tracking = mc::studies::run_edge(m, tracking_edge);
+  const nlohmann::json j{{"mechanism", st.mechanism},
+                         {"z_ba_m", st.z_ba_m},
+                         {"dip_vs_drop", fit_json(st.dip_vs_drop)},
+                         {"dip_vs_duration", fit_json(st.dip_vs_duration)},
+                         {"dip_vs_drop_unloaded", fit_json(st.dip_vs_drop_unloaded)},
+                         {"dip_vs_duration_unloaded", fit_json(st.dip_vs_duration_unloaded)},
+                         {"tracking_edge",
+                          {{"dip_m", tracking.dip_m},
+                           {"dip_at_s", tracking.dip_at_s},
+                           {"net_m", tracking.net_m},
+                           {"edge_s", tracking.edge_s}}}};
+  if (o.out) {
+    mc::ensure_writable_dir(*o.out);
+    mc::CsvTable t({"sweep", "top_V", "drop_V", "slew_V_s", "ramp_m_s", "unload_V", "edge_s", "dip_m",
+                    "dip_at_s", "net_m", "z_ba_m"});
+    add_rows(t, 0, st.drop_sweep);
+    add_rows(t, 1, st.drop_sweep_unloaded);
+    add_rows(t, 2, st.slew_sweep);
+    add_rows(t, 3, st.slew_sweep_unloaded);
+    add_rows(t, 4, st.speed_sweep);
+    add_rows(t, 5, st.top_sweep);
+    mc::cli::write_result_tables(
+        o,
+        {{"edges.csv",
+          t,
+          "edges_",
+          {"sweep: 0 drop, 1 drop unloaded, 2 slew, 3 slew unloaded, 4 ramp speed, 5 top voltage"}}},
+        j);
+    Report r("stickslip edge-dip");
+    r.section(
+        "The dip of one edge",
+        fmt::format("A stuck slider ramped at 100 um/s, then one edge: the PE falls by dV at the slew S "
+                    "from 100 V (held, or turned back by 72 % of dV: the tracking controller's "
+                    "unloading). The dip is the slider's largest excursion behind where it was when the "
+                    "edge started. Mechanism from the held edges' fits: {}.",
+                    st.mechanism));
+    r.add_result("dip ~ dV^p (held, 1 V/us), p", st.dip_vs_drop.exponent, "");
+    r.add_result("dip ~ T^p (held, dV 68.38 V), p", st.dip_vs_duration.exponent, "");
+    r.add_result("break-away strain z_ba", st.z_ba_m, "m");
+    r.add_result("the tracking controller's edge (unloaded): dip", tracking.dip_m, "m");
+    r.add_figure(
+        {"Dip against the edge's drop",
+         "At 1 V/us from 100 V, held and unloaded.",
+         {"Drop dV", "V", true},
+         {"Dip", "m", true},
+         {dip_series("held", st.drop_sweep, true), dip_series("unloaded", st.drop_sweep_unloaded, true)}});
+    r.add_figure(
+        {"Dip against the edge's duration",
+         "dV = 68.38 V at slews from 0.125 to 8 V/us, held and unloaded.",
+         {"Edge duration T = dV / S", "s", true},
+         {"Dip", "m", true},
+         {dip_series("held", st.slew_sweep, false), dip_series("unloaded", st.slew_sweep_unloaded, false)}});
+    mc::cli::write_report_if_requested(o, r);
+  }
+  mc::cli::emit(
+      o, j,
+      fmt::format("mechanism: {}; dip ~ dV^{:.2f} at 1 V/us, ~ T^{:.2f} at 68.38 V (held); unloaded "
+                  "dV^{:.2f}, T^{:.2f}; z_ba {:.0f} nm; the tracking controller's edge (unloaded) dips "
+                  "{:.0f} nm at {:.0f} us, "
+                  "rests {:+.0f} nm",
+                  st.mechanism, st.dip_vs_drop.exponent, st.dip_vs_duration.exponent,
+                  st.dip_vs_drop_unloaded.exponent, st.dip_vs_duration_unloaded.exponent, st.z_ba_m * 1e9,
+                  tracking.dip_m * 1e9, tracking.dip_at_s * 1e6, tracking.net_m * 1e9));
+}
+
 void add_stickslip(CLI::App& group) {
   {
     auto o = std::make_shared<CommonOptions>();
@@ -303,6 +408,16 @@ void add_stickslip(CLI::App& group) {
     mc::cli::add_output_options(*cmd, o->common);
     mc::cli::add_params_option(*cmd, o->common);
     cmd->callback([o] { run_accuracy(*o); });
+  }
+  {
+    auto o = std::make_shared<CommonOptions>();
+    auto* cmd = group.add_subcommand(
+        "edge-dip",
+        "One abrupt edge's backward dip against its drop, slew and operating point (the mechanism)");
+    mc::cli::add_output_options(*cmd, *o);
+    mc::cli::add_format_option(*cmd, *o);
+    mc::cli::add_params_option(*cmd, *o);
+    cmd->callback([o] { run_edge_dip(*o); });
   }
   {
     auto o = std::make_shared<CommonOptions>();
