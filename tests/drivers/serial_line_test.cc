@@ -213,10 +213,16 @@ TEST(SerialLine, ThePiGcs2DriverConfiguresAndMovesTheAxesOverTheLine) {
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_FALSE(p->faulted());
+  // The bus thread starved for a stale window (a loaded machine) leaves a reading stale, as it
+  // must say; a reading comes again once it runs.
+  const auto fresh = [&] {
+    return p->axis(0).measurement_fresh() && p->axis(1).measurement_fresh() && p->axis(2).measurement_fresh();
+  };
+  if (!fresh()) run_paced(*p, 2.0, fresh);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(fake.x_mm(i) * 1e-3, goal[i], 1e-9) << "axis " << i;
     EXPECT_NEAR(p->axis(i).position_m(), goal[i], 1e-9) << "axis " << i;
-    EXPECT_TRUE(p->axis(i).measurement_fresh());
+    EXPECT_TRUE(p->axis(i).measurement_fresh()) << "axis " << i;
   }
   const double poll_Hz = (fake.server.count("POS?") - polls_before) / elapsed;
   // Asked every 2 ms; the contract is a reading within every stale window (50 ms), whatever the

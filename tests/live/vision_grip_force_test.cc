@@ -321,7 +321,8 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
 // Each turn tares afresh over frames; a noisy frame must neither cut that average short nor pass
 // for a held part, or the tare keeps one frame's error (up to 50 uN).
 TEST(VisionGripForce, OpenFingersTurnedAnywhereReadNoForceAtTheConsolesDefaultView) {
-  GripRig rig{LiveParams{}};
+  LiveParams p;  // the console's default scene and view
+  GripRig rig(std::move(p));
   ASSERT_TRUE(
       rig.wait([](const LiveStatus& s) { return s.grip_vision && s.grip_vision->state == "measuring"; },
                MC_UNDER_ASAN ? 60.0 : 20.0));

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
 /// The device set: every device the loop drives, by its interface (device.h), and the simulated
-/// ones by their concrete types. The platform's builder fills it from the configuration
-/// (simulated devices, or a registered driver's: platform/driver_registry.h); a driver needs
-/// nothing above this layer to build one.
+/// ones by their concrete types. The platform fills it from the configuration (the simulated
+/// devices: platform/simulated_device_set.h; or a registered driver's: platform/driver_registry.h);
+/// a driver needs nothing above this layer to build one.
 
 #include <array>
 #include <memory>

@@ -8,6 +8,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/platform/driver_registry.h"
+#include "microcobot/platform/simulated_device_set.h"
 
 namespace mc::platform {
 namespace {
@@ -31,44 +32,9 @@ Platform::Platform(const PlatformConfig& config)
       loop_(config_.loop.base_rate_Hz),
       ring_(kRingCapacity) {
   model_ = std::make_unique<stickslip::ActuatorModel>(axis_params(config_));
-  const double dt = config_.loop.period_s();
-  const char* names[3] = {"axis_x", "axis_y", "axis_z"};
-  for (std::size_t i = 0; i < 3; ++i) {
-    motion::PositionSensorParams sp = config_.stage.sensor;
-    sp.seed = config_.stage.sensor.seed + static_cast<int>(i);  // independent noise per axis
-    auto axis = std::make_unique<devices::SimulatedSlaveAxis>(names[i], *model_, sp, 0.0);
-    sim_.axes[i] = axis.get();
-    devices_.axes[i] = std::move(axis);
-  }
-  if (config_.stage.rotary.enabled && !config_.optical_trap_scene()) {
-    motion::PositionSensorParams sp = config_.stage.sensor;
-    sp.seed = config_.stage.sensor.seed + 3;
-    auto rotary = std::make_unique<devices::SimulatedSlaveAxis>("axis_theta", *model_, sp, 0.0);
-    sim_.rotary = rotary.get();
-    devices_.rotary = std::move(rotary);
-  }
-  const std::array<const devices::SimulatedSlaveAxis*, 3> carriers{sim_.axes[0], sim_.axes[1], sim_.axes[2]};
-  const devices::Vec3 home{home_m_.x(), home_m_.y(), home_m_.z()};
-  if (config_.optical_trap_scene()) {
-    auto trap = std::make_unique<devices::SimulatedOpticalTweezers>("optical_tweezers", config_.optical_trap,
-                                                                    carriers, home, dt);
-    sim_.optical_tweezers = trap.get();
-    devices_.gripper = std::move(trap);
-  } else {
-    auto gripper = std::make_unique<devices::SimulatedGripper>(
-        "gripper", world_, std::array<const devices::SlaveAxis*, 3>{carriers[0], carriers[1], carriers[2]},
-        home);
-    if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
-    sim_.gripper = gripper.get();
-    devices_.gripper = std::move(gripper);
-  }
-  auto haptic = std::make_unique<devices::SimulatedHapticMaster>(
-      "dual_stage", config_.haptic.plant, config_.haptic.render, config_.haptic.pantograph, dt);
-  auto tweezers = std::make_unique<devices::SimulatedTweezersMaster>("teletweez", config_.tweezers, dt);
-  sim_.haptic = haptic.get();
-  sim_.tweezers = tweezers.get();
-  devices_.haptic = std::move(haptic);
-  devices_.tweezers = std::move(tweezers);
+  SimulatedDeviceSet built = build_simulated_devices(config_, *model_, world_, home_m_);
+  devices_ = std::move(built.devices);
+  sim_ = built.simulation;
   build();
 }
 
@@ -81,22 +47,7 @@ Platform::Platform(const PlatformConfig& config, devices::DeviceSet drivers)
       home_m_(config_.stage.home_x_m, config_.stage.home_y_m, config_.stage.home_z_m),
       loop_(config_.loop.base_rate_Hz),
       ring_(kRingCapacity) {
-  if (config_.devices.gripper == "simulated") {
-    // Hardware in the loop: this process's microworld under the driver's stage, the finger tips
-    // where its sensors say the stage is (the driver set's own gripper is not used).
-    require(!config_.optical_trap_scene(), "devices.gripper", "simulated needs the pick-place microworld");
-    for (std::size_t i = 0; i < 3; ++i)
-      if (devices_.axes[i] == nullptr)
-        throw InvalidParams("devices.axes[" + std::to_string(i) + "]", "is missing");
-    auto gripper = std::make_unique<devices::SimulatedGripper>(
-        "gripper", world_,
-        std::array<const devices::SlaveAxis*, 3>{devices_.axes[0].get(), devices_.axes[1].get(),
-                                                 devices_.axes[2].get()},
-        devices::Vec3{home_m_.x(), home_m_.y(), home_m_.z()});
-    if (devices_.rotary) gripper->set_rotary(devices_.rotary.get(), config_.stage.rotary);
-    sim_.gripper = gripper.get();
-    devices_.gripper = std::move(gripper);
-  }
+  if (config_.devices.gripper == "simulated") add_simulated_gripper(config_, world_, home_m_, devices_, sim_);
   // A driver set's companions may be the simulated masters (drivers/sim_companions.h): the
   // scripted operator moves their hands as on the simulated platform.
   sim_.haptic = dynamic_cast<devices::SimulatedHapticMaster*>(devices_.haptic.get());
