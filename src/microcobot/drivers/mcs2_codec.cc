@@ -74,8 +74,6 @@ std::string_view error_text(int code) {
       return "Amplifier disabled";
     case kNotReferenced:
       return "Not referenced";
-    case kBusyCalibrating:
-      return "Busy calibrating";
     case kBusyReferencing:
       return "Busy referencing";
     case kRangeLimitReached:

@@ -56,7 +56,6 @@ enum Error : int {
   kSensorDisabled = 0x0104,
   kAmplifierDisabled = 0x0106,
   kNotReferenced = 0x0112,
-  kBusyCalibrating = 0x0151,
   kBusyReferencing = 0x0152,
   kRangeLimitReached = 0x0202,
   kFeatureNotImplemented = 0x7ffe,
