@@ -210,8 +210,11 @@ TEST(Mcs2Server, HostileClientsAreSurvivedAndADisconnectMidMoveLeavesTheAxesHold
   const double a = static_cast<double>(std::stoll(good.ask(":CHAN0:POS?")));
   std::this_thread::sleep_for(500ms);
   const double b = static_cast<double>(std::stoll(good.ask(":CHAN0:POS?")));
-  EXPECT_LT(a - stopped_pm, 5e7);          // stopped within the heartbeat timeout (0.2 s at 0.1 mm/s)
-  EXPECT_NEAR(a, b, 1e6);                  // and holds
+  EXPECT_LT(a - stopped_pm, 5e7);  // stopped within the heartbeat timeout (0.2 s at 0.1 mm/s)
+  EXPECT_NEAR(a, b, 1e6);          // and holds
+  // The channel says so: not moving, no target held, the move failed.
+  EXPECT_EQ(good.stat(0) & (bit::kActivelyMoving | bit::kClosedLoopActive | bit::kMovementFailed),
+            bit::kMovementFailed);
   EXPECT_EQ(good.ask(":DEV:NOBM?"), "2");  // still served
   EXPECT_GE(rig.server->counters().closed_hostile, 1u);
 }

@@ -221,6 +221,20 @@ TEST(Mcs2Twin, StopHoldsTheChannelWhereItIs) {
   EXPECT_EQ(rig.ask(":CHAN0:POS:TARG?"), "1000000000\r\n");
 }
 
+TEST(Mcs2Twin, AStopFromAClientNotInControlStopsNothingAndLosingControlEndsTheMove) {
+  Mcs2Rig rig;
+  rig.referenced();
+  rig.ask(":MOVE0 3000000000");
+  rig.stage.axes[0].on_target = false;
+  EXPECT_EQ(rig.ask(":STOP0", /*client=*/2), "");
+  EXPECT_EQ(rig.stage.log.back(), "move");
+  EXPECT_EQ(rig.ask(":CHAN0:POS:TARG?", 2), "3000000000\r\n");
+  rig.stage.console = true;  // a console user takes control: the platform holds
+  rig.stage.axes[0].position = 1e-3;
+  EXPECT_EQ(rig.stat(0) & (bit::kActivelyMoving | bit::kMovementFailed), bit::kMovementFailed);
+  EXPECT_EQ(rig.ask(":CHAN0:POS:TARG?"), "1000000000\r\n");
+}
+
 TEST(Mcs2Twin, AnotherOperatorOrTheEstopRefuseMovesAndFlagThem) {
   Mcs2Rig rig;
   rig.stage.console = true;

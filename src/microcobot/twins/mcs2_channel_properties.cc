@@ -110,6 +110,7 @@ void Mcs2Twin::channel_property(ClientId client, int n, const mcs2::Command& c, 
     const auto v = value(mcs2::kSensorOff, mcs2::kSensorPowerSave);
     if (!v) return;
     if (*v != mcs2::kSensorOff && !ch.sensor_present) return push_error(mcs2::kNoSensorPresent);
+    if (*v == mcs2::kSensorOff && !may_stop(client)) return push_error(mcs2::kPermissionDenied);
     // Without its sensor the channel cannot hold a target: it stops and holds where it is.
     if (*v == mcs2::kSensorOff && ch.closed_loop) {
       stop(client, n);
@@ -122,6 +123,7 @@ void Mcs2Twin::channel_property(ClientId client, int n, const mcs2::Command& c, 
     if (c.query) return answer(ch.amplifier ? 1 : 0);
     const auto v = value(0, 1);
     if (!v) return;
+    if (*v == 0 && !may_stop(client)) return push_error(mcs2::kPermissionDenied);
     if (*v == 0 && ch.amplifier) {
       stop(client, n);  // no drive: it stops
       ch.closed_loop = false;

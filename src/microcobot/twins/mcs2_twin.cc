@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -139,6 +140,22 @@ std::uint32_t Mcs2Twin::state(int n) const {
 void Mcs2Twin::update() {
   const bool halted = stage_.halted();
   const auto now = Clock::now();
+  // The client whose motion ran lost control (it went away, a console user took over, the e-stop):
+  // the platform holds every axis where it is, so no channel goes on to its target.
+  if (owner_ != 0 && !stage_.controls(owner_)) {
+    owner_ = 0;
+    for (int n = 0; n < channels_; ++n) {
+      Mcs2Channel& c = ch_[static_cast<std::size_t>(n)];
+      // Short of its target by more than twice the platform's on-target tolerance (1 um; theta:
+      // 0.0115 deg), or a reference or a step run cut off: the move failed.
+      const std::int64_t short_of = std::llabs(c.target - (stage_units(n) + c.offset));
+      if (c.referencing || stage_.axis(n).stepping ||
+          (c.closed_loop && short_of > (rotary(n) ? 23'000'000 : 2'000'000)))
+        c.move_failed = true;
+      c.target = stage_units(n) + c.offset;
+      c.closed_loop = c.referencing = false;
+    }
+  }
   for (int n = 0; n < channels_; ++n) {
     Mcs2Channel& c = ch_[static_cast<std::size_t>(n)];
     const TwinStage::Axis a = stage_.axis(n);
@@ -178,7 +195,9 @@ bool Mcs2Twin::send_goal(ClientId client, int speed_channel) {
   if (!rotary(speed_channel)) linear = pace(speed_channel, stage_.max_speed(0));
   const double theta =
       channels_ > TwinStage::kTheta ? pace(TwinStage::kTheta, stage_.max_speed(TwinStage::kTheta)) : 0.0;
-  return accepted(stage_.move_to(client, goal, linear, theta));
+  if (!accepted(stage_.move_to(client, goal, linear, theta))) return false;
+  owner_ = client;
+  return true;
 }
 
 void Mcs2Twin::move(ClientId client, int n, const mcs2::Command& cmd) {
@@ -201,6 +220,7 @@ void Mcs2Twin::move(ClientId client, int n, const mcs2::Command& cmd) {
       c.move_failed = true;
       return;
     }
+    owner_ = client;
     // The platform runs either one closed-loop goal or open-loop runs: the other channels' targets
     // are dropped, every channel holds where it is.
     for (int k = 0; k < channels_; ++k) {
@@ -252,6 +272,7 @@ void Mcs2Twin::reference(ClientId client, int n) {
 
 void Mcs2Twin::stop(ClientId client, int n) {
   if (!channel_ok(n)) return;
+  if (!may_stop(client)) return;  // nothing of another operator's motion stops
   Mcs2Channel& c = ch_[static_cast<std::size_t>(n)];
   c.target = stage_units(n) + c.offset;
   c.referencing = false;

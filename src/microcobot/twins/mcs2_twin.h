@@ -82,6 +82,8 @@ class Mcs2Twin {
   void move(ClientId client, int n, const drivers::mcs2::Command& c);
   void reference(ClientId client, int n);
   void stop(ClientId client, int n);
+  /// True unless another client's motion runs the stage (its moves are its own to stop).
+  bool may_stop(ClientId client) const { return owner_ == 0 || stage_.controls(client); }
   /// Every channel's goal to the stage, closed loop: each channel that holds a target goes to it,
   /// the others stay; `speed_channel`'s VEL sets the pace. The error pushed on a refusal.
   bool send_goal(ClientId client, int speed_channel);
@@ -110,6 +112,7 @@ class Mcs2Twin {
   int channels_;  // 3, or 4 with the rotary positioner
   std::array<Mcs2Channel, TwinStage::kMaxAxes> ch_{};
   std::deque<int> errors_;
+  ClientId owner_ = 0;        // the client whose motion the stage runs (0: none)
   std::uint64_t pushed_ = 0;  // errors pushed so far (a line's sets stop at its first)
 };
 
