@@ -15,6 +15,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/drivers/mcs2_codec.h"
+#include "support/counting_allocator.h"
 #include "twin_rig.h"
 
 namespace mc::twins {
@@ -217,6 +218,29 @@ TEST(Mcs2Server, HostileClientsAreSurvivedAndADisconnectMidMoveLeavesTheAxesHold
             bit::kMovementFailed);
   EXPECT_EQ(good.ask(":DEV:NOBM?"), "2");  // still served
   EXPECT_GE(rig.server->counters().closed_hostile, 1u);
+}
+
+TEST(Mcs2Server, TheLoopThreadNeverAllocatesWhileAnMcs2ClientMovesStepsAndStopsTheStage) {
+  Mcs2LiveRig rig;
+  Mcs2Client c(rig.port());
+  c.send(":CHAN0:HOLD -1;:CHAN0:VEL 1000000000;:CHAN1:VEL 1000000000;:REF0");  // warm-up
+  ASSERT_TRUE(c.wait_state(0, bit::kIsReferenced | bit::kActivelyMoving, bit::kIsReferenced));
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard(rig.live->loop_thread_id());
+    c.send(":MOVE0 20000000;:CHAN1:MMOD 1;:MOVE1 -20000000");
+    ASSERT_TRUE(c.wait_state(0, bit::kActivelyMoving, 0));
+    ASSERT_TRUE(c.wait_state(1, bit::kActivelyMoving, 0));
+    c.send(":CHAN2:MMOD 4;:MOVE2 50");
+    ASSERT_TRUE(c.wait_state(2, bit::kActivelyMoving, 0));
+    c.send(":MOVE0 50000000");
+    std::this_thread::sleep_for(20ms);
+    c.send(":STOP0");
+    ASSERT_TRUE(c.wait_state(0, bit::kActivelyMoving, 0));
+    EXPECT_EQ(c.ask(":SYST:ERR:COUN?"), "0");
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
 }
 
 TEST(Mcs2Server, AnOverlongLineIsError363) {
