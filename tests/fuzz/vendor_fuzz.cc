@@ -1,6 +1,7 @@
-// libFuzzer harness: what a controller sends the vendor drivers, and the connection
-// text of the configuration. A reply is either parsed (finite values, whole lines) or refused with
-// one line (mc::Error); the reply framing never reads past its input; never a crash.
+// libFuzzer harness: what a controller sends the vendor drivers, what a client sends the
+// MCS2 twin (its line and command parser), and the connection text of the configuration. A reply is either
+// parsed (finite values, whole lines) or refused with one line (mc::Error); the reply framing never reads
+// past its input; never a crash.
 
 #include <cmath>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include "microcobot/drivers/anc300_codec.h"
 #include "microcobot/drivers/gcs2_codec.h"
 #include "microcobot/drivers/line_client.h"
+#include "microcobot/drivers/mcs2_codec.h"
 
 namespace {
 
@@ -39,6 +41,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (line.find('\n') != std::string::npos) std::abort();
     if (const auto v = anc300::value_of(line); v && v->empty()) std::abort();
   }
+  // MCS2: a client's line split and parsed (a command or an SCPI error, never both), a reply read.
+  namespace mcs2 = mc::drivers::mcs2;
+  for (const auto command : mcs2::split_commands(text)) {
+    if (command.empty() || command.size() > text.size()) std::abort();
+    mcs2::Command c;
+    const int e = mcs2::parse_command(command, c);
+    if (e == mcs2::kNoError && (c.header.empty() || c.index > 999)) std::abort();
+    if (e != mcs2::kNoError && mcs2::error_text(e) == "Unknown error") std::abort();
+    for (const auto& a : c.args) (void)mcs2::parse_rounded(a);
+  }
+  if (mcs2::reply_end(text) > text.size()) std::abort();
+  if (const auto r = mcs2::parse_error_reply(text); r && r->second.find('"') != std::string::npos)
+    std::abort();
   try {
     const auto c = mc::drivers::parse_connection(text, "pi-gcs2");
     if (c.is_serial() ? c.serial.path.front() != '/' || c.serial.baud == 0 : c.port == 0 || c.host.empty())

@@ -11,20 +11,23 @@ import time
 
 
 class Serve:
-    """`microcobot serve` with both twins on loopback, free ports; stop() ends it (SIGINT)."""
+    """`microcobot serve` with the twins of `protocols` (by default GCS 2.0 and ANC300) on
+    loopback, free ports; stop() ends it (SIGINT)."""
 
-    def __init__(self):
+    def __init__(self, protocols=("gcs2", "anc300")):
         cli = os.environ.get("MC_CLI")
         if not cli:
             raise RuntimeError("MC_CLI not set (run through ctest)")
         self.out = tempfile.mkdtemp(prefix="mc_twin_")
+        emulate = []
+        for p in protocols:
+            emulate += ["--emulate", f"{p}=127.0.0.1:0"]
         self.proc = subprocess.Popen(
-            [cli, "serve", "--listen", "127.0.0.1:0", "--out", self.out,
-             "--emulate", "gcs2=127.0.0.1:0", "--emulate", "anc300=127.0.0.1:0"],
+            [cli, "serve", "--listen", "127.0.0.1:0", "--out", self.out] + emulate,
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.url = self.proc.stdout.readline().strip()
         self.ports = {}
-        for _ in range(2):
+        for _ in protocols:
             words = self.proc.stdout.readline().split()
             assert len(words) == 3 and words[0] == "emulate", words
             self.ports[words[1]] = int(words[2].rsplit(":", 1)[1])

@@ -39,8 +39,6 @@ std::string random_token() {
   return t;
 }
 
-const char* protocol_name(twins::Protocol p) { return p == twins::Protocol::kGcs2 ? "gcs2" : "anc300"; }
-
 }  // namespace
 
 std::string_view role_name(Role role) {
@@ -179,7 +177,7 @@ std::vector<ServedTwin> Deployment::twins() const {
   if (!twin_server_) return served;
   const std::vector<std::uint16_t> ports = twin_server_->ports();
   for (std::size_t k = 0; k < config_.twins.size() && k < ports.size(); ++k)
-    served.push_back({config_.twins[k].protocol, protocol_name(config_.twins[k].protocol),
+    served.push_back({config_.twins[k].protocol, twins::protocol_name(config_.twins[k].protocol),
                       config_.twins[k].address, ports[k], !is_loopback(config_.twins[k].address)});
   return served;
 }

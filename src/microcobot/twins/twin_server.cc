@@ -27,6 +27,18 @@ bool loopback_address(const std::string& host) {
 
 }  // namespace
 
+const char* protocol_name(Protocol p) {
+  switch (p) {
+    case Protocol::kGcs2:
+      return "gcs2";
+    case Protocol::kAnc300:
+      return "anc300";
+    case Protocol::kMcs2:
+      return "mcs2";
+  }
+  return "?";
+}
+
 TwinEndpoint parse_emulate(const std::string& text) {
   TwinEndpoint e;
   const auto eq = text.find('=');
@@ -37,8 +49,12 @@ TwinEndpoint parse_emulate(const std::string& text) {
   } else if (name == "anc300") {
     e.protocol = Protocol::kAnc300;
     e.port = 7230;
+  } else if (name == "mcs2") {
+    e.protocol = Protocol::kMcs2;
+    e.port = drivers::mcs2::kDefaultPort;
   } else {
-    throw UsageError("--emulate: '" + excerpt(text) + "' must be gcs2[=ADDR:PORT] or anc300[=ADDR:PORT]");
+    throw UsageError("--emulate: '" + excerpt(text) +
+                     "' must be gcs2[=ADDR:PORT], anc300[=ADDR:PORT] or mcs2[=ADDR:PORT]");
   }
   if (eq == std::string::npos) return e;
   const std::string where = text.substr(eq + 1);
@@ -76,6 +92,7 @@ void TwinServerParams::validate() const {
           "must be within (0, 0.1] s", heartbeat_s);
   gcs2.validate();
   anc300.validate();
+  mcs2.validate();
 }
 
 struct TwinServer::Impl {
@@ -86,7 +103,7 @@ struct TwinServer::Impl {
     tcp::socket socket;
     Protocol protocol;
     ClientId id;
-    bool needs_token;  // off loopback: the GCS client's first line, the ANC300 password
+    bool needs_token;  // off loopback: the GCS or MCS2 client's first line, the ANC300 password
     bool authorized = false;
     Anc300Session anc;
     std::array<char, 4096> buffer{};
@@ -101,12 +118,18 @@ struct TwinServer::Impl {
   };
 
   Impl(TwinStage& st, TwinServerParams p)
-      : stage(st), params(std::move(p)), gcs2(st, params.gcs2), anc300(st, params.anc300), timer(io) {}
+      : stage(st),
+        params(std::move(p)),
+        gcs2(st, params.gcs2),
+        anc300(st, params.anc300),
+        mcs2(st, params.mcs2),
+        timer(io) {}
 
   TwinStage& stage;
   TwinServerParams params;
   Gcs2Twin gcs2;
   Anc300Twin anc300;
+  Mcs2Twin mcs2;
   asio::io_context io;
   std::vector<std::unique_ptr<tcp::acceptor>> acceptors;
   std::vector<Protocol> acceptor_protocols;
@@ -189,6 +212,8 @@ struct TwinServer::Impl {
     // Gone: if it controlled the stage, the stage holds.
     if (s.protocol == Protocol::kGcs2)
       gcs2.on_disconnect(s.id);
+    else if (s.protocol == Protocol::kMcs2)
+      mcs2.on_disconnect(s.id);
     else
       anc300.on_disconnect(s.id);
     sessions.erase(s.id);
@@ -242,8 +267,9 @@ struct TwinServer::Impl {
       }
       if (c == '\0') continue;  // telnet's CR NUL
       if (s.line.empty()) s.partial_since = Clock::now();
-      const std::size_t cap =
-          s.protocol == Protocol::kGcs2 ? drivers::gcs2::kMaxLineLength : drivers::anc300::kMaxLineLength;
+      const std::size_t cap = s.protocol == Protocol::kGcs2   ? drivers::gcs2::kMaxLineLength
+                              : s.protocol == Protocol::kMcs2 ? drivers::mcs2::kMaxLineLength
+                                                              : drivers::anc300::kMaxLineLength;
       if (s.line.size() < cap) {
         s.line += c;
       } else {
@@ -256,12 +282,16 @@ struct TwinServer::Impl {
   void on_line(Session& s, std::string& line, bool overlong) {
     count(&TwinServerCounters::lines);
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (s.protocol == Protocol::kGcs2) {
+    if (s.protocol == Protocol::kGcs2 || s.protocol == Protocol::kMcs2) {
       if (!s.authorized) {
         // Off loopback the first line is the token; anything else closes the connection.
         if (line != params.token) return hostile(s);
         s.authorized = true;
         return;
+      }
+      if (s.protocol == Protocol::kMcs2) {
+        if (overlong) return mcs2.on_overlong_line();
+        return send(s, mcs2.on_line(s.id, line));
       }
       if (overlong) return gcs2.on_overlong_line();
       return send(s, gcs2.on_line(s.id, line));
@@ -294,7 +324,7 @@ struct TwinServer::Impl {
         hostile(*s);  // slowloris: a line that never ends
         continue;
       }
-      const bool logged_in = s->protocol == Protocol::kGcs2 ? s->authorized : s->anc.authorized;
+      const bool logged_in = s->protocol == Protocol::kAnc300 ? s->anc.authorized : s->authorized;
       if (!logged_in && now - s->opened > login_timeout) {
         hostile(*s);
         continue;
@@ -333,7 +363,7 @@ void TwinServer::start() {
   for (const auto& e : m.params.endpoints) {
     boost::system::error_code ec;
     const auto address = asio::ip::make_address(e.address == "localhost" ? "127.0.0.1" : e.address, ec);
-    const char* name = e.protocol == Protocol::kGcs2 ? "gcs2" : "anc300";
+    const char* name = protocol_name(e.protocol);
     if (ec)
       throw InvalidInput(std::string("--emulate ") + name + ": '" + excerpt(e.address) +
                          "' is not an IP address");

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The vendor-protocol twins served over TCP (`microcobot serve --emulate gcs2
-/// --emulate anc300`): one thread runs every listening socket and connection (Boost.Asio), the
+/// --emulate anc300 --emulate mcs2`): one thread runs every listening socket and connection (Boost.Asio), the
 /// twins' controller state, and the stage's heartbeat; it is the only producer of the live
 /// platform's protocol ring (twins/live_stage.h) and never touches the loop otherwise.
 ///
@@ -12,10 +12,10 @@
 /// socket gets its pending replies, then is closed. A client that goes away releases control:
 /// the stage holds.
 ///
-/// Authentication: on loopback nothing is asked of GCS clients, and the ANC300 console's
+/// Authentication: on loopback nothing is asked of GCS and MCS2 clients, and the ANC300 console's
 /// password prompt accepts the controller's factory password (123456) or the token. Off
-/// loopback a token is required: the ANC300 password must be the token, a GCS client's first
-/// line must be the token (then it is answered as any controller).
+/// loopback a token is required: the ANC300 password must be the token, a GCS or MCS2 client's
+/// first line must be the token (then it is answered as any controller).
 
 #include <cstdint>
 #include <memory>
@@ -24,11 +24,14 @@
 
 #include "microcobot/twins/anc300_twin.h"
 #include "microcobot/twins/gcs2_twin.h"
+#include "microcobot/twins/mcs2_twin.h"
 #include "microcobot/twins/twin_stage.h"
 
 namespace mc::twins {
 
-enum class Protocol { kGcs2, kAnc300 };
+enum class Protocol { kGcs2, kAnc300, kMcs2 };
+/// The protocol's name as `--emulate` spells it ("gcs2", "anc300", "mcs2").
+const char* protocol_name(Protocol p);
 
 struct TwinEndpoint {
   Protocol protocol = Protocol::kGcs2;
@@ -36,8 +39,9 @@ struct TwinEndpoint {
   std::uint16_t port = 0;  ///< 0: a free one (ports() says which)
 };
 
-/// Parses `gcs2[=ADDR:PORT]` or `anc300[=ADDR:PORT]` (`serve --emulate`); the default ports are
-/// the controllers' (GCS 50000, ANC300 7230) on 127.0.0.1. Throws mc::UsageError naming the text.
+/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]` or `mcs2[=ADDR:PORT]` (`serve --emulate`); the
+/// default ports are the controllers' (GCS 50000, ANC300 7230, MCS2 55551) on 127.0.0.1. Throws
+/// mc::UsageError naming the text.
 TwinEndpoint parse_emulate(const std::string& text);
 
 struct TwinServerParams {
@@ -50,6 +54,7 @@ struct TwinServerParams {
   double heartbeat_s = 0.02;  ///< the controlling client's heartbeat period (< command_timeout_s)
   Gcs2TwinParams gcs2;
   Anc300TwinParams anc300;
+  Mcs2TwinParams mcs2;
   void validate() const;
 };
 
