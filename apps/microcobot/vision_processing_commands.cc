@@ -191,6 +191,8 @@ struct TrackOptions {
   double direction_deg = 30.0;
   std::optional<double> highpass_px;
   double template_above_px = 0.0;
+  std::optional<double> template_um;  ///< --template-um: the side in the object
+  bool template_px_given = false;     ///< --template-px given (else the side comes from the objective)
 };
 
 void run_track(const TrackOptions& o) {
@@ -240,12 +242,22 @@ void run_track(const TrackOptions& o) {
   // docs/parameters.md "Tracking the tool's tips").
   params.ecc_highpass_px = o.highpass_px.value_or(tool ? vs::kToolTipHighpass_px : 0.0);
   vs::TemplateTracker tracker(params);
+  // The side: as given in pixels; or in the object (--template-um; the tool's tips by default), in
+  // the objective's pixels.
+  int side_px = o.camera.template_px;
+  if (!o.template_px_given && (o.template_um || tool))
+    side_px = vs::template_side_px(o.template_um ? *o.template_um * 1e-6 : vs::kToolTemplateSide_m,
+                                   cam.pixel_size_m(), cam.sensor.width_px, cam.sensor.height_px);
   imaging::PixelRoi roi;
   try {
-    roi = centred_roi(u0, v0, o.camera.template_px, cam);
+    roi = centred_roi(u0, v0, side_px, cam);
   } catch (const mc::InvalidInput& e) {
-    if (!tool || o.template_above_px == 0.0) throw;
-    throw mc::InvalidInput(fmt::format("--template-above-px {:g}: {}", o.template_above_px, e.what()));
+    if (tool && o.template_above_px != 0.0)
+      throw mc::InvalidInput(fmt::format("--template-above-px {:g}: {}", o.template_above_px, e.what()));
+    if (o.template_um)
+      throw mc::InvalidInput(fmt::format("--template-um {:g} ({} px at {}): {}", *o.template_um, side_px,
+                                         cam.objective.name, e.what()));
+    throw;
   }
   tracker.set_template(frame, roi);
   const double u_off = tracker.last().u_px - renderer.u_of_x(start.x());
@@ -281,7 +293,7 @@ void run_track(const TrackOptions& o) {
                       {"found", found},
                       {"speed_m_s", o.speed_um_s * 1e-6},
                       {"direction_deg", o.direction_deg},
-                      {"template_px", o.camera.template_px},
+                      {"template_px", side_px},
                       {"highpass_px", params.ecc_highpass_px},
                       {"rms_error_px", rms},
                       {"max_error_px", worst},
@@ -348,8 +360,17 @@ void add_vision_processing(CLI::App& group) {
            "--template-above-px", o->template_above_px,
            "The tool's template this far above the tool point [px] (default 0: the tips' ends in it)")
         ->check(mc::cli::Range(-1000.0, 1000.0));
+    auto* um = cmd->add_option("--template-um", o->template_um,
+                               "Side of the tracked template in the object [um], in the objective's pixels "
+                               "(default for the tool: 50 um, at least 96 px)")
+                   ->check(mc::cli::Range(1.0, 10000.0));
+    CLI::Option* px = cmd->get_option("--template-px");
+    um->excludes(px);
     add_output_options(*cmd, o->common);
-    cmd->callback([o] { run_track(*o); });
+    cmd->callback([o, px] {
+      o->template_px_given = px->count() > 0;
+      run_track(*o);
+    });
   }
   add_vision_autofocus(group);
 }

@@ -65,6 +65,26 @@ TEST(VisionCli, TrackFollowsAPartWithinTheGoal) {
   EXPECT_LT(j["rms_error_px"].get<double>(), 0.05);
 }
 
+// The tool's template is sized in the object: 50 um of the tips' ends and gap at 20x and 50x, the
+// 96 px floor below. A side fixed in pixels held only the fingers' parallel sides at 50x and slid
+// along them by 45 px.
+TEST(VisionCli, TheToolsTemplateIsSizedToTheObjective) {
+  const std::pair<const char*, int> sides[] = {{"10x", 96}, {"20x", 189}, {"50x", 472}};
+  for (const auto& [objective, side] : sides) {
+    const auto r = run_cli(
+        {"vision", "track", "--target", "tool", "--objective", objective, "--frames", "20", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["template_px"].get<int>(), side) << objective;
+    EXPECT_EQ(j["found"].get<int>(), 20) << objective;
+    EXPECT_LT(j["rms_error_px"].get<double>(), 0.5) << objective;
+  }
+  const auto r = run_cli({"vision", "track", "--target", "tool", "--objective", "20x", "--template-um", "100",
+                          "--frames", "2", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["template_px"].get<int>(), 377);
+}
+
 TEST(VisionCli, AutofocusFindsThePartsTopFrom100UmAway) {
   for (const char* offset : {"100", "-100"}) {
     const auto r = run_cli({"vision", "autofocus", "--offset-um", offset, "--seed", "3", "--json"});
@@ -107,6 +127,14 @@ TEST(VisionCli, BadInputsGetOneLineAndTheirExitCode) {
   r = run_cli({"vision", "autofocus", "--metric", "sharpest"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr("--metric: focus metric 'sharpest'"));
+  EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
+  r = run_cli({"vision", "track", "--template-um", "50", "--template-px", "96"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--template-um"));
+  r = run_cli(
+      {"vision", "track", "--objective", "20x", "--template-um", "30"});  // the part's corner is out of view
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_THAT(r.err, HasSubstr("--template-um 30 (113 px at 20x)"));
   EXPECT_EQ(test::line_count(r.err), 1u) << r.err;
   r = run_cli({"vision", "track", "--scene", "optical-trap"});
   EXPECT_EQ(r.exit_code, 3);

@@ -22,6 +22,7 @@
 /// as imaging::Renderer's u_of_x/v_of_y. Not thread-safe: one tracker per camera thread. OpenCV
 /// stays inside template_tracker.cc.
 
+#include <algorithm>
 #include <memory>
 
 #include "microcobot/imaging/pixel_roi.h"
@@ -69,6 +70,25 @@ struct TrackerParams {
 /// The high-pass for the gripper's tips (TrackerParams::ecc_highpass_px) [px]: chosen on the
 /// tool-tracking tuning cases (docs/parameters.md "Tracking the tool's tips").
 inline constexpr double kToolTipHighpass_px = 1.5;
+
+/// The side of the tips' template in the object [m]: the tips' ends and the gap between them,
+/// whatever the objective (chosen on the tool-tracking tuning cases at 2x-50x, docs/parameters.md
+/// "Tracking the tool's tips"). A side in pixels fixed at every objective held the two tips' ends
+/// at 5x and 10x but, at 50x, only a stretch of the fingers' parallel sides, along which the
+/// match slides (45 px off, every frame found).
+inline constexpr double kToolTemplateSide_m = 50e-6;
+/// The fewest pixels a template side gets: below, ECC has too few gradients for a hundredth of a
+/// pixel (the 96 px side the tracker was tuned with at 5x and 10x).
+inline constexpr int kMinTemplateSide_px = 96;
+
+/// A template of `side_m` in the object as pixels of `pixel_m`: at least kMinTemplateSide_px, at
+/// most half the frame's smaller side (`width_px`, `height_px`).
+inline int template_side_px(double side_m, double pixel_m, int width_px, int height_px) {
+  const double px = side_m / pixel_m;
+  const int most = std::max(kMinTemplateSide_px, std::min(width_px, height_px) / 2);
+  if (!(px > kMinTemplateSide_px)) return kMinTemplateSide_px;  // also NaN
+  return px >= most ? most : static_cast<int>(px + 0.5);
+}
 
 /// TrackerParams for the gripper's tips: the defaults with kToolTipHighpass_px.
 inline TrackerParams tool_tip_tracker_params() {
