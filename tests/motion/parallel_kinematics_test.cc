@@ -178,6 +178,24 @@ TEST(ParallelKinematics, ConditioningVanishesAsTheLiftBringsTheLegsVertical) {
   EXPECT_LT(previous, 0.01);
 }
 
+TEST(ParallelKinematics, TheForwardKinematicsSingularityTestAgreesWithTheConditioning) {
+  // conditioning_at_least() decides by a bound where it can; its answer must be the SVD's.
+  const ParallelKinematics k;
+  const double vertical = k.geometry().leg_length_m - k.params().joint_height_m;
+  std::vector<SmarPodPose> poses = random_reachable_poses(k, 300, 23);
+  for (double f : {0.9, 0.99, 0.999, 0.9999, 0.999999}) poses.push_back({0, 0, f * vertical, 0, 0, 0});
+  int below = 0;
+  for (const SmarPodPose& p : poses) {
+    const ParallelJacobian J = k.jacobian(to_transform(p));
+    for (double threshold : {0.02, 0.1, 0.3, 0.4}) {
+      const bool expected = k.conditioning(J) >= threshold;
+      EXPECT_EQ(k.conditioning_at_least(J, threshold), expected) << describe(p) << " threshold " << threshold;
+      below += expected ? 0 : 1;
+    }
+  }
+  EXPECT_GT(below, 5);  // both answers were asked for
+}
+
 TEST(ParallelKinematics, PoseBeyondAStrokeIsRefusedNamingTheLegAndPositioner) {
   const ParallelKinematics k;
   const SmarPodPose far{9e-3, 0, 0, 0, 0, 0};

@@ -48,7 +48,7 @@ bool ParallelKinematics::closures(const PlatformTransform& T, LegClosure (&legs)
     c.axis = T.R * lg.axis;
     const double n_r = c.axis.dot(lg.e_r), n_t = c.axis.dot(lg.e_t), n_z = c.axis.z();
     const double pz = c.joint_m.z();
-    const double m = std::hypot(n_r, n_t);
+    const double m = std::sqrt(n_r * n_r + n_t * n_t);  // |n| = 1: no overflow to guard against
     const double cc = pz * n_z / m;
     c.discriminant = (L * L - pz * pz) - cc * cc;
     if (!(c.discriminant >= 0.0) || !(m > 0.0)) {
@@ -108,6 +108,18 @@ double ParallelKinematics::conditioning(const ParallelJacobian& J) const noexcep
   const auto& s = svd.singularValues();
   if (!(s[0] > 0.0)) return 0.0;
   return s[5] / s[0];
+}
+
+bool ParallelKinematics::conditioning_at_least(const ParallelJacobian& J, double threshold) const noexcept {
+  if (!J.allFinite()) return false;
+  ParallelJacobian Jn = J;
+  Jn.rightCols<3>() /= g_.params.platform_radius_m;
+  // sigma_max <= |Jn|_F and sigma_min >= 1 / |Jn^-1|_F: a lower bound of the conditioning that
+  // costs an LU, not an SVD. Only when it does not decide is the SVD computed.
+  const Eigen::PartialPivLU<ParallelJacobian> lu(Jn);
+  const ParallelJacobian inv = lu.inverse();
+  if (inv.allFinite() && 1.0 / (Jn.norm() * inv.norm()) >= threshold) return true;
+  return conditioning(J) >= threshold;
 }
 
 double ParallelKinematics::conditioning(const PlatformTransform& T) const noexcept {
@@ -173,8 +185,8 @@ ForwardResult ParallelKinematics::forward(const LegCoordinates& q, const Platfor
     converged = halvings == 0 && s == 1.0 && step_d + r_p * step_t <= kFinalStep_m;
   }
   if ((q_now - q).lpNorm<Eigen::Infinity>() > kAccepted_m) fail("the legs' residual stays above 1e-13 m");
-  const ParallelJacobian J = jacobian(out.T, legs);
-  if (conditioning(J) < g_.params.min_conditioning) fail("the solution is singular");
+  if (!conditioning_at_least(jacobian(out.T, legs), g_.params.min_conditioning))
+    fail("the solution is singular");
   double sph[kParallelLegs], rev[kParallelLegs];
   joint_angles(out.T, legs, sph, rev);
   for (int i = 0; i < kParallelLegs; ++i) {

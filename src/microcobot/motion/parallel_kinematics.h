@@ -85,6 +85,8 @@ class ParallelKinematics {
   /// sigma_min / sigma_max of J with rotation columns scaled by r; 0 where J is not finite.
   double conditioning(const PlatformTransform& T) const noexcept;
   double conditioning(const ParallelJacobian& J) const noexcept;
+  /// conditioning(J) >= threshold, without the SVD where a bound decides (the FK's check).
+  bool conditioning_at_least(const ParallelJacobian& J, double threshold) const noexcept;
   /// The passive joints' angles from home, per leg: the spherical joint's cone angle and the
   /// revolute's signed angle [rad].
   void joint_angles(const PlatformTransform& T, const LegClosure (&legs)[kParallelLegs],
