@@ -1,13 +1,16 @@
 // The 6-DOF parallel positioner's kinematics on one core (docs/benchmarks.md): poses per second
 // (counter items_per_second) of the closed-form inverse kinematics from a SmarPod pose, and of
 // the forward kinematics by Newton's method seeded with the previous pose of a random walk
-// (a servo loop's case) and from home (a cold start), over seeded random reachable poses.
+// (a servo loop's case) and from home (a cold start), over seeded random reachable poses; once, the
+// round trip's accuracy and the Newton steps over 10^5 poses.
 //   build/<dir>/bench/positioner_bench --benchmark_min_time=0.5
+#include <algorithm>
 #include <cstddef>
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <Eigen/Geometry>
 
 #include "microcobot/motion/parallel_kinematics.h"
 #include "microcobot/motion/parallel_workspace.h"
@@ -105,5 +108,50 @@ void ForwardFromHome(benchmark::State& state) {
   state.counters["newton_steps"] = static_cast<double>(steps) / static_cast<double>(state.iterations());
 }
 BENCHMARK(ForwardFromHome);
+
+/// The accuracy goals on 10^5 poses, once: the IK -> FK round trip of independent random reachable
+/// poses from home (counters max_error_m, max_error_rad) and, along a random walk, the fraction of
+/// forward kinematics from the previous pose done in at most 5 Newton steps (within_5_steps).
+void RoundTripOf100kPoses(benchmark::State& state) {
+  const mm::ParallelKinematics k;
+  constexpr int kN = 100000;
+  double worst_m = 0.0, worst_rad = 0.0, within_five = 0.0;
+  for (auto _ : state) {
+    std::mt19937_64 rng(100000);
+    std::uniform_real_distribution<double> t(-4e-3, 4e-3), z(-3e-3, 3e-3), a(-10 * kDeg, 10 * kDeg);
+    for (int n = 0; n < kN;) {
+      const mm::SmarPodPose p{t(rng), t(rng), z(rng), a(rng), a(rng), a(rng)};
+      if (!mm::check_pose(k, p).ok()) continue;
+      ++n;
+      const mm::PlatformTransform T = mm::to_transform(p);
+      mm::LegCoordinates q;
+      k.inverse(T, q);
+      const mm::ForwardResult f = k.forward(q);
+      worst_m = std::max(worst_m, (f.T.d - T.d).lpNorm<Eigen::Infinity>());
+      worst_rad = std::max(worst_rad, Eigen::AngleAxisd(f.T.R * T.R.transpose()).angle());
+    }
+    std::uniform_real_distribution<double> dt(-0.2e-3, 0.2e-3), da(-1 * kDeg, 1 * kDeg);
+    mm::SmarPodPose p;
+    mm::PlatformTransform previous;
+    int five = 0;
+    for (int n = 0; n < kN;) {
+      const mm::SmarPodPose next{p.x + dt(rng),  p.y + dt(rng),  p.z + dt(rng),
+                                 p.rx + da(rng), p.ry + da(rng), p.rz + da(rng)};
+      if (!mm::check_pose(k, next).ok()) continue;
+      ++n;
+      p = next;
+      mm::LegCoordinates q;
+      k.inverse(mm::to_transform(p), q);
+      const mm::ForwardResult f = k.forward(q, previous);
+      previous = f.T;
+      five += f.iterations <= 5 ? 1 : 0;
+    }
+    within_five = static_cast<double>(five) / kN;
+  }
+  state.counters["max_error_m"] = worst_m;
+  state.counters["max_error_rad"] = worst_rad;
+  state.counters["within_5_steps"] = within_five;
+}
+BENCHMARK(RoundTripOf100kPoses)->Iterations(1)->Unit(benchmark::kSecond);
 
 }  // namespace

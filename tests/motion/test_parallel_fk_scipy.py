@@ -120,5 +120,25 @@ def test_an_unreachable_pose_is_one_line_and_exit_3():
     assert r.stderr.count("\n") == 1 and "unreachable: stroke limit" in r.stderr, r.stderr
 
 
+def test_workspace_slices_through_every_reason_are_written_as_csv(tmp_path):
+    # Lifting the platform up to 12 mm passes the stroke limits and, beyond the lift at which the
+    # legs stand vertical (8.28 mm), their reach; a fine slice about that lift finds the singular
+    # band just below it. Every row is written, finite, and counted in the summary.
+    lift = LEG - HEIGHT
+    seen = set()
+    for name, range_a in (("wide", "-0.012,0.012"), ("fine", f"{lift - 3e-4!r},{lift + 3e-4!r}")):
+        out = tmp_path / name
+        j = cli_json("workspace", "--slice", "z,rz", "--range-a", range_a, "--range-b", "-0.01,0.01",
+                     "--points", "61", "--out", str(out))
+        rows = np.genfromtxt(out / "workspace_slice.csv", delimiter=",", names=True)
+        assert len(rows) == 61 * 61 == j["slice"]["points"]
+        assert np.all(np.isfinite(rows["conditioning"]))
+        assert np.all(rows["reach"][rows["z_m"] > lift + 1e-9] == 2)  # out of reach above the vertical legs
+        assert np.all(rows["conditioning"][rows["reach"] == 3] < 0.02)
+        assert j["slice"]["reachable"] == int(np.sum(rows["reach"] == 0))
+        seen |= set(np.unique(rows["reach"]).astype(int))
+    assert seen == {0, 2, 3, 4}  # reachable, out of reach, singular, stroke limit
+
+
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))

@@ -169,11 +169,10 @@ void SliceSpec::validate() const {
 CsvTable workspace_slice(const ParallelKinematics& k, const SliceSpec& s) {
   s.validate();
   CsvTable t;
-  for (const char* name : {"x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad", "reach", "conditioning", "q0_m",
-                           "q1_m", "q2_m", "q3_m", "q4_m", "q5_m"}) {
+  for (const char* name : {"x_m", "y_m", "z_m", "rx_rad", "ry_rad", "rz_rad", "reach", "conditioning"}) {
     t.add_column(name, {});
   }
-  std::array<double, 14> row{};
+  std::array<double, 8> row{};
   for (int ib = 0; ib < s.n_b; ++ib) {
     for (int ia = 0; ia < s.n_a; ++ia) {
       auto a = s.base.as_array();
@@ -183,7 +182,6 @@ CsvTable workspace_slice(const ParallelKinematics& k, const SliceSpec& s) {
       for (int j = 0; j < 6; ++j) row[j] = a[j];
       row[6] = static_cast<double>(c.reach);
       row[7] = c.conditioning;
-      for (int j = 0; j < 6; ++j) row[8 + j] = c.q[j];
       t.add_row(row);
     }
   }

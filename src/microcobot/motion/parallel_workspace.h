@@ -81,7 +81,7 @@ struct SliceSpec {
   void validate() const;  ///< throws InvalidParams naming the field
 };
 /// One row per grid point, columns x_m, y_m, z_m, rx_rad, ry_rad, rz_rad, reach (the Reach code),
-/// conditioning, q0_m .. q5_m (NaN where the legs do not close).
+/// conditioning (0 where a leg does not close).
 CsvTable workspace_slice(const ParallelKinematics& k, const SliceSpec& s);
 
 /// "x", "y", "z", "rx", "ry", "rz" for 0..5, and back (else UsageError).
