@@ -46,8 +46,9 @@ struct ParallelGeometryParams {
   double spherical_limit_rad = 0.5235987755982988;  // 30 deg
   /// The revolute joint's travel about its home angle.
   double revolute_limit_rad = 0.5235987755982988;  // 30 deg
-  /// A pose whose conditioning (ParallelKinematics::conditioning) is below this is singular:
-  /// near it a leg's 1 nm moves the platform by more than 1 nm / min_conditioning.
+  /// A pose whose conditioning (ParallelKinematics::conditioning) is below this is singular: the
+  /// platform's motion per metre of the legs' is over 1 / min_conditioning times larger in its
+  /// worst direction than in its best.
   double min_conditioning = 0.02;
 
   template <class V>
