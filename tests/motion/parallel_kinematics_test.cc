@@ -111,8 +111,9 @@ TEST(ParallelKinematics, ForwardFromThePreviousPoseConvergesInAtMostFiveStepsIn9
 }
 
 TEST(ParallelKinematics, ForwardFromHomeConvergesAcrossTheSampledWorkspaceInAtMostTenSteps) {
-  // The convergence domain: from the home seed to any sampled reachable pose (up to 8 mm and
-  // 20 deg away), the step limits and halving keep Newton's method on the legs' branch.
+  // The convergence domain: from the home seed to any sampled reachable pose (up to 4 mm, 3 mm in
+  // z and 10 deg a coordinate away), the step limits and halving keep Newton's method on the legs'
+  // branch.
   const ParallelKinematics k;
   int most = 0;
   for (const SmarPodPose& p : random_reachable_poses(k, 2000, 17)) {
