@@ -265,6 +265,44 @@ void run_workspace(const WorkspaceOptions& o) {
                 {"reachable_fraction", static_cast<double>(reachable) / static_cast<double>(t.rows())},
                 {"by_reason", by_reason}};
   mc::cli::write_result_table(o.common, "workspace_slice.csv", t, j);
+  if (o.common.out) {
+    // The slice as points in its two coordinates, one series per reason.
+    mc::report::Report r("positioner workspace");
+    r.section(
+        "Workspace slice",
+        fmt::format("microcobot positioner workspace --at {} --slice {},{} ({}); pivot {} ({})",
+                    numbers(o.at), o.slice[0], o.slice[1], unit_names(o), numbers(o.pivot), o.pivot_mode));
+    r.add_result("conditioning at --at", here.conditioning);
+    r.add_result("reachable points", reachable);
+    for (const char* n : {"rx", "ry", "rz"}) {
+      r.add_result(fmt::format("{} range min ({})", n, ranges[n]["min_reason"].get<std::string>()),
+                   ranges[n]["min"].get<double>(), o.units == "si" ? "rad" : "deg");
+      r.add_result(fmt::format("{} range max ({})", n, ranges[n]["max_reason"].get<std::string>()),
+                   ranges[n]["max"].get<double>(), o.units == "si" ? "rad" : "deg");
+    }
+    const auto unit = [](int axis) { return std::string(axis < 3 ? "m" : "rad"); };
+    mc::report::Figure fig{
+        fmt::format("Reach over {} and {}", o.slice[0], o.slice[1]),
+        "Each grid point marked by the first check it fails (docs/concepts/parallel-positioner.md).",
+        {o.slice[0], unit(s.axis_a)},
+        {o.slice[1], unit(s.axis_b)},
+        {}};
+    const auto& ca = t.column(std::size_t(s.axis_a));
+    const auto& cb = t.column(std::size_t(s.axis_b));
+    const auto& reach = t.column("reach");
+    for (int code = 0; code <= static_cast<int>(mm::Reach::kJointLimit); ++code) {
+      mc::report::Series ser{mm::to_string(static_cast<mm::Reach>(code)), {}, {}, true};
+      for (std::size_t row = 0; row < t.rows(); ++row) {
+        if (reach[row] == code) {
+          ser.x.push_back(ca[row]);
+          ser.y.push_back(cb[row]);
+        }
+      }
+      if (!ser.x.empty()) fig.series.push_back(std::move(ser));
+    }
+    r.add_figure(std::move(fig));
+    mc::cli::write_report_if_requested(o.common, r);
+  }
   std::string human = fmt::format("conditioning {:.3f}", here.conditioning);
   for (const char* n : {"rx", "ry", "rz"}) {
     human += fmt::format("; {} {:.6g} .. {:.6g} ({} .. {})", n, ranges[n]["min"].get<double>(),
