@@ -11,7 +11,7 @@ namespace mc::motion {
 
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 constexpr std::array<const char*, 6> kCoordinateNames = {"x", "y", "z", "rx", "ry", "rz"};
 
 }  // namespace
@@ -78,13 +78,13 @@ ReachCheck check_pose(const ParallelKinematics& k, const PlatformTransform& T) {
     if (sph[i] > p.spherical_limit_rad) {
       c.reach = Reach::kJointLimit;
       c.detail = fmt::format("leg {}'s spherical joint at {:.4g} deg beyond its {:.4g} deg cone", i,
-                             sph[i] * kDeg, p.spherical_limit_rad * kDeg);
+                             sph[i] * kDegreesPerRadian, p.spherical_limit_rad * kDegreesPerRadian);
       return c;
     }
     if (std::abs(rev[i]) > p.revolute_limit_rad) {
       c.reach = Reach::kJointLimit;
-      c.detail = fmt::format("leg {}'s revolute joint at {:.4g} deg beyond +-{:.4g} deg", i, rev[i] * kDeg,
-                             p.revolute_limit_rad * kDeg);
+      c.detail = fmt::format("leg {}'s revolute joint at {:.4g} deg beyond +-{:.4g} deg", i,
+                             rev[i] * kDegreesPerRadian, p.revolute_limit_rad * kDegreesPerRadian);
       return c;
     }
   }
@@ -125,7 +125,7 @@ RotationRange rotation_range(const ParallelKinematics& k, const SmarPodPose& at,
     return check_pose(k, SmarPodPose::from_array(a), pivot).reach;
   };
   RotationRange out;
-  constexpr double kScan = 0.25 / kDeg;
+  constexpr double kScan = 0.25 / kDegreesPerRadian;
   for (int sign : {-1, +1}) {
     double inside = centre, outside = centre;
     Reach why = Reach::kReachable;

@@ -74,12 +74,12 @@ Eigen::Vector3d pi_angles(const Eigen::Matrix3d& R) {
 namespace {
 
 /// d of a pose's translation t and rotation R about the pivot (the header's equations).
-Eigen::Vector3d displacement(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Pivot& pivot) {
+Eigen::Vector3d pivot_displacement(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Pivot& pivot) {
   const Eigen::Vector3d turn = pivot.point_m - R * pivot.point_m;  // (I - R) c
   return pivot.mode == PivotMode::kFixed ? Eigen::Vector3d(R * t + turn) : Eigen::Vector3d(t + turn);
 }
 
-Eigen::Vector3d translation(const PlatformTransform& T, const Pivot& pivot) {
+Eigen::Vector3d pivot_translation(const PlatformTransform& T, const Pivot& pivot) {
   const Eigen::Vector3d rest = T.d - (pivot.point_m - T.R * pivot.point_m);  // d - (I - R) c
   return pivot.mode == PivotMode::kFixed ? Eigen::Vector3d(T.R.transpose() * rest) : rest;
 }
@@ -89,12 +89,12 @@ Eigen::Vector3d translation(const PlatformTransform& T, const Pivot& pivot) {
 PlatformTransform to_transform(const SmarPodPose& p, const Pivot& pivot) {
   PlatformTransform T;
   T.R = smarpod_rotation(p.rx, p.ry, p.rz);
-  T.d = displacement(T.R, {p.x, p.y, p.z}, pivot);
+  T.d = pivot_displacement(T.R, {p.x, p.y, p.z}, pivot);
   return T;
 }
 
 SmarPodPose to_smarpod(const PlatformTransform& T, const Pivot& pivot) {
-  const Eigen::Vector3d t = translation(T, pivot);
+  const Eigen::Vector3d t = pivot_translation(T, pivot);
   const Eigen::Vector3d a = smarpod_angles(T.R);
   return {t.x(), t.y(), t.z(), a.x(), a.y(), a.z()};
 }
@@ -102,12 +102,12 @@ SmarPodPose to_smarpod(const PlatformTransform& T, const Pivot& pivot) {
 PlatformTransform to_transform(const PiPose& p, const Eigen::Vector3d& pivot_m) {
   PlatformTransform T;
   T.R = pi_rotation(p.U, p.V, p.W);
-  T.d = displacement(T.R, {p.X, p.Y, p.Z}, {pivot_m, PivotMode::kRelative});
+  T.d = pivot_displacement(T.R, {p.X, p.Y, p.Z}, {pivot_m, PivotMode::kRelative});
   return T;
 }
 
 PiPose to_pi(const PlatformTransform& T, const Eigen::Vector3d& pivot_m) {
-  const Eigen::Vector3d t = translation(T, {pivot_m, PivotMode::kRelative});
+  const Eigen::Vector3d t = pivot_translation(T, {pivot_m, PivotMode::kRelative});
   const Eigen::Vector3d a = pi_angles(T.R);
   return {t.x(), t.y(), t.z(), a.x(), a.y(), a.z()};
 }
