@@ -330,7 +330,7 @@ def gen_configuration(cli):
         allow = {l.strip() for l in allow_file.read_text().splitlines() if l.strip() and not l.startswith("#")}
     sources = [("platform", "Platform configuration", "`run --config FILE`, `serve --config FILE`",
                 yaml.safe_load(run([cli, "run", "--print-config"])), "microcobot run --print-config")]
-    for group in ("stickslip", "control", "haptics", "tweezers", "cell"):
+    for group in ("stickslip", "control", "positioner", "haptics", "tweezers", "cell"):
         sources.append((group, f"`{group}` parameters", f"`{group} ... --params FILE`",
                         json.loads(run([cli, group, "params", "--json"])), f"microcobot {group} params --json"))
     out = ["# Configuration and parameter keys\n", GENERATED,
