@@ -260,13 +260,13 @@ void Mcs2Controller::handshake(LineClient& bus) {
   poll_lines_.push_back(":SYST:ERR:COUN?");
   for (std::size_t i = 0; i < n; ++i) poll_lines_.push_back(fmt::format(":CHAN{}:POS?", channel(i)));
   sent_ = {};
-  cycle(bus);
+  poll(bus, {});  // the first positions; no target is sent before the axes are armed
 }
 
 void Mcs2Controller::cycle(LineClient& bus) {
   const Targets t = targets();
   const auto n = static_cast<std::size_t>(axis_count());
-  std::vector<std::string> lines;
+  std::vector<std::string> moves;
   for (std::size_t i = 0; i < n; ++i) {
     if (!t.wanted[i]) {
       sent_[i] = false;  // once armed again, the first target is sent whatever it is
@@ -276,27 +276,32 @@ void Mcs2Controller::cycle(LineClient& bus) {
     // Sent again once it moved by half a nm (theta: half a nm of arc): the coupling's target
     // at rest does not flood the controller with the same move.
     if (sent_[i] && std::abs(target - sent_m_[i]) < 0.5e-9) continue;
-    lines.push_back(fmt::format(":MOVE{} {}", channel(i), std::llround(target / si_per_wire(i))));
+    moves.push_back(fmt::format(":MOVE{} {}", channel(i), std::llround(target / si_per_wire(i))));
     sent_m_[i] = target;
     sent_[i] = true;
   }
-  const bool moved = !lines.empty();
-  const std::string first_move = moved ? lines.front() : std::string();
+  poll(bus, moves);
+  if (!moves.empty()) moves_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void Mcs2Controller::poll(LineClient& bus, std::vector<std::string> lines) {
+  const std::string after = lines.empty() ? std::string(":CHAN<n>:POS?") : lines.front();
+  const std::size_t first = lines.size();
   lines.insert(lines.end(), poll_lines_.begin(), poll_lines_.end());
   const auto replies = exchange(bus, lines);
   const auto errors = mcs2::parse_integer(replies[0]);
   if (!errors)
     throw BusFault("':SYST:ERR:COUN?': a reply that is not an integer: '" + excerpt(replies[0], 60) + "'");
-  check_errors(bus, *errors, moved ? first_move : std::string(":CHAN<n>:POS?"));
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto pos = mcs2::parse_integer(replies[i + 1]);
+  check_errors(bus, *errors, after);
+  for (std::size_t i = 0; i + 1 < replies.size(); ++i) {
+    // pm (ndeg) as an integer; a decimal is rounded (the EPICS driver reads it as a double).
+    const auto pos = mcs2::parse_rounded(replies[i + 1]);
     if (!pos)
-      throw BusFault("'" + poll_lines_[i + 1] + "': a reply that is not a position: '" +
+      throw BusFault("'" + lines[first + i + 1] + "': a reply that is not a position: '" +
                      excerpt(replies[i + 1], 60) + "'");
     publish_position(static_cast<int>(i), static_cast<double>(*pos) * si_per_wire(i));
   }
   publish_stamp();
-  if (moved) moves_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void Mcs2Controller::safe_state(LineClient& bus) {

@@ -94,6 +94,9 @@ class Mcs2Controller final : public BusController {
   /// `count`, the reply of :SYST:ERR:COUN?: throws BusFault with the oldest error's code and text
   /// (:SYST:ERR:NEXT?) unless it is 0. `after` says what was sent before.
   void check_errors(LineClient& bus, std::int64_t count, const std::string& after);
+  /// Sends `lines` (set commands, or none), then :SYST:ERR:COUN? (check_errors) and each
+  /// channel's :CHAN<n>:POS?, and publishes the positions.
+  void poll(LineClient& bus, std::vector<std::string> lines);
   /// Sends set commands, then :SYST:ERR:COUN? (check_errors).
   void command(LineClient& bus, const std::vector<std::string>& lines);
   int channel(std::size_t i) const { return i < 3 ? params_.channels[i] : params_.theta; }
