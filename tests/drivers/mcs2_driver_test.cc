@@ -45,6 +45,7 @@ struct FakeMcs2 {
   std::string idn = "SmarAct GmbH,MCS2,MCS2-00001234,1.4.2";
   int channels = 4;
   int no_sensor = -1;
+  bool refuse_reference = false;  // :REF answered by error 262 (the amplifier off)
   bool referenced[4] = {false, false, false, false};
   std::mutex m;
   std::int64_t pos_pm[4] = {0, 0, 0, 0};
@@ -77,7 +78,9 @@ struct FakeMcs2 {
     if (h == "CHAN:RLIM:MIN") return reply(-5'000'000'000LL);  // 5 mm, 5 deg
     if (h == "CHAN:RLIM:MAX") return reply(5'000'000'000LL);
     if (h == "CHAN:VEL" && c.query) return reply(1'000'000'000LL);  // 1 mm/s
-    if (h == "REF") {
+    if (h == "REF" && refuse_reference) {
+      errors.push_back(mcs2::kAmplifierDisabled);
+    } else if (h == "REF") {
       referenced[n] = true;
       pos_pm[n] = 0;
     }
@@ -222,6 +225,10 @@ TEST(Mcs2Driver, ConfigureRefusesAWrongIdentityTooFewChannelsNoSensorOrNoReferen
     FakeMcs2 fake;
     expect_one_line(configure_error(fake, ",reference=require"), "reference=require", fake.server.port());
     EXPECT_EQ(fake.server.count(":REF"), 0);
+    fake.refuse_reference = true;
+    expect_one_line(configure_error(fake), "':REF0': controller error 262 (Amplifier disabled)",
+                    fake.server.port());
+    fake.refuse_reference = false;
     // Linear channels for X, Y, Z: the rotary one there is refused.
     expect_one_line(configure_error(fake, ",channels=0+1+3"), "channel 3: base unit 3", fake.server.port());
   }

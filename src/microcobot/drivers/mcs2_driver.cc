@@ -157,7 +157,8 @@ void Mcs2Controller::check_errors(LineClient& bus, std::int64_t count, const std
   throw BusFault(fmt::format("'{}': controller error {} ({})", excerpt(after, 60), e->first, e->second));
 }
 
-void Mcs2Controller::command(LineClient& bus, const std::vector<std::string>& lines) {
+void Mcs2Controller::command(LineClient& bus, const std::vector<std::string>& lines,
+                             const std::string& after) {
   std::vector<std::string> all = lines;
   all.push_back(":SYST:ERR:COUN?");
   const auto replies = exchange(bus, all);
@@ -165,7 +166,7 @@ void Mcs2Controller::command(LineClient& bus, const std::vector<std::string>& li
   if (!count)
     throw BusFault("':SYST:ERR:COUN?': a reply that is not an integer: '" + excerpt(replies.back(), 60) +
                    "'");
-  check_errors(bus, *count, lines.empty() ? std::string() : lines.front());
+  check_errors(bus, *count, lines.empty() ? after : lines.front());
 }
 
 void Mcs2Controller::handshake(LineClient& bus) {
@@ -224,9 +225,8 @@ void Mcs2Controller::handshake(LineClient& bus) {
         static_cast<double>(query_integer(bus, fmt::format(":CHAN{}:VEL?", channel(i)))) * kMmPerM / kPmPerM;
     if (vel_mm_s > 0.0 && vel_mm_s < params_.operator_speed_mm_s)
       spdlog::warn(
-          "smaract-mcs2: channel {} moves at VEL {:g} mm/s, slower than the operator's {:g} mm/s: the stage "
-          "will "
-          "lag the coupling's target (option velocity_mm_s=1 sets VEL at configure)",
+          "smaract-mcs2: channel {} moves at VEL {:g} mm/s, slower than the operator's {:g} mm/s: "
+          "the stage will lag the coupling's target (option velocity_mm_s=1 sets VEL at configure)",
           channel(i), vel_mm_s, params_.operator_speed_mm_s);
   }
   if (!unreferenced.empty()) {
@@ -254,7 +254,7 @@ void Mcs2Controller::handshake(LineClient& bus) {
         throw BusFault(fmt::format(":REF{}: not referenced after {} s", names, params_.reference_timeout_s));
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    command(bus, {});  // an error the reference left (the queue read once more)
+    command(bus, {}, ":REF" + names);  // an error the reference left (the queue read once more)
   }
   poll_lines_.clear();
   poll_lines_.push_back(":SYST:ERR:COUN?");

@@ -97,8 +97,9 @@ class Mcs2Controller final : public BusController {
   /// Sends `lines` (set commands, or none), then :SYST:ERR:COUN? (check_errors) and each
   /// channel's :CHAN<n>:POS?, and publishes the positions.
   void poll(LineClient& bus, std::vector<std::string> lines);
-  /// Sends set commands, then :SYST:ERR:COUN? (check_errors).
-  void command(LineClient& bus, const std::vector<std::string>& lines);
+  /// Sends set commands, then :SYST:ERR:COUN? (check_errors; an error is said to follow the first
+  /// line, or `after` when there is none).
+  void command(LineClient& bus, const std::vector<std::string>& lines, const std::string& after = {});
   int channel(std::size_t i) const { return i < 3 ? params_.channels[i] : params_.theta; }
   std::string channel_list() const;
   /// The platform's unit (m; the rotary axis: m of arc) per the wire's (pm; ndeg).
