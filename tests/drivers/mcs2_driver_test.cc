@@ -143,12 +143,14 @@ TEST(Mcs2Driver, TheConnectionOptionsAreCheckedInOneLine) {
 
 TEST(Mcs2Driver, ReferencesRunsThePlatformToTheGoalOnEveryAxisWithoutAllocatingInTheLoop) {
   FakeMcs2 fake;
-  auto p = platform::make_platform(mcs2_config(fake.server.port(), ",theta=3"));
+  auto p = platform::make_platform(mcs2_config(fake.server.port(), ",theta=3,velocity_mm_s=1"));
   EXPECT_FALSE(p->simulated());
   ASSERT_TRUE(p->has_rotary());
   for (int c = 0; c < 4; ++c) EXPECT_EQ(fake.server.count(fmt::format(":REF{}", c)), 1) << c;
   EXPECT_EQ(fake.server.count(":CHAN0:MMOD 0"), 1);
   EXPECT_EQ(fake.server.count(":CHAN3:HOLD -1"), 1);
+  EXPECT_EQ(fake.server.count(":CHAN2:VEL 1000000000"), 1);  // 1 mm/s in pm/s, X, Y, Z only
+  EXPECT_EQ(fake.server.count(":CHAN3:VEL "), 0);
   const Eigen::Vector3d goal(20e-6, -15e-6, 10e-6);
   Console console(*p, goal);
   console.in.has_theta_goal = true;
