@@ -1,7 +1,8 @@
 // Does a driver-backed platform keep its 1 kHz slave control rate against the twin?
 // One run: the GCS 2.0 twin (the live platform, paced, with its TCP server) runs throughout; in
 // alternating 2 s phases (three of each) this process runs, paced to the wall clock, either the
-// simulated platform (no driver) or a platform whose axes are `pi-gcs2` on that twin, the console
+// simulated platform (no driver) or a platform whose axes are `pi-gcs2` on that twin (and, in the
+// second benchmark, `smaract-mcs2` on the MCS2 twin), the console
 // moving the stage between two goals 20 um apart every 0.5 s (MOV traffic). Per phase: loop ticks
 // per wall second, slave-control ticks per second (ticks / loop.slave_divisor), the loop's tick
 // time p99 and overruns; for the driver, its bus cycles per second (MOV + ERR? + POS?) and the
@@ -62,7 +63,8 @@ Phase run_phase(mc::platform::Platform& p, double seconds) {
   return r;
 }
 
-void BM_DriverBackedPlatformRate(benchmark::State& state) {
+// The phases against the twin's `protocol` port, the driver set `driver` on it.
+void driver_backed_rate(benchmark::State& state, mc::twins::Protocol protocol, const char* driver) {
   mc::drivers::register_vendor_drivers();
   for (auto _ : state) {
     mc::live::LiveParams lp;
@@ -70,13 +72,13 @@ void BM_DriverBackedPlatformRate(benchmark::State& state) {
     live.start([](const mc::platform::TelemetrySample&, std::size_t) {});
     mc::twins::LiveStage stage(live);
     mc::twins::TwinServerParams tp;
-    tp.endpoints = {{mc::twins::Protocol::kGcs2, "127.0.0.1", 0}};
+    tp.endpoints = {{protocol, "127.0.0.1", 0}};
     mc::twins::TwinServer server(stage, tp);
     server.start();
     mc::platform::PlatformConfig sim;
     sim.loop.realtime = true;
     mc::platform::PlatformConfig drv = sim;
-    drv.devices.driver = "pi-gcs2";
+    drv.devices.driver = driver;
     drv.devices.connection = fmt::format("127.0.0.1:{},velocity_mm_s=1", server.ports()[0]);
     std::array<Phase, 2> sum{};  // [0] simulated, [1] driver
     for (int k = 0; k < 6; ++k) {
@@ -109,6 +111,15 @@ void BM_DriverBackedPlatformRate(benchmark::State& state) {
     state.counters["drv_fresh_share"] = sum[1].fresh;
   }
 }
+void BM_DriverBackedPlatformRate(benchmark::State& state) {
+  driver_backed_rate(state, mc::twins::Protocol::kGcs2, "pi-gcs2");
+}
 BENCHMARK(BM_DriverBackedPlatformRate)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+// The same on `smaract-mcs2` against the MCS2 twin: its bus cycle is one round trip per query
+// (:SYST:ERR:COUN? and three :CHAN<n>:POS?, the :MOVEs written with the first).
+void BM_Mcs2DriverBackedPlatformRate(benchmark::State& state) {
+  driver_backed_rate(state, mc::twins::Protocol::kMcs2, "smaract-mcs2");
+}
+BENCHMARK(BM_Mcs2DriverBackedPlatformRate)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace

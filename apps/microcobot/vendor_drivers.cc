@@ -1,4 +1,4 @@
-// The vendor driver sets (pi-gcs2, anc300) registered before any command reads a
+// The vendor driver sets (pi-gcs2, anc300, smaract-mcs2) registered before any command reads a
 // configuration (`devices: {driver: pi-gcs2, connection: ...}`; docs/hardware.md, "Drivers").
 
 #include "microcobot/drivers/register_drivers.h"

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// What the vendor drivers (pi-gcs2, anc300) share: one controller per connection,
+/// What the vendor drivers (pi-gcs2, anc300, smaract-mcs2) share: one controller per connection,
 /// driven by a bus thread, with three position-controlled axes (devices/device.h) as its views.
 ///
 ///   loop (RT)     command_target_m() -> atomics      update(): fault() once the bus faulted

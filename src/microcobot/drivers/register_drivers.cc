@@ -4,6 +4,7 @@
 
 #include "microcobot/drivers/anc300_driver.h"
 #include "microcobot/drivers/gcs2_driver.h"
+#include "microcobot/drivers/mcs2_driver.h"
 #include "microcobot/platform/driver_registry.h"
 
 namespace mc::drivers {
@@ -13,6 +14,7 @@ void register_vendor_drivers() {
   std::call_once(once, [] {
     platform::register_devices("pi-gcs2", make_gcs2_devices);
     platform::register_devices("anc300", make_anc300_devices);
+    platform::register_devices("smaract-mcs2", make_mcs2_devices);
   });
 }
 

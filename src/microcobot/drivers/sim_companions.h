@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The devices a vendor driver set (pi-gcs2, anc300) does not drive: the haptic master and the
+/// The devices a vendor driver set (pi-gcs2, anc300, smaract-mcs2) does not drive: the haptic master and the
 /// TéléTweez are the simulated ones (the console, or their simulated hands, operate them), and
 /// the gripper is a stand-in with no microworld behind it (the stage is real, or another
 /// process's twin, so this process has no part to pick): it reports the opening it was commanded
