@@ -98,7 +98,7 @@ TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
     EXPECT_EQ(r.exit_code, 3) << command << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
     EXPECT_NE(r.err.find(
-                  "devices.driver: 'smaract' is not a registered driver (known: simulated, anc300, pi-gcs2)"),
+                  "devices.driver: 'smaract' is not a registered driver (known: simulated, anc300, pi-gcs2, smaract-mcs2)"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.out, "") << "nothing served or run";
