@@ -50,15 +50,11 @@ void Anc300DriverParams::validate() const {
 }
 
 Anc300DriverParams anc300_driver_params(const Connection& c) {
-  check_connection_options(c,
-                           "timeout_s, connect_timeout_s, poll_s, stale_s, password, axes, theta, voltage_V, "
-                           "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm, deadband_nm");
+  check_connection_options(c, std::string(kBusTimingOptions) +
+                                  ", password, axes, theta, voltage_V, "
+                                  "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm, deadband_nm");
   Anc300DriverParams p;
-  p.timing.reply_timeout_s = connection_number(c, "timeout_s", p.timing.reply_timeout_s, 0.001, 10.0);
-  p.timing.connect_timeout_s =
-      connection_number(c, "connect_timeout_s", p.timing.connect_timeout_s, 0.01, 60.0);
-  p.timing.poll_period_s = connection_number(c, "poll_s", p.timing.poll_period_s, 1e-4, 1.0);
-  p.timing.stale_timeout_s = connection_number(c, "stale_s", p.timing.stale_timeout_s, 1e-3, 10.0);
+  p.timing = bus_timing(c, p.timing);
   p.voltage_V = connection_number(c, "voltage_V", p.voltage_V, 1e-3, 150.0);
   p.frequency_Hz = connection_number(c, "frequency_Hz", p.frequency_Hz, 1.0, 10e3);
   p.max_run_s = connection_number(c, "max_run_s", p.max_run_s, 1e-4, 1.0);

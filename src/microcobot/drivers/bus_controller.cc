@@ -31,6 +31,14 @@ void BusTiming::validate() const {
           stale_timeout_s);
 }
 
+BusTiming bus_timing(const Connection& c, BusTiming t) {
+  t.reply_timeout_s = connection_number(c, "timeout_s", t.reply_timeout_s, 0.001, 10.0);
+  t.connect_timeout_s = connection_number(c, "connect_timeout_s", t.connect_timeout_s, 0.01, 60.0);
+  t.poll_period_s = connection_number(c, "poll_s", t.poll_period_s, 1e-4, 1.0);
+  t.stale_timeout_s = connection_number(c, "stale_s", t.stale_timeout_s, 1e-3, 10.0);
+  return t;
+}
+
 BusController::BusController(std::string driver, Connection connection, BusTiming timing)
     : driver_(std::move(driver)), connection_(std::move(connection)), timing_(timing) {
   timing_.validate();

@@ -44,6 +44,13 @@ struct BusTiming {
   void validate() const;
 };
 
+/// The timing options every bus driver's `connection` takes (timeout_s, connect_timeout_s,
+/// poll_s, stale_s), each over its default in `timing`; a value out of its range is refused naming
+/// the option (line_client.h, connection_number).
+BusTiming bus_timing(const Connection& c, BusTiming timing = {});
+/// Their names, for check_connection_options.
+inline constexpr std::string_view kBusTimingOptions = "timeout_s, connect_timeout_s, poll_s, stale_s";
+
 /// A failure on the bus (the bus thread's own exception: it never crosses to the loop).
 class BusFault : public std::runtime_error {
  public:

@@ -42,15 +42,11 @@ void Gcs2DriverParams::validate() const {
 }
 
 Gcs2DriverParams gcs2_driver_params(const Connection& c) {
-  check_connection_options(c,
-                           "timeout_s, connect_timeout_s, poll_s, stale_s, axes, theta, reference, "
-                           "reference_timeout_s, velocity_mm_s");
+  check_connection_options(c, std::string(kBusTimingOptions) +
+                                  ", axes, theta, reference, "
+                                  "reference_timeout_s, velocity_mm_s");
   Gcs2DriverParams p;
-  p.timing.reply_timeout_s = connection_number(c, "timeout_s", p.timing.reply_timeout_s, 0.001, 10.0);
-  p.timing.connect_timeout_s =
-      connection_number(c, "connect_timeout_s", p.timing.connect_timeout_s, 0.01, 60.0);
-  p.timing.poll_period_s = connection_number(c, "poll_s", p.timing.poll_period_s, 1e-4, 1.0);
-  p.timing.stale_timeout_s = connection_number(c, "stale_s", p.timing.stale_timeout_s, 1e-3, 10.0);
+  p.timing = bus_timing(c, p.timing);
   p.reference = connection_number(c, "reference", 1.0, 0.0, 1.0) != 0.0;
   p.reference_timeout_s = connection_number(c, "reference_timeout_s", p.reference_timeout_s, 0.01, 600.0);
   p.velocity_mm_s = connection_number(c, "velocity_mm_s", p.velocity_mm_s, 0.0, 1e3);
