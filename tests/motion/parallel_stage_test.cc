@@ -16,7 +16,7 @@
 #include "support/counting_allocator.h"
 
 namespace mc::motion {
-namespace {
+namespace parallel_stage_test {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
@@ -221,5 +221,5 @@ TEST(ParallelStage, OpenLoopSteppingMovesOnlyThatPositionerAndALaterMoveStartsFr
   EXPECT_LE(o.rest_rad, 10e-6);
 }
 
-}  // namespace
+}  // namespace parallel_stage_test
 }  // namespace mc::motion
