@@ -33,8 +33,17 @@ struct MoveOutcome {
   bool rested = false;
 };
 
+/// Powered up and at rest where it is (the trackers' power-up edge, which drags a slider by up to
+/// ~1 um, is over before the move, as on a positioner switched on before it is used).
+void settle(ParallelStage& stage) {
+  const double t_end = stage.time_s() + 1.0;
+  while (!stage.at_rest() && stage.time_s() < t_end) stage.tick();
+  ASSERT_TRUE(stage.at_rest());
+}
+
 MoveOutcome run_move(ParallelStage& stage, const PlatformTransform& goal) {
   MoveOutcome out;
+  settle(stage);
   stage.move_to(goal);
   while (stage.moving() && stage.time_s() < 60.0) {
     stage.tick();
@@ -73,11 +82,10 @@ std::vector<std::pair<PlatformTransform, PlatformTransform>> random_moves(const 
 }
 
 TEST(ParallelStage, RandomMovesComeToRestWithinHalfAMicronAndTenMicroradiansOfTheGoal) {
-  // Validation seed 2. No gain was tuned for the stage (the trackers' are the project's); seed 1
-  // served only to compare the angular speed limit (docs/concepts/parallel-positioner.md).
+  // Validation seed 2. No gain was tuned for the stage (the trackers' are the project's).
   ParallelStage stage(test::model(), test::step_map());
   const auto moves = random_moves(stage.kinematics(), 10, 2);
-  double worst_m = 0.0, worst_rad = 0.0, worst_path_m = 0.0;
+  double worst_m = 0.0, worst_rad = 0.0, worst_path_m = 0.0, worst_path_rad = 0.0;
   for (const auto& [start, goal] : moves) {
     stage.place(start);
     const MoveOutcome o = run_move(stage, goal);
@@ -86,16 +94,15 @@ TEST(ParallelStage, RandomMovesComeToRestWithinHalfAMicronAndTenMicroradiansOfTh
     worst_m = std::max(worst_m, o.rest_m);
     worst_rad = std::max(worst_rad, o.rest_rad);
     worst_path_m = std::max(worst_path_m, o.path_m);
+    worst_path_rad = std::max(worst_path_rad, o.path_rad);
   }
   EXPECT_LE(worst_m, 0.5e-6);
   EXPECT_LE(worst_rad, 10e-6);
-  // The line within 2 um is met on the 1 mm + 5 deg move below; these shorter, more strongly
-  // rotating moves leave it by up to ~1.5x (docs/concepts/parallel-positioner.md): a regression bound.
-  EXPECT_LE(worst_path_m, 4e-6);
+  EXPECT_LE(worst_path_m, 2e-6);
   RecordProperty("worst_rest_um", std::to_string(worst_m * 1e6));
   RecordProperty("worst_rest_urad", std::to_string(worst_rad * 1e6));
-  std::printf("10 random moves (seed 2): at rest worst %.4f um, %.3f urad; path worst %.3f um\n",
-              worst_m * 1e6, worst_rad * 1e6, worst_path_m * 1e6);
+  std::printf("10 random moves (seed 2): at rest worst %.4f um, %.3f urad; path worst %.3f um, %.2f urad\n",
+              worst_m * 1e6, worst_rad * 1e6, worst_path_m * 1e6, worst_path_rad * 1e6);
 }
 
 TEST(ParallelStage, AMillimetreAndFiveDegreeLineAt100UmPerSecondIsTrackedWithinTwoMicrons) {
