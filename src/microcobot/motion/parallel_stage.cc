@@ -122,11 +122,14 @@ void ParallelStage::safe_stop() noexcept {
 void ParallelStage::tick() noexcept {
   const double dt = model_.dt_s();
   // The legs' reference: the move's, once every tracker has powered up.
+  bool on_move = false;
   if (moving_) {
     bool ready = true;
     for (const auto& ax : axes_) ready = ready && ax.ctrl->ready();
     if (ready) {
+      on_move = true;
       if (!traj_->legs_at(kin_, t_move_, ref_)) {
+        on_move = false;
         safe_stop();
       } else {
         double s = 0.0, sd = 0.0, sdd = 0.0;
@@ -158,7 +161,6 @@ void ParallelStage::tick() noexcept {
         continue;
       }
     }
-    const bool on_move = moving_ && traj_ && ax.ctrl->ready();
     const auto ki = static_cast<Eigen::Index>(i);
     ax.ctrl->set_reference(on_move ? ReferenceSample{ref_.q(ki), ref_.v(ki), ref_.a(ki)}
                                    : ReferenceSample{ax.hold, 0.0, 0.0});
