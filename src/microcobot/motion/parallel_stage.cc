@@ -1,0 +1,211 @@
+#include "microcobot/motion/parallel_stage.h"
+
+#include <cmath>
+#include <cstdlib>
+
+#include "microcobot/core/error.h"
+#include "microcobot/motion/closed_loop.h"
+#include "microcobot/motion/parallel_workspace.h"
+
+namespace mc::motion {
+
+LegPositioner parse_leg_positioner(const std::string& name) {
+  if (name == "radial") return LegPositioner::kRadial;
+  if (name == "tangential") return LegPositioner::kTangential;
+  throw UsageError("the positioner must be radial or tangential (got '" + name + "')");
+}
+
+ParallelStage::ParallelStage(const stickslip::ActuatorModel& model, const StepMap& map,
+                             const ParallelStageParams& p)
+    : model_(model), map_(map), p_(p), kin_(p.geometry) {
+  p_.validate();
+  require(model.params().slider.stroke_m >= p_.geometry.stroke_m, "geometry.stroke_m",
+          "must not exceed the actuator model's stroke", p_.geometry.stroke_m);
+  ratio_ = steps_per_tick(model, p_.tracking.control_rate_Hz);
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    PositionSensorParams sp = p_.sensor;
+    sp.seed = p_.sensor.seed + static_cast<int>(i);  // independent noise per axis
+    auto& ax = axes_[i];
+    ax.state = model.initial_state();
+    ax.sensor = PositionSensor(sp);
+    ax.ctrl = std::make_unique<TrackingController>(p_.tracking, model.params(), map);
+    ax.gen = SawtoothGenerator(model.params().drive.slew_rate_V_s);
+  }
+  place(PlatformTransform{});
+}
+
+void ParallelStage::place(const PlatformTransform& T) {
+  const ReachCheck c = check_pose(kin_, T);
+  if (!c.ok()) throw PoseUnreachable(to_smarpod(T), c);
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    auto& ax = axes_[i];
+    const double q = c.q(static_cast<Eigen::Index>(i));
+    ax.state = model_.initial_state();
+    ax.state.x2_m = {q, q};
+    ax.stepping = false;
+    ax.gen.halt();
+    ax.measured = ax.sensor.measure(q);
+    ax.ctrl->reset(ax.measured, ax.state.u_V);
+    ax.hold = q;
+  }
+  measured_T_ = true_T_ = ref_T_ = T;
+  moving_ = false;
+  fault_ = false;
+  t_move_ = 0.0;
+}
+
+MoveCheck ParallelStage::move_to(const PlatformTransform& goal) { return move_to(goal, p_.move); }
+
+MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLimits& limits) {
+  if (fault_) throw InvalidInput("the positioner is stopped on a fault: place it again");
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    if (axes_[i].stepping)
+      throw InvalidInput("leg " + std::to_string(i / 2) + " is stepping open loop: wait for it or stop()");
+  }
+  // The goal's own check first: a NaN or an unreachable goal is named as such.
+  const ReachCheck g = check_pose(kin_, goal);
+  if (!g.ok()) throw InvalidInput(std::string("goal: ") + PoseUnreachable(to_smarpod(goal), g).what());
+  // The move starts where the legs are held (after a move: its goal; after stop() or stepping:
+  // where they were measured).
+  LegCoordinates q_hold;
+  for (std::size_t i = 0; i < axes_.size(); ++i) q_hold(static_cast<Eigen::Index>(i)) = axes_[i].hold;
+  const PlatformTransform start = kin_.forward(q_hold, ref_T_).T;
+  auto traj = std::make_unique<PoseTrajectory>(start, goal, limits);
+  const MoveCheck c = check_move(kin_, *traj);
+  if (!c.ok) throw InvalidInput(c.reason);
+  traj_ = std::move(traj);
+  ref_T_ = start;
+  t_move_ = 0.0;
+  moving_ = true;
+  return c;
+}
+
+void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz) {
+  require(leg >= 0 && leg < kParallelLegs, "leg", "must be 0, 1 or 2", leg);
+  require(steps != 0 && std::abs(steps) <= 100000, "steps", "must be non-zero, |steps| <= 100000", steps);
+  require(std::isfinite(frequency_Hz) && frequency_Hz > 0.0 && frequency_Hz <= 20000.0, "frequency_Hz",
+          "must be in (0, 20000] Hz", frequency_Hz);
+  if (fault_) throw InvalidInput("the positioner is stopped on a fault: place it again");
+  stop();
+  auto& ax = axes_[static_cast<std::size_t>(2 * leg + static_cast<int>(positioner))];
+  if (ax.stepping) throw InvalidInput("leg " + std::to_string(leg) + "'s positioner is already stepping");
+  ax.gen.command(p_.tracking.high_V, frequency_Hz, steps > 0 ? Direction::kForward : Direction::kBackward);
+  ax.gen.start(ax.state.u_V);
+  ax.steps_left = std::abs(steps);
+  ax.periods_at_start = ax.gen.periods();
+  ax.stepping = true;
+}
+
+void ParallelStage::hold_here(LegAxis& ax) noexcept { ax.hold = ax.measured; }
+
+void ParallelStage::stop() noexcept {
+  moving_ = false;
+  for (auto& ax : axes_) {
+    if (ax.stepping)
+      ax.steps_left = 0;  // ends with the present period
+    else
+      hold_here(ax);
+  }
+  ref_T_ = measured_T_;
+}
+
+void ParallelStage::safe_stop() noexcept {
+  fault_ = true;
+  moving_ = false;
+  for (auto& ax : axes_) {
+    ax.ctrl->emergency_stop();
+    ax.gen.halt();
+    ax.stepping = false;
+  }
+}
+
+void ParallelStage::tick() noexcept {
+  const double dt = model_.dt_s();
+  // The legs' reference: the move's, once every tracker has powered up.
+  bool on_move = false;
+  if (moving_) {
+    bool ready = true;
+    for (const auto& ax : axes_) ready = ready && ax.ctrl->ready();
+    if (ready) {
+      on_move = true;
+      if (!traj_->legs_at(kin_, t_move_, ref_)) {
+        on_move = false;
+        safe_stop();
+      } else {
+        double s = 0.0, sd = 0.0, sdd = 0.0;
+        traj_->profile(t_move_, s, sd, sdd);
+        ref_T_ = traj_->at(s);
+        t_move_ += tick_s();
+        if (t_move_ > traj_->duration_s() + tick_s()) {
+          moving_ = false;
+          for (std::size_t i = 0; i < axes_.size(); ++i) axes_[i].hold = ref_.q(static_cast<Eigen::Index>(i));
+          ref_T_ = traj_->goal();
+        }
+      }
+    }
+  }
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    auto& ax = axes_[i];
+    ax.measured = ax.sensor.measure(model_.slider_position(ax.state));
+    if (ax.stepping) {
+      // Open loop: the sawtooth runs its periods; the last one ends at 0 V, then the leg holds.
+      if (ax.gen.periods() - ax.periods_at_start >= ax.steps_left - 1) ax.gen.stop_at_period_end();
+      if (!ax.gen.running()) {
+        ax.stepping = false;
+        ax.ctrl->reset(ax.measured, ax.state.u_V);
+        hold_here(ax);
+      } else {
+        model_.set_operating_point(ax.state, ax.gen.amplitude_V(), ax.gen.frequency_Hz(), ax.gen.direction());
+        for (int k = 0; k < ratio_; ++k) model_.step(ax.state, ax.gen.next(dt));
+        if (ax.state.diverged) safe_stop();
+        continue;
+      }
+    }
+    const auto ki = static_cast<Eigen::Index>(i);
+    ax.ctrl->set_reference(on_move ? ReferenceSample{ref_.q(ki), ref_.v(ki), ref_.a(ki)}
+                                   : ReferenceSample{ax.hold, 0.0, 0.0});
+    ax.ctrl->update(ax.measured);
+    const auto& op = ax.ctrl->operating_point();
+    model_.set_operating_point(ax.state, op.amplitude_V, op.frequency_Hz, op.direction);
+    for (int k = 0; k < ratio_; ++k) model_.step(ax.state, ax.ctrl->next_drive(dt));
+    if (ax.state.diverged) safe_stop();
+  }
+  if (!fault_) update_poses();
+  t_ += tick_s();
+}
+
+void ParallelStage::update_poses() noexcept {
+  LegCoordinates qm, qt;
+  for (std::size_t i = 0; i < axes_.size(); ++i) {
+    qm(static_cast<Eigen::Index>(i)) = axes_[i].measured;
+    qt(static_cast<Eigen::Index>(i)) = model_.slider_position(axes_[i].state);
+  }
+  try {
+    measured_T_ = kin_.forward(qm, measured_T_).T;
+    true_T_ = kin_.forward(qt, true_T_).T;
+  } catch (...) {
+    // The legs stand where no pose of the positioner is (e.g. stepped beyond a joint limit).
+    safe_stop();
+  }
+}
+
+bool ParallelStage::at_rest() const noexcept {
+  if (moving_ || fault_) return false;
+  for (const auto& ax : axes_) {
+    if (ax.stepping || !ax.ctrl->ready() || !ax.ctrl->in_position()) return false;
+  }
+  return true;
+}
+
+LegAxisStatus ParallelStage::status(int axis) const noexcept {
+  const auto& ax = axes_[static_cast<std::size_t>(axis)];
+  LegAxisStatus s;
+  s.position_m = model_.slider_position(ax.state);
+  s.measured_m = ax.measured;
+  s.reference_m = ax.stepping ? ax.measured : (moving_ ? ref_.q(axis) : ax.hold);
+  s.voltage_V = ax.state.u_V;
+  s.stepping = ax.stepping;
+  return s;
+}
+
+}  // namespace mc::motion

@@ -1,0 +1,149 @@
+#pragma once
+/// @file
+/// The 6-DOF parallel stick-slip positioner under pose control (thesis: T. Lu, "Design and
+/// Realization of a Desktop Micro-manipulation Cobotic Platform", PhD thesis, Université Pierre et
+/// Marie Curie, 2016, §2.3, Fig. 2.4; structure: parallel_geometry.h; equations:
+/// docs/concepts/parallel-positioner.md, "Pose control").
+///
+/// Each of the six leg coordinates q_k is one SLC-1720 stick-slip axis of the project's model: one
+/// ActuatorModel (immutable, shared), six ActuatorStates, six sensors (independent noise streams:
+/// seed + k) and six trajectory-tracking controllers (tracking_controller.h). The slider position
+/// of axis k is q_k (0 at home, mid-stroke), so the platform steps, slips and drifts as its legs do.
+///
+/// Control is in the legs' space: a move's reference pose T(s(t)) (pose_trajectory.h) gives
+/// q_ref = IK(T) and its derivatives each tick, and each leg tracks its own q_ref; all legs follow
+/// the same s(t). The measured pose is FK of the six sensors' readings (Newton from the previous
+/// measured pose), the true pose FK of the six true slider positions (from the previous true pose):
+/// both are what the platform does, not what it was told.
+///
+/// Modes of a leg: tracking (moving or holding its reference), or stepping open loop
+/// (step_leg(): a sawtooth of N periods at full amplitude, recovery), after which it holds where
+/// it landed. stop() holds every leg where it is. A diverged model or a failed FK stops every
+/// axis at 0 V (fault()). tick() never allocates.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "microcobot/motion/parallel_kinematics.h"
+#include "microcobot/motion/pose_trajectory.h"
+#include "microcobot/motion/position_sensor.h"
+#include "microcobot/motion/sawtooth_generator.h"
+#include "microcobot/motion/step_map.h"
+#include "microcobot/motion/tracking_controller.h"
+#include "microcobot/stickslip/actuator.h"
+
+namespace mc::motion {
+
+inline constexpr int kParallelAxes = 2 * kParallelLegs;
+
+struct ParallelStageParams {
+  ParallelGeometryParams geometry;
+  TrackingParams tracking;
+  PositionSensorParams sensor;
+  PoseMoveLimits move;
+
+  template <class V>
+  void visit(V& v) {
+    v("geometry", geometry);
+    v("tracking", tracking);
+    v("sensor", sensor);
+    v("move", move);
+  }
+  void validate() const {
+    geometry.validate();
+    tracking.validate();
+    sensor.validate();
+    move.validate();
+  }
+};
+
+/// The two positioners of a leg's carriage.
+enum class LegPositioner { kRadial = 0, kTangential = 1 };
+LegPositioner parse_leg_positioner(const std::string& name);  ///< "radial" | "tangential", else UsageError
+
+struct LegAxisStatus {
+  double position_m = 0.0;   ///< true slider position (simulation)
+  double measured_m = 0.0;   ///< last sensor reading
+  double reference_m = 0.0;  ///< the tracker's reference
+  double voltage_V = 0.0;
+  bool stepping = false;  ///< open-loop stepping (step_leg)
+};
+
+class ParallelStage {
+ public:
+  /// `model` and `map` must outlive the stage. The model's stroke must cover the geometry's.
+  ParallelStage(const stickslip::ActuatorModel& model, const StepMap& map, const ParallelStageParams& p = {});
+
+  /// Places the platform at rest at `T` (simulation set-up): each slider at IK(T), the trackers
+  /// powering up to hold there. Throws PoseUnreachable for a pose out of the workspace.
+  void place(const PlatformTransform& T);
+  /// Starts a straight move in pose space from the pose the legs hold to `goal`, under the
+  /// params' limits; it runs once every tracker is ready (powered up). Refused before anything
+  /// moves (mc::InvalidInput with a one-line reason: check_move) when the goal or a pose along
+  /// the line is unreachable, singular, beyond a stroke or joint limit or not finite, when a leg
+  /// is stepping open loop, or after a fault. Returns the check (samples, peak leg speed).
+  MoveCheck move_to(const PlatformTransform& goal);
+  /// The same with other limits for this move.
+  MoveCheck move_to(const PlatformTransform& goal, const PoseMoveLimits& limits);
+  /// Open-loop stepping of one positioner (recovery): `steps` sawtooth periods at the full
+  /// amplitude and `frequency_Hz`, forward for steps > 0; the leg then holds where it landed. Any
+  /// move is stopped first (the other legs hold where they are).
+  void step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz);
+  /// Ends any move: every tracking leg holds where it is measured now; a stepping leg finishes
+  /// its period (U back at 0 V, no abrupt edge) and holds. Never allocates.
+  void stop() noexcept;
+  /// One control period (1 / tracking.control_rate_Hz). Never allocates.
+  void tick() noexcept;
+
+  bool moving() const noexcept { return moving_; }
+  /// Every leg tracking, no move under way and every tracker in position.
+  bool at_rest() const noexcept;
+  bool fault() const noexcept { return fault_; }
+  double time_s() const noexcept { return t_; }
+  double tick_s() const noexcept { return static_cast<double>(ratio_) * model_.dt_s(); }
+  /// Time into the present (or last) move [s]; 0 until every tracker is ready.
+  double move_time_s() const noexcept { return t_move_; }
+
+  const PlatformTransform& measured_pose() const noexcept { return measured_T_; }
+  const PlatformTransform& true_pose() const noexcept { return true_T_; }
+  /// The pose the legs are told to be at (the move's T(s(t)), or the held pose).
+  const PlatformTransform& reference_pose() const noexcept { return ref_T_; }
+  /// The present (or last) move; only valid after a move_to().
+  const PoseTrajectory& trajectory() const noexcept { return *traj_; }
+  bool has_trajectory() const noexcept { return traj_ != nullptr; }
+  LegAxisStatus status(int axis) const noexcept;
+  const ParallelKinematics& kinematics() const noexcept { return kin_; }
+  const ParallelStageParams& params() const noexcept { return p_; }
+
+ private:
+  struct LegAxis {
+    stickslip::ActuatorState state;
+    PositionSensor sensor;
+    std::unique_ptr<TrackingController> ctrl;
+    SawtoothGenerator gen;
+    double measured = 0.0;
+    double hold = 0.0;                  ///< the reference while holding
+    std::int64_t periods_at_start = 0;  ///< the generator's periods when step_leg() started
+    int steps_left = 0;                 ///< periods to run (0: end with the present one)
+    bool stepping = false;
+  };
+  void hold_here(LegAxis& ax) noexcept;
+  void update_poses() noexcept;
+  void safe_stop() noexcept;
+
+  const stickslip::ActuatorModel& model_;
+  const StepMap& map_;
+  ParallelStageParams p_;
+  ParallelKinematics kin_;
+  std::array<LegAxis, kParallelAxes> axes_;
+  std::unique_ptr<PoseTrajectory> traj_;
+  LegReference ref_;
+  PlatformTransform measured_T_, true_T_, ref_T_;
+  int ratio_ = 1;
+  double t_ = 0.0, t_move_ = 0.0;
+  bool moving_ = false, fault_ = false;
+};
+
+}  // namespace mc::motion
