@@ -52,6 +52,10 @@ TEST(ConsoleCommand, RefusesBadCommandsWithOneLineNamingTheField) {
   EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e999]})"), "/console/command: payload: is not valid JSON");
   EXPECT_EQ(message_of(R"({"goal_speed_m_s": -1})"), "/console/command: goal_speed_m_s: must be > 0");
   EXPECT_NE(message_of(R"({"fly": true})").find("fly: is not a known key"), std::string::npos);
+  // A key with a line break (found by the fuzzer) is named escaped: the message stays one line.
+  const std::string broken = message_of(R"({"deadm\n": true})");
+  EXPECT_NE(broken.find("deadm\\n: is not a known key"), std::string::npos) << broken;
+  EXPECT_EQ(broken.find('\n'), std::string::npos) << broken;
   EXPECT_EQ(message_of(R"({"goal_m": [0, 0, 1e308]})"), "accepted");  // finite: clamped to the workspace
   EXPECT_EQ(message_of(R"({"gripper_shake": 1})"), "/console/command: gripper_shake: must be true or false");
 }

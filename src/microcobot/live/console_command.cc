@@ -6,14 +6,16 @@
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
+#include "microcobot/core/input_file.h"
 
 namespace mc::live {
 namespace {
 
 using nlohmann::json;
 
+// `field` may be a key the client sent: escaped and cut (excerpt), so the error stays one line.
 [[noreturn]] void refuse(const char* channel, const std::string& field, const std::string& what) {
-  throw InvalidInput(std::string(channel) + ": " + field + ": " + what);
+  throw InvalidInput(std::string(channel) + ": " + excerpt(field) + ": " + what);
 }
 
 json parse_object(const char* channel, std::string_view text) {
