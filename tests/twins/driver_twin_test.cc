@@ -258,27 +258,25 @@ TEST(DriverTwin, Anc300CountingStepsDriftsByTheModelsStepError) {
   }
 }
 
-TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnPiGcs2UnderASimulatedGripper) {
-  // Hardware in the loop (docs/hardware.md): `microcobot run` with its axes behind pi-gcs2 on the
-  // twin of another process, and this process's simulated gripper and part carried where the
-  // controller's sensors say the stage is. The scripted watchmaker picks the part and places it
-  // 0.4 mm away; the twin's stage, read through its own port, ends over the target.
-  TwinProcess twin;
-  ASSERT_NE(twin.gcs2_port, 0) << test::read_text(twin.cli.err);
-  test::TempDir dir;
+// Hardware in the loop (docs/hardware.md): `microcobot run` with its axes behind `driver` on the
+// twin of another process (its port `port`), and this process's simulated gripper and part carried
+// where the controller's sensors say the stage is. The scripted watchmaker picks the part and
+// places it 0.4 mm away; the twin's stage, read through its own GCS port, ends over the target.
+void scripted_pick_and_place(const TwinProcess& twin, const std::string& driver, std::uint16_t port,
+                             const test::TempDir& dir) {
   test::write_text(
       dir / "hil.yaml",
-      fmt::format("devices: {{driver: pi-gcs2, connection: \"127.0.0.1:{},velocity_mm_s=1,timeout_s=1,"
+      fmt::format("devices: {{driver: {}, connection: \"127.0.0.1:{},velocity_mm_s=1,timeout_s=1,"
                   "stale_s=0.5\", gripper: simulated}}\nworld: {{target_x_m: 0.4e-3}}\n",
-                  twin.gcs2_port));
+                  driver, port));
   const auto r = test::run_cli({"run", "--config", (dir / "hil.yaml").string(), "--realtime", "--json",
                                 "--out", (dir / "out").string(), "--duration", "60"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   std::cout << fmt::format(
-      "[ pick-and-place on pi-gcs2 ] {}: placed {:.2f} um from the target in {:.1f} s "
-      "(wall {:.1f} s), tracking RMS {:.0f} nm\n",
-      j.at("verdict").get<std::string>(), 1e6 * j.at("placement_error_m").get<double>(),
+      "[ pick-and-place on {} ] {}: placed {:.2f} um from the target in {:.1f} s (wall {:.1f} s), tracking "
+      "RMS {:.0f} nm\n",
+      driver, j.at("verdict").get<std::string>(), 1e6 * j.at("placement_error_m").get<double>(),
       j.at("duration_s").get<double>(), j.at("wall_s").get<double>(),
       1e9 * j.at("tracking_error_rms_m").get<double>());
   EXPECT_TRUE(j.at("success").get<bool>()) << j.dump();
@@ -290,6 +288,13 @@ TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnPiGcs2UnderASimulatedGripper) {
   const auto x = twin_position_m(twin.gcs2_port);
   EXPECT_NEAR(x[0], 0.4e-3 - c.stage.home_x_m, 10e-6);
   EXPECT_NEAR(x[1], 0.0 - c.stage.home_y_m, 10e-6);
+}
+
+TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnPiGcs2UnderASimulatedGripper) {
+  TwinProcess twin;
+  ASSERT_NE(twin.gcs2_port, 0) << test::read_text(twin.cli.err);
+  test::TempDir dir;
+  scripted_pick_and_place(twin, "pi-gcs2", twin.gcs2_port, dir);
   // Without a part to pick, the scripted session is refused in one line before connecting.
   test::write_text(
       dir / "stand_in.yaml",
@@ -301,33 +306,10 @@ TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnPiGcs2UnderASimulatedGripper) {
 }
 
 TEST(DriverTwin, TheScriptedPickAndPlaceRunsOnSmaractMcs2UnderASimulatedGripper) {
-  // As on pi-gcs2 above: `microcobot run` with its axes behind smaract-mcs2 on the twin of another
-  // process, the simulated gripper and part carried where the MCS2's sensors say the stage is.
   TwinProcess twin;
   ASSERT_NE(twin.mcs2_port, 0) << test::read_text(twin.cli.err);
   test::TempDir dir;
-  test::write_text(
-      dir / "hil.yaml",
-      fmt::format("devices: {{driver: smaract-mcs2, connection: \"127.0.0.1:{},velocity_mm_s=1,timeout_s=1,"
-                  "stale_s=0.5\", gripper: simulated}}\nworld: {{target_x_m: 0.4e-3}}\n",
-                  twin.mcs2_port));
-  const auto r = test::run_cli({"run", "--config", (dir / "hil.yaml").string(), "--realtime", "--json",
-                                "--out", (dir / "out").string(), "--duration", "60"});
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
-  std::cout << fmt::format(
-      "[ pick-and-place on smaract-mcs2 ] {}: placed {:.2f} um from the target in {:.1f} s "
-      "(wall {:.1f} s), tracking RMS {:.0f} nm\n",
-      j.at("verdict").get<std::string>(), 1e6 * j.at("placement_error_m").get<double>(),
-      j.at("duration_s").get<double>(), j.at("wall_s").get<double>(),
-      1e9 * j.at("tracking_error_rms_m").get<double>());
-  EXPECT_TRUE(j.at("success").get<bool>()) << j.dump();
-  EXPECT_FALSE(j.at("faulted").get<bool>());
-  EXPECT_LE(j.at("placement_error_m").get<double>(), 5e-6);
-  PlatformConfig c;
-  const auto x = twin_position_m(twin.gcs2_port);
-  EXPECT_NEAR(x[0], 0.4e-3 - c.stage.home_x_m, 10e-6);
-  EXPECT_NEAR(x[1], 0.0 - c.stage.home_y_m, 10e-6);
+  scripted_pick_and_place(twin, "smaract-mcs2", twin.mcs2_port, dir);
 }
 
 TEST(DriverTwin, ServeRunsOnTheDriversOfAConfigurationAndAnUnreachableControllerIsOneLine) {
