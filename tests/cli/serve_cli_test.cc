@@ -97,8 +97,8 @@ TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
         run_cli({command, "--config", (dir / "bench.yaml").string(), "--out", (dir / "out").string()});
     EXPECT_EQ(r.exit_code, 3) << command << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
-    EXPECT_NE(r.err.find(
-                  "devices.driver: 'smaract' is not a registered driver (known: simulated, anc300, pi-gcs2, smaract-mcs2)"),
+    EXPECT_NE(r.err.find("devices.driver: 'smaract' is not a registered driver (known: simulated, anc300, "
+                         "pi-gcs2, smaract-mcs2)"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.out, "") << "nothing served or run";
