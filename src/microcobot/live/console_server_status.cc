@@ -180,6 +180,7 @@ std::string ConsoleServer::status_json() {
                    {"tool_px", {v.tool_u_px, v.tool_v_px}},
                    {"goal_px", v.has_goal ? json::array({v.goal_u_px, v.goal_v_px}) : json(nullptr)},
                    {"error_m", v.error_m},
+                   {"in_position", v.in_position},
                    {"confidence", v.confidence},
                    {"stage_m", {v.stage_x_m, v.stage_y_m}},
                    {"m_per_px", v.m_per_px},

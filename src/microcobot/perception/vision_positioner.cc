@@ -28,6 +28,8 @@ void VisionPositionerParams::validate() const {
           settle_frames);
   require(std::isfinite(in_position_m) && in_position_m > 0.0 && in_position_m <= servo.converged_m,
           "in_position_m", "must be within (0, servo.converged_m]", in_position_m);
+  require(max_hunt_frames > settle_frames && max_hunt_frames <= 1000, "max_hunt_frames",
+          "must be within (settle_frames, 1000]", max_hunt_frames);
 }
 
 VisionPositioner::VisionPositioner(const CameraRig& rig, const VisionPositionerParams& params)
@@ -104,7 +106,7 @@ void VisionPositioner::take_goal(PositionerStatus& st) {
     return;
   }
   has_goal_ = true;
-  converged_frames_ = 0;
+  converged_frames_ = hunt_frames_ = 0;
   in_position_ = false;
   st.goal_u_px = goal_px.x();
   st.goal_v_px = goal_px.y();
@@ -142,8 +144,8 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
       st.found = false;
       st.state = "hold (fingers turning)";
       servo_->clear_history();
-      converged_frames_ = 0;
-      in_position_ = false;
+      converged_frames_ = hunt_frames_ = 0;
+      in_position_ = st.in_position = false;
       moved_px_.setZero();
       publish(st);
       return std::nullopt;
@@ -157,6 +159,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
   double confidence = 0.0;
   if (!taught_) {
     if (!teach(map_.pixel_of(stage_m_), frame.gripper_opening_m, st)) {
+      st.in_position = false;  // not tracked
       publish(st);
       return std::nullopt;
     }
@@ -217,7 +220,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
   } else if (!enabled_.load(std::memory_order_relaxed)) {
     st.state = "no-deadman";
     servo_->clear_history();  // nothing it asked is moving the stage
-    converged_frames_ = 0;
+    converged_frames_ = hunt_frames_ = 0;
     in_position_ = false;
   } else if (frame_start_s < run_end_s_) {
     // Exposed while the last run may still play: the slider is anywhere within a period's stroke.
@@ -243,7 +246,8 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
     const bool within = c.status == vision::ServoStatus::kConverged;
     const bool tight = within && st.error_m <= p_.in_position_m;
     converged_frames_ = tight ? converged_frames_ + 1 : 0;
-    if (converged_frames_ > p_.settle_frames) in_position_ = true;
+    hunt_frames_ = within ? hunt_frames_ + 1 : 0;
+    if (converged_frames_ > p_.settle_frames || hunt_frames_ > p_.max_hunt_frames) in_position_ = true;
     if (!within) in_position_ = false;
     if (in_position_) {
       servo_->clear_history();  // nothing of what it just asked is played
@@ -255,6 +259,7 @@ std::optional<PositionerCommand> VisionPositioner::on_frame(const devices::Camer
     }
   }
   st.commands = commands_;
+  st.in_position = in_position_;
   publish(st);
   return out;
 }

@@ -71,7 +71,10 @@ struct PositionerStatus {
   double tool_u_px = 0.0, tool_v_px = 0.0;  ///< where the tool point is seen
   double goal_u_px = 0.0, goal_v_px = 0.0;  ///< where it is sent (the tool point's pixel)
   double error_m = 0.0;                     ///< the servo's predicted distance to the goal
-  double confidence = 0.0;                  ///< the tracker's correlation
+  /// The stage rests at the goal (the servo within its window, no run asked) until the error
+  /// leaves the converged window.
+  bool in_position = false;
+  double confidence = 0.0;  ///< the tracker's correlation
   /// The tool's stage position from the image (m, from the stage's home) and the map's pixel size.
   double stage_x_m = 0.0, stage_y_m = 0.0;
   double m_per_px = 0.0;
@@ -156,6 +159,7 @@ class VisionPositioner {
   Eigen::Vector2d moved_px_ = Eigen::Vector2d::Zero();  ///< commanded motion since the last frame
   double run_end_s_ = -1e9;                             ///< the last run may play until then
   int converged_frames_ = 0;                            ///< servoed frames in a row within the window
+  int hunt_frames_ = 0;  ///< servoed frames in a row within the converged window
   bool in_position_ = false;
   std::uint64_t frames_ = 0, commands_ = 0;
   // Status (camera thread -> any thread).

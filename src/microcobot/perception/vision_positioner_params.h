@@ -25,6 +25,12 @@ struct VisionPositionerParams {
   /// away from other structures, so a rest within 0.15 um is within 0.3 um of the goal.
   int settle_frames = 2;
   double in_position_m = 0.15e-6;
+  /// In position, too, after this many servoed frames in a row within the converged window that
+  /// never came within in_position_m: the last hundred nanometres are a stick-slip axis' finest
+  /// steps, whose sign near the break-away amplitude is a gamble (holding a part, the stage hunted
+  /// 0.15-0.25 um off at every third frame for seconds, each run swinging the tips by up to
+  /// 1.2 um). 15 frames: half a second at 30 Hz.
+  int max_hunt_frames = 15;
 
   template <class V>
   void visit(V& v) {
@@ -34,6 +40,7 @@ struct VisionPositionerParams {
     v("min_run_s", min_run_s);
     v("settle_frames", settle_frames);
     v("in_position_m", in_position_m);
+    v("max_hunt_frames", max_hunt_frames);
   }
   /// Throws mc::InvalidParams naming the field.
   void validate() const;
