@@ -1,5 +1,8 @@
-// The GCS 2.0 twin's cost, on the live platform (paced loop) in one run:
-//  - command-to-reply latency of `POS?` over loopback TCP (four clients polling at 100 Hz);
+// A vendor twin's cost, on the live platform (paced loop) in one run, for the GCS 2.0 twin and the
+// MCS2 twin (the benchmark's second argument, 0 and 1):
+//  - command-to-reply latency of a position query over loopback TCP (four clients polling at
+//    100 Hz): GCS `POS?` (every axis, one line each), MCS2 `:CHAN0:POS?;:CHAN1:POS?;:CHAN2:POS?`
+//    (three replies, one line each);
 //  - the loop's tick time p99 (the telemetry's tick_us) while those four clients poll, against
 //    the same loop with no client, in alternating 40 ms windows (240 of each, 9.6 s each in all):
 //    a machine's hiccup (another tenant, a page-cache flush) lands in either kind alike.
@@ -20,6 +23,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <string>
@@ -48,13 +52,30 @@ int connect_loopback(std::uint16_t port) {
   return fd;
 }
 
-// One POS? round trip: the reply ends with a line that does not end in a space.
-bool pos_query(int fd) {
-  static const std::string q = "POS?\n";
-  if (::send(fd, q.data(), q.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(q.size())) return false;
+// One position query's round trip, the whole reply read.
+struct PositionQuery {
+  std::string text;
+  // Whether `reply` is whole: GCS ends its last line without a space before the line feed; MCS2
+  // answers each of the three queries with one line.
+  bool (*complete)(const std::string& reply);
+};
+
+const PositionQuery& position_query(mc::twins::Protocol protocol) {
+  static const PositionQuery gcs2{"POS?\n", [](const std::string& r) {
+                                    return r.size() >= 2 && r.back() == '\n' && r[r.size() - 2] != ' ';
+                                  }};
+  static const PositionQuery mcs2{":CHAN0:POS?;:CHAN1:POS?;:CHAN2:POS?\r\n", [](const std::string& r) {
+                                    return std::count(r.begin(), r.end(), '\n') == 3;
+                                  }};
+  return protocol == mc::twins::Protocol::kMcs2 ? mcs2 : gcs2;
+}
+
+bool pos_query(int fd, const PositionQuery& q) {
+  if (::send(fd, q.text.data(), q.text.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(q.text.size()))
+    return false;
   std::string text;
   char buf[512];
-  while (text.size() < 2 || text.back() != '\n' || text[text.size() - 2] == ' ') {
+  while (!q.complete(text)) {
     const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
     if (n <= 0) return false;
     text.append(buf, static_cast<std::size_t>(n));
@@ -72,6 +93,9 @@ void allow_every_core() {
 
 void BM_TwinPollingCost(benchmark::State& state) {
   const int placement = static_cast<int>(state.range(0));
+  const auto protocol = state.range(1) == 0 ? mc::twins::Protocol::kGcs2 : mc::twins::Protocol::kMcs2;
+  state.SetLabel(mc::twins::protocol_name(protocol));
+  const PositionQuery& query = position_query(protocol);
   const int last_core = static_cast<int>(std::thread::hardware_concurrency()) - 1;
   for (auto _ : state) {
     mc::live::LiveParams lp;
@@ -87,7 +111,7 @@ void BM_TwinPollingCost(benchmark::State& state) {
     });
     mc::twins::LiveStage stage(live);
     mc::twins::TwinServerParams tp;
-    tp.endpoints = {{mc::twins::Protocol::kGcs2, "127.0.0.1", 0}};
+    tp.endpoints = {{protocol, "127.0.0.1", 0}};
     mc::twins::TwinServer server(stage, tp);
     server.start();
     const std::uint16_t port = server.ports()[0];
@@ -106,7 +130,7 @@ void BM_TwinPollingCost(benchmark::State& state) {
           std::this_thread::sleep_until(next);
           if (!polling.load()) continue;
           const auto t0 = Clock::now();
-          if (!pos_query(fd)) break;
+          if (!pos_query(fd, query)) break;
           samples[static_cast<std::size_t>(k)].push_back(
               std::chrono::duration<double>(Clock::now() - t0).count());
         }
@@ -150,10 +174,8 @@ void BM_TwinPollingCost(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_TwinPollingCost)
-    ->ArgName("placement")
-    ->Arg(0)
-    ->Arg(1)
-    ->Arg(2)
+    ->ArgNames({"placement", "protocol"})
+    ->ArgsProduct({{0, 1, 2}, {0, 1}})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();

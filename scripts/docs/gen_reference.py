@@ -566,7 +566,7 @@ def gen_vendor(cli):
     out = ["# Vendor protocols\n", GENERATED,
            "The commands the vendor-protocol twins answer, as the twins list them themselves (`serve --emulate`; "
            "what they mean, the documents followed and the drivers that speak them: [Connecting hardware]"
-           "(../hardware.md)). The drivers `pi-gcs2` and `anc300` send a subset of these.\n"]
+           "(../hardware.md)). The drivers `pi-gcs2`, `anc300` and `smaract-mcs2` send a subset of these.\n"]
     gcs_rows = [l.strip() for l in hlp.splitlines() if l.strip() and "end of help" not in l and "following commands" not in l]
     out.append("## PI GCS 2.0 (`serve --emulate gcs2`)\n")
     out.append("Answer to `HLP?`:\n")
@@ -580,6 +580,10 @@ def gen_vendor(cli):
     anc_rows = [l.strip() for l in anc_help.splitlines() if l.strip() and l.strip() not in ("OK", "> help", "help") and not l.startswith(">")]
     out.append("Answer to `help` (after the password):\n")
     out.append("```text\n" + "\n".join(anc_rows) + "\n```\n")
+    out.append("## SmarAct MCS2 (`serve --emulate mcs2`)\n")
+    out.append("The MCS2's ASCII interface has no help command, so the twin cannot list itself: its commands, "
+               "channel properties, units and error codes are tabled in [Connecting hardware]"
+               "(../hardware.md#smaract-mcs2-closed-loop-linear-positioners-a-rotary-positioner-open-loop-stepping).\n")
     return "\n".join(out) + "\n", {"gcs2": len(gcs_rows), "anc300": len(anc_rows)}
 
 
