@@ -66,7 +66,12 @@
       label: s.name,
       stroke: palette[i % palette.length],
       width: s.points ? 0 : 1.5,
-      points: s.points ? { show: true, size: 5, fill: palette[i % palette.length] } : { show: false },
+      // Unaligned series (uPlot's mode 2) have no x index range of their own: uPlot draws their
+      // points only where a filter lists them, so each lists all of its points.
+      points: s.points
+        ? Object.assign({ show: true, size: 5, fill: palette[i % palette.length] },
+                        aligned ? {} : { filter: (u, si) => u.data[si][0].map((_, k) => k) })
+        : { show: false },
       paths: s.points ? () => null : undefined,
       facets: aligned ? undefined : [{ scale: "x", auto: true }, { scale: "y", auto: true }],
     }));

@@ -19,6 +19,7 @@
 #include "microcobot/motion/parallel_kinematics.h"
 #include "microcobot/motion/parallel_workspace.h"
 #include "microcobot/motion/pose.h"
+#include "microcobot/studies/positioner_figures.h"
 #include "positioner_pose_options.h"
 
 namespace positioner_commands {
@@ -179,27 +180,9 @@ void run_workspace(const WorkspaceOptions& o) {
       r.add_result(fmt::format("{} range max ({})", n, ranges[n]["max_reason"].get<std::string>()),
                    ranges[n]["max"].get<double>(), o.units == "si" ? "rad" : "deg");
     }
-    const auto unit = [](int axis) { return std::string(axis < 3 ? "m" : "rad"); };
-    mc::report::Figure fig{
-        fmt::format("Reach over {} and {}", o.slice[0], o.slice[1]),
-        "Each grid point marked by the first check it fails (docs/concepts/parallel-positioner.md).",
-        {o.slice[0], unit(s.axis_a)},
-        {o.slice[1], unit(s.axis_b)},
-        {}};
-    const auto& ca = t.column(std::size_t(s.axis_a));
-    const auto& cb = t.column(std::size_t(s.axis_b));
-    const auto& reach = t.column("reach");
-    for (int code = 0; code <= static_cast<int>(mm::Reach::kJointLimit); ++code) {
-      mc::report::Series ser{mm::to_string(static_cast<mm::Reach>(code)), {}, {}, true};
-      for (std::size_t row = 0; row < t.rows(); ++row) {
-        if (reach[row] == code) {
-          ser.x.push_back(ca[row]);
-          ser.y.push_back(cb[row]);
-        }
-      }
-      if (!ser.x.empty()) fig.series.push_back(std::move(ser));
-    }
-    r.add_figure(std::move(fig));
+    r.add_figure(mc::studies::workspace_slice_figure(
+        t, s, fmt::format("Reach over {} and {}", o.slice[0], o.slice[1]),
+        "Each grid point marked by the first check it fails (docs/concepts/parallel-positioner.md)."));
     mc::cli::write_report_if_requested(o.common, r);
   }
   std::string human = fmt::format("conditioning {:.3f}", here.conditioning);

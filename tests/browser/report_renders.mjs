@@ -23,7 +23,10 @@ const fail = (msg) => { console.error("FAIL: " + msg); failures++; };
 // modes side by side (box plots of cycle time, placement error, peak forces).
 const cellModes = ["auto", "manual"];
 const reports = [
-  { name: "report", args: ["report", "--out", join(dir, "report")], index: join(dir, "report", "index.html") },
+  // Scatter figures (points in two coordinates of their own, uPlot's mode 2): the points of the
+  // first two series painted, in the palette's first two colours.
+  { name: "report", args: ["report", "--out", join(dir, "report")], index: join(dir, "report", "index.html"),
+    scatters: ["Reach over x and y at the home height", "Reach over rx and ry at the home position"] },
   { name: "session", args: ["run", "--out", join(dir, "session")], index: join(dir, "session", "index.html") },
   { name: "cell", args: ["cell", "compare", "--batch", "2", "--seed", "61", "--modes", cellModes.join(","),
                          "--out", join(dir, "cell")],
@@ -87,6 +90,13 @@ try {
         fail(`${rep.name}: '${title}' drew boxes ${JSON.stringify(f.boxes)}, expected one per mode ${JSON.stringify(cellModes)}`);
       else cellModes.forEach((m, k) => {
         if (f.colourInk[k] < 60) fail(`${rep.name}: '${title}': the ${m} box has ${f.colourInk[k]} pixels of its colour`);
+      });
+    }
+    for (const title of rep.scatters || []) {
+      const f = figures.find((x) => x.title === title);
+      if (!f) fail(`${rep.name}: no scatter figure '${title}'`);
+      else [0, 1].forEach((k) => {
+        if (f.colourInk[k] < 200) fail(`${rep.name}: '${title}': series ${k}'s points have ${f.colourInk[k]} pixels of its colour`);
       });
     }
     for (const e of consoleErrors) fail(`${rep.name}: console: ` + e);

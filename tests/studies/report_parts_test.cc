@@ -18,7 +18,7 @@ TEST(ReportParts, EveryModulesPartIsListedOnceInTheArchitecturesOrder) {
   std::vector<std::string> names;
   for (const ReportPart& p : parts) names.push_back(p.name);
   EXPECT_EQ(names, (std::vector<std::string>{"rng", "dsp", "stickslip", "identify", "haptics", "control",
-                                             "tweezers"}));
+                                             "positioner", "tweezers"}));
   for (std::size_t i = 1; i < parts.size(); ++i) EXPECT_LT(parts[i - 1].order, parts[i].order) << names[i];
   for (const ReportPart& p : parts) EXPECT_TRUE(p.build) << p.name;
 }

@@ -8,6 +8,7 @@
 #include "microcobot/studies/experiment_figures.h"
 #include "microcobot/studies/haptics_figures.h"
 #include "microcobot/studies/identification_figures.h"
+#include "microcobot/studies/positioner_figures.h"
 #include "microcobot/studies/tweezers_figures.h"
 
 namespace mc::studies {
@@ -20,6 +21,7 @@ std::vector<ReportPart> report_parts() {
       {"identify", 35, &identification_figures},
       {"haptics", 40, &haptics_figures},
       {"control", 50, &control_figures},
+      {"positioner", 60, &positioner_figures},
       {"tweezers", 70, &tweezers_figures},
   };
   std::stable_sort(parts.begin(), parts.end(),
