@@ -45,18 +45,20 @@
 
 namespace mc::motion {
 
-/// The learning law's parameters. Chosen on the tuning set's cases only
-/// (`microcobot control learn --set tuning`, docs/parameters.md) and judged on the validation set.
+/// The learning law's parameters. Chosen on the tuning set's 1-D cases only (seed 15:
+/// `microcobot control learn --set tuning --references 30`, a grid of gamma 0.3-1, Q 5-200 Hz,
+/// alpha 0-0.05 at lambda 2; docs/parameters.md) and judged on the validation set (seed 31).
 struct LearningParams {
   double control_rate_Hz = 10000.0;  ///< rate of feedforward()/record() [Hz]
-  double learning_gain = 0.5;        ///< gamma: fraction of the error corrected per trial
+  double learning_gain = 0.6;        ///< gamma: fraction of the error corrected per trial
   /// lambda: the error that tick i's correction acts on comes this many ticks later (the loop's
   /// delay, sample then the ramp's hold: ~1.5 ticks) [ticks].
   int lead_ticks = 2;
-  /// Q's corner: first-order low-pass run forward and backward (zero phase, -6 dB there) [Hz];
-  /// 0: no filter (Q = 1).
-  double q_cutoff_Hz = 500.0;
-  double forgetting = 0.0;         ///< alpha in [0, 1): the correction kept is (1 - alpha)
+  /// Q's corner: first-order low-pass run forward and backward (zero phase) [Hz]; 0: no filter
+  /// (Q = 1). Low, because only the slow part of the error repeats from trial to trial: the edges'
+  /// dips come at ticks that differ between trials (docs/concepts/control.md).
+  double q_cutoff_Hz = 20.0;
+  double forgetting = 0.05;        ///< alpha in [0, 1): the correction kept is (1 - alpha)
   double max_correction_m = 2e-6;  ///< |u| is clamped to this [m]
 
   template <class V>
