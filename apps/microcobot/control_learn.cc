@@ -78,8 +78,8 @@ void run_learn(const LearnOptions& o) {
   motion::IterativeLearning ilc(p.learning, longest);
   nlohmann::json refs = nlohmann::json::array();
   std::ostringstream csv, human;
-  csv << "case,trial,rms_error_m,max_error_m,final_error_m,correction_max_m\n";
-  std::vector<std::vector<double>> rms(static_cast<std::size_t>(o.trials)), mx(rms.size());
+  csv << "case,trial,rms_error_m,max_error_m,final_error_m,correction_max_m,change_rms_m\n";
+  std::vector<std::vector<double>> rms(static_cast<std::size_t>(o.trials)), mx(rms.size()), chg(rms.size());
   human << fmt::format("{:<12} {}\n", "case", "RMS / max nm per trial (trial 0: no correction yet)");
   for (const auto& c : cases) {
     ilc.reset();
@@ -92,12 +92,14 @@ void run_learn(const LearnOptions& o) {
                       {"rms_error_m", t.rms_m},
                       {"max_error_m", t.max_m},
                       {"final_error_m", t.final_m},
-                      {"correction_max_m", t.correction_max_m}});
-      csv << fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g}\n", c.name, t.trial, t.rms_m, t.max_m, t.final_m,
-                         t.correction_max_m);
+                      {"correction_max_m", t.correction_max_m},
+                      {"change_rms_m", t.change_rms_m}});
+      csv << fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", c.name, t.trial, t.rms_m, t.max_m,
+                         t.final_m, t.correction_max_m, t.change_rms_m);
       if (first_ok < 0 && t.rms_m <= kGoalRms_m && t.max_m <= kGoalMax_m) first_ok = t.trial;
       rms[static_cast<std::size_t>(t.trial)].push_back(t.rms_m);
       mx[static_cast<std::size_t>(t.trial)].push_back(t.max_m);
+      chg[static_cast<std::size_t>(t.trial)].push_back(t.change_rms_m);
       line += fmt::format(" {}/{}", nm(t.rms_m), nm(t.max_m));
     }
     refs.push_back({{"case", c.name},
@@ -107,12 +109,16 @@ void run_learn(const LearnOptions& o) {
     human << fmt::format("{:<12}{}   {}\n", c.name, line, studies::describe(c));
   }
   nlohmann::json per_trial = nlohmann::json::array();
+  const auto median_of = [](std::vector<double> r) {
+    std::sort(r.begin(), r.end());
+    return r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
+  };
   for (std::size_t t = 0; t < rms.size(); ++t) {
     auto r = rms[t];
     std::sort(r.begin(), r.end());
-    const double median = r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
     per_trial.push_back({{"trial", t},
-                         {"median_rms_m", median},
+                         {"median_rms_m", median_of(r)},
+                         {"median_change_rms_m", median_of(chg[t])},
                          {"worst_rms_m", r.back()},
                          {"worst_max_m", *std::max_element(mx[t].begin(), mx[t].end())}});
   }
@@ -134,10 +140,10 @@ void run_learn(const LearnOptions& o) {
                     to_string(set), seed, o.trials, cases.size());
     mc::write_file_atomic(*o.common.out / "learning.csv", head + csv.str());
   }
-  human << "trial  median RMS  worst RMS  worst max [nm]\n";
+  human << "trial  median RMS  worst RMS  worst max  median change from the previous trial [nm]\n";
   for (const auto& t : per_trial) {
-    human << fmt::format("{:>5}  {:>10}  {:>9}  {:>9}\n", t["trial"].get<int>(), nm(t["median_rms_m"]),
-                         nm(t["worst_rms_m"]), nm(t["worst_max_m"]));
+    human << fmt::format("{:>5}  {:>10}  {:>9}  {:>9}  {:>9}\n", t["trial"].get<int>(), nm(t["median_rms_m"]),
+                         nm(t["worst_rms_m"]), nm(t["worst_max_m"]), nm(t["median_change_rms_m"]));
   }
   human << fmt::format(
       "{} set (seed {}), {} references, trial {}: worst RMS {} nm (goal {}: {}), worst max {} nm (goal {}: "

@@ -118,6 +118,9 @@ class IterativeLearning {
   /// The present correction over the ticks learned.
   const std::vector<double>& correction() const noexcept { return u_; }
   long learned_ticks() const noexcept { return learned_ticks_; }
+  /// The errors recorded in the present (or last) trial, over recorded_ticks().
+  const std::vector<double>& errors() const noexcept { return e_; }
+  long recorded_ticks() const noexcept { return recorded_ticks_; }
 
  private:
   const LearningParams p_;

@@ -38,6 +38,7 @@ std::vector<LearningTrial> run_learning(const stickslip::ActuatorModel& model, c
           static_cast<double>(case_ticks(c)));
   const std::uint64_t id = case_identity(c, axis_id);
   std::vector<LearningTrial> out;
+  std::vector<double> previous;  // the previous trial's measured errors
   for (int t = 0; t < trials; ++t) {
     TrackerSetup su = setup;
     su.sensor.seed = c.sensor_seed + 1000 * (first_trial + t);
@@ -50,6 +51,14 @@ std::vector<LearningTrial> run_learning(const stickslip::ActuatorModel& model, c
       lt.correction_max_m = std::max(lt.correction_max_m, std::abs(ilc.feedforward(i)));
     const TrackingRecord rec =
         run_tracker(model, map, TrackerKind::kTracking, su, start, ref, duration, 100, from, &ilc);
+    const auto n = static_cast<std::size_t>(ilc.recorded_ticks());
+    if (t > 0 && n > 0) {
+      double sq = 0.0;
+      const std::size_t m = std::min(n, previous.size());
+      for (std::size_t i = 0; i < m; ++i) sq += std::pow(ilc.errors()[i] - previous[i], 2);
+      lt.change_rms_m = m > 0 ? std::sqrt(sq / static_cast<double>(m)) : 0.0;
+    }
+    previous.assign(ilc.errors().begin(), ilc.errors().begin() + static_cast<std::ptrdiff_t>(n));
     if (learn) ilc.learn();
     lt.rms_m = rec.metrics.rms_error_m;
     lt.max_m = rec.metrics.max_error_m;

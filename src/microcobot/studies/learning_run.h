@@ -23,6 +23,10 @@ struct LearningTrial {
   double max_m = 0.0;             ///< max |x - r| while the move runs
   double final_m = 0.0;           ///< |x - r| at the end
   double correction_max_m = 0.0;  ///< max |u| the trial ran with
+  /// RMS of the measured error's change from the previous trial, tick by tick over the
+  /// reference (0 for the first trial of the call): what did not repeat, which no learning
+  /// indexed by time can correct.
+  double change_rms_m = 0.0;
 };
 
 /// The identity of a 1-D case's reference (its samples at the 10 kHz tick, its start) mixed with
