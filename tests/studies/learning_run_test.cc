@@ -35,12 +35,14 @@ TEST(LearningRun, OnValidationReferencesTheRmsFallsOverTrials) {
   double first = 0.0, last = 0.0;
   for (const auto& c : validation_one_d(3)) {
     motion::IterativeLearning ilc(motion::LearningParams{}, case_ticks(c));
-    const auto t = run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), c, ilc, 11);
+    const auto t =
+        run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), c, ilc, 11);
     ASSERT_EQ(t.size(), 11u);
     const double tail = (t[8].rms_m + t[9].rms_m + t[10].rms_m) / 3.0;
     std::printf("%s: RMS %.1f nm -> %.1f nm (mean of trials 8-10), max %.0f -> %.0f nm\n", c.name.c_str(),
                 t[0].rms_m * 1e9, tail * 1e9, t[0].max_m * 1e9, t[10].max_m * 1e9);
-    for (const auto& x : t) EXPECT_LE(x.rms_m, kLearningScatter * t[0].rms_m) << c.name << " trial " << x.trial;
+    for (const auto& x : t)
+      EXPECT_LE(x.rms_m, kLearningScatter * t[0].rms_m) << c.name << " trial " << x.trial;
     first += t[0].rms_m;
     last += tail;
     EXPECT_EQ(ilc.trials(), 11);
@@ -84,9 +86,11 @@ TEST(LearningRun, ANewReferenceStartsFromNoCorrection) {
   EXPECT_NE(case_identity(cases[0]), case_identity(cases[1]));
   EXPECT_NE(case_identity(cases[0]), case_identity(cases[0], 1));  // another axis
   // The second reference's first trial is the one a fresh learner runs: nothing carried over.
-  const auto b = run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[1], ilc, 1);
+  const auto b =
+      run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[1], ilc, 1);
   motion::IterativeLearning fresh(motion::LearningParams{}, ticks);
-  const auto f = run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[1], fresh, 1);
+  const auto f =
+      run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[1], fresh, 1);
   EXPECT_EQ(b.front().correction_max_m, 0.0);
   EXPECT_EQ(b.front().rms_m, f.front().rms_m);
   EXPECT_EQ(ilc.trials(), 1);
@@ -94,11 +98,13 @@ TEST(LearningRun, ANewReferenceStartsFromNoCorrection) {
   const auto all = make_case_set(CaseSet::kValidation, kValidationSeed, kValidationCases);
   const auto three_d = std::find_if(all.begin(), all.end(), [](const auto& x) { return !is_one_d(x); });
   ASSERT_NE(three_d, all.end());
-  EXPECT_THROW(run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), *three_d, ilc, 1),
-               InvalidParams);
+  EXPECT_THROW(
+      run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), *three_d, ilc, 1),
+      InvalidParams);
   motion::IterativeLearning small(motion::LearningParams{}, 10);
-  EXPECT_THROW(run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[0], small, 1),
-               InvalidParams);
+  EXPECT_THROW(
+      run_learning(motion::test::model(), motion::test::step_map(), learning_setup(), cases[0], small, 1),
+      InvalidParams);
 }
 
 }  // namespace

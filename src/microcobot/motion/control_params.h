@@ -5,8 +5,8 @@
 /// which `--params FILE.yaml` and the Python module's control.params() accept.
 
 #include "microcobot/motion/baseline_position.h"
-#include "microcobot/motion/path_generator.h"
 #include "microcobot/motion/iterative_learning.h"
+#include "microcobot/motion/path_generator.h"
 #include "microcobot/motion/position_controller.h"
 #include "microcobot/motion/position_sensor.h"
 #include "microcobot/motion/reference.h"
