@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "control_learn.h"
 #include "control_validate.h"
 #include "microcobot/core/csv.h"
 #include "microcobot/core/error.h"
@@ -193,6 +194,7 @@ void add_control(CLI::App& group) {
     cmd->callback([o] { run_trajectory_cmd(*o); });
   }
   mc::cli::add_control_validate(group);
+  mc::cli::add_control_learn(group);
 }
 
 const bool kRegistered = mc::cli::register_group(

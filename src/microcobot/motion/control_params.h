@@ -5,6 +5,7 @@
 /// which `--params FILE.yaml` and the Python module's control.params() accept.
 
 #include "microcobot/motion/baseline_position.h"
+#include "microcobot/motion/iterative_learning.h"
 #include "microcobot/motion/path_generator.h"
 #include "microcobot/motion/position_controller.h"
 #include "microcobot/motion/position_sensor.h"
@@ -28,6 +29,7 @@ struct ControlParams {
   TrackingParams tracking;      ///< the tracking controller
   SetpointStreamParams stream;  ///< setpoint streaming
   PathLimits path;              ///< 3-D paths (jerk; velocity/acceleration from limits)
+  LearningParams learning;      ///< iterative learning of a repeated reference
 
   template <class V>
   void visit(V& v) {
@@ -41,6 +43,7 @@ struct ControlParams {
     v("tracking", tracking);
     v("stream", stream);
     v("path", path);
+    v("learning", learning);
   }
   void validate() const {
     model.validate();
@@ -53,6 +56,7 @@ struct ControlParams {
     tracking.validate();
     stream.validate();
     path.validate();
+    learning.validate();
   }
 };
 

@@ -291,8 +291,11 @@ PathRecord run_path(const ActuatorModel& model, const motion::StepMap& map, Trac
 
 TrackingRecord run_tracker(const ActuatorModel& model, const motion::StepMap& map, TrackerKind kind,
                            const TrackerSetup& setup, double start_m, const ReferenceFn& reference,
-                           double duration_s, int max_records, double metrics_from_s) {
+                           double duration_s, int max_records, double metrics_from_s,
+                           motion::IterativeLearning* learning) {
   require_positive(duration_s, "duration_s");
+  require(learning == nullptr || kind == TrackerKind::kTracking, "learning",
+          "applies to the tracking controller only");
   require(max_records >= 10, "max_records", "must be >= 10", max_records);
   require(metrics_from_s >= 0.0 && metrics_from_s < duration_s, "metrics_from_s",
           "must lie in [0, duration_s)", metrics_from_s);
@@ -319,7 +322,15 @@ TrackingRecord run_tracker(const ActuatorModel& model, const motion::StepMap& ma
     const double t_ref = static_cast<double>(k - wait) * tick;
     const motion::ReferenceSample r =
         k < wait ? motion::ReferenceSample{start_m, 0.0, 0.0} : reference(t_ref, tick);
-    tr->update(r, sensor.measure(model.slider_position(s)));
+    const double measured = sensor.measure(model.slider_position(s));
+    motion::ReferenceSample followed = r;
+    if (learning != nullptr && k >= wait) {
+      // Tick i = k - wait of the reference: the error after tick i - 1's drive, then tick i's correction.
+      const long i = k - wait;
+      if (i > 0) learning->record(i - 1, measured - ref.back());
+      followed.x_m += learning->feedforward(i);
+    }
+    tr->update(followed, measured);
     double a = 0.0, f = 1000.0;
     stickslip::Direction d = stickslip::Direction::kForward;
     tr->operating_point(a, f, d);

@@ -14,6 +14,7 @@
 
 #include "microcobot/motion/baseline_position.h"
 #include "microcobot/motion/control_params.h"
+#include "microcobot/motion/iterative_learning.h"
 #include "microcobot/motion/path_generator.h"
 #include "microcobot/motion/position_controller.h"
 #include "microcobot/motion/position_sensor.h"
@@ -63,10 +64,18 @@ using ReferenceFn = std::function<motion::ReferenceSample(double t_s, double dt_
 /// its time starts then. The metrics count the ticks whose reference time is >= `metrics_from_s`
 /// (a lead-in move before it leaves the drive where a previous move would). Divergence throws
 /// mc::ComputationFailed.
+///
+/// With `learning` (the tracking controller only), its correction for the reference's tick i is
+/// added to the reference position the controller follows (the metrics keep the reference itself),
+/// and the measured error x - r after each tick is recorded for it; the caller calls
+/// begin_trial() before and learn() after. A position offset rather than a voltage: the controller
+/// turns a wanted position into its voltage through the exact hysteresis inverse and phases its
+/// edges by it, so an offset is followed as any reference is, while a voltage added after the
+/// controller would be undone by its integral and unseen by its edge planning.
 TrackingRecord run_tracker(const stickslip::ActuatorModel& model, const motion::StepMap& map,
                            TrackerKind kind, const TrackerSetup& setup, double start_m,
                            const ReferenceFn& reference, double duration_s, int max_records = 20000,
-                           double metrics_from_s = 0.0);
+                           double metrics_from_s = 0.0, motion::IterativeLearning* learning = nullptr);
 
 /// The metrics of per-tick records: `moving[k]` marks ticks where the reference moves.
 TrackingMetrics tracking_metrics(const std::vector<double>& ref_m, const std::vector<double>& x_m,

@@ -106,7 +106,14 @@ ValidationCase draw_case(Rng& rng, CaseProfile profile, int index) {
   return c;
 }
 
+}  // namespace
+
+bool is_one_d(const ValidationCase& c) {
+  return c.profile == CaseProfile::kTrapezoid || c.profile == CaseProfile::kSine;
+}
+
 ReferenceFn one_d_reference(const ValidationCase& c, double& start_m, double& duration_s, double& from_s) {
+  require(is_one_d(c), "case", "must be a 1-D case (trapezoid or sine)");
   const bool trap = c.profile == CaseProfile::kTrapezoid;
   const double case_start = trap ? -0.5 * c.sign * c.distance_m : 0.0;
   const double lead = c.power_up ? 0.0 : c.lead_in_m;
@@ -134,8 +141,6 @@ ReferenceFn one_d_reference(const ValidationCase& c, double& start_m, double& du
     return sine->at(t - t0);
   };
 }
-
-}  // namespace
 
 std::string to_string(CaseProfile p) {
   switch (p) {

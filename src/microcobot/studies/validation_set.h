@@ -96,6 +96,14 @@ bool starts_backward_from_power_up(const ValidationCase& c);
 ValidationSummary summarise(const std::vector<ValidationCase>& cases, const std::vector<CaseResult>& results,
                             const TrackingGoals& goals = {});
 
+/// Whether the case runs on one axis (a trapezoid or a sine) rather than the XYZ stage.
+bool is_one_d(const ValidationCase& c);
+
+/// A 1-D case's reference, fresh (its limiters at their start): `start_m` where the axis starts,
+/// `duration_s` the run (lead-in, move, tail), `from_s` where the move starts on the reference's
+/// clock (after the lead-in and its rest). Throws mc::InvalidParams for a 3-D case.
+ReferenceFn one_d_reference(const ValidationCase& c, double& start_m, double& duration_s, double& from_s);
+
 /// A one-line description of the case's reference (SI units).
 std::string describe(const ValidationCase& c);
 
