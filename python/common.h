@@ -99,6 +99,7 @@ void bind_haptics(py::module_& m);
 void bind_tweezers(py::module_& m);
 void bind_vision(py::module_& m);
 void bind_cell(py::module_& m);
+void bind_positioner(py::module_& m);
 
 }  // namespace mc::py
 

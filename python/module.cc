@@ -1,5 +1,6 @@
 // The extension module `microcobot._microcobot`: error translation and the shared conversions;
-// the submodules are bound in stickslip_py.cc, dsp_py.cc, control_py.cc, vision_py.cc and cell_py.cc.
+// the submodules are bound in stickslip_py.cc, dsp_py.cc, control_py.cc, vision_py.cc, cell_py.cc and
+// positioner_py.cc.
 
 #include <sstream>
 
@@ -131,4 +132,9 @@ PYBIND11_MODULE(_microcobot, m) {
   auto cl = m.def_submodule(
       "cell", "The assembly cell: batches of pin insertions by mode, their results and summaries");
   mc::py::bind_cell(cl);
+  auto pos = m.def_submodule(
+      "positioner",
+      "The 6-DOF parallel positioner (thesis §2.3, Fig. 2.4): inverse and forward kinematics, "
+      "reachability, Jacobian and workspace over (N, 6) arrays");
+  mc::py::bind_positioner(pos);
 }
