@@ -5,7 +5,6 @@
 // kinematics, the checks and the conventions are the library's.
 
 #include <algorithm>
-#include <initializer_list>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -79,90 +78,6 @@ std::string describe_row(const double* v, const PoseFrame& f) {
          (f.pi ? " (PI's X Y Z U V W)" : "");
 }
 
-std::string shape_text(const std::vector<py::ssize_t>& s, bool batch) {
-  std::string t = batch ? "(N" : "(";
-  for (std::size_t i = 0; i < s.size(); ++i) t += (i == 0 && !batch ? "" : ", ") + std::to_string(s[i]);
-  return t + (s.size() == 1 && !batch ? ",)" : ")");
-}
-
-/// An input of items of `item` shape: one item, or a batch of N (shape (N, *item)).
-struct Batch {
-  DoubleArray a;
-  std::string name;
-  py::ssize_t n = 0;
-  bool single = false;
-  std::vector<py::ssize_t> item;
-  /// "poses[3]" (or "poses" for a single item): names a row in messages.
-  std::string row(py::ssize_t i) const { return single ? name : name + "[" + std::to_string(i) + "]"; }
-  /// The shape of a result of `out_item` items per input item.
-  std::vector<py::ssize_t> shape(const std::vector<py::ssize_t>& out_item) const {
-    std::vector<py::ssize_t> s;
-    if (!single) s.push_back(n);
-    s.insert(s.end(), out_item.begin(), out_item.end());
-    return s;
-  }
-};
-
-Batch batch_of(py::handle obj, const std::string& name, std::vector<py::ssize_t> item) {
-  Batch b{DoubleArray::ensure(obj), name, 0, false, std::move(item)};
-  const auto nd = static_cast<py::ssize_t>(b.item.size());
-  const std::string want = shape_text(b.item, true) + " or " + shape_text(b.item, false);
-  if (!b.a) throw InvalidInput(name + ": expected an array of numbers of shape " + want);
-  std::vector<py::ssize_t> got(b.a.shape(), b.a.shape() + b.a.ndim());
-  const bool single = b.a.ndim() == nd && got == b.item;
-  const bool batch = b.a.ndim() == nd + 1 && std::equal(b.item.begin(), b.item.end(), got.begin() + 1);
-  if (!single && !batch)
-    throw InvalidInput(name + ": expected shape " + want + " (got " + shape_text(got, false) + ")");
-  b.single = single;
-  b.n = single ? 1 : got[0];
-  return b;
-}
-
-void require_finite_rows(const Batch& b) {
-  const py::ssize_t w = b.a.size() / std::max<py::ssize_t>(b.n, 1);
-  for (py::ssize_t i = 0; i < b.a.size(); ++i) {
-    if (!std::isfinite(b.a.data()[i]))
-      throw InvalidInput(b.row(i / w) + ": non-finite value " + fmt::format("{}", b.a.data()[i]));
-  }
-}
-
-/// The result: `out` (checked: a writeable C-contiguous float64 array of `shape`, sharing no
-/// memory with the inputs unless it is one of them exactly; each row is read before it is written)
-/// or a new array.
-py::array_t<double> output(py::handle out, const std::vector<py::ssize_t>& shape,
-                           std::initializer_list<const Batch*> inputs) {
-  if (out.is_none()) return py::array_t<double>(shape);
-  const std::string want = "a writeable C-contiguous float64 array of shape " + shape_text(shape, false);
-  if (!py::isinstance<py::array>(out)) throw InvalidInput("out: expected " + want);
-  const auto any = py::reinterpret_borrow<py::array>(out);
-  std::vector<py::ssize_t> got(any.shape(), any.shape() + any.ndim());
-  if (!py::isinstance<py::array_t<double>>(out))  // float64 in the machine's byte order
-    throw InvalidInput("out: expected " + want + " (got dtype " + py::str(any.dtype()).cast<std::string>() +
-                       ")");
-  if (got != shape)
-    throw InvalidInput("out: expected " + want + " (got shape " + shape_text(got, false) + ")");
-  if (!(any.flags() & py::array::c_style))
-    throw InvalidInput("out: expected " + want + " (got a non-C-contiguous array)");
-  if (!any.writeable()) throw InvalidInput("out: expected " + want + " (got a read-only array)");
-  auto a = py::reinterpret_borrow<py::array_t<double>>(out);
-  const double* lo = a.data();
-  const double* hi = lo + a.size();
-  for (const Batch* in : inputs) {
-    if (in == nullptr || !in->a || in->a.size() == 0) continue;
-    const double* ilo = in->a.data();
-    const double* ihi = ilo + in->a.size();
-    if (lo < ihi && ilo < hi && !(ilo == lo && ihi == hi))
-      throw InvalidInput("out: shares memory with " + in->name + " (only the very same array may be both)");
-  }
-  return a;
-}
-
-/// A per-row result (an array or a list) as it is, or its one value as a Python scalar.
-py::object per_row(py::object o, bool single) {
-  if (!single) return o;
-  return py::isinstance<py::list>(o) ? py::object(o[py::int_(0)]) : o.attr("item")(0);
-}
-
 py::list reach_names() {
   py::list l;
   for (int c = 0; c <= static_cast<int>(mm::Reach::kJointLimit); ++c)
@@ -173,8 +88,8 @@ py::list reach_names() {
 py::array_t<double> ik(const K& k, py::handle poses, py::handle out, const std::string& convention,
                        py::handle pivot, const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(poses, "poses", {6});
-  auto o = output(out, b.shape({6}), {&b});
+  const ArrayRows b = array_rows(poses, "poses", {6});
+  auto o = output_array(out, b.shape({6}), {&b});
   const double* in = b.a.data();
   double* q = o.mutable_data();
   nogil([&] {
@@ -195,17 +110,17 @@ py::array_t<double> ik(const K& k, py::handle poses, py::handle out, const std::
 py::array_t<double> fk(const K& k, py::handle legs, py::handle guess, py::handle out,
                        const std::string& convention, py::handle pivot, const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(legs, "legs", {6});
-  Batch g;
+  const ArrayRows b = array_rows(legs, "legs", {6});
+  ArrayRows g;
   const bool guessed = !guess.is_none();
   if (guessed) {
-    g = batch_of(guess, "guess", {6});
+    g = array_rows(guess, "guess", {6});
     if (!g.single && g.n != b.n)
       throw InvalidInput(
           fmt::format("guess: expected one pose or one per row of legs ({}), got {}", b.n, g.n));
-    require_finite_rows(g);
+    require_finite(g);
   }
-  auto o = output(out, b.shape({6}), {&b, guessed ? &g : nullptr});
+  auto o = output_array(out, b.shape({6}), {&b, guessed ? &g : nullptr});
   const double* in = b.a.data();
   const double* seeds = guessed ? g.a.data() : nullptr;
   double* pose = o.mutable_data();
@@ -229,7 +144,7 @@ py::array_t<double> fk(const K& k, py::handle legs, py::handle guess, py::handle
 }
 
 py::object reach(const K& k, py::handle poses, const PoseFrame& f, bool details) {
-  const Batch b = batch_of(poses, "poses", {6});
+  const ArrayRows b = array_rows(poses, "poses", {6});
   py::array_t<bool> ok(b.n);
   py::array_t<int> code(b.n);
   py::array_t<double> cond(b.n);
@@ -259,8 +174,8 @@ py::object reach(const K& k, py::handle poses, const PoseFrame& f, bool details)
 py::array_t<double> jacobian(const K& k, py::handle poses, py::handle out, const std::string& convention,
                              py::handle pivot, const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(poses, "poses", {6});
-  auto o = output(out, b.shape({6, 6}), {&b});
+  const ArrayRows b = array_rows(poses, "poses", {6});
+  auto o = output_array(out, b.shape({6, 6}), {&b});
   const double* in = b.a.data();
   double* J = o.mutable_data();
   nogil([&] {
@@ -294,8 +209,8 @@ py::object check(const K& k, py::handle poses, const std::string& convention, py
 py::object conditioning(const K& k, py::handle poses, const std::string& convention, py::handle pivot,
                         const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(poses, "poses", {6});
-  require_finite_rows(b);
+  const ArrayRows b = array_rows(poses, "poses", {6});
+  require_finite(b);
   py::array_t<double> c(b.n);
   const double* in = b.a.data();
   double* cp = c.mutable_data();
@@ -310,7 +225,7 @@ py::dict rotation_range(const K& k, py::handle at, const std::string& axis, py::
   const PoseFrame f = frame_of("smarpod", pivot, mode);
   const int index = mm::parse_pose_coordinate(axis) - 3;
   if (index < 0) throw InvalidInput("axis: must be 'rx', 'ry' or 'rz' (got '" + axis + "')");
-  const Batch b = batch_of(at, "at", {6});
+  const ArrayRows b = array_rows(at, "at", {6});
   py::array_t<double> lo(b.n), hi(b.n);
   std::vector<std::string> lo_why(static_cast<std::size_t>(b.n)), hi_why(lo_why.size());
   const double* in = b.a.data();
@@ -355,9 +270,9 @@ py::dict workspace_slice(const K& k, py::handle at, const std::string& a, const 
   const PoseFrame f = frame_of("smarpod", pivot, mode);
   mm::SliceSpec s;
   if (!at.is_none()) {
-    const Batch base = batch_of(at, "at", {6});
+    const ArrayRows base = array_rows(at, "at", {6});
     if (!base.single) throw InvalidInput("at: expected one pose of shape (6,)");
-    require_finite_rows(base);
+    require_finite(base);
     const double* v = base.a.data();
     s.base = mm::SmarPodPose{v[0], v[1], v[2], v[3], v[4], v[5]};
   }
@@ -402,8 +317,8 @@ py::dict workspace_slice(const K& k, py::handle at, const std::string& a, const 
 py::array_t<double> to_transform(py::handle poses, const std::string& convention, py::handle pivot,
                                  const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(poses, "poses", {6});
-  require_finite_rows(b);
+  const ArrayRows b = array_rows(poses, "poses", {6});
+  require_finite(b);
   py::array_t<double> o(b.shape({4, 4}));
   for (py::ssize_t i = 0; i < b.n; ++i) {
     const mm::PlatformTransform T = transform_of(b.a.data() + 6 * i, f);
@@ -418,8 +333,8 @@ py::array_t<double> to_transform(py::handle poses, const std::string& convention
 py::array_t<double> from_transform(py::handle transforms, const std::string& convention, py::handle pivot,
                                    const std::string& mode) {
   const PoseFrame f = frame_of(convention, pivot, mode);
-  const Batch b = batch_of(transforms, "transforms", {4, 4});
-  require_finite_rows(b);
+  const ArrayRows b = array_rows(transforms, "transforms", {4, 4});
+  require_finite(b);
   py::array_t<double> o(b.shape({6}));
   for (py::ssize_t i = 0; i < b.n; ++i) {
     const Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> H(b.a.data() + 16 * i);
