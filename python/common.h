@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <span>
 #include <string>
 #include <vector>
@@ -81,6 +82,37 @@ inline std::span<const double> span_of(const DoubleArray& a, const std::string& 
   return {a.data(), static_cast<std::size_t>(a.size())};
 }
 
+/// An array input of items of one shape: one item (shape `item`) or N of them (shape (N, *item)),
+/// as C-contiguous float64 (not copied when it already is). A batch of rows for the vectorised
+/// calls (e.g. poses (N, 6)); a single item gives a result without the N axis.
+struct ArrayRows {
+  DoubleArray a;
+  std::string name;
+  py::ssize_t n = 0;
+  bool single = false;
+  std::vector<py::ssize_t> item;
+  /// "poses[3]" (or "poses" for a single item): names a row in messages.
+  std::string row(py::ssize_t i) const;
+  /// The shape of a result of `out_item` items per input item.
+  std::vector<py::ssize_t> shape(const std::vector<py::ssize_t>& out_item) const;
+};
+
+/// `obj` as ArrayRows; raises ValueError "<name>: expected shape (N, 6) or (6,) (got (3, 5))".
+ArrayRows array_rows(py::handle obj, const std::string& name, std::vector<py::ssize_t> item);
+
+/// Raises ValueError "<name>[i]: non-finite value nan" at the first non-finite value.
+void require_finite(const ArrayRows& r);
+
+/// The result array of a vectorised call: a new one, or the caller's `out` (as MuJoCo's `out=`: a
+/// loop of calls reuses it instead of allocating), checked to be a writeable C-contiguous float64
+/// array of `shape` that shares no memory with `inputs` unless it is one of them exactly (the
+/// calls read each row before they write it). Raises ValueError "out: expected ..." otherwise.
+py::array_t<double> output_array(py::handle out, const std::vector<py::ssize_t>& shape,
+                                 std::initializer_list<const ArrayRows*> inputs);
+
+/// A per-row result (an array or a list) as it is, or its one value as a Python scalar.
+py::object per_row(py::object o, bool single);
+
 /// Raises ComputationFailed unless every value of `v` is finite (no call returns NaN).
 void require_finite_result(std::span<const double> v, const std::string& what);
 
@@ -99,6 +131,7 @@ void bind_haptics(py::module_& m);
 void bind_tweezers(py::module_& m);
 void bind_vision(py::module_& m);
 void bind_cell(py::module_& m);
+void bind_positioner(py::module_& m);
 
 }  // namespace mc::py
 

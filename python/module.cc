@@ -1,7 +1,11 @@
 // The extension module `microcobot._microcobot`: error translation and the shared conversions;
-// the submodules are bound in stickslip_py.cc, dsp_py.cc, control_py.cc, vision_py.cc and cell_py.cc.
+// the submodules are bound in stickslip_py.cc, dsp_py.cc, control_py.cc, vision_py.cc, cell_py.cc and
+// positioner_py.cc.
 
+#include <algorithm>
 #include <sstream>
+
+#include <fmt/format.h>
 
 #include "common.h"
 #include "microcobot/core/error.h"
@@ -81,6 +85,84 @@ void check_array(const DoubleArray& a, const std::string& name, int ndim, py::ss
   }
 }
 
+namespace {
+
+/// "(N, 6)" (batch) or "(6,)": a shape as numpy prints it.
+std::string shape_text(const std::vector<py::ssize_t>& s, bool batch) {
+  std::string t = batch ? "(N" : "(";
+  for (std::size_t i = 0; i < s.size(); ++i) t += (i == 0 && !batch ? "" : ", ") + std::to_string(s[i]);
+  return t + (s.size() == 1 && !batch ? ",)" : ")");
+}
+
+}  // namespace
+
+std::string ArrayRows::row(py::ssize_t i) const {
+  return single ? name : name + "[" + std::to_string(i) + "]";
+}
+
+std::vector<py::ssize_t> ArrayRows::shape(const std::vector<py::ssize_t>& out_item) const {
+  std::vector<py::ssize_t> s;
+  if (!single) s.push_back(n);
+  s.insert(s.end(), out_item.begin(), out_item.end());
+  return s;
+}
+
+ArrayRows array_rows(py::handle obj, const std::string& name, std::vector<py::ssize_t> item) {
+  ArrayRows b{DoubleArray::ensure(obj), name, 0, false, std::move(item)};
+  const auto nd = static_cast<py::ssize_t>(b.item.size());
+  const std::string want = shape_text(b.item, true) + " or " + shape_text(b.item, false);
+  if (!b.a) throw InvalidInput(name + ": expected an array of numbers of shape " + want);
+  std::vector<py::ssize_t> got(b.a.shape(), b.a.shape() + b.a.ndim());
+  const bool single = b.a.ndim() == nd && got == b.item;
+  const bool batch = b.a.ndim() == nd + 1 && std::equal(b.item.begin(), b.item.end(), got.begin() + 1);
+  if (!single && !batch)
+    throw InvalidInput(name + ": expected shape " + want + " (got " + shape_text(got, false) + ")");
+  b.single = single;
+  b.n = single ? 1 : got[0];
+  return b;
+}
+
+void require_finite(const ArrayRows& b) {
+  const py::ssize_t w = b.a.size() / std::max<py::ssize_t>(b.n, 1);
+  for (py::ssize_t i = 0; i < b.a.size(); ++i) {
+    if (!std::isfinite(b.a.data()[i]))
+      throw InvalidInput(b.row(i / w) + ": non-finite value " + fmt::format("{}", b.a.data()[i]));
+  }
+}
+
+py::array_t<double> output_array(py::handle out, const std::vector<py::ssize_t>& shape,
+                                 std::initializer_list<const ArrayRows*> inputs) {
+  if (out.is_none()) return py::array_t<double>(shape);
+  const std::string want = "a writeable C-contiguous float64 array of shape " + shape_text(shape, false);
+  if (!py::isinstance<py::array>(out)) throw InvalidInput("out: expected " + want);
+  const auto any = py::reinterpret_borrow<py::array>(out);
+  std::vector<py::ssize_t> got(any.shape(), any.shape() + any.ndim());
+  if (!py::isinstance<py::array_t<double>>(out))  // float64 in the machine's byte order
+    throw InvalidInput("out: expected " + want + " (got dtype " + py::str(any.dtype()).cast<std::string>() +
+                       ")");
+  if (got != shape)
+    throw InvalidInput("out: expected " + want + " (got shape " + shape_text(got, false) + ")");
+  if (!(any.flags() & py::array::c_style))
+    throw InvalidInput("out: expected " + want + " (got a non-C-contiguous array)");
+  if (!any.writeable()) throw InvalidInput("out: expected " + want + " (got a read-only array)");
+  auto a = py::reinterpret_borrow<py::array_t<double>>(out);
+  const double* lo = a.data();
+  const double* hi = lo + a.size();
+  for (const ArrayRows* in : inputs) {
+    if (in == nullptr || !in->a || in->a.size() == 0) continue;
+    const double* ilo = in->a.data();
+    const double* ihi = ilo + in->a.size();
+    if (lo < ihi && ilo < hi && !(ilo == lo && ihi == hi))
+      throw InvalidInput("out: shares memory with " + in->name + " (only the very same array may be both)");
+  }
+  return a;
+}
+
+py::object per_row(py::object o, bool single) {
+  if (!single) return o;
+  return py::isinstance<py::list>(o) ? py::object(o[py::int_(0)]) : o.attr("item")(0);
+}
+
 void require_finite_result(std::span<const double> v, const std::string& what) {
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i])) {
@@ -131,4 +213,9 @@ PYBIND11_MODULE(_microcobot, m) {
   auto cl = m.def_submodule(
       "cell", "The assembly cell: batches of pin insertions by mode, their results and summaries");
   mc::py::bind_cell(cl);
+  auto pos = m.def_submodule(
+      "positioner",
+      "The 6-DOF parallel positioner (thesis §2.3, Fig. 2.4): inverse and forward kinematics, "
+      "reachability, Jacobian and workspace over (N, 6) arrays");
+  mc::py::bind_positioner(pos);
 }

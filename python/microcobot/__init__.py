@@ -13,6 +13,8 @@ Submodules:
     haptics    the dual-stage interface's rendering pipeline (thesis ch. 3), per tick and per block
     tweezers   TéléTweez design calculators (thesis ch. 4, app. A-B)
     vision     the microscope camera: render() a frame as a numpy array, camera_model() its optics
+    positioner the 6-DOF parallel positioner (thesis §2.3): Positioner(params) with ik, fk, reachable,
+               check, jacobian, conditioning, rotation_range, workspace_slice over (N, 6) arrays
     cell       the assembly cell: Batch(scene, parts, seed).run(mode), summarize(), and batch(config,
                seeds, client) for campaigns of many seeds on Dask
 
@@ -25,18 +27,18 @@ __license__ = "Apache-2.0"  # SPDX identifier (LICENSE)
 
 import sys as _sys
 
-from ._microcobot import (ComputationFailed, __version__, control, dsp, haptics, identify, platform, stickslip,
-                          tweezers, vision)
+from ._microcobot import (ComputationFailed, __version__, control, dsp, haptics, identify, platform, positioner,
+                          stickslip, tweezers, vision)
 
 # `import microcobot.dsp` and `from microcobot.dsp import butter` work like for a package.
-for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision"):
+for _name in ("stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision", "positioner"):
     _sys.modules[__name__ + "." + _name] = globals()[_name]
 del _name
 
 from . import cell  # noqa: E402  (pure Python over _microcobot.cell: the Dask campaigns)
 
 __all__ = [
-    "ComputationFailed", "__version__", "cell", "control", "dsp", "haptics", "identify", "platform", "stickslip", "tweezers",
-    "vision"
+    "ComputationFailed", "__version__", "cell", "control", "dsp", "haptics", "identify", "platform", "positioner",
+    "stickslip", "tweezers", "vision"
 ]
 ComputationFailed.__module__ = __name__

@@ -51,6 +51,11 @@ SCRIPTS = {
                              "the best of 3 rounds each.",
                              "PYTHONPATH={python} /usr/bin/python3 bench/python_rollout_bench.py "
                              "{bench}/stickslip_bench 3"),
+    "python_positioner_bench": ("`positioner.Positioner`'s vectorised calls over 20 000 reachable poses: "
+                                "ns per pose (ik and jacobian with the workspace check of every pose, fk "
+                                "by Newton from home or from a guess 1 um / 1 urad away), the best of 3 "
+                                "rounds, and the bytes one ik call allocates with and without out=.",
+                                "PYTHONPATH={python} /usr/bin/python3 bench/python_positioner_bench.py 20000 3"),
     "cell_dask_bench": ("`cell.batch` on a Dask LocalCluster of 2 worker processes against 1, the same "
                         "campaign of automatic cycles (wall seconds of each, and the speed-up).",
                         "PYTHONPATH={python} /usr/bin/python3 bench/cell_dask_bench.py 1 4 2"),

@@ -9,7 +9,7 @@ import pytest
 import microcobot
 
 PKG = pathlib.Path(microcobot.__file__).parent
-MODULES = ["stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision", "cell"]
+MODULES = ["stickslip", "identify", "dsp", "control", "platform", "haptics", "tweezers", "vision", "cell", "positioner"]
 
 
 def stub_names(tree):
