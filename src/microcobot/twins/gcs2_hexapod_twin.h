@@ -84,10 +84,15 @@ class Gcs2HexapodTwin {
   /// Plans, checks and queues a move to `goal`; false with the error set (7 refused, 1005 busy).
   bool send(ClientId client, const motion::PlatformTransform& goal);
   void stop_all();
-  /// Protocol units (mm, deg) in the enabled coordinate system, about the pivot, and back.
+  /// Protocol units (mm, deg) in the enabled coordinate system, about the pivot, and back. With
+  /// K = (R_K, d_K) the enabled system's frame in {H} (identity for ZERO) and c the pivot:
+  ///   pose = to_pi(K^-1 T, c),  K^-1 T = (R_K^T R, R_K^T (d - d_K));   T = K to_transform(pose, c),
+  /// to_pi and to_transform being PI's U -> V -> W convention about a pivot moving with the platform
+  /// (motion/pose.h, after PI's hexapod manuals, MS207E §3.7.4).
   Pose6 to_protocol(const motion::PlatformTransform& T) const;
   motion::PlatformTransform from_protocol(const Pose6& p) const;
-  motion::PlatformTransform cs_frame() const;  ///< the enabled system's frame in {H}
+  /// The enabled system's frame in {H}: K = to_transform(offsets) of its KSD offsets (pivot 0).
+  motion::PlatformTransform cs_frame() const;
 
   HexapodStage& stage_;
   Gcs2HexapodTwinParams params_;
