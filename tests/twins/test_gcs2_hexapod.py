@@ -1,14 +1,15 @@
 """The hexapod twin (PI C-887 dialect of GCS 2.0) in another process: `microcobot serve --emulate
-gcs2-hexapod=127.0.0.1:0` driven over a plain socket. The golden transcripts of
-tests/data/gcs2_hexapod (PIPython's connect, start-up and first move; sources in each header) are
-replayed with their replies checked; a pose sequence ends on target within tolerance; an
-unreachable pose is refused with the controller's error and nothing moves."""
+gcs2-hexapod=127.0.0.1:0` driven over a plain socket and through pyvisa-py. The golden transcripts
+of tests/data/gcs2_hexapod (PIPython's connect, start-up and first move; sources in each header)
+are replayed by both with their replies checked; a pose sequence ends on target within tolerance;
+an unreachable pose is refused with the controller's error and nothing moves."""
 
 import glob
 import os
 import time
 
 import pytest
+import pyvisa
 
 from twin_clients import RawGcs, Serve, replay
 
@@ -59,6 +60,26 @@ def reference(c):
 @pytest.mark.parametrize("path", TRANSCRIPTS, ids=os.path.basename)
 def test_raw_socket_replays_the_transcript(client, path):
     replay(path, client.write, client.read_line, timeout_s=30.0)
+
+
+@pytest.mark.parametrize("path", TRANSCRIPTS, ids=os.path.basename)
+def test_pyvisa_replays_the_transcript(serve, path):
+    rm = pyvisa.ResourceManager("@py")
+    inst = rm.open_resource(f"TCPIP::127.0.0.1::{serve.ports['gcs2-hexapod']}::SOCKET",
+                            read_termination="\n", write_termination="\n", timeout=5000)
+    inst.encoding = "latin-1"  # #7 answers the byte 0xB1
+
+    def write(line):
+        if line in ("#5", "#7", "#24"):
+            inst.write_raw(bytes([int(line[1:])]))
+        else:
+            inst.write(line)
+
+    try:
+        replay(path, write, inst.read, timeout_s=30.0)
+    finally:
+        inst.close()
+        rm.close()
 
 
 def test_a_pose_sequence_ends_on_target_within_a_micron_and_a_millidegree(client):
