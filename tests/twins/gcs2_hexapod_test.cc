@@ -276,5 +276,28 @@ TEST(Gcs2HexapodTwin, BadLinesGetTheControllersErrors) {
   EXPECT_NEAR(two[0].second, 0.0, 1e-3);
 }
 
+TEST(Gcs2HexapodTwin, AFullQueueAndAStopTheLoopHasNotAppliedAreRefusedAsBusy) {
+  // The loop not started: what is sent waits in the ring, and a stop is never applied.
+  HexapodStageParams p;
+  p.queue = 2;
+  HexapodStage stage(p);
+  Gcs2HexapodTwin twin(stage, Gcs2HexapodTwinParams{});
+  EXPECT_EQ(twin.on_line(1, "FRF"), "");
+  EXPECT_EQ(twin.on_byte(1, 7), "\xb0\n");  // referencing
+  EXPECT_EQ(twin.on_byte(1, 5), "3F\n");
+  EXPECT_EQ(twin.on_line(1, "FRF"), "");
+  EXPECT_EQ(twin.on_line(1, "ERR?"), "0\n");
+  EXPECT_EQ(twin.on_line(1, "FRF"), "");
+  EXPECT_EQ(twin.on_line(1, "ERR?"), "1005\n");
+  EXPECT_EQ(twin.on_line(1, "KSD WORK X 1"), "");
+  EXPECT_EQ(twin.on_line(1, "ERR?"), "536\n");  // not while moving
+  EXPECT_EQ(twin.on_byte(1, 24), "");
+  EXPECT_EQ(twin.on_byte(1, 7), "\xb1\n");  // the stop ended the referencing
+  EXPECT_EQ(twin.on_line(1, "ERR?"), "10\n");
+  EXPECT_EQ(twin.on_line(1, "MOV? X"), "");  // the stopped pose is not known yet
+  EXPECT_EQ(twin.on_line(1, "ERR?"), "1005\n");
+  EXPECT_FALSE(twin.referenced());
+}
+
 }  // namespace gcs2_hexapod_test
 }  // namespace mc::twins
