@@ -228,5 +228,33 @@ TEST(ParallelStage, OpenLoopSteppingMovesOnlyThatPositionerAndALaterMoveStartsFr
   EXPECT_LE(o.rest_rad, 10e-6);
 }
 
+TEST(ParallelStage, StartMoveRunsACheckedTrajectoryFromTheHeldPoseOnlyAndNeverAllocates) {
+  ParallelStage stage(test::model(), test::step_map());
+  settle(stage);
+  const PlatformTransform goal =
+      to_transform(SmarPodPose{0.1e-3, -0.05e-3, 0.02e-3, 0.2 * kDeg, 0.0, -0.1 * kDeg});
+  const PoseTrajectory traj(stage.reference_pose(), goal, stage.params().move);
+  ASSERT_TRUE(check_move(stage.kinematics(), traj).ok);
+  // A trajectory that starts elsewhere than the held pose is refused; nothing moves.
+  const PoseTrajectory elsewhere(to_transform(SmarPodPose{1e-6, 0, 0, 0, 0, 0}), goal, stage.params().move);
+  EXPECT_FALSE(stage.start_move(elsewhere));
+  EXPECT_FALSE(stage.moving());
+  {
+    mc::test::AllocationGuard guard;
+    EXPECT_TRUE(stage.start_move(traj));
+    EXPECT_FALSE(stage.start_move(traj));  // one at a time
+    while (stage.moving() && stage.time_s() < 30.0) stage.tick();
+    EXPECT_EQ(guard.allocations(), 0u);
+  }
+  const double t_end = stage.time_s() + 2.0;
+  while (!stage.at_rest() && stage.time_s() < t_end) stage.tick();
+  ASSERT_TRUE(stage.at_rest());
+  EXPECT_LE((stage.true_pose().d - goal.d).norm(), 0.5e-6);
+  EXPECT_LE(rotation_between(goal.R, stage.true_pose().R), 10e-6);
+  // The next one starts from the held goal exactly.
+  EXPECT_TRUE(
+      stage.start_move(PoseTrajectory(stage.reference_pose(), PlatformTransform{}, stage.params().move)));
+}
+
 }  // namespace parallel_stage_test
 }  // namespace mc::motion

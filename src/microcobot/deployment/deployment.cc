@@ -146,6 +146,7 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
     tp.endpoints = o.twins;
     tp.token = twin_token_;
     tp.gcs2.idn = std::string("microcobot, E-873 digital twin, 0, ") + MC_VERSION;
+    tp.gcs2_hexapod.idn = std::string("microcobot, C-887 digital twin, 0, ") + MC_VERSION;
     twin_stage_ = std::make_unique<twins::LiveStage>(live);
     twin_server_ = std::make_unique<twins::TwinServer>(*twin_stage_, tp);
   }

@@ -39,7 +39,7 @@ class TwinServer;
 
 namespace mc::deployment {
 
-/// A vendor twin as served: its protocol's name ("gcs2", "anc300", "mcs2"), address and bound port.
+/// A vendor twin as served: its protocol's name (twins::protocol_name), address and bound port.
 struct ServedTwin {
   twins::Protocol protocol = twins::Protocol::kGcs2;
   std::string name;

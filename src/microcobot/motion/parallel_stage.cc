@@ -31,6 +31,7 @@ ParallelStage::ParallelStage(const stickslip::ActuatorModel& model, const StepMa
     ax.ctrl = std::make_unique<TrackingController>(p_.tracking, model.params(), map);
     ax.gen = SawtoothGenerator(model.params().drive.slew_rate_V_s);
   }
+  spare_ = std::make_unique<PoseTrajectory>(PlatformTransform{}, PlatformTransform{}, p_.move);
   place(PlatformTransform{});
 }
 
@@ -78,6 +79,23 @@ MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLi
   t_move_ = 0.0;
   moving_ = true;
   return c;
+}
+
+bool ParallelStage::start_move(const PoseTrajectory& checked) noexcept {
+  if (fault_ || moving_) return false;
+  for (const auto& ax : axes_)
+    if (ax.stepping) return false;
+  constexpr double kSame = 1e-9;
+  if ((checked.start().R - ref_T_.R).cwiseAbs().maxCoeff() > kSame ||
+      (checked.start().d - ref_T_.d).cwiseAbs().maxCoeff() > kSame)
+    return false;
+  if (!traj_) traj_ = std::move(spare_);
+  if (!traj_) return false;
+  *traj_ = checked;
+  ref_T_ = checked.start();
+  t_move_ = 0.0;
+  moving_ = true;
+  return true;
 }
 
 void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz) {

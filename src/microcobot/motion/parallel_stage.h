@@ -87,6 +87,13 @@ class ParallelStage {
   MoveCheck move_to(const PlatformTransform& goal);
   /// The same with other limits for this move.
   MoveCheck move_to(const PlatformTransform& goal, const PoseMoveLimits& limits);
+  /// The real-time half of move_to(), for a loop whose moves are planned on another thread: starts
+  /// `checked`, a trajectory that check_move() passed, whose start is the pose the legs hold
+  /// (reference_pose() while no move runs). False, and nothing changes, while a move runs or a leg
+  /// steps, after a fault, or when the trajectory starts elsewhere than the held pose (by more than
+  /// 1 nm or 1 nrad in any entry of R or d). Never allocates (the trajectory's storage is made by
+  /// the constructor), never throws.
+  bool start_move(const PoseTrajectory& checked) noexcept;
   /// Open-loop stepping of one positioner (recovery): `steps` sawtooth periods at the full
   /// amplitude and `frequency_Hz`, forward for steps > 0; the leg then holds where it landed. Any
   /// move is stopped first (the other legs hold where they are).
@@ -139,6 +146,7 @@ class ParallelStage {
   ParallelKinematics kin_;
   std::array<LegAxis, kParallelAxes> axes_;
   std::unique_ptr<PoseTrajectory> traj_;
+  std::unique_ptr<PoseTrajectory> spare_;  ///< start_move()'s storage until traj_ exists
   LegReference ref_;
   PlatformTransform measured_T_, true_T_, ref_T_;
   int ratio_ = 1;

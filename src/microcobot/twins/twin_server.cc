@@ -35,6 +35,8 @@ const char* protocol_name(Protocol p) {
       return "anc300";
     case Protocol::kMcs2:
       return "mcs2";
+    case Protocol::kGcs2Hexapod:
+      return "gcs2-hexapod";
   }
   return "?";
 }
@@ -52,9 +54,13 @@ TwinEndpoint parse_emulate(const std::string& text) {
   } else if (name == "mcs2") {
     e.protocol = Protocol::kMcs2;
     e.port = drivers::mcs2::kDefaultPort;
+  } else if (name == "gcs2-hexapod") {
+    e.protocol = Protocol::kGcs2Hexapod;
+    e.port = 50000;  // the C-887's TCP port, as every GCS controller's
   } else {
     throw UsageError("--emulate: '" + excerpt(text) +
-                     "' must be gcs2[=ADDR:PORT], anc300[=ADDR:PORT] or mcs2[=ADDR:PORT]");
+                     "' must be gcs2[=ADDR:PORT], anc300[=ADDR:PORT], mcs2[=ADDR:PORT] or "
+                     "gcs2-hexapod[=ADDR:PORT]");
   }
   if (eq == std::string::npos) return e;
   const std::string where = text.substr(eq + 1);
@@ -93,6 +99,8 @@ void TwinServerParams::validate() const {
   gcs2.validate();
   anc300.validate();
   mcs2.validate();
+  gcs2_hexapod.validate();
+  hexapod.validate();
 }
 
 struct TwinServer::Impl {
@@ -123,13 +131,21 @@ struct TwinServer::Impl {
         gcs2(st, params.gcs2),
         anc300(st, params.anc300),
         mcs2(st, params.mcs2),
-        timer(io) {}
+        timer(io) {
+    for (const auto& e : params.endpoints)
+      if (e.protocol == Protocol::kGcs2Hexapod && !hexapod) {
+        hexapod_stage = std::make_unique<HexapodStage>(params.hexapod);
+        hexapod = std::make_unique<Gcs2HexapodTwin>(*hexapod_stage, params.gcs2_hexapod);
+      }
+  }
 
   TwinStage& stage;
   TwinServerParams params;
   Gcs2Twin gcs2;
   Anc300Twin anc300;
   Mcs2Twin mcs2;
+  std::unique_ptr<HexapodStage> hexapod_stage;  // with the hexapod twin only
+  std::unique_ptr<Gcs2HexapodTwin> hexapod;
   asio::io_context io;
   std::vector<std::unique_ptr<tcp::acceptor>> acceptors;
   std::vector<Protocol> acceptor_protocols;
@@ -212,6 +228,8 @@ struct TwinServer::Impl {
     // Gone: if it controlled the stage, the stage holds.
     if (s.protocol == Protocol::kGcs2)
       gcs2.on_disconnect(s.id);
+    else if (s.protocol == Protocol::kGcs2Hexapod)
+      hexapod->on_disconnect(s.id);
     else if (s.protocol == Protocol::kMcs2)
       mcs2.on_disconnect(s.id);
     else
@@ -251,10 +269,11 @@ struct TwinServer::Impl {
     std::size_t i = 0;
     for (; i < s.unprocessed.size() && !s.closed && s.waiting_axis < 0; ++i) {
       const char c = s.unprocessed[i];
-      if (s.protocol == Protocol::kGcs2 && s.authorized &&
+      const bool gcs = s.protocol == Protocol::kGcs2 || s.protocol == Protocol::kGcs2Hexapod;
+      if (gcs && s.authorized &&
           (c == drivers::gcs2::kMotionStatus || c == drivers::gcs2::kReadyStatus ||
            c == drivers::gcs2::kStopAll)) {
-        send(s, gcs2.on_byte(s.id, c));
+        send(s, s.protocol == Protocol::kGcs2 ? gcs2.on_byte(s.id, c) : hexapod->on_byte(s.id, c));
         continue;
       }
       if (c == '\n') {
@@ -267,7 +286,7 @@ struct TwinServer::Impl {
       }
       if (c == '\0') continue;  // telnet's CR NUL
       if (s.line.empty()) s.partial_since = Clock::now();
-      const std::size_t cap = s.protocol == Protocol::kGcs2   ? drivers::gcs2::kMaxLineLength
+      const std::size_t cap = gcs                             ? drivers::gcs2::kMaxLineLength
                               : s.protocol == Protocol::kMcs2 ? drivers::mcs2::kMaxLineLength
                                                               : drivers::anc300::kMaxLineLength;
       if (s.line.size() < cap) {
@@ -282,7 +301,7 @@ struct TwinServer::Impl {
   void on_line(Session& s, std::string& line, bool overlong) {
     count(&TwinServerCounters::lines);
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (s.protocol == Protocol::kGcs2 || s.protocol == Protocol::kMcs2) {
+    if (s.protocol != Protocol::kAnc300) {
       if (!s.authorized) {
         // Off loopback the first line is the token; anything else closes the connection.
         if (line != params.token) return hostile(s);
@@ -292,6 +311,10 @@ struct TwinServer::Impl {
       if (s.protocol == Protocol::kMcs2) {
         if (overlong) return mcs2.on_overlong_line();
         return send(s, mcs2.on_line(s.id, line));
+      }
+      if (s.protocol == Protocol::kGcs2Hexapod) {
+        if (overlong) return hexapod->on_overlong_line();
+        return send(s, hexapod->on_line(s.id, line));
       }
       if (overlong) return gcs2.on_overlong_line();
       return send(s, gcs2.on_line(s.id, line));
@@ -383,6 +406,7 @@ void TwinServer::start() {
     m.acceptor_protocols.push_back(e.protocol);
     m.acceptor_tokened.push_back(!loopback_address(e.address));
   }
+  if (m.hexapod_stage) m.hexapod_stage->start();
   for (std::size_t k = 0; k < m.acceptors.size(); ++k) m.accept(k);
   asio::post(m.io, [&m] { m.housekeeping(); });
   m.thread = std::thread([&m] { m.io.run(); });
@@ -403,10 +427,13 @@ void TwinServer::stop() {
     m.io.stop();
   });
   m.thread.join();
+  if (m.hexapod_stage) m.hexapod_stage->stop_loop();  // its clients gone: it holds
   m.running = false;
 }
 
 std::vector<std::uint16_t> TwinServer::ports() const { return impl_->bound; }
+
+const HexapodStage* TwinServer::hexapod_stage() const { return impl_->hexapod_stage.get(); }
 
 TwinServerCounters TwinServer::counters() const {
   std::lock_guard lock(impl_->counters_mutex);

@@ -1,9 +1,11 @@
 #pragma once
 /// @file
 /// The vendor-protocol twins served over TCP (`microcobot serve --emulate gcs2
-/// --emulate anc300 --emulate mcs2`): one thread runs every listening socket and connection (Boost.Asio), the
-/// twins' controller state, and the stage's heartbeat; it is the only producer of the live
-/// platform's protocol ring (twins/live_stage.h) and never touches the loop otherwise.
+/// --emulate anc300 --emulate mcs2 --emulate gcs2-hexapod`): one thread runs every listening socket and
+/// connection (Boost.Asio), the twins' controller state, and the stage's heartbeat; it is the only
+/// producer of the live platform's protocol ring (twins/live_stage.h) and never touches the loop
+/// otherwise. The hexapod twin drives a parallel positioner of its own (hexapod_stage.h), whose
+/// loop thread the server starts and stops with it.
 ///
 /// Survives any client: lines are capped (longer ones answered with the protocol's error and
 /// their rest discarded), a line left unfinished for `line_timeout_s` closes the connection
@@ -23,14 +25,16 @@
 #include <vector>
 
 #include "microcobot/twins/anc300_twin.h"
+#include "microcobot/twins/gcs2_hexapod_twin.h"
 #include "microcobot/twins/gcs2_twin.h"
+#include "microcobot/twins/hexapod_stage.h"
 #include "microcobot/twins/mcs2_twin.h"
 #include "microcobot/twins/twin_stage.h"
 
 namespace mc::twins {
 
-enum class Protocol { kGcs2, kAnc300, kMcs2 };
-/// The protocol's name as `--emulate` spells it ("gcs2", "anc300", "mcs2").
+enum class Protocol { kGcs2, kAnc300, kMcs2, kGcs2Hexapod };
+/// The protocol's name as `--emulate` spells it ("gcs2", "anc300", "mcs2", "gcs2-hexapod").
 const char* protocol_name(Protocol p);
 
 struct TwinEndpoint {
@@ -39,9 +43,9 @@ struct TwinEndpoint {
   std::uint16_t port = 0;  ///< 0: a free one (ports() says which)
 };
 
-/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]` or `mcs2[=ADDR:PORT]` (`serve --emulate`); the
-/// default ports are the controllers' (GCS 50000, ANC300 7230, MCS2 55551) on 127.0.0.1. Throws
-/// mc::UsageError naming the text.
+/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]`, `mcs2[=ADDR:PORT]` or `gcs2-hexapod[=ADDR:PORT]`
+/// (`serve --emulate`); the default ports are the controllers' (GCS and the C-887 50000, ANC300
+/// 7230, MCS2 55551) on 127.0.0.1. Throws mc::UsageError naming the text.
 TwinEndpoint parse_emulate(const std::string& text);
 
 struct TwinServerParams {
@@ -55,6 +59,8 @@ struct TwinServerParams {
   Gcs2TwinParams gcs2;
   Anc300TwinParams anc300;
   Mcs2TwinParams mcs2;
+  Gcs2HexapodTwinParams gcs2_hexapod;
+  HexapodStageParams hexapod;  ///< the hexapod twin's positioner (only built when it is served)
   void validate() const;
 };
 
@@ -78,6 +84,8 @@ class TwinServer {
   /// The bound port of each endpoint, in order (after start()).
   std::vector<std::uint16_t> ports() const;
   TwinServerCounters counters() const;
+  /// The hexapod twin's positioner; nullptr when no endpoint serves it.
+  const HexapodStage* hexapod_stage() const;
 
  private:
   struct Impl;

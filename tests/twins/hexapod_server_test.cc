@@ -1,0 +1,144 @@
+// The hexapod twin served over TCP (loopback, port 0) beside nothing else: the C-887 dialect's
+// lines and single bytes through the server, hostile clients (garbage, an overlong line, half
+// lines, a disconnect mid-move) survived with the platform holding, and the positioner's loop
+// thread never allocating while a client moves and stops it.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "fake_stage.h"
+#include "microcobot/core/error.h"
+#include "microcobot/drivers/gcs2_codec.h"
+#include "support/counting_allocator.h"
+#include "twin_rig.h"
+
+namespace mc::twins {
+namespace hexapod_server_test {
+
+using namespace std::chrono_literals;
+using testing::Client;
+
+/// The hexapod twin alone on loopback port 0 (the live stage it does not use: a fake).
+struct HexapodServerRig {
+  testing::FakeStage unused;
+  std::unique_ptr<TwinServer> server;
+  explicit HexapodServerRig(double line_timeout_s = 5.0) {
+    TwinServerParams tp;
+    tp.endpoints = {{Protocol::kGcs2Hexapod, "127.0.0.1", 0}};
+    tp.line_timeout_s = line_timeout_s;
+    tp.max_clients = 8;
+    server = std::make_unique<TwinServer>(unused, tp);
+    server->start();
+  }
+  ~HexapodServerRig() { server->stop(); }
+  std::uint16_t port() const { return server->ports()[0]; }
+};
+
+std::string byte_reply(const Client& c, char b) {
+  c.send(std::string(1, b));
+  return c.read_until([](const std::string& t) { return !t.empty() && t.back() == '\n'; });
+}
+
+bool wait_on_target(const Client& c, double timeout_s = 30.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (c.gcs("ONT? X Y Z U V W") == "X=1 \nY=1 \nZ=1 \nU=1 \nV=1 \nW=1\n") return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+double axis(const Client& c, const std::string& query) {
+  return drivers::gcs2::parse_axis_values(c.gcs(query)).at(0).second;
+}
+
+void reference(const Client& c) {
+  c.send("FRF X Y Z U V W\n");
+  ASSERT_EQ(c.gcs("ERR?"), "0\n");
+  ASSERT_TRUE(wait_on_target(c));
+  ASSERT_EQ(c.gcs("FRF?"), "X=1 \nY=1 \nZ=1 \nU=1 \nV=1 \nW=1\n");
+}
+
+TEST(HexapodServer, ParsesEmulateGcs2Hexapod) {
+  EXPECT_EQ(parse_emulate("gcs2-hexapod").port, 50000);
+  const auto e = parse_emulate("gcs2-hexapod=127.0.0.1:0");
+  EXPECT_EQ(e.protocol, Protocol::kGcs2Hexapod);
+  EXPECT_EQ(e.port, 0);
+  EXPECT_STREQ(protocol_name(e.protocol), "gcs2-hexapod");
+  EXPECT_THROW(parse_emulate("gcs2-hexapod=127.0.0.1"), UsageError);
+  EXPECT_THROW(parse_emulate("hexapod"), UsageError);
+}
+
+TEST(HexapodServer, AClientReferencesMovesAndReadsThePoseOverTcp) {
+  HexapodServerRig rig;
+  ASSERT_NE(rig.server->hexapod_stage(), nullptr);
+  Client c(rig.port(), 5.0);
+  EXPECT_NE(c.gcs("*IDN?").find("C-887"), std::string::npos);
+  EXPECT_EQ(byte_reply(c, 7), "\xb1\n");
+  reference(c);
+  c.send("VLS 0.5\nMOV X 0.02 Y -0.01 Z 0.01 U 0.1 V 0.1 W -0.1\n");
+  EXPECT_EQ(byte_reply(c, 5), "3F\n");
+  ASSERT_TRUE(wait_on_target(c));
+  EXPECT_EQ(byte_reply(c, 5), "0\n");
+  EXPECT_NEAR(axis(c, "POS? X"), 0.02, 1e-3);
+  EXPECT_NEAR(axis(c, "POS? W"), -0.1, 1e-3);
+  EXPECT_EQ(c.gcs("ERR?"), "0\n");
+}
+
+TEST(HexapodServer, HostileClientsAreSurvivedAndADisconnectMidMoveLeavesThePlatformHolding) {
+  HexapodServerRig rig(0.5);
+  {
+    Client garbage(rig.port());
+    garbage.send("\x01\x02\xff\xfe garbage ;;; \x7f\n");
+    garbage.send(std::string(3000, 'M') + "\n");  // overlong: error 3, its rest discarded
+    EXPECT_EQ(garbage.gcs("ERR?"), "3\n");
+    garbage.send("POS");  // half a line, finished later
+    std::this_thread::sleep_for(100ms);
+    EXPECT_EQ(garbage.gcs("? X").substr(0, 2), "X=");
+  }
+  {
+    Client slow(rig.port());
+    slow.send("POS? X");  // never finished: closed after the line timeout
+    EXPECT_TRUE(slow.closed_by_server());
+  }
+  Client mover(rig.port(), 5.0);
+  reference(mover);
+  mover.send("MOV X 0.2\n");  // 2 s at 0.1 mm/s
+  std::this_thread::sleep_for(400ms);
+  ::shutdown(mover.fd, SHUT_RDWR);  // gone mid-move
+  Client watcher(rig.port(), 5.0);
+  ASSERT_TRUE(wait_on_target(watcher, 5.0));
+  const double x = axis(watcher, "POS? X");
+  EXPECT_GT(x, 0.005);
+  EXPECT_LT(x, 0.19);
+  std::this_thread::sleep_for(300ms);
+  EXPECT_NEAR(axis(watcher, "POS? X"), x, 1e-3);  // holds
+  EXPECT_NE(watcher.gcs("*IDN?").find("C-887"), std::string::npos);
+  EXPECT_GE(rig.server->counters().closed_hostile, 1u);
+}
+
+TEST(HexapodServer, TheLoopThreadNeverAllocatesWhileAClientMovesAndStopsThePlatform) {
+  HexapodServerRig rig;
+  Client c(rig.port(), 5.0);
+  reference(c);  // warm-up: the first move has made the trajectory's storage
+  const HexapodStage* stage = rig.server->hexapod_stage();
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard(stage->loop_thread());
+    c.send("VLS 0.5\nMOV X 0.02 U 0.1\nMOV Y 0.02\n");
+    ASSERT_TRUE(wait_on_target(c));
+    c.send("MOV Z 0.1\n");
+    std::this_thread::sleep_for(50ms);
+    c.send(std::string(1, '\x18'));  // #24: no reply
+    ASSERT_TRUE(wait_on_target(c, 5.0));
+    EXPECT_EQ(c.gcs("ERR?"), "10\n");
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+}
+
+}  // namespace hexapod_server_test
+}  // namespace mc::twins
