@@ -133,7 +133,8 @@ void add_serve(CLI::App& cmd) {
       "--emulate", o->emulate,
       "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "
       "127.0.0.1:50000), anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230) or "
-      "mcs2[=ADDR:PORT] (SmarAct MCS2 ASCII, default 127.0.0.1:55551); docs/hardware.md");
+      "mcs2[=ADDR:PORT][,no_sensor=N[+M]] (SmarAct MCS2 ASCII, default 127.0.0.1:55551; no_sensor: channels "
+      "without a sensor, stepped open loop only); docs/hardware.md");
   cmd.add_option("--out", o->config.out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->config.record, "Start recording at once (else from the console)");
   cmd.add_flag("--record-csv", o->config.record_csv,

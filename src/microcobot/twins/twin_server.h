@@ -37,10 +37,13 @@ struct TwinEndpoint {
   Protocol protocol = Protocol::kGcs2;
   std::string address = "127.0.0.1";
   std::uint16_t port = 0;  ///< 0: a free one (ports() says which)
+  /// mcs2 only: the channels without a sensor (bit n: channel n; Mcs2TwinParams).
+  unsigned no_sensor_channels = 0;
 };
 
-/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]` or `mcs2[=ADDR:PORT]` (`serve --emulate`); the
-/// default ports are the controllers' (GCS 50000, ANC300 7230, MCS2 55551) on 127.0.0.1. Throws
+/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]` or `mcs2[=ADDR:PORT][,no_sensor=N[+M...]]`
+/// (`serve --emulate`; no_sensor: the MCS2 channels 0..3 built without a sensor); the default
+/// ports are the controllers' (GCS 50000, ANC300 7230, MCS2 55551) on 127.0.0.1. Throws
 /// mc::UsageError naming the text.
 TwinEndpoint parse_emulate(const std::string& text);
 
