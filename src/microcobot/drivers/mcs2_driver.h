@@ -7,7 +7,7 @@
 /// pm) and polls `:CHAN<n>:POS?` (bus_controller.h). Commands (docs/hardware.md, "smaract-mcs2"):
 ///
 ///   configure  *IDN? (must name an MCS2), the stale error queue drained, :DEV:NOCH? (every
-///              configured channel present), per channel :CHAN<n>:STAT? (sensor present),
+///              configured channel present), per channel :CHAN<n>:STAT? (sensor present, else below),
 ///              :CHAN<n>:TUN:BASE:UNIT? (metre; the rotary channel degree), RLIM:MIN?/MAX? (the
 ///              targets are clamped to them), MMOD 0, HOLD -1, [VEL v], VEL?, and for an
 ///              unreferenced channel :REF<n> then STAT? until referenced; the error queue read
