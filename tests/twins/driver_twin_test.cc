@@ -468,7 +468,8 @@ TEST(DriverTwin, SmaractMcs2StepsTheTwinsSensorlessChannelByCountingSteps) {
   run_paced(*p, 1.0, [] { return false; });
   EXPECT_FALSE(p->faulted());
   EXPECT_EQ(p->axis(2).position_m(), 0.0);  // not one step counted
-  EXPECT_NEAR(twin_position_m(twin.gcs2_port)[2], z0, 2e-9) << "moved without the deadman";
+  // Not one step (~50 nm): the twin's 1 nm readout and its loop's hold ripple of a few nm only.
+  EXPECT_NEAR(twin_position_m(twin.gcs2_port)[2], z0, 10e-9) << "moved without the deadman";
   in.deadman = true;
   const auto start = Clock::now();
   int there = 0;
