@@ -49,6 +49,8 @@ struct FakeMcs2 {
   bool referenced[4] = {false, false, false, false};
   std::mutex m;
   std::int64_t pos_pm[4] = {0, 0, 0, 0};
+  int move_mode[4] = {0, 0, 0, 0};
+  std::int64_t steps[4] = {0, 0, 0, 0};    // step mode: the periods played, signed
   std::deque<int> errors{mcs2::kAborted};  // stale: drained at configure
   std::atomic<int> stops[4] = {0, 0, 0, 0};
   test::FakeController server{[this](const std::string& line) { return answer(line); }};
@@ -85,7 +87,15 @@ struct FakeMcs2 {
       pos_pm[n] = 0;
     }
     if (h == "STOP") ++stops[n];
-    if (h == "MOVE") {
+    if (h == "CHAN:MMOD" && !c.query) move_mode[n] = static_cast<int>(*mcs2::parse_integer(c.args.at(0)));
+    if (h == "MOVE" && move_mode[n] == mcs2::kStep) {
+      // Step mode needs no sensor or reference: the periods are played at once.
+      if (mode == Mode::kError) {
+        errors.push_back(mcs2::kAmplifierDisabled);
+      } else {
+        steps[n] += *mcs2::parse_integer(c.args.at(0));
+      }
+    } else if (h == "MOVE") {
       if (!referenced[n]) {
         errors.push_back(mcs2::kNotReferenced);
       } else if (mode == Mode::kError) {
@@ -93,6 +103,10 @@ struct FakeMcs2 {
       } else {
         pos_pm[n] = *mcs2::parse_rounded(c.args.at(0));
       }
+    }
+    if (h == "CHAN:POS" && c.query && static_cast<int>(n) == no_sensor) {
+      errors.push_back(mcs2::kNoSensorPresent);
+      return reply(0);
     }
     if (h == "CHAN:POS" && c.query) {
       switch (mode.load()) {
@@ -131,6 +145,36 @@ TEST(Mcs2Driver, TheConnectionOptionsAreCheckedInOneLine) {
        {"h:1,channels=0+1", "h:1,channels=0+0+1", "h:1,channels=a+1+2", "h:1,theta=24", "h:1,theta=-1",
         "h:1,theta=1", "h:1,reference=yes", "h:1,velocity_mm_s=-1", "h:1,speed=1"})
     EXPECT_THROW(mcs2_driver_params(parse_connection(bad, "smaract-mcs2")), InvalidParams) << bad;
+  // The sensorless channels' options: a bad value, or one without sensorless=step, refused in one
+  // line naming the option.
+  const auto s = mcs2_driver_params(parse_connection(
+      "h:1,sensorless=step,voltage_V=40,frequency_Hz=2000,step_up_nm=20,step_down_nm=25", "x"));
+  EXPECT_TRUE(s.sensorless_step);
+  EXPECT_EQ(s.step.voltage_V, 40.0);
+  EXPECT_EQ(s.step.frequency_Hz, 2000.0);
+  EXPECT_NEAR(s.step.step_down_m, 25e-9, 1e-18);
+  EXPECT_FALSE(mcs2_driver_params(parse_connection("h:1", "x")).sensorless_step);
+  for (const auto& [bad, option] : std::vector<std::pair<const char*, const char*>>{
+           {"h:1,sensorless=yes", "option sensorless"},
+           {"h:1,sensorless=", "option sensorless"},
+           {"h:1,voltage_V=40", "option voltage_V"},
+           {"h:1,sensorless=step,voltage_V=101", "option voltage_V"},
+           {"h:1,sensorless=step,voltage_V=0", "option voltage_V"},
+           {"h:1,sensorless=step,frequency_Hz=20001", "option frequency_Hz"},
+           {"h:1,sensorless=step,frequency_Hz=abc", "option frequency_Hz"},
+           {"h:1,sensorless=step,max_run_s=2", "option max_run_s"},
+           {"h:1,sensorless=step,frequency_Hz=10,max_run_s=0.01", "option max_run_s"},
+           {"h:1,sensorless=step,step_up_nm=-1", "option step_up_nm"},
+           {"h:1,sensorless=step,deadband_nm=1e6", "option deadband_nm"}}) {
+    try {
+      mcs2_driver_params(parse_connection(bad, "smaract-mcs2"));
+      ADD_FAILURE() << bad << ": accepted";
+    } catch (const InvalidParams& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(option), std::string::npos) << bad << ": " << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
   // A serial path is refused (the MCS2's ASCII interface is its network port); so is theta without
   // the platform's rotary axis.
   auto serial = mcs2_config(1);
@@ -222,6 +266,10 @@ TEST(Mcs2Driver, ConfigureRefusesAWrongIdentityTooFewChannelsNoSensorOrNoReferen
     FakeMcs2 fake;
     fake.no_sensor = 1;
     expect_one_line(configure_error(fake), "channel 1: no sensor present", fake.server.port());
+    // The refusal names the option that drives it.
+    expect_one_line(configure_error(fake), "option sensorless=step", fake.server.port());
+    expect_one_line(configure_error(fake, ",sensorless=refuse"), "option sensorless=step",
+                    fake.server.port());
   }
   {
     FakeMcs2 fake;
@@ -315,6 +363,58 @@ TEST(Mcs2Driver, ThePlatformsEstopStopsEveryChannelAndRecoverReconnects) {
   run_paced(*p, 0.5);
   EXPECT_FALSE(p->faulted());
   EXPECT_NEAR(fake.x_m(0), -5e-6, 1e-12);
+}
+
+// A channel without sensor, with sensorless=step: stepped open loop in step mode, its position
+// counted (the periods sent times the step the options give), each run once the previous is over,
+// :STOP on the e-stop and on a fault; the closed-loop channels as before.
+TEST(Mcs2Driver, ASensorlessChannelIsSteppedOpenLoopItsPositionCounted) {
+  FakeMcs2 fake;
+  fake.no_sensor = 2;
+  auto p = platform::make_platform(mcs2_config(
+      fake.server.port(), ",sensorless=step,voltage_V=40,frequency_Hz=2000,step_up_nm=20,step_down_nm=25"));
+  EXPECT_EQ(fake.server.count(":CHAN2:MMOD 4"), 1);
+  EXPECT_EQ(fake.server.count(":CHAN2:STEP:FREQ 2000"), 1);
+  EXPECT_EQ(fake.server.count(":CHAN2:STEP:AMPL 26214"), 1);  // 40 V of 100 V: 65535 * 0.4
+  EXPECT_EQ(fake.server.count(":CHAN2:HOLD"), 0);
+  EXPECT_EQ(fake.server.count(":REF2"), 0);  // no reference mark without the sensor
+  EXPECT_EQ(fake.server.count(":CHAN2:POS?"), 0);
+  EXPECT_EQ(fake.server.count(":CHAN0:MMOD 0"), 1);
+  EXPECT_EQ(fake.server.count(":REF0"), 1);
+  const Eigen::Vector3d goal(5e-6, 0, 3e-6);
+  Console console(*p, goal);
+  run_paced(*p, 0.5);
+  ASSERT_FALSE(p->faulted());
+  EXPECT_NEAR(fake.x_m(0), goal[0], 1e-12);
+  // 3 um up at 20 nm a period: 150 periods, in runs of at most 2000 Hz x 20 ms = 40.
+  EXPECT_EQ(fake.steps[2], 150);
+  EXPECT_NEAR(p->axis(2).position_m(), 3e-6, 1e-12);
+  const auto lines = fake.server.lines();
+  int runs = 0;
+  for (const auto& l : lines)
+    if (l.rfind(":MOVE2 ", 0) == 0) {
+      ++runs;
+      const long long n = std::stoll(l.substr(7));
+      EXPECT_TRUE(n >= 1 && n <= 40) << l;
+    }
+  EXPECT_GE(runs, 4);  // 40 + 40 + 40 + 30 at least (the coupling's target ramps to the goal)
+  // Down 2 um at 25 nm: 80 periods back.
+  console.in.goal_m = console.home + Eigen::Vector3d(5e-6, 0, 1e-6);
+  run_paced(*p, 0.5);
+  EXPECT_EQ(fake.steps[2], 70);
+  EXPECT_NEAR(p->axis(2).position_m(), 1e-6, 1e-12);
+  // The e-stop stops the stepped channel too.
+  const int stops = fake.stops[2].load();
+  p->fault_all();
+  EXPECT_TRUE(test::eventually([&] { return fake.stops[2].load() > stops; }, 1000ms));
+  // A controller error faults the bus: the stepped channel is stopped with the others.
+  p->recover();
+  console.in.goal_m = console.home + Eigen::Vector3d(5e-6, 0, 3e-6);
+  fake.mode = Mode::kError;
+  const int before = fake.stops[2].load();
+  run_paced(*p, 2.0, [&] { return p->faulted(); });
+  ASSERT_TRUE(p->faulted());
+  EXPECT_TRUE(test::eventually([&] { return fake.stops[2].load() > before; }, 1000ms));
 }
 
 }  // namespace mcs2_driver_test

@@ -228,6 +228,14 @@ TEST(TwinServer, ParsesEmulateOptions) {
   EXPECT_EQ(e.port, 0);
   EXPECT_THROW(parse_emulate("smaract"), UsageError);
   EXPECT_THROW(parse_emulate("gcs2=1.2.3.4"), UsageError);
+  // The MCS2 twin's channels without a sensor.
+  const auto m = parse_emulate("mcs2=127.0.0.1:0,no_sensor=2+0");
+  EXPECT_EQ(m.port, 0);
+  EXPECT_EQ(m.no_sensor_channels, 0b101u);
+  EXPECT_EQ(parse_emulate("mcs2,no_sensor=3").no_sensor_channels, 0b1000u);
+  for (const char* bad : {"mcs2,no_sensor=4", "mcs2,no_sensor=", "mcs2,no_sensor=1+", "mcs2,sensor=1",
+                          "gcs2,no_sensor=1", "mcs2=127.0.0.1:0,no_sensor=12"})
+    EXPECT_THROW(parse_emulate(bad), UsageError) << bad;
   TwinServerParams p;
   p.endpoints = {{Protocol::kGcs2, "0.0.0.0", 0}};
   EXPECT_THROW(p.validate(), InvalidParams);  // off loopback without a token

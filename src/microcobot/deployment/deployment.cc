@@ -144,6 +144,8 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
   if (!o.twins.empty()) {
     twins::TwinServerParams tp;
     tp.endpoints = o.twins;
+    for (const auto& t : o.twins)
+      if (t.protocol == twins::Protocol::kMcs2) tp.mcs2.no_sensor_channels |= t.no_sensor_channels;
     tp.token = twin_token_;
     tp.gcs2.idn = std::string("microcobot, E-873 digital twin, 0, ") + MC_VERSION;
     tp.gcs2_hexapod.idn = std::string("microcobot, C-887 digital twin, 0, ") + MC_VERSION;

@@ -11,8 +11,6 @@
 #include "microcobot/core/input_file.h"
 #include "microcobot/drivers/anc300_codec.h"
 #include "microcobot/drivers/sim_companions.h"
-#include "microcobot/motion/step_map.h"
-#include "microcobot/stickslip/actuator.h"
 
 namespace mc::drivers {
 namespace {
@@ -34,33 +32,15 @@ void Anc300DriverParams::validate() const {
       theta == 0 || (theta >= 1 && theta <= 7 && theta != axes[0] && theta != axes[1] && theta != axes[2]),
       "devices.connection option theta", "must be an axis within 1..7 other than X's, Y's and Z's", theta);
   require(std::isfinite(radius_m) && radius_m > 0, "stage.rotary.radius_m", "must be > 0", radius_m);
-  require(std::isfinite(voltage_V) && voltage_V > 0 && voltage_V <= 150,
-          "devices.connection option voltage_V", "must be within (0, 150] V (the ANC300's range)", voltage_V);
-  require(std::isfinite(frequency_Hz) && frequency_Hz >= 1 && frequency_Hz <= 10e3,
-          "devices.connection option frequency_Hz", "must be within [1, 10000] Hz", frequency_Hz);
-  require(std::isfinite(max_run_s) && max_run_s >= 1.0 / frequency_Hz && max_run_s <= 1.0,
-          "devices.connection option max_run_s", "must be within [1/frequency_Hz, 1] s", max_run_s);
-  require(std::isfinite(deadband_m) && deadband_m >= 0 && deadband_m < 1e-4,
-          "devices.connection option deadband_nm", "must be within [0, 100000) nm (0: half a step)",
-          deadband_m * 1e9);
-  require(std::isfinite(step_up_m) && step_up_m > 0 && step_up_m < 1e-5, "step_up_nm",
-          "must be within (0, 10000) nm (or left to the model)", step_up_m * 1e9);
-  require(std::isfinite(step_down_m) && step_down_m > 0 && step_down_m < 1e-5, "step_down_nm",
-          "must be within (0, 10000) nm (or left to the model)", step_down_m * 1e9);
+  step.validate("ANC300", 150.0, 10e3);
 }
 
 Anc300DriverParams anc300_driver_params(const Connection& c) {
-  check_connection_options(c, std::string(kBusTimingOptions) +
-                                  ", password, axes, theta, voltage_V, "
-                                  "frequency_Hz, max_run_s, position, step_up_nm, step_down_nm, deadband_nm");
+  check_connection_options(c, std::string(kBusTimingOptions) + ", password, axes, theta, position, " +
+                                  std::string(kStepDriveOptions));
   Anc300DriverParams p;
   p.timing = bus_timing(c, p.timing);
-  p.voltage_V = connection_number(c, "voltage_V", p.voltage_V, 1e-3, 150.0);
-  p.frequency_Hz = connection_number(c, "frequency_Hz", p.frequency_Hz, 1.0, 10e3);
-  p.max_run_s = connection_number(c, "max_run_s", p.max_run_s, 1e-4, 1.0);
-  p.step_up_m = 1e-9 * connection_number(c, "step_up_nm", 0.0, 1e-3, 1e4);
-  p.step_down_m = 1e-9 * connection_number(c, "step_down_nm", 0.0, 1e-3, 1e4);
-  p.deadband_m = 1e-9 * connection_number(c, "deadband_nm", 0.0, 0.0, 1e5);
+  p.step = step_drive_options(c, p.step, 150.0, 10e3);
   if (const auto it = c.options.find("password"); it != c.options.end()) p.password = it->second;
   if (const auto it = c.options.find("position"); it != c.options.end()) {
     if (it->second != "counted" && it->second != "getpos")
@@ -167,8 +147,8 @@ void Anc300Controller::handshake(LineClient& bus) {
       throw BusFault(fmt::format("axis {} is not there: {}", a, e.what()));
     }
     request(bus, fmt::format("setm {} stp", a));
-    request(bus, fmt::format("setf {} {:.0f}", a, params_.frequency_Hz));
-    request(bus, fmt::format("setv {} {:.3f}", a, params_.voltage_V));
+    request(bus, fmt::format("setf {} {:.0f}", a, params_.step.frequency_Hz));
+    request(bus, fmt::format("setv {} {:.3f}", a, params_.step.voltage_V));
     stepping_mode_[i] = true;
     if (params_.sensor) est_m_[i] = read_position(bus, static_cast<int>(i));
     publish_position(static_cast<int>(i), est_m_[i]);
@@ -187,33 +167,28 @@ void Anc300Controller::cycle(LineClient& bus) {
   // Every axis off its target starts its run, then each is waited for: the ANC300 plays its
   // axes' runs at once, so a diagonal move goes at each axis's own speed.
   std::array<long long, kMaxAxes> run{};  // periods started this cycle, signed
-  const long long cap = std::max(1LL, static_cast<long long>(params_.frequency_Hz * params_.max_run_s));
   for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
     if (!t.wanted[i]) continue;
     if (!stepping_mode_[i]) {
       request(bus, fmt::format("setm {} stp", axis_id(i)));  // armed again after a safe state
       stepping_mode_[i] = true;
     }
-    const double e = t.m[i] - est_m_[i];
-    const double s = e >= 0.0 ? params_.step_up_m : params_.step_down_m;
-    const double band = params_.deadband_m > 0.0 ? params_.deadband_m : 0.5 * s;
-    if (std::abs(e) <= band) continue;
-    const long long n = std::min(std::max(1LL, std::llround(std::abs(e) / s)), cap);
-    request(bus, fmt::format("{} {} {}", e >= 0.0 ? "stepu" : "stepd", axis_id(i), n));
-    run[i] = e >= 0.0 ? n : -n;
+    const long long n = params_.step.periods_toward(t.m[i] - est_m_[i]);
+    if (n == 0) continue;
+    request(bus, fmt::format("{} {} {}", n > 0 ? "stepu" : "stepd", axis_id(i), std::abs(n)));
+    run[i] = n;
   }
   for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) {
     const long long n = run[i];
     if (n == 0) continue;
     // stepw answers once the run is over: n periods, then the reply's own time.
     request(bus, fmt::format("stepw {}", axis_id(i)),
-            static_cast<double>(std::abs(n)) / params_.frequency_Hz + timing().reply_timeout_s);
+            static_cast<double>(std::abs(n)) / params_.step.frequency_Hz + timing().reply_timeout_s);
     periods_[i].fetch_add(n);
     if (params_.sensor) {
       est_m_[i] = read_position(bus, static_cast<int>(i));
     } else {
-      est_m_[i] +=
-          n > 0 ? static_cast<double>(n) * params_.step_up_m : static_cast<double>(n) * params_.step_down_m;
+      est_m_[i] += params_.step.displacement_m(n);
     }
     publish_position(static_cast<int>(i), est_m_[i]);
   }
@@ -236,20 +211,9 @@ devices::DeviceSet make_anc300_devices(const platform::PlatformConfig& config) {
     throw InvalidParams("devices.connection option theta",
                         "needs the rotary axis (stage.rotary.enabled: true)");
   const stickslip::StickSlipParams axis = platform::axis_params(config);
-  if (p.step_up_m == 0.0 || p.step_down_m == 0.0) {
-    // The step of one period at the driver's amplitude and frequency, from the model identified for
-    // these axes (as the platform's StepMap measures its grid: 3 periods of warm-up, 6 averaged).
-    const stickslip::ActuatorModel model(axis);
-    const double v = std::min(p.voltage_V, axis.drive.max_V);
-    if (p.step_up_m == 0.0)
-      p.step_up_m = std::abs(
-          motion::measure_step(model, v, p.frequency_Hz, stickslip::Direction::kForward, 3, 6).step_m);
-    if (p.step_down_m == 0.0)
-      p.step_down_m = std::abs(
-          motion::measure_step(model, v, p.frequency_Hz, stickslip::Direction::kBackward, 3, 6).step_m);
-  }
-  spdlog::info("anc300 driver: {:.1f} nm up, {:.1f} nm down per period at {:g} V, {:g} Hz", 1e9 * p.step_up_m,
-               1e9 * p.step_down_m, p.voltage_V, p.frequency_Hz);
+  steps_from_model(p.step, axis);  // the step of one period from the model identified for these axes
+  spdlog::info("anc300 driver: {:.1f} nm up, {:.1f} nm down per period at {:g} V, {:g} Hz",
+               1e9 * p.step.step_up_m, 1e9 * p.step.step_down_m, p.step.voltage_V, p.step.frequency_Hz);
   auto controller = std::make_shared<Anc300Controller>(c, p);  // validates (a model step of 0 is refused)
   devices::DeviceSet d = make_sim_companions(config);
   const char* names[3] = {"anc300_axis_x", "anc300_axis_y", "anc300_axis_z"};

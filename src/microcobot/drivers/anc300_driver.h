@@ -6,11 +6,9 @@
 /// (`setf`) and knows nothing of where the slider is. So the driver closes the platform's
 /// position loop itself, in its bus thread, at the step level (docs/hardware.md, "anc300"):
 ///
-///   error e = target - position; n = max(1, round(|e| / s)) periods (s: the step of one period at
-///   the set amplitude and frequency, up or down), none while |e| is within the dead band (half a
-///   step unless given: option deadband_nm),
-///   at most frequency * max_run_s per command so that a moving target is followed; every axis
-///   off its target is started (`stepu|stepd AXIS n`, the controller plays the runs at once), then
+///   n periods toward the target as drivers/step_drive.h plans them (the step s of one period,
+///   the dead band, at most frequency * max_run_s per command); every axis off its target is
+///   started (`stepu|stepd AXIS n`, the controller plays the runs at once), then
 ///   each is waited for (`stepw AXIS` answers once its run is over)
 ///
 /// The position is either counted (the default, all a real ANC300 without a sensor gives: the
@@ -39,6 +37,7 @@
 
 #include "microcobot/devices/device_set.h"
 #include "microcobot/drivers/bus_controller.h"
+#include "microcobot/drivers/step_drive.h"
 #include "microcobot/platform/platform_config.h"
 
 namespace mc::drivers {
@@ -49,19 +48,13 @@ namespace mc::drivers {
 inline constexpr int kAnc300DefaultBaud = 38400;
 
 struct Anc300DriverParams {
-  BusTiming timing{2.0, 0.2, 0.005, 0.1};     ///< a step run blocks a cycle: slower than GCS's
-  std::string password = "123456";            ///< the controller's factory password
-  std::array<int, 3> axes = {1, 2, 3};        ///< the controller's axes for X, Y, Z
-  int theta = 0;                              ///< the controller's axis of the rotary axis; 0: none
-  double radius_m = 5e-3;                     ///< the rotary axis' contact radius: its arc per rad
-  double voltage_V = 60.0;                    ///< setv: the sawtooth amplitude
-  double frequency_Hz = 1000.0;               ///< setf
-  double max_run_s = 0.02;                    ///< the longest run of one command
-  bool sensor = false;                        ///< position=getpos (the twin's sensor) instead of counted
-  double step_up_m = 0.0, step_down_m = 0.0;  ///< s per period; 0: from the model
-  /// No step while |e| is below it; 0: half a step (the count's own resolution). A controller whose
-  /// runs start with a slip of their own (the twin: docs/hardware.md) needs it wider than that slip.
-  double deadband_m = 0.0;
+  BusTiming timing{2.0, 0.2, 0.005, 0.1};  ///< a step run blocks a cycle: slower than GCS's
+  std::string password = "123456";         ///< the controller's factory password
+  std::array<int, 3> axes = {1, 2, 3};     ///< the controller's axes for X, Y, Z
+  int theta = 0;                           ///< the controller's axis of the rotary axis; 0: none
+  double radius_m = 5e-3;                  ///< the rotary axis' contact radius: its arc per rad
+  bool sensor = false;                     ///< position=getpos (the twin's sensor) instead of counted
+  StepDriveParams step;                    ///< setv, setf, the runs and the counted step
   void validate() const;
 };
 

@@ -21,6 +21,8 @@ namespace {
 constexpr double kPmPerM = 1e12;
 constexpr double kNdegPerDeg = 1e9;
 constexpr double kMmPerM = 1e3;
+/// The longest a step run may take to show as moving in :CHAN<n>:STAT? after its :MOVE.
+constexpr double kRunStartWithin_s = 0.02;
 
 std::string trimmed(std::string s) {
   while (!s.empty() && (s.back() == '\r' || s.back() == '\n' || s.back() == ' ')) s.pop_back();
@@ -54,12 +56,14 @@ void Mcs2DriverParams::validate() const {
   require(std::isfinite(velocity_mm_s) && velocity_mm_s >= 0 && velocity_mm_s <= 1e3,
           "devices.connection option velocity_mm_s", "must be within [0, 1000] mm/s (0: the controller's)",
           velocity_mm_s);
+  if (sensorless_step) step.validate("MCS2", mcs2::kFullAmplitude_V, mcs2::kMaxStepFrequency_Hz);
 }
 
 Mcs2DriverParams mcs2_driver_params(const Connection& c) {
   check_connection_options(c, std::string(kBusTimingOptions) +
                                   ", channels, theta, reference, "
-                                  "reference_timeout_s, velocity_mm_s");
+                                  "reference_timeout_s, velocity_mm_s, sensorless, " +
+                                  std::string(kStepDriveOptions));
   Mcs2DriverParams p;
   p.timing = bus_timing(c, p.timing);
   p.reference_timeout_s = connection_number(c, "reference_timeout_s", p.reference_timeout_s, 0.01, 600.0);
@@ -90,7 +94,26 @@ Mcs2DriverParams mcs2_driver_params(const Connection& c) {
   }
   if (const auto it = c.options.find("theta"); it != c.options.end())
     p.theta = channel_number("theta", it->second);
-  p.validate();
+  if (const auto it = c.options.find("sensorless"); it != c.options.end()) {
+    if (it->second != "refuse" && it->second != "step")
+      throw InvalidParams("devices.connection option sensorless",
+                          "'" + excerpt(it->second) +
+                              "' must be refuse (a channel without sensor fails the configuration) or step "
+                              "(stepped open loop, its position counted)");
+    p.sensorless_step = it->second == "step";
+  }
+  for (const char* o :
+       {"voltage_V", "frequency_Hz", "max_run_s", "step_up_nm", "step_down_nm", "deadband_nm"})
+    if (c.options.count(o) && !p.sensorless_step)
+      throw InvalidParams(std::string("devices.connection option ") + o,
+                          "sets how a channel without sensor steps: it needs sensorless=step");
+  p.step = step_drive_options(c, p.step, mcs2::kFullAmplitude_V, mcs2::kMaxStepFrequency_Hz);
+  // The steps left to the model are known once the platform's is (make_mcs2_devices): the rest is
+  // checked here with a stand-in step.
+  Mcs2DriverParams checked = p;
+  if (checked.step.step_up_m == 0.0) checked.step.step_up_m = 1e-9;
+  if (checked.step.step_down_m == 0.0) checked.step.step_down_m = 1e-9;
+  checked.validate();
   return p;
 }
 
@@ -186,20 +209,29 @@ void Mcs2Controller::handshake(LineClient& bus) {
   for (std::size_t i = 0; i < n; ++i) {
     const int c = channel(i);
     const auto state = static_cast<std::uint32_t>(query_integer(bus, fmt::format(":CHAN{}:STAT?", c)));
-    if (!(state & mcs2::channel_state::kSensorPresent))
+    stepped_[i] = !(state & mcs2::channel_state::kSensorPresent);
+    if (stepped_[i] && !params_.sensorless_step)
       throw BusFault(fmt::format(
-          "channel {}: no sensor present (:CHAN{}:STAT? {:#x}): the driver moves closed-loop only", c, c,
-          state));
-    if (!(state & mcs2::channel_state::kIsReferenced)) unreferenced.push_back(c);
+          "channel {}: no sensor present (:CHAN{}:STAT? {:#x}): the driver moves it open-loop only with the "
+          "option sensorless=step (its position then counted)",
+          c, c, state));
+    if (!stepped_[i] && !(state & mcs2::channel_state::kIsReferenced)) unreferenced.push_back(c);
     const auto unit = query_integer(bus, fmt::format(":CHAN{}:TUN:BASE:UNIT?", c));
     const auto wanted = i < 3 ? mcs2::kUnitMeter : mcs2::kUnitDegree;
     if (unit != wanted)
       throw BusFault(fmt::format(
           "channel {}: base unit {} (:CHAN{}:TUN:BASE:UNIT?), not {} ({})", c, unit, c, wanted,
           i < 3 ? "metre: a linear positioner for X, Y, Z" : "degree: a rotary positioner for theta"));
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (stepped_[i]) {
+      // The range limit is on the sensor's scale; the count starts where the slider was.
+      min_m_[i] = -kInf;
+      max_m_[i] = kInf;
+      count_run(i, true);  // a run the lost connection cut: counted as far as its time tells
+      continue;
+    }
     const auto lo = query_integer(bus, fmt::format(":CHAN{}:RLIM:MIN?", c));
     const auto hi = query_integer(bus, fmt::format(":CHAN{}:RLIM:MAX?", c));
-    constexpr double kInf = std::numeric_limits<double>::infinity();
     const bool limited = lo != 0 || hi != 0;  // both 0: the controller has no range limit
     min_m_[i] = limited ? static_cast<double>(lo) * si_per_wire(i) : -kInf;
     max_m_[i] = limited ? static_cast<double>(hi) * si_per_wire(i) : kInf;
@@ -209,6 +241,15 @@ void Mcs2Controller::handshake(LineClient& bus) {
   }
   std::vector<std::string> setup;
   for (std::size_t i = 0; i < n; ++i) {
+    if (stepped_[i]) {
+      setup.push_back(fmt::format(":CHAN{}:MMOD {}", channel(i), static_cast<int>(mcs2::kStep)));
+      setup.push_back(
+          fmt::format(":CHAN{}:STEP:FREQ {}", channel(i), std::llround(params_.step.frequency_Hz)));
+      setup.push_back(fmt::format(":CHAN{}:STEP:AMPL {}", channel(i),
+                                  std::llround(params_.step.voltage_V / mcs2::kFullAmplitude_V *
+                                               static_cast<double>(mcs2::kFullAmplitude))));
+      continue;
+    }
     setup.push_back(fmt::format(":CHAN{}:MMOD {}", channel(i), static_cast<int>(mcs2::kAbsolute)));
     setup.push_back(fmt::format(":CHAN{}:HOLD -1", channel(i)));  // hold the target for ever
     if (i < 3 && params_.velocity_mm_s > 0.0)
@@ -217,6 +258,7 @@ void Mcs2Controller::handshake(LineClient& bus) {
   }
   command(bus, setup);
   for (std::size_t i = 0; i < 3; ++i) {
+    if (stepped_[i]) continue;
     const double vel_mm_s =
         static_cast<double>(query_integer(bus, fmt::format(":CHAN{}:VEL?", channel(i)))) * kMmPerM / kPmPerM;
     if (vel_mm_s > 0.0 && vel_mm_s < params_.operator_speed_mm_s)
@@ -254,7 +296,8 @@ void Mcs2Controller::handshake(LineClient& bus) {
   }
   poll_lines_.clear();
   poll_lines_.push_back(":SYST:ERR:COUN?");
-  for (std::size_t i = 0; i < n; ++i) poll_lines_.push_back(fmt::format(":CHAN{}:POS?", channel(i)));
+  for (std::size_t i = 0; i < n; ++i)
+    poll_lines_.push_back(fmt::format(":CHAN{}:{}?", channel(i), stepped_[i] ? "STAT" : "POS"));
   sent_ = {};
   poll(bus, {});  // the first positions; no target is sent before the axes are armed
 }
@@ -264,6 +307,10 @@ void Mcs2Controller::cycle(LineClient& bus) {
   const auto n = static_cast<std::size_t>(axis_count());
   std::vector<std::string> moves;
   for (std::size_t i = 0; i < n; ++i) {
+    if (stepped_[i]) {
+      if (t.wanted[i]) step_toward(i, t.m[i], moves);
+      continue;
+    }
     if (!t.wanted[i]) {
       sent_[i] = false;  // once armed again, the first target is sent whatever it is
       continue;
@@ -280,6 +327,29 @@ void Mcs2Controller::cycle(LineClient& bus) {
   if (!moves.empty()) moves_.fetch_add(1, std::memory_order_relaxed);
 }
 
+void Mcs2Controller::step_toward(std::size_t i, double target_m, std::vector<std::string>& moves) {
+  if (run_[i] != 0) return;  // a new :MOVE would replace the run under way, its periods uncounted
+  const long long periods = params_.step.periods_toward(target_m - est_m_[i]);
+  if (periods == 0) return;
+  moves.push_back(fmt::format(":MOVE{} {}", channel(i), periods));
+  run_[i] = periods;
+  run_start_[i] = Clock::now();
+  run_seen_moving_[i] = false;
+  periods_[i].fetch_add(periods);
+}
+
+void Mcs2Controller::count_run(std::size_t i, bool stopped) {
+  if (run_[i] == 0) return;
+  long long played = run_[i];
+  if (stopped) {
+    const double elapsed_s = std::chrono::duration<double>(Clock::now() - run_start_[i]).count();
+    const auto by_time = static_cast<long long>(elapsed_s * params_.step.frequency_Hz);
+    played = run_[i] > 0 ? std::min(run_[i], by_time) : std::max(run_[i], -by_time);
+  }
+  est_m_[i] += params_.step.displacement_m(played);
+  run_[i] = 0;
+}
+
 void Mcs2Controller::poll(LineClient& bus, std::vector<std::string> lines) {
   const std::string after = lines.empty() ? std::string(":CHAN<n>:POS?") : lines.front();
   const std::size_t first = lines.size();
@@ -290,6 +360,23 @@ void Mcs2Controller::poll(LineClient& bus, std::vector<std::string> lines) {
     throw BusFault("':SYST:ERR:COUN?': a reply that is not an integer: '" + excerpt(replies[0], 60) + "'");
   check_errors(bus, *errors, after);
   for (std::size_t i = 0; i + 1 < replies.size(); ++i) {
+    if (stepped_[i]) {
+      const auto state = mcs2::parse_integer(replies[i + 1]);
+      if (!state)
+        throw BusFault("'" + lines[first + i + 1] + "': a reply that is not a channel state: '" +
+                       excerpt(replies[i + 1], 60) + "'");
+      // The run is over once its periods' time is gone and the channel, seen moving, no longer
+      // moves; a controller may report it late (the twin starts it at its loop's next tick), so a
+      // run never seen moving is over only kRunStartWithin_s after its time.
+      const bool moving = *state & mcs2::channel_state::kActivelyMoving;
+      run_seen_moving_[i] = run_seen_moving_[i] || moving;
+      const double run_s = static_cast<double>(std::abs(run_[i])) / params_.step.frequency_Hz;
+      const double elapsed_s = std::chrono::duration<double>(Clock::now() - run_start_[i]).count();
+      if (run_[i] != 0 && !moving && elapsed_s >= run_s + (run_seen_moving_[i] ? 0.0 : kRunStartWithin_s))
+        count_run(i, false);
+      publish_position(static_cast<int>(i), est_m_[i]);
+      continue;
+    }
     // pm (ndeg) as an integer; a decimal is rounded (the EPICS driver reads it as a double).
     const auto pos = mcs2::parse_rounded(replies[i + 1]);
     if (!pos)
@@ -303,8 +390,10 @@ void Mcs2Controller::poll(LineClient& bus, std::vector<std::string> lines) {
 void Mcs2Controller::safe_state(LineClient& bus) {
   sent_ = {};
   std::vector<std::string> lines;
-  for (std::size_t i = 0; i < static_cast<std::size_t>(axis_count()); ++i)
+  for (std::size_t i = 0; i < static_cast<std::size_t>(axis_count()); ++i) {
     lines.push_back(fmt::format(":STOP{}", channel(i)));
+    count_run(i, true);  // the periods played before the stop, as far as their time tells
+  }
   lines.push_back(":SYST:ERR:COUN?");  // its reply: the stops were read
   exchange(bus, lines);
 }
@@ -322,10 +411,18 @@ devices::DeviceSet make_mcs2_devices(const platform::PlatformConfig& config) {
   if (params.theta >= 0 && !config.stage.rotary.enabled)
     throw InvalidParams("devices.connection option theta",
                         "needs the rotary axis (stage.rotary.enabled: true)");
-  auto controller = std::make_shared<Mcs2Controller>(c, params);
+  const stickslip::StickSlipParams axis = platform::axis_params(config);
+  if (params.sensorless_step) {
+    steps_from_model(params.step, axis);  // the step of one period from the model of these axes
+    spdlog::info(
+        "smaract-mcs2 driver: a channel without sensor steps {:.1f} nm up, {:.1f} nm down per period "
+        "at {:g} V, {:g} Hz (counted)",
+        1e9 * params.step.step_up_m, 1e9 * params.step.step_down_m, params.step.voltage_V,
+        params.step.frequency_Hz);
+  }
+  auto controller = std::make_shared<Mcs2Controller>(c, params);  // validates (a model step of 0 is refused)
   devices::DeviceSet d = make_sim_companions(config);
   const char* names[3] = {"mcs2_axis_x", "mcs2_axis_y", "mcs2_axis_z"};
-  const stickslip::StickSlipParams axis = platform::axis_params(config);
   for (std::size_t i = 0; i < 3; ++i)
     d.axes[i] = std::make_unique<BusAxis>(names[i], controller, static_cast<int>(i), axis.integrator.dt_s,
                                           axis.drive.max_V);

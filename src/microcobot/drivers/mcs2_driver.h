@@ -7,7 +7,7 @@
 /// pm) and polls `:CHAN<n>:POS?` (bus_controller.h). Commands (docs/hardware.md, "smaract-mcs2"):
 ///
 ///   configure  *IDN? (must name an MCS2), the stale error queue drained, :DEV:NOCH? (every
-///              configured channel present), per channel :CHAN<n>:STAT? (sensor present),
+///              configured channel present), per channel :CHAN<n>:STAT? (sensor present, else below),
 ///              :CHAN<n>:TUN:BASE:UNIT? (metre; the rotary channel degree), RLIM:MIN?/MAX? (the
 ///              targets are clamped to them), MMOD 0, HOLD -1, [VEL v], VEL?, and for an
 ///              unreferenced channel :REF<n> then STAT? until referenced; the error queue read
@@ -22,6 +22,14 @@
 /// a round trip: a cycle is 1 + one per channel. Positions are in pm on the wire (64-bit integers), m in the
 /// platform; the controller's 0 (the reference mark) is the platform's stage zero (its home).
 ///
+/// A channel without sensor (:CHAN<n>:STAT? without 0x20) is refused unless the option
+/// `sensorless=step` is given; then its axis is an open-loop stepped axis as the anc300 driver's
+/// (drivers/step_drive.h): its position counted (the periods sent times the model's step, from 0 at
+/// the first configure), moved by runs of steps toward the target: at configure MMOD 4 (step mode),
+/// STEP:FREQ, STEP:AMPL (no reference, VEL, HOLD or RLIM: they need the sensor); each cycle, once
+/// the previous run is over (its periods' time gone and :CHAN<n>:STAT? without 0x1, the channel's
+/// poll instead of POS?), :MOVE<n> <periods> (signed); the safe state's :STOP<n> as the others'.
+///
 /// The rotary axis under the gripper, with the option `theta=N`: the controller's rotary channel
 /// N (base unit degree, positions in ndeg), checked, referenced, moved and polled with the three;
 /// the platform's rotary axis position (the arc at stage.rotary.radius_m from its home) in the
@@ -35,6 +43,7 @@
 
 #include "microcobot/devices/device_set.h"
 #include "microcobot/drivers/bus_controller.h"
+#include "microcobot/drivers/step_drive.h"
 #include "microcobot/platform/platform_config.h"
 
 namespace mc::drivers {
@@ -53,12 +62,19 @@ struct Mcs2DriverParams {
   /// The operator's fastest stage move (teleop.max_jog_m_s, in mm/s): a channel whose VEL? is
   /// slower (and not 0, "as fast as allowed") lags the coupling's target: a warning at configure.
   double operator_speed_mm_s = 0.0;
+  /// sensorless=step: a channel without sensor is stepped open loop, its position counted; else
+  /// (sensorless=refuse) it is refused at configure.
+  bool sensorless_step = false;
+  /// The stepped channels' STEP:AMPL (voltage_V of 100 V full scale), STEP:FREQ, runs and step.
+  StepDriveParams step;
+  /// With sensorless_step the steps must be known (given, or from the model: make_mcs2_devices).
   void validate() const;
 };
 
 /// `connection` options: timeout_s, connect_timeout_s, poll_s, stale_s, channels (three indices
 /// joined by '+', "0+1+2"), theta (the rotary channel), reference (auto|require),
-/// reference_timeout_s, velocity_mm_s.
+/// reference_timeout_s, velocity_mm_s, sensorless (refuse|step) and, with sensorless=step only,
+/// voltage_V, frequency_Hz, max_run_s, step_up_nm, step_down_nm, deadband_nm (step_drive.h).
 Mcs2DriverParams mcs2_driver_params(const Connection& connection);
 
 class Mcs2Controller final : public BusController {
@@ -74,6 +90,10 @@ class Mcs2Controller final : public BusController {
   double max_m(int axis) const { return max_m_[static_cast<std::size_t>(axis)]; }
   /// Cycles that sent at least one :MOVE (tests, benchmarks).
   std::uint64_t moves_sent() const { return moves_.load(std::memory_order_relaxed); }
+  /// True for an axis whose channel has no sensor (stepped open loop), once configured.
+  bool stepped(int axis) const { return stepped_[static_cast<std::size_t>(axis)]; }
+  /// Periods commanded since the start on a stepped axis, signed (tests).
+  long long periods_sent(int axis) const { return periods_[static_cast<std::size_t>(axis)].load(); }
 
  protected:
   void handshake(LineClient& bus) override;
@@ -104,12 +124,25 @@ class Mcs2Controller final : public BusController {
   std::string channel_list() const;
   /// The platform's unit (m; the rotary axis: m of arc) per the wire's (pm; ndeg).
   double si_per_wire(std::size_t i) const;
+  /// A stepped axis' run toward its target, once the previous one is over: its :MOVE, if any.
+  void step_toward(std::size_t i, double target_m, std::vector<std::string>& moves);
+  /// Adds to the count what the run under way played: all of it once over, else (a stop) the
+  /// periods its time allowed.
+  void count_run(std::size_t i, bool stopped);
 
   Mcs2DriverParams params_;
   std::array<double, kMaxAxes> min_m_{}, max_m_{}, sent_m_{};
   std::array<bool, kMaxAxes> sent_{};
   std::vector<std::string> poll_lines_;  ///< the cycle's queries, built once at configure
   std::atomic<std::uint64_t> moves_{0};
+  // Stepped axes (bus thread): the counted position, the run under way (signed periods) and when
+  // it started.
+  std::array<bool, kMaxAxes> stepped_{};
+  std::array<double, kMaxAxes> est_m_{};
+  std::array<long long, kMaxAxes> run_{};
+  std::array<bool, kMaxAxes> run_seen_moving_{};
+  std::array<Clock::time_point, kMaxAxes> run_start_{};
+  std::array<std::atomic<long long>, kMaxAxes> periods_{};
 };
 
 /// The driver set `smaract-mcs2`: the three axes (and the rotary axis, option theta, which needs

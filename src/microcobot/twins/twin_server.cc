@@ -41,8 +41,23 @@ const char* protocol_name(Protocol p) {
   return "?";
 }
 
-TwinEndpoint parse_emulate(const std::string& text) {
+TwinEndpoint parse_emulate(const std::string& whole) {
   TwinEndpoint e;
+  std::string text = whole;
+  if (const auto comma = whole.find(','); comma != std::string::npos) {
+    text = whole.substr(0, comma);
+    const std::string option = whole.substr(comma + 1);
+    const std::string key = "no_sensor=";
+    bool ok = text.rfind("mcs2", 0) == 0 && option.rfind(key, 0) == 0 && option.size() > key.size() &&
+              (option.size() - key.size()) % 2 == 1;  // N, N+M, N+M+K
+    for (std::size_t k = key.size(); ok && k < option.size(); k += 2) {
+      ok = option[k] >= '0' && option[k] <= '3' && (k + 1 == option.size() || option[k + 1] == '+');
+      if (ok) e.no_sensor_channels |= 1u << (option[k] - '0');
+    }
+    if (!ok)
+      throw UsageError("--emulate: '" + excerpt(whole) +
+                       "': the one option is mcs2's no_sensor=N[+M...] (channels 0..3 without a sensor)");
+  }
   const auto eq = text.find('=');
   const std::string name = text.substr(0, eq);
   if (name == "gcs2") {

@@ -41,11 +41,14 @@ struct TwinEndpoint {
   Protocol protocol = Protocol::kGcs2;
   std::string address = "127.0.0.1";
   std::uint16_t port = 0;  ///< 0: a free one (ports() says which)
+  /// mcs2 only: the channels without a sensor (bit n: channel n; Mcs2TwinParams).
+  unsigned no_sensor_channels = 0;
 };
 
-/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]`, `mcs2[=ADDR:PORT]` or `gcs2-hexapod[=ADDR:PORT]`
-/// (`serve --emulate`); the default ports are the controllers' (GCS and the C-887 50000, ANC300
-/// 7230, MCS2 55551) on 127.0.0.1. Throws mc::UsageError naming the text.
+/// Parses `gcs2[=ADDR:PORT]`, `anc300[=ADDR:PORT]`, `mcs2[=ADDR:PORT][,no_sensor=N[+M...]]` or
+/// `gcs2-hexapod[=ADDR:PORT]` (`serve --emulate`; no_sensor: the MCS2 channels 0..3 built without
+/// a sensor); the default ports are the controllers' (GCS and the C-887 50000, ANC300 7230, MCS2
+/// 55551) on 127.0.0.1. Throws mc::UsageError naming the text.
 TwinEndpoint parse_emulate(const std::string& text);
 
 struct TwinServerParams {
