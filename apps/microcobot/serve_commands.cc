@@ -134,7 +134,8 @@ void add_serve(CLI::App& cmd) {
       "Serve a vendor protocol on the live stage (repeatable): gcs2[=ADDR:PORT] (PI GCS 2.0, default "
       "127.0.0.1:50000), anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230), "
       "mcs2[=ADDR:PORT][,no_sensor=N[+M]] (SmarAct MCS2 ASCII, default 127.0.0.1:55551; no_sensor: channels "
-      "without a sensor, stepped open loop only) or gcs2-hexapod[=ADDR:PORT] (PI C-887 hexapod dialect over a "
+      "without a sensor, stepped open loop only) or gcs2-hexapod[=ADDR:PORT] (PI C-887 hexapod dialect over "
+      "a "
       "simulated 6-DOF parallel positioner of its own, default 127.0.0.1:50000); docs/hardware.md");
   cmd.add_option("--out", o->config.out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->config.record, "Start recording at once (else from the console)");
