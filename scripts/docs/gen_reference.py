@@ -548,14 +548,16 @@ def ask(port, line, until, timeout=10.0, greeting=None):
 
 def gen_vendor(cli):
     import tempfile
-    gcs, anc, http = free_port(), free_port(), free_port()
+    gcs, anc, hexa, http = free_port(), free_port(), free_port(), free_port()
     with tempfile.TemporaryDirectory() as tmp:
         proc = subprocess.Popen([cli, "serve", "--listen", f"127.0.0.1:{http}", "--out", tmp,
-                                 "--emulate", f"gcs2=127.0.0.1:{gcs}", "--emulate", f"anc300=127.0.0.1:{anc}"],
+                                 "--emulate", f"gcs2=127.0.0.1:{gcs}", "--emulate", f"anc300=127.0.0.1:{anc}",
+                                 "--emulate", f"gcs2-hexapod=127.0.0.1:{hexa}"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             proc.stdout.readline()  # the console's URL: the server is up
             hlp = ask(gcs, "HLP?\n", "end of help")
+            hexapod_hlp = ask(hexa, "HLP?\n", "end of help")
             try:
                 anc_help = ask(anc, "help\r\n", "OK\r\n", greeting="Authorization code")
             except OSError:
@@ -567,15 +569,19 @@ def gen_vendor(cli):
            "The commands the vendor-protocol twins answer, as the twins list them themselves (`serve --emulate`; "
            "what they mean, the documents followed and the drivers that speak them: [Connecting hardware]"
            "(../hardware.md)). The drivers `pi-gcs2`, `anc300` and `smaract-mcs2` send a subset of these.\n"]
-    gcs_rows = [l.strip() for l in hlp.splitlines() if l.strip() and "end of help" not in l and "following commands" not in l]
-    out.append("## PI GCS 2.0 (`serve --emulate gcs2`)\n")
-    out.append("Answer to `HLP?`:\n")
-    out.append("| command | description |\n|---|---|")
-    for l in gcs_rows:
-        m = re.match(r"^(\S+(?: \[?\{<[^}]*\}\]?| \[ALL\])*)\s+(.*)$", l)
-        cmd, d = (m.group(1), m.group(2)) if m else (l, "")
-        out.append(f"| {code(cmd)} | {md_escape(d)} |")
-    out.append("")
+    def help_table(title, text):
+        rows = [l.strip() for l in text.splitlines() if l.strip() and "end of help" not in l and "following commands" not in l]
+        out.append(title)
+        out.append("Answer to `HLP?`:\n")
+        out.append("| command | description |\n|---|---|")
+        for l in rows:
+            m = re.match(r"^(\S+(?: \[?\{<[^}]*\}\]?| \[ALL\]| <[^>]*>)*)\s+(.*)$", l)
+            cmd, d = (m.group(1), m.group(2)) if m else (l, "")
+            out.append(f"| {code(cmd)} | {md_escape(d)} |")
+        out.append("")
+        return rows
+    gcs_rows = help_table("## PI GCS 2.0 (`serve --emulate gcs2`)\n", hlp)
+    hexapod_rows = help_table("## PI C-887 hexapod (`serve --emulate gcs2-hexapod`)\n", hexapod_hlp)
     out.append("## Attocube ANC300 (`serve --emulate anc300`)\n")
     anc_rows = [l.strip() for l in anc_help.splitlines() if l.strip() and l.strip() not in ("OK", "> help", "help") and not l.startswith(">")]
     out.append("Answer to `help` (after the password):\n")
@@ -584,7 +590,7 @@ def gen_vendor(cli):
     out.append("The MCS2's ASCII interface has no help command, so the twin cannot list itself: its commands, "
                "channel properties, units and error codes are tabled in [Connecting hardware]"
                "(../hardware.md#smaract-mcs2-closed-loop-linear-positioners-a-rotary-positioner-open-loop-stepping).\n")
-    return "\n".join(out) + "\n", {"gcs2": len(gcs_rows), "anc300": len(anc_rows)}
+    return "\n".join(out) + "\n", {"gcs2": len(gcs_rows), "gcs2-hexapod": len(hexapod_rows), "anc300": len(anc_rows)}
 
 
 # ---------------------------------------------------------------------------------------------
