@@ -17,7 +17,7 @@ LegPositioner parse_leg_positioner(const std::string& name) {
 
 ParallelStage::ParallelStage(const stickslip::ActuatorModel& model, const StepMap& map,
                              const ParallelStageParams& p)
-    : model_(model), map_(map), p_(p), kin_(p.geometry) {
+    : model_(model), p_(p), kin_(p.geometry) {
   p_.validate();
   require(model.params().slider.stroke_m >= p_.geometry.stroke_m, "geometry.stroke_m",
           "must not exceed the actuator model's stroke", p_.geometry.stroke_m);

@@ -141,7 +141,6 @@ class ParallelStage {
   void safe_stop() noexcept;
 
   const stickslip::ActuatorModel& model_;
-  const StepMap& map_;
   ParallelStageParams p_;
   ParallelKinematics kin_;
   std::array<LegAxis, kParallelAxes> axes_;
