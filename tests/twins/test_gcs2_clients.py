@@ -6,9 +6,8 @@ import glob
 import os
 
 import pytest
-import pyvisa
 
-from twin_clients import RawGcs, Serve, replay
+from twin_clients import RawGcs, Serve, replay, replay_over_pyvisa
 
 DATA = os.path.join(os.path.dirname(__file__), "..", "data", "gcs2")
 TRANSCRIPTS = sorted(glob.glob(os.path.join(DATA, "*.txt")))
@@ -32,19 +31,4 @@ def test_raw_socket_replays_the_transcript(serve, path):
 
 @pytest.mark.parametrize("path", TRANSCRIPTS, ids=os.path.basename)
 def test_pyvisa_replays_the_transcript(serve, path):
-    rm = pyvisa.ResourceManager("@py")
-    inst = rm.open_resource(f"TCPIP::127.0.0.1::{serve.ports['gcs2']}::SOCKET",
-                            read_termination="\n", write_termination="\n", timeout=5000)
-    inst.encoding = "latin-1"  # #7 answers the byte 0xB1
-
-    def write(line):
-        if line in ("#5", "#7", "#24"):
-            inst.write_raw(bytes([int(line[1:])]))
-        else:
-            inst.write(line)
-
-    try:
-        replay(path, write, inst.read)
-    finally:
-        inst.close()
-        rm.close()
+    replay_over_pyvisa(serve.ports['gcs2'], path)

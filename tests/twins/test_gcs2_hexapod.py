@@ -9,9 +9,8 @@ import os
 import time
 
 import pytest
-import pyvisa
 
-from twin_clients import RawGcs, Serve, replay
+from twin_clients import RawGcs, Serve, replay, replay_over_pyvisa
 
 DATA = os.path.join(os.path.dirname(__file__), "..", "data", "gcs2_hexapod")
 TRANSCRIPTS = sorted(glob.glob(os.path.join(DATA, "*.txt")))
@@ -64,22 +63,7 @@ def test_raw_socket_replays_the_transcript(client, path):
 
 @pytest.mark.parametrize("path", TRANSCRIPTS, ids=os.path.basename)
 def test_pyvisa_replays_the_transcript(serve, path):
-    rm = pyvisa.ResourceManager("@py")
-    inst = rm.open_resource(f"TCPIP::127.0.0.1::{serve.ports['gcs2-hexapod']}::SOCKET",
-                            read_termination="\n", write_termination="\n", timeout=5000)
-    inst.encoding = "latin-1"  # #7 answers the byte 0xB1
-
-    def write(line):
-        if line in ("#5", "#7", "#24"):
-            inst.write_raw(bytes([int(line[1:])]))
-        else:
-            inst.write(line)
-
-    try:
-        replay(path, write, inst.read, timeout_s=30.0)
-    finally:
-        inst.close()
-        rm.close()
+    replay_over_pyvisa(serve.ports['gcs2-hexapod'], path, timeout_s=30.0)
 
 
 def test_a_pose_sequence_ends_on_target_within_a_micron_and_a_millidegree(client):

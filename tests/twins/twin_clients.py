@@ -117,3 +117,26 @@ def replay(path, write, read_line, timeout_s=10.0):
                     break
                 assert time.monotonic() < end, (path, query, got)
                 time.sleep(0.02)
+
+
+def replay_over_pyvisa(port, path, timeout_s=10.0):
+    """Plays a GCS transcript through pyvisa-py's TCPIP SOCKET resource on loopback `port`, the
+    single-byte commands (#5, #7, #24) as raw bytes."""
+    import pyvisa
+
+    rm = pyvisa.ResourceManager("@py")
+    inst = rm.open_resource(f"TCPIP::127.0.0.1::{port}::SOCKET",
+                            read_termination="\n", write_termination="\n", timeout=5000)
+    inst.encoding = "latin-1"  # #7 answers the byte 0xB1
+
+    def write(line):
+        if line in ("#5", "#7", "#24"):
+            inst.write_raw(bytes([int(line[1:])]))
+        else:
+            inst.write(line)
+
+    try:
+        replay(path, write, inst.read, timeout_s=timeout_s)
+    finally:
+        inst.close()
+        rm.close()
