@@ -137,7 +137,7 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   flowing.loop().run_for(100);
   const double flowing_s = run(flowing);
   const double flowing_p99 = flowing.loop().tick_stats().quantile_s(0.99);
-  EXPECT_GE(got.size(), MC_UNDER_ASAN ? 5u : 20u) << "about 30 frames in the second";
+  EXPECT_GE(got.size(), MC_UNDER_SANITIZER ? 5u : 20u) << "about 30 frames in the second";
 
   // The camera thread stalls in its first frame (a slow consumer) and the loop runs on.
   std::atomic<int> delivered{0};
@@ -168,7 +168,7 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   EXPECT_GE(s.dropped, 30u - config.camera.ring_frames - 2);
   // Under AddressSanitizer a tick costs about a period (p99 95-120 us seen): the rate is a
   // property of the optimised build; there the bound only says the loop was not held up.
-  const double slack = MC_UNDER_ASAN ? 0.5 : 0.05;
+  const double slack = MC_UNDER_SANITIZER ? 0.5 : 0.05;
   EXPECT_LE(stalled_s, (1.0 + slack) * static_cast<double>(ticks) * config.loop.period_s())
       << "the loop kept its rate";
   EXPECT_LE(stalled_s, flowing_s + slack);

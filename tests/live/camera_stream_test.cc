@@ -134,7 +134,7 @@ TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraI
   // beside the cell's tests skipped 5 of 80 due frames; another had 4 frames dropped, due while
   // the camera thread was still busy (a dropped frame is never formed: the sequence above has no
   // gap for it). Both are the camera keeping up, which stays the rule, not the recording's loss.
-#if MC_UNDER_ASAN
+#if MC_UNDER_SANITIZER
   constexpr std::size_t kSkipShare = 5;
 #else
   constexpr std::size_t kSkipShare = 20;

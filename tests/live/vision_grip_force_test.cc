@@ -150,7 +150,7 @@ TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt)
   LiveParams p = grip_params();
   const double k = p.platform.world.gripper.finger_stiffness_N_m, w = p.platform.world.part_side_m;
   GripRig rig(std::move(p));
-  const double boot_s = MC_UNDER_ASAN ? 30.0 : 10.0;
+  const double boot_s = MC_UNDER_SANITIZER ? 30.0 : 10.0;
   ASSERT_TRUE(rig.wait(
       [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 3; },
       boot_s))
@@ -167,8 +167,8 @@ TEST(VisionGripForce, TheGripForceSeenAgreesWithTheSensorAndIsPublishedBesideIt)
   // sensor (the bias goal) once the fingers have settled.
   for (double force : {1e-3, 4e-3, 7e-3}) {
     rig.opening = w - 2.0 * force / k;
-    std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
-    const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+    std::this_thread::sleep_for(MC_UNDER_SANITIZER ? 1500ms : 500ms);
+    const auto g = rig.collect(MC_UNDER_SANITIZER ? 1500ms : 600ms);
     const auto st = rig.live.status().grip_vision.value();
     std::printf(
         "grip %.1f mN: sensor %.4f mN, vision %.4f mN (%+.2f %%), %zu of %zu frames measured, state %s\n",
@@ -210,11 +210,11 @@ TEST(VisionGripForce, ThePinPushedIntoItsBoresWallIsAContactForceSeenAsTheSensor
   GripRig rig(std::move(p));
   ASSERT_TRUE(rig.wait(
       [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 10; },
-      MC_UNDER_ASAN ? 30.0 : 10.0));
+      MC_UNDER_SANITIZER ? 30.0 : 10.0));
   rig.goal_y = 0.0, rig.goal_z = 200e-6;
   rig.opening = 160e-6;  // 1 mN on the 200 um pin: the grip holds 600 uN
-  const auto settle = MC_UNDER_ASAN ? 2500ms : 1200ms;
-  const auto window = MC_UNDER_ASAN ? 1500ms : 800ms;
+  const auto settle = MC_UNDER_SANITIZER ? 2500ms : 1200ms;
+  const auto window = MC_UNDER_SANITIZER ? 1500ms : 800ms;
   std::this_thread::sleep_for(settle);
   const auto centred = rig.collect(window);
   std::printf("centred: contact sensor %.1f uN, vision %.1f uN\n", 1e6 * centred.contact_sensor_N,
@@ -248,11 +248,11 @@ TEST(VisionGripForce, WithoutTheStagesXYSensorsTheTipsAreLookedForWhereThePositi
         return s.vision && s.vision->found && s.grip_vision && s.grip_vision->tared &&
                s.grip_vision->frames > 3;
       },
-      MC_UNDER_ASAN ? 30.0 : 10.0));
+      MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const double force = 3e-3;
   rig.opening = w - 2.0 * force / k;
-  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
-  const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+  std::this_thread::sleep_for(MC_UNDER_SANITIZER ? 1500ms : 500ms);
+  const auto g = rig.collect(MC_UNDER_SANITIZER ? 1500ms : 600ms);
   const auto st = rig.live.status().grip_vision.value();
   std::printf("grip %.1f mN, stage on vision: sensor %.4f mN, vision %.4f mN\n", 1e3 * force,
               1e3 * g.sensor_N, 1e3 * g.vision_N);
@@ -272,10 +272,10 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
   GripRig rig(std::move(p));
   ASSERT_TRUE(rig.wait(
       [](const LiveStatus& s) { return s.grip_vision && s.grip_vision->tared && s.grip_vision->frames > 3; },
-      MC_UNDER_ASAN ? 30.0 : 10.0));
+      MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const double force = 4e-3, turn = 20.0 * M_PI / 180.0;
   rig.opening = w - 2.0 * force / k;
-  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 500ms);
+  std::this_thread::sleep_for(MC_UNDER_SANITIZER ? 1500ms : 500ms);
   rig.theta_goal = turn;
   bool saw_turning = false;
   ASSERT_TRUE(test::eventually(
@@ -285,12 +285,12 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
                       (g && g->error.find("turning") != std::string::npos && !std::isfinite(g->grip_force_N));
         return std::abs(rig.theta.load() - turn) < 1e-5;
       },
-      MC_UNDER_ASAN ? 30s : 10s));
+      MC_UNDER_SANITIZER ? 30s : 10s));
   EXPECT_TRUE(saw_turning) << "the gauge did not say the fingers were turning";
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 5.0))
       << rig.live.status().grip_vision->error;
-  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1000ms : 300ms);
-  const auto g = rig.collect(MC_UNDER_ASAN ? 1500ms : 600ms);
+  std::this_thread::sleep_for(MC_UNDER_SANITIZER ? 1000ms : 300ms);
+  const auto g = rig.collect(MC_UNDER_SANITIZER ? 1500ms : 600ms);
   const auto st = rig.live.status().grip_vision.value();
   std::printf(
       "grip %.1f mN, fingers at %.1f deg: sensor %.4f mN, vision %.4f mN (%+.2f %%), %zu of %zu frames\n",
@@ -304,7 +304,7 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
   rig.theta_goal = 0.0;
   std::this_thread::sleep_for(300ms);
   rig.opening = 600e-6;
-  ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load()) < 1e-5; }, MC_UNDER_ASAN ? 30s : 10s));
+  ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load()) < 1e-5; }, MC_UNDER_SANITIZER ? 30s : 10s));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "untared"; }, 5.0))
       << rig.live.status().grip_vision->state;
   EXPECT_NE(rig.live.status().grip_vision->error.find("tare again"), std::string::npos)
@@ -325,14 +325,14 @@ TEST(VisionGripForce, OpenFingersTurnedAnywhereReadNoForceAtTheConsolesDefaultVi
   GripRig rig(std::move(p));
   ASSERT_TRUE(
       rig.wait([](const LiveStatus& s) { return s.grip_vision && s.grip_vision->state == "measuring"; },
-               MC_UNDER_ASAN ? 60.0 : 20.0));
+               MC_UNDER_SANITIZER ? 60.0 : 20.0));
   std::mt19937 draw(20261206);
   std::uniform_real_distribution<double> yaw_deg(-20.0, 20.0);
   for (int turn = 0; turn < 12; ++turn) {
     const double goal = yaw_deg(draw) * M_PI / 180.0;
     rig.theta_goal = goal;
     ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load() - goal) < 1e-5; },
-                                 MC_UNDER_ASAN ? 60s : 20s));
+                                 MC_UNDER_SANITIZER ? 60s : 20s));
     rig.theta_goal = std::nan("");  // let go, as the console does once there
     ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "measuring"; }, 10.0))
         << rig.live.status().grip_vision->error;
@@ -350,7 +350,7 @@ TEST(VisionGripForce, ATareOnRequestAndNoneWithoutFrames) {
   p.platform.vision_force.tare_at_start = false;
   GripRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision && s.grip_vision->frames > 3; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   // Untared: no force published.
   auto st = rig.live.status().grip_vision.value();
   EXPECT_EQ(st.state, "untared");

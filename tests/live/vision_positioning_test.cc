@@ -98,7 +98,7 @@ struct VisionRig {
         [](const LiveStatus& s) {
           return s.vision->state == "converged" && s.vision->has_goal && s.vision->in_position;
         },
-        MC_UNDER_ASAN ? 30.0 : 8.0);
+        MC_UNDER_SANITIZER ? 30.0 : 8.0);
     const auto st = live.status().vision.value();
     if (!converged) {
       why = "state " + st.state + ", error " + std::to_string(st.error_m) + " m; " + st.error;
@@ -123,7 +123,7 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(
-      rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, MC_UNDER_ASAN ? 30.0 : 10.0))
+      rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, MC_UNDER_SANITIZER ? 30.0 : 10.0))
       << "the tips' template was not taught: "
       << (rig.live.status().vision ? rig.live.status().vision->error : "");
   const Eigen::Vector2d start = rig.truth();
@@ -137,11 +137,11 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
     test::AllocationGuard guard(rig.live.loop_thread_id());
     rig.has_goal = true;
     rig.deadman = true;
-    rig.wait([](const LiveStatus& s) { return s.vision->commands >= 3; }, MC_UNDER_ASAN ? 20.0 : 5.0);
+    rig.wait([](const LiveStatus& s) { return s.vision->commands >= 3; }, MC_UNDER_SANITIZER ? 20.0 : 5.0);
     loop_allocations = guard.allocations();
   }
   EXPECT_EQ(loop_allocations, 0u);
-  const double budget_s = MC_UNDER_ASAN ? 30.0 : 8.0;
+  const double budget_s = MC_UNDER_SANITIZER ? 30.0 : 8.0;
   const bool converged =
       rig.wait([](const LiveStatus& s) { return s.vision->in_position && s.vision->has_goal; }, budget_s);
   const auto st = rig.live.status().vision.value();
@@ -157,7 +157,7 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   // 0.3 um.
   // Under ASan a loop tick takes about its period: a run plays longer than planned and may be
   // seen mid-period by the next exposure; there only convergence and rest are asserted.
-  const double bound_m = MC_UNDER_ASAN ? 3e-6 : 0.3e-6;
+  const double bound_m = MC_UNDER_SANITIZER ? 3e-6 : 0.3e-6;
   EXPECT_LT((arrived - goal).norm(), bound_m);
   EXPECT_GT(st.commands, 2u);
   EXPECT_TRUE(rig.live.status().vision->found);
@@ -179,7 +179,7 @@ TEST(VisionPositioning, AClickWithAPartsEdgeUnderATipsTemplateIsReachedOnTheOthe
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
@@ -190,7 +190,7 @@ TEST(VisionPositioning, AClickWithAPartsEdgeUnderATipsTemplateIsReachedOnTheOthe
   const Eigen::Vector2d arrived = *rest;
   std::printf("vision click-to-go, a part's edge under a tip: true error %.3f um\n",
               1e6 * (arrived - goal).norm());
-  EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  EXPECT_LT((arrived - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : 0.3e-6);
 }
 
 TEST(VisionPositioning, AHeldPartIsLiftedAndCarriedToTheClickedPoint) {
@@ -206,11 +206,11 @@ TEST(VisionPositioning, AHeldPartIsLiftedAndCarriedToTheClickedPoint) {
   const double home_z = p.platform.stage.home_z_m;
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   rig.goal = {home.x(), home.y(), home_z};
   rig.opening = side - 2.0 * 0.5e-3 / k;  // 0.5 mN of grip
   rig.deadman = true;
-  std::this_thread::sleep_for(MC_UNDER_ASAN ? 1500ms : 400ms);
+  std::this_thread::sleep_for(MC_UNDER_SANITIZER ? 1500ms : 400ms);
   ASSERT_TRUE(rig.live.status().vision->found) << "the gripped part took the tool away";
   // Lifted 30 um and carried 40 um right, 25 um down the image.
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
@@ -225,7 +225,7 @@ TEST(VisionPositioning, AHeldPartIsLiftedAndCarriedToTheClickedPoint) {
               static_cast<unsigned long long>(rig.live.status().vision->commands));
   // 0.135-0.279 um over 16 runs (docs/benchmarks.md): the held part's defocused top between the
   // fingers, static against them no more, still shades the templates' background. Bound 0.4 um.
-  EXPECT_LT((arrived - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.4e-6);
+  EXPECT_LT((arrived - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : 0.4e-6);
   const auto g = rig.live.status().grip_vision;
   ASSERT_TRUE(g.has_value());
   EXPECT_NEAR(g->grip_force_N, 0.5e-3, 0.025e-3) << g->state << " " << g->error;
@@ -236,7 +236,7 @@ TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
   const double m_per_px = p.platform.camera.m_per_px(p.platform.camera.objective);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const perception::PositionerStatus before = rig.live.status().vision.value();
   const Eigen::Vector2d start = rig.truth();
   // 30 px right, 20 px down: +x, -y on the stage (rows go down).
@@ -244,13 +244,13 @@ TEST(VisionPositioning, APixelOfTheImageIsAGoalForTheToolPoint) {
   rig.has_goal_px = true;
   rig.deadman = true;
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->in_position && s.vision->has_goal; },
-                       MC_UNDER_ASAN ? 30.0 : 8.0))
+                       MC_UNDER_SANITIZER ? 30.0 : 8.0))
       << rig.live.status().vision->state << " " << rig.live.status().vision->error;
   std::this_thread::sleep_for(300ms);
   rig.deadman = false;
   const Eigen::Vector2d moved = rig.truth() - start;
-  EXPECT_NEAR(moved.x(), 30.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
-  EXPECT_NEAR(moved.y(), -20.0 * m_per_px, MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  EXPECT_NEAR(moved.x(), 30.0 * m_per_px, MC_UNDER_SANITIZER ? 3e-6 : 0.3e-6);
+  EXPECT_NEAR(moved.y(), -20.0 * m_per_px, MC_UNDER_SANITIZER ? 3e-6 : 0.3e-6);
   const perception::PositionerStatus after = rig.live.status().vision.value();
   EXPECT_NEAR(after.goal_u_px, before.tool_u_px + 30.0, 1e-9);
   EXPECT_NEAR(after.goal_v_px, before.tool_v_px + 20.0, 1e-9);
@@ -266,7 +266,7 @@ TEST(VisionPositioning, AStageThatCannotComeCloserRestsWithinTheConvergedWindow)
   const double window_m = p.platform.stage.vision.servo.converged_m;
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
@@ -274,7 +274,7 @@ TEST(VisionPositioning, AStageThatCannotComeCloserRestsWithinTheConvergedWindow)
   std::string why;
   const auto rest = rig.converge_and_rest(why);
   ASSERT_TRUE(rest.has_value()) << why;
-  EXPECT_LT((*rest - goal).norm(), MC_UNDER_ASAN ? 3e-6 : window_m);
+  EXPECT_LT((*rest - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : window_m);
   // At rest: no run asked while it stays in position, the tips still.
   const std::uint64_t commands = rig.live.status().vision->commands;
   std::this_thread::sleep_for(500ms);
@@ -290,7 +290,7 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   const Eigen::Vector2d far_goal = home + Eigen::Vector2d(-250e-6, 150e-6);
   rig.goal = {far_goal.x(), far_goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;  // a goal, no deadman
@@ -301,7 +301,7 @@ TEST(VisionPositioning, NothingMovesWithoutTheDeadmanAndReleasingItStopsTheStage
 
   rig.deadman = true;  // it moves...
   ASSERT_TRUE(rig.wait([&](const LiveStatus&) { return (rig.truth() - home).norm() > 20e-6; },
-                       MC_UNDER_ASAN ? 20.0 : 5.0));
+                       MC_UNDER_SANITIZER ? 20.0 : 5.0));
   rig.deadman = false;                 // ...and stops at once on release (the run in flight is cut: 0 V)
   std::this_thread::sleep_for(100ms);  // the command's watchdog and the last tick
   const Eigen::Vector2d stopped = rig.truth();
@@ -319,11 +319,11 @@ TEST(VisionPositioning, TurnedFingersHoldTheStageWhileTurningThenAreFollowedTurn
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   rig.deadman = true;
   rig.theta_goal = 20.0 * M_PI / 180.0;  // about 2 s at the axis' 0.16 rad/s
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision->state == "hold (fingers turning)"; },
-                       MC_UNDER_ASAN ? 20.0 : 5.0));
+                       MC_UNDER_SANITIZER ? 20.0 : 5.0));
   const Eigen::Vector2d goal = home + Eigen::Vector2d(40e-6, -25e-6);
   rig.goal = {goal.x(), goal.y(), rig.live.params().platform.stage.home_z_m};
   rig.has_goal = true;
@@ -338,7 +338,7 @@ TEST(VisionPositioning, TurnedFingersHoldTheStageWhileTurningThenAreFollowedTurn
   const LiveStatus st = rig.live.status();
   std::printf("vision click-to-go with the fingers turned 20 deg: true error %.3f um\n",
               1e6 * (*rest - goal).norm());
-  EXPECT_LT((*rest - goal).norm(), MC_UNDER_ASAN ? 3e-6 : 0.3e-6);
+  EXPECT_LT((*rest - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : 0.3e-6);
   EXPECT_TRUE(st.vision->found);
 }
 
@@ -392,7 +392,7 @@ TEST(VisionPositioning, BadConfigurationsAndGoalsOutsideTheFrameAreRefusedInOneL
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
-                       MC_UNDER_ASAN ? 30.0 : 10.0));
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0));
   EXPECT_NE(rig.live.demo_unavailable_reason().find("encoders"), std::string::npos);
   const Eigen::Vector2d outside = home + Eigen::Vector2d(1.5e-3, 0.0);  // 5x sees +-0.42 mm
   rig.goal = {outside.x(), outside.y(), rig.live.params().platform.stage.home_z_m};

@@ -25,3 +25,8 @@
 #ifndef MC_UNDER_TSAN
 #define MC_UNDER_TSAN 0
 #endif
+
+/// MC_UNDER_SANITIZER: 1 under either sanitizer. Both slow the code they instrument several times
+/// (ThreadSanitizer more than AddressSanitizer on the camera's tracking), so a live test's
+/// timeouts and the precision it can reach in them get the sanitizer presets' wider bounds.
+#define MC_UNDER_SANITIZER (MC_UNDER_ASAN || MC_UNDER_TSAN)
