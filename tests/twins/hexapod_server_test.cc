@@ -79,7 +79,9 @@ TEST(HexapodServer, AClientReferencesMovesAndReadsThePoseOverTcp) {
   EXPECT_NE(c.gcs("*IDN?").find("C-887"), std::string::npos);
   EXPECT_EQ(byte_reply(c, 7), "\xb1\n");
   reference(c);
-  c.send("VLS 0.5\nMOV X 0.02 Y -0.01 Z 0.01 U 0.1 V 0.1 W -0.1\n");
+  // At 0.02 mm/s the move takes a second, so that #5 asked right after it reads every axis moving
+  // even when the sanitizers slow the reply by a tenth of a second.
+  c.send("VLS 0.02\nMOV X 0.02 Y -0.01 Z 0.01 U 0.1 V 0.1 W -0.1\n");
   EXPECT_EQ(byte_reply(c, 5), "3F\n");
   ASSERT_TRUE(wait_on_target(c));
   EXPECT_EQ(byte_reply(c, 5), "0\n");
