@@ -122,8 +122,8 @@ TEST(VisionPositioning, ClickToGoIsReachedByTheServoOnTheFramesAndTheStageRestsA
   LiveParams p = vision_params();
   const Eigen::Vector2d home(p.platform.stage.home_x_m, p.platform.stage.home_y_m);
   VisionRig rig(std::move(p));
-  ASSERT_TRUE(
-      rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; }, MC_UNDER_SANITIZER ? 30.0 : 10.0))
+  ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.vision && s.vision->taught; },
+                       MC_UNDER_SANITIZER ? 30.0 : 10.0))
       << "the tips' template was not taught: "
       << (rig.live.status().vision ? rig.live.status().vision->error : "");
   const Eigen::Vector2d start = rig.truth();
@@ -274,7 +274,11 @@ TEST(VisionPositioning, AStageThatCannotComeCloserRestsWithinTheConvergedWindow)
   std::string why;
   const auto rest = rig.converge_and_rest(why);
   ASSERT_TRUE(rest.has_value()) << why;
-  EXPECT_LT((*rest - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : window_m);
+  const perception::PositionerStatus seen = rig.live.status().vision.value();
+  EXPECT_LT((*rest - goal).norm(), MC_UNDER_SANITIZER ? 3e-6 : window_m)
+      << "the positioner saw " << seen.state << ", error " << seen.error_m << " m, tool at ("
+      << seen.tool_u_px << ", " << seen.tool_v_px << ") px for a goal at (" << seen.goal_u_px << ", "
+      << seen.goal_v_px << ") px";
   // At rest: no run asked while it stays in position, the tips still.
   const std::uint64_t commands = rig.live.status().vision->commands;
   std::this_thread::sleep_for(500ms);
