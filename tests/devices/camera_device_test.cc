@@ -22,6 +22,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// How long a frame may take to form: instrumented by a sanitizer on a loaded machine, the camera
+// thread can wait seconds for a core.
+constexpr std::chrono::seconds kFrameWait = MC_UNDER_SANITIZER ? 30s : 5s;
+
 platform::PlatformConfig camera_config() {
   test::register_test_camera();
   platform::PlatformConfig c;
@@ -63,7 +67,7 @@ TEST(Camera, FramesCarryTheLoopTimeAtMidExposureAndTheObjectiveAndFocusState) {
     platform.loop().run_for(100);
     const auto due =
         static_cast<std::size_t>(std::floor(static_cast<double>(ticks - 1) * dt / period + 1e-9)) + 1;
-    ASSERT_TRUE(test::eventually([&] { return got.size() >= due; }, 5s)) << due;
+    ASSERT_TRUE(test::eventually([&] { return got.size() >= due; }, kFrameWait)) << due;
   }
   std::lock_guard lock(got.mutex);
   ASSERT_EQ(got.frames.size(), 11u);
@@ -103,7 +107,7 @@ TEST(Camera, TheFocusDriveMovesAtItsSpeedWithinItsLimitsAndTheTurretChangesTheSc
   EXPECT_EQ(focus.objective(), 3);
   platform.camera()->set_sink([&](const CameraFrame& f) { got.add(f); });
   platform.loop().run_for(334);
-  ASSERT_TRUE(test::eventually([&] { return got.size() >= 1; }, 5s));
+  ASSERT_TRUE(test::eventually([&] { return got.size() >= 1; }, kFrameWait));
   std::lock_guard lock(got.mutex);
   const CameraFrame& f = got.frames.back();
   EXPECT_EQ(f.objective_name, "20x");
@@ -153,7 +157,8 @@ TEST(Camera, AStalledCameraThreadNeitherDelaysNorAllocatesOnTheLoop) {
   // from the moment it exists.
   double stalled_s = 0.0;
   std::thread runner([&] { stalled_s = run(stalled); });
-  ASSERT_TRUE(test::eventually([&] { return stalled.loop().thread_id() != std::this_thread::get_id(); }, 5s));
+  ASSERT_TRUE(
+      test::eventually([&] { return stalled.loop().thread_id() != std::this_thread::get_id(); }, kFrameWait));
   std::size_t allocations = 0;
   {
     test::AllocationGuard guard(stalled.loop().thread_id());
@@ -196,7 +201,7 @@ TEST(Camera, ACameraThatFailsPutsEveryDeviceInItsSafeState) {
   platform::Platform platform(config);
   platform.camera()->set_sink([&](const CameraFrame&) { frames.fetch_add(1); });
   platform.loop().run_for(334);
-  ASSERT_TRUE(test::eventually([&] { return frames.load() >= 1; }, 5s));
+  ASSERT_TRUE(test::eventually([&] { return frames.load() >= 1; }, kFrameWait));
   test::test_camera().fail.store(true);
   EXPECT_TRUE(test::eventually(
       [&] {
