@@ -101,7 +101,8 @@ for (const k of counts.keys()) counts.set(k, 0);
 await sleep(3000);
 const rates = Object.fromEntries([...counts].map(([k, n]) => [k, n / 3]));
 log("rates [Hz]: " + JSON.stringify(rates));
-const expect = { "/platform/telemetry": [50, 70], "/console/feedback": [50, 70], "/platform/status": [4, 6], "/platform/scene": [0.6, 1.5] };
+const expect = { "/platform/telemetry": [50, 70], "/console/feedback": [50, 70], "/platform/status": [4, 6], "/platform/scene": [0.6, 1.5],
+                 "/tf": [50, 70], "/robot/scene": [0.6, 1.5] };
 for (const [topic, [lo, hi]] of Object.entries(expect))
   if (!(rates[topic] >= lo && rates[topic] <= hi)) fail(`${topic} at ${rates[topic]} Hz, expected ${lo}-${hi}`);
 if (schemaErrors.length) fail("messages off their schema: " + schemaErrors.join("; "));

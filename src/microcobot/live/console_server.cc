@@ -62,6 +62,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       server_(params_.server, "microcobot",
               {{"/", {"text/html; charset=utf-8", console_page()}},
                {"/index.html", {"text/html; charset=utf-8", console_page()}}}),
+      frames_(live.telemetry_schema()),
       rumble_(params_.rumble_crossover_Hz, kTelemetryRate_Hz, params_.rumble_full_scale_N) {
   decimation_ =
       static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
@@ -149,6 +150,10 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
+  tf_ch_ = server_.add_channel(
+      {"/tf", "json", "foxglove.FrameTransforms", "jsonschema", RobotFrames::transforms_schema()});
+  robot_scene_ch_ = server_.add_channel(
+      {"/robot/scene", "json", "foxglove.SceneUpdate", "jsonschema", RobotFrames::scene_update_schema()});
   if (live_.has_camera()) {
     // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
     image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
@@ -264,6 +269,10 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   json_.clear();
   platform::telemetry_to_json(live_.telemetry_schema(), sample, json_);
   server_.publish(telemetry_ch_, ns, json_);  // recorded at full rate above
+  if (server_.subscriber_count(tf_ch_) > 0) {
+    frames_.transforms_json(s, tf_json_);
+    server_.publish(tf_ch_, ns, tf_json_);
+  }
   const double rumble = rumble_.take();
   auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
   const json f = {{"t_s", s[0]},
@@ -493,8 +502,14 @@ void ConsoleServer::status_thread() {
     live_.drain_link_costs(link_cost_);
     update_camera_demand();
     publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
-    if (n++ % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0)
+    if (n % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0) {
       publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());
+      if (server_.subscriber_count(robot_scene_ch_) > 0)
+        server_.publish(robot_scene_ch_,
+                        static_cast<std::uint64_t>(std::llround(std::max(0.0, now_status.t_s) * 1e9)),
+                        robot_scene_json(now_status.t_s));
+    }
+    ++n;
     note_changes(now_status);
   }
 }

@@ -7,6 +7,10 @@
 ///   /platform/status      5 Hz   e-stop, control, watchdog, lifecycles, tick p99, recording
 ///   /platform/scene       1 Hz   geometry and limits the microscope view needs
 ///   /console/feedback    60 Hz   contact and grip forces, the vibrotactile channel
+///   /tf                  60 Hz   the frames of the tool, gripper, fingers and part,
+///                                foxglove.FrameTransforms (live/robot_frames.h)
+///   /robot/scene          1 Hz   the fingers and the part as boxes in their frames,
+///                                foxglove.SceneUpdate: Foxglove's 3D panel draws the platform
 ///   /camera/image/compressed     every camera frame, sensor_msgs/msg/CompressedImage (CDR, JPEG)
 ///   /camera/preview/compressed   the same frames binned to the console's 640 px panel
 ///                                (live/camera_preview.h), encoded only while someone watches
@@ -49,6 +53,7 @@
 #include "microcobot/live/contact_rumble.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
+#include "microcobot/live/robot_frames.h"
 #include "microcobot/live/session_recording.h"
 #include "microcobot/runtime/timing_stats.h"
 #include "microcobot/server/foxglove_server.h"
@@ -115,6 +120,8 @@ class ConsoleServer {
   void update_camera_demand();
   std::string status_json();
   std::string scene_json() const;
+  /// The bodies of the 3-D view (foxglove.SceneUpdate) of the current scene.
+  std::string robot_scene_json(double t_s) const;
   /// Publishes to the clients and records (loop time t_s).
   void publish(server::ChannelId ch, RecordedTopic topic, double t_s, const std::string& payload);
   /// A status to one client (0: every client), recorded as an event of `kind`.
@@ -130,6 +137,8 @@ class ConsoleServer {
   server::FoxgloveServer server_;
   server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
   server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0, preview_ch_ = 0;
+  server::ChannelId tf_ch_ = 0, robot_scene_ch_ = 0;
+  RobotFrames frames_;  // the 3-D view's frame tree, from the telemetry's channels
   std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
   std::unique_ptr<CameraPreview> preview_;          // camera thread only
   std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera
@@ -143,7 +152,7 @@ class ConsoleServer {
   // Drain thread only.
   std::size_t decimation_ = 17, countdown_ = 0;
   ContactRumble rumble_;  // the feedback's vibrotactile channel
-  std::string json_;
+  std::string json_, tf_json_;
   runtime::TimingStats ticks_;      // the telemetry's tick_us, per second
   runtime::TimingStats ticks_cpu_;  // its tick_cpu_us, per second
 

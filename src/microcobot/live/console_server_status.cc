@@ -48,6 +48,15 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
   last_status_ = s;
 }
 
+std::string ConsoleServer::robot_scene_json(double t_s) const {
+  RobotBodies b;
+  b.part_side_m = live_.part_side_m();
+  b.part_height_m = live_.part_height_m();
+  b.finger_width_m = live_.finger_width_m();
+  b.finger_length_m = live_.finger_length_m();
+  return frames_.scene_update_json(b, t_s);
+}
+
 std::string ConsoleServer::scene_json() const {
   const auto& c = live_.limits();
   json j{{"kind", "pick-place"},

@@ -196,6 +196,7 @@ class LivePlatform {
   }
   /// The fingers' width as the camera sees them (world.gripper.finger_width_m).
   double finger_width_m() const { return scene_world().gripper.finger_width_m; }
+  double finger_length_m() const { return scene_world().gripper.finger_length_m; }
   /// Why the scripted demo cannot run here (empty: it can).
   std::string demo_unavailable_reason() const;
   /// The force limits the platform enforces (teleop/safety_limits.h).

@@ -1,0 +1,150 @@
+#include "microcobot/live/robot_frames.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+namespace mc::live {
+namespace {
+
+using nlohmann::json;
+
+double finite(double v) { return std::isfinite(v) ? v : 0.0; }
+
+json stamp(double t_s) {
+  const double t = std::isfinite(t_s) && t_s > 0.0 ? t_s : 0.0;
+  const double sec = std::floor(t);
+  auto nsec = static_cast<std::int64_t>(std::llround((t - sec) * 1e9));
+  auto whole = static_cast<std::int64_t>(sec);
+  if (nsec >= 1000000000) {  // rounding carried into the next second
+    nsec -= 1000000000;
+    ++whole;
+  }
+  return {{"sec", whole}, {"nsec", nsec}};
+}
+
+/// A rotation by `yaw` about z as a unit quaternion.
+json about_z(double yaw) {
+  const double a = 0.5 * finite(yaw);
+  return {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(a)}, {"w", std::cos(a)}};
+}
+
+json transform(const json& time, const char* parent, const char* child, double x, double y, double z,
+               double yaw) {
+  return {{"timestamp", time},
+          {"parent_frame_id", parent},
+          {"child_frame_id", child},
+          {"translation", {{"x", finite(x)}, {"y", finite(y)}, {"z", finite(z)}}},
+          {"rotation", about_z(yaw)}};
+}
+
+json box(double cx, double cy, double cz, double sx, double sy, double sz, std::array<double, 4> rgba) {
+  return {{"pose",
+           {{"position", {{"x", cx}, {"y", cy}, {"z", cz}}},
+            {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}, {"w", 1.0}}}}},
+          {"size", {{"x", sx}, {"y", sy}, {"z", sz}}},
+          {"color", {{"r", rgba[0]}, {"g", rgba[1]}, {"b", rgba[2]}, {"a", rgba[3]}}}};
+}
+
+/// A scene entity holding boxes only, in `frame`, kept until replaced (lifetime 0).
+json entity(const json& time, const char* frame, const char* id, json cubes) {
+  const json none = json::array();
+  return {
+      {"timestamp", time},    {"frame_id", frame}, {"id", id},       {"lifetime", {{"sec", 0}, {"nsec", 0}}},
+      {"frame_locked", true}, {"metadata", none},  {"arrows", none}, {"cubes", std::move(cubes)},
+      {"spheres", none},      {"cylinders", none}, {"lines", none},  {"triangles", none},
+      {"texts", none},        {"models", none}};
+}
+
+}  // namespace
+
+RobotFrames::RobotFrames(const platform::TelemetrySchema& schema)
+    : x_(schema.index("measured_x_m")),
+      y_(schema.index("measured_y_m")),
+      z_(schema.index("measured_z_m")),
+      theta_(schema.index("measured_theta_rad")),
+      opening_(schema.index("gripper_opening_m")) {
+  const auto px = schema.find("part_x_m"), py = schema.find("part_y_m"), pz = schema.find("part_z_m"),
+             yaw = schema.find("part_yaw_rad");
+  if (px && py && pz && yaw) part_ = PartChannels{*px, *py, *pz, *yaw};
+}
+
+void RobotFrames::transforms_json(const platform::TelemetrySample& s, std::string& out) const {
+  const json t = stamp(s[0]);
+  const double half = 0.5 * std::max(0.0, finite(s[opening_]));
+  json list = json::array({transform(t, "world", "tool", s[x_], s[y_], s[z_], 0.0),
+                           transform(t, "tool", "gripper", 0.0, 0.0, 0.0, s[theta_]),
+                           transform(t, "gripper", "finger_left", 0.0, half, 0.0, 0.0),
+                           transform(t, "gripper", "finger_right", 0.0, -half, 0.0, 0.0)});
+  if (part_)
+    list.push_back(transform(t, "world", "part", s[part_->x], s[part_->y], s[part_->z], s[part_->yaw]));
+  out = json{{"transforms", std::move(list)}}.dump();
+}
+
+std::string RobotFrames::scene_update_json(const RobotBodies& b, double t_s) const {
+  const json t = stamp(t_s);
+  const std::array<double, 4> steel{0.62, 0.66, 0.70, 1.0}, brass{0.85, 0.65, 0.25, 1.0};
+  json entities = json::array();
+  // Each finger hangs from the tool point: its box's top at the tool point's height.
+  const double w = b.finger_width_m, l = b.finger_length_m;
+  if (w > 0.0 && l > 0.0) {
+    entities.push_back(
+        entity(t, "finger_left", "finger_left", json::array({box(0, 0, -0.5 * l, w, w, l, steel)})));
+    entities.push_back(
+        entity(t, "finger_right", "finger_right", json::array({box(0, 0, -0.5 * l, w, w, l, steel)})));
+  }
+  // The part's pose is its base's centre: the box stands on it.
+  if (part_ && b.part_side_m > 0.0 && b.part_height_m > 0.0)
+    entities.push_back(entity(t, "part", "part",
+                              json::array({box(0, 0, 0.5 * b.part_height_m, b.part_side_m, b.part_side_m,
+                                               b.part_height_m, brass)})));
+  return json{{"deletions", json::array()}, {"entities", std::move(entities)}}.dump();
+}
+
+std::string RobotFrames::transforms_schema() {
+  const json number = {{"type", "number"}};
+  const json time = {{"type", "object"},
+                     {"properties", {{"sec", {{"type", "integer"}}}, {"nsec", {{"type", "integer"}}}}}};
+  const json xyz = {{"type", "object"}, {"properties", {{"x", number}, {"y", number}, {"z", number}}}};
+  const json quat = {{"type", "object"},
+                     {"properties", {{"x", number}, {"y", number}, {"z", number}, {"w", number}}}};
+  const json tf = {{"type", "object"},
+                   {"properties",
+                    {{"timestamp", time},
+                     {"parent_frame_id", {{"type", "string"}}},
+                     {"child_frame_id", {{"type", "string"}}},
+                     {"translation", xyz},
+                     {"rotation", quat}}}};
+  return json{{"title", "foxglove.FrameTransforms"},
+              {"type", "object"},
+              {"properties", {{"transforms", {{"type", "array"}, {"items", tf}}}}}}
+      .dump();
+}
+
+std::string RobotFrames::scene_update_schema() {
+  const json array = {{"type", "array"}};
+  const json entity = {{"type", "object"},
+                       {"properties",
+                        {{"timestamp", {{"type", "object"}}},
+                         {"frame_id", {{"type", "string"}}},
+                         {"id", {{"type", "string"}}},
+                         {"lifetime", {{"type", "object"}}},
+                         {"frame_locked", {{"type", "boolean"}}},
+                         {"metadata", array},
+                         {"arrows", array},
+                         {"cubes", array},
+                         {"spheres", array},
+                         {"cylinders", array},
+                         {"lines", array},
+                         {"triangles", array},
+                         {"texts", array},
+                         {"models", array}}}};
+  return json{{"title", "foxglove.SceneUpdate"},
+              {"type", "object"},
+              {"properties", {{"deletions", array}, {"entities", {{"type", "array"}, {"items", entity}}}}}}
+      .dump();
+}
+
+}  // namespace mc::live
