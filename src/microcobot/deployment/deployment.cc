@@ -14,6 +14,7 @@
 #include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/microscope_link.h"
+#include "microcobot/net/tf_publisher.h"
 #include "microcobot/twins/live_stage.h"
 #include "microcobot/twins/twin_server.h"
 
@@ -111,6 +112,9 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
   // The slave's camera on DDS as a ROS 2 image topic (built before the server that calls it).
   if (o.role == Role::kSlave && live.has_camera())
     images_ = std::make_unique<net::CameraImagePublisher>(o.domain, network);
+  // The slave's frames on DDS as ROS 2's /tf.
+  if (o.role == Role::kSlave)
+    frames_ = std::make_unique<net::TfPublisher>(o.domain, network, live.telemetry_schema());
   // The microscope's focus and turret on DDS: the slave takes them from any peer, the master
   // sends its operator's (net/microscope_link.h).
   if (o.role == Role::kSlave && live.has_camera()) {
@@ -139,6 +143,11 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
          [p = images_.get()] { return p->wanted(); }});
     log_(fmt::format("camera images on DDS, ROS 2 topic {} ({})", net::kCameraImageRosName,
                      net::kCameraImageTypeName));
+  }
+  if (frames_) {
+    server_->add_sample_consumer([p = frames_.get()](const platform::TelemetrySample& s) { p->publish(s); });
+    log_(fmt::format("the tool, gripper, fingers and part on DDS, ROS 2 topic {} ({})", net::kTfRosName,
+                     net::kTfTypeName));
   }
   // The vendor-protocol twins: their own thread, the live platform reached through its ring.
   if (!o.twins.empty()) {

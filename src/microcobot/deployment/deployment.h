@@ -26,6 +26,7 @@
 
 namespace mc::net {
 class CameraImagePublisher;
+class TfPublisher;
 class MicroscopeClient;
 class MicroscopeServer;
 class RemoteMaster;
@@ -100,6 +101,7 @@ class Deployment {
   std::unique_ptr<net::RemoteMaster> remote_master_;
   std::unique_ptr<live::LivePlatform> live_;
   std::unique_ptr<net::CameraImagePublisher> images_;
+  std::unique_ptr<net::TfPublisher> frames_;
   std::unique_ptr<net::MicroscopeServer> microscope_server_;
   std::unique_ptr<net::MicroscopeClient> microscope_client_;
   std::unique_ptr<live::ConsoleServer> server_;

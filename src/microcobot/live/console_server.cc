@@ -273,6 +273,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
     frames_.transforms_json(s, tf_json_);
     server_.publish(tf_ch_, ns, tf_json_);
   }
+  for (const SampleConsumer& c : sample_consumers_) c(s);
   const double rumble = rumble_.take();
   auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
   const json f = {{"t_s", s[0]},
@@ -309,6 +310,11 @@ void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
 void ConsoleServer::add_frame_consumer(FrameConsumer consumer) {
   if (started_) throw InvalidInput("console server: add frame consumers before start()");
   frame_consumers_.push_back(std::move(consumer));
+}
+
+void ConsoleServer::add_sample_consumer(SampleConsumer consumer) {
+  if (started_) throw InvalidInput("console server: add sample consumers before start()");
+  sample_consumers_.push_back(std::move(consumer));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,

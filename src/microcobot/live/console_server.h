@@ -93,6 +93,10 @@ class ConsoleServer {
     std::function<bool()> wanted;
   };
   void add_frame_consumer(FrameConsumer consumer);
+  /// Another consumer of the telemetry (e.g. the frames on DDS, net/tf_publisher): called on the
+  /// drain thread with each sample sent to the clients (60 Hz), never on the loop. Before start().
+  using SampleConsumer = std::function<void(const platform::TelemetrySample&)>;
+  void add_sample_consumer(SampleConsumer consumer);
   void start();
   /// The console's URL, with the token when one is needed.
   std::string url() const;
@@ -143,6 +147,7 @@ class ConsoleServer {
   std::unique_ptr<CameraPreview> preview_;          // camera thread only
   std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera
   std::vector<FrameConsumer> frame_consumers_;      // set before start()
+  std::vector<SampleConsumer> sample_consumers_;    // set before start()
 
   std::atomic<server::ClientId> controller_{0};
   std::atomic<bool> quit_{false};

@@ -31,8 +31,8 @@ json about_z(double yaw) {
   return {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(a)}, {"w", std::cos(a)}};
 }
 
-json transform(const json& time, const char* parent, const char* child, double x, double y, double z,
-               double yaw) {
+json transform(const json& time, std::string_view parent, std::string_view child, double x, double y,
+               double z, double yaw) {
   return {{"timestamp", time},
           {"parent_frame_id", parent},
           {"child_frame_id", child},
@@ -71,15 +71,25 @@ RobotFrames::RobotFrames(const platform::TelemetrySchema& schema)
   if (px && py && pz && yaw) part_ = PartChannels{*px, *py, *pz, *yaw};
 }
 
+std::size_t RobotFrames::transforms(const platform::TelemetrySample& s, FrameTransforms& out) const {
+  const double half = 0.5 * std::max(0.0, finite(s[opening_]));
+  out[0] = {"world", "tool", finite(s[x_]), finite(s[y_]), finite(s[z_]), 0.0};
+  out[1] = {"tool", "gripper", 0.0, 0.0, 0.0, finite(s[theta_])};
+  out[2] = {"gripper", "finger_left", 0.0, half, 0.0, 0.0};
+  out[3] = {"gripper", "finger_right", 0.0, -half, 0.0, 0.0};
+  if (!part_) return 4;
+  out[4] = {
+      "world", "part", finite(s[part_->x]), finite(s[part_->y]), finite(s[part_->z]), finite(s[part_->yaw])};
+  return 5;
+}
+
 void RobotFrames::transforms_json(const platform::TelemetrySample& s, std::string& out) const {
   const json t = stamp(s[0]);
-  const double half = 0.5 * std::max(0.0, finite(s[opening_]));
-  json list = json::array({transform(t, "world", "tool", s[x_], s[y_], s[z_], 0.0),
-                           transform(t, "tool", "gripper", 0.0, 0.0, 0.0, s[theta_]),
-                           transform(t, "gripper", "finger_left", 0.0, half, 0.0, 0.0),
-                           transform(t, "gripper", "finger_right", 0.0, -half, 0.0, 0.0)});
-  if (part_)
-    list.push_back(transform(t, "world", "part", s[part_->x], s[part_->y], s[part_->z], s[part_->yaw]));
+  FrameTransforms f;
+  const std::size_t n = transforms(s, f);
+  json list = json::array();
+  for (std::size_t i = 0; i < n; ++i)
+    list.push_back(transform(t, f[i].parent, f[i].child, f[i].x_m, f[i].y_m, f[i].z_m, f[i].yaw_rad));
   out = json{{"transforms", std::move(list)}}.dump();
 }
 

@@ -18,9 +18,11 @@
 /// width): they move only through the transforms, so the scene is sent again only when the scene
 /// changes (a restart, another scene). Built on the drain and status threads, never on the loop.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "microcobot/platform/telemetry_schema.h"
 
@@ -34,12 +36,24 @@ struct RobotBodies {
   double finger_length_m = 0.0;  ///< a finger's length, down from the tool point's height
 };
 
+/// One transform of the tree: `child`'s origin at (x, y, z) in `parent`, turned by `yaw` about z.
+struct FrameTransform {
+  std::string_view parent, child;  ///< views of string literals (null-terminated, static)
+  double x_m = 0.0, y_m = 0.0, z_m = 0.0, yaw_rad = 0.0;
+};
+/// The most transforms a sample gives (tool, gripper, two fingers, part).
+inline constexpr std::size_t kMaxRobotFrames = 5;
+using FrameTransforms = std::array<FrameTransform, kMaxRobotFrames>;
+
 class RobotFrames {
  public:
   /// Reads the channels it needs from `schema`. Throws mc::InvalidParams naming a built-in
   /// channel the schema lacks; the part's channels are optional.
   explicit RobotFrames(const platform::TelemetrySchema& schema);
 
+  /// The transforms of one sample into `out`; returns how many (4, or 5 with the part). Non-finite
+  /// values become 0 (a viewer must not get NaN). Allocates nothing.
+  std::size_t transforms(const platform::TelemetrySample& s, FrameTransforms& out) const;
   /// foxglove.FrameTransforms of one sample (its loop time stamps every transform), into `out`
   /// (replaced). Non-finite values are sent as 0 (a viewer must not get NaN).
   void transforms_json(const platform::TelemetrySample& s, std::string& out) const;

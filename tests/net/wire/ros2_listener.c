@@ -4,7 +4,7 @@
  * name, and prints what it reads. The wire-compatibility test (wire_compat_test.cc) checks the
  * values against what `microcobot link ping` publishes.
  *
- *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag|image
+ *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag|image|tf
  *                 [--count K] [--timeout S] [--ready-file PATH]
  *
  * Waits for K samples (default 1) and prints each as one JSON line on stdout, then exits 0.
@@ -18,7 +18,8 @@
  * local, keep last 1 so that the current state arrives even when published before the start;
  * /diagnostics (diag) reliable, volatile, keep last 1. Images (sensor_msgs/msg/CompressedImage,
  * the camera's frames) are best effort like the state topics; their JPEG is decoded here
- * (libjpeg-turbo's C API) and printed as its width, height and mean grey level.
+ * (libjpeg-turbo's C API) and printed as its width, height and mean grey level. /tf (tf2_msgs/msg/TFMessage)
+ * is read as tf2_ros's TransformListener does: reliable, volatile, keep last 100.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -37,7 +38,7 @@
 
 #include "loopback_config.h"
 
-enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag, kImage };
+enum MsgType { kPose, kWrench, kVector3, kJoint, kBool, kDiag, kImage, kTf };
 
 struct Options {
   long domain;
@@ -51,7 +52,7 @@ struct Options {
 static int usage(const char* msg, const char* arg) {
   fprintf(stderr,
           "ros2_listener: %s%s%s (usage: --domain N --topic /ros/name --type "
-          "pose|wrench|vector3|joint|bool|diag|image "
+          "pose|wrench|vector3|joint|bool|diag|image|tf "
           "[--count K] [--timeout S] [--ready-file PATH])\n",
           msg, arg ? ": " : "", arg ? arg : "");
   return 2;
@@ -108,8 +109,10 @@ static int parse_args(int argc, char** argv, struct Options* o, int* rc) {
         o->type = kDiag;
       } else if (strcmp(value, "image") == 0) {
         o->type = kImage;
+      } else if (strcmp(value, "tf") == 0) {
+        o->type = kTf;
       } else {
-        *rc = usage("--type must be pose, wrench, vector3, joint, bool, diag or image", value);
+        *rc = usage("--type must be pose, wrench, vector3, joint, bool, diag, image or tf", value);
         return 0;
       }
       have_type = 1;
@@ -292,6 +295,33 @@ static void print_sample(const struct Options* o, const char* type_name, const v
       put_jpeg(m);
       break;
     }
+    case kTf: {
+      const tf2_msgs_msg_dds__TFMessage_* m = sample;
+      fputs("{\"topic\":", stdout);
+      put_string(o->topic);
+      fputs(",\"type\":", stdout);
+      put_string(type_name);
+      fputs(",\"transforms\":[", stdout);
+      for (uint32_t i = 0; i < m->transforms_._length; ++i) {
+        const geometry_msgs_msg_dds__TransformStamped_* t = &m->transforms_._buffer[i];
+        const double xyz[3] = {t->transform_.translation_.x_, t->transform_.translation_.y_,
+                               t->transform_.translation_.z_};
+        const double q[4] = {t->transform_.rotation_.x_, t->transform_.rotation_.y_, t->transform_.rotation_.z_,
+                             t->transform_.rotation_.w_};
+        printf("%s{\"stamp\":{\"sec\":%d,\"nanosec\":%u},\"parent\":", i ? "," : "",
+               (int)t->header_.stamp_.sec_, (unsigned)t->header_.stamp_.nanosec_);
+        put_string(t->header_.frame_id_);
+        fputs(",\"child\":", stdout);
+        put_string(t->child_frame_id_);
+        fputs(",\"translation\":", stdout);
+        put_doubles(xyz, 3);
+        fputs(",\"rotation\":", stdout);
+        put_doubles(q, 4);
+        putchar('}');
+      }
+      putchar(']');
+      break;
+    }
     case kBool: {
       const std_msgs_msg_dds__Bool_* m = sample;
       fputs("{\"topic\":", stdout);
@@ -324,6 +354,8 @@ static const dds_topic_descriptor_t* descriptor(enum MsgType t) {
       return &diagnostic_msgs_msg_dds__DiagnosticArray__desc;
     case kImage:
       return &sensor_msgs_msg_dds__CompressedImage__desc;
+    case kTf:
+      return &tf2_msgs_msg_dds__TFMessage__desc;
   }
   return NULL;
 }
@@ -359,14 +391,14 @@ static int run_listener(const struct Options* o) {
   if (o->type == kBool) {
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-  } else if (o->type == kDiag) {
+  } else if (o->type == kDiag || o->type == kTf) {
     dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
   } else {
     dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
   }
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, o->type == kTf ? 100 : 1);
   const dds_entity_t reader = dds_create_reader(pp, topic, qos, NULL);
   dds_delete_qos(qos);
   if (reader < 0) {

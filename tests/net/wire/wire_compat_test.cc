@@ -317,6 +317,53 @@ TEST(WireCompat, ACProgramReadsTheSlavesCameraImagesAndDecodesTheirJpeg) {
   }
 }
 
+// The frames as any tf2 listener reads them: a plain C program built from ROS 2's IDL takes /tf
+// (tf2_msgs/msg/TFMessage) from a real `serve --role slave`: the tree of live/robot_frames.h, unit
+// quaternions, every transform of a message stamped alike, stamps moving on in loop time.
+TEST(WireCompat, ACProgramReadsTheSlavesFramesOnTf) {
+  TempDir dir;
+  Reaper reaper;
+  const std::string domain = std::to_string(net::test::test_domain_id());
+  const pid_t listener = test::spawn_process({MC_ROS2_LISTENER_PATH, "--domain", domain, "--topic", "/tf",
+                                              "--type", "tf", "--count", "10", "--timeout", "40"},
+                                             dir / "listener.out", dir / "listener.err");
+  reaper.pids.push_back(listener);
+  const pid_t slave =
+      test::spawn_process({MC_CLI_PATH, "serve", "--role", "slave", "--domain", domain, "--listen",
+                           "127.0.0.1:0", "--out", (dir / "slave").string(), "--duration", "60"},
+                          dir / "slave.out", dir / "slave.err");
+  reaper.pids.push_back(slave);
+  ASSERT_EQ(test::wait_process(listener, std::chrono::seconds(50)), 0)
+      << test::read_text(dir / "listener.err");
+  ::kill(slave, SIGTERM);
+  EXPECT_EQ(test::wait_process(slave, std::chrono::seconds(30)), 0) << test::read_text(dir / "slave.err");
+  EXPECT_NE(test::read_text(dir / "slave.err").find("ROS 2 topic /tf"), std::string::npos);
+
+  const std::vector<json> samples = json_lines(test::read_text(dir / "listener.out"));
+  ASSERT_EQ(samples.size(), 10u);
+  double last_s = -1.0;
+  for (const json& m : samples) {
+    EXPECT_EQ(m["type"], "tf2_msgs::msg::dds_::TFMessage_") << m;
+    std::map<std::string, std::string> parent;
+    ASSERT_EQ(m["transforms"].size(), 5u) << "tool, gripper, two fingers and the simulated part: " << m;
+    const json& first = m["transforms"][0]["stamp"];
+    for (const json& t : m["transforms"]) {
+      parent[t["child"].get<std::string>()] = t["parent"].get<std::string>();
+      EXPECT_EQ(t["stamp"], first) << "one sample, one stamp: " << m;
+      const auto q = t["rotation"].get<std::vector<double>>();
+      EXPECT_NEAR(std::hypot(std::hypot(q[0], q[1]), std::hypot(q[2], q[3])), 1.0, 1e-12) << t;
+    }
+    EXPECT_EQ(parent["tool"], "world");
+    EXPECT_EQ(parent["gripper"], "tool");
+    EXPECT_EQ(parent["finger_left"], "gripper");
+    EXPECT_EQ(parent["finger_right"], "gripper");
+    EXPECT_EQ(parent["part"], "world");
+    const double t_s = first["sec"].get<double>() + 1e-9 * first["nanosec"].get<double>();
+    EXPECT_GT(t_s, last_s) << m;
+    last_s = t_s;
+  }
+}
+
 // The microscope as any ROS 2 node sets it: a plain C program publishes a
 // latched JointState command (focus 150 um, objective 2) to a real `serve --role slave`; the C
 // listener then reads the slave's state topic: the drive went there and the turret turned.

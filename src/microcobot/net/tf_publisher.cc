@@ -1,0 +1,60 @@
+#include "microcobot/net/tf_publisher.h"
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "microcobot/live/camera_messages.h"
+#include "ros2_messages.h"
+
+namespace mc::net {
+
+TfPublisher::TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema)
+    : participant_(domain_id, network), frames_(schema) {
+  const dds_entity_t pp = participant_.handle();
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 100);
+  topic_ =
+      dds_create_topic(pp, &tf2_msgs_msg_dds__TFMessage__desc, std::string(kTfDdsName).c_str(), qos, nullptr);
+  if (topic_ >= 0) writer_ = dds_create_writer(pp, topic_, qos, nullptr);
+  dds_delete_qos(qos);
+  check_dds(topic_, "frames: cannot create the /tf topic");
+  check_dds(writer_, "frames: cannot create the /tf writer");
+}
+
+// The participant's deletion (its destructor) deletes the topic and the writer with it.
+TfPublisher::~TfPublisher() = default;
+
+bool TfPublisher::publish(const platform::TelemetrySample& s) {
+  live::FrameTransforms f;
+  const std::size_t n = frames_.transforms(s, f);
+  const live::RosTime stamp = live::ros_time(s[0]);
+  // The frame names as C strings for the generated type (string views of literals: terminated).
+  std::array<geometry_msgs_msg_dds__TransformStamped_, live::kMaxRobotFrames> list{};
+  for (std::size_t i = 0; i < n; ++i) {
+    geometry_msgs_msg_dds__TransformStamped_& t = list[i];
+    t.header_.stamp_.sec_ = stamp.sec;
+    t.header_.stamp_.nanosec_ = stamp.nanosec;
+    // The generated type holds non-const pointers; dds_write only reads them.
+    t.header_.frame_id_ = const_cast<char*>(f[i].parent.data());
+    t.child_frame_id_ = const_cast<char*>(f[i].child.data());
+    t.transform_.translation_ = {f[i].x_m, f[i].y_m, f[i].z_m};
+    // A rotation by yaw about z: q = (0, 0, sin(yaw / 2), cos(yaw / 2)).
+    t.transform_.rotation_ = {0.0, 0.0, std::sin(0.5 * f[i].yaw_rad), std::cos(0.5 * f[i].yaw_rad)};
+  }
+  tf2_msgs_msg_dds__TFMessage_ m{};
+  m.transforms_._buffer = list.data();
+  m.transforms_._length = static_cast<std::uint32_t>(n);
+  m.transforms_._maximum = m.transforms_._length;
+  m.transforms_._release = false;
+  if (dds_write(writer_, &m) < 0) {
+    ++failures_;
+    return false;
+  }
+  ++published_;
+  return true;
+}
+
+}  // namespace mc::net
