@@ -6,6 +6,7 @@
 #include <cstring>
 #include <deque>
 #include <mutex>
+#include <optional>
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -157,20 +158,46 @@ void H264Encoder::encode(const VideoImage& image, double t_s, std::uint64_t tag,
     throw InvalidInput("h264: " + std::to_string(image.data.size()) + " bytes for a " +
                        std::to_string(image.width) + "x" + std::to_string(image.height) + " image of " +
                        std::to_string(image.channels) + " channel(s)");
-  const int w = image.width & ~1, h = image.height & ~1;
+  if (held_) encode_held(t_s, sink);
+  held_samples_.assign(image.data.begin(), image.data.end());
+  held_width_ = image.width;
+  held_height_ = image.height;
+  held_channels_ = image.channels;
+  held_t_s_ = t_s;
+  held_tag_ = tag;
+  held_ = true;
+}
+
+void H264Encoder::flush(const Sink& sink) {
+  if (held_) encode_held(std::nullopt, sink);
+  end_stream(sink);
+}
+
+void H264Encoder::end_stream(const Sink& sink) {
+  if (!codec_) return;
+  if (const int rc = avcodec_send_frame(codec_->context, nullptr); rc < 0 && rc != AVERROR_EOF)
+    throw ComputationFailed("h264: flushing failed: " + av_error(rc));
+  drain(sink);
+  codec_.reset();  // the next frame starts a new stream
+}
+
+void H264Encoder::encode_held(std::optional<double> next_t_s, const Sink& sink) {
+  held_ = false;
+  const int w = held_width_ & ~1, h = held_height_ & ~1;
   if (!codec_ || codec_->width != w || codec_->height != h) {
-    if (codec_) flush(sink);
+    end_stream(sink);
     open(w, h);
   }
   Codec& c = *codec_;
   AVFrame* f = c.frame;
   if (const int rc = av_frame_make_writable(f); rc < 0)
     throw ComputationFailed("h264: frame not writable: " + av_error(rc));
-  const std::size_t stride = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.channels);
-  if (image.channels == 1) {
+  const std::uint8_t* samples = held_samples_.data();
+  const std::size_t stride = static_cast<std::size_t>(held_width_) * static_cast<std::size_t>(held_channels_);
+  if (held_channels_ == 1) {
     for (int y = 0; y < h; ++y)
       std::memcpy(f->data[0] + static_cast<std::ptrdiff_t>(y) * f->linesize[0],
-                  image.data.data() + static_cast<std::size_t>(y) * stride, static_cast<std::size_t>(w));
+                  samples + static_cast<std::size_t>(y) * stride, static_cast<std::size_t>(w));
     for (int y = 0; y < h / 2; ++y) {
       std::memset(f->data[1] + static_cast<std::ptrdiff_t>(y) * f->linesize[1], 128,
                   static_cast<std::size_t>(w / 2));
@@ -184,8 +211,8 @@ void H264Encoder::encode(const VideoImage& image, double t_s, std::uint64_t tag,
         double r = 0, g = 0, b = 0;
         for (int dy = 0; dy < 2; ++dy)
           for (int dx = 0; dx < 2; ++dx) {
-            const std::uint8_t* p = image.data.data() + static_cast<std::size_t>(y + dy) * stride +
-                                    3 * static_cast<std::size_t>(x + dx);
+            const std::uint8_t* p =
+                samples + static_cast<std::size_t>(y + dy) * stride + 3 * static_cast<std::size_t>(x + dx);
             f->data[0][static_cast<std::ptrdiff_t>(y + dy) * f->linesize[0] + x + dx] =
                 clamp_byte(0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2]);
             r += p[0], g += p[1], b += p[2];
@@ -198,30 +225,25 @@ void H264Encoder::encode(const VideoImage& image, double t_s, std::uint64_t tag,
       }
     }
   }
-  // A keyframe when the last one is an interval old (within half a frame period): by the frames'
-  // time, so that skipped frames do not stretch the interval as a count of frames would.
-  const bool key =
-      !keyframe_given_ || t_s - last_keyframe_t_s_ >= params_.keyframe_interval_s - 0.5 / frame_rate_Hz_;
+  // By the frames' own time, not their count (a camera that skips frames would stretch a count):
+  // this frame is a keyframe when the next one would come more than an interval after the last
+  // keyframe, so that no two keyframes are further apart than the interval (unless one gap between
+  // frames is longer).
+  const double interval = params_.keyframe_interval_s;
+  const bool key = !keyframe_given_ || held_t_s_ - last_keyframe_t_s_ > interval ||
+                   (next_t_s && *next_t_s - last_keyframe_t_s_ > interval + 1e-9);
   if (key) {
     keyframe_given_ = true;
-    last_keyframe_t_s_ = t_s;
+    last_keyframe_t_s_ = held_t_s_;
   }
   f->pict_type = key ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
   f->pts = c.next_pts++;
-  c.pending.push_back({f->pts, t_s, tag});
+  c.pending.push_back({f->pts, held_t_s_, held_tag_});
   if (const int rc = avcodec_send_frame(c.context, f); rc < 0)
     throw ComputationFailed("h264: encoding frame " + std::to_string(frames_in_) +
                             " failed: " + av_error(rc));
   ++frames_in_;
   drain(sink);
-}
-
-void H264Encoder::flush(const Sink& sink) {
-  if (!codec_) return;
-  if (const int rc = avcodec_send_frame(codec_->context, nullptr); rc < 0 && rc != AVERROR_EOF)
-    throw ComputationFailed("h264: flushing failed: " + av_error(rc));
-  drain(sink);
-  codec_.reset();  // the next frame starts a new stream
 }
 
 void H264Encoder::drain(const Sink& sink) {
@@ -241,6 +263,7 @@ void H264Encoder::drain(const Sink& sink) {
       p.tag = c.pending.front().tag;
       c.pending.pop_front();
     }
+    if (p.keyframe) last_keyframe_t_s_ = std::max(last_keyframe_t_s_, p.t_s);  // x264's own (a scene cut)
     ++packets_out_;
     try {
       sink(p);

@@ -8,7 +8,8 @@
 /// out in the order they went in, none needs a later one); a keyframe (an IDR picture, preceded
 /// by its SPS and PPS) at least every `keyframe_interval_s` of the frames' own time, whatever the
 /// camera's rate or the frames it skipped, so that a viewer seeking anywhere decodes within that
-/// interval.
+/// interval. To know that, a frame is encoded when the next one arrives (or at flush()): it is a
+/// keyframe when the next would come more than the interval after the last keyframe.
 ///
 /// Grey 8-bit samples are the luma of full-range 4:2:0 (Y = sample, Cb = Cr = 128: a decoder
 /// gives back the grey levels), RGB is converted by BT.601's full-range matrix (JFIF). Odd widths
@@ -20,9 +21,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "microcobot/devices/camera_frame.h"
 
@@ -88,13 +91,14 @@ class H264Encoder {
 
   const H264Params& params() const { return params_; }
 
-  /// Encodes `image`, taken at `t_s` (non-decreasing), and hands `sink` what comes out (with
-  /// "zerolatency", this frame's packet; else the packets of earlier frames as x264's lookahead
-  /// lets them go, in input order). A frame of another size than the last ends the stream and
-  /// starts another at a keyframe. Throws mc::InvalidInput for a malformed image and
-  /// mc::ComputationFailed when libavcodec fails.
+  /// Takes `image` (copied), taken at `t_s` (non-decreasing), encodes the frame before it and
+  /// hands `sink` what comes out (with "zerolatency", that frame's packet; else the packets of
+  /// earlier frames as x264's lookahead lets them go; always in input order). A frame of another
+  /// size than the one before ends the stream and starts another at a keyframe. Throws
+  /// mc::InvalidInput for a malformed image and mc::ComputationFailed when libavcodec fails.
   void encode(const VideoImage& image, double t_s, std::uint64_t tag, const Sink& sink);
-  /// Hands `sink` the packets still in the encoder (end of the recording).
+  /// Encodes the frame still held and hands `sink` every packet still in the encoder (end of the
+  /// recording); the next frame starts a new stream.
   void flush(const Sink& sink);
 
   std::uint64_t frames_in() const { return frames_in_; }
@@ -103,6 +107,8 @@ class H264Encoder {
  private:
   struct Codec;
   void open(int width, int height);
+  void encode_held(std::optional<double> next_t_s, const Sink& sink);
+  void end_stream(const Sink& sink);
   void drain(const Sink& sink);
 
   H264Params params_;
@@ -110,6 +116,12 @@ class H264Encoder {
   std::unique_ptr<Codec> codec_;
   bool keyframe_given_ = false;
   double last_keyframe_t_s_ = 0.0;
+  // The frame taken last, encoded when the next arrives.
+  bool held_ = false;
+  std::vector<std::uint8_t> held_samples_;
+  int held_width_ = 0, held_height_ = 0, held_channels_ = 1;
+  double held_t_s_ = 0.0;
+  std::uint64_t held_tag_ = 0;
   std::uint64_t frames_in_ = 0, packets_out_ = 0;
 };
 
