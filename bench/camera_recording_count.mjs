@@ -11,7 +11,9 @@ const path = process.argv[2];
 const { reader, file } = await openMcap(path, { zstd: (data, size) => zstd.decompress(data, Number(size)) });
 const topic = new Map([...reader.channelsById.values()].map((c) => [c.topic, c.id]));
 const counts = reader.statistics.channelMessageCounts;
-const images = Number(counts.get(topic.get("/camera/image/compressed")) || 0n);
+// The frames as JPEG (`--record-video jpeg`) or H.264 (`h264`, the default).
+const images = Number(counts.get(topic.get("/camera/image/compressed")) || 0n) +
+               Number(counts.get(topic.get("/camera/video")) || 0n);
 let first = null, last = null, gaps = 0, missing = 0, prev = null, t0 = null, t1 = null, dropped = 0, lat = [];
 for await (const m of reader.readMessages({ topics: ["/camera/state"] })) {
   const s = JSON.parse(new TextDecoder().decode(m.data));

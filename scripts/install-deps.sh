@@ -20,6 +20,7 @@ RUN_PACKAGES=(
   libmatio-dev         # MATLAB .mat files in and out (core/mat_file)
   libzstd-dev          # zstd-compressed chunks of the MCAP recordings (core/zstd)
   libturbojpeg0-dev    # the camera's JPEG frames (core/jpeg)
+  libavcodec-dev       # the recordings' H.264 video: libavcodec with libx264 (live/h264_encoder)
   libpng-dev           # the camera's PNG frames (imaging/png_file; zlib comes with it)
   libopencv-imgproc-dev libopencv-video-dev  # vision processing: template matching, ECC (vision/template_tracker)
   cyclonedds-dev cyclonedds-tools  # the DDS link between master and slave processes (src/microcobot/net; idlc)
@@ -39,6 +40,7 @@ TEST_PACKAGES=(
   libopencv-videoio-dev  # the real-camera driver (devices/opencv_camera.cc; CMake MC_WITH_OPENCV), built and tested by `make test`
   gstreamer1.0-plugins-base  # videotestsrc: the OpenCV driver's synthetic source in its test
   python3-pil          # an independent PNG reader for the camera's frames (tests/python/test_vision.py)
+  ffmpeg               # an independent H.264 decoder for the recordings' video (tests/live/h264_encoder_test.cc, tests/mcap/recorded_video.mjs)
   python3-pymeasure python3-pyvisa-py  # independent clients of the GCS 2.0 / ANC300 twins
   python3-dask python3-distributed  # microcobot.cell.batch: campaigns of many seeds on a process pool or a cluster
   python3-pandas       # the tutorials' DataFrames (examples/platform_pandas.py, examples/cell_compare.py)

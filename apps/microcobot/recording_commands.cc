@@ -80,6 +80,36 @@ void run_info(const InfoOptions& o) {
   nlohmann::json summary{{"file", o.file.string()},       {"bytes", std::filesystem::file_size(o.file)},
                          {"messages", c.messages.size()}, {"duration_s", duration},
                          {"chunks", c.chunk_count},       {"channels", channels}};
+  // How the camera was recorded (serve --record-video): its format, channel and encoder settings.
+  if (const mc::McapMetadata* v = c.find_metadata("video")) {
+    nlohmann::json video = nlohmann::json::object();
+    for (const auto& [k, value] : v->entries) video[k] = value;
+    const std::string* format = v->find("format");
+    const std::string* topic = v->find("topic");
+    text += "  video: " + (format ? *format : std::string("?"));
+    if (topic) {
+      for (const mc::McapChannel& ch : c.channels) {
+        if (ch.topic != *topic || !per.count(ch.id)) continue;
+        const PerChannel& p = per.at(ch.id);
+        const double span = 1e-9 * static_cast<double>(p.last - p.first);
+        const double per_minute = span > 0.0 ? 60.0 * static_cast<double>(p.bytes) / span : 0.0;
+        video["frames"] = p.messages;
+        video["bytes_per_minute"] = per_minute;
+        text += fmt::format(" on {}: {} frames, {:.1f} MB a minute", *topic, p.messages, 1e-6 * per_minute);
+      }
+    }
+    if (format && *format == "h264") {
+      const auto entry = [&](const char* key) {
+        const std::string* e = v->find(key);
+        return e ? *e : std::string("?");
+      };
+      text += fmt::format(" (libx264 {}{}, crf {}, a keyframe every {} s at most, no B-frames)",
+                          entry("preset"), entry("tune").empty() ? std::string() : "/" + entry("tune"),
+                          entry("crf"), entry("keyframe_interval_s"));
+    }
+    text += "\n";
+    summary["video"] = video;
+  }
   if (const mc::McapMetadata* r = c.find_metadata("recovery")) {
     nlohmann::json rec = nlohmann::json::object();
     for (const auto& [k, v] : r->entries) rec[k] = v;

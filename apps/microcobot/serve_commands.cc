@@ -34,10 +34,11 @@ struct ServeOptions {
   dp::ServeConfig config;
   std::string listen = "127.0.0.1:8080";
   double duration_s = 0.0;
-  std::string role = "single";       // single | master | slave
-  mc::cli::NetworkOptions network;   // where the DDS link goes (master and slave roles)
-  std::string passivity = "on";      // time-domain passivity control at this end's ports
-  std::vector<std::string> emulate;  // vendor-protocol twins: gcs2[=ADDR:PORT], ..., gcs2-hexapod[=...]
+  std::string role = "single";        // single | master | slave
+  mc::cli::NetworkOptions network;    // where the DDS link goes (master and slave roles)
+  std::string passivity = "on";       // time-domain passivity control at this end's ports
+  std::string record_video = "h264";  // h264 | jpeg | off
+  std::vector<std::string> emulate;   // vendor-protocol twins: gcs2[=ADDR:PORT], ..., gcs2-hexapod[=...]
 };
 
 // "HOST:PORT" or "[V6]:PORT".
@@ -59,6 +60,7 @@ dp::ServeConfig serve_config(const ServeOptions& o) {
   std::tie(c.listen_address, c.listen_port) = parse_listen(o.listen);
   c.role = o.role == "master" ? dp::Role::kMaster : o.role == "slave" ? dp::Role::kSlave : dp::Role::kSingle;
   c.passivity = o.passivity == "on";
+  c.record_video = dp::parse_record_video(o.record_video);
   if (o.network.given()) c.network = mc::cli::network_config(o.network);
   for (const auto& e : o.emulate) c.twins.push_back(mc::twins::parse_emulate(e));
   return c;
@@ -142,6 +144,12 @@ void add_serve(CLI::App& cmd) {
   cmd.add_flag("--record-csv", o->config.record_csv,
                "Also write each recording's telemetry as CSV beside its MCAP file (off: the MCAP file "
                "holds every sample; the console offers the CSV when it exists)");
+  cmd.add_option(
+      "--record-video", o->record_video,
+      "How recordings keep the camera: h264 (default: H.264 as foxglove.CompressedVideo on "
+      "/camera/video, keyframes every 2 s at most), jpeg (each frame's JPEG on "
+      "/camera/image/compressed, as the console's channel) or off (no camera channel); the console's "
+      "record request may choose otherwise");
   cmd.add_option("--duration", o->duration_s,
                  "Stop after this many seconds of wall-clock time (default: never)")
       ->check(mc::cli::Range(0.0, 1e7));

@@ -105,6 +105,14 @@ TEST(ServeCli, AnUnknownDriverInTheConfigurationIsOneLineListingTheKnownOnes) {
   }
 }
 
+TEST(ServeCli, ABadRecordVideoIsAUsageErrorNamingTheFlagAndWhatWasGiven) {
+  const auto r = run_cli({"serve", "--listen", "127.0.0.1:0", "--duration", "0.2", "--record-video", "mp4"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find("--record-video: 'mp4' must be h264, jpeg or off"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "") << "nothing served";
+}
+
 TEST(ServeCli, TheLinkFlagsAreUsageErrorsNamingTheFlag) {
   const struct {
     std::vector<std::string> args;

@@ -5,8 +5,9 @@
 //    parses them): a CompressedImage of format "jpeg" whose JPEG an independent decoder (Pillow,
 //    Debian's python3-pil) opens at the sensor's size; a CameraInfo whose K is the objective's
 //    scale; frame rate and stamps;
-//  - a recording taken meanwhile, read by @mcap/core with @foxglove/wasm-zstd's decompressor,
-//    holds the image channel, every frame of the recording in sequence, decodable the same way.
+//  - a recording taken meanwhile (its request asks for the JPEG frames), read by @mcap/core with
+//    @foxglove/wasm-zstd's decompressor, holds the image channel, every frame of the recording in
+//    sequence, decodable the same way.
 // Run by CTest (`camera_foxglove`); node --experimental-websocket.
 import { spawn, execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readdirSync, writeFileSync } from "node:fs";
@@ -79,10 +80,11 @@ for (const [topic, schema] of [["/camera/image/compressed", "sensor_msgs/msg/Com
 
 // Record while watching: the console's action channel.
 const actionChannel = client.advertise({ topic: "/console/action", encoding: "json", schemaName: "microcobot.Action" });
-const send = (name) => client.sendMessage(actionChannel, new TextEncoder().encode(JSON.stringify({ action: name })));
+const send = (name, options = {}) =>
+  client.sendMessage(actionChannel, new TextEncoder().encode(JSON.stringify({ action: name, ...options })));
 for (const k of Object.keys(got)) got[k].length = 0;
 const t0 = performance.now();
-send("record_start");
+send("record_start", { video: "jpeg" });  // the frames as the console's channel sends them
 await sleep(5000);
 send("record_stop");
 const seconds = (performance.now() - t0) / 1000;

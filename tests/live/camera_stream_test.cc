@@ -79,7 +79,9 @@ ConsoleServerParams server_params(const std::filesystem::path& out) {
 TEST(CameraStream, TheRecordingHoldsEveryFrameAsCdrCompressedImageWithItsCameraInfo) {
   test::TempDir dir;
   LivePlatform live(camera_params());
-  ConsoleServer server(live, server_params(dir.path()));
+  ConsoleServerParams sp = server_params(dir.path());
+  sp.record_video = RecordedVideo::kJpeg;  // `serve --record-video jpeg` (H.264: recorded_video_test.cc)
+  ConsoleServer server(live, sp);
   server.start();
   // Nobody looks yet: the camera forms no frame. The recording is a viewer: frames flow.
   std::this_thread::sleep_for(500ms);

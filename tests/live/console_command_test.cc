@@ -139,5 +139,29 @@ TEST(ConsoleCommand, ParsesActionsAndRefusesUnknownOnes) {
   EXPECT_THROW(parse_console_action(R"({"action": "estop", "x": 1})"), InvalidInput);
 }
 
+TEST(ConsoleCommand, RecordStartMayChooseTheVideoAndABadOneIsRefusedNamingIt) {
+  EXPECT_FALSE(parse_action_request(R"({"action": "record_start"})").video.has_value());
+  const ActionRequest jpeg = parse_action_request(R"({"action": "record_start", "video": "jpeg"})");
+  EXPECT_EQ(jpeg.action, ConsoleAction::kRecordStart);
+  EXPECT_EQ(jpeg.video, RecordedVideo::kJpeg);
+  EXPECT_EQ(parse_action_request(R"({"action": "record_start", "video": "h264"})").video,
+            RecordedVideo::kH264);
+  EXPECT_EQ(parse_action_request(R"({"action": "record_start", "video": "off"})").video, RecordedVideo::kOff);
+  const auto refused_action = [](std::string_view text) {
+    try {
+      parse_action_request(text);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused_action(R"({"action": "record_start", "video": "mp4"})"),
+            "/console/action: video: mp4 must be h264, jpeg or off");
+  EXPECT_EQ(refused_action(R"({"action": "record_start", "video": 1})"),
+            "/console/action: video: 1 must be h264, jpeg or off");
+  // Only record_start takes a video.
+  EXPECT_NE(refused_action(R"({"action": "estop", "video": "jpeg"})"), "accepted");
+}
+
 }  // namespace
 }  // namespace mc::live

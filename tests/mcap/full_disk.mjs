@@ -36,7 +36,8 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 let server;
 try {
   // The pick-and-place scene with its microscope camera (the default scene has one).
-  server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", "--out", dir, "--record"],
+  // JPEG frames: the disk fills within seconds (H.264 would take a minute).
+  server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", "--out", dir, "--record", "--record-video", "jpeg"],
                  { stdio: ["ignore", "pipe", "inherit"] });
   const exited = new Promise((resolve) => server.on("exit", (code, signal) => resolve({ code, signal })));
   const url = await new Promise((resolve, reject) => {

@@ -116,18 +116,19 @@ try {
 
   const topics = new Map([...reader.channelsById.values()].map((c) => [c.id, c.topic]));
   const expected = ["/platform/telemetry", "/platform/status", "/platform/scene", "/console/feedback",
-                    "/console/command", "/console/action", "/events", "/camera/image/compressed",
+                    "/console/command", "/console/action", "/events", "/camera/video",
                     "/camera/camera_info", "/camera/state"];
   for (const t of expected) if (![...topics.values()].includes(t)) fail(`no channel ${t}`);
-  // The camera's images and calibration are ROS 2 messages in CDR (tests/live/camera_foxglove.mjs
-  // decodes them); every other channel is JSON with its JSON Schema.
-  const cdr = new Map([["/camera/image/compressed", "sensor_msgs/msg/CompressedImage"],
-                       ["/camera/camera_info", "sensor_msgs/msg/CameraInfo"]]);
+  // The camera's calibration is a ROS 2 message in CDR (tests/live/camera_foxglove.mjs decodes
+  // it), its frames H.264 in Foxglove's CompressedVideo (serve's default; tests/mcap/recorded_video.mjs
+  // decodes them); every channel but the calibration is JSON with its JSON Schema.
+  const cdr = new Map([["/camera/camera_info", "sensor_msgs/msg/CameraInfo"]]);
   for (const c of reader.channelsById.values()) {
     const s = reader.schemasById.get(c.schemaId);
     const ok = cdr.has(c.topic)
       ? c.messageEncoding === "cdr" && s?.encoding === "ros2msg" && s?.name === cdr.get(c.topic)
-      : c.messageEncoding === "json" && s?.encoding === "jsonschema";
+      : c.messageEncoding === "json" && s?.encoding === "jsonschema" &&
+        (c.topic !== "/camera/video" || s?.name === "foxglove.CompressedVideo");
     if (!ok) fail(`${c.topic}: ${c.messageEncoding}/${s?.encoding} (${s?.name})`);
   }
 
@@ -165,6 +166,10 @@ try {
     last.set(topic, m.logTime);
     if (cdr.has(topic)) continue;
     const j = decode(m);
+    if (topic === "/camera/video") {  // stamped as Foxglove's schemas are, no t_s
+      if (j.format !== "h264" || typeof j.timestamp?.sec !== "number" || typeof j.data !== "string") badTs++;
+      continue;
+    }
     if (topic !== "/platform/scene" && typeof j.t_s !== "number") badTs++;  // the scene is geometry
     else if (topic === "/platform/telemetry" && Math.abs(Number(m.logTime - offset) - j.t_s * 1e9) > 1000) badTs++;
     if (topic === "/events") events.push(j);

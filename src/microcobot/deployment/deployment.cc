@@ -54,6 +54,11 @@ std::string_view role_name(Role role) {
   return "single";
 }
 
+live::RecordedVideo parse_record_video(std::string_view text) {
+  if (const auto v = live::parse_recorded_video(text)) return *v;
+  throw UsageError("--record-video: '" + excerpt(text) + "' must be h264, jpeg or off");
+}
+
 Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config)), log_(std::move(log)) {
   if (!log_) log_ = [](const std::string&) {};
   const ServeConfig& o = config_;
@@ -69,6 +74,7 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
     throw UsageError("--token: must be 8 to 256 characters without spaces or any of &#?%/\"'<>");
   sp.out_dir = o.out;
   sp.record_csv = o.record_csv;
+  sp.record_video = o.record_video;
   // Each recording holds the program's version and the configuration it ran (as --print-config
   // prints it: the keys --config takes), so a recording alone says what was run.
   sp.version = std::string("microcobot ") + MC_VERSION;

@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "microcobot/live/recorded_video.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/platform/platform_config.h"
 #include "microcobot/teleop/link_emulator.h"
@@ -32,6 +33,10 @@ enum class Role {
 
 /// "single", "master" or "slave".
 std::string_view role_name(Role role);
+
+/// `--record-video`'s value: "h264", "jpeg" or "off". Throws mc::UsageError naming the flag and
+/// what was given.
+live::RecordedVideo parse_record_video(std::string_view text);
 
 /// One line of what a deployment assembles (no newline); `serve` prints it on stderr.
 using Log = std::function<void(const std::string& line)>;
@@ -60,6 +65,9 @@ struct ServeConfig {
   std::filesystem::path out = "out/live";  ///< `--out`: the recordings' directory (created)
   bool record = false;                     ///< `--record`: start recording at once
   bool record_csv = false;                 ///< `--record-csv`: each recording's telemetry also as CSV
+  /// `--record-video`: how recordings keep the camera, unless the console's request says
+  /// (live/recorded_video.h).
+  live::RecordedVideo record_video = live::RecordedVideo::kH264;
 
   /// `--role`; `domain`, `network`, `link` and `passivity` are the DDS link's (master or slave).
   Role role = Role::kSingle;

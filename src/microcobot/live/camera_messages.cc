@@ -54,6 +54,23 @@ class CdrWriter {
   std::string& out_;
 };
 
+// RFC 4648 base64 (with padding), appended to `out`.
+void append_base64(std::span<const std::uint8_t> in, std::string& out) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::size_t i = 0;
+  for (; i + 3 <= in.size(); i += 3) {
+    const std::uint32_t v = (std::uint32_t{in[i]} << 16) | (std::uint32_t{in[i + 1]} << 8) | in[i + 2];
+    const char quad[4] = {kDigits[v >> 18], kDigits[(v >> 12) & 63], kDigits[(v >> 6) & 63], kDigits[v & 63]};
+    out.append(quad, 4);
+  }
+  if (const std::size_t rest = in.size() - i; rest > 0) {
+    const std::uint32_t v = (std::uint32_t{in[i]} << 16) | (rest == 2 ? std::uint32_t{in[i + 1]} << 8 : 0u);
+    const char quad[4] = {kDigits[v >> 18], kDigits[(v >> 12) & 63], rest == 2 ? kDigits[(v >> 6) & 63] : '=',
+                          '='};
+    out.append(quad, 4);
+  }
+}
+
 }  // namespace
 
 std::string_view compressed_image_schema() {
@@ -115,6 +132,42 @@ void encode_camera_info(const devices::CameraFrame& frame, RosTime stamp, std::s
   w.put<std::uint32_t>(1);
   for (int i = 0; i < 4; ++i) w.put<std::uint32_t>(0);  // roi: the whole image
   w.put<std::uint8_t>(0);
+}
+
+std::string compressed_video_schema() {
+  const nlohmann::json integer = {{"type", "integer"}, {"minimum", 0}};
+  return nlohmann::json{
+      {"title", "foxglove.CompressedVideo"},
+      {"description", "A single frame of a compressed video bitstream"},
+      {"type", "object"},
+      {"properties",
+       {{"timestamp",
+         {{"type", "object"},
+          {"title", "time"},
+          {"properties",
+           {{"sec", integer}, {"nsec", {{"type", "integer"}, {"minimum", 0}, {"maximum", 999999999}}}}},
+          {"description", "Timestamp of video frame"}}},
+        {"frame_id", {{"type", "string"}, {"description", "Frame of reference for the video."}}},
+        {"data",
+         {{"type", "string"},
+          {"contentEncoding", "base64"},
+          {"description", "Compressed video frame data: the NAL units of one picture, Annex B"}}},
+        {"format", {{"type", "string"}, {"description", "Video format: h264"}}}}}}
+      .dump();
+}
+
+void encode_compressed_video(std::span<const std::uint8_t> annexb, RosTime stamp, std::string& out) {
+  out.clear();
+  out.reserve(annexb.size() / 3 * 4 + 160);
+  out += "{\"timestamp\":{\"sec\":";
+  out += std::to_string(stamp.sec);
+  out += ",\"nsec\":";
+  out += std::to_string(stamp.nanosec);
+  out += "},\"frame_id\":\"";
+  out += kCameraFrameId;
+  out += "\",\"data\":\"";
+  append_base64(annexb, out);
+  out += "\",\"format\":\"h264\"}";
 }
 
 std::string camera_state_schema() {

@@ -8,6 +8,8 @@
 ///   /camera/camera_info       sensor_msgs/msg/CameraInfo       K from the objective's scale
 ///   /camera/state             microcobot.CameraState (JSON)    objective, focus, exposure, gain,
 ///                                                              scale, view centre, timings
+///   /camera/video             foxglove.CompressedVideo (JSON)  format "h264": the recordings'
+///                                                              H.264 (live/recorded_video.h)
 ///
 /// CDR as ROS 2 puts it on the wire (rmw_cyclonedds_cpp; what @foxglove/rosmsg2-serialization
 /// reads): the 4-byte encapsulation header 00 01 00 00 (CDR, little-endian), then the fields in
@@ -36,6 +38,8 @@ inline constexpr std::string_view kCameraImageTopic = "/camera/image/compressed"
 inline constexpr std::string_view kCameraPreviewTopic = "/camera/preview/compressed";
 inline constexpr std::string_view kCameraInfoTopic = "/camera/camera_info";
 inline constexpr std::string_view kCameraStateTopic = "/camera/state";
+/// The recordings' H.264 frames (`serve --record-video h264`).
+inline constexpr std::string_view kCameraVideoTopic = "/camera/video";
 inline constexpr std::string_view kCameraFrameId = "camera_optical_frame";
 
 /// The ros2msg schema texts (the .msg with its dependencies, as Foxglove expects).
@@ -43,6 +47,9 @@ std::string_view compressed_image_schema();
 std::string_view camera_info_schema();
 /// The JSON schema of /camera/state.
 std::string camera_state_schema();
+/// The JSON schema of foxglove.CompressedVideo (Foxglove's message schemas: timestamp {sec, nsec},
+/// frame_id, data as base64, format).
+std::string compressed_video_schema();
 
 /// A loop time as a ROS time (sec, nanosec).
 struct RosTime {
@@ -55,6 +62,9 @@ RosTime ros_time(double t_s);
 /// sensor_msgs/msg/CompressedImage of a JPEG (format "jpeg").
 void encode_compressed_image(std::span<const std::uint8_t> jpeg, RosTime stamp, std::string& out);
 void encode_compressed_image(const devices::CameraFrame& frame, RosTime stamp, std::string& out);
+/// foxglove.CompressedVideo of one H.264 access unit (Annex B), format "h264", as JSON into `out`
+/// (replaced): `{"timestamp": {"sec", "nsec"}, "frame_id", "data": base64 (RFC 4648), "format"}`.
+void encode_compressed_video(std::span<const std::uint8_t> annexb, RosTime stamp, std::string& out);
 /// sensor_msgs/msg/CameraInfo of `frame` (its objective's scale and working distance).
 void encode_camera_info(const devices::CameraFrame& frame, RosTime stamp, std::string& out);
 /// /camera/state's JSON of `frame`, with the pixel <-> stage calibration of its objective when

@@ -117,10 +117,22 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
   return c;
 }
 
-ConsoleAction parse_console_action(std::string_view text) {
+ConsoleAction parse_console_action(std::string_view text) { return parse_action_request(text).action; }
+
+ActionRequest parse_action_request(std::string_view text) {
   constexpr const char* kChannel = "/console/action";
   const json j = parse_object(kChannel, text);
-  if (j.size() != 1 || !j.contains("action")) refuse(kChannel, "payload", "must be {\"action\": NAME}");
+  if (!j.contains("action")) refuse(kChannel, "payload", "must be {\"action\": NAME}");
+  ActionRequest request;
+  if (j.size() == 2 && j.contains("video") && j["action"] == "record_start") {
+    const json& v = j["video"];
+    request.video = v.is_string() ? parse_recorded_video(v.get<std::string>()) : std::nullopt;
+    if (!request.video)
+      refuse(kChannel, "video",
+             excerpt(v.is_string() ? v.get<std::string>() : v.dump()) + " must be h264, jpeg or off");
+  } else if (j.size() != 1) {
+    refuse(kChannel, "payload", "must be {\"action\": NAME} (record_start may add \"video\")");
+  }
   const json& a = j["action"];
   if (!a.is_string()) refuse(kChannel, "action", "must be a string");
   static constexpr std::pair<std::string_view, ConsoleAction> kNames[] = {
@@ -145,7 +157,10 @@ ConsoleAction parse_console_action(std::string_view text) {
   };
   const std::string name = a.get<std::string>();
   for (const auto& [n, action] : kNames)
-    if (n == name) return action;
+    if (n == name) {
+      request.action = action;
+      return request;
+    }
   refuse(kChannel, "action",
          "must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
          "record_stop, vision_tare, next_part, task_start, task_pause, task_resume, task_confirm, "

@@ -7,8 +7,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
+
+#include "microcobot/live/recorded_video.h"
 
 namespace mc::live {
 
@@ -114,5 +117,15 @@ ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits&
 /// "task_confirm" | "task_take_over" | "task_hand_back" | "task_step_done" | "task_skip"}`.
 /// Throws mc::InvalidInput.
 ConsoleAction parse_console_action(std::string_view json);
+
+/// An action with its options: record_start may say how the recording keeps the camera,
+/// `{"action": "record_start", "video": "h264" | "jpeg" | "off"}` (unset: `serve --record-video`).
+struct ActionRequest {
+  ConsoleAction action = ConsoleAction::kEstop;
+  std::optional<RecordedVideo> video;
+};
+/// Parses what parse_console_action() does, and record_start's "video". Throws mc::InvalidInput
+/// ("/console/action: video: mp4 must be h264, jpeg or off").
+ActionRequest parse_action_request(std::string_view json);
 
 }  // namespace mc::live

@@ -187,6 +187,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     rp.version = params_.version;
     rp.config_yaml = params_.config_yaml;
     rp.camera = live_.has_camera();
+    rp.video = params_.record_video;
+    if (rp.camera) rp.frame_rate_Hz = live_.camera_params().frame_rate_Hz();
+    rp.h264 = params_.h264;
     rp.on_error = [this](const std::string& why) {
       server_.broadcast_status(StatusLevel::kError, "recording stopped: " + why);
     };
@@ -303,7 +306,7 @@ void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
   server_.publish(info_ch_, ns, info_cdr_);
   server_.publish(camera_state_ch_, ns, state);
   snapshot_->offer(f, state, t_s);
-  if (recording_) recording_->published_frame(t_s, image_cdr_, info_cdr_, state);
+  if (recording_) recording_->published_frame(t_s, f, image_cdr_, info_cdr_, state);
   for (const FrameConsumer& c : frame_consumers_) c.on_frame(f, t_s);
 }
 
@@ -366,7 +369,8 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
            "refused", "unknown-topic");
       return;
     }
-    const ConsoleAction a = parse_console_action(m.payload);
+    const ActionRequest request = parse_action_request(m.payload);
+    const ConsoleAction a = request.action;
     switch (a) {
       case ConsoleAction::kEstop:  // anyone may stop the platform
         live_.estop();
@@ -386,7 +390,7 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
         tell(m.client, StatusLevel::kInfo, "control: released", "release_control", "control");
         return;
       case ConsoleAction::kRecordStart: {
-        const std::string name = start_recording();
+        const std::string name = start_recording(request.video);
         server_.broadcast_status(StatusLevel::kInfo, "recording to " + name);
         return;
       }
@@ -467,12 +471,14 @@ void ConsoleServer::on_disconnect(server::ClientId client) {
   }
 }
 
-std::string ConsoleServer::start_recording() {
+std::string ConsoleServer::start_recording(std::optional<RecordedVideo> video) {
   if (!recording_) throw InvalidInput("recording is disabled: serve was started without --out");
   const double t_s = live_.status().t_s;
   const std::string was = recording_->name();
-  const std::string name = recording_->start(t_s, scene_json());
-  if (name != was) note(EventLevel::kInfo, "record_start", "recording to " + name);
+  const std::string name = recording_->start(t_s, scene_json(), video);
+  if (name != was)
+    note(EventLevel::kInfo, "record_start",
+         "recording to " + name + " (video " + std::string(recorded_video_name(recording_->video())) + ")");
   update_camera_demand();
   return name;
 }
@@ -481,9 +487,14 @@ void ConsoleServer::stop_recording() {
   if (recording_) recording_->stop();  // summary, index, footer; then renamed to its name
 }
 
+SessionRecording::VideoStats ConsoleServer::recording_video_stats() const {
+  return recording_ ? recording_->video_stats() : SessionRecording::VideoStats{};
+}
+
 void ConsoleServer::update_camera_demand() {
   if (!live_.has_camera()) return;
-  const bool recording = recording_ && !recording_->name().empty();
+  // A recording that keeps the camera is a viewer of it.
+  const bool recording = recording_ && recording_->video() != RecordedVideo::kOff;
   const bool watched = server_.subscriber_count(image_ch_) + server_.subscriber_count(preview_ch_) +
                            server_.subscriber_count(info_ch_) + server_.subscriber_count(camera_state_ch_) >
                        0;

@@ -70,8 +70,11 @@ struct ConsoleServerParams {
   double rumble_crossover_Hz = 100.0;  ///< the high band of the contact force
   double rumble_full_scale_N = 5e-6;   ///< high-band RMS that drives the rumble fully
   bool record_csv = false;             ///< recordings also write the telemetry as CSV (`serve --record-csv`)
-  std::string version;                 ///< the program's, into each recording's metadata
-  std::string config_yaml;             ///< the platform configuration, into each recording
+  /// How recordings keep the camera unless their request says (`serve --record-video`).
+  RecordedVideo record_video = RecordedVideo::kH264;
+  H264Params h264;          ///< the recordings' H.264 encoder
+  std::string version;      ///< the program's, into each recording's metadata
+  std::string config_yaml;  ///< the platform configuration, into each recording
   void validate() const;
 };
 
@@ -107,10 +110,13 @@ class ConsoleServer {
 
   /// Starts or stops a recording in out_dir: recording-YYYYmmdd-HHMMSS.mcap (the session:
   /// session_recording.h) and, with record_csv, the telemetry as recording-YYYYmmdd-HHMMSS.csv.
-  /// Returns the MCAP file's name. Throws mc::InvalidInput when recording is disabled or a file
-  /// cannot be created.
-  std::string start_recording();
+  /// `video`: how this recording keeps the camera (unset: record_video). Returns the MCAP file's
+  /// name. Throws mc::InvalidInput when recording is disabled or a file cannot be created.
+  std::string start_recording(std::optional<RecordedVideo> video = {});
   void stop_recording();
+  /// What the last recording's H.264 encoder did (SessionRecording::video_stats; empty without
+  /// --out).
+  SessionRecording::VideoStats recording_video_stats() const;
   server::ServerCounters counters() const { return server_.counters(); }
 
  private:

@@ -50,6 +50,12 @@ void SessionRecordingParams::validate() const {
   require(!telemetry.empty(), "telemetry", "needs the telemetry's channels");
   for (const RecordedSchema* s : {&status, &scene, &feedback})
     require(!s->topic.empty() && !s->schema.empty(), "recorded channels", "need a topic and a schema");
+  require(std::isfinite(frame_rate_Hz) && frame_rate_Hz > 0.0, "frame_rate_Hz", "must be > 0", frame_rate_Hz);
+  try {
+    h264.validate();
+  } catch (const InvalidParams& e) {
+    throw e.nested_in("h264");
+  }
 }
 
 bool SessionRecording::is_stem(std::string_view stem) {
@@ -80,7 +86,18 @@ std::string SessionRecording::name() const {
   return active_ ? name_ : std::string();
 }
 
-std::string SessionRecording::start(double t_s, const std::string& scene_json) {
+RecordedVideo SessionRecording::video() const {
+  std::lock_guard lock(mutex_);
+  return active_ ? video_ : RecordedVideo::kOff;
+}
+
+SessionRecording::VideoStats SessionRecording::video_stats() const {
+  std::lock_guard lock(mutex_);
+  return video_stats_;
+}
+
+std::string SessionRecording::start(double t_s, const std::string& scene_json,
+                                    std::optional<RecordedVideo> video_asked) {
   std::lock_guard control(control_mutex_);
   {
     std::lock_guard lock(mutex_);
@@ -89,6 +106,11 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
   if (writer_.joinable()) writer_.join();  // a writer that gave up (its error was reported)
   mcap_.reset();
   csv_.reset();
+  const RecordedVideo video = params_.camera ? video_asked.value_or(params_.video) : RecordedVideo::kOff;
+  // The encoder first: a libavcodec without libx264 refuses the recording before any file exists.
+  encoder_ = video == RecordedVideo::kH264
+                 ? std::make_unique<H264Encoder>(params_.h264, params_.frame_rate_Hz)
+                 : nullptr;
 
   const auto wall = std::chrono::system_clock::now();
   const std::int64_t wall_ns =
@@ -107,9 +129,10 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
 
   // The time base: wall clock at start minus loop time at start.
   const std::int64_t offset_ns = wall_ns - std::llround(t_s * 1e9);
-  auto w = std::make_unique<McapWriter>(params_.out_dir / (stem + ".mcap"),
-                                        params_.camera ? kCameraChunkBytes : McapWriter::kDefaultChunkBytes,
-                                        McapCompression{true, kZstdLevel});
+  auto w = std::make_unique<McapWriter>(
+      params_.out_dir / (stem + ".mcap"),
+      video != RecordedVideo::kOff ? kCameraChunkBytes : McapWriter::kDefaultChunkBytes,
+      McapCompression{true, kZstdLevel});
   w->set_chunk_max_span_ns(kChunkSpan_ns);
   const auto add = [&](RecordedTopic t, const std::string& topic, const std::string& schema_name,
                        const std::string& schema) {
@@ -132,10 +155,16 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
                      {"kind", text},
                      {"message", text},
                      {"client", {{"type", {"number", "null"}}}}}));
-  if (params_.camera) {
+  if (video == RecordedVideo::kH264) {
+    channel_[index(RecordedTopic::kCameraImage)] =
+        w->add_channel(w->add_schema("foxglove.CompressedVideo", "jsonschema", compressed_video_schema()),
+                       std::string(kCameraVideoTopic), "json");
+  } else if (video == RecordedVideo::kJpeg) {
     channel_[index(RecordedTopic::kCameraImage)] =
         w->add_channel(w->add_schema("sensor_msgs/msg/CompressedImage", "ros2msg", compressed_image_schema()),
                        std::string(kCameraImageTopic), "cdr");
+  }
+  if (video != RecordedVideo::kOff) {
     channel_[index(RecordedTopic::kCameraInfo)] =
         w->add_channel(w->add_schema("sensor_msgs/msg/CameraInfo", "ros2msg", camera_info_schema()),
                        std::string(kCameraInfoTopic), "cdr");
@@ -158,6 +187,24 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
       scene.emplace_back(k, v.is_string() ? v.get<std::string>() : v.dump());
   w->add_metadata("scene", scene);
   w->add_metadata("configuration", {{"yaml", params_.config_yaml}});
+  std::vector<std::pair<std::string, std::string>> video_entries = {
+      {"format", std::string(recorded_video_name(video))}};
+  if (video == RecordedVideo::kH264) {
+    const H264Params& h = params_.h264;
+    video_entries.insert(video_entries.end(),
+                         {{"topic", std::string(kCameraVideoTopic)},
+                          {"encoder", "libx264 (libavcodec)"},
+                          {"preset", h.preset},
+                          {"tune", h.tune},
+                          {"crf", fmt::format("{:g}", h.crf)},
+                          {"keyframe_interval_s", fmt::format("{:g}", h.keyframe_interval_s)},
+                          {"b_frames", "0"},
+                          {"pixel_format", "yuv420p full range (grey: chroma 128)"},
+                          {"frame_rate_Hz", fmt::format("{:g}", params_.frame_rate_Hz)}});
+  } else if (video == RecordedVideo::kJpeg) {
+    video_entries.emplace_back("topic", std::string(kCameraImageTopic));
+  }
+  w->add_metadata("video", video_entries);
   w->add_attachment("configuration.yaml", "application/yaml", params_.config_yaml,
                     static_cast<std::uint64_t>(wall_ns), static_cast<std::uint64_t>(wall_ns));
 
@@ -178,7 +225,10 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json) {
     offset_ns_ = offset_ns;
     last_ns_.fill(0);
     error_.clear();
+    video_ = video;
+    video_stats_ = {};
   }
+  last_keyframe_t_s_ = -1.0;
   writer_ = std::thread([this] { writer_thread(); });
   return stem + ".mcap";
 }
@@ -240,26 +290,39 @@ void SessionRecording::push(std::span<Item> items) {
 }
 
 void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t count) {
-  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry.size())};
+  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry.size()), {}};
   push(std::move(item));
 }
 
 void SessionRecording::published(RecordedTopic topic, double t_s, std::string_view payload) {
-  push(Item{topic, 0, t_s, std::string(payload), {}, 0});
+  push(Item{topic, 0, t_s, std::string(payload), {}, 0, {}});
 }
 
-void SessionRecording::published_frame(double t_s, std::string_view image, std::string_view info,
-                                       std::string_view state) {
-  if (!params_.camera) return;
-  std::array<Item, 3> frame{Item{RecordedTopic::kCameraImage, 0, t_s, std::string(image), {}, 0},
-                            Item{RecordedTopic::kCameraInfo, 0, t_s, std::string(info), {}, 0},
-                            Item{RecordedTopic::kCameraState, 0, t_s, std::string(state), {}, 0}};
-  push(frame);
+void SessionRecording::published_frame(double t_s, const devices::CameraFrame& frame, std::string_view image,
+                                       std::string_view info, std::string_view state) {
+  const RecordedVideo video = this->video();
+  if (video == RecordedVideo::kOff) return;
+  Item picture{RecordedTopic::kCameraImage, 0, t_s, {}, {}, 0, {}};
+  if (video == RecordedVideo::kH264) {
+    try {
+      const VideoImage v = to_video_image(frame.image, picture.payload);  // 8-bit: half a 12-bit frame
+      picture.shape = {v.width, v.height, v.channels};
+    } catch (const InvalidInput& e) {
+      event(EventLevel::kWarning, "video", std::string("frame not recorded: ") + e.what(), 0, t_s);
+      return;
+    }
+  } else {
+    picture.payload = std::string(image);
+  }
+  std::array<Item, 3> items{std::move(picture),
+                            Item{RecordedTopic::kCameraInfo, 0, t_s, std::string(info), {}, 0, {}},
+                            Item{RecordedTopic::kCameraState, 0, t_s, std::string(state), {}, 0, {}}};
+  push(items);
 }
 
 void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s,
                                 std::string_view payload) {
-  push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0});
+  push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0, {}});
 }
 
 void SessionRecording::event(EventLevel level, std::string_view kind, std::string_view message,
@@ -269,7 +332,8 @@ void SessionRecording::event(EventLevel level, std::string_view kind, std::strin
                   {"kind", kind},
                   {"message", message},
                   {"client", client ? json(client) : json(nullptr)}};
-  push(Item{RecordedTopic::kEvents, 0, t_s, j.dump(-1, ' ', false, json::error_handler_t::replace), {}, 0});
+  push(Item{
+      RecordedTopic::kEvents, 0, t_s, j.dump(-1, ' ', false, json::error_handler_t::replace), {}, 0, {}});
 }
 
 void SessionRecording::writer_thread() {
@@ -279,14 +343,16 @@ void SessionRecording::writer_thread() {
     {
       std::unique_lock lock(mutex_);
       wake_.wait(lock, [&] { return !queue_.empty() || stopping_; });
-      if (queue_.empty()) return;  // stopping, and everything is written
+      if (queue_.empty()) break;  // stopping, and everything queued is written
       batch.swap(queue_);
       queued_bytes_ = 0;
     }
     try {
       for (const Item& item : batch) {
         const std::uint16_t channel = channel_[index(item.topic)];
-        if (item.topic == RecordedTopic::kTelemetry) {
+        if (item.topic == RecordedTopic::kCameraImage && encoder_) {
+          write_video(item);
+        } else if (item.topic == RecordedTopic::kTelemetry) {
           const std::span<const double> sample(item.sample.data(), item.count);
           json_text.clear();
           platform::telemetry_to_json(params_.telemetry, sample, json_text);
@@ -301,6 +367,40 @@ void SessionRecording::writer_thread() {
       return;
     }
     batch.clear();
+  }
+  // The frames still in the encoder's lookahead, before the files close.
+  if (!encoder_) return;
+  try {
+    encoder_->flush([this](const H264Packet& p) { write_packet(p); });
+  } catch (const std::exception& e) {
+    abandon(e.what());
+  }
+}
+
+void SessionRecording::write_video(const Item& item) {
+  const VideoImage image{
+      item.shape.width, item.shape.height, item.shape.channels,
+      std::span(reinterpret_cast<const std::uint8_t*>(item.payload.data()), item.payload.size())};
+  {
+    std::lock_guard lock(mutex_);
+    ++video_stats_.frames;
+    video_stats_.thread = std::this_thread::get_id();
+  }
+  encoder_->encode(image, item.t_s, item.log_ns, [this](const H264Packet& p) { write_packet(p); });
+}
+
+void SessionRecording::write_packet(const H264Packet& p) {
+  encode_compressed_video(p.annexb, ros_time(p.t_s), video_message_);
+  mcap_->write(channel_[index(RecordedTopic::kCameraImage)], p.tag, p.tag, video_message_);
+  std::lock_guard lock(mutex_);
+  VideoStats& s = video_stats_;
+  ++s.packets;
+  s.bytes += p.annexb.size();
+  if (p.keyframe) {
+    ++s.keyframes;
+    if (last_keyframe_t_s_ >= 0.0)
+      s.longest_keyframe_gap_s = std::max(s.longest_keyframe_gap_s, p.t_s - last_keyframe_t_s_);
+    last_keyframe_t_s_ = p.t_s;
   }
 }
 

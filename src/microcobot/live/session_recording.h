@@ -7,10 +7,12 @@
 ///   /platform/status, /platform/scene, /console/feedback   what the server published
 ///   /console/command, /console/action   what the clients sent: `{"t_s", "client", "message"}`
 ///   /events   state changes and errors: `{"t_s", "level", "kind", "message", "client"}`
-///   /camera/image/compressed, /camera/camera_info (CDR, ros2msg schemas), /camera/state (JSON):
-///             every frame of the camera, when the platform has one (live/camera_messages.h)
+///   /camera/video (foxglove.CompressedVideo, H.264) or /camera/image/compressed (CDR JPEG), with
+///   /camera/camera_info (CDR) and /camera/state (JSON): every frame of the camera, when the
+///   platform has one and the recording keeps it (live/recorded_video.h, live/camera_messages.h)
 ///   Metadata "microcobot" (version, start, the time base), "scene", "configuration" (YAML),
-///   and the configuration again as the attachment `configuration.yaml`.
+///   "video" (the camera's format and, for H.264, the encoder's settings), and the configuration
+///   again as the attachment `configuration.yaml`.
 ///
 /// Log times are on the wall clock (UTC, ns since the epoch), as viewers expect: the loop time
 /// `t_s` (kept in every message) plus the offset wall-clock-at-start minus loop-time-at-start,
@@ -18,11 +20,12 @@
 /// clock does later (NTP steps). Each channel's log times never decrease (an event stamped by
 /// a thread that lost a race is stamped with the latest time of its channel).
 ///
-/// Threads: the callers (drain thread, server I/O thread, status thread) only append to a
-/// queue under a short lock; a writer thread of the recording's own encodes the telemetry as
-/// JSON, compresses the chunks (zstd, core/mcap_writer.h) and writes, so neither the loop nor
-/// the drain ever waits on a disk or a compressor. The queue is bounded (kMaxQueuedBytes):
-/// beyond it messages are dropped and counted in an event.
+/// Threads: the callers (drain thread, server I/O thread, status thread, camera thread) only
+/// append to a queue under a short lock; a writer thread of the recording's own encodes the
+/// telemetry as JSON and the camera's frames as H.264, compresses the chunks (zstd,
+/// core/mcap_writer.h) and writes, so neither the loop, the drain nor the camera ever waits on a
+/// disk or an encoder. The queue is bounded (kMaxQueuedBytes): beyond it messages are dropped and
+/// counted in an event.
 ///
 /// Files appear only when complete (temporary name, renamed at stop(): core/staged_file.h);
 /// a failed write abandons the recording and leaves nothing under its name.
@@ -34,12 +37,16 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <thread>
 #include <vector>
 
+#include "microcobot/devices/camera_frame.h"
+#include "microcobot/live/h264_encoder.h"
+#include "microcobot/live/recorded_video.h"
 #include "microcobot/platform/platform.h"
 
 namespace mc {
@@ -58,7 +65,7 @@ enum class RecordedTopic : std::uint8_t {
   kCommand,
   kAction,
   kEvents,
-  kCameraImage,
+  kCameraImage,  ///< the frame: its JPEG message, or its samples for the H.264 encoder
   kCameraInfo,
   kCameraState,
   kCount
@@ -82,8 +89,13 @@ struct SessionRecordingParams {
   RecordedSchema status, scene, feedback;
   std::string version;      ///< the program's, e.g. "microcobot 0.1.0"
   std::string config_yaml;  ///< the platform configuration (`run --print-config`'s keys)
-  /// Record the camera's channels (chunks then hold several frames: kCameraChunkBytes).
+  /// The platform has a camera: recordings may keep its frames (chunks then hold several frames:
+  /// kCameraChunkBytes).
   bool camera = false;
+  /// How recordings keep the camera unless start() says otherwise (`serve --record-video`).
+  RecordedVideo video = RecordedVideo::kH264;
+  double frame_rate_Hz = 30.0;  ///< the camera's (the H.264 stream's time base)
+  H264Params h264;              ///< the encoder's settings
   /// Called on the writer thread when a write fails and the recording is abandoned.
   std::function<void(const std::string& why)> on_error;
   void validate() const;
@@ -113,23 +125,41 @@ class SessionRecording {
   SessionRecording& operator=(const SessionRecording&) = delete;
 
   /// Opens recording-YYYYmmdd-HHMMSS.mcap (and .csv) in out_dir, writes the metadata and starts
-  /// the writer. `t_s` is the loop time now (the time base), `scene_json` the scene. Returns
-  /// the MCAP file's name; the same when already recording. Throws InvalidInput when a file
-  /// cannot be created.
-  std::string start(double t_s, const std::string& scene_json);
+  /// the writer. `t_s` is the loop time now (the time base), `scene_json` the scene, `video` how
+  /// this recording keeps the camera (unset: params' video). Returns the MCAP file's name; the
+  /// same when already recording (its video unchanged). Throws InvalidInput when a file cannot be
+  /// created, ComputationFailed when H.264 is asked and libavcodec cannot encode it.
+  std::string start(double t_s, const std::string& scene_json, std::optional<RecordedVideo> video = {});
   /// Writes what is queued, closes and renames the files. Throws InvalidInput when the last
   /// writes fail (nothing then remains). Idempotent.
   void stop();
   /// The MCAP file being written ("" when not recording).
   std::string name() const;
+  /// How the current recording keeps the camera (kOff when not recording or without a camera):
+  /// whether it wants the camera's frames.
+  RecordedVideo video() const;
+
+  /// What the H.264 encoder of the last recording did. Complete after stop().
+  struct VideoStats {
+    std::uint64_t frames = 0;     ///< frames given to the encoder
+    std::uint64_t packets = 0;    ///< access units written (one a frame)
+    std::uint64_t keyframes = 0;  ///< of them, IDR pictures
+    std::uint64_t bytes = 0;      ///< H.264 bytes (before base64)
+    double longest_keyframe_gap_s = 0.0;
+    std::thread::id thread;  ///< the one that encoded (the writer)
+  };
+  VideoStats video_stats() const;
 
   /// A telemetry sample (drain thread): no allocation unless the queue grows.
   void telemetry(const platform::TelemetrySample& s, std::size_t count);
   /// A message the server published (status, scene, feedback): its payload as sent.
   void published(RecordedTopic topic, double t_s, std::string_view payload);
   /// A camera frame's three messages (image, camera info, state), recorded together or not at
-  /// all: a stop between them never leaves a frame without its info or state.
-  void published_frame(double t_s, std::string_view image, std::string_view info, std::string_view state);
+  /// all: a stop between them never leaves a frame without its info or state. `image` is the
+  /// frame's JPEG message (kept with jpeg); with h264 the frame's samples are copied (8-bit) for
+  /// the writer to encode. Camera thread: never waits for the encoder.
+  void published_frame(double t_s, const devices::CameraFrame& frame, std::string_view image,
+                       std::string_view info, std::string_view state);
   /// A message a client sent on /console/command or /console/action, accepted or not.
   void received(RecordedTopic topic, std::uint64_t client, double t_s, std::string_view payload);
   /// An event (client 0: none).
@@ -145,13 +175,18 @@ class SessionRecording {
     RecordedTopic topic;
     std::uint64_t log_ns = 0;  // stamped by push()
     double t_s = 0.0;
-    std::string payload;  // empty for telemetry: encoded by the writer
+    std::string payload;  // empty for telemetry: encoded by the writer; 8-bit samples of a frame to encode
     platform::TelemetrySample sample;
     std::size_t count = 0;
+    struct Shape {
+      int width = 0, height = 0, channels = 0;
+    } shape;  // a frame to encode
   };
   void push(Item&& item) { push(std::span<Item>(&item, 1)); }
   void push(std::span<Item> items);  // all or none
   void writer_thread();
+  void write_video(const Item& item);
+  void write_packet(const H264Packet& packet);
   void abandon(const std::string& why);
 
   SessionRecordingParams params_;
@@ -166,11 +201,16 @@ class SessionRecording {
   std::uint64_t dropped_ = 0;
   std::int64_t offset_ns_ = 0;  // log time = t_s * 1e9 + offset_ns_
   std::array<std::uint64_t, static_cast<std::size_t>(RecordedTopic::kCount)> last_ns_{};
+  RecordedVideo video_ = RecordedVideo::kOff;
+  VideoStats video_stats_;
 
   // Writer thread (and start/stop while it is not running).
   std::thread writer_;
   std::unique_ptr<McapWriter> mcap_;
   std::unique_ptr<CsvStreamWriter> csv_;
+  std::unique_ptr<H264Encoder> encoder_;  // with h264
+  std::string video_message_;
+  double last_keyframe_t_s_ = -1.0;
   std::array<std::uint16_t, static_cast<std::size_t>(RecordedTopic::kCount)> channel_{};
   std::string error_;  // why the writer gave up
 };
