@@ -120,6 +120,10 @@ void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, doubl
 void ParallelStage::hold_here(LegAxis& ax) noexcept { ax.hold = ax.measured; }
 
 void ParallelStage::stop() noexcept {
+  bool stepping = false;
+  for (const auto& ax : axes_) stepping = stepping || ax.stepping;
+  // Already holding: the held pose stays exactly what it is (a move planned from it still starts).
+  if (!moving_ && !stepping) return;
   moving_ = false;
   for (auto& ax : axes_) {
     if (ax.stepping)
@@ -153,16 +157,19 @@ void ParallelStage::emergency_stop() noexcept {
 void ParallelStage::rearm() {
   if (fault_)
     throw InvalidInput("the positioner stopped on a fault (a diverged leg or no pose for its legs)");
+  // Never ticked since place(): the legs hold the placed pose exactly (a client plans its first
+  // move from it); else where their sensors read now.
+  const bool placed = t_ == 0.0;
   LegCoordinates qm;
   for (std::size_t i = 0; i < axes_.size(); ++i) qm(static_cast<Eigen::Index>(i)) = axes_[i].measured;
-  measured_T_ = kin_.forward(qm, measured_T_).T;  // throws where the legs close on no pose
+  if (!placed) measured_T_ = kin_.forward(qm, measured_T_).T;  // throws where the legs close on no pose
   for (auto& ax : axes_) {
     ax.stepping = false;
     ax.gen.halt();
     ax.ctrl->reset(ax.measured, ax.state.u_V);
-    hold_here(ax);
+    if (!placed) hold_here(ax);
   }
-  ref_T_ = measured_T_;
+  if (!placed) ref_T_ = measured_T_;
   moving_ = halted_ = false;
   t_move_ = 0.0;
 }

@@ -102,14 +102,16 @@ class ParallelStage {
   /// move is stopped first (the other legs hold where they are).
   void step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz);
   /// Ends any move: every tracking leg holds where it is measured now; a stepping leg finishes
-  /// its period (U back at 0 V, no abrupt edge) and holds. Never allocates.
+  /// its period (U back at 0 V, no abrupt edge) and holds. Holding already (no move, no leg
+  /// stepping), nothing changes: the held pose stays exact. Never allocates.
   void stop() noexcept;
   /// Every leg to 0 V at once (its tracker stopped, any stepping halted), no move: the safe state
   /// a platform's fault or e-stop asks for. The physics runs on (tick()) and the poses are still
   /// measured. Idempotent, never allocates; held until rearm().
   void emergency_stop() noexcept;
   /// After emergency_stop() (or at power-up): every tracker restarts where its sensor reads and the
-  /// legs hold there, the reference pose FK of those readings. Throws mc::InvalidInput after a
+  /// legs hold there, the reference pose FK of those readings (before the first tick: the pose
+  /// place() gave, exactly). Throws mc::InvalidInput after a
   /// fault (a diverged model, legs where no pose of the positioner is): that stays latched.
   void rearm();
   /// One control period (1 / tracking.control_rate_Hz). Never allocates.
