@@ -137,8 +137,8 @@ void add_serve(CLI::App& cmd) {
       "127.0.0.1:50000), anc300[=ADDR:PORT] (Attocube ANC300 console, default 127.0.0.1:7230), "
       "mcs2[=ADDR:PORT][,no_sensor=N[+M]] (SmarAct MCS2 ASCII, default 127.0.0.1:55551; no_sensor: channels "
       "without a sensor, stepped open loop only) or gcs2-hexapod[=ADDR:PORT] (PI C-887 hexapod dialect over "
-      "a "
-      "simulated 6-DOF parallel positioner of its own, default 127.0.0.1:50000); docs/hardware.md");
+      "the platform's 6-DOF parallel positioner, which it then carries (positioner: parallel), default "
+      "127.0.0.1:50000); docs/hardware.md");
   cmd.add_option("--out", o->config.out, "Directory of the MCAP recordings (default out/live)");
   cmd.add_flag("--record", o->config.record, "Start recording at once (else from the console)");
   cmd.add_flag("--record-csv", o->config.record_csv,

@@ -1,7 +1,7 @@
 // The PI hexapod (C-887) dialect of GCS 2.0 line by line: its codec (pose and pivot pairs, axis
-// queries, coordinate system names) and the twin over the simulated parallel positioner stepped
-// on its own loop thread: identification, reference, pose moves in PI's U -> V -> W convention
-// about the pivot, refusals before motion, stops, velocity and user coordinate systems.
+// queries, coordinate system names) and the twin over the live platform's parallel positioner
+// (`positioner: parallel`), stepped on the platform's loop: identification, reference, pose moves in PI's U
+// -> V -> W convention about the pivot, refusals before motion, stops, velocity and user coordinate systems.
 
 #include <gtest/gtest.h>
 
@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "hexapod_rig.h"
+#include "microcobot/core/error.h"
 #include "microcobot/drivers/gcs2_hexapod.h"
 #include "microcobot/motion/pose.h"
 
@@ -132,14 +133,14 @@ TEST(Gcs2HexapodTwin, AnUnreachablePoseIsRefusedWithError7AndNothingMoves) {
   EXPECT_EQ(r.ask("VMO? Z 40"), "0\n");
   EXPECT_EQ(r.byte(5), "0\n");  // a virtual move moves nothing
   const auto before = r.pose();
-  const double ticks = static_cast<double>(r.stage.ticks());
+  const double t0 = r.stage.positioner_view().time_s;
   for (const char* line : {"MOV Z 40", "MOV U 80", "MOV X 1e300"}) {
     EXPECT_EQ(r.ask(line), "") << line;
     EXPECT_EQ(r.err(), "7\n") << line;
     EXPECT_EQ(r.byte(5), "0\n") << line;
   }
   std::this_thread::sleep_for(200ms);
-  EXPECT_GT(static_cast<double>(r.stage.ticks()), ticks + 50);  // the loop ran all along
+  EXPECT_GT(r.stage.positioner_view().time_s, t0 + 0.05);  // the loop ran all along
   const auto after = r.pose();
   for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(after[i], before[i], 1e-4) << i;
   const auto target = r.pose("MOV?");
@@ -156,7 +157,7 @@ TEST(Gcs2HexapodTwin, RotationsTurnAboutThePivotWhichMovesOnlyWhileUnturned) {
   ASSERT_EQ(r.ask("MOV U 0.5 V -0.3 W 0.4"), "");
   ASSERT_TRUE(r.wait_on_target());
   // The platform turned about its pivot point c: R c + d = c (PI's pivot, motion/pose.h).
-  const HexapodView v = r.stage.view();
+  const live::PositionerView v = r.stage.positioner_view();
   const Eigen::Vector3d c(0.5e-3, 0.0, 2e-3);
   EXPECT_LT((v.measured.R * c + v.measured.d - c).norm(), 1e-6);
   const Eigen::Vector3d uvw = motion::pi_angles(v.measured.R) / kDeg;
@@ -276,19 +277,21 @@ TEST(Gcs2HexapodTwin, BadLinesGetTheControllersErrors) {
   EXPECT_NEAR(two[0].second, 0.0, 1e-3);
 }
 
-TEST(Gcs2HexapodTwin, AFullQueueAndAStopTheLoopHasNotAppliedAreRefusedAsBusy) {
+TEST(Gcs2HexapodTwin, AFullRingAndAStopTheLoopHasNotAppliedAreRefusedAsBusy) {
   // The loop not started: what is sent waits in the ring, and a stop is never applied.
-  HexapodStageParams p;
-  p.queue = 2;
-  HexapodStage stage(p);
-  Gcs2HexapodTwin twin(stage, Gcs2HexapodTwinParams{});
+  HexapodRig r(/*start=*/false);
+  Gcs2HexapodTwin& twin = r.twin;
   EXPECT_EQ(twin.on_line(1, "FRF"), "");
   EXPECT_EQ(twin.on_byte(1, 7), "\xb0\n");  // referencing
   EXPECT_EQ(twin.on_byte(1, 5), "3F\n");
-  EXPECT_EQ(twin.on_line(1, "FRF"), "");
   EXPECT_EQ(twin.on_line(1, "ERR?"), "0\n");
-  EXPECT_EQ(twin.on_line(1, "FRF"), "");
-  EXPECT_EQ(twin.on_line(1, "ERR?"), "1005\n");
+  // The live platform's protocol ring (256 commands) fills: then the controller is busy.
+  std::string code = "0\n";
+  for (int k = 0; k < 300 && code == "0\n"; ++k) {
+    EXPECT_EQ(twin.on_line(1, "FRF"), "");
+    code = twin.on_line(1, "ERR?");
+  }
+  EXPECT_EQ(code, "1005\n");
   EXPECT_EQ(twin.on_line(1, "KSD WORK X 1"), "");
   EXPECT_EQ(twin.on_line(1, "ERR?"), "536\n");  // not while moving
   EXPECT_EQ(twin.on_byte(1, 24), "");
@@ -297,6 +300,18 @@ TEST(Gcs2HexapodTwin, AFullQueueAndAStopTheLoopHasNotAppliedAreRefusedAsBusy) {
   EXPECT_EQ(twin.on_line(1, "MOV? X"), "");  // the stopped pose is not known yet
   EXPECT_EQ(twin.on_line(1, "ERR?"), "1005\n");
   EXPECT_FALSE(twin.referenced());
+}
+
+TEST(Gcs2HexapodTwin, RefusesToServeAPlatformWithoutAParallelPositioner) {
+  live::LiveParams p;  // positioner: cartesian
+  live::LivePlatform live(p);
+  LiveStage stage(live);
+  try {
+    Gcs2HexapodTwin twin(stage, Gcs2HexapodTwinParams{});
+    FAIL() << "served without a positioner";
+  } catch (const InvalidParams& e) {
+    EXPECT_NE(std::string(e.what()).find("positioner: parallel"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace gcs2_hexapod_test

@@ -1,26 +1,49 @@
 #pragma once
-// The hexapod twin's rig: its positioner stepped on its own loop thread and the C-887 dialect
-// over it, asked line by line from the test's thread (the protocol thread's place).
+// The hexapod twin's rig: the live platform with the thesis's assembly (`positioner: parallel`),
+// its loop paced, and the C-887 dialect over it through the live stage, asked line by line from
+// the test's thread (the protocol thread's place, which also sends the controlling client's
+// heartbeat before each line as the twin server does every 20 ms).
 
 #include <gtest/gtest.h>
 
 #include <array>
 #include <chrono>
+#include <memory>
 #include <string>
 #include <thread>
 
 #include "microcobot/drivers/gcs2_codec.h"
+#include "microcobot/live/live_platform.h"
 #include "microcobot/twins/gcs2_hexapod_twin.h"
-#include "microcobot/twins/hexapod_stage.h"
+#include "microcobot/twins/live_stage.h"
 
 namespace mc::twins::testing {
 
+/// The live platform's parameters with the parallel positioner carrying the part.
+inline live::LiveParams hexapod_live_params(double command_timeout_s = 2.0) {
+  live::LiveParams p;
+  p.platform.positioner = "parallel";
+  p.command_timeout_s = command_timeout_s;
+  return p;
+}
+
 struct HexapodRig {
-  HexapodStage stage;
+  live::LivePlatform live;
+  LiveStage stage;
   Gcs2HexapodTwin twin;
-  HexapodRig() : stage(HexapodStageParams{}), twin(stage, Gcs2HexapodTwinParams{}) { stage.start(); }
-  std::string ask(const std::string& line, ClientId c = 1) { return twin.on_line(c, line); }
-  std::string byte(char b) { return twin.on_byte(1, b); }
+  explicit HexapodRig(bool start = true, double command_timeout_s = 2.0)
+      : live(hexapod_live_params(command_timeout_s)), stage(live), twin(stage, Gcs2HexapodTwinParams{}) {
+    if (start) live.start([](const platform::TelemetrySample&, std::size_t) {});
+  }
+  ~HexapodRig() { live.stop(); }
+  std::string ask(const std::string& line, ClientId c = 1) {
+    stage.heartbeat();
+    return twin.on_line(c, line);
+  }
+  std::string byte(char b) {
+    stage.heartbeat();
+    return twin.on_byte(1, b);
+  }
   std::string err() { return ask("ERR?"); }
   /// Polls ONT? until every axis is on target (PIPython's waitontarget).
   bool wait_on_target(double timeout_s = 30.0) {

@@ -1,7 +1,7 @@
-// The hexapod twin served over TCP (loopback, port 0) beside nothing else: the C-887 dialect's
-// lines and single bytes through the server, hostile clients (garbage, an overlong line, half
-// lines, a disconnect mid-move) survived with the platform holding, and the positioner's loop
-// thread never allocating while a client moves and stops it.
+// The hexapod twin served over TCP (loopback, port 0) on the live platform's parallel positioner:
+// the C-887 dialect's lines and single bytes through the server, hostile clients (garbage, an
+// overlong line, half lines, a disconnect mid-move) survived with the platform holding, and the
+// platform's loop thread never allocating while a client moves and stops the positioner.
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <thread>
 
 #include "fake_stage.h"
+#include "hexapod_server_rig.h"
 #include "microcobot/core/error.h"
 #include "microcobot/drivers/gcs2_codec.h"
 #include "support/counting_allocator.h"
-#include "twin_rig.h"
 
 namespace mc::twins {
 namespace hexapod_server_test {
@@ -21,46 +21,11 @@ namespace hexapod_server_test {
 using namespace std::chrono_literals;
 using testing::Client;
 
-/// The hexapod twin alone on loopback port 0 (the live stage it does not use: a fake).
-struct HexapodServerRig {
-  testing::FakeStage unused;
-  std::unique_ptr<TwinServer> server;
-  explicit HexapodServerRig(double line_timeout_s = 5.0) {
-    TwinServerParams tp;
-    tp.endpoints = {{Protocol::kGcs2Hexapod, "127.0.0.1", 0}};
-    tp.line_timeout_s = line_timeout_s;
-    tp.max_clients = 8;
-    server = std::make_unique<TwinServer>(unused, tp);
-    server->start();
-  }
-  ~HexapodServerRig() { server->stop(); }
-  std::uint16_t port() const { return server->ports()[0]; }
-};
-
-std::string byte_reply(const Client& c, char b) {
-  c.send(std::string(1, b));
-  return c.read_until([](const std::string& t) { return !t.empty() && t.back() == '\n'; });
-}
-
-bool wait_on_target(const Client& c, double timeout_s = 30.0) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < end) {
-    if (c.gcs("ONT? X Y Z U V W") == "X=1 \nY=1 \nZ=1 \nU=1 \nV=1 \nW=1\n") return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return false;
-}
-
-double axis(const Client& c, const std::string& query) {
-  return drivers::gcs2::parse_axis_values(c.gcs(query)).at(0).second;
-}
-
-void reference(const Client& c) {
-  c.send("FRF X Y Z U V W\n");
-  ASSERT_EQ(c.gcs("ERR?"), "0\n");
-  ASSERT_TRUE(wait_on_target(c));
-  ASSERT_EQ(c.gcs("FRF?"), "X=1 \nY=1 \nZ=1 \nU=1 \nV=1 \nW=1\n");
-}
+using testing::axis;
+using testing::byte_reply;
+using testing::HexapodServerRig;
+using testing::reference;
+using testing::wait_on_target;
 
 TEST(HexapodServer, ParsesEmulateGcs2Hexapod) {
   EXPECT_EQ(parse_emulate("gcs2-hexapod").port, 50000);
@@ -70,11 +35,15 @@ TEST(HexapodServer, ParsesEmulateGcs2Hexapod) {
   EXPECT_STREQ(protocol_name(e.protocol), "gcs2-hexapod");
   EXPECT_THROW(parse_emulate("gcs2-hexapod=127.0.0.1"), UsageError);
   EXPECT_THROW(parse_emulate("hexapod"), UsageError);
+  // Served only on a platform with the parallel positioner.
+  testing::FakeStage cartesian;
+  TwinServerParams tp;
+  tp.endpoints = {{Protocol::kGcs2Hexapod, "127.0.0.1", 0}};
+  EXPECT_THROW({ TwinServer server(cartesian, tp); }, InvalidParams);
 }
 
 TEST(HexapodServer, AClientReferencesMovesAndReadsThePoseOverTcp) {
   HexapodServerRig rig;
-  ASSERT_NE(rig.server->hexapod_stage(), nullptr);
   Client c(rig.port(), 5.0);
   EXPECT_NE(c.gcs("*IDN?").find("C-887"), std::string::npos);
   EXPECT_EQ(byte_reply(c, 7), "\xb1\n");
@@ -126,10 +95,9 @@ TEST(HexapodServer, TheLoopThreadNeverAllocatesWhileAClientMovesAndStopsThePlatf
   HexapodServerRig rig;
   Client c(rig.port(), 5.0);
   reference(c);  // warm-up: the first move has made the trajectory's storage
-  const HexapodStage* stage = rig.server->hexapod_stage();
   std::size_t allocations = 0;
   {
-    test::AllocationGuard guard(stage->loop_thread());
+    test::AllocationGuard guard(rig.live->loop_thread_id());
     c.send("VLS 0.5\nMOV X 0.02 U 0.1\nMOV Y 0.02\n");
     ASSERT_TRUE(wait_on_target(c));
     c.send("MOV Z 0.1\n");

@@ -89,6 +89,15 @@ live::LiveParams live_params(const ServeConfig& o, const Log& log) {
   } else {
     pf::use_scene(lp.platform, scene);
   }
+  // The hexapod twin drives the platform's parallel positioner: the thesis's assembly, the part on
+  // the positioner and the gripper on the Cartesian robot.
+  for (const auto& t : o.twins) {
+    if (t.protocol != twins::Protocol::kGcs2Hexapod || lp.platform.parallel_positioner_enabled()) continue;
+    lp.platform.positioner = "parallel";
+    lp.platform.validate();
+    log("--emulate gcs2-hexapod: the part rides on the platform's parallel positioner (positioner: "
+        "parallel)");
+  }
   return lp;
 }
 

@@ -10,9 +10,11 @@
 
 #include "microcobot/devices/camera_device.h"
 #include "microcobot/devices/device.h"
+#include "microcobot/devices/parallel_positioner.h"
 #include "microcobot/devices/simulated_gripper.h"
 #include "microcobot/devices/simulated_haptic_master.h"
 #include "microcobot/devices/simulated_optical_tweezers.h"
+#include "microcobot/devices/simulated_parallel_positioner.h"
 #include "microcobot/devices/simulated_slave_axis.h"
 #include "microcobot/devices/simulated_tweezers_master.h"
 
@@ -32,6 +34,9 @@ struct DeviceSet {
   /// `camera` and `devices.camera` ask for; none when devices.camera.driver is "none").
   std::unique_ptr<Camera> camera;
   std::unique_ptr<FocusDrive> focus;
+  /// The 6-DOF parallel positioner carrying the part (optional: `positioner: parallel`, the
+  /// thesis's assembly; absent, the platform builds the simulated one the configuration asks for).
+  std::unique_ptr<ParallelPositioner> positioner;
 };
 
 /// The simulated devices of a platform, by their concrete types (non-owning; null for a driver's
@@ -43,6 +48,7 @@ struct SimulatedDevices {
   SimulatedOpticalTweezers* optical_tweezers = nullptr;  ///< the optical-trap scene's (else null)
   SimulatedHapticMaster* haptic = nullptr;
   SimulatedTweezersMaster* tweezers = nullptr;
+  SimulatedParallelPositioner* positioner = nullptr;  ///< `positioner: parallel` (else null)
 };
 
 }  // namespace mc::devices

@@ -133,6 +133,9 @@ class LivePlatform {
   bool push_protocol_command(const ProtocolCommand& c) noexcept { return protocol_->push(c); }
   /// What the loop last published for the protocol clients. Any thread.
   ProtocolView protocol_view() const noexcept;
+  /// What the loop last published of the parallel positioner (`positioner: parallel`). One reader
+  /// thread: the protocol thread.
+  PositionerView positioner_view() noexcept { return protocol_->positioner_view(); }
   /// The operator's control of the task (one producer thread: the server's). Wait-free; false
   /// without a task or when its ring is full.
   bool push_task_action(TaskAction a) noexcept { return task_ && task_->push(a); }

@@ -5,9 +5,14 @@
 /// data copied into the loop through the live platform's protocol ring (one producer: the
 /// protocol thread). The loop is the arbiter of who controls the stage: a protocol command counts
 /// only while no console client holds control, and the protocol's heartbeat is its deadman.
+/// A pose move of the parallel positioner (the hexapod twin's) travels planned and checked
+/// (motion::check_move() on the protocol thread): the loop only starts it.
 
 #include <array>
 #include <cstdint>
+#include <optional>
+
+#include "microcobot/motion/pose_trajectory.h"
 
 namespace mc::live {
 
@@ -19,6 +24,7 @@ struct ProtocolCommand {
     kSteps,      ///< open loop: `periods` sawtooth periods on `axis` (ANC300 stepu/stepd)
     kStop,       ///< stop every motion at once, every axis holding (HLT, STP, #24, stop)
     kRelease,    ///< the controlling client is gone: stop, hold, control free
+    kPoseMove,   ///< the parallel positioner along `pose` (checked), once the moves before it ended
   };
   Kind kind = Kind::kHeartbeat;
   std::array<double, 3> goal_m{};  ///< stage coordinates (relative to home) [m]
@@ -33,6 +39,23 @@ struct ProtocolCommand {
   int direction = 1;  ///< +1 up (forward), -1 down
   std::int64_t periods = 0;
   std::uint64_t seq = 0;  ///< increasing per command: the view says which the loop applied
+  /// kPoseMove: a trajectory motion::check_move() passed, planned from the pose the legs will hold
+  /// when it starts (the last queued move's goal, or the held pose).
+  std::optional<motion::PoseTrajectory> pose;
+};
+
+/// What the loop publishes of the parallel positioner for the protocol thread (one snapshot, a
+/// runtime::LatestValue: consistent as a whole).
+struct PositionerView {
+  motion::PlatformTransform measured;   ///< FK of the legs' sensors, {H}
+  motion::PlatformTransform reference;  ///< the pose the legs are told to be at (held: the next start)
+  bool moving = false;                  ///< a pose move runs or waits in the loop's queue
+  bool at_rest = false;                 ///< no move, every leg holding in position
+  bool halted = false;             ///< the platform's e-stop latched or a device faulted: every leg at 0 V
+  std::uint64_t started_seq = 0;   ///< the last pose move started (its command's seq)
+  std::uint64_t rejected_seq = 0;  ///< the last pose move dropped unstarted (halted, outranked, stale)
+  std::uint64_t stop_seq = 0;      ///< the last stop applied
+  double time_s = 0.0;             ///< loop time of the snapshot
 };
 
 /// What the loop publishes for the protocol clients (atomics, any thread). Index 3 is the rotary

@@ -12,6 +12,26 @@ void ProtocolSource::stop_and_hold(Platform& p) noexcept {
   p.hold();
   has_goal_ = false;
   pending_steps_ = {};
+  clear_pose_queue(true);
+}
+
+void ProtocolSource::queue_pose(const ProtocolCommand& c) noexcept {
+  if (pose_count_ == kPoseQueue || !c.pose) {
+    pose_rejected_ = std::max(pose_rejected_, c.seq);
+    return;
+  }
+  const std::size_t i = (pose_head_ + pose_count_) % kPoseQueue;
+  pose_queue_[i] = c.pose;  // a copy into storage of fixed size: no allocation
+  pose_seq_[i] = c.seq;
+  ++pose_count_;
+}
+
+void ProtocolSource::clear_pose_queue(bool rejected) noexcept {
+  while (pose_count_ > 0) {
+    if (rejected) pose_rejected_ = std::max(pose_rejected_, pose_seq_[pose_head_]);
+    pose_head_ = (pose_head_ + 1) % kPoseQueue;
+    --pose_count_;
+  }
 }
 
 SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
@@ -41,7 +61,13 @@ SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
         pending_steps_[static_cast<std::size_t>(std::clamp(c.axis, 0, 3))] = c;
         break;
       case ProtocolCommand::Kind::kStop:
+        clear_pose_queue(false);         // the stop covers the moves sent before it
         if (holding_) stop_and_hold(p);  // a protocol stop never interrupts another source
+        pose_stop_ = c.seq;
+        break;
+      case ProtocolCommand::Kind::kPoseMove:
+        last_t_ = now;
+        queue_pose(c);
         break;
       case ProtocolCommand::Kind::kRelease:
         stop_and_hold(p);
@@ -53,6 +79,7 @@ SourceRequest ProtocolSource::poll(const SourceTick& t) noexcept {
   if (p.faulted()) {
     has_goal_ = false;
     pending_steps_ = {};
+    clear_pose_queue(true);
   }
   SourceRequest r;
   if (now - last_t_ <= params_.command_timeout_s) r.claim = Claim::kActive;
@@ -111,10 +138,44 @@ void ProtocolSource::publish(const SourceTick& t) noexcept {
     stepping_[i].store(running, std::memory_order_relaxed);
   }
   driving_.store(holding_, std::memory_order_relaxed);
+  publish_positioner(t);
   applied_seq_.store(popped_seq_, std::memory_order_release);
 }
 
+void ProtocolSource::publish_positioner(const SourceTick& t) noexcept {
+  Platform& p = t.platform;
+  const devices::ParallelPositioner* pos = p.positioner();
+  if (pos == nullptr) {
+    clear_pose_queue(true);
+    return;
+  }
+  // The next queued move starts once the one under way has ended (it was planned from its goal),
+  // only while the protocol drives.
+  if (!holding_) clear_pose_queue(true);
+  if (pose_count_ > 0 && !pos->moving()) {
+    const std::uint64_t seq = pose_seq_[pose_head_];
+    if (p.start_pose_move(*pose_queue_[pose_head_]))
+      pose_started_ = std::max(pose_started_, seq);
+    else
+      pose_rejected_ = std::max(pose_rejected_, seq);
+    pose_head_ = (pose_head_ + 1) % kPoseQueue;
+    --pose_count_;
+  }
+  PositionerView v;
+  v.measured = pos->measured_pose();
+  v.reference = pos->reference_pose();
+  v.moving = pos->moving() || pose_count_ > 0;
+  v.at_rest = pos->at_rest() && pose_count_ == 0;
+  v.halted = p.faulted() || !pos->active();
+  v.started_seq = pose_started_;
+  v.rejected_seq = pose_rejected_;
+  v.stop_seq = pose_stop_;
+  v.time_s = t.tick.t_s;
+  positioner_view_.publish(v);
+}
+
 void ProtocolSource::reset() noexcept {
+  clear_pose_queue(true);
   last_t_ = -1e9;
   holding_ = has_goal_ = false;
   pending_steps_ = {};

@@ -6,6 +6,11 @@
 /// threads. The heartbeat is the client's deadman: the source is active while its last command
 /// or heartbeat is at most `command_timeout_s` old, and it ranks below a console client in
 /// control, the demo and a started task (LivePlatform's order).
+///
+/// Pose moves of the parallel positioner queue here (at most kPoseQueue): the next starts when the
+/// one under way has ended (Platform::start_pose_move, with the protocol's deadman); a stop clears
+/// the queue, and so does losing control (stale, outranked, released, halted), which also holds
+/// the positioner. Its state leaves as one PositionerView snapshot.
 
 #include <array>
 #include <atomic>
@@ -14,6 +19,7 @@
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/protocol_command.h"
+#include "microcobot/runtime/latest_value.h"
 #include "microcobot/runtime/spsc_ring.h"
 
 namespace mc::live {
@@ -35,6 +41,9 @@ class ProtocolSource final : public CommandSource {
   bool push(const ProtocolCommand& c) noexcept { return ring_.push(c); }
   /// What the loop last published (without the console's and the e-stop's parts). Any thread.
   ProtocolView view() const noexcept;
+  /// The positioner's newest snapshot (one reader thread: the protocol thread).
+  PositionerView positioner_view() noexcept { return positioner_view_.read(); }
+  static constexpr std::size_t kPoseQueue = 16;
 
   std::string_view name() const noexcept override { return "protocol"; }
   SourceRequest poll(const SourceTick& t) noexcept override;
@@ -45,6 +54,10 @@ class ProtocolSource final : public CommandSource {
 
  private:
   void stop_and_hold(platform::Platform& p) noexcept;
+  void queue_pose(const ProtocolCommand& c) noexcept;
+  /// Empties the pose queue; `rejected`: its moves are reported dropped (rejected_seq).
+  void clear_pose_queue(bool rejected) noexcept;
+  void publish_positioner(const SourceTick& t) noexcept;
 
   ProtocolSourceParams params_;
   runtime::SpscRing<ProtocolCommand> ring_{256};
@@ -57,6 +70,11 @@ class ProtocolSource final : public CommandSource {
   // The step runs asked since the last tick, one per axis: runs on several axes play at once.
   std::array<std::optional<ProtocolCommand>, 4> pending_steps_{};
   std::uint64_t popped_seq_ = 0;
+  std::array<std::optional<motion::PoseTrajectory>, kPoseQueue> pose_queue_{};
+  std::array<std::uint64_t, kPoseQueue> pose_seq_{};
+  std::size_t pose_head_ = 0, pose_count_ = 0;
+  std::uint64_t pose_started_ = 0, pose_rejected_ = 0, pose_stop_ = 0;
+  runtime::LatestValue<PositionerView> positioner_view_;
   // Published for the protocol thread (X, Y, Z [m], theta [rad]).
   std::array<std::atomic<double>, 4> position_{};
   std::array<std::atomic<bool>, 4> on_target_{}, stepping_{};

@@ -50,8 +50,9 @@ void ParallelStage::place(const PlatformTransform& T) {
     ax.hold = q;
   }
   measured_T_ = true_T_ = ref_T_ = T;
+  true_stale_ = false;
   moving_ = false;
-  fault_ = false;
+  fault_ = halted_ = false;
   t_move_ = 0.0;
 }
 
@@ -59,6 +60,7 @@ MoveCheck ParallelStage::move_to(const PlatformTransform& goal) { return move_to
 
 MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLimits& limits) {
   if (fault_) throw InvalidInput("the positioner is stopped on a fault: place it again");
+  if (halted_) throw InvalidInput("the positioner is halted (emergency stop): rearm it first");
   for (std::size_t i = 0; i < axes_.size(); ++i) {
     if (axes_[i].stepping)
       throw InvalidInput("leg " + std::to_string(i / 2) + " is stepping open loop: wait for it or stop()");
@@ -82,7 +84,7 @@ MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLi
 }
 
 bool ParallelStage::start_move(const PoseTrajectory& checked) noexcept {
-  if (fault_ || moving_) return false;
+  if (fault_ || halted_ || moving_) return false;
   for (const auto& ax : axes_)
     if (ax.stepping) return false;
   constexpr double kSame = 1e-9;
@@ -104,6 +106,7 @@ void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, doubl
   require(std::isfinite(frequency_Hz) && frequency_Hz > 0.0 && frequency_Hz <= 20000.0, "frequency_Hz",
           "must be in (0, 20000] Hz", frequency_Hz);
   if (fault_) throw InvalidInput("the positioner is stopped on a fault: place it again");
+  if (halted_) throw InvalidInput("the positioner is halted (emergency stop): rearm it first");
   stop();
   auto& ax = axes_[static_cast<std::size_t>(2 * leg + static_cast<int>(positioner))];
   if (ax.stepping) throw InvalidInput("leg " + std::to_string(leg) + "'s positioner is already stepping");
@@ -117,6 +120,10 @@ void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, doubl
 void ParallelStage::hold_here(LegAxis& ax) noexcept { ax.hold = ax.measured; }
 
 void ParallelStage::stop() noexcept {
+  bool stepping = false;
+  for (const auto& ax : axes_) stepping = stepping || ax.stepping;
+  // Already holding: the held pose stays exactly what it is (a move planned from it still starts).
+  if (!moving_ && !stepping) return;
   moving_ = false;
   for (auto& ax : axes_) {
     if (ax.stepping)
@@ -135,6 +142,36 @@ void ParallelStage::safe_stop() noexcept {
     ax.gen.halt();
     ax.stepping = false;
   }
+}
+
+void ParallelStage::emergency_stop() noexcept {
+  halted_ = true;
+  moving_ = false;
+  for (auto& ax : axes_) {
+    ax.ctrl->emergency_stop();
+    ax.gen.halt();
+    ax.stepping = false;
+  }
+}
+
+void ParallelStage::rearm() {
+  if (fault_)
+    throw InvalidInput("the positioner stopped on a fault (a diverged leg or no pose for its legs)");
+  // Never ticked since place(): the legs hold the placed pose exactly (a client plans its first
+  // move from it); else where their sensors read now.
+  const bool placed = t_ == 0.0;
+  LegCoordinates qm;
+  for (std::size_t i = 0; i < axes_.size(); ++i) qm(static_cast<Eigen::Index>(i)) = axes_[i].measured;
+  if (!placed) measured_T_ = kin_.forward(qm, measured_T_).T;  // throws where the legs close on no pose
+  for (auto& ax : axes_) {
+    ax.stepping = false;
+    ax.gen.halt();
+    ax.ctrl->reset(ax.measured, ax.state.u_V);
+    if (!placed) hold_here(ax);
+  }
+  if (!placed) ref_T_ = measured_T_;
+  moving_ = halted_ = false;
+  t_move_ = 0.0;
 }
 
 void ParallelStage::tick() noexcept {
@@ -193,22 +230,33 @@ void ParallelStage::tick() noexcept {
 }
 
 void ParallelStage::update_poses() noexcept {
-  LegCoordinates qm, qt;
-  for (std::size_t i = 0; i < axes_.size(); ++i) {
-    qm(static_cast<Eigen::Index>(i)) = axes_[i].measured;
-    qt(static_cast<Eigen::Index>(i)) = model_.slider_position(axes_[i].state);
-  }
+  LegCoordinates qm;
+  for (std::size_t i = 0; i < axes_.size(); ++i) qm(static_cast<Eigen::Index>(i)) = axes_[i].measured;
+  true_stale_ = true;
   try {
     measured_T_ = kin_.forward(qm, measured_T_).T;
-    true_T_ = kin_.forward(qt, true_T_).T;
   } catch (...) {
     // The legs stand where no pose of the positioner is (e.g. stepped beyond a joint limit).
     safe_stop();
   }
 }
 
+const PlatformTransform& ParallelStage::true_pose() const noexcept {
+  if (!true_stale_) return true_T_;
+  LegCoordinates qt;
+  for (std::size_t i = 0; i < axes_.size(); ++i)
+    qt(static_cast<Eigen::Index>(i)) = model_.slider_position(axes_[i].state);
+  try {
+    true_T_ = kin_.forward(qt, true_T_).T;
+  } catch (...) {
+    // The sliders fit no pose (a fault follows from the sensors' FK): the last true pose stands.
+  }
+  true_stale_ = false;
+  return true_T_;
+}
+
 bool ParallelStage::at_rest() const noexcept {
-  if (moving_ || fault_) return false;
+  if (moving_ || fault_ || halted_) return false;
   for (const auto& ax : axes_) {
     if (ax.stepping || !ax.ctrl->ready() || !ax.ctrl->in_position()) return false;
   }

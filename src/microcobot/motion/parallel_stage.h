@@ -13,13 +13,16 @@
 /// Control is in the legs' space: a move's reference pose T(s(t)) (pose_trajectory.h) gives
 /// q_ref = IK(T) and its derivatives each tick, and each leg tracks its own q_ref; all legs follow
 /// the same s(t). The measured pose is FK of the six sensors' readings (Newton from the previous
-/// measured pose), the true pose FK of the six true slider positions (from the previous true pose):
-/// both are what the platform does, not what it was told.
+/// measured pose), every tick; the true pose FK of the six true slider positions (from the last
+/// true pose), computed when asked (true_pose()): the simulation's truth, which no control needs,
+/// so a loop that reads it at its telemetry rate pays one FK there instead of one a tick. Both are
+/// what the platform does, not what it was told.
 ///
 /// Modes of a leg: tracking (moving or holding its reference), or stepping open loop
 /// (step_leg(): a sawtooth of N periods at full amplitude, recovery), after which it holds where
 /// it landed. stop() holds every leg where it is. A diverged model or a failed FK stops every
-/// axis at 0 V (fault()). tick() never allocates.
+/// axis at 0 V (fault()); so does emergency_stop() (halted()), the platform's safe state, until
+/// rearm(). tick() never allocates.
 
 #include <array>
 #include <cstdint>
@@ -90,17 +93,27 @@ class ParallelStage {
   /// The real-time half of move_to(), for a loop whose moves are planned on another thread: starts
   /// `checked`, a trajectory that check_move() passed, whose start is the pose the legs hold
   /// (reference_pose() while no move runs). False, and nothing changes, while a move runs or a leg
-  /// steps, after a fault, or when the trajectory starts elsewhere than the held pose (by more than
-  /// 1 nm or 1 nrad in any entry of R or d). Never allocates (the trajectory's storage is made by
-  /// the constructor), never throws.
+  /// steps, after a fault or an emergency stop, or when the trajectory starts elsewhere than the held pose
+  /// (by more than 1 nm or 1 nrad in any entry of R or d). Never allocates (the trajectory's storage is made
+  /// by the constructor), never throws.
   bool start_move(const PoseTrajectory& checked) noexcept;
   /// Open-loop stepping of one positioner (recovery): `steps` sawtooth periods at the full
   /// amplitude and `frequency_Hz`, forward for steps > 0; the leg then holds where it landed. Any
   /// move is stopped first (the other legs hold where they are).
   void step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz);
   /// Ends any move: every tracking leg holds where it is measured now; a stepping leg finishes
-  /// its period (U back at 0 V, no abrupt edge) and holds. Never allocates.
+  /// its period (U back at 0 V, no abrupt edge) and holds. Holding already (no move, no leg
+  /// stepping), nothing changes: the held pose stays exact. Never allocates.
   void stop() noexcept;
+  /// Every leg to 0 V at once (its tracker stopped, any stepping halted), no move: the safe state
+  /// a platform's fault or e-stop asks for. The physics runs on (tick()) and the poses are still
+  /// measured. Idempotent, never allocates; held until rearm().
+  void emergency_stop() noexcept;
+  /// After emergency_stop() (or at power-up): every tracker restarts where its sensor reads and the
+  /// legs hold there, the reference pose FK of those readings (before the first tick: the pose
+  /// place() gave, exactly). Throws mc::InvalidInput after a
+  /// fault (a diverged model, legs where no pose of the positioner is): that stays latched.
+  void rearm();
   /// One control period (1 / tracking.control_rate_Hz). Never allocates.
   void tick() noexcept;
 
@@ -108,13 +121,17 @@ class ParallelStage {
   /// Every leg tracking, no move under way and every tracker in position.
   bool at_rest() const noexcept;
   bool fault() const noexcept { return fault_; }
+  /// Stopped at 0 V by emergency_stop() (or a fault) until rearm().
+  bool halted() const noexcept { return halted_ || fault_; }
   double time_s() const noexcept { return t_; }
   double tick_s() const noexcept { return static_cast<double>(ratio_) * model_.dt_s(); }
   /// Time into the present (or last) move [s]; 0 until every tracker is ready.
   double move_time_s() const noexcept { return t_move_; }
 
   const PlatformTransform& measured_pose() const noexcept { return measured_T_; }
-  const PlatformTransform& true_pose() const noexcept { return true_T_; }
+  /// FK of the true slider positions, from the last true pose (computed on the first call after a
+  /// tick; the last one where they fit no pose). Never allocates unless that FK fails.
+  const PlatformTransform& true_pose() const noexcept;
   /// The pose the legs are told to be at (the move's T(s(t)), or the held pose).
   const PlatformTransform& reference_pose() const noexcept { return ref_T_; }
   /// The present (or last) move; only valid after a move_to().
@@ -147,10 +164,12 @@ class ParallelStage {
   std::unique_ptr<PoseTrajectory> traj_;
   std::unique_ptr<PoseTrajectory> spare_;  ///< start_move()'s storage until traj_ exists
   LegReference ref_;
-  PlatformTransform measured_T_, true_T_, ref_T_;
+  PlatformTransform measured_T_, ref_T_;
+  mutable PlatformTransform true_T_;
+  mutable bool true_stale_ = false;  ///< the sliders moved since true_T_ was computed
   int ratio_ = 1;
   double t_ = 0.0, t_move_ = 0.0;
-  bool moving_ = false, fault_ = false;
+  bool moving_ = false, fault_ = false, halted_ = false;
 };
 
 }  // namespace mc::motion

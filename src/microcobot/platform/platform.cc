@@ -52,11 +52,11 @@ Platform::Platform(const PlatformConfig& config, devices::DeviceSet drivers)
   // scripted operator moves their hands as on the simulated platform.
   sim_.haptic = dynamic_cast<devices::SimulatedHapticMaster*>(devices_.haptic.get());
   sim_.tweezers = dynamic_cast<devices::SimulatedTweezersMaster*>(devices_.tweezers.get());
-  const char* names[9] = {"axes[0]",  "axes[1]", "axes[2]", "gripper", "haptic",
-                          "tweezers", "camera",  "focus",   "rotary"};
+  const char* names[10] = {"axes[0]",  "axes[1]", "axes[2]", "gripper", "haptic",
+                           "tweezers", "camera",  "focus",   "rotary",  "positioner"};
   const auto d = devices();
   for (std::size_t i = 0; i < d.size(); ++i) {
-    if (i >= 6 && d[i] == nullptr) continue;  // optional: the camera, its focus, the rotary axis
+    if (i >= 6 && d[i] == nullptr) continue;  // optional: the camera, its focus, the rotary axis, ...
     if (d[i] == nullptr) throw InvalidParams(std::string("devices.") + names[i], "is missing");
     if (d[i]->state() != devices::Lifecycle::kUnconfigured)
       throw InvalidParams(std::string("devices.") + names[i], "must be handed over unconfigured");
@@ -98,6 +98,7 @@ void Platform::build() {
   teleop_ = std::make_unique<teleop::Teleoperation>(config_.teleop, dt, Eigen::Vector3d::Zero(),
                                                     world_.params().gripper.max_opening_m, limits);
   build_rotary();
+  build_positioner();
   build_telemetry();
   if (!devices_.camera && config_.camera.enabled) {
     if (auto source = make_camera_source(config_))
@@ -127,10 +128,10 @@ Platform::~Platform() {
     if (d != nullptr) d->deactivate();
 }
 
-std::array<devices::Device*, 9> Platform::devices() {
-  return {devices_.axes[0].get(), devices_.axes[1].get(), devices_.axes[2].get(),
-          devices_.gripper.get(), devices_.haptic.get(),  devices_.tweezers.get(),
-          devices_.camera.get(),  devices_.focus.get(),   devices_.rotary.get()};
+std::array<devices::Device*, 10> Platform::devices() {
+  return {devices_.axes[0].get(), devices_.axes[1].get(),   devices_.axes[2].get(), devices_.gripper.get(),
+          devices_.haptic.get(),  devices_.tweezers.get(),  devices_.camera.get(),  devices_.focus.get(),
+          devices_.rotary.get(),  devices_.positioner.get()};
 }
 
 const devices::SimulatedDevices& Platform::simulation() const {
@@ -241,7 +242,8 @@ void Platform::devices_task(double dt_s) noexcept {
   }
   stepping_ended |= rotary_drive(dt_s);
   // Every automatic move ends holding: the targets re-taken where the axes are.
-  if (stepping_ended) hold();
+  if (stepping_ended) hold_axes();
+  positioner_task(dt_s);
   devices_.gripper->update(dt_s);
   devices_.haptic->update(dt_s);
   devices_.tweezers->update(dt_s);
@@ -342,6 +344,11 @@ void Platform::set_fixtures(const teleop::FixtureSet& set) noexcept {
 }
 
 void Platform::hold() noexcept {
+  hold_axes();
+  stop_pose_move();
+}
+
+void Platform::hold_axes() noexcept {
   const Eigen::Vector3d measured(devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
                                  devices_.axes[2]->position_m());
   teleop_->hold_at(measured);

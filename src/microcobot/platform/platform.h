@@ -15,6 +15,10 @@
 /// The devices are reached through their interfaces only (device.h): the default platform
 /// builds the simulated ones, another constructor takes hardware drivers (docs/hardware.md).
 ///
+/// With `positioner: parallel` (the thesis's assembly, §2.3, Fig. 2.4) the part rides on the 6-DOF
+/// parallel positioner, one more device updated on every tick (platform_positioner.cc); its pose
+/// moves run only under the deadman of the input that drives the coupling.
+///
 /// A device that faults (a diverged model, a driver error) puts every device in its safe
 /// state at once: the axes to 0 V, the forces to zero, the gripper holding. Nothing on the
 /// loop path allocates, locks, throws or does I/O (tests/platform/platform_test.cc).
@@ -104,9 +108,27 @@ class Platform {
   void recover();
   void stop() noexcept { loop_.request_stop(); }
   /// Every axis holds where it is measured (target = position, zero velocity), the coupling
-  /// disengaged until the next engagement: how an automatic sequence hands control back.
-  /// On the loop (the operator task); real-time safe.
+  /// disengaged until the next engagement, the parallel positioner's legs too: how an automatic
+  /// sequence hands control back. On the loop (the operator task); real-time safe.
   void hold() noexcept;
+  /// The parallel positioner carrying the part (`positioner: parallel`), or null.
+  bool has_positioner() const noexcept { return devices_.positioner != nullptr; }
+  const devices::ParallelPositioner* positioner() const noexcept { return devices_.positioner.get(); }
+  /// Whether a pose move may run now: not faulted, and the console input that drives the
+  /// coupling active, fresh and with its deadman held (the rule of the open-loop runs).
+  bool pose_move_allowed() const noexcept {
+    return !faulted_ && console_.active && console_.fresh && console_.deadman;
+  }
+  /// Starts a pose move of the parallel positioner: `checked`, a trajectory motion::check_move()
+  /// passed off the loop, from the pose the legs hold. False, and nothing moves, without the
+  /// positioner, when pose_move_allowed() is false, while another move runs, or when it starts
+  /// elsewhere (devices::ParallelPositioner::start_move). The move holds where it is as soon as
+  /// pose_move_allowed() turns false (Platform::devices_task). On the loop; real-time safe.
+  bool start_pose_move(const motion::PoseTrajectory& checked) noexcept;
+  /// Ends the positioner's move: every leg holds where it is measured. Real-time safe.
+  void stop_pose_move() noexcept {
+    if (devices_.positioner) devices_.positioner->stop();
+  }
   /// Open-loop stepping (the ANC300's `stepu`/`stepd`): `periods` sawtooth periods
   /// of `amplitude_V` at `frequency_Hz` played straight to axis `axis` (0..2; 3: the rotary
   /// axis, turning its rotor by the arc the actuator steps), forward
@@ -231,8 +253,16 @@ class Platform {
   void run_loop(double duration_s, const std::function<void()>& drain_fn);
   void build();
   void arm_devices(bool fault_on_failure);
-  /// Every device; the camera, focus drive and rotary axis last, null when absent.
-  std::array<devices::Device*, 9> devices();
+  /// Every device; the camera, focus drive, rotary axis and parallel positioner last, null when
+  /// absent.
+  std::array<devices::Device*, 10> devices();
+  /// hold() without the parallel positioner: an XYZ run that ends leaves a pose move running.
+  void hold_axes() noexcept;
+  /// The parallel positioner's part of each task (platform_positioner.cc).
+  void build_positioner();
+  void positioner_task(double dt_s) noexcept;
+  static std::span<const BuiltinChannel> positioner_channels();
+  static std::span<const BuiltinChannel> positioner_truth_channels();
   /// The rotary axis' part of each task (platform_rotary.cc).
   void build_rotary();
   void rotary_command() noexcept;

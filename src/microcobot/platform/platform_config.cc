@@ -139,6 +139,16 @@ void PlatformConfig::validate() const {
   } else if (std::filesystem::path(stickslip_params_file).is_absolute()) {
     check_reach(*this, axis_params(*this).slider.stroke_m);
   }
+  require(positioner == "cartesian" || positioner == "parallel", "positioner",
+          "must be cartesian or parallel, not '" + excerpt(positioner) + "'");
+  in_section("parallel_positioner", [&] {
+    parallel_positioner.validate();
+    if (!parallel_positioner_enabled()) return;
+    // One loop tick is a whole number of the legs' control periods (the device ticks them).
+    const double n = parallel_positioner.tracking.control_rate_Hz / loop.base_rate_Hz;
+    require(n >= 1.0 - 1e-9 && std::abs(n - std::round(n)) < 1e-6 * n, "tracking.control_rate_Hz",
+            "must be a whole multiple of loop.base_rate_Hz", parallel_positioner.tracking.control_rate_Hz);
+  });
   in_section("optical_trap", [&] {
     optical_trap.validate();
     const double ratio = loop.period_s() / optical_trap.trap.dt_s;

@@ -21,6 +21,7 @@
 #include "microcobot/haptics/render_pipeline.h"
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/motion/parallel_stage.h"
 #include "microcobot/motion/position_controller.h"
 #include "microcobot/motion/position_sensor.h"
 #include "microcobot/motion/rotary_axis.h"
@@ -191,6 +192,12 @@ struct PlatformConfig {
   devices::CameraDeviceParams camera;
   /// The grip force measured by vision, live (vision_grip_force.h).
   perception::VisionGripForceParams vision_force;
+  /// What positions the part: "cartesian", nothing but the XYZ stage carrying the gripper (the
+  /// default), or "parallel", the thesis's assembly (§2.3, Fig. 2.4): the part on the 6-DOF
+  /// parallel stick-slip positioner (`parallel_positioner`, devices/parallel_positioner.h), the
+  /// gripper on the Cartesian robot.
+  std::string positioner = "cartesian";
+  motion::ParallelStageParams parallel_positioner;
 
   template <class V>
   void visit(V& v) {
@@ -206,8 +213,11 @@ struct PlatformConfig {
     v("optical_trap", optical_trap);
     v("camera", camera);
     v("vision_force", vision_force);
+    v("positioner", positioner);
+    v("parallel_positioner", parallel_positioner);
   }
   bool optical_trap_scene() const { return microworld == "optical-trap"; }
+  bool parallel_positioner_enabled() const { return positioner == "parallel"; }
   /// Validates every section and their consistency (rates); errors name the key path.
   void validate() const;
 };

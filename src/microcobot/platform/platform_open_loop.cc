@@ -36,7 +36,7 @@ void Platform::stop_open_loop() noexcept {
     any |= st->running();
     st->halt();
   }
-  if (any) hold();
+  if (any) hold_axes();
 }
 
 bool Platform::open_loop_must_stop(std::size_t i) const noexcept {

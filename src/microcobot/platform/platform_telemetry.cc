@@ -4,6 +4,7 @@
 
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/motion/pose.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/telemetry_schema.h"
 
@@ -137,6 +138,52 @@ std::span<const Platform::BuiltinChannel> Platform::simulation_channels() {
   return kChannels;
 }
 
+// The parallel positioner's pose (`positioner: parallel`), after the loop's and the simulation's
+// channels: the platform frame {P} in the base frame {H} (motion/pose.h), its origin's position and
+// the SmarPod angles of its rotation, R = Rz(rz) Ry(ry) Rx(rx), pivot at {P}'s origin.
+std::span<const Platform::BuiltinChannel> Platform::positioner_channels() {
+  using P = const Platform&;
+  static constexpr BuiltinChannel kChannels[] = {
+      {"positioner_x_m", "m", "the parallel positioner's measured pose (FK of its legs' sensors), x",
+       [](P p) noexcept { return p.devices_.positioner->measured_pose().d.x(); }},
+      {"positioner_y_m", "m", "the parallel positioner's measured pose, y",
+       [](P p) noexcept { return p.devices_.positioner->measured_pose().d.y(); }},
+      {"positioner_z_m", "m", "the parallel positioner's measured pose, z",
+       [](P p) noexcept { return p.devices_.positioner->measured_pose().d.z(); }},
+      {"positioner_rx_rad", "rad", "the parallel positioner's measured pose, rx (R = Rz Ry Rx)",
+       [](P p) noexcept { return motion::smarpod_angles(p.devices_.positioner->measured_pose().R).x(); }},
+      {"positioner_ry_rad", "rad", "the parallel positioner's measured pose, ry",
+       [](P p) noexcept { return motion::smarpod_angles(p.devices_.positioner->measured_pose().R).y(); }},
+      {"positioner_rz_rad", "rad", "the parallel positioner's measured pose, rz",
+       [](P p) noexcept { return motion::smarpod_angles(p.devices_.positioner->measured_pose().R).z(); }},
+      {"positioner_moving", "", "1 while a pose move of the parallel positioner runs",
+       [](P p) noexcept { return p.devices_.positioner->moving() ? 1.0 : 0.0; }},
+      {"positioner_u_max_V", "V", "the largest drive voltage over the parallel positioner's six legs",
+       [](P p) noexcept { return p.devices_.positioner->max_leg_voltage_V(); }},
+  };
+  return kChannels;
+}
+
+// The simulated positioner's true pose: FK of its sliders' true positions.
+std::span<const Platform::BuiltinChannel> Platform::positioner_truth_channels() {
+  using P = const Platform&;
+  static constexpr BuiltinChannel kChannels[] = {
+      {"positioner_true_x_m", "m", "the parallel positioner's true pose (its sliders, not its sensors), x",
+       [](P p) noexcept { return p.sim_.positioner->true_pose().d.x(); }},
+      {"positioner_true_y_m", "m", "the parallel positioner's true pose, y",
+       [](P p) noexcept { return p.sim_.positioner->true_pose().d.y(); }},
+      {"positioner_true_z_m", "m", "the parallel positioner's true pose, z",
+       [](P p) noexcept { return p.sim_.positioner->true_pose().d.z(); }},
+      {"positioner_true_rx_rad", "rad", "the parallel positioner's true pose, rx",
+       [](P p) noexcept { return motion::smarpod_angles(p.sim_.positioner->true_pose().R).x(); }},
+      {"positioner_true_ry_rad", "rad", "the parallel positioner's true pose, ry",
+       [](P p) noexcept { return motion::smarpod_angles(p.sim_.positioner->true_pose().R).y(); }},
+      {"positioner_true_rz_rad", "rad", "the parallel positioner's true pose, rz",
+       [](P p) noexcept { return motion::smarpod_angles(p.sim_.positioner->true_pose().R).z(); }},
+  };
+  return kChannels;
+}
+
 Eigen::Vector3d Platform::simulated_part_m() const noexcept {
   if (sim_.gripper != nullptr) return sim_.gripper->world_state().part_m;
   if (sim_.optical_tweezers != nullptr) return sim_.optical_tweezers->bead_m();
@@ -164,6 +211,14 @@ void Platform::build_telemetry() {
   for (const auto& c : loop_channels()) telemetry_sources_.emplace_back(c.source);
   if (records_simulation())
     for (const auto& c : simulation_channels()) telemetry_sources_.emplace_back(c.source);
+  auto add = [this](std::span<const BuiltinChannel> channels) {
+    for (const auto& c : channels) {
+      telemetry_.add({c.name, c.unit, c.description});
+      telemetry_sources_.emplace_back(c.source);
+    }
+  };
+  if (has_positioner()) add(positioner_channels());
+  if (sim_.positioner != nullptr) add(positioner_truth_channels());
   recorder_ = std::make_unique<Recorder>(telemetry_.names(), 1);
 }
 

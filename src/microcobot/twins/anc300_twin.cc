@@ -79,6 +79,8 @@ std::string Anc300Twin::refusal(TwinStage::Refusal r) const {
       return reply_error("Another operator controls the stage");
     case TwinStage::Refusal::kBusy:
       return reply_error("Controller busy, try again");
+    case TwinStage::Refusal::kUnreachable:
+      return reply_error("Out of range");
     case TwinStage::Refusal::kNone:
       break;
   }

@@ -59,6 +59,14 @@ double travel(const motion::ParallelKinematics& k, int i, double sign, double sp
   return sign * lo;
 }
 
+const motion::ParallelKinematics& positioner_of(const TwinStage& stage) {
+  const motion::ParallelKinematics* k = stage.positioner_kinematics();
+  if (k == nullptr)
+    throw InvalidParams("--emulate gcs2-hexapod",
+                        "needs the platform's parallel positioner (positioner: parallel)");
+  return *k;
+}
+
 }  // namespace
 
 void Gcs2HexapodTwinParams::validate() const {
@@ -73,16 +81,19 @@ void Gcs2HexapodTwinParams::validate() const {
           "must be one line of fewer than 200 characters");
 }
 
-Gcs2HexapodTwin::Gcs2HexapodTwin(HexapodStage& stage, Gcs2HexapodTwinParams params)
-    : stage_(stage), params_(std::move(params)), velocity_mm_s_(params_.velocity_mm_s) {
+Gcs2HexapodTwin::Gcs2HexapodTwin(TwinStage& stage, Gcs2HexapodTwinParams params)
+    : stage_(stage),
+      kin_(positioner_of(stage)),
+      params_(std::move(params)),
+      velocity_mm_s_(params_.velocity_mm_s) {
   params_.validate();
   // Translations searched within 50 mm, rotations within 89 deg (PI's angles are unique below 90).
   for (int i = 0; i < 6; ++i) {
     const double span = i < 3 ? 50.0 : 89.0;
-    tmn_[static_cast<std::size_t>(i)] = travel(stage_.kinematics(), i, -1.0, span);
-    tmx_[static_cast<std::size_t>(i)] = travel(stage_.kinematics(), i, +1.0, span);
+    tmn_[static_cast<std::size_t>(i)] = travel(kin_, i, -1.0, span);
+    tmx_[static_cast<std::size_t>(i)] = travel(kin_, i, +1.0, span);
   }
-  target_ = last_goal_ = stage_.view().reference;
+  target_ = last_goal_ = stage_.positioner_view().reference;
 }
 
 PlatformTransform Gcs2HexapodTwin::cs_frame() const {
@@ -99,11 +110,34 @@ PlatformTransform Gcs2HexapodTwin::from_protocol(const Pose6& p) const {
   return compose(cs_frame(), motion::to_transform(to_si(p), pivot_m_));
 }
 
-HexapodView Gcs2HexapodTwin::refresh() {
-  const HexapodView v = stage_.view();
+live::PositionerView Gcs2HexapodTwin::refresh() {
+  const live::PositionerView v = stage_.positioner_view();
   if (v.rejected_seq > seen_rejected_) {
     seen_rejected_ = v.rejected_seq;
-    error_ = g::kStopped;  // the stage refused to start it (a fault): it stands stopped
+    error_ = g::kStopped;  // the platform dropped it unstarted (halted, control lost): it stands stopped
+  }
+  if (v.halted && !halted_) {
+    // The platform's e-stop (or a device's fault): every leg at 0 V where it was, the target there.
+    halted_ = true;
+    error_ = g::kStopped;
+    target_ = last_goal_ = v.measured;
+    after_stop_ = false;
+    unsent_stop_ = 0;
+    referencing_ = 0;
+    mover_ = 0;
+  } else if (!v.halted && halted_) {
+    halted_ = false;  // reset: the legs hold where they were measured
+    target_ = last_goal_ = v.reference;
+  }
+  // Control lost to another operator (a console user): the platform held the positioner; the
+  // target is where it holds once the loop has stopped the move.
+  if (mover_ != 0 && !stage_.controls(mover_)) {
+    mover_ = 0;
+    control_lost_ = true;
+  }
+  if (control_lost_ && !v.moving) {
+    control_lost_ = false;
+    if (!halted_) target_ = last_goal_ = v.reference;
   }
   if (referencing_ && (stop_sent_ > referencing_ || v.rejected_seq >= referencing_)) referencing_ = 0;
   if (referencing_ && v.started_seq >= referencing_ && !v.moving && v.at_rest) {
@@ -113,16 +147,37 @@ HexapodView Gcs2HexapodTwin::refresh() {
   return v;
 }
 
-bool Gcs2HexapodTwin::busy(const HexapodView& v) const {
+bool Gcs2HexapodTwin::busy(const live::PositionerView& v) const {
   const bool pending = last_move_ > stop_sent_ && last_move_ > v.started_seq && last_move_ > v.rejected_seq;
   return pending || v.moving;
 }
 
+bool Gcs2HexapodTwin::send_stop(ClientId client) {
+  std::uint64_t seq = 0;
+  switch (stage_.stop_pose(client, seq)) {
+    case TwinStage::Refusal::kNone:
+      stop_sent_ = seq;
+      after_stop_ = true;
+      unsent_stop_ = 0;
+      return true;
+    case TwinStage::Refusal::kBusy:
+      after_stop_ = true;
+      unsent_stop_ = client;
+      return true;
+    default:
+      after_stop_ = false;
+      unsent_stop_ = 0;
+      return false;
+  }
+}
+
 bool Gcs2HexapodTwin::settle_stop() {
+  if (unsent_stop_ != 0) send_stop(unsent_stop_);  // a stop the full ring refused: again
   if (!after_stop_) return true;
+  if (unsent_stop_ != 0) return false;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(params_.stop_wait_s);
   for (;;) {
-    const HexapodView v = stage_.view();
+    const live::PositionerView v = stage_.positioner_view();
     if (v.stop_seq >= stop_sent_) {
       target_ = last_goal_ = v.reference;
       after_stop_ = false;
@@ -133,27 +188,27 @@ bool Gcs2HexapodTwin::settle_stop() {
   }
 }
 
-PlatformTransform Gcs2HexapodTwin::plan_start(const HexapodView& v) const {
+PlatformTransform Gcs2HexapodTwin::plan_start(const live::PositionerView& v) const {
   return busy(v) ? last_goal_ : v.reference;
 }
 
 std::optional<motion::PoseTrajectory> Gcs2HexapodTwin::plan(const PlatformTransform& goal,
-                                                            const HexapodView& v) const {
+                                                            const live::PositionerView& v) const {
   // VLS is the tool point's speed. The angular rate slows with it below the library's speed but
   // never exceeds the library's rate: turning drives the legs faster than translating does.
-  motion::PoseMoveLimits lim = stage_.move_limits();
+  motion::PoseMoveLimits lim = stage_.positioner_limits();
   const double scale = velocity_mm_s_ * kM / lim.max_speed_m_s;
   lim.max_speed_m_s *= scale;
   lim.max_angular_speed_rad_s *= std::min(1.0, scale);
   // The goal's own check first: it bounds the path's length, and so check_move()'s samples.
-  if (!motion::check_pose(stage_.kinematics(), goal).ok()) return std::nullopt;
+  if (!motion::check_pose(kin_, goal).ok()) return std::nullopt;
   try {
     // A move whose legs would outrun their speed limit runs slower, as a hexapod controller keeps
     // every strut within its velocity: speeds scaled by the legs' margin (accelerations by its
     // square, which scales a short move's triangular peak alike), checked again.
     for (int attempt = 0; attempt < 4; ++attempt) {
       motion::PoseTrajectory traj(plan_start(v), goal, lim);
-      const motion::MoveCheck c = motion::check_move(stage_.kinematics(), traj);
+      const motion::MoveCheck c = motion::check_move(kin_, traj);
       if (c.ok) return traj;
       if (c.reach != motion::Reach::kReachable || !(c.peak_leg_speed_m_s > lim.max_leg_speed_m_s))
         return std::nullopt;  // a pose on the way is out of the workspace
@@ -171,36 +226,50 @@ std::optional<motion::PoseTrajectory> Gcs2HexapodTwin::plan(const PlatformTransf
 
 bool Gcs2HexapodTwin::send(ClientId client, const PlatformTransform& goal) {
   if (!settle_stop()) return error_ = g::kControllerBusy, false;
-  const HexapodView v = refresh();
-  if (v.fault) return error_ = g::kStopped, false;
+  const live::PositionerView v = refresh();
+  if (v.halted) return error_ = g::kStopped, false;
   const auto traj = plan(goal, v);
   if (!traj) return error_ = g::kPositionOutOfLimits, false;  // refused: nothing moves
-  if (!stage_.push_move(*traj, seq_ + 1)) return error_ = g::kControllerBusy, false;
-  last_move_ = ++seq_;
+  std::uint64_t seq = 0;
+  std::string reason;
+  switch (stage_.move_pose(client, *traj, seq, reason)) {
+    case TwinStage::Refusal::kNone:
+      break;
+    case TwinStage::Refusal::kUnreachable:
+      return error_ = g::kPositionOutOfLimits, false;
+    case TwinStage::Refusal::kBusy:
+      return error_ = g::kControllerBusy, false;
+    case TwinStage::Refusal::kHalted:
+    case TwinStage::Refusal::kOtherOperator:
+      return error_ = g::kStopped, false;  // as the GCS 2.0 twin: the platform is not this client's
+  }
+  last_move_ = seq;
   last_goal_ = target_ = goal;
   mover_ = client;
   return true;
 }
 
-void Gcs2HexapodTwin::stop_all() {
-  stage_.push_stop(++seq_);
-  stop_sent_ = seq_;
-  after_stop_ = true;
+void Gcs2HexapodTwin::stop_all(ClientId client) {
   referencing_ = 0;
   mover_ = 0;
+  if (send_stop(client)) return;
+  // Nothing sent: another operator holds the platform (which holds the positioner) or it is halted.
+  const live::PositionerView v = refresh();
+  if (!busy(v) && !halted_) target_ = last_goal_ = v.reference;
 }
 
 void Gcs2HexapodTwin::on_disconnect(ClientId client) {
-  if (client != 0 && client == mover_ && busy(refresh())) stop_all();
+  if (client != 0 && client == mover_ && busy(refresh())) stop_all(client);
+  stage_.release(client);
 }
 
-std::string Gcs2HexapodTwin::on_byte(ClientId, char byte) {
-  const HexapodView v = refresh();
+std::string Gcs2HexapodTwin::on_byte(ClientId client, char byte) {
+  const live::PositionerView v = refresh();
   if (byte == g::kMotionStatus) return fmt::format("{:X}\n", busy(v) ? 0x3Fu : 0u);
   if (byte == g::kReadyStatus)
     return std::string(1, static_cast<char>(referencing_ ? g::kBusy : g::kReady)) + "\n";
   if (byte == g::kStopAll) {
-    stop_all();
+    stop_all(client);
     error_ = g::kStopped;
   }
   return "";
@@ -224,7 +293,7 @@ bool Gcs2HexapodTwin::execute(ClientId client, const g::Request& r, Lines& reply
       const auto q = g::parse_hexapod_query(r.args);
       if (q.error) return error_ = q.error, false;
     }
-    stop_all();  // the six axes move as one: halting one halts them all
+    stop_all(client);  // the six axes move as one: halting one halts them all
     error_ = g::kStopped;
     return true;
   }
@@ -312,7 +381,7 @@ bool Gcs2HexapodTwin::coordinate_system(const g::Request& r, Lines& reply) {
 
 bool Gcs2HexapodTwin::query(const g::Request& r, Lines& reply) {
   const std::string& m = r.mnemonic;
-  const HexapodView v = refresh();
+  const live::PositionerView v = refresh();
   auto per_axis = [&](auto&& value_of) {
     const auto q = g::parse_hexapod_query(r.args);
     if (q.error) return error_ = q.error, false;

@@ -1,10 +1,13 @@
 #pragma once
 /// @file
 /// The PI hexapod controller's dialect of GCS 2.0 (a C-887 and its six axes X, Y, Z in mm and U, V,
-/// W in deg) over the simulated parallel positioner of hexapod_stage.h: a protocol layer only. The
-/// pose conventions are motion/pose.h's (PI's U -> V -> W about moving axes, the pivot moving with
-/// the platform), the reachability and the refusal of a move motion/'s (check_move(): the goal and
-/// the straight path to it), the motion the ParallelStage's.
+/// W in deg) over the live platform's parallel positioner (`positioner: parallel`;
+/// devices/parallel_positioner.h), reached through the twins' stage (twin_stage.h, live_stage.h):
+/// a protocol layer only. The pose conventions are motion/pose.h's (PI's U -> V -> W about moving
+/// axes, the pivot moving with the platform), the reachability and the refusal of a move motion/'s
+/// (check_move(): the goal and the straight path to it), the motion the platform's: a move runs on
+/// the platform's loop under its safety (the client's control and heartbeat as the GCS 2.0 twin's,
+/// the console's e-stop: error 10, the target where the positioner stopped).
 ///
 /// Commands (docs/hardware.md, "PI hexapod (C-887) dialect"): *IDN?, CSV?, HLP?, SAI? [ALL], SVO?,
 /// SVO (1 only: a hexapod's servo is always on), FRF, FRF?, MOV, MVR, MOV?, POS?, ONT?, VMO?,
@@ -22,7 +25,6 @@
 
 #include "microcobot/drivers/gcs2_codec.h"
 #include "microcobot/motion/pose.h"
-#include "microcobot/twins/hexapod_stage.h"
 #include "microcobot/twins/twin_stage.h"
 
 namespace mc::twins {
@@ -43,16 +45,17 @@ struct Gcs2HexapodTwinParams {
 
 class Gcs2HexapodTwin {
  public:
-  /// `stage` must outlive the twin (its loop may run or not: unstarted, nothing moves).
-  Gcs2HexapodTwin(HexapodStage& stage, Gcs2HexapodTwinParams params);
+  /// `stage` must outlive the twin (its loop may run or not: unstarted, nothing moves). Throws
+  /// mc::InvalidParams when the stage has no parallel positioner.
+  Gcs2HexapodTwin(TwinStage& stage, Gcs2HexapodTwinParams params);
   /// The reply bytes to one line from `client` (empty when none is due).
   std::string on_line(ClientId client, std::string_view line);
   /// The reply bytes to a single-byte command (#5, #7, #24).
   std::string on_byte(ClientId client, char byte);
   /// A line longer than gcs2::kMaxLineLength arrived (its rest discarded): error 3.
   void on_overlong_line() { error_ = drivers::gcs2::kCommandTooLong; }
-  /// The client went away: if its move runs, the platform stops and holds (as the project's other
-  /// twins: a protocol client gone leaves every axis holding).
+  /// The client went away: if its move runs, the platform stops and holds, and its control is
+  /// released (as the project's other twins: a protocol client gone leaves every axis holding).
   void on_disconnect(ClientId client);
   int last_error() const { return error_; }
   bool referenced() const { return referenced_; }
@@ -68,22 +71,27 @@ class Gcs2HexapodTwin {
   bool query(const drivers::gcs2::Request& r, Lines& reply);
   bool move(ClientId client, const drivers::gcs2::Request& r);
   bool coordinate_system(const drivers::gcs2::Request& r, Lines& reply);
-  /// The loop's view, with the referencing and a rejected move brought up to date.
-  HexapodView refresh();
+  /// The loop's view, with the referencing, a rejected move and a halt brought up to date.
+  live::PositionerView refresh();
   /// A move sent and not yet started, or one running.
-  bool busy(const HexapodView& v) const;
-  bool on_target(const HexapodView& v) const { return !busy(v) && v.at_rest && v.stop_seq >= stop_sent_; }
+  bool busy(const live::PositionerView& v) const;
+  bool on_target(const live::PositionerView& v) const {
+    return !busy(v) && v.at_rest && v.stop_seq >= stop_sent_;
+  }
   /// Waits (bounded) for the last stop to be applied; then the target is the stopped pose.
   bool settle_stop();
   /// The pose the next move starts from: the last move's goal while one is queued or runs, the
   /// held pose otherwise.
-  motion::PlatformTransform plan_start(const HexapodView& v) const;
+  motion::PlatformTransform plan_start(const live::PositionerView& v) const;
   /// The move from plan_start() to `goal` when motion's check_move() passes it; nullopt otherwise.
   std::optional<motion::PoseTrajectory> plan(const motion::PlatformTransform& goal,
-                                             const HexapodView& v) const;
+                                             const live::PositionerView& v) const;
   /// Plans, checks and queues a move to `goal`; false with the error set (7 refused, 1005 busy).
   bool send(ClientId client, const motion::PlatformTransform& goal);
-  void stop_all();
+  void stop_all(ClientId client);
+  /// Sends `client`'s stop; one the full ring refuses is kept (unsent_stop_) and sent again by
+  /// settle_stop(). False when nothing is in flight.
+  bool send_stop(ClientId client);
   /// Protocol units (mm, deg) in the enabled coordinate system, about the pivot, and back. With
   /// K = (R_K, d_K) the enabled system's frame in {H} (identity for ZERO) and c the pivot:
   ///   pose = to_pi(K^-1 T, c),  K^-1 T = (R_K^T R, R_K^T (d - d_K));   T = K to_transform(pose, c),
@@ -94,7 +102,8 @@ class Gcs2HexapodTwin {
   /// The enabled system's frame in {H}: K = to_transform(offsets) of its KSD offsets (pivot 0).
   motion::PlatformTransform cs_frame() const;
 
-  HexapodStage& stage_;
+  TwinStage& stage_;
+  const motion::ParallelKinematics& kin_;  ///< the platform's positioner's (immutable)
   Gcs2HexapodTwinParams params_;
   std::array<double, 6> tmn_{}, tmx_{};
   double velocity_mm_s_;
@@ -103,10 +112,13 @@ class Gcs2HexapodTwin {
   std::string enabled_ = "ZERO";
   motion::PlatformTransform target_;     ///< the last commanded goal, {H}
   motion::PlatformTransform last_goal_;  ///< the goal of the last move sent, {H}
-  std::uint64_t seq_ = 0, last_move_ = 0, stop_sent_ = 0, referencing_ = 0, seen_rejected_ = 0;
+  std::uint64_t last_move_ = 0, stop_sent_ = 0, referencing_ = 0, seen_rejected_ = 0;
   ClientId mover_ = 0;
+  ClientId unsent_stop_ = 0;  ///< a stop the full ring refused, to send again
   bool referenced_ = false;
-  bool after_stop_ = false;  ///< a stop was sent: the target becomes the stopped pose once applied
+  bool after_stop_ = false;    ///< a stop was sent: the target becomes the stopped pose once applied
+  bool halted_ = false;        ///< the platform's e-stop (or a fault) seen: the legs at 0 V
+  bool control_lost_ = false;  ///< another operator took the platform mid-move
   int error_ = drivers::gcs2::kNoError;
 };
 

@@ -126,6 +126,7 @@ bool Gcs2Twin::send_goal(ClientId client, unsigned moved) {
     case TwinStage::Refusal::kHalted:
     case TwinStage::Refusal::kOtherOperator:
     case TwinStage::Refusal::kBusy:
+    case TwinStage::Refusal::kUnreachable:
       set_error(drivers::gcs2::kStopped);
       return false;
   }

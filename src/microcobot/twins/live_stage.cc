@@ -26,6 +26,8 @@ LiveStage::LiveStage(live::LivePlatform& live) : live_(live) {
     max_theta_speed_rad_s_ = l.max_theta_speed_rad_s;
   }
   max_voltage_V_ = platform::axis_params(live.params().platform).drive.max_V;
+  if (live.params().platform.parallel_positioner_enabled())
+    kinematics_.emplace(live.params().platform.parallel_positioner.geometry);
 }
 
 TwinStage::Axis LiveStage::axis(int i) const {
@@ -98,6 +100,37 @@ TwinStage::Refusal LiveStage::step(ClientId client, int i, double amplitude_V, d
   if (!push(c)) return Refusal::kBusy;
   step_seq_[static_cast<std::size_t>(c.axis)] = seq_;
   move_seq_ = seq_;  // the stage leaves its goal
+  return Refusal::kNone;
+}
+
+TwinStage::Refusal LiveStage::move_pose(ClientId client, const motion::PoseTrajectory& traj,
+                                        std::uint64_t& seq, std::string& reason) {
+  if (!kinematics_) {
+    reason = "the platform has no parallel positioner (positioner: parallel)";
+    return Refusal::kUnreachable;
+  }
+  // Checked here, on the protocol thread, whatever the twin checked: no unchecked move reaches
+  // the loop, which only starts it.
+  const motion::MoveCheck c = motion::check_move(*kinematics_, traj);
+  if (!c.ok) {
+    reason = c.reason;
+    return Refusal::kUnreachable;
+  }
+  if (const Refusal r = claim(client); r != Refusal::kNone) return r;
+  live::ProtocolCommand cmd;
+  cmd.kind = live::ProtocolCommand::Kind::kPoseMove;
+  cmd.pose = traj;
+  if (!push(cmd)) return Refusal::kBusy;
+  seq = seq_;
+  return Refusal::kNone;
+}
+
+TwinStage::Refusal LiveStage::stop_pose(ClientId client, std::uint64_t& seq) {
+  if (!controls(client) || halted()) return Refusal::kOtherOperator;
+  live::ProtocolCommand c;
+  c.kind = live::ProtocolCommand::Kind::kStop;
+  if (!push(c)) return Refusal::kBusy;
+  seq = seq_;
   return Refusal::kNone;
 }
 

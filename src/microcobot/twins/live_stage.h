@@ -5,6 +5,8 @@
 /// the stage (twins/twin_stage.h), the rotary axis with the three when the platform has it.
 /// Protocol thread only: it is the ring's single producer.
 
+#include <optional>
+
 #include "microcobot/live/live_platform.h"
 #include "microcobot/twins/twin_stage.h"
 
@@ -29,6 +31,16 @@ class LiveStage : public TwinStage {
   void stop(ClientId client) override;
   void release(ClientId client) override;
   void heartbeat() override;
+  const motion::ParallelKinematics* positioner_kinematics() const override {
+    return kinematics_ ? &*kinematics_ : nullptr;
+  }
+  motion::PoseMoveLimits positioner_limits() const override {
+    return live_.params().platform.parallel_positioner.move;
+  }
+  Refusal move_pose(ClientId client, const motion::PoseTrajectory& traj, std::uint64_t& seq,
+                    std::string& reason) override;
+  Refusal stop_pose(ClientId client, std::uint64_t& seq) override;
+  live::PositionerView positioner_view() override { return live_.positioner_view(); }
 
  private:
   Refusal claim(ClientId client);
@@ -38,7 +50,8 @@ class LiveStage : public TwinStage {
   int axis_count_ = 3;
   std::array<double, kMaxAxes> min_{}, max_{};
   double max_speed_m_s_ = 0.0, max_theta_speed_rad_s_ = 0.0, max_voltage_V_ = 0.0;
-  double home_rad_ = 0.0;  // theta's home: the gripper's yaw at the axis' 0
+  double home_rad_ = 0.0;                                 // theta's home: the gripper's yaw at the axis' 0
+  std::optional<motion::ParallelKinematics> kinematics_;  // the platform's positioner's geometry
   ClientId owner_ = 0;
   std::uint64_t seq_ = 0;
   std::uint64_t move_seq_ = 0;                      // the last goal's command

@@ -98,6 +98,9 @@ bool Mcs2Twin::accepted(TwinStage::Refusal r) {
     case TwinStage::Refusal::kBusy:
       push_error(mcs2::kAborted);
       return false;
+    case TwinStage::Refusal::kUnreachable:
+      push_error(mcs2::kAborted);
+      return false;
   }
   return false;
 }

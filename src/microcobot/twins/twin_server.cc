@@ -115,7 +115,6 @@ void TwinServerParams::validate() const {
   anc300.validate();
   mcs2.validate();
   gcs2_hexapod.validate();
-  hexapod.validate();
 }
 
 struct TwinServer::Impl {
@@ -148,10 +147,8 @@ struct TwinServer::Impl {
         mcs2(st, params.mcs2),
         timer(io) {
     for (const auto& e : params.endpoints)
-      if (e.protocol == Protocol::kGcs2Hexapod && !hexapod) {
-        hexapod_stage = std::make_unique<HexapodStage>(params.hexapod);
-        hexapod = std::make_unique<Gcs2HexapodTwin>(*hexapod_stage, params.gcs2_hexapod);
-      }
+      if (e.protocol == Protocol::kGcs2Hexapod && !hexapod)
+        hexapod = std::make_unique<Gcs2HexapodTwin>(st, params.gcs2_hexapod);
   }
 
   TwinStage& stage;
@@ -159,8 +156,7 @@ struct TwinServer::Impl {
   Gcs2Twin gcs2;
   Anc300Twin anc300;
   Mcs2Twin mcs2;
-  std::unique_ptr<HexapodStage> hexapod_stage;  // with the hexapod twin only
-  std::unique_ptr<Gcs2HexapodTwin> hexapod;
+  std::unique_ptr<Gcs2HexapodTwin> hexapod;  // with the hexapod twin only
   asio::io_context io;
   std::vector<std::unique_ptr<tcp::acceptor>> acceptors;
   std::vector<Protocol> acceptor_protocols;
@@ -421,7 +417,6 @@ void TwinServer::start() {
     m.acceptor_protocols.push_back(e.protocol);
     m.acceptor_tokened.push_back(!loopback_address(e.address));
   }
-  if (m.hexapod_stage) m.hexapod_stage->start();
   for (std::size_t k = 0; k < m.acceptors.size(); ++k) m.accept(k);
   asio::post(m.io, [&m] { m.housekeeping(); });
   m.thread = std::thread([&m] { m.io.run(); });
@@ -442,13 +437,10 @@ void TwinServer::stop() {
     m.io.stop();
   });
   m.thread.join();
-  if (m.hexapod_stage) m.hexapod_stage->stop_loop();  // its clients gone: it holds
   m.running = false;
 }
 
 std::vector<std::uint16_t> TwinServer::ports() const { return impl_->bound; }
-
-const HexapodStage* TwinServer::hexapod_stage() const { return impl_->hexapod_stage.get(); }
 
 TwinServerCounters TwinServer::counters() const {
   std::lock_guard lock(impl_->counters_mutex);

@@ -4,8 +4,8 @@
 /// --emulate anc300 --emulate mcs2 --emulate gcs2-hexapod`): one thread runs every listening socket and
 /// connection (Boost.Asio), the twins' controller state, and the stage's heartbeat; it is the only
 /// producer of the live platform's protocol ring (twins/live_stage.h) and never touches the loop
-/// otherwise. The hexapod twin drives a parallel positioner of its own (hexapod_stage.h), whose
-/// loop thread the server starts and stops with it.
+/// otherwise. The hexapod twin drives the platform's parallel positioner through the same stage
+/// (`positioner: parallel`; refused without one).
 ///
 /// Survives any client: lines are capped (longer ones answered with the protocol's error and
 /// their rest discarded), a line left unfinished for `line_timeout_s` closes the connection
@@ -27,7 +27,6 @@
 #include "microcobot/twins/anc300_twin.h"
 #include "microcobot/twins/gcs2_hexapod_twin.h"
 #include "microcobot/twins/gcs2_twin.h"
-#include "microcobot/twins/hexapod_stage.h"
 #include "microcobot/twins/mcs2_twin.h"
 #include "microcobot/twins/twin_stage.h"
 
@@ -63,7 +62,6 @@ struct TwinServerParams {
   Anc300TwinParams anc300;
   Mcs2TwinParams mcs2;
   Gcs2HexapodTwinParams gcs2_hexapod;
-  HexapodStageParams hexapod;  ///< the hexapod twin's positioner (only built when it is served)
   void validate() const;
 };
 
@@ -73,7 +71,8 @@ struct TwinServerCounters {
 
 class TwinServer {
  public:
-  /// `stage` must outlive the server. Throws mc::Error on bad parameters.
+  /// `stage` must outlive the server. Throws mc::Error on bad parameters, and for a gcs2-hexapod
+  /// endpoint on a stage without a parallel positioner.
   TwinServer(TwinStage& stage, TwinServerParams params);
   ~TwinServer();
   TwinServer(const TwinServer&) = delete;
@@ -87,8 +86,6 @@ class TwinServer {
   /// The bound port of each endpoint, in order (after start()).
   std::vector<std::uint16_t> ports() const;
   TwinServerCounters counters() const;
-  /// The hexapod twin's positioner; nullptr when no endpoint serves it.
-  const HexapodStage* hexapod_stage() const;
 
  private:
   struct Impl;

@@ -9,9 +9,16 @@
 /// client holds control, nobody else's protocol client holds it and the platform is not halted;
 /// it keeps it while connected (its connection is its deadman: the protocol thread's heartbeat),
 /// and loses it when it disconnects or a console client takes control (the stage then holds).
+/// The parallel positioner (the hexapod twin's), when the platform has one, is controlled the
+/// same way: one client at a time holds the stage and the positioner alike.
 
 #include <array>
 #include <cstdint>
+#include <string>
+
+#include "microcobot/live/protocol_command.h"
+#include "microcobot/motion/parallel_kinematics.h"
+#include "microcobot/motion/pose_trajectory.h"
 
 namespace mc::twins {
 
@@ -31,6 +38,7 @@ class TwinStage {
     kHalted,         ///< the platform's e-stop latched (GCS error 10, ANC300 ERROR)
     kOtherOperator,  ///< a console client or another protocol client holds control
     kBusy,           ///< the command ring is full (try again)
+    kUnreachable,    ///< a pose move motion::check_move() refuses (GCS error 7): nothing moves
   };
   struct Axis {
     double position = 0.0;   ///< measured (sensor): m (X, Y, Z) or rad (theta)
@@ -65,6 +73,27 @@ class TwinStage {
   virtual void release(ClientId client) = 0;
   /// Called every ~20 ms by the protocol thread: the controlling client's heartbeat.
   virtual void heartbeat() = 0;
+
+  /// The parallel positioner's kinematics (immutable; its geometry), null without a positioner.
+  virtual const motion::ParallelKinematics* positioner_kinematics() const { return nullptr; }
+  /// Its moves' library limits (docs/parameters.md).
+  virtual motion::PoseMoveLimits positioner_limits() const { return {}; }
+  /// A pose move along `traj`, planned from where the legs will hold when it starts (the last
+  /// move's goal, or the held pose: positioner_view().reference). Checked again here
+  /// (motion::check_move()): kUnreachable with the one-line reason in `reason` and nothing moves.
+  /// `seq` is its command's number (the view's started_seq / rejected_seq say what became of it).
+  virtual Refusal move_pose(ClientId /*client*/, const motion::PoseTrajectory& /*traj*/,
+                            std::uint64_t& /*seq*/, std::string& reason) {
+    reason = "the platform has no parallel positioner";
+    return Refusal::kUnreachable;
+  }
+  /// Stops the positioner's move and the queued ones (every leg holding), when `client` controls
+  /// the stage: kNone with the stop's `seq` (the view's stop_seq reaches it once applied);
+  /// kOtherOperator when nothing was sent (another operator's control or a halt: the positioner
+  /// holds already); kBusy when the ring is full (send it again).
+  virtual Refusal stop_pose(ClientId /*client*/, std::uint64_t& /*seq*/) { return Refusal::kOtherOperator; }
+  /// The loop's newest snapshot of the positioner (protocol thread).
+  virtual live::PositionerView positioner_view() { return {}; }
 };
 
 }  // namespace mc::twins

@@ -1,0 +1,33 @@
+// The platform's parallel positioner (`positioner: parallel`; devices/parallel_positioner.h): the
+// simulated one built from the configuration when no driver brings one, its pose moves under the
+// deadman of the input that drives the coupling, its update on every tick.
+#include <memory>
+
+#include "microcobot/devices/simulated_parallel_positioner.h"
+#include "microcobot/platform/platform.h"
+
+namespace mc::platform {
+
+void Platform::build_positioner() {
+  if (devices_.positioner || !config_.parallel_positioner_enabled()) return;
+  // The legs are the project's stick-slip axes: the platform's model and step map.
+  auto p = std::make_unique<devices::SimulatedParallelPositioner>(
+      "parallel_positioner", *model_, *map_, config_.parallel_positioner, config_.loop.period_s());
+  sim_.positioner = p.get();
+  devices_.positioner = std::move(p);
+}
+
+bool Platform::start_pose_move(const motion::PoseTrajectory& checked) noexcept {
+  return devices_.positioner != nullptr && pose_move_allowed() && devices_.positioner->start_move(checked);
+}
+
+void Platform::positioner_task(double dt_s) noexcept {
+  devices::ParallelPositioner* p = devices_.positioner.get();
+  if (p == nullptr) return;
+  // A move runs only under the rule it started with: the deadman released, the input stale or
+  // outranked, or a fault, and every leg holds where it is measured.
+  if (p->moving() && !pose_move_allowed()) p->stop();
+  p->update(dt_s);
+}
+
+}  // namespace mc::platform
