@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <thread>
 
 #include "microcobot/core/error.h"
 #include "microcobot/platform/platform.h"
@@ -131,7 +132,8 @@ TEST(CommandArbiter, ATickAllocatesNothingAndTheSourcesAreBounded) {
   ArbiterRig r;
   r.low.claim = Claim::kStandby;
   {
-    test::AllocationGuard guard;
+    // This thread's allocations only: the rig's platform has threads of its own (its camera).
+    test::AllocationGuard guard(std::this_thread::get_id());
     for (int i = 0; i < 1000; ++i) {
       r.high.claim = i % 100 < 50 ? Claim::kActive : Claim::kNone;  // hand-overs too
       r.tick();

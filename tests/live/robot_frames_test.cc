@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
@@ -102,6 +103,37 @@ TEST(RobotFrames, TheSceneDrawsTheFingersAndThePartAsBoxesOfTheirSizeInTheirFram
   // Without a part (the optical trap's scene) nothing is drawn for it.
   b.part_side_m = 0.0;
   EXPECT_EQ(json::parse(frames.scene_update_json(b, 1.5))["entities"].size(), 2u);
+}
+
+// The positioner's pose, R = Rz(rz) Ry(ry) Rx(rx), as the quaternion qz qy qx: the same rotation
+// as Eigen's product of the three elementary turns, on any angles.
+TEST(RobotFrames, TheParallelPositionersPoseIsItsZyxRotationAsAQuaternion) {
+  platform::TelemetrySchema schema = platform::builtin_telemetry(true);
+  for (const char* n : {"positioner_x_m", "positioner_y_m", "positioner_z_m"}) schema.add({n, "m", "pose"});
+  for (const char* n : {"positioner_rx_rad", "positioner_ry_rad", "positioner_rz_rad"})
+    schema.add({n, "rad", "pose"});
+  const RobotFrames frames(schema);
+  ASSERT_TRUE(frames.has_positioner());
+  for (const auto& [rx, ry, rz] :
+       {std::array{0.1, -0.2, 0.3}, std::array{-0.26, 0.17, 2.5}, std::array{0.0, 0.0, 0.0}}) {
+    platform::TelemetrySample s = sample(schema);
+    s[schema.index("positioner_x_m")] = 1e-3;
+    s[schema.index("positioner_rx_rad")] = rx;
+    s[schema.index("positioner_ry_rad")] = ry;
+    s[schema.index("positioner_rz_rad")] = rz;
+    FrameTransforms f;
+    const std::size_t n = frames.transforms(s, f);
+    ASSERT_EQ(n, 6u);
+    EXPECT_EQ(f[5].child, "positioner");
+    EXPECT_EQ(f[5].x_m, 1e-3);
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    const Eigen::Quaterniond q(f[5].qw, f[5].qx, f[5].qy, f[5].qz);
+    EXPECT_NEAR(q.norm(), 1.0, 1e-15);
+    EXPECT_LT((q.toRotationMatrix() - R).norm(), 1e-14) << rx << " " << ry << " " << rz;
+  }
 }
 
 TEST(RobotFrames, ASchemaWithoutTheStagesChannelsIsRefusedNamingTheChannel) {

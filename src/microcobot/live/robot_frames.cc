@@ -25,19 +25,33 @@ json stamp(double t_s) {
   return {{"sec", whole}, {"nsec", nsec}};
 }
 
-/// A rotation by `yaw` about z as a unit quaternion.
-json about_z(double yaw) {
-  const double a = 0.5 * finite(yaw);
-  return {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(a)}, {"w", std::cos(a)}};
+struct Quaternion {
+  double x = 0.0, y = 0.0, z = 0.0, w = 1.0;
+};
+
+/// A rotation by `a` about z.
+Quaternion about_z(double a) { return {0.0, 0.0, std::sin(0.5 * a), std::cos(0.5 * a)}; }
+
+/// R = Rz(rz) Ry(ry) Rx(rx) as q = qz qy qx (Hamilton products of the elementary turns).
+Quaternion from_zyx(double rx, double ry, double rz) {
+  const double cx = std::cos(0.5 * rx), sx = std::sin(0.5 * rx);
+  const double cy = std::cos(0.5 * ry), sy = std::sin(0.5 * ry);
+  const double cz = std::cos(0.5 * rz), sz = std::sin(0.5 * rz);
+  return {cz * cy * sx - sz * sy * cx, cz * sy * cx + sz * cy * sx, sz * cy * cx - cz * sy * sx,
+          cz * cy * cx + sz * sy * sx};
 }
 
-json transform(const json& time, std::string_view parent, std::string_view child, double x, double y,
-               double z, double yaw) {
+FrameTransform make(std::string_view parent, std::string_view child, double x, double y, double z,
+                    Quaternion q) {
+  return {parent, child, finite(x), finite(y), finite(z), q.x, q.y, q.z, q.w};
+}
+
+json transform(const json& time, const FrameTransform& f) {
   return {{"timestamp", time},
-          {"parent_frame_id", parent},
-          {"child_frame_id", child},
-          {"translation", {{"x", finite(x)}, {"y", finite(y)}, {"z", finite(z)}}},
-          {"rotation", about_z(yaw)}};
+          {"parent_frame_id", f.parent},
+          {"child_frame_id", f.child},
+          {"translation", {{"x", f.x_m}, {"y", f.y_m}, {"z", f.z_m}}},
+          {"rotation", {{"x", f.qx}, {"y", f.qy}, {"z", f.qz}, {"w", f.qw}}}};
 }
 
 json box(double cx, double cy, double cz, double sx, double sy, double sz, std::array<double, 4> rgba) {
@@ -69,18 +83,27 @@ RobotFrames::RobotFrames(const platform::TelemetrySchema& schema)
   const auto px = schema.find("part_x_m"), py = schema.find("part_y_m"), pz = schema.find("part_z_m"),
              yaw = schema.find("part_yaw_rad");
   if (px && py && pz && yaw) part_ = PartChannels{*px, *py, *pz, *yaw};
+  const auto qx = schema.find("positioner_x_m"), qy = schema.find("positioner_y_m"),
+             qz = schema.find("positioner_z_m"), rx = schema.find("positioner_rx_rad"),
+             ry = schema.find("positioner_ry_rad"), rz = schema.find("positioner_rz_rad");
+  if (qx && qy && qz && rx && ry && rz) positioner_ = PositionerChannels{*qx, *qy, *qz, *rx, *ry, *rz};
 }
 
 std::size_t RobotFrames::transforms(const platform::TelemetrySample& s, FrameTransforms& out) const {
   const double half = 0.5 * std::max(0.0, finite(s[opening_]));
-  out[0] = {"world", "tool", finite(s[x_]), finite(s[y_]), finite(s[z_]), 0.0};
-  out[1] = {"tool", "gripper", 0.0, 0.0, 0.0, finite(s[theta_])};
-  out[2] = {"gripper", "finger_left", 0.0, half, 0.0, 0.0};
-  out[3] = {"gripper", "finger_right", 0.0, -half, 0.0, 0.0};
-  if (!part_) return 4;
-  out[4] = {
-      "world", "part", finite(s[part_->x]), finite(s[part_->y]), finite(s[part_->z]), finite(s[part_->yaw])};
-  return 5;
+  std::size_t n = 0;
+  out[n++] = make("world", "tool", s[x_], s[y_], s[z_], {});
+  out[n++] = make("tool", "gripper", 0.0, 0.0, 0.0, about_z(finite(s[theta_])));
+  out[n++] = make("gripper", "finger_left", 0.0, half, 0.0, {});
+  out[n++] = make("gripper", "finger_right", 0.0, -half, 0.0, {});
+  if (part_)
+    out[n++] = make("world", "part", s[part_->x], s[part_->y], s[part_->z], about_z(finite(s[part_->yaw])));
+  if (positioner_) {
+    const PositionerChannels& c = *positioner_;
+    out[n++] = make("world", "positioner", s[c.x], s[c.y], s[c.z],
+                    from_zyx(finite(s[c.rx]), finite(s[c.ry]), finite(s[c.rz])));
+  }
+  return n;
 }
 
 void RobotFrames::transforms_json(const platform::TelemetrySample& s, std::string& out) const {
@@ -88,8 +111,7 @@ void RobotFrames::transforms_json(const platform::TelemetrySample& s, std::strin
   FrameTransforms f;
   const std::size_t n = transforms(s, f);
   json list = json::array();
-  for (std::size_t i = 0; i < n; ++i)
-    list.push_back(transform(t, f[i].parent, f[i].child, f[i].x_m, f[i].y_m, f[i].z_m, f[i].yaw_rad));
+  for (std::size_t i = 0; i < n; ++i) list.push_back(transform(t, f[i]));
   out = json{{"transforms", std::move(list)}}.dump();
 }
 

@@ -1,7 +1,6 @@
 #include "microcobot/net/tf_publisher.h"
 
 #include <array>
-#include <cmath>
 #include <string>
 
 #include "microcobot/live/camera_messages.h"
@@ -41,8 +40,7 @@ bool TfPublisher::publish(const platform::TelemetrySample& s) {
     t.header_.frame_id_ = const_cast<char*>(f[i].parent.data());
     t.child_frame_id_ = const_cast<char*>(f[i].child.data());
     t.transform_.translation_ = {f[i].x_m, f[i].y_m, f[i].z_m};
-    // A rotation by yaw about z: q = (0, 0, sin(yaw / 2), cos(yaw / 2)).
-    t.transform_.rotation_ = {0.0, 0.0, std::sin(0.5 * f[i].yaw_rad), std::cos(0.5 * f[i].yaw_rad)};
+    t.transform_.rotation_ = {f[i].qx, f[i].qy, f[i].qz, f[i].qw};
   }
   tf2_msgs_msg_dds__TFMessage_ m{};
   m.transforms_._buffer = list.data();
