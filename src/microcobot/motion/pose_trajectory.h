@@ -58,8 +58,12 @@ struct PoseMoveLimits {
   double sample_length_m = 10e-6;
   double sample_angle_rad = 1e-3;
   int min_samples = 16;
-  /// The tool point c in {P} [m].
-  double tool_x_m = 0.0, tool_y_m = 0.0, tool_z_m = 0.0;
+  /// The tool point c in {P}, x [m].
+  double tool_x_m = 0.0;
+  /// The tool point c in {P}, y [m].
+  double tool_y_m = 0.0;
+  /// The tool point c in {P}, z [m].
+  double tool_z_m = 0.0;
 
   template <class V>
   void visit(V& v) {
