@@ -81,15 +81,22 @@ TEST(HexapodSafety, TheConsolesEstopStopsTheTwinsMoveAndMovOntErrSaySo) {
   reference(c);
   c.send("MOV X 0.2\n");  // 2 s at 0.1 mm/s
   ASSERT_EQ(c.gcs("ERR?"), "0\n");
-  std::this_thread::sleep_for(500ms);
-  ASSERT_EQ(byte_reply(c, 5), "3F\n");
+  // The e-stop falls mid-move: once the twin says every axis moves and X is 20 um on its way
+  // (waited for, not slept: instrumented by a sanitizer the move starts later).
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  bool underway = false;
+  while (!underway && std::chrono::steady_clock::now() < until) {
+    underway = byte_reply(c, 5) == "3F\n" && axis(c, "POS? X") > 0.02;
+    if (!underway) std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_TRUE(underway) << "the move did not get under way";
   rig.live->estop();
   ASSERT_TRUE(test::wait_status(
       *rig.live, [](const live::LiveStatus& s) { return s.estopped; }, 2.0));
   std::this_thread::sleep_for(50ms);
   const double x = axis(c, "POS? X");
   EXPECT_GT(x, 0.01);
-  EXPECT_LT(x, 0.15);
+  EXPECT_LT(x, 0.19);  // short of the goal
   std::this_thread::sleep_for(300ms);
   EXPECT_NEAR(axis(c, "POS? X"), x, 0.5e-3);  // stopped, not moving on
   EXPECT_NEAR(axis(c, "MOV? X"), x, 1e-3);    // the target is where it stopped
