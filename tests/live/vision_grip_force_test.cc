@@ -304,7 +304,8 @@ TEST(VisionGripForce, TurnedFingersAreMeasuredOnceStillAndAGripperMovedWhileTurn
   rig.theta_goal = 0.0;
   std::this_thread::sleep_for(300ms);
   rig.opening = 600e-6;
-  ASSERT_TRUE(test::eventually([&] { return std::abs(rig.theta.load()) < 1e-5; }, MC_UNDER_SANITIZER ? 30s : 10s));
+  ASSERT_TRUE(
+      test::eventually([&] { return std::abs(rig.theta.load()) < 1e-5; }, MC_UNDER_SANITIZER ? 30s : 10s));
   ASSERT_TRUE(rig.wait([](const LiveStatus& s) { return s.grip_vision->state == "untared"; }, 5.0))
       << rig.live.status().grip_vision->state;
   EXPECT_NE(rig.live.status().grip_vision->error.find("tare again"), std::string::npos)

@@ -4,7 +4,8 @@
  * name, and prints what it reads. The wire-compatibility test (wire_compat_test.cc) checks the
  * values against what `microcobot link ping` publishes.
  *
- *   ros2_listener --domain N --topic /microcobot/slave/pose --type pose|wrench|vector3|joint|bool|diag|image|tf
+ *   ros2_listener --domain N --topic /microcobot/slave/pose
+ *                 --type pose|wrench|vector3|joint|bool|diag|image|tf
  *                 [--count K] [--timeout S] [--ready-file PATH]
  *
  * Waits for K samples (default 1) and prints each as one JSON line on stdout, then exits 0.
@@ -306,8 +307,8 @@ static void print_sample(const struct Options* o, const char* type_name, const v
         const geometry_msgs_msg_dds__TransformStamped_* t = &m->transforms_._buffer[i];
         const double xyz[3] = {t->transform_.translation_.x_, t->transform_.translation_.y_,
                                t->transform_.translation_.z_};
-        const double q[4] = {t->transform_.rotation_.x_, t->transform_.rotation_.y_, t->transform_.rotation_.z_,
-                             t->transform_.rotation_.w_};
+        const double q[4] = {t->transform_.rotation_.x_, t->transform_.rotation_.y_,
+                             t->transform_.rotation_.z_, t->transform_.rotation_.w_};
         printf("%s{\"stamp\":{\"sec\":%d,\"nanosec\":%u},\"parent\":", i ? "," : "",
                (int)t->header_.stamp_.sec_, (unsigned)t->header_.stamp_.nanosec_);
         put_string(t->header_.frame_id_);
