@@ -162,6 +162,12 @@ TEST(HexapodSafety, ATwinMoveHoldsWhenItsClientsHeartbeatGoesStale) {
   EXPECT_LT(x_mm, 0.05);  // 0.07 mm had it run on for the 0.7 s
   std::this_thread::sleep_for(300ms);
   EXPECT_NEAR(r.stage.positioner_view().measured.d.x() * 1e3, x_mm, 0.5e-3);
+  // The client is told, as after a stop: the target is where the legs hold and the error is 10,
+  // never an on-target at a goal it did not reach.
+  EXPECT_EQ(r.twin.on_line(1, "ERR?"), "10\n");
+  const double target_mm = drivers::gcs2::parse_axis_values(r.twin.on_line(1, "MOV? X")).at(0).second;
+  EXPECT_NEAR(target_mm, x_mm, 1e-3);
+  EXPECT_EQ(r.twin.on_line(1, "FRF? X"), "X=1\n");  // still referenced
 }
 
 }  // namespace hexapod_safety_test

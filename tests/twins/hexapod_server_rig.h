@@ -23,7 +23,7 @@ struct HexapodServerRig {
   /// The largest leg voltage of the last telemetry sample (channel positioner_u_max_V).
   std::atomic<double> u_max_V{std::nan("")};
   explicit HexapodServerRig(double line_timeout_s = 5.0) {
-    live = std::make_unique<live::LivePlatform>(hexapod_live_params(0.2));
+    live = std::make_unique<live::LivePlatform>(hexapod_live_params(twin_live_params().command_timeout_s));
     const std::size_t u = live->telemetry_schema().index("positioner_u_max_V");
     live->start([this, u](const platform::TelemetrySample& s, std::size_t) { u_max_V.store(s[u]); });
     stage = std::make_unique<LiveStage>(*live);

@@ -28,6 +28,18 @@ namespace mc::twins::testing {
 
 using namespace std::chrono_literals;
 
+/// The live platform's parameters for a twin served over TCP. The twin server's thread sends the
+/// controlling client's heartbeat every 20 ms; the platform's default timeout (0.2 s) holds the
+/// stage when that thread is starved longer, which a loaded machine running the sanitizers does,
+/// rightly stopping a move short. The rigs give the heartbeat 2 s, so that a test sees the protocol's
+/// own behaviour; a disconnect still holds the stage at once (the twin releases it), and the stale
+/// heartbeat has its own tests with the default.
+inline live::LiveParams twin_live_params() {
+  live::LiveParams p;
+  p.command_timeout_s = 2.0;
+  return p;
+}
+
 // A blocking loopback TCP client with a receive timeout.
 struct Client {
   int fd = -1;
@@ -88,7 +100,7 @@ struct Client {
 // The live platform (paced loop) with both twins on loopback port 0; the rotary axis' sensor as
 // the platform's telemetry reports it (not through the twins).
 struct TwinRig {
-  live::LiveParams params;
+  live::LiveParams params = twin_live_params();
   std::unique_ptr<live::LivePlatform> live;
   std::unique_ptr<LiveStage> stage;
   std::unique_ptr<TwinServer> server;

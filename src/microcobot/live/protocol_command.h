@@ -55,7 +55,10 @@ struct PositionerView {
   std::uint64_t started_seq = 0;   ///< the last pose move started (its command's seq)
   std::uint64_t rejected_seq = 0;  ///< the last pose move dropped unstarted (halted, outranked, stale)
   std::uint64_t stop_seq = 0;      ///< the last stop applied
-  double time_s = 0.0;             ///< loop time of the snapshot
+  /// The last pose move the loop ended short of its goal because the protocol lost control of the
+  /// platform (its heartbeat stale, a console user took control): the legs hold where they were.
+  std::uint64_t interrupted_seq = 0;
+  double time_s = 0.0;  ///< loop time of the snapshot
 };
 
 /// What the loop publishes for the protocol clients (atomics, any thread). Index 3 is the rotary

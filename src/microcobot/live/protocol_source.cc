@@ -102,6 +102,10 @@ void ProtocolSource::drive(const SourceTick& t, teleop::ConsoleInput& in) noexce
 }
 
 void ProtocolSource::released(const SourceTick& t) noexcept {
+  // A pose move under way at the last tick (the arbiter has held the platform since) ends short of
+  // its goal: its client is told (interrupted_seq).
+  if (holding_ && pose_running_) pose_interrupted_ = pose_started_;
+  pose_running_ = false;
   holding_ = false;
   stop_and_hold(t.platform);  // gone, stale or outranked: every axis holds
 }
@@ -161,6 +165,7 @@ void ProtocolSource::publish_positioner(const SourceTick& t) noexcept {
     pose_head_ = (pose_head_ + 1) % kPoseQueue;
     --pose_count_;
   }
+  pose_running_ = pos->moving();
   PositionerView v;
   v.measured = pos->measured_pose();
   v.reference = pos->reference_pose();
@@ -170,6 +175,7 @@ void ProtocolSource::publish_positioner(const SourceTick& t) noexcept {
   v.started_seq = pose_started_;
   v.rejected_seq = pose_rejected_;
   v.stop_seq = pose_stop_;
+  v.interrupted_seq = pose_interrupted_;
   v.time_s = t.tick.t_s;
   positioner_view_.publish(v);
 }
@@ -177,7 +183,7 @@ void ProtocolSource::publish_positioner(const SourceTick& t) noexcept {
 void ProtocolSource::reset() noexcept {
   clear_pose_queue(true);
   last_t_ = -1e9;
-  holding_ = has_goal_ = false;
+  holding_ = has_goal_ = pose_running_ = false;
   pending_steps_ = {};
   settled_s_ = {};
 }

@@ -10,7 +10,8 @@
 /// Pose moves of the parallel positioner queue here (at most kPoseQueue): the next starts when the
 /// one under way has ended (Platform::start_pose_move, with the protocol's deadman); a stop clears
 /// the queue, and so does losing control (stale, outranked, released, halted), which also holds
-/// the positioner. Its state leaves as one PositionerView snapshot.
+/// the positioner and marks the move under way interrupted. Its state leaves as one PositionerView
+/// snapshot.
 
 #include <array>
 #include <atomic>
@@ -73,7 +74,8 @@ class ProtocolSource final : public CommandSource {
   std::array<std::optional<motion::PoseTrajectory>, kPoseQueue> pose_queue_{};
   std::array<std::uint64_t, kPoseQueue> pose_seq_{};
   std::size_t pose_head_ = 0, pose_count_ = 0;
-  std::uint64_t pose_started_ = 0, pose_rejected_ = 0, pose_stop_ = 0;
+  std::uint64_t pose_started_ = 0, pose_rejected_ = 0, pose_stop_ = 0, pose_interrupted_ = 0;
+  bool pose_running_ = false;  // a pose move was under way at the last publish
   runtime::LatestValue<PositionerView> positioner_view_;
   // Published for the protocol thread (X, Y, Z [m], theta [rad]).
   std::array<std::atomic<double>, 4> position_{};

@@ -116,6 +116,13 @@ live::PositionerView Gcs2HexapodTwin::refresh() {
     seen_rejected_ = v.rejected_seq;
     error_ = g::kStopped;  // the platform dropped it unstarted (halted, control lost): it stands stopped
   }
+  if (v.interrupted_seq > seen_interrupted_) {
+    // The platform held the move under way short of its goal (the heartbeat went stale, a console
+    // user took control): it stands stopped where the legs hold, as after a stop.
+    seen_interrupted_ = v.interrupted_seq;
+    error_ = g::kStopped;
+    target_ = last_goal_ = v.reference;
+  }
   if (v.halted && !halted_) {
     // The platform's e-stop (or a device's fault): every leg at 0 V where it was, the target there.
     halted_ = true;
@@ -139,7 +146,10 @@ live::PositionerView Gcs2HexapodTwin::refresh() {
     control_lost_ = false;
     if (!halted_) target_ = last_goal_ = v.reference;
   }
-  if (referencing_ && (stop_sent_ > referencing_ || v.rejected_seq >= referencing_)) referencing_ = 0;
+  // A reference stopped, dropped or interrupted before its end leaves the platform unreferenced.
+  if (referencing_ &&
+      (stop_sent_ > referencing_ || v.rejected_seq >= referencing_ || v.interrupted_seq >= referencing_))
+    referencing_ = 0;
   if (referencing_ && v.started_seq >= referencing_ && !v.moving && v.at_rest) {
     referenced_ = true;
     referencing_ = 0;

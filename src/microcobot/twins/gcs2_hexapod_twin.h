@@ -112,7 +112,7 @@ class Gcs2HexapodTwin {
   std::string enabled_ = "ZERO";
   motion::PlatformTransform target_;     ///< the last commanded goal, {H}
   motion::PlatformTransform last_goal_;  ///< the goal of the last move sent, {H}
-  std::uint64_t last_move_ = 0, stop_sent_ = 0, referencing_ = 0, seen_rejected_ = 0;
+  std::uint64_t last_move_ = 0, stop_sent_ = 0, referencing_ = 0, seen_rejected_ = 0, seen_interrupted_ = 0;
   ClientId mover_ = 0;
   ClientId unsent_stop_ = 0;  ///< a stop the full ring refused, to send again
   bool referenced_ = false;
