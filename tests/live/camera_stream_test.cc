@@ -195,6 +195,32 @@ TEST(CameraStream, TheCameraFormsFramesOnlyWhileAClientSubscribesToThem) {
   server.stop();
 }
 
+// The JPEG costs the camera thread most of its frame time: it is made only while the image channel,
+// a JPEG recording or the DDS image topic needs it; the state (and the preview, the vision, the
+// snapshot, an H.264 recording) read the frame raw.
+TEST(CameraStream, AFrameCarriesItsJpegOnlyWhileTheImageChannelNeedsIt) {
+  test::TempDir dir;
+  LivePlatform live(camera_params());
+  ConsoleServer server(live, server_params(dir.path()));
+  server.start();
+  test::Console console(server.port());
+  const auto jpeg_bytes = [&](std::uint32_t id) {
+    const std::string m = console.next_on(id);
+    return m.empty() ? -1 : json::parse(m)["jpeg_bytes"].get<int>();
+  };
+  console.subscribe("/camera/state", 1);
+  for (int k = 0; k < 10; ++k) EXPECT_EQ(jpeg_bytes(1), 0) << "state " << k << ": nobody needs the JPEG";
+  console.subscribe("/camera/image/compressed", 2);
+  // The demand is read at the status rate (5 Hz): within a second every frame carries its JPEG.
+  ASSERT_TRUE(test::eventually([&] { return jpeg_bytes(1) > 0; }, 5s));
+  for (int k = 0; k < 5; ++k) EXPECT_GT(jpeg_bytes(1), 1000) << "state " << k;
+  ASSERT_TRUE(console.ws.send_json({{"op", "unsubscribe"}, {"subscriptionIds", {2}}}));
+  ASSERT_TRUE(test::eventually([&] { return jpeg_bytes(1) == 0; }, 5s));
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(jpeg_bytes(1), 0) << "state " << k << " after the image's client left";
+  server.stop();
+}
+
 // The console's panel subscribes to the preview: the same frame (same stamp) binned to 640 px.
 TEST(CameraStream, ThePreviewIsTheSameFrameBinnedToTheConsolesPanel) {
   test::TempDir dir;

@@ -241,9 +241,11 @@ void Camera::deliver(CameraFrame& frame, const SceneSnapshot& scene, std::int64_
   const Image& img = frame.image;
   if (const std::vector<std::uint8_t>* jpeg = source_->captured_jpeg())
     frame.jpeg.assign(jpeg->begin(), jpeg->end());
-  else
+  else if (jpeg_wanted())
     encoder.encode({img.width, img.height, img.channels, img.bit_depth, img.data}, params_.jpeg_quality,
                    frame.jpeg);
+  else
+    frame.jpeg.clear();  // nobody needs it: the frame's time goes to forming the next
   const std::int64_t t2 = steady_ns();
   const int objective = std::clamp(scene.objective, 0, static_cast<int>(params_.objectives.size()) - 1);
   const ObjectiveParams& o = params_.objectives[static_cast<std::size_t>(objective)];

@@ -157,6 +157,12 @@ class Camera : public Device {
   /// camera. True by default (any thread).
   void set_wanted(bool wanted) noexcept { wanted_.store(wanted, std::memory_order_release); }
   bool wanted() const noexcept { return wanted_.load(std::memory_order_acquire); }
+  /// Whether anyone needs the frames as JPEG (a client of the image channel, a JPEG recording,
+  /// the DDS image topic); while false a frame carries no JPEG (CameraFrame::jpeg empty) unless
+  /// its source gave one, so that the thread does not spend its frame time encoding what only
+  /// the vision, the snapshot or an H.264 recording reads raw. True by default (any thread).
+  void set_jpeg_wanted(bool wanted) noexcept { jpeg_wanted_.store(wanted, std::memory_order_release); }
+  bool jpeg_wanted() const noexcept { return jpeg_wanted_.load(std::memory_order_acquire); }
   /// Settings for the next frames, clamped to their ranges (any thread).
   void set_exposure_s(double exposure_s) noexcept;
   void set_gain(double gain) noexcept;
@@ -193,7 +199,7 @@ class Camera : public Device {
   double next_frame_t_s_ = 0.0;  // loop thread
   std::uint64_t next_frame_ = 0;
 
-  std::atomic<bool> running_{false}, failed_{false}, has_sink_{false}, wanted_{true};
+  std::atomic<bool> running_{false}, failed_{false}, has_sink_{false}, wanted_{true}, jpeg_wanted_{true};
   std::thread thread_;
   std::mutex sink_mutex_;  // the sink (held while it runs: do not set_sink from it)
   Sink sink_;

@@ -288,7 +288,10 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
 
 void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
   const RosTime stamp = ros_time(t_s);
-  encode_compressed_image(f, stamp, image_cdr_);
+  // A frame formed while nobody needed its JPEG carries none (the demand changes between frames):
+  // it goes everywhere but the image channel and a JPEG recording.
+  const bool has_jpeg = !f.jpeg.empty();
+  if (has_jpeg) encode_compressed_image(f, stamp, image_cdr_);
   encode_camera_info(f, stamp, info_cdr_);
   const LiveStatus s = live_.status();
   // The grip force seen in this frame (the gauge ran on it before it reached here).
@@ -297,7 +300,7 @@ void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
                                               live_.camera_params().calibration(f.objective),
                                               grip_of_frame ? &*s.grip_vision : nullptr);
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
-  server_.publish(image_ch_, ns, image_cdr_);
+  if (has_jpeg) server_.publish(image_ch_, ns, image_cdr_);
   if (server_.subscriber_count(preview_ch_) > 0) {
     encode_compressed_image(preview_->encode(f.image, live_.camera_params().jpeg_quality), stamp,
                             preview_cdr_);
@@ -306,7 +309,8 @@ void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
   server_.publish(info_ch_, ns, info_cdr_);
   server_.publish(camera_state_ch_, ns, state);
   snapshot_->offer(f, state, t_s);
-  if (recording_) recording_->published_frame(t_s, f, image_cdr_, info_cdr_, state);
+  if (recording_)
+    recording_->published_frame(t_s, f, has_jpeg ? image_cdr_ : std::string(), info_cdr_, state);
   for (const FrameConsumer& c : frame_consumers_) c.on_frame(f, t_s);
 }
 
@@ -501,6 +505,10 @@ void ConsoleServer::update_camera_demand() {
   bool consumed = false;
   for (const FrameConsumer& c : frame_consumers_) consumed = consumed || c.wanted();
   live_.set_camera_wanted(recording || watched || consumed);
+  // The JPEG is for the image channel, a JPEG recording and the consumers (the DDS image topic);
+  // the preview, the camera's state, the vision, the snapshot and H.264 read the frame raw.
+  const bool jpeg_recorded = recording_ && recording_->video() == RecordedVideo::kJpeg;
+  live_.set_camera_jpeg_wanted(jpeg_recorded || consumed || server_.subscriber_count(image_ch_) > 0);
 }
 
 void ConsoleServer::status_thread() {

@@ -186,8 +186,11 @@ void LivePlatform::attach_camera(Platform& p) {
 void LivePlatform::operator_tick(const runtime::TickInfo& t) noexcept {
   Platform& p = *platform_;
   if (estop_.exchange(false) && !p.faulted()) p.fault_all();
-  if (p.camera() != nullptr)
+  if (p.camera() != nullptr) {
+    // The JPEG demand first: a camera woken by this tick forms its first frame with it.
+    p.camera()->set_jpeg_wanted(camera_jpeg_wanted_.load(std::memory_order_relaxed));
     p.camera()->set_wanted(positioner_ != nullptr || camera_wanted_.load(std::memory_order_relaxed));
+  }
   if (interrupt_.load(std::memory_order_acquire)) p.stop();
 
   const SourceTick source_tick{t, p};

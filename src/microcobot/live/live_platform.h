@@ -108,6 +108,11 @@ class LivePlatform {
   /// camera forms none (devices::Camera::set_wanted). Any thread; applied by the loop, kept
   /// across scene rebuilds.
   void set_camera_wanted(bool wanted) noexcept { camera_wanted_.store(wanted, std::memory_order_relaxed); }
+  /// Whether anyone needs the frames as JPEG (devices::Camera::set_jpeg_wanted). Any thread;
+  /// applied by the loop, kept across scene rebuilds.
+  void set_camera_jpeg_wanted(bool wanted) noexcept {
+    camera_jpeg_wanted_.store(wanted, std::memory_order_relaxed);
+  }
   /// Whether the platform images (devices.camera.driver is not "none"), and its parameters.
   bool has_camera() const { return has_camera_; }
   const devices::CameraDeviceParams& camera_params() const { return params_.platform.camera; }
@@ -247,7 +252,7 @@ class LivePlatform {
   double t_offset_s_ = 0.0;
 
   std::atomic<bool> estop_{false}, interrupt_{false}, quit_{false};
-  std::atomic<bool> started_{false}, camera_wanted_{true};
+  std::atomic<bool> started_{false}, camera_wanted_{true}, camera_jpeg_wanted_{true};
   std::atomic<int> loop_request_{-1};  // a ConsoleAction the loop asks of the control thread
   Sink sink_;
   FrameSink frame_sink_;

@@ -311,6 +311,8 @@ void SessionRecording::published_frame(double t_s, const devices::CameraFrame& f
       event(EventLevel::kWarning, "video", std::string("frame not recorded: ") + e.what(), 0, t_s);
       return;
     }
+  } else if (image.empty()) {
+    return;  // formed before the recording asked for JPEGs: the next frames carry one
   } else {
     picture.payload = std::string(image);
   }

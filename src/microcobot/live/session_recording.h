@@ -156,8 +156,9 @@ class SessionRecording {
   void published(RecordedTopic topic, double t_s, std::string_view payload);
   /// A camera frame's three messages (image, camera info, state), recorded together or not at
   /// all: a stop between them never leaves a frame without its info or state. `image` is the
-  /// frame's JPEG message (kept with jpeg); with h264 the frame's samples are copied (8-bit) for
-  /// the writer to encode. Camera thread: never waits for the encoder.
+  /// frame's JPEG message (kept with jpeg; empty for a frame formed without its JPEG, which is then
+  /// not recorded); with h264 the frame's samples are copied (8-bit) for the writer to encode. Camera thread:
+  /// never waits for the encoder.
   void published_frame(double t_s, const devices::CameraFrame& frame, std::string_view image,
                        std::string_view info, std::string_view state);
   /// A message a client sent on /console/command or /console/action, accepted or not.
