@@ -27,6 +27,7 @@
 #include "microcobot/drivers/register_drivers.h"
 #include "microcobot/platform/driver_registry.h"
 #include "support/counting_allocator.h"
+#include "support/sanitizers.h"
 #include "support/test_support.h"
 
 namespace mc::drivers {
@@ -191,7 +192,7 @@ void expect_safe_within_one_timeout(Mode mode, bool halt_expected) {
   ASSERT_TRUE(p->faulted()) << "no fault after 2 s";
   std::cout << "[ gcs2 fault " << static_cast<int>(mode) << " ] platform in its safe state after " << 1e3 * t
             << " ms\n";
-  EXPECT_LE(t, kTimeout + 0.002 + 0.05);  // one timeout, one poll, and a loaded machine's slack
+  EXPECT_LE(t, kTimeout + 0.002 + test::kFaultSlack_s);  // one timeout, one poll, and the machine's slack
   for (int i = 0; i < 3; ++i) EXPECT_EQ(p->axis(i).state(), devices::Lifecycle::kFault);
   EXPECT_EQ(p->gripper().state(), devices::Lifecycle::kFault);
   run_paced(*p, 0.05);
