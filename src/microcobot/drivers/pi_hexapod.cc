@@ -1,6 +1,5 @@
 #include "microcobot/drivers/pi_hexapod.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -26,10 +25,9 @@ PiHexapod::PiHexapod(std::string name, std::shared_ptr<PiHexapodController> cont
 
 void PiHexapod::on_configure() {
   controller_->configure();
+  // After a reconnect the bus counts every move and stop asked before as done (the handshake drops
+  // what the faulted bus left in the ring); on a healthy bus a stop under way still settles.
   status_ = controller_->status();
-  // Counted from what the bus says: a move or stop lost with a faulted bus is not waited for.
-  move_seq_ = std::min(move_seq_, status_.move_done);
-  stop_seq_ = std::min(stop_seq_, status_.stop_done);
 }
 
 void PiHexapod::update(double /*dt_s*/) noexcept {

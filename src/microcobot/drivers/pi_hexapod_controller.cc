@@ -206,8 +206,9 @@ void PiHexapodController::cycle(LineClient& bus) {
   const std::uint64_t stop = stop_seq_.load(std::memory_order_acquire);
   HexapodMove m;
   while (moves_.pop(m)) {
-    if (m.seq > stop) send_move(bus, m);  // a move numbered before the last stop is dropped
+    // Done once taken, sent or not: a MOV that faults the bus is not waited for after a reconnect.
     bus_.move_done = std::max(bus_.move_done, m.seq);
+    if (m.seq > stop) send_move(bus, m);  // a move numbered before the last stop is dropped
   }
   bus_.measured = read_pose(bus);
   const std::string mask = gcs2::reply_lines(query(bus, std::string(1, gcs2::kMotionStatus))).at(0);
