@@ -232,11 +232,38 @@ TEST(DriverTwin, PiHexapodStopsTheTwinsMoveAndHoldsWhereItStopped) {
   EXPECT_NEAR(twin_pose(twin.port)[0], 0.05, 1e-3);
 }
 
+TEST(DriverTwin, PiHexapodTheEstopStopsTheTwinsMoveAndTheResetMovesAgain) {
+  HexapodTwinProcess twin;
+  ASSERT_NE(twin.port, 0) << test::read_text(twin.cli.err);
+  HexapodPlatform h(twin.port);
+  ASSERT_TRUE(h.run_until(10.0, [&] { return h.positioner().at_rest(); }));
+  ASSERT_TRUE(h.start({0.2, 0, 0, 0, 0, 0}));
+  ASSERT_TRUE(h.run_until(10.0, [&] { return twin_pose(twin.port)[0] > 0.02; }));
+  h.p->fault_all();  // the operator's e-stop: every device's safe state, the hexapod's #24
+  EXPECT_EQ(h.positioner().state(), devices::Lifecycle::kFault);
+  ASSERT_TRUE(h.run_until(10.0, [&] { return !h.positioner().moving(); })) << "the stop never settled";
+  const Pose6 stopped = twin_pose(twin.port);
+  EXPECT_LT(stopped[0], 0.19);
+  h.run_until(0.3, [] { return false; });
+  EXPECT_NEAR(twin_pose(twin.port)[0], stopped[0], 1e-3);  // holding
+  EXPECT_FALSE(h.start({0.0, 0, 0, 0, 0, 0}));             // refused until the reset
+  h.p->recover();                                          // the bus stood: configured again as it is
+  EXPECT_EQ(h.positioner().state(), devices::Lifecycle::kActive);
+  ASSERT_TRUE(h.run_until(10.0, [&] { return h.positioner().at_rest(); }));
+  ASSERT_TRUE(h.start({0.0, 0.02, 0, 0, 0, 0}));
+  ASSERT_TRUE(h.run_until(30.0, [&] { return h.positioner().at_rest() || h.p->faulted(); }));
+  EXPECT_FALSE(h.p->faulted());
+  const Pose6 at = twin_pose(twin.port);
+  EXPECT_NEAR(at[0], 0.0, 1e-3);
+  EXPECT_NEAR(at[1], 0.02, 1e-3);
+}
+
 // How the twin goes away mid-move.
 enum class Death { kKilled, kFrozen };
 
 // The twin goes away while the positioner moves: the platform is faulted (every device in its safe
-// state) within one reply timeout, a move is refused, and the reset fails in one line.
+// state) within one reply timeout and a move is refused; the reset then reconnects to a twin that
+// answers again (frozen, then continued) and fails in one line on one that is gone (killed).
 void expect_safe_within_one_timeout(Death death) {
   HexapodTwinProcess twin;
   ASSERT_NE(twin.port, 0) << test::read_text(twin.cli.err);
@@ -274,9 +301,23 @@ void expect_safe_within_one_timeout(Death death) {
   }
   // Every device of the platform is in its safe state.
   for (int i = 0; i < 3; ++i) EXPECT_EQ(h.p->axis(i).state(), devices::Lifecycle::kFault);
-  // A move is refused; the reset (a reconnect) fails in one line naming the controller's address.
-  EXPECT_FALSE(h.start({0.0, 0, 0, 0, 0, 0}));
-  if (death == Death::kFrozen) twin.kill_now();
+  EXPECT_FALSE(h.start({0.0, 0, 0, 0, 0, 0}));  // a move is refused
+  if (death == Death::kFrozen) {
+    // The twin answers again: the reset reconnects (the configure sequence again) and moves.
+    h.p->recover();
+    EXPECT_FALSE(h.p->faulted());
+    EXPECT_EQ(h.positioner().state(), devices::Lifecycle::kActive);
+    ASSERT_TRUE(h.run_until(10.0, [&] { return h.positioner().at_rest(); }));
+    ASSERT_TRUE(h.start({0.05, 0.01, 0, 0, 0, 0.05}));
+    ASSERT_TRUE(h.run_until(30.0, [&] { return h.positioner().at_rest() || h.p->faulted(); }));
+    EXPECT_FALSE(h.p->faulted());
+    const Pose6 at = twin_pose(twin.port);
+    EXPECT_NEAR(at[0], 0.05, 1e-3);
+    EXPECT_NEAR(at[1], 0.01, 1e-3);
+    EXPECT_NEAR(at[5], 0.05, 1e-3);
+    return;
+  }
+  // Nobody answers: the reset fails in one line naming the controller's address.
   try {
     h.p->recover();
     ADD_FAILURE() << "recovered without a controller";
@@ -293,7 +334,8 @@ TEST(DriverTwin, PiHexapodPutsThePlatformInItsSafeStateWithinOneTimeoutWhenTheTw
   expect_safe_within_one_timeout(Death::kKilled);
 }
 
-TEST(DriverTwin, PiHexapodPutsThePlatformInItsSafeStateWithinOneTimeoutWhenTheTwinFreezesMidMove) {
+TEST(DriverTwin,
+     PiHexapodPutsThePlatformInItsSafeStateWithinOneTimeoutWhenTheTwinFreezesMidMoveAndReconnects) {
   expect_safe_within_one_timeout(Death::kFrozen);
 }
 

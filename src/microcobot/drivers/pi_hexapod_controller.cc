@@ -119,6 +119,16 @@ motion::PlatformTransform PiHexapodController::read_pose(LineClient& bus) {
   return transform_of(read_six(bus, "POS?"), pivot_m_);
 }
 
+void PiHexapodController::drain_errors(LineClient& bus) {
+  for (int n = 0;; ++n) {
+    const auto code = gcs2::parse_error_reply(query(bus, "ERR?"));
+    if (!code) throw BusFault("ERR?: not an error code");
+    if (*code == 0) return;
+    if (n + 1 >= kMaxStaleErrors)
+      throw BusFault(fmt::format("ERR? still reads {} after {} reads", *code, n + 1));
+  }
+}
+
 void PiHexapodController::handshake(LineClient& bus) {
   const auto idn = gcs2::reply_lines(query(bus, "*IDN?", timing().connect_timeout_s));
   if (idn.size() != 1 || idn[0].empty())
@@ -126,14 +136,7 @@ void PiHexapodController::handshake(LineClient& bus) {
   if (!names_c887(idn[0]))
     throw BusFault("*IDN? reads '" + excerpt(idn[0], 80) + "': not a PI C-887 hexapod controller");
   set_identity(idn[0]);
-  // The stale errors of an earlier session are not this one's: ERR? until it reads 0.
-  for (int n = 0;; ++n) {
-    const auto code = gcs2::parse_error_reply(query(bus, "ERR?"));
-    if (!code) throw BusFault("ERR?: not an error code");
-    if (*code == 0) break;
-    if (n + 1 >= kMaxStaleErrors)
-      throw BusFault(fmt::format("ERR? still reads {} after {} reads", *code, n + 1));
-  }
+  drain_errors(bus);
   const auto found = gcs2::reply_lines(query(bus, "SAI? ALL"));
   std::string found_list;
   for (const auto& a : found) found_list += (found_list.empty() ? "" : ", ") + a;
@@ -177,6 +180,9 @@ void PiHexapodController::handshake(LineClient& bus) {
   const auto v = vls.size() == 1 ? gcs2::parse_number(vls[0]) : std::nullopt;
   if (!v) throw BusFault("VLS? reads '" + excerpt(vls.empty() ? "" : vls[0]) + "': not a velocity");
   vls_mm_s_ = *v;
+  // Again at the end: the controller may have raised one of an earlier session's meanwhile (a move
+  // of a client gone, stopped as the connection closed), which the first MOV must not read as its own.
+  drain_errors(bus);
   // A move left in the ring by a bus that faulted is not sent after the reconnect.
   HexapodMove stale;
   while (moves_.pop(stale)) bus_.move_done = std::max(bus_.move_done, stale.seq);

@@ -17,7 +17,7 @@
 ///   configure  *IDN? (must name a C-887), ERR? until 0 (the stale error queue drained), SAI? ALL
 ///              (X Y Z U V W listed), KEN? (ZERO: poses in the root coordinate system), SPI? (the
 ///              pivot), FRF? and, when unreferenced, FRF X Y Z U V W, ERR?, then FRF? until referenced
-///              (within reference_timeout_s), VLS?, POS?
+///              (within reference_timeout_s), VLS?, ERR? until 0 again, POS?
 ///   each cycle a move from the ring: [VLS v, ERR?] (when its speed differs from the last),
 ///              MOV X x Y y Z z U u V v W w, ERR? (must read 0); then POS?, #5, ONT?
 ///   stop, safe state  #24 (stop all), ERR? (0 or 10, "stopped by command")
@@ -108,6 +108,8 @@ class PiHexapodController final : public BusController {
   /// A query of the six axes (POS? X Y Z U V W ...): their values in order. Throws BusFault.
   std::array<double, 6> read_six(LineClient& bus, const std::string& mnemonic);
   motion::PlatformTransform read_pose(LineClient& bus);
+  /// ERR? until it reads 0: the errors of an earlier session are not this one's. Throws BusFault.
+  void drain_errors(LineClient& bus);
   void send_move(LineClient& bus, const HexapodMove& m);
 
   PiHexapodParams params_;
