@@ -122,12 +122,14 @@ motion::PlatformTransform transform_of(const Pose6& p) {
 struct HexapodPlatform {
   std::unique_ptr<Platform> p;
   teleop::ConsoleInput in;
-  explicit HexapodPlatform(std::uint16_t port) {
+  /// `speed_m_s`: the moves' tool point speed (parallel_positioner.move.max_speed_m_s), sent as VLS.
+  explicit HexapodPlatform(std::uint16_t port, double speed_m_s = motion::PoseMoveLimits{}.max_speed_m_s) {
     drivers::register_vendor_drivers();
     PlatformConfig c;
     c.positioner = "parallel";
     c.parallel_positioner.driver = "pi-hexapod";
     c.parallel_positioner.connection = fmt::format("127.0.0.1:{},timeout_s={},stale_s=0.5", port, kTimeout_s);
+    c.parallel_positioner.move.max_speed_m_s = speed_m_s;
     p = platform::make_platform(c);
     in.active = in.fresh = in.deadman = true;
     const auto& s = p->config().stage;
@@ -256,6 +258,24 @@ TEST(DriverTwin, PiHexapodTheEstopStopsTheTwinsMoveAndTheResetMovesAgain) {
   const Pose6 at = twin_pose(twin.port);
   EXPECT_NEAR(at[0], 0.0, 1e-3);
   EXPECT_NEAR(at[1], 0.02, 1e-3);
+}
+
+TEST(DriverTwin, PiHexapodAControllerErrorPutsThePlatformInItsSafeStateBeforeAnythingMoves) {
+  HexapodTwinProcess twin;
+  ASSERT_NE(twin.port, 0) << test::read_text(twin.cli.err);
+  // 0.6 mm/s: within the legs' speed limit (the move passes check_move), above the twin's VLS
+  // limit (0.5 mm/s): VLS is refused with error 8, and the MOV after it is never sent.
+  HexapodPlatform h(twin.port, 0.6e-3);
+  ASSERT_TRUE(h.run_until(10.0, [&] { return h.positioner().at_rest(); }));
+  const Pose6 before = twin_pose(twin.port);
+  ASSERT_TRUE(h.start({0.05, 0, 0, 0, 0, 0}));
+  ASSERT_TRUE(h.run_until(5.0, [&] { return h.p->faulted(); }));
+  EXPECT_EQ(h.positioner().state(), devices::Lifecycle::kFault);
+  const auto& c = static_cast<const drivers::PiHexapod&>(h.positioner()).controller();
+  EXPECT_EQ(c.fault_reason(), "'VLS 0.600000': controller error 8 (Velocity out of limits)");
+  EXPECT_EQ(c.moves_sent(), 0u);
+  h.run_until(0.3, [] { return false; });
+  EXPECT_NEAR(twin_pose(twin.port)[0], before[0], 1e-3);  // nothing moved
 }
 
 // How the twin goes away mid-move.
