@@ -29,6 +29,11 @@ std::map<std::string, CameraSourceFactory>& cameras() {
   return c;
 }
 
+std::map<std::string, PositionerFactory>& positioners() {
+  static std::map<std::string, PositionerFactory> p;
+  return p;
+}
+
 constexpr const char* kNoCamera = "none";
 constexpr const char* kOpenCv = "opencv";
 
@@ -121,6 +126,49 @@ std::unique_ptr<devices::FrameSource> make_camera_source(const PlatformConfig& c
     throw InvalidParams(
         "devices.camera.driver",
         "'" + excerpt(name) + "' is not a camera driver of this build (known: " + known + ")");
+  }
+  return factory(config);
+}
+
+void register_positioner(const std::string& name, PositionerFactory factory) {
+  if (!valid_name(name))
+    throw InvalidParams("parallel_positioner.driver",
+                        "a driver's name is 1-64 letters, digits, '-' or '_', not '" + excerpt(name) + "'");
+  if (name == kSimulated)
+    throw InvalidParams("parallel_positioner.driver", "'simulated' is the built-in positioner");
+  if (!factory) throw InvalidParams("parallel_positioner.driver", "'" + name + "' has no factory");
+  std::lock_guard lock(entries_mutex());
+  if (!positioners().emplace(name, std::move(factory)).second)
+    throw InvalidParams("parallel_positioner.driver", "'" + name + "' is registered twice");
+}
+
+std::vector<std::string> positioner_driver_names() {
+  std::vector<std::string> names{kSimulated};
+  std::lock_guard lock(entries_mutex());
+  for (const auto& entry : positioners()) names.push_back(entry.first);
+  return names;
+}
+
+bool is_positioner_driver(const std::string& name) {
+  if (name == kSimulated) return true;
+  std::lock_guard lock(entries_mutex());
+  return positioners().count(name) > 0;
+}
+
+std::unique_ptr<devices::ParallelPositioner> make_positioner(const PlatformConfig& config) {
+  const std::string& name = config.parallel_positioner.driver;
+  PositionerFactory factory;
+  {
+    std::lock_guard lock(entries_mutex());
+    const auto it = positioners().find(name);
+    if (it != positioners().end()) factory = it->second;
+  }
+  if (!factory) {
+    std::string known;
+    for (const std::string& n : positioner_driver_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InvalidParams(
+        "parallel_positioner.driver",
+        "'" + excerpt(name) + "' is not a registered positioner driver (known: " + known + ")");
   }
   return factory(config);
 }

@@ -60,6 +60,25 @@ bool is_camera_driver(const std::string& name);
 /// naming `devices.camera.driver` for an unknown one, mc::Error when the driver cannot be built.
 std::unique_ptr<devices::FrameSource> make_camera_source(const PlatformConfig& config);
 
+/// Builds the parallel positioner's device (unconfigured) from the configuration
+/// (`parallel_positioner.connection` says what to open; its geometry is there too). Throws mc::Error.
+using PositionerFactory =
+    std::function<std::unique_ptr<devices::ParallelPositioner>(const PlatformConfig& config)>;
+
+/// Registers a parallel positioner's driver under `name` (as register_devices; not "simulated"),
+/// selected by `parallel_positioner.driver` with `positioner: parallel`:
+///
+///     positioner: parallel
+///     parallel_positioner: {driver: pi-hexapod, connection: "192.168.10.7:50000"}
+void register_positioner(const std::string& name, PositionerFactory factory);
+/// The names `parallel_positioner.driver` accepts: "simulated", then the registered ones, sorted.
+std::vector<std::string> positioner_driver_names();
+bool is_positioner_driver(const std::string& name);
+/// The registered factory's positioner for `config.parallel_positioner.driver` (not "simulated":
+/// the platform builds that one). Throws mc::InvalidParams naming `parallel_positioner.driver` and
+/// the known names, mc::Error when the driver cannot be built.
+std::unique_ptr<devices::ParallelPositioner> make_positioner(const PlatformConfig& config);
+
 /// Registers a driver set at static initialisation, in a source file compiled into the program
 /// itself (a static library's object nobody references would be left out by the linker):
 ///     const mc::platform::DriverRegistration kLabBench{"lab-bench", make_lab_bench};

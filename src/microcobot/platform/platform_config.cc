@@ -143,6 +143,12 @@ void PlatformConfig::validate() const {
           "must be cartesian or parallel, not '" + excerpt(positioner) + "'");
   in_section("parallel_positioner", [&] {
     parallel_positioner.validate();
+    if (!is_positioner_driver(parallel_positioner.driver)) {
+      std::string known;
+      for (const std::string& n : positioner_driver_names()) known += (known.empty() ? "" : ", ") + n;
+      throw InvalidParams("driver", "'" + excerpt(parallel_positioner.driver) +
+                                        "' is not a registered positioner driver (known: " + known + ")");
+    }
     if (!parallel_positioner_enabled()) return;
     // One loop tick is a whole number of the legs' control periods (the device ticks them).
     const double n = parallel_positioner.tracking.control_rate_Hz / loop.base_rate_Hz;

@@ -175,6 +175,29 @@ struct DeviceSelection {
   bool simulated() const { return driver == "simulated"; }
 };
 
+/// The parallel positioner's section (`parallel_positioner:`): the simulated positioner's
+/// parameters (motion::ParallelStageParams: its geometry, its legs' tracking and sensors, its
+/// moves' limits, which a driver's positioner keeps for its kinematics and the moves' planning)
+/// and which device is the positioner (docs/hardware.md, "pi-hexapod").
+///
+///     parallel_positioner: {driver: pi-hexapod, connection: "192.168.10.7:50000,timeout_s=0.2"}
+struct ParallelPositionerSelection : motion::ParallelStageParams {
+  /// "simulated" (the six stick-slip legs of the project's model) or a registered positioner
+  /// driver ("pi-hexapod": a PI C-887 hexapod controller over TCP; platform/driver_registry.h).
+  std::string driver = "simulated";
+  /// What the driver opens, in its own syntax (`pi-hexapod`: HOST:PORT[,key=value...]); unused by
+  /// the simulation.
+  std::string connection;
+
+  template <class V>
+  void visit(V& v) {
+    motion::ParallelStageParams::visit(v);
+    v("driver", driver);
+    v("connection", connection);
+  }
+  bool simulated() const { return driver == "simulated"; }
+};
+
 struct PlatformConfig {
   DeviceSelection devices;
   LoopParams loop;
@@ -197,7 +220,8 @@ struct PlatformConfig {
   /// parallel stick-slip positioner (`parallel_positioner`, devices/parallel_positioner.h), the
   /// gripper on the Cartesian robot.
   std::string positioner = "cartesian";
-  motion::ParallelStageParams parallel_positioner;
+  /// The parallel positioner (with `positioner: parallel`): its model's parameters and its driver.
+  ParallelPositionerSelection parallel_positioner;
 
   template <class V>
   void visit(V& v) {

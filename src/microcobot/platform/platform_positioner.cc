@@ -1,15 +1,21 @@
 // The platform's parallel positioner (`positioner: parallel`; devices/parallel_positioner.h): the
-// simulated one built from the configuration when no driver brings one, its pose moves under the
+// simulated one built from the configuration when no driver brings one (or the registered driver
+// `parallel_positioner.driver` names, platform/driver_registry.h), its pose moves under the
 // deadman of the input that drives the coupling, its update on every tick.
 #include <memory>
 
 #include "microcobot/devices/simulated_parallel_positioner.h"
+#include "microcobot/platform/driver_registry.h"
 #include "microcobot/platform/platform.h"
 
 namespace mc::platform {
 
 void Platform::build_positioner() {
   if (devices_.positioner || !config_.parallel_positioner_enabled()) return;
+  if (!config_.parallel_positioner.simulated()) {
+    devices_.positioner = make_positioner(config_);  // a driver's (parallel_positioner.driver)
+    return;
+  }
   // The legs are the project's stick-slip axes: the platform's model and step map.
   auto p = std::make_unique<devices::SimulatedParallelPositioner>(
       "parallel_positioner", *model_, *map_, config_.parallel_positioner, config_.loop.period_s());
