@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # What a failed CI stage leaves to read, in a few lines at the end of the run's output (which is
-# often shown cut in the middle): each failed test's first failure lines, and a failed fuzzer's
-# verdict and sanitizer summary.
+# often shown cut in the middle): each failed test's output from its first failure on (30 lines,
+# the messages streamed into its assertions included), and a failed fuzzer's verdict and
+# sanitizer summary.
 # Usage: scripts/ci_digest.sh BUILD_DIR
 set -uo pipefail
 build=${1:?usage: scripts/ci_digest.sh BUILD_DIR}
@@ -15,7 +16,8 @@ while IFS=: read -r _ name; do
   awk -v n="$name" '
     index($0, "Test: " n) == 1 || $0 ~ ("^[0-9]+/[0-9]+ Test: " n "$") { on = 1; next }
     on && /^[0-9]+\/[0-9]+ Test: / { exit }
-    on && /Failure|FAILED|ERROR|error:|Assertion|Expected|Which is|evaluates to|The difference|Value of|Actual|fails again|SUMMARY|got:|< / { print "ci:   " $0; if (++k == 12) exit }
+    on && !shown && /Failure|ERROR|error:|Assertion|SUMMARY/ { shown = 1 }
+    on && shown { print "ci:   " $0; if (++k == 30) exit }
   ' "$log"
 done <"$failed"
 if grep -q "fuzz_parsers" "$failed"; then
