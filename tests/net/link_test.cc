@@ -1,5 +1,10 @@
 #include "microcobot/net/link.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -213,6 +218,38 @@ TEST(Link, RefusesADomainIdOutsideTheRange) {
   c.domain_id = test_domain_id();
   c.poll_period_s = 0.0;
   EXPECT_THROW(Link{c}, InvalidParams);
+}
+
+TEST(Link, ADomainWhosePortAnotherProgramHoldsFailsWithOneLineNamingThePort) {
+  // Cyclone's port mapping: the discovery multicast port of domain d is 7400 + 250 d. A socket
+  // bound there without SO_REUSEADDR (what a program given that port by the kernel holds) keeps
+  // Cyclone from creating the domain.
+  const int domain = test_domain_id();
+  const int port = 7400 + 250 * domain;
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_ANY);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    GTEST_SKIP() << "port " << port << " is already taken on this machine";
+  }
+  LinkConfig c;
+  c.domain_id = domain;
+  c.role = Role::kSlave;
+  try {
+    Link link(c);
+    ADD_FAILURE() << "the domain was created while port " << port << " was held";
+  } catch (const ComputationFailed& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cannot create domain " + std::to_string(domain)), std::string::npos) << what;
+    EXPECT_NE(what.find(std::to_string(port) + ": address in use"), std::string::npos) << what;
+    EXPECT_NE(what.find("another program holds the port"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  ::close(fd);
 }
 
 }  // namespace

@@ -16,15 +16,9 @@
 
 namespace mc::net::test {
 
-/// Highest domain id whose ports (7400 + 250 x domain + 10 + 2 x participant index + 1, indices
-/// up to 20) all lie below Linux's default ephemeral range (32768 and up). Above it, the
-/// discovery port can be taken by any socket another process bound to port 0, and Cyclone then
-/// fails to create the domain ("failed to bind ... address in use").
-inline constexpr int kMaxTestDomainId = 101;
-static_assert(7400 + 250 * kMaxTestDomainId + 10 + 2 * 20 + 1 < 32768);
-
-/// 1..kMaxTestDomainId from the pid (0 is ROS 2's default domain: left to real use).
-inline int test_domain_id() { return 1 + static_cast<int>(::getpid() % kMaxTestDomainId); }
+/// 1..kMaxPortableDomainId from the pid (0 is ROS 2's default domain: left to real use; above
+/// kMaxPortableDomainId another process' socket may hold the domain's port).
+inline int test_domain_id() { return 1 + static_cast<int>(::getpid() % kMaxPortableDomainId); }
 
 /// Polls `done` every millisecond for up to `timeout_s`; true when it became true.
 template <class F>

@@ -17,6 +17,12 @@ namespace mc::net {
 /// offsets) stays below 65536 up to 232; a margin of two.
 inline constexpr int kMaxDomainId = 230;
 
+/// Highest domain id whose ports (7400 + 250 x domain + 10 + 2 x participant index + 1, indices
+/// up to 20) all lie below Linux's default ephemeral range (32768 and up). Above it, a socket any
+/// program bound to port 0 may hold the domain's discovery port, and the domain cannot be created.
+inline constexpr int kMaxPortableDomainId = 101;
+static_assert(7400 + 250 * kMaxPortableDomainId + 10 + 2 * 20 + 1 < 32768);
+
 /// Where the link's traffic goes.
 struct NetworkConfig {
   /// The local interface DDS uses: an IPv4/IPv6 address of this machine or an interface name

@@ -49,6 +49,20 @@ class CycloneLogCapture {
   std::string text_;
 };
 
+/// Why a port Cyclone could not bind is taken, for the domain's error: ids above 101 put the
+/// domain's ports (7400 + 250 x domain and up) in Linux's default ephemeral range (32768 and up),
+/// where any program's socket bound to port 0 may hold one.
+std::string address_in_use_hint(int domain_id, const std::string& log) {
+  if (log.find("address in use") == std::string::npos) return "";
+  std::string hint = " (another program holds the port";
+  if (domain_id > kMaxPortableDomainId)
+    hint +=
+        "; domain ids above " + std::to_string(kMaxPortableDomainId) +
+        " use ports in Linux's ephemeral range, where any program's socket may take them: choose one up to " +
+        std::to_string(kMaxPortableDomainId);
+  return hint + ")";
+}
+
 }  // namespace
 
 dds_return_t check_dds(dds_return_t rc, const char* what) {
@@ -79,7 +93,8 @@ Participant::Participant(int domain_id, const NetworkConfig& network) : domain_i
     if (d < 0) {
       domains().erase(domain_id);
       throw ComputationFailed("DDS: cannot create domain " + std::to_string(domain_id) + " on interface '" +
-                              network.interface + "': " + (log.empty() ? dds_strretcode(d) : log));
+                              network.interface + "': " + (log.empty() ? dds_strretcode(d) : log) +
+                              address_in_use_hint(domain_id, log));
     }
     if (!log.empty()) std::fprintf(stderr, "DDS: %s\n", log.c_str());  // what Cyclone would have printed
     ref.domain = d;
