@@ -123,8 +123,12 @@ BusController::Clock::time_point BusController::deadline_in(double s) const {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
+BusController::Clock::duration BusController::reply_timeout() const {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timing_.reply_timeout_s));
+}
+
 BusController::Clock::time_point BusController::reply_deadline() const {
-  return deadline_in(timing_.reply_timeout_s);
+  return Clock::now() + reply_timeout();
 }
 
 void BusController::fail(const std::string& reason) noexcept {

@@ -112,6 +112,8 @@ class BusController {
   void publish_position(int axis, double m) noexcept;
   void publish_stamp() noexcept;  ///< the positions just published are fresh
   Clock::time_point reply_deadline() const;
+  /// The reply timeout as a duration.
+  Clock::duration reply_timeout() const;
   Clock::time_point deadline_in(double s) const;
   const Connection& connection() const { return connection_; }
   const BusTiming& timing() const { return timing_; }

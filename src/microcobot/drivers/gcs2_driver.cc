@@ -10,6 +10,7 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/drivers/gcs2_codec.h"
+#include "microcobot/drivers/gcs2_exchange.h"
 #include "microcobot/drivers/sim_companions.h"
 
 namespace mc::drivers {
@@ -78,28 +79,11 @@ double Gcs2Controller::si_per_wire(std::size_t i) const {
 }
 
 std::string Gcs2Controller::query(LineClient& bus, const std::string& line, double timeout_s) {
-  const auto deadline = timeout_s > 0.0 ? deadline_in(timeout_s) : reply_deadline();
-  if (!bus.send(line + "\n", deadline)) throw BusFault("'" + line + "': " + bus.error());
-  std::string reply;
-  if (!bus.read_until(
-          reply, [](const std::string& t) { return gcs2::reply_end(t); }, deadline)) {
-    std::string got = reply.empty() ? std::string() : " (got '" + excerpt(reply, 60) + "')";
-    throw BusFault("'" + line + "': " + bus.error() + got);
-  }
-  return reply;
+  return gcs2::query(bus, line, timeout_s > 0.0 ? deadline_in(timeout_s) : reply_deadline());
 }
 
 void Gcs2Controller::command(LineClient& bus, const std::string& line, int also_ok) {
-  const auto deadline = reply_deadline();
-  if (!bus.send(line + "\n", deadline)) throw BusFault("'" + line + "': " + bus.error());
-  const std::string reply = query(bus, "ERR?");
-  const auto code = gcs2::parse_error_reply(reply);
-  if (!code)
-    throw BusFault("'" + line + "' then ERR?: a reply that is not an error code: '" + excerpt(reply, 60) +
-                   "'");
-  if (*code != 0 && *code != also_ok)
-    throw BusFault(
-        fmt::format("'{}': controller error {} ({})", excerpt(line, 60), *code, gcs2::error_text(*code)));
+  gcs2::command(bus, line, reply_timeout(), gcs2::error_text, also_ok);
 }
 
 std::array<double, Gcs2Controller::kMaxAxes> Gcs2Controller::read_axes(LineClient& bus,
@@ -155,7 +139,7 @@ void Gcs2Controller::handshake(LineClient& bus) {
                      "': the rotary axis must be a rotation stage in deg");
   }
   // A stale error from an earlier session is not this one's.
-  if (!gcs2::parse_error_reply(query(bus, "ERR?"))) throw BusFault("ERR?: not an error code");
+  gcs2::clear_errors(bus, reply_timeout());
   const auto tmn = read_axes(bus, "TMN?"), tmx = read_axes(bus, "TMX?");
   for (std::size_t i = 0; i < n; ++i) {
     min_m_[i] = tmn[i] * si_per_wire(i);

@@ -12,13 +12,11 @@
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
 #include "microcobot/drivers/gcs2_codec.h"
+#include "microcobot/drivers/gcs2_exchange.h"
 #include "microcobot/drivers/gcs2_hexapod.h"
 
 namespace mc::drivers {
 namespace {
-
-/// ERR? reads at most this many stale errors at configure before the queue counts as stuck.
-constexpr int kMaxStaleErrors = 16;
 
 bool names_c887(const std::string& idn) {
   std::string upper;
@@ -67,33 +65,11 @@ PiHexapodController::PiHexapodController(Connection connection, PiHexapodParams 
 }
 
 std::string PiHexapodController::query(LineClient& bus, const std::string& line, double timeout_s) {
-  const auto deadline = timeout_s > 0.0 ? deadline_in(timeout_s) : reply_deadline();
-  // The single-byte commands (#5) go without LF.
-  const bool single = line.size() == 1;
-  const std::string name = single ? fmt::format("#{}", static_cast<int>(line[0])) : line;
-  if (!bus.send(single ? line : line + "\n", deadline)) throw BusFault("'" + name + "': " + bus.error());
-  std::string reply;
-  if (!bus.read_until(
-          reply, [](const std::string& t) { return gcs2::reply_end(t); }, deadline)) {
-    std::string got = reply.empty() ? std::string() : " (got '" + excerpt(reply, 60) + "')";
-    throw BusFault("'" + name + "': " + bus.error() + got);
-  }
-  return reply;
+  return gcs2::query(bus, line, timeout_s > 0.0 ? deadline_in(timeout_s) : reply_deadline());
 }
 
 void PiHexapodController::command(LineClient& bus, const std::string& line, int also_ok) {
-  if (!bus.send(line.size() == 1 ? line : line + "\n", reply_deadline()))
-    throw BusFault("'" + excerpt(line, 60) + "': " + bus.error());
-  const std::string reply = query(bus, "ERR?");
-  const auto code = gcs2::parse_error_reply(reply);
-  const std::string name =
-      line.size() == 1 ? fmt::format("#{}", static_cast<int>(line[0])) : excerpt(line, 60);
-  if (!code)
-    throw BusFault("'" + name + "' then ERR?: a reply that is not an error code: '" + excerpt(reply, 60) +
-                   "'");
-  if (*code != 0 && *code != also_ok)
-    throw BusFault(
-        fmt::format("'{}': controller error {} ({})", name, *code, gcs2::hexapod_error_text(*code)));
+  gcs2::command(bus, line, reply_timeout(), gcs2::hexapod_error_text, also_ok);
 }
 
 std::array<double, 6> PiHexapodController::read_six(LineClient& bus, const std::string& mnemonic) {
@@ -119,16 +95,6 @@ motion::PlatformTransform PiHexapodController::read_pose(LineClient& bus) {
   return transform_of(read_six(bus, "POS?"), pivot_m_);
 }
 
-void PiHexapodController::drain_errors(LineClient& bus) {
-  for (int n = 0;; ++n) {
-    const auto code = gcs2::parse_error_reply(query(bus, "ERR?"));
-    if (!code) throw BusFault("ERR?: not an error code");
-    if (*code == 0) return;
-    if (n + 1 >= kMaxStaleErrors)
-      throw BusFault(fmt::format("ERR? still reads {} after {} reads", *code, n + 1));
-  }
-}
-
 void PiHexapodController::handshake(LineClient& bus) {
   const auto idn = gcs2::reply_lines(query(bus, "*IDN?", timing().connect_timeout_s));
   if (idn.size() != 1 || idn[0].empty())
@@ -136,7 +102,7 @@ void PiHexapodController::handshake(LineClient& bus) {
   if (!names_c887(idn[0]))
     throw BusFault("*IDN? reads '" + excerpt(idn[0], 80) + "': not a PI C-887 hexapod controller");
   set_identity(idn[0]);
-  drain_errors(bus);
+  gcs2::clear_errors(bus, reply_timeout());
   const auto found = gcs2::reply_lines(query(bus, "SAI? ALL"));
   std::string found_list;
   for (const auto& a : found) found_list += (found_list.empty() ? "" : ", ") + a;
@@ -182,7 +148,7 @@ void PiHexapodController::handshake(LineClient& bus) {
   vls_mm_s_ = *v;
   // Again at the end: the controller may have raised one of an earlier session's meanwhile (a move
   // of a client gone, stopped as the connection closed), which the first MOV must not read as its own.
-  drain_errors(bus);
+  gcs2::clear_errors(bus, reply_timeout());
   // A move left in the ring by a bus that faulted is not sent after the reconnect.
   HexapodMove stale;
   while (moves_.pop(stale)) bus_.move_done = std::max(bus_.move_done, stale.seq);

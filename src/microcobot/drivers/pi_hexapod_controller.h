@@ -108,8 +108,6 @@ class PiHexapodController final : public BusController {
   /// A query of the six axes (POS? X Y Z U V W ...): their values in order. Throws BusFault.
   std::array<double, 6> read_six(LineClient& bus, const std::string& mnemonic);
   motion::PlatformTransform read_pose(LineClient& bus);
-  /// ERR? until it reads 0: the errors of an earlier session are not this one's. Throws BusFault.
-  void drain_errors(LineClient& bus);
   void send_move(LineClient& bus, const HexapodMove& m);
 
   PiHexapodParams params_;
