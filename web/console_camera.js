@@ -92,6 +92,9 @@ listen("/platform/scene", (sc) => {
   $("snapshot").href = "/camera/snapshot.tiff" + location.search;  // the token, when the server needs one
   $("follow-label").hidden = !!cam;
   $("overlay-label").hidden = !cam;
+  $("record-video-label").hidden = !cam;
+  // The server's default until the operator chooses (a later scene keeps the choice).
+  if (cam && !mc.recordVideoChosen) $("record-video").value = cam.record_video;
   if (!cam || cameraControlsFor === JSON.stringify(cam)) return;
   cameraControlsFor = JSON.stringify(cam);
   const sel = $("objective");

@@ -157,5 +157,9 @@ $("reset").addEventListener("click", () => action("reset"));
 $("demo").addEventListener("click", () => action("demo"));
 $("restart").addEventListener("click", () => action("restart"));
 $("vision-tare").addEventListener("click", () => action("vision_tare"));
-$("record").addEventListener("click", () => action(mc.status && mc.status.recording ? "record_stop" : "record_start"));
+$("record").addEventListener("click", () => {
+  if (mc.status && mc.status.recording) action("record_stop");
+  else action("record_start", $("record-video-label").hidden ? {} : {video: $("record-video").value});
+});
+$("record-video").addEventListener("change", () => { mc.recordVideoChosen = true; });
 

@@ -148,9 +148,10 @@ function connect() {
 
 // An action on /console/action; the ones the control thread may refuse (demo, restart, reset)
 // are answered through the status's last_error, which the status script watches after them.
-function action(name) {
+// `extra`: the action's other keys (record_start's "video").
+function action(name, extra = {}) {
   if (!client) return;
-  client.publish("/console/action", {action: name});
+  client.publish("/console/action", {action: name, ...extra});
   mc.lastAction = {name, at: performance.now()};
 }
 

@@ -152,6 +152,7 @@ listen("/platform/status", (s) => {
   $("estop").classList.toggle("latched", s.estopped);
   $("record").textContent = s.recording ? "Stop recording" : "Record";
   $("record").classList.toggle("on", !!s.recording);
+  $("record-video").disabled = !!s.recording;  // chosen per recording, before it starts
   if ((s.recording || "") !== mc.lastRecording) {  // a recording started or ended: list again
     mc.lastRecording = s.recording || "";
     listRecordings();

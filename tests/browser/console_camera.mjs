@@ -3,10 +3,12 @@
 // pixels lies within 2 px of where the calibration (view centre, objective scale) puts the
 // part's true position; focusing on the part's top sharpens it; the 5x objective shows it 2.5
 // times larger; the ground-truth overlay is off by default and labelled when on; a click on the
-// image sends the stage there (with the deadman). Run by CTest (`console_browser_camera`);
+// image sends the stage there (with the deadman); a recording made with the video chosen under
+// Recordings keeps the camera that way. Run by CTest (`console_browser_camera`);
 // screenshots to MC_ARTIFACTS.
-import { writeFileSync } from "node:fs";
+import { readdirSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
+import { loadReaders, openIndexed } from "../mcap/indexed_reader.mjs";
 import { startConsole } from "./console_session.mjs";
 
 // The microscope looks at the part's start (x = 0), the whole part in the 5x field too.
@@ -148,4 +150,32 @@ await s.run(async () => {
   log(`camera: ${st.objective_name}, ${(st.m_per_px * 1e6).toFixed(3)} um/px, capture ${st.capture_ms.toFixed(1)} ms, ` +
       `JPEG ${st.encode_ms.toFixed(1)} ms, scene-to-JPEG ${st.latency_ms.toFixed(1)} ms, page decode ` +
       `${(await page.evaluate(() => window.mc.camera.decodeMs)).toFixed(1)} ms`);
+
+  // How the next recording keeps the camera, chosen under Recordings: the server's default shown,
+  // JPEG chosen, locked while recording; the file then holds the JPEG frames and no H.264
+  // (read back by @mcap/core through its index).
+  const video = page.locator("#record-video");
+  if (!(await video.isVisible())) fail("no video choice under Recordings with a camera");
+  const shown = await video.inputValue();
+  if (shown !== "h264") fail(`the video choice shows ${shown}, the server's default is h264`);
+  await video.selectOption("jpeg");
+  await page.click("#record");
+  await until("recording", () => window.mc.status && !!window.mc.status.recording, 10);
+  if (!(await video.isDisabled())) fail("the video choice can change while recording");
+  await page.waitForTimeout(1500);
+  await video.scrollIntoViewIfNeeded();
+  await shot("camera-06-recording-with-jpeg-video");
+  await page.click("#record");
+  await until("the recording listed as finished", () => !!document.querySelector("#recordings a[download]"), 15);
+  const files = readdirSync(join(s.dir, "rec")).filter((f) => f.endsWith(".mcap"));
+  if (files.length !== 1) fail(`expected one recording, found ${files.join(", ")}`);
+  else {
+    const { reader, close } = await openIndexed(await loadReaders("console_camera"), join(s.dir, "rec", files[0]));
+    const counts = {};
+    for (const [id, n] of reader.statistics.channelMessageCounts) counts[reader.channelsById.get(id).topic] = Number(n);
+    await close();
+    log(`recording ${files[0]}: ${counts["/camera/image/compressed"] || 0} JPEG frames, ${counts["/camera/video"] || 0} H.264 frames`);
+    if (!(counts["/camera/image/compressed"] >= 10)) fail("the recording holds fewer than 10 JPEG frames");
+    if (counts["/camera/video"]) fail("the recording holds H.264 frames though JPEG was chosen");
+  }
 }, "the console shows the camera, focus and objective change it, click-to-go through its scale");

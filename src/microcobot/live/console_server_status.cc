@@ -108,7 +108,9 @@ std::string ConsoleServer::scene_json() const {
                    {"frame_rate_Hz", cam.frame_rate_Hz()},
                    {"exposure_range_s", {c.min_exposure_s, c.max_exposure_s}},
                    {"gain_range", {c.min_gain, c.max_gain}},
-                   {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}}};
+                   {"view_center_m", {cam.view_center_x_m, cam.view_center_y_m}},
+                   // How a recording keeps the camera unless its record_start says (the page's choice).
+                   {"record_video", recorded_video_name(params_.record_video)}};
   } else {
     j["camera"] = nullptr;
   }
