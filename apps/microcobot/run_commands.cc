@@ -45,11 +45,12 @@ void run(const RunOptions& o) {
   sp.scenario = o.scenario;
   sp.max_duration_s = o.duration_s;
   sp.validate();
+  // A signal from here on stops the run cleanly (one that came while the session was built
+  // stops it at its start): the recording and report are written, marked as interrupted, and the
+  // command exits 128 + signal.
+  mc::cli::set_cooperative_interrupts(true);
   mc::cell::Session session(config, sp);
   const auto total = static_cast<std::size_t>(std::ceil(o.duration_s));
-  // A signal during the run stops it cleanly: the recording and report are written, marked
-  // as interrupted, and the command exits 128 + signal.
-  mc::cli::set_cooperative_interrupts(true);
   const auto result = session.run(
       [&](double t) {
         mc::cli::progress("run " + o.scenario, static_cast<std::size_t>(std::lround(t)), total);

@@ -338,7 +338,10 @@ TEST(Hardening, SignalsRemoveTemporariesAndExit130Or143) {
   auto s = spawn(
       {"control", "trajectory", "--profile", "sine", "--frequency", "0.005", "--out", (d / "o").string()},
       d / "err");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  // Once its staging directory stands beside err (the signal handlers are in place before the
+  // command line is parsed, --out is staged while it is parsed).
+  ASSERT_TRUE(test::eventually([&] { return entries(d.path()) >= 2; }, std::chrono::seconds(60)))
+      << test::read_text(d / "err");
   ::kill(s.pid, SIGINT);
   EXPECT_EQ(wait_exit(s.pid), 130);
   const auto err = test::read_text(d / "err");
@@ -348,11 +351,20 @@ TEST(Hardening, SignalsRemoveTemporariesAndExit130Or143) {
   EXPECT_EQ(entries(d.path()), 1u);  // only err
 }
 
+// The threads of a running process (its /proc status' "Threads:"); 0 once it is gone.
+int thread_count(pid_t pid) {
+  const std::string status = test::read_text("/proc/" + std::to_string(pid) + "/status");
+  const auto at = status.find("Threads:");
+  return at == std::string::npos ? 0 : std::atoi(status.c_str() + at + 8);
+}
+
 TEST(Hardening, AnInterruptedRunKeepsAMarkedRecording) {
   TempDir d;
-  // --realtime paces the simulated 37 s to the wall clock: the signal comes mid-run.
+  // --realtime paces the simulated 37 s to the wall clock: the signal comes mid-run, once the
+  // session's threads run (the command takes signals as a stop from before it builds them).
   auto s = spawn({"run", "--realtime", "--out", (d / "s").string()}, d / "err");
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  ASSERT_TRUE(test::eventually([&] { return thread_count(s.pid) >= 2; }, std::chrono::seconds(60)))
+      << test::read_text(d / "err");
   ::kill(s.pid, SIGTERM);
   EXPECT_EQ(wait_exit(s.pid), 143);
   const auto err = test::read_text(d / "err");
