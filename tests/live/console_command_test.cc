@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
 
 #include "microcobot/core/error.h"
@@ -91,6 +92,30 @@ TEST(ConsoleCommand, TheRotaryAxisCommandsAreClampedAndRefusedWithoutTheAxis) {
   } catch (const InvalidInput& e) {
     EXPECT_STREQ(e.what(), "/console/command: theta_rate_rad_s: must be a number");
   }
+}
+
+TEST(ConsoleCommand, APoseGoalIsSixFiniteNumbersAndRefusedWithoutTheParallelPositioner) {
+  ConsoleLimits limits;
+  limits.has_positioner = true;
+  const auto c =
+      parse_console_command(R"({"deadman": true, "pose_goal": [1e-4, 0, -2e-5, 0.01, 0, -0.02]})", limits);
+  ASSERT_TRUE(c.has_pose_goal);
+  EXPECT_EQ(c.pose_goal, (std::array<double, 6>{1e-4, 0, -2e-5, 0.01, 0, -0.02}));
+  EXPECT_FALSE(parse_console_command(R"({"deadman": true})", limits).has_pose_goal);
+  EXPECT_EQ(message_of(R"({"pose_goal": [0, 0, 0, 0, 0, 0]})"),
+            "/console/command: pose_goal: there is no parallel positioner (positioner: parallel)");
+  const auto refused = [&](const std::string& payload) {
+    try {
+      parse_console_command(payload, limits);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"({"pose_goal": [0, 0, 0]})"),
+            "/console/command: pose_goal: must be an array of 6 numbers [x, y, z, rx, ry, rz] (m, rad)");
+  EXPECT_EQ(refused(R"({"pose_goal": [0, 0, 0, 0, "a", 0]})"),
+            "/console/command: pose_goal[4]: must be a number");
 }
 
 TEST(ConsoleCommand, AGoalPixelMustLieInTheCamerasFrame) {

@@ -13,9 +13,12 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mcap_reader.h"
 #include "microcobot/imaging/camera_params.h"
+#include "microcobot/motion/pose.h"
 #include "microcobot/server/foxglove_protocol.h"
 #include "support/console_client.h"
 #include "support/counting_allocator.h"
@@ -305,6 +308,84 @@ TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
   const json tare_refused = observer.ws.read_status("control");
   ASSERT_FALSE(tare_refused.is_null());
   EXPECT_NE(tare_refused.value("message", "").find("take control first"), std::string::npos) << tare_refused;
+}
+
+// The parallel positioner's pose as the legs' sensors measure it (the protocol's view: this test
+// is its one reader) and its distance from `goal` [m, rad].
+struct PoseOff {
+  double position_m, rotation_rad;
+  bool at_rest, moving;
+};
+PoseOff pose_off(LivePlatform& live, const std::array<double, 6>& goal) {
+  const PositionerView v = live.positioner_view();
+  const Eigen::Matrix3d R = motion::smarpod_rotation(goal[3], goal[4], goal[5]);
+  const Eigen::AngleAxisd turn(R.transpose() * v.measured.R);
+  return {(v.measured.d - Eigen::Vector3d(goal[0], goal[1], goal[2])).norm(), std::abs(turn.angle()),
+          v.at_rest, v.moving};
+}
+
+TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUnreachableOneIsRefused) {
+  test::TempDir dir;
+  LiveParams lp;
+  lp.platform.positioner = "parallel";
+  LivePlatform live(lp);
+  ConsoleServer server(live, Rig::params(dir.path(), ""));
+  server.start();
+  Console c(server.port());
+  ASSERT_TRUE(c.action("take_control"));
+  ASSERT_FALSE(c.ws.read_status("control").is_null());
+  const std::array<double, 6> home{}, goal{120e-6, -60e-6, 40e-6, 0.004, -0.003, 0.02};
+  // The goal sent as the page sends it, every 30 ms, with or without the deadman, for `s`
+  // seconds or until `done`.
+  const auto send_for = [&](const std::array<double, 6>& g, bool deadman, double s, auto done) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+    while (std::chrono::steady_clock::now() < end) {
+      EXPECT_TRUE(c.command({{"deadman", deadman}, {"pose_goal", g}}));
+      if (done()) return true;
+      std::this_thread::sleep_for(30ms);
+    }
+    return false;
+  };
+  const auto never = [] { return false; };
+
+  // Without the deadman nothing moves.
+  send_for(goal, false, 0.5, never);
+  EXPECT_LT(pose_off(live, home).position_m, 0.2e-6);
+  EXPECT_FALSE(pose_off(live, home).moving);
+
+  // With it the platform goes there and stays.
+  ASSERT_TRUE(send_for(goal, true, 60.0, [&] {
+    const PoseOff o = pose_off(live, goal);
+    return o.at_rest && o.position_m < 0.5e-6 && o.rotation_rad < 10e-6;
+  }));
+  const PoseOff arrived = pose_off(live, goal);
+  EXPECT_LT(arrived.position_m, 0.5e-6);
+  EXPECT_LT(arrived.rotation_rad, 10e-6);
+
+  // Released mid-way to another goal: the platform holds where it is, short of the goal.
+  const std::array<double, 6> other{-150e-6, 80e-6, 0.0, 0.0, 0.005, -0.01};
+  ASSERT_TRUE(send_for(other, true, 30.0, [&] { return pose_off(live, goal).position_m > 20e-6; }));
+  send_for(other, false, 0.3, never);  // the platform holds once the deadman is up
+  const PoseOff held = pose_off(live, other);
+  send_for(other, false, 0.5, never);
+  const PoseOff later = pose_off(live, other);
+  EXPECT_FALSE(later.moving);
+  EXPECT_GT(later.position_m, 20e-6) << "the move went on without the deadman";
+  EXPECT_NEAR(later.position_m, held.position_m, 0.2e-6) << "the platform drifted without the deadman";
+
+  // A pose out of the workspace: one line naming the field and why, and nothing moves.
+  const std::array<double, 6> far{0.02, 0.0, 0.0, 0.0, 0.0, 0.0};
+  ASSERT_TRUE(c.command({{"deadman", true}, {"pose_goal", far}}));
+  const json refused = c.ws.read_status("/console/command");
+  ASSERT_FALSE(refused.is_null());
+  EXPECT_EQ(refused.value("level", -1), 2);
+  const std::string message = refused.value("message", "");
+  EXPECT_NE(message.find("/console/command: pose_goal: "), std::string::npos) << message;
+  EXPECT_NE(message.find("unreachable"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  send_for(far, true, 0.4, never);
+  EXPECT_NEAR(pose_off(live, other).position_m, later.position_m, 0.2e-6);
+  server.stop();
 }
 
 }  // namespace

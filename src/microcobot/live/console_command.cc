@@ -99,12 +99,21 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
       c.objective = static_cast<int>(i);
     } else if (key == "exposure_s") {
       c.exposure_s = std::clamp(finite(kChannel, value, key), limits.min_exposure_s, limits.max_exposure_s);
+    } else if (key == "pose_goal") {
+      if (!limits.has_positioner)
+        refuse(kChannel, key, "there is no parallel positioner (positioner: parallel)");
+      if (!value.is_array() || value.size() != 6)
+        refuse(kChannel, key, "must be an array of 6 numbers [x, y, z, rx, ry, rz] (m, rad)");
+      for (std::size_t i = 0; i < 6; ++i)
+        c.pose_goal[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
+      c.has_pose_goal = true;
     } else if (key == "gain") {
       c.gain = std::clamp(finite(kChannel, value, key), limits.min_gain, limits.max_gain);
     } else {
       refuse(kChannel, key,
              "is not a known key (deadman, velocity_m_s, goal_m, goal_px, goal_speed_m_s, gripper_opening_m, "
-             "gripper_shake, theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain)");
+             "gripper_shake, theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain, "
+             "pose_goal)");
     }
   }
   // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.

@@ -37,6 +37,8 @@ struct ConsoleLimits {
   double max_exposure_s = 33e-3;
   double min_gain = 1.0;
   double max_gain = 16.0;
+  /// Whether the platform has a parallel positioner (`positioner: parallel`): pose_goal.
+  bool has_positioner = false;
 };
 
 /// The console's continuous command (sent at ~30 Hz by the client in control: also its
@@ -68,6 +70,11 @@ struct ConsoleCommand {
   int objective = -1;       ///< -1: unchanged
   double exposure_s = 0.0;  ///< 0: unchanged
   double gain = 0.0;        ///< 0: unchanged
+  /// The parallel positioner to a pose, with the deadman: its platform {P} in its home frame {H},
+  /// x, y, z [m] and rx, ry, rz [rad] with R = Rz(rz) Ry(ry) Rx(rx) (the telemetry's positioner
+  /// channels). Reachability is checked where the move is planned (console_pose_goal.h).
+  bool has_pose_goal = false;
+  std::array<double, 6> pose_goal{};
   /// When the server received it (steady clock, ns; 0: unknown): the loop measures the
   /// command-to-target latency from it.
   std::int64_t received_ns = 0;
@@ -107,7 +114,8 @@ inline bool is_task_action(ConsoleAction a) {
 /// "goal_px": [u, v] (optional: a camera pixel, within the frame), "goal_speed_m_s": v (optional),
 /// "gripper_opening_m": o (optional), "theta_goal_rad": a, "theta_rate_rad_s": w (optional: the rotary
 /// axis; refused without one), "focus_z_m": z, "objective": i, "exposure_s": e, "gain": g (optional;
-/// the microscope)}`; unknown keys are refused. Values are checked finite and clamped to `limits`; an
+/// the microscope), "pose_goal": [x, y, z, rx, ry, rz] (optional: the parallel positioner; refused
+/// without one)}`; unknown keys are refused. Values are checked finite and clamped to `limits`; an
 /// objective that is not on the turret is refused. Throws mc::InvalidInput
 /// ("/console/command: velocity_m_s[1]: must be a finite number").
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);

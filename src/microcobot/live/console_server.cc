@@ -64,6 +64,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                {"/index.html", {"text/html; charset=utf-8", console_page()}}}),
       frames_(live.telemetry_schema()),
       rumble_(params_.rumble_crossover_Hz, kTelemetryRate_Hz, params_.rumble_full_scale_N) {
+  if (live.params().platform.parallel_positioner_enabled())
+    pose_goal_.emplace(live.params().platform.parallel_positioner.geometry);
   decimation_ =
       static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
   telemetry_ch_ = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
@@ -361,9 +363,19 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
              "control");
         return;
       }
-      if (!live_.push_command(c))
+      if (!live_.push_command(c)) {
         tell(m.client, StatusLevel::kWarning, "/console/command: the loop is busy; command dropped",
              "refused", "/console/command");
+        return;
+      }
+      if (pose_goal_) {
+        const ConsolePoseGoal::Step step = pose_goal_->on_command(c, live_.console_pose_view());
+        if (!step.refusal.empty())
+          tell(m.client, StatusLevel::kError, "/console/command: pose_goal: " + step.refusal, "refused",
+               "/console/command");
+        else if (step.push && !live_.push_console_pose_move(*step.push))
+          pose_goal_->not_sent();  // planned again with the next command
+      }
       return;
     }
     if (m.topic != "/console/action") {

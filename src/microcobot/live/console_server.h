@@ -50,6 +50,7 @@
 
 #include "microcobot/live/camera_preview.h"
 #include "microcobot/live/camera_snapshot.h"
+#include "microcobot/live/console_pose_goal.h"
 #include "microcobot/live/contact_rumble.h"
 #include "microcobot/live/live_platform.h"
 #include "microcobot/live/recording_files.h"
@@ -148,7 +149,8 @@ class ConsoleServer {
   server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
   server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0, preview_ch_ = 0;
   server::ChannelId tf_ch_ = 0, robot_scene_ch_ = 0;
-  RobotFrames frames_;  // the 3-D view's frame tree, from the telemetry's channels
+  RobotFrames frames_;                        // the 3-D view's frame tree, from the telemetry's channels
+  std::optional<ConsolePoseGoal> pose_goal_;  // server thread: go-to pose (positioner: parallel)
   std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
   std::unique_ptr<CameraPreview> preview_;          // camera thread only
   std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera

@@ -55,6 +55,35 @@ void ConsoleSource::drive(const SourceTick& t, teleop::ConsoleInput& in) noexcep
 
 void ConsoleSource::publish(const SourceTick& t) noexcept {
   if (positioner_) vision_tick(t.platform, t.tick);
+  pose_tick(t.platform);
+}
+
+void ConsoleSource::pose_tick(Platform& p) noexcept {
+  ConsolePoseMove m;
+  while (pose_moves_.pop(m)) {
+    if (pending_pose_) pose_handled_ = pending_pose_->seq;  // outdated by a newer one
+    pending_pose_ = m;
+  }
+  const devices::ParallelPositioner* pos = p.positioner();
+  if (pending_pose_) {
+    if (pos == nullptr || !driving_ || !p.pose_move_allowed() || !pending_pose_->trajectory) {
+      // A stop, or no deadman: the move under way ends where it is (the platform holds without
+      // the deadman anyway), and nothing starts.
+      if (pos != nullptr && driving_ && pos->moving()) p.stop_pose_move();
+      pose_handled_ = pending_pose_->seq;
+      pending_pose_.reset();
+    } else if (!pos->moving()) {
+      p.start_pose_move(*pending_pose_->trajectory);  // refused (nothing moves) if it no longer fits
+      pose_handled_ = pending_pose_->seq;
+      pending_pose_.reset();
+    }
+  }
+  if (pos == nullptr) return;
+  ConsolePoseView v;
+  v.reference = pos->reference_pose();
+  v.moving = pos->moving() || pending_pose_.has_value();
+  v.handled_seq = pose_handled_;
+  pose_view_.publish(v);
 }
 
 void ConsoleSource::vision_tick(Platform& p, const runtime::TickInfo& t) noexcept {
@@ -85,6 +114,11 @@ void ConsoleSource::reset() noexcept {
   perception::PositionerCommand stale;
   while (vision_.pop(stale)) {
   }
+  // Moves planned for the scene before: dropped (their sequence numbers count as handled).
+  ConsolePoseMove old;
+  while (pose_moves_.pop(old)) pose_handled_ = old.seq;
+  if (pending_pose_) pose_handled_ = pending_pose_->seq;
+  pending_pose_.reset();
 }
 
 void ConsoleSource::drain_latencies(runtime::TimingStats& stats) noexcept {

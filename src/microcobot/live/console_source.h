@@ -7,6 +7,9 @@
 /// control (or the task it supervises is started), on standby otherwise: the lowest-ranked
 /// driver, whose input, not fresh, holds the stage when nobody drives.
 ///
+/// The parallel positioner's go-to pose (console_pose_goal.h): moves planned and checked by the
+/// server arrive through their own ring and start only while the console drives with its deadman.
+///
 /// What the console supervises rides on its input: the cell's task (live_task.h) drives or
 /// holds in its place once started, and with x and y positioned by vision
 /// (`stage.xy_sensor: vision`) the positioner takes its goals and plays its joystick open loop.
@@ -16,8 +19,10 @@
 
 #include "microcobot/live/command_source.h"
 #include "microcobot/live/console_command.h"
+#include "microcobot/live/console_pose_goal.h"
 #include "microcobot/live/live_task.h"
 #include "microcobot/perception/vision_positioner.h"
+#include "microcobot/runtime/latest_value.h"
 #include "microcobot/runtime/spsc_ring.h"
 #include "microcobot/runtime/timing_stats.h"
 
@@ -41,6 +46,11 @@ class ConsoleSource final : public CommandSource {
   /// Whether a client holds control (its commands count; otherwise the stage holds). Any thread.
   void set_in_control(bool in_control) noexcept { in_control_.store(in_control); }
   bool in_control() const noexcept { return in_control_.load(); }
+  /// A pose move or stop of the parallel positioner (the server's thread, one producer; planned and
+  /// checked there). Wait-free; false when the ring is full.
+  bool push_pose_move(const ConsolePoseMove& m) noexcept { return pose_moves_.push(m); }
+  /// What the loop last published of the positioner for the console. One reader: the server's thread.
+  ConsolePoseView pose_view() noexcept { return pose_view_.read(); }
   /// A velocity run the positioner asks for (camera thread, one producer). Wait-free.
   bool push_vision(const perception::PositionerCommand& c) noexcept { return vision_.push(c); }
   /// The controlling client's commands are fresh (as of the last tick). Any thread.
@@ -61,6 +71,9 @@ class ConsoleSource final : public CommandSource {
   /// With x and y positioned by vision: the positioner's runs and the joystick's played open
   /// loop while the console drives with its deadman. After the input is set.
   void vision_tick(platform::Platform& p, const runtime::TickInfo& t) noexcept;
+  /// The parallel positioner's pose moves: the newest taken from the ring starts while the
+  /// console drives with its deadman (a stop ends the move under way); else it is dropped.
+  void pose_tick(platform::Platform& p) noexcept;
 
   ConsoleSourceParams params_;
   LiveTask* task_;
@@ -68,11 +81,15 @@ class ConsoleSource final : public CommandSource {
   runtime::SpscRing<ConsoleCommand> commands_{256};
   runtime::SpscRing<perception::PositionerCommand> vision_{16};  // camera thread -> loop
   runtime::SpscRing<double> latencies_{4096};                    // loop -> status thread [s]
+  runtime::SpscRing<ConsolePoseMove> pose_moves_{8};             // server thread -> loop
+  runtime::LatestValue<ConsolePoseView> pose_view_;              // loop -> server thread
   std::atomic<bool> in_control_{false}, fresh_{false};
   // Loop thread only.
   ConsoleCommand latest_;
   double last_command_t_ = -1e9;
-  bool driving_ = false;  // it holds control in this tick
+  bool driving_ = false;                         // it holds control in this tick
+  std::optional<ConsolePoseMove> pending_pose_;  // taken from the ring, not started yet
+  std::uint64_t pose_handled_ = 0;
 };
 
 }  // namespace mc::live

@@ -68,6 +68,7 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
     limits_.max_m[i] = home[i] + tp.workspace_max_m;
   }
   limits_.max_opening_m = params_.platform.world.gripper.max_opening_m;
+  limits_.has_positioner = platform_->has_positioner();
   if (platform_->has_rotary()) {
     limits_.min_theta_rad = platform_->yaw_min_rad();
     limits_.max_theta_rad = platform_->yaw_max_rad();

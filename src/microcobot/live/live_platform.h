@@ -125,6 +125,11 @@ class LivePlatform {
 
   /// The controlling client's command (one producer thread: the server's). Wait-free.
   bool push_command(const ConsoleCommand& c) noexcept { return console_->push(c); }
+  /// The console's pose move or stop for the parallel positioner (console_pose_goal.h; the same
+  /// producer thread as push_command). Wait-free; false when the ring is full.
+  bool push_console_pose_move(const ConsolePoseMove& m) noexcept { return console_->push_pose_move(m); }
+  /// What the loop last published of the positioner for the console. One reader: that thread.
+  ConsolePoseView console_pose_view() noexcept { return console_->pose_view(); }
   /// A microscope command from the network (net/microscope_link.h: the slave's microscope topic;
   /// one producer thread): only its focus, objective, exposure and gain count. Wait-free; false
   /// when the ring is full. Applied at the next operator tick in every role: the focus drive and

@@ -1,0 +1,73 @@
+#include "microcobot/live/console_pose_goal.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "microcobot/motion/pose.h"
+
+namespace mc::live {
+namespace {
+
+// A goal is reached (or the same goal) within a nanometre and a nanoradian: the move's last
+// reference is its goal, so the loop's own rounding is all that may differ.
+constexpr double kSame_m = 1e-9, kSame_rad = 1e-9;
+
+bool same_pose(const motion::PlatformTransform& a, const motion::PlatformTransform& b) {
+  const Eigen::AngleAxisd turn(a.R.transpose() * b.R);
+  return (a.d - b.d).norm() <= kSame_m && std::abs(turn.angle()) <= kSame_rad;
+}
+
+}  // namespace
+
+motion::PlatformTransform pose_goal_transform(const ConsoleCommand& c) {
+  const auto& g = c.pose_goal;
+  motion::PlatformTransform T;
+  T.R = motion::smarpod_rotation(g[3], g[4], g[5]);
+  T.d = Eigen::Vector3d(g[0], g[1], g[2]);
+  return T;
+}
+
+ConsolePoseGoal::ConsolePoseGoal(const motion::ParallelGeometryParams& geometry,
+                                 const motion::PoseMoveLimits& limits)
+    : kinematics_(geometry), limits_(limits) {
+  limits_.validate();
+}
+
+ConsolePoseGoal::Step ConsolePoseGoal::on_command(const ConsoleCommand& c, const ConsolePoseView& v) {
+  Step step;
+  if (seq_ > v.handled_seq) return step;  // the loop has not taken the last one yet
+  if (!c.has_pose_goal) {
+    // The operator stopped asking: a move of the console's ends where it is.
+    if (v.moving && goal_) {
+      goal_.reset();
+      step.push = ConsolePoseMove{++seq_, std::nullopt};
+    }
+    return step;
+  }
+  if (!c.deadman) return step;  // the platform holds without it; the goal waits for it
+  const motion::PlatformTransform goal = pose_goal_transform(c);
+  if (v.moving) {
+    // Towards this goal already; another goal stops it first (the next command plans from there).
+    if (!(goal_ && same_pose(*goal_, goal))) {
+      goal_.reset();
+      step.push = ConsolePoseMove{++seq_, std::nullopt};
+    }
+    return step;
+  }
+  if (same_pose(v.reference, goal)) return step;            // arrived
+  if (refused_ && same_pose(*refused_, goal)) return step;  // told already
+  motion::PoseTrajectory trajectory(v.reference, goal, limits_);
+  const motion::MoveCheck check = motion::check_move(kinematics_, trajectory);
+  if (!check.ok) {
+    refused_ = goal;
+    step.refusal = check.reason;
+    return step;
+  }
+  refused_.reset();
+  goal_ = goal;
+  step.push = ConsolePoseMove{++seq_, std::move(trajectory)};
+  return step;
+}
+
+}  // namespace mc::live
