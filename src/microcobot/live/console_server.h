@@ -12,7 +12,7 @@
 ///                                foxglove.FrameTransforms (live/robot_frames.h)
 ///   /robot/scene          1 Hz   the fingers and the part as boxes in their frames (and the
 ///                                positioner's bodies), foxglove.SceneUpdate: Foxglove's 3D panel
-///                                draws the platform
+///                                and the console's positioner view draw the platform
 ///   /camera/image/compressed     every camera frame, sensor_msgs/msg/CompressedImage (CDR, JPEG)
 ///   /camera/preview/compressed   the same frames binned to the console's 640 px panel
 ///                                (live/camera_preview.h), encoded only while someone watches
