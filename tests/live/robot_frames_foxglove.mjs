@@ -12,6 +12,7 @@ import { spawn } from "node:child_process";
 import { existsSync, mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
+import { connect } from "node:net";
 import { createInterface } from "node:readline";
 import foxglove from "@foxglove/ws-protocol";
 import schemas from "@foxglove/schemas/jsonschema.js";
@@ -40,8 +41,11 @@ async function check(label, extraArgs, parallel) {
   const server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", "--out", dir, ...extraArgs], { stdio: ["ignore", "pipe", "inherit"] });
   const exited = new Promise((resolve) => server.on("exit", (code, signal) => resolve({ code, signal })));
   let urlTimer;
+  const stdoutLines = [];
   const url = await new Promise((resolve, reject) => {
-    createInterface({ input: server.stdout }).once("line", resolve);
+    const rl = createInterface({ input: server.stdout });
+    rl.once("line", resolve);
+    rl.on("line", (line) => stdoutLines.push(line));  // then "emulate NAME ADDR:PORT" per twin
     server.once("exit", () => reject(new Error("serve exited before printing its URL")));
     urlTimer = setTimeout(() => reject(new Error("no URL within 60 s")), 60000);
   });
@@ -71,6 +75,15 @@ async function check(label, extraArgs, parallel) {
   while ((received["/tf"].length < 30 || received["/robot/scene"].length < 1 || received["/platform/scene"].length < 1) &&
          Date.now() < deadline)
     await sleep(100);
+
+  if (parallel) {
+    // A pose off home through the hexapod twin, then the frames it sends at rest there.
+    const twin = stdoutLines.find((l) => l.startsWith("emulate gcs2-hexapod "));
+    if (!twin) throw new Error("serve printed no gcs2-hexapod twin");
+    await movePositioner(Number(twin.split(":").at(-1)), "MOV X 1 Y -0.5 Z 0.6 U 1.5 V -1 W 3");
+    const n = received["/tf"].length;
+    while (received["/tf"].length < n + 10) await sleep(50);
+  }
 
   for (const [topic, schemaName] of [["/tf", "foxglove.FrameTransforms"], ["/robot/scene", "foxglove.SceneUpdate"]]) {
     const c = channels.get(topic);
@@ -160,6 +173,8 @@ const position = (prim) => [prim.pose.position.x, prim.pose.position.y, prim.pos
 // joint cylinders, in the platform's frame), each joint held by one leg.
 function checkPositioner(tf, update, tel) {
   const platform = tf.transforms.find((t) => t.child_frame_id === "positioner");
+  const away = Math.hypot(platform.translation.x, platform.translation.y, platform.translation.z);
+  if (!(away > 1e-3)) fail(`the platform's frame is ${away} m from home: the pose move did not happen`);
   if (tel && Math.abs(platform.translation.x - tel.positioner_x_m) > 5e-6)
     fail(`the platform's frame at x ${platform.translation.x}, the telemetry measures ${tel.positioner_x_m}`);
   const entity = (id) => update.entities.find((e) => e.id === id && e.frame_id === id);
@@ -187,10 +202,45 @@ function checkPositioner(tf, update, tel) {
   if (held.size !== 3) fail(`the legs hold ${held.size} distinct joints of the platform`);
 }
 
+// The hexapod twin's GCS socket: referenced, then `move` (mm, deg), waited for on target.
+async function movePositioner(port, move) {
+  const socket = connect(port, "127.0.0.1");
+  await new Promise((resolve, reject) => { socket.once("connect", resolve); socket.once("error", reject); });
+  const lines = [];
+  createInterface({ input: socket }).on("line", (l) => lines.push(l.trim()));
+  const ask = async (line, n = 1) => {
+    socket.write(line + "\n");
+    const end = Date.now() + 10000;
+    while (lines.length < n && Date.now() < end) await sleep(5);
+    if (lines.length < n) throw new Error(`no reply to ${line}`);
+    return lines.splice(0, n);
+  };
+  const onTarget = async () => {
+    const end = Date.now() + 60000;
+    while (Date.now() < end) {
+      if ((await ask("ONT? X Y Z U V W", 6)).every((l) => l.endsWith("=1"))) return;
+      await sleep(100);
+    }
+    throw new Error("the positioner not on target within 60 s");
+  };
+  try {
+    for (const line of ["FRF", "VLS 0.5", move]) {
+      socket.write(line + "\n");
+      const [err] = await ask("ERR?");
+      if (err !== "0") throw new Error(`${line}: error ${err}`);
+      if (line !== "VLS 0.5") await onTarget();
+    }
+    log(`positioner at ${(await ask("POS?", 6)).join(" ")}`);
+  } finally {
+    socket.destroy();
+  }
+}
+
 await check("default platform", [], false);
 const parallelConfig = join(dir, "parallel.yaml");
-writeFileSync(parallelConfig, "positioner: parallel\ndevices:\n  camera:\n    driver: none\n");
-await check("parallel positioner", ["--config", parallelConfig], true);
+writeFileSync(parallelConfig, "devices:\n  camera:\n    driver: none\n");
+// The hexapod twin puts the part on the parallel positioner (positioner: parallel) and moves it.
+await check("parallel positioner", ["--config", parallelConfig, "--emulate", "gcs2-hexapod=127.0.0.1:0"], true);
 
 if (failures) process.exit(1);
 log("robot_frames_foxglove: the 3-D frames and bodies hold Foxglove's schemas and the platform's state");
