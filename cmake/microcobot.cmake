@@ -113,7 +113,7 @@ function(mc_embed_console_assets target)
   set(_out ${PROJECT_BINARY_DIR}/generated/console_assets.cc)
   set(_files)
   foreach(_f console.html console.css console_link.js console_plots.js console_microscope.js console_camera.js
-             console_controls.js console_positions.js console_status.js console_task.js)
+             console_controls.js console_positions.js console_positioner.js console_status.js console_task.js)
     list(APPEND _files ${PROJECT_SOURCE_DIR}/web/${_f})
   endforeach()
   string(REPLACE ";" "\\;" _list "${_files}")

@@ -5,7 +5,8 @@
 // The page's scripts, inlined in this order (web/console.html): console_link.js (the protocol,
 // the shared state, the connection), console_plots.js, console_microscope.js,
 // console_controls.js (the operator's inputs and the command), console_positions.js (readout,
-// go-to, step jog, saved positions), console_status.js (banners, status, scene, forces,
+// go-to, step jog, saved positions), console_positioner.js (the parallel positioner in 3-D),
+// console_task.js, console_status.js (banners, status, scene, forces,
 // recordings; it connects last). They share the page's global scope as classic scripts do.
 "use strict";
 

@@ -46,9 +46,12 @@ export async function startConsole(name, serveArgs, timeoutS, options = {}) {
   s.server = spawn(cli, ["serve", "--listen", "127.0.0.1:0", ...args], { stdio: ["ignore", "pipe", "inherit"] });
   s.exited = new Promise((resolve) => s.server.on("exit", (code, signal) => resolve({ code, signal })));
   let urlTimer;
+  // serve's stdout after its URL: one line per vendor-protocol twin ("emulate NAME ADDR:PORT").
+  s.stdoutLines = [];
   s.url = await new Promise((resolve, reject) => {
     const rl = createInterface({ input: s.server.stdout });
     rl.once("line", resolve);
+    rl.on("line", (line) => s.stdoutLines.push(line));
     s.server.once("exit", () => reject(new Error("serve exited before printing its URL")));
     urlTimer = setTimeout(() => reject(new Error("serve printed no URL within 60 s")), 60000);
   });

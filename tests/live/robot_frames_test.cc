@@ -4,12 +4,16 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <string>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "microcobot/core/error.h"
+#include "microcobot/motion/parallel_kinematics.h"
+#include "support/counting_allocator.h"
 
 namespace mc::live {
 namespace {
@@ -134,6 +138,148 @@ TEST(RobotFrames, TheParallelPositionersPoseIsItsZyxRotationAsAQuaternion) {
     EXPECT_NEAR(q.norm(), 1.0, 1e-15);
     EXPECT_LT((q.toRotationMatrix() - R).norm(), 1e-14) << rx << " " << ry << " " << rz;
   }
+}
+
+platform::TelemetrySchema schema_with_positioner() {
+  platform::TelemetrySchema schema = platform::builtin_telemetry(true);
+  for (const char* n : {"positioner_x_m", "positioner_y_m", "positioner_z_m"}) schema.add({n, "m", "pose"});
+  for (const char* n : {"positioner_rx_rad", "positioner_ry_rad", "positioner_rz_rad"})
+    schema.add({n, "rad", "pose"});
+  return schema;
+}
+
+/// A sample whose positioner channels hold (x, y, z, rx, ry, rz).
+platform::TelemetrySample positioner_sample(const platform::TelemetrySchema& schema,
+                                            const std::array<double, 6>& p) {
+  platform::TelemetrySample s = sample(schema);
+  const char* names[] = {"positioner_x_m",    "positioner_y_m",    "positioner_z_m",
+                         "positioner_rx_rad", "positioner_ry_rad", "positioner_rz_rad"};
+  for (std::size_t i = 0; i < 6; ++i) s[schema.index(names[i])] = p[i];
+  return s;
+}
+
+const FrameTransform& find(const FrameTransforms& f, std::size_t n, std::string_view child) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (f[i].child == child) return f[i];
+  throw std::runtime_error("no frame " + std::string(child));
+}
+
+/// The transform's rigid motion: a point in `child` to `parent`.
+Eigen::Isometry3d isometry(const FrameTransform& t) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.linear() = Eigen::Quaterniond(t.qw, t.qx, t.qy, t.qz).toRotationMatrix();
+  m.translation() = Eigen::Vector3d(t.x_m, t.y_m, t.z_m);
+  return m;
+}
+
+// Each leg's frame starts at its carriage's spherical joint B_i and its z axis runs the leg's
+// length L to the platform's revolute joint P_i, both from the kinematics' closure at the measured
+// pose; through the frame tree, that end is where the platform's own frame puts the joint
+// (d + R p_i in {H}): the drawn legs hold the drawn platform at every pose.
+TEST(RobotFrames, EachLegsFrameSpansFromItsCarriagesJointToThePlatformsJointAtTheMeasuredPose) {
+  const platform::TelemetrySchema schema = schema_with_positioner();
+  const motion::ParallelGeometryParams geometry;
+  const RobotFrames frames(schema, &geometry);
+  ASSERT_NE(frames.positioner_kinematics(), nullptr);
+  const motion::ParallelKinematics kinematics(geometry);
+  const double L = kinematics.geometry().leg_length_m;
+  for (const std::array<double, 6>& p : {std::array<double, 6>{0, 0, 0, 0, 0, 0},
+                                         std::array<double, 6>{1e-3, -0.5e-3, 0.8e-3, 0.05, -0.03, 0.1},
+                                         std::array<double, 6>{-2e-3, 1.5e-3, -1e-3, -0.08, 0.06, -0.15}}) {
+    motion::PlatformTransform T;
+    T.R = motion::smarpod_rotation(p[3], p[4], p[5]);
+    T.d = {p[0], p[1], p[2]};
+    motion::LegClosure legs[motion::kParallelLegs];
+    motion::LegCoordinates q;
+    ASSERT_TRUE(kinematics.closures(T, legs, q));
+    FrameTransforms f;
+    const std::size_t n = frames.transforms(positioner_sample(schema, p), f);
+    ASSERT_EQ(n, kMaxRobotFrames);
+    const FrameTransform& base = find(f, n, "positioner_base");
+    EXPECT_EQ(base.parent, "world");
+    EXPECT_DOUBLE_EQ(base.z_m, -kinematics.geometry().home_height_m);
+    const Eigen::Isometry3d world_base = isometry(base), world_platform = isometry(find(f, n, "positioner"));
+    for (int i = 0; i < motion::kParallelLegs; ++i) {
+      const std::string id = std::to_string(i);
+      const FrameTransform& leg = find(f, n, "leg_" + id);
+      EXPECT_EQ(leg.parent, "positioner_base");
+      const Eigen::Isometry3d m = isometry(leg);
+      EXPECT_LT((m.translation() - legs[i].carriage_m).norm(), 1e-15) << "leg " << i;
+      EXPECT_LT((m * Eigen::Vector3d(0, 0, L) - legs[i].joint_m).norm(), 1e-12) << "leg " << i;
+      const Eigen::Vector3d joint_in_world = world_platform * kinematics.geometry().legs[i].platform_m;
+      EXPECT_LT((world_base * m * Eigen::Vector3d(0, 0, L) - joint_in_world).norm(), 1e-12) << "leg " << i;
+      // The carriage at B_i = (b + u_i) e_r + w_i e_t, x along e_r: its coordinates are the legs'.
+      const motion::LegGeometry& g = kinematics.geometry().legs[i];
+      const FrameTransform& carriage = find(f, n, "carriage_" + id);
+      const Eigen::Isometry3d c = isometry(carriage);
+      const Eigen::Vector3d B = (geometry.base_radius_m + q[2 * i]) * g.e_r + q[2 * i + 1] * g.e_t;
+      EXPECT_LT((c.translation() - B).norm(), 1e-15) << "carriage " << i;
+      EXPECT_LT((c.linear() * Eigen::Vector3d::UnitX() - g.e_r).norm(), 1e-15) << "carriage " << i;
+      EXPECT_LT((c.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitZ()).norm(), 1e-15);
+    }
+  }
+}
+
+TEST(RobotFrames, APoseNoLegsCloseAtSendsThePlatformAndItsBaseAloneAndTransformsNeverAllocate) {
+  const platform::TelemetrySchema schema = schema_with_positioner();
+  const motion::ParallelGeometryParams geometry;
+  const RobotFrames frames(schema, &geometry);
+  FrameTransforms f;
+  // 30 mm up: beyond the legs' length (28.3 mm) above the carriages.
+  EXPECT_EQ(frames.transforms(positioner_sample(schema, {0, 0, 30e-3, 0, 0, 0}), f), 7u);
+  EXPECT_EQ(f[6].child, "positioner_base");
+  EXPECT_EQ(frames.transforms(
+                positioner_sample(schema, {std::numeric_limits<double>::quiet_NaN(), 0, 0, 0, 0, 0}), f),
+            kMaxRobotFrames);  // NaN read as 0: home
+  // Without the geometry (the DDS frames): the platform's frame alone.
+  EXPECT_EQ(RobotFrames(schema).transforms(positioner_sample(schema, {}), f), 6u);
+  const platform::TelemetrySample s = positioner_sample(schema, {1e-3, -0.5e-3, 0.8e-3, 0.05, -0.03, 0.1});
+  std::size_t n = 0;
+  test::AllocationGuard guard;
+  for (int k = 0; k < 100; ++k) n += frames.transforms(s, f);
+  EXPECT_EQ(guard.allocations(), 0u);
+  EXPECT_EQ(n, 100 * kMaxRobotFrames);
+}
+
+// The positioner's bodies: its base plate, each carriage with its spherical joint, each leg a
+// cylinder of the leg's length L from B_i to P_i along its frame's z, and the platform's plate
+// under {P}'s origin with its revolute joints at p_i and the origin (the default pivot) marked.
+TEST(RobotFrames, TheSceneDrawsThePositionersBaseCarriagesLegsAndPlatformInTheirFrames) {
+  const platform::TelemetrySchema schema = schema_with_positioner();
+  motion::ParallelGeometryParams geometry;
+  geometry.joint_height_m = 25e-3;  // not the default: the bodies follow the geometry
+  const RobotFrames frames(schema, &geometry);
+  const motion::ParallelGeometry& g = frames.positioner_kinematics()->geometry();
+  const json u = json::parse(frames.scene_update_json(RobotBodies{}, 2.0));
+  std::map<std::string, json> by_id;
+  for (const json& e : u["entities"]) {
+    EXPECT_EQ(e["frame_id"], e["id"]);
+    by_id[e["id"].get<std::string>()] = e;
+  }
+  ASSERT_EQ(by_id.size(), 2u + 2u * motion::kParallelLegs) << u.dump();
+  for (int i = 0; i < motion::kParallelLegs; ++i) {
+    const json& leg = by_id.at("leg_" + std::to_string(i))["cylinders"];
+    ASSERT_EQ(leg.size(), 1u);
+    EXPECT_DOUBLE_EQ(leg[0]["size"]["z"].get<double>(), g.leg_length_m);
+    EXPECT_DOUBLE_EQ(leg[0]["pose"]["position"]["z"].get<double>(), 0.5 * g.leg_length_m);
+    const json& carriage = by_id.at("carriage_" + std::to_string(i));
+    ASSERT_EQ(carriage["spheres"].size(), 1u);
+    EXPECT_EQ(carriage["spheres"][0]["pose"]["position"]["z"].get<double>(), 0.0);  // the joint: B_i
+    EXPECT_LT(carriage["cubes"][0]["pose"]["position"]["z"].get<double>(), 0.0);    // under it
+  }
+  const json& platform = by_id.at("positioner");
+  ASSERT_EQ(platform["cylinders"].size(), 1u + motion::kParallelLegs);  // the plate, the joints
+  for (int i = 0; i < motion::kParallelLegs; ++i) {
+    const json& c = platform["cylinders"][i + 1]["pose"]["position"];
+    const Eigen::Vector3d at(c["x"].get<double>(), c["y"].get<double>(), c["z"].get<double>());
+    EXPECT_LT((at - g.legs[i].platform_m).norm(), 1e-15) << "revolute joint " << i;
+  }
+  EXPECT_LE(platform["cylinders"][0]["pose"]["position"]["z"].get<double>(), 0.0);  // under the top
+  ASSERT_EQ(platform["spheres"].size(), 1u);
+  EXPECT_EQ(platform["spheres"][0]["pose"]["position"]["x"].get<double>(), 0.0);
+  EXPECT_EQ(by_id.at("positioner_base")["cylinders"].size(), 1u);
+  // Without the geometry, no positioner bodies.
+  EXPECT_EQ(json::parse(RobotFrames(schema).scene_update_json(RobotBodies{}, 2.0))["entities"].size(), 0u);
 }
 
 TEST(RobotFrames, ASchemaWithoutTheStagesChannelsIsRefusedNamingTheChannel) {

@@ -120,7 +120,10 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
     images_ = std::make_unique<net::CameraImagePublisher>(o.domain, network);
   // The slave's frames on DDS as ROS 2's /tf.
   if (o.role == Role::kSlave)
-    frames_ = std::make_unique<net::TfPublisher>(o.domain, network, live.telemetry_schema());
+    frames_ = std::make_unique<net::TfPublisher>(o.domain, network, live.telemetry_schema(),
+                                                 live.params().platform.parallel_positioner_enabled()
+                                                     ? &live.params().platform.parallel_positioner.geometry
+                                                     : nullptr);
   // The microscope's focus and turret on DDS: the slave takes them from any peer, the master
   // sends its operator's (net/microscope_link.h).
   if (o.role == Role::kSlave && live.has_camera()) {

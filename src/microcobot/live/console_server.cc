@@ -62,7 +62,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
       server_(params_.server, "microcobot",
               {{"/", {"text/html; charset=utf-8", console_page()}},
                {"/index.html", {"text/html; charset=utf-8", console_page()}}}),
-      frames_(live.telemetry_schema()),
+      frames_(live.telemetry_schema(), live.params().platform.parallel_positioner_enabled()
+                                           ? &live.params().platform.parallel_positioner.geometry
+                                           : nullptr),
       rumble_(params_.rumble_crossover_Hz, kTelemetryRate_Hz, params_.rumble_full_scale_N) {
   if (live.params().platform.parallel_positioner_enabled())
     pose_goal_.emplace(live.params().platform.parallel_positioner.geometry);

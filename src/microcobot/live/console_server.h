@@ -7,10 +7,12 @@
 ///   /platform/status      5 Hz   e-stop, control, watchdog, lifecycles, tick p99, recording
 ///   /platform/scene       1 Hz   geometry and limits the microscope view needs
 ///   /console/feedback    60 Hz   contact and grip forces, the vibrotactile channel
-///   /tf                  60 Hz   the frames of the tool, gripper, fingers and part,
+///   /tf                  60 Hz   the frames of the tool, gripper, fingers and part (and of the
+///                                parallel positioner's platform, base, carriages and legs),
 ///                                foxglove.FrameTransforms (live/robot_frames.h)
-///   /robot/scene          1 Hz   the fingers and the part as boxes in their frames,
-///                                foxglove.SceneUpdate: Foxglove's 3D panel draws the platform
+///   /robot/scene          1 Hz   the fingers and the part as boxes in their frames (and the
+///                                positioner's bodies), foxglove.SceneUpdate: Foxglove's 3D panel
+///                                and the console's positioner view draw the platform
 ///   /camera/image/compressed     every camera frame, sensor_msgs/msg/CompressedImage (CDR, JPEG)
 ///   /camera/preview/compressed   the same frames binned to the console's 640 px panel
 ///                                (live/camera_preview.h), encoded only while someone watches

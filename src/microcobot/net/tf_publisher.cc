@@ -8,8 +8,9 @@
 
 namespace mc::net {
 
-TfPublisher::TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema)
-    : participant_(domain_id, network), frames_(schema) {
+TfPublisher::TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema,
+                         const motion::ParallelGeometryParams* positioner)
+    : participant_(domain_id, network), frames_(schema, positioner) {
   const dds_entity_t pp = participant_.handle();
   dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));

@@ -27,8 +27,11 @@ inline constexpr std::string_view kTfTypeName = "tf2_msgs::msg::dds_::TFMessage_
 class TfPublisher {
  public:
   /// A participant of its own on `domain_id` with the link's network configuration; the frames
-  /// from `schema`'s channels. Throws InvalidParams / ComputationFailed as Participant does.
-  TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema);
+  /// from `schema`'s channels, and the parallel positioner's base, carriages and legs with its
+  /// geometry `positioner` (live::RobotFrames). Throws InvalidParams / ComputationFailed as
+  /// Participant does.
+  TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema,
+              const motion::ParallelGeometryParams* positioner = nullptr);
   ~TfPublisher();
   TfPublisher(const TfPublisher&) = delete;
   TfPublisher& operator=(const TfPublisher&) = delete;
