@@ -143,6 +143,7 @@ function currentCommand() {
       cmd.theta_goal_rad = mc.input.thetaGoal;
     }
   }
+  if (mc.input.poseGoal) cmd.pose_goal = mc.input.poseGoal;  // the parallel positioner's go-to pose
   Object.assign(cmd, mc.microscopeCommand ? mc.microscopeCommand() : {});  // focus, objective, exposure, gain
   return cmd;
 }

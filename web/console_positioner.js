@@ -6,7 +6,9 @@
 // The measured pose is shown in numbers beside it from the telemetry (x, y, z in µm, rx, ry, rz
 // in degrees, R = Rz(rz) Ry(ry) Rx(rx) about the platform frame's origin in its home frame); the
 // platform's plate at home is outlined dashed, so that a pose's few millimetres show (zoomed).
-// A view only: dragging turns the view and the wheel zooms it, nothing here sends a command.
+// Dragging turns the view and the wheel zooms it. Below it, the go-to pose: the goal typed in
+// (µm, degrees), sent as the command's pose_goal (SI) with every command while it stands; the
+// platform moves only while the deadman is held (the server plans, the loop starts: docs/console.md).
 "use strict";
 
 const pos3d = {
@@ -58,9 +60,39 @@ listen("/platform/telemetry", (t) => {
     const digits = k.endsWith("um") ? 1 : 3, shown = Number(v.toFixed(digits));
     $("pos3d-" + k).textContent = (shown === 0 ? 0 : shown).toFixed(digits);  // no "-0.0"
   }
+  showPoseGoal(pose);
   $("pos3d-moving").textContent = t.positioner_moving ? "moving" : "at rest";
   $("pos3d-moving").className = t.positioner_moving ? "pill warn" : "pill";
 });
+
+// ---------------------------------------------------------------------------------------------
+// The go-to pose: the fields in µm and degrees, the goal sent in metres and radians.
+const poseKeys = ["x_um", "y_um", "z_um", "rx_deg", "ry_deg", "rz_deg"];
+$("pose-go").addEventListener("click", () => {
+  const values = poseKeys.map((k) => Number($("pose-goal-" + k).value || "0"));
+  if (!values.every(Number.isFinite)) {
+    $("pose-goal-state").textContent = "a field is not a number";
+    return;
+  }
+  mc.input.poseGoal = values.map((v, i) => (i < 3 ? v / um : (v * Math.PI) / 180));
+  mc.input.poseGoalShown = values;
+});
+$("pose-here").addEventListener("click", () => {
+  const p = mc.positioner3d.pose;
+  if (!p) return;
+  for (const k of poseKeys) $("pose-goal-" + k).value = String(Number(p[k].toFixed(k.endsWith("um") ? 3 : 5)));
+});
+$("pose-cancel").addEventListener("click", () => { mc.input.poseGoal = null; });
+// Where the goal stands: reached (within 0.5 µm and 0.001°), or how to get there.
+function showPoseGoal(pose) {
+  const g = mc.input.poseGoal ? mc.input.poseGoalShown : null;
+  let text = "";
+  if (g) {
+    const reached = poseKeys.every((k, i) => Math.abs(pose[k] - g[i]) <= (i < 3 ? 0.5 : 1e-3));
+    text = reached ? "goal reached" : mc.input.deadman ? "going to the goal…" : "hold the deadman (Space) to go";
+  }
+  $("pose-goal-state").textContent = text;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Geometry: 3-vectors as arrays, rotations as row-major 3 x 3 arrays.

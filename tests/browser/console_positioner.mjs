@@ -3,7 +3,8 @@
 // shows the positioner's panel with its bodies drawn and the measured pose in numbers; a pose move
 // commanded through the twin's GCS socket (FRF, MOV, polled with ONT?) moves the drawn platform by
 // where the page's own projection puts the measured pose, and the numbers follow the telemetry
-// throughout. The panel sends nothing: no console command leaves the page while it is used.
+// throughout. Turning the view sends nothing. The panel's go-to pose moves the platform only
+// while the deadman is held, to the goal typed in.
 // Screenshots at 1400x950 and 1024x768 go to MC_ARTIFACTS.
 import { connect } from "node:net";
 import { createInterface } from "node:readline";
@@ -188,4 +189,36 @@ await s.run(async () => {
   const small = await page.locator("#positioner-view").boundingBox();
   if (!(small.width >= 250 && small.x + small.width <= 1024)) fail(`at 1024x768 the 3-D view is ${JSON.stringify(small)}`);
   await shot("positioner-1024x768");
-}, "the positioner's 3-D panel draws the measured pose and its numbers follow the telemetry");
+
+  // The go-to pose from the panel, as an operator uses it: control taken, a goal typed in
+  // (µm, degrees) and Go pressed; nothing moves until the deadman is held; held, the platform goes
+  // there (the numbers shown within 0.5 µm and 0.001°) and the panel says so.
+  await page.setViewportSize({ width: 1400, height: 950 });
+  await page.click("#take-control");
+  await until("in control", () => window.mc.inControl, 10);
+  const start = (await shown()).telemetry;
+  const goal = [start[0] + 150, start[1] - 80, start[2] + 40, start[3] + 0.2, start[4] - 0.1, start[5] + 0.5];
+  const keys = ["x_um", "y_um", "z_um", "rx_deg", "ry_deg", "rz_deg"];
+  for (let i = 0; i < 6; i++) await page.fill("#pose-goal-" + keys[i], goal[i].toFixed(i < 3 ? 1 : 3));
+  await page.click("#pose-go");
+  await page.locator("#pose-go").scrollIntoViewIfNeeded();
+  await until("the panel asks for the deadman", () => /deadman/.test(document.getElementById("pose-goal-state").textContent), 5);
+  await page.waitForTimeout(600);
+  const still = (await shown()).telemetry;
+  if (Math.hypot(still[0] - start[0], still[1] - start[1], still[2] - start[2]) > 0.2)
+    fail(`the platform moved without the deadman: ${start.slice(0, 3)} -> ${still.slice(0, 3)} µm`);
+  await page.keyboard.down(" ");
+  try {
+    await until("the goal reached", () => document.getElementById("pose-goal-state").textContent === "goal reached", 60);
+  } finally {
+    await page.keyboard.up(" ");
+  }
+  const reached = await shown();
+  checkNumbers("at the goal", reached);
+  for (let i = 0; i < 6; i++)
+    if (!(Math.abs(reached.telemetry[i] - Number(goal[i].toFixed(i < 3 ? 1 : 3))) <= (i < 3 ? 0.5 : 1e-3)))
+      fail(`${keys[i]}: ${reached.telemetry[i]} at the goal ${goal[i]}`);
+  log(`go-to pose: at (${reached.telemetry.map((v, i) => v.toFixed(i < 3 ? 2 : 4)).join(", ")}) µm, °`);
+  await shot("positioner-1400x950-goto-reached");
+  await page.locator("#positioner-group").screenshot({ path: `${s.artifacts}/positioner-panel-goto.png` });
+}, "the positioner's 3-D panel draws the measured pose, its numbers follow the telemetry, and its go-to pose moves it with the deadman");
