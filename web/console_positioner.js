@@ -83,6 +83,19 @@ $("pose-here").addEventListener("click", () => {
   for (const k of poseKeys) $("pose-goal-" + k).value = String(Number(p[k].toFixed(k.endsWith("um") ? 3 : 5)));
 });
 $("pose-cancel").addEventListener("click", () => { mc.input.poseGoal = null; });
+// A step along or about one axis from the goal standing, or from the measured pose: the fields
+// show the new goal, sent as Go would.
+function poseJog(sign) {
+  const p = mc.positioner3d.pose;
+  if (!p) return;
+  const base = mc.input.poseGoal ? mc.input.poseGoalShown.slice() : poseKeys.map((k) => p[k]);
+  const axis = Number($("pose-jog-axis").value), size = Number($("pose-jog-size").value);
+  base[axis] += sign * (axis < 3 ? size : size / 100);  // µm, or degrees (the sizes pair 1 µm with 0.01°)
+  poseKeys.forEach((k, i) => { $("pose-goal-" + k).value = String(Number(base[i].toFixed(i < 3 ? 3 : 5))); });
+  $("pose-go").click();
+}
+$("pose-jog-minus").addEventListener("click", () => poseJog(-1));
+$("pose-jog-plus").addEventListener("click", () => poseJog(1));
 // Where the goal stands: reached (within 0.5 µm and 0.001°), or how to get there.
 function showPoseGoal(pose) {
   const g = mc.input.poseGoal ? mc.input.poseGoalShown : null;

@@ -219,6 +219,22 @@ await s.run(async () => {
     if (!(Math.abs(reached.telemetry[i] - Number(goal[i].toFixed(i < 3 ? 1 : 3))) <= (i < 3 ? 0.5 : 1e-3)))
       fail(`${keys[i]}: ${reached.telemetry[i]} at the goal ${goal[i]}`);
   log(`go-to pose: at (${reached.telemetry.map((v, i) => v.toFixed(i < 3 ? 2 : 4)).join(", ")}) µm, °`);
+  // The step jog: 1° about z from that goal, with the deadman.
+  await page.selectOption("#pose-jog-axis", "5");
+  await page.selectOption("#pose-jog-size", "100");
+  await page.click("#pose-jog-plus");
+  await page.keyboard.down(" ");
+  try {
+    await until("the step reached", () => document.getElementById("pose-goal-state").textContent === "goal reached" &&
+                Math.abs(window.mc.positioner3d.pose.rz_deg - Number(document.getElementById("pose-goal-rz_deg").value)) < 1e-3, 60);
+  } finally {
+    await page.keyboard.up(" ");
+  }
+  const stepped = (await shown()).telemetry;
+  log(`step jog rz: ${reached.telemetry[5].toFixed(4)} -> ${stepped[5].toFixed(4)}°`);
+  if (!(Math.abs(stepped[5] - reached.telemetry[5] - 1) <= 2e-3)) fail(`the 1° step about z turned ${stepped[5] - reached.telemetry[5]}°`);
+  for (let i = 0; i < 5; i++)
+    if (!(Math.abs(stepped[i] - reached.telemetry[i]) <= (i < 3 ? 0.5 : 1e-3))) fail(`the rz step moved ${keys[i]}`);
   await shot("positioner-1400x950-goto-reached");
   await page.locator("#positioner-group").screenshot({ path: `${s.artifacts}/positioner-panel-goto.png` });
 }, "the positioner's 3-D panel draws the measured pose, its numbers follow the telemetry, and its go-to pose moves it with the deadman");
