@@ -93,6 +93,7 @@ TEST(Deployment, ASingleRoleServesTheConsoleAndATwinThenStopsWithEveryDeviceSafe
   ASSERT_TRUE(g_deployment_bench) << "the configured driver set was built";
   EXPECT_TRUE(log.has("building the platform")) << "on the drivers 'deployment-bench'";
   EXPECT_TRUE(log.has("'deployment-bench'"));
+  EXPECT_FALSE(log.has("parallel positioner")) << "none configured";
   EXPECT_TRUE(deployment.config().token.empty()) << "on loopback no token is drawn";
 
   deployment.start();
@@ -144,6 +145,17 @@ TEST(Deployment, ASlaveRoleJoinsItsDomainAndReportsItsPorts) {
   EXPECT_EQ(test::http_request(deployment.port(), "GET", "/").status, 200);
   ASSERT_TRUE(deployment.port_energy());
   deployment.stop();
+}
+
+TEST(Deployment, TheStartLineSaysWhatRunsTheParallelPositioner) {
+  test::TempDir dir;
+  ServeConfig config;
+  config.listen_port = 0;
+  config.out = dir / "live";
+  config.platform.positioner = "parallel";
+  LogLines log;
+  Deployment deployment(config, log.sink());
+  EXPECT_TRUE(log.has("on the simulated devices, the parallel positioner simulated"));
 }
 
 TEST(Deployment, ABadConfigurationFailsWithOneClearErrorBeforeAnythingIsServed) {

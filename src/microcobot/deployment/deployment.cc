@@ -103,10 +103,17 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
   RemoteEnds ends = attach_role(o, lp);
   remote_slave_ = std::move(ends.slave);
   remote_master_ = std::move(ends.master);
-  log_("building the platform (the stick-slip step map takes about a second) on " +
-       (lp.platform.devices.simulated()
-            ? std::string("the simulated devices")
-            : "the drivers '" + lp.platform.devices.driver + "' (" + lp.platform.devices.connection + ")"));
+  // What is simulated and what a driver runs: the stage's devices, and the parallel positioner.
+  std::string on = lp.platform.devices.simulated() ? std::string("the simulated devices")
+                                                   : "the drivers '" + lp.platform.devices.driver + "' (" +
+                                                         lp.platform.devices.connection + ")";
+  if (lp.platform.parallel_positioner_enabled()) {
+    const platform::ParallelPositionerSelection& pp = lp.platform.parallel_positioner;
+    on += pp.simulated()
+              ? ", the parallel positioner simulated"
+              : ", the parallel positioner on the driver '" + pp.driver + "' (" + pp.connection + ")";
+  }
+  log_("building the platform (the stick-slip step map takes about a second) on " + on);
   const net::NetworkConfig network = o.network.value_or(net::NetworkConfig{});
   if (o.role != Role::kSingle)
     log_(fmt::format(
