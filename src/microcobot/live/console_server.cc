@@ -150,10 +150,10 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
-  tf_ch_ = server_.add_channel(
-      {"/tf", "json", "foxglove.FrameTransforms", "jsonschema", RobotFrames::transforms_schema()});
-  robot_scene_ch_ = server_.add_channel(
-      {"/robot/scene", "json", "foxglove.SceneUpdate", "jsonschema", RobotFrames::scene_update_schema()});
+  tf_ch_ = server_.add_channel({std::string(kTransformsTopic), "json", "foxglove.FrameTransforms",
+                                "jsonschema", RobotFrames::transforms_schema()});
+  robot_scene_ch_ = server_.add_channel({std::string(kRobotSceneTopic), "json", "foxglove.SceneUpdate",
+                                         "jsonschema", RobotFrames::scene_update_schema()});
   if (live_.has_camera()) {
     // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
     image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
@@ -480,6 +480,7 @@ std::string ConsoleServer::start_recording(std::optional<RecordedVideo> video) {
   const double t_s = live_.status().t_s;
   const std::string was = recording_->name();
   const std::string name = recording_->start(t_s, scene_json(), video);
+  recording_->robot_bodies(t_s, robot_bodies());  // the 3-D bodies from the start
   if (name != was)
     note(EventLevel::kInfo, "record_start",
          "recording to " + name + " (video " + std::string(recorded_video_name(recording_->video())) + ")");
@@ -527,6 +528,8 @@ void ConsoleServer::status_thread() {
     live_.drain_link_costs(link_cost_);
     update_camera_demand();
     publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
+    // The recording writes the bodies again only when they change (a restart, another scene).
+    if (recording_) recording_->robot_bodies(now_status.t_s, robot_bodies());
     if (n % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0) {
       publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());
       if (server_.subscriber_count(robot_scene_ch_) > 0)

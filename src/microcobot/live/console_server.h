@@ -130,7 +130,8 @@ class ConsoleServer {
   void update_camera_demand();
   std::string status_json();
   std::string scene_json() const;
-  /// The bodies of the 3-D view (foxglove.SceneUpdate) of the current scene.
+  /// The bodies of the 3-D view of the current scene, and their foxglove.SceneUpdate.
+  RobotBodies robot_bodies() const;
   std::string robot_scene_json(double t_s) const;
   /// Publishes to the clients and records (loop time t_s).
   void publish(server::ChannelId ch, RecordedTopic topic, double t_s, const std::string& payload);

@@ -89,6 +89,13 @@ RobotFrames::RobotFrames(const platform::TelemetrySchema& schema)
   if (qx && qy && qz && rx && ry && rz) positioner_ = PositionerChannels{*qx, *qy, *qz, *rx, *ry, *rz};
 }
 
+bool RobotFrames::fits(const platform::TelemetrySchema& schema) {
+  for (const char* name :
+       {"measured_x_m", "measured_y_m", "measured_z_m", "measured_theta_rad", "gripper_opening_m"})
+    if (!schema.find(name)) return false;
+  return true;
+}
+
 std::size_t RobotFrames::transforms(const platform::TelemetrySample& s, FrameTransforms& out) const {
   const double half = 0.5 * std::max(0.0, finite(s[opening_]));
   std::size_t n = 0;
