@@ -254,6 +254,7 @@ void ConsoleServer::stop() {
 void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t count) {
   const std::span<const double> sample(s.data(), count);
   if (recording_) recording_->telemetry(s, count);  // every sample; encoded by its writer
+  for (const SampleConsumer& c : every_sample_consumers_) c(s);
   ticks_.add(s[kTick] * 1e-6);
   ticks_cpu_.add(s[kTickCpu] * 1e-6);
   if (ticks_.count() >= 1000) {  // the loop's tick p99 over the last second
@@ -322,6 +323,11 @@ void ConsoleServer::add_frame_consumer(FrameConsumer consumer) {
 void ConsoleServer::add_sample_consumer(SampleConsumer consumer) {
   if (started_) throw InvalidInput("console server: add sample consumers before start()");
   sample_consumers_.push_back(std::move(consumer));
+}
+
+void ConsoleServer::add_every_sample_consumer(SampleConsumer consumer) {
+  if (started_) throw InvalidInput("console server: add sample consumers before start()");
+  every_sample_consumers_.push_back(std::move(consumer));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
