@@ -35,7 +35,9 @@ PositionerPosePublisher::~PositionerPosePublisher() = default;
 bool PositionerPosePublisher::publish(const platform::TelemetrySample& s) {
   live::FrameTransforms f;
   const std::size_t n = frames_.transforms(s, f);
-  const live::FrameTransform& p = f[n - 1];  // the positioner's is the tree's last (robot_frames.h)
+  std::size_t k = 0;  // the `world -> positioner` transform (fits(): the tree has it)
+  while (k + 1 < n && f[k].child != "positioner") ++k;
+  const live::FrameTransform& p = f[k];
   const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
                               std::chrono::system_clock::now().time_since_epoch())
                               .count();
