@@ -125,8 +125,8 @@ class SessionRecording {
   /// lose what the system had not written yet.
   static constexpr std::uint64_t kChunkSpan_ns = 500'000'000;
   /// The rate of /tf in a recording: one telemetry sample's frames every 10 ms. Every sample's
-  /// (1 kHz) would grow the file by about as much as the telemetry itself for a replay a viewer
-  /// draws at its screen's rate (docs/console.md, "Recordings" says by how much).
+  /// (1 kHz) would add half to nearly all of the file again for a replay a viewer draws at its
+  /// screen's rate (docs/console.md, "Recordings", Size: measured).
   static constexpr double kTransformsRate_Hz = 100.0;
 
   explicit SessionRecording(SessionRecordingParams params);

@@ -183,8 +183,8 @@ TEST(WireCompat, ACProgramReadsTheParallelPositionersPoseAtHome) {
     EXPECT_NEAR(std::hypot(std::hypot(o[0], o[1]), std::hypot(o[2], o[3])), 1.0, 1e-12) << m;
   }
   // Every loop sample's pose, not the console's 60 Hz (which would take 5 s); best effort: the
-  // listener may lose a few.
-  EXPECT_LT(1e-9 * static_cast<double>(stamp_ns(samples.back()) - stamp_ns(samples.front())), 1.0);
+  // listener may lose a few, and a loop under a sanitizer runs late.
+  EXPECT_LT(1e-9 * static_cast<double>(stamp_ns(samples.back()) - stamp_ns(samples.front())), 2.5);
 
   // /tf's `world -> positioner` is the same pose.
   int seen = 0;
