@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <map>
@@ -119,6 +120,75 @@ TEST(SessionRecording, HoldsEveryChannelOnTheWallClockWithEventsAndMetadata) {
   EXPECT_EQ(*m.find_metadata("configuration")->find("yaml"), "loop:\n  base_rate_Hz: 10000\n");
   ASSERT_EQ(m.attachments.size(), 1u);
   EXPECT_EQ(m.attachments[0].name, "configuration.yaml");
+}
+
+TEST(SessionRecording, HoldsTheRobotsFramesAHundredTimesASecondAndItsBodiesWhenTheyChange) {
+  test::TempDir dir;
+  auto p = params(dir.path(), false);
+  p.telemetry = platform::builtin_telemetry(true);  // the stage's channels: the frames are drawn
+  const platform::TelemetrySchema& schema = p.telemetry;
+  const std::size_t x = schema.index("measured_x_m"), theta = schema.index("measured_theta_rad");
+  SessionRecording rec(p);
+  const std::string name = rec.start(5.0, "{}");
+  RobotBodies bodies{40e-6, 20e-6, 10e-6, 100e-6};
+  rec.robot_bodies(5.0, bodies);
+  for (int i = 0; i < 500; ++i) {
+    platform::TelemetrySample s{};
+    s[0] = 5.0 + 0.001 * i;
+    s[x] = 1e-6 * i;
+    s[theta] = 0.01 * i;
+    if (i == 200) continue;  // a lost sample: the next one carries the frames
+    rec.telemetry(s, schema.size());
+    if (i % 100 == 50) rec.robot_bodies(s[0], bodies);  // unchanged: not written again
+    if (i == 300) {
+      bodies.part_side_m = 50e-6;  // another scene
+      rec.robot_bodies(s[0], bodies);
+    }
+  }
+  rec.stop();
+
+  const McapContents m = read_mcap(dir / name);
+  std::map<std::string, std::uint16_t> ids;
+  for (const auto& c : m.channels) ids[c.topic] = c.id;
+  ASSERT_EQ(ids.count("/tf"), 1u);
+  ASSERT_EQ(ids.count("/robot/scene"), 1u);
+  std::map<std::uint64_t, json> telemetry;  // by log time
+  std::vector<std::pair<std::uint64_t, json>> tf, scenes;
+  for (const auto& msg : m.messages) {
+    if (msg.channel_id == ids["/platform/telemetry"]) telemetry[msg.log_time_ns] = json::parse(msg.data);
+    if (msg.channel_id == ids["/tf"]) tf.emplace_back(msg.log_time_ns, json::parse(msg.data));
+    if (msg.channel_id == ids["/robot/scene"]) scenes.emplace_back(msg.log_time_ns, json::parse(msg.data));
+  }
+  ASSERT_EQ(telemetry.size(), 499u);
+  // 5.000, 5.010, ..., 5.490, with 5.201 for the lost 5.200.
+  ASSERT_EQ(tf.size(), 50u);
+  for (const auto& [ns, frames] : tf) {
+    ASSERT_EQ(telemetry.count(ns), 1u) << "a /tf without the telemetry sample of its log time";
+    const json& s = telemetry[ns];
+    const json& tool = frames["transforms"][0];
+    EXPECT_EQ(tool["child_frame_id"], "tool");
+    // The telemetry's JSON keeps 10 significant digits, the frames every one.
+    const double measured = s["measured_x_m"];
+    EXPECT_NEAR(tool["translation"]["x"].get<double>(), measured, 1e-9 * std::abs(measured));
+    EXPECT_NEAR(frames["transforms"][1]["rotation"]["z"].get<double>(),
+                std::sin(0.5 * s["measured_theta_rad"].get<double>()), 1e-15);
+  }
+  EXPECT_EQ(telemetry[tf[20].first]["t_s"], 5.201);  // after 5.000 ... 5.190
+  ASSERT_EQ(scenes.size(), 2u);                      // the start and the part's new side
+  for (const auto& [ns, scene] : scenes) EXPECT_EQ(scene["entities"].size(), 3u);
+  EXPECT_EQ(scenes[1].second["entities"][2]["cubes"][0]["size"]["x"], 50e-6);
+}
+
+TEST(SessionRecording, ATelemetryWithoutTheStagesChannelsRecordsNoFrames) {
+  test::TempDir dir;
+  SessionRecording rec(params(dir.path(), false));
+  const std::string name = rec.start(0.0, "{}");
+  rec.robot_bodies(0.0, RobotBodies{40e-6, 20e-6, 10e-6, 100e-6});
+  for (int i = 0; i < 100; ++i) rec.telemetry(sample(0.001 * i), kChannels);
+  rec.stop();
+  const McapContents m = read_mcap(dir / name);
+  for (const auto& c : m.channels) EXPECT_TRUE(c.topic != "/tf" && c.topic != "/robot/scene") << c.topic;
+  EXPECT_EQ(m.messages.size(), 100u);
 }
 
 TEST(SessionRecording, TheCsvIsWrittenOnlyWhenAsked) {

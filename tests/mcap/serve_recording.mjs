@@ -2,7 +2,7 @@
 // with the zstd decompressor of npm @foxglove/wasm-zstd (both pinned in package-lock.json).
 // A client takes control, drives, sends a refused command and a malformed message, presses the
 // e-stop and resets; then SIGTERM closes the recording. Checks: every channel the server
-// publishes plus the clients' commands, actions and the events; the events of what happened
+// publishes (the 3-D frames and bodies among them) plus the clients' commands, actions and the events; the events of what happened
 // (take_control, estop, refused with the client id, protocol); metadata (version, scene,
 // configuration) and the configuration attachment; zstd chunks smaller than their records;
 // log times on the wall clock (within a minute of Date.now()), t_s kept, monotonic per channel;
@@ -116,8 +116,8 @@ try {
 
   const topics = new Map([...reader.channelsById.values()].map((c) => [c.id, c.topic]));
   const expected = ["/platform/telemetry", "/platform/status", "/platform/scene", "/console/feedback",
-                    "/console/command", "/console/action", "/events", "/camera/video",
-                    "/camera/camera_info", "/camera/state"];
+                    "/console/command", "/console/action", "/events", "/tf", "/robot/scene",
+                    "/camera/video", "/camera/camera_info", "/camera/state"];
   for (const t of expected) if (![...topics.values()].includes(t)) fail(`no channel ${t}`);
   // The camera's calibration is a ROS 2 message in CDR (tests/live/camera_foxglove.mjs decodes
   // it), its frames H.264 in Foxglove's CompressedVideo (serve's default; tests/mcap/recorded_video.mjs
@@ -168,6 +168,11 @@ try {
     const j = decode(m);
     if (topic === "/camera/video") {  // stamped as Foxglove's schemas are, no t_s
       if (j.format !== "h264" || typeof j.timestamp?.sec !== "number" || typeof j.data !== "string") badTs++;
+      continue;
+    }
+    if (topic === "/tf" || topic === "/robot/scene") {  // Foxglove's too (tests/mcap/recording_frames.mjs)
+      const stamps = topic === "/tf" ? j.transforms : j.entities;
+      if (!stamps?.length || stamps.some((e) => typeof e.timestamp?.sec !== "number")) badTs++;
       continue;
     }
     if (topic !== "/platform/scene" && typeof j.t_s !== "number") badTs++;  // the scene is geometry

@@ -70,5 +70,26 @@ TEST(TopicTable, QosObjectsCarryTheTable) {
   dds_delete_qos(q);
 }
 
+TEST(TopicTable, ThePositionersPoseIsAStateTopicBesideTheCouplings) {
+  const ObserverTopicSpec& t = kPositionerPoseTopic;
+  EXPECT_EQ(std::string(t.dds_name), "rt/" + std::string(t.ros_name.substr(1)));
+  EXPECT_EQ(std::string(descriptor(RosType::kPoseStamped)->m_typename), std::string(t.type_name));
+  EXPECT_EQ(t.publisher, Role::kSlave);
+  EXPECT_EQ(t.rate_Hz, topic(Channel::kMeasuredPose).rate_Hz);
+  for (const TopicSpec& c : topic_table()) EXPECT_NE(c.ros_name, t.ros_name);  // not the link's
+  // Its QoS is the state profile's, field by field.
+  dds_qos_t* state = make_qos(topic(Channel::kMeasuredPose));
+  dds_qos_t* q = make_state_qos();
+  dds_reliability_kind_t kind{};
+  dds_duration_t block = 0, deadline = 0;
+  ASSERT_TRUE(dds_qget_reliability(q, &kind, &block));
+  EXPECT_EQ(kind, DDS_RELIABILITY_BEST_EFFORT);
+  ASSERT_TRUE(dds_qget_deadline(q, &deadline));
+  EXPECT_EQ(deadline, DDS_MSECS(10));
+  EXPECT_TRUE(dds_qos_equal(q, state));
+  dds_delete_qos(q);
+  dds_delete_qos(state);
+}
+
 }  // namespace
 }  // namespace mc::net

@@ -14,6 +14,7 @@
 #include "microcobot/net/camera_image_publisher.h"
 #include "microcobot/net/cyclone_config.h"
 #include "microcobot/net/microscope_link.h"
+#include "microcobot/net/positioner_pose_publisher.h"
 #include "microcobot/net/tf_publisher.h"
 #include "microcobot/twins/live_stage.h"
 #include "microcobot/twins/twin_server.h"
@@ -131,6 +132,10 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
                                                  live.params().platform.parallel_positioner_enabled()
                                                      ? &live.params().platform.parallel_positioner.geometry
                                                      : nullptr);
+  // With a parallel positioner, its pose as a state topic of its own.
+  if (o.role == Role::kSlave && net::PositionerPosePublisher::fits(live.telemetry_schema()))
+    positioner_pose_ =
+        std::make_unique<net::PositionerPosePublisher>(o.domain, network, live.telemetry_schema());
   // The microscope's focus and turret on DDS: the slave takes them from any peer, the master
   // sends its operator's (net/microscope_link.h).
   if (o.role == Role::kSlave && live.has_camera()) {
@@ -164,6 +169,12 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
     server_->add_sample_consumer([p = frames_.get()](const platform::TelemetrySample& s) { p->publish(s); });
     log_(fmt::format("the tool, gripper, fingers and part on DDS, ROS 2 topic {} ({})", net::kTfRosName,
                      net::kTfTypeName));
+  }
+  if (positioner_pose_) {
+    server_->add_every_sample_consumer(
+        [p = positioner_pose_.get()](const platform::TelemetrySample& s) { p->publish(s); });
+    log_(fmt::format("the parallel positioner's pose on DDS, ROS 2 topic {} ({})",
+                     net::kPositionerPoseTopic.ros_name, net::kPositionerPoseTopic.type_name));
   }
   // The vendor-protocol twins: their own thread, the live platform reached through its ring.
   if (!o.twins.empty()) {

@@ -26,6 +26,7 @@
 
 namespace mc::net {
 class CameraImagePublisher;
+class PositionerPosePublisher;
 class TfPublisher;
 class MicroscopeClient;
 class MicroscopeServer;
@@ -102,6 +103,7 @@ class Deployment {
   std::unique_ptr<live::LivePlatform> live_;
   std::unique_ptr<net::CameraImagePublisher> images_;
   std::unique_ptr<net::TfPublisher> frames_;
+  std::unique_ptr<net::PositionerPosePublisher> positioner_pose_;  // with a parallel positioner
   std::unique_ptr<net::MicroscopeServer> microscope_server_;
   std::unique_ptr<net::MicroscopeClient> microscope_client_;
   std::unique_ptr<live::ConsoleServer> server_;

@@ -154,10 +154,10 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
   feedback_ch_ = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
-  tf_ch_ = server_.add_channel(
-      {"/tf", "json", "foxglove.FrameTransforms", "jsonschema", RobotFrames::transforms_schema()});
-  robot_scene_ch_ = server_.add_channel(
-      {"/robot/scene", "json", "foxglove.SceneUpdate", "jsonschema", RobotFrames::scene_update_schema()});
+  tf_ch_ = server_.add_channel({std::string(kTransformsTopic), "json", "foxglove.FrameTransforms",
+                                "jsonschema", RobotFrames::transforms_schema()});
+  robot_scene_ch_ = server_.add_channel({std::string(kRobotSceneTopic), "json", "foxglove.SceneUpdate",
+                                         "jsonschema", RobotFrames::scene_update_schema()});
   if (live_.has_camera()) {
     // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
     image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
@@ -185,6 +185,8 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     rp.out_dir = params_.out_dir;
     rp.csv = params_.record_csv;
     rp.telemetry = live_.telemetry_schema();
+    if (live_.params().platform.parallel_positioner_enabled())
+      rp.positioner_geometry = live_.params().platform.parallel_positioner.geometry;
     rp.status = recorded(status_ch_);
     rp.scene = recorded(scene_ch_);
     rp.feedback = recorded(feedback_ch_);
@@ -258,6 +260,7 @@ void ConsoleServer::stop() {
 void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t count) {
   const std::span<const double> sample(s.data(), count);
   if (recording_) recording_->telemetry(s, count);  // every sample; encoded by its writer
+  for (const SampleConsumer& c : every_sample_consumers_) c(s);
   ticks_.add(s[kTick] * 1e-6);
   ticks_cpu_.add(s[kTickCpu] * 1e-6);
   if (ticks_.count() >= 1000) {  // the loop's tick p99 over the last second
@@ -326,6 +329,11 @@ void ConsoleServer::add_frame_consumer(FrameConsumer consumer) {
 void ConsoleServer::add_sample_consumer(SampleConsumer consumer) {
   if (started_) throw InvalidInput("console server: add sample consumers before start()");
   sample_consumers_.push_back(std::move(consumer));
+}
+
+void ConsoleServer::add_every_sample_consumer(SampleConsumer consumer) {
+  if (started_) throw InvalidInput("console server: add sample consumers before start()");
+  every_sample_consumers_.push_back(std::move(consumer));
 }
 
 void ConsoleServer::publish(server::ChannelId ch, RecordedTopic topic, double t_s,
@@ -494,6 +502,7 @@ std::string ConsoleServer::start_recording(std::optional<RecordedVideo> video) {
   const double t_s = live_.status().t_s;
   const std::string was = recording_->name();
   const std::string name = recording_->start(t_s, scene_json(), video);
+  recording_->robot_bodies(t_s, robot_bodies());  // the 3-D bodies from the start
   if (name != was)
     note(EventLevel::kInfo, "record_start",
          "recording to " + name + " (video " + std::string(recorded_video_name(recording_->video())) + ")");
@@ -541,6 +550,8 @@ void ConsoleServer::status_thread() {
     live_.drain_link_costs(link_cost_);
     update_camera_demand();
     publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
+    // The recording writes the bodies again only when they change (a restart, another scene).
+    if (recording_) recording_->robot_bodies(now_status.t_s, robot_bodies());
     if (n % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0) {
       publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());
       if (server_.subscriber_count(robot_scene_ch_) > 0)

@@ -24,8 +24,8 @@
 /// HTTP: `/` the console; `/recordings...` the recordings in --out, their downloads and reports
 /// (live/recording_files.h); `/camera/snapshot.tiff|.png` the latest full frame, lossless
 /// (live/camera_snapshot.h). A recording (live/session_recording.h) holds every channel above at
-/// full rate (the preview excepted: it holds the full frames), what the clients sent, the events (control,
-/// e-stop, demo, refusals, errors) and the configuration.
+/// full rate (the preview excepted: it holds the full frames; /tf at 100 Hz), what the clients sent, the
+/// events (control, e-stop, demo, refusals, errors) and the configuration.
 ///
 /// One client controls at a time; the others observe until they take control. Any client may
 /// press the e-stop. Every message is parsed, checked and clamped (console_command.h) before it
@@ -103,6 +103,9 @@ class ConsoleServer {
   /// drain thread with each sample sent to the clients (60 Hz), never on the loop. Before start().
   using SampleConsumer = std::function<void(const platform::TelemetrySample&)>;
   void add_sample_consumer(SampleConsumer consumer);
+  /// The same with every sample (the loop's 1 kHz, e.g. the positioner's pose on DDS,
+  /// net/positioner_pose_publisher): it must take little time, the drain waits for it.
+  void add_every_sample_consumer(SampleConsumer consumer);
   void start();
   /// The console's URL, with the token when one is needed.
   std::string url() const;
@@ -133,7 +136,8 @@ class ConsoleServer {
   void update_camera_demand();
   std::string status_json();
   std::string scene_json() const;
-  /// The bodies of the 3-D view (foxglove.SceneUpdate) of the current scene.
+  /// The bodies of the 3-D view of the current scene, and their foxglove.SceneUpdate.
+  RobotBodies robot_bodies() const;
   std::string robot_scene_json(double t_s) const;
   /// Publishes to the clients and records (loop time t_s).
   void publish(server::ChannelId ch, RecordedTopic topic, double t_s, const std::string& payload);
@@ -153,11 +157,12 @@ class ConsoleServer {
   server::ChannelId tf_ch_ = 0, robot_scene_ch_ = 0;
   RobotFrames frames_;                        // the 3-D view's frame tree, from the telemetry's channels
   std::optional<ConsolePoseGoal> pose_goal_;  // server thread: go-to pose (positioner: parallel)
-  std::string image_cdr_, info_cdr_, preview_cdr_;  // camera thread only
-  std::unique_ptr<CameraPreview> preview_;          // camera thread only
-  std::unique_ptr<CameraSnapshot> snapshot_;        // null without a camera
-  std::vector<FrameConsumer> frame_consumers_;      // set before start()
-  std::vector<SampleConsumer> sample_consumers_;    // set before start()
+  std::string image_cdr_, info_cdr_, preview_cdr_;      // camera thread only
+  std::unique_ptr<CameraPreview> preview_;              // camera thread only
+  std::unique_ptr<CameraSnapshot> snapshot_;            // null without a camera
+  std::vector<FrameConsumer> frame_consumers_;          // set before start()
+  std::vector<SampleConsumer> sample_consumers_;        // set before start()
+  std::vector<SampleConsumer> every_sample_consumers_;  // set before start()
 
   std::atomic<server::ClientId> controller_{0};
   std::atomic<bool> quit_{false};

@@ -48,13 +48,17 @@ void ConsoleServer::note_changes(const LiveStatus& s) {
   last_status_ = s;
 }
 
-std::string ConsoleServer::robot_scene_json(double t_s) const {
+RobotBodies ConsoleServer::robot_bodies() const {
   RobotBodies b;
   b.part_side_m = live_.part_side_m();
   b.part_height_m = live_.part_height_m();
   b.finger_width_m = live_.finger_width_m();
   b.finger_length_m = live_.finger_length_m();
-  return frames_.scene_update_json(b, t_s);
+  return b;
+}
+
+std::string ConsoleServer::robot_scene_json(double t_s) const {
+  return frames_.scene_update_json(robot_bodies(), t_s);
 }
 
 std::string ConsoleServer::scene_json() const {

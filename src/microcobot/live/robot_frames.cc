@@ -175,6 +175,13 @@ std::size_t RobotFrames::positioner_frames(const platform::TelemetrySample& s, F
   return n;
 }
 
+bool RobotFrames::fits(const platform::TelemetrySchema& schema) {
+  for (const char* name :
+       {"measured_x_m", "measured_y_m", "measured_z_m", "measured_theta_rad", "gripper_opening_m"})
+    if (!schema.find(name)) return false;
+  return true;
+}
+
 std::size_t RobotFrames::transforms(const platform::TelemetrySample& s, FrameTransforms& out) const {
   const double half = 0.5 * std::max(0.0, finite(s[opening_]));
   std::size_t n = 0;

@@ -49,12 +49,17 @@
 
 namespace mc::live {
 
+/// The topics of the two messages, live and in recordings.
+inline constexpr std::string_view kTransformsTopic = "/tf";
+inline constexpr std::string_view kRobotSceneTopic = "/robot/scene";
+
 /// What the scene update draws: the bodies' sizes [m].
 struct RobotBodies {
   double part_side_m = 0.0;      ///< the part's square side (0: no part drawn)
   double part_height_m = 0.0;    ///< its height
   double finger_width_m = 0.0;   ///< a finger's width along the gripper's x and y
   double finger_length_m = 0.0;  ///< a finger's length, down from the tool point's height
+  bool operator==(const RobotBodies&) const = default;
 };
 
 /// One transform of the tree: `child`'s origin at (x, y, z) in `parent`, turned by the unit
@@ -77,6 +82,9 @@ class RobotFrames {
   /// platform are then drawn when the schema has its pose (null: its frame alone).
   explicit RobotFrames(const platform::TelemetrySchema& schema,
                        const motion::ParallelGeometryParams* positioner = nullptr);
+  /// Whether `schema` has the channels the constructor needs (the stage's, the rotary axis' and
+  /// the gripper's).
+  static bool fits(const platform::TelemetrySchema& schema);
 
   /// The transforms of one sample into `out`; returns how many (4, then the part and the
   /// positioner where the schema has them, then its base, carriages and links with its

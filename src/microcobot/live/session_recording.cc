@@ -67,6 +67,8 @@ bool SessionRecording::is_stem(std::string_view stem) {
 
 SessionRecording::SessionRecording(SessionRecordingParams params) : params_(std::move(params)) {
   params_.validate();
+  if (RobotFrames::fits(params_.telemetry))
+    frames_.emplace(params_.telemetry, params_.positioner_geometry ? &*params_.positioner_geometry : nullptr);
 }
 
 SessionRecording::~SessionRecording() {
@@ -155,6 +157,12 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json,
                      {"kind", text},
                      {"message", text},
                      {"client", {{"type", {"number", "null"}}}}}));
+  if (frames_) {
+    add(RecordedTopic::kTransforms, std::string(kTransformsTopic), "foxglove.FrameTransforms",
+        RobotFrames::transforms_schema());
+    add(RecordedTopic::kRobotScene, std::string(kRobotSceneTopic), "foxglove.SceneUpdate",
+        RobotFrames::scene_update_schema());
+  }
   if (video == RecordedVideo::kH264) {
     channel_[index(RecordedTopic::kCameraImage)] =
         w->add_channel(w->add_schema("foxglove.CompressedVideo", "jsonschema", compressed_video_schema()),
@@ -229,6 +237,8 @@ std::string SessionRecording::start(double t_s, const std::string& scene_json,
     video_stats_ = {};
   }
   last_keyframe_t_s_ = -1.0;
+  next_tf_t_s_.reset();
+  scene_written_.reset();
   writer_ = std::thread([this] { writer_thread(); });
   return stem + ".mcap";
 }
@@ -290,19 +300,19 @@ void SessionRecording::push(std::span<Item> items) {
 }
 
 void SessionRecording::telemetry(const platform::TelemetrySample& s, std::size_t count) {
-  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry.size()), {}};
+  Item item{RecordedTopic::kTelemetry, 0, s[0], {}, s, std::min(count, params_.telemetry.size()), {}, {}};
   push(std::move(item));
 }
 
 void SessionRecording::published(RecordedTopic topic, double t_s, std::string_view payload) {
-  push(Item{topic, 0, t_s, std::string(payload), {}, 0, {}});
+  push(Item{topic, 0, t_s, std::string(payload), {}, 0, {}, {}});
 }
 
 void SessionRecording::published_frame(double t_s, const devices::CameraFrame& frame, std::string_view image,
                                        std::string_view info, std::string_view state) {
   const RecordedVideo video = this->video();
   if (video == RecordedVideo::kOff) return;
-  Item picture{RecordedTopic::kCameraImage, 0, t_s, {}, {}, 0, {}};
+  Item picture{RecordedTopic::kCameraImage, 0, t_s, {}, {}, 0, {}, {}};
   if (video == RecordedVideo::kH264) {
     try {
       const VideoImage v = to_video_image(frame.image, picture.payload);  // 8-bit: half a 12-bit frame
@@ -317,14 +327,20 @@ void SessionRecording::published_frame(double t_s, const devices::CameraFrame& f
     picture.payload = std::string(image);
   }
   std::array<Item, 3> items{std::move(picture),
-                            Item{RecordedTopic::kCameraInfo, 0, t_s, std::string(info), {}, 0, {}},
-                            Item{RecordedTopic::kCameraState, 0, t_s, std::string(state), {}, 0, {}}};
+                            Item{RecordedTopic::kCameraInfo, 0, t_s, std::string(info), {}, 0, {}, {}},
+                            Item{RecordedTopic::kCameraState, 0, t_s, std::string(state), {}, 0, {}, {}}};
   push(items);
+}
+
+void SessionRecording::robot_bodies(double t_s, const RobotBodies& bodies) {
+  if (!frames_) return;
+  Item item{RecordedTopic::kRobotScene, 0, t_s, {}, {}, 0, {}, bodies};
+  push(std::move(item));
 }
 
 void SessionRecording::received(RecordedTopic topic, std::uint64_t client, double t_s,
                                 std::string_view payload) {
-  push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0, {}});
+  push(Item{topic, 0, t_s, received_json(client, t_s, payload), {}, 0, {}, {}});
 }
 
 void SessionRecording::event(EventLevel level, std::string_view kind, std::string_view message,
@@ -335,7 +351,7 @@ void SessionRecording::event(EventLevel level, std::string_view kind, std::strin
                   {"message", message},
                   {"client", client ? json(client) : json(nullptr)}};
   push(Item{
-      RecordedTopic::kEvents, 0, t_s, j.dump(-1, ' ', false, json::error_handler_t::replace), {}, 0, {}});
+      RecordedTopic::kEvents, 0, t_s, j.dump(-1, ' ', false, json::error_handler_t::replace), {}, 0, {}, {}});
 }
 
 void SessionRecording::writer_thread() {
@@ -360,6 +376,11 @@ void SessionRecording::writer_thread() {
           platform::telemetry_to_json(params_.telemetry, sample, json_text);
           mcap_->write(channel, item.log_ns, item.log_ns, json_text);
           if (csv_) csv_->append(sample);
+          write_transforms(item);
+        } else if (item.topic == RecordedTopic::kRobotScene) {
+          if (scene_written_ == item.bodies) continue;  // unchanged: the viewer keeps what it has
+          mcap_->write(channel, item.log_ns, item.log_ns, frames_->scene_update_json(item.bodies, item.t_s));
+          scene_written_ = item.bodies;
         } else {
           mcap_->write(channel, item.log_ns, item.log_ns, item.payload);
         }
@@ -377,6 +398,21 @@ void SessionRecording::writer_thread() {
   } catch (const std::exception& e) {
     abandon(e.what());
   }
+}
+
+void SessionRecording::write_transforms(const Item& item) {
+  if (!frames_) return;
+  // The samples on a grid kTransformsRate_Hz apart, within half a telemetry period (the loop's
+  // times are not exact multiples): a lost sample's next one stands in for it and the grid goes
+  // on; a time far off the grid (a rebuilt platform's loop) starts a new one.
+  constexpr double period_s = 1.0 / kTransformsRate_Hz, slack_s = 0.5e-3;
+  const double t = item.t_s;
+  if (next_tf_t_s_ && t < *next_tf_t_s_ - slack_s && t > *next_tf_t_s_ - 1.5 * period_s) return;
+  frames_->transforms_json(item.sample, tf_json_);
+  // At the sample's own log time: a reader finds the telemetry the frames came from.
+  mcap_->write(channel_[index(RecordedTopic::kTransforms)], item.log_ns, item.log_ns, tf_json_);
+  const bool on_grid = next_tf_t_s_ && t >= *next_tf_t_s_ - slack_s && t < *next_tf_t_s_ + period_s - slack_s;
+  next_tf_t_s_ = (on_grid ? *next_tf_t_s_ : t) + period_s;
 }
 
 void SessionRecording::write_video(const Item& item) {

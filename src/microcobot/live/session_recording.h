@@ -7,6 +7,10 @@
 ///   /platform/status, /platform/scene, /console/feedback   what the server published
 ///   /console/command, /console/action   what the clients sent: `{"t_s", "client", "message"}`
 ///   /events   state changes and errors: `{"t_s", "level", "kind", "message", "client"}`
+///   /tf (foxglove.FrameTransforms) the robot's frames (live/robot_frames.h) of the telemetry
+///   samples kTransformsRate_Hz apart, and /robot/scene (foxglove.SceneUpdate) its bodies at the
+///   start and whenever they change: Foxglove's 3D panel replays the robot from the file. Both
+///   are computed by the writer from what the recording holds, with the server's schemas.
 ///   /camera/video (foxglove.CompressedVideo, H.264) or /camera/image/compressed (CDR JPEG), with
 ///   /camera/camera_info (CDR) and /camera/state (JSON): every frame of the camera, when the
 ///   platform has one and the recording keeps it (live/recorded_video.h, live/camera_messages.h)
@@ -47,6 +51,7 @@
 #include "microcobot/devices/camera_frame.h"
 #include "microcobot/live/h264_encoder.h"
 #include "microcobot/live/recorded_video.h"
+#include "microcobot/live/robot_frames.h"
 #include "microcobot/platform/platform.h"
 
 namespace mc {
@@ -65,6 +70,8 @@ enum class RecordedTopic : std::uint8_t {
   kCommand,
   kAction,
   kEvents,
+  kTransforms,   ///< /tf, written by the writer from the telemetry (never pushed)
+  kRobotScene,   ///< /robot/scene: pushed as its bodies, written when they change
   kCameraImage,  ///< the frame: its JPEG message, or its samples for the H.264 encoder
   kCameraInfo,
   kCameraState,
@@ -85,6 +92,9 @@ struct SessionRecordingParams {
   std::filesystem::path out_dir;        ///< where recordings go
   bool csv = false;                     ///< also the telemetry as <stem>.csv (`serve --record-csv`)
   platform::TelemetrySchema telemetry;  ///< the telemetry's channels (LivePlatform::telemetry_schema())
+  /// The parallel positioner's geometry (`positioner: parallel`): its base, legs and platform in
+  /// the recorded /tf and /robot/scene, as the live channels have them.
+  std::optional<motion::ParallelGeometryParams> positioner_geometry;
   /// /platform/status, /platform/scene, /console/feedback as the server advertises them.
   RecordedSchema status, scene, feedback;
   std::string version;      ///< the program's, e.g. "microcobot 0.1.0"
@@ -117,6 +127,10 @@ class SessionRecording {
   /// a second (`serve` recovers the rest at start). Not synced to the disk: a power cut may also
   /// lose what the system had not written yet.
   static constexpr std::uint64_t kChunkSpan_ns = 500'000'000;
+  /// The rate of /tf in a recording: one telemetry sample's frames every 10 ms. Every sample's
+  /// (1 kHz) would add half to nearly all of the file again for a replay a viewer draws at its
+  /// screen's rate (docs/console.md, "Recordings", Size: measured).
+  static constexpr double kTransformsRate_Hz = 100.0;
 
   explicit SessionRecording(SessionRecordingParams params);
   /// An unstopped recording is abandoned (its temporary files removed).
@@ -161,6 +175,10 @@ class SessionRecording {
   /// never waits for the encoder.
   void published_frame(double t_s, const devices::CameraFrame& frame, std::string_view image,
                        std::string_view info, std::string_view state);
+  /// The robot's bodies now (any thread; cheap: the writer compares them with the last it wrote
+  /// and writes /robot/scene only at the first and when they change). Nothing without the
+  /// stage's channels in the telemetry (RobotFrames::fits).
+  void robot_bodies(double t_s, const RobotBodies& bodies);
   /// A message a client sent on /console/command or /console/action, accepted or not.
   void received(RecordedTopic topic, std::uint64_t client, double t_s, std::string_view payload);
   /// An event (client 0: none).
@@ -181,17 +199,20 @@ class SessionRecording {
     std::size_t count = 0;
     struct Shape {
       int width = 0, height = 0, channels = 0;
-    } shape;  // a frame to encode
+    } shape;             // a frame to encode
+    RobotBodies bodies;  // the scene's
   };
   void push(Item&& item) { push(std::span<Item>(&item, 1)); }
   void push(std::span<Item> items);  // all or none
   void writer_thread();
+  void write_transforms(const Item& telemetry);
   void write_video(const Item& item);
   void write_packet(const H264Packet& packet);
   void abandon(const std::string& why);
 
   SessionRecordingParams params_;
-  std::mutex control_mutex_;  // start/stop
+  std::optional<RobotFrames> frames_;  // when the telemetry has the stage's channels
+  std::mutex control_mutex_;           // start/stop
 
   mutable std::mutex mutex_;  // the queue and the state below
   std::condition_variable wake_;
@@ -212,6 +233,9 @@ class SessionRecording {
   std::unique_ptr<H264Encoder> encoder_;  // with h264
   std::string video_message_;
   double last_keyframe_t_s_ = -1.0;
+  std::optional<double> next_tf_t_s_;         // the telemetry time of the next /tf
+  std::optional<RobotBodies> scene_written_;  // the bodies of the last /robot/scene written
+  std::string tf_json_;
   std::array<std::uint16_t, static_cast<std::size_t>(RecordedTopic::kCount)> channel_{};
   std::string error_;  // why the writer gave up
 };

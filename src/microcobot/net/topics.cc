@@ -116,6 +116,8 @@ dds_qos_t* make_qos(const TopicSpec& spec) {
   return qos;
 }
 
+dds_qos_t* make_state_qos() { return make_qos(topic(Channel::kMeasuredPose)); }
+
 const dds_topic_descriptor_t* descriptor(RosType type) {
   switch (type) {
     case RosType::kPoseStamped:

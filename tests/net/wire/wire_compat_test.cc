@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "net/net_test_support.h"
+#include "net/wire/wire_test_support.h"
 #include "support/test_support.h"
 
 namespace mc {
@@ -27,6 +28,9 @@ namespace {
 
 using nlohmann::json;
 using test::TempDir;
+using wire::json_lines;
+using wire::Reaper;
+using wire::system_ns;
 
 constexpr char kPoseType[] = "geometry_msgs::msg::dds_::PoseStamped_";
 constexpr char kJointType[] = "sensor_msgs::msg::dds_::JointState_";
@@ -53,36 +57,6 @@ bool on_gripper_pattern(double opening) {
   }
   return false;
 }
-
-std::int64_t system_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-std::vector<json> json_lines(const std::string& text) {
-  std::vector<json> lines;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty()) lines.push_back(json::parse(line));
-  }
-  return lines;
-}
-
-// Kills (SIGKILL) and reaps the children still running when the test ends early.
-struct Reaper {
-  std::vector<pid_t> pids;
-  ~Reaper() {
-    for (pid_t p : pids) {
-      int status = 0;
-      if (::waitpid(p, &status, WNOHANG) == 0) {
-        ::kill(p, SIGKILL);
-        ::waitpid(p, &status, 0);
-      }
-    }
-  }
-};
 
 struct Listener {
   std::string topic, type;
@@ -338,6 +312,8 @@ TEST(WireCompat, ACProgramReadsTheSlavesFramesOnTf) {
   ::kill(slave, SIGTERM);
   EXPECT_EQ(test::wait_process(slave, std::chrono::seconds(30)), 0) << test::read_text(dir / "slave.err");
   EXPECT_NE(test::read_text(dir / "slave.err").find("ROS 2 topic /tf"), std::string::npos);
+  // Without a parallel positioner no pose of it is published.
+  EXPECT_EQ(test::read_text(dir / "slave.err").find("/microcobot/slave/positioner/pose"), std::string::npos);
 
   const std::vector<json> samples = json_lines(test::read_text(dir / "listener.out"));
   ASSERT_EQ(samples.size(), 10u);
