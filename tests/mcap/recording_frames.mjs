@@ -6,7 +6,8 @@
 // comes at 100 Hz, each at the log time of a telemetry sample of the same file whose channels it
 // carries (the tool at the measured position, the gripper turned by the measured angle, the
 // fingers +-half the measured opening, the positioner at its measured pose as q = qz qy qx); the
-// tool moves; one /robot/scene (the scene did not change), before the first /tf; `recording
+// tool moves; one /robot/scene (the scene did not change: the fingers, the part, the positioner's
+// base, carriages, legs and platform, each in a frame /tf gives), before the first /tf; `recording
 // info` lists both channels; a copy cut mid-file and recovered (`recording recover`) keeps them.
 //
 // Usage: MC_CLI=path/to/microcobot node --experimental-websocket recording_frames.mjs
@@ -180,7 +181,13 @@ try {
     if (whole.tf.length && whole.scenes[0].logTime > whole.tf[0].logTime + 300000000n)
       fail("the scene came more than 0.3 s after the first frames");
     const ids = whole.scenes[0].j.entities.map((e) => e.id).sort().join(",");
-    if (ids !== "finger_left,finger_right,part") fail(`the scene draws ${ids}`);
+    // The fingers and the part, and the parallel positioner's base, carriages, legs and platform.
+    const expected = "carriage_0,carriage_1,carriage_2,finger_left,finger_right,leg_0,leg_1,leg_2,part,positioner,positioner_base";
+    if (ids !== expected) fail(`the scene draws ${ids}, not ${expected}`);
+    // Every body's frame is one the recorded /tf places (a replay draws each where it is).
+    const placed = new Set(["world", ...whole.tf.flatMap((m) => m.j.transforms.map((t) => t.child_frame_id))]);
+    const unplaced = whole.scenes[0].j.entities.filter((e) => !placed.has(e.frame_id)).map((e) => `${e.id} in ${e.frame_id}`);
+    if (unplaced.length) fail(`bodies in frames the recorded /tf never gives: ${unplaced.join(", ")}`);
   }
 
   // `recording info` lists both channels with their counts.
