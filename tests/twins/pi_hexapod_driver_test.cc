@@ -234,6 +234,28 @@ TEST(DriverTwin, PiHexapodStopsTheTwinsMoveAndHoldsWhereItStopped) {
   EXPECT_NEAR(twin_pose(twin.port)[0], 0.05, 1e-3);
 }
 
+TEST(DriverTwin, PiHexapodAStopWhileHoldingKeepsTheHeldPoseSoAMovePlannedFromItStarts) {
+  // A vendor client's move is planned from the pose the platform published; the hand-over to that
+  // client holds the platform first (Platform::hold: a stop). Holding already, the stop must not
+  // hold again where the sensors read (a nanometre away): the planned move would not start.
+  HexapodTwinProcess twin;
+  ASSERT_NE(twin.port, 0) << test::read_text(twin.cli.err);
+  HexapodPlatform h(twin.port);
+  ASSERT_TRUE(h.run_until(10.0, [&] { return h.positioner().at_rest(); }));
+  const motion::PlatformTransform held = h.positioner().reference_pose();
+  motion::PoseTrajectory planned(held, transform_of({0.01, 0, 0, 0, 0, 0}),
+                                 h.p->config().parallel_positioner.move);
+  ASSERT_TRUE(motion::check_move(h.positioner().kinematics(), planned).ok);
+  h.p->stop_pose_move();
+  h.run_until(0.3, [] { return false; });  // bus cycles read the pose again meanwhile
+  EXPECT_EQ(h.positioner().reference_pose().d, held.d);
+  EXPECT_EQ(h.positioner().reference_pose().R, held.R);
+  ASSERT_TRUE(h.p->start_pose_move(planned)) << "the move planned from the held pose did not start";
+  ASSERT_TRUE(h.run_until(30.0, [&] { return h.positioner().at_rest() || h.p->faulted(); }));
+  EXPECT_FALSE(h.p->faulted());
+  EXPECT_NEAR(twin_pose(twin.port)[0], 0.01, 1e-3);
+}
+
 TEST(DriverTwin, PiHexapodTheEstopStopsTheTwinsMoveAndTheResetMovesAgain) {
   HexapodTwinProcess twin;
   ASSERT_NE(twin.port, 0) << test::read_text(twin.cli.err);

@@ -54,6 +54,13 @@ bool PiHexapod::start_move(const motion::PoseTrajectory& checked) noexcept {
 }
 
 void PiHexapod::stop() noexcept {
+  // Already holding: the held pose stays exactly what it is, so that a move planned from it still
+  // starts (a stop would hold again where the sensors read, a nanometre away), as the simulated
+  // positioner does (motion::ParallelStage::stop).
+  if (moving()) send_stop();
+}
+
+void PiHexapod::send_stop() noexcept {
   if (stop_seq_ > status_.stop_done) return;  // one stop at a time: it drops every move before it
   stop_seq_ = ++seq_;
   controller_->request_stop(stop_seq_);

@@ -10,10 +10,10 @@
 /// The controller plans and runs each pose move itself: start_move() hands the checked
 /// trajectory's goal (and its tool point's speed, as VLS) to the bus thread, which sends it as
 /// `MOV X Y Z U V W`; the pose comes back from `POS?`, moving from `#5`, on target from `ONT?`
-/// (drivers/pi_hexapod_controller.h). stop() and the safe state send `#24`. A fault of the bus (a
-/// reply later than the timeout, a lost connection, a controller error, a reply that does not
-/// parse) faults the device at its next update(), and the platform puts every device in its safe
-/// state; the next configure() (the platform's reset) reconnects.
+/// (drivers/pi_hexapod_controller.h). The safe state sends `#24`, and stop() while a move runs (holding, it
+/// keeps the held pose). A fault of the bus (a reply later than the timeout, a lost connection, a controller
+/// error, a reply that does not parse) faults the device at its next update(), and the platform puts every
+/// device in its safe state; the next configure() (the platform's reset) reconnects.
 ///
 /// The loop's side (update, start_move, stop, enter_safe_state and the getters) neither allocates,
 /// locks, throws nor does I/O: a ring push, atomics and a triple-buffer read.
@@ -38,7 +38,7 @@ class PiHexapod final : public devices::ParallelPositioner {
   /// Takes the bus thread's newest status; faults the device once the bus faulted.
   void update(double dt_s) noexcept override;
   /// Stops the controller (#24): every queued move dropped, the hexapod holding where it stops.
-  void enter_safe_state() noexcept override { stop(); }
+  void enter_safe_state() noexcept override { send_stop(); }  // #24 whatever it was doing
 
   const motion::ParallelKinematics& kinematics() const noexcept override { return kinematics_; }
   /// Sends `checked`'s goal (MOV) and its speed (VLS, mm/s of the tool point's max_speed_m_s):
@@ -63,6 +63,8 @@ class PiHexapod final : public devices::ParallelPositioner {
   void on_configure() override;
 
  private:
+  /// `#24` through the bus thread (one at a time).
+  void send_stop() noexcept;
   std::shared_ptr<PiHexapodController> controller_;
   motion::ParallelKinematics kinematics_;
   HexapodStatus status_;        ///< the loop's copy of the bus thread's newest
