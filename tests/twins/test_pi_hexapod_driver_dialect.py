@@ -168,7 +168,7 @@ def test_the_drivers_lines_are_pipythons():
         # The platform on the driver, through the stand-in; its own twin lets a vendor client move it.
         platform, ports = start_serve(
             ["--emulate", "gcs2-hexapod=127.0.0.1:0"],
-            "positioner: parallel\nparallel_positioner: {driver: pi-hexapod, connection: \"127.0.0.1:%d\"}\n"
+            "positioner: parallel\nparallel_positioner: {driver: pi-hexapod, connection: \"127.0.0.1:%d,timeout_s=1,stale_s=0.5\"}\n"
             % stand_in.port, tempfile.mkdtemp(prefix="mc_driver_"))
         client = RawGcs(ports["gcs2-hexapod"])
         try:

@@ -12,6 +12,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
+#include <algorithm>
 
 #include <array>
 #include <cmath>
@@ -182,9 +183,15 @@ TEST(WireCompat, ACProgramReadsTheParallelPositionersPoseAtHome) {
     for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(o[i], q[i], 3e-7) << i << " " << m;
     EXPECT_NEAR(std::hypot(std::hypot(o[0], o[1]), std::hypot(o[2], o[3])), 1.0, 1e-12) << m;
   }
-  // Every loop sample's pose, not the console's 60 Hz (which would take 5 s); best effort: the
-  // listener may lose a few, and a loop under a sanitizer runs late.
-  EXPECT_LT(1e-9 * static_cast<double>(stamp_ns(samples.back()) - stamp_ns(samples.front())), 2.5);
+  // Every loop sample's pose (1 ms apart), not the console's 60 Hz (17 ms apart): the median gap
+  // between two stamps, which a late loop's few long gaps (a sanitizer, a loaded machine) and the
+  // listener's few losses leave in place.
+  std::vector<double> gaps_s;
+  for (std::size_t i = 1; i < samples.size(); ++i)
+    gaps_s.push_back(1e-9 * static_cast<double>(stamp_ns(samples[i]) - stamp_ns(samples[i - 1])));
+  std::nth_element(gaps_s.begin(), gaps_s.begin() + static_cast<std::ptrdiff_t>(gaps_s.size() / 2),
+                   gaps_s.end());
+  EXPECT_LT(gaps_s[gaps_s.size() / 2], 8e-3) << "the poses come at the console's rate, not the loop's";
 
   // /tf's `world -> positioner` is the same pose.
   int seen = 0;
