@@ -88,6 +88,12 @@ TEST(ConsolePoseGoal, AGoalOutOfReachIsRefusedOnceWithItsReasonAndNothingIsSent)
   const auto again = planner.on_command(goal_command({0.02, 0, 0, 0, 0, 0}), v);
   EXPECT_FALSE(again.push);
   EXPECT_TRUE(again.refusal.empty()) << "told once per goal, not at the command rate";
+  // Goals of any size are refused at once, by the goal's own check (no path sampled to them).
+  for (const double huge : {1e3, 1e300}) {
+    const auto far = planner.on_command(goal_command({huge, 0, 0, 0, 0, huge}), v);
+    EXPECT_FALSE(far.push);
+    EXPECT_NE(far.refusal.find("unreachable"), std::string::npos) << far.refusal;
+  }
   // A push the ring refused is planned again with the next command.
   const auto planned = planner.on_command(goal_command({1e-4, 0, 0, 0, 0, 0}), v);
   ASSERT_TRUE(planned.push);

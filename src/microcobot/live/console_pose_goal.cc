@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include "microcobot/motion/parallel_workspace.h"
 #include "microcobot/motion/pose.h"
 
 namespace mc::live {
@@ -57,6 +58,15 @@ ConsolePoseGoal::Step ConsolePoseGoal::on_command(const ConsoleCommand& c, const
   }
   if (same_pose(v.reference, goal)) return step;            // arrived
   if (refused_ && same_pose(*refused_, goal)) return step;  // told already
+  // The goal's own check first: it bounds the path's length, and so the samples check_move() takes
+  // along it (a goal a light-year away is refused here, not sampled).
+  const motion::ReachCheck reach = motion::check_pose(kinematics_, goal);
+  if (!reach.ok()) {
+    refused_ = goal;
+    step.refusal = "the goal is unreachable: " + motion::to_string(reach.reach) +
+                   (reach.detail.empty() ? "" : ": " + reach.detail);
+    return step;
+  }
   motion::PoseTrajectory trajectory(v.reference, goal, limits_);
   const motion::MoveCheck check = motion::check_move(kinematics_, trajectory);
   if (!check.ok) {
