@@ -1,7 +1,10 @@
 #pragma once
 // A TwinStage whose state the test sets: what the twins read, and a log of what they asked.
 
+#include <atomic>
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "microcobot/twins/twin_stage.h"
@@ -63,7 +66,12 @@ struct FakeStage : TwinStage {
       log.push_back("release");
     }
   }
-  void heartbeat() override {}
+  /// Milliseconds the next heartbeat blocks the protocol thread: a server starved of the CPU.
+  std::atomic<int> stall_next_heartbeat_ms{0};
+  void heartbeat() override {
+    if (const int ms = stall_next_heartbeat_ms.exchange(0))
+      std::this_thread::sleep_for(std::chrono::milliseconds(ms));
+  }
 };
 
 }  // namespace mc::twins::testing

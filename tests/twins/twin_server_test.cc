@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "fake_stage.h"
 #include "microcobot/core/error.h"
 #include "support/counting_allocator.h"
 #include "twin_rig.h"
@@ -182,6 +183,28 @@ TEST(TwinServer, AHugeLineIsCappedItsRestDiscardedAndTheClientStillServed) {
   EXPECT_EQ(huge.read_until([](const std::string& t) { return drivers::gcs2::reply_complete(t); }), "3\n");
   EXPECT_EQ(huge.gcs("CSV?"), "2.0\n");
   EXPECT_EQ(rig.server->counters().closed_hostile, 0u);
+}
+
+// A line whose rest the client sent in time but the protocol thread, starved of the CPU (a
+// loaded machine, a sanitizer), has not read yet is not a slowloris: the slow one is the server.
+TEST(TwinServer, ALineWhoseRestWaitsUnreadWhileTheServerIsStarvedIsAnswered) {
+  testing::FakeStage fake;
+  TwinServerParams tp;
+  tp.endpoints = {{Protocol::kGcs2, "127.0.0.1", 0}};
+  tp.line_timeout_s = 0.5;
+  TwinServer server(fake, tp);
+  server.start();
+  Client c(server.ports()[0]);
+  EXPECT_EQ(c.gcs("CSV?"), "2.0\n");
+  c.send("ER");  // half a line, read by the server within a heartbeat
+  std::this_thread::sleep_for(100ms);
+  fake.stall_next_heartbeat_ms = 800;  // the protocol thread blocked past the line timeout
+  std::this_thread::sleep_for(100ms);
+  c.send("R?\n");  // the rest, in the kernel before the timeout
+  EXPECT_EQ(c.read_until([](const std::string& t) { return drivers::gcs2::reply_complete(t); }), "0\n")
+      << "closed as a slowloris";
+  EXPECT_EQ(server.counters().closed_hostile, 0u);
+  server.stop();
 }
 
 TEST(TwinServer, TheLoopThreadNeverAllocatesWhileProtocolClientsMoveTheStage) {

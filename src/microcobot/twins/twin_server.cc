@@ -345,16 +345,27 @@ struct TwinServer::Impl {
     s.waiting_axis = anc300.waiting_axis();  // stepw: answered by the housekeeping once it stops
   }
 
+  /// Whether bytes of a session's unfinished line already wait in the kernel for this thread to
+  /// read: then the server, starved of the CPU, is late, not the client. Granted up to four
+  /// timeouts, so that a client streaming a line without end is still closed.
+  bool server_was_late(Session& s, Clock::duration partial_for, Clock::duration line_timeout) {
+    boost::system::error_code ec;
+    const std::size_t waiting = s.socket.available(ec);
+    return !ec && waiting > 0 && partial_for <= 4 * line_timeout;
+  }
+
   void housekeeping() {
     stage.heartbeat();
     const auto now = Clock::now();
-    const auto line_timeout = std::chrono::duration<double>(params.line_timeout_s);
+    const auto line_timeout =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params.line_timeout_s));
     const auto login_timeout = std::chrono::duration<double>(params.login_timeout_s);
     std::vector<std::shared_ptr<Session>> all;
     for (auto& [id, s] : sessions) all.push_back(s);
     for (auto& s : all) {
       if (s->closed) continue;
-      if (!s->line.empty() && now - s->partial_since > line_timeout) {
+      const Clock::duration partial_for = now - s->partial_since;
+      if (!s->line.empty() && partial_for > line_timeout && !server_was_late(*s, partial_for, line_timeout)) {
         hostile(*s);  // slowloris: a line that never ends
         continue;
       }
