@@ -1,35 +1,35 @@
 #include "microcobot/net/camera_image_publisher.h"
 
-#include <string>
-
 #include "microcobot/live/camera_messages.h"
 #include "ros2_messages.h"
 
 namespace mc::net {
 
-CameraImagePublisher::CameraImagePublisher(int domain_id, const NetworkConfig& network)
-    : participant_(domain_id, network) {
-  const dds_entity_t pp = participant_.handle();
-  dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
-  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  topic_ = dds_create_topic(pp, &sensor_msgs_msg_dds__CompressedImage__desc,
-                            std::string(kCameraImageDdsName).c_str(), qos, nullptr);
-  if (topic_ >= 0) writer_ = dds_create_writer(pp, topic_, qos, nullptr);
-  dds_delete_qos(qos);
-  check_dds(topic_, "camera images: cannot create the topic");
-  check_dds(writer_, "camera images: cannot create the writer");
-  // The publication-matched status is read by wanted(); it need not wake anyone.
-  check_dds(dds_set_status_mask(writer_, DDS_PUBLICATION_MATCHED_STATUS), "camera images: status mask");
+namespace {
+
+// As ROS 2's sensor-data profile: best effort, volatile, keep last 1.
+QosPtr sensor_data_qos() {
+  QosPtr qos(dds_create_qos());
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  return qos;
 }
 
-// The participant's deletion (its destructor) deletes the topic and the writer with it.
-CameraImagePublisher::~CameraImagePublisher() = default;
+}  // namespace
+
+CameraImagePublisher::CameraImagePublisher(int domain_id, const NetworkConfig& network)
+    : participant_(domain_id, network),
+      writer_(participant_.handle(), sensor_msgs_msg_dds__CompressedImage__desc, kCameraImageDdsName,
+              sensor_data_qos().get(), "camera images") {
+  // The publication-matched status is read by wanted(); it need not wake anyone.
+  check_dds(dds_set_status_mask(writer_.writer(), DDS_PUBLICATION_MATCHED_STATUS),
+            "camera images: status mask");
+}
 
 bool CameraImagePublisher::wanted() const {
   dds_publication_matched_status_t status{};
-  if (dds_get_publication_matched_status(writer_, &status) < 0) return false;
+  if (dds_get_publication_matched_status(writer_.writer(), &status) < 0) return false;
   return status.current_count > 0;
 }
 
@@ -46,12 +46,7 @@ bool CameraImagePublisher::publish(const devices::CameraFrame& frame, double t_s
   m.data_._length = static_cast<std::uint32_t>(frame.jpeg.size());
   m.data_._maximum = m.data_._length;
   m.data_._release = false;
-  if (dds_write(writer_, &m) < 0) {
-    ++failures_;
-    return false;
-  }
-  ++published_;
-  return true;
+  return writer_.write(&m);
 }
 
 }  // namespace mc::net

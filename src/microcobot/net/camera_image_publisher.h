@@ -18,6 +18,7 @@
 
 #include "microcobot/devices/camera_frame.h"
 #include "microcobot/net/participant.h"
+#include "microcobot/net/topic_writer.h"
 
 namespace mc::net {
 
@@ -30,7 +31,6 @@ class CameraImagePublisher {
   /// A participant of its own on `domain_id` with the link's network configuration. Throws
   /// InvalidParams / ComputationFailed as Participant does.
   CameraImagePublisher(int domain_id, const NetworkConfig& network);
-  ~CameraImagePublisher();
   CameraImagePublisher(const CameraImagePublisher&) = delete;
   CameraImagePublisher& operator=(const CameraImagePublisher&) = delete;
 
@@ -40,13 +40,12 @@ class CameraImagePublisher {
   /// Returns false when DDS refused the write (counted in failures()).
   bool publish(const devices::CameraFrame& frame, double t_s);
 
-  std::uint64_t published() const { return published_; }
-  std::uint64_t failures() const { return failures_; }
+  std::uint64_t published() const { return writer_.written(); }
+  std::uint64_t failures() const { return writer_.failures(); }
 
  private:
   Participant participant_;
-  dds_entity_t topic_ = 0, writer_ = 0;
-  std::uint64_t published_ = 0, failures_ = 0;  // camera thread
+  TopicWriter writer_;  // written on the camera thread
 };
 
 }  // namespace mc::net

@@ -4,9 +4,9 @@
 /// part's carrier as it follows the stage's tool on /microcobot/slave/pose:
 ///
 ///   /microcobot/slave/positioner/pose   DDS rt/microcobot/slave/positioner/pose
-///   geometry_msgs::msg::dds_::PoseStamped_   frame_id "positioner_base"
+///   geometry_msgs::msg::dds_::PoseStamped_   frame_id "world"
 ///
-/// The pose is the platform {P} in the positioner's base {H} as its legs' sensors measure it (the
+/// The pose is the platform {P} in the positioner's home frame {H} as its legs' sensors measure it (the
 /// telemetry's positioner_* channels): position in metres, orientation R = Rz(rz) Ry(ry) Rx(rx) as
 /// the unit quaternion q = qz(rz) qy(ry) qx(rx) (the `world -> positioner` transform of /tf,
 /// live/robot_frames.h; the base is the world's origin). Published with every telemetry sample
@@ -21,12 +21,14 @@
 
 #include "microcobot/live/robot_frames.h"
 #include "microcobot/net/participant.h"
+#include "microcobot/net/topic_writer.h"
 #include "microcobot/platform/telemetry_schema.h"
 
 namespace mc::net {
 
-/// The positioner's base frame, the pose's header.frame_id.
-inline constexpr std::string_view kPositionerBaseFrame = "positioner_base";
+/// The pose's header.frame_id: /tf's `world`, the positioner's home frame {H} (not
+/// `positioner_base`, its base {B}, which /tf puts h + o below).
+inline constexpr std::string_view kPositionerPoseFrame = "world";
 
 class PositionerPosePublisher {
  public:
@@ -37,21 +39,19 @@ class PositionerPosePublisher {
   /// ComputationFailed as Participant does.
   PositionerPosePublisher(int domain_id, const NetworkConfig& network,
                           const platform::TelemetrySchema& schema);
-  ~PositionerPosePublisher();
   PositionerPosePublisher(const PositionerPosePublisher&) = delete;
   PositionerPosePublisher& operator=(const PositionerPosePublisher&) = delete;
 
   /// Writes the pose of sample `s`. Returns false when DDS refused the write (counted).
   bool publish(const platform::TelemetrySample& s);
 
-  std::uint64_t published() const { return published_; }
-  std::uint64_t failures() const { return failures_; }
+  std::uint64_t published() const { return writer_.written(); }
+  std::uint64_t failures() const { return writer_.failures(); }
 
  private:
   Participant participant_;
   live::RobotFrames frames_;
-  dds_entity_t topic_ = 0, writer_ = 0;
-  std::uint64_t published_ = 0, failures_ = 0;  // drain thread
+  TopicWriter writer_;  // written on the drain thread
 };
 
 }  // namespace mc::net

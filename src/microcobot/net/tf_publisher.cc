@@ -8,24 +8,25 @@
 
 namespace mc::net {
 
-TfPublisher::TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema,
-                         const motion::ParallelGeometryParams* positioner)
-    : participant_(domain_id, network), frames_(schema, positioner) {
-  const dds_entity_t pp = participant_.handle();
-  dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 100);
-  topic_ =
-      dds_create_topic(pp, &tf2_msgs_msg_dds__TFMessage__desc, std::string(kTfDdsName).c_str(), qos, nullptr);
-  if (topic_ >= 0) writer_ = dds_create_writer(pp, topic_, qos, nullptr);
-  dds_delete_qos(qos);
-  check_dds(topic_, "frames: cannot create the /tf topic");
-  check_dds(writer_, "frames: cannot create the /tf writer");
+namespace {
+
+// As tf2_ros's TransformBroadcaster: reliable, volatile, keep last 100.
+QosPtr tf_qos() {
+  QosPtr qos(dds_create_qos());
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 100);
+  return qos;
 }
 
-// The participant's deletion (its destructor) deletes the topic and the writer with it.
-TfPublisher::~TfPublisher() = default;
+}  // namespace
+
+TfPublisher::TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema,
+                         const motion::ParallelGeometryParams* positioner)
+    : participant_(domain_id, network),
+      frames_(schema, positioner),
+      writer_(participant_.handle(), tf2_msgs_msg_dds__TFMessage__desc, kTfDdsName, tf_qos().get(),
+              "frames") {}
 
 bool TfPublisher::publish(const platform::TelemetrySample& s) {
   live::FrameTransforms f;
@@ -48,12 +49,7 @@ bool TfPublisher::publish(const platform::TelemetrySample& s) {
   m.transforms_._length = static_cast<std::uint32_t>(n);
   m.transforms_._maximum = m.transforms_._length;
   m.transforms_._release = false;
-  if (dds_write(writer_, &m) < 0) {
-    ++failures_;
-    return false;
-  }
-  ++published_;
-  return true;
+  return writer_.write(&m);
 }
 
 }  // namespace mc::net

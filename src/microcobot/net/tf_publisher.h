@@ -17,6 +17,7 @@
 
 #include "microcobot/live/robot_frames.h"
 #include "microcobot/net/participant.h"
+#include "microcobot/net/topic_writer.h"
 
 namespace mc::net {
 
@@ -32,21 +33,19 @@ class TfPublisher {
   /// Participant does.
   TfPublisher(int domain_id, const NetworkConfig& network, const platform::TelemetrySchema& schema,
               const motion::ParallelGeometryParams* positioner = nullptr);
-  ~TfPublisher();
   TfPublisher(const TfPublisher&) = delete;
   TfPublisher& operator=(const TfPublisher&) = delete;
 
   /// Writes the frames of sample `s`. Returns false when DDS refused the write (counted).
   bool publish(const platform::TelemetrySample& s);
 
-  std::uint64_t published() const { return published_; }
-  std::uint64_t failures() const { return failures_; }
+  std::uint64_t published() const { return writer_.written(); }
+  std::uint64_t failures() const { return writer_.failures(); }
 
  private:
   Participant participant_;
   live::RobotFrames frames_;
-  dds_entity_t topic_ = 0, writer_ = 0;
-  std::uint64_t published_ = 0, failures_ = 0;  // drain thread
+  TopicWriter writer_;  // written on the drain thread
 };
 
 }  // namespace mc::net

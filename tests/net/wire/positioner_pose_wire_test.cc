@@ -4,7 +4,7 @@
 // /microcobot/slave/positioner/pose (geometry_msgs/msg/PoseStamped) and /tf once the legs have
 // settled at home after power-up. The pose is the one the platform reports through its PI C-887
 // twin's GCS port (`--emulate gcs2-hexapod`, POS?: a query takes no control), at the home pose, in
-// the positioner's base, at a state topic's 1 kHz, stamped with ROS time; /tf's
+// the positioner's home frame (/tf's `world`), at a state topic's 1 kHz, stamped with ROS time; /tf's
 // `world -> positioner` agrees. The quaternion's formula away from the identity is
 // RobotFrames.TheParallelPositionersPoseIsItsZyxRotationAsAQuaternion's (the same transforms()).
 
@@ -170,7 +170,7 @@ TEST(WireCompat, ACProgramReadsTheParallelPositionersPoseAtHome) {
   std::int64_t last_ns = 0;
   for (const json& m : samples) {
     EXPECT_EQ(m["type"], kPoseType) << m;
-    EXPECT_EQ(m["frame_id"], "positioner_base") << m;
+    EXPECT_EQ(m["frame_id"], "world") << m;  // /tf's frame of `world -> positioner`
     const std::int64_t ns = stamp_ns(m);
     EXPECT_GE(ns, t0) << m;
     EXPECT_LE(ns, t1) << m;
