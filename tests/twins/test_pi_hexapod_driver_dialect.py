@@ -10,14 +10,10 @@ transcript checks (test_gcs2_hexapod.py), answered each (ERR? 0 throughout)."""
 
 import os
 import re
-import signal
-import socket
-import subprocess
 import tempfile
-import threading
 import time
 
-from twin_clients import RawGcs, read_transcript
+from twin_clients import RawGcs, RecordingStandIn, read_transcript, start_serve, stop
 
 DATA = os.path.join(os.path.dirname(__file__), "..", "data", "gcs2_hexapod")
 AXES = "XYZUVW"
@@ -61,97 +57,6 @@ def transcript_forms():
             mnemonic, _, args = line.partition(" ")
             forms.setdefault(mnemonic, set()).add(form(mnemonic, args))
     return forms
-
-
-class RecordingStandIn:
-    """Relays one client to `port` on loopback and keeps every byte the client sent."""
-
-    def __init__(self, port):
-        self.target = port
-        self.listener = socket.create_server(("127.0.0.1", 0))
-        self.port = self.listener.getsockname()[1]
-        self.sent = bytearray()
-        self.lock = threading.Lock()
-        self.threads = []
-        threading.Thread(target=self._accept, daemon=True).start()
-
-    def _accept(self):
-        while True:
-            try:
-                client, _ = self.listener.accept()
-            except OSError:
-                return
-            upstream = socket.create_connection(("127.0.0.1", self.target))
-            for src, dst, keep in ((client, upstream, True), (upstream, client, False)):
-                t = threading.Thread(target=self._pump, args=(src, dst, keep), daemon=True)
-                t.start()
-                self.threads.append(t)
-
-    def _pump(self, src, dst, keep):
-        try:
-            while True:
-                chunk = src.recv(4096)
-                if not chunk:
-                    break
-                if keep:
-                    with self.lock:
-                        self.sent += chunk
-                dst.sendall(chunk)
-        except OSError:
-            pass
-        finally:
-            for s in (src, dst):
-                try:
-                    s.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass
-
-    def lines(self):
-        """What the client sent: LF-terminated lines, the single bytes 5, 7 and 24 as #5, #7, #24."""
-        with self.lock:
-            data = bytes(self.sent)
-        out, line = [], bytearray()
-        for b in data:
-            if b in (5, 7, 24) and not line:
-                out.append(f"#{b}")
-            elif b == 10:
-                out.append(line.decode("latin-1"))
-                line = bytearray()
-            else:
-                line.append(b)
-        return out
-
-    def close(self):
-        self.listener.close()
-
-
-def start_serve(args, config_text, out):
-    cli = os.environ.get("MC_CLI")
-    if not cli:
-        raise RuntimeError("MC_CLI not set (run through ctest)")
-    config = os.path.join(out, "config.yaml")
-    with open(config, "w", encoding="utf-8") as f:
-        f.write(config_text)
-    proc = subprocess.Popen([cli, "serve", "--listen", "127.0.0.1:0", "--out", out, "--config", config] + args,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    url = proc.stdout.readline()
-    assert url.startswith("http"), (url, proc.stderr.read() if proc.poll() is not None else "")
-    ports = {}
-    for _ in [a for a in args if a == "--emulate"]:
-        words = proc.stdout.readline().split()
-        assert len(words) == 3 and words[0] == "emulate", words
-        ports[words[1]] = int(words[2].rsplit(":", 1)[1])
-    return proc, ports
-
-
-def stop(proc):
-    proc.send_signal(signal.SIGINT)
-    try:
-        proc.wait(timeout=30)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        raise
-    assert proc.returncode == 0, proc.stderr.read()
 
 
 def ask(c, line, lines=1):

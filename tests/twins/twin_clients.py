@@ -1,5 +1,6 @@
 """Shared helpers of the twins' client tests: a `microcobot serve --emulate` process on
-loopback port 0, and the golden-transcript player (tests/data/gcs2/*.txt, syntax in their headers)."""
+loopback port 0, the golden-transcript player (tests/data/gcs2/*.txt, syntax in their headers), and
+the recording stand-in that relays a driver to a twin and keeps what the driver sent."""
 
 import os
 import re
@@ -7,6 +8,7 @@ import signal
 import socket
 import subprocess
 import tempfile
+import threading
 import time
 
 
@@ -140,3 +142,97 @@ def replay_over_pyvisa(port, path, timeout_s=10.0):
     finally:
         inst.close()
         rm.close()
+
+
+class RecordingStandIn:
+    """Relays one client to `port` on loopback and keeps every byte the client sent."""
+
+    def __init__(self, port):
+        self.target = port
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self.listener.getsockname()[1]
+        self.sent = bytearray()
+        self.lock = threading.Lock()
+        self.threads = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self):
+        while True:
+            try:
+                client, _ = self.listener.accept()
+            except OSError:
+                return
+            upstream = socket.create_connection(("127.0.0.1", self.target))
+            for src, dst, keep in ((client, upstream, True), (upstream, client, False)):
+                t = threading.Thread(target=self._pump, args=(src, dst, keep), daemon=True)
+                t.start()
+                self.threads.append(t)
+
+    def _pump(self, src, dst, keep):
+        try:
+            while True:
+                chunk = src.recv(4096)
+                if not chunk:
+                    break
+                if keep:
+                    with self.lock:
+                        self.sent += chunk
+                dst.sendall(chunk)
+        except OSError:
+            pass
+        finally:
+            for s in (src, dst):
+                try:
+                    s.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
+
+    def lines(self, single_bytes=(5, 7, 24)):
+        """What the client sent: its lines (LF-terminated, a CR before the LF dropped), and each of
+        `single_bytes` sent between lines as #<byte> (GCS 2.0's #5, #7, #24)."""
+        with self.lock:
+            data = bytes(self.sent)
+        out, line = [], bytearray()
+        for b in data:
+            if b in single_bytes and not line:
+                out.append(f"#{b}")
+            elif b == 10:
+                out.append(line.decode("latin-1").removesuffix("\r"))
+                line = bytearray()
+            else:
+                line.append(b)
+        return out
+
+    def close(self):
+        self.listener.close()
+
+
+def start_serve(args, config_text, out):
+    """`microcobot serve` with `config_text` as its configuration and `args`; returns the process and
+    the ports of its `--emulate` twins by protocol."""
+    cli = os.environ.get("MC_CLI")
+    if not cli:
+        raise RuntimeError("MC_CLI not set (run through ctest)")
+    config = os.path.join(out, "config.yaml")
+    with open(config, "w", encoding="utf-8") as f:
+        f.write(config_text)
+    proc = subprocess.Popen([cli, "serve", "--listen", "127.0.0.1:0", "--out", out, "--config", config] + args,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    url = proc.stdout.readline()
+    assert url.startswith("http"), (url, proc.stderr.read() if proc.poll() is not None else "")
+    ports = {}
+    for _ in [a for a in args if a == "--emulate"]:
+        words = proc.stdout.readline().split()
+        assert len(words) == 3 and words[0] == "emulate", words
+        ports[words[1]] = int(words[2].rsplit(":", 1)[1])
+    return proc, ports
+
+
+def stop(proc):
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        raise
+    assert proc.returncode == 0, proc.stderr.read()
