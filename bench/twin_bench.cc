@@ -1,8 +1,10 @@
-// A vendor twin's cost, on the live platform (paced loop) in one run, for the GCS 2.0 twin and the
-// MCS2 twin (the benchmark's second argument, 0 and 1):
+// A vendor twin's cost, on the live platform (paced loop) in one run, for the GCS 2.0 twin, the
+// MCS2 twin and the PI C-887 hexapod twin on the platform with the parallel positioner (the
+// benchmark's second argument, 0, 1 and 2):
 //  - command-to-reply latency of a position query over loopback TCP (four clients polling at
 //    100 Hz): GCS `POS?` (every axis, one line each), MCS2 `:CHAN0:POS?;:CHAN1:POS?;:CHAN2:POS?`
-//    (three replies, one line each);
+//    (three replies, one line each), the hexapod's `POS? X Y Z U V W` (the pose's forward
+//    kinematics from the legs' sensors, six lines);
 //  - the loop's tick time p99 (the telemetry's tick_us) while those four clients poll, against
 //    the same loop with no client, in alternating 40 ms windows (240 of each, 9.6 s each in all):
 //    a machine's hiccup (another tenant, a page-cache flush) lands in either kind alike.
@@ -24,6 +26,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <string>
@@ -67,7 +70,15 @@ const PositionQuery& position_query(mc::twins::Protocol protocol) {
   static const PositionQuery mcs2{":CHAN0:POS?;:CHAN1:POS?;:CHAN2:POS?\r\n", [](const std::string& r) {
                                     return std::count(r.begin(), r.end(), '\n') == 3;
                                   }};
-  return protocol == mc::twins::Protocol::kMcs2 ? mcs2 : gcs2;
+  static const PositionQuery hexapod{"POS? X Y Z U V W\n", gcs2.complete};
+  switch (protocol) {
+    case mc::twins::Protocol::kMcs2:
+      return mcs2;
+    case mc::twins::Protocol::kGcs2Hexapod:
+      return hexapod;
+    default:
+      return gcs2;
+  }
 }
 
 bool pos_query(int fd, const PositionQuery& q) {
@@ -93,13 +104,16 @@ void allow_every_core() {
 
 void BM_TwinPollingCost(benchmark::State& state) {
   const int placement = static_cast<int>(state.range(0));
-  const auto protocol = state.range(1) == 0 ? mc::twins::Protocol::kGcs2 : mc::twins::Protocol::kMcs2;
+  constexpr std::array kProtocols{mc::twins::Protocol::kGcs2, mc::twins::Protocol::kMcs2,
+                                  mc::twins::Protocol::kGcs2Hexapod};
+  const auto protocol = kProtocols.at(static_cast<std::size_t>(state.range(1)));
   state.SetLabel(mc::twins::protocol_name(protocol));
   const PositionQuery& query = position_query(protocol);
   const int last_core = static_cast<int>(std::thread::hardware_concurrency()) - 1;
   for (auto _ : state) {
     mc::live::LiveParams lp;
     if (placement > 0) lp.platform.loop.cpu = last_core;
+    if (protocol == mc::twins::Protocol::kGcs2Hexapod) lp.platform.positioner = "parallel";
     mc::live::LivePlatform live(lp);
     // Nobody watches the microscope (as `serve` without a console open or a recording): the
     // simulated camera renders no frame. Rendering one (a third of a core, the simulation's cost,
@@ -179,7 +193,7 @@ void BM_TwinPollingCost(benchmark::State& state) {
 }
 BENCHMARK(BM_TwinPollingCost)
     ->ArgNames({"placement", "protocol"})
-    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2}, {0, 1, 2}})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
