@@ -362,11 +362,20 @@ TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUn
   EXPECT_LT(arrived.position_m, 0.5e-6);
   EXPECT_LT(arrived.rotation_rad, 10e-6);
 
-  // Released mid-way to another goal: the platform holds where it is, short of the goal.
+  // Released mid-way to another goal: the platform holds where it is, short of the goal. The loop
+  // thread allocates nothing meanwhile (the move planned on the server thread, handed over by a
+  // ring; the first move made whatever storage the path keeps).
   const std::array<double, 6> other{-150e-6, 80e-6, 0.0, 0.0, 0.005, -0.01};
-  ASSERT_TRUE(send_for(other, true, 30.0, [&] { return pose_off(live, goal).position_m > 20e-6; }));
-  send_for(other, false, 0.3, never);  // the platform holds once the deadman is up
-  const PoseOff held = pose_off(live, other);
+  std::size_t allocations = 0;
+  PoseOff held{};
+  {
+    test::AllocationGuard guard(live.loop_thread_id());
+    ASSERT_TRUE(send_for(other, true, 30.0, [&] { return pose_off(live, goal).position_m > 20e-6; }));
+    send_for(other, false, 0.3, never);  // the platform holds once the deadman is up
+    held = pose_off(live, other);
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u) << "the loop thread allocated during a console pose move";
   send_for(other, false, 0.5, never);
   const PoseOff later = pose_off(live, other);
   EXPECT_FALSE(later.moving);
