@@ -118,6 +118,39 @@ TEST(ConsoleCommand, APoseGoalIsSixFiniteNumbersAndRefusedWithoutTheParallelPosi
             "/console/command: pose_goal[4]: must be a number");
 }
 
+TEST(ConsoleCommand, APoseJogIsSixFiniteNumbersClampedToTheMoveSpeedsAndNotWithAGoal) {
+  ConsoleLimits limits;
+  limits.has_positioner = true;
+  limits.pose_max_speed_m_s = 100e-6;
+  limits.pose_max_angular_speed_rad_s = 0.01;
+  const auto c =
+      parse_console_command(R"({"deadman": true, "pose_jog": [3e-4, 4e-4, 0, 0, 0, -0.002]})", limits);
+  ASSERT_TRUE(c.has_pose_jog);
+  // 500 um/s asked: 100 um/s along the same direction; the rotation within its cap unchanged.
+  EXPECT_NEAR(c.pose_jog[0], 60e-6, 1e-12);
+  EXPECT_NEAR(c.pose_jog[1], 80e-6, 1e-12);
+  EXPECT_EQ(c.pose_jog[5], -0.002);
+  EXPECT_NEAR(parse_console_command(R"({"pose_jog": [0, 0, 0, 0.03, 0.04, 0]})", limits).pose_jog[4], 0.008,
+              1e-12);
+  EXPECT_EQ(message_of(R"({"pose_jog": [0, 0, 0, 0, 0, 0]})"),
+            "/console/command: pose_jog: there is no parallel positioner (positioner: parallel)");
+  const auto refused = [&](const std::string& payload) {
+    try {
+      parse_console_command(payload, limits);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(
+      refused(R"({"pose_jog": [0, 0, 0, 0, 0]})"),
+      "/console/command: pose_jog: must be an array of 6 numbers [vx, vy, vz, wx, wy, wz] (m/s, rad/s)");
+  EXPECT_EQ(refused(R"({"pose_jog": [0, 0, null, 0, 0, 0]})"),
+            "/console/command: pose_jog[2]: must be a number");
+  EXPECT_EQ(refused(R"({"pose_jog": [0, 0, 0, 0, 0, 0], "pose_goal": [0, 0, 0, 0, 0, 0]})"),
+            "/console/command: pose_jog: cannot come with pose_goal (a jog or a goal, one at a time)");
+}
+
 TEST(ConsoleCommand, AGoalPixelMustLieInTheCamerasFrame) {
   ConsoleLimits limits;
   limits.max_goal_px = {639.0, 511.0};

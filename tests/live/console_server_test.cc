@@ -18,6 +18,7 @@
 #include "microcobot/core/csv.h"
 #include "microcobot/core/mcap_reader.h"
 #include "microcobot/imaging/camera_params.h"
+#include "microcobot/motion/parallel_workspace.h"
 #include "microcobot/motion/pose.h"
 #include "microcobot/server/foxglove_protocol.h"
 #include "support/console_client.h"
@@ -394,6 +395,83 @@ TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUn
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   send_for(far, true, 0.4, never);
   EXPECT_NEAR(pose_off(live, other).position_m, later.position_m, 0.2e-6);
+  server.stop();
+}
+
+TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadmanAndStopsAtTheEdge) {
+  test::TempDir dir;
+  LiveParams lp;
+  lp.platform.positioner = "parallel";
+  LivePlatform live(lp);
+  ConsoleServer server(live, Rig::params(dir.path(), ""));
+  server.start();
+  Console c(server.port());
+  ASSERT_TRUE(c.action("take_control"));
+  ASSERT_FALSE(c.ws.read_status("control").is_null());
+  // The jog sent as the page sends it while a key is held, every 30 ms, for `s` seconds or until
+  // `done`. The positioner as the protocol's view publishes it (this test is its one reader).
+  const auto jog_for = [&](const std::array<double, 6>& j, bool deadman, double s, auto done) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+    while (std::chrono::steady_clock::now() < end) {
+      EXPECT_TRUE(c.command({{"deadman", deadman}, {"pose_jog", j}}));
+      if (done()) return true;
+      std::this_thread::sleep_for(30ms);
+    }
+    return false;
+  };
+  const auto never = [] { return false; };
+  PositionerView v = live.positioner_view();
+  const std::array<double, 6> along_x{50e-6, 0, 0, 0, 0, 0};
+
+  // Without the deadman nothing moves.
+  jog_for(along_x, false, 0.5, [&] {
+    v = live.positioner_view();
+    return false;
+  });
+  EXPECT_LT(std::abs(v.reference.d.x()), 0.2e-6);
+  EXPECT_FALSE(v.moving);
+
+  // With it the platform goes along x at the jog's speed, timed on the loop's clock (the page's
+  // commands come late on a loaded machine, not the loop's reference).
+  ASSERT_TRUE(
+      jog_for(along_x, true, 30.0, [&] { return (v = live.positioner_view()).reference.d.x() > 20e-6; }));
+  const PositionerView v0 = v;
+  ASSERT_TRUE(jog_for(along_x, true, 30.0, [&] {
+    return (v = live.positioner_view()).reference.d.x() > v0.reference.d.x() + 20e-6;
+  }));
+  const double speed = (v.reference.d.x() - v0.reference.d.x()) / (v.time_s - v0.time_s);
+  EXPECT_GT(speed, 40e-6);
+  EXPECT_LT(speed, 51e-6);
+  EXPECT_LT(std::abs(v.reference.d.y()) + std::abs(v.reference.d.z()), 1e-9) << "the jog left its line";
+  EXPECT_LT((v.measured.d - v.reference.d).norm(), 2e-6) << "the legs lag the jog";
+
+  // Released: the platform holds where it is.
+  jog_for({0, 0, 0, 0, 0, 0}, true, 0.3, never);
+  const PositionerView held = live.positioner_view();
+  jog_for({0, 0, 0, 0, 0, 0}, true, 0.5, never);
+  const PositionerView later = live.positioner_view();
+  EXPECT_FALSE(later.moving);
+  EXPECT_NEAR(later.reference.d.x(), held.reference.d.x(), 1e-12);
+  EXPECT_NEAR(later.measured.d.x(), held.reference.d.x(), 0.5e-6);
+
+  // A turn jog about z stops at the workspace's edge: reachable there, not a milliradian further.
+  const std::array<double, 6> turn{0, 0, 0, 0, 0, 0.1};
+  double last_rz = -1.0;
+  int still = 0;
+  ASSERT_TRUE(jog_for(turn, true, 120.0,
+                      [&] {
+                        const double rz = motion::log_so3(live.positioner_view().reference.R).z();
+                        still = rz == last_rz ? still + 1 : 0;
+                        last_rz = rz;
+                        return still >= 10;
+                      }))
+      << "the turn never stopped: rz " << last_rz;
+  const motion::ParallelKinematics k(lp.platform.parallel_positioner.geometry);
+  const motion::PlatformTransform edge = live.positioner_view().reference;
+  EXPECT_TRUE(motion::check_pose(k, edge).ok());
+  motion::PlatformTransform further = edge;
+  further.R = motion::exp_so3(Eigen::Vector3d(0, 0, 1e-3)) * edge.R;
+  EXPECT_FALSE(motion::check_pose(k, further).ok()) << "stopped at rz " << last_rz << " inside the workspace";
   server.stop();
 }
 

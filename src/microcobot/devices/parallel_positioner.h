@@ -23,6 +23,19 @@ class ParallelPositioner : public Device {
   /// nothing moves, unless Active and at rest from any other move, or when it starts elsewhere.
   /// Never allocates.
   virtual bool start_move(const motion::PoseTrajectory& checked) noexcept = 0;
+  /// Follows a streamed pose (motion::ParallelStage::follow: the reference pursues `target`
+  /// within `limits`, the legs' speed limit and the workspace, whose edge stops it). False, and
+  /// nothing moves, unless Active and free of a planned move. A device that takes planned moves
+  /// only refuses it: the default (a PI C-887 plans each move from its MOV; it is not streamed a
+  /// pose). Never allocates.
+  virtual bool follow(const motion::PlatformTransform& /*target*/,
+                      const motion::PoseMoveLimits& /*limits*/) noexcept {
+    return false;
+  }
+  /// Whether a followed target drives it; stop() ends that.
+  virtual bool following() const noexcept { return false; }
+  /// Whether the followed reference stands at the workspace's edge (its next step not reachable).
+  virtual bool follow_blocked() const noexcept { return false; }
   /// Ends any move: every leg holds where it is measured. Never allocates.
   virtual void stop() noexcept = 0;
   /// FK of the legs' sensors, {H}.

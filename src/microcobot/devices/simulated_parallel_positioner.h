@@ -31,6 +31,12 @@ class SimulatedParallelPositioner final : public ParallelPositioner {
 
   const motion::ParallelKinematics& kinematics() const noexcept override { return stage_.kinematics(); }
   bool start_move(const motion::PoseTrajectory& checked) noexcept override;
+  bool follow(const motion::PlatformTransform& target,
+              const motion::PoseMoveLimits& limits) noexcept override {
+    return active() && stage_.follow(target, limits);
+  }
+  bool following() const noexcept override { return stage_.following(); }
+  bool follow_blocked() const noexcept override { return stage_.follow_blocked(); }
   void stop() noexcept override { stage_.stop(); }
   const motion::PlatformTransform& measured_pose() const noexcept override { return stage_.measured_pose(); }
   const motion::PlatformTransform& reference_pose() const noexcept override {

@@ -107,15 +107,25 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
       for (std::size_t i = 0; i < 6; ++i)
         c.pose_goal[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
       c.has_pose_goal = true;
+    } else if (key == "pose_jog") {
+      if (!limits.has_positioner)
+        refuse(kChannel, key, "there is no parallel positioner (positioner: parallel)");
+      if (!value.is_array() || value.size() != 6)
+        refuse(kChannel, key, "must be an array of 6 numbers [vx, vy, vz, wx, wy, wz] (m/s, rad/s)");
+      for (std::size_t i = 0; i < 6; ++i)
+        c.pose_jog[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
+      c.has_pose_jog = true;
     } else if (key == "gain") {
       c.gain = std::clamp(finite(kChannel, value, key), limits.min_gain, limits.max_gain);
     } else {
       refuse(kChannel, key,
              "is not a known key (deadman, velocity_m_s, goal_m, goal_px, goal_speed_m_s, gripper_opening_m, "
              "gripper_shake, theta_goal_rad, theta_rate_rad_s, focus_z_m, objective, exposure_s, gain, "
-             "pose_goal)");
+             "pose_goal, pose_jog)");
     }
   }
+  if (c.has_pose_goal && c.has_pose_jog)
+    refuse(kChannel, "pose_jog", "cannot come with pose_goal (a jog or a goal, one at a time)");
   // Clamp to the platform's limits: a console can ask for anything, the stage gets what it can do.
   const double speed = std::hypot(c.velocity_m_s[0], c.velocity_m_s[1], c.velocity_m_s[2]);
   if (speed > limits.max_speed_m_s)
@@ -123,6 +133,14 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
   c.goal_speed_m_s = std::min(c.goal_speed_m_s, limits.max_speed_m_s);
   for (std::size_t i = 0; i < 3; ++i) c.goal_m[i] = std::clamp(c.goal_m[i], limits.min_m[i], limits.max_m[i]);
   c.gripper_opening_m = std::clamp(c.gripper_opening_m, 0.0, limits.max_opening_m);
+  // The jog's translation and rotation each within the positioner's move speeds.
+  for (std::size_t part = 0; part < 2; ++part) {
+    double* v = c.pose_jog.data() + 3 * part;
+    const double cap = part == 0 ? limits.pose_max_speed_m_s : limits.pose_max_angular_speed_rad_s;
+    const double speed = std::hypot(v[0], v[1], v[2]);
+    if (speed > cap)
+      for (int i = 0; i < 3; ++i) v[i] = speed > 0.0 ? v[i] * cap / speed : 0.0;
+  }
   return c;
 }
 

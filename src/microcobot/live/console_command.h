@@ -37,8 +37,11 @@ struct ConsoleLimits {
   double max_exposure_s = 33e-3;
   double min_gain = 1.0;
   double max_gain = 16.0;
-  /// Whether the platform has a parallel positioner (`positioner: parallel`): pose_goal.
+  /// Whether the platform has a parallel positioner (`positioner: parallel`): pose_goal, pose_jog;
+  /// and its moves' speeds (motion::PoseMoveLimits), a jog's bounds.
   bool has_positioner = false;
+  double pose_max_speed_m_s = 0.0;
+  double pose_max_angular_speed_rad_s = 0.0;
 };
 
 /// The console's continuous command (sent at ~30 Hz by the client in control: also its
@@ -75,6 +78,11 @@ struct ConsoleCommand {
   /// channels). Reachability is checked where the move is planned (console_pose_goal.h).
   bool has_pose_goal = false;
   std::array<double, 6> pose_goal{};
+  /// The parallel positioner jogged while the command says so, with the deadman: vx, vy, vz
+  /// [m/s] of its platform's origin and wx, wy, wz [rad/s] about it, in {H} (ConsoleSource: the
+  /// positioner follows a target a quarter of a second ahead; live/console_source.h).
+  bool has_pose_jog = false;
+  std::array<double, 6> pose_jog{};
   /// When the server received it (steady clock, ns; 0: unknown): the loop measures the
   /// command-to-target latency from it.
   std::int64_t received_ns = 0;
@@ -114,8 +122,9 @@ inline bool is_task_action(ConsoleAction a) {
 /// "goal_px": [u, v] (optional: a camera pixel, within the frame), "goal_speed_m_s": v (optional),
 /// "gripper_opening_m": o (optional), "theta_goal_rad": a, "theta_rate_rad_s": w (optional: the rotary
 /// axis; refused without one), "focus_z_m": z, "objective": i, "exposure_s": e, "gain": g (optional;
-/// the microscope), "pose_goal": [x, y, z, rx, ry, rz] (optional: the parallel positioner; refused
-/// without one)}`; unknown keys are refused. Values are checked finite and clamped to `limits`; an
+/// the microscope), "pose_goal": [x, y, z, rx, ry, rz] or "pose_jog": [vx, vy, vz, wx, wy, wz]
+/// (optional, one or the other: the parallel positioner; refused without one)}`; unknown keys are
+/// refused. Values are checked finite and clamped to `limits`; an
 /// objective that is not on the turret is refused. Throws mc::InvalidInput
 /// ("/console/command: velocity_m_s[1]: must be a finite number").
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);

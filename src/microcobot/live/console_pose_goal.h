@@ -30,7 +30,9 @@ struct ConsolePoseMove {
 /// What the loop last published of the positioner for the console (ConsoleSource).
 struct ConsolePoseView {
   motion::PlatformTransform reference;  ///< the pose the legs are told to be at
-  bool moving = false;                  ///< a pose move runs
+  bool moving = false;                  ///< a pose move runs, or a jog moves it
+  bool jogging = false;                 ///< a jog drives it (it follows the jog's target)
+  bool at_edge = false;                 ///< the jog stopped at the workspace's edge
   std::uint64_t handled_seq = 0;        ///< the last ConsolePoseMove the loop took (started, or dropped)
 };
 

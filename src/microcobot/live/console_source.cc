@@ -1,6 +1,9 @@
 #include "microcobot/live/console_source.h"
 
+#include <algorithm>
+
 #include "microcobot/live/microscope_source.h"
+#include "microcobot/motion/pose.h"
 
 namespace mc::live {
 
@@ -68,8 +71,8 @@ void ConsoleSource::pose_tick(Platform& p) noexcept {
   if (pending_pose_) {
     if (pos == nullptr || !driving_ || !p.pose_move_allowed() || !pending_pose_->trajectory) {
       // A stop, or no deadman: the move under way ends where it is (the platform holds without
-      // the deadman anyway), and nothing starts.
-      if (pos != nullptr && driving_ && pos->moving()) p.stop_pose_move();
+      // the deadman anyway), and nothing starts. A jog is the jog's own to end (below).
+      if (pos != nullptr && driving_ && pos->moving() && !pos->following()) p.stop_pose_move();
       pose_handled_ = pending_pose_->seq;
       pending_pose_.reset();
     } else if (!pos->moving()) {
@@ -79,11 +82,38 @@ void ConsoleSource::pose_tick(Platform& p) noexcept {
     }
   }
   if (pos == nullptr) return;
+  jog_tick(p);
   ConsolePoseView v;
   v.reference = pos->reference_pose();
   v.moving = pos->moving() || pending_pose_.has_value();
+  v.jogging = pos->following();
+  v.at_edge = pos->follow_blocked();
   v.handled_seq = pose_handled_;
   pose_view_.publish(v);
+}
+
+void ConsoleSource::jog_tick(Platform& p) noexcept {
+  // A target this far ahead of the reference at the jog's speed: the pursuit's braking distance
+  // at the move limits' accelerations is shorter, so the reference keeps the jog's speed.
+  constexpr double kLookahead_s = 0.25;
+  const devices::ParallelPositioner& pos = *p.positioner();
+  const std::array<double, 6>& j = latest_.pose_jog;
+  const Eigen::Vector3d v(j[0], j[1], j[2]), w(j[3], j[4], j[5]);
+  const bool jog =
+      driving_ && latest_.has_pose_jog && (v.norm() > 0.0 || w.norm() > 0.0) && p.pose_move_allowed();
+  if (!jog) {
+    // Released (no jog, a still one, no deadman, stale): the positioner holds where it is.
+    if (pos.following()) p.stop_pose_move();
+    return;
+  }
+  if (pos.moving() && !pos.following()) p.stop_pose_move();  // the jog takes over from a move
+  motion::PoseMoveLimits lim = p.config().parallel_positioner.move;
+  lim.max_speed_m_s = std::min(lim.max_speed_m_s, v.norm());
+  lim.max_angular_speed_rad_s = std::min(lim.max_angular_speed_rad_s, w.norm());
+  motion::PlatformTransform target = pos.reference_pose();
+  target.d += kLookahead_s * v;
+  target.R = motion::exp_so3(kLookahead_s * w) * target.R;
+  p.follow_pose(target, lim);  // refused by a positioner that takes planned moves only
 }
 
 void ConsoleSource::vision_tick(Platform& p, const runtime::TickInfo& t) noexcept {

@@ -8,7 +8,9 @@
 /// driver, whose input, not fresh, holds the stage when nobody drives.
 ///
 /// The parallel positioner's go-to pose (console_pose_goal.h): moves planned and checked by the
-/// server arrive through their own ring and start only while the console drives with its deadman.
+/// server arrive through their own ring and start only while the console drives with its deadman;
+/// its jog (a twist in the command) makes it follow a target streamed on the loop, under the same
+/// deadman.
 ///
 /// What the console supervises rides on its input: the cell's task (live_task.h) drives or
 /// holds in its place once started, and with x and y positioned by vision
@@ -74,6 +76,10 @@ class ConsoleSource final : public CommandSource {
   /// The parallel positioner's pose moves: the newest taken from the ring starts while the
   /// console drives with its deadman (a stop ends the move under way); else it is dropped.
   void pose_tick(platform::Platform& p) noexcept;
+  /// The console's jog of the parallel positioner (ConsoleCommand::pose_jog): while it drives with
+  /// its deadman, the positioner follows a target ahead of its reference at the jog's speeds;
+  /// released, it holds where it is.
+  void jog_tick(platform::Platform& p) noexcept;
 
   ConsoleSourceParams params_;
   LiveTask* task_;

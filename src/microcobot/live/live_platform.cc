@@ -69,6 +69,8 @@ LivePlatform::LivePlatform(LiveParams params) : params_(std::move(params)) {
   }
   limits_.max_opening_m = params_.platform.world.gripper.max_opening_m;
   limits_.has_positioner = platform_->has_positioner();
+  limits_.pose_max_speed_m_s = params_.platform.parallel_positioner.move.max_speed_m_s;
+  limits_.pose_max_angular_speed_rad_s = params_.platform.parallel_positioner.move.max_angular_speed_rad_s;
   if (platform_->has_rotary()) {
     limits_.min_theta_rad = platform_->yaw_min_rad();
     limits_.max_theta_rad = platform_->yaw_max_rad();

@@ -1,5 +1,6 @@
 #include "microcobot/motion/parallel_stage.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -51,7 +52,7 @@ void ParallelStage::place(const PlatformTransform& T) {
   }
   measured_T_ = true_T_ = ref_T_ = T;
   true_stale_ = false;
-  moving_ = false;
+  moving_ = following_ = follow_blocked_ = false;
   fault_ = halted_ = false;
   t_move_ = 0.0;
 }
@@ -65,6 +66,7 @@ MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLi
     if (axes_[i].stepping)
       throw InvalidInput("leg " + std::to_string(i / 2) + " is stepping open loop: wait for it or stop()");
   }
+  if (following_) stop();  // a planned move takes over from a streamed target
   // The goal's own check first: a NaN or an unreachable goal is named as such.
   const ReachCheck g = check_pose(kin_, goal);
   if (!g.ok()) throw InvalidInput(std::string("goal: ") + PoseUnreachable(to_smarpod(goal), g).what());
@@ -84,7 +86,7 @@ MoveCheck ParallelStage::move_to(const PlatformTransform& goal, const PoseMoveLi
 }
 
 bool ParallelStage::start_move(const PoseTrajectory& checked) noexcept {
-  if (fault_ || halted_ || moving_) return false;
+  if (fault_ || halted_ || moving_ || following_) return false;
   for (const auto& ax : axes_)
     if (ax.stepping) return false;
   constexpr double kSame = 1e-9;
@@ -98,6 +100,99 @@ bool ParallelStage::start_move(const PoseTrajectory& checked) noexcept {
   t_move_ = 0.0;
   moving_ = true;
   return true;
+}
+
+namespace {
+
+// The velocity one tick of `h` later that pursues the error `e` (the target minus the reference):
+// toward it at the speed from which `a_max` stops on it, at most `v_max` and no faster than
+// reaching it within the tick, reached from `v` with at most `a_max` of acceleration.
+Eigen::Vector3d pursue(const Eigen::Vector3d& e, const Eigen::Vector3d& v, double v_max, double a_max,
+                       double h) noexcept {
+  const double distance = e.norm();
+  Eigen::Vector3d wanted = Eigen::Vector3d::Zero();
+  if (distance > 0.0)
+    wanted = e * (std::min({v_max, std::sqrt(2.0 * a_max * distance), distance / h}) / distance);
+  const Eigen::Vector3d dv = wanted - v;
+  const double dv_max = a_max * h, dv_norm = dv.norm();
+  return dv_norm <= dv_max ? wanted : Eigen::Vector3d(v + dv * (dv_max / dv_norm));
+}
+
+}  // namespace
+
+bool ParallelStage::follow(const PlatformTransform& target, const PoseMoveLimits& limits) noexcept {
+  if (fault_ || halted_ || moving_) return false;
+  for (const auto& ax : axes_)
+    if (ax.stepping) return false;
+  if (!target.R.allFinite() || !target.d.allFinite()) return false;
+  for (double x : {limits.max_speed_m_s, limits.max_angular_speed_rad_s, limits.max_acceleration_m_s2,
+                   limits.max_angular_acceleration_rad_s2, limits.max_leg_speed_m_s})
+    if (!std::isfinite(x) || x < 0.0) return false;
+  if (!following_) {
+    // From the held pose, at rest: the legs' reference starts where they hold.
+    for (std::size_t i = 0; i < axes_.size(); ++i) ref_.q(static_cast<Eigen::Index>(i)) = axes_[i].hold;
+    ref_.v.setZero();
+    ref_.a.setZero();
+    follow_v_.setZero();
+    follow_w_.setZero();
+    follow_blocked_ = false;
+    follow_still_ = true;
+    following_ = true;
+  }
+  follow_target_ = target;
+  follow_limits_ = limits;
+  return true;
+}
+
+void ParallelStage::advance_follow() noexcept {
+  const double h = tick_s();
+  const PoseMoveLimits& lim = follow_limits_;
+  const Eigen::Vector3d e_d = follow_target_.d - ref_T_.d;
+  const Eigen::Vector3d e_r = log_so3(follow_target_.R * ref_T_.R.transpose());
+  Eigen::Vector3d v = pursue(e_d, follow_v_, lim.max_speed_m_s, lim.max_acceleration_m_s2, h);
+  Eigen::Vector3d w =
+      pursue(e_r, follow_w_, lim.max_angular_speed_rad_s, lim.max_angular_acceleration_rad_s2, h);
+  // On the target (within rounding) at a speed a tick's braking takes out: there, exactly, at rest.
+  const bool arrive_d = e_d.norm() < kFollowArrival && follow_v_.norm() <= lim.max_acceleration_m_s2 * h;
+  const bool arrive_r =
+      e_r.norm() < kFollowArrival && follow_w_.norm() <= lim.max_angular_acceleration_rad_s2 * h;
+  if (arrive_d) v.setZero();
+  if (arrive_r) w.setZero();
+  PlatformTransform next;
+  LegCoordinates q;
+  Reach reach = Reach::kReachable;
+  const double stroke_left = 0.5 * p_.geometry.stroke_m - kFollowStrokeMargin_m;
+  // The legs' speeds within their limit: the step scaled down once where one leg would go faster.
+  for (int pass = 0; pass < 2; ++pass) {
+    next.d = arrive_d ? follow_target_.d : Eigen::Vector3d(ref_T_.d + v * h);
+    next.R = arrive_r ? follow_target_.R : Eigen::Matrix3d(exp_so3(w * h) * ref_T_.R);
+    reach = reach_of(kin_, next, q);
+    if (reach == Reach::kReachable && q.cwiseAbs().maxCoeff() > stroke_left) reach = Reach::kStrokeLimit;
+    if (reach != Reach::kReachable) break;
+    const double leg_speed = ((q - ref_.q) / h).cwiseAbs().maxCoeff();
+    if (leg_speed <= lim.max_leg_speed_m_s || leg_speed == 0.0) break;
+    const double scale = lim.max_leg_speed_m_s / leg_speed;
+    v *= scale;
+    w *= scale;
+  }
+  follow_blocked_ = reach != Reach::kReachable;
+  if (follow_blocked_) {
+    // The reference stays where it is, at rest: the workspace's edge is a wall.
+    follow_v_.setZero();
+    follow_w_.setZero();
+    ref_.v.setZero();
+    ref_.a.setZero();
+    follow_still_ = true;
+    return;
+  }
+  const LegCoordinates leg_v = (q - ref_.q) / h;
+  ref_.a = (leg_v - ref_.v) / h;
+  ref_.v = leg_v;
+  ref_.q = q;
+  ref_T_ = next;
+  follow_v_ = v;
+  follow_w_ = w;
+  follow_still_ = v.isZero(0.0) && w.isZero(0.0);
 }
 
 void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz) {
@@ -123,8 +218,8 @@ void ParallelStage::stop() noexcept {
   bool stepping = false;
   for (const auto& ax : axes_) stepping = stepping || ax.stepping;
   // Already holding: the held pose stays exactly what it is (a move planned from it still starts).
-  if (!moving_ && !stepping) return;
-  moving_ = false;
+  if (!moving_ && !stepping && !following_) return;
+  moving_ = following_ = follow_blocked_ = false;
   for (auto& ax : axes_) {
     if (ax.stepping)
       ax.steps_left = 0;  // ends with the present period
@@ -136,7 +231,7 @@ void ParallelStage::stop() noexcept {
 
 void ParallelStage::safe_stop() noexcept {
   fault_ = true;
-  moving_ = false;
+  moving_ = following_ = false;
   for (auto& ax : axes_) {
     ax.ctrl->emergency_stop();
     ax.gen.halt();
@@ -146,7 +241,7 @@ void ParallelStage::safe_stop() noexcept {
 
 void ParallelStage::emergency_stop() noexcept {
   halted_ = true;
-  moving_ = false;
+  moving_ = following_ = false;
   for (auto& ax : axes_) {
     ax.ctrl->emergency_stop();
     ax.gen.halt();
@@ -170,7 +265,7 @@ void ParallelStage::rearm() {
     if (!placed) hold_here(ax);
   }
   if (!placed) ref_T_ = measured_T_;
-  moving_ = halted_ = false;
+  moving_ = following_ = follow_blocked_ = halted_ = false;
   t_move_ = 0.0;
 }
 
@@ -197,6 +292,14 @@ void ParallelStage::tick() noexcept {
           ref_T_ = traj_->goal();
         }
       }
+    }
+  }
+  if (following_) {
+    bool ready = true;
+    for (const auto& ax : axes_) ready = ready && ax.ctrl->ready();
+    if (ready) {
+      on_move = true;
+      advance_follow();
     }
   }
   for (std::size_t i = 0; i < axes_.size(); ++i) {
@@ -256,7 +359,7 @@ const PlatformTransform& ParallelStage::true_pose() const noexcept {
 }
 
 bool ParallelStage::at_rest() const noexcept {
-  if (moving_ || fault_ || halted_) return false;
+  if (moving_ || following_ || fault_ || halted_) return false;
   for (const auto& ax : axes_) {
     if (ax.stepping || !ax.ctrl->ready() || !ax.ctrl->in_position()) return false;
   }
@@ -268,7 +371,7 @@ LegAxisStatus ParallelStage::status(int axis) const noexcept {
   LegAxisStatus s;
   s.position_m = model_.slider_position(ax.state);
   s.measured_m = ax.measured;
-  s.reference_m = ax.stepping ? ax.measured : (moving_ ? ref_.q(axis) : ax.hold);
+  s.reference_m = ax.stepping ? ax.measured : (moving_ || following_ ? ref_.q(axis) : ax.hold);
   s.voltage_V = ax.state.u_V;
   s.stepping = ax.stepping;
   return s;

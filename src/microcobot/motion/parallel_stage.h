@@ -18,6 +18,9 @@
 /// so a loop that reads it at its telemetry rate pays one FK there instead of one a tick. Both are
 /// what the platform does, not what it was told.
 ///
+/// A coupling streams poses instead (follow()): the reference pursues the latest target within the
+/// move limits and the workspace, tick by tick.
+///
 /// Modes of a leg: tracking (moving or holding its reference), or stepping open loop
 /// (step_leg(): a sawtooth of N periods at full amplitude, recovery), after which it holds where
 /// it landed. stop() holds every leg where it is. A diverged model or a failed FK stops every
@@ -40,6 +43,12 @@
 namespace mc::motion {
 
 inline constexpr int kParallelAxes = 2 * kParallelLegs;
+/// How far short of a stroke's end a followed reference stops: the tracking's error (under a
+/// micrometre) and the sensor's noise keep the leg's reading inside the stroke, which the forward
+/// kinematics requires (a reading beyond it faults the stage).
+inline constexpr double kFollowStrokeMargin_m = 10e-6;
+/// A followed target is reached within this (m, rad): rounding, not a tolerance of the control.
+inline constexpr double kFollowArrival = 1e-12;
 
 struct ParallelStageParams {
   ParallelGeometryParams geometry;
@@ -97,6 +106,21 @@ class ParallelStage {
   /// (by more than 1 nm or 1 nrad in any entry of R or d). Never allocates (the trajectory's storage is made
   /// by the constructor), never throws.
   bool start_move(const PoseTrajectory& checked) noexcept;
+  /// Follows `target`, a pose streamed by a coupling (the console's jog, a master's position): the
+  /// reference pose goes toward it, its translation and its rotation (about the platform's origin,
+  /// in {H}) each along the shortest way at most at `limits`' speeds and accelerations, braking to
+  /// stop on it; the legs track IK of that reference and their speeds stay within
+  /// max_leg_speed_m_s. It never leaves the workspace: a step to a pose that is not reachable
+  /// (reach_of: a stroke, a joint limit, a singularity; a leg within kFollowStrokeMargin_m of its
+  /// stroke's end) is not taken and the reference stops where it is, follow_blocked() until a step
+  /// is reachable again. A new target replaces the last at
+  /// any time. Refused (false, nothing changes) while a move runs or a leg steps, after a fault or
+  /// an emergency stop, or for a target or limits that are not finite. stop() ends it: every leg
+  /// holds where it is measured. Never allocates.
+  bool follow(const PlatformTransform& target, const PoseMoveLimits& limits) noexcept;
+  bool follow(const PlatformTransform& target) noexcept { return follow(target, p_.move); }
+  bool following() const noexcept { return following_; }
+  bool follow_blocked() const noexcept { return follow_blocked_; }
   /// Open-loop stepping of one positioner (recovery): `steps` sawtooth periods at the full
   /// amplitude and `frequency_Hz`, forward for steps > 0; the leg then holds where it landed. Any
   /// move is stopped first (the other legs hold where they are).
@@ -117,8 +141,9 @@ class ParallelStage {
   /// One control period (1 / tracking.control_rate_Hz). Never allocates.
   void tick() noexcept;
 
-  bool moving() const noexcept { return moving_; }
-  /// Every leg tracking, no move under way and every tracker in position.
+  /// A move under way, or a followed reference still moving.
+  bool moving() const noexcept { return moving_ || (following_ && !follow_still_); }
+  /// Every leg tracking, no move under way or target followed, and every tracker in position.
   bool at_rest() const noexcept;
   bool fault() const noexcept { return fault_; }
   /// Stopped at 0 V by emergency_stop() (or a fault) until rearm().
@@ -154,6 +179,8 @@ class ParallelStage {
     bool stepping = false;
   };
   void hold_here(LegAxis& ax) noexcept;
+  /// One tick of follow(): the reference one step toward the target (the legs' in ref_).
+  void advance_follow() noexcept;
   void update_poses() noexcept;
   void safe_stop() noexcept;
 
@@ -170,6 +197,12 @@ class ParallelStage {
   int ratio_ = 1;
   double t_ = 0.0, t_move_ = 0.0;
   bool moving_ = false, fault_ = false, halted_ = false;
+  // follow(): the target, its limits, the reference's velocity (translation [m/s], rotation in
+  // {H} [rad/s]).
+  PlatformTransform follow_target_;
+  PoseMoveLimits follow_limits_;
+  Eigen::Vector3d follow_v_ = Eigen::Vector3d::Zero(), follow_w_ = Eigen::Vector3d::Zero();
+  bool following_ = false, follow_blocked_ = false, follow_still_ = true;
 };
 
 }  // namespace mc::motion

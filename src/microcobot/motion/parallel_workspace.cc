@@ -34,59 +34,89 @@ std::string to_string(Reach r) {
   return "reachable";
 }
 
-ReachCheck check_pose(const ParallelKinematics& k, const PlatformTransform& T) {
-  ReachCheck c;
+namespace {
+
+// What failed, for the check's detail: the leg or positioner and the quantity beyond its limit.
+struct Failure {
+  Reach reach = Reach::kReachable;
+  int index = 0;       // the leg (out of reach, joints) or the positioner (stroke)
+  double value = 0.0;  // the conditioning, the positioner's q [m] or the joint's angle [rad]
+  bool revolute = false;
+};
+
+// The header's checks in order, without a word of text: nothing allocates. `conditioning`: the
+// Jacobian's conditioning is computed (an SVD) where a bound would decide the check alone.
+Failure classify(const ParallelKinematics& k, const PlatformTransform& T, LegCoordinates& q,
+                 double* conditioning) noexcept {
   if (!T.R.allFinite() || !T.d.allFinite()) {
-    c.reach = Reach::kNotFinite;
-    c.detail = "the pose has a NaN or infinite coordinate";
-    c.q.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return c;
+    q.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return {Reach::kNotFinite};
   }
   const ParallelGeometryParams& p = k.params();
   LegClosure legs[kParallelLegs];
-  if (!k.closures(T, legs, c.q)) {
-    c.reach = Reach::kOutOfReach;
-    for (int i = 0; i < kParallelLegs; ++i) {
-      if (!(legs[i].discriminant >= 0.0)) {
-        c.detail =
-            fmt::format("leg {} cannot close (its {:.4g} mm leg does not reach the base plane's carriage)", i,
-                        k.geometry().leg_length_m * 1e3);
-        break;
-      }
-    }
-    c.q.setConstant(std::numeric_limits<double>::quiet_NaN());
-    return c;
+  if (!k.closures(T, legs, q)) {
+    q.setConstant(std::numeric_limits<double>::quiet_NaN());
+    for (int i = 0; i < kParallelLegs; ++i)
+      if (!(legs[i].discriminant >= 0.0)) return {Reach::kOutOfReach, i};
+    return {Reach::kOutOfReach};
   }
-  c.conditioning = k.conditioning(k.jacobian(T, legs));
-  if (c.conditioning < p.min_conditioning) {
-    c.reach = Reach::kSingular;
-    c.detail = fmt::format("conditioning {:.3g} < {:g}", c.conditioning, p.min_conditioning);
-    return c;
+  const ParallelJacobian J = k.jacobian(T, legs);
+  if (conditioning != nullptr) {
+    *conditioning = k.conditioning(J);
+    if (*conditioning < p.min_conditioning) return {Reach::kSingular, 0, *conditioning};
+  } else if (!k.conditioning_at_least(J, p.min_conditioning)) {
+    return {Reach::kSingular, 0, k.conditioning(J)};
   }
   const double half = 0.5 * p.stroke_m;
-  for (int j = 0; j < 6; ++j) {
-    if (std::abs(c.q[j]) > half) {
-      c.reach = Reach::kStrokeLimit;
-      c.detail = fmt::format("leg {}'s {} positioner at {:.6g} mm beyond its stroke +-{:g} mm", j / 2,
-                             j % 2 == 0 ? "radial" : "tangential", c.q[j] * 1e3, half * 1e3);
-      return c;
-    }
-  }
+  for (int j = 0; j < 6; ++j)
+    if (std::abs(q[j]) > half) return {Reach::kStrokeLimit, j, q[j]};
   double sph[kParallelLegs], rev[kParallelLegs];
   k.joint_angles(T, legs, sph, rev);
   for (int i = 0; i < kParallelLegs; ++i) {
-    if (sph[i] > p.spherical_limit_rad) {
-      c.reach = Reach::kJointLimit;
-      c.detail = fmt::format("leg {}'s spherical joint at {:.4g} deg beyond its {:.4g} deg cone", i,
-                             sph[i] * kDegreesPerRadian, p.spherical_limit_rad * kDegreesPerRadian);
-      return c;
-    }
-    if (std::abs(rev[i]) > p.revolute_limit_rad) {
-      c.reach = Reach::kJointLimit;
-      c.detail = fmt::format("leg {}'s revolute joint at {:.4g} deg beyond +-{:.4g} deg", i,
-                             rev[i] * kDegreesPerRadian, p.revolute_limit_rad * kDegreesPerRadian);
-      return c;
-    }
+    if (sph[i] > p.spherical_limit_rad) return {Reach::kJointLimit, i, sph[i], false};
+    if (std::abs(rev[i]) > p.revolute_limit_rad) return {Reach::kJointLimit, i, rev[i], true};
+  }
+  return {};
+}
+
+}  // namespace
+
+Reach reach_of(const ParallelKinematics& k, const PlatformTransform& T, LegCoordinates& q) noexcept {
+  return classify(k, T, q, nullptr).reach;
+}
+
+ReachCheck check_pose(const ParallelKinematics& k, const PlatformTransform& T) {
+  ReachCheck c;
+  const Failure f = classify(k, T, c.q, &c.conditioning);
+  c.reach = f.reach;
+  const ParallelGeometryParams& p = k.params();
+  switch (f.reach) {
+    case Reach::kReachable:
+      break;
+    case Reach::kNotFinite:
+      c.detail = "the pose has a NaN or infinite coordinate";
+      break;
+    case Reach::kOutOfReach:
+      c.detail =
+          fmt::format("leg {} cannot close (its {:.4g} mm leg does not reach the base plane's carriage)",
+                      f.index, k.geometry().leg_length_m * 1e3);
+      break;
+    case Reach::kSingular:
+      c.detail = fmt::format("conditioning {:.3g} < {:g}", f.value, p.min_conditioning);
+      break;
+    case Reach::kStrokeLimit:
+      c.detail =
+          fmt::format("leg {}'s {} positioner at {:.6g} mm beyond its stroke +-{:g} mm", f.index / 2,
+                      f.index % 2 == 0 ? "radial" : "tangential", f.value * 1e3, 0.5 * p.stroke_m * 1e3);
+      break;
+    case Reach::kJointLimit:
+      c.detail =
+          f.revolute
+              ? fmt::format("leg {}'s revolute joint at {:.4g} deg beyond +-{:.4g} deg", f.index,
+                            f.value * kDegreesPerRadian, p.revolute_limit_rad * kDegreesPerRadian)
+              : fmt::format("leg {}'s spherical joint at {:.4g} deg beyond its {:.4g} deg cone", f.index,
+                            f.value * kDegreesPerRadian, p.spherical_limit_rad * kDegreesPerRadian);
+      break;
   }
   return c;
 }

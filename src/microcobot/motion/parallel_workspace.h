@@ -43,6 +43,9 @@ struct ReachCheck {
 
 /// The check of the header, for the platform transform `T`.
 ReachCheck check_pose(const ParallelKinematics& k, const PlatformTransform& T);
+/// The same check without its words, for the loop: the first reason that fails (kReachable when
+/// none), `q` the legs' coordinates where they close. Never allocates.
+Reach reach_of(const ParallelKinematics& k, const PlatformTransform& T, LegCoordinates& q) noexcept;
 /// The same for a SmarPod pose about `pivot` (a NaN in the pose is kNotFinite).
 ReachCheck check_pose(const ParallelKinematics& k, const SmarPodPose& p, const Pivot& pivot = {});
 

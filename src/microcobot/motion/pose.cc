@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include <fmt/format.h>
+#include <Eigen/Geometry>
 
 #include "microcobot/core/error.h"
 
@@ -85,6 +86,17 @@ Eigen::Vector3d pivot_translation(const PlatformTransform& T, const Pivot& pivot
 }
 
 }  // namespace
+
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) noexcept {
+  const double a = w.norm();
+  if (a < 1e-300) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(a, w / a).toRotationMatrix();
+}
+
+Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) noexcept {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
 
 PlatformTransform to_transform(const SmarPodPose& p, const Pivot& pivot) {
   PlatformTransform T;

@@ -78,6 +78,11 @@ Eigen::Matrix3d pi_rotation(double u, double v, double w);
 /// (U, V, W) of R, V in [-pi/2, pi/2]; at |V| = pi/2 W = 0 by convention.
 Eigen::Vector3d pi_angles(const Eigen::Matrix3d& R);
 
+/// exp([w]x) (Rodrigues): the rotation by |w| about w; the identity for w = 0.
+Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) noexcept;
+/// log(R): R's axis-angle vector, |w| in [0, pi].
+Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) noexcept;
+
 /// The transform of a SmarPod pose about `pivot` (d = t + (I-R)c or R t + (I-R)c), and back.
 PlatformTransform to_transform(const SmarPodPose& p, const Pivot& pivot = {});
 SmarPodPose to_smarpod(const PlatformTransform& T, const Pivot& pivot = {});

@@ -13,19 +13,6 @@ namespace {
 
 bool finite(const PlatformTransform& T) { return T.R.allFinite() && T.d.allFinite(); }
 
-/// exp([w]x) (Rodrigues), identity for |w| = 0.
-Eigen::Matrix3d exp_so3(const Eigen::Vector3d& w) noexcept {
-  const double a = w.norm();
-  if (a < 1e-300) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(a, w / a).toRotationMatrix();
-}
-
-/// log(R) as an axis-angle vector, |w| in [0, pi].
-Eigen::Vector3d log_so3(const Eigen::Matrix3d& R) noexcept {
-  const Eigen::AngleAxisd aa(R);
-  return aa.angle() * aa.axis();
-}
-
 }  // namespace
 
 void PoseMoveLimits::validate() const {

@@ -125,6 +125,11 @@ class Platform {
   /// elsewhere (devices::ParallelPositioner::start_move). The move holds where it is as soon as
   /// pose_move_allowed() turns false (Platform::devices_task). On the loop; real-time safe.
   bool start_pose_move(const motion::PoseTrajectory& checked) noexcept;
+  /// Makes the parallel positioner follow `target` (devices::ParallelPositioner::follow: the
+  /// console's jog, a master's position): false, and nothing moves, without the positioner, when
+  /// pose_move_allowed() is false or the positioner refuses. It holds where it is as soon as
+  /// pose_move_allowed() turns false, as a move does. On the loop; real-time safe.
+  bool follow_pose(const motion::PlatformTransform& target, const motion::PoseMoveLimits& limits) noexcept;
   /// Ends the positioner's move: every leg holds where it is measured. Real-time safe.
   void stop_pose_move() noexcept {
     if (devices_.positioner) devices_.positioner->stop();

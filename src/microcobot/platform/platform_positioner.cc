@@ -1,7 +1,7 @@
 // The platform's parallel positioner (`positioner: parallel`; devices/parallel_positioner.h): the
 // simulated one built from the configuration when no driver brings one (or the registered driver
-// `parallel_positioner.driver` names, platform/driver_registry.h), its pose moves under the
-// deadman of the input that drives the coupling, its update on every tick.
+// `parallel_positioner.driver` names, platform/driver_registry.h), its pose moves and followed
+// poses under the deadman of the input that drives the coupling, its update on every tick.
 #include <memory>
 
 #include "microcobot/devices/simulated_parallel_positioner.h"
@@ -27,12 +27,17 @@ bool Platform::start_pose_move(const motion::PoseTrajectory& checked) noexcept {
   return devices_.positioner != nullptr && pose_move_allowed() && devices_.positioner->start_move(checked);
 }
 
+bool Platform::follow_pose(const motion::PlatformTransform& target,
+                           const motion::PoseMoveLimits& limits) noexcept {
+  return devices_.positioner != nullptr && pose_move_allowed() && devices_.positioner->follow(target, limits);
+}
+
 void Platform::positioner_task(double dt_s) noexcept {
   devices::ParallelPositioner* p = devices_.positioner.get();
   if (p == nullptr) return;
-  // A move runs only under the rule it started with: the deadman released, the input stale or
-  // outranked, or a fault, and every leg holds where it is measured.
-  if (p->moving() && !pose_move_allowed()) p->stop();
+  // A move or a followed target runs only under the rule it started with: the deadman released,
+  // the input stale or outranked, or a fault, and every leg holds where it is measured.
+  if ((p->moving() || p->following()) && !pose_move_allowed()) p->stop();
   p->update(dt_s);
 }
 
