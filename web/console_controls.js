@@ -143,7 +143,11 @@ function currentCommand() {
       cmd.theta_goal_rad = mc.input.thetaGoal;
     }
   }
-  if (mc.input.poseGoal) cmd.pose_goal = mc.input.poseGoal;  // the parallel positioner's go-to pose
+  if (mc.input.poseJog) {
+    cmd.pose_jog = mc.input.poseJog;  // the parallel positioner's jog, while a hold button is pressed
+  } else if (mc.input.poseGoal) {
+    cmd.pose_goal = mc.input.poseGoal;  // its go-to pose
+  }
   Object.assign(cmd, mc.microscopeCommand ? mc.microscopeCommand() : {});  // focus, objective, exposure, gain
   return cmd;
 }

@@ -96,6 +96,22 @@ function poseJog(sign) {
 }
 $("pose-jog-minus").addEventListener("click", () => poseJog(-1));
 $("pose-jog-plus").addEventListener("click", () => poseJog(1));
+// Hold to jog: the twist [vx, vy, vz, wx, wy, wz] (m/s, rad/s) sent while a button is pressed
+// (the server clamps it to the positioner's move speeds); a goal standing is forgotten.
+function holdJog(sign) {
+  const axis = Number($("pose-jog-axis").value), speed = Number($("pose-hold-speed").value);
+  const twist = [0, 0, 0, 0, 0, 0];
+  twist[axis] = sign * (axis < 3 ? speed / um : ((speed / 100) * Math.PI) / 180);  // µm/s, or °/s (50 µm/s with 0.5°/s)
+  mc.input.poseGoal = null;
+  mc.input.poseJog = twist;
+}
+for (const [id, sign] of [["pose-hold-minus", -1], ["pose-hold-plus", 1]]) {
+  const b = $(id);
+  b.addEventListener("pointerdown", (e) => { b.setPointerCapture(e.pointerId); holdJog(sign); });
+  for (const end of ["pointerup", "pointercancel", "lostpointercapture"]) {
+    b.addEventListener(end, () => { mc.input.poseJog = null; });
+  }
+}
 // Where the goal stands: reached (within 0.5 µm and 0.001°), or how to get there.
 function showPoseGoal(pose) {
   const g = mc.input.poseGoal ? mc.input.poseGoalShown : null;

@@ -237,4 +237,31 @@ await s.run(async () => {
     if (!(Math.abs(stepped[i] - reached.telemetry[i]) <= (i < 3 ? 0.5 : 1e-3))) fail(`the rz step moved ${keys[i]}`);
   await shot("positioner-1400x950-goto-reached");
   await page.locator("#positioner-group").screenshot({ path: `${s.artifacts}/positioner-panel-goto.png` });
+  // Hold to jog: y at 50 µm/s while the button is pressed with the deadman; released, it holds.
+  await page.selectOption("#pose-jog-axis", "1");
+  await page.selectOption("#pose-hold-speed", "50");
+  await page.locator("#pose-hold-plus").scrollIntoViewIfNeeded();
+  await page.locator("#pose-hold-plus").hover();
+  const before = (await shown()).telemetry;
+  await page.keyboard.down(" ");
+  const t0 = Date.now();
+  await page.mouse.down();
+  try {
+    await page.waitForTimeout(1500);
+  } finally {
+    await page.mouse.up();
+    await page.keyboard.up(" ");
+  }
+  const held_s = (Date.now() - t0) / 1000;
+  await page.waitForTimeout(500);
+  const jogged = (await shown()).telemetry;
+  await page.waitForTimeout(500);
+  const after = (await shown()).telemetry;
+  const dy = jogged[1] - before[1];
+  log(`hold jog y: ${dy.toFixed(1)} µm in ${held_s.toFixed(2)} s held`);
+  if (!(dy > 40 && dy <= 50 * held_s + 1)) fail(`the 50 µm/s jog held ${held_s} s moved y by ${dy} µm`);
+  if (!(Math.abs(after[1] - jogged[1]) <= 0.5)) fail(`released, the platform went on: ${jogged[1]} -> ${after[1]} µm`);
+  for (const i of [0, 2, 3, 4, 5])
+    if (!(Math.abs(jogged[i] - before[i]) <= (i < 3 ? 0.5 : 1e-3))) fail(`the y jog moved ${keys[i]}: ${before[i]} -> ${jogged[i]}`);
+  await shot("positioner-1400x950-jogged");
 }, "the positioner's 3-D panel draws the measured pose, its numbers follow the telemetry, and its go-to pose moves it with the deadman");
