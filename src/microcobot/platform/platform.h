@@ -193,6 +193,8 @@ class Platform {
     return levelling_.state == TipLevellingStatus::State::kRunning;
   }
   const TipLevellingStatus& tip_levelling() const noexcept { return levelling_; }
+  /// The tips' misalignment now: the simulated gripper's truth (NaN on a driver's gripper).
+  double tip_misalignment_m() const noexcept;
   /// The rotary axis: present, its measured angle and its target [rad] (the
   /// console's theta commands move the target, with the console's deadman; hold() holds it).
   bool has_rotary() const noexcept { return devices_.rotary != nullptr; }
@@ -279,7 +281,6 @@ class Platform {
   void levelling_targets(std::array<double, StageController::kMaxAxes>& target,
                          std::array<double, StageController::kMaxAxes>& velocity) const noexcept;
   void end_levelling(TipLevellingStatus::State state, const char* why) noexcept;
-  double tip_misalignment_m() const noexcept;
   void telemetry_task() noexcept;
   /// The built-in channels, each with the function that reads it (platform_telemetry.cc).
   struct BuiltinChannel;
