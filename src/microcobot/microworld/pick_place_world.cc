@@ -247,8 +247,11 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
                                      double dt_s, double yaw, const AlignDrives& align_V) const noexcept {
   PickPlaceOutput out;
   step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
-  // Only the align benders are driven; the grasp pair rests at 0 V (the closing is step_gripper's).
-  step_fingers(fingers_, s.fingers, BenderDrives{{}, align_V}, dt_s);
+  // Only the align benders are driven (the closing is step_gripper's): the grasp pair, never
+  // driven, is not stepped.
+  for (std::size_t k = 0; k < 2; ++k)
+    step_bender(finger_bender(fingers_, fingers_.align, static_cast<int>(k)), s.fingers.align[k], align_V[k],
+                dt_s);
   out.tips = read_tips(fingers_, s.fingers, -g.z());
   out.tip_misalignment_m = misalignment_m(fingers_, s.fingers);
   const double side = p_.part_side_m;

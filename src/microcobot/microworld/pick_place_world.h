@@ -196,8 +196,8 @@ struct PickPlaceState {
   bool finger_contact_rolled = false;
   int neighbour_contacts = 0;  ///< steps in which a finger or the held part struck a neighbour
   bool crashed = false;        ///< a finger tip went into the substrate at some point
-  /// The fingers' benders (only the align pair is driven here; the closing is `gripper`'s) and
-  /// their mounts (gripper.tip_misalignment_m).
+  /// The fingers' benders (only the align pair is stepped here, the grasp pair rests at 0 V: the
+  /// closing is `gripper`'s) and their mounts (gripper.tip_misalignment_m).
   BenderFingersState fingers;
   /// The held part's tilt about the fingers' closing axis from the tips' misalignment (0 unless
   /// grasped).
