@@ -39,13 +39,12 @@ bool Platform::start_tip_levelling() noexcept {
     for (int i = 0; i < 4; ++i)
       if (open_loop_running(i)) refusal = "refused: an open-loop run is under way";
   }
-  levelling_ = TipLevellingStatus{};
-  levelling_.misalignment_before_m = levelling_.misalignment_m = tip_misalignment_m();
   if (refusal != nullptr) {
-    levelling_.state = TipLevellingStatus::State::kFailed;
-    levelling_.failure = refusal;
+    refuse_tip_levelling(refusal);
     return false;
   }
+  levelling_ = TipLevellingStatus{};
+  levelling_.misalignment_before_m = levelling_.misalignment_m = tip_misalignment_m();
   microworld::BenderDrives drives;
   drives.align_V = devices_.gripper->align_V();
   alignment_->start(drives);
