@@ -162,6 +162,7 @@ $("reset").addEventListener("click", () => action("reset"));
 $("demo").addEventListener("click", () => action("demo"));
 $("restart").addEventListener("click", () => action("restart"));
 $("vision-tare").addEventListener("click", () => action("vision_tare"));
+$("level-tips").addEventListener("click", () => action("level_tips"));
 $("record").addEventListener("click", () => {
   if (mc.status && mc.status.recording) action("record_stop");
   else action("record_start", $("record-video-label").hidden ? {} : {video: $("record-video").value});

@@ -115,9 +115,27 @@ function showGripVision(g) {
   $("contact-vision-out").textContent = isNum(c) ? (c < 0 ? "−" : "") + fmtForce(unit, Math.abs(c)) : g.state === "measuring" ? "no stage sensor" : "—";
   $("contact-vision-out").title = isNum(g.bend_m) ? `tips bent ${(g.bend_m * um).toFixed(2)} µm` : "";
 }
+// The fingertips' levelling (/platform/status "levelling"): its state, why it failed, the tips'
+// misalignment (null: the gripper does not know it).
+function showLevelling(l) {
+  $("levelling-row").hidden = !l;
+  if (!l) return;
+  const dz = (m) => (isNum(m) ? (m * um).toFixed(2) + " µm" : "—");
+  const text = {
+    idle: "tips " + dz(l.misalignment_m) + " apart",
+    running: `${l.phase} (pass ${l.passes}): tips ${dz(l.misalignment_m)} apart; hold the deadman`,
+    done: `done in ${l.passes} passes: tips ${dz(l.misalignment_before_m)} → ${dz(l.misalignment_m)} apart`,
+    failed: `failed: ${l.failure}; tips ${dz(l.misalignment_m)} apart`,
+  }[l.state];
+  $("levelling-out").textContent = text || l.state;
+  $("levelling-out").className = l.state === "failed" ? "bad" : "";
+  $("levelling-out").title = `peak tip contact ${(l.peak_contact_N * um).toFixed(1)} µN`;
+  $("level-tips").disabled = l.state === "running";
+}
 listen("/platform/status", (s) => {
   mc.status = s;
   showGripVision(s.grip_vision);
+  showLevelling(s.levelling);
   const demo = watchDemo(s);
   watchLastError(s);
   const rows = [

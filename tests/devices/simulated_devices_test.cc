@@ -112,5 +112,47 @@ TEST(SimulatedGripper, ClosesOnThePartUnderTheStageAndStepsWithoutAllocating) {
   EXPECT_GT(g.grip_force_N(), 0.0);
 }
 
+TEST(SimulatedGripper, ItsAlignDrivesLevelMisalignedTipsAndItsTipsFeelTheSubstrate) {
+  const stickslip::ActuatorModel model{stickslip::StickSlipParams{}};
+  microworld::PickPlaceParams p;
+  p.gripper.tip_misalignment_m = 20e-6;
+  const microworld::PickPlaceWorld world{p};
+  SimulatedSlaveAxis x("x", model, {}, 0.0), y("y", model, {}, 0.0), z("z", model, {}, 0.0);
+  // Away from the part, the reference 5 um above the substrate: finger 0's tip, 10 um lower, presses.
+  SimulatedGripper g("gripper", world, {&x, &y, &z}, Vec3{1e-3, 1e-3, 5e-6});
+  EXPECT_TRUE(g.has_align_drives());
+  EXPECT_DOUBLE_EQ(g.align_limit_V(), 150.0);
+  g.command_align_V({0.0, -50.0});  // not configured: ignored
+  for (Device* d : std::array<Device*, 4>{&x, &y, &z, &g}) {
+    d->configure();
+    d->activate();
+  }
+  EXPECT_EQ(g.align_V(), (std::array<double, 2>{0.0, 0.0}));
+  g.update(kDt);
+  EXPECT_NEAR(g.tip_contact_N()[0], 50.0 * 5e-6, 1e-12);
+  EXPECT_DOUBLE_EQ(g.tip_contact_N()[1], 0.0);
+  EXPECT_NEAR(g.tip_misalignment_m(), 20e-6, 1e-15);
+  g.command_align_V({0.0, -500.0});  // clamped to the drive's range
+  EXPECT_EQ(g.align_V(), (std::array<double, 2>{0.0, -150.0}));
+  g.command_align_V({0.0, std::nan("")});  // refused whole
+  EXPECT_EQ(g.align_V(), (std::array<double, 2>{0.0, -150.0}));
+  g.command_align_V({0.0, -30.0});
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    for (int i = 0; i < 20000; ++i) g.update(kDt);
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  // Finger 1's tip brought down by about 1 um/V less the hysteresis' share, past finger 0's and onto
+  // the substrate (5 um below the reference).
+  EXPECT_LT(g.tip_misalignment_m(), 0.0);
+  EXPECT_GT(g.tip_misalignment_m(), -10e-6);
+  EXPECT_GT(g.tip_contact_N()[1], 0.0);
+  g.fault();  // the safe state holds the drives where they are
+  g.command_align_V({0.0, 0.0});
+  EXPECT_EQ(g.align_V(), (std::array<double, 2>{0.0, -30.0}));
+}
+
 }  // namespace
 }  // namespace mc::devices

@@ -311,6 +311,34 @@ TEST(ConsoleServer, ARefusedMessageSaysWhichOneAndTheSceneCarriesTheLimits) {
   EXPECT_NE(tare_refused.value("message", "").find("take control first"), std::string::npos) << tare_refused;
 }
 
+TEST(ConsoleServer, LevelTipsIsTheControllingClientsAndItsResultIsInTheStatus) {
+  Rig rig;
+  Console c(rig.server.port());
+  ASSERT_TRUE(c.action("take_control"));
+  ASSERT_FALSE(c.ws.read_status("control").is_null());
+  c.subscribe("/platform/status", 8);
+  const json idle = json::parse(c.next_on(8)).at("levelling");
+  ASSERT_TRUE(idle.is_object()) << idle.dump();  // the simulated gripper has align drives
+  EXPECT_EQ(idle.at("state"), "idle");
+  EXPECT_DOUBLE_EQ(idle.at("misalignment_m").get<double>(), 0.0);  // level tips by default
+  // An observer's is refused; the controller's without the deadman is refused by the loop, which
+  // says why in the status.
+  Console observer(rig.server.port());
+  ASSERT_TRUE(observer.action("level_tips"));
+  const json refused = observer.ws.read_status("control");
+  ASSERT_FALSE(refused.is_null());
+  EXPECT_NE(refused.value("message", "").find("take control first"), std::string::npos) << refused;
+  ASSERT_TRUE(c.command({{"deadman", false}}));
+  ASSERT_TRUE(c.action("level_tips"));
+  json levelling;
+  for (int i = 0; i < 50; ++i) {
+    levelling = json::parse(c.next_on(8)).at("levelling");
+    if (levelling.at("state") == "failed") break;
+  }
+  EXPECT_EQ(levelling.at("state"), "failed") << levelling.dump();
+  EXPECT_EQ(levelling.at("failure").get<std::string>().rfind("refused", 0), 0u) << levelling.dump();
+}
+
 // The parallel positioner's pose as the legs' sensors measure it (the protocol's view: this test
 // is its one reader) and its distance from `goal` [m, rad].
 struct PoseOff {

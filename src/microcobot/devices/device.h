@@ -15,6 +15,7 @@
 /// called at every tick once configured, whatever the state (a simulated device keeps its
 /// physics running; a hardware driver keeps its bus alive).
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -171,6 +172,18 @@ class Gripper : public Device {
   /// none ignores it (can_shake() false).
   virtual void command_shake(bool /*on*/) noexcept {}
   virtual bool can_shake() const { return false; }
+  /// The 4-DOF PiezoGripper's vertical benders (thesis §1.1.4: "the vertical motion is used to
+  /// align the fingertips"; microworld/bender_fingers.h): each finger's align drive [V], positive
+  /// raises its tip. A gripper without them ignores the command (has_align_drives() false).
+  virtual bool has_align_drives() const { return false; }
+  virtual void command_align_V(const std::array<double, 2>& /*drives_V*/) noexcept {}
+  /// The align drives in force [V] (zeros without them).
+  virtual std::array<double, 2> align_V() const { return {}; }
+  /// The align drives' range +-this [V] (0 without them).
+  virtual double align_limit_V() const { return 0.0; }
+  /// Each tip's vertical contact force on the substrate [N] (the tips' touch, by vision or a force
+  /// sensor at the tip; zeros when the gripper reads none).
+  virtual std::array<double, 2> tip_contact_N() const { return {}; }
 };
 
 }  // namespace mc::devices

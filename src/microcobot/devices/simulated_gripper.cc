@@ -1,5 +1,6 @@
 #include "microcobot/devices/simulated_gripper.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "microcobot/core/error.h"
@@ -22,6 +23,7 @@ void SimulatedGripper::on_configure() {
   state_ = world_.initial_state();
   command_m_ = world_.params().gripper.max_opening_m;
   shake_ = false;
+  align_V_ = {};
   state_.last_gripper_m = tip_position_m();
   state_.last_gripper_yaw_rad = yaw_rad();
   out_ = world_.step(state_, tip_position_m(), command_m_, 0.0, yaw_rad());
@@ -36,9 +38,15 @@ void SimulatedGripper::command_opening_m(double opening) noexcept {
   if (active() && std::isfinite(opening)) command_m_ = opening;
 }
 
+void SimulatedGripper::command_align_V(const std::array<double, 2>& drives_V) noexcept {
+  if (!active() || !std::isfinite(drives_V[0]) || !std::isfinite(drives_V[1])) return;
+  const double limit = align_limit_V();
+  for (std::size_t k = 0; k < 2; ++k) align_V_[k] = std::clamp(drives_V[k], -limit, limit);
+}
+
 void SimulatedGripper::update(double dt_s) noexcept {
   state_.gripper.shaking = shake_;
-  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad());
+  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad(), align_V_);
 }
 
 }  // namespace mc::devices

@@ -6,7 +6,9 @@
 /// simulated axes' truth, a driver's sensor) plus the mount offset `home_m` (where the finger
 /// tips are when every axis is at 0). The safe state keeps the last opening command: a gripper
 /// that let go of the part on a fault would drop it. With a rotary axis (set_rotary) the fingers
-/// turn with it about the vertical through their tips.
+/// turn with it about the vertical through their tips. Its align drives (the 4-DOF PiezoGripper's
+/// vertical benders) raise or lower each tip in the microworld; the safe state holds them where
+/// they are (a tip let down on a fault could strike the substrate).
 
 #include <array>
 
@@ -34,6 +36,15 @@ class SimulatedGripper final : public Gripper {
   /// The burst shakes the fingers in the microworld while on (an inactive gripper ignores it).
   void command_shake(bool on) noexcept override { shake_ = active() && on; }
   bool can_shake() const override { return true; }
+  bool has_align_drives() const override { return true; }
+  /// Clamped to the drives' range; ignored when inactive or not finite.
+  void command_align_V(const std::array<double, 2>& drives_V) noexcept override;
+  std::array<double, 2> align_V() const override { return align_V_; }
+  double align_limit_V() const override { return world_.params().gripper.align.max_voltage_V; }
+  /// The tips' contact forces in the microworld (a force sensor at each tip).
+  std::array<double, 2> tip_contact_N() const override { return out_.tips.contact_N; }
+  /// The tips' vertical misalignment off the substrate: finger 1's height minus finger 0's [m].
+  double tip_misalignment_m() const noexcept { return out_.tip_misalignment_m; }
   void update(double dt_s) noexcept override;
   /// The safe state keeps the opening but stops the burst.
   void enter_safe_state() noexcept override { shake_ = false; }
@@ -69,6 +80,7 @@ class SimulatedGripper final : public Gripper {
   microworld::PickPlaceOutput out_;
   double command_m_;
   bool shake_ = false;
+  std::array<double, 2> align_V_{};
 };
 
 }  // namespace mc::devices

@@ -173,6 +173,7 @@ ActionRequest parse_action_request(std::string_view text) {
       {"record_stop", ConsoleAction::kRecordStop},
       {"vision_tare", ConsoleAction::kVisionTare},
       {"next_part", ConsoleAction::kNextPart},
+      {"level_tips", ConsoleAction::kLevelTips},
       {"task_start", ConsoleAction::kTaskStart},
       {"task_pause", ConsoleAction::kTaskPause},
       {"task_resume", ConsoleAction::kTaskResume},
@@ -189,11 +190,10 @@ ActionRequest parse_action_request(std::string_view text) {
       return request;
     }
   refuse(kChannel, "action",
-         "must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
-         "record_stop, vision_tare, next_part, task_start, task_pause, task_resume, task_confirm, "
-         "task_take_over, "
-         "task_hand_back, "
-         "task_step_done, task_skip");
+         excerpt(name) +
+             " must be one of estop, reset, take_control, release_control, demo, restart, record_start, "
+             "record_stop, vision_tare, next_part, level_tips, task_start, task_pause, task_resume, "
+             "task_confirm, task_take_over, task_hand_back, task_step_done, task_skip");
 }
 
 }  // namespace mc::live

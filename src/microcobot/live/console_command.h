@@ -102,6 +102,9 @@ enum class ConsoleAction {
   /// The batch's next part (`serve --cell`): the scene rebuilt on it, its task not started (after
   /// the last part, the first again). The controlling client, as Restart.
   kNextPart,
+  /// The PiezoGripper's tips levelled by touch (Platform::start_tip_levelling): the controlling
+  /// client, running while it holds the deadman.
+  kLevelTips,
   // The supervised task (`serve --cell`, live_task.h): its controls, in TaskAction's order.
   kTaskStart,
   kTaskPause,
@@ -130,9 +133,9 @@ inline bool is_task_action(ConsoleAction a) {
 ConsoleCommand parse_console_command(std::string_view json, const ConsoleLimits& limits);
 
 /// Parses `{"action": "estop" | "reset" | "take_control" | "release_control" | "demo" |
-/// "restart" | "record_start" | "record_stop" | "vision_tare" | "task_start" | "task_pause" | "task_resume" |
-/// "task_confirm" | "task_take_over" | "task_hand_back" | "task_step_done" | "task_skip"}`.
-/// Throws mc::InvalidInput.
+/// "restart" | "record_start" | "record_stop" | "vision_tare" | "next_part" | "level_tips" | "task_start" |
+/// "task_pause" | "task_resume" | "task_confirm" | "task_take_over" | "task_hand_back" | "task_step_done" |
+/// "task_skip"}`. Throws mc::InvalidInput.
 ConsoleAction parse_console_action(std::string_view json);
 
 /// An action with its options: record_start may say how the recording keeps the camera,

@@ -102,6 +102,18 @@ void ConsoleServer::on_message(const server::ClientMessage& m) {
           note(EventLevel::kInfo, "vision_tare", "force by vision tared at the next frame", m.client);
         }
         return;
+      case ConsoleAction::kLevelTips:
+        if (m.client != controller) {
+          tell(m.client, StatusLevel::kWarning, "control: take control first; action ignored", "refused",
+               "control");
+        } else if (!live_.request_tip_levelling()) {
+          tell(m.client, StatusLevel::kWarning, "level_tips: the gripper has no align drives", "refused",
+               "level_tips");
+        } else {
+          note(EventLevel::kInfo, "level_tips", "tip levelling requested: it runs while the deadman is held",
+               m.client);
+        }
+        return;
       case ConsoleAction::kReset:
       case ConsoleAction::kDemo:
       case ConsoleAction::kRestart:

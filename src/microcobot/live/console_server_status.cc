@@ -223,6 +223,21 @@ std::string ConsoleServer::status_json() {
   } else {
     j["grip_vision"] = nullptr;
   }
+  if (s.levelling) {
+    // The tips' levelling (Level tips): its state, why it failed, the misalignment (null: the
+    // gripper does not know it, a driver's).
+    const platform::TipLevellingStatus& l = *s.levelling;
+    const auto metres_or_null = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    j["levelling"] = {{"state", platform::to_string(l.state)},
+                      {"phase", microworld::to_string(l.phase)},
+                      {"failure", l.failure},
+                      {"passes", l.passes},
+                      {"misalignment_before_m", metres_or_null(l.misalignment_before_m)},
+                      {"misalignment_m", metres_or_null(l.misalignment_m)},
+                      {"peak_contact_N", l.peak_contact_N}};
+  } else {
+    j["levelling"] = nullptr;
+  }
   const DemoResult& d = s.demo_result;
   if (d.outcome == DemoResult::Outcome::kNone) {
     j["demo_result"] = nullptr;

@@ -59,6 +59,13 @@ void ConsoleSource::drive(const SourceTick& t, teleop::ConsoleInput& in) noexcep
 void ConsoleSource::publish(const SourceTick& t) noexcept {
   if (positioner_) vision_tick(t.platform, t.tick);
   pose_tick(t.platform);
+  if (level_tips_.exchange(false, std::memory_order_relaxed)) {
+    // Only under the console's own deadman: another input driving the coupling refuses it.
+    if (driving_)
+      t.platform.start_tip_levelling();
+    else
+      t.platform.refuse_tip_levelling("refused: the console does not drive the stage");
+  }
 }
 
 void ConsoleSource::pose_tick(Platform& p) noexcept {
@@ -141,6 +148,7 @@ void ConsoleSource::reset() noexcept {
   latest_ = ConsoleCommand{};
   last_command_t_ = -1e9;
   driving_ = false;
+  level_tips_.store(false, std::memory_order_relaxed);
   perception::PositionerCommand stale;
   while (vision_.pop(stale)) {
   }

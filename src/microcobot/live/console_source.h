@@ -53,6 +53,9 @@ class ConsoleSource final : public CommandSource {
   bool push_pose_move(const ConsolePoseMove& m) noexcept { return pose_moves_.push(m); }
   /// What the loop last published of the positioner for the console. One reader: the server's thread.
   ConsolePoseView pose_view() noexcept { return pose_view_.read(); }
+  /// Level the gripper's tips (the controlling client's Level tips; any thread): started at the
+  /// next tick if the console drives then (Platform::start_tip_levelling's rules), else refused.
+  void request_tip_levelling() noexcept { level_tips_.store(true, std::memory_order_relaxed); }
   /// A velocity run the positioner asks for (camera thread, one producer). Wait-free.
   bool push_vision(const perception::PositionerCommand& c) noexcept { return vision_.push(c); }
   /// The controlling client's commands are fresh (as of the last tick). Any thread.
@@ -89,7 +92,7 @@ class ConsoleSource final : public CommandSource {
   runtime::SpscRing<double> latencies_{4096};                    // loop -> status thread [s]
   runtime::SpscRing<ConsolePoseMove> pose_moves_{8};             // server thread -> loop
   runtime::LatestValue<ConsolePoseView> pose_view_;              // loop -> server thread
-  std::atomic<bool> in_control_{false}, fresh_{false};
+  std::atomic<bool> in_control_{false}, fresh_{false}, level_tips_{false};
   // Loop thread only.
   ConsoleCommand latest_;
   double last_command_t_ = -1e9;

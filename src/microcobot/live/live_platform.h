@@ -164,6 +164,14 @@ class LivePlatform {
     return true;
   }
 
+  /// The gripper's tips levelled at the next tick, under the console's deadman (ConsoleSource::
+  /// request_tip_levelling). Any thread; false when the gripper has no align drives.
+  bool request_tip_levelling() noexcept {
+    if (!readings_.has_levelling()) return false;
+    console_->request_tip_levelling();
+    return true;
+  }
+
   LiveStatus status() const;
   /// Moves the command-to-target latencies measured by the loop since the last call (from the
   /// server's receipt of a command to the tick that applies it) into `stats`. One consumer

@@ -20,6 +20,18 @@ void LoopReadings::publish(platform::Platform& p, double t_live_s) noexcept {
     camera_dropped_.store(p.camera()->dropped(), relaxed);
   }
   ticks_.store(p.loop().ticks(), relaxed);
+  if (p.gripper().has_align_drives()) {
+    const platform::TipLevellingStatus& l = p.tip_levelling();
+    levelling_phase_.store(static_cast<int>(l.phase), relaxed);
+    levelling_passes_.store(l.passes, relaxed);
+    levelling_failure_.store(l.failure, relaxed);
+    levelling_before_m_.store(l.misalignment_before_m, relaxed);
+    levelling_misalignment_m_.store(p.tip_misalignment_m(), relaxed);  // now, whatever the state
+    levelling_peak_N_.store(l.peak_contact_N, relaxed);
+    levelling_state_.store(static_cast<int>(l.state), relaxed);
+  } else {
+    levelling_state_.store(-1, relaxed);
+  }
 }
 
 void LoopReadings::fill(LiveStatus& s) const noexcept {
@@ -37,6 +49,18 @@ void LoopReadings::fill(LiveStatus& s) const noexcept {
   s.focus_z_m = focus_z_m_.load(relaxed);
   s.focus_target_m = focus_target_m_.load(relaxed);
   s.objective = objective_.load(relaxed);
+  const int levelling = levelling_state_.load(relaxed);
+  if (levelling >= 0) {
+    platform::TipLevellingStatus l;
+    l.state = static_cast<platform::TipLevellingStatus::State>(levelling);
+    l.phase = static_cast<microworld::AlignmentPhase>(levelling_phase_.load(relaxed));
+    l.passes = levelling_passes_.load(relaxed);
+    l.failure = levelling_failure_.load(relaxed);
+    l.misalignment_before_m = levelling_before_m_.load(relaxed);
+    l.misalignment_m = levelling_misalignment_m_.load(relaxed);
+    l.peak_contact_N = levelling_peak_N_.load(relaxed);
+    s.levelling = l;
+  }
 }
 
 }  // namespace mc::live

@@ -46,6 +46,8 @@ struct LiveStatus {
   /// The grip force measured by vision (`vision_force.enabled`, a camera, the gripper's scene;
   /// none otherwise).
   std::optional<perception::VisionGripStatus> grip_vision;
+  /// The gripper's tip levelling (Level tips; none without align drives).
+  std::optional<platform::TipLevellingStatus> levelling;
   /// The source holding control of the coupling ("console", "protocol", "demo", "remote", a
   /// caller's; empty before the first tick).
   std::string control;
@@ -63,6 +65,8 @@ class LoopReadings {
   void fill(LiveStatus& s) const noexcept;
   double t_s() const noexcept { return t_s_.load(std::memory_order_relaxed); }
   bool estopped() const noexcept { return estopped_.load(std::memory_order_relaxed); }
+  /// Whether the gripper has align drives (its tips can be levelled). Any thread.
+  bool has_levelling() const noexcept { return levelling_state_.load(std::memory_order_relaxed) >= 0; }
   /// Stopped for good: every device in its safe state (LivePlatform::stop).
   void set_stopped() noexcept { estopped_.store(true, std::memory_order_relaxed); }
 
@@ -74,6 +78,10 @@ class LoopReadings {
   std::atomic<int> rotary_lifecycle_{-1};  // -1: no rotary axis
   std::atomic<double> focus_z_m_{0.0}, focus_target_m_{0.0};
   std::atomic<int> objective_{0};
+  // The tip levelling (platform::TipLevellingStatus; state -1: no align drives).
+  std::atomic<int> levelling_state_{-1}, levelling_phase_{0}, levelling_passes_{0};
+  std::atomic<const char*> levelling_failure_{""};
+  std::atomic<double> levelling_before_m_{0.0}, levelling_misalignment_m_{0.0}, levelling_peak_N_{0.0};
 };
 
 }  // namespace mc::live

@@ -111,6 +111,11 @@ PickPlaceParams flat_part_scene() {
 PickPlaceWorld::PickPlaceWorld(PickPlaceParams params) : p_(std::move(params)) {
   p_.validate();
   weight_ = p_.part_weight_N();
+  // One set of figures for both models: the closing model's stiffness and friction are the tips'.
+  fingers_.align = p_.gripper.align;
+  fingers_.contact_stiffness_N_m = p_.gripper.finger_stiffness_N_m;
+  fingers_.tip_face_height_m = p_.gripper.tip_face_height_m;
+  fingers_.friction_coefficient = p_.finger_friction;
 }
 
 PickPlaceState PickPlaceWorld::initial_state() const {
@@ -120,6 +125,8 @@ PickPlaceState PickPlaceWorld::initial_state() const {
               rest_z_m(p_.part_start_m.x(), p_.part_start_m.y(), p_.part_yaw_rad)};
   s.gripper.free_opening_m = p_.gripper.max_opening_m;
   s.last_gripper_m = {p_.part_start_m.x(), p_.part_start_m.y(), 10 * p_.part_side_m};
+  const double m = p_.gripper.tip_misalignment_m;
+  s.fingers.mount_z_m = {-0.5 * m, 0.5 * m};
   return s;
 }
 
@@ -237,9 +244,16 @@ Eigen::Vector2d PickPlaceWorld::rubbing_force(const Eigen::Vector2d& motion, dou
 }
 
 PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g, double opening_command_m,
-                                     double dt_s, double yaw) const noexcept {
+                                     double dt_s, double yaw, const AlignDrives& align_V) const noexcept {
   PickPlaceOutput out;
   step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
+  // Only the align benders are driven (the closing is step_gripper's): the grasp pair, never
+  // driven, is not stepped.
+  for (std::size_t k = 0; k < 2; ++k)
+    step_bender(finger_bender(fingers_, fingers_.align, static_cast<int>(k)), s.fingers.align[k], align_V[k],
+                dt_s);
+  out.tips = read_tips(fingers_, s.fingers, -g.z());
+  out.tip_misalignment_m = misalignment_m(fingers_, s.fingers);
   const double side = p_.part_side_m;
   const Eigen::Vector3d motion = g - s.last_gripper_m;
   const Eigen::Vector3d last_g = s.last_gripper_m;
@@ -251,6 +265,8 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
   if (g.z() < 0.0) {
     out.force_on_gripper_N.z() += p_.substrate_stiffness_N_m * (-g.z());
     s.crashed = true;
+  } else {
+    out.force_on_gripper_N.z() += out.tips.contact_N[0] + out.tips.contact_N[1];
   }
 
   const bool held = s.phase != PartPhase::kOnSubstrate;
@@ -260,7 +276,9 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
   out.part_between_fingers = between;
   out.grip_force_N = grip;
   out.opening_m = grip > 0.0 ? side : s.gripper.free_opening_m;
-  const double hold_capacity = 2.0 * p_.finger_friction * grip;    // friction the grip can transmit
+  // The friction the grip can transmit: over the faces' overlap only (thesis §1.1.4, F_hold).
+  const double hold_capacity = holding_force_N(fingers_, grip, out.tip_misalignment_m);
+  out.holding_force_N = hold_capacity;
   const double substrate_hold = p_.substrate_pulloff_N + weight_;  // force to tear the part off
 
   switch (s.phase) {
@@ -384,6 +402,8 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
   s.finger_deflection_m = turned({on_fingers.x() / (2.0 * p_.gripper.finger_stiffness_N_m), 0.0}, yaw);
   out.part_on_substrate =
       s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
+  s.part_tilt_rad =
+      s.phase == PartPhase::kGrasped ? part_tilt_rad(out.tip_misalignment_m, p_.part_side_m) : 0.0;
   return out;
 }
 

@@ -43,6 +43,16 @@
 /// Goldberg, "Orienting polygonal parts without sensors", Algorithmica 10, 1993): a grasped part's
 /// yaw is the fingers' plus a multiple of 90 deg, and it turns with them. A part down in its hole
 /// is held by the walls: it keeps its yaw, the fingers slip round it.
+///
+/// The fingers' vertical alignment (thesis §1.1.4, the 4-DOF PiezoGripper; bender_fingers.h): each
+/// tip stands at its mount height (gripper.tip_misalignment_m, split about the reference) plus its
+/// align bender's deflection, driven by the align drives given to step(). Tips at different heights
+/// dz hold the part with the faces' overlap only, F_hold = 2 mu F_grip max(0, 1 - |dz| / h_face)
+/// (holding_force_N, mu = finger_friction), in place of 2 mu F_grip everywhere the grip holds (the
+/// lift-off, the drag, the hole's walls), and a lifted part turns between them by atan(dz / side)
+/// (part_tilt_rad). Each tip below the substrate presses on it with its bender's stiffness
+/// (read_tips): the gripper feels those forces while its reference point is above the substrate
+/// (below it, the crash's stiff reaction). Level tips (the default) grip as the closing model alone.
 
 #include <cmath>
 
@@ -51,6 +61,7 @@
 #include <array>
 
 #include "microcobot/core/params.h"
+#include "microcobot/microworld/bender_fingers.h"
 #include "microcobot/microworld/neighbours.h"
 #include "microcobot/microworld/piezo_gripper.h"
 #include "microcobot/microworld/surface_forces.h"
@@ -185,6 +196,12 @@ struct PickPlaceState {
   bool finger_contact_rolled = false;
   int neighbour_contacts = 0;  ///< steps in which a finger or the held part struck a neighbour
   bool crashed = false;        ///< a finger tip went into the substrate at some point
+  /// The fingers' benders (only the align pair is stepped here, the grasp pair rests at 0 V: the
+  /// closing is `gripper`'s) and their mounts (gripper.tip_misalignment_m).
+  BenderFingersState fingers;
+  /// The held part's tilt about the fingers' closing axis from the tips' misalignment (0 unless
+  /// grasped).
+  double part_tilt_rad = 0.0;
 };
 
 /// What the world returns each step: the forces the slave feels (to be fed back, scaled, to
@@ -196,7 +213,15 @@ struct PickPlaceOutput {
   bool part_between_fingers = false;
   bool part_on_substrate = true;
   bool touching_neighbour = false;  ///< a finger or the held part strikes another part of the scene
+  /// The tips in the gripper's frame against the substrate (bender_fingers.h): each one's height
+  /// and vertical contact force.
+  TipReading tips;
+  double tip_misalignment_m = 0.0;  ///< finger 1's tip height minus finger 0's, off the substrate
+  double holding_force_N = 0.0;     ///< the friction the grip holds the part with (F_hold)
 };
+
+/// The align drives for one step [V]: each finger's vertical bender (positive raises its tip).
+using AlignDrives = std::array<double, 2>;
 
 class PickPlaceWorld {
  public:
@@ -207,8 +232,13 @@ class PickPlaceWorld {
   /// Advances by dt with the gripper point at `gripper_m`, the fingers turned by `gripper_yaw_rad`
   /// (closing along that direction) and their opening commanded to `opening_command_m`. Never
   /// allocates.
+  /// The align benders go toward `align_V` (level tips at 0 V unless mounted misaligned).
   PickPlaceOutput step(PickPlaceState& s, const Eigen::Vector3d& gripper_m, double opening_command_m,
-                       double dt_s, double gripper_yaw_rad = 0.0) const noexcept;
+                       double dt_s, double gripper_yaw_rad = 0.0,
+                       const AlignDrives& align_V = {}) const noexcept;
+  /// The fingers as bender_fingers.h sees them: the align benders and the face height of
+  /// `gripper`, the tips' stiffness its finger_stiffness_N_m, the friction finger_friction.
+  const BenderFingersParams& fingers() const noexcept { return fingers_; }
   /// Horizontal distance from the part centre to the target.
   double placement_error_m(const PickPlaceState& s) const;
   /// The part's orientation against the hole's, modulo the square's 90 deg, in [-45, 45) deg.
@@ -238,6 +268,7 @@ class PickPlaceWorld {
   Eigen::Vector2d confine_to_hole(Eigen::Vector3d& part, double part_yaw, double yaw, bool in_hole,
                                   double capacity_N, Eigen::Vector2d& slip_m) const noexcept;
   PickPlaceParams p_;
+  BenderFingersParams fingers_;
   double weight_;
 };
 

@@ -20,6 +20,11 @@ void PiezoGripperParams::validate() const {
           "gripper.shake_amplitude_m", "must be within [0, 20 um]", shake_amplitude_m);
   require(std::isfinite(shake_frequency_Hz) && shake_frequency_Hz > 0.0 && shake_frequency_Hz <= 100e3,
           "gripper.shake_frequency_Hz", "must be within (0, 100 kHz]", shake_frequency_Hz);
+  require(std::isfinite(tip_misalignment_m) && std::abs(tip_misalignment_m) <= 200e-6,
+          "gripper.tip_misalignment_m", "must be within [-200 um, 200 um]", tip_misalignment_m);
+  require(std::isfinite(tip_face_height_m) && tip_face_height_m >= 1e-6 && tip_face_height_m <= 1e-3,
+          "gripper.tip_face_height_m", "must be within [1 um, 1 mm]", tip_face_height_m);
+  align.validate("gripper.align");
 }
 
 void step_gripper(const PiezoGripperParams& p, PiezoGripperState& s, double command_m, double dt_s) noexcept {

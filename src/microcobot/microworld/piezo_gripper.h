@@ -5,8 +5,13 @@
 /// (bender bandwidth) with a slew limit, and a spring of stiffness k_finger at its tip, so
 /// that a part of width w held between fingers commanded to an opening o < w is squeezed by
 ///     F_grip = k_finger (w - o) / 2      (each finger deflects by (w - o) / 2).
+///
+/// Each finger also has its vertical (align) bender (thesis §1.1.4: "the vertical motion is used to
+/// align the fingertips", bender_fingers.h): the pick-and-place world carries their state, and a
+/// finger mounted higher than the other (tip_misalignment_m) grips with the faces' overlap only.
 
 #include "microcobot/core/params.h"
+#include "microcobot/microworld/piezo_bender.h"
 
 namespace mc::microworld {
 
@@ -28,6 +33,14 @@ struct PiezoGripperParams {
   /// bending mode of a 2 mm piezo bender (tens of kHz), accelerates the tips at 990 m/s^2.
   double shake_amplitude_m = 1e-6;
   double shake_frequency_Hz = 5e3;
+  /// The fingers' vertical mounting error: finger 1's tip this much above finger 0's at 0 V on
+  /// the align drives (each tip half of it from the gripper's reference height, finger 0 below).
+  /// 0: level tips, the grip of the closing model alone.
+  double tip_misalignment_m = 0.0;
+  /// The height of a tip's gripping face: a misalignment dz holds over 1 - |dz| / this of it
+  /// (bender_fingers.h, holding_force_N).
+  double tip_face_height_m = 50e-6;
+  PiezoBenderParams align;  ///< each finger's vertical bender (positive drive raises its tip)
 
   template <class V>
   void visit(V& v) {
@@ -41,6 +54,9 @@ struct PiezoGripperParams {
     v("finger_thickness_m", finger_thickness_m);
     v("shake_amplitude_m", shake_amplitude_m);
     v("shake_frequency_Hz", shake_frequency_Hz);
+    v("tip_misalignment_m", tip_misalignment_m);
+    v("tip_face_height_m", tip_face_height_m);
+    v("align", align);
   }
   void validate() const;
 };

@@ -39,7 +39,7 @@ struct TipAlignmentParams {
   double settle_s = 5.0;               ///< the wait before the check pass (the creep shows)
   double tolerance_m = 0.5e-6;         ///< tips level when the second touches within this
   double max_travel_m = 200e-6;        ///< the longest descent looking for a touch
-  int max_passes = 4;
+  int max_passes = 4;  ///< passes at most (approach, level, lift, settle): the last must find the tips level
 
   template <class V>
   void visit(V& v) {

@@ -108,6 +108,9 @@ void Platform::build() {
     devices_.focus = std::make_unique<devices::FocusDrive>("focus", config_.camera);
 
   arm_devices(/*fault_on_failure=*/false);
+  if (devices_.gripper->has_align_drives())
+    alignment_ =
+        std::make_unique<microworld::TipAlignment>(config_.alignment, devices_.gripper->align_limit_V());
 
   loop_.add_task("operator", config_.loop.operator_divisor, [this](const runtime::TickInfo& t) {
     if (operator_) operator_(t);
@@ -146,6 +149,7 @@ void Platform::fault_all() noexcept {
   stage_->emergency_stop();
   for (auto& st : steppers_) st->halt();
   faulted_ = true;
+  if (tip_levelling_running()) end_levelling(TipLevellingStatus::State::kFailed, "a fault or the e-stop");
 }
 
 void Platform::teleoperation_task() noexcept {
@@ -176,6 +180,7 @@ void Platform::teleoperation_task() noexcept {
   in.console.deadman = console_.deadman && !faulted_;
   const auto& out = teleop_->tick(in);
   rotary_command();
+  levelling_task(config_.loop.period_s());
 
   devices_.haptic->command_force_N({out.haptic_force_N.x(), out.haptic_force_N.y()});
   devices_.tweezers->command_grip_force_N(out.finger_force_N);
@@ -202,6 +207,7 @@ void Platform::slave_control_task() noexcept {
     target[i] = out.slave_target_m[k], velocity[i] = out.slave_velocity_m_s[k], all_measured[i] = measured[i];
   }
   rotary_control(target, velocity, all_measured);
+  levelling_targets(target, velocity);
   if (position_controlled_) {
     // The stage's own loop (the slave process) follows the target.
     for (std::size_t i = 0; i < 3; ++i) devices_.axes[i]->command_target_m(target[i], velocity[i]);

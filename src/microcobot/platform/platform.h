@@ -43,6 +43,7 @@
 #include "microcobot/devices/simulated_slave_axis.h"
 #include "microcobot/devices/simulated_tweezers_master.h"
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/microworld/tip_alignment.h"
 #include "microcobot/motion/rotary_axis.h"
 #include "microcobot/motion/step_map.h"
 #include "microcobot/platform/platform_config.h"
@@ -56,6 +57,22 @@
 #include "microcobot/teleop/teleoperation.h"
 
 namespace mc::platform {
+
+/// The PiezoGripper's tip levelling run on the slave (Platform::start_tip_levelling), as the loop
+/// last left it.
+struct TipLevellingStatus {
+  enum class State : std::uint8_t { kIdle, kRunning, kDone, kFailed };
+  State state = State::kIdle;
+  microworld::AlignmentPhase phase = microworld::AlignmentPhase::kIdle;
+  const char* failure = "";  ///< why it failed or was refused (a static string; empty otherwise)
+  int passes = 0;
+  double peak_contact_N = 0.0;  ///< the highest tip contact force read while it ran
+  /// The tips' misalignment (finger 1's height minus finger 0's) when it started and now (the
+  /// simulated gripper's truth; NaN on a driver's gripper, which does not know it).
+  double misalignment_before_m = std::nan("");
+  double misalignment_m = std::nan("");
+};
+const char* to_string(TipLevellingStatus::State s) noexcept;
 
 class Platform {
  public:
@@ -162,6 +179,27 @@ class Platform {
   bool open_loop_running(int axis) const noexcept {
     return steppers_[static_cast<std::size_t>(axis)] && steppers_[static_cast<std::size_t>(axis)]->running();
   }
+  /// Levels the PiezoGripper's tips by touch (microworld/tip_alignment.h, `alignment`): the Z
+  /// axis brings the gripper down onto the substrate and the higher tip's align drive lowers it
+  /// until both touch, then lifts; x and y hold where they are. An automatic sequence under the
+  /// pose moves' rule: refused (false, the status says why) without a gripper with align drives,
+  /// while one runs or an open-loop run does, or unless pose_move_allowed(); it stops with every
+  /// axis holding (hold()) and the align drives where they are as soon as pose_move_allowed()
+  /// turns false (the deadman released, the input stale or outranked, a fault, the e-stop), on a
+  /// contact force over contact_force_limit_N, or a tip's over alignment.max_contact_N, and
+  /// when it is done or fails. On the loop; real-time safe.
+  bool start_tip_levelling() noexcept;
+  /// Ends a levelling under way (failed: stopped), every axis holding. Real-time safe.
+  void stop_tip_levelling() noexcept;
+  /// A levelling asked for by an input that does not drive the coupling: refused, the status
+  /// saying `why` (a static string); one under way goes on. Real-time safe.
+  void refuse_tip_levelling(const char* why) noexcept;
+  bool tip_levelling_running() const noexcept {
+    return levelling_.state == TipLevellingStatus::State::kRunning;
+  }
+  const TipLevellingStatus& tip_levelling() const noexcept { return levelling_; }
+  /// The tips' misalignment now: the simulated gripper's truth (NaN on a driver's gripper).
+  double tip_misalignment_m() const noexcept;
   /// The rotary axis: present, its measured angle and its target [rad] (the
   /// console's theta commands move the target, with the console's deadman; hold() holds it).
   bool has_rotary() const noexcept { return devices_.rotary != nullptr; }
@@ -242,6 +280,12 @@ class Platform {
   void devices_task(double dt_s) noexcept;
   /// Whether axis i's open-loop run must stop now (the safety rules of start_open_loop_steps).
   bool open_loop_must_stop(std::size_t i) const noexcept;
+  /// The tip levelling's part of each task (platform_levelling.cc): one step of the procedure at
+  /// every tick, and its Z target in place of the coupling's.
+  void levelling_task(double dt_s) noexcept;
+  void levelling_targets(std::array<double, StageController::kMaxAxes>& target,
+                         std::array<double, StageController::kMaxAxes>& velocity) const noexcept;
+  void end_levelling(TipLevellingStatus::State state, const char* why) noexcept;
   void telemetry_task() noexcept;
   /// The built-in channels, each with the function that reads it (platform_telemetry.cc).
   struct BuiltinChannel;
@@ -306,6 +350,17 @@ class Platform {
   std::unique_ptr<Recorder> recorder_;
   std::function<void(const runtime::TickInfo&)> operator_;
   teleop::ConsoleInput console_;
+  /// The tip levelling: the procedure (null without align drives), its status, and the stage
+  /// target it runs (stage coordinates: x, y held, z moved at the procedure's speed).
+  std::unique_ptr<microworld::TipAlignment> alignment_;
+  TipLevellingStatus levelling_;
+  Eigen::Vector3d levelling_target_m_ = Eigen::Vector3d::Zero();
+  double levelling_velocity_m_s_ = 0.0;
+  double levelling_press_N_ = 0.0, levelling_press_rate_N_s_ = 0.0;  ///< the higher tip contact, its rise
+  /// The press's rise smoothed over this; the stage's stopping time the guard looks ahead by
+  /// (a few slave ticks: the stick-slip axis ends the step under way).
+  static constexpr double kLevellingRateTau_s = 1e-3;
+  static constexpr double kLevellingStop_s = 2e-3;
   bool faulted_ = false;
   bool vision_xy_ = false;            ///< x and y open loop, positioned by vision (stage.xy_sensor)
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)

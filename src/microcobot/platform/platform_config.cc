@@ -80,6 +80,7 @@ void PlatformConfig::validate() const {
     throw InvalidParams("driver", "'" + excerpt(devices.camera.driver) +
                                       "' is not a camera driver of this build (known: " + known + ")");
   });
+  alignment.validate();  // its errors name alignment.*
   in_section("camera", [&] { camera.validate(); });
   in_section("vision_force", [&] { vision_force.validate(); });
   in_section("loop", [&] { loop.validate(); });

@@ -21,6 +21,7 @@
 #include "microcobot/haptics/render_pipeline.h"
 #include "microcobot/microworld/optical_trap.h"
 #include "microcobot/microworld/pick_place_world.h"
+#include "microcobot/microworld/tip_alignment.h"
 #include "microcobot/motion/parallel_stage.h"
 #include "microcobot/motion/position_controller.h"
 #include "microcobot/motion/position_sensor.h"
@@ -222,6 +223,9 @@ struct PlatformConfig {
   std::string positioner = "cartesian";
   /// The parallel positioner (with `positioner: parallel`): its model's parameters and its driver.
   ParallelPositionerSelection parallel_positioner;
+  /// The PiezoGripper's tips levelled by touch on the substrate (the console's Level tips; a gripper
+  /// with align drives): microworld/tip_alignment.h, Platform::start_tip_levelling.
+  microworld::TipAlignmentParams alignment;
 
   template <class V>
   void visit(V& v) {
@@ -239,6 +243,7 @@ struct PlatformConfig {
     v("vision_force", vision_force);
     v("positioner", positioner);
     v("parallel_positioner", parallel_positioner);
+    v("alignment", alignment);
   }
   bool optical_trap_scene() const { return microworld == "optical-trap"; }
   bool parallel_positioner_enabled() const { return positioner == "parallel"; }
