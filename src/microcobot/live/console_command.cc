@@ -137,9 +137,9 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
   for (std::size_t part = 0; part < 2; ++part) {
     double* v = c.pose_jog.data() + 3 * part;
     const double cap = part == 0 ? limits.pose_max_speed_m_s : limits.pose_max_angular_speed_rad_s;
-    const double speed = std::hypot(v[0], v[1], v[2]);
-    if (speed > cap)
-      for (int i = 0; i < 3; ++i) v[i] = speed > 0.0 ? v[i] * cap / speed : 0.0;
+    const double magnitude = std::hypot(v[0], v[1], v[2]);
+    if (magnitude > cap)
+      for (int i = 0; i < 3; ++i) v[i] = v[i] * cap / magnitude;
   }
   return c;
 }
