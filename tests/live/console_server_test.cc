@@ -339,6 +339,19 @@ TEST(ConsoleServer, LevelTipsIsTheControllingClientsAndItsResultIsInTheStatus) {
   EXPECT_EQ(levelling.at("failure").get<std::string>().rfind("refused", 0), 0u) << levelling.dump();
 }
 
+// `command` sent as the page sends it, every 30 ms, for `s` seconds or until `done()`: whether
+// `done()` came true.
+template <class Done>
+bool send_as_the_page(Console& c, const json& command, double s, Done done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+  while (std::chrono::steady_clock::now() < end) {
+    EXPECT_TRUE(c.command(command));
+    if (done()) return true;
+    std::this_thread::sleep_for(30ms);
+  }
+  return false;
+}
+
 // The parallel positioner's pose as the legs' sensors measure it (the protocol's view: this test
 // is its one reader) and its distance from `goal` [m, rad].
 struct PoseOff {
@@ -367,13 +380,7 @@ TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUn
   // The goal sent as the page sends it, every 30 ms, with or without the deadman, for `s`
   // seconds or until `done`.
   const auto send_for = [&](const std::array<double, 6>& g, bool deadman, double s, auto done) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
-    while (std::chrono::steady_clock::now() < end) {
-      EXPECT_TRUE(c.command({{"deadman", deadman}, {"pose_goal", g}}));
-      if (done()) return true;
-      std::this_thread::sleep_for(30ms);
-    }
-    return false;
+    return send_as_the_page(c, {{"deadman", deadman}, {"pose_goal", g}}, s, done);
   };
   const auto never = [] { return false; };
 
@@ -439,13 +446,7 @@ TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadm
   // The jog sent as the page sends it while a key is held, every 30 ms, for `s` seconds or until
   // `done`. The positioner as the protocol's view publishes it (this test is its one reader).
   const auto jog_for = [&](const std::array<double, 6>& j, bool deadman, double s, auto done) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
-    while (std::chrono::steady_clock::now() < end) {
-      EXPECT_TRUE(c.command({{"deadman", deadman}, {"pose_jog", j}}));
-      if (done()) return true;
-      std::this_thread::sleep_for(30ms);
-    }
-    return false;
+    return send_as_the_page(c, {{"deadman", deadman}, {"pose_jog", j}}, s, done);
   };
   const auto never = [] { return false; };
   PositionerView v = live.positioner_view();

@@ -39,6 +39,18 @@ std::array<double, 3> vec3(const char* channel, const json& v, const std::string
   return out;
 }
 
+// The parallel positioner's six numbers (a pose, a twist); `names`: theirs and their units, for
+// the error. Refused without the positioner.
+std::array<double, 6> vec6(const char* channel, const json& v, const std::string& field, bool has_positioner,
+                           const char* names) {
+  if (!has_positioner) refuse(channel, field, "there is no parallel positioner (positioner: parallel)");
+  if (!v.is_array() || v.size() != 6)
+    refuse(channel, field, std::string("must be an array of 6 numbers ") + names);
+  std::array<double, 6> out{};
+  for (std::size_t i = 0; i < 6; ++i) out[i] = finite(channel, v[i], field + "[" + std::to_string(i) + "]");
+  return out;
+}
+
 }  // namespace
 
 ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits& limits) {
@@ -100,20 +112,10 @@ ConsoleCommand parse_console_command(std::string_view text, const ConsoleLimits&
     } else if (key == "exposure_s") {
       c.exposure_s = std::clamp(finite(kChannel, value, key), limits.min_exposure_s, limits.max_exposure_s);
     } else if (key == "pose_goal") {
-      if (!limits.has_positioner)
-        refuse(kChannel, key, "there is no parallel positioner (positioner: parallel)");
-      if (!value.is_array() || value.size() != 6)
-        refuse(kChannel, key, "must be an array of 6 numbers [x, y, z, rx, ry, rz] (m, rad)");
-      for (std::size_t i = 0; i < 6; ++i)
-        c.pose_goal[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
+      c.pose_goal = vec6(kChannel, value, key, limits.has_positioner, "[x, y, z, rx, ry, rz] (m, rad)");
       c.has_pose_goal = true;
     } else if (key == "pose_jog") {
-      if (!limits.has_positioner)
-        refuse(kChannel, key, "there is no parallel positioner (positioner: parallel)");
-      if (!value.is_array() || value.size() != 6)
-        refuse(kChannel, key, "must be an array of 6 numbers [vx, vy, vz, wx, wy, wz] (m/s, rad/s)");
-      for (std::size_t i = 0; i < 6; ++i)
-        c.pose_jog[i] = finite(kChannel, value[i], key + "[" + std::to_string(i) + "]");
+      c.pose_jog = vec6(kChannel, value, key, limits.has_positioner, "[vx, vy, vz, wx, wy, wz] (m/s, rad/s)");
       c.has_pose_jog = true;
     } else if (key == "gain") {
       c.gain = std::clamp(finite(kChannel, value, key), limits.min_gain, limits.max_gain);
