@@ -121,6 +121,14 @@ struct TwinRig {
     server->stop();
     live->stop();
   }
+  /// The rotary axis' angle in the telemetry, once a sample has reached it (the drain thread, which a
+  /// sanitizer on a loaded machine may leave behind by seconds); NaN after `timeout_s` without one.
+  double logged_theta_rad(double timeout_s = 10.0) const {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::isnan(theta_rad.load()) && std::chrono::steady_clock::now() < end)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return theta_rad.load();
+  }
   std::uint16_t gcs_port() const { return server->ports()[0]; }
   std::uint16_t anc_port() const { return server->ports()[1]; }
   double x_mm(const Client& c) const {

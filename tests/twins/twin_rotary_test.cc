@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -90,7 +91,8 @@ TEST(TwinRotary, AGoalBeyondTheTravelIsRefusedAndNothingTurns) {
   Client c(rig.gcs_port());
   reference_theta(c);
   EXPECT_EQ(c.gcs("TMX? 4"), "4=61.879442\n");  // the platform keeps +-62 deg
-  const double before = rig.theta_rad.load();
+  const double before = rig.logged_theta_rad();
+  ASSERT_FALSE(std::isnan(before)) << "no telemetry sample in 10 s";
   c.send("MOV 4 70\n");
   EXPECT_EQ(c.gcs("ERR?"), "7\n");
   c.send("VEL 4 10\n");  // over 0.16 rad/s
@@ -137,7 +139,7 @@ TEST(TwinRotary, AnAnc300ClientStepsTheRotaryPositionerUpAndBack) {
   EXPECT_EQ(ask("setf 4 500"), "OK\r\n");
   EXPECT_EQ(ask("setv 4 60"), "OK\r\n");
   std::this_thread::sleep_for(300ms);  // still, and the telemetry's drain caught up
-  const double t0 = rig.theta_rad.load();
+  const double t0 = rig.logged_theta_rad();
   EXPECT_EQ(ask("stepu 4 100"), "OK\r\n");
   EXPECT_EQ(ask("stepw 4"), "OK\r\n");  // answered once the run is over
   std::this_thread::sleep_for(300ms);   // still, and the telemetry's drain caught up
