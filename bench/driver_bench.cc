@@ -22,9 +22,9 @@
 
 #include "microcobot/drivers/bus_controller.h"
 #include "microcobot/drivers/pi_hexapod.h"
-#include "microcobot/motion/pose.h"
 #include "microcobot/drivers/register_drivers.h"
 #include "microcobot/live/live_platform.h"
+#include "microcobot/motion/pose.h"
 #include "microcobot/platform/driver_registry.h"
 #include "microcobot/twins/live_stage.h"
 #include "microcobot/twins/twin_server.h"
@@ -77,7 +77,8 @@ Phase run_phase(mc::platform::Platform& p, double seconds, bool positioner) {
     in.goal_m = home + Eigen::Vector3d(slot % 2 == 0 ? 10e-6 : -10e-6, 0, 0);
     p.set_console_input(in);
     // The move that starts where the positioner holds: the next one first.
-    for (std::size_t k = 0; positioner && slot != last_slot && k < moves.size() && p.positioner()->at_rest(); ++k) {
+    for (std::size_t k = 0; positioner && slot != last_slot && k < moves.size() && p.positioner()->at_rest();
+         ++k) {
       const std::size_t m = (next_move + k) % moves.size();
       if (!p.start_pose_move(moves[m])) continue;
       last_slot = slot;

@@ -339,6 +339,19 @@ TEST(ConsoleServer, LevelTipsIsTheControllingClientsAndItsResultIsInTheStatus) {
   EXPECT_EQ(levelling.at("failure").get<std::string>().rfind("refused", 0), 0u) << levelling.dump();
 }
 
+// A live platform with the parallel positioner served to one console client.
+struct PositionerConsole {
+  test::TempDir dir;
+  LiveParams lp = [] {
+    LiveParams p;
+    p.platform.positioner = "parallel";
+    return p;
+  }();
+  LivePlatform live{lp};
+  ConsoleServer server{live, Rig::params(dir.path(), "")};
+  Console console{(server.start(), server.port())};
+};
+
 // `command` sent as the page sends it, every 30 ms, for `s` seconds or until `done()`: whether
 // `done()` came true.
 template <class Done>
@@ -367,13 +380,10 @@ PoseOff pose_off(LivePlatform& live, const std::array<double, 6>& goal) {
 }
 
 TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUnreachableOneIsRefused) {
-  test::TempDir dir;
-  LiveParams lp;
-  lp.platform.positioner = "parallel";
-  LivePlatform live(lp);
-  ConsoleServer server(live, Rig::params(dir.path(), ""));
-  server.start();
-  Console c(server.port());
+  PositionerConsole rig;
+  LivePlatform& live = rig.live;
+  ConsoleServer& server = rig.server;
+  Console& c = rig.console;
   ASSERT_TRUE(c.action("take_control"));
   ASSERT_FALSE(c.ws.read_status("control").is_null());
   const std::array<double, 6> home{}, goal{120e-6, -60e-6, 40e-6, 0.004, -0.003, 0.02};
@@ -434,13 +444,11 @@ TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUn
 }
 
 TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadmanAndStopsAtTheEdge) {
-  test::TempDir dir;
-  LiveParams lp;
-  lp.platform.positioner = "parallel";
-  LivePlatform live(lp);
-  ConsoleServer server(live, Rig::params(dir.path(), ""));
-  server.start();
-  Console c(server.port());
+  PositionerConsole rig;
+  LiveParams& lp = rig.lp;
+  LivePlatform& live = rig.live;
+  ConsoleServer& server = rig.server;
+  Console& c = rig.console;
   ASSERT_TRUE(c.action("take_control"));
   ASSERT_FALSE(c.ws.read_status("control").is_null());
   // The jog sent as the page sends it while a key is held, every 30 ms, for `s` seconds or until
