@@ -197,7 +197,9 @@ TEST(SerialLine, APathThatIsNotThereOrNotATtyIsRefusedInOneLine) {
 
 TEST(SerialLine, ThePiGcs2DriverConfiguresAndMovesTheAxesOverTheLine) {
   FakeGcs2 fake(test::FakeController::Transport::kPty);
-  auto p = platform::make_platform(serial_gcs2_config(fake.server.tty_path()));
+  // The controller here is a thread of this process, which a loaded machine may starve for longer
+  // than the default 0.1 s reply timeout (the timeout's own rule is tested below): 1 s.
+  auto p = platform::make_platform(serial_gcs2_config(fake.server.tty_path() + ",timeout_s=1"));
   EXPECT_FALSE(p->simulated());
   EXPECT_GE(fake.server.count("*IDN?"), 1);
   EXPECT_GE(fake.server.count("SAI?"), 1);
