@@ -10,7 +10,9 @@ random.Random(seed)).
 
 A trial is kept only if it also meets the hard constraint the unit tests assert: a 400 nm move
 (inside the PE's stroke) only scans, with no step and a max error <= 30 nm (`control trajectory
---profile trapezoid --distance 4e-7 --velocity 2e-4`). --freeze keeps named values at their start.
+--profile trapezoid --distance 4e-7 --velocity 2e-4`). --freeze keeps named values at their start;
+--fixed KEY=VALUE writes a value the search leaves alone into every trial (a design, such as a split
+edge, tried with the searched gains retuned around it).
 
 Cost (lower is better), on the tuning set's per-case figures:
     mean RMS / 100 nm
@@ -83,10 +85,10 @@ def cost_of(result):
     return cost
 
 
-def write_params(path, values):
+def write_params(path, values, fixed):
     # JSON is YAML: `--params` reads it as the `tracking:` section.
     with open(path + ".tmp", "w") as f:
-        json.dump({"tracking": values}, f, indent=1)
+        json.dump({"tracking": {**values, **fixed}}, f, indent=1)
     os.replace(path + ".tmp", path)
 
 
@@ -133,6 +135,9 @@ def main():
     ap.add_argument("--cases", type=int, help="random tuning cases (default: the set's 32)")
     ap.add_argument("--out", required=True, help="directory for trials.jsonl and best.yaml")
     ap.add_argument("--freeze", default="", help="comma-separated keys kept at their start values")
+    ap.add_argument("--fixed", default="", help="comma-separated KEY=VALUE tracking values written into "
+                    "every trial and never searched (e.g. edge_split_s=305e-6: a design tried with the "
+                    "searched gains retuned around it)")
     a = ap.parse_args()
     frozen = {k for k in a.freeze.split(",") if k}
     unknown = frozen - {k for k, *_ in SEARCHED}
@@ -142,22 +147,31 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     defaults = json.loads(subprocess.run([a.cli, "control", "params", "--json"], check=True,
                                          capture_output=True, text=True).stdout)["tracking"]
+    fixed = {}
+    for item in (i for i in a.fixed.split(",") if i):
+        key, _, value = item.partition("=")
+        if key not in defaults or key in {k for k, *_ in SEARCHED}:
+            ap.error(f"--fixed: '{key}' is not a tracking value outside the search")
+        try:
+            fixed[key] = float(value)
+        except ValueError:
+            ap.error(f"--fixed: {key}={value!r} is not a number")
     start = json.load(open(a.start))["tracking"] if a.start else {}
     best = {k: float(start.get(k, defaults[k])) for k, *_ in SEARCHED}
     rng = random.Random(a.seed)
     trial_file = os.path.join(a.out, "trial.yaml")
     log = open(os.path.join(a.out, "trials.jsonl"), "w")
-    write_params(trial_file, best)
+    write_params(trial_file, best, fixed)
     print(f"start: at-rest scan violation {at_rest_scan_violation(a.cli, trial_file):.3f}", flush=True)
     res = run(a.cli, trial_file, a.cases)
     best_cost = cost_of(res)
     log.write(json.dumps({"trial": 0, "cost": best_cost, "values": best, "summary": res["summary"]}) + "\n")
     log.flush()
     print(f"start cost {best_cost:.3f} {res['summary']}", flush=True)
-    write_params(os.path.join(a.out, "best.yaml"), best)
+    write_params(os.path.join(a.out, "best.yaml"), best, fixed)
     for t in range(1, a.trials + 1):
         cand = perturb(rng, best, a.scale, searched)
-        write_params(trial_file, cand)
+        write_params(trial_file, cand, fixed)
         try:
             violation = at_rest_scan_violation(a.cli, trial_file)
             if violation > 0:
@@ -175,13 +189,13 @@ def main():
         log.flush()
         if kept:
             best, best_cost = cand, c
-            write_params(os.path.join(a.out, "best.yaml"), best)
+            write_params(os.path.join(a.out, "best.yaml"), best, fixed)
             s = res["summary"]
             print(f"trial {t}: cost {c:.3f} passed {s['passed']}/{s['cases']} median "
                   f"{s['median_rms_m']*1e9:.0f} worst rms {s['worst_rms_m']*1e9:.0f} max "
                   f"{s['worst_max_m']*1e9:.0f} path {s['worst_path_deviation_m']*1e9:.0f} pu "
                   f"{s['worst_powerup_backward_m']*1e9:.0f}", flush=True)
-    print(json.dumps({"best_cost": best_cost, "tracking": best}, indent=1))
+    print(json.dumps({"best_cost": best_cost, "tracking": {**best, **fixed}}, indent=1))
     return 0
 
 

@@ -266,16 +266,18 @@ void run_accuracy(const AccuracyOptions& o) {
 /// One sweep's rows: the case, what it did.
 void add_rows(mc::CsvTable& t, int sweep_id, const std::vector<mc::studies::EdgeDip>& dips) {
   for (const auto& d : dips) {
-    const std::array<double, 11> row{static_cast<double>(sweep_id),
+    const std::array<double, 13> row{static_cast<double>(sweep_id),
                                      d.edge.top_V,
                                      d.edge.drop_V,
                                      d.edge.slew_V_s,
                                      d.edge.ramp_m_s,
                                      d.edge.unload_V,
+                                     d.edge.split_delay_s,
                                      d.edge_s,
                                      d.dip_m,
                                      d.dip_at_s,
                                      d.net_m,
+                                     d.overshoot_m,
                                      d.z_ba_m};
     t.add_row(row);
   }
@@ -283,6 +285,19 @@ void add_rows(mc::CsvTable& t, int sweep_id, const std::vector<mc::studies::Edge
 
 nlohmann::json fit_json(const mc::studies::PowerFit& f) {
   return {{"exponent", f.exponent}, {"factor", f.factor}, {"points", f.points}};
+}
+
+/// The split edges' dip, rest and overshoot against the halves' delay.
+std::vector<Series> split_series(const std::vector<mc::studies::EdgeDip>& dips) {
+  std::vector<Series> out{
+      {"dip", {}, {}, false}, {"rest (behind the start)", {}, {}, false}, {"overshoot", {}, {}, false}};
+  for (const auto& d : dips) {
+    for (auto& s : out) s.x.push_back(d.edge.split_delay_s);
+    out[0].y.push_back(d.dip_m);
+    out[1].y.push_back(-d.net_m);
+    out[2].y.push_back(d.overshoot_m);
+  }
+  return out;
 }
 
 Series dip_series(const std::string& name, const std::vector<mc::studies::EdgeDip>& dips, bool by_drop) {
@@ -312,23 +327,31 @@ void run_edge_dip(const CommonOptions& o) {
                           {{"dip_m", tracking.dip_m},
                            {"dip_at_s", tracking.dip_at_s},
                            {"net_m", tracking.net_m},
-                           {"edge_s", tracking.edge_s}}}};
+                           {"overshoot_m", tracking.overshoot_m},
+                           {"edge_s", tracking.edge_s}}},
+                         {"least_split_edge",
+                          {{"split_delay_s", st.least_split.edge.split_delay_s},
+                           {"dip_m", st.least_split.dip_m},
+                           {"net_m", st.least_split.net_m},
+                           {"overshoot_m", st.least_split.overshoot_m}}}};
   if (o.out) {
     mc::ensure_writable_dir(*o.out);
-    mc::CsvTable t({"sweep", "top_V", "drop_V", "slew_V_s", "ramp_m_s", "unload_V", "edge_s", "dip_m",
-                    "dip_at_s", "net_m", "z_ba_m"});
+    mc::CsvTable t({"sweep", "top_V", "drop_V", "slew_V_s", "ramp_m_s", "unload_V", "split_delay_s", "edge_s",
+                    "dip_m", "dip_at_s", "net_m", "overshoot_m", "z_ba_m"});
     add_rows(t, 0, st.drop_sweep);
     add_rows(t, 1, st.drop_sweep_unloaded);
     add_rows(t, 2, st.slew_sweep);
     add_rows(t, 3, st.slew_sweep_unloaded);
     add_rows(t, 4, st.speed_sweep);
     add_rows(t, 5, st.top_sweep);
+    add_rows(t, 6, st.split_sweep);
     mc::cli::write_result_tables(
         o,
         {{"edges.csv",
           t,
           "edges_",
-          {"sweep: 0 drop, 1 drop unloaded, 2 slew, 3 slew unloaded, 4 ramp speed, 5 top voltage"}}},
+          {"sweep: 0 drop, 1 drop unloaded, 2 slew, 3 slew unloaded, 4 ramp speed, 5 top voltage, 6 split "
+           "edge's delay (unloaded)"}}},
         j);
     Report r("stickslip edge-dip");
     r.section(
@@ -342,6 +365,8 @@ void run_edge_dip(const CommonOptions& o) {
     r.add_result("dip ~ T^p (held, dV 68.38 V), p", st.dip_vs_duration.exponent, "");
     r.add_result("break-away strain z_ba", st.z_ba_m, "m");
     r.add_result("the tracking controller's edge (unloaded): dip", tracking.dip_m, "m");
+    r.add_result("the same edge split in two halves: least dip", st.least_split.dip_m, "m");
+    r.add_result("... at the halves' delay", st.least_split.edge.split_delay_s, "s");
     r.add_figure(
         {"Dip against the edge's drop",
          "At 1 V/us from 100 V, held and unloaded.",
@@ -354,17 +379,26 @@ void run_edge_dip(const CommonOptions& o) {
          {"Edge duration T = dV / S", "s", true},
          {"Dip", "m", true},
          {dip_series("held", st.slew_sweep, false), dip_series("unloaded", st.slew_sweep_unloaded, false)}});
+    r.add_figure({"The edge split in two halves",
+                  "The tracking controller's edge (68.38 V at 1 V/us, unloaded by 72 %) as two halves, the "
+                  "second delayed: the dip, where the slider rests behind the start, and the overshoot "
+                  "beyond that rest.",
+                  {"Delay between the halves", "s", false},
+                  {"Displacement", "m", false},
+                  split_series(st.split_sweep)});
     mc::cli::write_report_if_requested(o, r);
   }
   mc::cli::emit(
       o, j,
       fmt::format("mechanism: {}; dip ~ dV^{:.2f} at 1 V/us, ~ T^{:.2f} at 68.38 V (held); unloaded "
                   "dV^{:.2f}, T^{:.2f}; z_ba {:.0f} nm; the tracking controller's edge (unloaded) dips "
-                  "{:.0f} nm at {:.0f} us, "
-                  "rests {:+.0f} nm",
+                  "{:.0f} nm at {:.0f} us, rests {:+.0f} nm; split in two halves {:.0f} us apart it dips "
+                  "{:.0f} nm, rests {:+.0f} nm",
                   st.mechanism, st.dip_vs_drop.exponent, st.dip_vs_duration.exponent,
                   st.dip_vs_drop_unloaded.exponent, st.dip_vs_duration_unloaded.exponent, st.z_ba_m * 1e9,
-                  tracking.dip_m * 1e9, tracking.dip_at_s * 1e6, tracking.net_m * 1e9));
+                  tracking.dip_m * 1e9, tracking.dip_at_s * 1e6, tracking.net_m * 1e9,
+                  st.least_split.edge.split_delay_s * 1e6, st.least_split.dip_m * 1e9,
+                  st.least_split.net_m * 1e9));
 }
 
 void add_stickslip(CLI::App& group) {

@@ -476,10 +476,15 @@ TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadm
   ASSERT_TRUE(jog_for(along_x, true, 30.0, [&] {
     return (v = live.positioner_view()).reference.d.x() > v0.reference.d.x() + 20e-6;
   }));
+  // A jog whose commands come late (an instrumented server's thread, starved) goes stale: the
+  // positioner holds where the legs are until a fresh one comes, then accelerates again from there:
+  // slower on average (19-29 um/s measured under the sanitizers), and a few tens of nanometres off
+  // its line where it was taken up again.
   const double speed = (v.reference.d.x() - v0.reference.d.x()) / (v.time_s - v0.time_s);
-  EXPECT_GT(speed, 40e-6);
+  EXPECT_GT(speed, MC_UNDER_SANITIZER ? 10e-6 : 40e-6);
   EXPECT_LT(speed, 51e-6);
-  EXPECT_LT(std::abs(v.reference.d.y()) + std::abs(v.reference.d.z()), 1e-9) << "the jog left its line";
+  EXPECT_LT(std::abs(v.reference.d.y()) + std::abs(v.reference.d.z()), MC_UNDER_SANITIZER ? 0.1e-6 : 1e-9)
+      << "the jog left its line";
   EXPECT_LT((v.measured.d - v.reference.d).norm(), 2e-6) << "the legs lag the jog";
 
   // Released: the platform holds where it is.

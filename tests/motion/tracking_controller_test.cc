@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -197,6 +198,69 @@ TEST(TrackingController, EdgesGoTheWayTheReferenceMoves) {
   EXPECT_NEAR(test::model().slider_position(s), x_ref, 1.5e-6);
 }
 
+TEST(TrackingController, ASplitEdgeFallsInTwoHalvesItsDelayApartAndEndsWhereOneEdgeEnds) {
+  // The drive of a forward move's first edge, sampled every microsecond from the tick it starts
+  // in, with the edge whole and split (edge_split_s): both end at low_V + unload_V; the split one
+  // holds between its halves until split_s after its start.
+  TrackingParams p;
+  p.powerup_V = 0.0;  // from the range's bottom, no ramp-in
+  const auto first_edge = [&p](double split_s) {
+    TrackingParams q = p;
+    q.edge_split_s = split_s;
+    TrackingController c(q, test::model().params(), test::step_map());
+    auto s = test::model().initial_state();
+    PositionSensor sensor;
+    c.reset(0.0, q.low_V);
+    std::vector<double> u;
+    double x_ref = 0.0;
+    for (int k = 0; k < 20000; ++k) {
+      x_ref += 100e-6 * 1e-4;
+      c.set_reference({x_ref, 100e-6, 0.0});
+      c.update(sensor.measure(test::model().slider_position(s)));
+      if (c.edges() == 0) {
+        for (int i = 0; i < 100; ++i) test::model().step(s, c.next_drive(1e-6));
+        continue;
+      }
+      if (!c.in_edge()) break;  // the tick after the edge's last leg
+      for (int i = 0; i < 100; ++i) {
+        test::model().step(s, c.next_drive(1e-6));
+        u.push_back(c.voltage_V());
+      }
+    }
+    return u;
+  };
+  const std::vector<double> whole = first_edge(0.0);
+  const double split_s = 305e-6;
+  const std::vector<double> halves = first_edge(split_s);
+  ASSERT_FALSE(whole.empty());
+  ASSERT_FALSE(halves.empty());
+  const double end_V = p.low_V + p.unload_V;
+  EXPECT_NEAR(whole.back(), end_V, 1e-9);
+  EXPECT_NEAR(halves.back(), end_V, 1e-9);
+  // Sampled every microsecond, a leg's end within a sample is seen up to the slew's 1 V past it.
+  const double slew = test::model().params().drive.slew_rate_V_s, per_sample_V = slew * 1e-6;
+  EXPECT_NEAR(*std::min_element(whole.begin(), whole.end()), p.low_V, per_sample_V);
+  // The first half's bottom lies halfway from where the edge started (within edge_ready_V of the
+  // range's end) down to low_V; the second half falls as far from the first's unloading, to
+  // low_V + unload_V / 2.
+  const double start_V = halves.front() + per_sample_V;
+  const auto second_bottom = std::min_element(halves.begin(), halves.end());
+  EXPECT_NEAR(*second_bottom, p.low_V + 0.5 * p.unload_V, per_sample_V);
+  const auto first_bottom = std::min_element(halves.begin(), halves.begin() + 50);
+  EXPECT_NEAR(*first_bottom, 0.5 * (start_V + p.low_V), per_sample_V);
+  // Between the halves the drive is held at the first half's unloading: the longest run of equal
+  // samples before the second half lasts until split_s after the edge's start.
+  std::ptrdiff_t run = 0, longest = 0;
+  for (auto it = halves.begin() + 1; it != second_bottom; ++it) {
+    run = *it == *(it - 1) ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const double first_s = (0.5 * (start_V - p.low_V) + 0.5 * p.unload_V) / slew;
+  EXPECT_NEAR(static_cast<double>(longest) * 1e-6, split_s - first_s, 2e-6);
+  // One edge's legs take (ΔV + unload) / S; the split edge's, split_s longer than their half.
+  EXPECT_NEAR(static_cast<double>(halves.size() - whole.size()) * 1e-6, split_s - first_s, 100e-6);
+}
+
 TEST(TrackingController, UpdateAndDriveNeverAllocate) {
   TrackingController c(TrackingParams{}, test::model().params(), test::step_map());
   auto s = test::model().initial_state();
@@ -237,6 +301,9 @@ TEST(TrackingController, InvalidParamsAreRejected) {
   EXPECT_THROW(p.validate(), InvalidParams);
   p = TrackingParams{};
   p.powerup_unload_V = p.high_V;
+  EXPECT_THROW(p.validate(), InvalidParams);
+  p = TrackingParams{};
+  p.edge_split_s = -1e-6;
   EXPECT_THROW(p.validate(), InvalidParams);
 }
 

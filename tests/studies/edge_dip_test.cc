@@ -55,6 +55,23 @@ TEST(EdgeDip, TheDipGrowsInProportionToTheDropNotAsItsSquare) {
   EXPECT_NEAR(f.exponent, 1.0, 0.25) << "a drag during the slip would give ~2, pre-sliding ~0";
 }
 
+TEST(EdgeDip, AnEdgeSplitHalfTheContactModesPeriodApartRingsLessButSlipsFurther) {
+  EdgeCase e;
+  e.unload_V = 49.16;  // the tracking controller's unloaded edge
+  const EdgeDip one = run_edge(model(), e);
+  e.split_delay_s = 0.5 / 1640.0;  // half the period of the contact's stiff mode
+  const EdgeDip shaped = run_edge(model(), e);
+  e.split_delay_s = 1.0 / 1640.0;  // a whole period: the halves' ringings add
+  const EdgeDip in_phase = run_edge(model(), e);
+  // The shaper cancels the ringing: the overshoot beyond the rest shrinks, and the dip with it
+  // against the whole period's split.
+  EXPECT_LT(shaped.overshoot_m, 0.5 * one.overshoot_m);
+  EXPECT_LT(shaped.dip_m, in_phase.dip_m);
+  // Each half slips on its own: the slider comes to rest further back than after one edge.
+  EXPECT_LT(shaped.net_m, one.net_m - 50e-9);
+  EXPECT_NEAR(shaped.overshoot_m, shaped.dip_m + shaped.net_m, 1e-15);
+}
+
 TEST(EdgeDip, BadCasesAreRefusedNamingTheirField) {
   const auto refused = [](EdgeCase e, const std::string& field) {
     try {
@@ -77,6 +94,9 @@ TEST(EdgeDip, BadCasesAreRefusedNamingTheirField) {
   e = {};
   e.slew_V_s = 100.0;  // a 0.68 s fall does not fit in the 10 ms window
   EXPECT_TRUE(refused(e, "edge.window_s"));
+  e = {};
+  e.split_delay_s = 10e-6;  // shorter than a half edge (34 us)
+  EXPECT_TRUE(refused(e, "edge.split_delay_s"));
 }
 
 TEST(EdgeDip, ThePowerFitRecoversAKnownLawAndNeedsTwoPoints) {

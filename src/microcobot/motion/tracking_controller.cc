@@ -29,6 +29,7 @@ void TrackingParams::validate() const {
   require(unload_V >= 0.0 && unload_V <= high_V - low_V - 10.0, "tracking.unload_V",
           "must be in [0, high_V - low_V - 10]", unload_V);
   require_non_negative(edge_margin_m, "tracking.edge_margin_m");
+  require_in_range(edge_split_s, 0.0, 5e-3, "tracking.edge_split_s");
   require_in_range(edge_ready_V, 0.0, 50.0, "tracking.edge_ready_V");
   require_in_range(lead_fraction, 0.0, 1.0, "tracking.lead_fraction");
   require_positive(lead_window_m, "tracking.lead_window_m");
@@ -131,18 +132,39 @@ void TrackingController::start_edge(double x, bool forward) noexcept {
   op_.frequency_Hz = flyback_frequency_Hz(ref_.v_m_s, op_.amplitude_V, d);
   op_.direction = d;
   edge_ = true;
-  edge_forward_ = forward;
   // A backward edge spans the sawtooth's amplitude from the ramp's floor: from the range's bottom
   // that is high_V; from below it (the amplifier at 0 V after power-up) it stays as wide as every
   // other edge, and the ramp keeps using the voltages below low_V (a full 0 -> high_V edge slips
   // further and rings harder: a 200 um/s backward move from power-up peaked at 650 nm of error
   // with it, 624 nm with this one).
-  edge_target_V_ = forward ? low : std::min(p_.high_V, floor_V_ + op_.amplitude_V);
+  const double target = forward ? low : std::min(p_.high_V, floor_V_ + op_.amplitude_V);
   if (forward) floor_V_ = low;
-  unload_V_ = p_.unload_V * op_.amplitude_V / (p_.high_V - p_.low_V);
-  unloading_ = false;
+  plan_edge(target, p_.unload_V * op_.amplitude_V / (p_.high_V - p_.low_V), p_.edge_split_s);
   backslip_.edge_at(x, forward);
   ++edges_;
+}
+
+void TrackingController::plan_edge(double target_V, double unload_V, double split_s) noexcept {
+  const double back = target_V < u_ ? 1.0 : -1.0;  // the unloading turns against the edge
+  leg_ = leg_count_ = 0;
+  const auto to = [this](double v) { legs_[static_cast<std::size_t>(leg_count_++)] = {v, 0.0}; };
+  if (split_s <= 0.0) {
+    to(target_V);
+    if (unload_V > 0.0) to(target_V + back * unload_V);
+    return;
+  }
+  // Two halves, each an edge and its unloading at half the voltages; the second starts split_s
+  // after the first (at once if the first takes longer).
+  const double half = 0.5 * (target_V - u_), middle = u_ + half;
+  to(middle);
+  if (unload_V > 0.0) to(middle + back * 0.5 * unload_V);
+  const double first_s = (std::abs(half) + 0.5 * unload_V) / slew_;
+  if (split_s > first_s) {
+    const double held = legs_[static_cast<std::size_t>(leg_count_ - 1)].to_V;
+    legs_[static_cast<std::size_t>(leg_count_++)] = {held, split_s - first_s};
+  }
+  to(target_V + back * 0.5 * unload_V);
+  if (unload_V > 0.0) to(target_V + back * unload_V);
 }
 
 void TrackingController::start_ramp_in(double x) noexcept {
@@ -154,10 +176,7 @@ void TrackingController::start_ramp_in(double x) noexcept {
   op_.amplitude_V = p_.powerup_V + p_.powerup_unload_V - u_;
   op_.direction = Direction::kBackward;
   edge_ = true;
-  edge_forward_ = false;
-  edge_target_V_ = p_.powerup_V + p_.powerup_unload_V;
-  unload_V_ = p_.powerup_unload_V;
-  unloading_ = false;
+  plan_edge(p_.powerup_V + p_.powerup_unload_V, p_.powerup_unload_V, 0.0);
   backslip_.edge_at(x, false, 0.0);
   powerup_.ramp_in = powerup_.ramp_in_started = true;
 }
@@ -284,25 +303,28 @@ stickslip::DriveSegment TrackingController::next_drive(double dt_s) noexcept {
     return seg;
   }
   if (edge_) {
-    // The edge (and its unloading reversal) at the slew limit; a corner wherever a leg ends.
+    // The edge's legs (the edge, its unloading reversal, a split edge's hold) at the slew limit;
+    // a corner wherever a leg ends.
     double left = dt_s;
     while (edge_ && left > 0.0) {
-      const double need = std::abs(edge_target_V_ - u_) / slew_;
+      EdgeLeg& leg = legs_[static_cast<std::size_t>(leg_)];
+      const bool hold = leg.hold_s > 0.0;
+      const double need = hold ? leg.hold_s : std::abs(leg.to_V - u_) / slew_;
       if (need > left) {
-        u_ += std::copysign(slew_ * left, edge_target_V_ - u_);
+        if (hold)
+          leg.hold_s -= left;
+        else
+          u_ += std::copysign(slew_ * left, leg.to_V - u_);
         break;
       }
       left -= need;
-      u_ = edge_target_V_;
+      u_ = leg.to_V;
       if (left > dt_s * 1e-9 && seg.corners < stickslip::DriveSegment::kMaxCorners) {
         seg.u_V[static_cast<std::size_t>(seg.corners)] = u_;
         seg.at[static_cast<std::size_t>(seg.corners)] = (dt_s - left) / dt_s;
         ++seg.corners;
       }
-      if (!unloading_ && unload_V_ > 0.0) {
-        unloading_ = true;
-        edge_target_V_ += edge_forward_ ? unload_V_ : -unload_V_;
-      } else {
+      if (++leg_ == leg_count_) {
         edge_ = false;
         pending_anchor_ = true;
         u_cmd_ = u_prev_cmd_ = u_;

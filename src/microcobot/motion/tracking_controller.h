@@ -29,6 +29,7 @@
 ///    when one is, it is the same edge. The final position is held by the same scanning loop.
 /// update() and next_drive() never allocate; the model and the step map are fixed at construction.
 
+#include <array>
 #include <cstdint>
 
 #include "microcobot/motion/backslip_estimate.h"
@@ -75,6 +76,11 @@ struct TrackingParams {
   /// without it the slider recoils by ~1 um after a full-range edge (model, 100 V) [V]. For the
   /// low_V..high_V edge; a sprint edge unloads in proportion to its amplitude.
   double unload_V = 49.16;
+  /// A shaped edge: the edge and its unloading in two halves, the second starting this long
+  /// after the first, so that the halves' recoils cancel on the contact mode whose half period
+  /// this is (a zero-vibration shaper; 305 us for the 1.64 kHz mode). Each half slips, so the
+  /// edge's backslip is larger (docs/concepts/control.md, "The edge's dip"). 0: one edge [s].
+  double edge_split_s = 0.0;
   /// Backslip of an unloaded edge assumed before the first edge is measured [m].
   double backslip_m = 0.0;
   /// At rest, an edge only when the wanted PE extension lies this far beyond the range [m].
@@ -147,6 +153,7 @@ struct TrackingParams {
     v("guard_V", guard_V);
     v("edge_ready_V", edge_ready_V);
     v("unload_V", unload_V);
+    v("edge_split_s", edge_split_s);
     v("backslip_m", backslip_m);
     v("edge_margin_m", edge_margin_m);
     v("lead_fraction", lead_fraction);
@@ -226,6 +233,9 @@ class TrackingController {
  private:
   void start_edge(double x, bool forward) noexcept;
   void start_ramp_in(double x) noexcept;
+  /// The legs of an edge from the present voltage to `target_V`, turning back by `unload_V`, in
+  /// two halves `split_s` apart when split_s > 0.
+  void plan_edge(double target_V, double unload_V, double split_s) noexcept;
   void anchor_after_edge() noexcept;
   double flyback_frequency_Hz(double v_m_s, double amplitude_V, stickslip::Direction d) const noexcept;
 
@@ -245,12 +255,17 @@ class TrackingController {
   double since_edge_s_ = 1.0;
   BackslipEstimate backslip_;  ///< per direction, refined by each edge's outcome
   double x_filt_ = 0.0;
-  double edge_target_V_ = 0.0;
-  double unload_V_ = 0.0;  ///< the present edge's unloading (unload_V scaled to its amplitude)
+  /// The edge under way, as legs run one after the other: each to its voltage at the slew limit,
+  /// or held for hold_s (> 0). An edge, its unloading, and with edge_split_s the same in halves.
+  struct EdgeLeg {
+    double to_V = 0.0, hold_s = 0.0;
+  };
+  std::array<EdgeLeg, 5> legs_{};
+  int leg_ = 0, leg_count_ = 0;
   /// The ramp's lowest voltage: low_V, or below it after power-up until the ramp rises through low_V
   /// or a forward edge lands there.
   double floor_V_ = 0.0;
-  bool edge_ = false, edge_forward_ = true, unloading_ = false, pending_anchor_ = false;
+  bool edge_ = false, pending_anchor_ = false;
   bool stopped_ = false, in_position_ = false, have_x_ = false, sprint_ = false;
   /// The power-up (see powerup_V): under way until ready(); its ramp-in edge started, and running
   /// with its catch-up; the time settled since.

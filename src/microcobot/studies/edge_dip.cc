@@ -22,27 +22,51 @@ void check(const EdgeCase& e) {
   if (!(e.ramp_m_s > 0.0 && std::isfinite(e.ramp_m_s))) bad("ramp_m_s", e.ramp_m_s, "must be > 0 m/s");
   if (!(e.unload_V >= 0.0 && e.unload_V <= e.drop_V))
     bad("unload_V", e.unload_V, "must lie in [0, drop_V] V");
-  const double busy_s = (e.drop_V + e.unload_V) / e.slew_V_s;
+  const double half_s = 0.5 * (e.drop_V + e.unload_V) / e.slew_V_s;
+  if (!(e.split_delay_s == 0.0 || (e.split_delay_s >= half_s && e.split_delay_s <= 0.1)))
+    bad("split_delay_s", e.split_delay_s, "must be 0 or lie in [(ΔV + unload_V) / 2S, 0.1] s");
+  const double busy_s = e.split_delay_s + (e.drop_V + e.unload_V) / e.slew_V_s;
   if (!(e.window_s >= 1e-3 + busy_s && e.window_s <= 1.0))
     bad("window_s", e.window_s, "must outlast the edge by 1 ms and be at most 1 s");
 }
 
-/// The drive: up at `r` V/s to the top, down by ΔV at S, up by the unloading at S, then held.
+/// The drive, piecewise linear through its knots (t, u), held after the last: up at `r` V/s to
+/// the top, down by ΔV at S (or by two halves, the second `split_delay_s` after the first), up
+/// by the unloading at S.
 struct EdgeDrive {
-  double r, t_edge, t_fall_end, t_unload_end;
-  const EdgeCase& e;
-  double u(double t) const {
-    if (t <= t_edge) return r * t;
-    if (t <= t_fall_end) return e.top_V - e.slew_V_s * (t - t_edge);
-    const double bottom = e.top_V - e.drop_V;
-    if (t <= t_unload_end) return bottom + e.slew_V_s * (t - t_fall_end);
-    return bottom + e.unload_V;
+  static constexpr std::size_t kMaxKnots = 8;
+  std::array<double, kMaxKnots> t{}, u{};
+  std::size_t n = 0;
+
+  EdgeDrive(const EdgeCase& e, double ramp_V_s) {
+    add(0.0, 0.0);
+    add(e.top_V / ramp_V_s, e.top_V);
+    const int halves = e.split_delay_s > 0.0 ? 2 : 1;
+    const double drop = e.drop_V / halves, unload = e.unload_V / halves, t0 = t[n - 1];
+    for (int i = 0; i < halves; ++i) {
+      const double start = t0 + i * e.split_delay_s;
+      if (start > t[n - 1]) add(start, u[n - 1]);
+      add(t[n - 1] + drop / e.slew_V_s, u[n - 1] - drop);
+      if (unload > 0.0) add(t[n - 1] + unload / e.slew_V_s, u[n - 1] + unload);
+    }
   }
-  /// The segment from t to t + h, with the drive's corners inside it.
-  stickslip::DriveSegment segment(double t, double h) const {
-    stickslip::DriveSegment s = stickslip::DriveSegment::to(u(t + h));
-    for (double c : std::array<double, 3>{t_edge, t_fall_end, t_unload_end})
-      if (c > t && c < t + h) s.add_corner((c - t) / h, u(c));
+  void add(double tk, double uk) {
+    t[n] = tk;
+    u[n] = uk;
+    ++n;
+  }
+  double edge_start_s() const { return t[1]; }
+  double at(double time) const {
+    if (time >= t[n - 1]) return u[n - 1];
+    std::size_t k = 1;
+    while (time > t[k]) ++k;
+    return u[k - 1] + (u[k] - u[k - 1]) * (time - t[k - 1]) / (t[k] - t[k - 1]);
+  }
+  /// The segment from `from` to `from` + h, with the drive's corners inside it.
+  stickslip::DriveSegment segment(double from, double h) const {
+    stickslip::DriveSegment s = stickslip::DriveSegment::to(at(from + h));
+    for (std::size_t k = 1; k < n; ++k)
+      if (t[k] > from && t[k] < from + h) s.add_corner((t[k] - from) / h, u[k]);
     return s;
   }
 };
@@ -54,14 +78,13 @@ EdgeDip run_edge(const stickslip::ActuatorModel& model, const EdgeCase& edge) {
   const auto& p = model.params();
   const double g = p.pe.static_gain_m_V;
   const double r = edge.ramp_m_s / g;  // the ramp's rate: the slider's speed while it sticks [V/s]
-  EdgeDrive d{r, edge.top_V / r, 0.0, 0.0, edge};
-  d.t_fall_end = d.t_edge + edge.drop_V / edge.slew_V_s;
-  d.t_unload_end = d.t_fall_end + edge.unload_V / edge.slew_V_s;
+  const EdgeDrive d(edge, r);
+  const double t_edge = d.edge_start_s();
 
   stickslip::ActuatorState s = model.initial_state();
   model.set_operating_point(s, edge.drop_V, r / edge.drop_V, stickslip::Direction::kForward);
   const double h = model.dt_s();
-  const double t_end = d.t_edge + edge.window_s;
+  const double t_end = t_edge + edge.window_s;
   const auto steps = static_cast<long>(std::ceil(t_end / h));
   EdgeDip out;
   out.edge = edge;
@@ -72,14 +95,14 @@ EdgeDip run_edge(const stickslip::ActuatorModel& model, const EdgeCase& edge) {
   long tail_n = 0;
   for (long k = 0; k < steps; ++k) {
     const double t = static_cast<double>(k) * h;
-    if (t <= d.t_edge && t + h > d.t_edge) x0 = model.slider_position(s);  // the grid point before it
+    if (t <= t_edge && t + h > t_edge) x0 = model.slider_position(s);  // the grid point before it
     model.step(s, d.segment(t, h));
     if (s.diverged) throw ComputationFailed(fmt::format("the model diverged at t = {:g} s", t + h));
     if (std::isnan(x0)) continue;
     const double dx = model.slider_position(s) - x0;
     if (dx < low) {
       low = dx;
-      out.dip_at_s = t + h - d.t_edge;
+      out.dip_at_s = t + h - t_edge;
     }
     if (t + h > t_end - 1e-3) {
       tail_sum += dx;
@@ -88,6 +111,7 @@ EdgeDip run_edge(const stickslip::ActuatorModel& model, const EdgeCase& edge) {
   }
   out.dip_m = -low;
   out.net_m = tail_n > 0 ? tail_sum / static_cast<double>(tail_n) : 0.0;
+  out.overshoot_m = out.dip_m + out.net_m;
   return out;
 }
 
@@ -140,7 +164,9 @@ EdgeStudy run_edge_study(const stickslip::ActuatorModel& model,
   const std::vector<double> slews{0.125e6, 0.25e6, 0.5e6, 1e6, 2e6, 4e6, 8e6};
   const std::vector<double> speeds{10e-6, 50e-6, 100e-6, 200e-6, 400e-6};
   const std::vector<double> tops{50.0, 70.0, 85.0, 100.0};
-  const std::size_t total = 2 * drops.size() + 2 * slews.size() + speeds.size() + tops.size();
+  std::vector<double> delays;
+  for (int i = 0; i < 61; ++i) delays.push_back(60e-6 + 20e-6 * i);
+  const std::size_t total = 2 * drops.size() + 2 * slews.size() + speeds.size() + tops.size() + delays.size();
   std::size_t done = 0;
   const auto run = [&](EdgeCase e) {
     EdgeDip d = run_edge(model, e);
@@ -173,6 +199,14 @@ EdgeStudy run_edge_study(const stickslip::ActuatorModel& model,
     e.drop_V = std::min(e.drop_V, top);
     st.top_sweep.push_back(run(e));
   }
+  for (double delay : delays) {
+    EdgeCase e = tracking;
+    e.unload_V = kUnload * e.drop_V;
+    e.split_delay_s = delay;
+    st.split_sweep.push_back(run(e));
+  }
+  st.least_split = *std::min_element(st.split_sweep.begin(), st.split_sweep.end(),
+                                     [](const EdgeDip& a, const EdgeDip& b) { return a.dip_m < b.dip_m; });
   // The fits over ΔV of 8 V and more (below, the dip is a few tens of nanometres and the PE's
   // own ringing weighs in it).
   std::vector<EdgeDip> slipping;

@@ -38,15 +38,23 @@ struct EdgeCase {
   double ramp_m_s = 100e-6;  ///< the ramp's speed before the edge (the slider's speed) [m/s]
   double unload_V = 0.0;     ///< after the fall, turn back up by this much at S (0: hold) [V]
   double window_s = 10e-3;   ///< how long the slider is watched after the edge starts [s]
+  /// A shaped edge: the edge and its unloading in two halves (ΔV / 2, then unload_V / 2), the
+  /// second starting this long after the first (at least one half's duration); the halves'
+  /// recoils cancel on a contact mode whose half period this is (a zero-vibration shaper, Singer
+  /// & Seering 1990). 0: one edge [s].
+  double split_delay_s = 0.0;
 };
 
 /// What one edge did.
 struct EdgeDip {
   EdgeCase edge;
-  double edge_s = 0.0;       ///< T = ΔV / S [s]
-  double dip_m = 0.0;        ///< largest excursion behind the start (>= 0) [m]
-  double dip_at_s = 0.0;     ///< when it was reached, from the edge's start [s]
-  double net_m = 0.0;        ///< where the slider rests against the start (< 0: behind) [m]
+  double edge_s = 0.0;    ///< T = ΔV / S [s]
+  double dip_m = 0.0;     ///< largest excursion behind the start (>= 0) [m]
+  double dip_at_s = 0.0;  ///< when it was reached, from the edge's start [s]
+  double net_m = 0.0;     ///< where the slider rests against the start (< 0: behind) [m]
+  /// How far the dip overshoots where the slider comes to rest: dip + net, the part a lead on the
+  /// predicted backslip cannot split [m].
+  double overshoot_m = 0.0;
   double z_ba_m = 0.0;       ///< the contact's break-away strain at this operating point [m]
   double pe_travel_m = 0.0;  ///< the PE's static stroke over ΔV: g ΔV [m]
 };
@@ -69,6 +77,10 @@ PowerFit fit_power(const std::vector<double>& x, const std::vector<double>& y);
 struct EdgeStudy {
   std::vector<EdgeDip> drop_sweep, slew_sweep, speed_sweep, top_sweep;
   std::vector<EdgeDip> drop_sweep_unloaded, slew_sweep_unloaded;
+  /// The tracking controller's edge (unloaded) split in two halves, against the halves' delay
+  /// (60 us to 1.26 ms), and the delay whose dip is least.
+  std::vector<EdgeDip> split_sweep;
+  EdgeDip least_split;
   PowerFit dip_vs_drop, dip_vs_duration;  ///< held edges: dip ~ ΔV^p, dip ~ T^p (ΔV fixed)
   PowerFit dip_vs_drop_unloaded, dip_vs_duration_unloaded;
   double z_ba_m = 0.0;  ///< at the tracking controller's edge (68.38 V, 100 um/s)
