@@ -66,11 +66,12 @@ function(mc_test_code_optimization target)
   endif()
 endfunction()
 
-# mc_add_module_tests(NAME [LIBS ...] [LABELS ...] [SERIAL gtest-filter])
+# mc_add_module_tests(NAME [LIBS ...] [LABELS ...] [SERIAL gtest-filter] [NEEDS_CLI gtest-filter])
 # Every tests/NAME/*_test.cc goes into the executable NAME_tests, registered with CTest. Tests
-# matching SERIAL are heavy (MC_HEAVY_TEST_PROPERTIES).
+# matching SERIAL are heavy (MC_HEAVY_TEST_PROPERTIES); tests matching NEEDS_CLI run the command
+# line as a process and are registered only in a tree that builds it (MC_BUILD_CLI).
 function(mc_add_module_tests name)
-  cmake_parse_arguments(ARG "" "SERIAL" "LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "SERIAL;NEEDS_CLI" "LIBS;LABELS" ${ARGN})
   if(NOT MC_TEST_MODULES STREQUAL "all" AND NOT name IN_LIST MC_TEST_MODULES)
     return()
   endif()
@@ -84,8 +85,10 @@ function(mc_add_module_tests name)
   target_compile_definitions(${name}_tests PRIVATE
     MC_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
     MC_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    MC_CLI_PATH="$<TARGET_FILE:microcobot_cli>")
-  add_dependencies(${name}_tests microcobot_cli)
+    MC_CLI_PATH="${MC_CLI_FILE}")
+  if(TARGET microcobot_cli)
+    add_dependencies(${name}_tests microcobot_cli)
+  endif()
   mc_test_code_optimization(${name}_tests)
   # Unity build (MC_UNITY_TESTS, CMakeLists.txt): the test files of a module are compiled a few at a
   # time in one translation unit, so gtest, gmock, nlohmann::json and Eigen are parsed once per
@@ -95,11 +98,24 @@ function(mc_add_module_tests name)
     set_target_properties(${name}_tests PROPERTIES UNITY_BUILD ON
       UNITY_BUILD_BATCH_SIZE ${MC_UNITY_TESTS_BATCH_SIZE})
   endif()
+  set(_skip "")
+  if(ARG_NEEDS_CLI AND NOT TARGET microcobot_cli)
+    set(_skip "${ARG_NEEDS_CLI}")
+  endif()
   if(ARG_SERIAL)
-    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "-${ARG_SERIAL}"
+    set(_light "-${ARG_SERIAL}")
+    set(_heavy "${ARG_SERIAL}")
+    if(_skip)
+      string(APPEND _light ":${_skip}")
+      string(APPEND _heavy "-${_skip}")
+    endif()
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "${_light}"
       PROPERTIES LABELS "${name};${ARG_LABELS}")
-    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "${ARG_SERIAL}"
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "${_heavy}"
       PROPERTIES LABELS "${name};${ARG_LABELS}" ${MC_HEAVY_TEST_PROPERTIES})
+  elseif(_skip)
+    gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60 TEST_FILTER "-${_skip}"
+      PROPERTIES LABELS "${name};${ARG_LABELS}")
   else()
     gtest_discover_tests(${name}_tests DISCOVERY_TIMEOUT 60
       PROPERTIES LABELS "${name};${ARG_LABELS}")

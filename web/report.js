@@ -22,17 +22,42 @@
   }
 
   // Tick labels: plain numbers in the readable range, engineering notation outside it
-  // (micro-scale positions in metres would otherwise print as 0.000002).
-  function tick(v) {
+  // (micro-scale positions in metres would otherwise print as 0.000002), with `digits`
+  // significant digits at least.
+  function tick(v, digits = 3) {
     if (v === null || v === undefined) return "";
     const a = Math.abs(v);
     if (a === 0) return "0";
-    if (a >= 1e-3 && a < 1e5) return String(+v.toPrecision(6));
-    return v.toExponential(Math.abs(+v.toExponential(2).split("e")[0] % 1) < 1e-9 ? 0 : 2).replace("e+", "e");
+    if (a >= 1e-3 && a < 1e5) return String(+v.toPrecision(Math.max(6, digits)));
+    let [m, e] = v.toExponential(digits - 1).split("e");
+    if (m.includes(".")) m = m.replace(/0+$/, "").replace(/\.$/, "");
+    return m + "e" + e.replace("+", "");
   }
-  function axisOpts(a, vertical) {
+  // An axis' labels with as many digits as its neighbouring ticks need to read apart (a move of
+  // 0.1 mm drawn to the nanometre spans 1e-4 to 1.0001e-4).
+  function ticks(vals) {
+    const shown = vals.filter(v => v !== null && v !== undefined);
+    let digits = 3;
+    while (digits < 15 && new Set(shown.map(v => tick(v, digits))).size < shown.length) ++digits;
+    return vals.map(v => tick(v, digits));
+  }
+  // A log axis labels its decades; one that spans less than two decades also labels 2 and 5 of
+  // each, so that every axis reads at least two values. Its other ticks stay unlabelled.
+  function mantissa(v) { return +(v / Math.pow(10, Math.floor(Math.log10(v) + 1e-9))).toPrecision(3); }
+  function logTicks(vals) {
+    let keep = vals.map(v => v > 0 && mantissa(v) === 1);
+    if (keep.filter(Boolean).length < 2) keep = vals.map(v => v > 0 && [1, 2, 5].includes(mantissa(v)));
+    return vals.map((v, i) => (keep[i] ? tick(v) : ""));
+  }
+  // The labels drawn are also the container's data-x-ticks / data-y-ticks (the browser test
+  // reads them: the canvas has no text to read).
+  function axisOpts(a, vertical, container) {
     const o = { label: axisTitle(a) };
-    if (!a.log) o.values = (u, vals) => vals.map(tick);
+    o.values = (u, vals) => {
+      const labels = a.log ? logTicks(vals) : ticks(vals);
+      container.setAttribute(vertical ? "data-y-ticks" : "data-x-ticks", labels.filter(t => t !== "").join(" "));
+      return labels;
+    };
     if (vertical) o.size = (u, values) => 28 + 7 * Math.max(3, ...(values || []).map(s => String(s).length));
     return o;
   }
@@ -81,7 +106,7 @@
       height: 340,
       mode: aligned ? 1 : 2,
       scales: { x: Object.assign({ time: false }, scaleOpts(fig.x)), y: scaleOpts(fig.y) },
-      axes: [axisOpts(fig.x, false), axisOpts(fig.y, true)],
+      axes: [axisOpts(fig.x, false, container), axisOpts(fig.y, true, container)],
       series: [aligned ? { label: axisTitle(fig.x) } : {}].concat(seriesOpts),
       legend: { show: true },
       hooks: {
@@ -166,7 +191,7 @@
       axes: [
         { label: fig.x.label, splits: () => xs, values: () => groups.map(g => g.name + " (n = " + g.box.n + ")"),
           grid: { show: false } },
-        axisOpts(fig.y, true),
+        axisOpts(fig.y, true, container),
       ],
       // The medians as an invisible series: uPlot needs one; the boxes are the hook's.
       series: [{}, { label: "median", paths: () => null, points: { show: false } }],

@@ -32,6 +32,9 @@ const reports = [
                          "--out", join(dir, "cell")],
     index: join(dir, "cell", "index.html"), boxes: ["Cycle time by mode", "Placement error by mode",
                                                     "Peak grip force by mode", "Peak contact force by mode"] },
+  // Log axes over values far below 1 (dips of 1e-7 m against edges of 1e-5 s).
+  { name: "edge-dip", args: ["stickslip", "edge-dip", "--out", join(dir, "edge-dip")],
+    index: join(dir, "edge-dip", "index.html") },
 ];
 
 try {
@@ -74,13 +77,22 @@ try {
       }
       return { id: box.id, title: box.querySelector(".u-title")?.textContent || box.id,
                drawn: chart.getAttribute("data-drawn"), points: Number(chart.getAttribute("data-points")), ink,
-               boxes: JSON.parse(chart.getAttribute("data-boxes") || "null"), colourInk };
+               boxes: JSON.parse(chart.getAttribute("data-boxes") || "null"), colourInk,
+               ticks: ["data-x-ticks", "data-y-ticks"].map((k) => chart.getAttribute(k)) };
     }));
     if (figures.length === 0) fail(`${rep.name}: the report has no figures`);
     for (const f of figures) {
       if (f.drawn !== "1") fail(`${rep.name}: ${f.id} (${f.title}) was not drawn`);
       if (!(f.points > 0)) fail(`${rep.name}: ${f.id} (${f.title}) has no data points`);
       if (f.ink < 50) fail(`${rep.name}: ${f.id} (${f.title}) canvas is blank (${f.ink} painted pixels)`);
+      // Every numeric axis reads: at least two labels, no two alike (a log axis of small values
+      // once labelled every decade "0").
+      f.ticks.forEach((t, k) => {
+        if (t === null) return;  // an axis of names (the box plots' groups)
+        const labels = t.split(" ").filter((x) => x !== "");
+        if (labels.length < 2 || new Set(labels).size !== labels.length)
+          fail(`${rep.name}: ${f.id} (${f.title}): its ${"xy"[k]} axis reads '${t}'`);
+      });
     }
     // Box plots: each expected figure drew one box per mode, in the order the modes were given.
     for (const title of rep.boxes || []) {

@@ -124,6 +124,33 @@ TEST(Mcap, OneChunkPerMebibyteByDefault) {
   EXPECT_EQ(read_mcap(dir / "big.mcap").chunk_count, 3u);
 }
 
+// A long recording's one growing part, the summary's chunk index, takes what its records take:
+// no allocation and no vector per chunk. 20 000 chunks of eight channels (a 0.5 s chunk span:
+// 2.8 hours) hold 153 bytes of ChunkIndex record each, plus at most one block reserved ahead.
+TEST(Mcap, TheChunkIndexHoldsItsRecordsBytesAndNoMore) {
+  test::TempDir dir;
+  constexpr std::size_t kChunks = 20'000, kChannels = 8;
+  // Eight messages of 131 bytes of records (9 prefix, 22 header, 100 payload) close a 1000-byte chunk.
+  McapWriter w(dir / "long.mcap", 1000);
+  const auto s = w.add_schema("s", "jsonschema", "{}");
+  std::vector<std::uint16_t> ch;
+  for (std::size_t c = 0; c < kChannels; ++c)
+    ch.push_back(w.add_channel(s, "/c" + std::to_string(c), "json"));
+  const std::string p(100, 'z');
+  for (std::uint64_t k = 0; k < kChunks; ++k)
+    for (std::size_t c = 0; c < kChannels; ++c) w.write(ch[c], k * kChannels + c, 0, p);
+  EXPECT_EQ(w.chunk_count(), kChunks);
+  // 9 prefix + start, end, offset, length (32) + the offsets map (4 + 8 x 10) + index length (8)
+  // + compression "" (4) + two sizes (16).
+  constexpr std::size_t kRecord = 9 + 32 + 4 + kChannels * 10 + 8 + 4 + 16;
+  EXPECT_LE(w.chunk_index_bytes(), kChunks * kRecord + (std::size_t{64} << 10) + 4096);
+  EXPECT_GE(w.chunk_index_bytes(), kChunks * kRecord);
+  w.close();
+  const McapContents m = read_mcap(dir / "long.mcap");  // checks each ChunkIndex against its chunk
+  EXPECT_EQ(m.chunk_count, kChunks);
+  EXPECT_EQ(m.messages.size(), kChunks * kChannels);
+}
+
 TEST(Mcap, AFileWithoutMessagesIsValid) {
   test::TempDir dir;
   McapWriter w(dir / "e.mcap");

@@ -51,8 +51,17 @@ int wait_process(pid_t pid, std::chrono::milliseconds timeout) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+namespace {
+// The built command line; a tree built without it (MC_BUILD_CLI off) registers no test that runs it.
+std::string cli_path() {
+  const std::string path = MC_CLI_PATH;
+  if (path.empty()) throw std::runtime_error("this build tree has no command line (MC_BUILD_CLI is off)");
+  return path;
+}
+}  // namespace
+
 BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesystem::path& prefix) {
-  std::vector<std::string> argv{MC_CLI_PATH};
+  std::vector<std::string> argv{cli_path()};
   argv.insert(argv.end(), args.begin(), args.end());
   BackgroundCli b;
   b.out = prefix.string() + ".out";
@@ -63,7 +72,7 @@ BackgroundCli spawn_cli(const std::vector<std::string>& args, const std::filesys
 
 CliResult run_cli(const std::vector<std::string>& args) {
   TempDir tmp;
-  std::vector<std::string> argv{MC_CLI_PATH};
+  std::vector<std::string> argv{cli_path()};
   argv.insert(argv.end(), args.begin(), args.end());
   const pid_t pid = spawn_process(argv, tmp / "stdout", tmp / "stderr");
   int status = 0;

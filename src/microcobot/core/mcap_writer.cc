@@ -258,7 +258,7 @@ void McapWriter::take_checkpoint() {
   c.data_crc = data_crc_;
   c.schemas = schemas_.size();
   c.channels = channels_.size();
-  c.chunks = chunk_indexes_.size();
+  c.chunks = chunk_indexes_.mark();
   c.indexes = indexes_.size();
   c.attachments = attachment_count_;
   c.metadata = metadata_count_;
@@ -285,7 +285,7 @@ std::uint64_t McapWriter::close_at_last_chunk() {
     channels_[i].count = c.channel_counts[i];
     channels_[i].index.clear();
   }
-  chunk_indexes_.resize(c.chunks);
+  chunk_indexes_.truncate(c.chunks);
   indexes_.resize(c.indexes);
   attachment_count_ = c.attachments;
   metadata_count_ = c.metadata;
@@ -302,11 +302,8 @@ std::uint64_t McapWriter::close_at_last_chunk() {
 
 void McapWriter::close_chunk() {
   if (chunk_.empty()) return;
-  ChunkIndex ci{};
-  ci.start_ns = chunk_start_ns_;
-  ci.end_ns = chunk_end_ns_;
-  ci.offset = position();
-  ci.records_size = chunk_.size();
+  const std::uint64_t chunk_offset = position();
+  const std::uint64_t records_size = chunk_.size();
   // Chunk: start, end, uncompressed size, uncompressed CRC, compression, records (u64 length).
   // The CRC is of the records before compression (spec, "Chunk"): a reader checks what it
   // decompressed.
@@ -317,7 +314,7 @@ void McapWriter::close_chunk() {
     zstd_compress(chunk_, compression_.zstd_level, compressed_);
     stored = compressed_;
   }
-  ci.stored_size = stored.size();
+  const std::uint64_t stored_size = stored.size();
   scratch_.clear();
   put_u8(scratch_, static_cast<std::uint8_t>(McapOpcode::kChunk));
   const std::uint64_t content = 8 + 8 + 8 + 4 + 4 + compression.size() + 8 + stored.size();
@@ -332,14 +329,17 @@ void McapWriter::close_chunk() {
   put(stored);
   records_bytes_ += chunk_.size();
   stored_bytes_ += stored.size();
-  ci.length = kRecordPrefix + content;
-  // One MessageIndex per channel present in the chunk, entries in log-time order.
+  // One MessageIndex per channel present in the chunk, entries in log-time order; where each
+  // starts goes into the ChunkIndex's message_index_offsets (channel id u16, offset u64).
+  std::string& offsets = index_offsets_;
+  offsets.clear();
   const std::uint64_t index_start = position();
   for (std::size_t c = 0; c < channels_.size(); ++c) {
     auto& index = channels_[c].index;
     if (index.empty()) continue;
     if (!std::is_sorted(index.begin(), index.end())) std::stable_sort(index.begin(), index.end());
-    ci.index_offsets.emplace_back(static_cast<std::uint16_t>(c + 1), position());
+    put_u16(offsets, static_cast<std::uint16_t>(c + 1));
+    put_u64(offsets, position());
     scratch_.clear();
     put_u16(scratch_, static_cast<std::uint16_t>(c + 1));
     put_u32(scratch_, static_cast<std::uint32_t>(index.size() * 16));
@@ -350,9 +350,47 @@ void McapWriter::close_chunk() {
     put_record(McapOpcode::kMessageIndex, scratch_);
     index.clear();
   }
-  ci.index_length = position() - index_start;
-  chunk_indexes_.push_back(std::move(ci));
+  const std::uint64_t index_length = position() - index_start;
+  // ChunkIndex (spec, "Chunk Index"): start, end, chunk offset and length, the message index
+  // offsets, their length, compression, compressed and uncompressed sizes.
+  scratch_.clear();
+  put_u64(scratch_, chunk_start_ns_);
+  put_u64(scratch_, chunk_end_ns_);
+  put_u64(scratch_, chunk_offset);
+  put_u64(scratch_, kRecordPrefix + content);
+  put_str(scratch_, offsets);
+  put_u64(scratch_, index_length);
+  put_str(scratch_, compression);
+  put_u64(scratch_, stored_size);
+  put_u64(scratch_, records_size);
+  std::string& record = chunk_index_record_;
+  record.clear();
+  put_u8(record, static_cast<std::uint8_t>(McapOpcode::kChunkIndex));
+  put_u64(record, scratch_.size());
+  record += scratch_;
+  chunk_indexes_.append(record);
   chunk_.clear();
+}
+
+void McapWriter::ChunkIndexLog::append(std::string_view record) {
+  if (blocks.empty() || blocks.back().size() + record.size() > kBlockBytes) {
+    blocks.emplace_back();
+    blocks.back().reserve(std::max(kBlockBytes, record.size()));
+  }
+  blocks.back() += record;
+  ++count;
+}
+
+void McapWriter::ChunkIndexLog::truncate(const Mark& m) {
+  blocks.resize(m.blocks);
+  if (!blocks.empty()) blocks.back().resize(m.last_size);
+  count = m.count;
+}
+
+std::size_t McapWriter::ChunkIndexLog::reserved() const {
+  std::size_t n = blocks.capacity() * sizeof(std::string);
+  for (const auto& b : blocks) n += b.capacity();
+  return n;
 }
 
 void McapWriter::close() {
@@ -392,7 +430,7 @@ void McapWriter::close() {
     put_u32(s, static_cast<std::uint32_t>(channels_.size()));
     put_u32(s, attachment_count_);
     put_u32(s, metadata_count_);
-    put_u32(s, static_cast<std::uint32_t>(chunk_indexes_.size()));
+    put_u32(s, static_cast<std::uint32_t>(chunk_indexes_.count));
     put_u64(s, message_count_ ? start_ns_ : 0);
     put_u64(s, message_count_ ? end_ns_ : 0);
     std::string counts;
@@ -404,24 +442,7 @@ void McapWriter::close() {
     add_record(McapOpcode::kStatistics, s);
   });
   group(McapOpcode::kChunkIndex, [&] {
-    for (const auto& ci : chunk_indexes_) {
-      std::string s;
-      put_u64(s, ci.start_ns);
-      put_u64(s, ci.end_ns);
-      put_u64(s, ci.offset);
-      put_u64(s, ci.length);
-      std::string offsets;
-      for (const auto& [id, off] : ci.index_offsets) {
-        put_u16(offsets, id);
-        put_u64(offsets, off);
-      }
-      put_str(s, offsets);
-      put_u64(s, ci.index_length);
-      put_str(s, compression_.zstd ? "zstd" : "");
-      put_u64(s, ci.stored_size);   // compressed size
-      put_u64(s, ci.records_size);  // uncompressed size
-      add_record(McapOpcode::kChunkIndex, s);
-    }
+    for (const auto& block : chunk_indexes_.blocks) summary += block;  // whole records already
   });
   for (const McapOpcode op : {McapOpcode::kAttachmentIndex, McapOpcode::kMetadataIndex}) {
     group(op, [&] {

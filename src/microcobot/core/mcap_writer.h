@@ -126,15 +126,30 @@ class McapWriter {
 
   const std::filesystem::path& path() const { return path_; }
   std::uint64_t message_count() const { return message_count_; }
-  std::size_t chunk_count() const { return chunk_indexes_.size(); }
+  std::size_t chunk_count() const { return chunk_indexes_.count; }
+  /// The memory the summary's chunk index holds (bytes reserved): the one part of a writer's
+  /// memory that grows with the recording, about 80 bytes and 10 per channel in a chunk, each
+  /// chunk's ChunkIndex record kept as the bytes the summary will hold.
+  std::size_t chunk_index_bytes() const { return chunk_indexes_.reserved(); }
   /// Chunk records written so far, before and after compression (equal when uncompressed).
   std::uint64_t records_bytes() const { return records_bytes_; }
   std::uint64_t stored_bytes() const { return stored_bytes_; }
 
  private:
-  struct ChunkIndex {
-    std::uint64_t start_ns, end_ns, offset, length, index_length, records_size, stored_size;
-    std::vector<std::pair<std::uint16_t, std::uint64_t>> index_offsets;  // channel, file offset
+  // The ChunkIndex records for the summary, serialised as each chunk closes (opcode, length,
+  // content) into blocks of a fixed size: no allocation per chunk, and no more than a block
+  // reserved beyond what the records take however long the recording.
+  struct ChunkIndexLog {
+    static constexpr std::size_t kBlockBytes = std::size_t{64} << 10;
+    struct Mark {
+      std::size_t count = 0, blocks = 0, last_size = 0;
+    };
+    std::vector<std::string> blocks;
+    std::size_t count = 0;
+    void append(std::string_view record);
+    Mark mark() const { return {count, blocks.size(), blocks.empty() ? 0 : blocks.back().size()}; }
+    void truncate(const Mark& m);
+    std::size_t reserved() const;
   };
   struct ChannelState {
     std::string record;  // the Channel record's content, repeated in the summary
@@ -169,8 +184,10 @@ class McapWriter {
   std::vector<ChannelState> channels_;  // id - 1
   std::string chunk_;                   // the open chunk's records
   std::string scratch_;                 // record being assembled
+  std::string index_offsets_;           // the closing chunk's message_index_offsets
+  std::string chunk_index_record_;      // the closing chunk's ChunkIndex record
   std::uint64_t chunk_start_ns_ = 0, chunk_end_ns_ = 0;
-  std::vector<ChunkIndex> chunk_indexes_;
+  ChunkIndexLog chunk_indexes_;
   std::vector<IndexEntry> indexes_;  // attachments and metadata, in file order
   std::uint32_t attachment_count_ = 0, metadata_count_ = 0;
   std::uint64_t records_bytes_ = 0, stored_bytes_ = 0;
@@ -183,7 +200,8 @@ class McapWriter {
   struct Checkpoint {
     std::uint64_t position = 0;
     std::uint32_t data_crc = 0;
-    std::size_t schemas = 0, channels = 0, chunks = 0, indexes = 0;
+    std::size_t schemas = 0, channels = 0, indexes = 0;
+    ChunkIndexLog::Mark chunks;
     std::uint32_t attachments = 0, metadata = 0;
     std::uint64_t messages = 0, start_ns = 0, end_ns = 0, records_bytes = 0, stored_bytes = 0;
     std::vector<std::uint64_t> channel_counts;
