@@ -13,10 +13,10 @@
 // own console.
 //
 // Every minute it reports the slave's resident memory (the median of the minute's 2-s samples) and
-// its peak, open file descriptors and threads (/proc), the loop's tick p99 and overruns and the
-// camera's dropped frames (the status), the recording's bytes, the GCS client's replies, the
-// master's memory, descriptors and threads, and the share of the slave's statuses that heard its
-// master. With --check it exits 1 when, after the first minute, either process's median resident
+// its peak, open file descriptors and threads (/proc), the loop's tick p99 and overruns, the
+// camera's dropped frames (the status; and when, to the 2-s sample), the recording's bytes, the
+// GCS client's replies, the master's memory, descriptors and threads, and the share of the slave's
+// statuses that heard its master. With --check it exits 1 when, after the first minute, either process's median resident
 // memory grows by more than 2 % (5 % for runs under 10 minutes: the allocator's arenas settle over
 // minutes), descriptors or threads change, GCS queries go unanswered, or the slave heard its
 // master in less than 90 % of a minute's statuses. The timing figures are reported, not judged:
@@ -129,10 +129,16 @@ const median = (xs) => {
 const rows = [];
 const t0 = Date.now();
 let lastDropped = 0, lastOverruns = 0, lastAnswered = 0, lastAsked = 0, lastStatuses = 0, lastFresh = 0;
+let seenDropped = 0;
 for (let m = 1; m <= minutes; ++m) {
-  const rss = [], masterRss = [];
-  for (let t = t0 + (m - 1) * 60000 + (m === 1 ? 30000 : 0); t < t0 + m * 60000; t += kSampleMs) {
+  const rss = [], masterRss = [], dropsAt = [];
+  for (let t = t0 + (m - 1) * 60000; t < t0 + m * 60000; t += kSampleMs) {
     await sleep(t - Date.now());
+    // When the camera dropped frames: the seconds since the start of each 2-s sample that saw some.
+    const d = slaveStatus().camera?.dropped ?? 0;
+    if (d > seenDropped) dropsAt.push([Math.round((t - t0) / 1000), d - seenDropped]);
+    seenDropped = Math.max(seenDropped, d);
+    if (m === 1 && t < t0 + 30000) continue;
     rss.push(proc(server.pid).rss_MB);
     if (master) masterRss.push(proc(master.child.pid).rss_MB);
   }
@@ -142,7 +148,7 @@ for (let m = 1; m <= minutes; ++m) {
   const mp = master ? { ...proc(master.child.pid), rss_median_MB: median(masterRss) } : null;
   const dropped = s.camera ? s.camera.dropped : 0;
   const row = { minute: m, ...p, tick_p99_us: s.tick_p99_us, overruns: (s.overruns ?? 0) - lastOverruns,
-                dropped_frames: dropped - lastDropped, recording_MB: recordingBytes() / 1e6,
+                dropped_frames: dropped - lastDropped, dropped_at_s: dropsAt, recording_MB: recordingBytes() / 1e6,
                 gcs_replies: gcs.answered - lastAnswered, gcs_asked: gcs.asked - lastAsked,
                 ...(mp && { master_rss_MB: mp.rss_MB, master_rss_median_MB: mp.rss_median_MB, master_fds: mp.fds, master_threads: mp.threads,
                             // the share of the slave's 5 Hz statuses that heard the master
@@ -156,7 +162,8 @@ for (let m = 1; m <= minutes; ++m) {
   lastAsked = gcs.asked;
   rows.push(row);
   log(`[${m} min] rss median ${row.rss_median_MB.toFixed(1)} MB (now ${row.rss_MB.toFixed(1)}, peak ${row.hwm_MB.toFixed(1)}), fds ${row.fds}, threads ${row.threads}, ` +
-      `tick p99 ${row.tick_p99_us} us, overruns ${row.overruns}, dropped frames ${row.dropped_frames}, ` +
+      `tick p99 ${row.tick_p99_us} us, overruns ${row.overruns}, dropped frames ${row.dropped_frames}` +
+      (dropsAt.length ? ` (at ${dropsAt.map(([t, n]) => `${n} by ${t} s`).join(", ")})` : "") + ", " +
       `recording ${row.recording_MB.toFixed(0)} MB, GCS replies ${row.gcs_replies} of ${row.gcs_asked}` +
       (mp ? `; master rss median ${mp.rss_median_MB.toFixed(1)} MB, fds ${mp.fds}, threads ${mp.threads}, heard ${row.master_heard_pct.toFixed(1)} %` : ""));
 }

@@ -341,12 +341,15 @@ TEST(ConsoleServer, LevelTipsIsTheControllingClientsAndItsResultIsInTheStatus) {
 
 // A live platform with the parallel positioner served to one console client.
 struct PositionerConsole {
+  explicit PositionerConsole(double command_timeout_s = LiveParams{}.command_timeout_s)
+      : lp([command_timeout_s] {
+          LiveParams p;
+          p.platform.positioner = "parallel";
+          p.command_timeout_s = command_timeout_s;
+          return p;
+        }()) {}
   test::TempDir dir;
-  LiveParams lp = [] {
-    LiveParams p;
-    p.platform.positioner = "parallel";
-    return p;
-  }();
+  LiveParams lp;
   LivePlatform live{lp};
   ConsoleServer server{live, Rig::params(dir.path(), "")};
   Console console{(server.start(), server.port())};
@@ -444,7 +447,11 @@ TEST(ConsoleServer, APoseGoalMovesTheParallelPositionerOnlyWithTheDeadmanAndAnUn
 }
 
 TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadmanAndStopsAtTheEdge) {
-  PositionerConsole rig;
+  // Under the sanitizers the instrumented server delivers the page's commands late: a second
+  // before they go stale, so that the jog is judged at its speed and on its line, not on how often
+  // a starved thread let it lapse (a lapsed jog holds where the legs are and starts again from
+  // there, off its line by the legs' error at rest).
+  PositionerConsole rig(MC_UNDER_SANITIZER ? 1.0 : LiveParams{}.command_timeout_s);
   LiveParams& lp = rig.lp;
   LivePlatform& live = rig.live;
   ConsoleServer& server = rig.server;
@@ -476,14 +483,13 @@ TEST(ConsoleServer, APoseJogMovesTheParallelPositionerAtItsSpeedOnlyWithTheDeadm
   ASSERT_TRUE(jog_for(along_x, true, 30.0, [&] {
     return (v = live.positioner_view()).reference.d.x() > v0.reference.d.x() + 20e-6;
   }));
-  // A jog whose commands come late (an instrumented server's thread, starved) goes stale: the
-  // positioner holds where the legs are until a fresh one comes, then accelerates again from there:
-  // slower on average (19-29 um/s measured under the sanitizers), and a few tens of nanometres off
-  // its line where it was taken up again.
+  // A jog that still lapses (a command more than a second late under a sanitizer) holds where the
+  // legs are until a fresh one comes, then accelerates again from there: slower on average, and off
+  // its line by at most the positioner's error at rest (0.5 um).
   const double speed = (v.reference.d.x() - v0.reference.d.x()) / (v.time_s - v0.time_s);
   EXPECT_GT(speed, MC_UNDER_SANITIZER ? 10e-6 : 40e-6);
   EXPECT_LT(speed, 51e-6);
-  EXPECT_LT(std::abs(v.reference.d.y()) + std::abs(v.reference.d.z()), MC_UNDER_SANITIZER ? 0.1e-6 : 1e-9)
+  EXPECT_LT(std::abs(v.reference.d.y()) + std::abs(v.reference.d.z()), MC_UNDER_SANITIZER ? 0.5e-6 : 1e-9)
       << "the jog left its line";
   EXPECT_LT((v.measured.d - v.reference.d).norm(), 2e-6) << "the legs lag the jog";
 
