@@ -20,6 +20,7 @@
 #include "microcobot/core/input_file.h"
 #include "microcobot/deployment/deployment.h"
 #include "microcobot/net/cyclone_config.h"
+#include "microcobot/runtime/allocator.h"
 #include "network_options.h"
 #include "signals.h"
 
@@ -68,6 +69,10 @@ dp::ServeConfig serve_config(const ServeOptions& o) {
 
 void serve(const ServeOptions& o) {
   const dp::ServeConfig config = serve_config(o);
+  // A session of hours: frames, encoded images and recording chunks mapped and unmapped whole,
+  // so that the resident memory follows what is live (runtime/allocator.h). Where the C library
+  // is not glibc its own policy stays.
+  mc::runtime::keep_large_blocks_mapped();
   mc::cli::set_cooperative_interrupts(true);
   dp::Deployment deployment(config, [](const std::string& line) { std::cerr << "serve: " << line << "\n"; });
   deployment.start();
