@@ -70,7 +70,7 @@ dp::ServeConfig serve_config(const ServeOptions& o) {
 void serve(const ServeOptions& o) {
   const dp::ServeConfig config = serve_config(o);
   // A session of hours: frames, encoded images and recording chunks mapped and unmapped whole,
-  // so that the resident memory follows what is live (runtime/allocator.h). Where the C library
+  // not left to fragment the threads' arenas (runtime/allocator.h). Where the C library
   // is not glibc its own policy stays.
   mc::runtime::keep_large_blocks_mapped();
   mc::cli::set_cooperative_interrupts(true);

@@ -5,10 +5,10 @@
 /// each such free raises the threshold to that block's size (up to 32 MiB), after which blocks of
 /// that size come from the heap and the threads' arenas, whose freed pages stay resident while
 /// any smaller block lives above them. A `serve` frees camera frames, encoded images, recording
-/// chunks and client queues of a few hundred kilobytes to a few megabytes many times a second, so
-/// its resident memory then creeps up for minutes as the arenas fragment. Fixing the threshold
-/// turns that adjustment off: such blocks are mapped and unmapped whole, and the resident memory
-/// follows what is live. Process-wide; configuration-time code (call it before the threads start).
+/// chunks and client queues of a few hundred kilobytes to a few megabytes many times a second,
+/// which the raised threshold leaves to the arenas, where they can fragment. Fixing the threshold
+/// turns that adjustment off: such blocks are mapped and unmapped whole. Process-wide;
+/// configuration-time code (call it before the threads start).
 
 #include <cstddef>
 
