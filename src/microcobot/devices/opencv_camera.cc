@@ -1,22 +1,46 @@
-// The one translation unit that includes OpenCV (its headers are heavy, so they are kept in few places;
-// docs/architecture.md). Built only with MC_WITH_OPENCV (src/microcobot/CMakeLists.txt).
+// The OpenCV camera driver: OpenCV itself is in the plugin (opencv_capture_plugin.h says why), which
+// this file loads with dlopen on the first camera it opens. The plugin's path is fixed when CMake
+// configures (MC_OPENCV_CAPTURE_PLUGIN, in the build tree beside the libraries); a build without
+// MC_WITH_OPENCV has no plugin there, and the driver is then absent.
 #include "microcobot/devices/opencv_camera.h"
+
+#include <dlfcn.h>
 
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <thread>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
-
 #include "microcobot/core/error.h"
 #include "microcobot/core/input_file.h"
+#include "microcobot/devices/opencv_capture_plugin.h"
 
 namespace mc::devices {
 namespace {
+
+struct Plugin {
+  McCaptureOpenFn open;
+  McCaptureReadFn read;
+  McCaptureCloseFn close;
+};
+
+// Loaded once and kept for the process's life: unloading it while a camera thread may still be in
+// its code would unmap that code. A failed load throws, and the next camera tries again.
+const Plugin& plugin() {
+  static const Plugin loaded = [] {
+    void* handle = dlopen(MC_OPENCV_CAPTURE_PLUGIN, RTLD_NOW | RTLD_LOCAL);
+    if (!handle)
+      throw InvalidInput(std::string("camera: the OpenCV driver's plugin cannot be loaded: ") + dlerror());
+    Plugin p{reinterpret_cast<McCaptureOpenFn>(dlsym(handle, "mc_capture_open")),
+             reinterpret_cast<McCaptureReadFn>(dlsym(handle, "mc_capture_read")),
+             reinterpret_cast<McCaptureCloseFn>(dlsym(handle, "mc_capture_close"))};
+    if (!p.open || !p.read || !p.close)
+      throw InvalidInput(std::string("camera: '") + MC_OPENCV_CAPTURE_PLUGIN +
+                         "' is not this build's OpenCV plugin (a function is missing)");
+    return p;
+  }();
+  return loaded;
+}
 
 bool all_digits(const std::string& s) {
   return !s.empty() && s.size() < 4 && s.find_first_not_of("0123456789") == std::string::npos;
@@ -30,37 +54,32 @@ class OpenCvCamera final : public FrameSource {
                           "the opencv driver needs a source: a device index, a device or video file, or a "
                           "GStreamer pipeline");
   }
+  ~OpenCvCamera() override { close(); }
+  OpenCvCamera(const OpenCvCamera&) = delete;
+  OpenCvCamera& operator=(const OpenCvCamera&) = delete;
 
   void open(const CameraDeviceParams& params) override {
     close();
+    const bool pipeline = source_.find('!') != std::string::npos;
     std::error_code ec;
-    file_ = !all_digits(source_) && source_.find('!') == std::string::npos &&
-            std::filesystem::is_regular_file(source_, ec);
-    bool ok = false;
-    if (all_digits(source_)) {
-      ok = capture_.open(std::stoi(source_), cv::CAP_ANY);
-    } else if (source_.find('!') != std::string::npos) {
-      ok = capture_.open(source_, cv::CAP_GSTREAMER);
-    } else {
-      ok = open_named();
-    }
-    if (!ok || !capture_.isOpened())
-      throw InvalidInput("camera: OpenCV cannot open '" + excerpt(source_) + "' (backends: " + backends() +
-                         ")");
-    if (!file_ && source_.find('!') == std::string::npos) {
-      // A live camera is asked for the configured sensor and rate (best effort: it may refuse);
-      // a GStreamer pipeline says its own caps (setting them restarts it).
-      capture_.set(cv::CAP_PROP_FRAME_WIDTH, params.sensor.width_px);
-      capture_.set(cv::CAP_PROP_FRAME_HEIGHT, params.sensor.height_px);
-      capture_.set(cv::CAP_PROP_FPS, params.sensor.frame_rate_Hz);
-    }
+    file_ = !all_digits(source_) && !pipeline && std::filesystem::is_regular_file(source_, ec);
+    const int kind = all_digits(source_) ? kMcCaptureIndex : pipeline ? kMcCapturePipeline : kMcCaptureNamed;
+    // A live camera is asked for the configured sensor and rate (best effort: it may refuse); a
+    // GStreamer pipeline says its own caps (setting them restarts it).
+    const bool set_format = !file_ && !pipeline;
+    char error[512] = "";
+    capture_ = plugin().open(source_.c_str(), kind, set_format ? 1 : 0, params.sensor.width_px,
+                             params.sensor.height_px, params.sensor.frame_rate_Hz, error, sizeof error);
+    if (!capture_)
+      throw InvalidInput("camera: OpenCV cannot open '" + excerpt(source_) + "' (" + error + ")");
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(1.0 / params.sensor.frame_rate_Hz));
     next_ = std::chrono::steady_clock::now();
   }
 
   void close() override {
-    if (capture_.isOpened()) capture_.release();
+    if (capture_) plugin().close(capture_);
+    capture_ = nullptr;
   }
 
   bool renders_scene() const override { return false; }
@@ -73,61 +92,38 @@ class OpenCvCamera final : public FrameSource {
       if (next_ < now) next_ = now;
       std::this_thread::sleep_until(next_);
     }
-    if (!capture_.read(frame_) || frame_.empty()) {
-      if (!file_ || !capture_.set(cv::CAP_PROP_POS_FRAMES, 0) || !capture_.read(frame_) || frame_.empty())
-        throw ComputationFailed("camera: '" + excerpt(source_) + "' stopped delivering frames");
-    }
-    if (frame_.channels() == 3) {
-      cv::cvtColor(frame_, converted_, cv::COLOR_BGR2RGB);
-    } else if (frame_.channels() == 4) {
-      cv::cvtColor(frame_, converted_, cv::COLOR_BGRA2RGB);
-    } else {
-      converted_ = frame_;
-    }
-    const int depth = converted_.depth();
-    if (depth != CV_8U && depth != CV_16U)
-      throw ComputationFailed("camera: '" + excerpt(source_) + "' delivers samples OpenCV calls depth " +
-                              std::to_string(depth) + " (8 or 16-bit unsigned expected)");
-    const int bits = depth == CV_8U ? 8 : 16;
-    out.resize(converted_.cols, converted_.rows, converted_.channels(), bits);
-    const std::size_t row = static_cast<std::size_t>(converted_.cols) * converted_.elemSize();
-    for (int y = 0; y < converted_.rows; ++y)
-      std::memcpy(out.data.data() + static_cast<std::size_t>(y) * row, converted_.ptr(y), row);
+    McCaptureFrame frame{};
+    char error[512] = "";
+    const int read = capture_ ? plugin().read(capture_, file_ ? 1 : 0, &frame, error, sizeof error) : 0;
+    if (read == 0) throw ComputationFailed("camera: '" + excerpt(source_) + "' stopped delivering frames");
+    if (read < 0) throw ComputationFailed("camera: '" + excerpt(source_) + "' " + error);
+    out.resize(frame.cols, frame.rows, frame.channels, frame.bits);
+    for (int y = 0; y < frame.rows; ++y)
+      std::memcpy(out.data.data() + static_cast<std::size_t>(y) * frame.row_bytes,
+                  frame.data + static_cast<std::size_t>(y) * frame.row_bytes, frame.row_bytes);
     return true;
   }
 
  private:
-  // A file, a device node or a URL, through each stream back-end but gPhoto2. gPhoto2 drives
-  // still cameras over USB: for any name it autodetects on the USB bus, which is slow, and
-  // libgphoto2 2.5.30 leaks every device list it scans (LeakSanitizer saw 2,500 on one machine).
-  bool open_named() {
-    for (const cv::VideoCaptureAPIs api : cv::videoio_registry::getStreamBackends()) {
-      if (api == cv::CAP_GPHOTO2) continue;
-      if (capture_.open(source_, api) && capture_.isOpened()) return true;
-    }
-    return false;
-  }
-
-  static std::string backends() {
-    std::string names;
-    for (const cv::VideoCaptureAPIs api : cv::videoio_registry::getStreamBackends())
-      names += (names.empty() ? "" : ", ") + cv::videoio_registry::getBackendName(api);
-    return names;
-  }
-
   std::string source_;
   bool file_ = false;
-  cv::VideoCapture capture_;
-  cv::Mat frame_, converted_;
+  McCapture* capture_ = nullptr;
   std::chrono::steady_clock::duration period_{};
   std::chrono::steady_clock::time_point next_{};
 };
 
 }  // namespace
 
-bool opencv_camera_available() { return true; }
+bool opencv_camera_available() {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(MC_OPENCV_CAPTURE_PLUGIN, ec);
+}
 
 std::unique_ptr<FrameSource> make_opencv_camera(const std::string& source) {
+  if (!opencv_camera_available())
+    throw InvalidParams("devices.camera.driver",
+                        "'opencv': this build has no OpenCV (install libopencv-videoio-dev, then cmake "
+                        "-DMC_WITH_OPENCV=ON; make test does both)");
   return std::make_unique<OpenCvCamera>(source);
 }
 
