@@ -6,14 +6,11 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/tweezers/smoothstep.h"
 
 namespace mc::tweezers {
 
 namespace {
-double smoothstep(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return x * x * (3 - 2 * x);
-}
 int substeps(double plant, double control) {
   const double r = plant / control;
   require(r >= 1 && std::abs(r - std::round(r)) < 1e-9, "plant_rate_Hz",

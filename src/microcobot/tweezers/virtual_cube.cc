@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "microcobot/core/error.h"
+#include "microcobot/tweezers/smoothstep.h"
 
 namespace mc::tweezers {
 
@@ -65,14 +66,6 @@ double VirtualCubeRenderer::update(double lever_m) noexcept {
   // The wall pushes the tips open: negative (opening) torque, saturated at the motor's limit.
   return std::clamp(-rendered_force_ * torque_per_newton_, -max_torque_, max_torque_);
 }
-
-namespace {
-double smoothstep(double x) {
-  x = std::clamp(x, 0.0, 1.0);
-  return x * x * (3 - 2 * x);
-}
-double smoothstep_rate(double x) { return (x <= 0 || x >= 1) ? 0.0 : 6 * x * (1 - x); }
-}  // namespace
 
 VirtualCubeResult simulate_virtual_cube(const TeleTweezParams& model_params, const VirtualCubeParams& cube) {
   VirtualCubeRenderer renderer(model_params, cube);
