@@ -80,6 +80,10 @@ function(mc_add_module_tests name)
     return()
   endif()
   add_executable(${name}_tests ${_sources})
+  # A module outside the library `microcobot` (the studies) is linked by its own tests.
+  if(TARGET mc_${name})
+    list(APPEND ARG_LIBS mc_${name})
+  endif()
   target_link_libraries(${name}_tests PRIVATE microcobot mc_test_support ${ARG_LIBS}
     GTest::gtest GTest::gmock GTest::gtest_main mc_warnings)
   target_compile_definitions(${name}_tests PRIVATE

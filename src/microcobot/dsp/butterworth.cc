@@ -6,9 +6,10 @@
 #include "microcobot/core/error.h"
 
 namespace mc::dsp {
-namespace {
 
 using C = std::complex<double>;
+
+namespace {
 
 void check_order(int order, int max_order, const char* field) {
   require(order >= 1 && order <= max_order, field, "must be in [1, " + std::to_string(max_order) + "]",

@@ -8,9 +8,11 @@
 #include "microcobot/core/error.h"
 
 namespace mc::dsp {
-namespace {
 
 using C = std::complex<double>;
+
+namespace {
+
 using CVec = std::vector<C>;
 
 bool is_real(const C& c) { return c.imag() == 0.0; }
