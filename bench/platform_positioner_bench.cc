@@ -1,11 +1,15 @@
 // The platform's loop tick (every task of one 10 kHz tick: coupling, slave control, the devices'
 // updates, telemetry) with the thesis's assembly, the parallel positioner's six legs beside the
 // Cartesian robot (`positioner: parallel`), against the Cartesian robot alone, interleaved in one
-// run while both move: p99 and median of each and their ratio (docs/benchmarks.md).
+// run while both move: p99 and median of each and their ratio (docs/benchmarks.md). Twice: the
+// legs stepped on the loop (`parallel_positioner.controller: loop`), and on their controller's
+// thread (`controller: thread`), where the loop only exchanges commands and poses with it.
 //   build/<dir>/bench/platform_positioner_bench
 #include <algorithm>
 #include <chrono>
 #include <numbers>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -34,7 +38,7 @@ void drive(pf::Platform& p) {
   p.set_console_input(in);
 }
 
-void PlatformTickWithTheParallelPositioner(benchmark::State& state) {
+void PlatformTick(benchmark::State& state, const std::string& controller) {
   constexpr int kBlock = 100, kBlocks = 200;  // 20 000 ticks (2 s) of each
   std::vector<double> cart_s, both_s;
   for (auto _ : state) {
@@ -42,9 +46,15 @@ void PlatformTickWithTheParallelPositioner(benchmark::State& state) {
     c.devices.camera.driver = "none";
     pf::Platform cartesian(c);
     c.positioner = "parallel";
+    c.parallel_positioner.controller = controller;
     pf::Platform both(c);
     for (pf::Platform* p : {&cartesian, &both}) {
       for (int k = 0; k < 2000; ++k) p->tick_for_test();  // the trackers power up
+      // On its thread, they power up on the wall clock.
+      for (int k = 0; k < 10000 && p->has_positioner() && !p->positioner()->at_rest(); ++k) {
+        p->tick_for_test();
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      }
       drive(*p);
     }
     // The 1 mm + 5 deg pose move of the motion benchmark.
@@ -69,6 +79,11 @@ void PlatformTickWithTheParallelPositioner(benchmark::State& state) {
       }
     }
     if (!both.positioner()->moving()) state.SkipWithError("the pose move ended inside the measurement");
+    // On its thread: the control periods it ran meanwhile, and the wakes that found it starved.
+    if (const auto* ctl = both.simulation().positioner->controller()) {
+      state.counters["controller_periods"] = static_cast<double>(ctl->view().periods);
+      state.counters["controller_late_wakes"] = static_cast<double>(ctl->view().late_wakes);
+    }
   }
   const double c50 = percentile(cart_s, 0.5), b50 = percentile(both_s, 0.5);
   const double c99 = percentile(cart_s, 0.99), b99 = percentile(both_s, 0.99);
@@ -79,6 +94,11 @@ void PlatformTickWithTheParallelPositioner(benchmark::State& state) {
   state.counters["ratio_median"] = b50 / c50;
   state.counters["ratio_p99"] = b99 / c99;
 }
+void PlatformTickWithTheParallelPositioner(benchmark::State& state) { PlatformTick(state, "loop"); }
+void PlatformTickWithThePositionersControllerThread(benchmark::State& state) {
+  PlatformTick(state, "thread");
+}
 BENCHMARK(PlatformTickWithTheParallelPositioner)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(PlatformTickWithThePositionersControllerThread)->Iterations(1)->Unit(benchmark::kSecond);
 
 }  // namespace

@@ -11,9 +11,20 @@
 ///   configure()         ParallelStage::rearm(): the legs hold where they are measured (refused
 ///                       after a model fault: it stays latched)
 ///
-/// Nothing here allocates after construction (the stage makes its storage there).
+/// With a controller thread (parallel_positioner_controller.h) the stage is stepped there instead,
+/// paced by the wall clock as a real controller's own processor steps its legs: update() exchanges
+/// the commands and the newest status with it, the getters read that status, and the commands take
+/// effect at its next wake (wake_period_s). For live sessions; studies and tests step it on the
+/// loop, where a run is reproducible.
+///
+/// Nothing here allocates after construction (the stage makes its storage there; the controller
+/// thread is started by the first configure()).
+
+#include <memory>
+#include <optional>
 
 #include "microcobot/devices/parallel_positioner.h"
+#include "microcobot/devices/parallel_positioner_controller.h"
 #include "microcobot/motion/parallel_stage.h"
 
 namespace mc::devices {
@@ -21,44 +32,51 @@ namespace mc::devices {
 class SimulatedParallelPositioner final : public ParallelPositioner {
  public:
   /// `model` and `map` must outlive the device; `loop_period_s` must be a whole number of the
-  /// stage's control periods (1 / params.tracking.control_rate_Hz). Throws mc::InvalidParams.
-  SimulatedParallelPositioner(std::string name, const stickslip::ActuatorModel& model,
-                              const motion::StepMap& map, const motion::ParallelStageParams& params,
-                              double loop_period_s);
+  /// stage's control periods (1 / params.tracking.control_rate_Hz). With `controller_thread`, the
+  /// stage is stepped on a controller thread of its own. Throws mc::InvalidParams.
+  SimulatedParallelPositioner(
+      std::string name, const stickslip::ActuatorModel& model, const motion::StepMap& map,
+      const motion::ParallelStageParams& params, double loop_period_s,
+      std::optional<ParallelPositionerControllerParams> controller_thread = std::nullopt);
+  ~SimulatedParallelPositioner() override;
 
   void update(double dt_s) noexcept override;
-  void enter_safe_state() noexcept override { stage_.emergency_stop(); }
+  void enter_safe_state() noexcept override;
 
   const motion::ParallelKinematics& kinematics() const noexcept override { return stage_.kinematics(); }
   bool start_move(const motion::PoseTrajectory& checked) noexcept override;
   bool follow(const motion::PlatformTransform& target,
-              const motion::PoseMoveLimits& limits) noexcept override {
-    return active() && stage_.follow(target, limits);
-  }
-  bool following() const noexcept override { return stage_.following(); }
-  bool follow_blocked() const noexcept override { return stage_.follow_blocked(); }
-  void stop() noexcept override { stage_.stop(); }
-  const motion::PlatformTransform& measured_pose() const noexcept override { return stage_.measured_pose(); }
-  const motion::PlatformTransform& reference_pose() const noexcept override {
-    return stage_.reference_pose();
-  }
-  bool moving() const noexcept override { return stage_.moving(); }
-  bool at_rest() const noexcept override { return stage_.at_rest(); }
+              const motion::PoseMoveLimits& limits) noexcept override;
+  bool following() const noexcept override;
+  bool follow_blocked() const noexcept override;
+  void stop() noexcept override;
+  const motion::PlatformTransform& measured_pose() const noexcept override;
+  const motion::PlatformTransform& reference_pose() const noexcept override;
+  bool moving() const noexcept override;
+  bool at_rest() const noexcept override;
   double max_leg_voltage_V() const noexcept override;
 
   /// Open-loop stepping of one leg's positioner (recovery; ParallelStage::step_leg): off the loop,
-  /// while Active. Throws mc::InvalidParams or mc::InvalidInput (a fault, not Active).
+  /// while Active. Throws mc::InvalidParams or mc::InvalidInput (a fault, not Active). With a
+  /// controller thread, the stepping is queued; one the stage then refuses counts in
+  /// controller()->view().refused.
   void step_leg(int leg, motion::LegPositioner positioner, int steps, double frequency_Hz);
   /// The simulation's truth: FK of the six sliders' true positions.
-  const motion::PlatformTransform& true_pose() const noexcept { return stage_.true_pose(); }
+  const motion::PlatformTransform& true_pose() const noexcept;
+  /// The stage, for a loop that steps it: with a controller thread the stage is that thread's,
+  /// and the getters above are what the host reads.
   const motion::ParallelStage& stage() const noexcept { return stage_; }
+  /// The controller thread, or nullptr when the stage is stepped on the loop.
+  const ParallelPositionerController* controller() const noexcept { return controller_.get(); }
 
  protected:
-  void on_configure() override { stage_.rearm(); }
+  void on_configure() override;
 
  private:
   motion::ParallelStage stage_;
   int ticks_per_update_ = 1;
+  std::optional<ParallelPositionerControllerParams> thread_params_;
+  std::unique_ptr<ParallelPositionerController> controller_;  ///< from the first configure()
 };
 
 }  // namespace mc::devices

@@ -195,11 +195,15 @@ void ParallelStage::advance_follow() noexcept {
   follow_still_ = v.isZero(0.0) && w.isZero(0.0);
 }
 
-void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz) {
+void ParallelStage::check_step_leg(int leg, int steps, double frequency_Hz) {
   require(leg >= 0 && leg < kParallelLegs, "leg", "must be 0, 1 or 2", leg);
   require(steps != 0 && std::abs(steps) <= 100000, "steps", "must be non-zero, |steps| <= 100000", steps);
   require(std::isfinite(frequency_Hz) && frequency_Hz > 0.0 && frequency_Hz <= 20000.0, "frequency_Hz",
           "must be in (0, 20000] Hz", frequency_Hz);
+}
+
+void ParallelStage::step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz) {
+  check_step_leg(leg, steps, frequency_Hz);
   if (fault_) throw InvalidInput("the positioner is stopped on a fault: place it again");
   if (halted_) throw InvalidInput("the positioner is halted (emergency stop): rearm it first");
   stop();

@@ -125,6 +125,8 @@ class ParallelStage {
   /// amplitude and `frequency_Hz`, forward for steps > 0; the leg then holds where it landed. Any
   /// move is stopped first (the other legs hold where they are).
   void step_leg(int leg, LegPositioner positioner, int steps, double frequency_Hz);
+  /// step_leg()'s checks of its arguments: throws mc::InvalidParams.
+  static void check_step_leg(int leg, int steps, double frequency_Hz);
   /// Ends any move: every tracking leg holds where it is measured now; a stepping leg finishes
   /// its period (U back at 0 V, no abrupt edge) and holds. Holding already (no move, no leg
   /// stepping), nothing changes: the held pose stays exact. Never allocates.

@@ -144,6 +144,8 @@ void PlatformConfig::validate() const {
           "must be cartesian or parallel, not '" + excerpt(positioner) + "'");
   in_section("parallel_positioner", [&] {
     parallel_positioner.validate();
+    require(parallel_positioner.controller == "loop" || parallel_positioner.controller == "thread",
+            "controller", "must be loop or thread, not '" + excerpt(parallel_positioner.controller) + "'");
     if (!is_positioner_driver(parallel_positioner.driver)) {
       std::string known;
       for (const std::string& n : positioner_driver_names()) known += (known.empty() ? "" : ", ") + n;
@@ -156,6 +158,8 @@ void PlatformConfig::validate() const {
     require(n >= 1.0 - 1e-9 && std::abs(n - std::round(n)) < 1e-6 * n, "tracking.control_rate_Hz",
             "must be a whole multiple of loop.base_rate_Hz", parallel_positioner.tracking.control_rate_Hz);
   });
+  in_section("parallel_positioner.controller_thread",
+             [&] { parallel_positioner.controller_thread.validate(); });
   in_section("optical_trap", [&] {
     optical_trap.validate();
     const double ratio = loop.period_s() / optical_trap.trap.dt_s;

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "microcobot/devices/camera_device.h"
+#include "microcobot/devices/parallel_positioner_controller.h"
 #include "microcobot/haptics/dual_stage_plant.h"
 #include "microcobot/haptics/pantograph.h"
 #include "microcobot/haptics/render_pipeline.h"
@@ -189,14 +190,24 @@ struct ParallelPositionerSelection : motion::ParallelStageParams {
   /// What the driver opens, in its own syntax (`pi-hexapod`: HOST:PORT[,key=value...]); unused by
   /// the simulation.
   std::string connection;
+  /// Where the simulated positioner's legs are stepped: "loop" (on the platform's loop, every
+  /// tick: a run is reproducible; studies and tests) or "thread" (on a controller thread of its
+  /// own paced by the wall clock, as a real controller steps its legs on its own processor: the
+  /// loop only exchanges commands and poses with it; live sessions).
+  std::string controller = "loop";
+  /// The controller thread's wake period, host timeout and command ring (controller: thread).
+  devices::ParallelPositionerControllerParams controller_thread;
 
   template <class V>
   void visit(V& v) {
     motion::ParallelStageParams::visit(v);
     v("driver", driver);
     v("connection", connection);
+    v("controller", controller);
+    v("controller_thread", controller_thread);
   }
   bool simulated() const { return driver == "simulated"; }
+  bool controller_on_thread() const { return controller == "thread"; }
 };
 
 struct PlatformConfig {

@@ -17,8 +17,10 @@ void Platform::build_positioner() {
     return;
   }
   // The legs are the project's stick-slip axes: the platform's model and step map.
+  const auto& c = config_.parallel_positioner;
   auto p = std::make_unique<devices::SimulatedParallelPositioner>(
-      "parallel_positioner", *model_, *map_, config_.parallel_positioner, config_.loop.period_s());
+      "parallel_positioner", *model_, *map_, c, config_.loop.period_s(),
+      c.controller_on_thread() ? std::optional(c.controller_thread) : std::nullopt);
   sim_.positioner = p.get();
   devices_.positioner = std::move(p);
 }
