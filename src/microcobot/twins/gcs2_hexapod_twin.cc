@@ -126,6 +126,7 @@ live::PositionerView Gcs2HexapodTwin::refresh() {
   if (v.halted && !halted_) {
     // The platform's e-stop (or a device's fault): every leg at 0 V where it was, the target there.
     halted_ = true;
+    settled_ = false;
     error_ = g::kStopped;
     target_ = last_goal_ = v.measured;
     after_stop_ = false;

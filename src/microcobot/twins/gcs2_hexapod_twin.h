@@ -75,8 +75,18 @@ class Gcs2HexapodTwin {
   live::PositionerView refresh();
   /// A move sent and not yet started, or one running.
   bool busy(const live::PositionerView& v) const;
-  bool on_target(const live::PositionerView& v) const {
-    return !busy(v) && v.at_rest && v.stop_seq >= stop_sent_;
+  /// No move sent or running, the last stop applied, and the legs at rest; once so, on target until
+  /// the next move, stop or halt. The legs' rest is their trackers' 3 nm in-position flag, which
+  /// the sensor's noise flickers while they hold; a PI controller's ONT? does not flicker once its
+  /// move has settled.
+  bool on_target(const live::PositionerView& v) {
+    if (busy(v) || v.stop_seq < stop_sent_ || v.halted) return false;
+    if (v.at_rest) {
+      settled_move_ = last_move_;
+      settled_stop_ = stop_sent_;
+      settled_ = true;
+    }
+    return settled_ && settled_move_ == last_move_ && settled_stop_ == stop_sent_;
   }
   /// Waits (bounded) for the last stop to be applied; then the target is the stopped pose.
   bool settle_stop();
@@ -113,6 +123,9 @@ class Gcs2HexapodTwin {
   motion::PlatformTransform target_;     ///< the last commanded goal, {H}
   motion::PlatformTransform last_goal_;  ///< the goal of the last move sent, {H}
   std::uint64_t last_move_ = 0, stop_sent_ = 0, referencing_ = 0, seen_rejected_ = 0, seen_interrupted_ = 0;
+  // ONT?'s latch: the move and stop last seen settled.
+  std::uint64_t settled_move_ = 0, settled_stop_ = 0;
+  bool settled_ = false;
   ClientId mover_ = 0;
   ClientId unsent_stop_ = 0;  ///< a stop the full ring refused, to send again
   bool referenced_ = false;
