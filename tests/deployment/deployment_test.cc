@@ -155,7 +155,9 @@ TEST(Deployment, TheStartLineSaysWhatRunsTheParallelPositioner) {
   config.platform.positioner = "parallel";
   LogLines log;
   Deployment deployment(config, log.sink());
-  EXPECT_TRUE(log.has("on the simulated devices, the parallel positioner simulated"));
+  EXPECT_TRUE(
+      log.has("on the simulated devices, the parallel positioner simulated (its legs on their controller's "
+              "thread)"));
 }
 
 TEST(Deployment, ABadConfigurationFailsWithOneClearErrorBeforeAnythingIsServed) {

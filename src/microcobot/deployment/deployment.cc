@@ -111,7 +111,9 @@ Deployment::Deployment(ServeConfig config, Log log) : config_(std::move(config))
   if (lp.platform.parallel_positioner_enabled()) {
     const platform::ParallelPositionerSelection& pp = lp.platform.parallel_positioner;
     on += pp.simulated()
-              ? ", the parallel positioner simulated"
+              ? std::string(", the parallel positioner simulated") +
+                    (pp.controller_on_thread() ? " (its legs on their controller's thread)"
+                                               : " (its legs on the loop)")
               : ", the parallel positioner on the driver '" + pp.driver + "' (" + pp.connection + ")";
   }
   log_("building the platform (the stick-slip step map takes about a second) on " + on);

@@ -98,6 +98,10 @@ live::LiveParams live_params(const ServeConfig& o, const Log& log) {
     log("--emulate gcs2-hexapod: the part rides on the platform's parallel positioner (positioner: "
         "parallel)");
   }
+  // A live session steps the simulated positioner's legs as a real controller does, on a thread of
+  // their own beside the loop (devices/parallel_positioner_controller.h).
+  auto& controller = lp.platform.parallel_positioner.controller;
+  if (controller == "auto") controller = "thread";
   return lp;
 }
 

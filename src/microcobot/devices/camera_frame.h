@@ -37,7 +37,12 @@ struct SceneSnapshot {
   double part_velocity_m_s[3] = {};
   int part_phase = 0;         ///< microworld::PartPhase
   double part_yaw_rad = 0.0;  ///< the part's orientation (the rotary axis turns it)
-  bool has_beads = false;     ///< the optical-trap scene's beads
+  /// The substrate carried by the parallel positioner (devices/carried_seat.h): how far its top
+  /// plate has moved (x, y) and turned about the vertical from home; the hole and the scene's
+  /// other parts ride on it. Zero without a positioner.
+  double seat_m[2] = {};
+  double seat_yaw_rad = 0.0;
+  bool has_beads = false;  ///< the optical-trap scene's beads
   double probe_bead_m[3] = {};
   double obstacle_bead_m[2] = {};
   double focus_z_m = 0.0;   ///< height of the focal plane above the substrate (focus drive)

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "microcobot/core/error.h"
+#include "microcobot/devices/simulated_parallel_positioner.h"
 
 namespace mc::devices {
 
@@ -24,9 +25,16 @@ void SimulatedGripper::on_configure() {
   command_m_ = world_.params().gripper.max_opening_m;
   shake_ = false;
   align_V_ = {};
-  state_.last_gripper_m = tip_position_m();
-  state_.last_gripper_yaw_rad = yaw_rad();
-  out_ = world_.step(state_, tip_position_m(), command_m_, 0.0, yaw_rad());
+  seat_.T = carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{};
+  state_.last_gripper_m = seat_.to_seat(tip_position_m());
+  state_.last_gripper_yaw_rad = yaw_rad() - seat_.yaw_rad();
+  step_world(0.0);
+}
+
+void SimulatedGripper::step_world(double dt_s) noexcept {
+  seat_.T = carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{};
+  out_ = world_.step(state_, seat_.to_seat(tip_position_m()), command_m_, dt_s, yaw_rad() - seat_.yaw_rad(),
+                     align_V_, seat_.tilt_rad());
 }
 
 Eigen::Vector3d SimulatedGripper::tip_position_m() const {
@@ -46,7 +54,7 @@ void SimulatedGripper::command_align_V(const std::array<double, 2>& drives_V) no
 
 void SimulatedGripper::update(double dt_s) noexcept {
   state_.gripper.shaking = shake_;
-  out_ = world_.step(state_, tip_position_m(), command_m_, dt_s, yaw_rad(), align_V_);
+  step_world(dt_s);
 }
 
 }  // namespace mc::devices

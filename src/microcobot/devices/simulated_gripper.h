@@ -8,15 +8,21 @@
 /// that let go of the part on a fault would drop it. With a rotary axis (set_rotary) the fingers
 /// turn with it about the vertical through their tips. Its align drives (the 4-DOF PiezoGripper's
 /// vertical benders) raise or lower each tip in the microworld; the safe state holds them where
-/// they are (a tip let down on a fault could strike the substrate).
+/// they are (a tip let down on a fault could strike the substrate). On a parallel positioner
+/// (set_carrier: the thesis's assembly) the substrate, the part on it and its hole ride on the
+/// positioner's top plate: the microworld is stepped in the seat's frame (carried_seat.h), and
+/// what this class reports (the contact force, the part's place, the fingers' bend) is in the world's.
 
 #include <array>
 
+#include "microcobot/devices/carried_seat.h"
 #include "microcobot/devices/device.h"
 #include "microcobot/microworld/pick_place_world.h"
 #include "microcobot/motion/rotary_axis.h"
 
 namespace mc::devices {
+
+class SimulatedParallelPositioner;
 
 class SimulatedGripper final : public Gripper {
  public:
@@ -31,7 +37,8 @@ class SimulatedGripper final : public Gripper {
   /// hysteresis), so its open-loop model is exact (docs/errata.md).
   double free_opening_m() const override { return state_.gripper.free_opening_m; }
   Vec3 contact_force_N() const override {
-    return {out_.force_on_gripper_N.x(), out_.force_on_gripper_N.y(), out_.force_on_gripper_N.z()};
+    const Eigen::Vector3d f = seat_.vector_to_world(out_.force_on_gripper_N);
+    return {f.x(), f.y(), f.z()};
   }
   /// The burst shakes the fingers in the microworld while on (an inactive gripper ignores it).
   void command_shake(bool on) noexcept override { shake_ = active() && on; }
@@ -55,6 +62,14 @@ class SimulatedGripper final : public Gripper {
     rotary_ = axis;
     rotary_params_ = params;
   }
+  /// The parallel positioner whose top plate carries the substrate (`positioner` must outlive the
+  /// gripper; its true pose is read at every update); call before configure().
+  void set_carrier(const SimulatedParallelPositioner* positioner) noexcept { carrier_ = positioner; }
+  /// The seat's pose at the last update (identity without a carrier).
+  const CarriedSeat& seat() const noexcept { return seat_; }
+  /// The part's centre and orientation about the vertical, in the world's frame.
+  Eigen::Vector3d part_position_m() const noexcept { return seat_.to_world(state_.part_m); }
+  double part_yaw_rad() const noexcept { return state_.part_yaw_rad + seat_.yaw_rad(); }
   /// Where the finger tips are (world frame), and the fingers' yaw (0 without a rotary axis).
   Eigen::Vector3d tip_position_m() const;
   double yaw_rad() const noexcept {
@@ -62,7 +77,11 @@ class SimulatedGripper final : public Gripper {
   }
   /// The fingers' common-mode bend under a lateral force (world x, y): the tips are seen there,
   /// away from tip_position_m() (microworld/pick_place_world.h).
-  Eigen::Vector2d finger_deflection_m() const { return state_.finger_deflection_m; }
+  Eigen::Vector2d finger_deflection_m() const {
+    const Eigen::Vector3d bend(state_.finger_deflection_m.x(), state_.finger_deflection_m.y(), 0.0);
+    return seat_.vector_to_world(bend).head<2>();
+  }
+  /// The microworld's state, in the seat's frame (the world's without a carrier).
   const microworld::PickPlaceState& world_state() const { return state_; }
   const microworld::PickPlaceOutput& world_output() const { return out_; }
   const microworld::PickPlaceWorld& world() const { return world_; }
@@ -71,7 +90,12 @@ class SimulatedGripper final : public Gripper {
   void on_configure() override;
 
  private:
+  /// One step of the microworld in the seat's frame, from the carrier's pose now.
+  void step_world(double dt_s) noexcept;
+
   const microworld::PickPlaceWorld& world_;
+  const SimulatedParallelPositioner* carrier_ = nullptr;
+  CarriedSeat seat_;
   std::array<const SlaveAxis*, 3> axes_;
   const SlaveAxis* rotary_ = nullptr;
   motion::RotaryAxisParams rotary_params_;

@@ -144,13 +144,23 @@ double PickPlaceWorld::hole_play_m(double yaw_rad) const noexcept {
   return 0.5 * (p_.hole_side_m - p_.part_side_m * (std::abs(std::cos(d)) + std::abs(std::sin(d))));
 }
 
-double PickPlaceWorld::rest_z_m(double x, double y, double yaw_rad) const noexcept {
+double PickPlaceWorld::hole_entry_depth_m(double yaw_rad, double tilt_rad) const noexcept {
+  if (p_.hole_side_m <= 0.0 || hole_play_m(yaw_rad) + 1e-12 <= 0.0) return 0.0;
+  const double theta = std::abs(tilt_rad);
+  if (theta < 1e-12) return p_.hole_depth_m;
+  // Wedged at two-point contact: the pin's width w cos(theta) plus its lean l sin(theta) span D.
+  const double w = p_.hole_side_m - 2.0 * hole_play_m(yaw_rad);  // the footprint across a side
+  const double l_max = (p_.hole_side_m - w * std::cos(theta)) / std::sin(theta);
+  return std::clamp(l_max, 0.0, p_.hole_depth_m);
+}
+
+double PickPlaceWorld::rest_z_m(double x, double y, double yaw_rad, double tilt_rad) const noexcept {
   const double half_height = 0.5 * p_.height_m();
   if (p_.hole_side_m <= 0.0) return half_height;
   const double play = hole_play_m(yaw_rad) + 1e-12;
   const Eigen::Vector2d d = turned({x - p_.target_m.x(), y - p_.target_m.y()}, -p_.hole_yaw_rad);
   const bool fits = play > 0.0 && std::abs(d.x()) <= play && std::abs(d.y()) <= play;
-  return fits ? half_height - p_.hole_depth_m : half_height;
+  return fits ? half_height - hole_entry_depth_m(yaw_rad, tilt_rad) : half_height;
 }
 
 bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
@@ -159,7 +169,7 @@ bool PickPlaceWorld::inserted(const PickPlaceState& s) const noexcept {
 
 bool PickPlaceWorld::placed(const PickPlaceState& s) const noexcept {
   if (s.phase != PartPhase::kOnSubstrate) return false;
-  if (p_.hole_side_m > 0.0) return inserted(s);
+  if (p_.hole_side_m > 0.0) return s.part_m.z() <= 0.5 * p_.height_m() - p_.hole_depth_m + 1e-9;
   return std::abs(s.part_m.z() - 0.5 * p_.height_m()) < 1e-9 && placement_error_m(s) <= p_.seat_tolerance_m;
 }
 
@@ -244,8 +254,11 @@ Eigen::Vector2d PickPlaceWorld::rubbing_force(const Eigen::Vector2d& motion, dou
 }
 
 PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g, double opening_command_m,
-                                     double dt_s, double yaw, const AlignDrives& align_V) const noexcept {
+                                     double dt_s, double yaw, const AlignDrives& align_V,
+                                     double seat_tilt_rad) const noexcept {
   PickPlaceOutput out;
+  s.seat_tilt_rad = seat_tilt_rad;
+  const double tilt = seat_tilt_rad;
   step_gripper(p_.gripper, s.gripper, opening_command_m, dt_s);
   // Only the align benders are driven (the closing is step_gripper's): the grasp pair, never
   // driven, is not stepped.
@@ -322,7 +335,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       // friction may hold it too (release.h, roll): the finger's contact peels as it turns.
       const bool stuck_on_seat =
           s.phase == PartPhase::kStuckToFinger &&
-          s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
+          s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad, tilt) + p_.meniscus_rupture_m;
       const bool seat_holds_turn =
           stuck_on_seat && (in_hole || seat_moment_Nm(p_) > finger_peel_moment_Nm(p_)) && yaw != last_yaw;
       if (seat_holds_turn) {
@@ -341,7 +354,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
       Eigen::Vector2d slip;
       out.force_on_gripper_N.head<2>() += confine_to_hole(next, s.part_yaw_rad, yaw, in_hole, held_by, slip);
       s.offset_m.head<2>() += slip;
-      const double floor = rest_z_m(next.x(), next.y(), s.part_yaw_rad);
+      const double floor = rest_z_m(next.x(), next.y(), s.part_yaw_rad, tilt);
       if (next.z() < floor) {  // pressed onto the substrate: the part stops, the fingers slide down
         const double press = floor - next.z();
         s.offset_m.z() += press;
@@ -401,7 +414,7 @@ PickPlaceOutput PickPlaceWorld::step(PickPlaceState& s, const Eigen::Vector3d& g
   const Eigen::Vector2d on_fingers = turned(out.force_on_gripper_N.head<2>(), -yaw);
   s.finger_deflection_m = turned({on_fingers.x() / (2.0 * p_.gripper.finger_stiffness_N_m), 0.0}, yaw);
   out.part_on_substrate =
-      s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad) + p_.meniscus_rupture_m;
+      s.part_m.z() <= rest_z_m(s.part_m.x(), s.part_m.y(), s.part_yaw_rad, tilt) + p_.meniscus_rupture_m;
   s.part_tilt_rad =
       s.phase == PartPhase::kGrasped ? part_tilt_rad(out.tip_misalignment_m, p_.part_side_m) : 0.0;
   return out;

@@ -53,6 +53,15 @@
 /// (part_tilt_rad). Each tip below the substrate presses on it with its bender's stiffness
 /// (read_tips): the gripper feels those forces while its reference point is above the substrate
 /// (below it, the crash's stiff reaction). Level tips (the default) grip as the closing model alone.
+///
+/// A tilted seat (the substrate on the parallel positioner turned about a horizontal axis,
+/// devices/carried_seat.h; the world is then written in the substrate's frame): a part held
+/// upright by the fingers meets its hole's axis at the seat's tilt theta, and a rigid pin
+/// tilted in a hole wedges at two-point contact once its lean spans the hole (Whitney,
+/// "Quasi-static assembly of compliantly supported rigid parts", J. Dyn. Syst. Meas. Control
+/// 104(1), 1982): a pin w wide across a side of the hole D goes in to the depth
+/// l_max = (D - w cos theta) / sin theta and no further (the tilt taken across a side of the
+/// hole, the worse case for a square pin). The part is placed only at the hole's bottom.
 
 #include <cmath>
 
@@ -202,6 +211,8 @@ struct PickPlaceState {
   /// The held part's tilt about the fingers' closing axis from the tips' misalignment (0 unless
   /// grasped).
   double part_tilt_rad = 0.0;
+  /// The seat's tilt against the fingers' vertical at the last step (step()'s seat_tilt_rad).
+  double seat_tilt_rad = 0.0;
 };
 
 /// What the world returns each step: the forces the slave feels (to be fed back, scaled, to
@@ -232,10 +243,12 @@ class PickPlaceWorld {
   /// Advances by dt with the gripper point at `gripper_m`, the fingers turned by `gripper_yaw_rad`
   /// (closing along that direction) and their opening commanded to `opening_command_m`. Never
   /// allocates.
-  /// The align benders go toward `align_V` (level tips at 0 V unless mounted misaligned).
+  /// The align benders go toward `align_V` (level tips at 0 V unless mounted misaligned). The
+  /// seat is tilted by `seat_tilt_rad` against the fingers' vertical (the file's comment: how deep
+  /// a held part then goes into its hole).
   PickPlaceOutput step(PickPlaceState& s, const Eigen::Vector3d& gripper_m, double opening_command_m,
-                       double dt_s, double gripper_yaw_rad = 0.0,
-                       const AlignDrives& align_V = {}) const noexcept;
+                       double dt_s, double gripper_yaw_rad = 0.0, const AlignDrives& align_V = {},
+                       double seat_tilt_rad = 0.0) const noexcept;
   /// The fingers as bender_fingers.h sees them: the align benders and the face height of
   /// `gripper`, the tips' stiffness its finger_stiffness_N_m, the friction finger_friction.
   const BenderFingersParams& fingers() const noexcept { return fingers_; }
@@ -244,15 +257,19 @@ class PickPlaceWorld {
   /// The part's orientation against the hole's, modulo the square's 90 deg, in [-45, 45) deg.
   double orientation_error_rad(const PickPlaceState& s) const noexcept;
   /// Height of the part's centre when it rests at (x, y) turned by `yaw_rad`: in the hole when its
-  /// footprint fits the hole's clearance, on the substrate (or the hole's rim) otherwise.
-  double rest_z_m(double x, double y, double yaw_rad = 0.0) const noexcept;
+  /// footprint fits the hole's clearance (held `tilt_rad` off the hole's axis: only as deep as the
+  /// tilt lets it, hole_entry_depth_m), on the substrate (or the hole's rim) otherwise.
+  double rest_z_m(double x, double y, double yaw_rad = 0.0, double tilt_rad = 0.0) const noexcept;
+  /// How deep a part turned by `yaw_rad` and tilted by `tilt_rad` against the hole's axis goes into
+  /// it: the hole's depth, or where its lean wedges it (the file's comment); 0 when it does not fit.
+  double hole_entry_depth_m(double yaw_rad, double tilt_rad) const noexcept;
   /// Half the play the hole leaves a part turned by `yaw_rad` along each of its sides (negative:
   /// it does not fit at that angle).
   double hole_play_m(double yaw_rad) const noexcept;
   /// The part is down in the hole (its bottom below the substrate).
   bool inserted(const PickPlaceState& s) const noexcept;
-  /// The part is where the target wants it and let go: down in the hole, or, on a flat seat,
-  /// resting on the substrate within seat_tolerance_m of the target.
+  /// The part is where the target wants it and let go: down at the hole's bottom, or, on a flat
+  /// seat, resting on the substrate within seat_tolerance_m of the target.
   bool placed(const PickPlaceState& s) const noexcept;
 
  private:

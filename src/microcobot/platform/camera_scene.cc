@@ -1,6 +1,7 @@
 #include "microcobot/platform/camera_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string_view>
 
@@ -112,12 +113,19 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, ima
   // Pick-and-place (and pin-in-hole): a lapped steel substrate, the brass part, the hole at the
   // target, the two fingers closing along x.
   const auto& w = c.world;
+  // What rides on the carried seat: turned about the world's origin (the top plate's centre at
+  // home), then moved with it.
+  const double cy = std::cos(pose.seat_yaw_rad), sy = std::sin(pose.seat_yaw_rad);
+  const auto carried = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d(pose.seat_x_m + cy * p.x() - sy * p.y(), pose.seat_y_m + sy * p.x() + cy * p.y());
+  };
   if (w.hole_side_m > 0.0) {
     imaging::Hole h;
-    h.x_m = w.target_m.x(), h.y_m = w.target_m.y();
+    const Eigen::Vector2d at = carried(w.target_m.head<2>());
+    h.x_m = at.x(), h.y_m = at.y();
     h.size_x_m = h.size_y_m = w.hole_side_m;
     h.depth_m = w.hole_depth_m;
-    h.angle_rad = w.hole_yaw_rad;
+    h.angle_rad = w.hole_yaw_rad + pose.seat_yaw_rad;
     s.holes.push_back(h);
   }
   imaging::Part part;
@@ -131,10 +139,11 @@ void fill_camera_scene(const PlatformConfig& c, const CameraScenePose& pose, ima
   for (int i = 0; i < w.neighbour_count; ++i) {
     const microworld::NeighbourPart& n = w.neighbours[static_cast<std::size_t>(i)];
     imaging::Part other;
-    other.x_m = n.xy_m.x(), other.y_m = n.xy_m.y();
+    const Eigen::Vector2d at = carried(n.xy_m);
+    other.x_m = at.x(), other.y_m = at.y();
     other.z_top_m = n.top_z_m;
     other.size_x_m = other.size_y_m = n.side_m;
-    other.angle_rad = n.yaw_rad;
+    other.angle_rad = n.yaw_rad + pose.seat_yaw_rad;
     s.parts.push_back(other);
   }
   const double finger_width_m = w.gripper.finger_width_m;

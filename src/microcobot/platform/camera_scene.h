@@ -37,6 +37,9 @@ struct CameraScenePose {
   double part_yaw_rad = 0.0;                              ///< the part's orientation
   double vx_m_s = 0.0, vy_m_s = 0.0;                      ///< the tool's velocity
   double part_vx_m_s = 0.0, part_vy_m_s = 0.0;
+  /// The substrate carried by the parallel positioner: its displacement and heading from home
+  /// (devices::SceneSnapshot::seat_m); the hole and the other parts drawn where it takes them.
+  double seat_x_m = 0.0, seat_y_m = 0.0, seat_yaw_rad = 0.0;
 };
 
 /// The pose at the scene's start: the tool at the stage's home, the gripper open, the part at

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "microcobot/core/error.h"
@@ -168,14 +169,26 @@ void Platform::teleoperation_task() noexcept {
   in.haptic_fresh = haptic_watchdog_.tick();
   in.tweezers_opening_m = devices_.tweezers->opening_m();
   in.tweezers_fresh = tweezers_watchdog_.tick();
+  // The master on the parallel positioner moves the part: the coupling's slave is the positioner's
+  // plate, and the contact it renders is the fingers' reaction on the part.
+  const bool to_positioner = master_on_positioner();
+  if (to_positioner != coupling_.master_on) switch_master_slave(to_positioner);
   for (int i = 0; i < 3; ++i)
     in.slave_position_m[i] = devices_.axes[static_cast<std::size_t>(i)]->position_m();
   const devices::Vec3 f = devices_.gripper->contact_force_N();
   in.contact_force_N = {f.x, f.y, f.z};
+  if (to_positioner) {
+    in.slave_position_m = devices_.positioner->measured_pose().d;
+    in.contact_force_N = -in.contact_force_N;
+  }
+  teleop_->set_height_ceiling(to_positioner ? plate_ceiling_m(devices_.positioner->measured_pose().R)
+                                            : std::numeric_limits<double>::infinity());
   in.grip_force_N = devices_.gripper->grip_force_N();
   in.gripper_opening_m = devices_.gripper->opening_m();
-  in.slave_fresh = devices_.axes[0]->measurement_fresh() && devices_.axes[1]->measurement_fresh() &&
-                   devices_.axes[2]->measurement_fresh();
+  in.slave_fresh = to_positioner
+                       ? devices_.positioner->state() == devices::Lifecycle::kActive
+                       : devices_.axes[0]->measurement_fresh() && devices_.axes[1]->measurement_fresh() &&
+                             devices_.axes[2]->measurement_fresh();
   in.console = console_;
   in.console.deadman = console_.deadman && !faulted_;
   const auto& out = teleop_->tick(in);
@@ -195,7 +208,7 @@ void Platform::slave_control_task() noexcept {
                                           devices_.axes[2]->position_m()};
   // Operator-to-slave tracking error: the target the operator commands now against
   // where the slave is, while the coupling is engaged.
-  if (out.engaged) {
+  if (out.engaged && !coupling_.master_on) {
     const double e = (out.slave_target_m - Eigen::Vector3d(measured[0], measured[1], measured[2])).norm();
     tracking_.sum_sq_m2 += e * e;
     tracking_.max_m = std::max(tracking_.max_m, e);
@@ -205,6 +218,10 @@ void Platform::slave_control_task() noexcept {
   for (std::size_t i = 0; i < 3; ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     target[i] = out.slave_target_m[k], velocity[i] = out.slave_velocity_m_s[k], all_measured[i] = measured[i];
+  }
+  if (coupling_.master_on) {  // the master moves the part: the gripper holds where it was
+    for (std::size_t i = 0; i < 3; ++i)
+      target[i] = coupling_.stage_hold_m[static_cast<Eigen::Index>(i)], velocity[i] = 0.0;
   }
   rotary_control(target, velocity, all_measured);
   levelling_targets(target, velocity);
@@ -275,7 +292,7 @@ void Platform::camera_task(const runtime::TickInfo& t) noexcept {
     tool[static_cast<Eigen::Index>(i)] =
         home_m_[static_cast<Eigen::Index>(i)] + devices_.axes[i]->carried_position_m();
   }
-  if (sim_.gripper != nullptr) part = sim_.gripper->world_state().part_m;
+  if (sim_.gripper != nullptr) part = sim_.gripper->part_position_m();
   if (sim_.optical_tweezers != nullptr) part = sim_.optical_tweezers->bead_m();
   const std::size_t oldest = history_index_;  // the entry written kVelocityTicks ticks ago
   const Eigen::Vector3d tool_then = tool_history_[oldest], part_then = part_history_[oldest];
@@ -301,7 +318,10 @@ void Platform::camera_task(const runtime::TickInfo& t) noexcept {
   if (sim_.gripper != nullptr) {
     s.has_part = true;
     s.part_phase = static_cast<int>(sim_.gripper->world_state().phase);
-    s.part_yaw_rad = sim_.gripper->world_state().part_yaw_rad;
+    s.part_yaw_rad = sim_.gripper->part_yaw_rad();
+    const devices::CarriedSeat& seat = sim_.gripper->seat();
+    s.seat_m[0] = seat.T.d.x(), s.seat_m[1] = seat.T.d.y();
+    s.seat_yaw_rad = seat.yaw_rad();
     const Eigen::Vector2d bend = sim_.gripper->finger_deflection_m();
     s.finger_deflection_m[0] = bend.x(), s.finger_deflection_m[1] = bend.y();
   }
@@ -357,7 +377,12 @@ void Platform::hold() noexcept {
 void Platform::hold_axes() noexcept {
   const Eigen::Vector3d measured(devices_.axes[0]->position_m(), devices_.axes[1]->position_m(),
                                  devices_.axes[2]->position_m());
-  teleop_->hold_at(measured);
+  if (coupling_.master_on) {  // the coupling drives the positioner: its target is the plate's
+    coupling_.stage_hold_m = measured;
+    teleop_->hold_at(devices_.positioner->measured_pose().d);
+  } else {
+    teleop_->hold_at(measured);
+  }
   if (rotary_target_) rotary_target_->hold_at(yaw_rad());
 }
 

@@ -136,6 +136,11 @@ class Platform {
   bool pose_move_allowed() const noexcept {
     return !faulted_ && console_.active && console_.fresh && console_.deadman;
   }
+  /// The haptic master drives the parallel positioner now (`master_drives: positioner` while the
+  /// console does not hold control): its handle moves the part, the Cartesian robot holds.
+  bool master_on_positioner() const noexcept {
+    return config_.master_drives_positioner() && devices_.positioner != nullptr && !console_.active;
+  }
   /// Starts a pose move of the parallel positioner: `checked`, a trajectory motion::check_move()
   /// passed off the loop, from the pose the legs hold. False, and nothing moves, without the
   /// positioner, when pose_move_allowed() is false, while another move runs, or when it starts
@@ -310,6 +315,19 @@ class Platform {
   /// The parallel positioner's part of each task (platform_positioner.cc).
   void build_positioner();
   void positioner_task(double dt_s) noexcept;
+  /// The master's and the dial's pose for the positioner (master_on_positioner()): true when one
+  /// of them drives it this tick, under its deadman.
+  bool master_pose_task() noexcept;
+  /// The coupling's slave switched between the Cartesian robot and the positioner: each holds,
+  /// and the coupling re-takes its target from the one it now drives.
+  void switch_master_slave(bool to_positioner) noexcept;
+  /// The highest the positioner's plate may stand turned by `R`: the seat's point under the finger
+  /// tips min_tip_height_m below them.
+  double plate_ceiling_m(const Eigen::Matrix3d& R) const noexcept;
+  /// The seat carried onto the finger tips since the last tick: its point under them moved up
+  /// while they are under their floor over it, or along their contact force while it is over its
+  /// limit (the poses a real platform knows; platform_positioner.cc).
+  bool seat_closes_on_tips() noexcept;
   static std::span<const BuiltinChannel> positioner_channels();
   static std::span<const BuiltinChannel> positioner_truth_channels();
   /// The rotary axis' part of each task (platform_rotary.cc).
@@ -362,6 +380,15 @@ class Platform {
   static constexpr double kLevellingRateTau_s = 1e-3;
   static constexpr double kLevellingStop_s = 2e-3;
   bool faulted_ = false;
+  /// The parallel positioner's coupling (platform_positioner.cc): its reference at the last tick
+  /// (which way the seat went), and the master on it: whether it drives it now and drove it the last
+  /// tick, the pose it asks for, where the Cartesian robot holds meanwhile.
+  struct PositionerCoupling {
+    motion::PlatformTransform seat_reference;
+    bool master_on = false, master_driving = false;
+    motion::PlatformTransform master_pose;
+    Eigen::Vector3d stage_hold_m = Eigen::Vector3d::Zero();
+  } coupling_;
   bool vision_xy_ = false;            ///< x and y open loop, positioned by vision (stage.xy_sensor)
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)
   /// The camera's scene (loop thread): tool and part positions of the last ticks, for velocities

@@ -142,10 +142,15 @@ void PlatformConfig::validate() const {
   }
   require(positioner == "cartesian" || positioner == "parallel", "positioner",
           "must be cartesian or parallel, not '" + excerpt(positioner) + "'");
+  require(master_drives == "stage" || master_drives == "positioner", "master_drives",
+          "must be stage or positioner, not '" + excerpt(master_drives) + "'");
+  require(!master_drives_positioner() || parallel_positioner_enabled(), "master_drives",
+          "must be stage with positioner: cartesian (there is no parallel positioner to drive)");
   in_section("parallel_positioner", [&] {
     parallel_positioner.validate();
-    require(parallel_positioner.controller == "loop" || parallel_positioner.controller == "thread",
-            "controller", "must be loop or thread, not '" + excerpt(parallel_positioner.controller) + "'");
+    const std::string& where = parallel_positioner.controller;
+    require(where == "auto" || where == "loop" || where == "thread", "controller",
+            "must be auto, loop or thread, not '" + excerpt(where) + "'");
     if (!is_positioner_driver(parallel_positioner.driver)) {
       std::string known;
       for (const std::string& n : positioner_driver_names()) known += (known.empty() ? "" : ", ") + n;

@@ -191,10 +191,11 @@ struct ParallelPositionerSelection : motion::ParallelStageParams {
   /// the simulation.
   std::string connection;
   /// Where the simulated positioner's legs are stepped: "loop" (on the platform's loop, every
-  /// tick: a run is reproducible; studies and tests) or "thread" (on a controller thread of its
+  /// tick: a run is reproducible; studies and tests), "thread" (on a controller thread of its
   /// own paced by the wall clock, as a real controller steps its legs on its own processor: the
-  /// loop only exchanges commands and poses with it; live sessions).
-  std::string controller = "loop";
+  /// loop only exchanges commands and poses with it), or "auto" (the default): "thread" in a live
+  /// session (`serve`, deployment::live_params), "loop" everywhere else.
+  std::string controller = "auto";
   /// The controller thread's wake period, host timeout and command ring (controller: thread).
   devices::ParallelPositionerControllerParams controller_thread;
 
@@ -234,6 +235,12 @@ struct PlatformConfig {
   std::string positioner = "cartesian";
   /// The parallel positioner (with `positioner: parallel`): its model's parameters and its driver.
   ParallelPositionerSelection parallel_positioner;
+  /// What the haptic master's x, y, z drive while it holds control: "stage", the Cartesian robot
+  /// carrying the gripper (the default), or "positioner" (with `positioner: parallel`), the
+  /// parallel positioner carrying the part, whose pose then follows the handle within its moves'
+  /// limits while the console's dial turns it about the vertical (Platform, "The master on the
+  /// positioner"). The gripper keeps the TéléTweez either way; the console drives the Cartesian robot.
+  std::string master_drives = "stage";
   /// The PiezoGripper's tips levelled by touch on the substrate (the console's Level tips; a gripper
   /// with align drives): microworld/tip_alignment.h, Platform::start_tip_levelling.
   microworld::TipAlignmentParams alignment;
@@ -254,10 +261,12 @@ struct PlatformConfig {
     v("vision_force", vision_force);
     v("positioner", positioner);
     v("parallel_positioner", parallel_positioner);
+    v("master_drives", master_drives);
     v("alignment", alignment);
   }
   bool optical_trap_scene() const { return microworld == "optical-trap"; }
   bool parallel_positioner_enabled() const { return positioner == "parallel"; }
+  bool master_drives_positioner() const { return master_drives == "positioner"; }
   /// Validates every section and their consistency (rates); errors name the key path.
   void validate() const;
 };

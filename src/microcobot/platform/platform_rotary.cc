@@ -30,6 +30,7 @@ void Platform::rotary_command() noexcept {
   if (!rotary_target_) return;
   teleop::ConsoleInput c = console_;
   c.deadman = console_.deadman && !faulted_;
+  if (coupling_.master_on) c.theta_rate_rad_s = 0.0;  // the dial turns the part's positioner
   rotary_target_->tick(c);
 }
 

@@ -129,7 +129,7 @@ std::span<const Platform::BuiltinChannel> Platform::simulation_channels() {
       {"slave_theta_rad", "rad", "the gripper's true yaw (0 in the optical trap)",
        [](P p) noexcept { return p.sim_.gripper ? p.sim_.gripper->yaw_rad() : 0.0; }},
       {"part_yaw_rad", "rad", "the part's yaw (0 in the optical trap)",
-       [](P p) noexcept { return p.sim_.gripper ? p.sim_.gripper->world_state().part_yaw_rad : 0.0; }},
+       [](P p) noexcept { return p.sim_.gripper ? p.sim_.gripper->part_yaw_rad() : 0.0; }},
       {"gripper_shaking", "", "1 while the gripper's release burst shakes its fingers",
        [](P p) noexcept {
          return p.sim_.gripper && p.sim_.gripper->world_state().gripper.shaking ? 1.0 : 0.0;
@@ -185,7 +185,7 @@ std::span<const Platform::BuiltinChannel> Platform::positioner_truth_channels() 
 }
 
 Eigen::Vector3d Platform::simulated_part_m() const noexcept {
-  if (sim_.gripper != nullptr) return sim_.gripper->world_state().part_m;
+  if (sim_.gripper != nullptr) return sim_.gripper->part_position_m();
   if (sim_.optical_tweezers != nullptr) return sim_.optical_tweezers->bead_m();
   return Eigen::Vector3d::Zero();
 }

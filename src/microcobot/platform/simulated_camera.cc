@@ -44,6 +44,8 @@ class SimulatedCamera final : public devices::FrameSource {
     pose.vy_m_s = scene.tool_velocity_m_s[1];
     pose.part_vx_m_s = scene.part_velocity_m_s[0];
     pose.part_vy_m_s = scene.part_velocity_m_s[1];
+    pose.seat_x_m = scene.seat_m[0], pose.seat_y_m = scene.seat_m[1];
+    pose.seat_yaw_rad = scene.seat_yaw_rad;
     fill_camera_scene(config_, pose, snapshot_);
     snapshot_.t_s = scene.t_s;
 

@@ -23,6 +23,9 @@
 ///
 /// tick() runs on the real-time path at the haptic rate: no allocation, lock, exception or I/O.
 
+#include <cmath>
+#include <limits>
+
 #include <Eigen/Core>
 
 #include "microcobot/teleop/safety_limits.h"
@@ -142,6 +145,12 @@ class Teleoperation {
   /// Holds the slave where it is measured (target = position, zero velocity), disengaged: the
   /// hand-back after an automatic sequence. Real-time safe.
   void hold_at(const Eigen::Vector3d& measured_m) noexcept;
+  /// The highest target height from the next tick (+inf, or NaN: none), on every input path, the
+  /// master's own height going with it (no wind-up): the platform's limit for a slave that rises
+  /// toward the tool (the seat on the parallel positioner under the finger tips). Real-time safe.
+  void set_height_ceiling(double ceiling_m) noexcept {
+    ceiling_m_ = std::isnan(ceiling_m) ? std::numeric_limits<double>::infinity() : ceiling_m;
+  }
   /// The virtual fixtures for the coming ticks (stage coordinates; virtual_fixtures.h), on every
   /// input path. Real-time safe.
   /// A guide that moves starts again from level 0 (slewed up), and the master's target is
@@ -170,6 +179,7 @@ class Teleoperation {
 
   TeleoperationParams p_;
   SafetyLimits limits_;
+  double ceiling_m_ = std::numeric_limits<double>::infinity();
   bool contact_limited_ = false;
   double dt_;
   TeleoperationOutput out_;

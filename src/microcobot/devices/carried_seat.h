@@ -1,0 +1,37 @@
+#pragma once
+/// @file
+/// The substrate carried by the parallel positioner: the thesis's assembly (§2.3, Fig. 2.4) puts
+/// the part on the 6-DOF robot and the gripper on the Cartesian one. The substrate is the
+/// positioner's top plate, and the world frame is that plate's frame at home (the microworld's
+/// origin at the plate's centre, its z = 0 the plate's surface): the plate's pose T = (R, d)
+/// relative to home (motion::PlatformTransform, the positioner's true pose) carries every point of
+/// the substrate, the part resting on it and its hole with it, p_world = R p_seat + d. The
+/// microworld (microworld/pick_place_world.h) is stepped in the seat's frame: the gripper's point
+/// is taken there, its yaw less the seat's, and the seat's tilt against the gripper's vertical
+/// decides how deep a held part goes into its hole.
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "microcobot/motion/pose.h"
+
+namespace mc::devices {
+
+struct CarriedSeat {
+  motion::PlatformTransform T;  ///< the seat's pose in the world (identity: at home)
+
+  Eigen::Vector3d to_seat(const Eigen::Vector3d& world_m) const noexcept {
+    return T.R.transpose() * (world_m - T.d);
+  }
+  Eigen::Vector3d to_world(const Eigen::Vector3d& seat_m) const noexcept { return T.R * seat_m + T.d; }
+  /// A vector (a force, a displacement) from the seat's axes to the world's.
+  Eigen::Vector3d vector_to_world(const Eigen::Vector3d& v) const noexcept { return T.R * v; }
+  /// The seat's heading about the vertical: the angle of its x axis projected on the world's plane.
+  double yaw_rad() const noexcept { return std::atan2(T.R(1, 0), T.R(0, 0)); }
+  /// The angle between the seat's normal and the world's vertical (the gripper's axis).
+  double tilt_rad() const noexcept { return std::acos(std::clamp(T.R(2, 2), -1.0, 1.0)); }
+};
+
+}  // namespace mc::devices
