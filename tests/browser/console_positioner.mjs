@@ -122,7 +122,7 @@ await s.run(async () => {
     c.write("VLS 0.5");
     const err1 = await c.ask("ERR?");
     if (err1[0] !== "0") throw new Error("VLS: error " + err1[0]);
-    const goal = [1.5, -1.0, 0.8, 2.0, -1.5, 5.0];  // X, Y, Z [mm], U, V, W [deg]
+    const goal = [1.5, -1.0, -0.8, 2.0, -1.5, 5.0];  // X, Y, Z [mm], U, V, W [deg]: down, clear of the tips
     const move = async () => {
       c.write("MOV " + goal.map((v, i) => "XYZUVW"[i] + " " + v).join(" "));
       const err2 = await c.ask("ERR?");

@@ -103,5 +103,23 @@ TEST(ConsolePoseGoal, AGoalOutOfReachIsRefusedOnceWithItsReasonAndNothingIsSent)
   EXPECT_EQ(retried.push->seq, planned.push->seq);
 }
 
+TEST(ConsolePoseGoal, AGoalThatBringsTheSeatOntoTheFingerTipsIsRefusedWithTheGapItWouldLeave) {
+  ConsolePoseGoal planner(motion::ParallelGeometryParams{});
+  ConsolePoseView v;
+  v.tips_m = Eigen::Vector3d(-1.5e-3, 0, 60e-6);  // 60 um over the seat at home
+  v.tip_floor_m = 10e-6;
+  const auto refused = planner.on_command(goal_command({0, 0, 100e-6, 0, 0, 0}), v);
+  EXPECT_FALSE(refused.push);
+  EXPECT_NE(refused.refusal.find("within 0.0 um of the finger tips (their floor: 10 um)"), std::string::npos)
+      << refused.refusal;
+  // A tilt that swings the seat's edge under the tips up into them: refused along the way.
+  const auto tilted = planner.on_command(goal_command({0, 0, 0, 0, 0.05, 0}), v);  // ry 2.9 deg
+  EXPECT_FALSE(tilted.push);
+  EXPECT_NE(tilted.refusal.find("finger tips"), std::string::npos) << tilted.refusal;
+  // Up to the floor and no further is planned.
+  const auto up = planner.on_command(goal_command({0, 0, 49e-6, 0, 0, 0}), v);
+  ASSERT_TRUE(up.push) << up.refusal;
+}
+
 }  // namespace
 }  // namespace mc::live

@@ -80,7 +80,7 @@ async function check(label, extraArgs, parallel) {
     // A pose off home through the hexapod twin, then the frames it sends at rest there.
     const twin = stdoutLines.find((l) => l.startsWith("emulate gcs2-hexapod "));
     if (!twin) throw new Error("serve printed no gcs2-hexapod twin");
-    await movePositioner(Number(twin.split(":").at(-1)), "MOV X 1 Y -0.5 Z 0.6 U 1.5 V -1 W 3");
+    await movePositioner(Number(twin.split(":").at(-1)), "MOV X 1 Y -0.5 Z -0.6 U 1.5 V -1 W 3");
     const n = received["/tf"].length;
     while (received["/tf"].length < n + 10) await sleep(50);
   }

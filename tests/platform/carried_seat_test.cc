@@ -97,7 +97,7 @@ TEST(CarriedSeat, ThePartMovesAndTurnsWithThePositionersTopPlate) {
   EXPECT_NEAR(snapshot.holes[0].angle_rad, 1 * kSeatDeg, 1e-6);
 }
 
-TEST(CarriedSeat, ASeatRaisedOntoTheTipsStopsAtTheirFloorAndMovesAwayAgain) {
+TEST(CarriedSeat, NeitherRobotBringsTheSeatAndTheTipsNearerThanTheirFloor) {
   PlatformConfig c;
   c.positioner = "parallel";
   c.stage.home_x_m = -1.5e-3;  // over the bare substrate, 60 um above it
@@ -106,17 +106,33 @@ TEST(CarriedSeat, ASeatRaisedOntoTheTipsStopsAtTheirFloorAndMovesAwayAgain) {
   const double floor = c.world.min_tip_height_m;
   p.loop().run_for(2000);
   drive_with_deadman(p, true);
-  ASSERT_TRUE(start_plate_move(p, {0, 0, 100e-6, 0, 0, 0}));  // would put the seat 40 um above the tips
-  settle_plate(p, 4.0);
-  ASSERT_TRUE(p.positioner()->at_rest());
-  const Eigen::Vector3d tips = seat_gripper(p).tip_position_m();
-  const double clearance = seat_gripper(p).seat().to_seat(tips).z();
-  std::printf("raised onto the tips: stopped %.3f um over the seat (floor %.0f um)\n", 1e6 * clearance,
-              1e6 * floor);
-  EXPECT_LT(clearance, floor) << "it stopped at the floor";
-  EXPECT_GT(clearance, floor - 0.2e-6) << "within a tick's travel and the stop of it";
+  const auto clearance = [&] { return seat_gripper(p).seat().to_seat(seat_gripper(p).tip_position_m()).z(); };
+  // A move whose path would raise the seat within the floor is refused before anything moves.
+  const PlatformTransform before = p.simulation().positioner->true_pose();
+  EXPECT_FALSE(start_plate_move(p, {0, 0, 100e-6, 0, 0, 0}));
+  p.loop().run_for(1000);
+  EXPECT_LT((p.simulation().positioner->true_pose().d - before.d).norm(), 50e-9);
+  // The plate rises 40 um while the console's joystick lowers the tips at 50 um/s: the gripper
+  // stops at the floor over the rising seat, and the seat stops at the floor under the tips.
+  ASSERT_TRUE(start_plate_move(p, {0, 0, 40e-6, 0, 0, 0}));
+  teleop::ConsoleInput in = p.console_input();
+  in.has_goal = false;
+  in.velocity_m_s = {0, 0, -50e-6};
+  p.set_console_input(in);
+  double lowest = clearance();
+  for (int i = 0; i < 20000; ++i) {
+    p.loop().run_for(1);
+    lowest = std::min(lowest, clearance());
+  }
+  std::printf(
+      "plate up 40 um, tips down at 50 um/s: the tips' lowest over the seat %.3f um (floor %.0f um)\n",
+      1e6 * lowest, 1e6 * floor);
+  EXPECT_GT(lowest, floor - 0.2e-6);
+  EXPECT_LT(clearance(), floor + 1e-6) << "they met at the floor";
   EXPECT_FALSE(seat_gripper(p).world_state().crashed);
   // Down again: a move away from the tips runs.
+  in.velocity_m_s.setZero();
+  p.set_console_input(in);
   ASSERT_TRUE(start_plate_move(p, {0, 0, 0, 0, 0, 0}));
   settle_plate(p, 4.0);
   EXPECT_LT(p.simulation().positioner->true_pose().d.norm(), 0.1e-6);

@@ -4,6 +4,9 @@
 
 #include <Eigen/Geometry>
 
+#include <fmt/format.h>
+
+#include "microcobot/devices/carried_seat.h"
 #include "microcobot/motion/parallel_workspace.h"
 #include "microcobot/motion/pose.h"
 
@@ -72,6 +75,16 @@ ConsolePoseGoal::Step ConsolePoseGoal::on_command(const ConsoleCommand& c, const
   if (!check.ok) {
     refused_ = goal;
     step.refusal = check.reason;
+    return step;
+  }
+  // The seat on the plate must keep clear of the finger tips over it (Platform::start_pose_move
+  // refuses such a move as well; here it is said why).
+  const double lowest = devices::lowest_tip_height_m(trajectory, v.tips_m);
+  if (lowest < v.tip_floor_m) {
+    refused_ = goal;
+    step.refusal =
+        fmt::format("the seat would come within {:.1f} um of the finger tips (their floor: {:.0f} um)",
+                    1e6 * std::max(lowest, 0.0), 1e6 * v.tip_floor_m);
     return step;
   }
   refused_.reset();

@@ -12,6 +12,7 @@
 /// Server thread only (one instance per console server).
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -34,6 +35,10 @@ struct ConsolePoseView {
   bool jogging = false;                 ///< a jog drives it (it follows the jog's target)
   bool at_edge = false;                 ///< the jog stopped at the workspace's edge
   std::uint64_t handled_seq = 0;        ///< the last ConsolePoseMove the loop took (started, or dropped)
+  /// Where the finger tips stand (world frame), and how near the seat may come to them (the
+  /// platform's world.min_tip_height_m): a goal whose path brings it nearer is refused.
+  Eigen::Vector3d tips_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  double tip_floor_m = 0.0;
 };
 
 /// The goal of a command as the transform of {P} in {H} (R = Rz(rz) Ry(ry) Rx(rx)).

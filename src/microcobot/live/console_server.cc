@@ -70,11 +70,11 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     pose_goal_.emplace(live.params().platform.parallel_positioner.geometry);
   decimation_ =
       static_cast<std::size_t>(std::max(1.0, std::round(kTelemetryRate_Hz / params_.telemetry_rate_Hz)));
-  telemetry_ch_ = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
+  ch_.telemetry = server_.add_channel({std::string(platform::kTelemetryTopic), "json",
                                        std::string(platform::kTelemetrySchemaName), "jsonschema",
                                        platform::telemetry_json_schema(live_.telemetry_schema())});
   const json number = {{"type", "number"}}, boolean = {{"type", "boolean"}}, text = {{"type", "string"}};
-  status_ch_ = server_.add_channel({"/platform/status", "json", "microcobot.Status", "jsonschema",
+  ch_.status = server_.add_channel({"/platform/status", "json", "microcobot.Status", "jsonschema",
                                     schema({{"t_s", number},
                                             {"estopped", boolean},
                                             {"controlled", boolean},
@@ -121,7 +121,7 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                                "demo_unavailable_reason",
                                                "neighbours",
                                                "optics"};
-  scene_ch_ =
+  ch_.scene =
       server_.add_channel({"/platform/scene", "json", "microcobot.Scene", "jsonschema",
                            schema({{"kind", text},
                                    {"part_side_m", number},
@@ -151,25 +151,25 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
                                    {"neighbours", {{"type", "array"}, {"items", {{"type", "object"}}}}},
                                    {"optics", {{"type", "object"}}}},
                                   scene_keys)});
-  feedback_ch_ = server_.add_channel(
+  ch_.feedback = server_.add_channel(
       {"/console/feedback", "json", "microcobot.Feedback", "jsonschema",
        schema({{"t_s", number}, {"contact_N", vec3}, {"grip_N", number}, {"rumble", number}})});
-  tf_ch_ = server_.add_channel({std::string(kTransformsTopic), "json", "foxglove.FrameTransforms",
+  ch_.tf = server_.add_channel({std::string(kTransformsTopic), "json", "foxglove.FrameTransforms",
                                 "jsonschema", RobotFrames::transforms_schema()});
-  robot_scene_ch_ = server_.add_channel({std::string(kRobotSceneTopic), "json", "foxglove.SceneUpdate",
+  ch_.robot_scene = server_.add_channel({std::string(kRobotSceneTopic), "json", "foxglove.SceneUpdate",
                                          "jsonschema", RobotFrames::scene_update_schema()});
   if (live_.has_camera()) {
     // A slow viewer gets the newest image, not a queue of old ones (scene-to-screen latency).
-    image_ch_ = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
+    ch_.image = server_.add_channel({std::string(kCameraImageTopic), "cdr", "sensor_msgs/msg/CompressedImage",
                                      "ros2msg", std::string(compressed_image_schema()), true});
-    preview_ch_ =
+    ch_.preview =
         server_.add_channel({std::string(kCameraPreviewTopic), "cdr", "sensor_msgs/msg/CompressedImage",
                              "ros2msg", std::string(compressed_image_schema()), true});
     preview_ = std::make_unique<CameraPreview>();
     snapshot_ = std::make_unique<CameraSnapshot>();
-    info_ch_ = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
+    ch_.info = server_.add_channel({std::string(kCameraInfoTopic), "cdr", "sensor_msgs/msg/CameraInfo",
                                     "ros2msg", std::string(camera_info_schema())});
-    camera_state_ch_ = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",
+    ch_.camera_state = server_.add_channel({std::string(kCameraStateTopic), "json", "microcobot.CameraState",
                                             "jsonschema", camera_state_schema()});
     live_.set_frame_sink([this](const devices::CameraFrame& f, double t_s) { on_frame(f, t_s); });
   }
@@ -187,9 +187,9 @@ ConsoleServer::ConsoleServer(LivePlatform& live, ConsoleServerParams params)
     rp.telemetry = live_.telemetry_schema();
     if (live_.params().platform.parallel_positioner_enabled())
       rp.positioner_geometry = live_.params().platform.parallel_positioner.geometry;
-    rp.status = recorded(status_ch_);
-    rp.scene = recorded(scene_ch_);
-    rp.feedback = recorded(feedback_ch_);
+    rp.status = recorded(ch_.status);
+    rp.scene = recorded(ch_.scene);
+    rp.feedback = recorded(ch_.feedback);
     rp.version = params_.version;
     rp.config_yaml = params_.config_yaml;
     rp.camera = live_.has_camera();
@@ -278,10 +278,10 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, s[0]) * 1e9));
   json_.clear();
   platform::telemetry_to_json(live_.telemetry_schema(), sample, json_);
-  server_.publish(telemetry_ch_, ns, json_);  // recorded at full rate above
-  if (server_.subscriber_count(tf_ch_) > 0) {
+  server_.publish(ch_.telemetry, ns, json_);  // recorded at full rate above
+  if (server_.subscriber_count(ch_.tf) > 0) {
     frames_.transforms_json(s, tf_json_);
-    server_.publish(tf_ch_, ns, tf_json_);
+    server_.publish(ch_.tf, ns, tf_json_);
   }
   for (const SampleConsumer& c : sample_consumers_) c(s);
   const double rumble = rumble_.take();
@@ -290,7 +290,7 @@ void ConsoleServer::on_sample(const platform::TelemetrySample& s, std::size_t co
                   {"contact_N", {finite(s[kContactX]), finite(s[kContactX + 1]), finite(s[kContactX + 2])}},
                   {"grip_N", finite(s[kGrip])},
                   {"rumble", rumble}};
-  publish(feedback_ch_, RecordedTopic::kFeedback, s[0], f.dump());
+  publish(ch_.feedback, RecordedTopic::kFeedback, s[0], f.dump());
 }
 
 void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
@@ -307,14 +307,14 @@ void ConsoleServer::on_frame(const devices::CameraFrame& f, double t_s) {
                                               live_.camera_params().calibration(f.objective),
                                               grip_of_frame ? &*s.grip_vision : nullptr);
   const auto ns = static_cast<std::uint64_t>(std::llround(std::max(0.0, t_s) * 1e9));
-  if (has_jpeg) server_.publish(image_ch_, ns, image_cdr_);
-  if (server_.subscriber_count(preview_ch_) > 0) {
+  if (has_jpeg) server_.publish(ch_.image, ns, image_cdr_);
+  if (server_.subscriber_count(ch_.preview) > 0) {
     encode_compressed_image(preview_->encode(f.image, live_.camera_params().jpeg_quality), stamp,
                             preview_cdr_);
-    server_.publish(preview_ch_, ns, preview_cdr_);
+    server_.publish(ch_.preview, ns, preview_cdr_);
   }
-  server_.publish(info_ch_, ns, info_cdr_);
-  server_.publish(camera_state_ch_, ns, state);
+  server_.publish(ch_.info, ns, info_cdr_);
+  server_.publish(ch_.camera_state, ns, state);
   snapshot_->offer(f, state, t_s);
   if (recording_)
     recording_->published_frame(t_s, f, has_jpeg ? image_cdr_ : std::string(), info_cdr_, state);
@@ -372,8 +372,8 @@ void ConsoleServer::update_camera_demand() {
   if (!live_.has_camera()) return;
   // A recording that keeps the camera is a viewer of it.
   const bool recording = recording_ && recording_->video() != RecordedVideo::kOff;
-  const bool watched = server_.subscriber_count(image_ch_) + server_.subscriber_count(preview_ch_) +
-                           server_.subscriber_count(info_ch_) + server_.subscriber_count(camera_state_ch_) >
+  const bool watched = server_.subscriber_count(ch_.image) + server_.subscriber_count(ch_.preview) +
+                           server_.subscriber_count(ch_.info) + server_.subscriber_count(ch_.camera_state) >
                        0;
   bool consumed = false;
   for (const FrameConsumer& c : frame_consumers_) consumed = consumed || c.wanted();
@@ -381,7 +381,7 @@ void ConsoleServer::update_camera_demand() {
   // The JPEG is for the image channel, a JPEG recording and the consumers (the DDS image topic);
   // the preview, the camera's state, the vision, the snapshot and H.264 read the frame raw.
   const bool jpeg_recorded = recording_ && recording_->video() == RecordedVideo::kJpeg;
-  live_.set_camera_jpeg_wanted(jpeg_recorded || consumed || server_.subscriber_count(image_ch_) > 0);
+  live_.set_camera_jpeg_wanted(jpeg_recorded || consumed || server_.subscriber_count(ch_.image) > 0);
 }
 
 void ConsoleServer::status_thread() {
@@ -399,13 +399,13 @@ void ConsoleServer::status_thread() {
     live_.drain_command_latencies(latency_);
     live_.drain_link_costs(link_cost_);
     update_camera_demand();
-    publish(status_ch_, RecordedTopic::kStatus, now_status.t_s, status_json());
+    publish(ch_.status, RecordedTopic::kStatus, now_status.t_s, status_json());
     // The recording writes the bodies again only when they change (a restart, another scene).
     if (recording_) recording_->robot_bodies(now_status.t_s, robot_bodies());
     if (n % static_cast<int>(std::max(1.0, params_.status_rate_Hz)) == 0) {
-      publish(scene_ch_, RecordedTopic::kScene, now_status.t_s, scene_json());
-      if (server_.subscriber_count(robot_scene_ch_) > 0)
-        server_.publish(robot_scene_ch_,
+      publish(ch_.scene, RecordedTopic::kScene, now_status.t_s, scene_json());
+      if (server_.subscriber_count(ch_.robot_scene) > 0)
+        server_.publish(ch_.robot_scene,
                         static_cast<std::uint64_t>(std::llround(std::max(0.0, now_status.t_s) * 1e9)),
                         robot_scene_json(now_status.t_s));
     }

@@ -152,9 +152,12 @@ class ConsoleServer {
   LivePlatform& live_;
   ConsoleServerParams params_;
   server::FoxgloveServer server_;
-  server::ChannelId telemetry_ch_ = 0, status_ch_ = 0, scene_ch_ = 0, feedback_ch_ = 0;
-  server::ChannelId image_ch_ = 0, info_ch_ = 0, camera_state_ch_ = 0, preview_ch_ = 0;
-  server::ChannelId tf_ch_ = 0, robot_scene_ch_ = 0;
+  /// The channels the server advertises (the camera's only with a camera).
+  struct Channels {
+    server::ChannelId telemetry = 0, status = 0, scene = 0, feedback = 0;
+    server::ChannelId image = 0, info = 0, camera_state = 0, preview = 0;
+    server::ChannelId tf = 0, robot_scene = 0;
+  } ch_;
   RobotFrames frames_;                        // the 3-D view's frame tree, from the telemetry's channels
   std::optional<ConsolePoseGoal> pose_goal_;  // server thread: go-to pose (positioner: parallel)
   std::string image_cdr_, info_cdr_, preview_cdr_;      // camera thread only

@@ -96,6 +96,8 @@ void ConsoleSource::pose_tick(Platform& p) noexcept {
   v.jogging = pos->following();
   v.at_edge = pos->follow_blocked();
   v.handled_seq = pose_handled_;
+  v.tips_m = p.tips_m();
+  v.tip_floor_m = p.tip_floor_m();
   pose_view_.publish(v);
 }
 

@@ -165,6 +165,9 @@ void ProtocolSource::publish_positioner(const SourceTick& t) noexcept {
     pose_head_ = (pose_head_ + 1) % kPoseQueue;
     --pose_count_;
   }
+  // A move under way the platform stopped short (the seat onto the tips, ...): its client is told.
+  if (pose_running_ && p.pose_moves_stopped() != platform_stops_) pose_interrupted_ = pose_started_;
+  platform_stops_ = p.pose_moves_stopped();
   pose_running_ = pos->moving();
   PositionerView v;
   v.measured = pos->measured_pose();

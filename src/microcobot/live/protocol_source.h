@@ -75,7 +75,8 @@ class ProtocolSource final : public CommandSource {
   std::array<std::uint64_t, kPoseQueue> pose_seq_{};
   std::size_t pose_head_ = 0, pose_count_ = 0;
   std::uint64_t pose_started_ = 0, pose_rejected_ = 0, pose_stop_ = 0, pose_interrupted_ = 0;
-  bool pose_running_ = false;  // a pose move was under way at the last publish
+  bool pose_running_ = false;         // a pose move was under way at the last publish
+  std::uint64_t platform_stops_ = 0;  // Platform::pose_moves_stopped() at the last publish
   runtime::LatestValue<PositionerView> positioner_view_;
   // Published for the protocol thread (X, Y, Z [m], theta [rad]).
   std::array<std::atomic<double>, 4> position_{};

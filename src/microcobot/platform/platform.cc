@@ -183,6 +183,9 @@ void Platform::teleoperation_task() noexcept {
   }
   teleop_->set_height_ceiling(to_positioner ? plate_ceiling_m(devices_.positioner->measured_pose().R)
                                             : std::numeric_limits<double>::infinity());
+  // The tips' floor over a seat the positioner raised: the Cartesian robot's target keeps above it.
+  teleop_->set_height_floor(devices_.positioner && !to_positioner ? stage_floor_m()
+                                                                  : -std::numeric_limits<double>::infinity());
   in.grip_force_N = devices_.gripper->grip_force_N();
   in.gripper_opening_m = devices_.gripper->opening_m();
   in.slave_fresh = to_positioner

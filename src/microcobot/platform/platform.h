@@ -143,15 +143,24 @@ class Platform {
   }
   /// Starts a pose move of the parallel positioner: `checked`, a trajectory motion::check_move()
   /// passed off the loop, from the pose the legs hold. False, and nothing moves, without the
-  /// positioner, when pose_move_allowed() is false, while another move runs, or when it starts
-  /// elsewhere (devices::ParallelPositioner::start_move). The move holds where it is as soon as
-  /// pose_move_allowed() turns false (Platform::devices_task). On the loop; real-time safe.
+  /// positioner, when pose_move_allowed() is false, while another move runs, when it starts
+  /// elsewhere (devices::ParallelPositioner::start_move), or when it would bring the seat within
+  /// world.min_tip_height_m of the finger tips (devices::lowest_tip_height_m). The move holds where it is as
+  /// soon as pose_move_allowed() turns false (Platform::devices_task). On the loop; real-time safe.
   bool start_pose_move(const motion::PoseTrajectory& checked) noexcept;
   /// Makes the parallel positioner follow `target` (devices::ParallelPositioner::follow: the
   /// console's jog, a master's position): false, and nothing moves, without the positioner, when
   /// pose_move_allowed() is false or the positioner refuses. It holds where it is as soon as
   /// pose_move_allowed() turns false, as a move does. On the loop; real-time safe.
   bool follow_pose(const motion::PlatformTransform& target, const motion::PoseMoveLimits& limits) noexcept;
+  /// The moves and followed poses of the parallel positioner the platform has stopped short of
+  /// their goal (its rules: the deadman, a stale input, the seat onto the finger tips), counted
+  /// from the start: how an input learns that its move ended early. Real-time safe.
+  std::uint64_t pose_moves_stopped() const noexcept { return coupling_.stops; }
+  /// Where the finger tips stand (world frame: the stage's home plus its measured axes), and the
+  /// least height over the substrate any input may bring them to (world.min_tip_height_m).
+  Eigen::Vector3d tips_m() const noexcept;
+  double tip_floor_m() const noexcept { return world_.params().min_tip_height_m; }
   /// Ends the positioner's move: every leg holds where it is measured. Real-time safe.
   void stop_pose_move() noexcept {
     if (devices_.positioner) devices_.positioner->stop();
@@ -324,6 +333,9 @@ class Platform {
   /// The highest the positioner's plate may stand turned by `R`: the seat's point under the finger
   /// tips min_tip_height_m below them.
   double plate_ceiling_m(const Eigen::Matrix3d& R) const noexcept;
+  /// The lowest the Cartesian robot's z target may go (stage coordinates): the tips
+  /// min_tip_height_m over the carried seat's surface under them.
+  double stage_floor_m() const noexcept;
   /// The seat carried onto the finger tips since the last tick: its point under them moved up
   /// while they are under their floor over it, or along their contact force while it is over its
   /// limit (the poses a real platform knows; platform_positioner.cc).
@@ -388,6 +400,7 @@ class Platform {
     bool master_on = false, master_driving = false;
     motion::PlatformTransform master_pose;
     Eigen::Vector3d stage_hold_m = Eigen::Vector3d::Zero();
+    std::uint64_t stops = 0;  ///< pose_moves_stopped()
   } coupling_;
   bool vision_xy_ = false;            ///< x and y open loop, positioned by vision (stage.xy_sensor)
   bool position_controlled_ = false;  ///< the axes take targets (a remote slave stage)

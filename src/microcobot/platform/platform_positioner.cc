@@ -31,7 +31,17 @@ void Platform::build_positioner() {
 }
 
 bool Platform::start_pose_move(const motion::PoseTrajectory& checked) noexcept {
-  return devices_.positioner != nullptr && pose_move_allowed() && devices_.positioner->start_move(checked);
+  // A move that would bring the seat within the tips' floor is refused before anything moves
+  // (from where the tips stand now: nothing else moves them while the console moves the plate).
+  return devices_.positioner != nullptr && pose_move_allowed() &&
+         devices::lowest_tip_height_m(checked, tips_m()) >= world_.params().min_tip_height_m &&
+         devices_.positioner->start_move(checked);
+}
+
+Eigen::Vector3d Platform::tips_m() const noexcept {
+  Eigen::Vector3d tips = home_m_;
+  for (std::size_t i = 0; i < 3; ++i) tips[static_cast<Eigen::Index>(i)] += devices_.axes[i]->position_m();
+  return tips;
 }
 
 bool Platform::follow_pose(const motion::PlatformTransform& target,
@@ -46,7 +56,10 @@ void Platform::positioner_task(double dt_s) noexcept {
   // A move or a followed target runs only under the rule it started with: the deadman released,
   // the input stale or outranked, or a fault, and every leg holds where it is measured.
   const bool closing = seat_closes_on_tips();
-  if ((p->moving() || p->following()) && (!(pose_move_allowed() || master) || closing)) p->stop();
+  if ((p->moving() || p->following()) && (!(pose_move_allowed() || master) || closing)) {
+    p->stop();
+    ++coupling_.stops;
+  }
   p->update(dt_s);
 }
 
@@ -94,19 +107,24 @@ bool Platform::master_pose_task() noexcept {
 }
 
 double Platform::plate_ceiling_m(const Eigen::Matrix3d& R) const noexcept {
-  Eigen::Vector3d tips = home_m_;
-  for (std::size_t i = 0; i < 3; ++i) tips[static_cast<Eigen::Index>(i)] += devices_.axes[i]->position_m();
+  const Eigen::Vector3d tips = tips_m();
   Eigen::Vector3d under = devices::CarriedSeat{devices_.positioner->measured_pose()}.to_seat(tips);
   under.z() = 0.0;  // on the seat's surface
   return tips.z() - world_.params().min_tip_height_m - (R * under).z();
+}
+
+double Platform::stage_floor_m() const noexcept {
+  const devices::CarriedSeat seat{devices_.positioner->measured_pose()};
+  Eigen::Vector3d under = seat.to_seat(tips_m());
+  under.z() = 0.0;  // on the seat's surface
+  return seat.to_world(under).z() + world_.params().min_tip_height_m - home_m_.z();
 }
 
 bool Platform::seat_closes_on_tips() noexcept {
   // From what a real platform knows: the legs' reference and measured poses, the Cartesian
   // robot's axes and the gripper's contact force. The reference, free of the sensors' noise,
   // says which way the seat went this tick.
-  Eigen::Vector3d tips = home_m_;
-  for (std::size_t i = 0; i < 3; ++i) tips[static_cast<Eigen::Index>(i)] += devices_.axes[i]->position_m();
+  const Eigen::Vector3d tips = tips_m();
   const devices::CarriedSeat last{coupling_.seat_reference}, now{devices_.positioner->reference_pose()};
   coupling_.seat_reference = now.T;
   const Eigen::Vector3d under = last.to_seat(tips);  // the seat's point under the tips

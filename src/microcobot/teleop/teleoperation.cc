@@ -114,6 +114,10 @@ void Teleoperation::apply_limits(const TeleoperationInput& in, double requested_
   }
   const Eigen::Vector3d before = out_.slave_target_m;
   limits_.limit_target(out_.slave_target_m, out_.slave_velocity_m_s, in.slave_position_m, in.contact_force_N);
+  if (out_.slave_target_m.z() < floor_m_) {
+    out_.slave_target_m.z() = floor_m_;
+    out_.slave_velocity_m_s.z() = std::max(0.0, out_.slave_velocity_m_s.z());
+  }
   if (out_.slave_target_m.z() > ceiling_m_) {
     out_.slave_target_m.z() = ceiling_m_;
     out_.slave_velocity_m_s.z() = std::min(0.0, out_.slave_velocity_m_s.z());

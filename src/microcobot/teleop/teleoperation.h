@@ -151,6 +151,12 @@ class Teleoperation {
   void set_height_ceiling(double ceiling_m) noexcept {
     ceiling_m_ = std::isnan(ceiling_m) ? std::numeric_limits<double>::infinity() : ceiling_m;
   }
+  /// The lowest target height from the next tick (-inf, or NaN: none) beside the limits' own
+  /// floor, the higher of the two acting, the master's height going with it: the platform's floor
+  /// over a substrate that moves (the seat raised by the parallel positioner). Real-time safe.
+  void set_height_floor(double floor_m) noexcept {
+    floor_m_ = std::isnan(floor_m) ? -std::numeric_limits<double>::infinity() : floor_m;
+  }
   /// The virtual fixtures for the coming ticks (stage coordinates; virtual_fixtures.h), on every
   /// input path. Real-time safe.
   /// A guide that moves starts again from level 0 (slewed up), and the master's target is
@@ -180,6 +186,7 @@ class Teleoperation {
   TeleoperationParams p_;
   SafetyLimits limits_;
   double ceiling_m_ = std::numeric_limits<double>::infinity();
+  double floor_m_ = -std::numeric_limits<double>::infinity();
   bool contact_limited_ = false;
   double dt_;
   TeleoperationOutput out_;
