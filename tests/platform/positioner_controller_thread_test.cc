@@ -186,5 +186,28 @@ TEST(PositionerControllerThread, ABadControllerOrThreadParameterIsOneLineNamingI
   }
 }
 
+TEST(PositionerControllerThread, AStreamedTargetIsPursuedAsTheConsolesJogStreamsIt) {
+  Platform p{threaded()};
+  console_deadman(p, true);
+  ASSERT_TRUE(tick_until(p, [&] { return p.positioner()->at_rest(); }));
+  const Eigen::Vector3d start = threaded_sim(p).true_pose().d;
+  // The jog's stream: every tick, a target a quarter of a second ahead of the reference at 50 um/s.
+  motion::PoseMoveLimits limits = p.config().parallel_positioner.move;
+  limits.max_speed_m_s = 50e-6;
+  const auto moved = [&] { return (threaded_sim(p).true_pose().d - start).y(); };
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (moved() < 20e-6 && std::chrono::steady_clock::now() < end) {
+    for (int i = 0; i < 10; ++i) {
+      PlatformTransform target = p.positioner()->reference_pose();
+      target.d.y() += 0.25 * 50e-6;
+      p.follow_pose(target, limits);
+      p.loop().run_for(1);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_GE(moved(), 20e-6) << "the plate followed the streamed target";
+  EXPECT_TRUE(p.positioner()->following());
+}
+
 }  // namespace
 }  // namespace mc::platform
