@@ -13,6 +13,7 @@
 #include "microcobot/devices/carried_seat.h"
 #include "microcobot/motion/pose.h"
 #include "microcobot/platform/platform.h"
+#include "support/counting_allocator.h"
 #include "support/test_support.h"
 
 namespace mc::platform {
@@ -170,6 +171,27 @@ TEST(MasterOnPositioner, TheConsoleTakingControlHoldsThePlateAndDrivesTheGripper
   rig.run_s(0.5);
   EXPECT_LT((rig.plate().d - held).norm(), 0.3e-6) << "the plate held";
   EXPECT_NEAR(rig.stage().x() - stage0.x(), 10e-6, 2e-6) << "the console drove the gripper";
+}
+
+TEST(MasterOnPositioner, TheLoopPathAllocatesNothingWhileTheMasterAndTheDialDriveThePlate) {
+  MasterRig rig;
+  rig.run_s(0.2);
+  rig.hand.deadman = true;
+  rig.run_s(0.1);  // warm-up: first touches
+  std::size_t allocations = 0;
+  {
+    test::AllocationGuard guard;
+    rig.hand.hand_m = {3e-3, 1e-3};
+    rig.run_s(0.3);
+    rig.console.fresh = rig.console.deadman = true;
+    rig.console.theta_rate_rad_s = 0.5 * kMasterDeg;
+    rig.run_s(0.2);
+    rig.hand.deadman = rig.console.deadman = false;  // released: held, the coupling re-anchored
+    rig.run_s(0.1);
+    allocations = guard.allocations();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_GT(rig.plate().d.norm(), 5e-6) << "it moved meanwhile";
 }
 
 }  // namespace
