@@ -83,6 +83,8 @@ void AssemblyBatchParams::validate() const {
           "must be auto, open, shake or roll (got '" + release + "')");
   require(std::isfinite(min_release_margin) && min_release_margin >= 1.0 && min_release_margin <= 100.0,
           "min_release_margin", "must be within [1, 100]", min_release_margin);
+  require(std::isfinite(max_seat_tilt_rad) && max_seat_tilt_rad >= 0.0 && max_seat_tilt_rad <= 0.07,
+          "max_seat_tilt_rad", "must be within [0, 0.07] rad (4 deg)", max_seat_tilt_rad);
   world.validate();
 }
 
@@ -161,6 +163,9 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   // The bores' errors from a stream of their own: without them, the batch is the one of before.
   std::mt19937_64 bore_rng(static_cast<std::uint64_t>(params.seed) * 0xA24BAED4963EE407ULL + 0x626f7265ULL);
   std::normal_distribution<double> bore(0.0, 1.0);
+  // The seats' tilts from a stream of their own: without them, the batch is the one of before.
+  std::mt19937_64 tilt_rng(static_cast<std::uint64_t>(params.seed) * 0x9FB21C651E98DF25ULL + 0x74696c74ULL);
+  std::uniform_real_distribution<double> tilt_u(0.0, 1.0);
   const bool grid = params.layout == "grid";
   const int per_side = grid ? grid_cells_per_side(params.half_size_m, params.grid_pitch_m) : 1;
   const int per_load = per_side * per_side;
@@ -188,6 +193,11 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     const Eigen::Vector2d bore_error(params.bore_error_m * bore(bore_rng),
                                      params.bore_error_m * bore(bore_rng));
     j.world.target_m = {j.target_m.x() + bore_error.x(), j.target_m.y() + bore_error.y(), 0.0};
+    if (params.max_seat_tilt_rad > 0.0) {  // a tilt up to the largest, about a horizontal axis drawn uniform
+      const double tilt = params.max_seat_tilt_rad * tilt_u(tilt_rng), axis = 2.0 * M_PI * tilt_u(tilt_rng);
+      j.world.seat_tilt_x_rad = tilt * std::cos(axis);
+      j.world.seat_tilt_y_rad = tilt * std::sin(axis);
+    }
     j.nominal_part_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
     j.target_yaw_rad = params.max_yaw_rad * yaw(yaw_rng);
     j.world.part_yaw_rad = j.nominal_part_yaw_rad + params.slot_yaw_error_rad * slot_yaw(yaw_rng);

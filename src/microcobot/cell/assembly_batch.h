@@ -77,6 +77,11 @@ struct AssemblyBatchParams {
   /// the plate's fixture and machining. The cell is told the drawing; its camera sees the bore
   /// (cell_camera.h, look_bore). 0: the bores are where the drawing says.
   double bore_error_m = 0.0;
+  /// The largest tilt of each part's seat on what carries it (world.seat_tilt_x_rad, _y_rad): a
+  /// magnitude uniform in [0, max] about a horizontal axis of uniform direction, from a stream of
+  /// its own; not told to the cell, which levels the seat on the parallel positioner
+  /// (seat_levelling.h). 0: each part's seat is world's.
+  double max_seat_tilt_rad = 0.0;
   std::string release = "auto";     ///< auto, open, shake or roll (header)
   double min_release_margin = 1.2;  ///< auto: the margin a strategy must reach to be chosen
   /// The microworld every part is put in (adhesion, friction, gripper, force limits); its part,
@@ -111,6 +116,7 @@ struct AssemblyBatchParams {
     v("flat_seat_min_pulloff_N", flat_seat_min_pulloff_N);
     v("flat_seat_max_pulloff_N", flat_seat_max_pulloff_N);
     v("bore_error_m", bore_error_m);
+    v("max_seat_tilt_rad", max_seat_tilt_rad);
     v("release", release);
     v("min_release_margin", min_release_margin);
     v("world", world);

@@ -77,7 +77,7 @@ AssemblyTask::AssemblyTask(const AssemblyTaskParams& params, const AssemblyGoal&
   require(goal.yaw_min_rad < goal.yaw_max_rad, "goal.yaw_min_rad", "must be below goal.yaw_max_rad",
           goal.yaw_min_rad);
   grasp_z_ = grasp_height_m(p_, goal);
-  rim_z_ = grasp_z_;
+  rim_z_ = surface_z_ = grasp_z_;
   require(grasp_z_ < goal.part_height_m, "grip_above_m", "must grasp below the pin's top (part_height_m)",
           p_.grip_above_m);
   safe_z_ = std::max(goal.part_height_m, goal.tallest_neighbour_m) + p_.clearance_height_m;

@@ -78,6 +78,7 @@
 /// handing back and skipping never jump. Never allocates; noexcept.
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <string_view>
 
@@ -271,6 +272,13 @@ class AssemblyTask {
   /// Why the task failed ("" otherwise); a static string.
   std::string_view failure() const noexcept { return supervisor_.failure(); }
   int search_tries() const noexcept { return search_.tries(); }
+  /// The tool's height at which the held part's bottom meets the seat over the target, as
+  /// measured (the seat's levelling touches, seat_levelling.h): the insertion's heights count from
+  /// it instead of the grasp height (a part grasped off a tilted tray sits higher or lower in the
+  /// fingers than drawn). Ignored when not finite.
+  void set_surface_contact_m(double z_m) noexcept {
+    if (std::isfinite(z_m)) rim_z_ = surface_z_ = z_m;
+  }
   /// Tip height at which the inserting descent met its stop (NaN before).
   double insert_contact_z_m() const noexcept { return search_.contact_z_m(); }
   static std::string_view name(Step s) noexcept;
@@ -311,7 +319,8 @@ class AssemblyTask {
   Step step_ = Step::kApproach;
   double step_s_ = 0.0, settled_s_ = 0.0;
   double grasp_z_ = 0.0, safe_z_ = 0.0, carry_z_ = 0.0;
-  double rim_z_ = 0.0;  // tool-point height at which the held pin's bottom meets the surface
+  double rim_z_ = 0.0;      // tool-point height at which the held pin's bottom meets the surface
+  double surface_z_ = 0.0;  // ... over the target, as the insertion counts it (set_surface_contact_m)
   double opening_command_ = 0.0;
   Release release_ = Release::kOpen;
   double release_s_ = 0.0;                                 // time in the release's strategy

@@ -11,7 +11,8 @@ namespace mc::cell {
 
 void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
   const Eigen::Vector2d xy = search_xy();
-  const double floor_z = grasp_z_ - goal_.hole_depth_m;  // tips when the pin's bottom is on the bore's floor
+  const double floor_z =
+      surface_z_ - goal_.hole_depth_m;  // tips when the pin's bottom is on the bore's floor
   switch (search_.phase()) {
     case InsertionSearch::Phase::kDescend: {
       if (looks_.align_move()) {  // the servo's correction, at the carrying height, before its next look
@@ -21,7 +22,7 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
       // Aim below the floor: the descent ends on a contact, on the rim or on the floor. Slowly
       // only where a contact may come: the last 20 um to the surface and to the floor.
       const double z = s.tip_m.z(), near = 20e-6;
-      const bool free = z > grasp_z_ + near || (z < grasp_z_ - near && z > floor_z + near);
+      const bool free = z > surface_z_ + near || (z < surface_z_ - near && z > floor_z + near);
       move_to({xy.x(), xy.y(), floor_z - near}, free ? p_.z_speed_m_s : p_.insert_speed_m_s, s, dt);
       if (s.contact_N.z() <= p_.contact_threshold_N) {
         if (settled_s_ > 0.0) fail("no contact below the bore's floor: the pin is not in the fingers");
@@ -29,7 +30,7 @@ void AssemblyTask::insert_tick(const TaskSensors& s, double dt) noexcept {
       }
       const double contact_z = s.tip_m.z();
       search_.record_contact(contact_z);
-      if (goal_.flat_seat || contact_z < grasp_z_ - 0.5 * goal_.hole_depth_m) {
+      if (goal_.flat_seat || contact_z < surface_z_ - 0.5 * goal_.hole_depth_m) {
         enter(Step::kRelease);  // down in the bore, or on the flat seat
         break;
       }

@@ -50,6 +50,11 @@ nlohmann::json CycleResult::to_json() const {
           {"looks_found", looks_found},
           {"look_error_m", look_error_m},
           {"look_wall_s", look_wall_s},
+          {"seat_levelled", seat_levelled},
+          {"seat_tilt_before_rad", seat_tilt_before_rad},
+          {"seat_tilt_after_rad", seat_tilt_after_rad},
+          {"level_rounds", level_rounds},
+          {"level_s", level_s},
           {"step_s", step_times_json(step_s)}};
 }
 
@@ -97,6 +102,11 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("looks_found", r.looks_found);
   get("look_error_m", r.look_error_m);
   get("look_wall_s", r.look_wall_s);
+  get("seat_levelled", r.seat_levelled);
+  get("seat_tilt_before_rad", r.seat_tilt_before_rad);
+  get("seat_tilt_after_rad", r.seat_tilt_after_rad);
+  get("level_rounds", r.level_rounds);
+  get("level_s", r.level_s);
   nlohmann::json steps;
   get("step_s", steps);
   for (std::size_t i = 0; i < r.step_s.size(); ++i) {

@@ -9,6 +9,7 @@
 #include "microcobot/cell/task_io.h"
 #include "microcobot/core/error.h"
 #include "microcobot/devices/simulated_gripper.h"
+#include "microcobot/motion/pose_trajectory.h"
 
 namespace mc::cell {
 
@@ -41,6 +42,7 @@ void CellRunParams::validate() const {
   }
   manual.validate();
   camera.validate();
+  level_seat.validate();
   require(person.master != "click" || mode != "assisted", "person.master",
           "click: the console's click-to-go is for manual runs (the click is the platform's move already)");
   require(!camera.enabled || mode == "auto", "camera.enabled", "is the robot's (mode auto)");
@@ -128,13 +130,25 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     }
     for (std::size_t i = 0; i + 1 < params_.autonomy.size(); ++i)
       task_->set_autonomy(static_cast<AssemblyTask::Step>(i), params_.autonomy[i]);
+    const std::string& level = params_.level_seat.mode;
+    require(level != "on" || p.has_positioner(), "level_seat.mode",
+            "is on, but the seat does not ride on a parallel positioner (positioner: parallel)");
+    if (level == "on" || (level == "auto" && p.has_positioner()))
+      level_.procedure = std::make_unique<SeatLevelling>(params_.level_seat, goal.target_m,
+                                                         AssemblyTask::grasp_height_m(params_.task, goal));
     p.set_operator([this](const runtime::TickInfo& t) {
       TaskSensors s = read_task_sensors(*platform_, home_m_);
       if (!finished_) meter_->sample(s);  // the cycle's measures end with it
+      if (levelling_now()) {
+        meter_->time_step(task_->step(), t.dt_s);
+        level_tick(s, t);
+        if (observer_) observer_(t.t_s);
+        return;
+      }
       if (task_->step() == AssemblyTask::Step::kVerify && !camera_) {
         // The cell's camera on the pin, at the precision the assisted person's guidance has.
         const double sd = params_.person.assist_vision_sd_m;
-        s.part_m = platform_->simulation().gripper->world_state().part_m;
+        s.part_m = platform_->simulation().gripper->part_position_m();
         for (int i = 0; i < 3; ++i) s.part_m[i] += vision_rng_.normal(0.0, sd);
       }
       // The supervisor confirms a waiting step after confirm_delay_s (the task holds meanwhile).
@@ -210,6 +224,58 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
 }
 
 CellCycle::~CellCycle() = default;
+
+bool CellCycle::levelling_now() const noexcept {
+  return level_.procedure && !level_.procedure->finished() && task_->step() == AssemblyTask::Step::kInsert &&
+         !task_->operator_drives() && !task_->finished();
+}
+
+void CellCycle::level_tick(const TaskSensors& s, const runtime::TickInfo& t) {
+  SeatLevelling& l = *level_.procedure;
+  level_.s += t.dt_s;
+  if (l.phase() == SeatLevelling::Phase::kMove) {
+    const devices::ParallelPositioner& positioner = *platform_->positioner();
+    if (level_.path_ready) {  // planned off the loop since the last tick
+      level_.path_ready = false;
+      level_.stops = platform_->pose_moves_stopped();
+      level_.move_started = platform_->start_pose_move(*level_.path);
+      l.move_started(level_.move_started, "the platform refused the levelling move (the tips' floor)");
+    } else if (l.wants_move() && !level_.plan_requested) {
+      level_.plan_requested = true;  // planned between runs (plan_level_move)
+      platform_->stop();
+    } else if (level_.move_started && !positioner.moving()) {
+      level_.move_started = false;
+      l.moved(platform_->pose_moves_stopped() == level_.stops);
+    }
+  }
+  platform_->set_console_input(l.tick(s, t.dt_s));
+  if (l.phase() == SeatLevelling::Phase::kDone) task_->set_surface_contact_m(l.contact_height_m());
+  if (l.phase() == SeatLevelling::Phase::kFailed) {
+    finished_ = true;
+    finished_at_s_ = t.t_s;
+    platform_->hold();  // the sequence ends with every axis holding
+    held_ = true;
+  }
+}
+
+void CellCycle::plan_level_move() {
+  level_.plan_requested = false;
+  level_.path.reset();
+  const devices::ParallelPositioner& positioner = *platform_->positioner();
+  const motion::PlatformTransform from = positioner.reference_pose();
+  // The seat as the touches measured it: the platform's floor and refusals take it there.
+  platform_->set_seat_on_plate(level_.procedure->seat_on_plate(from));
+  try {
+    motion::PoseTrajectory path(from, level_.procedure->level_goal(from),
+                                platform_->config().parallel_positioner.move);
+    if (!motion::check_move(positioner.kinematics(), path).ok)
+      return level_.procedure->move_started(false, "the levelling pose is beyond the positioner's reach");
+    level_.path.emplace(std::move(path));
+    level_.path_ready = true;
+  } catch (const std::exception&) {
+    level_.procedure->move_started(false, "the levelling pose could not be planned");
+  }
+}
 
 void CellCycle::hand_over(const runtime::TickInfo& t) {
   if (!person_has_step_ && task_->status() == AssemblyTask::Status::kOperator) {
@@ -293,6 +359,7 @@ void CellCycle::run_for(double duration_s) {
   const double end = std::min(p.loop().time_s() + duration_s, params_.max_cycle_s);
   while (!finished_ && !p.faulted() && p.loop().time_s() < end - 1e-9) {
     p.run(std::min(1.0, end - p.loop().time_s()));
+    if (level_.plan_requested) plan_level_move();
     if (look_requested_) {
       // The look the task asks for (the operator stopped the run): its time passes with the task
       // holding, then the camera looks, off the loop.
@@ -353,6 +420,9 @@ CycleResult CellCycle::result() const {
     r.success = task_->status() == AssemblyTask::Status::kSucceeded && inserted;
     if (p.faulted()) {
       r.verdict = "a device faulted";
+    } else if (level_.procedure && level_.procedure->phase() == SeatLevelling::Phase::kFailed) {
+      r.success = false;
+      r.verdict = "levelling the seat failed: " + std::string(level_.procedure->failure());
     } else if (!finished_) {
       r.verdict =
           "not finished within max_cycle_s (in step " + std::string(AssemblyTask::name(task_->step())) + ")";
@@ -397,6 +467,13 @@ CycleResult CellCycle::result() const {
       r.verdict =
           inserted ? "inserted and released" : "the operator finished but the pin is not down in its bore";
     }
+  }
+  if (level_.procedure) {
+    r.seat_levelled = level_.procedure->phase() == SeatLevelling::Phase::kDone;
+    r.seat_tilt_before_rad = level_.procedure->tilt_before_rad();
+    r.seat_tilt_after_rad = level_.procedure->tilt_rad();
+    r.level_rounds = level_.procedure->rounds();
+    r.level_s = level_.s;
   }
   r.looks = looks_;
   r.looks_found = looks_found_;

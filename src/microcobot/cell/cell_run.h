@@ -15,6 +15,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "microcobot/cell/cell_camera.h"
 #include "microcobot/cell/person_operator.h"
 #include "microcobot/cell/pick_place_operator.h"
+#include "microcobot/cell/seat_levelling.h"
 #include "microcobot/core/rng.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
@@ -53,6 +55,9 @@ struct CellRunParams {
   std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> autonomy = all_auto();
   /// The cell's camera (mode auto): its looks at the pin in its slot, in the fingers, placed.
   CellCameraParams camera;
+  /// The seat levelled by touch before each insertion (mode auto; seat_levelling.h): by default
+  /// when the part rides on a parallel positioner (`positioner: parallel`).
+  SeatLevellingParams level_seat;
   /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up to ~5 mm at
   /// 100 um/s, where the main scenario's is 2 mm).
   cell::PickPlaceOperatorParams manual = manual_defaults();
@@ -67,6 +72,7 @@ struct CellRunParams {
     v("confirm_delay_s", confirm_delay_s);
     v("manual", manual);
     v("camera", camera);
+    v("level_seat", level_seat);
   }
   void validate() const;
   static std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> all_auto() {
@@ -114,6 +120,12 @@ struct CycleResult {
   double look_wall_s = 0.0;        ///< wall-clock time spent rendering and measuring
   bool ended_holding =
       false;  ///< every axis' target (the rotary's too) at its measured position, the coupling off
+  /// The seat levelled before the insertion (seat_levelling.h): whether it ran, the tilt its first
+  /// and last rounds of touches measured, its rounds and its simulated time (within the insert step's).
+  bool seat_levelled = false;
+  double seat_tilt_before_rad = 0.0, seat_tilt_after_rad = 0.0;
+  int level_rounds = 0;
+  double level_s = 0.0;
   /// Simulated seconds spent in each step of the task (auto) or of the person (manual, assisted),
   /// indexed by AssemblyTask::Step (kDone: none); all zero for the scripted watchmaker, whose
   /// phases differ. Where a cycle's time goes, mode against mode.
@@ -190,6 +202,19 @@ class CellCycle {
   double look_error_m_ = 0.0, look_wall_s_ = 0.0;
   std::string last_look_miss_;   // why the last look that found nothing did not
   bool look_requested_ = false;  // the operator stopped the run for a look
+  /// The seat's levelling before the insertion: the procedure (null: none), ticked in place of the
+  /// task while it runs; its plate move planned off the loop (plan_level_move()) and started on it.
+  struct Levelling {
+    std::unique_ptr<SeatLevelling> procedure;
+    std::optional<motion::PoseTrajectory> path;
+    bool plan_requested = false, path_ready = false, move_started = false;
+    std::uint64_t stops = 0;  // the platform's stopped pose moves when the move started
+    double s = 0.0;           // its simulated time
+  } level_;
+  /// Whether the leveller drives this tick (the task at its insertion's start, the robot's).
+  bool levelling_now() const noexcept;
+  void level_tick(const TaskSensors& s, const runtime::TickInfo& t);
+  void plan_level_move();
   /// The look the task awaits, off the loop: the frames rendered from the truth, measured, seen.
   void look();
   int confirmations_ = 0;

@@ -15,7 +15,8 @@ SimulatedGripper::SimulatedGripper(std::string name, const microworld::PickPlace
       axes_(axes),
       home_m_(home_m.x, home_m.y, home_m.z),
       state_(world.initial_state()),
-      command_m_(world.params().gripper.max_opening_m) {
+      command_m_(world.params().gripper.max_opening_m),
+      mount_(tilted_mount(world.params().seat_tilt_x_rad, world.params().seat_tilt_y_rad)) {
   for (const auto* a : axes_) require(a != nullptr, this->name() + ".axes", "must all be set");
   require(home_m_.allFinite(), this->name() + ".home_m", "must be finite");
 }
@@ -25,14 +26,16 @@ void SimulatedGripper::on_configure() {
   command_m_ = world_.params().gripper.max_opening_m;
   shake_ = false;
   align_V_ = {};
-  seat_.T = carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{};
+  seat_ = CarriedSeat::on_plate(carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{},
+                                mount_);
   state_.last_gripper_m = seat_.to_seat(tip_position_m());
   state_.last_gripper_yaw_rad = yaw_rad() - seat_.yaw_rad();
   step_world(0.0);
 }
 
 void SimulatedGripper::step_world(double dt_s) noexcept {
-  seat_.T = carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{};
+  seat_ = CarriedSeat::on_plate(carrier_ != nullptr ? carrier_->true_pose() : motion::PlatformTransform{},
+                                mount_);
   out_ = world_.step(state_, seat_.to_seat(tip_position_m()), command_m_, dt_s, yaw_rad() - seat_.yaw_rad(),
                      align_V_, seat_.tilt_rad());
 }

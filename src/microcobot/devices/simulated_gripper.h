@@ -65,7 +65,8 @@ class SimulatedGripper final : public Gripper {
   /// The parallel positioner whose top plate carries the substrate (`positioner` must outlive the
   /// gripper; its true pose is read at every update); call before configure().
   void set_carrier(const SimulatedParallelPositioner* positioner) noexcept { carrier_ = positioner; }
-  /// The seat's pose at the last update (identity without a carrier).
+  /// The seat's pose at the last update: the carrier's composed with the seat's tilt on it
+  /// (identity without a carrier and without a tilt).
   const CarriedSeat& seat() const noexcept { return seat_; }
   /// The part's centre and orientation about the vertical, in the world's frame.
   Eigen::Vector3d part_position_m() const noexcept { return seat_.to_world(state_.part_m); }
@@ -103,6 +104,7 @@ class SimulatedGripper final : public Gripper {
   microworld::PickPlaceState state_;
   microworld::PickPlaceOutput out_;
   double command_m_;
+  motion::PlatformTransform mount_;  ///< the seat on its carrier (world.seat_tilt_x_rad, _y_rad)
   bool shake_ = false;
   std::array<double, 2> align_V_{};
 };

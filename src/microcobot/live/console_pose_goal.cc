@@ -79,7 +79,7 @@ ConsolePoseGoal::Step ConsolePoseGoal::on_command(const ConsoleCommand& c, const
   }
   // The seat on the plate must keep clear of the finger tips over it (Platform::start_pose_move
   // refuses such a move as well; here it is said why).
-  const double lowest = devices::lowest_tip_height_m(trajectory, v.tips_m);
+  const double lowest = devices::lowest_tip_height_m(trajectory, v.tips_m, v.seat_on_plate);
   if (lowest < v.tip_floor_m) {
     refused_ = goal;
     step.refusal =

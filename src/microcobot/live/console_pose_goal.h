@@ -39,6 +39,7 @@ struct ConsolePoseView {
   /// platform's world.min_tip_height_m): a goal whose path brings it nearer is refused.
   Eigen::Vector3d tips_m = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   double tip_floor_m = 0.0;
+  motion::PlatformTransform seat_on_plate;  ///< the seat's pose on the plate as measured
 };
 
 /// The goal of a command as the transform of {P} in {H} (R = Rz(rz) Ry(ry) Rx(rx)).

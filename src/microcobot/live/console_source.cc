@@ -98,6 +98,7 @@ void ConsoleSource::pose_tick(Platform& p) noexcept {
   v.handled_seq = pose_handled_;
   v.tips_m = p.tips_m();
   v.tip_floor_m = p.tip_floor_m();
+  v.seat_on_plate = p.seat_on_plate();
   pose_view_.publish(v);
 }
 

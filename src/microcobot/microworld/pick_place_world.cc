@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -61,6 +62,10 @@ void PickPlaceParams::validate() const {
           "roll_edge_fraction", "must be within [0, 1]", roll_edge_fraction);
   require(std::isfinite(roll_peel_angle_rad) && roll_peel_angle_rad > 0.0 && roll_peel_angle_rad <= 0.5,
           "roll_peel_angle_rad", "must be within (0, 0.5] rad", roll_peel_angle_rad);
+  for (const auto& [tilt, name] :
+       {std::pair{seat_tilt_x_rad, "seat_tilt_x_rad"}, {seat_tilt_y_rad, "seat_tilt_y_rad"}})
+    require(std::isfinite(tilt) && std::abs(tilt) <= 0.1, name, "must be within [-0.1, 0.1] rad (5.7 deg)",
+            tilt);
   require(neighbour_count >= 0 && neighbour_count <= kMaxNeighbours, "neighbour_count",
           fmt::format("must be within [0, {}]", kMaxNeighbours), neighbour_count);
   for (int i = 0; i < neighbour_count; ++i) {

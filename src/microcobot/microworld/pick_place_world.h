@@ -122,6 +122,12 @@ struct PickPlaceParams {
   /// beyond van der Waals' nanometre range, and far above the rotary axis' holding jitter).
   double roll_edge_fraction = 0.1;
   double roll_peel_angle_rad = 0.01;
+  /// The substrate's tilt on what carries it (the parallel positioner's plate, or the bench): its
+  /// surface turned by Ry(seat_tilt_y_rad) Rx(seat_tilt_x_rad) about the world's origin, a fixture
+  /// that does not sit flat. The cell is not told it: it measures the seat by touch and levels it
+  /// on the positioner (cell/seat_levelling.h). 0: the seat is flat on its carrier.
+  double seat_tilt_x_rad = 0.0;
+  double seat_tilt_y_rad = 0.0;
   /// The scene's other parts (neighbours.h): set by the cell from its batch (assembly_batch.h), not
   /// a file's key; the first neighbour_count count.
   static constexpr int kMaxNeighbours = 8;
@@ -156,6 +162,8 @@ struct PickPlaceParams {
     v("seat_tolerance_m", seat_tolerance_m);
     v("roll_edge_fraction", roll_edge_fraction);
     v("roll_peel_angle_rad", roll_peel_angle_rad);
+    v("seat_tilt_x_rad", seat_tilt_x_rad);
+    v("seat_tilt_y_rad", seat_tilt_y_rad);
   }
   void validate() const;
   double part_weight_N() const;

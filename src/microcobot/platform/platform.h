@@ -157,6 +157,11 @@ class Platform {
   /// their goal (its rules: the deadman, a stale input, the seat onto the finger tips), counted
   /// from the start: how an input learns that its move ended early. Real-time safe.
   std::uint64_t pose_moves_stopped() const noexcept { return coupling_.stops; }
+  /// The seat's pose on the positioner's plate as measured (identity: flat on it, the default):
+  /// the floor and the refusals of the moves take the seat there (devices::CarriedSeat::on_plate).
+  /// Set by whoever measured it (the cell's touch probe, cell/seat_levelling.h). Real-time safe.
+  void set_seat_on_plate(const motion::PlatformTransform& mount) noexcept { coupling_.seat_on_plate = mount; }
+  const motion::PlatformTransform& seat_on_plate() const noexcept { return coupling_.seat_on_plate; }
   /// Where the finger tips stand (world frame: the stage's home plus its measured axes), and the
   /// least height over the substrate any input may bring them to (world.min_tip_height_m).
   Eigen::Vector3d tips_m() const noexcept;
@@ -397,6 +402,7 @@ class Platform {
   /// tick, the pose it asks for, where the Cartesian robot holds meanwhile.
   struct PositionerCoupling {
     motion::PlatformTransform seat_reference;
+    motion::PlatformTransform seat_on_plate;  ///< set_seat_on_plate()
     bool master_on = false, master_driving = false;
     motion::PlatformTransform master_pose;
     Eigen::Vector3d stage_hold_m = Eigen::Vector3d::Zero();

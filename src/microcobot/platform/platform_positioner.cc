@@ -34,7 +34,8 @@ bool Platform::start_pose_move(const motion::PoseTrajectory& checked) noexcept {
   // A move that would bring the seat within the tips' floor is refused before anything moves
   // (from where the tips stand now: nothing else moves them while the console moves the plate).
   return devices_.positioner != nullptr && pose_move_allowed() &&
-         devices::lowest_tip_height_m(checked, tips_m()) >= world_.params().min_tip_height_m &&
+         devices::lowest_tip_height_m(checked, tips_m(), coupling_.seat_on_plate) >=
+             world_.params().min_tip_height_m &&
          devices_.positioner->start_move(checked);
 }
 
@@ -108,13 +109,16 @@ bool Platform::master_pose_task() noexcept {
 
 double Platform::plate_ceiling_m(const Eigen::Matrix3d& R) const noexcept {
   const Eigen::Vector3d tips = tips_m();
-  Eigen::Vector3d under = devices::CarriedSeat{devices_.positioner->measured_pose()}.to_seat(tips);
+  const motion::PlatformTransform& mount = coupling_.seat_on_plate;
+  Eigen::Vector3d under =
+      devices::CarriedSeat::on_plate(devices_.positioner->measured_pose(), mount).to_seat(tips);
   under.z() = 0.0;  // on the seat's surface
-  return tips.z() - world_.params().min_tip_height_m - (R * under).z();
+  return tips.z() - world_.params().min_tip_height_m - (R * (mount.R * under + mount.d)).z();
 }
 
 double Platform::stage_floor_m() const noexcept {
-  const devices::CarriedSeat seat{devices_.positioner->measured_pose()};
+  const auto seat =
+      devices::CarriedSeat::on_plate(devices_.positioner->measured_pose(), coupling_.seat_on_plate);
   Eigen::Vector3d under = seat.to_seat(tips_m());
   under.z() = 0.0;  // on the seat's surface
   return seat.to_world(under).z() + world_.params().min_tip_height_m - home_m_.z();
@@ -125,11 +129,14 @@ bool Platform::seat_closes_on_tips() noexcept {
   // robot's axes and the gripper's contact force. The reference, free of the sensors' noise,
   // says which way the seat went this tick.
   const Eigen::Vector3d tips = tips_m();
-  const devices::CarriedSeat last{coupling_.seat_reference}, now{devices_.positioner->reference_pose()};
-  coupling_.seat_reference = now.T;
+  const motion::PlatformTransform& mount = coupling_.seat_on_plate;
+  const auto last = devices::CarriedSeat::on_plate(coupling_.seat_reference, mount);
+  const auto now = devices::CarriedSeat::on_plate(devices_.positioner->reference_pose(), mount);
+  coupling_.seat_reference = devices_.positioner->reference_pose();
   const Eigen::Vector3d under = last.to_seat(tips);  // the seat's point under the tips
   const Eigen::Vector3d moved = now.to_world(under) - last.to_world(under);
-  const double clearance = devices::CarriedSeat{devices_.positioner->measured_pose()}.to_seat(tips).z();
+  const double clearance =
+      devices::CarriedSeat::on_plate(devices_.positioner->measured_pose(), mount).to_seat(tips).z();
   const devices::Vec3 f = devices_.gripper->contact_force_N();
   const Eigen::Vector3d force(f.x, f.y, f.z);
   const bool under_floor = clearance < world_.params().min_tip_height_m && moved.z() > 0.0;
