@@ -83,6 +83,10 @@ void AssemblyBatchParams::validate() const {
           "must be auto, open, shake or roll (got '" + release + "')");
   require(std::isfinite(min_release_margin) && min_release_margin >= 1.0 && min_release_margin <= 100.0,
           "min_release_margin", "must be within [1, 100]", min_release_margin);
+  require(std::isfinite(max_tip_misalignment_m) && max_tip_misalignment_m >= 0.0 &&
+              max_tip_misalignment_m <= 40e-6,
+          "max_tip_misalignment_m", "must be within [0, 40] um (the tip faces' height is 50 um)",
+          max_tip_misalignment_m);
   require(std::isfinite(max_seat_tilt_rad) && max_seat_tilt_rad >= 0.0 && max_seat_tilt_rad <= 0.07,
           "max_seat_tilt_rad", "must be within [0, 0.07] rad (4 deg)", max_seat_tilt_rad);
   world.validate();
@@ -166,6 +170,9 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
   // The seats' tilts from a stream of their own: without them, the batch is the one of before.
   std::mt19937_64 tilt_rng(static_cast<std::uint64_t>(params.seed) * 0x9FB21C651E98DF25ULL + 0x74696c74ULL);
   std::uniform_real_distribution<double> tilt_u(0.0, 1.0);
+  // The tips' misalignments from a stream of their own likewise.
+  std::mt19937_64 tips_rng(static_cast<std::uint64_t>(params.seed) * 0xE7037ED1A0B428DBULL + 0x74697073ULL);
+  std::uniform_real_distribution<double> tips_u(-1.0, 1.0);
   const bool grid = params.layout == "grid";
   const int per_side = grid ? grid_cells_per_side(params.half_size_m, params.grid_pitch_m) : 1;
   const int per_load = per_side * per_side;
@@ -193,6 +200,8 @@ std::vector<AssemblyJob> assembly_jobs(const AssemblyBatchParams& params) {
     const Eigen::Vector2d bore_error(params.bore_error_m * bore(bore_rng),
                                      params.bore_error_m * bore(bore_rng));
     j.world.target_m = {j.target_m.x() + bore_error.x(), j.target_m.y() + bore_error.y(), 0.0};
+    if (params.max_tip_misalignment_m > 0.0)
+      j.world.gripper.tip_misalignment_m = params.max_tip_misalignment_m * tips_u(tips_rng);
     if (params.max_seat_tilt_rad > 0.0) {  // a tilt up to the largest, about a horizontal axis drawn uniform
       const double tilt = params.max_seat_tilt_rad * tilt_u(tilt_rng), axis = 2.0 * M_PI * tilt_u(tilt_rng);
       j.world.seat_tilt_x_rad = tilt * std::cos(axis);

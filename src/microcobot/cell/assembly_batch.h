@@ -82,6 +82,10 @@ struct AssemblyBatchParams {
   /// its own; not told to the cell, which levels the seat on the parallel positioner
   /// (seat_levelling.h). 0: each part's seat is world's.
   double max_seat_tilt_rad = 0.0;
+  /// The largest vertical misalignment of the gripper's tips in each part's cycle
+  /// (world.gripper.tip_misalignment_m, uniform in [-max, max], from a stream of its own): a finger
+  /// remounted off level, which the cell's first step levels (tip_levelling_step.h). 0: the world's.
+  double max_tip_misalignment_m = 0.0;
   std::string release = "auto";     ///< auto, open, shake or roll (header)
   double min_release_margin = 1.2;  ///< auto: the margin a strategy must reach to be chosen
   /// The microworld every part is put in (adhesion, friction, gripper, force limits); its part,
@@ -117,6 +121,7 @@ struct AssemblyBatchParams {
     v("flat_seat_max_pulloff_N", flat_seat_max_pulloff_N);
     v("bore_error_m", bore_error_m);
     v("max_seat_tilt_rad", max_seat_tilt_rad);
+    v("max_tip_misalignment_m", max_tip_misalignment_m);
     v("release", release);
     v("min_release_margin", min_release_margin);
     v("world", world);

@@ -55,6 +55,10 @@ nlohmann::json CycleResult::to_json() const {
           {"seat_tilt_after_rad", seat_tilt_after_rad},
           {"level_rounds", level_rounds},
           {"level_s", level_s},
+          {"tips_levelled", tips_levelled},
+          {"tip_misalignment_before_m", tip_misalignment_before_m},
+          {"tip_misalignment_after_m", tip_misalignment_after_m},
+          {"level_tips_s", level_tips_s},
           {"step_s", step_times_json(step_s)}};
 }
 
@@ -107,6 +111,10 @@ CycleResult CycleResult::from_json(const nlohmann::json& j) {
   get("seat_tilt_after_rad", r.seat_tilt_after_rad);
   get("level_rounds", r.level_rounds);
   get("level_s", r.level_s);
+  get("tips_levelled", r.tips_levelled);
+  get("tip_misalignment_before_m", r.tip_misalignment_before_m);
+  get("tip_misalignment_after_m", r.tip_misalignment_after_m);
+  get("level_tips_s", r.level_tips_s);
   nlohmann::json steps;
   get("step_s", steps);
   for (std::size_t i = 0; i < r.step_s.size(); ++i) {

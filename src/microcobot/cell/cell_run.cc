@@ -43,6 +43,7 @@ void CellRunParams::validate() const {
   manual.validate();
   camera.validate();
   level_seat.validate();
+  level_tips.validate();
   require(person.master != "click" || mode != "assisted", "person.master",
           "click: the console's click-to-go is for manual runs (the click is the platform's move already)");
   require(!camera.enabled || mode == "auto", "camera.enabled", "is the robot's (mode auto)");
@@ -136,9 +137,31 @@ CellCycle::CellCycle(const AssemblyJob& job, const CellRunParams& params, platfo
     if (level == "on" || (level == "auto" && p.has_positioner()))
       level_.procedure = std::make_unique<SeatLevelling>(params_.level_seat, goal.target_m,
                                                          AssemblyTask::grasp_height_m(params_.task, goal));
+    if (params_.level_tips.mode == "on") {
+      require(p.gripper().has_align_drives(), "level_tips.mode",
+              "is on, but the gripper has no align drives");
+      level_.tips = std::make_unique<TipLevellingStep>(params_.level_tips, goal.open_m);
+    }
     p.set_operator([this](const runtime::TickInfo& t) {
       TaskSensors s = read_task_sensors(*platform_, home_m_);
       if (!finished_) meter_->sample(s);  // the cycle's measures end with it
+      if (level_.failed) {  // a levelling failed: the cycle ended there, holding (deadman let go)
+        teleop::ConsoleInput holding;
+        holding.active = holding.fresh = true;
+        platform_->set_console_input(holding);
+        if (observer_) observer_(t.t_s);
+        return;
+      }
+      if (level_.tips && !level_.tips->finished()) {  // before the task's first step
+        level_.tips_s += t.dt_s;
+        level_.tips->tick(*platform_, s);
+        if (level_.tips->phase() == TipLevellingStep::Phase::kFailed) {
+          level_.failed = finished_ = held_ = true;  // the step ended holding
+          finished_at_s_ = t.t_s;
+        }
+        if (observer_) observer_(t.t_s);
+        return;
+      }
       if (levelling_now()) {
         meter_->time_step(task_->step(), t.dt_s);
         level_tick(s, t);
@@ -251,7 +274,7 @@ void CellCycle::level_tick(const TaskSensors& s, const runtime::TickInfo& t) {
   platform_->set_console_input(l.tick(s, t.dt_s));
   if (l.phase() == SeatLevelling::Phase::kDone) task_->set_surface_contact_m(l.contact_height_m());
   if (l.phase() == SeatLevelling::Phase::kFailed) {
-    finished_ = true;
+    level_.failed = finished_ = true;
     finished_at_s_ = t.t_s;
     platform_->hold();  // the sequence ends with every axis holding
     held_ = true;
@@ -420,6 +443,9 @@ CycleResult CellCycle::result() const {
     r.success = task_->status() == AssemblyTask::Status::kSucceeded && inserted;
     if (p.faulted()) {
       r.verdict = "a device faulted";
+    } else if (level_.tips && level_.tips->phase() == TipLevellingStep::Phase::kFailed) {
+      r.success = false;
+      r.verdict = "levelling the tips failed: " + std::string(level_.tips->failure());
     } else if (level_.procedure && level_.procedure->phase() == SeatLevelling::Phase::kFailed) {
       r.success = false;
       r.verdict = "levelling the seat failed: " + std::string(level_.procedure->failure());
@@ -467,6 +493,13 @@ CycleResult CellCycle::result() const {
       r.verdict =
           inserted ? "inserted and released" : "the operator finished but the pin is not down in its bore";
     }
+  }
+  if (level_.tips) {
+    const platform::TipLevellingStatus& tips = p.tip_levelling();
+    r.tips_levelled = level_.tips->phase() == TipLevellingStep::Phase::kDone;
+    r.tip_misalignment_before_m = tips.misalignment_before_m;
+    r.tip_misalignment_after_m = tips.misalignment_m;
+    r.level_tips_s = level_.tips_s;
   }
   if (level_.procedure) {
     r.seat_levelled = level_.procedure->phase() == SeatLevelling::Phase::kDone;

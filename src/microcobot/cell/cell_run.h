@@ -27,6 +27,7 @@
 #include "microcobot/cell/person_operator.h"
 #include "microcobot/cell/pick_place_operator.h"
 #include "microcobot/cell/seat_levelling.h"
+#include "microcobot/cell/tip_levelling_step.h"
 #include "microcobot/core/rng.h"
 #include "microcobot/platform/platform.h"
 #include "microcobot/platform/platform_config.h"
@@ -58,6 +59,9 @@ struct CellRunParams {
   /// The seat levelled by touch before each insertion (mode auto; seat_levelling.h): by default
   /// when the part rides on a parallel positioner (`positioner: parallel`).
   SeatLevellingParams level_seat;
+  /// The PiezoGripper's tips levelled by touch at each cycle's start (mode auto;
+  /// tip_levelling_step.h): off by default.
+  TipLevellingStepParams level_tips;
   /// The scripted watchmaker (mode "scripted"), with time for the batch's longer transports (up to ~5 mm at
   /// 100 um/s, where the main scenario's is 2 mm).
   cell::PickPlaceOperatorParams manual = manual_defaults();
@@ -73,6 +77,7 @@ struct CellRunParams {
     v("manual", manual);
     v("camera", camera);
     v("level_seat", level_seat);
+    v("level_tips", level_tips);
   }
   void validate() const;
   static std::array<AssemblyTask::Autonomy, AssemblyTask::kStepCount> all_auto() {
@@ -126,6 +131,11 @@ struct CycleResult {
   double seat_tilt_before_rad = 0.0, seat_tilt_after_rad = 0.0;
   int level_rounds = 0;
   double level_s = 0.0;
+  /// The tips levelled at the cycle's start (tip_levelling_step.h): whether they were, their
+  /// misalignment before and after (the simulation's truth), its simulated time.
+  bool tips_levelled = false;
+  double tip_misalignment_before_m = 0.0, tip_misalignment_after_m = 0.0;
+  double level_tips_s = 0.0;
   /// Simulated seconds spent in each step of the task (auto) or of the person (manual, assisted),
   /// indexed by AssemblyTask::Step (kDone: none); all zero for the scripted watchmaker, whose
   /// phases differ. Where a cycle's time goes, mode against mode.
@@ -208,8 +218,11 @@ class CellCycle {
     std::unique_ptr<SeatLevelling> procedure;
     std::optional<motion::PoseTrajectory> path;
     bool plan_requested = false, path_ready = false, move_started = false;
-    std::uint64_t stops = 0;  // the platform's stopped pose moves when the move started
-    double s = 0.0;           // its simulated time
+    std::uint64_t stops = 0;                 // the platform's stopped pose moves when the move started
+    double s = 0.0;                          // its simulated time
+    std::unique_ptr<TipLevellingStep> tips;  // the tips' levelling at the start (null: none)
+    double tips_s = 0.0;
+    bool failed = false;  // either failed: the cycle ended there
   } level_;
   /// Whether the leveller drives this tick (the task at its insertion's start, the robot's).
   bool levelling_now() const noexcept;
