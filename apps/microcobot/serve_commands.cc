@@ -90,14 +90,8 @@ void serve(const ServeOptions& o) {
         << "serve: listening on every interface: from another machine, open this machine's address on port "
         << deployment.port() << " with the same token\n";
   const auto start = std::chrono::steady_clock::now();
-  auto trimmed = start;
   while (mc::cli::interrupt_signal() == 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    // The threads' freed pages handed back every 10 s, from this idle thread (runtime/allocator.h).
-    if (std::chrono::steady_clock::now() - trimmed >= std::chrono::seconds(10)) {
-      mc::runtime::release_free_pages();
-      trimmed = std::chrono::steady_clock::now();
-    }
     if (o.duration_s > 0 &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration_s)
       break;

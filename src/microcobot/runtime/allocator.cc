@@ -14,12 +14,4 @@ bool keep_large_blocks_mapped() {
 #endif
 }
 
-bool release_free_pages() {
-#if defined(__GLIBC__)
-  return malloc_trim(0) == 1;
-#else
-  return false;
-#endif
-}
-
 }  // namespace mc::runtime

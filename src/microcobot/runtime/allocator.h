@@ -21,12 +21,4 @@ inline constexpr std::size_t kLargeBlockBytes = 128 * 1024;
 /// its trim threshold). Returns false where the C library refuses or is not glibc.
 bool keep_large_blocks_mapped();
 
-/// Hands back to the system the pages that lie wholly free inside every arena (malloc_trim(0)):
-/// an arena returns only its free top by itself, so the pages its threads freed below a block
-/// still in use stay resident, and over the first quarter of an hour a session's resident memory
-/// creeps up by its threads' peaks. Walks each arena under its lock (about a millisecond for a
-/// few hundred megabytes): call it from a housekeeping thread, never the loop's. Returns whether
-/// memory was released (false where the C library is not glibc).
-bool release_free_pages();
-
 }  // namespace mc::runtime
