@@ -7,7 +7,7 @@
 namespace mc::cell {
 namespace {
 
-constexpr double kThere_m = 1e-6;
+constexpr double kStepThere_m = 1e-6;
 
 }  // namespace
 
@@ -36,7 +36,7 @@ bool TipLevellingStep::head_for(const Eigen::Vector3d& goal, double speed, const
   in_.has_goal = true;
   in_.goal_m = goal;
   in_.goal_speed_m_s = speed;
-  return (s.tip_m - goal).norm() <= kThere_m;
+  return (s.tip_m - goal).norm() <= kStepThere_m;
 }
 
 void TipLevellingStep::fail(platform::Platform& p, const char* why) noexcept {
@@ -74,7 +74,7 @@ void TipLevellingStep::tick(platform::Platform& p, const TaskSensors& s) noexcep
       [[fallthrough]];
     case Phase::kBack:
       // Straight up first, then over: the patch is clear, the way back at the start's height too.
-      if (s.tip_m.z() < start_.z() - kThere_m && (s.tip_m.head<2>() - start_.head<2>()).norm() > kThere_m) {
+      if (s.tip_m.z() < start_.z() - kStepThere_m && (s.tip_m.head<2>() - start_.head<2>()).norm() > kStepThere_m) {
         head_for({s.tip_m.x(), s.tip_m.y(), start_.z()}, p_.z_speed_m_s, s);
       } else if (head_for(start_, p_.travel_speed_m_s, s)) {
         phase_ = Phase::kDone;
