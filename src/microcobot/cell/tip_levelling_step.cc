@@ -74,7 +74,8 @@ void TipLevellingStep::tick(platform::Platform& p, const TaskSensors& s) noexcep
       [[fallthrough]];
     case Phase::kBack:
       // Straight up first, then over: the patch is clear, the way back at the start's height too.
-      if (s.tip_m.z() < start_.z() - kStepThere_m && (s.tip_m.head<2>() - start_.head<2>()).norm() > kStepThere_m) {
+      if (s.tip_m.z() < start_.z() - kStepThere_m &&
+          (s.tip_m.head<2>() - start_.head<2>()).norm() > kStepThere_m) {
         head_for({s.tip_m.x(), s.tip_m.y(), start_.z()}, p_.z_speed_m_s, s);
       } else if (head_for(start_, p_.travel_speed_m_s, s)) {
         phase_ = Phase::kDone;
