@@ -69,8 +69,8 @@ struct SeatLevellingParams {
   double probe_radius_m = 350e-6;
   double probe_speed_m_s = 20e-6;  ///< the descent that finds the touch
   /// The touch that measures, from retouch_m over the one found: slow, for the stick-slip Z's
-  /// steps to stay well under the press the threshold takes (at 50 um/s the touches scatter by
-  /// 0.25 um, 0.5 mrad over the probe's triangle; at 2 um/s by a tenth of that).
+  /// steps to stay well under the press the threshold takes (measured at 50 um/s, seats were
+  /// left 0.5 mrad off: docs/parameters.md).
   double touch_speed_m_s = 2e-6;
   double retouch_m = 3e-6;
   double approach_speed_m_s = 200e-6;  ///< the descent down to search_from_m
